@@ -1,0 +1,207 @@
+"""
+Colorimetry
+===========
+
+Spectral reflectance to linear ACEScg, and the perceptual metrics.
+
+-   :func:`spectral_to_ACEScg_weights`: the matrix that maps a reflectance
+    spectrum sampled at given wavelengths to linear ACEScg, computed once.
+-   :func:`reflectance_to_ACEScg`: applies those weights.
+-   :func:`ACEScg_to_XYZ`, :func:`ACEScg_to_Lab`, :func:`ACEScg_to_Lab_jacobian`:
+    CIE 1976 L*a*b* with the ACES white as reference white, and its derivative.
+-   :func:`delta_E_2000`: CIE Delta E 2000 through colour-science.
+
+Conventions: CIE 1931 2 degree observer; illuminant the CIE D series at the
+ACES white point (D60, xy = 0.32168, 0.33767); CAT02 adaptation to the ACEScg
+white; each row of the weights normalised so that a perfect reflector maps to
+(1, 1, 1). colour-science is imported once, lazily (its import takes ~1 s).
+
+References
+----------
+Academy of Motion Picture Arts and Sciences (2016). S-2014-004, ACEScg.
+CIE 015:2018 Colorimetry, 4th ed. (Lab, Section 8.2.1).
+Sharma, G., Wu, W., & Dalal, E. N. (2005). The CIEDE2000 color-difference
+formula. Color Research & Application, 30(1), 21-30.
+"""
+
+from __future__ import annotations
+
+import functools
+import threading
+
+import numpy as np
+
+from .nk import VISIBLE_RANGE_NM
+
+__all__ = [
+    "ACES_WHITE_XY",
+    "spectral_to_ACEScg_weights",
+    "reflectance_to_ACEScg",
+    "ACEScg_to_XYZ",
+    "ACEScg_to_Lab",
+    "ACEScg_to_Lab_jacobian",
+    "delta_E_2000",
+]
+
+ACES_WHITE_XY = np.array([0.32168, 0.33767])
+"""CIE xy chromaticity of the ACES white point (~D60)."""
+
+_LOCK = threading.Lock()
+
+# CIE Lab constants: delta = 6/29 splits the cube root from its linear segment.
+_DELTA = 6.0 / 29.0
+_DELTA3 = _DELTA**3
+
+
+def _colour():
+    """Import colour-science once (slow import), quietly."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        import colour
+    return colour
+
+
+@functools.cache
+def _weights_1nm() -> np.ndarray:
+    colour = _colour()
+    shape = colour.SpectralShape(VISIBLE_RANGE_NM[0], VISIBLE_RANGE_NM[1], 1)
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
+    illuminant = colour.sd_CIE_illuminant_D_series(ACES_WHITE_XY).copy().align(shape)
+    S = illuminant.values
+    W_XYZ = (cmfs.values * S[:, None]).T  # 3 x N
+    W_XYZ /= W_XYZ[1].sum()
+    XYZ_w = W_XYZ.sum(axis=1)
+    acescg = colour.RGB_COLOURSPACES["ACEScg"]
+    XYZ_wr = acescg.matrix_RGB_to_XYZ @ np.ones(3)
+    cat = colour.adaptation.matrix_chromatic_adaptation_VonKries(
+        XYZ_w, XYZ_wr, transform="CAT02"
+    )
+    W = acescg.matrix_XYZ_to_RGB @ cat @ W_XYZ
+    # A perfect reflector maps to (1, 1, 1) exactly.
+    W /= W.sum(axis=1, keepdims=True)
+    W.setflags(write=False)
+    return W
+
+
+def _hat_matrix(fine: np.ndarray, nodes: np.ndarray) -> np.ndarray:
+    """P such that P @ values(nodes) is their linear interpolation at ``fine``."""
+    P = np.zeros((fine.size, nodes.size))
+    index = np.clip(np.searchsorted(nodes, fine, side="right") - 1, 0, nodes.size - 2)
+    lo, hi = nodes[index], nodes[index + 1]
+    w = np.clip((fine - lo) / (hi - lo), 0.0, 1.0)
+    rows = np.arange(fine.size)
+    P[rows, index] = 1.0 - w
+    P[rows, index + 1] += w
+    return P
+
+
+def spectral_to_ACEScg_weights(wavelength_nm) -> np.ndarray:
+    """
+    Weights :math:`W` (3 x N) with :math:`RGB = W R(\\lambda)`.
+
+    ``wavelength_nm`` must span 360-830 nm. On the 1 nm grid the weights are
+    the CIE integration itself; on a coarser grid they integrate the linear
+    interpolation of the reflectance between the nodes, so a reflectance that
+    is linear between nodes gives exactly the 1 nm result.
+
+    Parameters
+    ----------
+    wavelength_nm
+        Strictly increasing wavelengths :math:`\\lambda` in nm from 360 to 830.
+
+    Returns
+    -------
+    numpy.ndarray
+        3 x N weights to linear ACEScg; every row sums to 1.
+    """
+    nodes = np.asarray(wavelength_nm, dtype=np.float64)
+    if nodes.ndim != 1 or nodes.size < 2 or np.any(np.diff(nodes) <= 0):
+        raise ValueError("`wavelength_nm` must be strictly increasing with >= 2 samples")
+    if nodes[0] != VISIBLE_RANGE_NM[0] or nodes[-1] != VISIBLE_RANGE_NM[1]:
+        raise ValueError(
+            f"`wavelength_nm` must span {VISIBLE_RANGE_NM[0]:.0f}-"
+            f"{VISIBLE_RANGE_NM[1]:.0f} nm, got {nodes[0]:g}-{nodes[-1]:g}"
+        )
+    with _LOCK:
+        W1 = _weights_1nm()
+    fine = np.arange(VISIBLE_RANGE_NM[0], VISIBLE_RANGE_NM[1] + 0.5, 1.0)
+    if nodes.size == fine.size and np.array_equal(nodes, fine):
+        return W1.copy()
+    return W1 @ _hat_matrix(fine, nodes)
+
+
+def reflectance_to_ACEScg(reflectance, weights) -> np.ndarray:
+    """
+    Linear ACEScg of reflectance spectra: ``reflectance[..., N] @ weights.T``.
+    """
+    return np.asarray(reflectance, dtype=np.float64) @ np.asarray(weights).T
+
+
+@functools.cache
+def _matrices() -> tuple[np.ndarray, np.ndarray]:
+    colour = _colour()
+    acescg = colour.RGB_COLOURSPACES["ACEScg"]
+    M = np.array(acescg.matrix_RGB_to_XYZ, dtype=np.float64)
+    XYZ_n = M @ np.ones(3)
+    return M, XYZ_n
+
+
+def ACEScg_to_XYZ(RGB) -> np.ndarray:
+    """Linear ACEScg to CIE XYZ (Y of white = 1), ACES white."""
+    with _LOCK:
+        M, _ = _matrices()
+    return np.asarray(RGB, dtype=np.float64) @ M.T
+
+
+def _f_lab(t: np.ndarray) -> np.ndarray:
+    return np.where(
+        t > _DELTA3, np.cbrt(t), t / (3.0 * _DELTA * _DELTA) + 4.0 / 29.0
+    )
+
+
+def _df_lab(t: np.ndarray) -> np.ndarray:
+    safe = np.maximum(t, _DELTA3)
+    return np.where(
+        t > _DELTA3, 1.0 / (3.0 * np.cbrt(safe) ** 2), 1.0 / (3.0 * _DELTA * _DELTA)
+    )
+
+
+def ACEScg_to_Lab(RGB) -> np.ndarray:
+    """
+    Linear ACEScg to CIE 1976 L*a*b* (L in [0, 100]) with the ACES white as
+    reference white. Negative values follow the linear segment of the CIE
+    formula, so the map is defined and differentiable everywhere.
+    """
+    with _LOCK:
+        M, XYZ_n = _matrices()
+    XYZ = np.asarray(RGB, dtype=np.float64) @ M.T / XYZ_n
+    f = _f_lab(XYZ)
+    L = 116.0 * f[..., 1] - 16.0
+    a = 500.0 * (f[..., 0] - f[..., 1])
+    b = 200.0 * (f[..., 1] - f[..., 2])
+    return np.stack([L, a, b], axis=-1)
+
+
+def ACEScg_to_Lab_jacobian(RGB) -> np.ndarray:
+    """
+    :math:`\\partial Lab / \\partial RGB`, shape ``RGB.shape + (3,)``:
+    ``J[..., i, j] = d Lab_i / d RGB_j``.
+    """
+    with _LOCK:
+        M, XYZ_n = _matrices()
+    Mn = M / XYZ_n[:, None]
+    XYZ = np.asarray(RGB, dtype=np.float64) @ Mn.T
+    df = _df_lab(XYZ)  # (..., 3)
+    dF = df[..., :, None] * Mn  # d f_i / d RGB_j
+    L = 116.0 * dF[..., 1, :]
+    a = 500.0 * (dF[..., 0, :] - dF[..., 1, :])
+    b = 200.0 * (dF[..., 1, :] - dF[..., 2, :])
+    return np.stack([L, a, b], axis=-2)
+
+
+def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
+    """CIE Delta E 2000 between two CIE Lab arrays (colour-science)."""
+    colour = _colour()
+    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 2000"), dtype=np.float64)

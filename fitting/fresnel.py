@@ -1,0 +1,105 @@
+"""
+Exact Fresnel reflectance
+=========================
+
+-   :func:`fresnel_conductor`: unpolarised reflectance of a conductor
+    :math:`n + i k` seen from a clear dielectric of real index
+    :math:`\\eta_i`, vectorised over any broadcastable shapes.
+-   :func:`fresnel_dielectric`: the real-index special case in closed form.
+
+References
+----------
+Born, M., & Wolf, E. (1999). Principles of Optics (7th ed.), Section 1.5.
+Pharr, M., Jakob, W., & Humphreys, G. (2023). Physically Based Rendering,
+4th ed., Section 9.3 (``FrComplex``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["fresnel_conductor", "fresnel_dielectric"]
+
+
+def fresnel_conductor(cos_theta, eta_i, n, k) -> np.ndarray:
+    """
+    Unpolarised Fresnel reflectance :math:`(R_s + R_p)/2` of a conductor.
+
+    With the relative index :math:`\\eta = (n + i k)/\\eta_i`,
+    :math:`\\cos\\theta_t = \\sqrt{1 - (1 - \\mu^2)/\\eta^2}` (principal
+    branch) and
+
+    .. math::
+
+        r_s = \\frac{\\mu - \\eta\\cos\\theta_t}{\\mu + \\eta\\cos\\theta_t},
+        \\quad
+        r_p = \\frac{\\eta\\mu - \\cos\\theta_t}{\\eta\\mu + \\cos\\theta_t},
+        \\quad
+        R = \\tfrac12(|r_s|^2 + |r_p|^2).
+
+    Parameters
+    ----------
+    cos_theta
+        :math:`\\mu = \\cos\\theta` in the incident medium, [0, 1]; values
+        outside are clamped.
+    eta_i
+        Real index of the incident (coating) medium, >= 1.
+    n, k
+        Real part and extinction coefficient of the conductor's index.
+
+    Returns
+    -------
+    numpy.ndarray
+        Reflectance in [0, 1], broadcast over the inputs. Never NaN: grazing
+        incidence gives 1, total internal reflection (k = 0, eta_i > n) gives
+        1, an index-matched interface gives 0.
+    """
+    mu = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    eta = (np.asarray(n, dtype=np.float64) + 1j * np.asarray(k, dtype=np.float64)) / (
+        np.asarray(eta_i, dtype=np.float64)
+    )
+    sin2_t = (1.0 - mu * mu) / (eta * eta)
+    # Principal complex square root: for k = 0 past the critical angle the
+    # argument is negative real, cos_t is imaginary and |r_s| = |r_p| = 1 (TIR).
+    cos_t = np.sqrt(1.0 - sin2_t)
+    eta_cos_t = eta * cos_t
+    eta_mu = eta * mu
+    num_s, den_s = mu - eta_cos_t, mu + eta_cos_t
+    num_p, den_p = eta_mu - cos_t, eta_mu + cos_t
+    # Both denominators vanish only for mu = 0 and eta = 1 (index matched at
+    # grazing): there the interface does not exist and R is 0.
+    tiny = np.finfo(np.float64).tiny
+    abs2_den_s = np.maximum(np.abs(den_s) ** 2, tiny)
+    abs2_den_p = np.maximum(np.abs(den_p) ** 2, tiny)
+    R = 0.5 * (np.abs(num_s) ** 2 / abs2_den_s + np.abs(num_p) ** 2 / abs2_den_p)
+    return np.clip(R, 0.0, 1.0)
+
+
+def fresnel_dielectric(cos_theta, eta_i, eta_t) -> np.ndarray:
+    """
+    Unpolarised Fresnel reflectance between two real indices in closed form.
+
+    Parameters
+    ----------
+    cos_theta
+        :math:`\\mu` in the incident medium, [0, 1].
+    eta_i, eta_t
+        Real indices of the incident and transmitting media, > 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        Reflectance in [0, 1]; 1 under total internal reflection.
+    """
+    mu = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    eta_i = np.asarray(eta_i, dtype=np.float64)
+    eta_t = np.asarray(eta_t, dtype=np.float64)
+    sin2_t = (eta_i / eta_t) ** 2 * (1.0 - mu * mu)
+    tir = sin2_t >= 1.0
+    cos_t = np.sqrt(np.clip(1.0 - sin2_t, 0.0, 1.0))
+    tiny = np.finfo(np.float64).tiny
+    rs = (eta_i * mu - eta_t * cos_t) / np.maximum(eta_i * mu + eta_t * cos_t, tiny)
+    rp = (eta_t * mu - eta_i * cos_t) / np.maximum(eta_t * mu + eta_i * cos_t, tiny)
+    R = np.where(tir, 1.0, 0.5 * (rs * rs + rp * rp))
+    # Equal indices: no interface, no reflection, even at grazing incidence.
+    return np.clip(np.where(eta_i == eta_t, 0.0, R), 0.0, 1.0)

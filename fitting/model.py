@@ -1,0 +1,217 @@
+"""
+Coated-conductor Fresnel model
+==============================
+
+The RGB model of Vernooij (2024), Eq. 1 and 2, defined once for numpy. The
+GLSL version in ``preview_shaders/glsl/`` mirrors it term by term and the two
+are tested against each other.
+
+Per channel :math:`c \\in \\{R, G, B\\}`:
+
+.. math::
+
+    F(\\mu, \\eta_i) = F_0 + (1 - F_0)(1 - \\mu)^5 - a\\,\\mu(1 - \\mu)^{\\alpha}
+    \\qquad \\text{(Eq. 1)}
+
+with each of :math:`F_0, a, \\alpha` a polynomial of degree *d* <= 2 in the
+normalised coating index :math:`t = (\\eta_i - lo)/(hi - lo)`, clamped to
+[0, 1] (Eq. 2 uses :math:`\\eta_i` itself; *t* is better conditioned and
+kinder to float16).
+
+Coefficient layout: ``coefficients[p, c, j]`` with parameter *p* in
+(F0, a, alpha), channel *c* in (R, G, B), power *j* in (1, t, t^2). This is
+also the order of the 27 halves of the binary pack.
+
+-   :func:`coated_conductor_model`: evaluates the model, linear ACEScg.
+-   :func:`model_parameters`: F0, a, alpha per channel at given eta_i.
+-   :func:`collapse_to_eta_i`: the scene-specialised 9 numbers at one eta_i.
+-   :func:`model_jacobian`: derivative of the model in its coefficients.
+
+References
+----------
+Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
+Lazanyi, I., & Szirmay-Kalos, L. (2005). Fresnel term approximations for metals. WSCG.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "PARAMETERS",
+    "CHANNELS",
+    "ALPHA_MIN",
+    "DEFAULT_ETA_I_RANGE",
+    "normalised_eta_i",
+    "check_coefficients",
+    "model_parameters",
+    "collapse_to_eta_i",
+    "coated_conductor_model",
+    "model_from_parameters",
+    "model_jacobian",
+]
+
+PARAMETERS = ("F0", "a", "alpha")
+CHANNELS = ("R", "G", "B")
+DEFAULT_ETA_I_RANGE: tuple[float, float] = (1.0, 2.5)
+
+ALPHA_MIN = 1.0e-3
+"""Lower clamp of the exponent alpha: keeps (1 - mu)^alpha finite at mu = 1
+for any coefficients (a non-positive exponent would give 0^0 or 1/0)."""
+
+
+def check_coefficients(coefficients) -> np.ndarray:
+    """
+    Validate a coefficient array of shape (3, 3, d + 1), d in {0, 1, 2}.
+
+    Raises
+    ------
+    ValueError
+        If the shape is wrong or a value is not finite.
+    """
+    C = np.asarray(coefficients, dtype=np.float64)
+    if C.ndim != 3 or C.shape[:2] != (3, 3) or not 1 <= C.shape[2] <= 3:
+        raise ValueError(
+            "`coefficients` must have shape (3, 3, d + 1) with d in {0, 1, 2} "
+            f"(parameter F0/a/alpha, channel R/G/B, power), got {C.shape}"
+        )
+    if not np.all(np.isfinite(C)):
+        raise ValueError("`coefficients` must be finite")
+    return C
+
+
+def check_eta_i_range(eta_i_range) -> tuple[float, float]:
+    """Validate ``eta_i_range`` = (lo, hi) with 1 <= lo <= hi <= 3."""
+    try:
+        lo, hi = (float(v) for v in eta_i_range)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`eta_i_range` must be two numbers [lo, hi], got {eta_i_range!r}"
+        ) from None
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        raise ValueError(f"`eta_i_range` must be finite, got [{lo}, {hi}]")
+    if not (1.0 <= lo <= hi <= 3.0):
+        raise ValueError(
+            f"`eta_i_range` must satisfy 1 <= lo <= hi <= 3, got [{lo:g}, {hi:g}]"
+        )
+    return lo, hi
+
+
+def normalised_eta_i(eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> np.ndarray:
+    """
+    :math:`t = (\\eta_i - lo)/(hi - lo)` clamped to [0, 1]; 0 when lo = hi.
+    """
+    lo, hi = eta_i_range
+    eta_i = np.asarray(eta_i, dtype=np.float64)
+    if hi <= lo:
+        return np.zeros_like(eta_i)
+    return np.clip((eta_i - lo) / (hi - lo), 0.0, 1.0)
+
+
+def _powers(t: np.ndarray, degree: int) -> np.ndarray:
+    """(..., degree + 1) array of 1, t, t^2."""
+    return np.stack([t**j for j in range(degree + 1)], axis=-1)
+
+
+def model_parameters(coefficients, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> np.ndarray:
+    """
+    F0, a and alpha per channel at ``eta_i``.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``eta_i.shape + (3, 3)``: [..., parameter, channel]; alpha is
+        clamped to :data:`ALPHA_MIN`.
+    """
+    C = np.asarray(coefficients, dtype=np.float64)
+    t = normalised_eta_i(eta_i, eta_i_range)
+    T = _powers(t, C.shape[2] - 1)
+    P = np.einsum("...j,pcj->...pc", T, C)
+    P[..., 2, :] = np.maximum(P[..., 2, :], ALPHA_MIN)
+    return P
+
+
+def collapse_to_eta_i(coefficients, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> np.ndarray:
+    """
+    The scene-specialised model at one constant ``eta_i``: a (3, 3, 1) array
+    of F0, a, alpha per channel (the quadratics evaluated on the CPU).
+    """
+    C = check_coefficients(coefficients)
+    P = model_parameters(C, float(eta_i), eta_i_range)
+    return P[..., None]
+
+
+def model_from_parameters(cos_theta, F0, a, alpha) -> np.ndarray:
+    """
+    Eq. 1 from per-channel parameters broadcast against ``cos_theta``:
+    :math:`F_0 + (1 - F_0)(1 - \\mu)^5 - a\\mu(1 - \\mu)^{\\alpha}`.
+    """
+    mu = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
+    x = 1.0 - mu
+    x5 = x**5
+    return F0 + (1.0 - F0) * x5 - a * mu * x ** np.maximum(alpha, ALPHA_MIN)
+
+
+def coated_conductor_model(
+    cos_theta, eta_i, coefficients, eta_i_range=DEFAULT_ETA_I_RANGE
+) -> np.ndarray:
+    """
+    Evaluate the coated-conductor model (Vernooij 2024, Eq. 1 and 2).
+
+    Parameters
+    ----------
+    cos_theta
+        :math:`\\mu = \\cos\\theta` in the coating, [0, 1] (clamped).
+    eta_i
+        Index of the coating, broadcast against ``cos_theta``; clamped to
+        ``eta_i_range``.
+    coefficients
+        (3, 3, d + 1) array, see the module docstring for the layout.
+    eta_i_range
+        The fitted domain [lo, hi] of eta_i.
+
+    Returns
+    -------
+    numpy.ndarray
+        Reflectance in linear ACEScg, shape ``broadcast(cos_theta, eta_i) + (3,)``.
+    """
+    C = np.asarray(coefficients, dtype=np.float64)
+    mu, eta_i = np.broadcast_arrays(
+        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
+    )
+    P = model_parameters(C, eta_i, eta_i_range)
+    return model_from_parameters(mu[..., None], P[..., 0, :], P[..., 1, :], P[..., 2, :])
+
+
+def model_jacobian(cos_theta, eta_i, coefficients, eta_i_range=DEFAULT_ETA_I_RANGE):
+    """
+    Model values and their derivative in the coefficients.
+
+    Returns
+    -------
+    tuple
+        ``F`` of shape (S, 3) and ``J`` of shape (S, 3, 3, d + 1) with
+        ``J[s, c, p, j] = dF[s, c] / d coefficients[p, c, j]`` (a channel
+        depends only on its own coefficients), for S flattened samples.
+    """
+    C = np.asarray(coefficients, dtype=np.float64)
+    mu = np.clip(np.ravel(np.asarray(cos_theta, dtype=np.float64)), 0.0, 1.0)
+    t = np.ravel(normalised_eta_i(eta_i, eta_i_range))
+    T = _powers(t, C.shape[2] - 1)  # (S, d+1)
+    P = np.einsum("sj,pcj->spc", T, C)
+    alpha_raw = P[:, 2, :]
+    alpha = np.maximum(alpha_raw, ALPHA_MIN)
+    F0, a = P[:, 0, :], P[:, 1, :]
+    x = (1.0 - mu)[:, None]
+    x5 = x**5
+    x_alpha = x**alpha
+    mu_x_alpha = mu[:, None] * x_alpha
+    F = F0 + (1.0 - F0) * x5 - a * mu_x_alpha
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_x = np.where(x > 0.0, np.log(np.where(x > 0.0, x, 1.0)), 0.0)
+    dF0 = np.broadcast_to(1.0 - x5, F.shape)
+    da = -mu_x_alpha
+    dalpha = np.where(alpha_raw > ALPHA_MIN, -a * mu_x_alpha * log_x, 0.0)
+    dP = np.stack([dF0, da, dalpha], axis=-1)  # (S, c, p)
+    J = dP[..., None] * T[:, None, None, :]
+    return F, J

@@ -1,0 +1,299 @@
+"""
+Coefficient packs
+=================
+
+The float16 coefficient pack a renderer loads: a documented binary format
+(``docs/pack-format.md``) and its JSON view, with exact round trips.
+
+-   :class:`PackedMaterial`: one material's float16 coefficients and metadata.
+-   :func:`encode_pack`, :func:`decode_pack`: binary.
+-   :func:`pack_to_json`, :func:`pack_from_json`: the JSON view.
+-   :func:`to_float16`: float16 with a refusal (never inf) past the range.
+-   :func:`halves_to_uint32`: the 14 uint32 words a shader reads with
+    ``unpackHalf2x16``.
+
+Binary layout (little-endian)::
+
+    magic "CFPK" | version u16 = 1 | count u16 | total_length u32
+    count x material:
+        name_len u16 | name utf-8 | source_len u16 | source utf-8
+        eta_lo f32 | eta_hi f32 | degree u8 | reserved u8 (0) x 3
+        9 * (degree + 1) float16 coefficients, order [parameter][channel][power]
+    crc32 u32 of every byte before it
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import zlib
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .model import CHANNELS, PARAMETERS, check_coefficients, check_eta_i_range
+
+__all__ = [
+    "PACK_MAGIC",
+    "PACK_VERSION",
+    "FLOAT16_MAX",
+    "PackedMaterial",
+    "to_float16",
+    "encode_pack",
+    "decode_pack",
+    "material_to_json",
+    "material_from_json",
+    "pack_to_json",
+    "pack_from_json",
+    "halves_to_uint32",
+]
+
+PACK_MAGIC = b"CFPK"
+PACK_VERSION = 1
+FLOAT16_MAX = float(np.finfo(np.float16).max)
+_HEADER = struct.Struct("<4sHHI")
+_MAX_TEXT = 65535
+
+
+def to_float16(values, name: str = "coefficients") -> np.ndarray:
+    """
+    Round to float16 (nearest, ties to even); values whose magnitude rounds
+    past the float16 range are refused, never stored as inf.
+    """
+    array = np.asarray(values, dtype=np.float64)
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"`{name}` must be finite")
+    with np.errstate(over="ignore"):
+        halves = array.astype(np.float16)
+    if not np.all(np.isfinite(halves)):
+        worst = float(np.max(np.abs(array)))
+        raise ValueError(
+            f"`{name}` must lie within the float16 range +/-{FLOAT16_MAX:g}, got {worst:g}"
+        )
+    return halves
+
+
+@dataclass(frozen=True)
+class PackedMaterial:
+    """
+    One material of a pack.
+
+    ``coefficients`` is a float16 array of shape (3, 3, degree + 1), see
+    :mod:`fitting.model` for the layout; ``eta_i_range`` is the fitted domain.
+    """
+
+    name: str
+    coefficients: np.ndarray
+    eta_i_range: tuple[float, float] = (1.0, 2.5)
+    source: str = ""
+    metrics: dict[str, Any] = field(default_factory=dict, compare=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError("`name` must be a non-empty string")
+        for label, text in (("name", self.name), ("source", self.source)):
+            if len(text.encode("utf-8")) > _MAX_TEXT:
+                raise ValueError(f"`{label}` must be at most {_MAX_TEXT} bytes of UTF-8")
+        C = check_coefficients(self.coefficients)
+        halves = to_float16(C)
+        if not np.array_equal(halves.astype(np.float64), C):
+            raise ValueError(
+                "`coefficients` must be exactly representable in float16; round "
+                "them with `to_float16` first"
+            )
+        lo, hi = check_eta_i_range(self.eta_i_range)
+        # The pack stores the domain as float32.
+        lo, hi = float(np.float32(lo)), float(np.float32(hi))
+        halves.setflags(write=False)
+        object.__setattr__(self, "coefficients", halves)
+        object.__setattr__(self, "eta_i_range", (lo, hi))
+
+    @property
+    def degree(self) -> int:
+        return self.coefficients.shape[2] - 1
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PackedMaterial):
+            return NotImplemented
+        return (
+            self.name == other.name
+            and self.source == other.source
+            and self.eta_i_range == other.eta_i_range
+            and self.coefficients.shape == other.coefficients.shape
+            and self.coefficients.tobytes() == other.coefficients.tobytes()
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+def encode_pack(materials: list[PackedMaterial]) -> bytes:
+    """Encode materials into the binary pack format (see module docstring)."""
+    materials = list(materials)
+    if not materials:
+        raise ValueError("`materials` must hold at least one material")
+    if len(materials) > 65535:
+        raise ValueError(f"`materials` must hold at most 65535 materials, got {len(materials)}")
+    body = bytearray()
+    for material in materials:
+        if not isinstance(material, PackedMaterial):
+            raise ValueError("`materials` must hold PackedMaterial instances")
+        for text in (material.name, material.source):
+            raw = text.encode("utf-8")
+            body += struct.pack("<H", len(raw)) + raw
+        lo, hi = material.eta_i_range
+        body += struct.pack("<ffB3x", lo, hi, material.degree)
+        body += material.coefficients.astype("<f2").tobytes()
+    total = _HEADER.size + len(body) + 4
+    head = _HEADER.pack(PACK_MAGIC, PACK_VERSION, len(materials), total)
+    data = head + bytes(body)
+    return data + struct.pack("<I", zlib.crc32(data))
+
+
+class _Reader:
+    def __init__(self, data: bytes, end: int) -> None:
+        self.data, self.offset, self.end = data, _HEADER.size, end
+
+    def take(self, size: int, what: str) -> bytes:
+        if self.offset + size > self.end:
+            raise ValueError(f"`data` is truncated: {what} at byte {self.offset} runs past the end")
+        chunk = self.data[self.offset : self.offset + size]
+        self.offset += size
+        return chunk
+
+
+def decode_pack(data: bytes) -> list[PackedMaterial]:
+    """
+    Decode a binary pack.
+
+    Raises
+    ------
+    ValueError
+        On a wrong magic or version, a truncated file, a wrong length, a
+        checksum mismatch, or invalid content.
+    """
+    data = bytes(data)
+    if len(data) < _HEADER.size + 4:
+        raise ValueError(f"`data` is truncated: {len(data)} bytes is shorter than a pack header")
+    magic, version, count, total = _HEADER.unpack_from(data)
+    if magic != PACK_MAGIC:
+        raise ValueError(f"`data` is not a coefficient pack: magic {magic!r}, expected {PACK_MAGIC!r}")
+    if version != PACK_VERSION:
+        raise ValueError(f"`data` has pack version {version}, only version {PACK_VERSION} is supported")
+    if total != len(data):
+        raise ValueError(
+            f"`data` has the wrong length: the header says {total} bytes, got {len(data)}"
+            + (" (truncated)" if len(data) < total else "")
+        )
+    (crc,) = struct.unpack_from("<I", data, total - 4)
+    if crc != zlib.crc32(data[: total - 4]):
+        raise ValueError("`data` is damaged: checksum mismatch")
+    reader = _Reader(data, total - 4)
+    materials = []
+    for _ in range(count):
+        texts = []
+        for what in ("name", "source"):
+            (size,) = struct.unpack("<H", reader.take(2, f"{what} length"))
+            try:
+                texts.append(reader.take(size, what).decode("utf-8"))
+            except UnicodeDecodeError:
+                raise ValueError(f"`data` has a {what} that is not UTF-8") from None
+        lo, hi, degree = struct.unpack("<ffB3x", reader.take(12, "eta_i range"))
+        if degree > 2:
+            raise ValueError(f"`data` has polynomial degree {degree}, must be 0, 1 or 2")
+        count_c = 9 * (degree + 1)
+        raw = reader.take(2 * count_c, "coefficients")
+        halves = np.frombuffer(raw, dtype="<f2").astype(np.float16).reshape(3, 3, degree + 1)
+        if not np.all(np.isfinite(halves)):
+            raise ValueError("`data` holds a coefficient that is not finite")
+        materials.append(
+            PackedMaterial(texts[0], halves, (lo, hi), source=texts[1])
+        )
+    if reader.offset != reader.end:
+        raise ValueError(
+            f"`data` has the wrong length: {reader.end - reader.offset} unexpected bytes after the last material"
+        )
+    return materials
+
+
+def material_to_json(material: PackedMaterial) -> dict[str, Any]:
+    """The JSON view of one material (values exactly as stored in float16)."""
+    C = material.coefficients.astype(np.float64)
+    return {
+        "name": material.name,
+        "eta_i_range": list(material.eta_i_range),
+        "colour_space": "ACEScg",
+        "degree": material.degree,
+        "coefficients": {
+            p: [[float(v) for v in C[i, c]] for c in range(3)]
+            for i, p in enumerate(PARAMETERS)
+        },
+        "source": material.source,
+        "metrics": material.metrics,
+    }
+
+
+def material_from_json(view: dict[str, Any]) -> PackedMaterial:
+    """Inverse of :func:`material_to_json`; values must be exact float16."""
+    if not isinstance(view, dict):
+        raise ValueError("material must be a JSON object")
+    try:
+        coefficients = np.array(
+            [[view["coefficients"][p][c] for c in range(3)] for p in PARAMETERS],
+            dtype=np.float64,
+        )
+    except (KeyError, IndexError, TypeError, ValueError) as error:
+        raise ValueError(
+            "`coefficients` must hold F0, a and alpha, each three rows "
+            f"({', '.join(CHANNELS)}) of numbers: {error!r}"
+        ) from None
+    if view.get("colour_space", "ACEScg") != "ACEScg":
+        raise ValueError(f"`colour_space` must be 'ACEScg', got {view.get('colour_space')!r}")
+    return PackedMaterial(
+        name=view.get("name", ""),
+        coefficients=coefficients,
+        eta_i_range=tuple(view.get("eta_i_range", (1.0, 2.5))),
+        source=view.get("source", "") or "",
+        metrics=view.get("metrics") or {},
+    )
+
+
+def pack_to_json(materials: list[PackedMaterial]) -> str:
+    """The JSON view of a pack: ``{"format", "version", "materials": [...]}``."""
+    return json.dumps(
+        {
+            "format": "coated-fresnel-pack",
+            "version": PACK_VERSION,
+            "materials": [material_to_json(m) for m in materials],
+        },
+        indent=2,
+    )
+
+
+def pack_from_json(text: str | bytes) -> list[PackedMaterial]:
+    """Inverse of :func:`pack_to_json`."""
+    try:
+        view = json.loads(text)
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise ValueError(f"pack JSON is not valid JSON: {error}") from None
+    if not isinstance(view, dict) or view.get("format") != "coated-fresnel-pack":
+        raise ValueError("pack JSON must be an object with `format` 'coated-fresnel-pack'")
+    if view.get("version") != PACK_VERSION:
+        raise ValueError(f"pack JSON `version` must be {PACK_VERSION}, got {view.get('version')!r}")
+    materials = view.get("materials")
+    if not isinstance(materials, list) or not materials:
+        raise ValueError("pack JSON `materials` must be a non-empty list")
+    return [material_from_json(m) for m in materials]
+
+
+def halves_to_uint32(coefficients) -> np.ndarray:
+    """
+    Pack float16 coefficients in layout order into uint32 words, two halves
+    per word, the earlier one in the low 16 bits (GLSL ``unpackHalf2x16``
+    returns it in ``.x``). 27 halves give 14 words, the last padded with 0.
+    """
+    halves = np.ascontiguousarray(np.asarray(coefficients, dtype=np.float16).ravel())
+    bits = halves.view(np.uint16).astype(np.uint32)
+    if bits.size % 2:
+        bits = np.append(bits, np.uint32(0))
+    return bits[0::2] | (bits[1::2] << 16)
