@@ -1,0 +1,29 @@
+"""
+preview_shaders: the coated-conductor model as a renderer runs it
+=================================================================
+
+GLSL mirrors of :mod:`fitting.model` and its baselines (``glsl/``), the
+headless GL machinery that runs them on one dedicated render thread, and the
+preview sphere the service and the editor show.
+
+-   :mod:`preview_shaders.gl`: the GL context and its render thread.
+-   :mod:`preview_shaders.evaluate`: full-screen evaluation of each shader
+    variant (parity tests, cost benchmark).
+
+References
+----------
+Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
+"""
+
+from .evaluate import VARIANTS, ShaderInputs, evaluate_grid, shader_inputs, time_variant
+from .gl import RenderThread, load_shader_source
+
+__all__ = [
+    "VARIANTS",
+    "ShaderInputs",
+    "evaluate_grid",
+    "shader_inputs",
+    "time_variant",
+    "RenderThread",
+    "load_shader_source",
+]

@@ -1,0 +1,252 @@
+"""
+Full-screen shader evaluation
+=============================
+
+Each Fresnel variant of ``glsl/evaluate.frag`` evaluated over a grid of
+(cos theta, eta_i) into a float32 target: the parity tests read it back and
+compare it with numpy, the cost benchmark times it.
+
+-   :data:`VARIANTS`: the variant names, in ``CF_VARIANT`` order.
+-   :class:`ShaderInputs`: the uniforms every variant reads.
+-   :func:`shader_inputs`: builds them from a coefficient pack.
+-   :func:`padded_coefficients`: a degree-0/1 fit as 27 halves.
+-   :func:`evaluate_grid`: renders one variant and reads it back.
+-   :func:`decode_halves_in_shader`: the 27 coefficients as GLSL decodes them.
+-   :func:`time_variant`: GL timer query and wall time of full-screen renders.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from fitting.model import collapse_to_eta_i
+from fitting.pack import PackedMaterial, halves_to_uint32
+
+from .gl import GLState, RenderThread, check_gl_error
+
+__all__ = [
+    "VARIANTS",
+    "ShaderInputs",
+    "padded_coefficients",
+    "shader_inputs",
+    "evaluate_grid",
+    "decode_halves_in_shader",
+    "time_variant",
+]
+
+VARIANTS = ("packed", "floats", "collapsed", "lazanyi", "schlick", "exact")
+"""Model from float16 halves in uint32, model from float coefficients,
+scene-specialised model (Eq. 1 only), adjusted Lazanyi, Schlick, exact RGB
+conductor Fresnel."""
+
+
+def padded_coefficients(coefficients) -> np.ndarray:
+    """(3, 3, 3) float16 coefficients: a lower degree padded with zero powers
+    (the same model, since 0 * t^j adds nothing)."""
+    C = np.asarray(coefficients, dtype=np.float16)
+    padded = np.zeros((3, 3, 3), dtype=np.float16)
+    padded[:, :, : C.shape[2]] = C
+    return padded
+
+
+@dataclass(frozen=True)
+class ShaderInputs:
+    """
+    Uniform values of the variants. ``words``: 14 uint32 (two halves each);
+    ``coefficients``: the same 27 values as float32; ``eta_i_range``: fitted
+    domain; ``collapsed``: (3, 3) F0/a/alpha rows at ``collapse_eta_i``;
+    ``F0_air``, ``F82_air``: linear ACEScg reflectance in air at 0 and ~82
+    degrees (adjusted Lazanyi; Schlick reads ``F0_air``); ``n``, ``k``:
+    per-channel conductor index (exact RGB Fresnel).
+    """
+
+    words: np.ndarray
+    coefficients: np.ndarray
+    eta_i_range: tuple[float, float]
+    collapse_eta_i: float
+    collapsed: np.ndarray
+    F0_air: np.ndarray
+    F82_air: np.ndarray
+    n: np.ndarray
+    k: np.ndarray
+
+
+def shader_inputs(
+    packed: PackedMaterial,
+    collapse_eta_i: float = 1.5,
+    F0_air=(0.0, 0.0, 0.0),
+    F82_air=(0.0, 0.0, 0.0),
+    n=(1.0, 1.0, 1.0),
+    k=(0.0, 0.0, 0.0),
+) -> ShaderInputs:
+    """The uniforms of every variant for one material."""
+    halves = padded_coefficients(packed.coefficients)
+    return ShaderInputs(
+        words=halves_to_uint32(halves),
+        coefficients=halves.astype(np.float32).ravel(),
+        eta_i_range=packed.eta_i_range,
+        collapse_eta_i=float(collapse_eta_i),
+        collapsed=collapse_to_eta_i(
+            packed.coefficients.astype(np.float64), collapse_eta_i, packed.eta_i_range
+        )[..., 0],
+        F0_air=np.asarray(F0_air, dtype=np.float64),
+        F82_air=np.asarray(F82_air, dtype=np.float64),
+        n=np.asarray(n, dtype=np.float64),
+        k=np.asarray(k, dtype=np.float64),
+    )
+
+
+def _set(program, name: str, value) -> None:
+    """Set a uniform the compiler kept (a variant's unused ones are gone)."""
+    if name in program:
+        program[name].value = value
+
+
+def _set_uniforms(program, variant: str, inputs: ShaderInputs) -> None:
+    _set(program, "cf_words", [int(w) for w in inputs.words])
+    # mat3 fills column by column: the layout order is already column-major.
+    _set(program, "cf_C", [tuple(float(c) for c in m) for m in inputs.coefficients.reshape(3, 9)])
+    _set(program, "cf_eta_i_range", tuple(float(v) for v in inputs.eta_i_range))
+    if variant == "collapsed":
+        F0, a, alpha = (tuple(float(v) for v in row) for row in inputs.collapsed)
+        _set(program, "cf_F0", F0)
+        _set(program, "cf_a", a)
+        _set(program, "cf_alpha", alpha)
+    else:
+        _set(program, "cf_F0", tuple(float(v) for v in inputs.F0_air))
+    _set(program, "cf_F0_air", tuple(float(v) for v in inputs.F0_air))
+    _set(program, "cf_F82_air", tuple(float(v) for v in inputs.F82_air))
+    _set(program, "cf_n", tuple(float(v) for v in inputs.n))
+    _set(program, "cf_k", tuple(float(v) for v in inputs.k))
+
+
+def _check_variant(variant: str) -> int:
+    if variant not in VARIANTS:
+        raise ValueError(f"`variant` must be one of {', '.join(VARIANTS)}, got {variant!r}")
+    return VARIANTS.index(variant)
+
+
+def _evaluate_grid(state: GLState, variant, inputs, grid, width, height):
+    ctx = state.ctx
+    program, vao = state.program(
+        "evaluate.frag", {"CF_VARIANT": _check_variant(variant), "CF_WRITE_INPUTS": 1}
+    )
+    _set_uniforms(program, variant, inputs)
+    program["u_grid"].value = tuple(float(g) for g in grid)
+    fbo, targets = state.float_targets((width, height), 2)
+    try:
+        fbo.use()
+        vao.render(mode=ctx.TRIANGLES, vertices=3)
+        F, inputs_out = (
+            np.frombuffer(fbo.read(components=4, dtype="f4", attachment=i), np.float32)
+            .reshape(height, width, 4)
+            for i in range(2)
+        )
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+    return F[..., :3].copy(), inputs_out[..., 0].copy(), inputs_out[..., 1].copy()
+
+
+def evaluate_grid(
+    thread: RenderThread,
+    variant: str,
+    inputs: ShaderInputs,
+    cos_theta_axis: tuple[float, float, int],
+    eta_i_axis: tuple[float, float, int],
+):
+    """
+    Evaluate one variant over a grid into a float32 target and read it back.
+
+    Parameters
+    ----------
+    cos_theta_axis, eta_i_axis
+        (start, step, count): column i has cos theta = start + i step, row j
+        eta_i = start + j step, computed in the shader in float32.
+
+    Returns
+    -------
+    tuple
+        ``F`` (count_eta, count_mu, 3) linear ACEScg float32, and the float32
+        ``cos_theta`` and ``eta_i`` (count_eta, count_mu) the shader used.
+    """
+    mu0, mu_step, width = cos_theta_axis
+    eta0, eta_step, height = eta_i_axis
+    grid = (mu0, mu_step, eta0, eta_step)
+    return thread.call(_evaluate_grid, variant, inputs, grid, int(width), int(height))
+
+
+def _decode_halves(state: GLState, words):
+    ctx = state.ctx
+    program, vao = state.program("unpack_halves.frag")
+    program["cf_words"].value = [int(w) for w in words]
+    fbo, targets = state.float_targets((27, 1), 1)
+    try:
+        fbo.use()
+        vao.render(mode=ctx.TRIANGLES, vertices=3)
+        data = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32)
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+    return data.reshape(27, 4)[:, 0].copy()
+
+
+def decode_halves_in_shader(thread: RenderThread, words) -> np.ndarray:
+    """The 27 float32 values ``cf_unpack_coefficients`` decodes from 14 words."""
+    words = np.asarray(words, dtype=np.uint32)
+    if words.shape != (14,):
+        raise ValueError(f"`words` must hold 14 uint32, got shape {words.shape}")
+    return thread.call(_decode_halves, words)
+
+
+def _time_variant(state: GLState, variant, inputs, width, height, repeats, warmup):
+    ctx = state.ctx
+    program, vao = state.program(
+        "evaluate.frag", {"CF_VARIANT": _check_variant(variant), "CF_WRITE_INPUTS": 0}
+    )
+    _set_uniforms(program, variant, inputs)
+    # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
+    program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
+    fbo, targets = state.float_targets((width, height), 1)
+    query = ctx.query(time=True)
+    gpu_ns, wall_s = [], []
+    try:
+        fbo.use()
+        for i in range(warmup + repeats):
+            ctx.finish()
+            start = time.perf_counter()
+            with query:
+                vao.render(mode=ctx.TRIANGLES, vertices=3)
+                # llvmpipe's query covers only completed work: finish inside.
+                ctx.finish()
+            elapsed = time.perf_counter() - start
+            if i >= warmup:
+                gpu_ns.append(query.elapsed)
+                wall_s.append(elapsed)
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+    return np.array(gpu_ns, dtype=np.float64), np.array(wall_s)
+
+
+def time_variant(
+    thread: RenderThread,
+    variant: str,
+    inputs: ShaderInputs,
+    width: int = 2560,
+    height: int = 1440,
+    repeats: int = 10,
+    warmup: int = 2,
+):
+    """
+    Time full-screen renders of one variant into an RGBA32F target.
+
+    Returns
+    -------
+    tuple
+        GL timer-query times in ns and wall times in s, one per repeat.
+    """
+    return thread.call(_time_variant, variant, inputs, width, height, repeats, warmup)

@@ -1,0 +1,183 @@
+"""
+Headless GL
+===========
+
+The one place where the GL context is made, and the dedicated thread that
+owns it. A GL context works only on the thread that created it (elsewhere it
+silently reads zeros), so every GL call of the package runs on a
+:class:`RenderThread`.
+
+-   :func:`load_shader_source`: a ``glsl/`` file with its ``#include``
+    lines resolved and host ``#define`` lines inserted.
+-   :class:`RenderThread`: owns a moderngl context (EGL, headless: Mesa's
+    llvmpipe without a GPU) and runs callables on it, one at a time.
+-   :class:`GLState`: what a callable gets on the render thread: the context
+    and cached programs.
+-   :func:`check_gl_error`: raises if the GL error state is not clean.
+"""
+
+from __future__ import annotations
+
+import queue
+import re
+import threading
+from concurrent.futures import Future
+from pathlib import Path
+from typing import Any, Callable
+
+import moderngl
+
+__all__ = [
+    "GLSL_DIR",
+    "GL_VERSION",
+    "load_shader_source",
+    "check_gl_error",
+    "GLState",
+    "RenderThread",
+]
+
+GLSL_DIR = Path(__file__).with_name("glsl")
+GL_VERSION = 430
+"""GLSL 4.30 core: ``unpackHalf2x16`` and timer queries are core there."""
+
+_INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
+
+
+def load_shader_source(name: str, defines: dict[str, int] | None = None) -> str:
+    """
+    Source of ``glsl/<name>`` with ``#include "file"`` lines replaced by the
+    file (recursively; each file is included once, its include guard covers
+    repeats) and ``#define NAME value`` lines after the ``#version`` line.
+    """
+    seen: set[str] = set()
+
+    def expand(file_name: str) -> str:
+        path = GLSL_DIR / file_name
+        if not path.is_file():
+            raise ValueError(f"`{file_name}` is not a shader in {GLSL_DIR}")
+        if file_name in seen:
+            return ""
+        seen.add(file_name)
+        return _INCLUDE.sub(lambda m: expand(m.group(1)), path.read_text())
+
+    source = expand(name)
+    head, _, body = source.partition("\n")
+    if not head.startswith("#version"):
+        raise ValueError(f"`{name}` must start with a #version line")
+    lines = [f"#define {key} {int(value)}" for key, value in (defines or {}).items()]
+    return "\n".join([head, *lines, body])
+
+
+def check_gl_error(ctx: moderngl.Context) -> None:
+    """Raise ``RuntimeError`` if the context's GL error state is not clean."""
+    error = ctx.error
+    if error != "GL_NO_ERROR":
+        raise RuntimeError(f"GL error: {error}")
+
+
+class GLState:
+    """The render thread's context with its compiled programs, cached."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self._programs: dict[tuple, tuple[moderngl.Program, moderngl.VertexArray]] = {}
+        # moderngl rebinds the previously bound framebuffer after creating a
+        # new one; if that one was released, GL reports INVALID_OPERATION. A
+        # framebuffer that is never released is bound before every release.
+        self._idle = ctx.simple_framebuffer((1, 1))
+
+    def float_targets(self, size: tuple[int, int], count: int):
+        """A framebuffer with ``count`` RGBA32F colour attachments of ``size``."""
+        targets = [self.ctx.texture(size, 4, dtype="f4") for _ in range(count)]
+        return self.ctx.framebuffer(color_attachments=targets), targets
+
+    def release_targets(self, fbo: moderngl.Framebuffer, targets) -> None:
+        """Release what :meth:`float_targets` made."""
+        self._idle.use()
+        fbo.release()
+        for target in targets:
+            target.release()
+
+    def program(
+        self, fragment: str, defines: dict[str, int] | None = None
+    ) -> tuple[moderngl.Program, moderngl.VertexArray]:
+        """A full-screen program (``fullscreen.vert`` + ``fragment``) and its VAO."""
+        key = (fragment, tuple(sorted((defines or {}).items())))
+        if key not in self._programs:
+            program = self.ctx.program(
+                vertex_shader=load_shader_source("fullscreen.vert"),
+                fragment_shader=load_shader_source(fragment, defines),
+            )
+            vao = self.ctx.vertex_array(program, [])
+            self._programs[key] = (program, vao)
+        return self._programs[key]
+
+
+def _create_context() -> moderngl.Context:
+    """The one place a GL context is created (headless, EGL)."""
+    return moderngl.create_context(standalone=True, backend="egl", require=GL_VERSION)
+
+
+class RenderThread:
+    """
+    A thread that owns one GL context and runs submitted callables on it.
+
+    ``call(fn, *args)`` runs ``fn(state, *args)`` on the render thread with a
+    :class:`GLState` and returns its result (or raises its exception); it is
+    thread-safe, and calls run one at a time in submission order.
+
+    Raises
+    ------
+    RuntimeError
+        From the constructor, if no GL context can be created.
+    """
+
+    def __init__(self, name: str = "preview-render") -> None:
+        self._jobs: queue.Queue = queue.Queue()
+        self._ready: Future = Future()
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+        self._thread.start()
+        info = self._ready.result()
+        self.renderer: str = info["GL_RENDERER"]
+        self.version: str = info["GL_VERSION"]
+
+    def _run(self) -> None:
+        try:
+            ctx = _create_context()
+        except Exception as error:  # reported to the constructor's caller
+            self._ready.set_exception(RuntimeError(f"no GL context: {error}"))
+            return
+        state = GLState(ctx)
+        self._ready.set_result(dict(ctx.info))
+        while True:
+            job = self._jobs.get()
+            if job is None:
+                break
+            fn, args, kwargs, future = job
+            if not future.set_running_or_notify_cancel():
+                continue
+            try:
+                future.set_result(fn(state, *args, **kwargs))
+            except BaseException as error:
+                future.set_exception(error)
+        ctx.release()
+
+    def call(self, fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+        """Run ``fn(state, *args, **kwargs)`` on the render thread; return its result."""
+        if not self._thread.is_alive():
+            raise RuntimeError("the render thread is closed")
+        future: Future = Future()
+        self._jobs.put((fn, args, kwargs, future))
+        return future.result()
+
+    def close(self) -> None:
+        """Stop the thread after the submitted work; release the context."""
+        if self._thread.is_alive():
+            self._jobs.put(None)
+            self._thread.join()
+
+    def __enter__(self) -> "RenderThread":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

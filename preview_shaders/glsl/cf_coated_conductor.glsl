@@ -1,0 +1,87 @@
+// The coated-conductor Fresnel model of Vernooij (2024), Eq. 1 and 2: the
+// GLSL mirror of fitting/model.py, term by term.
+//
+// Coefficient layout (fitting.model): coefficients[p][c][j], parameter p in
+// (F0, a, alpha), channel c in (R, G, B), power j in (1, t, t^2); 27 values
+// in that order. Here each parameter is one mat3 whose column c holds the
+// powers of channel c, so T * M (T = (1, t, t^2)) gives the three channels.
+//
+// Reference: H. B. Vernooij, "A Fresnel Model for Coated Materials",
+// Eurographics 2024 (Short Papers).
+#ifndef CF_COATED_CONDUCTOR_GLSL
+#define CF_COATED_CONDUCTOR_GLSL
+
+#include "cf_common.glsl"
+
+// Normalised coating index t = (eta_i - lo) / (hi - lo), clamped to [0, 1]
+// (fitting.model.normalised_eta_i). A single-index fit (hi == lo) has t = 0.
+float cf_normalised_eta_i(float eta_i, vec2 eta_i_range)
+{
+    float width = eta_i_range.y - eta_i_range.x;
+    if (width <= 0.0)
+        return 0.0;
+    return clamp((eta_i - eta_i_range.x) / width, 0.0, 1.0);
+}
+
+// Vernooij 2024, Eq. 2 (in t instead of eta_i): F0, a and alpha per channel,
+// each c0 + c1 t + c2 t^2 (fitting.model.model_parameters). alpha is clamped
+// to CF_ALPHA_MIN there, as in numpy.
+void cf_coated_conductor_parameters(float t, mat3 C_F0, mat3 C_a, mat3 C_alpha,
+                                    out vec3 F0, out vec3 a, out vec3 alpha)
+{
+    vec3 T = vec3(1.0, t, t * t);
+    F0 = T * C_F0;
+    a = T * C_a;
+    alpha = max(T * C_alpha, vec3(CF_ALPHA_MIN));
+}
+
+// Vernooij 2024, Eq. 1 (Lazanyi & Szirmay-Kalos 2005 error term on Schlick):
+// F = F0 + (1 - F0)(1 - mu)^5 - a mu (1 - mu)^alpha per channel
+// (fitting.model.model_from_parameters). This alone is the scene-specialised
+// model: with eta_i constant, F0, a and alpha are collapsed on the CPU.
+vec3 cf_coated_conductor_eq1(float NdotV, vec3 F0, vec3 a, vec3 alpha)
+{
+    float mu = cf_saturate(NdotV);
+    float x = 1.0 - mu;
+    // alpha >= CF_ALPHA_MIN > 0, so pow(0, alpha) = 0 is defined at mu = 1.
+    vec3 x_alpha = pow(vec3(x), max(alpha, vec3(CF_ALPHA_MIN)));
+    return F0 + (1.0 - F0) * cf_pow5(x) - a * mu * x_alpha;
+}
+
+// The general model from float coefficients (Vernooij 2024, Eq. 1 and 2).
+vec3 cf_coated_conductor(float NdotV, float eta_i, vec2 eta_i_range,
+                         mat3 C_F0, mat3 C_a, mat3 C_alpha)
+{
+    vec3 F0, a, alpha;
+    float t = cf_normalised_eta_i(eta_i, eta_i_range);
+    cf_coated_conductor_parameters(t, C_F0, C_a, C_alpha, F0, a, alpha);
+    return cf_coated_conductor_eq1(NdotV, F0, a, alpha);
+}
+
+// Decodes the 27 float16 coefficients packed two per uint32, the earlier one
+// in the low 16 bits (fitting.pack.halves_to_uint32), so unpackHalf2x16(w).x
+// is the earlier half; the 28th half is padding. Written out rather than
+// looped through a float[27] so no compiler needs a local array for it.
+void cf_unpack_coefficients(uint words[14], out mat3 C_F0, out mat3 C_a, out mat3 C_alpha)
+{
+    vec2 h0 = unpackHalf2x16(words[0]), h1 = unpackHalf2x16(words[1]);
+    vec2 h2 = unpackHalf2x16(words[2]), h3 = unpackHalf2x16(words[3]);
+    vec2 h4 = unpackHalf2x16(words[4]), h5 = unpackHalf2x16(words[5]);
+    vec2 h6 = unpackHalf2x16(words[6]), h7 = unpackHalf2x16(words[7]);
+    vec2 h8 = unpackHalf2x16(words[8]), h9 = unpackHalf2x16(words[9]);
+    vec2 h10 = unpackHalf2x16(words[10]), h11 = unpackHalf2x16(words[11]);
+    vec2 h12 = unpackHalf2x16(words[12]), h13 = unpackHalf2x16(words[13]);
+    C_F0 = mat3(h0.x, h0.y, h1.x, h1.y, h2.x, h2.y, h3.x, h3.y, h4.x);
+    C_a = mat3(h4.y, h5.x, h5.y, h6.x, h6.y, h7.x, h7.y, h8.x, h8.y);
+    C_alpha = mat3(h9.x, h9.y, h10.x, h10.y, h11.x, h11.y, h12.x, h12.y, h13.x);
+}
+
+// The general model from the packed halves, exactly what a renderer uploads.
+vec3 cf_coated_conductor_packed(float NdotV, float eta_i, vec2 eta_i_range, uint words[14])
+{
+    mat3 C_F0, C_a, C_alpha;
+    cf_unpack_coefficients(words, C_F0, C_a, C_alpha);
+    return cf_coated_conductor(NdotV, eta_i, eta_i_range, C_F0, C_a, C_alpha);
+}
+
+#endif
