@@ -58,7 +58,7 @@ vec3 cf_studio_environment(vec3 direction)
 
     // Dim frontal fill: keeps the sphere's centre (which reflects the
     // camera side) from going black.
-    L += vec3(0.22) * pow(max(d.z, 0.0), 3.0);
+    L += vec3(0.4) * pow(max(d.z, 0.0), 3.0);
     return L;
 }
 

@@ -1,0 +1,323 @@
+"""
+Preview sphere
+==============
+
+The headless preview the service and the editor show: a smooth sphere under
+a uniform white sky (the paper's validation setting, where the sphere shows
+F(cos theta) directly) or in a studio, drawn by ``glsl/preview.frag`` on one
+dedicated render thread, with an optional split view (Vernooij 2024,
+Figure 2): left the model, right adjusted Lazanyi or the spectral reference.
+
+Service entry point (thread-safe; the GL work runs on the renderer's own
+thread, the spectral reference and metrics on the caller's)::
+
+    renderer = PreviewRenderer()
+    result = renderer.render_preview(
+        packed,                 # fitting.pack.PackedMaterial (float16 coefficients)
+        nk,                     # fitting.nk.SpectralNK or None; needed by
+                                # compare="lazanyi" | "reference"
+        eta_i=1.5,              # coating index, [1, 3]
+        size=512,               # pixels per side, 64..2048
+        compare="none",         # "none" | "lazanyi" | "reference"
+        environment="white_sky" # "white_sky" | "studio"
+    )
+    result.png                  # bytes: the (split) view, 8-bit sRGB PNG
+    result.image                # (size, size, 3) float32 linear ACEScg
+    renderer.close()
+
+:class:`PreviewResult` also holds the full model image, the comparison image,
+cos theta per pixel and, with compare="reference", the Delta E 2000 and FLIP
+maps between model and reference with their means over the sphere.
+
+Geometry: orthographic camera on +z, sphere centre at the image centre,
+radius 0.45 size; pixel (x, y) (top row first) has its centre at
+(x + 0.5, size - y - 0.5) in GL window coordinates; on the sphere
+cos theta = N.z = sqrt(1 - r^2) with r the distance from the centre over the
+radius.
+
+-   :data:`COMPARISONS`, :data:`ENVIRONMENTS`: the accepted values.
+-   :class:`PreviewRenderer`, :class:`PreviewResult`.
+-   :func:`reference_image`: the spectral reference of a rendered view.
+-   :func:`difference_maps`: Delta E 2000 and FLIP maps and means.
+-   :func:`sphere_cos_theta`: cos theta per pixel from the geometry, in numpy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fitting.colorimetry import ACEScg_to_Lab, delta_E_2000
+from fitting.baselines import baseline_inputs
+from fitting.pack import PackedMaterial, halves_to_uint32
+from fitting.reference import reference_ACEScg
+
+from .display import ACEScg_to_sRGB, encode_png, to_uint8
+from .evaluate import padded_coefficients
+from .gl import GLState, RenderThread, check_gl_error
+
+__all__ = [
+    "COMPARISONS",
+    "ENVIRONMENTS",
+    "SIZE_RANGE",
+    "ETA_I_LIMITS",
+    "SPHERE_RADIUS",
+    "PreviewResult",
+    "PreviewRenderer",
+    "reference_image",
+    "difference_maps",
+    "sphere_cos_theta",
+    "padded_words",
+]
+
+COMPARISONS = ("none", "lazanyi", "reference")
+ENVIRONMENTS = ("white_sky", "studio")
+SIZE_RANGE = (64, 2048)
+ETA_I_LIMITS = (1.0, 3.0)
+SPHERE_RADIUS = 0.45
+"""Sphere radius as a fraction of the image size."""
+
+
+def _check_size(size) -> int:
+    if isinstance(size, bool) or not isinstance(size, (int, np.integer)):
+        raise ValueError(f"`size` must be an integer in [64, 2048], got {size!r}")
+    if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
+        raise ValueError(f"`size` must lie in [64, 2048], got {size}")
+    return int(size)
+
+
+def _check_eta_i(eta_i) -> float:
+    try:
+        value = float(eta_i)
+    except (TypeError, ValueError):
+        raise ValueError(f"`eta_i` must be a number in [1, 3], got {eta_i!r}") from None
+    if not (np.isfinite(value) and ETA_I_LIMITS[0] <= value <= ETA_I_LIMITS[1]):
+        raise ValueError(f"`eta_i` must lie in [1, 3], got {value:g}")
+    return value
+
+
+def _check_choice(name: str, value, choices) -> str:
+    if value not in choices:
+        raise ValueError(f"`{name}` must be one of {', '.join(choices)}, got {value!r}")
+    return value
+
+
+def sphere_cos_theta(size: int) -> tuple[np.ndarray, np.ndarray]:
+    """
+    cos theta per pixel (top row first) and the sphere mask, from the
+    geometry in float64 (the module docstring gives the geometry).
+    """
+    size = _check_size(size)
+    centre = 0.5 * size
+    radius = SPHERE_RADIUS * size
+    x = (np.arange(size) + 0.5 - centre) / radius
+    y = (size - np.arange(size) - 0.5 - centre) / radius
+    r2 = x[None, :] ** 2 + y[:, None] ** 2
+    mask = r2 < 1.0
+    return np.where(mask, np.sqrt(np.clip(1.0 - r2, 0.0, 1.0)), 0.0), mask
+
+
+@dataclass
+class PreviewResult:
+    """
+    One preview. Images are (size, size, 3) float32 linear ACEScg, top row
+    first; ``png`` is ``image`` through the display transform
+    (:mod:`preview_shaders.display`).
+
+    ``image``: the view (split when ``compare`` is not "none");
+    ``model``: the model over the whole sphere; ``comparison``: adjusted
+    Lazanyi or the reference over the whole sphere (None for "none");
+    ``cos_theta``, ``mask``: cos theta per pixel and the sphere;
+    ``radiance``: the environment radiance each pixel sees;
+    ``delta_E``, ``flip``: maps model vs reference (compare="reference"),
+    with ``delta_E_mean``, ``flip_mean`` over the sphere's pixels.
+    """
+
+    image: np.ndarray
+    png: bytes
+    model: np.ndarray
+    comparison: np.ndarray | None
+    cos_theta: np.ndarray
+    mask: np.ndarray
+    radiance: np.ndarray
+    compare: str
+    eta_i: float
+    environment: str
+    delta_E: np.ndarray | None = None
+    delta_E_mean: float | None = None
+    flip: np.ndarray | None = None
+    flip_mean: float | None = None
+
+
+def _render_layers(state: GLState, words, eta_i_range, F0_air, F82_air, eta_i, size,
+                   environment, split_column):
+    """On the render thread: colour, geometry and radiance, top row first."""
+    ctx = state.ctx
+    program, vao = state.program("preview.frag")
+    program["u_centre"].value = (0.5 * size, 0.5 * size)
+    program["u_radius"].value = SPHERE_RADIUS * size
+    program["u_split_column"].value = float(split_column)
+    program["u_environment"].value = ENVIRONMENTS.index(environment)
+    program["u_eta_i"].value = eta_i
+    program["cf_words"].value = [int(w) for w in words]
+    program["cf_eta_i_range"].value = tuple(float(v) for v in eta_i_range)
+    program["cf_F0_air"].value = tuple(float(v) for v in F0_air)
+    program["cf_F82_air"].value = tuple(float(v) for v in F82_air)
+    fbo, targets = state.float_targets((size, size), 3)
+    try:
+        fbo.use()
+        vao.render(mode=ctx.TRIANGLES, vertices=3)
+        layers = [
+            np.frombuffer(fbo.read(components=4, dtype="f4", attachment=i), np.float32)
+            .reshape(size, size, 4)[::-1]
+            .copy()
+            for i in range(3)
+        ]
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+    return layers
+
+
+def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0) -> np.ndarray:
+    """
+    The spectral reference of a rendered view: on the sphere, the exact
+    reflectance of ``nk`` (:func:`fitting.reference.reference_ACEScg`) at
+    each pixel's cos theta times the radiance the pixel sees; elsewhere the
+    radiance. float32 linear ACEScg.
+    """
+    image = np.array(radiance[..., :3], dtype=np.float64)
+    F = reference_ACEScg(nk, cos_theta[mask].astype(np.float64), eta_i, step_nm)
+    image[mask] = F * image[mask]
+    return image.astype(np.float32)
+
+
+def difference_maps(test, reference, mask):
+    """
+    Per-pixel Delta E 2000 (CIE Lab with the ACES white) and FLIP (LDR,
+    flip-evaluator, on the display-encoded sRGB images) between two linear
+    ACEScg images, and the mean of each over ``mask``.
+
+    Returns
+    -------
+    tuple
+        (delta_E map, delta_E mean, FLIP map, FLIP mean).
+    """
+    import flip_evaluator
+
+    delta_E = delta_E_2000(ACEScg_to_Lab(test), ACEScg_to_Lab(reference)).astype(np.float32)
+    flip, _, _ = flip_evaluator.evaluate(
+        ACEScg_to_sRGB(reference).astype(np.float32),
+        ACEScg_to_sRGB(test).astype(np.float32),
+        "LDR",
+        inputsRGB=True,
+        applyMagma=False,
+        computeMeanError=False,
+    )
+    flip = np.asarray(flip, dtype=np.float32).reshape(mask.shape)
+    return delta_E, float(delta_E[mask].mean()), flip, float(flip[mask].mean())
+
+
+class PreviewRenderer:
+    """
+    Renders previews; owns (or shares) one :class:`RenderThread`. Thread-safe:
+    the GL work of concurrent calls is serialised on that thread.
+    """
+
+    def __init__(self, thread: RenderThread | None = None) -> None:
+        self._owns_thread = thread is None
+        self.thread = thread or RenderThread()
+
+    def close(self) -> None:
+        if self._owns_thread:
+            self.thread.close()
+
+    def __enter__(self) -> "PreviewRenderer":
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def render_preview(
+        self,
+        packed: PackedMaterial,
+        nk=None,
+        eta_i: float = 1.5,
+        size: int = 512,
+        compare: str = "none",
+        environment: str = "white_sky",
+        step_nm: float = 1.0,
+    ) -> PreviewResult:
+        """
+        Render the preview sphere (see the module docstring).
+
+        Raises
+        ------
+        ValueError
+            For ``size`` outside [64, 2048], ``eta_i`` outside [1, 3], an
+            unknown ``compare`` or ``environment``, a ``packed`` that is not a
+            PackedMaterial, or a comparison without ``nk``.
+        """
+        if not isinstance(packed, PackedMaterial):
+            raise ValueError(f"`packed` must be a PackedMaterial, got {type(packed).__name__}")
+        size = _check_size(size)
+        eta_i = _check_eta_i(eta_i)
+        compare = _check_choice("compare", compare, COMPARISONS)
+        environment = _check_choice("environment", environment, ENVIRONMENTS)
+        if compare != "none" and nk is None:
+            raise ValueError(f"`nk` is needed for compare={compare!r}: the material's n, k")
+
+        baseline = baseline_inputs(nk) if nk is not None else None
+        F0_air = baseline["F0_air"] if baseline else np.zeros(3)
+        F82_air = baseline["F82_air"] if baseline else np.zeros(3)
+        words = padded_words(packed)
+        common = (words, packed.eta_i_range, F0_air, F82_air, eta_i, size, environment)
+        model, geometry, radiance = self.thread.call(_render_layers, *common, size)
+        mask = geometry[..., 1] > 0.5
+        cos_theta = geometry[..., 0]
+        model = model[..., :3]
+        comparison = None
+        if compare == "lazanyi":
+            comparison = self.thread.call(_render_layers, *common, 0)[0][..., :3]
+        elif compare == "reference":
+            comparison = reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm)
+        image = model.copy()
+        if comparison is not None:
+            # The same rule as the shader's split: columns from size // 2 on.
+            image[:, size // 2 :] = comparison[:, size // 2 :]
+        result = PreviewResult(
+            image=image,
+            png=encode_png(to_uint8(ACEScg_to_sRGB(image))),
+            model=model,
+            comparison=comparison,
+            cos_theta=cos_theta,
+            mask=mask,
+            radiance=radiance[..., :3],
+            compare=compare,
+            eta_i=eta_i,
+            environment=environment,
+        )
+        if compare == "reference":
+            (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
+                difference_maps(model, comparison, mask)
+            )
+        return result
+
+    def render_split_in_shader(self, packed, nk, eta_i, size, environment="white_sky"):
+        """The model | adjusted Lazanyi split drawn by the shader itself (one
+        pass), float32 linear ACEScg, top row first."""
+        size = _check_size(size)
+        eta_i = _check_eta_i(eta_i)
+        environment = _check_choice("environment", environment, ENVIRONMENTS)
+        baseline = baseline_inputs(nk)
+        layers = self.thread.call(
+            _render_layers, padded_words(packed), packed.eta_i_range, baseline["F0_air"],
+            baseline["F82_air"], eta_i, size, environment, size // 2,
+        )
+        return layers[0][..., :3]
+
+
+def padded_words(packed: PackedMaterial) -> np.ndarray:
+    """The 14 uint32 words of a material's coefficients, padded to degree 2."""
+    return halves_to_uint32(padded_coefficients(packed.coefficients))
