@@ -28,6 +28,7 @@ Frantar, E., et al. (2023). GPTQ: Accurate post-training quantization. ICLR
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import time
 from dataclasses import dataclass, field
@@ -35,6 +36,7 @@ from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
+from threadpoolctl import ThreadpoolController
 
 from .baselines import baseline_inputs, lazanyi_adjusted, schlick
 from .colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_jacobian
@@ -65,6 +67,10 @@ __all__ = [
 OBJECTIVES = ("rgb", "lab", "de2000")
 DEFAULT_OBJECTIVE = "de2000"
 """The objective with the lower Delta E 2000 on the library (docs/results.md)."""
+
+# The fit's matrices are tiny (hundreds x 27): BLAS threads only add
+# synchronisation cost, and oversubscribe the pool's worker processes.
+_THREADPOOLS = ThreadpoolController()
 
 _IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight
 _ALPHA_CANDIDATES = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0, 16.0, 24.0])
@@ -324,6 +330,16 @@ def _initial_guess(target, mu, eta, eta_i_range, degree) -> np.ndarray:
     return x0
 
 
+def _single_threaded_blas(function):
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        with _THREADPOOLS.limit(limits=1, user_api="blas"):
+            return function(*args, **kwargs)
+
+    return wrapper
+
+
+@_single_threaded_blas
 def fit_coefficients(
     target_RGB,
     cos_theta,

@@ -1,0 +1,121 @@
+"""
+Command line
+============
+
+``python -m fitting library | fit | reproduce | scene``
+
+-   ``library``: the built-in materials with their sources.
+-   ``fit Au`` or ``fit --nk FILE``: fit and write a binary pack (``-o``) or
+    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain.
+-   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
+    conductors and the Section 4.3 float16 study.
+-   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.scene`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+__all__ = ["main", "parse_eta_range"]
+
+
+def parse_eta_range(text: str) -> tuple[float, float]:
+    """``"1:2.5"`` -> (1.0, 2.5); a single number gives a single eta_i."""
+    parts = text.split(":")
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--eta-range must be LO:HI, got {text!r}") from None
+    if len(values) == 1:
+        values = values * 2
+    if len(values) != 2:
+        raise argparse.ArgumentTypeError(f"--eta-range must be LO:HI, got {text!r}")
+    return values[0], values[1]
+
+
+def _cmd_library(args) -> int:
+    from .library import LIBRARY, LIBRARY_NAMES, library_material
+
+    for name in LIBRARY_NAMES:
+        nk = library_material(name)
+        lo, hi = nk.wavelength_range_nm
+        shelf, book, page = LIBRARY[name]
+        citation = nk.source.split(": ", 1)[-1].splitlines()[0]
+        print(f"{name:5s} {shelf}/{book}/{page:18s} {lo:7.1f}-{hi:8.1f} nm  {citation}")
+    return 0
+
+
+def _cmd_fit(args) -> int:
+    from .fit import fit_material
+    from .library import library_material
+    from .pack import encode_pack, material_to_json
+    from .sources import read_nk
+
+    if (args.material is None) == (args.nk is None):
+        print("error: give a library material name or --nk FILE (not both)", file=sys.stderr)
+        return 2
+    if args.nk is not None:
+        path = Path(args.nk)
+        nk = read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
+    else:
+        nk = library_material(args.material)
+    result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
+    view = material_to_json(result.packed)
+    view["fit"] = result.summary()
+    if args.output:
+        Path(args.output).write_bytes(encode_pack([result.packed]))
+        print(f"wrote {args.output}", file=sys.stderr)
+    if args.json or not args.output:
+        print(json.dumps(view, indent=2))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from .fit import OBJECTIVES, DEFAULT_OBJECTIVE
+
+    parser = argparse.ArgumentParser(
+        prog="python -m fitting",
+        description="Measured n, k of a conductor to the float16 coated-conductor Fresnel model.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("library", help="list the built-in materials")
+    p.set_defaults(func=_cmd_library)
+
+    p = sub.add_parser("fit", help="fit a library material or an n, k file")
+    p.add_argument("material", nargs="?", help="library material name, e.g. Au")
+    p.add_argument("--nk", metavar="FILE", help="n, k file: CSV, JSON or refractiveindex.info YAML")
+    p.add_argument("--name", help="material name for --nk (default: the file name)")
+    p.add_argument("--eta-range", type=parse_eta_range, default=(1.0, 2.5), metavar="LO:HI",
+                   help="eta_i domain of the fit (default 1:2.5)")
+    p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)
+    p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
+    p.add_argument("--json", action="store_true", help="print the JSON view")
+    p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
+    p.set_defaults(func=_cmd_fit)
+
+    p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
+    p.add_argument("-o", "--output", default="docs/results.md", metavar="FILE")
+    p.add_argument("--materials", help="comma-separated subset (default: all 22)")
+    p.set_defaults(func=lambda args: __import__("fitting.reproduce", fromlist=["run"]).run(args))
+
+    try:
+        from .scene import add_scene_parser
+    except ImportError:  # the scene module is optional while it is being written
+        add_scene_parser = None
+    if add_scene_parser is not None:
+        add_scene_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2

@@ -1,0 +1,189 @@
+"""
+Reproduction of the paper's results
+===================================
+
+``python -m fitting reproduce`` writes ``docs/results.md``:
+
+-   Table 1 for all 22 conductors: mean and max Delta E 2000 of ours (float16
+    and float32, default objective), ours with the paper's linear-RGB
+    objective, and every baseline, on the paper's 100 x 100 grid over
+    cos theta in [0, 1] and eta_i in [1, 2.5] against the 1 nm reference.
+-   The Section 4.3 study: the increase of mean Delta E from float32 to
+    float16 coefficients at eta_i = 1, 1.5, 2 and 2.5.
+-   Which objective gives the lower Delta E (the default).
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .baselines import baseline_inputs, lazanyi_adjusted, schlick
+from .fit import DEFAULT_OBJECTIVE, fit_material
+from .library import LIBRARY, LIBRARY_NAMES, library_material
+from .metrics import BREAKDOWN_ETA_I, error_metrics
+from .model import coated_conductor_model
+from .reference import evaluation_grid, reference_ACEScg
+
+__all__ = ["PAPER_TABLE_1", "reproduce_material", "run"]
+
+PAPER_TABLE_1 = {"Al": 0.09, "Au": 0.14, "Cu": 0.10, "Ta": 0.47, "Cr": 0.31}
+"""Mean Delta E 2000 of the paper's model (Vernooij 2024, Table 1)."""
+
+ETA_I_RANGE = (1.0, 2.5)
+
+
+def _progress(done: int, total: int, label: str) -> None:
+    width = 30
+    filled = int(width * done / total)
+    sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total} {label:8s}")
+    sys.stderr.flush()
+
+
+def reproduce_material(name: str, samples: int = 100) -> dict:
+    """All models of one library conductor scored on the paper's grid."""
+    nk = library_material(name)
+    M, E = evaluation_grid(samples, ETA_I_RANGE)
+    rows = E[:, 0]
+    ref = reference_ACEScg(nk, M, E)
+    out: dict = {"name": name, "page": "/".join(LIBRARY[name])}
+    fits = {}
+    for objective in sorted({DEFAULT_OBJECTIVE, "rgb"}):
+        fit = fit_material(nk, ETA_I_RANGE, objective=objective)
+        fits[objective] = fit
+        out[f"ours_f16_{objective}"] = error_metrics(
+            ref, coated_conductor_model(M, E, fit.coefficients_float16, ETA_I_RANGE), rows
+        )
+        out[f"ours_f32_{objective}"] = error_metrics(
+            ref,
+            coated_conductor_model(M, E, fit.coefficients.astype(np.float32), ETA_I_RANGE),
+            rows,
+        )
+        out[f"fit_ms_{objective}"] = 1e3 * fit.timings["total"]
+    inputs = baseline_inputs(nk)
+    exact_F0 = reference_ACEScg(nk, np.ones_like(E[:, :1]), E[:, :1])
+    out["lazanyi_adjusted"] = error_metrics(
+        ref, lazanyi_adjusted(M, E, inputs["F0_air"], inputs["F82_air"]), rows
+    )
+    out["lazanyi_exact_F0"] = error_metrics(
+        ref, lazanyi_adjusted(M, E, inputs["F0_air"], inputs["F82_air"], exact_F0), rows
+    )
+    out["schlick_air"] = error_metrics(ref, schlick(M, inputs["F0_air"]), rows)
+    out["schlick_exact_F0"] = error_metrics(ref, schlick(M, exact_F0), rows)
+    out["coverage"] = fits[DEFAULT_OBJECTIVE].coverage
+    return out
+
+
+BASELINE_KEYS = ("lazanyi_adjusted", "lazanyi_exact_F0", "schlick_air", "schlick_exact_F0")
+
+
+def _table(results: list[dict]) -> list[str]:
+    d = DEFAULT_OBJECTIVE
+    lines = [
+        "| Conductor | Ours f16 | Ours f32 | Ours f16, paper's RGB objective | Adj. Lazanyi | Lazanyi, exact F0 | Schlick, air F0 | Schlick, exact F0 | Paper Table 1 (ours) | f16 beats all baselines |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+
+    def cell(m):
+        return f"{m['delta_E_mean']:.3f} / {m['delta_E_max']:.2f}"
+
+    for r in results:
+        ours = r[f"ours_f16_{d}"]["delta_E_mean"]
+        beats = all(ours < r[k]["delta_E_mean"] for k in BASELINE_KEYS)
+        paper = PAPER_TABLE_1.get(r["name"])
+        lines.append(
+            f"| {r['name']} | {cell(r[f'ours_f16_{d}'])} | {cell(r[f'ours_f32_{d}'])} | "
+            f"{cell(r['ours_f16_rgb'])} | "
+            + " | ".join(cell(r[k]) for k in BASELINE_KEYS)
+            + f" | {'' if paper is None else f'{paper:.2f}'} | {'yes' if beats else '**no**'} |"
+        )
+    return lines
+
+
+def _float16_study(results: list[dict]) -> list[str]:
+    d = DEFAULT_OBJECTIVE
+    header = "| Conductor | " + " | ".join(f"eta_i = {e:g}" for e in BREAKDOWN_ETA_I) + " |"
+    lines = [header, "|---|" + "---|" * len(BREAKDOWN_ETA_I)]
+    worst = {f"{e:g}": (-np.inf, "") for e in BREAKDOWN_ETA_I}
+    for r in results:
+        cells = []
+        for e in BREAKDOWN_ETA_I:
+            key = f"{e:g}"
+            inc = (
+                r[f"ours_f16_{d}"]["by_eta_i"][key]["delta_E_mean"]
+                - r[f"ours_f32_{d}"]["by_eta_i"][key]["delta_E_mean"]
+            )
+            cells.append(f"{inc:+.4f}")
+            if inc > worst[key][0]:
+                worst[key] = (inc, r["name"])
+        lines.append(f"| {r['name']} | " + " | ".join(cells) + " |")
+    lines.append(
+        "| **largest increase** | "
+        + " | ".join(f"**{worst[f'{e:g}'][0]:+.4f}** ({worst[f'{e:g}'][1]})" for e in BREAKDOWN_ETA_I)
+        + " |"
+    )
+    return lines
+
+
+def run(args) -> int:
+    names = LIBRARY_NAMES if not getattr(args, "materials", None) else tuple(args.materials.split(","))
+    for name in names:
+        if name not in LIBRARY:
+            raise ValueError(f"`materials` must name library conductors, got {name!r}")
+    t0 = time.perf_counter()
+    results = []
+    for i, name in enumerate(names):
+        _progress(i, len(names), name)
+        results.append(reproduce_material(name))
+    _progress(len(names), len(names), "done")
+    sys.stderr.write("\n")
+    d = DEFAULT_OBJECTIVE
+    mean = lambda key: float(np.mean([r[key]["delta_E_mean"] for r in results]))  # noqa: E731
+    all_beat = all(
+        all(r[f"ours_f16_{d}"]["delta_E_mean"] < r[k]["delta_E_mean"] for k in BASELINE_KEYS)
+        for r in results
+    )
+    lines = [
+        "# Results: the paper's Table 1 and Section 4.3, reproduced",
+        "",
+        "Written by `python -m fitting reproduce` (do not edit by hand). "
+        f"Conductors: {len(results)}; grid: 100 x 100 over cos theta in [0, 1] and eta_i in [1, 2.5] "
+        "(the paper's 10,000 samples), reference at 1 nm, CIE 1931 2 degree observer, D60 (ACES white), "
+        "linear ACEScg, Delta E 2000 with the ACES white as Lab reference white.",
+        "",
+        f"Default objective: `{d}`. Ours = the float16 coefficients actually shipped; f32 = the same fit "
+        "with float32 coefficients. Each cell is mean / max Delta E 2000.",
+        "",
+        "## Which objective",
+        "",
+        "| Objective | mean Delta E over the 22 (float16) |",
+        "|---|---|",
+    ]
+    for objective in sorted({d, "rgb"}):
+        lines.append(f"| `{objective}` | {mean(f'ours_f16_{objective}'):.4f} |")
+    lines += [
+        "",
+        f"Ours (float16) beats every baseline on every conductor: **{'yes' if all_beat else 'no'}**.",
+        "",
+        "## Table 1, all 22 conductors",
+        "",
+        *_table(results),
+        "",
+        "## Section 4.3: float16 against float32",
+        "",
+        "Increase of the mean Delta E 2000 from float32 to float16 coefficients in the row of the grid "
+        "at each eta_i (the paper found up to +0.0738, Nb at 2.5, with five conductors above 0.03 there).",
+        "",
+        *_float16_study(results),
+        "",
+        f"Run time: {time.perf_counter() - t0:.0f} s.",
+        "",
+    ]
+    output = Path(getattr(args, "output", "docs/results.md"))
+    output.parent.mkdir(parents=True, exist_ok=True)
+    output.write_text("\n".join(lines))
+    print(f"wrote {output}")
+    return 0

@@ -1,0 +1,141 @@
+"""
+Exact RGB conductor Fresnel
+===========================
+
+The "exact" Fresnel term as RGB renderers usually run it: the Fresnel
+equations of a conductor evaluated once per RGB channel with one complex
+index :math:`n_c + i k_c` per channel (Gulbrandsen 2014 and the
+``conductor`` materials of RGB renderers). It is exact for a material whose
+index does not vary within a channel, and is the yardstick the speed against
+error report (``docs/speed-vs-error.md``) compares the model with. The GLSL
+mirror is ``cf_fresnel_conductor`` in
+``preview_shaders/glsl/cf_fresnel_baselines.glsl`` (shader variant ``exact``),
+fed with the per-channel index chosen here.
+
+How the per-channel index is chosen: measured data give *n*, *k* per
+wavelength, not per channel, and there is no unique projection. Here
+:math:`(n_c, k_c)` are the values that make the exact Fresnel equations in air
+(eta_i = 1) reproduce channel *c* of the spectral reference in linear ACEScg
+best in the least-squares sense over cos theta in [0, 1]: the best an artist
+entering RGB *n*, *k* could do, so the error left at eta_i > 1 is the error of
+the per-channel approach itself, not of a poor choice of index.
+
+-   :func:`rgb_nk`: per-channel :math:`(n_c, k_c)` of a material.
+-   :func:`rgb_fresnel_conductor`: the exact Fresnel equations per channel,
+    linear ACEScg.
+
+References
+----------
+Gulbrandsen, O. (2014). Artist friendly metallic Fresnel. JCGT, 3(4), 64-72.
+Hoffman, N. (2019). Fresnel Equations Considered Harmful. MAM workshop.
+Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .fresnel import fresnel_conductor
+from .nk import DEFAULT_MIN_COVERAGE, SpectralNK
+from .reference import reference_ACEScg
+
+__all__ = ["RGB_NK_SAMPLES", "rgb_nk", "rgb_fresnel_conductor"]
+
+RGB_NK_SAMPLES = 64
+"""Values of cos theta, evenly over [0, 1], at which (n_c, k_c) are fitted."""
+
+# Bounds of the per-channel index: n > 0 as for any SpectralNK; the upper
+# bounds exceed every conductor of the library (n < 5, k < 12 in 360-830 nm).
+_N_BOUNDS = (1.0e-3, 20.0)
+_K_BOUNDS = (0.0, 50.0)
+
+
+def rgb_nk(
+    nk: SpectralNK, step_nm: float = 1.0, min_coverage: float = DEFAULT_MIN_COVERAGE
+) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Per-channel complex index of a material for the exact RGB Fresnel term.
+
+    For each channel *c*, solves
+
+    .. math::
+
+        \\min_{n_c, k_c} \\sum_s \\bigl(F(\\mu_s, 1; n_c, k_c) - R_c(\\mu_s)\\bigr)^2
+
+    with :math:`F` the exact unpolarised Fresnel reflectance in air,
+    :math:`R_c` channel *c* of the spectral reference (linear ACEScg) and
+    :math:`\\mu_s` :data:`RGB_NK_SAMPLES` values evenly over [0, 1], by the
+    trust-region reflective method from the start :math:`n = 1`, :math:`k`
+    from F0 (deterministic), within n in [1e-3, 20], k in [0, 50].
+
+    Parameters
+    ----------
+    nk
+        Measured spectral *n*, *k*.
+    step_nm
+        Spectral step of the reference (nm).
+    min_coverage
+        Smallest covered fraction of 360-830 nm accepted.
+
+    Returns
+    -------
+    tuple
+        ``n`` and ``k``, each shape (3,) for R, G, B.
+
+    Raises
+    ------
+    ValueError
+        For data covering too little of the visible range.
+    """
+    mu = np.linspace(0.0, 1.0, RGB_NK_SAMPLES)
+    target = reference_ACEScg(nk, mu, 1.0, step_nm, min_coverage)
+    n_out, k_out = np.empty(3), np.empty(3)
+    for c in range(3):
+        R = target[:, c]
+        # At normal incidence with n = 1 the reflectance is k^2 / (4 + k^2).
+        F0 = float(np.clip(R[-1], 0.0, 0.999))
+        x0 = np.array([1.0, np.sqrt(4.0 * F0 / (1.0 - F0))])
+        fit = least_squares(
+            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R,
+            np.clip(x0, [_N_BOUNDS[0], _K_BOUNDS[0]], [_N_BOUNDS[1], _K_BOUNDS[1]]),
+            bounds=([_N_BOUNDS[0], _K_BOUNDS[0]], [_N_BOUNDS[1], _K_BOUNDS[1]]),
+            method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+        )
+        n_out[c], k_out[c] = fit.x
+    return n_out, k_out
+
+
+def rgb_fresnel_conductor(cos_theta, eta_i, n_rgb, k_rgb) -> np.ndarray:
+    """
+    Exact Fresnel reflectance per RGB channel.
+
+    Parameters
+    ----------
+    cos_theta
+        :math:`\\mu` in the coating, [0, 1] (clamped).
+    eta_i
+        Real index of the coating, >= 1, broadcast against ``cos_theta``.
+    n_rgb, k_rgb
+        Per-channel index, shape (3,) each (see :func:`rgb_nk`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``broadcast(cos_theta, eta_i).shape + (3,)``, linear ACEScg in [0, 1];
+        never NaN (see :func:`fitting.fresnel.fresnel_conductor`).
+    """
+    n_rgb = np.asarray(n_rgb, dtype=np.float64)
+    k_rgb = np.asarray(k_rgb, dtype=np.float64)
+    if n_rgb.shape != (3,) or k_rgb.shape != (3,):
+        raise ValueError(
+            f"`n_rgb` and `k_rgb` must have shape (3,), got {n_rgb.shape} and {k_rgb.shape}"
+        )
+    if not (np.all(np.isfinite(n_rgb)) and np.all(n_rgb > 0)):
+        raise ValueError(f"`n_rgb` must be finite and > 0, got {n_rgb.tolist()}")
+    if not (np.all(np.isfinite(k_rgb)) and np.all(k_rgb >= 0)):
+        raise ValueError(f"`k_rgb` must be finite and >= 0, got {k_rgb.tolist()}")
+    mu, eta = np.broadcast_arrays(
+        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
+    )
+    return fresnel_conductor(mu[..., None], eta[..., None], n_rgb, k_rgb)
