@@ -108,7 +108,8 @@ def _set(program, name: str, value) -> None:
 def _set_uniforms(program, variant: str, inputs: ShaderInputs) -> None:
     _set(program, "cf_words", [int(w) for w in inputs.words])
     # mat3 fills column by column: the layout order is already column-major.
-    _set(program, "cf_C", [tuple(float(c) for c in m) for m in inputs.coefficients.reshape(3, 9)])
+    for name, m in zip(("cf_C_F0", "cf_C_a", "cf_C_alpha"), inputs.coefficients.reshape(3, 9)):
+        _set(program, name, tuple(float(c) for c in m))
     _set(program, "cf_eta_i_range", tuple(float(v) for v in inputs.eta_i_range))
     if variant == "collapsed":
         F0, a, alpha = (tuple(float(v) for v in row) for row in inputs.collapsed)

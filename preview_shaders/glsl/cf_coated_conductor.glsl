@@ -18,9 +18,10 @@
 float cf_normalised_eta_i(float eta_i, vec2 eta_i_range)
 {
     float width = eta_i_range.y - eta_i_range.x;
-    if (width <= 0.0)
-        return 0.0;
-    return clamp((eta_i - eta_i_range.x) / width, 0.0, 1.0);
+    // A select, not a branch: software rasterisers run both sides of a
+    // branch under masks; the floor keeps the unused quotient finite.
+    float t = clamp((eta_i - eta_i_range.x) / max(width, CF_FLT_MIN), 0.0, 1.0);
+    return width > 0.0 ? t : 0.0;
 }
 
 // Vernooij 2024, Eq. 2 (in t instead of eta_i): F0, a and alpha per channel,

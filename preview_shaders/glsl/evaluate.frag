@@ -13,8 +13,10 @@ uniform vec4 u_grid;
 uniform uint cf_words[14];
 uniform vec2 cf_eta_i_range;
 #elif CF_VARIANT == 1
-// The 27 coefficients as floats: parameter p is cf_C[p], column c channel c.
-uniform mat3 cf_C[3];
+// The 27 coefficients as floats, one mat3 per parameter, column c channel c.
+uniform mat3 cf_C_F0;
+uniform mat3 cf_C_a;
+uniform mat3 cf_C_alpha;
 uniform vec2 cf_eta_i_range;
 #elif CF_VARIANT == 2
 uniform vec3 cf_F0;
@@ -43,7 +45,7 @@ void main()
 #if CF_VARIANT == 0
     vec3 F = cf_coated_conductor_packed(NdotV, eta_i, cf_eta_i_range, cf_words);
 #elif CF_VARIANT == 1
-    vec3 F = cf_coated_conductor(NdotV, eta_i, cf_eta_i_range, cf_C[0], cf_C[1], cf_C[2]);
+    vec3 F = cf_coated_conductor(NdotV, eta_i, cf_eta_i_range, cf_C_F0, cf_C_a, cf_C_alpha);
 #elif CF_VARIANT == 2
     vec3 F = cf_coated_conductor_eq1(NdotV, cf_F0, cf_a, cf_alpha);
 #elif CF_VARIANT == 3
