@@ -1,0 +1,67 @@
+"""
+The paper's Figure 2 cases: Cr, Ta and Co at eta_i 1.5 and 2.5 under the
+white sky. For each, the model and adjusted Lazanyi are compared with the
+spectral reference of the same view (per pixel, fitting.reference): mean
+FLIP and mean Delta E 2000 over the sphere. Writes the split views (model |
+Lazanyi, model | reference) and the FLIP maps to docs/images/.
+
+    .venv/bin/python benchmarks/flip_figure2.py [--size 256]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
+
+from fitting.fit import fit_material  # noqa: E402
+from fitting.library import library_material  # noqa: E402
+from preview_shaders.display import ACEScg_to_sRGB, encode_png, false_colour, to_uint8  # noqa: E402
+from preview_shaders.preview import PreviewRenderer, difference_maps  # noqa: E402
+
+MATERIALS = ("Cr", "Ta", "Co")
+ETA_I = (1.5, 2.5)
+
+
+def _png(path: Path, image_uint8) -> None:
+    path.write_bytes(encode_png(image_uint8))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--size", type=int, default=256)
+    parser.add_argument("--images", type=Path, default=ROOT / "docs" / "images")
+    args = parser.parse_args()
+    args.images.mkdir(parents=True, exist_ok=True)
+    rows = []
+    with PreviewRenderer() as renderer:
+        for name in MATERIALS:
+            nk = library_material(name)
+            packed = fit_material(nk).packed
+            for eta_i in ETA_I:
+                ref = renderer.render_preview(packed, nk, eta_i, args.size, "reference")
+                laz = renderer.render_preview(packed, nk, eta_i, args.size, "lazanyi")
+                _, laz_dE, laz_flip_map, laz_flip = difference_maps(
+                    laz.comparison, ref.comparison, ref.mask
+                )
+                stem = f"shader_fig2_{name}_{eta_i:g}"
+                (args.images / f"{stem}_model_lazanyi.png").write_bytes(laz.png)
+                (args.images / f"{stem}_model_reference.png").write_bytes(ref.png)
+                # FLIP maps side by side: model vs reference | Lazanyi vs reference.
+                both = np.concatenate([ref.flip, laz_flip_map], axis=1)
+                _png(args.images / f"{stem}_flip.png", false_colour(both, 1.0, "magma"))
+                rows.append((name, eta_i, ref.flip_mean, laz_flip, ref.delta_E_mean, laz_dE))
+    print(f"{args.size} x {args.size}, white sky, means over the sphere's pixels\n")
+    print("| material | eta_i | FLIP model | FLIP adj. Lazanyi | dE2000 model | dE2000 adj. Lazanyi |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for name, eta_i, flip_m, flip_l, de_m, de_l in rows:
+        print(f"| {name} | {eta_i:g} | {flip_m:.4f} | {flip_l:.4f} | {de_m:.3f} | {de_l:.3f} |")
+
+
+if __name__ == "__main__":
+    main()
