@@ -9,6 +9,9 @@ preview sphere the service and the editor show.
 -   :mod:`preview_shaders.gl`: the GL context and its render thread.
 -   :mod:`preview_shaders.evaluate`: full-screen evaluation of each shader
     variant (parity tests, cost benchmark).
+-   :mod:`preview_shaders.preview`: :class:`PreviewRenderer`, the preview
+    sphere (service entry point ``render_preview``).
+-   :mod:`preview_shaders.display`: the ACEScg to sRGB display transform.
 
 References
 ----------
@@ -17,6 +20,7 @@ Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
 
 from .evaluate import VARIANTS, ShaderInputs, evaluate_grid, shader_inputs, time_variant
 from .gl import RenderThread, load_shader_source
+from .preview import PreviewRenderer, PreviewResult
 
 __all__ = [
     "VARIANTS",
@@ -26,4 +30,6 @@ __all__ = [
     "time_variant",
     "RenderThread",
     "load_shader_source",
+    "PreviewRenderer",
+    "PreviewResult",
 ]
