@@ -395,7 +395,7 @@ def fit_coefficients(
     weights
         Optional (S,) non-negative sample weights :math:`w_s`.
     irls_rounds
-        For ``de2000``: rounds of reweighting by :math:`1/\Delta E_s` that
+        For ``de2000``: rounds of reweighting by :math:`1/\\Delta E_s` that
         turn the sum of squares into the mean Delta E.
 
     Returns

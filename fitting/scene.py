@@ -498,8 +498,9 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
     for degree in range(spec.max_degree + 1):
         fit = _fit_degree(entry, degree, settings)
         fits[degree] = fit
+        # Scored as shipped: float16 coefficients, the pack's float32 domain.
         by_degree[degree] = _error(
-            ref, coated_conductor_model(M, E, fit.coefficients_float16, spec.domain)
+            ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range)
         )
     general_fit = fit_material(entry.nk, general_domain(spec), settings, degree=2)
     general = PackedMaterial(

