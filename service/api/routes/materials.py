@@ -1,0 +1,91 @@
+"""
+Materials
+=========
+
+``GET /api/v1/materials``: the built-in library and the saved materials
+(fits of uploaded or inline n, k and of edited curves).
+``GET /api/v1/materials/{material_id}``: one material with its latest fit.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Annotated
+
+from fastapi import APIRouter, HTTPException, Path, status
+
+from fitting.library import LIBRARY_NAMES, library_material
+from fitting.nk import visible_coverage
+
+from ...models import (
+    API_PREFIX,
+    MATERIAL_ID_PATTERN,
+    ErrorBody,
+    MaterialDetail,
+    MaterialList,
+    MaterialSummary,
+    fit_public,
+)
+from ..deps import ERROR_RESPONSES, StoreDep
+
+router = APIRouter(prefix=f"{API_PREFIX}/materials", tags=["materials"])
+
+
+@functools.cache
+def _library_entry(name: str) -> tuple[str, float, tuple[float, float]]:
+    nk = library_material(name)
+    return nk.source, visible_coverage(nk.wavelength_range_nm), nk.wavelength_range_nm
+
+
+@router.get("", response_model=MaterialList)
+def list_materials(store: StoreDep) -> MaterialList:
+    """The 22 built-in conductors, then the saved materials, oldest first."""
+    materials = []
+    for name in LIBRARY_NAMES:
+        source, coverage, _ = _library_entry(name)
+        latest = store.latest_fit(name)
+        materials.append(MaterialSummary(
+            id=name, name=name, kind="library", source=source, coverage=coverage,
+            latest_fit_id=latest.id if latest else None,
+        ))
+    for row in store.saved_materials():
+        materials.append(MaterialSummary(
+            id=row.material_id, name=row.name, kind=row.kind, source=row.source,
+            coverage=row.coverage, latest_fit_id=row.latest_fit_id,
+        ))
+    return MaterialList(materials=materials)
+
+
+@router.get(
+    "/{material_id}",
+    response_model=MaterialDetail,
+    responses={**ERROR_RESPONSES, status.HTTP_404_NOT_FOUND: {"model": ErrorBody}},
+)
+def get_material(
+    material_id: Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
+                                     description="A library name or a saved material's id")],
+    store: StoreDep,
+) -> MaterialDetail:
+    """One material with its latest fit (None for a library material not fitted yet)."""
+    latest = store.latest_fit(material_id)
+    if material_id in LIBRARY_NAMES:
+        source, coverage, wavelength_range = _library_entry(material_id)
+        return MaterialDetail(
+            id=material_id, name=material_id, kind="library", source=source,
+            coverage=coverage, latest_fit_id=latest.id if latest else None,
+            wavelength_range_nm=wavelength_range,
+            latest_fit=fit_public(latest) if latest else None,
+        )
+    if latest is None:
+        raise HTTPException(
+            status.HTTP_404_NOT_FOUND,
+            f"`material_id` {material_id!r} is neither a built-in material nor a saved one",
+        )
+    wavelength_range = None
+    if latest.nk is not None:
+        wavelength_range = (latest.nk["wavelength_nm"][0], latest.nk["wavelength_nm"][-1])
+    return MaterialDetail(
+        id=material_id, name=latest.name, kind=latest.kind, source=latest.source,
+        coverage=latest.coverage, latest_fit_id=latest.id,
+        wavelength_range_nm=wavelength_range, latest_fit=fit_public(latest),
+    )

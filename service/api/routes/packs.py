@@ -1,0 +1,37 @@
+"""
+Packs
+=====
+
+``POST /api/v1/packs``: several stored fits in one download (a scene's
+materials together), in any pack format. Reads only; saves nothing.
+"""
+
+from fastapi import APIRouter, HTTPException, Response, status
+
+from ...models import API_PREFIX, ErrorBody, PackRequest
+from ..deps import ERROR_RESPONSES, StoreDep
+from .fits import PACK_CONTENT, pack_response
+
+router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
+
+
+@router.post(
+    "",
+    response_class=Response,
+    responses={
+        status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
+        status.HTTP_404_NOT_FOUND: {"model": ErrorBody, "description": "An id is not stored"},
+        **ERROR_RESPONSES,
+    },
+)
+def create_pack(request: PackRequest, store: StoreDep) -> Response:
+    """The fits named by ``fit_ids``, in that order, as one pack."""
+    records = []
+    for index, fit_id in enumerate(request.fit_ids):
+        record = store.get_fit(fit_id)
+        if record is None:
+            raise HTTPException(
+                status.HTTP_404_NOT_FOUND, f"`fit_ids[{index}]` {fit_id} is not a stored fit"
+            )
+        records.append(record)
+    return pack_response(records, request.format, request.name)

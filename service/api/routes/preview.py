@@ -1,0 +1,84 @@
+"""
+Preview
+=======
+
+``GET /api/v1/preview.png?fit=ID&eta_i=1.5&size=512&compare=none``: the
+preview sphere of a stored fit (``preview_shaders.preview``), optionally
+split with adjusted Lazanyi or the spectral reference (these need the
+fit's n, k). One renderer per app, made on first use; it owns its GL
+thread, so concurrent requests are serialised there.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Annotated, Literal
+
+from fastapi import APIRouter, HTTPException, Query, Request, Response, status
+
+from fitting.pack import material_from_json
+
+from ...models import API_PREFIX, FIT_ID_PATTERN, ErrorBody
+from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep
+from .fits import _nk_of, stored_fit
+
+router = APIRouter(prefix=API_PREFIX, tags=["preview"])
+_lock = threading.Lock()
+
+
+def renderer(request: Request):
+    """The app's preview renderer, made on first use."""
+    state = request.app.state
+    with _lock:
+        if state.preview_renderer is None:
+            from preview_shaders.preview import PreviewRenderer
+
+            state.preview_renderer = PreviewRenderer()
+        return state.preview_renderer
+
+
+@router.get(
+    "/preview.png",
+    response_class=Response,
+    responses={
+        status.HTTP_200_OK: {"content": {"image/png": {"schema": {"type": "string", "format": "binary"}}}},
+        status.HTTP_404_NOT_FOUND: {"model": ErrorBody},
+        status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody},
+        **ERROR_RESPONSES,
+    },
+)
+def preview_png(
+    request: Request, store: StoreDep, settings: SettingsDep,
+    fit: Annotated[str, Query(pattern=FIT_ID_PATTERN, description="A stored fit's id")],
+    eta_i: Annotated[float, Query(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.5,
+    size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
+    compare: Annotated[Literal["none", "lazanyi", "reference"], Query()] = "none",
+    environment: Annotated[Literal["white_sky", "studio"], Query()] = "white_sky",
+) -> Response:
+    """The preview sphere as an 8-bit sRGB PNG."""
+    if size > settings.max_preview_size:
+        raise HTTPException(
+            status.HTTP_422_UNPROCESSABLE_CONTENT,
+            f"`size` must be at most {settings.max_preview_size} (COATED_MAX_PREVIEW_SIZE), got {size}",
+        )
+    record = stored_fit(store, fit)
+    nk = _nk_of(record)
+    if compare != "none" and nk is None:
+        raise HTTPException(
+            status.HTTP_422_UNPROCESSABLE_CONTENT,
+            f"`compare`={compare!r} needs measured n, k; fit {fit} was made from curves",
+        )
+    try:
+        active = renderer(request)
+    except Exception as error:  # no GL driver: the rest of the service still works
+        raise HTTPException(
+            status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
+        ) from None
+    try:
+        result = active.render_preview(
+            material_from_json(record.material), nk, eta_i=eta_i, size=size,
+            compare=compare, environment=environment,
+        )
+    except ValueError as error:
+        raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
+    return Response(result.png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})

@@ -1,0 +1,303 @@
+"""
+Request and response models
+===========================
+
+Pydantic v2 models of the HTTP API. Constraints live on the fields so that
+bad input is refused by the schema and shows in the OpenAPI document.
+
+-   Requests: :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`.
+-   Responses: :class:`FitPublic` (with :class:`Coefficients`,
+    :class:`FitMetrics`, :class:`FitLinks`), :class:`MaterialSummary`,
+    :class:`MaterialList`, :class:`MaterialDetail`, :class:`CurvesPublic`,
+    :class:`Health`, :class:`ErrorBody`.
+-   :func:`fit_public`: a stored :class:`service.store.FitRecord` as
+    :class:`FitPublic`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from fitting.fit import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.library import LIBRARY_NAMES
+
+from .store import FIT_KINDS, FitRecord
+
+__all__ = [
+    "API_PREFIX",
+    "MAX_NK_SAMPLES",
+    "FIT_ID_PATTERN",
+    "MATERIAL_ID_PATTERN",
+    "PACK_FORMATS",
+    "FitId",
+    "LibraryName",
+    "Objective",
+    "PackFormat",
+    "NKData",
+    "FitRequest",
+    "PackRequest",
+    "Coefficients",
+    "DeltaE",
+    "FitMetrics",
+    "FitLinks",
+    "FitPublic",
+    "MaterialSummary",
+    "MaterialList",
+    "MaterialDetail",
+    "CurvesPublic",
+    "Health",
+    "ErrorItem",
+    "ErrorBody",
+    "fit_public",
+]
+
+API_PREFIX = "/api/v1"
+MAX_NK_SAMPLES = 20_000
+"""Most wavelength samples accepted in one n, k table."""
+FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
+MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
+PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
+
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, description="nm")]
+IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
+IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
+EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)]
+FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
+LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
+Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
+PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
+Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
+
+
+class NKData(BaseModel):
+    """Measured optical constants: wavelength in nm (strictly increasing), n > 0, k >= 0."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    wavelength_nm: list[Wavelength] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
+    n: list[IndexN] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
+    k: list[IndexK] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
+
+    @model_validator(mode="after")
+    def _check_table(self) -> "NKData":
+        size = len(self.wavelength_nm)
+        for label in ("n", "k"):
+            if len(getattr(self, label)) != size:
+                raise ValueError(
+                    f"`{label}` must have one value per wavelength ({size}), "
+                    f"got {len(getattr(self, label))}"
+                )
+        for i in range(1, size):
+            if self.wavelength_nm[i] <= self.wavelength_nm[i - 1]:
+                rule = "duplicate" if self.wavelength_nm[i] == self.wavelength_nm[i - 1] else "unsorted"
+                raise ValueError(
+                    f"`wavelength_nm` must be strictly increasing ({rule}): "
+                    f"{self.wavelength_nm[i]:g} after {self.wavelength_nm[i - 1]:g} at index {i}"
+                )
+        return self
+
+
+class FitRequest(BaseModel):
+    """
+    A fit: either ``material`` (a built-in conductor) or ``nk`` (measured
+    data, with a ``name``), over the coating-index domain ``eta_i_range``.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [
+                {"material": "Au"},
+                {"material": "Cu", "eta_i_range": [1.2, 1.8], "objective": "de2000"},
+                {
+                    "name": "my gold",
+                    "nk": {"wavelength_nm": [350, 600, 850], "n": [1.6, 0.25, 0.2],
+                           "k": [1.9, 3.0, 5.4]},
+                },
+            ]
+        },
+    )
+
+    material: LibraryName | None = Field(None, description="A built-in conductor")
+    name: Text | None = Field(None, description="Display name of inline data")
+    source: str = Field("", max_length=2000, description="Citation of inline data")
+    nk: NKData | None = None
+    eta_i_range: tuple[EtaI, EtaI] = Field(
+        (1.0, 2.5), description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
+    )
+    objective: Objective = DEFAULT_OBJECTIVE
+
+    @model_validator(mode="after")
+    def _check_choice(self) -> "FitRequest":
+        if (self.material is None) == (self.nk is None):
+            raise ValueError(
+                "give exactly one of `material` (a built-in conductor) or `nk` (inline data)"
+            )
+        if self.material is not None and self.name is not None:
+            raise ValueError("`name` is only for inline `nk` data (a built-in material has its own)")
+        lo, hi = self.eta_i_range
+        if lo > hi:
+            raise ValueError(f"`eta_i_range` must not be empty: lo {lo:g} > hi {hi:g}")
+        return self
+
+
+class PackRequest(BaseModel):
+    """Several stored fits in one pack (a scene's materials)."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    fit_ids: list[FitId] = Field(min_length=1, max_length=256)
+    format: PackFormat = "binary"
+    name: Annotated[str, Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9._-]+$")] = "materials"
+
+
+class Coefficients(BaseModel):
+    """Float16 coefficients, three rows (R, G, B) of powers (1, t, t^2) each."""
+
+    F0: list[list[float]]
+    a: list[list[float]]
+    alpha: list[list[float]]
+
+
+class DeltaE(BaseModel):
+    """CIE Delta E 2000 against the reference on the scoring grid."""
+
+    model_config = ConfigDict(extra="allow")
+
+    delta_E_mean: float
+    delta_E_max: float
+
+
+class FitMetrics(BaseModel):
+    """Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
+
+    grid: str | None = None
+    model: DeltaE | None = None
+    lazanyi_adjusted: DeltaE | None = None
+    details: dict[str, Any] = Field(default_factory=dict)
+
+
+class FitLinks(BaseModel):
+    self: str
+    pack_binary: str
+    pack_json: str
+    pack_glsl: str
+    pack_hlsl: str
+    curves: str
+
+
+class FitPublic(BaseModel):
+    """A stored fit."""
+
+    id: str
+    kind: Literal[FIT_KINDS]  # type: ignore[valid-type]
+    material_id: str
+    name: str
+    source: str
+    library_material: str | None = None
+    base_fit_id: str | None = None
+    eta_i_range: tuple[float, float]
+    objective: str
+    degree: int
+    colour_space: Literal["ACEScg"] = "ACEScg"
+    coefficients: Coefficients
+    metrics: FitMetrics
+    timings: dict[str, float]
+    convergence: dict[str, Any]
+    coverage: float | None = None
+    has_nk: bool
+    created_at: float
+    links: FitLinks
+
+
+class MaterialSummary(BaseModel):
+    id: str
+    name: str
+    kind: Literal[FIT_KINDS]  # type: ignore[valid-type]
+    source: str
+    coverage: float | None = None
+    latest_fit_id: str | None = None
+
+
+class MaterialList(BaseModel):
+    materials: list[MaterialSummary]
+
+
+class MaterialDetail(MaterialSummary):
+    wavelength_range_nm: tuple[float, float] | None = None
+    latest_fit: FitPublic | None = None
+
+
+class CurvesPublic(BaseModel):
+    """RGB curves against the angle, linear ACEScg; None where there is no n, k."""
+
+    fit_id: str
+    eta_i: float
+    colour_space: Literal["ACEScg"] = "ACEScg"
+    theta_deg: list[float]
+    cos_theta: list[float]
+    model: list[list[float]]
+    reference: list[list[float]] | None = None
+    lazanyi_adjusted: list[list[float]] | None = None
+
+
+class Health(BaseModel):
+    status: Literal["ok"]
+    fits_in_flight: int
+    fit_workers: int
+    max_in_flight: int
+
+
+class ErrorItem(BaseModel):
+    loc: list[str | int]
+    msg: str
+    type: str
+
+
+class ErrorBody(BaseModel):
+    """Every 4xx and 5xx answer: what broke which rule."""
+
+    detail: str
+    errors: list[ErrorItem] = Field(default_factory=list)
+
+
+def fit_public(record: FitRecord) -> FitPublic:
+    """The public view of a stored fit."""
+    view = record.material
+    base = f"{API_PREFIX}/fits/{record.id}"
+    metrics = record.metrics
+    return FitPublic(
+        id=record.id,
+        kind=record.kind,
+        material_id=record.material_id,
+        name=record.name,
+        source=record.source,
+        library_material=record.library_material,
+        base_fit_id=record.base_fit_id,
+        eta_i_range=tuple(view["eta_i_range"]),
+        objective=record.objective,
+        degree=view["degree"],
+        coefficients=Coefficients(**view["coefficients"]),
+        metrics=FitMetrics(
+            grid=metrics.get("grid"),
+            model=metrics.get("model_float16"),
+            lazanyi_adjusted=metrics.get("lazanyi_adjusted"),
+            details=metrics,
+        ),
+        timings=record.timings,
+        convergence=record.convergence,
+        coverage=record.coverage,
+        has_nk=record.nk is not None or record.library_material is not None,
+        created_at=record.created_at,
+        links=FitLinks(
+            self=base,
+            pack_binary=f"{base}/pack?format=binary",
+            pack_json=f"{base}/pack?format=json",
+            pack_glsl=f"{base}/pack?format=glsl",
+            pack_hlsl=f"{base}/pack?format=hlsl",
+            curves=f"{base}/curves?eta_i=1.5&samples=91",
+        ),
+    )
