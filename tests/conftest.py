@@ -1,0 +1,128 @@
+"""
+Shared fixtures of the test suite.
+
+-   ``client``: a ``fastapi.testclient.TestClient`` over
+    ``service.main.create_app`` with a fresh data directory (``tmp_path``),
+    the lifespan run (store open, fitting pool made on the first fit), one
+    fit worker, metrics on a 30 x 30 grid (fast; the service default is the
+    paper's 100 x 100). Use it as ``client.post("/api/v1/fits", json=...)``.
+-   ``live_server``: a real ``python -m service --port <free port>`` process
+    on 127.0.0.1 with a fresh data directory; waits for ``/healthz`` and
+    yields the base URL (``"http://127.0.0.1:<port>"``); terminates the
+    process afterwards. Mark tests that use it ``@pytest.mark.server``.
+-   :func:`server_process`: the context manager behind ``live_server``, for
+    tests that need their own data directory, environment or a restart
+    (``with server_process(data_dir, COATED_FIT_QUEUE="0") as server: ...``;
+    ``server.url``, ``server.process``, ``server.kill()``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Iterator
+
+import httpx
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+SERVER_START_TIMEOUT_S = 120.0
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that was free a moment ago."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+class ServerProcess:
+    """A running ``python -m service``: its URL, process and data directory."""
+
+    def __init__(self, data_dir: Path, env: dict[str, str], log: Path) -> None:
+        self.data_dir = data_dir
+        self.port = free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        self.log = log
+        self._log_file = open(log, "ab")
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "service", "--host", "127.0.0.1", "--port", str(self.port),
+             "--data-dir", str(data_dir)],
+            cwd=ROOT, env={**os.environ, **env}, stdout=self._log_file, stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
+
+    def wait_ready(self, timeout_s: float = SERVER_START_TIMEOUT_S) -> None:
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            if self.process.poll() is not None:
+                raise RuntimeError(f"the server exited with {self.process.returncode}:\n{self.log_text()}")
+            try:
+                if httpx.get(f"{self.url}/healthz", timeout=2.0).status_code == 200:
+                    return
+            except httpx.TransportError:
+                pass
+            time.sleep(0.2)
+        raise RuntimeError(f"the server did not answer /healthz in {timeout_s} s:\n{self.log_text()}")
+
+    def log_text(self) -> str:
+        self._log_file.flush()
+        return self.log.read_text(errors="replace")[-4000:]
+
+    def kill(self) -> None:
+        """SIGKILL the server and its worker processes (its own session)."""
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(self.process.pid, signal.SIGKILL)
+        self.process.wait(timeout=30)
+
+    def stop(self) -> None:
+        """SIGTERM (graceful shutdown), SIGKILL after 30 s."""
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                self.kill()
+        # Worker processes left behind by a kill share the session; end them too.
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(self.process.pid, signal.SIGKILL)
+        self._log_file.close()
+
+
+@contextlib.contextmanager
+def server_process(data_dir: Path, **env: str) -> Iterator[ServerProcess]:
+    """Start ``python -m service`` on a free loopback port; stop it on exit."""
+    env = {"COATED_FIT_WORKERS": "1", "COATED_METRICS_SAMPLES": "30", **env}
+    server = ServerProcess(Path(data_dir), env, Path(data_dir).with_suffix(".log"))
+    try:
+        server.wait_ready()
+        yield server
+    finally:
+        server.stop()
+
+
+@pytest.fixture
+def client(tmp_path):
+    from fastapi.testclient import TestClient
+
+    from service.config import Settings
+    from service.main import create_app
+
+    settings = Settings(
+        data_dir=tmp_path / "data", fit_workers=1, warm_pool=False, metrics_samples=30,
+    )
+    with TestClient(create_app(settings)) as test_client:
+        yield test_client
+
+
+@pytest.fixture
+def live_server(tmp_path) -> Iterator[str]:
+    with server_process(tmp_path / "data") as server:
+        yield server.url
