@@ -74,7 +74,8 @@ def _cmd_fit(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .fit import OBJECTIVES, DEFAULT_OBJECTIVE
+    from .fit import DEFAULT_OBJECTIVE, OBJECTIVES
+    from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
         prog="python -m fitting",
@@ -102,12 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--materials", help="comma-separated subset (default: all 22)")
     p.set_defaults(func=lambda args: __import__("fitting.reproduce", fromlist=["run"]).run(args))
 
-    try:
-        from .scene import add_scene_parser
-    except ImportError:  # the scene module is optional while it is being written
-        add_scene_parser = None
-    if add_scene_parser is not None:
-        add_scene_parser(sub)
+    add_scene_parser(sub)
     return parser
 
 

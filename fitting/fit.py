@@ -62,6 +62,7 @@ __all__ = [
     "quantise_coefficients",
     "evaluate_material",
     "fit_grid",
+    "GRIDS",
 ]
 
 OBJECTIVES = ("rgb", "lab", "de2000")
@@ -83,10 +84,11 @@ class FitSettings:
 
     Attributes
     ----------
-    mu_samples, eta_samples
-        Size of the fitting grid: ``mu_samples`` values of cos theta evenly
-        over [0, 1] times ``eta_samples`` values of eta_i evenly over the
-        domain (1 when the domain is a single value).
+    mu_samples, eta_samples, grid
+        The fitting grid (:func:`fit_grid`): ``mu_samples`` values of cos
+        theta over [0, 1] times ``eta_samples`` values of eta_i over the
+        domain (1 when the domain is a single value), at Gauss-Legendre nodes
+        with quadrature weights (``"gauss"``) or evenly (``"uniform"``).
     step_nm
         Spectral step of the reference used for fitting (nm).
     objective
@@ -105,8 +107,9 @@ class FitSettings:
         Reweighting rounds of the ``de2000`` objective (mean Delta E).
     """
 
-    mu_samples: int = 24
-    eta_samples: int = 7
+    mu_samples: int = 16
+    eta_samples: int = 6
+    grid: str = "gauss"
     step_nm: float = 5.0
     objective: str = DEFAULT_OBJECTIVE
     degree: int = 2
@@ -120,6 +123,8 @@ class FitSettings:
             raise ValueError(f"`mu_samples` must be an integer in [4, 1000], got {self.mu_samples!r}")
         if not (isinstance(self.eta_samples, int) and 1 <= self.eta_samples <= 1000):
             raise ValueError(f"`eta_samples` must be an integer in [1, 1000], got {self.eta_samples!r}")
+        if self.grid not in GRIDS:
+            raise ValueError(f"`grid` must be one of {', '.join(GRIDS)}, got {self.grid!r}")
         if self.objective not in OBJECTIVES:
             raise ValueError(f"`objective` must be one of {', '.join(OBJECTIVES)}, got {self.objective!r}")
         if self.degree not in (0, 1, 2):
@@ -204,15 +209,46 @@ class FitResult:
         }
 
 
+GRIDS = ("gauss", "uniform")
+
+
 def fit_grid(
-    eta_i_range: tuple[float, float], mu_samples: int = 24, eta_samples: int = 7
-) -> tuple[np.ndarray, np.ndarray]:
-    """Flattened fitting grid (cos_theta, eta_i) over [0, 1] x eta_i_range."""
+    eta_i_range: tuple[float, float],
+    mu_samples: int = 16,
+    eta_samples: int = 6,
+    kind: str = "gauss",
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    Flattened fitting grid over [0, 1] x ``eta_i_range`` with sample weights.
+
+    The error the fit is judged by is the mean over a fine uniform grid, an
+    approximation of the integral over (cos theta, eta_i). ``"gauss"`` places
+    the samples at Gauss-Legendre nodes with their quadrature weights, which
+    integrate smooth functions exactly to degree 2n - 1, so a small grid
+    stands for the fine one; ``"uniform"`` spaces them evenly with equal
+    weights. A single eta_i (lo = hi) gives one row.
+
+    Returns
+    -------
+    tuple
+        ``cos_theta``, ``eta_i`` and ``weights`` (mean 1), each flattened
+        (samples indexed [eta_i, cos_theta]).
+    """
+    if kind not in GRIDS:
+        raise ValueError(f"`kind` must be one of {', '.join(GRIDS)}, got {kind!r}")
     lo, hi = eta_i_range
-    mu = np.linspace(0.0, 1.0, mu_samples)
-    eta = np.array([lo]) if hi <= lo else np.linspace(lo, hi, eta_samples)
+
+    def axis(n, a, b):
+        if kind == "uniform":
+            return np.linspace(a, b, n), np.ones(n)
+        x, w = np.polynomial.legendre.leggauss(n)
+        return a + 0.5 * (x + 1.0) * (b - a), w
+
+    mu, w_mu = axis(mu_samples, 0.0, 1.0)
+    eta, w_eta = (np.array([lo]), np.ones(1)) if hi <= lo else axis(eta_samples, lo, hi)
     E, M = np.meshgrid(eta, mu, indexing="ij")
-    return M.ravel(), E.ravel()
+    W = np.outer(w_eta, w_mu)
+    return M.ravel(), E.ravel(), (W / W.mean()).ravel()
 
 
 def _de2000_weights(Lab_ref: np.ndarray) -> np.ndarray:
@@ -579,12 +615,15 @@ def fit_material(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    mu, eta = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples)
+    mu, eta, weights = fit_grid(
+        eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid
+    )
     target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
     t_ref = time.perf_counter()
     result = fit_coefficients(
         target, mu, eta, eta_i_range, settings.degree, settings.objective,
-        settings.max_nfev, settings.quantise, irls_rounds=settings.irls_rounds,
+        settings.max_nfev, settings.quantise, weights=weights,
+        irls_rounds=settings.irls_rounds,
     )
     result.coverage = coverage
     result.timings["reference"] = t_ref - t0

@@ -122,10 +122,31 @@ class TestBaselines:
         np.testing.assert_allclose(out, reference_ACEScg(nk, 1.0, np.array([1.0, 2.0])), atol=1e-12)
 
 
+class TestFitGrid:
+    def test_gauss_weights_integrate_polynomials(self):
+        mu, eta, w = fit_grid((1.0, 2.5), 4, 3)
+        # Mean of w f over the grid = the mean of f over the domain, exactly
+        # for degree <= 2n - 1 per axis.
+        f = mu**7 * (eta - 1.0) ** 5
+        exact = (1.0 / 8.0) * (1.5**6 / 6.0) / 1.5
+        assert np.mean(w * f) == pytest.approx(exact, rel=1e-12)
+
+    def test_uniform_and_single_eta(self):
+        mu, eta, w = fit_grid((1.0, 2.5), 5, 3, "uniform")
+        np.testing.assert_array_equal(w, 1.0)
+        assert mu[:5].tolist() == [0.0, 0.25, 0.5, 0.75, 1.0]
+        mu, eta, w = fit_grid((1.7, 1.7), 8, 6)
+        assert mu.size == 8 and np.all(eta == 1.7)
+        with pytest.raises(ValueError, match="`kind` must be one of"):
+            fit_grid((1.0, 2.5), kind="random")
+        with pytest.raises(ValueError, match="`grid` must be one of"):
+            FitSettings(grid="random")
+
+
 class TestFitCoefficients:
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
     def test_recovers_known_coefficients(self, objective):
-        mu, eta = fit_grid((1.0, 2.5), 32, 9)
+        mu, eta, _ = fit_grid((1.0, 2.5), 32, 9, "uniform")
         target = coated_conductor_model(mu, eta, KNOWN)
         result = fit_coefficients(target, mu, eta, (1.0, 2.5), objective=objective)
         assert result.success
@@ -139,7 +160,7 @@ class TestFitCoefficients:
         assert a.coefficients_float16.tobytes() == b.coefficients_float16.tobytes()
 
     def test_non_convergence_is_reported(self):
-        mu, eta = fit_grid((1.0, 2.5))
+        mu, eta, _ = fit_grid((1.0, 2.5))
         target = reference_ACEScg(library_material("Au"), mu, eta, 5.0)
         result = fit_coefficients(target, mu, eta, max_nfev=1, objective="rgb")
         assert not result.success and result.status == 0
@@ -147,7 +168,7 @@ class TestFitCoefficients:
         assert np.all(np.isfinite(result.coefficients_float16.astype(float)))
 
     def test_validation(self):
-        mu, eta = fit_grid((1.0, 2.5))
+        mu, eta, _ = fit_grid((1.0, 2.5))
         target = np.full((mu.size, 3), 0.5)
         with pytest.raises(ValueError, match="`objective` must be one of"):
             fit_coefficients(target, mu, eta, objective="l1")
@@ -176,7 +197,7 @@ class TestQuantisation:
     def test_float16_never_worse_than_rounding(self):
         nk = library_material("Nb")
         result = fit_material(nk)
-        mu, eta = fit_grid((1.0, 2.5))
+        mu, eta, _ = fit_grid((1.0, 2.5))
         target = reference_ACEScg(nk, mu, eta, 5.0)
         # The final IRLS problem is internal; compare on the plain de2000 problem.
         problem = _Problem(target, mu, eta, (1.0, 2.5), 2, "lab")
