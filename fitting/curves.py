@@ -397,7 +397,7 @@ def blend_weights(eta_i, edit_eta_i, width: float) -> np.ndarray:
     W[..., 0] = np.where(below, _smoothstep(1.0 - (e[0] - eta) / width), 0.0)
     W[..., -1] = np.where(above, _smoothstep(1.0 - (eta - e[-1]) / width), W[..., -1])
     for k in range(e.size - 1):
-        inside = (eta > e[k]) & (eta < e[k + 1])
+        inside = (eta >= e[k]) & (eta < e[k + 1])
         s = _smoothstep((eta - e[k]) / (e[k + 1] - e[k]))
         W[..., k] = np.where(inside, 1.0 - s, W[..., k])
         W[..., k + 1] = np.where(inside, s, W[..., k + 1])
@@ -407,7 +407,7 @@ def blend_weights(eta_i, edit_eta_i, width: float) -> np.ndarray:
 
 
 def edited_target(
-    base: CurveBase, curves: Sequence[RGBCurve], cos_theta, eta_i, blend_width: float = 0.5
+    base: CurveBase, curves: Sequence[RGBCurve], cos_theta, eta_i, blend_width: float = 1.0
 ) -> np.ndarray:
     """
     The base with the edits blended in, at (cos theta, eta_i), (..., 3),
@@ -452,15 +452,20 @@ class CurveFitSettings:
     blend_width
         Distance in eta_i over which an edit fades beyond the outermost
         edited indices (:func:`blend_weights`).
+    edit_weight
+        Least-squares weight of each sample of an edited row relative to a
+        sample of a base row (with a base): the edited curves are what the
+        artist looks at.
     """
 
     mu_samples: int = 12
     eta_samples: int = 5
     objective: str = "de2000"
     irls_rounds: int = 0
-    max_nfev: int = 100
+    max_nfev: int = 15
     quantise: bool = True
-    blend_width: float = 0.5
+    blend_width: float = 1.0
+    edit_weight: float = 3.0
 
     def __post_init__(self) -> None:
         if not (isinstance(self.mu_samples, int) and 4 <= self.mu_samples <= 256):
@@ -476,6 +481,9 @@ class CurveFitSettings:
         width = self.blend_width
         if not (isinstance(width, (int, float)) and np.isfinite(width) and width > 0):
             raise ValueError(f"`blend_width` must be a finite number > 0, got {width!r}")
+        weight = self.edit_weight
+        if not (isinstance(weight, (int, float)) and np.isfinite(weight) and 1 <= weight <= 1000):
+            raise ValueError(f"`edit_weight` must be a number in [1, 1000], got {weight!r}")
 
 
 def _delta_E(reference: np.ndarray, model: np.ndarray) -> np.ndarray:
@@ -567,6 +575,8 @@ def fit_curves(
         E, M = np.meshgrid(rows, mu_row, indexing="ij")
         mu, eta = M.ravel(), E.ravel()
         target = edited_target(base, curves, mu, eta, settings.blend_width)
+        is_edit = np.any(np.abs(eta[:, None] - edited[None, :]) <= 1e-6, axis=1)
+        weights = np.where(is_edit, settings.edit_weight, 1.0)
         degree = 2
         source = f"{base.name} with RGB curves edited at eta_i {_describe(curves)}"
         if base.source:
@@ -576,11 +586,12 @@ def fit_curves(
         eta = np.repeat([c.eta_i for c in curves], settings.mu_samples)
         target = np.concatenate([c.sampled(np.linspace(c.cos_theta[0], c.cos_theta[-1], settings.mu_samples)) for c in curves])
         degree = min(2, len(curves) - 1)
+        weights = None
         source = f"RGB curves at eta_i {_describe(curves)}"
     t_target = time.perf_counter()
     result = fit_coefficients(
         target, mu, eta, eta_i_range, degree, settings.objective, settings.max_nfev,
-        settings.quantise, irls_rounds=settings.irls_rounds,
+        settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
     )
     C16 = result.coefficients_float16
     dE_curves = [
