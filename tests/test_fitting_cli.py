@@ -44,7 +44,14 @@ def test_fit_user_file(tmp_path):
     assert view["name"] == "metal" and view["source"] == "user CSV"
 
 
+def test_fit_any_database_page():
+    view = json.loads(run("fit", "--page", "main/Ni/Johnson", "--no-metrics").stdout)
+    assert view["name"] == "Ni (Johnson)" and "main/Ni/Johnson" in view["source"]
+
+
 def test_errors_are_clear():
+    result = run("fit", "--page", "main/Ni", check=False)
+    assert result.returncode == 2 and "SHELF/BOOK/PAGE" in result.stderr
     result = run("fit", "Unobtainium", check=False)
     assert result.returncode == 2 and "`material` must be one of" in result.stderr
     result = run("fit", "Au", "--eta-range", "2:1", check=False)
