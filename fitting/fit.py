@@ -38,9 +38,8 @@ import numpy as np
 from scipy.optimize import least_squares
 from threadpoolctl import ThreadpoolController
 
-from .baselines import baseline_inputs, lazanyi_adjusted, schlick
 from .colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_jacobian
-from .metrics import error_metrics
+from .metrics import baseline_metrics, error_metrics
 from .model import (
     DEFAULT_ETA_I_RANGE,
     check_eta_i_range,
@@ -666,16 +665,7 @@ def evaluate_material(
         "coverage": result.coverage,
     }
     if baselines:
-        inputs = baseline_inputs(nk, 1.0, min_coverage)
-        exact_F0 = reference_ACEScg(nk, np.ones_like(E[:, :1]), E[:, :1], 1.0, min_coverage)
-        out["lazanyi_adjusted"] = error_metrics(
-            ref, lazanyi_adjusted(M, E, inputs["F0_air"], inputs["F82_air"]), rows
-        )
-        out["lazanyi_exact_F0"] = error_metrics(
-            ref, lazanyi_adjusted(M, E, inputs["F0_air"], inputs["F82_air"], exact_F0), rows
-        )
-        out["schlick_air"] = error_metrics(ref, schlick(M, inputs["F0_air"]), rows)
-        out["schlick_exact_F0"] = error_metrics(ref, schlick(M, exact_F0), rows)
+        out.update(baseline_metrics(nk, M, E, ref, min_coverage))
     return out
 
 

@@ -5,6 +5,8 @@ Error metrics
 -   :func:`error_metrics`: mean and max CIE Delta E 2000 and RMSE between a
     reference and an approximation on the scoring grid, with the breakdown per
     eta_i row.
+-   :func:`baseline_metrics`: the same for every baseline of
+    :mod:`fitting.baselines`.
 
 Lab uses the ACES white as reference white (:func:`fitting.colorimetry.ACEScg_to_Lab`).
 
@@ -18,9 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .baselines import BASELINES, baseline_ACEScg
 from .colorimetry import ACEScg_to_Lab, delta_E_2000
 
-__all__ = ["BREAKDOWN_ETA_I", "delta_E_map", "error_metrics"]
+__all__ = ["BREAKDOWN_ETA_I", "delta_E_map", "error_metrics", "baseline_metrics"]
 
 BREAKDOWN_ETA_I = (1.0, 1.5, 2.0, 2.5)
 
@@ -63,3 +66,18 @@ def error_metrics(reference_RGB, model_RGB, eta_i_rows=None) -> dict:
                 }
         out["by_eta_i"] = by
     return out
+
+
+def baseline_metrics(nk, cos_theta, eta_i, reference_RGB, min_coverage: float = 0.9) -> dict:
+    """
+    :func:`error_metrics` of every baseline (:data:`fitting.baselines.BASELINES`)
+    of ``nk`` against ``reference_RGB`` on the grid (cos_theta, eta_i), both
+    (E, M) indexed [eta_i, cos_theta]; keyed by baseline name.
+    """
+    rows = np.asarray(eta_i)[:, 0]
+    return {
+        name: error_metrics(
+            reference_RGB, baseline_ACEScg(name, nk, cos_theta, eta_i, 1.0, min_coverage), rows
+        )
+        for name in BASELINES
+    }

@@ -21,10 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .baselines import baseline_inputs, lazanyi_adjusted, schlick
 from .fit import DEFAULT_OBJECTIVE, fit_material
 from .library import LIBRARY, LIBRARY_NAMES, library_material
-from .metrics import BREAKDOWN_ETA_I, error_metrics
+from .metrics import BREAKDOWN_ETA_I, baseline_metrics, error_metrics
 from .model import coated_conductor_model
 from .reference import evaluation_grid, reference_ACEScg
 
@@ -63,20 +62,12 @@ def reproduce_material(name: str, samples: int = 100) -> dict:
             rows,
         )
         out[f"fit_ms_{objective}"] = 1e3 * fit.timings["total"]
-    inputs = baseline_inputs(nk)
-    exact_F0 = reference_ACEScg(nk, np.ones_like(E[:, :1]), E[:, :1])
-    out["lazanyi_adjusted"] = error_metrics(
-        ref, lazanyi_adjusted(M, E, inputs["F0_air"], inputs["F82_air"]), rows
-    )
-    out["lazanyi_exact_F0"] = error_metrics(
-        ref, lazanyi_adjusted(M, E, inputs["F0_air"], inputs["F82_air"], exact_F0), rows
-    )
-    out["schlick_air"] = error_metrics(ref, schlick(M, inputs["F0_air"]), rows)
-    out["schlick_exact_F0"] = error_metrics(ref, schlick(M, exact_F0), rows)
+    out.update(baseline_metrics(nk, M, E, ref))
     out["coverage"] = fits[DEFAULT_OBJECTIVE].coverage
     return out
 
 
+# Table columns, in the order of the header.
 BASELINE_KEYS = ("lazanyi_adjusted", "lazanyi_exact_F0", "schlick_air", "schlick_exact_F0")
 
 
