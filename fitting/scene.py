@@ -65,7 +65,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .fit import FitResult, FitSettings, fit_coefficients, fit_material
+from .fit import FitResult, FitSettings, fit_coefficients, fit_grid, fit_material
 from .library import LIBRARY_NAMES, library_material
 from .metrics import delta_E_map
 from .model import DEFAULT_ETA_I_RANGE, coated_conductor_model
@@ -436,14 +436,14 @@ def _fit_degree(entry: SceneMaterial, degree: int, settings: FitSettings) -> Fit
     spec = entry.eta_i
     if spec.kind != "set":
         return fit_material(entry.nk, spec.domain, settings, degree=degree)
-    # A set: the fitting grid holds exactly the scene's values.
+    # A set: the fitting grid's rows are exactly the scene's values.
     t0 = time.perf_counter()
-    mu = np.linspace(0.0, 1.0, settings.mu_samples)
-    E, M = np.meshgrid(np.array(spec.values), mu, indexing="ij")
-    target = reference_ACEScg(entry.nk, M.ravel(), E.ravel(), settings.step_nm, settings.min_coverage)
+    rows = [fit_grid((v, v), settings.mu_samples, 1, settings.grid) for v in spec.values]
+    mu, eta, weights = (np.concatenate(parts) for parts in zip(*rows))
+    target = reference_ACEScg(entry.nk, mu, eta, settings.step_nm, settings.min_coverage)
     result = fit_coefficients(
-        target, M.ravel(), E.ravel(), spec.domain, degree, settings.objective,
-        settings.max_nfev, settings.quantise, irls_rounds=settings.irls_rounds,
+        target, mu, eta, spec.domain, degree, settings.objective,
+        settings.max_nfev, settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
     )
     result.packed = PackedMaterial(
         entry.name, result.coefficients_float16, spec.domain, source=entry.nk.source
