@@ -1,0 +1,58 @@
+// Calls to the service's HTTP API (same origin). A refusal becomes an Error
+// whose message is the service's `detail` (it names the field and the rule).
+
+const API = "/api/v1";
+
+async function answer(response) {
+  if (response.ok) return response.json();
+  let detail = `${response.status} ${response.statusText}`;
+  try {
+    const body = await response.json();
+    if (body && body.detail) detail = body.detail;
+  } catch (_) {
+    // Not JSON (a proxy's page): the status line is all there is.
+  }
+  const error = new Error(detail);
+  error.status = response.status;
+  throw error;
+}
+
+export async function getJSON(path) {
+  return answer(await fetch(API + path, { headers: { Accept: "application/json" } }));
+}
+
+export async function postJSON(path, body) {
+  return answer(await fetch(API + path, {
+    method: "POST",
+    headers: { "Content-Type": "application/json", Accept: "application/json" },
+    body: JSON.stringify(body),
+  }));
+}
+
+export async function postForm(path, form) {
+  return answer(await fetch(API + path, { method: "POST", body: form }));
+}
+
+export const listMaterials = () => getJSON("/materials");
+export const getMaterial = (id) => getJSON(`/materials/${encodeURIComponent(id)}`);
+export const fitLibrary = (name, etaRange) => postJSON("/fits", { material: name, eta_i_range: etaRange });
+export const fitFromCurves = (body) => postJSON("/fits/from-curves", body);
+export const errorMap = (fitId) => getJSON(`/fits/${fitId}/error-map?angles=46&rows=31`);
+
+export function uploadNK(file) {
+  const form = new FormData();
+  form.append("file", file, file.name);
+  return postForm("/fits/upload", form);
+}
+
+export function curves(fitId, etaI, samples) {
+  return getJSON(`/fits/${fitId}/curves?eta_i=${etaI.toFixed(3)}&samples=${samples}`);
+}
+
+export function previewURL(fitId, etaI, compare) {
+  return `${API}/preview.png?fit=${fitId}&eta_i=${etaI.toFixed(3)}&size=320&compare=${compare}`;
+}
+
+export function packURL(fitId, format) {
+  return `${API}/fits/${fitId}/pack?format=${format}`;
+}

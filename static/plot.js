@@ -1,0 +1,160 @@
+// The reflectance plot: R, G, B against the angle theta (0 to 90 degrees) in
+// SVG, with draggable, focusable control points on the edited target.
+
+const SVG = "http://www.w3.org/2000/svg";
+const W = 640, H = 400;
+const M = { left: 48, right: 14, top: 12, bottom: 36 };
+
+function el(name, attributes = {}, parent = null) {
+  const node = document.createElementNS(SVG, name);
+  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
+  if (parent) parent.appendChild(node);
+  return node;
+}
+
+export class ReflectancePlot {
+  /**
+   * @param {HTMLElement} container
+   * @param {object} hooks  onDrag(channel, handleIndex, value), onDragEnd()
+   */
+  constructor(container, hooks) {
+    this.hooks = hooks;
+    this.svg = el("svg", { viewBox: `0 0 ${W} ${H}`, role: "group", "aria-label": "Reflectance curves" });
+    container.appendChild(this.svg);
+    this.yMin = 0;
+    this.yMax = 1;
+    this.layers = {};
+    for (const name of ["grid", "axis", "lazanyi", "reference", "target", "model", "handles"]) {
+      this.layers[name] = el("g", { class: name }, this.svg);
+    }
+    this.dragging = null;
+    this.svg.addEventListener("pointermove", (event) => this.#move(event));
+    this.svg.addEventListener("pointerup", () => this.#release());
+    this.svg.addEventListener("pointercancel", () => this.#release());
+  }
+
+  x(theta) { return M.left + (theta / 90) * (W - M.left - M.right); }
+  y(value) { return H - M.bottom - ((value - this.yMin) / (this.yMax - this.yMin)) * (H - M.top - M.bottom); }
+  value(py) { return this.yMin + ((H - M.bottom - py) / (H - M.top - M.bottom)) * (this.yMax - this.yMin); }
+
+  #axes() {
+    const { grid, axis } = this.layers;
+    grid.replaceChildren();
+    axis.replaceChildren();
+    for (let t = 0; t <= 90; t += 15) {
+      el("line", { x1: this.x(t), x2: this.x(t), y1: M.top, y2: H - M.bottom }, grid);
+      el("text", { x: this.x(t), y: H - M.bottom + 16, "text-anchor": "middle" }, axis).textContent = `${t}°`;
+    }
+    const step = this.yMax - this.yMin > 0.5 ? 0.1 : 0.05;
+    for (let v = Math.ceil(this.yMin / step) * step; v <= this.yMax + 1e-9; v += step) {
+      el("line", { x1: M.left, x2: W - M.right, y1: this.y(v), y2: this.y(v) }, grid);
+      el("text", { x: M.left - 6, y: this.y(v) + 4, "text-anchor": "end" }, axis).textContent = v.toFixed(2);
+    }
+    el("text", { x: (M.left + W - M.right) / 2, y: H - 4, "text-anchor": "middle" }, axis).textContent = "angle θ in the coating";
+  }
+
+  #path(layer, theta, rgb, className) {
+    for (let c = 0; c < 3; c++) {
+      const d = theta.map((t, i) => `${i ? "L" : "M"}${this.x(t).toFixed(1)},${this.y(rgb[i][c]).toFixed(1)}`).join("");
+      el("path", { d, class: `${className} c${c}`, "data-channel": c }, layer);
+    }
+  }
+
+  /**
+   * Draw everything. `data`: theta (n), reference, target, model, lazanyi
+   * (each n x 3 or null), handles: angles of the control points, channel:
+   * 0, 1, 2 or "all" (which handles take the pointer).
+   */
+  draw(data) {
+    this.data = data;
+    const all = [data.reference, data.target, data.model, data.lazanyi].filter(Boolean).flat(2);
+    // The grazing end is 1 for every curve; the interesting part is the dip.
+    // The scale stays put during a drag so that the point stays under the pointer.
+    if (!this.dragging) this.yMin = Math.max(0, Math.floor((Math.min(...all) - 0.05) * 10) / 10);
+    this.yMax = 1.0;
+    this.#axes();
+    for (const name of ["lazanyi", "reference", "target", "model"]) {
+      this.layers[name].replaceChildren();
+      if (data[name]) this.#path(this.layers[name], data.theta, data[name], name);
+    }
+    this.#handles();
+  }
+
+  #handles() {
+    const layer = this.layers.handles;
+    const { theta, target, handles, channel } = this.data;
+    const signature = target ? `${handles.join(",")}|${channel}` : "";
+    if (signature !== this.signature) {
+      // Rebuilt only when the set of handles changes, never during a drag
+      // (a new element would lose the pointer capture and the focus).
+      this.signature = signature;
+      layer.replaceChildren();
+      this.nodes = new Map();
+      if (target) this.#buildHandles(layer, handles, channel);
+    }
+    if (!target) return;
+    for (const [key, circle] of this.nodes) {
+      const [c, h] = key.split(":").map(Number);
+      const value = target[theta.indexOf(handles[h])][c];
+      circle.setAttribute("cy", this.y(value));
+      circle.setAttribute("aria-valuenow", value.toFixed(3));
+      circle.setAttribute("aria-valuetext", `${value.toFixed(3)} at ${handles[h]} degrees`);
+    }
+  }
+
+  #buildHandles(layer, handles, channel) {
+    const names = ["red", "green", "blue"];
+    handles.forEach((angle, h) => {
+      for (let c = 0; c < 3; c++) {
+        const active = channel === "all" || Number(channel) === c;
+        const circle = el("circle", {
+          cx: this.x(angle), r: 6, class: `handle c${c}${active ? "" : " inactive"}`,
+          tabindex: active ? 0 : -1, role: "slider",
+          "aria-label": `${names[c]} reflectance at ${angle} degrees`,
+          "aria-valuemin": 0, "aria-valuemax": 1,
+          "data-channel": c, "data-handle": h, "data-angle": angle,
+        }, layer);
+        this.nodes.set(`${c}:${h}`, circle);
+        if (!active) continue;
+        circle.addEventListener("pointerdown", (event) => {
+          event.preventDefault();
+          circle.setPointerCapture(event.pointerId);
+          circle.focus();
+          this.dragging = { channel: c, handle: h, moved: false };
+        });
+        circle.addEventListener("keydown", (event) => this.#key(event, c, h));
+        circle.addEventListener("keyup", (event) => {
+          if (["ArrowUp", "ArrowDown", "PageUp", "PageDown"].includes(event.key)) this.hooks.onDragEnd();
+        });
+      }
+    });
+  }
+
+  #key(event, c, h) {
+    const { theta, target, handles } = this.data;
+    const current = target[theta.indexOf(handles[h])][c];
+    const steps = { ArrowUp: 0.01, ArrowDown: -0.01, PageUp: 0.05, PageDown: -0.05 };
+    if (!(event.key in steps)) return;
+    event.preventDefault();
+    const step = steps[event.key] * (event.shiftKey ? 5 : 1);
+    this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)));
+  }
+
+  #move(event) {
+    if (!this.dragging) return;
+    const point = this.svg.createSVGPoint();
+    point.x = event.clientX;
+    point.y = event.clientY;
+    const local = point.matrixTransform(this.svg.getScreenCTM().inverse());
+    const value = Math.min(1, Math.max(0, this.value(local.y)));
+    this.dragging.moved = true;
+    this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value);
+  }
+
+  #release() {
+    if (!this.dragging) return;
+    const moved = this.dragging.moved;
+    this.dragging = null;
+    if (moved) this.hooks.onDragEnd();
+  }
+}

@@ -1,0 +1,152 @@
+"""
+The curve editor in a real Chromium (Debian's, through the Python playwright
+package) against a real server process on 127.0.0.1: pick Au, move the
+eta_i slider, drag a red control point, refit, undo, save, reload, download.
+"""
+
+from __future__ import annotations
+
+import pytest
+from playwright.sync_api import expect, sync_playwright
+
+from fitting.pack import decode_pack
+
+pytestmark = [pytest.mark.server, pytest.mark.browser]
+
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
+]
+TIMEOUT_MS = 120_000  # first fits and previews start worker processes and a GL context
+
+
+@pytest.fixture
+def editor_url(live_server):
+    return live_server + "/"
+
+
+@pytest.fixture
+def page():
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        context = browser.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+        page = context.new_page()
+        page.set_default_timeout(TIMEOUT_MS)
+        errors: list[str] = []
+        page.on("pageerror", lambda error: errors.append(str(error)))
+        yield page
+        browser.close()
+        assert not errors, errors
+
+
+def wait_idle(page):
+    """No request of the page's in flight (the busy indicator is down)."""
+    page.wait_for_function("!document.body.hasAttribute('aria-busy')")
+
+
+def wait_fit(page, not_id):
+    """Wait for a refit that replaced ``not_id`` and for its preview."""
+    page.wait_for_function(
+        "([old]) => { const id = document.getElementById('fit-id').textContent;"
+        " return id.length === 32 && id !== old"
+        " && document.getElementById('preview').dataset.fit === id"
+        " && !document.body.hasAttribute('aria-busy'); }",
+        arg=[not_id],
+    )
+    return page.inner_text("#fit-id")
+
+
+def open_editor(page, url):
+    page.goto(url)
+    page.wait_for_selector("body[data-ready=true]")
+    wait_idle(page)
+
+
+def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
+    open_editor(page, editor_url)
+    expect(page.locator("#material")).to_have_value("library:Au")
+    base_id = page.inner_text("#fit-id")
+    assert len(base_id) == 32
+    page.wait_for_function(f"document.getElementById('preview').dataset.fit === '{base_id}'")
+    base_coefficients = page.text_content("#coefficients")
+    base_preview = page.locator("#preview").screenshot()
+
+    # The eta_i slider, by keyboard: 1.50 -> 1.60.
+    page.focus("#eta")
+    for _ in range(10):
+        page.keyboard.press("ArrowRight")
+    expect(page.locator("#eta-value")).to_have_text("1.60")
+    page.wait_for_selector("#plot[data-eta='1.60']")
+    wait_idle(page)
+    reference_red = page.get_attribute("path.reference.c0", "d")
+    assert page.get_attribute("path.target.c0", "d") == reference_red
+
+    # Drag the red control point at 60 degrees down.
+    handle = page.locator("circle.handle.c0[data-angle='60']")
+    box = handle.bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.down()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + 70, steps=6)
+    page.mouse.up()
+    edited_id = wait_fit(page, base_id)
+    assert page.text_content("#coefficients") != base_coefficients
+    assert page.locator("#preview").screenshot() != base_preview
+    edited_red = page.get_attribute("path.target.c0", "d")
+    assert edited_red != reference_red
+    expect(page.locator("#de-label")).to_contain_text("edited curves")
+    assert float(page.inner_text("#de-mean")) >= 0.0
+
+    # Undo brings the measured curve (and the material's own fit) back.
+    page.click("#undo")
+    page.wait_for_function(f"document.getElementById('fit-id').textContent === '{base_id}'")
+    wait_idle(page)
+    assert page.get_attribute("path.target.c0", "d") == reference_red
+    # Redo gives the same, content-addressed fit again.
+    page.click("#redo")
+    page.wait_for_function(f"document.getElementById('fit-id').textContent === '{edited_id}'")
+    wait_idle(page)
+
+    # A green point moved with the keyboard.
+    green = page.locator("input[name=channel][value='1']")
+    green.check()
+    point = page.locator("circle.handle.c1[data-angle='36']")
+    before = float(point.get_attribute("aria-valuenow"))
+    point.focus()
+    page.keyboard.press("Shift+ArrowUp")
+    after = float(point.get_attribute("aria-valuenow"))
+    assert after == pytest.approx(min(1.0, before + 0.05), abs=1e-3)
+    keyboard_id = wait_fit(page, edited_id)
+
+    # Save under a name; it is listed after a reload.
+    page.fill("#name", "Pale gold browser test")
+    page.click("#save")
+    expect(page.locator("#message")).to_contain_text("Saved")
+    saved_id = page.inner_text("#fit-id")
+    assert saved_id != keyboard_id  # the name is part of the fit's identity
+    open_editor(page, editor_url)
+    option = page.locator("#material option", has_text="Pale gold browser test")
+    expect(option).to_have_count(1)
+
+    # Open the saved material and download its binary pack.
+    page.select_option("#material", option.get_attribute("value"))
+    page.wait_for_function(f"document.getElementById('fit-id').textContent === '{saved_id}'")
+    wait_idle(page)
+    page.select_option("#format", "binary")
+    with page.expect_download() as download:
+        page.click("#download")
+    path = tmp_path / "pack.cfpk"
+    download.value.save_as(path)
+    (material,) = decode_pack(path.read_bytes())
+    assert material.name == "Pale gold browser test"
+    assert material.degree == 2 and material.eta_i_range == (1.0, 2.5)
+
+
+def test_refusal_is_shown(page, editor_url, tmp_path):
+    open_editor(page, editor_url)
+    broken = tmp_path / "broken.csv"
+    broken.write_text("wavelength_nm,n,k\n500,1.0\n")
+    page.set_input_files("#upload", str(broken))
+    expect(page.locator("#message")).not_to_be_empty()
+    wait_idle(page)
+    assert "500" not in page.inner_text("#fit-id")  # nothing was fitted
+    assert page.locator("#message").get_attribute("role") == "alert"
