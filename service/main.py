@@ -139,7 +139,20 @@ async def _validation_error(request: Request, error: RequestValidationError) -> 
     )
 
 
+# FastAPI's answer when a body cannot be decoded at all (JSON that is not
+# UTF-8, a broken multipart stream); answered as any other invalid body.
+_UNPARSABLE_BODY = "There was an error parsing the body"
+
+
 async def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
+    if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail == _UNPARSABLE_BODY:
+        media_type = request.headers.get("content-type", "none").split(";")[0]
+        return JSONResponse(
+            {"detail": f"the body could not be parsed as {media_type}: JSON must be UTF-8 text, "
+                       "uploads multipart/form-data with a `file` part",
+             "errors": [{"loc": ["body"], "msg": "unparsable body", "type": "body_unparsable"}]},
+            status_code=status.HTTP_422_UNPROCESSABLE_CONTENT,
+        )
     return JSONResponse(
         {"detail": str(error.detail), "errors": []},
         status_code=error.status_code,

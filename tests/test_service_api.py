@@ -189,6 +189,7 @@ class TestFits:
         [
             ("bad.csv", "wavelength_nm,n,k\n400,1,x\n", {}, "CSV line 2"),
             ("bad.csv", "", {}, "CSV is empty"),
+            ("bad.csv", "\r\U00100000:/1", {}, "not a readable CSV"),
             ("bad.yaml", "DATA: [\n", {}, "YAML is not valid"),
             ("bad.json", "{", {}, "JSON is not valid"),
             ("bad.exe", "MZ", {}, "`format`"),
@@ -202,6 +203,14 @@ class TestFits:
         response = client.post(f"{API}/fits/upload", files={"file": (file_name, content)}, data=form)
         assert response.status_code == 422, response.text
         assert needle in response.json()["detail"]
+
+    def test_upload_broken_multipart_422(self, client):
+        response = client.post(
+            f"{API}/fits/upload", content=b"--x\r\nContent-Disposition: form-data; name=\"file\"",
+            headers={"content-type": "multipart/form-data; boundary=x"},
+        )
+        assert response.status_code == 422, response.text
+        assert "`file` (body): Field required" in response.json()["detail"]
 
     def test_upload_too_large_413(self, tmp_path):
         with app_client(tmp_path, max_upload_bytes=2000) as client:
@@ -233,6 +242,7 @@ class TestBadInput:
             (b'{"material": NaN}', "material"),
             (b'{"material": "Au", "eta_i_range": [1, Infinity]}', "eta_i_range[1]"),
             (b'[1, 2]', "dictionary"),
+            (b'\xe75\xbd\x91{"material": "Au"}', "must be UTF-8"),
             (b'{"material": 3}', "material"),
             (b'{"material": "Unobtainium"}', "material"),
             (b"{}", "exactly one of"),
