@@ -26,23 +26,36 @@ vec3 cf_f0_in_medium(vec3 F0_air, float eta_i)
     return r * r;
 }
 
-// Lazanyi & Szirmay-Kalos 2005 error term in Hoffman's 2019 F82 notation,
-// with the Hoffman 2020 external-medium adjustment of F0 (the paper's
-// "adjusted Lazanyi"): F = F0' + (1 - F0')(1 - mu)^5 - a mu (1 - mu)^6, with
-// a = [F0 + (1 - F0)(1 - mu_bar)^5 - F82] / (mu_bar (1 - mu_bar)^6) from the
-// air F0 and F82, mu_bar = 1/7 (cos 81.7 deg).
-vec3 cf_lazanyi_adjusted(float NdotV, float eta_i, vec3 F0_air, vec3 F82_air)
+// Lazanyi & Szirmay-Kalos 2005 error term in Hoffman's 2019 F82 notation:
+// F = F0 + (1 - F0)(1 - mu)^5 - a mu (1 - mu)^6. With eta_i constant over a
+// scene, F0 (cf_f0_in_medium) and a (cf_lazanyi_a) are computed once on the
+// CPU and this is all the shader evaluates (the counterpart of the
+// scene-specialised model).
+vec3 cf_lazanyi(float NdotV, vec3 F0, vec3 a)
+{
+    float mu = cf_saturate(NdotV);
+    float x = 1.0 - mu;
+    float x5 = cf_pow5(x);
+    return F0 + (1.0 - F0) * x5 - a * (mu * x5 * x);
+}
+
+// Hoffman 2019: a = [F0 + (1 - F0)(1 - mu_bar)^5 - F82] / (mu_bar (1 - mu_bar)^6)
+// from the air F0 and F82, mu_bar = 1/7 (cos 81.7 deg).
+vec3 cf_lazanyi_a(vec3 F0_air, vec3 F82_air)
 {
     const float mu_bar = 1.0 / 7.0;
     const float x_bar = 1.0 - mu_bar;
     const float x_bar5 = x_bar * x_bar * x_bar * x_bar * x_bar;
     const float denominator = mu_bar * x_bar5 * x_bar;
-    vec3 a = (F0_air + (1.0 - F0_air) * x_bar5 - F82_air) / denominator;
-    vec3 F0 = cf_f0_in_medium(F0_air, eta_i);
-    float mu = cf_saturate(NdotV);
-    float x = 1.0 - mu;
-    float x5 = cf_pow5(x);
-    return F0 + (1.0 - F0) * x5 - a * (mu * x5 * x);
+    return (F0_air + (1.0 - F0_air) * x_bar5 - F82_air) / denominator;
+}
+
+// The paper's "adjusted Lazanyi": cf_lazanyi with a from the air F0 and F82
+// and the Hoffman 2020 external-medium F0 at eta_i, both in the shader (what
+// a renderer computes when eta_i varies per pixel).
+vec3 cf_lazanyi_adjusted(float NdotV, float eta_i, vec3 F0_air, vec3 F82_air)
+{
+    return cf_lazanyi(NdotV, cf_f0_in_medium(F0_air, eta_i), cf_lazanyi_a(F0_air, F82_air));
 }
 
 // Principal square root of complex z = re + i im per channel; the branch
