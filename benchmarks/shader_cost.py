@@ -1,33 +1,56 @@
 """
-Cost of each Fresnel shader variant: full-screen 2560 x 1440 evaluations
-into an RGBA32F target, timed with a GL timer query around finished work
-(on llvmpipe a query covers only completed work, so ctx.finish() is called
-inside the timed block) and with wall time. Prints each variant's median and
-its ratio to adjusted Lazanyi.
+Cost of each Fresnel shader variant: full-screen 2560 x 1440 evaluations of
+``preview_shaders/glsl/evaluate.frag`` into an RGBA32F target (cos theta
+across the screen, eta_i in [1, 2.5] down it, coefficients and material
+inputs as uniforms, as a renderer feeds them). Each render is timed three
+ways: a GL timer query around finished work (on llvmpipe a query covers only
+completed work, so ctx.finish() is called inside it), wall time, and the
+process's CPU time (on llvmpipe: the rasteriser threads' work, which other
+processes' load disturbs less than the wall time).
 
     .venv/bin/python benchmarks/shader_cost.py [--repeats 15] [--material Au]
 
+Fairness:
+
+-   A pass with no Fresnel term (``CF_VARIANT`` 7: the same grid inputs and
+    RGBA32F store) is timed with the variants. Its time is the pass's fixed
+    cost (rasterisation, inputs, store, finish), paid alike by every
+    variant; the "net" ratios subtract it from both sides, so they compare
+    the Fresnel terms alone. Raw ratios are printed too.
+-   Adjusted Lazanyi computes what a renderer computes when eta_i varies per
+    pixel: the external-medium F0 from eta_i in the shader. The
+    scene-specialised model (eta_i constant, F0, a, alpha collapsed on the
+    CPU) is also compared with Lazanyi at the same constant eta_i, whose F0
+    and a are likewise computed on the CPU (``CF_VARIANT`` 6).
+-   Variants are interleaved round by round, one warm-up render before each
+    timed one, so drifting machine load hits every variant alike.
+
 Paper (RTX 2080 Ti): model 199 us, adjusted Lazanyi 143 us (1.39x). Targets:
-general model <= 1.15x, scene-specialised <= 1.05x.
+general model <= 1.15x, scene-specialised <= 1.05x of adjusted Lazanyi.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from fitting.baselines import baseline_inputs  # noqa: E402
+from fitting.baselines import baseline_inputs, external_medium_F0, lazanyi_a  # noqa: E402
 from fitting.fit import fit_material  # noqa: E402
 from fitting.library import library_material  # noqa: E402
 from fitting.nk import resample_nk  # noqa: E402
-from preview_shaders.evaluate import VARIANTS, shader_inputs, time_variant  # noqa: E402
-from preview_shaders.gl import RenderThread  # noqa: E402
+from preview_shaders.evaluate import VARIANTS, _set_uniforms, shader_inputs  # noqa: E402
+from preview_shaders.gl import RenderThread, check_gl_error  # noqa: E402
 
+# Benchmark-only variants of evaluate.frag, after the tested ones.
+LAZANYI_SCENE = "lazanyi_scene"
+FIXED = "fixed"
+BENCH_VARIANTS = VARIANTS + (LAZANYI_SCENE, FIXED)
 LABELS = {
     "packed": "model, float16 halves (general)",
     "floats": "model, float coefficients (general)",
@@ -35,10 +58,56 @@ LABELS = {
     "lazanyi": "adjusted Lazanyi",
     "schlick": "Schlick",
     "exact": "exact RGB conductor Fresnel",
+    LAZANYI_SCENE: "adjusted Lazanyi, scene eta_i (F0, a from CPU)",
+    FIXED: "no Fresnel term (fixed cost of the pass)",
 }
 # n, k for the exact RGB Fresnel: the spectral data at these wavelengths
 # (nm), a renderer's usual choice for R, G, B.
 RGB_WAVELENGTHS_NM = np.array([630.0, 532.0, 465.0])
+
+
+def _programs(state, inputs):
+    """One full-screen program per benchmark variant, uniforms set."""
+    programs = {}
+    for index, variant in enumerate(BENCH_VARIANTS):
+        program, vao = state.program("evaluate.frag", {"CF_VARIANT": index, "CF_WRITE_INPUTS": 0})
+        _set_uniforms(program, variant if variant in VARIANTS else "lazanyi", inputs)
+        if variant == LAZANYI_SCENE:
+            F0 = external_medium_F0(inputs.F0_air, inputs.collapse_eta_i)
+            a = lazanyi_a(inputs.F0_air, inputs.F82_air)
+            program["cf_F0"].value = tuple(float(v) for v in F0)
+            program["cf_a"].value = tuple(float(v) for v in a)
+        programs[variant] = (program, vao)
+    return programs
+
+
+def _time_rounds(state, inputs, width, height, rounds):
+    """(timer query ns, wall s, CPU s) per variant per round, interleaved."""
+    ctx = state.ctx
+    programs = _programs(state, inputs)
+    fbo, targets = state.float_targets((width, height), 1)
+    query = ctx.query(time=True)
+    samples = {variant: [] for variant in BENCH_VARIANTS}
+    try:
+        fbo.use()
+        for _ in range(rounds):
+            for variant, (program, vao) in programs.items():
+                # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
+                program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
+                for timed in (False, True):
+                    ctx.finish()
+                    wall, cpu = time.perf_counter(), time.process_time()
+                    with query:
+                        vao.render(mode=ctx.TRIANGLES, vertices=3)
+                        # llvmpipe's query covers only completed work: finish inside.
+                        ctx.finish()
+                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+                    if timed:
+                        samples[variant].append((query.elapsed, wall, cpu))
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+    return {variant: np.array(s, dtype=np.float64) for variant, s in samples.items()}
 
 
 def main() -> None:
@@ -57,26 +126,34 @@ def main() -> None:
     with RenderThread("shader-cost") as thread:
         print(f"device: {thread.renderer}, {thread.version}")
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
-              f"{args.repeats} (one warm-up render before each; variants interleaved)\n")
-        times = {}
-        # Interleaved rounds, so drifting machine load hits every variant alike.
-        samples = {v: ([], []) for v in VARIANTS}
-        for _ in range(args.repeats):
-            for variant in VARIANTS:
-                gpu_ns, wall_s = time_variant(thread, variant, inputs, args.width, args.height,
-                                              repeats=1, warmup=1)
-                samples[variant][0].extend(gpu_ns)
-                samples[variant][1].extend(wall_s)
-        for variant in VARIANTS:
-            gpu_ns, wall_s = samples[variant]
-            times[variant] = (np.median(gpu_ns) / 1e3, np.median(wall_s) * 1e6)
-    base_gpu, base_wall = times["lazanyi"]
-    print(f"| variant | timer query (us) | ratio | wall (us) | ratio |")
-    print(f"|---|---:|---:|---:|---:|")
-    for variant in VARIANTS:
-        gpu, wall = times[variant]
-        print(f"| {LABELS[variant]} | {gpu:.0f} | {gpu / base_gpu:.2f}x | {wall:.0f} | "
-              f"{wall / base_wall:.2f}x |")
+              f"{args.repeats} (one warm-up render before each; variants interleaved); "
+              f"scene eta_i {inputs.collapse_eta_i}\n")
+        samples = thread.call(_time_rounds, inputs, args.width, args.height, args.repeats)
+
+    # Medians in ms (timer query in us); quartiles of the wall time.
+    query = {v: np.median(s[:, 0]) / 1e3 for v, s in samples.items()}
+    wall = {v: np.median(s[:, 1]) * 1e3 for v, s in samples.items()}
+    wall_q = {v: np.percentile(s[:, 1], [25, 75]) * 1e3 for v, s in samples.items()}
+    cpu = {v: np.median(s[:, 2]) * 1e3 for v, s in samples.items()}
+
+    def ratio(times, variant, base="lazanyi", net=False):
+        fixed = times[FIXED] if net else 0.0
+        return (times[variant] - fixed) / (times[base] - fixed)
+
+    print("Ratios to adjusted Lazanyi; net = with the fixed cost of the pass "
+          "subtracted from both sides.\n")
+    print("| variant | timer query (us) | wall (ms) [IQR] | wall ratio | wall net ratio "
+          "| CPU (ms) | CPU net ratio |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    for v in BENCH_VARIANTS:
+        net = "" if v == FIXED else f"{ratio(wall, v, net=True):.2f}x"
+        cpu_net = "" if v == FIXED else f"{ratio(cpu, v, net=True):.2f}x"
+        print(f"| {LABELS[v]} | {query[v]:.0f} | {wall[v]:.1f} [{wall_q[v][0]:.1f}, "
+              f"{wall_q[v][1]:.1f}] | {ratio(wall, v):.2f}x | {net} | {cpu[v]:.1f} | {cpu_net} |")
+    print("\nScene-specialised model against Lazanyi at the same constant eta_i: "
+          f"wall {ratio(wall, 'collapsed', LAZANYI_SCENE):.2f}x, "
+          f"net {ratio(wall, 'collapsed', LAZANYI_SCENE, net=True):.2f}x; "
+          f"CPU net {ratio(cpu, 'collapsed', LAZANYI_SCENE, net=True):.2f}x")
 
 
 if __name__ == "__main__":
