@@ -458,8 +458,8 @@ class CurveFitSettings:
         artist looks at.
     """
 
-    mu_samples: int = 12
-    eta_samples: int = 5
+    mu_samples: int = 8
+    eta_samples: int = 4
     objective: str = "de2000"
     irls_rounds: int = 0
     max_nfev: int = 15
