@@ -1,0 +1,159 @@
+"""
+Load benchmark of the HTTP service
+==================================
+
+Starts a real ``python -m service`` on a free loopback port with a fresh
+data directory, then runs a bounded load generator against it:
+
+-   ``--fit-clients`` closed-loop clients that each POST a new fit (inline
+    n, k with a unique name, so every request is a real fit, never a store
+    hit) back to back for ``--duration`` seconds;
+-   ``--readers`` closed-loop clients that download the binary pack of a
+    stored fit at the same time.
+
+Prints one table: fits per second (answered 201), 503 refusals, and the
+latency percentiles of pack downloads with no fits running (idle) and while
+the fits run (under load).
+
+Usage::
+
+    .venv/bin/python benchmarks/service_load.py [--duration 20] [--fit-clients 4]
+        [--readers 2] [--workers N] [--metrics-samples 100]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import httpx
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+API = "/api/v1"
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def nk_body(name: str) -> dict:
+    """A smooth gold-like n, k over 350-850 nm."""
+    wavelength = np.linspace(350.0, 850.0, 26)
+    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2)
+    k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
+    return {"name": name, "nk": {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}}
+
+
+def percentiles(samples: list[float]) -> tuple[float, float, float, float]:
+    ms = np.asarray(samples) * 1e3
+    return tuple(float(np.percentile(ms, q)) for q in (50, 95, 99)) + (float(ms.max()),)
+
+
+def read_packs(url: str, fit_id: str, stop: threading.Event, out: list[float]) -> None:
+    with httpx.Client(base_url=url, timeout=60) as http:
+        while not stop.is_set():
+            start = time.perf_counter()
+            response = http.get(f"{API}/fits/{fit_id}/pack")
+            elapsed = time.perf_counter() - start
+            response.raise_for_status()
+            out.append(elapsed)
+
+
+def post_fits(url: str, client: int, stop: threading.Event, counts: dict, lock: threading.Lock) -> None:
+    with httpx.Client(base_url=url, timeout=300) as http:
+        j = 0
+        while not stop.is_set():
+            response = http.post(f"{API}/fits", json=nk_body(f"load {client}-{j}"))
+            j += 1
+            with lock:
+                counts[response.status_code] = counts.get(response.status_code, 0) + 1
+            if response.status_code == 503:
+                time.sleep(float(response.headers.get("retry-after", "1")))
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--duration", type=float, default=20.0, help="seconds of load (default 20)")
+    parser.add_argument("--idle", type=float, default=5.0, help="seconds of idle pack reads (default 5)")
+    parser.add_argument("--fit-clients", type=int, default=4)
+    parser.add_argument("--readers", type=int, default=2)
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--metrics-samples", type=int, default=100)
+    args = parser.parse_args()
+
+    with tempfile.TemporaryDirectory() as data:
+        port = free_port()
+        url = f"http://127.0.0.1:{port}"
+        env = {**os.environ, "COATED_FIT_WORKERS": str(args.workers),
+               "COATED_METRICS_SAMPLES": str(args.metrics_samples)}
+        server = subprocess.Popen(
+            [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
+            cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )
+        try:
+            deadline = time.monotonic() + 120
+            while True:
+                try:
+                    if httpx.get(f"{url}/healthz", timeout=2).status_code == 200:
+                        break
+                except httpx.TransportError:
+                    pass
+                if time.monotonic() > deadline or server.poll() is not None:
+                    raise SystemExit("the server did not start")
+                time.sleep(0.2)
+            fit_id = httpx.post(f"{url}{API}/fits", json={"material": "Au"}, timeout=120).json()["id"]
+
+            def run(seconds: float, fit_clients: int) -> tuple[list[float], dict, float]:
+                stop, lock = threading.Event(), threading.Lock()
+                latencies: list[float] = []
+                counts: dict = {}
+                threads = [threading.Thread(target=read_packs, args=(url, fit_id, stop, latencies))
+                           for _ in range(args.readers)]
+                threads += [threading.Thread(target=post_fits, args=(url, i, stop, counts, lock))
+                            for i in range(fit_clients)]
+                start = time.perf_counter()
+                for thread in threads:
+                    thread.start()
+                time.sleep(seconds)
+                stop.set()
+                for thread in threads:
+                    thread.join()
+                return latencies, counts, time.perf_counter() - start
+
+            idle, _, _ = run(args.idle, 0)
+            loaded, counts, elapsed = run(args.duration, args.fit_clients)
+        finally:
+            server.terminate()
+            server.wait(timeout=60)
+
+    fits = counts.get(201, 0)
+    print(f"service load: {args.workers} fit workers, {args.fit_clients} fit clients, "
+          f"{args.readers} pack readers, {args.duration:g} s, metrics grid "
+          f"{args.metrics_samples}x{args.metrics_samples}, machine {os.cpu_count()} CPUs")
+    print()
+    print("| quantity | value |")
+    print("|---|---|")
+    print(f"| fits answered 201 | {fits} |")
+    print(f"| fits per second | {fits / elapsed:.2f} |")
+    print(f"| fits refused 503 (Retry-After) | {counts.get(503, 0)} |")
+    print(f"| other answers | {sum(v for k, v in counts.items() if k not in (201, 503))} |")
+    for label, samples in (("idle", idle), ("under load", loaded)):
+        p50, p95, p99, worst = percentiles(samples)
+        print(f"| pack download {label}: requests | {len(samples)} |")
+        print(f"| pack download {label}: p50 / p95 / p99 / max ms | "
+              f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
