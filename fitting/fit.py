@@ -41,6 +41,7 @@ from threadpoolctl import ThreadpoolController
 from .colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_jacobian
 from .metrics import baseline_metrics, error_metrics
 from .model import (
+    ALPHA_MIN,
     DEFAULT_ETA_I_RANGE,
     check_eta_i_range,
     coated_conductor_model,
@@ -48,7 +49,7 @@ from .model import (
     normalised_eta_i,
 )
 from .nk import DEFAULT_MIN_COVERAGE, SpectralNK, resample_nk
-from .pack import PackedMaterial, to_float16
+from .pack import FLOAT16_MAX, PackedMaterial, to_float16
 from .reference import evaluation_grid, reference_ACEScg, spectral_weights
 
 __all__ = [
@@ -73,6 +74,12 @@ DEFAULT_OBJECTIVE = "de2000"
 _THREADPOOLS = ThreadpoolController()
 
 _IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight
+# Box bounds of the coefficients: F0, a, alpha. Generous for every measured
+# conductor (|c| < 4 for F0 and a, < 12 for alpha), they keep parameters the
+# data cannot identify (alpha where a ~ 0) from running away, and every
+# coefficient far inside the float16 range. alpha's constant term stays at or
+# above the model's clamp.
+_BOUND = np.array([16.0, 64.0, 256.0])
 _ALPHA_CANDIDATES = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0, 16.0, 24.0])
 
 
@@ -339,6 +346,15 @@ class _Problem:
         return J.reshape(S * 3, -1)
 
 
+def _bounds(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Box bounds (lower, upper) of the flattened coefficients, see ``_BOUND``."""
+    upper = np.broadcast_to(_BOUND[:, None, None], (3, 3, degree + 1)).copy()
+    lower = -upper
+    lower[2, :, 0] = ALPHA_MIN
+    # Strictly feasible start: x0 is clipped into the open box.
+    return lower.ravel(), upper.ravel()
+
+
 def _initial_guess(target, mu, eta, eta_i_range, degree) -> np.ndarray:
     """
     Variable projection on a ladder of constant exponents: for each alpha the
@@ -460,10 +476,11 @@ def fit_coefficients(
         if weights.size != mu.size or np.any(weights < 0) or not np.all(np.isfinite(weights)):
             raise ValueError("`weights` must be one finite value >= 0 per sample")
     problem = _Problem(target, mu, eta, eta_i_range, degree, objective, weights)
-    x0 = _initial_guess(target, mu, eta, eta_i_range, degree).ravel()
+    lower, upper = _bounds(degree)
+    x0 = np.clip(_initial_guess(target, mu, eta, eta_i_range, degree).ravel(), lower, upper)
     result = least_squares(
-        problem.residuals, x0, jac=problem.jacobian, method="trf", x_scale="jac",
-        ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev,
+        problem.residuals, x0, jac=problem.jacobian, bounds=(lower, upper), method="trf",
+        x_scale="jac", ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev,
     )
     nfev, njev = result.nfev, result.njev or 0
     if objective == "de2000":
@@ -479,8 +496,9 @@ def fit_coefficients(
                 target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor)
             )
             result = least_squares(
-                problem.residuals, result.x, jac=problem.jacobian, method="trf",
-                x_scale="jac", ftol=1e-8, xtol=1e-8, gtol=1e-8, max_nfev=max_nfev,
+                problem.residuals, result.x, jac=problem.jacobian, bounds=(lower, upper),
+                method="trf", x_scale="jac", ftol=1e-8, xtol=1e-8, gtol=1e-8,
+                max_nfev=max_nfev,
             )
             nfev, njev = nfev + result.nfev, njev + (result.njev or 0)
     t_fit = time.perf_counter()
@@ -545,7 +563,7 @@ def quantise_coefficients(problem: _Problem, C: np.ndarray, passes: int = 3) -> 
     delta = np.zeros(n)
     free = np.ones(n, dtype=bool)
     for i in np.argsort(-np.diag(H)):
-        target = float(np.float16(x[i] + delta[i]))
+        target = float(np.float16(np.clip(x[i] + delta[i], -FLOAT16_MAX, FLOAT16_MAX)))
         step = target - x[i] - delta[i]
         delta[i] = target - x[i]
         free[i] = False
@@ -554,7 +572,12 @@ def quantise_coefficients(problem: _Problem, C: np.ndarray, passes: int = 3) -> 
             F = np.flatnonzero(free)
             rhs = Hs[np.ix_(F, [i])].ravel() * (step * scale[i])
             delta[F] -= np.linalg.solve(Hs[np.ix_(F, F)], rhs) / scale[F]
-    x16 = (x + delta).astype(np.float16)
+    with np.errstate(over="ignore", invalid="ignore"):
+        x16 = (x + delta).astype(np.float16)
+    if not np.all(np.isfinite(x16)):
+        # A near-singular compensation step left the float16 range: start
+        # the coordinate moves from nearest rounding instead.
+        x16 = to_float16(x)
     delta = x16.astype(np.float64) - x
     best = q(delta)
     for _ in range(passes):
@@ -562,7 +585,10 @@ def quantise_coefficients(problem: _Problem, C: np.ndarray, passes: int = 3) -> 
         for i in range(n):
             for steps in (-1, 1):
                 trial = delta.copy()
-                trial[i] = float(_float16_neighbours(x16[i], steps)) - x[i]
+                neighbour = _float16_neighbours(x16[i], steps)
+                if not np.isfinite(neighbour):
+                    continue
+                trial[i] = float(neighbour) - x[i]
                 value = q(trial)
                 if value < best - 1e-15 * abs(best):
                     best, delta = value, trial
@@ -632,7 +658,7 @@ def fit_material(
     )
     result.timings["total"] = time.perf_counter() - t0
     if evaluate:
-        result.metrics = evaluate_material(nk, result)
+        result.metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
         result.packed = PackedMaterial(
             name=nk.name, coefficients=result.coefficients_float16,
             eta_i_range=eta_i_range, source=nk.source, metrics=result.metrics,

@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .validation import as_finite_array
+
 __all__ = ["fresnel_conductor", "fresnel_dielectric"]
 
 
@@ -50,13 +52,14 @@ def fresnel_conductor(cos_theta, eta_i, n, k) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Reflectance in [0, 1], broadcast over the inputs. Never NaN: grazing
+        Reflectance in [0, 1], broadcast over the inputs (a non-finite input
+        raises ``ValueError``). Never NaN: grazing
         incidence gives 1, total internal reflection (k = 0, eta_i > n) gives
         1, an index-matched interface gives 0.
     """
-    mu = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
-    eta = (np.asarray(n, dtype=np.float64) + 1j * np.asarray(k, dtype=np.float64)) / (
-        np.asarray(eta_i, dtype=np.float64)
+    mu = np.clip(as_finite_array("cos_theta", cos_theta), 0.0, 1.0)
+    eta = (as_finite_array("n", n) + 1j * as_finite_array("k", k)) / as_finite_array(
+        "eta_i", eta_i
     )
     sin2_t = (1.0 - mu * mu) / (eta * eta)
     # Principal complex square root: for k = 0 past the critical angle the
@@ -91,9 +94,9 @@ def fresnel_dielectric(cos_theta, eta_i, eta_t) -> np.ndarray:
     numpy.ndarray
         Reflectance in [0, 1]; 1 under total internal reflection.
     """
-    mu = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
-    eta_i = np.asarray(eta_i, dtype=np.float64)
-    eta_t = np.asarray(eta_t, dtype=np.float64)
+    mu = np.clip(as_finite_array("cos_theta", cos_theta), 0.0, 1.0)
+    eta_i = as_finite_array("eta_i", eta_i)
+    eta_t = as_finite_array("eta_t", eta_t)
     sin2_t = (eta_i / eta_t) ** 2 * (1.0 - mu * mu)
     tir = sin2_t >= 1.0
     cos_t = np.sqrt(np.clip(1.0 - sin2_t, 0.0, 1.0))

@@ -37,6 +37,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .validation import as_finite_array
+
 __all__ = [
     "PARAMETERS",
     "CHANNELS",
@@ -174,10 +176,15 @@ def coated_conductor_model(
     -------
     numpy.ndarray
         Reflectance in linear ACEScg, shape ``broadcast(cos_theta, eta_i) + (3,)``.
+
+    Raises
+    ------
+    ValueError
+        If ``cos_theta`` or ``eta_i`` is not finite.
     """
     C = np.asarray(coefficients, dtype=np.float64)
     mu, eta_i = np.broadcast_arrays(
-        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
+        as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
     )
     P = model_parameters(C, eta_i, eta_i_range)
     return model_from_parameters(mu[..., None], P[..., 0, :], P[..., 1, :], P[..., 2, :])

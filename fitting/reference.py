@@ -24,6 +24,7 @@ import numpy as np
 
 from .colorimetry import spectral_to_ACEScg_weights
 from .fresnel import fresnel_conductor
+from .validation import as_finite_array
 from .nk import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM, SpectralNK, resample_nk
 
 __all__ = ["spectral_grid", "spectral_weights", "reference_ACEScg", "evaluation_grid"]
@@ -88,10 +89,10 @@ def reference_ACEScg(
     nodes, W = spectral_weights(step_nm)
     sampled = resample_nk(nk, nodes, min_coverage)
     mu, eta = np.broadcast_arrays(
-        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
+        as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
     )
-    if np.any(eta < 1.0) or not np.all(np.isfinite(eta)):
-        raise ValueError("`eta_i` must be finite and >= 1")
+    if np.any(eta < 1.0):
+        raise ValueError(f"`eta_i` must be >= 1, got {eta.min():g}")
     shape = mu.shape
     mu, eta = mu.reshape(-1, 1), eta.reshape(-1, 1)
     out = np.empty((mu.shape[0], 3))

@@ -88,6 +88,14 @@ class TestModel:
             coated_conductor_model(mu, 1.9, collapsed), coated_conductor_model(mu, 1.9, KNOWN), atol=1e-14
         )
 
+    def test_non_finite_input_refused(self):
+        with pytest.raises(ValueError, match="`cos_theta` must be finite, got nan"):
+            coated_conductor_model([0.2, np.nan], 1.5, KNOWN)
+        with pytest.raises(ValueError, match="`eta_i` must be finite, got inf"):
+            coated_conductor_model(0.2, np.inf, KNOWN)
+        with pytest.raises(ValueError, match="`eta_i` must be numbers"):
+            coated_conductor_model(0.2, "glass", KNOWN)
+
     def test_bad_coefficients(self):
         with pytest.raises(ValueError, match="`coefficients` must have shape"):
             collapse_to_eta_i(np.zeros((3, 3, 4)), 1.5)

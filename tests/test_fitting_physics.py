@@ -56,9 +56,17 @@ class TestFresnelConductor:
         assert R[3, 2, 1] == pytest.approx(fresnel_conductor(mu[3, 0, 0], eta[0, 2, 0], n[1], 2.0))
 
     def test_never_nan_on_extremes(self):
-        mu = np.array([-1.0, 0.0, 1e-300, 0.5, 1.0, 2.0, np.nan])
-        R = fresnel_conductor(mu[:-1], 1.0, 1e-9, 1e9)
+        mu = np.array([-1.0, 0.0, 1e-300, 0.5, 1.0, 2.0])
+        R = fresnel_conductor(mu, 1.0, 1e-9, 1e9)
         assert np.all(np.isfinite(R)) and np.all((R >= 0) & (R <= 1))
+
+    def test_non_finite_input_refused(self):
+        with pytest.raises(ValueError, match="`cos_theta` must be finite, got nan"):
+            fresnel_conductor([0.5, np.nan], 1.0, 0.2, 3.0)
+        with pytest.raises(ValueError, match="`k` must be finite, got inf"):
+            fresnel_conductor(0.5, 1.0, 0.2, np.inf)
+        with pytest.raises(ValueError, match="`eta_t` must be finite"):
+            fresnel_dielectric(0.5, 1.0, np.nan)
 
 
 class TestColorimetry:

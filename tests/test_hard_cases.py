@@ -179,11 +179,6 @@ class TestFloat16Limits:
 
 
 class TestEvaluateWithLowCoverage:
-    @pytest.mark.xfail(
-        strict=True,
-        reason="fitting.fit.fit_material does not pass settings.min_coverage to "
-        "evaluate_material, which refuses the data with the default 0.9 (reported to the lead)",
-    )
     def test_metrics_honour_min_coverage(self):
         nk = HARD_CASES["TiO2 min_coverage 0.8"][0]()
         result = fit_material(nk, min_coverage=0.8, evaluate=True)
@@ -191,12 +186,6 @@ class TestEvaluateWithLowCoverage:
 
 
 class TestSingleIndexFitWithUnidentifiableExponent:
-    @pytest.mark.xfail(
-        strict=True,
-        reason="fitting core: with a ~ 0 in a channel the exponent alpha of a single-eta_i "
-        "fit runs away (1e8-1e16) or the quantiser overflows, and the fit is refused "
-        "(reported to the lead)",
-    )
     @pytest.mark.parametrize("name, eta_i", [("Ag", 1.5151515151515151),
                                              ("Fe", 1.8787878787878789),
                                              ("Ta", 2.121212121212121)])
