@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 
 from fitting.fit import fit_material  # noqa: E402
 from fitting.library import library_material  # noqa: E402
-from preview_shaders.display import ACEScg_to_sRGB, encode_png, false_colour, to_uint8  # noqa: E402
+from preview_shaders.display import encode_png, false_colour  # noqa: E402
 from preview_shaders.preview import PreviewRenderer, difference_maps  # noqa: E402
 
 MATERIALS = ("Cr", "Ta", "Co")

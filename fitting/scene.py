@@ -32,7 +32,11 @@ min(2, m - 1) (a range counts as many values); the lowest degree whose float16
 fit has a mean Delta E 2000 at most :data:`DEGREE_TOLERANCE_MEAN` above the
 highest degree's and no worse than the general fit's, and a max at most
 :data:`DEGREE_TOLERANCE_MAX` above the highest degree's, is kept
-(:func:`choose_degree`).
+(:func:`choose_degree`). Where no scene fit beats the general fit on the
+scene's eta_i (a narrow range the general fit already follows as closely),
+the general fit itself is shipped for that material
+(``metrics["from_general_fit"]``), so a scene material is never worse than
+the general fit.
 
 Each material is compared with the general fit (degree 2, 27 coefficients,
 over the default domain [1, 2.5], widened to hold the scene's eta_i): bytes in
@@ -494,6 +498,13 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
     mu = np.linspace(0.0, 1.0, EVALUATION_MU_SAMPLES)
     E, M = np.meshgrid(eta_rows, mu, indexing="ij")
     ref = reference_ACEScg(entry.nk, M, E, 1.0, settings.min_coverage)
+    general_fit = fit_material(entry.nk, general_domain(spec), settings, degree=2)
+    general = PackedMaterial(
+        entry.name, general_fit.coefficients_float16, general_fit.eta_i_range,
+        source=entry.nk.source,
+    )
+    general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
+    general_error = _error(ref, general_model)
     fits, by_degree = {}, {}
     for degree in range(spec.max_degree + 1):
         fit = _fit_degree(entry, degree, settings)
@@ -502,19 +513,25 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
         by_degree[degree] = _error(
             ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range)
         )
-    general_fit = fit_material(entry.nk, general_domain(spec), settings, degree=2)
-    general = PackedMaterial(
-        entry.name, general_fit.coefficients_float16, general_fit.eta_i_range,
-        source=entry.nk.source,
-    )
-    general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
-    general_error = _error(ref, general_model)
     chosen = choose_degree(by_degree, general_error)
+    scene_error = by_degree[chosen]
+    if scene_error["mean"] > general_error["mean"]:
+        # No scene fit beats the general fit on the scene's eta_i (a narrow
+        # range the general fit already follows as well as its own fit can):
+        # the general fit itself serves it, never a worse one.
+        packed = PackedMaterial(
+            entry.name, general.coefficients, general.eta_i_range, source=entry.nk.source,
+            metrics={"delta_E_2000": general_error, "eta_i": spec.to_json(),
+                     "from_general_fit": True},
+        )
+        scene_error = general_error
+    else:
+        packed = PackedMaterial(
+            entry.name, fits[chosen].packed.coefficients, spec.domain, source=entry.nk.source,
+            metrics={"delta_E_2000": scene_error, "eta_i": spec.to_json(),
+                     "from_general_fit": False},
+        )
     fit = fits[chosen]
-    packed = PackedMaterial(
-        entry.name, fit.coefficients_float16, spec.domain, source=entry.nk.source,
-        metrics={"delta_E_2000": by_degree[chosen], "eta_i": spec.to_json()},
-    )
     scene_model = coated_conductor_model(M, E, packed.coefficients, packed.eta_i_range)
     return SceneMaterialResult(
         material=entry,
@@ -522,7 +539,7 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
         fit=fit,
         general=general,
         by_degree=by_degree,
-        scene=by_degree[chosen],
+        scene=scene_error,
         general_error=general_error,
         scene_vs_general=_error(general_model, scene_model),
         seconds=time.perf_counter() - t0,

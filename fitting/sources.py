@@ -204,7 +204,10 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV") -> 
     Read a CSV with columns wavelength, n, k; the wavelength header states
     its unit, e.g. ``wavelength_nm,n,k`` or ``wavelength (um),n,k``.
     """
-    rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
+    try:
+        rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
+    except csv.Error as error:
+        raise ValueError(f"CSV is malformed: {error}") from None
     if not rows:
         raise ValueError("CSV is empty: expected a header `wavelength_nm,n,k` and rows")
     header = [c.strip() for c in rows[0]]

@@ -5,7 +5,7 @@ Fitting jobs
 Content-addressed fits run in a bounded process pool, shared by every router
 that makes fits (``fits``, ``curves``, ``scenes``).
 
--   :class:`NKFitSpec`, :class:`CurveFitSpec`: the inputs of a fit; their
+-   :class:`NKFitSpec`: the inputs of an n, k fit; its
     ``fit_id`` is the content address of everything that determines the
     result.
 -   :func:`nk_from_spec`: the validated :class:`fitting.nk.SpectralNK` of a spec.
@@ -13,7 +13,7 @@ that makes fits (``fits``, ``curves``, ``scenes``).
     time limit per fit.
 -   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`: why a fit
     was not run (the HTTP edge answers 503, 504 and 503).
--   :func:`fit_nk`, :func:`run_curve_fit`: look the id up in the store, else
+-   :func:`fit_nk`: look the id up in the store, else
     fit in the pool, build the :class:`service.store.FitRecord` and save it;
     return ``(record, created)``.
 
@@ -34,7 +34,7 @@ import multiprocessing
 import threading
 import time
 from concurrent.futures.process import BrokenProcessPool
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from typing import Any, Awaitable, Callable
 
 import numpy as np
@@ -44,12 +44,10 @@ from fitting.fit import (
     FitSettings,
     content_id,
     evaluate_material,
-    fit_coefficients,
     fit_material,
 )
 from fitting.library import library_material
-from fitting.metrics import delta_E_map
-from fitting.model import check_eta_i_range, coated_conductor_model
+from fitting.model import check_eta_i_range
 from fitting.nk import DEFAULT_MIN_COVERAGE, SpectralNK, resample_nk
 from fitting.pack import PackedMaterial, material_to_json
 from fitting.reference import spectral_grid, spectral_weights
@@ -59,14 +57,12 @@ from .store import FitRecord, Store
 __all__ = [
     "FIT_FORMAT_VERSION",
     "NKFitSpec",
-    "CurveFitSpec",
     "nk_from_spec",
     "Overloaded",
     "FitTimeout",
     "WorkerLost",
     "FitRunner",
     "fit_nk",
-    "run_curve_fit",
 ]
 
 FIT_FORMAT_VERSION = "fit/v1"
@@ -109,39 +105,6 @@ class NKFitSpec:
             FIT_FORMAT_VERSION, self.kind, self.name, self.source, nk.content_key(),
             repr((float(lo), float(hi))), self.objective, repr(FitSettings()),
             str(self.metrics_samples),
-        )
-
-
-@dataclass(frozen=True)
-class CurveFitSpec:
-    """
-    A fit to RGB samples (linear ACEScg) at (cos theta, eta_i), e.g. curves
-    edited in the browser; ``base_fit_id`` names the fit they started from.
-    """
-
-    name: str
-    target_RGB: tuple[tuple[float, float, float], ...]
-    cos_theta: tuple[float, ...]
-    eta_i: tuple[float, ...]
-    eta_i_range: tuple[float, float]
-    objective: str = DEFAULT_OBJECTIVE
-    degree: int = 2
-    source: str = "edited curves"
-    base_fit_id: str | None = None
-    material_id: str | None = None
-    provenance: dict[str, Any] = field(default_factory=dict, compare=False)
-
-    @property
-    def fit_id(self) -> str:
-        arrays = b"".join(
-            np.ascontiguousarray(a, dtype="<f8").tobytes()
-            for a in (self.target_RGB, self.cos_theta, self.eta_i)
-        )
-        lo, hi = self.eta_i_range
-        return content_id(
-            FIT_FORMAT_VERSION, "curves", self.name, self.source, arrays,
-            repr((float(lo), float(hi))), self.objective, str(self.degree),
-            self.base_fit_id or "",
         )
 
 
@@ -202,37 +165,6 @@ def _nk_job(spec: NKFitSpec) -> dict[str, Any]:
         "timings": timings,
         "convergence": summary,
         "coverage": result.coverage,
-    }
-
-
-def _curve_job(spec: CurveFitSpec) -> dict[str, Any]:
-    """Worker process: fit the model to RGB samples; score it against them."""
-    target = np.asarray(spec.target_RGB, dtype=np.float64)
-    mu = np.asarray(spec.cos_theta, dtype=np.float64)
-    eta = np.asarray(spec.eta_i, dtype=np.float64)
-    result = fit_coefficients(
-        target, mu, eta, spec.eta_i_range, spec.degree, spec.objective,
-    )
-    dE = delta_E_map(
-        target, coated_conductor_model(mu, eta, result.coefficients_float16, result.eta_i_range)
-    )
-    packed = PackedMaterial(
-        name=spec.name, coefficients=result.coefficients_float16,
-        eta_i_range=result.eta_i_range, source=spec.source,
-    )
-    metrics = {
-        "grid": f"{mu.size} samples",
-        "model_float16": {"delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max())},
-    }
-    summary = result.summary()
-    summary.pop("timings")
-    _check_finite("metrics", metrics)
-    return {
-        "material": material_to_json(packed),
-        "metrics": metrics,
-        "timings": {**result.timings, "total": sum(result.timings.values())},
-        "convergence": summary,
-        "coverage": None,
     }
 
 
@@ -431,32 +363,6 @@ async def fit_nk(spec: NKFitSpec, store: Store, runner: FitRunner) -> tuple[FitR
                 "wavelength_nm": list(spec.wavelength_nm), "n": list(spec.n), "k": list(spec.k),
             },
             provenance={"fit_format": FIT_FORMAT_VERSION, "settings": asdict(FitSettings())},
-        )
-        return await asyncio.to_thread(store.put_fit, record)
-
-    return await runner.once(fit_id, make), True
-
-
-async def run_curve_fit(
-    spec: CurveFitSpec, store: Store, runner: FitRunner
-) -> tuple[FitRecord, bool]:
-    """
-    As :func:`fit_nk` for a fit to RGB samples (no n, k): the record has
-    kind "curves", metrics against the samples themselves, and
-    ``base_fit_id``; its material id is ``spec.material_id`` or the fit id.
-    """
-    check_eta_i_range(spec.eta_i_range)
-    fit_id = spec.fit_id
-    stored = await asyncio.to_thread(store.get_fit, fit_id)
-    if stored is not None:
-        return stored, False
-
-    async def make() -> FitRecord:
-        job = await runner.run(_curve_job, spec)
-        record = _record(
-            fit_id, "curves", spec.material_id or fit_id, spec.name, spec.source, job,
-            spec.objective, base_fit_id=spec.base_fit_id,
-            provenance={"fit_format": FIT_FORMAT_VERSION, **spec.provenance},
         )
         return await asyncio.to_thread(store.put_fit, record)
 

@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import json
 from contextlib import asynccontextmanager
+from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, Request, status
 from fastapi.exceptions import RequestValidationError
 from fastapi.middleware.cors import CORSMiddleware
 from fastapi.responses import JSONResponse
+from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -27,6 +29,9 @@ from .config import Settings
 from .fitting_jobs import FitRunner
 from .models import API_PREFIX
 from .store import SQLiteStore
+
+STATIC_DIR = Path(__file__).resolve().parents[1] / "static"
+"""The browser editor, served at ``/``."""
 
 __all__ = ["create_app", "BodySizeLimit"]
 
@@ -201,6 +206,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_exception_handler(StarletteHTTPException, _http_error)
     for module in (health, materials, fits, packs, preview, curves, scenes):
         app.include_router(module.router)
+    # The browser editor (static/), after the API so that /api, /docs and
+    # /openapi.json keep their routes; html=True serves index.html at /.
+    app.mount("/", StaticFiles(directory=STATIC_DIR, html=True), name="editor")
     if settings.cors_origins:
         app.add_middleware(
             CORSMiddleware, allow_origins=settings.cors_origins,

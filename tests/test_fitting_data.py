@@ -119,6 +119,7 @@ class TestSources:
             ("wavelength_nm,n,k\n400,one,1\n", "line 2 must hold three numbers"),
             ("wavelength_nm,k,n\n400,1,1\n", "columns 2 and 3 must be `n` and `k`"),
             ("wavelength_nm,n,k\n400,1,1\n300,1,1\n", "strictly increasing"),
+            ("\r\udcf4\n\"a\rb", "CSV is malformed"),
         ],
     )
     def test_csv_errors(self, text, message):

@@ -189,7 +189,7 @@ class TestFits:
         [
             ("bad.csv", "wavelength_nm,n,k\n400,1,x\n", {}, "CSV line 2"),
             ("bad.csv", "", {}, "CSV is empty"),
-            ("bad.csv", "\r\U00100000:/1", {}, "not a readable CSV"),
+            ("bad.csv", "\r\U00100000:/1", {}, "CSV is malformed"),
             ("bad.yaml", "DATA: [\n", {}, "YAML is not valid"),
             ("bad.json", "{", {}, "JSON is not valid"),
             ("bad.exe", "MZ", {}, "`format`"),

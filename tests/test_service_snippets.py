@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+
+import moderngl
 import numpy as np
 import pytest
 
@@ -52,7 +55,6 @@ def materials() -> list[FitRecord]:
 
 
 def render(source: str, function: str, size=(33, 9)) -> np.ndarray:
-    moderngl = pytest.importorskip("moderngl")
     ctx = moderngl.create_context(standalone=True, backend="egl")
     try:
         program = ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT % (source, function))
@@ -83,6 +85,36 @@ def test_glsl_snippet_matches_numpy(index):
     eta = np.linspace(1.0, 3.0, image.shape[0])[:, None]
     expected = coated_conductor_model(mu, eta, coefficients, tuple(view["eta_i_range"]))
     np.testing.assert_allclose(image, expected, atol=2e-5)
+
+
+HLSL_ENTRY = """
+float4 main(float4 position : SV_Position) : SV_Target
+{
+    float NdotV = saturate(position.x / 32.0);
+    float eta_i = 1.0 + position.y / 8.0;
+    return float4(%s, 1.0);
+}
+"""
+
+
+def test_hlsl_snippet_compiles(tmp_path):
+    # glslang's HLSL front end (Debian glslang-tools) compiles the snippet to
+    # SPIR-V as a pixel shader calling every material function.
+    source = render_pack(materials(), "hlsl", "test pack").decode()
+    calls = " + ".join(f"cf_material_{i}(NdotV, eta_i)" for i in ("gold_1", "gold_1_2", "m_9_lives"))
+    path = tmp_path / "pack.hlsl"
+    path.write_text(source + HLSL_ENTRY % calls)
+    result = subprocess.run(
+        ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "pack.spv"), str(path)],
+        capture_output=True, text=True, timeout=60,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert (tmp_path / "pack.spv").stat().st_size > 0
+    broken = tmp_path / "broken.hlsl"
+    broken.write_text(source + HLSL_ENTRY % "cf_material_missing(NdotV, eta_i)")
+    result = subprocess.run(["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", str(broken)],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode != 0
 
 
 def test_snippet_comments_cannot_break_out():

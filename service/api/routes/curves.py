@@ -36,7 +36,6 @@ from fitting.curves import (
     CURVE_MIN_SAMPLES,
     CurveBase,
     CurveFitSettings,
-    RGBCurve,
     check_curves,
     curve_base_from_coefficients,
     curve_base_from_nk,

@@ -16,7 +16,6 @@ from the store (200) without refitting; a new fit answers 201.
 
 from __future__ import annotations
 
-import csv
 from pathlib import PurePath
 from typing import Annotated
 
@@ -156,10 +155,7 @@ async def upload_fit(
     data = await file.read()
     display = (name or PurePath(file_name).stem or "uploaded").strip()[:200]
     with fit_errors():
-        try:
-            nk: SpectralNK = await run_in_threadpool(read_nk, data, fmt, display)
-        except csv.Error as error:  # the csv module's own parse errors (e.g. a bare CR)
-            raise ValueError(f"`file` is not a readable CSV: {error}") from None
+        nk: SpectralNK = await run_in_threadpool(read_nk, data, fmt, display)
         if nk.wavelength_nm.size > MAX_NK_SAMPLES:
             raise ValueError(
                 f"`file` must hold at most {MAX_NK_SAMPLES} wavelengths, got {nk.wavelength_nm.size}"
