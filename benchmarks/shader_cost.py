@@ -33,24 +33,25 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from fitting.baselines import baseline_inputs, external_medium_F0, lazanyi_a  # noqa: E402
+from fitting.baselines import baseline_inputs  # noqa: E402
 from fitting.fit import fit_material  # noqa: E402
 from fitting.library import library_material  # noqa: E402
 from fitting.rgb_fresnel import rgb_nk  # noqa: E402
-from preview_shaders.evaluate import VARIANTS, _set_uniforms, shader_inputs  # noqa: E402
-from preview_shaders.gl import RenderThread, check_gl_error  # noqa: E402
+from preview_shaders.evaluate import (  # noqa: E402
+    FIXED,
+    LAZANYI_SCENE,
+    TIMING_VARIANTS,
+    shader_inputs,
+    time_variants,
+)
+from preview_shaders.gl import RenderThread  # noqa: E402
 
-# Benchmark-only variants of evaluate.frag, after the tested ones.
-LAZANYI_SCENE = "lazanyi_scene"
-FIXED = "fixed"
-BENCH_VARIANTS = VARIANTS + (LAZANYI_SCENE, FIXED)
 LABELS = {
     "packed": "model, float16 halves (general)",
     "floats": "model, float coefficients (general)",
@@ -61,50 +62,6 @@ LABELS = {
     LAZANYI_SCENE: "adjusted Lazanyi, scene eta_i (F0, a from CPU)",
     FIXED: "no Fresnel term (fixed cost of the pass)",
 }
-
-
-def _programs(state, inputs):
-    """One full-screen program per benchmark variant, uniforms set."""
-    programs = {}
-    for index, variant in enumerate(BENCH_VARIANTS):
-        program, vao = state.program("evaluate.frag", {"CF_VARIANT": index, "CF_WRITE_INPUTS": 0})
-        _set_uniforms(program, variant if variant in VARIANTS else "lazanyi", inputs)
-        if variant == LAZANYI_SCENE:
-            F0 = external_medium_F0(inputs.F0_air, inputs.collapse_eta_i)
-            a = lazanyi_a(inputs.F0_air, inputs.F82_air)
-            program["cf_F0"].value = tuple(float(v) for v in F0)
-            program["cf_a"].value = tuple(float(v) for v in a)
-        programs[variant] = (program, vao)
-    return programs
-
-
-def _time_rounds(state, inputs, width, height, rounds):
-    """(timer query ns, wall s, CPU s) per variant per round, interleaved."""
-    ctx = state.ctx
-    programs = _programs(state, inputs)
-    fbo, targets = state.float_targets((width, height), 1)
-    query = ctx.query(time=True)
-    samples = {variant: [] for variant in BENCH_VARIANTS}
-    try:
-        fbo.use()
-        for _ in range(rounds):
-            for variant, (program, vao) in programs.items():
-                # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
-                program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
-                for timed in (False, True):
-                    ctx.finish()
-                    wall, cpu = time.perf_counter(), time.process_time()
-                    with query:
-                        vao.render(mode=ctx.TRIANGLES, vertices=3)
-                        # llvmpipe's query covers only completed work: finish inside.
-                        ctx.finish()
-                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-                    if timed:
-                        samples[variant].append((query.elapsed, wall, cpu))
-        check_gl_error(ctx)
-    finally:
-        state.release_targets(fbo, targets)
-    return {variant: np.array(s, dtype=np.float64) for variant, s in samples.items()}
 
 
 def main() -> None:
@@ -126,7 +83,7 @@ def main() -> None:
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
               f"{args.repeats} (one warm-up render before each; variants interleaved); "
               f"scene eta_i {inputs.collapse_eta_i}\n")
-        samples = thread.call(_time_rounds, inputs, args.width, args.height, args.repeats)
+        samples = time_variants(thread, inputs, TIMING_VARIANTS, args.width, args.height, args.repeats)
 
     # Medians in ms (timer query in us); quartiles of the wall time.
     query = {v: np.median(s[:, 0]) / 1e3 for v, s in samples.items()}
@@ -143,7 +100,7 @@ def main() -> None:
     print("| variant | timer query (us) | wall (ms) [IQR] | wall ratio | wall net ratio "
           "| CPU (ms) | CPU net ratio |")
     print("|---|---:|---:|---:|---:|---:|---:|")
-    for v in BENCH_VARIANTS:
+    for v in TIMING_VARIANTS:
         net = "" if v == FIXED else f"{ratio(wall, v, net=True):.2f}x"
         cpu_net = "" if v == FIXED else f"{ratio(cpu, v, net=True):.2f}x"
         print(f"| {LABELS[v]} | {query[v]:.0f} | {wall[v]:.1f} [{wall_q[v][0]:.1f}, "

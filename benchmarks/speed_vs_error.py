@@ -15,7 +15,7 @@ exact RGB conductor Fresnel (``fitting.rgb_fresnel``) and the exact spectral
 reference. Error: Delta E 2000 against the 1 nm reference on the paper's
 100 x 100 grid (cos theta in [0, 1], eta_i in [1, 2.5]). Shader cost: wall
 time of full-screen 2560 x 1440 RGBA32F renders on this machine's GL
-(llvmpipe without a GPU), measured with ``preview_shaders.evaluate.time_variant``
+(llvmpipe without a GPU), measured with ``preview_shaders.evaluate.time_variants``
 as ``benchmarks/shader_cost.py`` does, variants interleaved, median, relative
 to adjusted Lazanyi. CPU cost: numpy evaluation per sample (median of 3 runs
 over 10^6 samples; 10^4 for the spectral reference). Bytes: per material as a
@@ -152,26 +152,19 @@ def cpu_cost_ns(repeats: int = 3) -> dict[str, float]:
     return out
 
 
-def shader_cost(repeats: int) -> dict[str, float] | None:
-    """Median wall time (us) of each shader variant at 2560 x 1440, or None without GL."""
-    try:
-        from preview_shaders.evaluate import VARIANTS, shader_inputs, time_variant
-        from preview_shaders.gl import RenderThread
-    except ImportError:
-        return None
+def shader_cost(repeats: int) -> dict[str, float]:
+    """Median wall time (us) of each shader variant at 2560 x 1440."""
+    from preview_shaders.evaluate import VARIANTS, shader_inputs, time_variants
+    from preview_shaders.gl import RenderThread
+
     nk = library_material("Au")
     packed = fit_material(nk).packed
     air = baseline_inputs(nk)
     n_rgb, k_rgb = rgb_nk(nk)
     inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
-    samples = {v: [] for v in VARIANTS}
     with RenderThread("speed-vs-error") as thread:
-        # Interleaved rounds, so drifting machine load hits every variant alike.
-        for _ in range(repeats):
-            for variant in VARIANTS:
-                _, wall_s = time_variant(thread, variant, inputs, WIDTH, HEIGHT, repeats=1, warmup=1)
-                samples[variant].extend(wall_s)
-    return {v: float(np.median(s)) * 1e6 for v, s in samples.items()}
+        samples = time_variants(thread, inputs, VARIANTS, WIDTH, HEIGHT, repeats)
+    return {v: float(np.median(s[:, 1])) * 1e6 for v, s in samples.items()}
 
 
 def pareto_front(points: dict[str, tuple[float, float]]) -> list[str]:

@@ -18,7 +18,7 @@ References
 Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
 """
 
-from .evaluate import VARIANTS, ShaderInputs, evaluate_grid, shader_inputs, time_variant
+from .evaluate import VARIANTS, ShaderInputs, evaluate_grid, shader_inputs, time_variants
 from .gl import RenderThread, load_shader_source
 from .preview import PreviewRenderer, PreviewResult
 
@@ -27,7 +27,7 @@ __all__ = [
     "ShaderInputs",
     "evaluate_grid",
     "shader_inputs",
-    "time_variant",
+    "time_variants",
     "RenderThread",
     "load_shader_source",
     "PreviewRenderer",

@@ -12,7 +12,8 @@ compare it with numpy, the cost benchmark times it.
 -   :func:`padded_coefficients`: a degree-0/1 fit as 27 halves.
 -   :func:`evaluate_grid`: renders one variant and reads it back.
 -   :func:`decode_halves_in_shader`: the 27 coefficients as GLSL decodes them.
--   :func:`time_variant`: GL timer query and wall time of full-screen renders.
+-   :func:`time_variants`: GL timer query, wall and CPU time of full-screen
+    renders of several variants, interleaved.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fitting.baselines import external_medium_F0, lazanyi_a
 from fitting.model import collapse_to_eta_i
 from fitting.pack import PackedMaterial, halves_to_uint32
 
@@ -34,13 +36,22 @@ __all__ = [
     "shader_inputs",
     "evaluate_grid",
     "decode_halves_in_shader",
-    "time_variant",
+    "TIMING_VARIANTS",
+    "time_variants",
 ]
 
 VARIANTS = ("packed", "floats", "collapsed", "lazanyi", "schlick", "exact")
 """Model from float16 halves in uint32, model from float coefficients,
 scene-specialised model (Eq. 1 only), adjusted Lazanyi, Schlick, exact RGB
 conductor Fresnel."""
+
+LAZANYI_SCENE = "lazanyi_scene"
+FIXED = "fixed"
+TIMING_VARIANTS = VARIANTS + (LAZANYI_SCENE, FIXED)
+"""The variants and, for timing only (``CF_VARIANT`` 6 and 7 of
+evaluate.frag): adjusted Lazanyi at the scene's constant eta_i with F0 and a
+from the CPU (the like-for-like counterpart of the scene-specialised model),
+and a pass with no Fresnel term (the fixed cost every variant pays)."""
 
 
 def padded_coefficients(coefficients) -> np.ndarray:
@@ -203,51 +214,72 @@ def decode_halves_in_shader(thread: RenderThread, words) -> np.ndarray:
     return thread.call(_decode_halves, words)
 
 
-def _time_variant(state: GLState, variant, inputs, width, height, repeats, warmup):
-    ctx = state.ctx
+def _timing_program(state: GLState, variant: str, inputs: ShaderInputs):
+    """The full-screen program of one timing variant, uniforms set."""
     program, vao = state.program(
-        "evaluate.frag", {"CF_VARIANT": _check_variant(variant), "CF_WRITE_INPUTS": 0}
+        "evaluate.frag", {"CF_VARIANT": TIMING_VARIANTS.index(variant), "CF_WRITE_INPUTS": 0}
     )
-    _set_uniforms(program, variant, inputs)
-    # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
-    program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
+    _set_uniforms(program, variant if variant in VARIANTS else "lazanyi", inputs)
+    if variant == LAZANYI_SCENE:
+        # What a renderer precomputes when eta_i is constant for the scene.
+        F0 = external_medium_F0(inputs.F0_air, inputs.collapse_eta_i)
+        a = lazanyi_a(inputs.F0_air, inputs.F82_air)
+        program["cf_F0"].value = tuple(float(v) for v in F0)
+        program["cf_a"].value = tuple(float(v) for v in a)
+    return program, vao
+
+
+def _time_variants(state: GLState, inputs, variants, width, height, rounds):
+    ctx = state.ctx
+    programs = {v: _timing_program(state, v, inputs) for v in variants}
     fbo, targets = state.float_targets((width, height), 1)
     query = ctx.query(time=True)
-    gpu_ns, wall_s = [], []
+    samples = {variant: [] for variant in variants}
     try:
         fbo.use()
-        for i in range(warmup + repeats):
-            ctx.finish()
-            start = time.perf_counter()
-            with query:
-                vao.render(mode=ctx.TRIANGLES, vertices=3)
-                # llvmpipe's query covers only completed work: finish inside.
-                ctx.finish()
-            elapsed = time.perf_counter() - start
-            if i >= warmup:
-                gpu_ns.append(query.elapsed)
-                wall_s.append(elapsed)
+        for _ in range(rounds):
+            for variant, (program, vao) in programs.items():
+                # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
+                program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
+                for timed in (False, True):  # one warm-up render before each timed one
+                    ctx.finish()
+                    wall, cpu = time.perf_counter(), time.process_time()
+                    with query:
+                        vao.render(mode=ctx.TRIANGLES, vertices=3)
+                        # llvmpipe's query covers only completed work: finish inside.
+                        ctx.finish()
+                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+                    if timed:
+                        samples[variant].append((query.elapsed, wall, cpu))
         check_gl_error(ctx)
     finally:
         state.release_targets(fbo, targets)
-    return np.array(gpu_ns, dtype=np.float64), np.array(wall_s)
+    return {variant: np.array(s, dtype=np.float64) for variant, s in samples.items()}
 
 
-def time_variant(
+def time_variants(
     thread: RenderThread,
-    variant: str,
     inputs: ShaderInputs,
+    variants=TIMING_VARIANTS,
     width: int = 2560,
     height: int = 1440,
-    repeats: int = 10,
-    warmup: int = 2,
-):
+    rounds: int = 15,
+) -> dict[str, np.ndarray]:
     """
-    Time full-screen renders of one variant into an RGBA32F target.
+    Time full-screen renders of ``variants`` (names of
+    :data:`TIMING_VARIANTS`) into an RGBA32F target, interleaved round by
+    round so drifting machine load hits every variant alike, one warm-up
+    render before each timed one.
 
     Returns
     -------
-    tuple
-        GL timer-query times in ns and wall times in s, one per repeat.
+    dict
+        Per variant, a (rounds, 3) array: GL timer query (ns), wall time (s)
+        and process CPU time (s) of each timed render.
     """
-    return thread.call(_time_variant, variant, inputs, width, height, repeats, warmup)
+    for variant in variants:
+        if variant not in TIMING_VARIANTS:
+            raise ValueError(
+                f"`variants` must name {', '.join(TIMING_VARIANTS)}, got {variant!r}"
+            )
+    return thread.call(_time_variants, inputs, tuple(variants), width, height, rounds)

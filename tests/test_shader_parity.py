@@ -14,6 +14,8 @@ from fitting.fresnel import fresnel_conductor
 from fitting.model import coated_conductor_model, collapse_to_eta_i, model_from_parameters
 from fitting.pack import PackedMaterial, halves_to_uint32, to_float16
 from preview_shaders.evaluate import (
+    TIMING_VARIANTS,
+    time_variants,
     decode_halves_in_shader,
     evaluate_grid,
     padded_coefficients,
@@ -197,3 +199,17 @@ class TestShaderSources:
     def test_unknown_variant_is_refused(self, thread):
         with pytest.raises(ValueError, match="`variant` must be one of"):
             evaluate_grid(thread, "cook", shader_inputs(MATERIALS["random-0"]), MU_AXIS, ETA_AXIS)
+
+
+class TestTimingHarness:
+    """The harness behind benchmarks/shader_cost.py renders every variant cleanly."""
+
+    def test_every_timing_variant_renders(self, thread):
+        samples = time_variants(thread, shader_inputs(MATERIALS["random-0"]), TIMING_VARIANTS, 64, 32, 2)
+        assert set(samples) == set(TIMING_VARIANTS)
+        for values in samples.values():
+            assert values.shape == (2, 3) and np.all(np.isfinite(values)) and np.all(values[:, 1] > 0)
+
+    def test_unknown_variant_refused(self, thread):
+        with pytest.raises(ValueError, match="`variants` must name"):
+            time_variants(thread, shader_inputs(MATERIALS["random-0"]), ("phong",), 64, 32, 1)
