@@ -355,6 +355,24 @@ def _bounds(degree: int) -> tuple[np.ndarray, np.ndarray]:
     return lower.ravel(), upper.ravel()
 
 
+def _solve(problem: _Problem, x0: np.ndarray, bounds, tol: float, max_nfev: int):
+    """
+    TRF from ``x0``, unbounded first (cheaper per iteration); the bounded
+    solve is run only when the unbounded optimum leaves the box, i.e. when
+    the data leave some coefficient unidentified.
+    """
+    lower, upper = bounds
+    options = dict(jac=problem.jacobian, method="trf", x_scale="jac",
+                   ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev)
+    result = least_squares(problem.residuals, x0, **options)
+    if np.all(np.isfinite(result.x)) and np.all((result.x >= lower) & (result.x <= upper)):
+        return result
+    bounded = least_squares(problem.residuals, x0, bounds=(lower, upper), **options)
+    bounded.nfev += result.nfev
+    bounded.njev = (bounded.njev or 0) + (result.njev or 0)
+    return bounded
+
+
 def _initial_guess(target, mu, eta, eta_i_range, degree) -> np.ndarray:
     """
     Variable projection on a ladder of constant exponents: for each alpha the
@@ -476,12 +494,9 @@ def fit_coefficients(
         if weights.size != mu.size or np.any(weights < 0) or not np.all(np.isfinite(weights)):
             raise ValueError("`weights` must be one finite value >= 0 per sample")
     problem = _Problem(target, mu, eta, eta_i_range, degree, objective, weights)
-    lower, upper = _bounds(degree)
-    x0 = np.clip(_initial_guess(target, mu, eta, eta_i_range, degree).ravel(), lower, upper)
-    result = least_squares(
-        problem.residuals, x0, jac=problem.jacobian, bounds=(lower, upper), method="trf",
-        x_scale="jac", ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=max_nfev,
-    )
+    bounds = _bounds(degree)
+    x0 = np.clip(_initial_guess(target, mu, eta, eta_i_range, degree).ravel(), *bounds)
+    result = _solve(problem, x0, bounds, 1e-10, max_nfev)
     nfev, njev = result.nfev, result.njev or 0
     if objective == "de2000":
         # Mean Delta E, not its RMS: iteratively reweighted least squares with
@@ -495,11 +510,7 @@ def fit_coefficients(
             problem = _Problem(
                 target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor)
             )
-            result = least_squares(
-                problem.residuals, result.x, jac=problem.jacobian, bounds=(lower, upper),
-                method="trf", x_scale="jac", ftol=1e-8, xtol=1e-8, gtol=1e-8,
-                max_nfev=max_nfev,
-            )
+            result = _solve(problem, result.x, bounds, 1e-8, max_nfev)
             nfev, njev = nfev + result.nfev, njev + (result.njev or 0)
     t_fit = time.perf_counter()
     C = result.x.reshape(problem.shape)
@@ -526,15 +537,6 @@ def fit_coefficients(
     )
 
 
-def _float16_neighbours(values: np.ndarray, steps: int) -> np.ndarray:
-    """float16 values ``steps`` ulps away (positive: up)."""
-    h = np.asarray(values, dtype=np.float16)
-    direction = np.float16(np.inf) if steps > 0 else np.float16(-np.inf)
-    for _ in range(abs(steps)):
-        h = np.nextafter(h, direction)
-    return h
-
-
 def quantise_coefficients(problem: _Problem, C: np.ndarray, passes: int = 3) -> np.ndarray:
     """
     Float16 coefficients that minimise the fit's objective near the float64
@@ -557,9 +559,6 @@ def quantise_coefficients(problem: _Problem, C: np.ndarray, passes: int = 3) -> 
     scale = np.sqrt(np.maximum(np.diag(H), 1e-300))
     Hs = H / np.outer(scale, scale) + 1e-12 * np.eye(n)
 
-    def q(delta):
-        return float(delta @ H @ delta + 2.0 * g @ delta)
-
     delta = np.zeros(n)
     free = np.ones(n, dtype=bool)
     for i in np.argsort(-np.diag(H)):
@@ -579,23 +578,24 @@ def quantise_coefficients(problem: _Problem, C: np.ndarray, passes: int = 3) -> 
         # the coordinate moves from nearest rounding instead.
         x16 = to_float16(x)
     delta = x16.astype(np.float64) - x
-    best = q(delta)
-    for _ in range(passes):
-        improved = False
-        for i in range(n):
-            for steps in (-1, 1):
-                trial = delta.copy()
-                neighbour = _float16_neighbours(x16[i], steps)
-                if not np.isfinite(neighbour):
-                    continue
-                trial[i] = float(neighbour) - x[i]
-                value = q(trial)
-                if value < best - 1e-15 * abs(best):
-                    best, delta = value, trial
-                    x16[i] = np.float16(x[i] + trial[i])
-                    improved = True
-        if not improved:
+    # One-ulp coordinate moves, best first. The change of q for a move s_i of
+    # coordinate i alone is s_i (2 (H delta + g)_i + s_i H_ii): all moves are
+    # scored at once, the best taken, the gradient updated, until none helps.
+    gradient = H @ delta + g
+    for _ in range(passes * n):
+        with np.errstate(over="ignore", invalid="ignore"):
+            up = np.nextafter(x16, np.float16(np.inf)).astype(np.float64) - x16
+            down = np.nextafter(x16, np.float16(-np.inf)).astype(np.float64) - x16
+        steps = np.stack([up, down])
+        change = steps * (2.0 * gradient + steps * np.diag(H))
+        change[~np.isfinite(change)] = np.inf
+        k, i = np.unravel_index(np.argmin(change), change.shape)
+        if not change[k, i] < 0.0:  # q strictly decreases: no cycles
             break
+        step = steps[k, i]
+        x16[i] = np.float16(x16[i] + step)
+        delta[i] += step
+        gradient += H[:, i] * step
     x16 = (x + delta).astype(np.float16)
     nearest = to_float16(x)
     cost = np.sum(problem.residuals(x16.astype(np.float64)) ** 2)
