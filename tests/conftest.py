@@ -10,6 +10,8 @@ Shared fixtures of the test suite.
     on 127.0.0.1 with a fresh data directory; waits for ``/healthz`` and
     yields the base URL (``"http://127.0.0.1:<port>"``); terminates the
     process afterwards. Mark tests that use it ``@pytest.mark.server``.
+-   :func:`app_client`: the TestClient factory behind ``client``, with
+    settings overrides (``with app_client(tmp_path, fit_queue=0) as c: ...``).
 -   :func:`server_process`: the context manager behind ``live_server``, for
     tests that need their own data directory, environment or a restart
     (``with server_process(data_dir, COATED_FIT_QUEUE="0") as server: ...``;
@@ -108,17 +110,24 @@ def server_process(data_dir: Path, **env: str) -> Iterator[ServerProcess]:
         server.stop()
 
 
-@pytest.fixture
-def client(tmp_path):
+def app_client(tmp_path: Path, **overrides):
+    """
+    A TestClient over an app with its own data directory under ``tmp_path``,
+    one fit worker, no pool warm-up, and ``overrides`` of
+    :class:`service.config.Settings` (use it as a context manager).
+    """
     from fastapi.testclient import TestClient
 
     from service.config import Settings
     from service.main import create_app
 
-    settings = Settings(
-        data_dir=tmp_path / "data", fit_workers=1, warm_pool=False, metrics_samples=30,
-    )
-    with TestClient(create_app(settings)) as test_client:
+    settings = Settings(data_dir=tmp_path / "data", fit_workers=1, warm_pool=False, **overrides)
+    return TestClient(create_app(settings))
+
+
+@pytest.fixture
+def client(tmp_path):
+    with app_client(tmp_path, metrics_samples=30) as test_client:
         yield test_client
 
 

@@ -9,6 +9,7 @@ from fitting.library import library_material
 from fitting.pack import decode_pack, pack_from_json
 from service.config import Settings
 from service.main import create_app
+from conftest import app_client
 
 API = "/api/v1"
 SCENE = {"name": "desk", "materials": [
@@ -26,11 +27,6 @@ def shared(tmp_path_factory):
         response = client.post(f"{API}/scenes", json=SCENE)
         assert response.status_code == 200, response.text
         yield client, response.json()
-
-
-def app_client(tmp_path, **overrides) -> TestClient:
-    settings = Settings(data_dir=tmp_path / "data", fit_workers=1, warm_pool=False, **overrides)
-    return TestClient(create_app(settings))
 
 
 class TestScenePack:

@@ -18,6 +18,7 @@ from fitting.reference import reference_ACEScg
 from fitting.metrics import delta_E_map
 from service.config import Settings
 from service.main import create_app
+from conftest import app_client
 
 API = "/api/v1"
 
@@ -46,11 +47,6 @@ def shared(tmp_path_factory):
         response = client.post(f"{API}/fits", json={"material": "Au"})
         assert response.status_code == 201, response.text
         yield client, response.json()
-
-
-def app_client(tmp_path, **overrides) -> TestClient:
-    settings = Settings(data_dir=tmp_path / "data", fit_workers=1, warm_pool=False, **overrides)
-    return TestClient(create_app(settings))
 
 
 class TestHealthAndDocs:
