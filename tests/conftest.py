@@ -121,8 +121,8 @@ def app_client(tmp_path: Path, **overrides):
     from service.config import Settings
     from service.main import create_app
 
-    settings = Settings(data_dir=tmp_path / "data", fit_workers=1, warm_pool=False, **overrides)
-    return TestClient(create_app(settings))
+    options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False, **overrides}
+    return TestClient(create_app(Settings(**options)))
 
 
 @pytest.fixture

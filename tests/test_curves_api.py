@@ -4,14 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fastapi.testclient import TestClient
 
 from fitting.curves import curve_base_from_nk
 from fitting.library import library_material
 from fitting.model import coated_conductor_model
 from fitting.pack import decode_pack
-from service.config import Settings
-from service.main import create_app
+from conftest import app_client
 
 ANGLE = np.linspace(0.0, 90.0, 31)
 URL = "/api/v1/fits/from-curves"
@@ -26,9 +24,7 @@ def gold_curve(eta_i=1.5, red_scale=1.0):
 
 @pytest.fixture(scope="module")
 def shared(tmp_path_factory):
-    settings = Settings(data_dir=tmp_path_factory.mktemp("curves") / "data", fit_workers=1,
-                        warm_pool=False, metrics_samples=30)
-    with TestClient(create_app(settings)) as client:
+    with app_client(tmp_path_factory.mktemp("curves"), metrics_samples=30) as client:
         yield client
 
 
@@ -140,9 +136,7 @@ class TestFromCurves:
         assert response.status_code == 422
 
     def test_token_required_401(self, tmp_path):
-        settings = Settings(data_dir=tmp_path / "data", fit_workers=1, warm_pool=False,
-                            require_token=True, api_token="secret")
-        with TestClient(create_app(settings)) as client:
+        with app_client(tmp_path, require_token=True, api_token="secret") as client:
             response = client.post(URL, json={"curves": [gold_curve()]})
             assert response.status_code == 401 and "Authorization: Bearer" in response.json()["detail"]
 

@@ -3,12 +3,9 @@
 import base64
 
 import pytest
-from fastapi.testclient import TestClient
 
 from fitting.library import library_material
 from fitting.pack import decode_pack, pack_from_json
-from service.config import Settings
-from service.main import create_app
 from conftest import app_client
 
 API = "/api/v1"
@@ -21,9 +18,7 @@ SCENE = {"name": "desk", "materials": [
 @pytest.fixture(scope="module")
 def shared(tmp_path_factory):
     """One app with one worker, the scene fitted once."""
-    settings = Settings(data_dir=tmp_path_factory.mktemp("scenes") / "data", fit_workers=1,
-                        warm_pool=False, metrics_samples=30)
-    with TestClient(create_app(settings)) as client:
+    with app_client(tmp_path_factory.mktemp("scenes"), metrics_samples=30) as client:
         response = client.post(f"{API}/scenes", json=SCENE)
         assert response.status_code == 200, response.text
         yield client, response.json()

@@ -8,7 +8,6 @@ import time
 
 import numpy as np
 import pytest
-from fastapi.testclient import TestClient
 
 from fitting.fit import fit_material
 from fitting.library import LIBRARY_NAMES, library_material
@@ -17,7 +16,6 @@ from fitting.pack import decode_pack, pack_from_json
 from fitting.reference import reference_ACEScg
 from fitting.metrics import delta_E_map
 from service.config import Settings
-from service.main import create_app
 from conftest import app_client
 
 API = "/api/v1"
@@ -39,11 +37,7 @@ def csv_text(nk: dict) -> str:
 @pytest.fixture(scope="module")
 def shared(tmp_path_factory):
     """One app (one worker process) for the tests that fit, with Au fitted."""
-    settings = Settings(
-        data_dir=tmp_path_factory.mktemp("shared") / "data", fit_workers=1, warm_pool=True,
-        metrics_samples=30,
-    )
-    with TestClient(create_app(settings)) as client:
+    with app_client(tmp_path_factory.mktemp("shared"), warm_pool=True, metrics_samples=30) as client:
         response = client.post(f"{API}/fits", json={"material": "Au"})
         assert response.status_code == 201, response.text
         yield client, response.json()
