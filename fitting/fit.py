@@ -75,7 +75,8 @@ _THREADPOOLS = ThreadpoolController()
 
 _IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight
 # Box bounds of the coefficients: F0, a, alpha. Generous for every measured
-# conductor (|c| < 4 for F0 and a, < 12 for alpha), they keep parameters the
+# conductor (on the 22 of the library |c| < 1 for F0, < 12 for a, < 9 for
+# alpha), they keep parameters the
 # data cannot identify (alpha where a ~ 0) from running away, and every
 # coefficient far inside the float16 range. alpha's constant term stays at or
 # above the model's clamp.
@@ -163,7 +164,8 @@ class FitResult:
         Convergence report of :func:`scipy.optimize.least_squares`
         (``status`` > 0 is convergence, 0 is the evaluation budget).
     cost
-        Half the sum of squared residuals at the float64 optimum.
+        Half the sum of squared (weighted) residuals of the last solve at the
+        float64 optimum.
     cost_float16
         The same for the float16 coefficients.
     timings
@@ -351,7 +353,6 @@ def _bounds(degree: int) -> tuple[np.ndarray, np.ndarray]:
     upper = np.broadcast_to(_BOUND[:, None, None], (3, 3, degree + 1)).copy()
     lower = -upper
     lower[2, :, 0] = ALPHA_MIN
-    # Strictly feasible start: x0 is clipped into the open box.
     return lower.ravel(), upper.ravel()
 
 
@@ -436,13 +437,21 @@ def fit_coefficients(
         \\end{cases}
 
     over the coefficients :math:`C \\in \\mathbb{R}^{3 \\times 3 \\times (d+1)}`
-    (unbounded), with :math:`M` the model of :mod:`fitting.model`, :math:`T_s`
-    the target, and :math:`A_s` the first-order CIEDE2000 metric at the target
-    colour, so that :math:`\\lVert r_s \\rVert \\approx \\Delta E_{00}`.
-    The start is a variable-projection solve over constant exponents, so the
-    result is deterministic. Stopping: ``ftol = xtol = gtol = 1e-10`` or
-    ``max_nfev`` evaluations. The float16 coefficients then minimise the same
-    objective over the float16 lattice (:func:`quantise_coefficients`).
+    subject to the box :math:`|C_{F_0}| \\le 16`, :math:`|C_a| \\le 64`,
+    :math:`|C_\\alpha| \\le 256` with :math:`C_{\\alpha,0} \\ge` ``ALPHA_MIN``
+    (inactive for every measured conductor: the unbounded problem is solved
+    first, the bounded one only when its optimum leaves the box, e.g. an
+    alpha the data cannot identify), with :math:`M` the model of
+    :mod:`fitting.model`, :math:`T_s` the target, and :math:`A_s` the
+    first-order CIEDE2000 metric at the target colour, so that
+    :math:`\\lVert r_s \\rVert \\approx \\Delta E_{00}`. For ``de2000``,
+    ``irls_rounds`` rounds then reweight :math:`w_s` by
+    :math:`1/\\max(\\Delta E_s, 0.02)` so that the optimum approaches the mean
+    Delta E. The start is a variable-projection solve over constant exponents,
+    so the result is deterministic. Stopping: ``ftol = xtol = gtol = 1e-10``
+    (1e-8 in the reweighting rounds) or ``max_nfev`` evaluations per solve.
+    The float16 coefficients then minimise the same objective over the
+    float16 lattice (:func:`quantise_coefficients`).
 
     Parameters
     ----------
