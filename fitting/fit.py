@@ -76,10 +76,9 @@ _THREADPOOLS = ThreadpoolController()
 _IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight
 # Box bounds of the coefficients: F0, a, alpha. Generous for every measured
 # conductor (on the 22 of the library |c| < 1 for F0, < 12 for a, < 9 for
-# alpha), they keep parameters the
-# data cannot identify (alpha where a ~ 0) from running away, and every
-# coefficient far inside the float16 range. alpha's constant term stays at or
-# above the model's clamp.
+# alpha), they keep parameters the data cannot identify (alpha where a ~ 0)
+# from running away, and every coefficient far inside the float16 range.
+# alpha's constant term stays at or above the model's clamp.
 _BOUND = np.array([16.0, 64.0, 256.0])
 _ALPHA_CANDIDATES = np.array([1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0, 16.0, 24.0])
 
