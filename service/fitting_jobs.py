@@ -352,7 +352,8 @@ async def fit_nk(spec: NKFitSpec, store: Store, runner: FitRunner) -> tuple[FitR
     fit_id = spec.fit_id
     stored = await asyncio.to_thread(store.get_fit, fit_id)
     if stored is not None:
-        return stored, False
+        # Asked for again: logged as the material's latest save.
+        return await asyncio.to_thread(store.put_fit, stored), False
 
     async def make() -> FitRecord:
         job = await runner.run(_nk_job, spec)

@@ -13,15 +13,18 @@ implementation on SQLite in WAL mode, :class:`SQLiteStore`.
 
 Records are content addressed (the id is a hash of the fit's inputs) and
 written once: ``put_fit`` of an existing id keeps the first record, nothing
-is ever updated or deleted, so a save that was answered is never lost. Each
-save is one transaction committed with ``synchronous=FULL`` before the
-request is answered, so it survives a crash of the process (and of the
-machine) once answered.
+is ever updated or deleted, so a save that was answered is never lost.
+Every ``put_fit`` also appends to an append-only log of saves, so that the
+latest fit of a material is the one saved last, even when it is an earlier
+fit saved again (an artist's undo, then save). Each save is one transaction
+committed with ``synchronous=FULL`` before the request is answered, so it
+survives a crash of the process (and of the machine) once answered.
 
 Replacing SQLite by a server database (several service instances sharing one
-store) means a second class with the same five methods, e.g. on PostgreSQL
-with ``INSERT ... ON CONFLICT (id) DO NOTHING`` for ``put_fit`` and a JSONB
-column for the record; see ``docs/service.md``.
+store) means a second class with the same methods, e.g. on PostgreSQL
+with ``INSERT ... ON CONFLICT (id) DO NOTHING`` for the record and a
+``BIGSERIAL`` save log in ``put_fit``, and a JSONB column for the record;
+see ``docs/service.md``.
 """
 
 from __future__ import annotations
@@ -124,13 +127,16 @@ class Store(Protocol):
     """The store interface of the service (thread-safe implementations)."""
 
     def put_fit(self, record: FitRecord) -> FitRecord:
-        """Save ``record`` unless its id exists; return the stored record."""
+        """
+        Save ``record`` unless its id exists, and log the save (the fit
+        becomes its material's latest); return the stored record.
+        """
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
         """The record of ``fit_id``, or None."""
 
     def latest_fit(self, material_id: str) -> FitRecord | None:
-        """The most recent fit of a material, or None."""
+        """The fit of a material saved last, or None."""
 
     def saved_materials(self) -> list[MaterialRow]:
         """Materials with at least one non-library fit, oldest first."""
@@ -151,6 +157,17 @@ CREATE TABLE IF NOT EXISTS fits (
     record TEXT NOT NULL
 );
 CREATE INDEX IF NOT EXISTS fits_by_material ON fits (material_id, created_at);
+CREATE TABLE IF NOT EXISTS saves (
+    seq INTEGER PRIMARY KEY AUTOINCREMENT,
+    material_id TEXT NOT NULL,
+    fit_id TEXT NOT NULL REFERENCES fits (id),
+    saved_at REAL NOT NULL
+);
+CREATE INDEX IF NOT EXISTS saves_by_material ON saves (material_id, seq);
+-- Stores written before the save log: each fit counts as saved once, in order.
+INSERT INTO saves (material_id, fit_id, saved_at)
+    SELECT material_id, id, created_at FROM fits
+    WHERE id NOT IN (SELECT fit_id FROM saves) ORDER BY created_at, rowid;
 """
 
 
@@ -196,6 +213,11 @@ class SQLiteStore:
                 "VALUES (?, ?, ?, ?, ?)",
                 (record.id, record.kind, record.material_id, record.created_at, record.to_json()),
             )
+            connection.execute(
+                "INSERT INTO saves (material_id, fit_id, saved_at) "
+                "SELECT material_id, id, ? FROM fits WHERE id = ?",
+                (time.time(), record.id),
+            )
         stored = self.get_fit(record.id)
         assert stored is not None
         return stored
@@ -208,18 +230,20 @@ class SQLiteStore:
 
     def latest_fit(self, material_id: str) -> FitRecord | None:
         row = self._connection().execute(
-            "SELECT record FROM fits WHERE material_id = ? "
-            "ORDER BY created_at DESC, rowid DESC LIMIT 1",
+            "SELECT f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
+            "WHERE s.material_id = ? ORDER BY s.seq DESC LIMIT 1",
             (material_id,),
         ).fetchone()
         return None if row is None else FitRecord.from_json(row[0])
 
     def saved_materials(self) -> list[MaterialRow]:
         rows = self._connection().execute(
-            "SELECT f.record, m.first FROM fits f JOIN ("
-            "  SELECT material_id, MIN(created_at) AS first, MAX(rowid) AS last "
-            "  FROM fits WHERE kind != 'library' GROUP BY material_id"
-            ") m ON f.rowid = m.last ORDER BY m.first, f.material_id"
+            "SELECT f.record, m.first FROM ("
+            "  SELECT s.material_id, MIN(s.saved_at) AS first, MAX(s.seq) AS last "
+            "  FROM saves s JOIN fits f ON f.id = s.fit_id WHERE f.kind != 'library' "
+            "  GROUP BY s.material_id"
+            ") m JOIN saves s ON s.seq = m.last JOIN fits f ON f.id = s.fit_id "
+            "ORDER BY m.first, m.material_id"
         ).fetchall()
         out = []
         for text, first in rows:
@@ -232,9 +256,6 @@ class SQLiteStore:
                 )
             )
         return out
-
-    def count(self) -> int:
-        return self._connection().execute("SELECT COUNT(*) FROM fits").fetchone()[0]
 
     def check(self) -> None:
         try:

@@ -73,6 +73,37 @@ class TestFromCurves:
         assert len(mine) == 1 and mine[0]["kind"] == "curves"
         assert mine[0]["latest_fit_id"] == fit["id"]
 
+    def test_undo_then_save_makes_the_earlier_state_latest(self, shared):
+        body_a = {"name": "undo test", "base": {"material": "Au"}, "curves": [gold_curve(red_scale=0.9)]}
+        body_b = {"name": "undo test", "base": {"material": "Au"}, "curves": [gold_curve(red_scale=0.7)]}
+        a = shared.post(URL, json=body_a).json()
+        b = shared.post(URL, json=body_b).json()
+        assert a["material_id"] == b["material_id"] and a["id"] != b["id"]
+        again = shared.post(URL, json=body_a)
+        assert again.status_code == 200 and again.json()["id"] == a["id"]
+        material = shared.get(f"/api/v1/materials/{a['material_id']}").json()
+        assert material["latest_fit_id"] == a["id"]
+        listed = [m for m in shared.get("/api/v1/materials").json()["materials"] if m["name"] == "undo test"]
+        assert [m["latest_fit_id"] for m in listed] == [a["id"]]
+
+    def test_an_edited_base_keeps_its_edits(self, shared):
+        # X: Au with red pulled down at eta_i 1; then X edited at eta_i 2.5 only.
+        low = gold_curve(eta_i=1.0, red_scale=0.4)
+        x = shared.post(URL, json={"name": "red down", "base": {"material": "Au"}, "curves": [low]}).json()
+        y = shared.post(URL, json={"name": "red down", "base": {"fit": x["id"]},
+                                   "curves": [gold_curve(eta_i=2.5)]})
+        assert y.status_code == 201, y.text
+        y = y.json()
+        assert y["base_fit_id"] == x["id"] and y["library_material"] == "Au"
+
+        def red_at_normal(fit):
+            (m,) = decode_pack(shared.get(f"/api/v1/fits/{fit['id']}/pack?format=binary").content)
+            return coated_conductor_model(1.0, 1.0, m.coefficients, m.eta_i_range)[0]
+
+        gold = red_at_normal(shared.post("/api/v1/fits", json={"material": "Au"}).json())
+        assert red_at_normal(x) < gold - 0.3
+        assert red_at_normal(y) == pytest.approx(red_at_normal(x), abs=0.03)
+
     def test_downloads(self, shared, edited):
         _, fit = edited
         for fmt in ("json", "glsl", "hlsl"):

@@ -41,7 +41,39 @@ class TestSQLiteStore:
         first = store.put_fit(record("1" * 32, name="first"))
         again = store.put_fit(record("1" * 32, name="second"))
         assert again == first and again.name == "first"
-        assert store.count() == 1
+        assert store.latest_fit(first.material_id) == first
+
+    def test_saving_an_earlier_fit_again_makes_it_latest(self, store):
+        # An artist's undo then save: the earlier state is the material's latest.
+        a = store.put_fit(record("1" * 32, material_id="m" * 32, kind="curves", name="A"))
+        b = store.put_fit(record("2" * 32, material_id="m" * 32, kind="curves", name="B"))
+        assert store.latest_fit("m" * 32) == b
+        store.put_fit(a)
+        assert store.latest_fit("m" * 32) == a
+        (row,) = store.saved_materials()
+        assert row.latest_fit_id == a.id and row.name == "A"
+
+    def test_store_from_before_the_save_log_is_read(self, tmp_path):
+        import sqlite3
+
+        path = tmp_path / "old.sqlite"
+        old = sqlite3.connect(path)
+        old.executescript(
+            "CREATE TABLE fits (id TEXT PRIMARY KEY, kind TEXT NOT NULL, material_id TEXT NOT NULL,"
+            " created_at REAL NOT NULL, record TEXT NOT NULL);"
+        )
+        for i, name in ((1, "old"), (2, "new")):
+            r = record(str(i) * 32, material_id="a" * 32, name=name, created_at=float(i))
+            old.execute("INSERT INTO fits VALUES (?, ?, ?, ?, ?)",
+                        (r.id, r.kind, r.material_id, r.created_at, r.to_json()))
+        old.commit()
+        old.close()
+        store = SQLiteStore(path)
+        try:
+            assert store.latest_fit("a" * 32).name == "new"
+            assert [m.name for m in store.saved_materials()] == ["new"]
+        finally:
+            store.close()
 
     def test_latest_and_saved_materials(self, store):
         store.put_fit(record("1" * 32, material_id="Au", kind="library", library_material="Au"))

@@ -235,15 +235,17 @@ def _base_spec(request: CurveFitRequest, store: Store) -> tuple[_BaseSpec | None
             f"`eta_i_range` must be the base fit's domain [{domain[0]:g}, {domain[1]:g}] or "
             f"omitted, got [{requested[0]:g}, {requested[1]:g}]"
         )
-    if record.library_material is not None:
-        spec = _BaseSpec("nk", record.library_material, record.source, domain,
-                         library_material=record.library_material)
-    elif record.nk is not None:
-        spec = _BaseSpec("nk", record.name, record.source, domain,
-                         nk=(tuple(record.nk["wavelength_nm"]), tuple(record.nk["n"]), tuple(record.nk["k"])))
-    else:
+    if record.kind == "curves":
+        # An edited material: its edits live in its stored model, not in the
+        # n, k it started from.
         spec = _BaseSpec("model", record.name, record.source, domain,
                          coefficients=packed.coefficients.astype(np.float64).tolist())
+    elif record.library_material is not None:
+        spec = _BaseSpec("nk", record.library_material, record.source, domain,
+                         library_material=record.library_material)
+    else:  # an n, k fit
+        spec = _BaseSpec("nk", record.name, record.source, domain,
+                         nk=(tuple(record.nk["wavelength_nm"]), tuple(record.nk["n"]), tuple(record.nk["k"])))
     return spec, record
 
 
@@ -293,8 +295,19 @@ async def create_fit_from_curves(
         stored = await asyncio.to_thread(store.get_fit, fit_id)
         created = stored is None
         if stored is not None:
-            record = stored
+            # An earlier state saved again (undo, then save): it becomes the
+            # material's latest.
+            record = await asyncio.to_thread(store.put_fit, stored)
         else:
+            # The measured data behind the edit (for the reference curves and
+            # previews): the base's, or, for an edited base, the data it had.
+            measured_library = base.library_material if base else None
+            measured_nk = None if base is None or base.nk is None else {
+                "wavelength_nm": list(base.nk[0]), "n": list(base.nk[1]), "k": list(base.nk[2]),
+            }
+            if base_record is not None and base_record.kind == "curves":
+                measured_library, measured_nk = base_record.library_material, base_record.nk
+
             async def make() -> FitRecord:
                 job = await runner.run(
                     _curves_job, base, curves, eta_i_range, request.name.strip(),
@@ -308,10 +321,7 @@ async def create_fit_from_curves(
                     name=request.name.strip(), source=job["source"], material=job["material"],
                     metrics=job["metrics"], timings=job["timings"], convergence=job["convergence"],
                     objective=request.objective,
-                    library_material=base.library_material if base else None,
-                    nk=None if base is None or base.nk is None else {
-                        "wavelength_nm": list(base.nk[0]), "n": list(base.nk[1]), "k": list(base.nk[2]),
-                    },
+                    library_material=measured_library, nk=measured_nk,
                     base_fit_id=base_record.id if base_record else None,
                     provenance={
                         "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
