@@ -69,6 +69,9 @@ class Settings(BaseSettings):
         requests get 413.
     max_preview_size
         Largest preview side in pixels.
+    max_previews_in_flight
+        Previews rendered at once (a spectral-reference preview is seconds of
+        CPU); past it a preview request is answered 503 with Retry-After.
     """
 
     model_config = SettingsConfigDict(env_prefix="COATED_", extra="ignore")
@@ -86,6 +89,7 @@ class Settings(BaseSettings):
     max_body_bytes: int = Field(default=1_000_000, ge=1_000)
     max_upload_bytes: int = Field(default=2_000_000, ge=1_000)
     max_preview_size: int = Field(default=1024, ge=64, le=2048)
+    max_previews_in_flight: int = Field(default=2, ge=1, le=64)
 
     @model_validator(mode="after")
     def _check_token(self) -> "Settings":

@@ -9,6 +9,7 @@ that makes fits (``fits``, ``curves``, ``scenes``).
     ``fit_id`` is the content address of everything that determines the
     result.
 -   :func:`nk_from_spec`: the validated :class:`fitting.nk.SpectralNK` of a spec.
+-   :func:`measured_nk`: the n, k behind a stored fit, if any.
 -   :class:`FitRunner`: the process pool with a bound on fits in flight and a
     time limit per fit.
 -   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`: why a fit
@@ -58,6 +59,9 @@ __all__ = [
     "FIT_FORMAT_VERSION",
     "NKFitSpec",
     "nk_from_spec",
+    "check_finite",
+    "fit_record",
+    "measured_nk",
     "Overloaded",
     "FitTimeout",
     "WorkerLost",
@@ -108,6 +112,21 @@ class NKFitSpec:
         )
 
 
+def measured_nk(record: FitRecord) -> SpectralNK | None:
+    """
+    The measured n, k behind a stored fit: its library material's, or its
+    stored data; None for a fit made from curves alone.
+    """
+    if record.library_material is not None:
+        return library_material(record.library_material)
+    if record.nk is None:
+        return None
+    return SpectralNK(
+        np.asarray(record.nk["wavelength_nm"]), np.asarray(record.nk["n"]),
+        np.asarray(record.nk["k"]), name=record.name, source=record.source,
+    )
+
+
 def nk_from_spec(spec: NKFitSpec) -> SpectralNK:
     """
     The validated n, k of a spec, checked to cover enough of 360-830 nm.
@@ -131,7 +150,9 @@ def nk_from_spec(spec: NKFitSpec) -> SpectralNK:
     return nk
 
 
-def _check_finite(what: str, values: dict[str, Any]) -> None:
+def check_finite(what: str, values: dict[str, Any]) -> None:
+    """Refuse (ValueError) a fit whose ``values`` hold NaN or infinity anywhere."""
+
     def walk(value):
         if isinstance(value, dict):
             return all(walk(v) for v in value.values())
@@ -158,7 +179,7 @@ def _nk_job(spec: NKFitSpec) -> dict[str, Any]:
     )
     summary = result.summary()
     summary.pop("timings")
-    _check_finite("metrics", metrics)
+    check_finite("metrics", metrics)
     return {
         "material": material_to_json(packed),
         "metrics": metrics,
@@ -324,12 +345,13 @@ class FitRunner:
             pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _record(fit_id: str, kind: str, material_id: str, name: str, source: str,
-            job: dict[str, Any], objective: str, **extra: Any) -> FitRecord:
+def fit_record(fit_id: str, kind: str, material_id: str, name: str, source: str,
+               job: dict[str, Any], objective: str, **extra: Any) -> FitRecord:
+    """The record of a finished fitting job (material, metrics, timings, convergence)."""
     return FitRecord(
         id=fit_id, kind=kind, material_id=material_id, name=name, source=source,
         material=job["material"], metrics=job["metrics"], timings=job["timings"],
-        convergence=job["convergence"], objective=objective, coverage=job["coverage"],
+        convergence=job["convergence"], objective=objective, coverage=job.get("coverage"),
         created_at=time.time(), **extra,
     )
 
@@ -357,7 +379,7 @@ async def fit_nk(spec: NKFitSpec, store: Store, runner: FitRunner) -> tuple[FitR
 
     async def make() -> FitRecord:
         job = await runner.run(_nk_job, spec)
-        record = _record(
+        record = fit_record(
             fit_id, spec.kind, spec.material_id, spec.name, nk.source, job, spec.objective,
             library_material=spec.library_material,
             nk=None if spec.library_material else {

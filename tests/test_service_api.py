@@ -463,3 +463,49 @@ class TestSecurity:
         with app_client(tmp_path, cors_origins=["https://editor.example"]) as client:
             response = client.get(f"{API}/materials", headers={"Origin": "https://editor.example"})
             assert response.headers["access-control-allow-origin"] == "https://editor.example"
+
+    def test_cross_site_writes_refused(self, client):
+        # A multipart upload needs no CORS preflight: without this check any
+        # page a user visits could plant materials in the store.
+        files = {"file": ("x.csv", csv_text(gold_like_nk()), "text/csv")}
+        response = client.post(f"{API}/fits/upload", files=files, headers={"Origin": "http://evil.example"})
+        assert response.status_code == 403 and "cross-site writes are refused" in response.json()["detail"]
+        response = client.post(f"{API}/fits", json={"material": "Au"}, headers={"Origin": "null"})
+        assert response.status_code == 403
+        listed = client.get(f"{API}/materials").json()["materials"]
+        assert not [m for m in listed if m["kind"] != "library"]
+        # The editor's own page (same origin) and pipelines (no Origin) write as before.
+        same = client.post(f"{API}/fits/upload", files=files, headers={"Origin": "http://testserver"})
+        assert same.status_code == 201, same.text
+
+    def test_configured_origin_may_write(self, tmp_path):
+        with app_client(tmp_path, cors_origins=["https://editor.example"]) as client:
+            response = client.post(f"{API}/fits/upload", files={"file": ("x.csv", csv_text(gold_like_nk()), "text/csv")},
+                                   headers={"Origin": "https://editor.example"})
+            assert response.status_code == 201, response.text
+
+
+class TestPackNames:
+    def test_duplicate_names_refused(self, shared):
+        client, fit = shared
+        other = client.post(f"{API}/fits", json={"material": "Au", "eta_i_range": [1.0, 2.0]}).json()
+        assert other["id"] != fit["id"] and other["name"] == fit["name"]
+        response = client.post(f"{API}/packs", json={"fit_ids": [fit["id"], other["id"]]})
+        assert response.status_code == 422
+        assert "names in a pack must be unique" in response.json()["detail"]
+
+
+class TestPreviewBound:
+    def test_previews_past_the_bound_get_503(self, tmp_path, monkeypatch):
+        import threading
+
+        with app_client(tmp_path, max_previews_in_flight=1, metrics_samples=10) as client:
+            fit = client.post(f"{API}/fits", json={"material": "Ag"}).json()
+            # Hold the only slot, as a long spectral-reference preview would.
+            client.app.state.preview_slots = threading.BoundedSemaphore(1)
+            client.app.state.preview_slots.acquire()
+            response = client.get(f"{API}/preview.png", params={"fit": fit["id"], "size": 64})
+            assert response.status_code == 503 and response.headers["retry-after"] == "2"
+            client.app.state.preview_slots.release()
+            response = client.get(f"{API}/preview.png", params={"fit": fit["id"], "size": 64})
+            assert response.status_code == 200 and response.content[:4] == b"\x89PNG"

@@ -59,10 +59,28 @@ _bearer = HTTPBearer(auto_error=False, description="COATED_API_TOKEN, when the s
 
 
 def require_write_access(
+    request: Request,
     settings: SettingsDep,
     credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)],
 ) -> None:
-    """Refuse a write without the configured bearer token (when one is required)."""
+    """
+    Refuse a cross-site write from a browser, and a write without the
+    configured bearer token (when one is required).
+
+    A browser names the page that sends a request in ``Origin``; a write
+    from a page of another site (a multipart upload needs no CORS
+    preflight) is refused unless that origin is in ``cors_origins``.
+    Pipelines (curl, scripts) send no ``Origin``.
+    """
+    origin = request.headers.get("origin")
+    if origin is not None:
+        own = f"{request.url.scheme}://{request.headers.get('host', '')}"
+        if origin != own and origin not in settings.cors_origins:
+            raise HTTPException(
+                status.HTTP_403_FORBIDDEN,
+                f"cross-site writes are refused: `Origin` {origin!r} is neither this service "
+                f"({own}) nor in COATED_CORS_ORIGINS",
+            )
     if not settings.token_required:
         return
     expected = settings.api_token.get_secret_value().encode() if settings.api_token else b""
@@ -109,6 +127,7 @@ ERROR_RESPONSES = {
 FIT_ERROR_RESPONSES = {
     **ERROR_RESPONSES,
     status.HTTP_401_UNAUTHORIZED: _error("Missing or wrong bearer token (when required)"),
+    status.HTTP_403_FORBIDDEN: _error("A cross-site write from a browser (Origin of another site)"),
     status.HTTP_413_CONTENT_TOO_LARGE: _error("The body is larger than the limit"),
     status.HTTP_503_SERVICE_UNAVAILABLE: _error("Too many fits in flight; see Retry-After"),
     status.HTTP_504_GATEWAY_TIMEOUT: _error("The fit ran past its time limit"),

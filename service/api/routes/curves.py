@@ -20,7 +20,6 @@ provenance, so the edited target can be rebuilt.
 from __future__ import annotations
 
 import asyncio
-import math
 import time
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal
@@ -49,11 +48,11 @@ from fitting.model import check_eta_i_range, coated_conductor_model
 from fitting.nk import SpectralNK
 from fitting.pack import material_from_json, material_to_json
 
-from ...fitting_jobs import FIT_FORMAT_VERSION
-from ...models import API_PREFIX, FIT_ID_PATTERN, ErrorBody, FitPublic, LibraryName, NKData, Objective, fit_public
+from ...fitting_jobs import FIT_FORMAT_VERSION, check_finite, fit_record, measured_nk
+from ...models import FIT_ID_PATTERN, ErrorBody, EtaI, FitPublic, LibraryName, NKData, Objective
 from ...store import FitRecord, Store
 from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_errors
-from .fits import FitIdPath, stored_fit
+from .fits import FitIdPath, fit_answer, stored_fit
 
 router = APIRouter(prefix="/api/v1", tags=["curves"])
 
@@ -61,7 +60,6 @@ CURVES_FORMAT = "curves/v1"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 _DEFAULTS = CurveFitSettings()
 
-EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)]
 CosTheta = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
 Angle = Annotated[float, Field(ge=0.0, le=90.0, allow_inf_nan=False)]
 Reflectance = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
@@ -313,14 +311,11 @@ async def create_fit_from_curves(
                     _curves_job, base, curves, eta_i_range, request.name.strip(),
                     request.objective, request.blend_width,
                 )
-                if not all(math.isfinite(v) for v in job["metrics"]["model_float16"].values()):
-                    raise ValueError("the fit gave non-finite metrics: the curves cannot be fitted")
-                record = FitRecord(
-                    id=fit_id, kind="curves",
-                    material_id=content_id("edited material", request.name.strip()),
-                    name=request.name.strip(), source=job["source"], material=job["material"],
-                    metrics=job["metrics"], timings=job["timings"], convergence=job["convergence"],
-                    objective=request.objective,
+                check_finite("metrics", job["metrics"])
+                name = request.name.strip()
+                record = fit_record(
+                    fit_id, "curves", content_id("edited material", name), name, job["source"],
+                    job, request.objective,
                     library_material=measured_library, nk=measured_nk,
                     base_fit_id=base_record.id if base_record else None,
                     provenance={
@@ -333,14 +328,11 @@ async def create_fit_from_curves(
                         },
                         "settings": {k: getattr(_DEFAULTS, k) for k in _DEFAULTS.__dataclass_fields__},
                     },
-                    created_at=time.time(),
                 )
                 return await asyncio.to_thread(store.put_fit, record)
 
             record = await runner.once(fit_id, make)
-    response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
-    response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
-    return fit_public(record)
+    return fit_answer(record, created, response)
 
 
 class ErrorMap(BaseModel):
@@ -371,22 +363,20 @@ def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
         if base["kind"] == "model":
             grid = curve_base_from_coefficients(np.asarray(base["coefficients"]), domain, base["name"])
         else:
-            grid = curve_base_from_nk(_record_nk(record), domain)
+            grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
         E, M = np.meshgrid(eta, mu, indexing="ij")
         width = request.get("blend_width", _DEFAULTS.blend_width)
         return eta, edited_target(grid, curves, M, E, width), "edited target"
-    grid = curve_base_from_nk(_record_nk(record), domain)
+    grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
     E, M = np.meshgrid(eta, mu, indexing="ij")
     return eta, grid.rgb(M, E), "reference"
 
 
-def _record_nk(record: FitRecord) -> SpectralNK:
-    if record.library_material is not None:
-        return library_material(record.library_material)
-    if record.nk is None:
+def _measured_nk_or_refuse(record: FitRecord) -> SpectralNK:
+    nk = measured_nk(record)
+    if nk is None:
         raise ValueError(f"fit {record.id} has no n, k to compare against")
-    return SpectralNK(np.asarray(record.nk["wavelength_nm"]), np.asarray(record.nk["n"]),
-                      np.asarray(record.nk["k"]), name=record.name, source=record.source)
+    return nk
 
 
 def _error_map(record: FitRecord, angles: int, rows: int) -> ErrorMap:

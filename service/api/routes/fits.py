@@ -25,7 +25,6 @@ from fastapi.concurrency import run_in_threadpool
 
 from fitting.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.fit import DEFAULT_OBJECTIVE
-from fitting.library import library_material
 from fitting.model import coated_conductor_model
 from fitting.nk import SpectralNK
 from fitting.pack import material_from_json
@@ -33,7 +32,7 @@ from fitting.reference import reference_ACEScg
 from fitting.sources import FORMATS, read_nk
 
 from ...downloads import PACK_MEDIA_TYPES, download_name, render_pack
-from ...fitting_jobs import NKFitSpec, fit_nk
+from ...fitting_jobs import NKFitSpec, fit_nk, measured_nk
 from ...models import (
     API_PREFIX,
     FIT_ID_PATTERN,
@@ -80,12 +79,17 @@ def stored_fit(store: Store, fit_id: str) -> FitRecord:
     return record
 
 
-async def _answer(spec: NKFitSpec, store: Store, runner, response: Response) -> FitPublic:
-    with fit_errors():
-        record, created = await fit_nk(spec, store, runner)
+def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPublic:
+    """A fit's answer: 201 when just fitted, 200 from the store; Location of the fit."""
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
     return fit_public(record)
+
+
+async def _answer(spec: NKFitSpec, store: Store, runner, response: Response) -> FitPublic:
+    with fit_errors():
+        record, created = await fit_nk(spec, store, runner)
+    return fit_answer(record, created, response)
 
 
 @router.post(
@@ -205,18 +209,6 @@ def pack_response(records: list[FitRecord], format: str, stem: str) -> Response:
     )
 
 
-def _nk_of(record: FitRecord) -> SpectralNK | None:
-    """The measured n, k of a fit (library or stored data), None for curve fits."""
-    if record.library_material is not None:
-        return library_material(record.library_material)
-    if record.nk is not None:
-        return SpectralNK(
-            np.asarray(record.nk["wavelength_nm"]), np.asarray(record.nk["n"]),
-            np.asarray(record.nk["k"]), name=record.name, source=record.source,
-        )
-    return None
-
-
 @router.get(
     "/{fit_id}/curves", response_model=CurvesPublic, responses={**ERROR_RESPONSES, **NOT_FOUND}
 )
@@ -237,7 +229,7 @@ def get_curves(
     mu = np.clip(np.cos(np.radians(theta)), 0.0, 1.0)
     model = coated_conductor_model(mu, eta_i, packed.coefficients, packed.eta_i_range)
     reference = baseline = None
-    nk = _nk_of(record)
+    nk = measured_nk(record)
     if nk is not None:
         reference = reference_ACEScg(nk, mu, eta_i).tolist()
         inputs = baseline_inputs(nk)

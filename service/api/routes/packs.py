@@ -25,13 +25,24 @@ router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
     },
 )
 def create_pack(request: PackRequest, store: StoreDep) -> Response:
-    """The fits named by ``fit_ids``, in that order, as one pack."""
-    records = []
+    """
+    The fits named by ``fit_ids``, in that order, as one pack. A renderer
+    looks materials up by name, so names in a pack are unique: two fits of
+    the same name are refused (422) rather than shipped ambiguously.
+    """
+    records, names = [], {}
     for index, fit_id in enumerate(request.fit_ids):
         record = store.get_fit(fit_id)
         if record is None:
             raise HTTPException(
                 status.HTTP_404_NOT_FOUND, f"`fit_ids[{index}]` {fit_id} is not a stored fit"
             )
+        if record.name in names:
+            raise HTTPException(
+                status.HTTP_422_UNPROCESSABLE_CONTENT,
+                f"`fit_ids[{index}]` is named {record.name!r} like `fit_ids[{names[record.name]}]`: "
+                "names in a pack must be unique",
+            )
+        names[record.name] = index
         records.append(record)
     return pack_response(records, request.format, request.name)

@@ -6,7 +6,10 @@ Preview
 preview sphere of a stored fit (``preview_shaders.preview``), optionally
 split with adjusted Lazanyi or the spectral reference (these need the
 fit's n, k). One renderer per app, made on first use; it owns its GL
-thread, so concurrent requests are serialised there.
+thread, so concurrent requests are serialised there. At most
+``max_previews_in_flight`` previews are computed at once (the spectral
+reference of a large preview is seconds of CPU); past it a request is
+answered 503 with Retry-After rather than queued.
 """
 
 from __future__ import annotations
@@ -20,7 +23,8 @@ from fitting.pack import material_from_json
 
 from ...models import API_PREFIX, FIT_ID_PATTERN, ErrorBody
 from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep
-from .fits import _nk_of, stored_fit
+from ...fitting_jobs import measured_nk
+from .fits import stored_fit
 
 router = APIRouter(prefix=API_PREFIX, tags=["preview"])
 _lock = threading.Lock()
@@ -35,6 +39,15 @@ def renderer(request: Request):
 
             state.preview_renderer = PreviewRenderer()
         return state.preview_renderer
+
+
+def _slots(request: Request, settings) -> threading.BoundedSemaphore:
+    """The app's bound on previews in flight, made on first use."""
+    state = request.app.state
+    with _lock:
+        if getattr(state, "preview_slots", None) is None:
+            state.preview_slots = threading.BoundedSemaphore(settings.max_previews_in_flight)
+        return state.preview_slots
 
 
 @router.get(
@@ -62,23 +75,34 @@ def preview_png(
             f"`size` must be at most {settings.max_preview_size} (COATED_MAX_PREVIEW_SIZE), got {size}",
         )
     record = stored_fit(store, fit)
-    nk = _nk_of(record)
+    nk = measured_nk(record)
     if compare != "none" and nk is None:
         raise HTTPException(
             status.HTTP_422_UNPROCESSABLE_CONTENT,
             f"`compare`={compare!r} needs measured n, k; fit {fit} was made from curves",
         )
-    try:
-        active = renderer(request)
-    except Exception as error:  # no GL driver: the rest of the service still works
+    slots = _slots(request, settings)
+    if not slots.acquire(blocking=False):
         raise HTTPException(
-            status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
-        ) from None
-    try:
-        result = active.render_preview(
-            material_from_json(record.material), nk, eta_i=eta_i, size=size,
-            compare=compare, environment=environment,
+            status.HTTP_503_SERVICE_UNAVAILABLE,
+            f"{settings.max_previews_in_flight} previews are being rendered "
+            "(COATED_MAX_PREVIEWS_IN_FLIGHT); retry shortly",
+            headers={"Retry-After": "2"},
         )
-    except ValueError as error:
-        raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
+    try:
+        try:
+            active = renderer(request)
+        except Exception as error:  # no GL driver: the rest of the service still works
+            raise HTTPException(
+                status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
+            ) from None
+        try:
+            result = active.render_preview(
+                material_from_json(record.material), nk, eta_i=eta_i, size=size,
+                compare=compare, environment=environment,
+            )
+        except ValueError as error:
+            raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
+    finally:
+        slots.release()
     return Response(result.png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})

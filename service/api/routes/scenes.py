@@ -30,6 +30,7 @@ from fitting.library import LIBRARY_NAMES, library_material
 from fitting.nk import SpectralNK
 from fitting.scene import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS, fit_scene, parse_scene
 
+from ...fitting_jobs import measured_nk
 from ...models import API_PREFIX, NKData
 from ...store import Store
 from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_errors
@@ -101,13 +102,13 @@ def _resolver(store: Store):
         if material in LIBRARY_NAMES:
             return library_material(material)
         record = store.latest_fit(material)
-        if record is None or record.nk is None:
+        nk = None if record is None else measured_nk(record)
+        if nk is None:
             raise ValueError(
                 f"`material` must be a built-in conductor ({', '.join(LIBRARY_NAMES)}) "
                 f"or the id of a saved material with n, k, got {material!r}"
             )
-        return SpectralNK(record.nk["wavelength_nm"], record.nk["n"], record.nk["k"],
-                          name=record.name, source=record.source)
+        return nk
 
     return resolve
 
