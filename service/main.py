@@ -153,8 +153,9 @@ async def _http_error(request: Request, error: StarletteHTTPException) -> JSONRe
     if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail == _UNPARSABLE_BODY:
         media_type = request.headers.get("content-type", "none").split(";")[0]
         return JSONResponse(
-            {"detail": f"the body could not be parsed as {media_type}: JSON must be UTF-8 text, "
-                       "uploads multipart/form-data with a `file` part",
+            {"detail": f"the body could not be parsed as {media_type}: JSON must be UTF-8 text "
+                       "nested at most a few hundred levels deep, uploads multipart/form-data "
+                       "with a `file` part",
              "errors": [{"loc": ["body"], "msg": "unparsable body", "type": "body_unparsable"}]},
             status_code=status.HTTP_422_UNPROCESSABLE_CONTENT,
         )

@@ -233,6 +233,7 @@ class TestBadInput:
             (b'{"material": "Au", "eta_i_range": [1, Infinity]}', "eta_i_range[1]"),
             (b'[1, 2]', "dictionary"),
             (b'\xe75\xbd\x91{"material": "Au"}', "must be UTF-8"),
+            (b"[" * 100_000 + b"]" * 100_000, "nested at most"),
             (b'{"material": 3}', "material"),
             (b'{"material": "Unobtainium"}', "material"),
             (b"{}", "exactly one of"),
