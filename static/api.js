@@ -1,10 +1,32 @@
 // Calls to the service's HTTP API (same origin). A refusal becomes an Error
-// whose message is the service's `detail` (it names the field and the rule).
+// whose message is the service's `detail` (it names the field and the rule)
+// and whose `status` is the HTTP status (401: the API token is missing or wrong).
 
 const API = "/api/v1";
+const TOKEN_KEY = "coated-api-token";
 
-async function answer(response) {
-  if (response.ok) return response.json();
+// The bearer token of the write endpoints (COATED_API_TOKEN), kept for this
+// tab only; sent with every request once set.
+export function getToken() {
+  try {
+    return sessionStorage.getItem(TOKEN_KEY) || "";
+  } catch (_) {
+    return ""; // storage disabled: no token
+  }
+}
+
+export function setToken(token) {
+  if (token) sessionStorage.setItem(TOKEN_KEY, token);
+  else sessionStorage.removeItem(TOKEN_KEY);
+}
+
+function headers(extra = {}) {
+  const token = getToken();
+  return token ? { ...extra, Authorization: `Bearer ${token}` } : extra;
+}
+
+async function answer(response, read = (r) => r.json()) {
+  if (response.ok) return read(response);
   let detail = `${response.status} ${response.statusText}`;
   try {
     const body = await response.json();
@@ -18,19 +40,19 @@ async function answer(response) {
 }
 
 export async function getJSON(path) {
-  return answer(await fetch(API + path, { headers: { Accept: "application/json" } }));
+  return answer(await fetch(API + path, { headers: headers({ Accept: "application/json" }) }));
 }
 
 export async function postJSON(path, body) {
   return answer(await fetch(API + path, {
     method: "POST",
-    headers: { "Content-Type": "application/json", Accept: "application/json" },
+    headers: headers({ "Content-Type": "application/json", Accept: "application/json" }),
     body: JSON.stringify(body),
   }));
 }
 
 export async function postForm(path, form) {
-  return answer(await fetch(API + path, { method: "POST", body: form }));
+  return answer(await fetch(API + path, { method: "POST", headers: headers(), body: form }));
 }
 
 export const listMaterials = () => getJSON("/materials");
@@ -49,8 +71,10 @@ export function curves(fitId, etaI, samples) {
   return getJSON(`/fits/${fitId}/curves?eta_i=${etaI.toFixed(3)}&samples=${samples}`);
 }
 
-export function previewURL(fitId, etaI, compare) {
-  return `${API}/preview.png?fit=${fitId}&eta_i=${etaI.toFixed(3)}&size=320&compare=${compare}`;
+// The preview sphere as a PNG blob.
+export async function preview(fitId, etaI, compare) {
+  const path = `/preview.png?fit=${fitId}&eta_i=${etaI.toFixed(3)}&size=320&compare=${compare}`;
+  return answer(await fetch(API + path, { headers: headers() }), (r) => r.blob());
 }
 
 export function packURL(fitId, format) {

@@ -26,9 +26,10 @@ const state = {
   baseCurves: null, // reference, lazanyi and base model at the current eta_i
   model: null,      // the current fit at the current eta_i
   request: 0,       // drops answers of superseded refits
+  etaRequest: 0,    // drops curves of superseded eta_i (or fits)
 };
 
-const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: refit });
+const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: guard(refit) });
 
 // ---------------------------------------------------------------- messages
 
@@ -36,6 +37,26 @@ function say(text, ok = false) {
   const box = $("message");
   box.textContent = text;
   box.classList.toggle("ok", ok);
+}
+
+// A refusal, shown; a 401 (the service wants its API token) opens the token
+// field and remembers `retry`, run again once a token is entered.
+let retryAfterToken = null;
+function report(error, retry = null, prefix = "") {
+  if (error.status !== 401) {
+    say(prefix + error.message);
+    return;
+  }
+  retryAfterToken = retry;
+  $("token-settings").open = true;
+  $("token").focus();
+  say(`${prefix}The service needs its API token (401). Enter it under “API token” ` +
+    `and press Use token${retry ? "; the action is then retried" : ""}.`);
+}
+
+function guard(work) {
+  const run = (...args) => Promise.resolve(work(...args)).catch((error) => report(error, () => run(...args)));
+  return run;
 }
 
 let busyCount = 0;
@@ -112,6 +133,7 @@ function setBase(fit) {
   $("material-source").textContent = fit.source ? fit.source.split("\n")[0].slice(0, 160) : "";
   $("compare").disabled = !fit.has_nk;
   if (!fit.has_nk) $("compare").value = "none";
+  $("reset").title = fit.kind === "curves" ? "Back to the saved edit as opened" : "Back to the measured data";
   say("");
   return showEta().then(showFit);
 }
@@ -120,19 +142,24 @@ function setBase(fit) {
 
 const key = (eta) => Number(eta).toFixed(2);
 
+// The curves an edit starts from: the measured reference, or for a saved
+// edit (a curve fit) its own model, so that editing it again starts from it.
 function target() {
   const edit = state.edits[key(state.eta)];
   if (edit) return edit;
   if (!state.baseCurves) return null;
+  if (state.base.kind === "curves") return state.baseCurves.model;
   return state.baseCurves.reference || state.baseCurves.model;
 }
 
 async function showEta() {
   $("eta-value").textContent = key(state.eta);
+  const request = ++state.etaRequest;
   const [base, current] = await Promise.all([
     api.curves(state.base.id, state.eta, SAMPLES),
     state.fit.id === state.base.id ? null : api.curves(state.fit.id, state.eta, SAMPLES),
   ]);
+  if (request !== state.etaRequest) return; // a later eta_i (or fit) asked since
   state.theta = base.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
   state.baseCurves = base;
   state.model = current ? current.model : base.model;
@@ -181,15 +208,20 @@ function snapshot() {
 
 let dragStart = null;
 
+// Move a control point; true when the target changed (then a refit follows).
 function drag(channel, handle, value) {
   const k = key(state.eta);
-  if (dragStart === null) dragStart = snapshot();
-  const current = target().map((rgb) => rgb.slice());
+  // The slider moved and its curves are not in yet: the plot shows another eta_i.
+  if (!state.baseCurves || key(state.baseCurves.eta_i) !== k) return false;
+  // Clamped: the reference can exceed 1 by rounding (1.0000000000000002 at 90 degrees).
+  const current = target().map((rgb) => rgb.map((v) => Math.min(1, Math.max(0, v))));
   const i = state.theta.indexOf(HANDLES[handle]);
+  const delta = value - current[i][channel];
+  if (delta === 0) return false;
+  if (dragStart === null) dragStart = snapshot();
   const channels = document.querySelector("input[name=channel]:checked").value === "all" ? [0, 1, 2] : [channel];
   const at = (t) => Math.exp(-0.5 * ((t - HANDLES[handle]) / FALLOFF_DEG) ** 2) * (1 - (t / 90) ** 6);
   const peak = at(HANDLES[handle]);
-  const delta = value - current[i][channel];
   for (let j = 0; j < state.theta.length; j++) {
     // Grazing (90 degrees) stays 1: the model meets 1 there whatever its coefficients.
     const w = at(state.theta[j]) / peak;
@@ -197,6 +229,7 @@ function drag(channel, handle, value) {
   }
   state.edits[k] = current;
   redraw();
+  return true;
 }
 
 async function refit() {
@@ -208,7 +241,9 @@ async function refit() {
   await fitEdits();
 }
 
-async function fitEdits() {
+// Refit the edits; true when the fit of the current edits is shown, false
+// when the service refused (reported with `prefix`; `retry` after a 401).
+async function fitEdits(prefix = "The service refused the edit: ", retry = fitEdits) {
   const etas = Object.keys(state.edits).sort();
   const request = ++state.request;
   if (!etas.length) {
@@ -221,24 +256,25 @@ async function fitEdits() {
     };
     try {
       const fit = await busy("Fitting…", () => api.fitFromCurves(body));
-      if (request !== state.request) return;
+      if (request !== state.request) return false;
       state.fit = fit;
       say("");
     } catch (error) {
-      if (request === state.request) say(`The service refused the edit: ${error.message}`);
+      if (request === state.request) report(error, retry, prefix);
       redraw();
-      return;
+      return false;
     }
   }
   await showEta();
   await showFit();
+  return request === state.request;
 }
 
 // ---------------------------------------------------------------- fit views
 
 async function showFit() {
   const fit = state.fit;
-  const edited = Object.keys(state.edits).length > 0 && fit.kind === "curves";
+  const edited = fit.kind === "curves";
   const model = fit.metrics.model || {};
   $("de-label").textContent = edited ? "Fit vs edited curves, mean ΔE00" : "Fit vs measured reference, mean ΔE00";
   $("de-mean").textContent = model.delta_E_mean != null ? model.delta_E_mean.toFixed(3) : "–";
@@ -260,12 +296,7 @@ async function showPreview() {
   const compare = fit.has_nk ? $("compare").value : "none";
   const img = $("preview");
   try {
-    const response = await busy("Rendering the preview…", () => fetch(api.previewURL(fit.id, state.eta, compare)));
-    if (!response.ok) {
-      const body = await response.json().catch(() => ({}));
-      throw new Error(body.detail || `${response.status} ${response.statusText}`);
-    }
-    const blob = await response.blob();
+    const blob = await busy("Rendering the preview…", () => api.preview(fit.id, state.eta, compare));
     if (previewURL) URL.revokeObjectURL(previewURL);
     previewURL = URL.createObjectURL(blob);
     img.src = previewURL;
@@ -324,7 +355,8 @@ async function save() {
     $("name").focus();
     return;
   }
-  await fitEdits();
+  // A refused refit (401, 503, 422) is reported by fitEdits: nothing was saved.
+  if (!(await fitEdits("Not saved: ", save))) return;
   if (state.fit.kind !== "curves") return;
   await loadMaterials($("material").value);
   say(`Saved “${state.fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
@@ -339,10 +371,15 @@ async function upload(file) {
   });
 }
 
-function guard(work) {
-  return (...args) => Promise.resolve(work(...args)).catch((error) => say(error.message));
-}
-
+$("token").value = api.getToken();
+$("token-form").addEventListener("submit", (event) => {
+  event.preventDefault();
+  api.setToken($("token").value.trim());
+  say(api.getToken() ? "API token set for this tab." : "API token cleared.", true);
+  const retry = retryAfterToken;
+  retryAfterToken = null;
+  if (retry) guard(retry)();
+});
 $("material").addEventListener("change", guard((event) => pickMaterial(event.target.value)));
 $("upload").addEventListener("change", guard((event) => event.target.files[0] && upload(event.target.files[0])));
 $("eta").addEventListener("input", (event) => setEta(Number(event.target.value)));
@@ -360,7 +397,7 @@ $("download").addEventListener("click", (event) => {
   if (!state.fit) event.preventDefault();
 });
 document.addEventListener("keydown", (event) => {
-  if (!(event.ctrlKey || event.metaKey) || event.target.matches("input[type=text]")) return;
+  if (!(event.ctrlKey || event.metaKey) || event.target.matches("input[type=text], input[type=password]")) return;
   const k = event.key.toLowerCase();
   if (k === "z" && !event.shiftKey) { event.preventDefault(); guard(() => undoRedo(state.undo, state.redo))(); }
   if ((k === "z" && event.shiftKey) || k === "y") { event.preventDefault(); guard(() => undoRedo(state.redo, state.undo))(); }

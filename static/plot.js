@@ -15,7 +15,7 @@ function el(name, attributes = {}, parent = null) {
 export class ReflectancePlot {
   /**
    * @param {HTMLElement} container
-   * @param {object} hooks  onDrag(channel, handleIndex, value), onDragEnd()
+   * @param {object} hooks  onDrag(channel, handleIndex, value) -> whether the point moved, onDragEnd()
    */
   constructor(container, hooks) {
     this.hooks = hooks;
@@ -28,6 +28,7 @@ export class ReflectancePlot {
       this.layers[name] = el("g", { class: name }, this.svg);
     }
     this.dragging = null;
+    this.keyMoved = false; // a key press moved a point since the last refit
     this.svg.addEventListener("pointermove", (event) => this.#move(event));
     this.svg.addEventListener("pointerup", () => this.#release());
     this.svg.addEventListener("pointercancel", () => this.#release());
@@ -124,7 +125,9 @@ export class ReflectancePlot {
         });
         circle.addEventListener("keydown", (event) => this.#key(event, c, h));
         circle.addEventListener("keyup", (event) => {
-          if (["ArrowUp", "ArrowDown", "PageUp", "PageDown"].includes(event.key)) this.hooks.onDragEnd();
+          if (!["ArrowUp", "ArrowDown", "PageUp", "PageDown"].includes(event.key) || !this.keyMoved) return;
+          this.keyMoved = false;
+          this.hooks.onDragEnd();
         });
       }
     });
@@ -137,7 +140,7 @@ export class ReflectancePlot {
     if (!(event.key in steps)) return;
     event.preventDefault();
     const step = steps[event.key] * (event.shiftKey ? 5 : 1);
-    this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)));
+    if (this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)))) this.keyMoved = true;
   }
 
   #move(event) {
@@ -147,8 +150,7 @@ export class ReflectancePlot {
     point.y = event.clientY;
     const local = point.matrixTransform(this.svg.getScreenCTM().inverse());
     const value = Math.min(1, Math.max(0, this.value(local.y)));
-    this.dragging.moved = true;
-    this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value);
+    if (this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value)) this.dragging.moved = true;
   }
 
   #release() {

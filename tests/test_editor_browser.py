@@ -1,12 +1,17 @@
 """
 The curve editor in a real Chromium (Debian's, through the Python playwright
 package) against a real server process on 127.0.0.1: pick Au, move the
-eta_i slider, drag a red control point, refit, undo, save, reload, download.
+eta_i slider, drag a red control point, refit, undo, save, reload, reopen the
+saved edit (it is the baseline of further edits), download; a refused save is
+reported, not claimed; a server that requires a bearer token asks for it.
 """
 
 from __future__ import annotations
 
+import json
+
 import pytest
+from conftest import server_process
 from playwright.sync_api import expect, sync_playwright
 
 from fitting.pack import decode_pack
@@ -60,6 +65,22 @@ def open_editor(page, url):
     page.goto(url)
     page.wait_for_selector("body[data-ready=true]")
     wait_idle(page)
+
+
+def edit_by_keyboard(page, channel=1, angle=36, key="Shift+ArrowUp"):
+    """Move one control point with the keyboard; the refit follows."""
+    page.locator(f"input[name=channel][value='{channel}']").check()
+    point = page.locator(f"circle.handle.c{channel}[data-angle='{angle}']")
+    point.focus()
+    page.keyboard.press(key)
+    return point
+
+
+def from_curves_requests(page):
+    """The POST /fits/from-curves requests the page makes from now on."""
+    seen = []
+    page.on("request", lambda r: seen.append(r) if r.url.endswith("/api/v1/fits/from-curves") else None)
+    return seen
 
 
 def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
@@ -117,6 +138,17 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     assert after == pytest.approx(min(1.0, before + 0.05), abs=1e-3)
     keyboard_id = wait_fit(page, edited_id)
 
+    # A key press that moves nothing (the point is at 1 already) does not refit.
+    point = edit_by_keyboard(page, 1, 84, "Shift+PageUp")
+    page.keyboard.press("Shift+PageUp")
+    page.wait_for_function("document.querySelector(\"circle.handle.c1[data-angle='84']\")"
+                           ".getAttribute('aria-valuenow') === '1.000'")
+    keyboard_id = wait_fit(page, keyboard_id)
+    requests = from_curves_requests(page)
+    page.keyboard.press("ArrowUp")
+    page.wait_for_timeout(500)
+    assert requests == [] and page.inner_text("#fit-id") == keyboard_id
+
     # Save under a name; it is listed after a reload.
     page.fill("#name", "Pale gold browser test")
     page.click("#save")
@@ -127,8 +159,19 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     option = page.locator("#material option", has_text="Pale gold browser test")
     expect(option).to_have_count(1)
 
-    # Open the saved material and download its binary pack.
+    # Open the saved material: its own fit is the baseline of further edits
+    # (the edited target starts on its model curve, not on the measured data)
+    # and the base of the refit.
     page.select_option("#material", option.get_attribute("value"))
+    page.wait_for_function(f"document.getElementById('fit-id').textContent === '{saved_id}'")
+    wait_idle(page)
+    assert page.get_attribute("path.target.c0", "d") == page.get_attribute("path.model.c0", "d")
+    assert page.get_attribute("path.target.c0", "d") != page.get_attribute("path.reference.c0", "d")
+    with page.expect_request("**/api/v1/fits/from-curves") as request:
+        edit_by_keyboard(page, 0, 50, "ArrowDown")
+    assert request.value.post_data_json["base"] == {"fit": saved_id}
+    wait_fit(page, saved_id)
+    page.click("#undo")
     page.wait_for_function(f"document.getElementById('fit-id').textContent === '{saved_id}'")
     wait_idle(page)
     page.select_option("#format", "binary")
@@ -150,3 +193,73 @@ def test_refusal_is_shown(page, editor_url, tmp_path):
     wait_idle(page)
     assert "500" not in page.inner_text("#fit-id")  # nothing was fitted
     assert page.locator("#message").get_attribute("role") == "alert"
+
+
+def test_refused_save_is_not_claimed(page, editor_url):
+    open_editor(page, editor_url)
+    base_id = page.inner_text("#fit-id")
+    edit_by_keyboard(page)
+    edited_id = wait_fit(page, base_id)
+
+    # The refit behind Save is refused (503): the page says so, names the
+    # service's reason, and neither claims nor lists a saved material.
+    detail = "too many fits in flight (2 queued); retry after 1 s"
+    page.route("**/api/v1/fits/from-curves", lambda route: route.fulfill(
+        status=503, content_type="application/json", body=json.dumps({"detail": detail})))
+    page.fill("#name", "Refused browser test")
+    page.click("#save")
+    expect(page.locator("#message")).to_have_text(f"Not saved: {detail}")
+    wait_idle(page)
+    expect(page.locator("#message")).not_to_have_class("message ok")
+    assert page.inner_text("#fit-id") == edited_id
+    expect(page.locator("#material option", has_text="Refused browser test")).to_have_count(0)
+
+    # Once the service takes it again, Save works.
+    page.unroute("**/api/v1/fits/from-curves")
+    page.click("#save")
+    expect(page.locator("#message")).to_contain_text("Saved “Refused browser test”")
+    expect(page.locator("#material option", has_text="Refused browser test")).to_have_count(1)
+
+
+def test_token_is_asked_for_kept_and_sent(page, tmp_path):
+    token = "editor-browser-test-token"
+    with server_process(tmp_path / "data", COATED_REQUIRE_TOKEN="true", COATED_API_TOKEN=token) as server:
+        writes = []
+        page.on("request", lambda r: writes.append(r) if r.method == "POST" else None)
+        page.goto(server.url + "/")
+
+        # The first fit (POST /fits) is refused with 401: the token field opens,
+        # takes the focus, and the message says what to do.
+        message = page.locator("#message")
+        expect(message).to_contain_text("needs its API token (401)")
+        expect(page.locator("#token-settings")).to_have_attribute("open", "")
+        expect(page.locator("#token")).to_be_focused()
+        assert page.get_attribute("body", "data-ready") is None
+
+        # A wrong token is refused again; the right one retries the action.
+        page.fill("#token", "wrong")
+        page.press("#token", "Enter")
+        expect(message).to_contain_text("needs its API token (401)")
+        wait_idle(page)
+        page.fill("#token", token)
+        page.click("#token-form button[type=submit]")
+        page.wait_for_selector("body[data-ready=true]")
+        wait_idle(page)
+        base_id = page.inner_text("#fit-id")
+        assert len(base_id) == 32
+        assert writes[-1].headers.get("authorization") == f"Bearer {token}"
+
+        # Edits and saves go through with the token.
+        edit_by_keyboard(page)
+        wait_fit(page, base_id)
+        assert writes[-1].url.endswith("/fits/from-curves")
+        assert writes[-1].headers.get("authorization") == f"Bearer {token}"
+        page.fill("#name", "Token browser test")
+        page.click("#save")
+        expect(message).to_contain_text("Saved “Token browser test”")
+
+        # The token is kept for the tab (sessionStorage): a reload works at once.
+        assert page.evaluate("sessionStorage.getItem('coated-api-token')") == token
+        open_editor(page, server.url + "/")
+        expect(page.locator("#token-settings")).not_to_have_attribute("open", "")
+        expect(message).to_be_empty()
