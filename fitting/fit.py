@@ -175,6 +175,9 @@ class FitResult:
         The :class:`fitting.pack.PackedMaterial` (n, k fits).
     metrics
         Filled by :func:`evaluate_material` or the caller.
+    model
+        The model kind (:data:`fitting.models.kinds.MODEL_KINDS`); an
+        ``rgb-conductor`` fit has coefficients of shape (2, 3) and degree 0.
     """
 
     coefficients: np.ndarray
@@ -193,6 +196,7 @@ class FitResult:
     coverage: float = 1.0
     packed: PackedMaterial | None = None
     metrics: dict[str, Any] = field(default_factory=dict)
+    model: str = "coated-conductor"
 
     @property
     def iterations(self) -> int:
@@ -202,6 +206,7 @@ class FitResult:
     def summary(self) -> dict[str, Any]:
         """JSON-friendly report of the convergence and timings."""
         return {
+            "model": self.model,
             "success": self.success,
             "status": self.status,
             "message": self.message,

@@ -1,0 +1,6 @@
+"""
+Models
+======
+
+Each model kind with its evaluator and its pack form (layer 3).
+"""
