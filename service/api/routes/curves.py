@@ -44,8 +44,9 @@ from fitting.curves import (
 from fitting.fit import content_id
 from fitting.library import library_material
 from fitting.metrics import delta_E_map
-from fitting.model import check_eta_i_range, coated_conductor_model
+from fitting.model import check_eta_i_range
 from fitting.nk import SpectralNK
+from fitting.models.kinds import model_ACEScg
 from fitting.pack import material_from_json, material_to_json
 
 from ...fitting_jobs import FIT_FORMAT_VERSION, check_finite, fit_record, measured_nk
@@ -387,7 +388,7 @@ def _error_map(record: FitRecord, angles: int, rows: int) -> ErrorMap:
     eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
     eta, target, against = _target_of(record, mu, eta)
     E, M = np.meshgrid(eta, mu, indexing="ij")
-    model = coated_conductor_model(M, E, packed.coefficients, packed.eta_i_range)
+    model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
     dE = delta_E_map(target, model)
     return ErrorMap(
         fit_id=record.id, against=against, theta_deg=theta.tolist(), eta_i=eta.tolist(),

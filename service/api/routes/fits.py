@@ -25,7 +25,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from fitting.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.fit import DEFAULT_OBJECTIVE
-from fitting.model import coated_conductor_model
+from fitting.models.kinds import model_ACEScg
 from fitting.nk import SpectralNK
 from fitting.pack import material_from_json
 from fitting.reference import reference_ACEScg
@@ -111,6 +111,7 @@ async def create_fit(
             kind="library", name=request.material, source="",
             eta_i_range=request.eta_i_range, objective=request.objective,
             library_material=request.material, metrics_samples=settings.metrics_samples,
+            model=request.model,
         )
     else:
         spec = NKFitSpec(
@@ -118,6 +119,7 @@ async def create_fit(
             eta_i_range=request.eta_i_range, objective=request.objective,
             wavelength_nm=tuple(request.nk.wavelength_nm), n=tuple(request.nk.n),
             k=tuple(request.nk.k), metrics_samples=settings.metrics_samples,
+            model=request.model,
         )
     return await _answer(spec, store, runner, response)
 
@@ -227,7 +229,7 @@ def get_curves(
     packed = material_from_json(record.material)
     theta = np.linspace(0.0, 90.0, samples)
     mu = np.clip(np.cos(np.radians(theta)), 0.0, 1.0)
-    model = coated_conductor_model(mu, eta_i, packed.coefficients, packed.eta_i_range)
+    model = model_ACEScg(packed.model, mu, eta_i, packed.coefficients, packed.eta_i_range)
     reference = baseline = None
     nk = measured_nk(record)
     if nk is not None:
