@@ -25,12 +25,12 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from fitting import LIBRARY_NAMES, fit_material, library_material  # noqa: E402
-from fitting.fit import OBJECTIVES  # noqa: E402
+from fitting.fits.settings import OBJECTIVES  # noqa: E402
 from fitting.fits.rgb_conductor import fit_rgb_conductor  # noqa: E402
-from fitting.metrics import delta_E_map  # noqa: E402
-from fitting.model import coated_conductor_model  # noqa: E402
+from fitting.colour.delta_e import delta_E_map  # noqa: E402
+from fitting.models.coated_conductor import coated_conductor_model  # noqa: E402
 from fitting.models.rgb_conductor import rgb_conductor_model  # noqa: E402
-from fitting.reference import evaluation_grid, reference_ACEScg  # noqa: E402
+from fitting.colour.reference import evaluation_grid, reference_ACEScg  # noqa: E402
 
 ETA_I_RANGE = (1.0, 2.5)
 

@@ -4,7 +4,7 @@ Fits by model kind
 
 -   :func:`fit_model`: measured *n*, *k* to a float16 pack material of any
     kind of :data:`fitting.models.kinds.MODEL_KINDS`, by
-    :func:`fitting.fit.fit_material` (``coated-conductor``) or
+    :func:`fitting.fits.material.fit_material` (``coated-conductor``) or
     :func:`fitting.fits.rgb_conductor.fit_rgb_conductor` (``rgb-conductor``).
 -   :func:`evaluate_model`: the metrics of such a fit on the paper's grid.
 """
@@ -13,11 +13,14 @@ from __future__ import annotations
 
 from typing import Any
 
-from ..fit import FitResult, FitSettings, evaluate_material, fit_material
-from ..model import DEFAULT_ETA_I_RANGE
+from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE
 from ..models.kinds import DEFAULT_MODEL, check_model
-from ..nk import DEFAULT_MIN_COVERAGE, SpectralNK
+from ..optics.nk import SpectralNK
+from .evaluate import evaluate_material
+from .material import fit_material
+from .result import FitResult
 from .rgb_conductor import evaluate_rgb_conductor, fit_rgb_conductor
+from .settings import FitSettings
 
 __all__ = ["fit_model", "evaluate_model"]
 
@@ -32,7 +35,7 @@ def fit_model(
 ) -> FitResult:
     """
     Fit kind ``model`` to ``nk`` over ``eta_i_range``; ``settings`` and
-    ``overrides`` as :func:`fitting.fit.fit_material` (``degree`` applies to
+    ``overrides`` as :func:`fitting.fits.material.fit_material` (``degree`` applies to
     the coated-conductor only). The result's ``model`` and ``packed.model``
     name the kind.
 
@@ -52,7 +55,7 @@ def evaluate_model(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
     min_coverage: float = DEFAULT_MIN_COVERAGE,
 ) -> dict[str, Any]:
-    """:func:`fitting.fit.evaluate_material` for a fit of either kind."""
+    """:func:`fitting.fits.evaluate.evaluate_material` for a fit of either kind."""
     if result.model == "rgb-conductor":
         return evaluate_rgb_conductor(nk, result, samples, baselines, min_coverage)
     return evaluate_material(nk, result, samples, baselines, min_coverage)

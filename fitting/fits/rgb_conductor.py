@@ -1,65 +1,59 @@
 """
-RGB conductor fit
-=================
+RGB conductor fits
+==================
 
 The model kind ``rgb-conductor`` (:mod:`fitting.models.rgb_conductor`)
 fitted to reflectance data: per channel *n* and *k* such that the exact
 Fresnel equations of the relative index :math:`(n_c + i k_c)/\\eta_i`
 follow the target over the whole (cos theta, eta_i) domain, with the
-objectives, grid and spectral step of the material fit
-(:class:`fitting.fit.FitSettings`), and float16 values chosen to minimise
-the objective, not merely rounded.
+objectives and grid of the material fit (:class:`fitting.fits.settings.FitSettings`),
+and float16 values chosen to minimise the objective, not merely rounded
+(:mod:`fitting.fits.rgb_conductor_quantise`).
 
 -   :func:`fit_rgb_conductor_coefficients`: the fit to RGB samples.
--   :func:`quantise_rgb_conductor`: float16 n, k minimising the objective.
 -   :func:`fit_rgb_conductor`: from measured *n*, *k* to a float16
-    :class:`fitting.pack.PackedMaterial` of kind ``rgb-conductor``.
+    :class:`fitting.models.pack.PackedMaterial` of kind ``rgb-conductor``.
 -   :func:`evaluate_rgb_conductor`: Delta E 2000 against the 1 nm reference
-    on the paper's 100 x 100 grid (as :func:`fitting.fit.evaluate_material`).
+    on the paper's 100 x 100 grid (as :func:`fitting.fits.evaluate.evaluate_material`).
+-   :func:`rgb_nk`: the older yardstick of the speed-against-error report,
+    per-channel n, k fitted in air (eta_i = 1) in linear RGB.
 
 References
 ----------
+Gulbrandsen, O. (2014). Artist friendly metallic Fresnel. JCGT, 3(4), 64-72.
 Pharr, M., Jakob, W., & Humphreys, G. (2023). Physically Based Rendering,
 4th ed., Section 14.3 (``CoatedConductor``: the relative index).
 Branch, M. A., Coleman, T. F., & Li, Y. (1999). Trust-region reflective
 least squares. SIAM J. Sci. Comput., 21(1), 1-23.
-Sharma, G., Wu, W., & Dalal, E. N. (2005). The CIEDE2000 color-difference formula.
 """
 
 from __future__ import annotations
 
-import itertools
 import time
 from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..colorimetry import ACEScg_to_Lab, delta_E_2000
-from ..fresnel import fresnel_conductor
-from ..fit import OBJECTIVES, FitResult, FitSettings, _de2000_weights, fit_grid
-from ..metrics import baseline_metrics, error_metrics
-from ..model import DEFAULT_ETA_I_RANGE, check_eta_i_range
+from ..colour.reference import evaluation_grid, reference_ACEScg, spectral_weights
+from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, check_eta_i_range
+from ..models.pack import PackedMaterial, to_float16
 from ..models.rgb_conductor import MODEL_KIND, rgb_conductor_model
-from ..nk import DEFAULT_MIN_COVERAGE, SpectralNK, resample_nk
-from ..pack import PackedMaterial, to_float16
-from ..reference import evaluation_grid, reference_ACEScg, spectral_weights
+from ..optics.fresnel import fresnel_conductor
+from ..optics.nk import SpectralNK, resample_nk
+from .metrics import baseline_metrics, error_metrics
+from .result import FitResult
+from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
+from .settings import OBJECTIVES, FitSettings, fit_grid
 
 __all__ = [
     "DEFAULT_SETTINGS",
-    "N_BOUNDS",
-    "K_BOUNDS",
+    "RGB_NK_SAMPLES",
     "fit_rgb_conductor_coefficients",
-    "quantise_rgb_conductor",
     "fit_rgb_conductor",
     "evaluate_rgb_conductor",
+    "rgb_nk",
 ]
-
-N_BOUNDS = (1.0e-3, 20.0)
-"""Bounds of n per channel: n > 0 as for any SpectralNK; every conductor of
-the library has n < 5 in 360-830 nm."""
-K_BOUNDS = (0.0, 50.0)
-"""Bounds of k per channel; the library's conductors have k < 12."""
 
 DEFAULT_SETTINGS = FitSettings(step_nm=1.0)
 """The material fit's settings with the reference at 1 nm: six unknowns fit in
@@ -71,61 +65,13 @@ _IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight, as the ma
 _N_STARTS = (0.2, 1.0, 3.0)  # starts of n per channel: the rgb problem has local minima
 
 
-class _Objective:
-    """Residuals of one fit: samples S, 3 outputs each (rgb, Lab or first-order CIEDE2000)."""
-
-    def __init__(self, target, mu, eta, objective, weights):
-        self.mu, self.eta, self.objective = mu, eta, objective
-        self.target = target
-        self.w = np.ones(mu.size) if weights is None else weights
-        if objective == "rgb":
-            self.target_out = target
-        else:
-            self.target_out = ACEScg_to_Lab(target)
-            self.A = _de2000_weights(self.target_out) if objective == "de2000" else None
-
-    def outputs(self, F):
-        if self.objective == "rgb":
-            return F - self.target_out
-        d = ACEScg_to_Lab(F) - self.target_out
-        if self.A is not None:
-            d = np.einsum("sij,sj->si", self.A, d)
-        return d
-
-    def residuals(self, x):
-        F = rgb_conductor_model(self.mu, self.eta, x.reshape(2, 3))
-        return (self.outputs(F) * np.sqrt(self.w)[:, None]).ravel()
-
-    def score(self, F):
-        """
-        The objective itself for reflectances ``F`` of shape (..., S, 3):
-        the weighted sum of squared residuals (``rgb``, ``lab``), or the
-        weighted sum of CIEDE2000 differences (``de2000``, which the
-        reweighted least squares approaches).
-        """
-        if self.objective == "de2000":
-            dE = delta_E_2000(np.broadcast_to(ACEScg_to_Lab(self.target), F.shape), ACEScg_to_Lab(F))
-            return np.sum(dE * self.w, axis=-1)
-        if self.objective == "rgb":
-            d = F - self.target_out
-        else:
-            d = ACEScg_to_Lab(F) - self.target_out
-        return np.sum(np.sum(d * d, axis=-1) * self.w, axis=-1)
-
-
-def _bounds():
-    lower = np.array([N_BOUNDS[0]] * 3 + [K_BOUNDS[0]] * 3)
-    upper = np.array([N_BOUNDS[1]] * 3 + [K_BOUNDS[1]] * 3)
-    return lower, upper
-
-
 def _initial_guess(target, mu, eta, weights) -> np.ndarray:
     """
     Per channel, the linear-RGB least-squares fit of (n_c, k_c) from a few
     starts of n (k from the normal-incidence reflectance); the best start
     wins, so the result is deterministic.
     """
-    lower, upper = _bounds()
+    lower, upper = nk_bounds()
     sqrt_w = np.sqrt(weights)
     x0 = np.empty((2, 3))
     # The sample nearest normal incidence in the lowest coating fixes k for a start.
@@ -150,90 +96,6 @@ def _initial_guess(target, mu, eta, weights) -> np.ndarray:
     return x0
 
 
-def _lattice(value: float, radius: int, lo: float, hi: float) -> np.ndarray:
-    """The float16 values nearest ``value``, ``radius`` on either side, clipped to [lo, hi]."""
-    h = np.float16(value)
-    below = h if float(h) <= value else np.nextafter(h, np.float16(-np.inf))
-    values = [below]
-    for _ in range(radius - 1):
-        values.insert(0, np.nextafter(values[0], np.float16(-np.inf)))
-    above = np.nextafter(below, np.float16(np.inf))
-    values.append(above)
-    for _ in range(radius - 1):
-        values.append(np.nextafter(values[-1], np.float16(np.inf)))
-    out = np.array(values, dtype=np.float64)
-    out = np.unique(np.clip(out, lo, hi))
-    return out[np.isfinite(out)]
-
-
-def quantise_rgb_conductor(
-    objective: _Objective, x: np.ndarray, radius: int = 8, keep: int = 8, passes: int = 8
-) -> np.ndarray:
-    """
-    Float16 n, k that minimise the fit's objective near the float64 optimum.
-
-    The objective is the fit's own (:meth:`_Objective.score`: the weighted
-    CIEDE2000 sum for ``de2000``, not its quadratic model). n and k of a
-    channel are strongly correlated (the error has a long valley), so the
-    best lattice point can lie several ulps from the optimum:
-
-    1.  per channel, every pair of the ``radius`` float16 values either side
-        of n and of k is scored with the other channels at the optimum,
-        and the ``keep`` best pairs are kept;
-    2.  every combination of the kept pairs of the three channels
-        (``keep``^3) is scored; the best is taken;
-    3.  one-ulp moves of single values are taken while they lower the
-        objective.
-
-    Plain rounding is among the candidates of step 1 but may be screened
-    out; the result is compared with it and the better kept, so it is never
-    worse than plain rounding on the fitting grid.
-    """
-    x = np.asarray(x, dtype=np.float64).reshape(2, 3)
-    lower, upper = _bounds()
-    mu, eta = objective.mu, objective.eta
-    F_opt = rgb_conductor_model(mu, eta, x)
-    kept = []  # per channel: (keep, 2) pairs of (n, k) and their (keep, S) reflectance
-    for c in range(3):
-        ns = _lattice(x[0, c], radius, lower[c], upper[c])
-        ks = _lattice(x[1, c], radius, lower[3 + c], upper[3 + c])
-        pairs = np.array(list(itertools.product(ns, ks)))
-        C = np.zeros((2, 3, pairs.shape[0]))
-        C[0] = 1.0
-        C[:, c, :] = pairs.T
-        # One evaluation for all pairs: channel c of each, the others at the optimum.
-        F_c = fresnel_conductor(mu[None, :], eta[None, :], pairs[:, :1], pairs[:, 1:])
-        F = np.broadcast_to(F_opt, (pairs.shape[0],) + F_opt.shape).copy()
-        F[:, :, c] = F_c
-        best = np.argsort(objective.score(F), kind="stable")[:keep]
-        kept.append((pairs[best], F_c[best]))
-    combos = np.array(list(itertools.product(*(range(len(k[0])) for k in kept))))
-    F = np.stack([kept[c][1][combos[:, c]] for c in range(3)], axis=-1)
-    scores = objective.score(F)
-    i = int(np.argmin(scores))
-    h = np.array([kept[c][0][combos[i, c]] for c in range(3)]).T.astype(np.float16)
-    current = float(scores[i])
-    # One-ulp moves from the best (the screening may have left the optimum at an edge).
-    for _ in range(passes * 6):
-        moves = []
-        for p, c in itertools.product(range(2), range(3)):
-            for direction in (np.float16(-np.inf), np.float16(np.inf)):
-                trial = h.copy()
-                trial[p, c] = np.nextafter(h[p, c], direction)
-                value = float(trial[p, c])
-                if np.isfinite(value) and lower[3 * p + c] <= value <= upper[3 * p + c]:
-                    moves.append(trial)
-        F = np.stack([rgb_conductor_model(mu, eta, t.astype(np.float64)) for t in moves])
-        trial_scores = objective.score(F)
-        j = int(np.argmin(trial_scores))
-        if not trial_scores[j] < current:
-            break
-        h, current = moves[j], float(trial_scores[j])
-    nearest = to_float16(x)
-    nearest_score = float(objective.score(rgb_conductor_model(mu, eta, nearest.astype(np.float64))))
-    return h if current <= nearest_score else nearest
-
-
 def fit_rgb_conductor_coefficients(
     target_RGB,
     cos_theta,
@@ -255,7 +117,7 @@ def fit_rgb_conductor_coefficients(
         \\min_{n, k \\in \\mathbb{R}^3} \\tfrac12 \\sum_s w_s \\lVert r_s \\rVert^2,
         \\qquad r_s = \\text{residual of } F(\\mu_s; (n + i k)/\\eta_s) - T_s
 
-    with the residual of :func:`fitting.fit.fit_coefficients` for each
+    with the residual of :func:`fitting.fits.solver.fit_coefficients` for each
     objective (linear RGB, Lab, first-order CIEDE2000), within
     :data:`N_BOUNDS` x :data:`K_BOUNDS`. For ``de2000``, ``irls_rounds``
     rounds reweight :math:`w_s` by :math:`1/\\max(\\Delta E_s, 0.02)` so that
@@ -275,9 +137,9 @@ def fit_rgb_conductor_coefficients(
         Domain [lo, hi] of eta_i, 1 <= lo <= hi <= 3 (recorded; the model
         does not depend on it).
     objective
-        One of :data:`fitting.fit.OBJECTIVES`.
+        One of :data:`fitting.fits.settings.OBJECTIVES`.
     max_nfev, quantise, weights, irls_rounds
-        As :func:`fitting.fit.fit_coefficients`.
+        As :func:`fitting.fits.solver.fit_coefficients`.
 
     Returns
     -------
@@ -306,22 +168,22 @@ def fit_rgb_conductor_coefficients(
         base = np.ravel(np.asarray(weights, dtype=np.float64))
         if base.size != mu.size or np.any(base < 0) or not np.all(np.isfinite(base)):
             raise ValueError("`weights` must be one finite value >= 0 per sample")
-    bounds = _bounds()
+    bounds = nk_bounds()
     x = _initial_guess(target, mu, eta, base).ravel()
-    problem = _Objective(target, mu, eta, objective, base)
+    problem = RGBConductorObjective(target, mu, eta, objective, base)
     options = dict(bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev)
     result = least_squares(problem.residuals, x, ftol=1e-10, xtol=1e-10, gtol=1e-10, **options)
     nfev, njev = result.nfev, result.njev or 0
     if objective == "de2000":
         for _ in range(irls_rounds):
-            dE = np.linalg.norm(_Objective(target, mu, eta, objective, None).residuals(result.x).reshape(-1, 3), axis=1)
+            dE = np.linalg.norm(RGBConductorObjective(target, mu, eta, objective, None).residuals(result.x).reshape(-1, 3), axis=1)
             floor = max(_IRLS_FLOOR, 1e-3 * float(dE.max()))
-            problem = _Objective(target, mu, eta, objective, base / np.maximum(dE, floor))
+            problem = RGBConductorObjective(target, mu, eta, objective, base / np.maximum(dE, floor))
             result = least_squares(problem.residuals, result.x, ftol=1e-8, xtol=1e-8, gtol=1e-8, **options)
             nfev, njev = nfev + result.nfev, njev + (result.njev or 0)
     t_fit = time.perf_counter()
     C = result.x.reshape(2, 3)
-    scorer = _Objective(target, mu, eta, objective, base)
+    scorer = RGBConductorObjective(target, mu, eta, objective, base)
     C16 = quantise_rgb_conductor(scorer, C) if quantise else to_float16(C)
     cost16 = 0.5 * float(np.sum(problem.residuals(C16.astype(np.float64).ravel()) ** 2))
     t_end = time.perf_counter()
@@ -353,13 +215,13 @@ def fit_rgb_conductor(
     """
     Fit the ``rgb-conductor`` kind to the spectral reference of ``nk`` over
     ``eta_i_range``, on the grid of ``settings`` (that of
-    :func:`fitting.fit.fit_material`; ``degree`` does not apply), by
+    :func:`fitting.fits.material.fit_material`; ``degree`` does not apply), by
     default :data:`DEFAULT_SETTINGS`.
 
     Returns
     -------
     FitResult
-        With ``packed`` (a :class:`fitting.pack.PackedMaterial` of model
+        With ``packed`` (a :class:`fitting.models.pack.PackedMaterial` of model
         ``rgb-conductor``), ``coverage``, ``timings`` and, when ``evaluate``
         is true, ``metrics`` from :func:`evaluate_rgb_conductor`.
 
@@ -403,7 +265,7 @@ def evaluate_rgb_conductor(
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
     (``samples`` x ``samples`` over [0, 1] x the fitted domain) for the
     float16 and float64 n, k, and (optionally) the baselines; the same
-    shape as :func:`fitting.fit.evaluate_material`.
+    shape as :func:`fitting.fits.evaluate.evaluate_material`.
     """
     lo, hi = result.eta_i_range
     M, E = evaluation_grid(samples, (lo, hi))
@@ -418,3 +280,64 @@ def evaluate_rgb_conductor(
     if baselines:
         out.update(baseline_metrics(nk, M, E, ref, min_coverage))
     return out
+
+
+RGB_NK_SAMPLES = 64
+"""Values of cos theta, evenly over [0, 1], at which (n_c, k_c) are fitted."""
+
+
+
+
+def rgb_nk(
+    nk: SpectralNK, step_nm: float = 1.0, min_coverage: float = DEFAULT_MIN_COVERAGE
+) -> tuple[np.ndarray, np.ndarray]:
+    """
+    Per-channel complex index of a material for the exact RGB Fresnel term.
+
+    For each channel *c*, solves
+
+    .. math::
+
+        \\min_{n_c, k_c} \\sum_s \\bigl(F(\\mu_s, 1; n_c, k_c) - R_c(\\mu_s)\\bigr)^2
+
+    with :math:`F` the exact unpolarised Fresnel reflectance in air,
+    :math:`R_c` channel *c* of the spectral reference (linear ACEScg) and
+    :math:`\\mu_s` :data:`RGB_NK_SAMPLES` values evenly over [0, 1], by the
+    trust-region reflective method from the start :math:`n = 1`, :math:`k`
+    from F0 (deterministic), within n in [1e-3, 20], k in [0, 50].
+
+    Parameters
+    ----------
+    nk
+        Measured spectral *n*, *k*.
+    step_nm
+        Spectral step of the reference (nm).
+    min_coverage
+        Smallest covered fraction of 360-830 nm accepted.
+
+    Returns
+    -------
+    tuple
+        ``n`` and ``k``, each shape (3,) for R, G, B.
+
+    Raises
+    ------
+    ValueError
+        For data covering too little of the visible range.
+    """
+    mu = np.linspace(0.0, 1.0, RGB_NK_SAMPLES)
+    target = reference_ACEScg(nk, mu, 1.0, step_nm, min_coverage)
+    n_out, k_out = np.empty(3), np.empty(3)
+    for c in range(3):
+        R = target[:, c]
+        # At normal incidence with n = 1 the reflectance is k^2 / (4 + k^2).
+        F0 = float(np.clip(R[-1], 0.0, 0.999))
+        x0 = np.array([1.0, np.sqrt(4.0 * F0 / (1.0 - F0))])
+        fit = least_squares(
+            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R,
+            np.clip(x0, [N_BOUNDS[0], K_BOUNDS[0]], [N_BOUNDS[1], K_BOUNDS[1]]),
+            bounds=([N_BOUNDS[0], K_BOUNDS[0]], [N_BOUNDS[1], K_BOUNDS[1]]),
+            method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+        )
+        n_out[c], k_out[c] = fit.x
+    return n_out, k_out

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import check_coefficients, coated_conductor_model
+from .coated_conductor import check_coefficients, coated_conductor_model
 from .rgb_conductor import check_rgb_conductor_coefficients, rgb_conductor_model
 
 __all__ = [

@@ -4,24 +4,30 @@ RGB conductor model kind
 
 The model kind ``rgb-conductor``: the exact Fresnel equations of a conductor
 evaluated once per RGB channel with one complex index :math:`n_c + i k_c`
-per channel, seen from a coating of real index :math:`\\eta_i`, i.e. with the
+per channel (Gulbrandsen 2014 and the ``conductor`` materials of RGB
+renderers), seen from a coating of real index :math:`\\eta_i`, i.e. with the
 relative index :math:`(n_c + i k_c)/\\eta_i` (as pbrt-v4's
-``CoatedConductor`` divides the conductor's index by the interface's). Six
+``CoatedConductor`` divides the conductor's index by the interface's). It is
+exact for a material whose index does not vary within a channel. Six
 numbers per material, float16 in the pack.
 
 Coefficient layout: ``coefficients[p, c]`` with parameter *p* in (n, k) and
 channel *c* in (R, G, B); also the order of the 6 halves of the pack. The
-GLSL mirror is ``cf_rgb_conductor`` in
-``preview_shaders/glsl/cf_rgb_conductor.glsl``.
+GLSL mirror is ``cf_rgb_conductor`` / ``cf_rgb_conductor_packed`` in
+``preview_shaders/glsl/cf_rgb_conductor.glsl`` (shader variants ``exact``
+and ``rgb_conductor``). How n, k are chosen from measured data is a fit:
+:mod:`fitting.fits.rgb_conductor`.
 
 -   :data:`MODEL_KIND`, :data:`NK_PARAMETERS`.
 -   :func:`check_rgb_conductor_coefficients`: shape (2, 3), finite, n > 0,
     k >= 0.
--   :func:`rgb_conductor_model`: the reflectance, linear ACEScg.
+-   :func:`rgb_conductor_model`: the kind's reflectance, linear ACEScg.
+-   :func:`rgb_fresnel_conductor`: the same from separate n and k arrays.
 
 References
 ----------
 Born, M., & Wolf, E. (1999). Principles of Optics (7th ed.), Section 1.5.
+Gulbrandsen, O. (2014). Artist friendly metallic Fresnel. JCGT, 3(4), 64-72.
 Pharr, M., Jakob, W., & Humphreys, G. (2023). Physically Based Rendering,
 4th ed., Sections 9.3 and 14.3 (``FrComplex``, ``CoatedConductor``).
 """
@@ -30,14 +36,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..fresnel import fresnel_conductor
-from ..validation import as_finite_array
+from ..domain import as_finite_array
+from ..optics.fresnel import fresnel_conductor
 
 __all__ = [
     "MODEL_KIND",
     "NK_PARAMETERS",
     "check_rgb_conductor_coefficients",
     "rgb_conductor_model",
+    "rgb_fresnel_conductor",
 ]
 
 MODEL_KIND = "rgb-conductor"
@@ -98,3 +105,25 @@ def rgb_conductor_model(cos_theta, eta_i, coefficients) -> np.ndarray:
         as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
     )
     return fresnel_conductor(mu[..., None], eta[..., None], C[0], C[1])
+
+
+def rgb_fresnel_conductor(cos_theta, eta_i, n_rgb, k_rgb) -> np.ndarray:
+    """
+    :func:`rgb_conductor_model` from ``n_rgb`` and ``k_rgb``, shape (3,) each.
+
+    Raises
+    ------
+    ValueError
+        If a shape is not (3,), or n is not finite and > 0, or k not finite and >= 0.
+    """
+    n_rgb = np.asarray(n_rgb, dtype=np.float64)
+    k_rgb = np.asarray(k_rgb, dtype=np.float64)
+    if n_rgb.shape != (3,) or k_rgb.shape != (3,):
+        raise ValueError(
+            f"`n_rgb` and `k_rgb` must have shape (3,), got {n_rgb.shape} and {k_rgb.shape}"
+        )
+    if not (np.all(np.isfinite(n_rgb)) and np.all(n_rgb > 0)):
+        raise ValueError(f"`n_rgb` must be finite and > 0, got {n_rgb.tolist()}")
+    if not (np.all(np.isfinite(k_rgb)) and np.all(k_rgb >= 0)):
+        raise ValueError(f"`k_rgb` must be finite and >= 0, got {k_rgb.tolist()}")
+    return rgb_conductor_model(cos_theta, eta_i, np.stack([n_rgb, k_rgb]))

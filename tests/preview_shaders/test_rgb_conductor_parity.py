@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting.library import library_material
+from fitting.optics.library import library_material
 from fitting.models.rgb_conductor import rgb_conductor_model
-from fitting.pack import PackedMaterial, to_float16
+from fitting.models.pack import PackedMaterial, to_float16
 from preview_shaders.evaluate import MODEL_VARIANTS, evaluate_grid, shader_inputs
 from preview_shaders.gl import RenderThread, load_shader_source
 

@@ -14,7 +14,7 @@ import pytest
 
 from conftest import app_client
 from fitting.models.rgb_conductor import rgb_conductor_model
-from fitting.pack import PACK_VERSION, decode_pack, pack_from_json
+from fitting.models.pack import PACK_VERSION, decode_pack, pack_from_json
 
 API = "/api/v1"
 

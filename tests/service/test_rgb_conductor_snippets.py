@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from fitting.models.kinds import model_ACEScg
-from fitting.pack import PackedMaterial, material_from_json, material_to_json, to_float16
+from fitting.models.pack import PackedMaterial, material_from_json, material_to_json, to_float16
 from service.downloads import render_pack
 from service.store import FitRecord
 

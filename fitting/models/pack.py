@@ -38,9 +38,10 @@ from typing import Any
 
 import numpy as np
 
-from .model import CHANNELS, PARAMETERS, check_eta_i_range
-from .models.kinds import DEFAULT_MODEL, MODEL_KINDS, check_model, check_model_coefficients
-from .models.rgb_conductor import NK_PARAMETERS
+from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
+from .coated_conductor import CHANNELS, PARAMETERS
+from .kinds import DEFAULT_MODEL, MODEL_KINDS, check_model, check_model_coefficients, coefficient_count
+from .rgb_conductor import NK_PARAMETERS
 
 __all__ = [
     "PACK_MAGIC",
@@ -56,6 +57,7 @@ __all__ = [
     "pack_to_json",
     "pack_from_json",
     "halves_to_uint32",
+    "material_record_bytes",
 ]
 
 PACK_MAGIC = b"CFPK"
@@ -93,14 +95,14 @@ class PackedMaterial:
 
     ``model`` is its kind (:data:`fitting.models.kinds.MODEL_KINDS`);
     ``coefficients`` a float16 array of shape (3, 3, degree + 1) for a
-    ``coated-conductor`` (layout of :mod:`fitting.model`) or (2, 3), n and k
+    ``coated-conductor`` (layout of :mod:`fitting.models.coated_conductor`) or (2, 3), n and k
     per channel, for an ``rgb-conductor``; ``eta_i_range`` is the fitted
     domain.
     """
 
     name: str
     coefficients: np.ndarray
-    eta_i_range: tuple[float, float] = (1.0, 2.5)
+    eta_i_range: tuple[float, float] = DEFAULT_ETA_I_RANGE
     source: str = ""
     metrics: dict[str, Any] = field(default_factory=dict, compare=False)
     model: str = DEFAULT_MODEL
@@ -143,6 +145,15 @@ class PackedMaterial:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def material_record_bytes(name: str, source: str, degree: int, model: str = DEFAULT_MODEL) -> int:
+    """
+    Bytes of one material in the binary pack (see the layout above): name and
+    source with their u16 lengths, the f32 domain, degree, kind and padding,
+    and the float16 coefficients (9 (degree + 1), or 6 for an rgb-conductor).
+    """
+    return 2 + len(name.encode()) + 2 + len(source.encode()) + 12 + 2 * coefficient_count(model, degree)
 
 
 def encode_pack(materials: list[PackedMaterial], version: int = PACK_VERSION) -> bytes:
@@ -305,7 +316,7 @@ def material_from_json(view: dict[str, Any]) -> PackedMaterial:
     return PackedMaterial(
         name=view.get("name", ""),
         coefficients=coefficients,
-        eta_i_range=tuple(view.get("eta_i_range", (1.0, 2.5))),
+        eta_i_range=tuple(view.get("eta_i_range", DEFAULT_ETA_I_RANGE)),
         source=view.get("source", "") or "",
         metrics=view.get("metrics") or {},
         model=model,
