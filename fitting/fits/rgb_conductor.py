@@ -56,10 +56,10 @@ __all__ = [
 ]
 
 DEFAULT_SETTINGS = FitSettings(step_nm=1.0)
-"""The material fit's settings with the reference at 1 nm: six unknowns fit in
-milliseconds on the 12 x 4 grid, and at this kind's accuracy (mean Delta E
-about 0.02) the 5 nm reference's own error is no longer negligible
-(``benchmarks/rgb_conductor.py``: 0.0192 at 1 nm)."""
+"""The material fit's settings with the reference at 1 nm: the reference on the
+48 samples of the 12 x 4 grid is cheap at any step, and at this kind's
+accuracy (mean Delta E about 0.02) the 5 nm reference's own error is no
+longer negligible (``benchmarks/rgb_conductor.py``: 0.0191 at 1 nm)."""
 
 _IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight, as the material fit
 _N_STARTS = (0.2, 1.0, 3.0)  # starts of n per channel: the rgb problem has local minima
