@@ -32,6 +32,7 @@ general model <= 1.15x, scene-specialised <= 1.05x of adjusted Lazanyi.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -40,8 +41,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from fitting.fits.material import fit_material
-from fitting.fits.rgb_conductor import rgb_nk
+from fitting.fits.rgb_conductor import fit_rgb_conductor, rgb_nk
 from fitting.models.baselines import baseline_inputs
+from fitting.models.pack import halves_to_uint32
 from fitting.optics.library import library_material
 from preview_shaders.evaluate import (  # noqa: E402
     FIXED,
@@ -59,6 +61,7 @@ LABELS = {
     "lazanyi": "adjusted Lazanyi",
     "schlick": "Schlick",
     "exact": "exact RGB conductor Fresnel",
+    "rgb_conductor": "rgb-conductor kind, float16 halves",
     LAZANYI_SCENE: "adjusted Lazanyi, scene eta_i (F0, a from CPU)",
     FIXED: "no Fresnel term (fixed cost of the pass)",
 }
@@ -78,6 +81,9 @@ def main() -> None:
     # The exact RGB Fresnel gets the project's per-channel index (fitting.models.rgb_conductor).
     n_rgb, k_rgb = rgb_nk(nk)
     inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
+    # The rgb-conductor kind decodes its own fitted float16 n, k (3 words).
+    rgb_words = halves_to_uint32(fit_rgb_conductor(nk).coefficients_float16)
+    inputs = dataclasses.replace(inputs, rgb_words=rgb_words)
     with RenderThread("shader-cost") as thread:
         print(f"device: {thread.renderer}, {thread.version}")
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
