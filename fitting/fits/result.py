@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..models.pack import PackedMaterial
+from .metrics import ErrorMetrics
 
 __all__ = ["FitResult"]
 
@@ -51,6 +52,11 @@ class FitResult:
     model
         The model kind (:data:`fitting.models.kinds.MODEL_KINDS`); an
         ``rgb-conductor`` fit has coefficients of shape (2, 3) and degree 0.
+        Filled by :func:`fitting.fits.evaluate.evaluate_material` or the
+        caller: the JSON of the errors (and, for curve fits, the counts).
+    error
+        The float16 model's error as :class:`fitting.fits.metrics.ErrorMetrics`,
+        where it was measured (``metrics`` holds its JSON).
     """
 
     coefficients: np.ndarray
@@ -70,6 +76,7 @@ class FitResult:
     packed: PackedMaterial | None = None
     metrics: dict[str, Any] = field(default_factory=dict)
     model: str = "coated-conductor"
+    error: ErrorMetrics | None = None
 
     @property
     def iterations(self) -> int:

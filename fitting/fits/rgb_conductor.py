@@ -264,21 +264,24 @@ def evaluate_rgb_conductor(
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
     (``samples`` x ``samples`` over [0, 1] x the fitted domain) for the
-    float16 and float64 n, k, and (optionally) the baselines; the same
-    shape as :func:`fitting.fits.evaluate.evaluate_material`.
+    float16 and float64 n, k, and (optionally) the baselines; the JSON of
+    :func:`fitting.fits.evaluate.evaluate_material`. Sets ``result.error``
+    to the float16 model's :class:`fitting.fits.metrics.ErrorMetrics`.
     """
     lo, hi = result.eta_i_range
     M, E = evaluation_grid(samples, (lo, hi))
     ref = reference_ACEScg(nk, M, E, 1.0, min_coverage)
     rows = E[:, 0]
-    out = {
+    against = f"spectral reference 1 nm, {samples} x {samples}"
+    result.error = error_metrics(ref, rgb_conductor_model(M, E, result.coefficients_float16), rows, against)
+    out: dict[str, Any] = {
         "grid": f"{samples}x{samples}",
-        "model_float16": error_metrics(ref, rgb_conductor_model(M, E, result.coefficients_float16), rows),
-        "model_float64": error_metrics(ref, rgb_conductor_model(M, E, result.coefficients), rows),
+        "model_float16": result.error.to_dict(),
+        "model_float64": error_metrics(ref, rgb_conductor_model(M, E, result.coefficients), rows, against).to_dict(),
         "coverage": result.coverage,
     }
     if baselines:
-        out.update(baseline_metrics(nk, M, E, ref, min_coverage))
+        out.update({name: m.to_dict() for name, m in baseline_metrics(nk, M, E, ref, min_coverage, against).items()})
     return out
 
 

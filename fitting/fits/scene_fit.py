@@ -26,13 +26,13 @@ import time
 
 import numpy as np
 
-from ..colour.delta_e import delta_E_map
 from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE
 from ..models.coated_conductor import coated_conductor_model
 from ..models.kinds import model_ACEScg
 from ..models.pack import PackedMaterial
 from .material import fit_material
+from .metrics import ErrorMetrics, delta_E_summary
 from .result import FitResult
 from .rgb_conductor import DEFAULT_SETTINGS as RGB_SETTINGS
 from .rgb_conductor import fit_rgb_conductor_coefficients
@@ -70,8 +70,8 @@ CANDIDATES = (
 """(kind, degree) from the cheapest to the dearest to shade. Shader cost
 relative to adjusted Lazanyi on llvmpipe (docs/speed-vs-error.md): a degree-0
 coated-conductor is Eq. 1 with constant parameters (9 halves, 1.04x); the
-rgb-conductor a complex square root per channel (6 halves, 1.56x); degrees 1
-and 2 the general model's polynomial in t (18 and 27 halves, 2.91x), degree 1
+rgb-conductor a complex square root per channel (6 halves, 1.60x); degrees 1
+and 2 the general model's polynomial in t (18 and 27 halves, 2.9x), degree 1
 first for its fewer bytes."""
 
 
@@ -80,7 +80,7 @@ def _label(kind: str, degree: int) -> str:
 
 
 def choose_candidate(
-    errors: dict[tuple[str, int], dict[str, float]], max_delta_e: float | None, prefer: str | None
+    errors: dict[tuple[str, int], ErrorMetrics], max_delta_e: float | None, prefer: str | None
 ) -> tuple[tuple[str, int], str]:
     """
     The (kind, degree) a scene material gets, and why: with ``max_delta_e``
@@ -89,25 +89,25 @@ def choose_candidate(
     the most accurate (lowest mean, the cheaper on a tie).
     """
     ordered = [c for c in CANDIDATES if c in errors]
-    best = min(ordered, key=lambda c: errors[c]["mean"])
+    best = min(ordered, key=lambda c: errors[c].mean)
     if prefer == "accuracy":
         return best, (
             f"prefer accuracy: {_label(*best)} has the lowest mean Delta E 2000 "
-            f"({errors[best]['mean']:.4f}) of {len(ordered)} candidates"
+            f"({errors[best].mean:.4f}) of {len(ordered)} candidates"
         )
     for candidate in ordered:
-        if errors[candidate]["mean"] <= max_delta_e:
+        if errors[candidate].mean <= max_delta_e:
             cheaper = ordered[: ordered.index(candidate)]
             why = "" if not cheaper else "; cheaper candidates miss it: " + ", ".join(
-                f"{_label(*c)} {errors[c]['mean']:.4f}" for c in cheaper
+                f"{_label(*c)} {errors[c].mean:.4f}" for c in cheaper
             )
             return candidate, (
                 f"max_delta_e {max_delta_e:g}: {_label(*candidate)} is the cheapest candidate within it "
-                f"(mean Delta E 2000 {errors[candidate]['mean']:.4f}){why}"
+                f"(mean Delta E 2000 {errors[candidate].mean:.4f}){why}"
             )
     return best, (
         f"max_delta_e {max_delta_e:g}: no candidate is within it; {_label(*best)} is the most "
-        f"accurate (mean Delta E 2000 {errors[best]['mean']:.4f})"
+        f"accurate (mean Delta E 2000 {errors[best].mean:.4f})"
     )
 
 
@@ -124,13 +124,13 @@ def _fit_rgb_conductor(entry: SceneMaterial) -> tuple[PackedMaterial, FitResult]
         target, mu, eta, spec.domain, settings.objective, settings.max_nfev, settings.quantise,
         weights=weights, irls_rounds=settings.irls_rounds,
     )
-    return PackedMaterial(entry.name, result.coefficients_float16, spec.domain,
-                          source=entry.nk.source, model="rgb-conductor"), result
+    packed = PackedMaterial(entry.name, result.coefficients_float16, spec.domain,
+                            source=entry.nk.source, model="rgb-conductor")
+    return packed, result
 
 
-def _error(ref: np.ndarray, model: np.ndarray) -> dict[str, float]:
-    dE = delta_E_map(ref, model)
-    return {"mean": float(dE.mean()), "max": float(dE.max())}
+def _error(ref: np.ndarray, model: np.ndarray, against: str) -> ErrorMetrics:
+    return delta_E_summary(ref, model, against)
 
 
 def _fit_degree(entry: SceneMaterial, degree: int, settings: FitSettings) -> FitResult:
@@ -155,7 +155,7 @@ def _fit_degree(entry: SceneMaterial, degree: int, settings: FitSettings) -> Fit
 
 
 def choose_degree(
-    by_degree: dict[int, dict[str, float]], general_error: dict[str, float]
+    by_degree: dict[int, ErrorMetrics], general_error: ErrorMetrics
 ) -> int:
     """
     The degree rule: the lowest degree whose mean Delta E is at most
@@ -165,12 +165,12 @@ def choose_degree(
     qualifies, the degree with the lowest mean.
     """
     top = by_degree[max(by_degree)]
-    bound_mean = min(top["mean"] + DEGREE_TOLERANCE_MEAN, general_error["mean"])
+    bound_mean = min(top.mean + DEGREE_TOLERANCE_MEAN, general_error.mean)
     for degree in sorted(by_degree):
         error = by_degree[degree]
-        if error["mean"] <= bound_mean and error["max"] <= top["max"] + DEGREE_TOLERANCE_MAX:
+        if error.mean <= bound_mean and error.max <= top.max + DEGREE_TOLERANCE_MAX:
             return degree
-    return min(by_degree, key=lambda d: (by_degree[d]["mean"], d))
+    return min(by_degree, key=lambda d: (by_degree[d].mean, d))
 
 
 def general_domain(spec: EtaSpec) -> tuple[float, float]:
@@ -200,59 +200,60 @@ def fit_scene_material(
     mu = np.linspace(0.0, 1.0, EVALUATION_MU_SAMPLES)
     E, M = np.meshgrid(eta_rows, mu, indexing="ij")
     ref = reference_ACEScg(entry.nk, M, E, 1.0, settings.min_coverage)
+    against = f"spectral reference 1 nm, {M.shape[1]} x {M.shape[0]} (cos theta x the scene's eta_i)"
     general_fit = fit_material(entry.nk, general_domain(spec), settings, degree=2)
     general = PackedMaterial(
         entry.name, general_fit.coefficients_float16, general_fit.eta_i_range,
         source=entry.nk.source,
     )
     general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
-    general_error = _error(ref, general_model)
+    general_error = _error(ref, general_model, against)
     fits, by_degree = {}, {}
     for degree in range(spec.max_degree + 1):
         fit = _fit_degree(entry, degree, settings)
         fits[degree] = fit
         # Scored as shipped: float16 coefficients, the pack's float32 domain.
         by_degree[degree] = _error(
-            ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range)
+            ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range), against
         )
     choice = None
     if max_delta_e is not None or prefer is not None:
         rgb_packed, rgb_fit = _fit_rgb_conductor(entry)
         errors = {("coated-conductor", d): e for d, e in by_degree.items()}
         errors[("rgb-conductor", 0)] = _error(ref, model_ACEScg(
-            "rgb-conductor", M, E, rgb_packed.coefficients, rgb_packed.eta_i_range))
+            "rgb-conductor", M, E, rgb_packed.coefficients, rgb_packed.eta_i_range), against)
         (kind, chosen), reason = choose_candidate(errors, max_delta_e, prefer)
         choice = {
             "rule": "prefer accuracy" if prefer == "accuracy" else f"max_delta_e {max_delta_e:g}",
             "model": kind, "degree": chosen, "reason": reason,
-            "candidates": {_label(*c): errors[c] for c in CANDIDATES if c in errors},
+            "candidates": {_label(*c): errors[c].to_dict() for c in CANDIDATES if c in errors},
         }
-        if kind == "rgb-conductor":
-            fits[chosen] = rgb_fit
-            rgb_packed = PackedMaterial(
-                rgb_packed.name, rgb_packed.coefficients, rgb_packed.eta_i_range, source=rgb_packed.source,
-                metrics={"delta_E_2000": errors[(kind, 0)], "eta_i": spec.to_json(), "from_general_fit": False},
-                model=kind,
-            )
     else:
         chosen = choose_degree(by_degree, general_error)
     scene_error = by_degree[chosen]
     if choice is not None and choice["model"] == "rgb-conductor":
-        packed, scene_error = rgb_packed, choice["candidates"]["rgb-conductor"]
-    elif choice is None and scene_error["mean"] > general_error["mean"]:
+        fits[chosen] = rgb_fit
+        scene_error = errors[("rgb-conductor", 0)]
+        packed = PackedMaterial(
+            entry.name, rgb_packed.coefficients, spec.domain, source=entry.nk.source,
+            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
+                     "from_general_fit": False},
+            model="rgb-conductor",
+        )
+    elif choice is None and scene_error.mean > general_error.mean:
         # No scene fit beats the general fit on the scene's eta_i (a narrow
         # range the general fit already follows as well as its own fit can):
         # the general fit itself serves it, never a worse one.
         packed = PackedMaterial(
             entry.name, general.coefficients, general.eta_i_range, source=entry.nk.source,
-            metrics={"delta_E_2000": general_error, "eta_i": spec.to_json(),
+            metrics={"delta_E_2000": general_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": True},
         )
         scene_error = general_error
     else:
         packed = PackedMaterial(
             entry.name, fits[chosen].packed.coefficients, spec.domain, source=entry.nk.source,
-            metrics={"delta_E_2000": scene_error, "eta_i": spec.to_json(),
+            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": False},
         )
     fit = fits[chosen]
@@ -265,7 +266,7 @@ def fit_scene_material(
         by_degree=by_degree,
         scene=scene_error,
         general_error=general_error,
-        scene_vs_general=_error(general_model, scene_model),
+        scene_vs_general=_error(general_model, scene_model, "the general fit's model"),
         seconds=time.perf_counter() - t0,
         choice=choice,
     )

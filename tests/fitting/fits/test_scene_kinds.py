@@ -9,13 +9,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from fitting.fits.metrics import ErrorMetrics
 from fitting.fits.scene_fit import CANDIDATES, choose_candidate, fit_scene
 from fitting.fits.scene_schema import parse_scene
 from fitting.models.pack import decode_pack, pack_from_json
 
 
 def errors(*means):
-    return {c: {"mean": m, "max": 3 * m} for c, m in zip(CANDIDATES, means)}
+    return {c: ErrorMetrics(m, 3 * m, "test", layout="summary") for c, m in zip(CANDIDATES, means)}
 
 
 class TestChooseCandidate:
