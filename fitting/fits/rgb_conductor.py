@@ -86,7 +86,7 @@ def _initial_guess(target, mu, eta, weights) -> np.ndarray:
             k2 = (F0 * (n + eta_0) ** 2 - (n - eta_0) ** 2) / (1.0 - F0)
             start = np.clip([n, np.sqrt(max(k2, 0.0))], [lower[c], lower[3 + c]], [upper[c], upper[3 + c]])
             fit = least_squares(
-                lambda x: (rgb_conductor_model(mu, eta, np.array([[x[0]] * 3, [x[1]] * 3]))[:, c] - R) * sqrt_w,
+                lambda x: (fresnel_conductor(mu, eta, x[0], x[1]) - R) * sqrt_w,
                 start, bounds=([lower[c], lower[3 + c]], [upper[c], upper[3 + c]]),
                 method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10,
             )
