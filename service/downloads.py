@@ -16,7 +16,7 @@ Stored fits as the files a renderer loads:
 The snippet text comes from the template files in ``service/templates/``.
 
 Exports of one fit for one coating index (:mod:`fitting.exports`), made
-from the fit's measured n, k:
+from the fit's measured n, k, or for a fit of edited curves from its model:
 
 -   ``mtlx``, ``openpbr``: MaterialX documents; ``blender``: a Blender
     Python script; ``gltf``: a glTF 2.0 asset.
@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from fitting.exports import EXPORT_FORMATS, export_material
+from fitting.model import coated_conductor_model
 from fitting.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
@@ -181,19 +182,34 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
     The export of one stored fit in ``format`` (one of
     :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``.
 
+    A fit of measured n, k is exported from them (the spectral reference
+    under the coat); a fit made from edited curves from its own float16
+    model curve, which it defines only on its eta_i domain.
+
     Raises
     ------
     ValueError
-        For an unknown format, eta_i outside [1, 3], or a fit without
-        measured n, k (made from curves alone).
+        For an unknown format, eta_i outside [1, 3], or, for a curve fit,
+        eta_i outside the fit's domain.
     """
-    nk = measured_nk(record)
-    if nk is None:
+    if record.kind != "curves":
+        nk = measured_nk(record)
+        if nk is not None:
+            return export_material(nk, format, eta_i)
+    packed = material_from_json(record.material)
+    lo, hi = packed.eta_i_range
+    if not lo <= eta_i <= hi:
         raise ValueError(
-            f"`format` {format!r} needs the fit's measured n, k; fit {record.id} was made "
-            "from curves alone"
+            f"`eta_i` must lie in the fit's domain [{lo:g}, {hi:g}] for an export of a fit "
+            f"made from curves, got {eta_i:g}"
         )
-    return export_material(nk, format, eta_i)
+    model = {
+        "name": record.name, "source": record.source,
+        "origin": f"float16 model curve of fit {record.id} (edited curves) under the coat",
+        "reflectance": lambda mu, eta: coated_conductor_model(
+            mu, eta, packed.coefficients, packed.eta_i_range),
+    }
+    return export_material(model, format, eta_i)
 
 
 def download_name(stem: str, format: str) -> str:

@@ -76,8 +76,10 @@ def export_material(
     fit_or_nk
         Measured n, k (:class:`fitting.nk.SpectralNK`), a mapping
         ``{"name", "source", "n", "k"}`` of per-channel n, k (an
-        ``rgb-conductor`` fit, linear ACEScg), or :class:`ExportValues`
-        already computed (then ``eta_i`` must be theirs).
+        ``rgb-conductor`` fit, linear ACEScg), a mapping with a
+        ``reflectance(cos_theta, eta_i)`` model curve (see
+        :func:`export_values`), or :class:`ExportValues` already computed
+        (then ``eta_i`` must be theirs).
     format
         One of :data:`EXPORT_FORMATS`.
     eta_i

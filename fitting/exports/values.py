@@ -13,7 +13,8 @@ converted to linear Rec.709 with CAT02 adaptation (a perfect reflector stays
 (1, 1, 1)), at :data:`EXPORT_SAMPLES` values of :math:`\\mu = \\cos\\theta`
 in the coating, evenly over [0, 1]. For a material given only as per-channel
 n, k (an ``rgb-conductor`` fit, linear ACEScg) the target is that model's
-curve at eta_i. Each value is a per-channel least-squares fit to T:
+curve at eta_i, and for a fit made from edited curves the fit's own model
+curve. Each value is a per-channel least-squares fit to T:
 
 -   relative index :math:`(n_c + i k_c)` of an exact conductor in air
     (MaterialX ``conductor_bsdf``, Blender Metallic BSDF "Physical
@@ -251,7 +252,10 @@ def export_values(
         A :class:`fitting.nk.SpectralNK` (measured n, k: the target is the
         1 nm spectral reference), or a mapping ``{"name", "source", "n",
         "k"}`` with per-channel n, k in linear ACEScg (an ``rgb-conductor``
-        fit: the target is its exact Fresnel curve of (n + i k) / eta_i).
+        fit: the target is its exact Fresnel curve of (n + i k) / eta_i), or
+        a mapping ``{"name", "source", "reflectance", "origin"}`` whose
+        ``reflectance(cos_theta, eta_i)`` gives a fitted model's linear ACEScg
+        curve (a fit made from edited curves: the target is that curve).
     eta_i
         Coating index, in [1, 3].
     roughness, coat_roughness
@@ -271,6 +275,16 @@ def export_values(
         name, source = fit_or_nk.name, fit_or_nk.source
         target_ACEScg = reference_ACEScg(fit_or_nk, mu, eta, 1.0)
         origin = f"spectral reference under the coat, 1 nm, {EXPORT_SAMPLES} cos theta"
+    elif isinstance(fit_or_nk, dict) and callable(fit_or_nk.get("reflectance")):
+        name = str(fit_or_nk.get("name", "material"))
+        source = str(fit_or_nk.get("source", ""))
+        target_ACEScg = np.asarray(fit_or_nk["reflectance"](mu, eta), dtype=np.float64)
+        if target_ACEScg.shape != (EXPORT_SAMPLES, 3) or not np.all(np.isfinite(target_ACEScg)):
+            raise ValueError(
+                f"`fit_or_nk['reflectance']` must give finite ({EXPORT_SAMPLES}, 3) RGB, "
+                f"got shape {target_ACEScg.shape}"
+            )
+        origin = str(fit_or_nk.get("origin", "the fit's model curve under the coat"))
     elif isinstance(fit_or_nk, dict) and {"n", "k"} <= set(fit_or_nk):
         name = str(fit_or_nk.get("name", "material"))
         source = str(fit_or_nk.get("source", ""))
@@ -278,7 +292,8 @@ def export_values(
         origin = f"rgb-conductor model curve under the coat, {EXPORT_SAMPLES} cos theta"
     else:
         raise ValueError(
-            "`fit_or_nk` must be a SpectralNK or a mapping with per-channel `n` and `k`, "
+            "`fit_or_nk` must be a SpectralNK or a mapping with per-channel `n` and `k` "
+            "or a `reflectance` function, "
             f"got {type(fit_or_nk).__name__}"
         )
     target = ACEScg_to_lin_rec709(target_ACEScg)
