@@ -14,7 +14,7 @@ base Fresnel of each export as its tool evaluates it
     tint fitted under the coat, both in [0, 1];
 -   ``gltf``: Schlick with the fitted F0;
 -   for comparison, the air-fitted ACEScg per-channel index of
-    :func:`fitting.rgb_fresnel.rgb_nk` divided by eta_i, in a renderer working
+    :func:`fitting.fits.rgb_conductor.rgb_nk` divided by eta_i, in a renderer working
     in ACEScg (``rgb_nk ACEScg``) and pasted into a Rec.709 tool unchanged
     (``rgb_nk as 709``).
 
@@ -36,10 +36,10 @@ sys.path.insert(0, str(ROOT))
 
 from fitting.exports import export_fidelity, export_values  # noqa: E402
 from fitting.exports.tool_fresnel import mx_fresnel_conductor  # noqa: E402
-from fitting.exports.values import lin_rec709_to_ACEScg  # noqa: E402
-from fitting.library import LIBRARY_NAMES, library_material  # noqa: E402
-from fitting.metrics import delta_E_map  # noqa: E402
-from fitting.rgb_fresnel import rgb_nk  # noqa: E402
+from fitting.exports.colour_space import lin_rec709_to_ACEScg  # noqa: E402
+from fitting.colour.delta_e import delta_E_map  # noqa: E402
+from fitting.fits.rgb_conductor import rgb_nk  # noqa: E402
+from fitting.optics.library import LIBRARY_NAMES, library_material  # noqa: E402
 
 COLUMNS = ("mtlx / Metallic BSDF", "openpbr / Principled", "gltf", "rgb_nk ACEScg", "rgb_nk as 709")
 

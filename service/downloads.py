@@ -39,8 +39,8 @@ from pathlib import Path
 import numpy as np
 
 from fitting.exports import EXPORT_FORMATS, export_material
-from fitting.model import coated_conductor_model
-from fitting.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
 from .fitting_jobs import FIT_FORMAT_VERSION, measured_nk

@@ -28,7 +28,8 @@ from .gltf import gltf_document
 from .mtlx import mtlx_document
 from .openpbr import openpbr_document
 from .tool_fresnel import TOOL_MODELS, export_fidelity, tool_curve
-from .values import ETA_I_LIMITS, ExportValues, check_eta_i, export_values
+from ..domain import check_eta_i
+from .values import ETA_I_LIMITS, ExportValues, export_values
 
 __all__ = [
     "EXPORT_FORMATS",
@@ -74,7 +75,7 @@ def export_material(
     Parameters
     ----------
     fit_or_nk
-        Measured n, k (:class:`fitting.nk.SpectralNK`), a mapping
+        Measured n, k (:class:`fitting.optics.nk.SpectralNK`), a mapping
         ``{"name", "source", "n", "k"}`` of per-channel n, k (an
         ``rgb-conductor`` fit, linear ACEScg), a mapping with a
         ``reflectance(cos_theta, eta_i)`` model curve (see

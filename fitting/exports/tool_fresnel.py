@@ -37,6 +37,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..colour.delta_e import delta_E_map
+from .colour_space import lin_rec709_to_ACEScg
+
 __all__ = [
     "F82_COS_THETA",
     "TOOL_MODELS",
@@ -175,8 +178,5 @@ def export_fidelity(values, target: str) -> dict:
     dict
         ``{"delta_E_mean", "delta_E_max"}``.
     """
-    from ..metrics import delta_E_map
-    from .values import lin_rec709_to_ACEScg
-
     dE = delta_E_map(values.target_ACEScg, lin_rec709_to_ACEScg(tool_curve(values, target)))
     return {"delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max())}

@@ -8,7 +8,7 @@ default ``lin_rec709`` of MaterialX, Blender's scene linear, glTF's linear
 sRGB) to the reflectance of the metal under the coat.
 
 The target curve :math:`T(\\mu)` is the spectral reference under the coat
-(:func:`fitting.reference.reference_ACEScg` at eta_i, 1 nm, linear ACEScg)
+(:func:`fitting.colour.reference.reference_ACEScg` at eta_i, 1 nm, linear ACEScg)
 converted to linear Rec.709 with CAT02 adaptation (a perfect reflector stays
 (1, 1, 1)), at :data:`EXPORT_SAMPLES` values of :math:`\\mu = \\cos\\theta`
 in the coating, evenly over [0, 1]. For a material given only as per-channel
@@ -27,7 +27,6 @@ curve. Each value is a per-channel least-squares fit to T:
 -   :data:`EXPORT_SAMPLES`, :data:`ETA_I_LIMITS`
 -   :class:`ExportValues`: the fitted values and their provenance.
 -   :func:`export_values`: computes them.
--   :func:`ACEScg_to_lin_rec709`, :func:`lin_rec709_to_ACEScg`.
 -   :func:`project_version`.
 
 References
@@ -49,11 +48,12 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..colorimetry import _colour
-from ..fresnel import fresnel_conductor
-from ..nk import SpectralNK
-from ..reference import reference_ACEScg
-from ..rgb_fresnel import rgb_fresnel_conductor
+from ..colour.reference import reference_ACEScg
+from ..domain import ETA_I_MAX, ETA_I_MIN, check_eta_i, check_number
+from ..models.rgb_conductor import rgb_fresnel_conductor
+from ..optics.fresnel import fresnel_conductor
+from ..optics.nk import SpectralNK
+from .colour_space import ACEScg_to_lin_rec709
 from .tool_fresnel import f82_tint, schlick
 
 __all__ = [
@@ -61,43 +61,20 @@ __all__ = [
     "ETA_I_LIMITS",
     "ExportValues",
     "export_values",
-    "ACEScg_to_lin_rec709",
-    "lin_rec709_to_ACEScg",
     "project_version",
-    "check_eta_i",
     "check_roughness",
 ]
 
 EXPORT_SAMPLES = 100
 """Values of cos theta in the coating, evenly over [0, 1], fitted and scored."""
 
-ETA_I_LIMITS = (1.0, 3.0)
-"""Accepted coating indices (the project's rule for eta_i)."""
+ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
+"""Accepted coating indices (the project's rule, :func:`fitting.domain.check_eta_i`)."""
 
 # Per-channel relative index bounds: n > 0 as for any conductor; above every
 # library conductor divided by eta_i >= 1 (n < 5, k < 12 in 360-830 nm).
 _N_BOUNDS = (1.0e-3, 20.0)
 _K_BOUNDS = (0.0, 50.0)
-
-
-@functools.cache
-def _ACEScg_to_rec709() -> np.ndarray:
-    colour = _colour()
-    M = colour.RGB_to_RGB(
-        np.eye(3), "ACEScg", "ITU-R BT.709", chromatic_adaptation_transform="CAT02"
-    ).T
-    M.setflags(write=False)
-    return M
-
-
-def ACEScg_to_lin_rec709(RGB) -> np.ndarray:
-    """Linear ACEScg (ACES white) to linear Rec.709 (D65), CAT02; white to white."""
-    return np.asarray(RGB, dtype=np.float64) @ _ACEScg_to_rec709().T
-
-
-def lin_rec709_to_ACEScg(RGB) -> np.ndarray:
-    """Inverse of :func:`ACEScg_to_lin_rec709`."""
-    return np.asarray(RGB, dtype=np.float64) @ np.linalg.inv(_ACEScg_to_rec709()).T
 
 
 @functools.cache
@@ -113,27 +90,9 @@ def project_version() -> str:
             return "unknown"
 
 
-def check_eta_i(eta_i) -> float:
-    """``eta_i`` as a float in :data:`ETA_I_LIMITS`, else ``ValueError``."""
-    try:
-        value = float(eta_i)
-    except (TypeError, ValueError):
-        raise ValueError(f"`eta_i` must be a number, got {eta_i!r:.40}") from None
-    lo, hi = ETA_I_LIMITS
-    if not (np.isfinite(value) and lo <= value <= hi):
-        raise ValueError(f"`eta_i` must lie in [{lo:g}, {hi:g}], got {eta_i}")
-    return value
-
-
 def check_roughness(name: str, value) -> float:
     """A perceptual roughness in [0, 1], else ``ValueError`` naming ``name``."""
-    try:
-        r = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"`{name}` must be a number, got {value!r:.40}") from None
-    if not (np.isfinite(r) and 0.0 <= r <= 1.0):
-        raise ValueError(f"`{name}` must lie in [0, 1], got {value}")
-    return r
+    return check_number(name, value, 0.0, 1.0)
 
 
 @dataclass(frozen=True)
@@ -249,7 +208,7 @@ def export_values(
     Parameters
     ----------
     fit_or_nk
-        A :class:`fitting.nk.SpectralNK` (measured n, k: the target is the
+        A :class:`fitting.optics.nk.SpectralNK` (measured n, k: the target is the
         1 nm spectral reference), or a mapping ``{"name", "source", "n",
         "k"}`` with per-channel n, k in linear ACEScg (an ``rgb-conductor``
         fit: the target is its exact Fresnel curve of (n + i k) / eta_i), or

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from conftest import app_client
-from fitting.curves import curve_base_from_nk
+from fitting.fits.curves_base import curve_base_from_nk
 from fitting.exports import export_material
-from fitting.library import library_material
+from fitting.optics.library import library_material
 
 API = "/api/v1"
 

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from fitting.exports import export_material
-from fitting.library import library_material
+from fitting.optics.library import library_material
 
 ROOT = Path(__file__).resolve().parents[3]
 

@@ -17,7 +17,7 @@ from PIL import Image
 
 from fitting.exports import export_material, export_values
 from fitting.exports.blender import NODE_NAMES
-from fitting.library import library_material
+from fitting.optics.library import library_material
 
 ROOT = Path(__file__).resolve().parents[3]
 BLENDER_PYTHON = ROOT / ".venv-blender" / "bin" / "python"

@@ -14,18 +14,17 @@ from fitting.exports.tool_fresnel import (
     schlick,
     tool_curve,
 )
+from fitting.exports.colour_space import ACEScg_to_lin_rec709, lin_rec709_to_ACEScg
 from fitting.exports.values import (
     EXPORT_SAMPLES,
-    ACEScg_to_lin_rec709,
     _fit_f82_tint,
     _fit_relative_index,
     _fit_schlick,
-    lin_rec709_to_ACEScg,
     project_version,
 )
-from fitting.fresnel import fresnel_conductor
-from fitting.library import library_material
-from fitting.rgb_fresnel import rgb_nk
+from fitting.optics.fresnel import fresnel_conductor
+from fitting.optics.library import library_material
+from fitting.fits.rgb_conductor import rgb_nk
 
 MU = np.linspace(0.0, 1.0, EXPORT_SAMPLES)
 
@@ -144,7 +143,7 @@ class TestInputs:
 
     @pytest.mark.parametrize("eta_i, rule", [
         (0.8, "`eta_i` must lie in [1, 3], got 0.8"), (3.5, "`eta_i` must lie in [1, 3], got 3.5"),
-        (float("nan"), "`eta_i` must lie in [1, 3], got nan"), ("x", "`eta_i` must be a number"),
+        (float("nan"), "`eta_i` must lie in [1, 3], got nan"), ("x", "`eta_i` must be a number, got 'x'"),
     ])
     def test_bad_eta_i(self, eta_i, rule):
         with pytest.raises(ValueError) as info:
@@ -154,9 +153,9 @@ class TestInputs:
     def test_bad_format_roughness_and_input(self, cu_values):
         with pytest.raises(ValueError, match="`format` must be one of mtlx, openpbr, blender, gltf, got 'usd'"):
             export_material(cu_values, "usd", 1.5)
-        with pytest.raises(ValueError, match=r"`roughness` must lie in \[0, 1\], got 1.5"):
+        with pytest.raises(ValueError, match=r"`roughness` must be a number in \[0, 1\], got 1.5"):
             export_values(library_material("Cu"), 1.5, roughness=1.5)
-        with pytest.raises(ValueError, match="`coat_roughness` must lie in"):
+        with pytest.raises(ValueError, match=r"`coat_roughness` must be a number in \[0, 1\], got -0.1"):
             export_values(library_material("Cu"), 1.5, coat_roughness=-0.1)
         with pytest.raises(ValueError, match="`fit_or_nk` must be a SpectralNK"):
             export_values([1, 2, 3], 1.5)

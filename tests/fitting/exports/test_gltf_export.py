@@ -18,7 +18,7 @@ import pytest
 
 from fitting.exports import export_material, export_values
 from fitting.exports.gltf import uv_sphere
-from fitting.library import library_material
+from fitting.optics.library import library_material
 
 ROOT = Path(__file__).resolve().parents[3]
 VALIDATOR = ROOT / "scripts" / "gltf-validator"

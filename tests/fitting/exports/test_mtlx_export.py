@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from fitting.exports import export_material, export_values
-from fitting.library import library_material
+from fitting.optics.library import library_material
 
 CASES = [("Cu", 1.5), ("Au", 2.0)]
 
