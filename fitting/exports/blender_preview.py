@@ -8,12 +8,16 @@ environment)::
 
     .venv-blender/bin/python fitting/exports/blender_preview.py EXPORT.py \
         --values values.json [--render sphere.png --size 64 --samples 8 --output principled]
+    .venv-blender/bin/python fitting/exports/blender_preview.py EXPORT.gltf --gltf \
+        --values values.json [--render sphere.png ...]
 
-It starts from Blender's factory settings, executes the exported script,
-calls its ``build_material()``, writes every input value of every node of
-the material (as Blender stores them) to ``--values``, and optionally renders
-a sphere with the material in Cycles on the CPU: a UV sphere in front of a
-camera, lit by a checkered environment so that the reflection shows.
+It starts from Blender's factory settings, executes the exported script and
+calls its ``build_material()`` (or, with ``--gltf``, imports the glTF export
+with Blender's bundled glTF importer), writes every input value of every node
+of the material (as Blender stores them) to ``--values``, and optionally
+renders a sphere with the material in Cycles on the CPU: a UV sphere (the
+glTF's own sphere with ``--gltf``) in front of a camera, lit by a checkered
+environment so that the reflection shows.
 """
 
 from __future__ import annotations
@@ -46,17 +50,24 @@ def node_values(material) -> dict:
         [link.from_node.name, link.from_socket.name, link.to_node.name, link.to_socket.identifier]
         for link in material.node_tree.links
     ]
+    custom = material.get("coated_fresnel")
+    # The glTF importer keeps a material's extras as a property group.
+    custom = custom.to_dict() if hasattr(custom, "to_dict") else custom
     return {"material": material.name, "nodes": out, "links": links,
-            "custom": dict(coated_fresnel=material.get("coated_fresnel"))}
+            "custom": {"coated_fresnel": custom}}
 
 
-def render_sphere(material, path: str, size: int, samples: int) -> None:
-    """A Cycles CPU render of a sphere with ``material`` to the PNG ``path``."""
+def render_sphere(material, path: str, size: int, samples: int, sphere=None) -> None:
+    """
+    A Cycles CPU render to the PNG ``path`` of ``sphere`` (a new UV sphere
+    with ``material`` when None) at the origin, radius 1.
+    """
     scene = bpy.context.scene
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0)
-    sphere = bpy.context.active_object
-    bpy.ops.object.shade_smooth()
-    sphere.data.materials.append(material)
+    if sphere is None:
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0)
+        sphere = bpy.context.active_object
+        bpy.ops.object.shade_smooth()
+        sphere.data.materials.append(material)
     camera_data = bpy.data.cameras.new("camera")
     camera_data.lens = 80.0
     camera = bpy.data.objects.new("camera", camera_data)
@@ -71,7 +82,7 @@ def render_sphere(material, path: str, size: int, samples: int) -> None:
     tree.nodes.clear()
     coords = tree.nodes.new("ShaderNodeTexCoord")
     checker = tree.nodes.new("ShaderNodeTexChecker")
-    checker.inputs["Scale"].default_value = 4.0
+    checker.inputs["Scale"].default_value = 2.0
     checker.inputs["Color1"].default_value = (0.9, 0.9, 0.9, 1.0)
     checker.inputs["Color2"].default_value = (0.05, 0.05, 0.05, 1.0)
     background = tree.nodes.new("ShaderNodeBackground")
@@ -96,7 +107,8 @@ def render_sphere(material, path: str, size: int, samples: int) -> None:
 
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="blender_preview.py")
-    parser.add_argument("script", help="the exported Blender script")
+    parser.add_argument("script", help="the exported Blender script (or glTF file with --gltf)")
+    parser.add_argument("--gltf", action="store_true", help="import a glTF export instead")
     parser.add_argument("--values", required=True, help="write the node values here (JSON)")
     parser.add_argument("--render", help="render a sphere to this PNG")
     parser.add_argument("--size", type=int, default=64)
@@ -105,13 +117,20 @@ def main(argv: list[str]) -> int:
     args = parser.parse_args(argv)
 
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    namespace = runpy.run_path(args.script, run_name="coated_fresnel_export")
-    material = namespace["build_material"]()
-    namespace["use_output"](material, args.output)
+    sphere = None
+    if args.gltf:
+        if bpy.ops.import_scene.gltf(filepath=args.script) != {"FINISHED"}:
+            raise RuntimeError(f"Blender's glTF importer refused {args.script}")
+        (sphere,) = [o for o in bpy.context.scene.objects if o.type == "MESH"]
+        material = sphere.active_material
+    else:
+        namespace = runpy.run_path(args.script, run_name="coated_fresnel_export")
+        material = namespace["build_material"]()
+        namespace["use_output"](material, args.output)
     with open(args.values, "w") as f:
         json.dump(node_values(material), f, indent=1, sort_keys=True)
     if args.render:
-        render_sphere(material, args.render, args.size, args.samples)
+        render_sphere(material, args.render, args.size, args.samples, sphere)
     return 0
 
 
