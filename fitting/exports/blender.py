@@ -2,7 +2,7 @@
 Blender export
 ==============
 
-A Python script that builds the material's node tree in Blender (4.2 or
+A Python script that builds the material's node tree in Blender (4.3 or
 later; checked with the ``bpy`` 5.0 module). Run it in Blender's Text Editor
 or ``blender --python FILE``; it calls :func:`build_material` in the script,
 which makes a material with two outputs:
