@@ -14,8 +14,12 @@ Two figures, small (the machine has two shared cores):
     project's preview sphere under a uniform white sky (the paper's
     validation setting, where a pixel shows F(cos theta) at its cos theta):
     spectral reference, ``mtlx`` (conductor at the relative index),
-    ``openpbr`` (F82 tint), ``gltf`` (Schlick). MaterialX's own GLSL renderer
-    needs an X display, which this machine does not have.
+    ``openpbr`` (F82 tint), ``gltf`` (Schlick).
+-   ``docs/images/exports_materialx.png``: the ``mtlx`` and ``openpbr``
+    documents rendered with the GLSL MaterialX generates for them, on the
+    project's EGL context (:mod:`preview_shaders.materialx_render`; MaterialX's
+    own GLSL renderer needs an X display) under a uniform white environment,
+    next to the spectral reference on the same sphere; coat included.
 
     .venv/bin/python benchmarks/exports_renders.py [--materials Au,Cu] [--eta-i 1.5]
 """
@@ -38,11 +42,14 @@ from fitting.exports import export_material, export_values, tool_curve  # noqa: 
 from fitting.exports.colour_space import lin_rec709_to_ACEScg  # noqa: E402
 from fitting.optics.library import library_material  # noqa: E402
 from preview_shaders.display import ACEScg_to_sRGB, to_uint8  # noqa: E402
+from preview_shaders.gl import RenderThread  # noqa: E402
+from preview_shaders.materialx_render import render_materialx  # noqa: E402
 from preview_shaders.preview import sphere_cos_theta  # noqa: E402
 
 BLENDER_PYTHON = ROOT / ".venv-blender" / "bin" / "python"
 PREVIEW = ROOT / "fitting" / "exports" / "blender_preview.py"
 CYCLES = ROOT / "docs" / "images" / "exports_cycles.png"
+MATERIALX = ROOT / "docs" / "images" / "exports_materialx.png"
 WHITE_SKY = ROOT / "docs" / "images" / "exports_white_sky.png"
 
 
@@ -81,6 +88,21 @@ def white_sky(values, size: int) -> list[np.ndarray]:
     return images
 
 
+def materialx(values, size: int, thread: RenderThread) -> list[np.ndarray]:
+    """Reference, then the mtlx and openpbr documents as MaterialX's GLSL renders them, uint8."""
+    images = [white_sky(values, size)[0]]
+    for format in ("mtlx", "openpbr"):
+        rgb, coverage = render_materialx(
+            export_material(values, format, values.eta_i).decode(), size, thread)
+        centre = rgb[size // 2, size // 2]
+        print(f"{values.name} {format}: centre pixel (cos theta 1), linear Rec.709 "
+              f"{np.round(centre.astype(np.float64), 3).tolist()}; reference under the coat "
+              f"{np.round(values.target[-1], 3).tolist()}")
+        rgb = np.where(coverage[..., None], lin_rec709_to_ACEScg(rgb), 0.18)
+        images.append(to_uint8(ACEScg_to_sRGB(rgb)))
+    return images
+
+
 def grid(rows: list[list[np.ndarray]], gap: int = 2) -> Image.Image:
     h, w, _ = rows[0][0].shape
     out = np.full((len(rows) * (h + gap) - gap, len(rows[0]) * (w + gap) - gap, 3), 255, np.uint8)
@@ -100,6 +122,9 @@ def main(argv: list[str] | None = None) -> int:
     all_values = [export_values(library_material(m), args.eta_i) for m in args.materials.split(",")]
     grid([white_sky(v, max(args.size, 64)) for v in all_values]).save(WHITE_SKY)
     print(f"wrote {WHITE_SKY.relative_to(ROOT)}")
+    with RenderThread("exports-materialx") as thread:
+        grid([materialx(v, max(args.size, 64), thread) for v in all_values]).save(MATERIALX)
+    print(f"wrote {MATERIALX.relative_to(ROOT)}")
     with tempfile.TemporaryDirectory() as work:
         rows = [cycles(v, Path(work), args.size, args.samples) for v in all_values]
     grid(rows).save(CYCLES)

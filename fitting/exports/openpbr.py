@@ -7,7 +7,7 @@ shipped in MaterialX's ``bxdf`` library): a fully metallic base whose
 ``base_color`` and ``specular_color`` are the F0 and F82 tint of the F82-tint
 model fitted to the metal's reflectance *under* the coat
 (:mod:`fitting.exports.values`), with ``coat_weight`` 1 and ``coat_ior``
-eta_i. OpenPBR leaves the Fresnel of a metal under a coat undefined (the
+eta_i, ``coat_darkening`` 0. OpenPBR leaves the Fresnel of a metal under a coat undefined (the
 F82 model assumes air), so the fit to the curve under the coat is what lets
 it see the coat; ``specular_roughness`` and ``coat_roughness`` are the
 surface's own inputs.
@@ -49,6 +49,10 @@ def openpbr_document(values: ExportValues) -> str:
         ("coat_color", "color3", triple((1.0, 1.0, 1.0))),
         ("coat_roughness", "float", number(values.coat_roughness)),
         ("coat_ior", "float", number(values.eta_i)),
+        # Off: the fitted F0 and tint already are the metal seen under the
+        # coat; OpenPBR's darkening (internal reflections in the coat, meant
+        # for rough or diffuse bases) would darken it a second time.
+        ("coat_darkening", "float", number(0.0)),
     ):
         add_input(shader, name, type_, value=value)
     material = ET.SubElement(

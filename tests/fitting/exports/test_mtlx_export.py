@@ -121,7 +121,8 @@ class TestOpenPBR:
         np.testing.assert_allclose(list(value_of(shader, "base_color")), values.F0, atol=1e-6)
         np.testing.assert_allclose(list(value_of(shader, "specular_color")), values.F82_tint, atol=1e-6)
         for name, expected in (("base_metalness", 1.0), ("coat_weight", 1.0),
-                               ("coat_ior", values.eta_i), ("specular_roughness", values.roughness)):
+                               ("coat_ior", values.eta_i), ("specular_roughness", values.roughness),
+                               ("coat_darkening", 0.0)):
             assert value_of(shader, name) == pytest.approx(expected)
         assert "f82-tint" in material.getDocString()
 
