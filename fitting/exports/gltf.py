@@ -115,7 +115,6 @@ def gltf_document(values: ExportValues) -> str:
         "asset": {
             "version": "2.0",
             "generator": provenance["generator"],
-            "copyright": provenance["source"],
             "extras": {"coated_fresnel": provenance},
         },
         "extensionsUsed": ["KHR_materials_clearcoat"],
