@@ -7,17 +7,23 @@ read back, for the parity tests.
 
 -   :func:`evaluate_brdf_grid`: ``glsl/microfacet.frag`` over a grid of view
     and light angles.
+-   :func:`upload_lut`: a :class:`fitting.shading.ibl.SplitSumLUT` as the 3D
+    float texture ``cf_ibl.glsl`` reads (call on the render thread).
+-   :func:`decode_lut_in_shader`: every texel as ``texelFetch`` returns it.
+-   :func:`evaluate_split_sum_grid`: ``cf_split_sum_model`` over a grid of
+    (NdotV, roughness).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from fitting.shading.ibl import SplitSumLUT
 from fitting.shading.microfacet import check_mode
 
 from .gl import GLState, RenderThread, check_gl_error
 
-__all__ = ["evaluate_brdf_grid"]
+__all__ = ["evaluate_brdf_grid", "upload_lut", "decode_lut_in_shader", "evaluate_split_sum_grid"]
 
 
 def _read(fbo, index: int, width: int, height: int) -> np.ndarray:
@@ -82,3 +88,78 @@ def evaluate_brdf_grid(
     l0, l_step, height = theta_l_axis
     grid = (v0, v_step, l0, l_step)
     return thread.call(_brdf_grid, mode, uniforms, grid, phi, int(width), int(height))
+
+
+def upload_lut(state: GLState, lut: SplitSumLUT):
+    """The LUT as an RGB32F 3D texture, (NdotV, roughness, alpha) = (x, y, z),
+    nearest filtering (the shader interpolates)."""
+    n_alpha, n_r, n_mu = lut.shape
+    texture = state.ctx.texture3d(
+        (n_mu, n_r, n_alpha), 3, np.ascontiguousarray(lut.data, dtype="f4").tobytes(), dtype="f4"
+    )
+    texture.filter = (state.ctx.NEAREST, state.ctx.NEAREST)
+    return texture
+
+
+def _lut_pass(state: GLState, lut: SplitSumLUT, defines, uniforms, size, slices):
+    ctx = state.ctx
+    program, vao = state.program("ibl.frag", defines)
+    texture = upload_lut(state, lut)
+    uniforms = {**uniforms, "cf_alpha_range": tuple(float(v) for v in lut.alpha_range), "cf_lut": 0}
+    for name, value in uniforms.items():
+        if name in program:
+            program[name].value = value
+    width, height = size
+    fbo, targets = state.float_targets((width, height), 2)
+    out = []
+    try:
+        texture.use(location=0)
+        fbo.use()
+        for k in slices:
+            if "u_slice" in program:
+                program["u_slice"].value = int(k)
+            vao.render(mode=ctx.TRIANGLES, vertices=3)
+            out.append(tuple(_read(fbo, i, width, height) for i in range(2)))
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+        texture.release()
+    return out
+
+
+def decode_lut_in_shader(thread: RenderThread, lut: SplitSumLUT) -> np.ndarray:
+    """Every texel of ``lut`` read back through ``texelFetch``: float32 of
+    the shape of ``lut.data``."""
+    n_alpha, n_r, n_mu = lut.shape
+    passes = thread.call(_lut_pass, lut, {"CF_IBL_PASS": 0}, {}, (n_mu, n_r), range(n_alpha))
+    return np.stack([value for value, _ in passes])
+
+
+def evaluate_split_sum_grid(
+    thread: RenderThread,
+    lut: SplitSumLUT,
+    F0,
+    a,
+    alpha,
+    NdotV_axis: tuple[float, float, int] = (0.0, 1.0 / 127.0, 128),
+    roughness_axis: tuple[float, float, int] = (0.0, 1.0 / 127.0, 128),
+):
+    """
+    ``cf_split_sum_model`` over a grid (column: NdotV = start + i step, row:
+    roughness likewise, float32 in the shader).
+
+    Returns
+    -------
+    tuple
+        The albedo (rows, columns, 3), and the float32 NdotV and roughness
+        (rows, columns) the shader used.
+    """
+    uniforms = {
+        "cf_F0": tuple(float(v) for v in F0),
+        "cf_a": tuple(float(v) for v in a),
+        "cf_alpha": tuple(float(v) for v in alpha),
+        "u_grid": (NdotV_axis[0], NdotV_axis[1], roughness_axis[0], roughness_axis[1]),
+    }
+    size = (int(NdotV_axis[2]), int(roughness_axis[2]))
+    ((value, inputs),) = thread.call(_lut_pass, lut, {"CF_IBL_PASS": 1}, uniforms, size, [0])
+    return value, inputs[..., 0].copy(), inputs[..., 1].copy()
