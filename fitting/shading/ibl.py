@@ -58,8 +58,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..baselines import external_medium_F0, lazanyi_a
-from ..validation import as_finite_array
+from ..domain import as_finite_array
+from ..models.baselines import external_medium_F0, lazanyi_a
+from ..models.coated_conductor import ALPHA_MIN
 from .microfacet import alpha_g_from_roughness, sample_visible_normal, smith_G1, smith_G2
 
 __all__ = [
@@ -294,7 +295,7 @@ def split_sum_model(NdotV, roughness, F0, a, alpha, lut: SplitSumLUT | None = No
         Broadcast against each other; clamped to [0, 1].
     F0, a, alpha
         Per-channel parameters (3,) of the model at one eta_i
-        (:func:`fitting.model.collapse_to_eta_i`).
+        (:func:`fitting.models.coated_conductor.collapse_to_eta_i`).
 
     Returns
     -------
@@ -320,7 +321,7 @@ def split_sum_lazanyi(
     NdotV, roughness, eta_i, F0_air, F82_air, lut: SplitSumLUT | None = None
 ) -> np.ndarray:
     """
-    Directional albedo with adjusted Lazanyi (:func:`fitting.baselines.lazanyi_adjusted`):
+    Directional albedo with adjusted Lazanyi (:func:`fitting.models.baselines.lazanyi_adjusted`):
     the model's form with :math:`F_0'` at ``eta_i`` (scalar), *a* from F0 and
     F82 in air and :math:`\\alpha = 6`.
     """
@@ -341,10 +342,8 @@ def average_fresnel(F0, a, alpha) -> np.ndarray:
     from :math:`2\\int\\mu(1-\\mu)^5 d\\mu = 2B(2, 6) = 1/21` and
     :math:`2\\int\\mu^2(1-\\mu)^\\alpha d\\mu = 2B(3, \\alpha + 1)` with the Beta
     function :math:`B(3, \\alpha+1) = 2/((\\alpha+1)(\\alpha+2)(\\alpha+3))`.
-    Alpha is clamped to :data:`fitting.model.ALPHA_MIN` as the model does.
+    Alpha is clamped to :data:`fitting.models.coated_conductor.ALPHA_MIN` as the model does.
     """
-    from ..model import ALPHA_MIN
-
     F0, a = np.asarray(F0, dtype=np.float64), np.asarray(a, dtype=np.float64)
     alpha = np.maximum(np.asarray(alpha, dtype=np.float64), ALPHA_MIN)
     return F0 + (1.0 - F0) / 21.0 - 4.0 * a / ((alpha + 1.0) * (alpha + 2.0) * (alpha + 3.0))

@@ -82,9 +82,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..fresnel import fresnel_dielectric
-from ..model import model_from_parameters
-from ..validation import as_finite_array
+from ..domain import as_finite_array
+from ..models.coated_conductor import model_from_parameters
+from ..optics.fresnel import fresnel_dielectric
 
 __all__ = [
     "MODES",
@@ -298,7 +298,7 @@ def microfacet_brdf(
         [:data:`ROUGHNESS_MIN`, 1]).
     F0, a, alpha
         The model's parameters per channel (3,) at ``eta_i``
-        (:func:`fitting.model.collapse_to_eta_i`).
+        (:func:`fitting.models.coated_conductor.collapse_to_eta_i`).
     mode
         ``immersed`` or ``coated`` (see the module docstring).
     eta_i

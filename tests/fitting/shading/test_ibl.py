@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from fitting.baselines import lazanyi_adjusted, external_medium_F0, lazanyi_a
-from fitting.model import model_from_parameters
+from fitting.models.baselines import lazanyi_adjusted, external_medium_F0, lazanyi_a
+from fitting.models.coated_conductor import model_from_parameters
 from fitting.shading.ibl import (
     SplitSumLUT,
     _hammersley,
