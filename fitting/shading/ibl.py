@@ -32,6 +32,8 @@ varies per channel and with eta_i. The slices are spaced evenly in
     through Heitz's visible-normal sampling).
 -   :func:`split_sum_model`, :func:`split_sum_schlick`,
     :func:`split_sum_lazanyi`: the albedo of the model and the baselines.
+-   :func:`split_sum_coated`: an approximate pre-integrated albedo of the
+    ``coated`` mode from the same LUT.
 -   :func:`average_fresnel`: the closed-form hemispherical average
     :math:`2\\int_0^1 F\\mu\\,d\\mu` of the model.
 -   :func:`energy_compensation`: the multiple-scattering factor from it.
@@ -61,6 +63,7 @@ import numpy as np
 from ..domain import as_finite_array
 from ..models.baselines import external_medium_F0, lazanyi_a
 from ..models.coated_conductor import ALPHA_MIN
+from ..optics.fresnel import fresnel_dielectric
 from .microfacet import alpha_g_from_roughness, sample_visible_normal, smith_G1, smith_G2
 
 __all__ = [
@@ -75,6 +78,7 @@ __all__ = [
     "split_sum_model",
     "split_sum_schlick",
     "split_sum_lazanyi",
+    "split_sum_coated",
     "average_fresnel",
     "energy_compensation",
 ]
@@ -328,6 +332,38 @@ def split_sum_lazanyi(
     F0 = external_medium_F0(F0_air, float(eta_i))
     a = lazanyi_a(F0_air, F82_air)
     return split_sum_model(NdotV, roughness, F0, a, np.full(3, 6.0), lut)
+
+
+def split_sum_coated(
+    NdotV, roughness, F0, a, alpha, eta_i, coat_roughness=0.0, lut: SplitSumLUT | None = None
+) -> np.ndarray:
+    """
+    Approximate directional albedo of the ``coated`` BRDF from the LUT:
+
+    .. math::
+
+        E \\approx F_{0c} A_c + B_c + [1 - F_c(\\mu_v)]^2\\,E_s(\\mu_t)
+
+    with the coat's lobe by Schlick's form at
+    :math:`F_{0c} = ((\\eta_i - 1)/(\\eta_i + 1))^2` (:math:`A_c, B_c` at
+    ``coat_roughness``), and the base's albedo :math:`E_s` of
+    :func:`split_sum_model` at the refracted cosine
+    :math:`\\mu_t = \\sqrt{1 - (1 - \\mu_v^2)/\\eta_i^2}`, transmitted in and
+    out at the view angle. Exact for a smooth coat over a smooth base (the
+    light leaves at the mirror angle); for a rough base it ignores the light
+    lost by total internal reflection, so it overestimates (docs/shading.md
+    gives its error against Monte Carlo). Equals :func:`split_sum_model` at
+    eta_i = 1.
+    """
+    lut = lut or default_lut()
+    mu, r = _inputs(NdotV, roughness)
+    eta = max(float(as_finite_array("eta_i", eta_i)), 1.0)
+    mu = np.clip(mu, 0.0, 1.0)
+    F0c = ((eta - 1.0) / (eta + 1.0)) ** 2
+    coat = split_sum_schlick(mu, coat_roughness, np.full(3, F0c), lut) if eta > 1.0 else 0.0
+    T = (1.0 - fresnel_dielectric(mu, 1.0, eta))[..., None]
+    mu_t = np.sqrt(1.0 - (1.0 - mu * mu) / (eta * eta))
+    return coat + T * T * split_sum_model(mu_t, r, F0, a, alpha, lut)
 
 
 def average_fresnel(F0, a, alpha) -> np.ndarray:
