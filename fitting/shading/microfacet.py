@@ -82,7 +82,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..domain import as_finite_array
 from ..models.coated_conductor import model_from_parameters
 from ..optics.fresnel import fresnel_dielectric
 
@@ -125,10 +124,10 @@ def check_mode(mode: str) -> str:
 def alpha_g_from_roughness(roughness) -> np.ndarray:
     """
     GGX :math:`\\alpha_g = r^2` from perceptual roughness *r*, with *r*
-    clamped to [:data:`ROUGHNESS_MIN`, 1] (a kernel clamps, it does not
-    raise on a finite number).
+    clamped to [:data:`ROUGHNESS_MIN`, 1] (a kernel clamps, it never raises
+    on numeric input; NaN gives NaN, as every physics kernel of the house).
     """
-    r = np.clip(as_finite_array("roughness", roughness), ROUGHNESS_MIN, 1.0)
+    r = np.clip(np.asarray(roughness, dtype=np.float64), ROUGHNESS_MIN, 1.0)
     return r * r
 
 
@@ -259,7 +258,8 @@ def coated_brdf(wo, wi, roughness, base_fresnel, eta_i, coat_roughness=0.0) -> n
     """
     wo = np.asarray(wo, dtype=np.float64)
     wi = np.asarray(wi, dtype=np.float64)
-    eta = np.maximum(as_finite_array("eta_i", eta_i), 1.0)
+    # Below 1 there is no coat to speak of: clamped (never raises).
+    eta = np.maximum(np.asarray(eta_i, dtype=np.float64), 1.0)
     NdotV, NdotL = wo[..., 2], wi[..., 2]
     coat = specular_brdf(
         wo, wi, alpha_g_from_roughness(coat_roughness),

@@ -191,9 +191,9 @@ def directional_albedo(
     if masking not in MASKING:
         raise ValueError(f"`masking` must be one of {', '.join(MASKING)}, got {masking!r}")
     mu_all = np.clip(np.atleast_1d(as_finite_array("NdotV", NdotV)).ravel(), 1.0e-4, 1.0)
-    alpha_g = float(alpha_g_from_roughness(roughness))
+    alpha_g = float(alpha_g_from_roughness(as_finite_array("roughness", roughness)))
     eta = max(float(as_finite_array("eta_i", eta_i)), 1.0)
-    coat_alpha = float(alpha_g_from_roughness(coat_roughness))
+    coat_alpha = float(alpha_g_from_roughness(as_finite_array("coat_roughness", coat_roughness)))
     rng = np.random.default_rng(int(seed))
     means, errors = [], []
     for mu in mu_all:
@@ -251,7 +251,7 @@ def model_directional_albedo(
     if P.ndim != 3 or P.shape[1] != 3 or not np.all(np.isfinite(P)):
         raise ValueError(f"`parameters` must be finite with shape (M, 3, C), got {P.shape}")
     mu_all = np.clip(np.atleast_1d(as_finite_array("NdotV", NdotV)).ravel(), 1.0e-4, 1.0)
-    alpha_g = float(alpha_g_from_roughness(roughness))
+    alpha_g = float(alpha_g_from_roughness(as_finite_array("roughness", roughness)))
     rng = np.random.default_rng(int(seed))
     F0, a, alpha = (P[:, i, :][:, None, :] for i in range(3))
     means, errors = [], []

@@ -45,8 +45,8 @@ class TestGGX:
     def test_roughness_clamped(self):
         assert alpha_g_from_roughness(0.0) == ROUGHNESS_MIN**2
         assert alpha_g_from_roughness(3.0) == 1.0
-        with pytest.raises(ValueError, match="`roughness` must be finite"):
-            alpha_g_from_roughness(np.nan)
+        # A kernel never raises on numeric input: NaN propagates.
+        assert np.isnan(alpha_g_from_roughness(np.nan))
 
 
 class TestSmith:
@@ -109,8 +109,8 @@ class TestBRDF:
     def test_bad_input(self):
         with pytest.raises(ValueError, match="`mode` must be one of immersed, coated"):
             microfacet_brdf([0, 0, 1], [0, 0, 1], 0.3, *CR, mode="layered")
-        with pytest.raises(ValueError, match="`eta_i` must be finite"):
-            microfacet_brdf([0, 0, 1], [0, 0, 1], 0.3, *CR, mode="coated", eta_i=np.inf)
+        f = microfacet_brdf([0, 0, 1], [0, 0, 1], 0.3, *CR, mode="coated", eta_i=np.nan)
+        assert np.all(np.isnan(f))
 
 
 class TestVisibleNormalSampling:
