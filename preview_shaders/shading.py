@@ -12,9 +12,13 @@ read back, for the parity tests.
 -   :func:`decode_lut_in_shader`: every texel as ``texelFetch`` returns it.
 -   :func:`evaluate_split_sum_grid`: ``cf_split_sum_model`` over a grid of
     (NdotV, roughness).
+-   :func:`time_split_sum`: GL timer query, wall and CPU time of full-screen
+    split-sum passes (model, adjusted Lazanyi, Schlick, none), interleaved.
 """
 
 from __future__ import annotations
+
+import time
 
 import numpy as np
 
@@ -23,7 +27,17 @@ from fitting.shading.microfacet import check_mode
 
 from .gl import GLState, RenderThread, check_gl_error
 
-__all__ = ["evaluate_brdf_grid", "upload_lut", "decode_lut_in_shader", "evaluate_split_sum_grid"]
+__all__ = [
+    "evaluate_brdf_grid",
+    "upload_lut",
+    "decode_lut_in_shader",
+    "evaluate_split_sum_grid",
+    "SPLIT_SUM_VARIANTS",
+    "time_split_sum",
+]
+
+SPLIT_SUM_VARIANTS = ("split_sum_model", "split_sum_lazanyi", "split_sum_schlick", "split_sum_fixed")
+"""``CF_IBL_PASS`` 1 .. 4 of ``glsl/ibl.frag``."""
 
 
 def _read(fbo, index: int, width: int, height: int) -> np.ndarray:
@@ -163,3 +177,69 @@ def evaluate_split_sum_grid(
     size = (int(NdotV_axis[2]), int(roughness_axis[2]))
     ((value, inputs),) = thread.call(_lut_pass, lut, {"CF_IBL_PASS": 1}, uniforms, size, [0])
     return value, inputs[..., 0].copy(), inputs[..., 1].copy()
+
+
+def _time_split_sum(state: GLState, lut, per_variant, width, height, rounds):
+    ctx = state.ctx
+    texture = upload_lut(state, lut)
+    programs = {}
+    for index, variant in enumerate(SPLIT_SUM_VARIANTS, start=1):
+        program, vao = state.program("ibl.frag", {"CF_IBL_PASS": index})
+        values = {**per_variant[variant], "cf_alpha_range": tuple(float(v) for v in lut.alpha_range), "cf_lut": 0,
+                  "u_grid": (0.0, 1.0 / (width - 1), 0.0, 1.0 / (height - 1))}
+        for name, value in values.items():
+            if name in program:
+                program[name].value = value
+        programs[variant] = vao
+    fbo, targets = state.float_targets((width, height), 2)
+    query = ctx.query(time=True)
+    samples = {variant: [] for variant in SPLIT_SUM_VARIANTS}
+    try:
+        texture.use(location=0)
+        fbo.use()
+        for _ in range(rounds):
+            for variant, vao in programs.items():
+                for timed in (False, True):  # one warm-up render before each timed one
+                    ctx.finish()
+                    wall, cpu = time.perf_counter(), time.process_time()
+                    with query:
+                        vao.render(mode=ctx.TRIANGLES, vertices=3)
+                        # llvmpipe's query covers only completed work: finish inside.
+                        ctx.finish()
+                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+                    if timed:
+                        samples[variant].append((query.elapsed, wall, cpu))
+        check_gl_error(ctx)
+    finally:
+        state.release_targets(fbo, targets)
+        texture.release()
+    return {variant: np.array(s, dtype=np.float64) for variant, s in samples.items()}
+
+
+def time_split_sum(
+    thread: RenderThread, lut: SplitSumLUT, F0, a, alpha, F0_lazanyi, a_lazanyi, F0_air,
+    width: int = 2560, height: int = 1440, rounds: int = 15,
+) -> dict[str, np.ndarray]:
+    """
+    Time full-screen split-sum passes of :data:`SPLIT_SUM_VARIANTS` (NdotV
+    across the screen, roughness down it, into two RGBA32F targets),
+    interleaved round by round, one warm-up render before each timed one.
+    The model gets ``F0, a, alpha`` (collapsed at the scene's eta_i),
+    adjusted Lazanyi ``F0_lazanyi, a_lazanyi`` (from the CPU), Schlick
+    ``F0_air``.
+
+    Returns
+    -------
+    dict
+        Per variant a (rounds, 3) array: GL timer query (ns), wall (s), CPU (s).
+    """
+    def vec3(values):
+        return tuple(float(v) for v in values)
+
+    per_variant = {
+        "split_sum_model": {"cf_F0": vec3(F0), "cf_a": vec3(a), "cf_alpha": vec3(alpha)},
+        "split_sum_lazanyi": {"cf_F0": vec3(F0_lazanyi), "cf_a": vec3(a_lazanyi)},
+        "split_sum_schlick": {"cf_F0": vec3(F0_air)},
+        "split_sum_fixed": {},
+    }
+    return thread.call(_time_split_sum, lut, per_variant, int(width), int(height), int(rounds))
