@@ -66,7 +66,7 @@ LABELS = {
     FIXED: "no Fresnel term (fixed cost of the pass)",
 }
 SPLIT_LABELS = {
-    "split_sum_model": "split sum, model (3 alpha lookups, 28 fetches)",
+    "split_sum_model": "split sum, model (3 alpha lookups, 24 fetches)",
     "split_sum_lazanyi": "split sum, adjusted Lazanyi (alpha = 6, 8 fetches)",
     "split_sum_schlick": "split sum, Schlick (8 fetches)",
     "split_sum_fixed": "no split sum (fixed cost of the pass)",
