@@ -149,7 +149,7 @@ def _yaml_loader(max_depth: int, max_nodes: int):
     from yaml.resolver import Resolver
 
     try:
-        from yaml import CParser  # libyaml: fast, and its parser is not recursive
+        from yaml._yaml import CParser  # libyaml: fast, and its parser is not recursive
         parser_bases: tuple[type, ...] = (CParser,)
     except ImportError:  # pragma: no cover - PyYAML without libyaml
         from yaml.parser import Parser
@@ -250,8 +250,9 @@ def csv_rows_bounded(text: str, max_rows: int = MAX_SAMPLES + 1,
                      max_line_chars: int = MAX_LINE_CHARS) -> list[list[str]]:
     """
     The non-blank rows of a CSV text, refusing more than ``max_rows`` lines,
-    a line longer than ``max_line_chars`` or a row of more than
-    ``max_columns`` fields; all three are checked before the rows are built.
+    a line or a (quoted, multi-line) field longer than ``max_line_chars``, or
+    a row of more than ``max_columns`` fields; the line count and length are
+    checked before the rows are built, the others row by row.
     """
     check_text_size(text, "CSV")
     lines = text.count("\n") + 1
@@ -268,6 +269,12 @@ def csv_rows_bounded(text: str, max_rows: int = MAX_SAMPLES + 1,
             if len(row) > max_columns:
                 raise ValueError(
                     f"CSV line {line} must have at most {max_columns} columns, got {len(row)}"
+                )
+            longest = max(map(len, row), default=0)
+            if longest > max_line_chars:  # a quoted field spanning lines
+                raise ValueError(
+                    f"CSV fields must be at most {max_line_chars} characters long, "
+                    f"got {longest} in row {line}"
                 )
             if row and any(cell.strip() for cell in row):
                 rows.append(row)
