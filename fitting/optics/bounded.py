@@ -141,6 +141,10 @@ def load_json_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
         raise ValueError(f"JSON is not valid: {excerpt(str(error), 120)[1:-1]}") from None
 
 
+class _YamlLimit(ValueError):
+    """A bound of the YAML loader (aliases, depth, nodes): its message is final."""
+
+
 def _yaml_loader(max_depth: int, max_nodes: int):
     """A SafeLoader class whose composer counts nodes and depth and refuses aliases."""
     import yaml
@@ -167,18 +171,18 @@ def _yaml_loader(max_depth: int, max_nodes: int):
         def compose_node(self, parent, index):
             event = self.peek_event()
             if isinstance(event, AliasEvent):
-                raise ValueError(
+                raise _YamlLimit(
                     f"YAML aliases (`*{excerpt(event.anchor, 30)[1:-1]}`) are not accepted: "
                     "an n, k file has no repeated parts"
                 )
             self._nodes += 1
             if self._nodes > max_nodes:
-                raise ValueError(f"YAML must have at most {max_nodes} nodes")
+                raise _YamlLimit(f"YAML must have at most {max_nodes} nodes")
             nested = isinstance(event, (SequenceStartEvent, MappingStartEvent))
             if nested:
                 self._depth += 1
                 if self._depth > max_depth:
-                    raise ValueError(f"YAML must nest at most {max_depth} levels deep")
+                    raise _YamlLimit(f"YAML must nest at most {max_depth} levels deep")
             try:
                 return super().compose_node(parent, index)
             finally:
@@ -189,7 +193,7 @@ def _yaml_loader(max_depth: int, max_nodes: int):
         def flatten_mapping(self, node):
             for key, _ in node.value:
                 if key.tag == "tag:yaml.org,2002:merge":
-                    raise ValueError("YAML merge keys (`<<`) are not accepted")
+                    raise _YamlLimit("YAML merge keys (`<<`) are not accepted")
             super().flatten_mapping(node)
 
     # The composer comes first, so that compose_* and get_*node are its own,
@@ -241,6 +245,15 @@ def load_yaml_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
         raise ValueError(f"YAML is not valid: {excerpt(str(error), 80)[1:-1]}") from None
     except RecursionError:
         raise ValueError(f"YAML must nest at most {max_depth} levels deep") from None
+    except _YamlLimit as error:
+        raise ValueError(str(error)) from None
+    except (ValueError, TypeError, OverflowError) as error:
+        # A tagged scalar that does not construct (`!!float abc`, a date out
+        # of range, an integer of 5,000 digits): Python's message may repeat
+        # the whole scalar, so only an excerpt is kept.
+        raise ValueError(
+            f"YAML is not valid: a value could not be read ({excerpt(str(error), 80)[1:-1]})"
+        ) from None
     finally:
         loader.dispose()
 

@@ -298,8 +298,8 @@ def gen_wrong_types(rng: random.Random) -> list[Case]:
     for i in range(20):
         field_name = rng.choice(["wavelength_nm", "n", "k", "name", "source"])
         value, _ = rng.choice(json_wrong)
-        if field_name in ("name", "source") and value.startswith('"'):
-            value = "7"
+        if field_name in ("name", "source") and (value.startswith('"') or value == "null"):
+            value = rng.choice(["7", "[1]", "true"])  # text and null are legal there
         view = {"wavelength_nm": "[400, 500]", "n": "[1, 2]", "k": "[0, 0]", field_name: value}
         text = "{" + ", ".join(f'"{key}": {val}' for key, val in view.items()) + "}"
         cases.append(upload("wrong_types", f"json-file-{field_name}-{i}", text, "bad.json", field_name))
@@ -328,6 +328,60 @@ def gen_wrong_types(rng: random.Random) -> list[Case]:
     ]
     for i, (path, value, expect) in enumerate(body_wrong):
         cases.append(json_body("wrong_types", f"json-body-{expect}-{i}", path, value, expect))
+    return cases
+
+
+def gen_yaml_tags(rng: random.Random) -> list[Case]:
+    """Explicit tags and constructs that SafeLoader builds or refuses: never a 500, never an echo."""
+    cases = []
+    for i in range(24):
+        filler = "".join(rng.choice("xyz0123456789") for _ in range(rng.randint(100, 200_000)))
+        shape = rng.choice(["python", "unknown", "float", "int", "timestamp", "binary", "documents",
+                            "unhashable", "big-int", "wrong-node", "long-anchor"])
+        value = {
+            "python": rng.choice(["!!python/object/apply:os.system ['true']", "!!python/name:os.system ''",
+                                  "!!python/object:__main__.X {}"]),
+            "unknown": f"!{filler[:rng.randint(1, 5000)]} x",
+            "float": f"!!float {filler}",
+            "int": f"!!int {filler}",
+            "timestamp": rng.choice(["!!timestamp 2020-13-45", "!!timestamp 0000-00-00", "2020-02-31"]),
+            "binary": f"!!binary '{filler}*'",
+            "documents": "x\n---\nDATA: []\n---\n" + "--- a\n" * rng.randint(1, 1000),
+            "unhashable": "{? [a, b] : 1}",
+            "big-int": "9" * rng.randint(4_301, 500_000),
+            "wrong-node": rng.choice(["!!str [1, 2]", "!!map [1]", "!!seq {a: 1}", "!!omap {a: 1}",
+                                      "!!pairs [1]", "!!set [1]"]),
+            "long-anchor": f"[&{filler[:60_000]} 1, *{filler[:60_000]}]",
+        }[shape]
+        where = rng.choice(["REFERENCES", "data", "top"])
+        if where == "REFERENCES":
+            text = f"REFERENCES: {value}\nDATA:\n{GOOD_NK_ENTRY}"
+        elif where == "data":
+            text = f"DATA:\n  - type: tabulated nk\n    data: {value}\n"
+        else:
+            text = f"COMMENTS: {value}\nDATA:\n{GOOD_NK_ENTRY}"
+        expect = r"YAML|REFERENCES|`data`|DATA|coverage|cover"
+        cases.append(yaml_upload("yaml_tags", f"{shape}-{where}-{i}", text, expect))
+    return cases
+
+
+def gen_big_numbers(rng: random.Random) -> list[Case]:
+    """Integer literals past Python's 4300-digit limit and floats past float64."""
+    cases = []
+    for i in range(12):
+        digits = rng.randint(4_301, 400_000)
+        literal = rng.choice(["9" * digits, "-" + "1" * digits, "1" + "0" * digits + ".5",
+                              "1e" + "9" * rng.randint(3, 5000)])
+        field_name = rng.choice(["wavelength_nm", "n", "k"])
+        nk = {key: json.dumps(v) for key, v in GOOD_JSON.items()}
+        nk[field_name] = f"[{literal}, 1, 2]"
+        nk_text = "{" + ", ".join(f'"{key}": {val}' for key, val in nk.items()) + "}"
+        if rng.random() < 0.5:
+            cases.append(upload("big_numbers", f"file-{field_name}-{i}", nk_text, "big.json",
+                                r"JSON|finite|float64|must be"))
+        else:
+            cases.append(body("big_numbers", f"body-{field_name}-{i}", f"{API}/fits",
+                              f'{{"name": "x", "nk": {nk_text}}}', r"parsed|finite|valid"))
     return cases
 
 
@@ -580,7 +634,7 @@ def gen_csv_hostile(rng: random.Random) -> list[Case]:
 
 GENERATORS: list[Callable[[random.Random], list[Case]]] = [
     gen_yaml_alias_bomb, gen_deep_nesting, gen_huge_wavelength_range, gen_huge_samples,
-    gen_wrong_types, gen_booleans, gen_non_finite, gen_oversized, gen_malformed_multipart,
+    gen_wrong_types, gen_yaml_tags, gen_big_numbers, gen_booleans, gen_non_finite, gen_oversized, gen_malformed_multipart,
     gen_encoding, gen_bom, gen_csv_hostile,
 ]
 CLASSES = [g.__name__.removeprefix("gen_") for g in GENERATORS]
