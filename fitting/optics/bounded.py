@@ -17,6 +17,7 @@ hostile file cannot make a large amount of work or memory.
 -   :func:`check_sample_count`: the number of samples of a formula entry
     over a wavelength range, refused before anything is allocated.
 -   :func:`excerpt`: a short, printable excerpt of bad input for a message.
+-   :func:`kind_of`: what a parsed value is, in words ("a list", "a date").
 
 Every refusal is a ``ValueError`` naming the limit and its value.
 """
@@ -24,6 +25,7 @@ Every refusal is a ``ValueError`` naming the limit and its value.
 from __future__ import annotations
 
 import csv
+import datetime
 import io
 import json
 import math
@@ -41,6 +43,7 @@ __all__ = [
     "MAX_LINE_CHARS",
     "MAX_EXCERPT_CHARS",
     "excerpt",
+    "kind_of",
     "check_text_size",
     "load_json_bounded",
     "load_yaml_bounded",
@@ -73,6 +76,28 @@ def excerpt(value: Any, limit: int = MAX_EXCERPT_CHARS) -> str:
     text = repr(value) if not isinstance(value, str) else repr(value[: limit + 1])
     text = text.encode("ascii", "backslashreplace").decode("ascii")
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def kind_of(value: Any) -> str:
+    """What a parsed value is, in words, for a message about a wrong type."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return f"a boolean ({value})"
+    if isinstance(value, (int, float)):
+        return f"a number ({excerpt(value, 30)})"
+    if isinstance(value, (bytes, bytearray)):
+        return "binary data"
+    if isinstance(value, (datetime.date, datetime.datetime)):
+        return f"a date ({value})"
+    if isinstance(value, (list, tuple)):
+        return "a list"
+    if isinstance(value, dict):
+        return "a map"
+    if isinstance(value, (set, frozenset)):
+        return "a set"
+    return f"{type(value).__name__}"
+
 
 
 def check_text_size(text: str | bytes, what: str, limit: int = MAX_TEXT_CHARS) -> None:

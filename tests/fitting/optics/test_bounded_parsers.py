@@ -1,6 +1,6 @@
 """
 The bounded parsers of fitting.optics.bounded and the readers built on
-them (fitting.sources): every hostile shape is refused with a ValueError
+them (fitting.optics.readers): every hostile shape is refused with a ValueError
 that names the limit, quickly and without building the hostile document.
 """
 
@@ -24,7 +24,7 @@ from fitting.optics.bounded import (
     load_json_bounded,
     load_yaml_bounded,
 )
-from fitting.sources import read_nk, read_nk_csv, read_nk_json, read_nk_yaml
+from fitting.optics.readers import read_nk, read_nk_csv, read_nk_json, read_nk_yaml
 
 GOOD_YAML = """\
 REFERENCES: "P. B. Johnson and R. W. Christy. <i>Phys. Rev. B</i> 6, 4370 (1972)"
