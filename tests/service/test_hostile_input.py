@@ -632,10 +632,31 @@ def gen_csv_hostile(rng: random.Random) -> list[Case]:
     return cases
 
 
+def gen_hostile_queries(rng: random.Random) -> list[Case]:
+    """Query parameters and path ids out of range, of the wrong type, huge or non-finite."""
+    cases = []
+    for i in range(20):
+        fit_id = "".join(rng.choice("0123456789abcdef") for _ in range(32))
+        bad = rng.choice(["1e9", "-1", "nan", "inf", "true", "x" * rng.randint(1, 5000), "9" * 5000, ""])
+        path, name = rng.choice([
+            (f"{API}/fits/{fit_id}/curves?samples={bad}", "samples"),
+            (f"{API}/fits/{fit_id}/curves?eta_i={bad}", "eta_i"),
+            (f"{API}/fits/{fit_id}/error-map?angles={bad}", "angles"),
+            (f"{API}/fits/{fit_id}/error-map?rows={bad}", "rows"),
+            (f"{API}/fits/{fit_id}/pack?format={bad}", "format"),
+            (f"{API}/preview.png?fit={fit_id}&size={bad}", "size"),
+            (f"{API}/preview.png?fit={fit_id}&eta_i={bad}", "eta_i"),
+            (f"{API}/preview.png?fit={bad}", "fit"),
+            (f"{API}/fits/{bad or 'x'}", "fit_id"),
+        ])
+        cases.append(Case("hostile_queries", f"{name}-{i}", "GET", path, name, path.encode()))
+    return cases
+
+
 GENERATORS: list[Callable[[random.Random], list[Case]]] = [
     gen_yaml_alias_bomb, gen_deep_nesting, gen_huge_wavelength_range, gen_huge_samples,
     gen_wrong_types, gen_yaml_tags, gen_big_numbers, gen_booleans, gen_non_finite, gen_oversized, gen_malformed_multipart,
-    gen_encoding, gen_bom, gen_csv_hostile,
+    gen_encoding, gen_bom, gen_csv_hostile, gen_hostile_queries,
 ]
 CLASSES = [g.__name__.removeprefix("gen_") for g in GENERATORS]
 
