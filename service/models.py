@@ -22,9 +22,12 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fitting.domain import DEFAULT_ETA_I_RANGE
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.optics.bounded import excerpt
 from fitting.optics.library import LIBRARY_NAMES
 
 from .store import FIT_KINDS, FitRecord
+
+_MAX_UNKNOWN_LISTED = 5
 
 __all__ = [
     "API_PREFIX",
@@ -36,6 +39,7 @@ __all__ = [
     "LibraryName",
     "Objective",
     "PackFormat",
+    "RequestModel",
     "NKData",
     "FitRequest",
     "PackRequest",
@@ -73,14 +77,39 @@ PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
 Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
-class NKData(BaseModel):
+class RequestModel(BaseModel):
+    """
+    Base of the request models: unknown fields are refused, and a body with
+    many of them is refused in one error naming the first few (pydantic
+    would make one error per field, tens of thousands from a 1 MB body, all
+    on the event loop).
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _few_unknown_fields(cls, data: Any) -> Any:
+        fields = cls.model_fields
+        if isinstance(data, dict) and len(data) > len(fields) + _MAX_UNKNOWN_LISTED:
+            unknown = [key for key in data if key not in fields]
+            if len(unknown) > _MAX_UNKNOWN_LISTED:
+                shown = ", ".join(excerpt(key, 30) for key in unknown[:_MAX_UNKNOWN_LISTED])
+                raise ValueError(
+                    f"extra fields are not permitted: {len(unknown)} unknown fields ({shown}, ...)"
+                )
+        return data
+
+
+class NKData(RequestModel):
     """Measured optical constants: wavelength in nm (strictly increasing), n > 0, k >= 0."""
 
     model_config = ConfigDict(extra="forbid")
 
-    wavelength_nm: list[Wavelength] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
-    n: list[IndexN] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
-    k: list[IndexK] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
+    # fail_fast: one error per list, not one per bad item (20,000 booleans).
+    wavelength_nm: list[Wavelength] = Field(min_length=2, max_length=MAX_NK_SAMPLES, fail_fast=True)
+    n: list[IndexN] = Field(min_length=2, max_length=MAX_NK_SAMPLES, fail_fast=True)
+    k: list[IndexK] = Field(min_length=2, max_length=MAX_NK_SAMPLES, fail_fast=True)
 
     @model_validator(mode="after")
     def _check_table(self) -> "NKData":
@@ -101,7 +130,7 @@ class NKData(BaseModel):
         return self
 
 
-class FitRequest(BaseModel):
+class FitRequest(RequestModel):
     """
     A fit: either ``material`` (a built-in conductor) or ``nk`` (measured
     data, with a ``name``), over the coating-index domain ``eta_i_range``.
@@ -145,7 +174,7 @@ class FitRequest(BaseModel):
         return self
 
 
-class PackRequest(BaseModel):
+class PackRequest(RequestModel):
     """Several stored fits in one pack (a scene's materials)."""
 
     model_config = ConfigDict(extra="forbid")

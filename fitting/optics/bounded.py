@@ -99,7 +99,6 @@ def kind_of(value: Any) -> str:
     return f"{type(value).__name__}"
 
 
-
 def check_text_size(text: str | bytes, what: str, limit: int = MAX_TEXT_CHARS) -> None:
     """Refuse a file text longer than ``limit`` characters (or bytes)."""
     if len(text) > limit:

@@ -327,6 +327,10 @@ def gen_wrong_types(rng: random.Random) -> list[Case]:
         (f"{API}/fits/from-curves", {"curves": [{"eta_i": 1.5, "angle_deg": "0 90", "rgb": []}]},
          "curves"),
     ]
+    for i in range(3):  # thousands of unknown fields: refused in one error, cheaply
+        extra = {f"x{j}": j for j in range(rng.randint(1_000, 50_000))}
+        body_wrong.append((rng.choice([f"{API}/fits", f"{API}/packs", f"{API}/scenes"]),
+                           {"material": "Au", **extra}, r"extra fields are not permitted: \d+ unknown"))
     for i, (path, value, expect) in enumerate(body_wrong):
         cases.append(json_body("wrong_types", f"json-body-{expect}-{i}", path, value, expect))
     return cases

@@ -32,7 +32,7 @@ from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.optics.nk import SpectralNK
 
 from ...fitting_jobs import measured_nk
-from ...models import API_PREFIX, NKData
+from ...models import API_PREFIX, NKData, RequestModel
 from ...store import Store
 from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_errors
 
@@ -42,7 +42,7 @@ EtaValue = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False, strict=Tr
 Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
-class EtaRange(BaseModel):
+class EtaRange(RequestModel):
     """A range of coating indices, min <= max."""
 
     model_config = ConfigDict(extra="forbid")
@@ -51,7 +51,7 @@ class EtaRange(BaseModel):
     max: EtaValue
 
 
-class SceneMaterialRequest(BaseModel):
+class SceneMaterialRequest(RequestModel):
     """One material of a scene: ``material`` (built-in or saved id) or ``nk``, and its eta_i."""
 
     model_config = ConfigDict(extra="forbid")
@@ -74,13 +74,14 @@ class SceneMaterialRequest(BaseModel):
         return self
 
 
-class SceneRequest(BaseModel):
+class SceneRequest(RequestModel):
     """A scene description (see ``fitting.scene``)."""
 
     model_config = ConfigDict(extra="forbid")
 
     name: Name = "scene"
-    materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS)
+    materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS,
+                                                  fail_fast=True)
 
 
 class ScenePublic(BaseModel):
