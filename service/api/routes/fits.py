@@ -24,7 +24,7 @@ from fastapi import APIRouter, File, Form, HTTPException, Path, Query, Response,
 from fastapi.concurrency import run_in_threadpool
 
 from fitting.colour.reference import reference_ACEScg
-from fitting.domain import cos_theta_from_angle
+from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN, cos_theta_from_angle
 from fitting.fits.settings import DEFAULT_OBJECTIVE
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.models.coated_conductor import coated_conductor_model
@@ -135,8 +135,8 @@ async def upload_fit(
         Form(pattern=r"^(csv|json|yaml|yml)$", description="Default: from the file name"),
     ] = None,
     name: Annotated[str | None, Form(min_length=1, max_length=200, pattern=r"\S")] = None,
-    eta_i_min: Annotated[float, Form(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.0,
-    eta_i_max: Annotated[float, Form(ge=1.0, le=3.0, allow_inf_nan=False)] = 2.5,
+    eta_i_min: Annotated[float, Form(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)] = DEFAULT_ETA_I_RANGE[0],
+    eta_i_max: Annotated[float, Form(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)] = DEFAULT_ETA_I_RANGE[1],
     objective: Annotated[Objective, Form()] = DEFAULT_OBJECTIVE,
 ) -> FitPublic:
     """
@@ -215,7 +215,7 @@ def pack_response(records: list[FitRecord], format: str, stem: str) -> Response:
 )
 def get_curves(
     fit_id: FitIdPath, store: StoreDep,
-    eta_i: Annotated[float, Query(ge=1.0, le=3.0, allow_inf_nan=False,
+    eta_i: Annotated[float, Query(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False,
                                   description="Coating index")] = 1.5,
     samples: Annotated[int, Query(ge=2, le=1024, description="Angles from 0 to 90 degrees")] = 91,
 ) -> CurvesPublic:
