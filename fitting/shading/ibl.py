@@ -38,6 +38,8 @@ varies per channel and with eta_i. The slices are spaced evenly in
     :math:`2\\int_0^1 F\\mu\\,d\\mu` of the model.
 -   :func:`energy_compensation`: the multiple-scattering factor from it.
 -   :func:`encode_lut`, :func:`decode_lut`: the file format (docs/shading.md).
+-   :func:`cached_lut`, :func:`default_lut`: the LUT through a deterministic
+    on-disk cache (generated once per machine, not per process).
 
 References
 ----------
@@ -53,10 +55,15 @@ Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import hashlib
+import os
 import struct
+import tempfile
 import zlib
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -73,6 +80,9 @@ __all__ = [
     "SplitSumLUT",
     "generate_lut",
     "default_lut",
+    "cached_lut",
+    "lut_cache_path",
+    "cache_dir",
     "encode_lut",
     "decode_lut",
     "split_sum_model",
@@ -278,10 +288,83 @@ def decode_lut(blob: bytes) -> SplitSumLUT:
     return SplitSumLUT(data, (float(lo), float(hi)))
 
 
+CACHE_FORMAT_VERSION = 1
+"""Bumped whenever :func:`generate_lut` or the file format changes, so that
+stale cache files are never read."""
+
+CACHE_ENV = "CF_CACHE_DIR"
+"""Environment variable naming the cache folder (default
+``$XDG_CACHE_HOME/coated-fresnel``, else ``~/.cache/coated-fresnel``)."""
+
+
+def cache_dir() -> Path:
+    """The on-disk cache folder (:data:`CACHE_ENV`)."""
+    if os.environ.get(CACHE_ENV):
+        return Path(os.environ[CACHE_ENV])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "coated-fresnel"
+
+
+def lut_cache_path(
+    shape: tuple[int, int, int] = LUT_SHAPE,
+    alpha_range: tuple[float, float] = ALPHA_RANGE,
+    samples: int = LUT_SAMPLES,
+) -> Path:
+    """
+    The cache file of one LUT: the name holds the format version and a
+    SHA-256 of the generation parameters (shape, alpha range as float32
+    bits, samples), so that any change of them misses the cache.
+    """
+    n_alpha, n_r, n_mu = (int(v) for v in shape)
+    lo, hi = (float(v) for v in alpha_range)
+    key = struct.pack("<4I3I2f", CACHE_FORMAT_VERSION, n_alpha, n_r, n_mu, int(samples), 3, 0, lo, hi)
+    digest = hashlib.sha256(MAGIC + key).hexdigest()[:16]
+    return cache_dir() / f"ibl_lut_v{CACHE_FORMAT_VERSION}_{n_mu}x{n_r}x{n_alpha}_{int(samples)}_{digest}.cflut"
+
+
+def cached_lut(
+    shape: tuple[int, int, int] = LUT_SHAPE,
+    alpha_range: tuple[float, float] = ALPHA_RANGE,
+    samples: int = LUT_SAMPLES,
+) -> SplitSumLUT:
+    """
+    :func:`generate_lut` through the on-disk cache: a valid cache file
+    (:func:`decode_lut` checks its CRC and header, and its shape and alpha
+    range must match) is read; otherwise the LUT is generated and written
+    atomically (a temporary file in the same folder, then ``os.replace``),
+    so concurrent processes never see a partial file. A cache folder that
+    cannot be written only costs the regeneration.
+    """
+    path = lut_cache_path(shape, alpha_range, samples)
+    expected_range = tuple(float(np.float32(v)) for v in alpha_range)
+    try:
+        lut = decode_lut(path.read_bytes())
+        if lut.shape == tuple(int(v) for v in shape) and lut.alpha_range == expected_range:
+            return lut
+    except (OSError, ValueError):
+        pass
+    lut = generate_lut(shape, alpha_range, samples)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+        try:
+            with os.fdopen(fd, "wb") as handle:
+                handle.write(encode_lut(lut))
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            raise
+    except OSError:
+        pass
+    return decode_lut(encode_lut(lut))
+
+
 @functools.cache
 def default_lut() -> SplitSumLUT:
-    """The LUT at the default shape and sample count, generated once per process."""
-    return generate_lut()
+    """The LUT at the default shape and sample count, from the on-disk cache
+    (:func:`cached_lut`), once per process."""
+    return cached_lut()
 
 
 def _inputs(NdotV, roughness):
