@@ -4,6 +4,8 @@ Command line: ``python -m preview_shaders render ...``.
     python -m preview_shaders render --material Au --eta-i 1.5 --size 512 \\
         --compare lazanyi -o out.png
     python -m preview_shaders render --fit pack.cfpk --eta-i 2.0 -o out.png
+    python -m preview_shaders render --material Cr --eta-i 1.5 --roughness 0.3 \
+        --mode coated --coat-roughness 0.1 --environment studio -o rough.png
 
 Without ``--fit`` the built-in material is fitted on the spot
 (:func:`fitting.fits.material.fit_material`); with it, the material is read from a
@@ -21,7 +23,7 @@ from fitting.models.pack import PACK_MAGIC, decode_pack, pack_from_json
 from fitting.optics.library import LIBRARY_NAMES, library_material
 
 from .display import encode_png, false_colour
-from .preview import COMPARISONS, ENVIRONMENTS, PreviewRenderer
+from .preview import COMPARISONS, ENVIRONMENTS, MODES, PreviewRenderer
 
 
 def _read_pack(path: Path, name: str | None):
@@ -53,11 +55,13 @@ def _render(args) -> int:
         nk = library_material(packed.name) if packed.name in LIBRARY_NAMES else None
     with PreviewRenderer() as renderer:
         result = renderer.render_preview(
-            packed, nk, args.eta_i, args.size, args.compare, args.environment
+            packed, nk, args.eta_i, args.size, args.compare, args.environment,
+            roughness=args.roughness, mode=args.mode, coat_roughness=args.coat_roughness,
         )
     args.output.write_bytes(result.png)
     print(f"wrote {args.output} ({packed.name}, eta_i {args.eta_i:g}, {args.size} px, "
-          f"compare {args.compare}, {args.environment})")
+          f"compare {args.compare}, {args.environment}, {args.mode}, roughness {args.roughness:g}"
+          + (f", coat roughness {args.coat_roughness:g}" if args.mode == "coated" else "") + ")")
     if result.delta_E is not None:
         print(f"mean Delta E 2000 over the sphere: {result.delta_E_mean:.4f}")
         print(f"mean FLIP over the sphere: {result.flip_mean:.4f}")
@@ -79,6 +83,11 @@ def main(argv: list[str] | None = None) -> int:
     render.add_argument("--size", type=int, default=512, help="pixels per side, 64..2048")
     render.add_argument("--compare", default="none", help=" | ".join(COMPARISONS))
     render.add_argument("--environment", default="white_sky", help=" | ".join(ENVIRONMENTS))
+    render.add_argument("--roughness", type=float, default=0.0,
+                        help="GGX perceptual roughness, [0, 1] (0: the smooth sphere)")
+    render.add_argument("--mode", default="immersed", help=" | ".join(MODES))
+    render.add_argument("--coat-roughness", type=float, default=0.0,
+                        help="with --mode coated: the coat's roughness, [0, 1]")
     render.add_argument("--delta-e-map", type=Path, help="with --compare reference: "
                         "Delta E 2000 map PNG (viridis, 0..2)")
     render.add_argument("--flip-map", type=Path, help="with --compare reference: "

@@ -19,7 +19,10 @@ thread, the spectral reference and metrics on the caller's)::
         eta_i=1.5,              # coating index, [1, 3]
         size=512,               # pixels per side, 64..2048
         compare="none",         # "none" | "lazanyi" | "reference"
-        environment="white_sky" # "white_sky" | "studio"
+        environment="white_sky",# "white_sky" | "studio"
+        roughness=0.0,          # GGX perceptual roughness, [0, 1]
+        mode="immersed",        # "immersed" | "coated" (a clear coat of index eta_i)
+        coat_roughness=0.0,     # the coat's roughness (mode="coated"), [0, 1]
     )
     result.png                  # bytes: the (split) view, 8-bit sRGB PNG
     result.image                # (size, size, 3) float32 linear ACEScg
@@ -39,6 +42,10 @@ radius.
 -   :class:`PreviewRenderer`, :class:`PreviewResult`.
 -   :func:`reference_image`: the spectral reference of a rendered view.
 -   :func:`difference_maps`: Delta E 2000 and FLIP maps and means.
+Rough spheres and the coated mode (issue 11) are drawn by
+``glsl/preview_rough.frag`` through the split sum with a prefiltered
+environment (:mod:`preview_shaders.rough`).
+
 -   :func:`sphere_cos_theta`: cos theta per pixel from the geometry, in numpy.
 """
 
@@ -63,6 +70,7 @@ from .gl import GLState, RenderThread, check_gl_error
 __all__ = [
     "COMPARISONS",
     "ENVIRONMENTS",
+    "MODES",
     "SIZE_RANGE",
     "ETA_I_LIMITS",
     "SPHERE_RADIUS",
@@ -75,6 +83,7 @@ __all__ = [
 ]
 
 COMPARISONS = ("none", "lazanyi", "reference")
+MODES = ("immersed", "coated")
 ENVIRONMENTS = ("white_sky", "studio")
 SIZE_RANGE = (64, 2048)
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
@@ -92,6 +101,15 @@ def _check_size(size) -> int:
 
 def _check_eta_i(eta_i) -> float:
     return check_eta_i(eta_i)
+
+
+def _check_unit(name: str, value) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"`{name}` must be a number in [0, 1], got {value!r}")
+    value = float(value)
+    if not (np.isfinite(value) and 0.0 <= value <= 1.0):
+        raise ValueError(f"`{name}` must lie in [0, 1], got {value}")
+    return value
 
 
 def _check_choice(name: str, value, choices) -> str:
@@ -145,6 +163,9 @@ class PreviewResult:
     delta_E_mean: float | None = None
     flip: np.ndarray | None = None
     flip_mean: float | None = None
+    roughness: float = 0.0
+    mode: str = "immersed"
+    coat_roughness: float = 0.0
 
 
 def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, size,
@@ -248,6 +269,9 @@ class PreviewRenderer:
         compare: str = "none",
         environment: str = "white_sky",
         step_nm: float = 1.0,
+        roughness: float = 0.0,
+        mode: str = "immersed",
+        coat_roughness: float = 0.0,
     ) -> PreviewResult:
         """
         Render the preview sphere (see the module docstring).
@@ -257,7 +281,15 @@ class PreviewRenderer:
         ValueError
             For ``size`` outside [64, 2048], ``eta_i`` outside [1, 3], an
             unknown ``compare`` or ``environment``, a ``packed`` that is not a
-            PackedMaterial, or a comparison without ``nk``.
+            PackedMaterial, or a comparison without ``nk``; ``roughness``
+            or ``coat_roughness`` outside [0, 1], an unknown ``mode``, or a
+            rough / coated view of a model kind other than coated-conductor.
+
+        ``roughness`` = 0 with ``mode`` = "immersed" is the smooth sphere of
+        ``preview.frag`` (the paper's validation view, unchanged); any other
+        combination is drawn by ``preview_rough.frag``
+        (:mod:`preview_shaders.rough`): the split sum with the environment
+        prefiltered at the roughness, the comparison under the same lighting.
         """
         if not isinstance(packed, PackedMaterial):
             raise ValueError(f"`packed` must be a PackedMaterial, got {type(packed).__name__}")
@@ -267,6 +299,17 @@ class PreviewRenderer:
         environment = _check_choice("environment", environment, ENVIRONMENTS)
         if compare != "none" and nk is None:
             raise ValueError(f"`nk` is needed for compare={compare!r}: the material's n, k")
+        roughness = _check_unit("roughness", roughness)
+        coat_roughness = _check_unit("coat_roughness", coat_roughness)
+        mode = _check_choice("mode", mode, MODES)
+        if roughness > 0.0 or mode != "immersed":
+            if packed.model != "coated-conductor":
+                raise ValueError(
+                    f"`roughness` > 0 and `mode` coated need the coated-conductor model kind, "
+                    f"got {packed.model!r}"
+                )
+            return self._render_rough(packed, nk, eta_i, size, compare, environment, step_nm,
+                                      roughness, mode, coat_roughness)
 
         baseline = baseline_inputs(nk) if nk is not None else None
         F0_air = baseline["F0_air"] if baseline else np.zeros(3)
@@ -296,6 +339,58 @@ class PreviewRenderer:
             compare=compare,
             eta_i=eta_i,
             environment=environment,
+        )
+        if compare == "reference":
+            (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
+                difference_maps(model, comparison, mask)
+            )
+        return result
+
+    def _render_rough(self, packed, nk, eta_i, size, compare, environment, step_nm,
+                      roughness, mode, coat_roughness) -> PreviewResult:
+        from fitting.shading.ibl import default_lut
+
+        from .rough import prefiltered_environment, render_rough_layers, rough_reference_image
+
+        baseline = baseline_inputs(nk) if nk is not None else None
+        lut = default_lut()
+        prefiltered = prefiltered_environment(self.thread, ENVIRONMENTS.index(environment))
+        uniforms = {
+            "u_centre": (0.5 * size, 0.5 * size),
+            "u_radius": SPHERE_RADIUS * size,
+            "u_environment": ENVIRONMENTS.index(environment),
+            "u_eta_i": eta_i,
+            "u_mode": MODES.index(mode),
+            "u_roughness": roughness,
+            "u_coat_roughness": coat_roughness,
+            "cf_words": [int(w) for w in padded_words(packed)],
+            "cf_eta_i_range": tuple(float(v) for v in packed.eta_i_range),
+            "cf_F0_air": tuple(float(v) for v in (baseline["F0_air"] if baseline else np.zeros(3))),
+            "cf_F82_air": tuple(float(v) for v in (baseline["F82_air"] if baseline else np.zeros(3))),
+        }
+
+        def layers(split_column):
+            return self.thread.call(render_rough_layers, lut.data, lut.alpha_range, prefiltered,
+                                    {**uniforms, "u_split_column": float(split_column)}, size)
+
+        model, geometry, radiance, coat_radiance = layers(size)
+        mask = geometry[..., 1] > 0.5
+        cos_theta = geometry[..., 0]
+        model = model[..., :3]
+        comparison = None
+        if compare == "lazanyi":
+            comparison = layers(0)[0][..., :3]
+        elif compare == "reference":
+            comparison = rough_reference_image(nk, cos_theta, mask, radiance, coat_radiance, eta_i,
+                                               roughness, mode, coat_roughness, step_nm)
+        image = model.copy()
+        if comparison is not None:
+            image[:, size // 2 :] = comparison[:, size // 2 :]
+        result = PreviewResult(
+            image=image, png=encode_png(to_uint8(ACEScg_to_sRGB(image))), model=model,
+            comparison=comparison, cos_theta=cos_theta, mask=mask, radiance=radiance[..., :3],
+            compare=compare, eta_i=eta_i, environment=environment,
+            roughness=roughness, mode=mode, coat_roughness=coat_roughness,
         )
         if compare == "reference":
             (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
