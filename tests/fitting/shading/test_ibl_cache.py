@@ -7,8 +7,8 @@ import os
 import numpy as np
 import pytest
 
-from fitting.shading import ibl
-from fitting.shading.ibl import cached_lut, decode_lut, encode_lut, generate_lut, lut_cache_path
+from fitting.shading import lut as ibl
+from fitting.shading.lut import cached_lut, decode_lut, encode_lut, generate_lut, lut_cache_path
 
 SMALL = dict(shape=(3, 4, 5), alpha_range=(0.5, 12.0), samples=64)
 
