@@ -13,6 +13,9 @@ Stored fits as the files a renderer loads:
     ``cf_material_<name>(NdotV, eta_i)`` function.
 -   ``hlsl``: the same for HLSL, with the HLSL functions from
     ``service/templates/cf_coated_conductor.hlsl`` and ``cf_rgb_conductor.hlsl``.
+-   with the coated-conductor kind both snippets also carry the split-sum
+    lookup ``cf_split_sum_model`` (and the baselines) that reads the LUT of
+    ``GET /api/v1/ibl-lut`` (``cf_ibl.glsl``, ``templates/cf_ibl.hlsl``).
 
 The snippet text comes from the template files in ``service/templates/``.
 
@@ -49,8 +52,10 @@ from .store import FitRecord
 
 __all__ = [
     "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "render_export",
-    "download_name", "glsl_identifier",
+    "download_name", "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
+
+IBL_LUT_FILENAME = "cf_ibl_lut.cflut"
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
 PACK_MEDIA_TYPES = {
@@ -76,10 +81,12 @@ def _model_source(language: str, kinds: tuple[str, ...]) -> str:
     """
     The function of each model kind in ``kinds``: GLSL from
     ``preview_shaders/glsl`` with its includes inlined (each file once),
-    HLSL from the templates.
+    HLSL from the templates; with the coated-conductor kind, the split-sum
+    functions too (``cf_ibl.glsl``; its HLSL twin ``templates/cf_ibl.hlsl``).
     """
     if language == "hlsl":
-        return "\n\n".join((TEMPLATE_DIR / f"{_MODEL_FILES[k]}.hlsl").read_text().strip() for k in kinds)
+        files = [f"{_MODEL_FILES[k]}.hlsl" for k in kinds] + [f"{f}.hlsl" for f in _split_sum(kinds)]
+        return "\n\n".join((TEMPLATE_DIR / f).read_text().strip() for f in files)
     seen: set[str] = set()
 
     def expand(file_name: str) -> str:
@@ -88,7 +95,23 @@ def _model_source(language: str, kinds: tuple[str, ...]) -> str:
         seen.add(file_name)
         return _INCLUDE.sub(lambda m: expand(m.group(1)), (GLSL_DIR / file_name).read_text())
 
-    return "\n".join(expand(f"{_MODEL_FILES[k]}.glsl").strip() for k in kinds)
+    files = [f"{_MODEL_FILES[k]}.glsl" for k in kinds] + [f"{f}.glsl" for f in _split_sum(kinds)]
+    return "\n".join(expand(f).strip() for f in files)
+
+
+def _split_sum(kinds: tuple[str, ...]) -> list[str]:
+    """The split-sum lookup (cf_ibl: cf_split_sum_model and the baselines,
+    reading the LUT of GET /api/v1/ibl-lut) goes with the coated-conductor kind."""
+    return ["cf_ibl"] if "coated-conductor" in kinds else []
+
+
+@functools.cache
+def ibl_lut_file() -> bytes:
+    """The default split-sum LUT as its file (:func:`fitting.shading.lut.encode_lut`),
+    from the on-disk cache, once per process."""
+    from fitting.shading.lut import default_lut, encode_lut
+
+    return encode_lut(default_lut())
 
 
 def glsl_identifier(name: str) -> str:

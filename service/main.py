@@ -24,7 +24,7 @@ from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-from .api.routes import curves, fits, health, materials, packs, preview, scenes
+from .api.routes import curves, fits, health, ibl, materials, packs, preview, scenes
 from .config import Settings
 from .fitting_jobs import FitRunner
 from .models import API_PREFIX
@@ -216,7 +216,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(Exception, _unexpected_error)
-    for module in (health, materials, fits, packs, preview, curves, scenes):
+    for module in (health, materials, fits, packs, preview, curves, scenes, ibl):
         app.include_router(module.router)
     # The browser editor (static/), after the API so that /api, /docs and
     # /openapi.json keep their routes; html=True serves index.html at /.

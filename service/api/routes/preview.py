@@ -2,7 +2,8 @@
 Preview
 =======
 
-``GET /api/v1/preview.png?fit=ID&eta_i=1.5&size=512&compare=none``: the
+``GET /api/v1/preview.png?fit=ID&eta_i=1.5&size=512&compare=none``
+(``&roughness=0.3&mode=coated&coat_roughness=0.1``): the
 preview sphere of a stored fit (``preview_shaders.preview``), optionally
 split with adjusted Lazanyi or the spectral reference (these need the
 fit's n, k). One renderer per app, made on first use; it owns its GL
@@ -68,8 +69,16 @@ def preview_png(
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
     compare: Annotated[Literal["none", "lazanyi", "reference"], Query()] = "none",
     environment: Annotated[Literal["white_sky", "studio"], Query()] = "white_sky",
+    roughness: Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False,
+                                      description="GGX perceptual roughness of the metal")] = 0.0,
+    mode: Annotated[Literal["immersed", "coated"], Query(
+        description="immersed: the camera in the medium of index eta_i; coated: a clear coat of "
+                    "index eta_i seen from air")] = "immersed",
+    coat_roughness: Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False,
+                                           description="The coat's roughness (mode=coated)")] = 0.0,
 ) -> Response:
-    """The preview sphere as an 8-bit sRGB PNG."""
+    """The preview sphere as an 8-bit sRGB PNG: smooth (roughness 0, immersed),
+    or rough / coated through the split sum with a prefiltered environment."""
     if size > settings.max_preview_size:
         raise HTTPException(
             status.HTTP_422_UNPROCESSABLE_CONTENT,
@@ -100,7 +109,8 @@ def preview_png(
         try:
             result = active.render_preview(
                 material_from_json(record.material), nk, eta_i=eta_i, size=size,
-                compare=compare, environment=environment,
+                compare=compare, environment=environment, roughness=roughness, mode=mode,
+                coat_roughness=coat_roughness,
             )
         except ValueError as error:
             raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
