@@ -30,14 +30,31 @@ see ``docs/service.md``.
 from __future__ import annotations
 
 import json
+import logging
+import os
 import sqlite3
 import threading
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
+from typing import Any, Callable, Protocol, TypeVar, runtime_checkable
 
-__all__ = ["FIT_KINDS", "FitRecord", "MaterialRow", "Store", "SQLiteStore"]
+log = logging.getLogger("service.store")
+_T = TypeVar("_T")
+
+__all__ = [
+    "FIT_KINDS",
+    "FitRecord",
+    "MaterialRow",
+    "MaterialPage",
+    "Store",
+    "SQLiteStore",
+    "StoreError",
+    "StoreFull",
+    "StoreUnavailable",
+    "StoreDamaged",
+    "RecordDamaged",
+]
 
 FIT_KINDS = ("library", "nk", "curves")
 """How a fit was made: a built-in material, measured n, k, edited curves."""
@@ -111,7 +128,7 @@ class FitRecord:
 
 @dataclass(frozen=True)
 class MaterialRow:
-    """A saved (non-library) material: its latest fit's name, source and coverage."""
+    """A material's summary row: its latest fit's name, source, coverage and id."""
 
     material_id: str
     name: str
@@ -120,6 +137,48 @@ class MaterialRow:
     kind: str
     latest_fit_id: str
     created_at: float
+    seq: int = 0
+
+
+@dataclass(frozen=True)
+class MaterialPage:
+    """
+    One page of saved materials, oldest first; ``next_cursor`` continues
+    after the last row (None at the end); ``skipped`` names rows that could
+    not be read (reported, not fatal to the rest).
+    """
+
+    rows: list[MaterialRow]
+    next_cursor: int | None
+    skipped: list[str] = field(default_factory=list)
+
+
+class StoreError(RuntimeError):
+    """The store cannot do what was asked; ``status`` is the HTTP answer."""
+
+    status = 503
+
+
+class StoreFull(StoreError):
+    """No room for the save: the disk (or the store's quota) is full (507)."""
+
+    status = 507
+
+
+class StoreUnavailable(StoreError):
+    """The store cannot be read or written (read-only, missing, I/O error) (503)."""
+
+    status = 503
+
+
+class StoreDamaged(StoreUnavailable, sqlite3.DatabaseError):
+    """The store's file is not a sound SQLite database (503; at start-up: exit)."""
+
+
+class RecordDamaged(StoreError):
+    """A stored record could not be decoded (500; the rest of the store is fine)."""
+
+    status = 500
 
 
 @runtime_checkable
@@ -141,8 +200,17 @@ class Store(Protocol):
     def saved_materials(self) -> list[MaterialRow]:
         """Materials with at least one non-library fit, oldest first."""
 
+    def material_page(self, after: int | None, limit: int) -> MaterialPage:
+        """Saved materials after cursor ``after`` (None: from the first), at most ``limit``."""
+
+    def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
+        """The latest fit id of each of ``material_ids`` that has one."""
+
     def check(self) -> None:
-        """Raise ``RuntimeError`` if the store is unusable or damaged."""
+        """Raise :class:`StoreError` if the store is unusable or damaged."""
+
+    def writable(self) -> str | None:
+        """None when a save can be written now, else why not (cheap; no write)."""
 
     def close(self) -> None:
         """Release connections."""
@@ -168,7 +236,39 @@ CREATE INDEX IF NOT EXISTS saves_by_material ON saves (material_id, seq);
 INSERT INTO saves (material_id, fit_id, saved_at)
     SELECT material_id, id, created_at FROM fits
     WHERE id NOT IN (SELECT fit_id FROM saves) ORDER BY created_at, rowid;
+-- One summary row per material (its first save and its latest fit), kept by
+-- put_fit, so that a listing reads one short row per material it returns.
+CREATE TABLE IF NOT EXISTS materials (
+    material_id TEXT PRIMARY KEY,
+    first_seq INTEGER NOT NULL,
+    first_saved_at REAL NOT NULL,
+    latest_fit_id TEXT NOT NULL,
+    kind TEXT NOT NULL,
+    name TEXT NOT NULL,
+    source TEXT NOT NULL,
+    coverage REAL
+);
+CREATE INDEX IF NOT EXISTS materials_by_first ON materials (kind, first_seq);
 """
+
+_UPSERT_MATERIAL = (
+    "INSERT INTO materials (material_id, first_seq, first_saved_at, latest_fit_id, kind, name, "
+    "source, coverage) VALUES (?, ?, ?, ?, ?, ?, ?, ?) "
+    "ON CONFLICT (material_id) DO UPDATE SET latest_fit_id = excluded.latest_fit_id, "
+    "kind = excluded.kind, name = excluded.name, source = excluded.source, "
+    "coverage = excluded.coverage"
+)
+
+
+def _translate(error: sqlite3.Error, path: Path) -> StoreError:
+    """A SQLite error as the store error it means."""
+    code = getattr(error, "sqlite_errorname", "") or ""
+    if code == "SQLITE_FULL" or "full" in str(error):
+        return StoreFull(f"the store at {path} is full ({error}): free disk space or raise "
+                         "COATED_STORE_MAX_BYTES, then retry")
+    if code in ("SQLITE_CORRUPT", "SQLITE_NOTADB"):
+        return StoreDamaged(f"the store at {path} is damaged: {error}")
+    return StoreUnavailable(f"the store at {path} is unavailable: {error}")
 
 
 class SQLiteStore:
@@ -176,94 +276,213 @@ class SQLiteStore:
     :class:`Store` on one SQLite file in WAL mode: one connection per
     thread (WAL lets readers run while a writer commits), ``synchronous=FULL``
     so that a committed save survives a crash.
+
+    ``max_bytes`` caps the file (SQLite's ``max_page_count``; a save past it
+    is :class:`StoreFull`); ``min_free_bytes`` is the free disk space below
+    which :meth:`writable` reports the store full before any work is done.
+    Every SQLite error leaves as a :class:`StoreError` naming what happened.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, max_bytes: int | None = None,
+                 min_free_bytes: int = 0) -> None:
         self.path = Path(path)
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.max_bytes = max_bytes
+        self.min_free_bytes = min_free_bytes
         self._local = threading.local()
         self._connections: list[sqlite3.Connection] = []
         self._lock = threading.Lock()
         self._closed = False
-        connection = self._connection()
-        connection.execute("PRAGMA journal_mode=WAL")
-        with connection:
-            connection.executescript(_SCHEMA)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise StoreUnavailable(f"the store directory {self.path.parent} cannot be made: "
+                                   f"{error.strerror or error}") from None
+
+        def setup() -> None:
+            connection = self._connection()
+            connection.execute("PRAGMA journal_mode=WAL")
+            with connection:
+                connection.executescript(_SCHEMA)
+            self._backfill_materials(connection)
+
+        self._guard(setup)
+
+    # -- plumbing ----------------------------------------------------------
+
+    def _guard(self, function: Callable[[], _T]) -> _T:
+        try:
+            return function()
+        except sqlite3.Error as error:
+            raise _translate(error, self.path) from None
 
     def _connection(self) -> sqlite3.Connection:
         connection = getattr(self._local, "connection", None)
         if connection is None:
             if self._closed:
-                raise RuntimeError("the store is closed")
+                raise StoreUnavailable("the store is closed")
             connection = sqlite3.connect(self.path, timeout=30.0, check_same_thread=False)
             connection.execute("PRAGMA synchronous=FULL")
             connection.execute("PRAGMA busy_timeout=30000")
+            if self.max_bytes:
+                (page_size,) = connection.execute("PRAGMA page_size").fetchone()
+                connection.execute(f"PRAGMA max_page_count={max(1, self.max_bytes // page_size)}")
             self._local.connection = connection
             with self._lock:
                 self._connections.append(connection)
         return connection
 
+    def _decode(self, fit_id: str, text: Any) -> FitRecord:
+        try:
+            return FitRecord.from_json(text)
+        except (TypeError, ValueError) as error:
+            log.error("stored fit %s cannot be decoded: %s", fit_id, error)
+            raise RecordDamaged(f"the stored record of fit {fit_id} is damaged and cannot be "
+                                "read; the rest of the store is unaffected") from None
+
+    def _backfill_materials(self, connection: sqlite3.Connection) -> None:
+        """Summary rows for materials saved before the summary table existed."""
+        missing = connection.execute(
+            "SELECT s.material_id, MIN(s.seq), MIN(s.saved_at), MAX(s.seq) FROM saves s "
+            "WHERE s.material_id NOT IN (SELECT material_id FROM materials) GROUP BY s.material_id"
+        ).fetchall()
+        for material_id, first_seq, first_at, last_seq in missing:
+            for (fit_id, text) in connection.execute(
+                "SELECT f.id, f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
+                "WHERE s.material_id = ? AND s.seq <= ? ORDER BY s.seq DESC", (material_id, last_seq)
+            ).fetchall():
+                try:
+                    record = FitRecord.from_json(text)
+                except (TypeError, ValueError) as error:
+                    log.error("stored fit %s cannot be decoded, skipped: %s", fit_id, error)
+                    continue
+                with connection:
+                    connection.execute(_UPSERT_MATERIAL, (
+                        material_id, first_seq, first_at, record.id, record.kind, record.name,
+                        record.source, record.coverage))
+                break
+
+    # -- the interface -----------------------------------------------------
+
     def put_fit(self, record: FitRecord) -> FitRecord:
         if not record.created_at:
             record = FitRecord(**{**asdict(record), "created_at": time.time()})
-        connection = self._connection()
-        with connection:
-            connection.execute(
-                "INSERT OR IGNORE INTO fits (id, kind, material_id, created_at, record) "
-                "VALUES (?, ?, ?, ?, ?)",
-                (record.id, record.kind, record.material_id, record.created_at, record.to_json()),
-            )
-            connection.execute(
-                "INSERT INTO saves (material_id, fit_id, saved_at) "
-                "SELECT material_id, id, ? FROM fits WHERE id = ?",
-                (time.time(), record.id),
-            )
-        stored = self.get_fit(record.id)
-        assert stored is not None
-        return stored
+        text = record.to_json()
+
+        def write() -> FitRecord:
+            connection = self._connection()
+            with connection:
+                connection.execute(
+                    "INSERT OR IGNORE INTO fits (id, kind, material_id, created_at, record) "
+                    "VALUES (?, ?, ?, ?, ?)",
+                    (record.id, record.kind, record.material_id, record.created_at, text),
+                )
+                stored_text = connection.execute(
+                    "SELECT record FROM fits WHERE id = ?", (record.id,)).fetchone()[0]
+                stored = self._decode(record.id, stored_text)
+                now = time.time()
+                seq = connection.execute(
+                    "INSERT INTO saves (material_id, fit_id, saved_at) VALUES (?, ?, ?)",
+                    (stored.material_id, stored.id, now),
+                ).lastrowid
+                connection.execute(_UPSERT_MATERIAL, (
+                    stored.material_id, seq, now, stored.id, stored.kind, stored.name,
+                    stored.source, stored.coverage))
+            return stored
+
+        return self._guard(write)
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
-        row = self._connection().execute(
-            "SELECT record FROM fits WHERE id = ?", (fit_id,)
-        ).fetchone()
-        return None if row is None else FitRecord.from_json(row[0])
+        row = self._guard(lambda: self._connection().execute(
+            "SELECT record FROM fits WHERE id = ?", (fit_id,)).fetchone())
+        return None if row is None else self._decode(fit_id, row[0])
 
     def latest_fit(self, material_id: str) -> FitRecord | None:
-        row = self._connection().execute(
-            "SELECT f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
-            "WHERE s.material_id = ? ORDER BY s.seq DESC LIMIT 1",
-            (material_id,),
-        ).fetchone()
-        return None if row is None else FitRecord.from_json(row[0])
+        """The latest decodable fit of a material (a damaged one is logged and passed over)."""
+        rows = self._guard(lambda: self._connection().execute(
+            "SELECT f.id, f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
+            "WHERE s.material_id = ? ORDER BY s.seq DESC LIMIT 16", (material_id,)).fetchall())
+        for fit_id, text in rows:
+            try:
+                return self._decode(fit_id, text)
+            except RecordDamaged:
+                continue
+        return None
+
+    def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
+        if not material_ids:
+            return {}
+        marks = ",".join("?" * len(material_ids))
+        rows = self._guard(lambda: self._connection().execute(
+            f"SELECT material_id, latest_fit_id FROM materials WHERE material_id IN ({marks})",
+            list(material_ids)).fetchall())
+        return dict(rows)
+
+    def material_page(self, after: int | None, limit: int) -> MaterialPage:
+        rows = self._guard(lambda: self._connection().execute(
+            "SELECT material_id, name, source, coverage, kind, latest_fit_id, first_saved_at, "
+            "first_seq FROM materials WHERE kind != 'library' AND first_seq > ? "
+            "ORDER BY first_seq LIMIT ?", (after or 0, limit + 1)).fetchall())
+        out, skipped = [], []
+        for material_id, name, source, coverage, kind, latest, first_at, seq in rows[:limit]:
+            if (kind not in FIT_KINDS or not isinstance(name, str) or not isinstance(source, str)
+                    or not (coverage is None or isinstance(coverage, float))):
+                log.error("the summary of material %r cannot be read, skipped", material_id)
+                skipped.append(str(material_id))
+                continue
+            out.append(MaterialRow(material_id=material_id, name=name, source=source,
+                                   coverage=coverage, kind=kind, latest_fit_id=latest,
+                                   created_at=first_at, seq=seq))
+        next_cursor = rows[limit - 1][7] if len(rows) > limit else None
+        return MaterialPage(out, next_cursor, skipped)
 
     def saved_materials(self) -> list[MaterialRow]:
-        rows = self._connection().execute(
-            "SELECT f.record, m.first FROM ("
-            "  SELECT s.material_id, MIN(s.saved_at) AS first, MAX(s.seq) AS last "
-            "  FROM saves s JOIN fits f ON f.id = s.fit_id WHERE f.kind != 'library' "
-            "  GROUP BY s.material_id"
-            ") m JOIN saves s ON s.seq = m.last JOIN fits f ON f.id = s.fit_id "
-            "ORDER BY m.first, m.material_id"
-        ).fetchall()
-        out = []
-        for text, first in rows:
-            record = FitRecord.from_json(text)
-            out.append(
-                MaterialRow(
-                    material_id=record.material_id, name=record.name, source=record.source,
-                    coverage=record.coverage, kind=record.kind, latest_fit_id=record.id,
-                    created_at=first,
-                )
-            )
-        return out
+        rows: list[MaterialRow] = []
+        cursor = None
+        while True:
+            page = self.material_page(cursor, 1000)
+            rows.extend(page.rows)
+            if page.next_cursor is None:
+                return rows
+            cursor = page.next_cursor
 
     def check(self) -> None:
         try:
             (result,) = self._connection().execute("PRAGMA quick_check").fetchone()
+        except StoreError:
+            raise
         except sqlite3.Error as error:
-            raise RuntimeError(f"the store at {self.path} is unusable: {error}") from None
+            raise StoreUnavailable(f"the store at {self.path} is unusable: {error}") from None
         if result != "ok":
-            raise RuntimeError(f"the store at {self.path} is damaged: {result}")
+            raise StoreDamaged(f"the store at {self.path} is damaged: {result}")
+
+    def ping(self) -> None:
+        """A cheap read (no integrity scan): raises :class:`StoreError` if the store cannot answer."""
+        self._guard(lambda: self._connection().execute("SELECT 1 FROM saves LIMIT 1").fetchall())
+
+    def writable(self) -> str | None:
+        try:
+            free = os.statvfs(self.path.parent)
+            free_bytes = free.f_bavail * free.f_frsize
+        except OSError as error:
+            return f"the store directory {self.path.parent} cannot be read: {error}"
+        if free_bytes < self.min_free_bytes:
+            return (f"the disk of the store has {free_bytes} bytes free, less than "
+                    f"COATED_STORE_MIN_FREE_BYTES ({self.min_free_bytes})")
+        try:
+            connection = self._connection()
+            if self.max_bytes:
+                (pages,) = connection.execute("PRAGMA page_count").fetchone()
+                (page_size,) = connection.execute("PRAGMA page_size").fetchone()
+                if (pages + 16) * page_size > self.max_bytes:
+                    return (f"the store holds {pages * page_size} bytes, at its quota "
+                            f"COATED_STORE_MAX_BYTES ({self.max_bytes})")
+            # A write statement that changes nothing: refused by a read-only store.
+            connection.execute("DELETE FROM saves WHERE 0")
+        except StoreError as error:
+            return str(error)
+        except sqlite3.Error as error:
+            return str(_translate(error, self.path))
+        return None
 
     def close(self) -> None:
         with self._lock:
