@@ -33,10 +33,11 @@ import numpy as np
 from fitting.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
-from .fitting_jobs import FIT_FORMAT_VERSION
+from .jobs.common import FIT_FORMAT_VERSION
 from .store import FitRecord
 
-__all__ = ["PACK_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "download_name", "glsl_identifier"]
+__all__ = ["PACK_MEDIA_TYPES", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack", "pack_response", "download_name",
+           "glsl_identifier"]
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
 PACK_MEDIA_TYPES = {
@@ -167,3 +168,23 @@ def download_name(stem: str, format: str) -> str:
     """``<stem>.<suffix>`` with only [A-Za-z0-9._-] in the stem (a safe header value)."""
     safe = re.sub(r"[^A-Za-z0-9._-]", "_", stem).strip("._") or "material"
     return f"{safe[:80]}.{PACK_MEDIA_TYPES[format][1]}"
+
+
+def pack_response(records: list[FitRecord], format: str, stem: str):
+    """A download with its media type and Content-Disposition file name."""
+    from fastapi import Response
+
+    body = render_pack(records, format, stem)
+    media_type, _ = PACK_MEDIA_TYPES[format]
+    return Response(
+        body, media_type=media_type,
+        headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
+    )
+
+
+PACK_CONTENT = {
+    "application/octet-stream": {"schema": {"type": "string", "format": "binary"}},
+    "application/json": {"schema": {"type": "object"}},
+    "text/plain": {"schema": {"type": "string"}},
+}
+"""The OpenAPI content of a download."""

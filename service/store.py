@@ -476,8 +476,12 @@ class SQLiteStore:
                 if (pages + 16) * page_size > self.max_bytes:
                     return (f"the store holds {pages * page_size} bytes, at its quota "
                             f"COATED_STORE_MAX_BYTES ({self.max_bytes})")
-            # A write statement that changes nothing: refused by a read-only store.
-            connection.execute("DELETE FROM saves WHERE 0")
+            # A write statement that changes nothing: refused by a read-only
+            # store; rolled back at once so that it holds no lock.
+            try:
+                connection.execute("DELETE FROM saves WHERE 0")
+            finally:
+                connection.rollback()
         except StoreError as error:
             return str(error)
         except sqlite3.Error as error:

@@ -1,17 +1,11 @@
 """
-Request and response models
-===========================
+n, k fits, packs and plotted curves
+===================================
 
-Pydantic v2 models of the HTTP API. Constraints live on the fields so that
-bad input is refused by the schema and shows in the OpenAPI document.
-
--   Requests: :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`.
--   Responses: :class:`FitPublic` (with :class:`Coefficients`,
-    :class:`FitMetrics`, :class:`FitLinks`), :class:`MaterialSummary`,
-    :class:`MaterialList`, :class:`MaterialDetail`, :class:`CurvesPublic`,
-    :class:`Health`, :class:`ErrorBody`.
--   :func:`fit_public`: a stored :class:`service.store.FitRecord` as
-    :class:`FitPublic`.
+Requests :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`;
+responses :class:`FitPublic` (with :class:`Coefficients`,
+:class:`service.schemas.metrics.FitMetrics`, :class:`FitLinks`) and
+:class:`CurvesPublic`; :func:`fit_public` is a stored record's view.
 """
 
 from __future__ import annotations
@@ -20,56 +14,27 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.fit import DEFAULT_OBJECTIVE, OBJECTIVES
-from fitting.library import LIBRARY_NAMES
+from ..store import FIT_KINDS, FitRecord
+from .common import (
+    API_PREFIX,
+    DEFAULT_ETA_I_RANGE,
+    DEFAULT_OBJECTIVE,
+    MAX_NK_SAMPLES,
+    EtaI,
+    FitId,
+    LibraryName,
+    Objective,
+    PackFormat,
+    Text,
+)
+from .metrics import FitDetails, FitMetrics
 
-from .store import FIT_KINDS, FitRecord
+__all__ = ["NKData", "FitRequest", "PackRequest", "Coefficients", "FitLinks", "FitPublic",
+           "CurvesPublic", "fit_public"]
 
-__all__ = [
-    "API_PREFIX",
-    "MAX_NK_SAMPLES",
-    "FIT_ID_PATTERN",
-    "MATERIAL_ID_PATTERN",
-    "PACK_FORMATS",
-    "FitId",
-    "LibraryName",
-    "Objective",
-    "PackFormat",
-    "NKData",
-    "FitRequest",
-    "PackRequest",
-    "Coefficients",
-    "DeltaE",
-    "FitMetrics",
-    "FitLinks",
-    "FitPublic",
-    "MaterialSummary",
-    "MaterialList",
-    "MaterialDetail",
-    "CurvesPublic",
-    "Health",
-    "ErrorItem",
-    "ErrorBody",
-    "fit_public",
-]
-
-API_PREFIX = "/api/v1"
-MAX_NK_SAMPLES = 20_000
-"""Most wavelength samples accepted in one n, k table."""
-FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
-MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
-PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
-
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, description="nm")]
 IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)]
-FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
-LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
-Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
-PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
-Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
 class NKData(BaseModel):
@@ -99,6 +64,9 @@ class NKData(BaseModel):
                 )
         return self
 
+    def arrays(self) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+        return tuple(self.wavelength_nm), tuple(self.n), tuple(self.k)
+
 
 class FitRequest(BaseModel):
     """
@@ -126,7 +94,7 @@ class FitRequest(BaseModel):
     source: str = Field("", max_length=2000, description="Citation of inline data")
     nk: NKData | None = None
     eta_i_range: tuple[EtaI, EtaI] = Field(
-        (1.0, 2.5), description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
+        DEFAULT_ETA_I_RANGE, description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
     )
     objective: Objective = DEFAULT_OBJECTIVE
 
@@ -162,24 +130,6 @@ class Coefficients(BaseModel):
     alpha: list[list[float]]
 
 
-class DeltaE(BaseModel):
-    """CIE Delta E 2000 against the reference on the scoring grid."""
-
-    model_config = ConfigDict(extra="allow")
-
-    delta_E_mean: float
-    delta_E_max: float
-
-
-class FitMetrics(BaseModel):
-    """Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
-
-    grid: str | None = None
-    model: DeltaE | None = None
-    lazanyi_adjusted: DeltaE | None = None
-    details: dict[str, Any] = Field(default_factory=dict)
-
-
 class FitLinks(BaseModel):
     self: str
     pack_binary: str
@@ -213,24 +163,6 @@ class FitPublic(BaseModel):
     links: FitLinks
 
 
-class MaterialSummary(BaseModel):
-    id: str
-    name: str
-    kind: Literal[FIT_KINDS]  # type: ignore[valid-type]
-    source: str
-    coverage: float | None = None
-    latest_fit_id: str | None = None
-
-
-class MaterialList(BaseModel):
-    materials: list[MaterialSummary]
-
-
-class MaterialDetail(MaterialSummary):
-    wavelength_range_nm: tuple[float, float] | None = None
-    latest_fit: FitPublic | None = None
-
-
 class CurvesPublic(BaseModel):
     """RGB curves against the angle, linear ACEScg; None where there is no n, k."""
 
@@ -242,26 +174,6 @@ class CurvesPublic(BaseModel):
     model: list[list[float]]
     reference: list[list[float]] | None = None
     lazanyi_adjusted: list[list[float]] | None = None
-
-
-class Health(BaseModel):
-    status: Literal["ok"]
-    fits_in_flight: int
-    fit_workers: int
-    max_in_flight: int
-
-
-class ErrorItem(BaseModel):
-    loc: list[str | int]
-    msg: str
-    type: str
-
-
-class ErrorBody(BaseModel):
-    """Every 4xx and 5xx answer: what broke which rule."""
-
-    detail: str
-    errors: list[ErrorItem] = Field(default_factory=list)
 
 
 def fit_public(record: FitRecord) -> FitPublic:
@@ -285,7 +197,7 @@ def fit_public(record: FitRecord) -> FitPublic:
             grid=metrics.get("grid"),
             model=metrics.get("model_float16"),
             lazanyi_adjusted=metrics.get("lazanyi_adjusted"),
-            details=metrics,
+            details=FitDetails.model_validate(metrics),
         ),
         timings=record.timings,
         convergence=record.convergence,

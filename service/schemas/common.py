@@ -1,0 +1,70 @@
+"""
+Shared types and the error body
+===============================
+
+Constants and constrained field types of the API, built from the core's
+rules (eta_i limits, objectives, library names), and the one error shape
+every 4xx and 5xx answer has (:class:`ErrorBody`). :class:`Mirror` is the
+base of response models that mirror a core result: extra keys kept, keys the
+result did not have left out, so the JSON is the core's, key for key.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_serializer
+
+from fitting.fit import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.library import LIBRARY_NAMES
+
+from ..jobs.nk import MAX_NK_SAMPLES
+
+__all__ = [
+    "API_PREFIX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
+    "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
+    "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "PackFormat", "Text",
+    "Mirror", "ErrorItem", "ErrorBody",
+]
+
+API_PREFIX = "/api/v1"
+FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
+MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
+PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
+ETA_I_LIMITS = (1.0, 3.0)
+"""Every coating index lies in [1, 3] (fitting.model.check_eta_i_range)."""
+DEFAULT_ETA_I_RANGE = (1.0, 2.5)
+"""The default fitted domain (the paper's)."""
+
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+EtaI = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)]
+FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
+LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
+Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
+PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
+Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
+
+
+class Mirror(BaseModel):
+    """A response model mirroring a core result: only the keys it was given, extras kept."""
+
+    model_config = ConfigDict(extra="allow")
+
+    @model_serializer(mode="wrap")
+    def _given_keys(self, handler) -> Any:
+        data = handler(self)
+        given = self.model_fields_set | set(self.model_extra or ())
+        return {key: value for key, value in data.items() if key in given}
+
+
+class ErrorItem(BaseModel):
+    loc: list[str | int]
+    msg: str
+    type: str
+
+
+class ErrorBody(BaseModel):
+    """Every 4xx and 5xx answer: what broke which rule."""
+
+    detail: str
+    errors: list[ErrorItem] = Field(default_factory=list)
