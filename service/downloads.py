@@ -65,7 +65,54 @@ def _glsl_model() -> str:
         seen.add(file_name)
         return _INCLUDE.sub(lambda m: expand(m.group(1)), (GLSL_DIR / file_name).read_text())
 
-    return expand("cf_coated_conductor.glsl").strip()
+    return _only_reachable(expand("cf_coated_conductor.glsl"), "cf_coated_conductor").strip()
+
+
+_FUNCTION_START = re.compile(r"^[A-Za-z_]\w*(?:\s+[A-Za-z_]\w*)*\s+([A-Za-z_]\w*)\s*\(")
+
+
+def _only_reachable(source: str, root: str) -> str:
+    """
+    ``source`` without the top-level functions that ``root`` never calls
+    (with the comment just above each): the snippet ships only what its
+    materials use, so no unused helper can need a newer GLSL version or an
+    extension (``cf_unpack_coefficients`` needs ``unpackHalf2x16``, GLSL
+    4.20 or ES 3.00).
+    """
+    lines = source.splitlines()
+    items: list[tuple[str | None, list[str]]] = []  # (function name or None, lines)
+    i = 0
+    while i < len(lines):
+        match = _FUNCTION_START.match(lines[i])
+        if match and not lines[i].rstrip().endswith(";") and not lines[i].startswith("#"):
+            comment: list[str] = []
+            while items and items[-1][0] is None and items[-1][1] and items[-1][1][-1].startswith("//"):
+                comment.insert(0, items[-1][1].pop())
+            body, depth, opened = [], 0, False
+            while i < len(lines):
+                body.append(lines[i])
+                depth += lines[i].count("{") - lines[i].count("}")
+                opened = opened or "{" in lines[i]
+                i += 1
+                if opened and depth == 0:
+                    break
+            items.append((match.group(1), comment + body))
+            continue
+        if items and items[-1][0] is None:
+            items[-1][1].append(lines[i])
+        else:
+            items.append((None, [lines[i]]))
+        i += 1
+    functions = {name: "\n".join(text) for name, text in items if name}
+    keep, todo = set(), [root]
+    while todo:
+        name = todo.pop()
+        if name in keep or name not in functions:
+            continue
+        keep.add(name)
+        todo.extend(set(re.findall(r"\b([A-Za-z_]\w*)\s*\(", functions[name])) - keep)
+    out = [line for name, text in items if name is None or name in keep for line in text]
+    return re.sub(r"\n{3,}", "\n\n", "\n".join(out))
 
 
 def glsl_identifier(name: str) -> str:
@@ -117,17 +164,27 @@ def _material_block(language: str, record: FitRecord, packed: PackedMaterial, id
     )
 
 
+def _symbols(language: str, ident: str) -> set[str]:
+    """Every identifier the material block of ``ident`` defines."""
+    text = (TEMPLATE_DIR / f"material.{language}").read_text()
+    suffixes = set(re.findall(r"\$\{prefix\}(\w+)", text))
+    return {f"cf_{ident}{s}" for s in suffixes} | {f"cf_material_{ident}"}
+
+
 def _snippet(language: str, records: list[FitRecord], pack_name: str) -> str:
-    used: set[str] = set()
+    model = _glsl_model() if language == "glsl" else (TEMPLATE_DIR / "cf_coated_conductor.hlsl").read_text().strip()
+    # Symbols are unique within the pack: a material whose symbols would meet
+    # another's (``material x`` and ``x F0`` both define cf_material_x_F0) or
+    # the model's gets the next free suffix.
+    used = set(re.findall(r"\b[A-Za-z_]\w*", model))
     blocks = []
     for record in records:
         ident = base = glsl_identifier(record.name)
         suffix = 2
-        while ident in used:
+        while _symbols(language, ident) & used:
             ident, suffix = f"{base}_{suffix}", suffix + 1
-        used.add(ident)
+        used |= _symbols(language, ident)
         blocks.append(_material_block(language, record, material_from_json(record.material), ident))
-    model = _glsl_model() if language == "glsl" else (TEMPLATE_DIR / "cf_coated_conductor.hlsl").read_text().strip()
     return _template(f"pack.{language}").substitute(
         pack_name=_comment(pack_name, 80), count=len(records), fit_format=FIT_FORMAT_VERSION,
         model=model, materials="".join(blocks),

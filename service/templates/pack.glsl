@@ -4,7 +4,7 @@
 // Model: H. B. Vernooij, "A Fresnel Model for Coated Materials",
 // Eurographics 2024, Eq. 1 and 2, with F0, a and alpha quadratic in
 // t = clamp((eta_i - lo) / (hi - lo), 0, 1). Reflectance is linear ACEScg.
-// Needs GLSL 4.20 or later (unpackHalf2x16 in cf_unpack_coefficients).
+// Compiles as GLSL 3.30 and GLSL ES 3.00 or later.
 //
 // Usage: vec3 F = cf_material_<name>(NdotV, eta_i);
 // NdotV is cos theta inside the coating, eta_i the coating's index.

@@ -18,9 +18,10 @@ from typing import Annotated
 from fastapi import APIRouter, Query, Response, status
 from fastapi.concurrency import run_in_threadpool
 
+from ...jobs.common import stored_fit
 from ...jobs.curves import error_map, fit_from_curves, prepare_curve_fit
 from ...schemas import API_PREFIX, CurveFitRequest, ErrorMap, FitPublic, fit_public
-from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoredFit, StoreDep, WriteAccess
+from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, StoreDep, WriteAccess
 
 router = APIRouter(prefix=API_PREFIX, tags=["curves"])
 
@@ -58,7 +59,7 @@ async def create_fit_from_curves(request: CurveFitRequest, store: StoreDep, runn
 
 @router.get("/fits/{fit_id}/error-map", response_model=ErrorMap, responses={**ERROR_RESPONSES, **NOT_FOUND})
 async def get_error_map(
-    record: StoredFit,
+    fit_id: FitIdPath, store: StoreDep,
     angles: Annotated[int, Query(ge=2, le=181, description="Angles evenly from 0 to 90 degrees")] = 46,
     rows: Annotated[int, Query(ge=1, le=101, description="eta_i values evenly over the domain")] = 31,
 ) -> ErrorMap:
@@ -67,4 +68,5 @@ async def get_error_map(
     the spectral reference (5 nm) of its n, k, or for a curve fit the edited
     target (with a base) or the curves themselves (rows at their eta_i).
     """
+    record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query: 422 before 404
     return ErrorMap(**await run_in_threadpool(error_map, record, angles, rows))

@@ -25,6 +25,7 @@ from fastapi.concurrency import run_in_threadpool
 from fitting.sources import FORMATS, read_nk
 
 from ...downloads import PACK_CONTENT, pack_response
+from ...jobs.common import stored_fit
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...schemas import (
     API_PREFIX,
@@ -39,7 +40,17 @@ from ...schemas import (
     fit_public,
 )
 from ...store import FitRecord
-from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, SettingsDep, StoredFit, StoreDep, WriteAccess
+from ..deps import (
+    ERROR_RESPONSES,
+    FIT_ERROR_RESPONSES,
+    NOT_FOUND,
+    FitIdPath,
+    RunnerDep,
+    SettingsDep,
+    StoredFit,
+    StoreDep,
+    WriteAccess,
+)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -127,7 +138,7 @@ def get_fit(record: StoredFit) -> FitPublic:
     **ERROR_RESPONSES, **NOT_FOUND,
 })
 def get_pack(
-    record: StoredFit,
+    fit_id: FitIdPath, store: StoreDep,
     format: Annotated[PackFormat, Query(description="binary | json | glsl | hlsl")] = "binary",
 ) -> Response:
     """
@@ -135,12 +146,13 @@ def get_pack(
     ready-to-paste ``glsl`` / ``hlsl`` snippet with the coefficients and the
     evaluation function.
     """
+    record = stored_fit(store, fit_id)  # after the query is validated: 422 before 404
     return pack_response([record], format, f"{record.name}-{record.id[:8]}")
 
 
 @router.get("/{fit_id}/curves", response_model=CurvesPublic, responses={**ERROR_RESPONSES, **NOT_FOUND})
 def get_curves(
-    record: StoredFit,
+    fit_id: FitIdPath, store: StoreDep,
     eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
                                   description="Coating index")] = 1.5,
     samples: Annotated[int, Query(ge=2, le=1024, description="Angles from 0 to 90 degrees")] = 91,
@@ -150,4 +162,4 @@ def get_curves(
     from 0 to 90 degrees: the float16 model, the 1 nm spectral reference
     and adjusted Lazanyi (both None for fits without n, k).
     """
-    return CurvesPublic(**angle_curves(record, eta_i, samples))
+    return CurvesPublic(**angle_curves(stored_fit(store, fit_id), eta_i, samples))
