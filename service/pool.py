@@ -205,7 +205,7 @@ class FitRunner:
                     future = pool.submit(function, *args)
                     result = await asyncio.wrap_future(future)
                 except (BrokenProcessPool, RuntimeError) as error:
-                    if isinstance(error, RuntimeError) and "shutdown" not in str(error):
+                    if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                         raise
                     self._restart(pool)
                     if attempt == 2:
