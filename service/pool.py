@@ -85,8 +85,8 @@ def _warm_worker() -> None:
     weights of the fit (5 nm) and of the metrics (1 nm) once, seconds that
     would otherwise land on the first fit.
     """
-    from fitting.fit import FitSettings
-    from fitting.reference import spectral_weights
+    from fitting.colour.reference import spectral_weights
+    from fitting.fits.settings import FitSettings
 
     spectral_weights(FitSettings().step_nm)
     spectral_weights(1.0)

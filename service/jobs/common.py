@@ -15,17 +15,16 @@ What every job shares
 
 from __future__ import annotations
 
-import hashlib
-import json
 import math
 import time
 from typing import Any
 
 import numpy as np
 
-from fitting.library import library_material
-from fitting.nk import SpectralNK
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
 
+from ..ids import content_address
 from ..store import FitRecord, Store, StoreFull, StoreUnavailable
 
 __all__ = [
@@ -41,32 +40,6 @@ __all__ = [
 
 FIT_FORMAT_VERSION = "fit/v2"
 """Part of every fit id: bump it when a change to the fit (or to the id's encoding) changes ids."""
-
-
-def _canonical(value: Any) -> Any:
-    if isinstance(value, bytes):
-        return {"bytes": value.hex()}
-    if isinstance(value, np.ndarray):
-        return {"f8": np.ascontiguousarray(value, dtype="<f8").tobytes().hex()}
-    if isinstance(value, dict):
-        return {str(k): _canonical(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_canonical(v) for v in value]
-    if isinstance(value, float):
-        return {"float": value.hex()}  # exact, and NaN or inf cannot collide with a number
-    return value
-
-
-def content_address(*parts: Any) -> str:
-    """
-    The id (32 hex digits of SHA-256) of ``parts``: each part (str, number,
-    bytes, array, list, dict) in canonical JSON, so that no content can move
-    between parts (a NUL in a name is just a character) and two different
-    inputs never share an encoding.
-    """
-    text = json.dumps([_canonical(p) for p in parts], sort_keys=True, ensure_ascii=True,
-                      separators=(",", ":"), allow_nan=False)
-    return hashlib.sha256(text.encode("ascii")).hexdigest()[:32]
 
 
 def check_finite(what: str, values: Any) -> None:

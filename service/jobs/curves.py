@@ -27,20 +27,20 @@ from typing import Any, Literal
 
 import numpy as np
 
-from fitting.curves import (
+from fitting.colour.delta_e import delta_E_map
+from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, cos_theta_from_angle
+from fitting.fits.curves import CurveFitSettings, fit_curves
+from fitting.fits.curves_base import (
     CurveBase,
-    CurveFitSettings,
-    check_curves,
     curve_base_from_coefficients,
     curve_base_from_nk,
     edited_target,
-    fit_curves,
 )
-from fitting.library import library_material
-from fitting.metrics import delta_E_map
-from fitting.model import check_eta_i_range, coated_conductor_model
-from fitting.nk import SpectralNK
-from fitting.pack import material_from_json, material_to_json
+from fitting.fits.curves_input import check_curves
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import material_from_json, material_to_json
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
 
 from ..pool import FitRunner
 from ..store import FitRecord, Store
@@ -59,7 +59,7 @@ __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", 
 CURVES_FORMAT = "curves/v1"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 DEFAULTS = CurveFitSettings()
-DEFAULT_DOMAIN = (1.0, 2.5)
+DEFAULT_DOMAIN = DEFAULT_ETA_I_RANGE
 
 
 @dataclass(frozen=True)
@@ -291,7 +291,7 @@ def error_map(record: FitRecord, angles: int, rows: int) -> dict[str, Any]:
     packed = material_from_json(record.material)
     lo, hi = packed.eta_i_range
     theta = np.linspace(0.0, 90.0, angles)
-    mu = np.where(theta == 90.0, 0.0, np.cos(np.radians(theta)))
+    mu = cos_theta_from_angle(theta)
     eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
     eta, target, against = _target_of(record, mu, eta)
     E, M = np.meshgrid(eta, mu, indexing="ij")

@@ -15,18 +15,23 @@ from __future__ import annotations
 
 import asyncio
 import time
+from pathlib import PurePath
 from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
-from fitting.baselines import baseline_inputs, lazanyi_adjusted
-from fitting.fit import DEFAULT_OBJECTIVE, FitSettings, evaluate_material, fit_material
-from fitting.library import library_material
-from fitting.model import check_eta_i_range, coated_conductor_model
-from fitting.nk import DEFAULT_MIN_COVERAGE, SpectralNK, resample_nk
-from fitting.pack import PackedMaterial, material_from_json, material_to_json
-from fitting.reference import reference_ACEScg, spectral_grid
+from fitting.colour.reference import reference_ACEScg, spectral_grid
+from fitting.domain import DEFAULT_MIN_COVERAGE, check_eta_i_range, cos_theta_from_angle
+from fitting.fits.evaluate import evaluate_material
+from fitting.fits.material import fit_material
+from fitting.fits.settings import DEFAULT_OBJECTIVE, FitSettings
+from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import PackedMaterial, material_from_json, material_to_json
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK, resample_nk
+from fitting.optics.readers import FORMATS, read_nk
 
 from ..pool import FitRunner
 from ..store import FitRecord, Store
@@ -102,6 +107,26 @@ class NKFit:
         """A fit of an n, k already read (an upload)."""
         return cls._make("nk", nk.name, nk, eta_i_range, objective, metrics_samples, None)
 
+    @classmethod
+    def upload(cls, data: bytes, file_name: str, format: str | None, name: str | None,
+               eta_i_range, objective: str = DEFAULT_OBJECTIVE, metrics_samples: int = 100) -> "NKFit":
+        """
+        A fit of an uploaded file: ``format`` (csv, json, yaml) or the file
+        name's suffix; the display name ``name`` or the file's stem.
+        """
+        lo, hi = eta_i_range
+        if lo > hi:
+            raise ValueError(f"`eta_i_range` must not be empty: eta_i_min {lo:g} > eta_i_max {hi:g}")
+        file_name = PurePath(file_name).name
+        fmt = format or PurePath(file_name).suffix.lstrip(".").lower()
+        if fmt not in (*FORMATS, "yml", "txt"):
+            raise ValueError(
+                f"`format` must be one of {', '.join(FORMATS)} (or a file name ending in one), "
+                f"got {(fmt or file_name)[:40]!r}"
+            )
+        display = (name or PurePath(file_name).stem or "uploaded").strip()[:200]
+        return cls.from_nk(read_nk(data, fmt, display), eta_i_range, objective, metrics_samples)
+
 
 def _nk_job(fit: NKFit) -> dict[str, Any]:
     """Worker process: fit, quantise and score one material."""
@@ -165,7 +190,7 @@ def angle_curves(record: FitRecord, eta_i: float, samples: int) -> dict[str, Any
     """
     packed = material_from_json(record.material)
     theta = np.linspace(0.0, 90.0, samples)
-    mu = np.clip(np.cos(np.radians(theta)), 0.0, 1.0)
+    mu = cos_theta_from_angle(theta)
     model = coated_conductor_model(mu, eta_i, packed.coefficients, packed.eta_i_range)
     reference = baseline = None
     nk = measured_nk(record)

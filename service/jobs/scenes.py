@@ -26,17 +26,16 @@ from typing import Any
 
 import numpy as np
 
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
-from fitting.scene import (
-    EtaSpec,
-
-    SceneMaterial,
-    fit_scene_material,
+from fitting.fits.scene_fit import fit_scene_material
+from fitting.fits.scene_schema import EtaSpec, SceneMaterial, parse_eta_i, parse_scene
+from fitting.models.pack import (
+    PackedMaterial,
+    encode_pack,
+    material_from_json,
     material_record_bytes,
-    parse_eta_i,
-    parse_scene,
+    pack_to_json,
 )
+from fitting.optics.library import LIBRARY_NAMES, library_material
 
 from ..pool import FitRunner
 from ..store import Store

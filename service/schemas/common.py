@@ -15,8 +15,9 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_serializer
 
-from fitting.fit import DEFAULT_OBJECTIVE, OBJECTIVES
-from fitting.library import LIBRARY_NAMES
+from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
+from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.optics.library import LIBRARY_NAMES
 
 from ..jobs.nk import MAX_NK_SAMPLES
 
@@ -31,10 +32,8 @@ API_PREFIX = "/api/v1"
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
-ETA_I_LIMITS = (1.0, 3.0)
-"""Every coating index lies in [1, 3] (fitting.model.check_eta_i_range)."""
-DEFAULT_ETA_I_RANGE = (1.0, 2.5)
-"""The default fitted domain (the paper's)."""
+ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
+"""Every coating index lies in [1, 3] (fitting.domain)."""
 
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 EtaI = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)]

@@ -12,7 +12,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.curves import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES, CurveFitSettings
+from fitting.fits.curves import CurveFitSettings
+from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 
 from .common import FIT_ID_PATTERN, EtaI, LibraryName, Objective
 from .fits import NKData

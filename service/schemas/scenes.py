@@ -13,8 +13,8 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.library import LIBRARY_NAMES
-from fitting.scene import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS
+from fitting.fits.scene_schema import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS
+from fitting.optics.library import LIBRARY_NAMES
 
 from .common import ETA_I_LIMITS, Mirror
 from .fits import NKData

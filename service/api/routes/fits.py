@@ -16,13 +16,10 @@ from the store (200) without refitting; a new fit answers 201.
 
 from __future__ import annotations
 
-from pathlib import PurePath
 from typing import Annotated
 
 from fastapi import APIRouter, File, Form, Query, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
-
-from fitting.sources import FORMATS, read_nk
 
 from ...downloads import PACK_CONTENT, pack_response
 from ...jobs.common import stored_fit
@@ -105,25 +102,9 @@ async def upload_fit(
     file is parsed, never stored or executed as given; the fit keeps its
     n, k as numbers.
     """
-    if eta_i_min > eta_i_max:
-        raise ValueError(
-            f"`eta_i_range` must not be empty: eta_i_min {eta_i_min:g} > eta_i_max {eta_i_max:g}"
-        )
-    file_name = PurePath(file.filename or "").name
-    fmt = format or PurePath(file_name).suffix.lstrip(".").lower()
-    if fmt not in (*FORMATS, "yml", "txt"):
-        raise ValueError(
-            f"`format` must be one of {', '.join(FORMATS)} (or a file name ending in one), "
-            f"got {(fmt or file_name)[:40]!r}"
-        )
     data = await file.read()
-    display = (name or PurePath(file_name).stem or "uploaded").strip()[:200]
-
-    def read() -> NKFit:
-        nk = read_nk(data, fmt, display)
-        return NKFit.from_nk(nk, (eta_i_min, eta_i_max), objective, settings.metrics_samples)
-
-    fit = await run_in_threadpool(read)
+    fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
+                                  (eta_i_min, eta_i_max), objective, settings.metrics_samples)
     return fit_answer(*await fit_nk(fit, store, runner), response)
 
 

@@ -13,9 +13,9 @@ Health and domain
 from fastapi import APIRouter, status
 from fastapi.concurrency import run_in_threadpool
 
-from fitting.curves import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
-from fitting.fit import OBJECTIVES
-from fitting.library import LIBRARY_NAMES
+from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
+from fitting.fits.settings import OBJECTIVES
+from fitting.optics.library import LIBRARY_NAMES
 
 from ...schemas import (
     API_PREFIX,

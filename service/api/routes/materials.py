@@ -16,8 +16,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, Path, Query
 
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.nk import visible_coverage
+from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.optics.nk import visible_coverage
 
 from ...schemas import API_PREFIX, MATERIAL_ID_PATTERN, MaterialDetail, MaterialList, MaterialSummary, fit_public
 from ..deps import ERROR_RESPONSES, NOT_FOUND, SettingsDep, StoreDep

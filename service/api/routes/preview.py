@@ -19,7 +19,7 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 
-from fitting.pack import material_from_json
+from fitting.models.pack import material_from_json
 
 from ...jobs.common import measured_nk, stored_fit
 from ...schemas import API_PREFIX, ETA_I_LIMITS, FIT_ID_PATTERN, ErrorBody
