@@ -73,6 +73,13 @@ def _cmd_fit(args) -> int:
     else:
         nk = library_material(args.material)
     result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
+    if not result.success:
+        what = (f"the fit of {nk.name!r} did not converge (solver status {result.status}: "
+                f"{result.message}); its coefficients are the best found")
+        if args.strict:
+            print(f"error: {what}; nothing written (--strict)", file=sys.stderr)
+            return 3
+        print(f"warning: {what}", file=sys.stderr)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -108,6 +115,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with status 3 (writing nothing) when the fit does not converge")
     p.set_defaults(func=_cmd_fit)
 
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_serializer
+from pydantic import BaseModel, ConfigDict, Field
 
 from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
@@ -25,7 +25,7 @@ __all__ = [
     "API_PREFIX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "PackFormat", "Text",
-    "Mirror", "ErrorItem", "ErrorBody",
+    "Mirror", "absent", "ErrorItem", "ErrorBody",
 ]
 
 API_PREFIX = "/api/v1"
@@ -45,15 +45,22 @@ Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
 class Mirror(BaseModel):
-    """A response model mirroring a core result: only the keys it was given, extras kept."""
+    """
+    A response model mirroring a core result: extra keys kept; optional
+    fields declared with :func:`absent` are left out when the result did not
+    have them, so the JSON is the core's key for key.
+    """
 
     model_config = ConfigDict(extra="allow")
 
-    @model_serializer(mode="wrap")
-    def _given_keys(self, handler) -> Any:
-        data = handler(self)
-        given = self.model_fields_set | set(self.model_extra or ())
-        return {key: value for key, value in data.items() if key in given}
+
+def _is_none(value: Any) -> bool:
+    return value is None
+
+
+def absent(description: str | None = None) -> Any:
+    """An optional field of a :class:`Mirror`: None, and then not in the JSON."""
+    return Field(None, exclude_if=_is_none, description=description)
 
 
 class ErrorItem(BaseModel):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pydantic import BaseModel, Field
 
-from .common import Mirror
+from .common import Mirror, absent
 
 __all__ = ["RowError", "DeltaE", "CurveError", "FitDetails", "FitMetrics"]
 
@@ -29,9 +29,9 @@ class DeltaE(Mirror):
 
     delta_E_mean: float
     delta_E_max: float
-    rmse: float | None = None
-    by_eta_i: dict[str, RowError] | None = Field(None, description="Nearest row to each of eta_i 1, 1.5, 2, 2.5")
-    against: str | None = None
+    rmse: float | None = absent()
+    by_eta_i: dict[str, RowError] | None = absent("Nearest row to each of eta_i 1, 1.5, 2, 2.5")
+    against: str | None = absent()
 
 
 class CurveError(Mirror):
@@ -45,17 +45,17 @@ class CurveError(Mirror):
 class FitDetails(Mirror):
     """Every metric of a fit, as the core gave it."""
 
-    grid: str | None = None
-    model_float16: DeltaE | None = None
-    model_float64: DeltaE | None = None
-    schlick_air: DeltaE | None = None
-    schlick_exact_F0: DeltaE | None = None
-    lazanyi_adjusted: DeltaE | None = None
-    lazanyi_exact_F0: DeltaE | None = None
-    coverage: float | None = None
-    by_curve: list[CurveError] | None = None
-    fitted_samples: int | None = None
-    target: DeltaE | None = None
+    grid: str | None = absent()
+    model_float16: DeltaE | None = absent()
+    model_float64: DeltaE | None = absent()
+    schlick_air: DeltaE | None = absent()
+    schlick_exact_F0: DeltaE | None = absent()
+    lazanyi_adjusted: DeltaE | None = absent()
+    lazanyi_exact_F0: DeltaE | None = absent()
+    coverage: float | None = absent()
+    by_curve: list[CurveError] | None = absent()
+    fitted_samples: int | None = absent()
+    target: DeltaE | None = absent()
 
 
 class FitMetrics(BaseModel):
