@@ -29,12 +29,15 @@ class Health(BaseModel):
 class Domain(BaseModel):
     """The rules a client checks before sending (the service checks them again)."""
 
-    eta_i_limits: tuple[float, float] = Field(description="Every coating index lies in [lo, hi]")
-    default_eta_i_range: tuple[float, float] = Field(description="The default fitted domain")
+    eta_i_limits: list[float] = Field(min_length=2, max_length=2,
+                                      description="Every coating index lies in [lo, hi]")
+    default_eta_i_range: list[float] = Field(min_length=2, max_length=2,
+                                             description="The default fitted domain")
     objectives: list[str]
     default_objective: str
     library: list[str] = Field(description="The built-in conductors")
     pack_formats: list[str]
-    curve_samples: tuple[int, int] = Field(description="Samples per edited curve, [min, max]")
+    curve_samples: list[int] = Field(min_length=2, max_length=2,
+                                     description="Samples per edited curve, [min, max]")
     max_curves: int
     max_nk_samples: int

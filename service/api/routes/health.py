@@ -52,9 +52,9 @@ async def healthz(store: StoreDep, runner: RunnerDep) -> Health:
 
 
 DOMAIN = Domain(
-    eta_i_limits=ETA_I_LIMITS, default_eta_i_range=DEFAULT_ETA_I_RANGE, objectives=list(OBJECTIVES),
+    eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE), objectives=list(OBJECTIVES),
     default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES), pack_formats=list(PACK_FORMATS),
-    curve_samples=(CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES), max_curves=CURVE_MAX_COUNT,
+    curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
     max_nk_samples=MAX_NK_SAMPLES,
 )
 
