@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 
-from conftest import ROOT
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def glass_csv(tmp_path):

@@ -276,15 +276,6 @@ def test_symbols_unique_and_every_download_compiles(tmp_path):
     assert result.returncode == 0, result.stdout
 
 
-def test_ids_from_an_unambiguous_encoding():
-    from service.jobs.common import content_address
-
-    assert content_address("a\x00b", "c") != content_address("a", "b\x00c")
-    assert content_address("ab", "c") != content_address("a", "bc")
-    assert content_address(b"\x00", "") != content_address("", b"\x00")
-    assert content_address(1.0) != content_address(1) and content_address([1.5]) == content_address([1.5])
-
-
 # -- 9. edits in scenes, float32 bounds --------------------------------------------
 
 def test_scene_uses_the_edited_model(tmp_path):
