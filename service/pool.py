@@ -171,6 +171,14 @@ class FitRunner:
         waves = math.ceil(max(self._in_flight, 1) / self.workers)
         return max(1, math.ceil(waves * self._mean_s))
 
+    def check_capacity(self) -> None:
+        """
+        Refuse (:class:`Overloaded`) at once when the pool is full, before a
+        request spends CPU on validating its input; :meth:`run` checks again.
+        """
+        if self._in_flight >= self.max_in_flight:
+            raise Overloaded(self._retry_after(), self.max_in_flight)
+
     def _acquire(self) -> None:
         with self._lock:
             if self._in_flight >= self.max_in_flight:

@@ -75,6 +75,7 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
     ``eta_i_range``; the answer carries the float16 coefficients, Delta E
     2000 of the model and of adjusted Lazanyi, and timings.
     """
+    runner.check_capacity()
     if request.material is not None:
         fit = await run_in_threadpool(NKFit.library, request.material, request.eta_i_range,
                                       request.objective, settings.metrics_samples)
@@ -102,6 +103,7 @@ async def upload_fit(
     file is parsed, never stored or executed as given; the fit keeps its
     n, k as numbers.
     """
+    runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
                                   (eta_i_min, eta_i_max), objective, settings.metrics_samples)

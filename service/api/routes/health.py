@@ -10,8 +10,10 @@ Health and domain
     other constants a client checks before sending, from the core.
 """
 
+import asyncio
+from concurrent.futures import ThreadPoolExecutor
+
 from fastapi import APIRouter, status
-from fastapi.concurrency import run_in_threadpool
 
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 from fitting.fits.settings import OBJECTIVES
@@ -34,6 +36,10 @@ from ..deps import RunnerDep, StoreDep
 router = APIRouter(tags=["health"])
 
 
+# Its own thread: the probe never queues behind the requests' thread work.
+_PROBE_THREAD = ThreadPoolExecutor(1, thread_name_prefix="healthz")
+
+
 def _probe(store: Store) -> str | None:
     store.ping()  # StoreError -> 503
     return store.writable()
@@ -43,7 +49,7 @@ def _probe(store: Store) -> str | None:
             responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
 async def healthz(store: StoreDep, runner: RunnerDep) -> Health:
     """Readiness: the store answers and the fitting pool is up; whether a save can be written."""
-    problem = await run_in_threadpool(_probe, store)
+    problem = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
         status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
         max_in_flight=runner.max_in_flight, store_writable=problem is None, store_problem=problem,
