@@ -65,6 +65,13 @@ def _cmd_fit(args) -> int:
         return _write_export(nk, args)
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
                        evaluate=not args.no_metrics)
+    if not result.success:
+        what = (f"the fit of {nk.name!r} did not converge (solver status {result.status}: "
+                f"{result.message}); its coefficients are the best found")
+        if args.strict:
+            print(f"error: {what}; nothing written (--strict)", file=sys.stderr)
+            return 3
+        print(f"warning: {what}", file=sys.stderr)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -123,6 +130,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
     p.add_argument("--coat-roughness", type=float, default=0.03,
                    help="coat roughness of --export, [0, 1]")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with status 3 (writing nothing) when the fit does not converge")
     p.set_defaults(func=_cmd_fit)
 
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
