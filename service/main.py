@@ -166,6 +166,16 @@ async def _http_error(request: Request, error: StarletteHTTPException) -> JSONRe
     )
 
 
+async def _unexpected_error(request: Request, error: Exception) -> JSONResponse:
+    # Last resort: an exception no route turned into a 4xx still answers the
+    # documented JSON error shape (Starlette logs the traceback and re-raises).
+    return JSONResponse(
+        {"detail": f"internal error ({type(error).__name__}); the request was not completed",
+         "errors": []},
+        status_code=status.HTTP_500_INTERNAL_SERVER_ERROR,
+    )
+
+
 def create_app(settings: Settings | None = None) -> FastAPI:
     """
     The service application.
@@ -205,6 +215,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.preview_renderer = None
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(StarletteHTTPException, _http_error)
+    app.add_exception_handler(Exception, _unexpected_error)
     for module in (health, materials, fits, packs, preview, curves, scenes):
         app.include_router(module.router)
     # The browser editor (static/), after the API so that /api, /docs and

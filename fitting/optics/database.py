@@ -30,7 +30,7 @@ def clean_citation(text: str | None) -> str:
     if not text:
         return ""
     text = re.sub(r"<br\s*/?>", "\n", text)
-    text = re.sub(r"<[^>]+>", "", text)
+    text = re.sub(r"<[^<>]*>", "", text)  # [^<>]: linear time on text full of "<"
     return re.sub(r"[ \t]+", " ", text).strip()
 
 

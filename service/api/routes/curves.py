@@ -51,7 +51,9 @@ from fitting.optics.nk import SpectralNK
 
 from ...ids import content_id
 from ...fitting_jobs import FIT_FORMAT_VERSION, check_finite, fit_record, measured_nk
-from ...models import FIT_ID_PATTERN, ErrorBody, EtaI, FitPublic, LibraryName, NKData, Objective
+from ...models import (
+    FIT_ID_PATTERN, ErrorBody, EtaI, FitPublic, LibraryName, NKData, Objective, RequestModel,
+)
 from ...store import FitRecord, Store
 from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_errors
 from .fits import FitIdPath, fit_answer, stored_fit
@@ -62,12 +64,12 @@ CURVES_FORMAT = "curves/v1"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 _DEFAULTS = CurveFitSettings()
 
-CosTheta = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
-Angle = Annotated[float, Field(ge=0.0, le=90.0, allow_inf_nan=False)]
-Reflectance = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)]
+CosTheta = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=True)]
+Angle = Annotated[float, Field(ge=0.0, le=90.0, allow_inf_nan=False, strict=True)]
+Reflectance = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=True)]
 
 
-class CurveIn(BaseModel):
+class CurveIn(RequestModel):
     """
     One RGB reflectance curve at coating index ``eta_i``: linear ACEScg in
     [0, 1] against cos theta in [0, 1] (or the angle in degrees, [0, 90]).
@@ -76,10 +78,12 @@ class CurveIn(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
     eta_i: EtaI
-    cos_theta: list[CosTheta] | None = Field(None, min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES)
-    angle_deg: list[Angle] | None = Field(None, min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES)
+    cos_theta: list[CosTheta] | None = Field(None, min_length=CURVE_MIN_SAMPLES,
+                                             max_length=CURVE_MAX_SAMPLES, fail_fast=True)
+    angle_deg: list[Angle] | None = Field(None, min_length=CURVE_MIN_SAMPLES,
+                                          max_length=CURVE_MAX_SAMPLES, fail_fast=True)
     rgb: list[tuple[Reflectance, Reflectance, Reflectance]] = Field(
-        min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES,
+        min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES, fail_fast=True,
         description="[R, G, B] per sample, linear ACEScg",
     )
 
@@ -95,7 +99,7 @@ class CurveIn(BaseModel):
         return self
 
 
-class CurveBaseIn(BaseModel):
+class CurveBaseIn(RequestModel):
     """The material being edited: exactly one of a built-in name, a stored fit or n, k."""
 
     model_config = ConfigDict(extra="forbid")
@@ -112,7 +116,7 @@ class CurveBaseIn(BaseModel):
         return self
 
 
-class CurveFitRequest(BaseModel):
+class CurveFitRequest(RequestModel):
     """
     Curves to fit, alone (``base`` null: the eta_i dependence is what the
     curves determine) or as edits of ``base`` (each curve replaces the base
@@ -143,7 +147,7 @@ class CurveFitRequest(BaseModel):
     )
     curves: list[CurveIn] = Field(min_length=1, max_length=CURVE_MAX_COUNT)
     objective: Objective = _DEFAULTS.objective
-    blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False)
+    blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False, strict=True)
 
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":

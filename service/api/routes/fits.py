@@ -168,12 +168,12 @@ async def upload_fit(
         raise HTTPException(
             status.HTTP_422_UNPROCESSABLE_CONTENT,
             f"`format` must be one of {', '.join(FORMATS)} (or a file name ending in one), "
-            f"got {fmt or file_name!r}",
+            f"got {fmt or file_name!r:.60}",
         )
     data = await file.read()
     display = (name or PurePath(file_name).stem or "uploaded").strip()[:200]
     with fit_errors():
-        nk: SpectralNK = await run_in_threadpool(read_nk, data, fmt, display)
+        nk: SpectralNK = await run_in_threadpool(read_nk, data, fmt, display, MAX_NK_SAMPLES)
         if nk.wavelength_nm.size > MAX_NK_SAMPLES:
             raise ValueError(
                 f"`file` must hold at most {MAX_NK_SAMPLES} wavelengths, got {nk.wavelength_nm.size}"

@@ -33,17 +33,17 @@ from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.optics.nk import SpectralNK
 
 from ...fitting_jobs import measured_nk
-from ...models import API_PREFIX, NKData
+from ...models import API_PREFIX, NKData, RequestModel
 from ...store import Store
 from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_errors
 
 router = APIRouter(prefix=API_PREFIX, tags=["scenes"])
 
-EtaValue = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False, description="1 is uncoated")]
+EtaValue = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False, strict=True, description="1 is uncoated")]
 Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
-class EtaRange(BaseModel):
+class EtaRange(RequestModel):
     """A range of coating indices, min <= max."""
 
     model_config = ConfigDict(extra="forbid")
@@ -52,7 +52,7 @@ class EtaRange(BaseModel):
     max: EtaValue
 
 
-class SceneMaterialRequest(BaseModel):
+class SceneMaterialRequest(RequestModel):
     """One material of a scene: ``material`` (built-in or saved id) or ``nk``, and its eta_i."""
 
     model_config = ConfigDict(extra="forbid")
@@ -75,13 +75,14 @@ class SceneMaterialRequest(BaseModel):
         return self
 
 
-class SceneRequest(BaseModel):
+class SceneRequest(RequestModel):
     """A scene description (see ``fitting.scene``)."""
 
     model_config = ConfigDict(extra="forbid")
 
     name: Name = "scene"
-    materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS)
+    materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS,
+                                                  fail_fast=True)
     max_delta_e: float | None = Field(
         default=None, gt=0.0, le=100.0, allow_inf_nan=False,
         description="Each material gets the cheapest model kind and degree whose mean Delta E 2000 "
