@@ -10,6 +10,8 @@ Command line
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.scene`).
+-   ``batch --shelf main``: a selection of the refractiveindex.info database
+    into one pack and report (:mod:`fitting.batch`).
 """
 
 from __future__ import annotations
@@ -82,6 +84,7 @@ def _cmd_fit(args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from .fit import DEFAULT_OBJECTIVE, OBJECTIVES
+    from .cli_batch import add_batch_parser
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -113,6 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=lambda args: __import__("fitting.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
+    add_batch_parser(sub)
     return parser
 
 
