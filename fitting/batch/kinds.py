@@ -23,10 +23,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..fit import fit_material
-from ..model import coated_conductor_model
-from ..nk import SpectralNK
-from ..pack import PackedMaterial, material_from_json, material_to_json
+from ..fits.material import fit_material
+from ..models.coated_conductor import coated_conductor_model
+from ..models.pack import PackedMaterial, material_from_json, material_to_json
+from ..optics.nk import SpectralNK
 
 __all__ = [
     "DEFAULT_MODEL_KIND",

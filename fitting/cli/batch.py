@@ -25,7 +25,7 @@ __all__ = ["add_batch_parser"]
 
 
 def _cmd_batch(args) -> int:
-    from .batch import read_page_list, run_batch, select_pages
+    from ..batch import read_page_list, run_batch, select_pages
 
     if args.page_list is not None:
         pages = select_pages(page_list=read_page_list(args.page_list))
@@ -45,10 +45,13 @@ def _cmd_batch(args) -> int:
     return 0
 
 
-def add_batch_parser(sub) -> None:
-    """Add the ``batch`` sub-command to an argparse sub-parser group."""
-    from .batch import MODEL_KINDS
-    from .cli import parse_eta_range
+def add_batch_parser(sub, parse_eta_range) -> None:
+    """
+    Add the ``batch`` sub-command to an argparse sub-parser group;
+    ``parse_eta_range`` is the ``--eta-range`` type of the main parser.
+    """
+    from ..batch import MODEL_KINDS
+    from ..domain import DEFAULT_ETA_I_RANGE
 
     p = sub.add_parser("batch", help="fit a selection of the refractiveindex.info database")
     chosen = p.add_mutually_exclusive_group()
@@ -60,7 +63,7 @@ def add_batch_parser(sub) -> None:
     p.add_argument("--model", action="append", choices=sorted(MODEL_KINDS), metavar="KIND",
                    help=f"model kind to fit, repeatable (default coated-conductor; one of "
                         f"{', '.join(sorted(MODEL_KINDS))})")
-    p.add_argument("--eta-range", type=parse_eta_range, default=(1.0, 2.5), metavar="LO:HI",
+    p.add_argument("--eta-range", type=parse_eta_range, default=DEFAULT_ETA_I_RANGE, metavar="LO:HI",
                    help="eta_i domain of the fits (default 1:2.5)")
     p.add_argument("-o", "--output", default="batch-output", metavar="DIR",
                    help="output directory with the journal (default batch-output)")
