@@ -99,7 +99,7 @@ def preview_png(
         try:
             result = active.render_preview(
                 material_from_json(record.material), nk, eta_i=eta_i, size=size,
-                compare=compare, environment=environment,
+                compare=compare, environment=environment, differences=False,
             )
         except ValueError as error:
             raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
