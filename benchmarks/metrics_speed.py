@@ -68,8 +68,8 @@ def main() -> int:
             a = error_metrics(reference_ACEScg(nk, M, E, 1.0), model)
             b = evaluate_material(nk, result, baselines=False)["model_float16"]
             print(f"| {name} | {fit:.1f} | {slow:.1f} | {grid:.1f} | {evaluate:.1f} | "
-                  f"{fit + evaluate:.1f} | {abs(a['delta_E_mean'] - b['delta_E_mean']):.1e} / "
-                  f"{abs(a['delta_E_max'] - b['delta_E_max']):.1e} |")
+                  f"{fit + evaluate:.1f} | {abs(a.mean - b['delta_E_mean']):.1e} / "
+                  f"{abs(a.max - b['delta_E_max']):.1e} |")
     return 0
 
 

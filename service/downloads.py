@@ -15,8 +15,16 @@ Stored fits as the files a renderer loads:
 
 The snippet text comes from the template files in ``service/templates/``.
 
+Exports of one fit for one coating index (:mod:`fitting.exports`), made
+from the fit's measured n, k, or for a fit of edited curves from its model:
+
+-   ``mtlx``, ``openpbr``: MaterialX documents; ``blender``: a Blender
+    Python script; ``gltf``: a glTF 2.0 asset.
+
 -   :data:`PACK_MEDIA_TYPES`: media type and file suffix per format.
+-   :data:`EXPORT_MEDIA_TYPES`: the same for the exports.
 -   :func:`render_pack`: the bytes of a download.
+-   :func:`render_export`: the bytes of an export of one fit.
 -   :func:`download_name`: a safe file name for Content-Disposition.
 -   :func:`glsl_identifier`: a material name as a GLSL/HLSL identifier.
 """
@@ -30,13 +38,18 @@ from pathlib import Path
 
 import numpy as np
 
+from fitting.exports import EXPORT_FORMATS, export_material
+from fitting.models.coated_conductor import coated_conductor_model
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
-from .fitting_jobs import FIT_FORMAT_VERSION
+from .fitting_jobs import FIT_FORMAT_VERSION, measured_nk
 from .store import FitRecord
 
-__all__ = ["PACK_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "download_name", "glsl_identifier"]
+__all__ = [
+    "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "render_export",
+    "download_name", "glsl_identifier",
+]
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
 PACK_MEDIA_TYPES = {
@@ -45,6 +58,7 @@ PACK_MEDIA_TYPES = {
     "glsl": ("text/plain; charset=utf-8", "glsl"),
     "hlsl": ("text/plain; charset=utf-8", "hlsl"),
 }
+EXPORT_MEDIA_TYPES = dict(EXPORT_FORMATS)
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 
@@ -163,7 +177,43 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return _snippet(format, records, pack_name).encode("utf-8")
 
 
+def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
+    """
+    The export of one stored fit in ``format`` (one of
+    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``.
+
+    A fit of measured n, k is exported from them (the spectral reference
+    under the coat); a fit made from edited curves from its own float16
+    model curve, which it defines only on its eta_i domain.
+
+    Raises
+    ------
+    ValueError
+        For an unknown format, eta_i outside [1, 3], or, for a curve fit,
+        eta_i outside the fit's domain.
+    """
+    if record.kind != "curves":
+        nk = measured_nk(record)
+        if nk is not None:
+            return export_material(nk, format, eta_i)
+    packed = material_from_json(record.material)
+    lo, hi = packed.eta_i_range
+    if not lo <= eta_i <= hi:
+        raise ValueError(
+            f"`eta_i` must lie in the fit's domain [{lo:g}, {hi:g}] for an export of a fit "
+            f"made from curves, got {eta_i:g}"
+        )
+    model = {
+        "name": record.name, "source": record.source,
+        "origin": f"float16 model curve of fit {record.id} (edited curves) under the coat",
+        "reflectance": lambda mu, eta: coated_conductor_model(
+            mu, eta, packed.coefficients, packed.eta_i_range),
+    }
+    return export_material(model, format, eta_i)
+
+
 def download_name(stem: str, format: str) -> str:
     """``<stem>.<suffix>`` with only [A-Za-z0-9._-] in the stem (a safe header value)."""
     safe = re.sub(r"[^A-Za-z0-9._-]", "_", stem).strip("._") or "material"
-    return f"{safe[:80]}.{PACK_MEDIA_TYPES[format][1]}"
+    suffix = {**PACK_MEDIA_TYPES, **EXPORT_MEDIA_TYPES}[format][1]
+    return f"{safe[:80]}.{suffix}"

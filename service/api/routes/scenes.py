@@ -26,6 +26,7 @@ from fastapi import APIRouter
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from fitting.domain import ETA_I_MAX, ETA_I_MIN
 from fitting.fits.scene_fit import fit_scene
 from fitting.fits.scene_schema import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS, parse_scene
 from fitting.optics.library import LIBRARY_NAMES, library_material
@@ -38,7 +39,7 @@ from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_er
 
 router = APIRouter(prefix=API_PREFIX, tags=["scenes"])
 
-EtaValue = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False, description="1 is uncoated")]
+EtaValue = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False, description="1 is uncoated")]
 Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
