@@ -12,8 +12,10 @@ the batch scores against the spectral reference.
 -   :data:`MODEL_KINDS`: the registered kinds; :data:`DEFAULT_MODEL_KIND`.
 -   :func:`register_model_kind`, :func:`check_model_kinds`.
 
-A new kind plugs in with one :func:`register_model_kind` call in its own
-module (imported below), giving a ``fit(nk, eta_i_range) -> KindFit``.
+The kinds are those of :data:`fitting.models.kinds.MODEL_KINDS`
+(``coated-conductor``, ``rgb-conductor``); a new kind plugs in with one
+:func:`register_model_kind` call below, giving a ``fit(nk, eta_i_range) ->
+KindFit``.
 """
 
 from __future__ import annotations
@@ -24,7 +26,8 @@ from typing import Any, Callable
 import numpy as np
 
 from ..fits.material import fit_material
-from ..models.coated_conductor import coated_conductor_model
+from ..fits.rgb_conductor import fit_rgb_conductor
+from ..models.kinds import DEFAULT_MODEL, model_ACEScg
 from ..models.pack import PackedMaterial, material_from_json, material_to_json
 from ..optics.nk import SpectralNK
 
@@ -67,7 +70,7 @@ class ModelKind:
 
 
 MODEL_KINDS: dict[str, ModelKind] = {}
-DEFAULT_MODEL_KIND = "coated-conductor"
+DEFAULT_MODEL_KIND = DEFAULT_MODEL
 
 
 def register_model_kind(kind: ModelKind) -> ModelKind:
@@ -98,18 +101,25 @@ def check_model_kinds(kinds) -> tuple[str, ...]:
     return names
 
 
-def _fit_coated_conductor(nk: SpectralNK, eta_i_range) -> KindFit:
-    result = fit_material(nk, eta_i_range, evaluate=False)
-    C, domain = result.coefficients_float16, result.eta_i_range
+def _kind_fit(packed: PackedMaterial) -> KindFit:
+    """The record of ``packed`` and its model evaluated from the float16 coefficients as shipped."""
+    C = packed.coefficients.astype(np.float64)
+    kind, domain = packed.model, packed.eta_i_range
     return KindFit(
-        material=material_to_json(result.packed),
-        model_ACEScg=lambda M, E: coated_conductor_model(M, E, C, domain),
+        material=material_to_json(packed),
+        model_ACEScg=lambda M, E: model_ACEScg(kind, M, E, C, domain),
     )
 
 
 register_model_kind(ModelKind(
     name="coated-conductor",
     description="Vernooij (2024) coated-conductor model, 27 float16 coefficients",
-    fit=_fit_coated_conductor,
+    fit=lambda nk, eta_i_range: _kind_fit(fit_material(nk, eta_i_range).packed),
+    decode=material_from_json,
+))
+register_model_kind(ModelKind(
+    name="rgb-conductor",
+    description="exact Fresnel per channel of a fitted RGB n + i k, 6 float16 coefficients",
+    fit=lambda nk, eta_i_range: _kind_fit(fit_rgb_conductor(nk, eta_i_range).packed),
     decode=material_from_json,
 ))

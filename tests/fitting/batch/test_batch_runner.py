@@ -156,6 +156,20 @@ class TestRunBatch:
         pages = [json.loads(line)["page"] for line in lines[1:]]
         assert sorted(pages) == PAGES  # nothing twice, nothing lost
 
+    def test_every_kind_in_one_pack(self, tmp_path):
+        kinds = ["coated-conductor", "rgb-conductor"]
+        result = run_batch(["main/Au/Johnson", "main/Al/Mathewson"], tmp_path, kinds=kinds,
+                           workers=1, samples=SAMPLES, progress=False)
+        pack = decode_pack((tmp_path / "pack.cfpk").read_bytes())
+        assert [(m.name, m.model) for m in pack] == [
+            ("main/Au/Johnson [coated-conductor]", "coated-conductor"),
+            ("main/Au/Johnson [rgb-conductor]", "rgb-conductor"),
+        ]
+        header = (tmp_path / "report.csv").read_text().splitlines()[0]
+        assert "rgb-conductor_delta_E_mean" in header
+        record = next(r for r in result.records if r["status"] == "fitted")
+        assert 0.0 < record["kinds"]["rgb-conductor"]["delta_E_mean"] < 1.0
+
     def test_journal_of_another_batch_is_refused(self, tmp_path):
         Journal(tmp_path, {"pages": 1}).close()
         with pytest.raises(ValueError, match="journal of a different batch"):
