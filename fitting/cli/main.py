@@ -11,6 +11,8 @@ Command line
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
+-   ``batch --shelf main``: a selection of the refractiveindex.info database
+    into one pack and report (:mod:`fitting.cli.batch`).
 -   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
     Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
@@ -96,6 +98,7 @@ def _write_export(nk, args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+    from .batch import add_batch_parser
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
@@ -140,6 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
+    add_batch_parser(sub, parse_eta_range)
     add_ibl_parsers(sub)
     return parser
 

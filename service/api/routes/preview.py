@@ -95,7 +95,7 @@ def preview_png(
             ) from None
         result = active.render_preview(
             material_from_json(record.material), nk, eta_i=eta_i, size=size,
-            compare=compare, environment=environment,
+            compare=compare, environment=environment, differences=False,
         )
     finally:
         slots.release()
