@@ -2,41 +2,54 @@
 // or more coating indices, refit on the service (POST /fits/from-curves),
 // see the fit, its preview and its error map, save and download it.
 //
-// The page never evaluates the model itself: every curve, metric and image
-// comes from the service, so the model has one definition per language.
+// Curves and metrics come from the service; the preview runs the project's
+// own GLSL in WebGL2 (preview.js), so the model has one definition per
+// language. Refits run while a point is dragged: one request in flight, the
+// latest edit sent next, answers older than the one shown dropped; the fit
+// id, figures, curves and preview always show the same fit (present()).
 
 import * as api from "./api.js";
 import { drawErrorMap } from "./heatmap.js";
 import { ReflectancePlot } from "./plot.js";
+import { ENVIRONMENT, PANEL, ShaderBall } from "./preview.js";
 
 const SAMPLES = 46; // 0, 2, ..., 90 degrees
 const HANDLES = [0, 20, 36, 50, 60, 70, 78, 84];
 const FALLOFF_DEG = 9; // width of the bump a dragged point makes
+const RETRY_MS = [250, 500, 1000, 2000, 4000]; // backoff after a 503 (or Retry-After)
 
 const $ = (id) => document.getElementById(id);
 
 const state = {
   base: null,       // the fit being edited (its curves are the starting point)
-  fit: null,        // the current fit (the base's until the first edit)
+  fit: null,        // the fit on screen (id, figures, curves and preview)
   eta: 1.5,
   edits: {},        // eta_i (2 decimals) -> target rgb, SAMPLES x 3
   undo: [],
   redo: [],
   theta: [],
   baseCurves: null, // reference, lazanyi and base model at the current eta_i
-  model: null,      // the current fit at the current eta_i
-  request: 0,       // drops answers of superseded refits
+  model: null,      // the fit on screen at the current eta_i
   etaRequest: 0,    // drops curves of superseded eta_i (or fits)
 };
 
-const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: guard(refit) });
+// The refit pipeline: `wanted` is the latest edit not yet sent; one request
+// in flight at a time; `shown` is the sequence number of the answer on
+// screen, and an answer older than it is dropped.
+const live = { wanted: null, inFlight: false, seq: 0, shown: 0, attempt: 0, waiters: [], timer: null, failed: null };
+
+const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: dragEnd });
+let ball = null; // the WebGL2 preview, once its shaders compiled
 
 // ---------------------------------------------------------------- messages
 
-function say(text, ok = false) {
+// `kind` tags a message so that it can be cleared by what resolves it
+// ("retry": cleared by the next answer).
+function say(text, ok = false, kind = "") {
   const box = $("message");
   box.textContent = text;
   box.classList.toggle("ok", ok);
+  box.dataset.kind = text ? kind : "";
 }
 
 // A refusal, shown; a 401 (the service wants its API token) opens the token
@@ -74,6 +87,14 @@ async function busy(text, work) {
       document.body.removeAttribute("aria-busy");
     }
   }
+}
+
+// "updating…" on the preview and plot while the fit on screen is not the
+// fit of the edits on screen.
+function updating(on) {
+  $("preview-state").hidden = !on;
+  document.querySelector(".side").classList.toggle("updating", on);
+  $("plot").classList.toggle("updating", on);
 }
 
 // ---------------------------------------------------------------- materials
@@ -116,12 +137,13 @@ async function pickMaterial(value) {
   });
 }
 
-function setBase(fit) {
+async function setBase(fit) {
   state.base = fit;
-  state.fit = fit;
   state.edits = {};
   state.undo = [];
   state.redo = [];
+  live.wanted = null;
+  live.shown = ++live.seq; // answers for the previous material are dropped
   const [lo, hi] = fit.eta_i_range;
   const slider = $("eta");
   slider.min = lo;
@@ -132,10 +154,39 @@ function setBase(fit) {
   $("name").value = fit.kind === "curves" ? fit.name : `${fit.name} edited`;
   $("material-source").textContent = fit.source ? fit.source.split("\n")[0].slice(0, 160) : "";
   $("compare").disabled = !fit.has_nk;
-  if (!fit.has_nk) $("compare").value = "none";
   $("reset").title = fit.kind === "curves" ? "Back to the saved edit as opened" : "Back to the measured data";
   say("");
-  return showEta().then(showFit);
+  const [curves] = await Promise.all([api.curves(fit.id, state.eta, SAMPLES), loadReference(fit)]);
+  state.baseCurves = curves;
+  state.theta = curves.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
+  present(fit, curves);
+}
+
+// The spectral reference texture of the base (its measured n, k) for the
+// preview; fits without n, k show the model alone.
+async function loadReference(fit) {
+  if (!ball || !fit.has_nk) {
+    applyPanels();
+    return;
+  }
+  try {
+    ball.setReference(await api.referenceTexture(fit.id));
+  } catch (error) {
+    say(`Spectral reference unavailable: ${error.message}`);
+  }
+  applyPanels();
+}
+
+function applyPanels() {
+  if (!ball) return;
+  const split = state.base && state.base.has_nk ? $("compare").value : "none";
+  const panels = {
+    all: [PANEL.model, PANEL.lazanyi, PANEL.reference],
+    reference: [PANEL.model, PANEL.reference],
+    lazanyi: [PANEL.model, PANEL.lazanyi],
+    none: [PANEL.model],
+  }[split];
+  ball.set({ panels });
 }
 
 // ---------------------------------------------------------------- curves
@@ -152,14 +203,17 @@ function target() {
   return state.baseCurves.reference || state.baseCurves.model;
 }
 
+// The curves at the current eta_i: the base's (reference, Lazanyi) and the
+// shown fit's model.
 async function showEta() {
   $("eta-value").textContent = key(state.eta);
   const request = ++state.etaRequest;
+  const fit = state.fit;
   const [base, current] = await Promise.all([
     api.curves(state.base.id, state.eta, SAMPLES),
-    state.fit.id === state.base.id ? null : api.curves(state.fit.id, state.eta, SAMPLES),
+    fit.id === state.base.id ? null : api.curves(fit.id, state.eta, SAMPLES),
   ]);
-  if (request !== state.etaRequest) return; // a later eta_i (or fit) asked since
+  if (request !== state.etaRequest || fit !== state.fit) return; // a later eta_i (or fit) since
   state.theta = base.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
   state.baseCurves = base;
   state.model = current ? current.model : base.model;
@@ -167,6 +221,7 @@ async function showEta() {
 }
 
 function redraw() {
+  if (!state.baseCurves) return;
   const edited = Boolean(state.edits[key(state.eta)]);
   $("plot").dataset.eta = key(state.eta);
   plot.draw({
@@ -208,7 +263,8 @@ function snapshot() {
 
 let dragStart = null;
 
-// Move a control point; true when the target changed (then a refit follows).
+// Move a control point; true when the target changed (a refit follows at
+// once, throttled by the pipeline).
 function drag(channel, handle, value) {
   const k = key(state.eta);
   // The slider moved and its curves are not in yet: the plot shows another eta_i.
@@ -216,66 +272,130 @@ function drag(channel, handle, value) {
   // Clamped: the reference can exceed 1 by rounding (1.0000000000000002 at 90 degrees).
   const current = target().map((rgb) => rgb.map((v) => Math.min(1, Math.max(0, v))));
   const i = state.theta.indexOf(HANDLES[handle]);
-  const delta = value - current[i][channel];
-  if (delta === 0) return false;
+  const before = current[i][channel];
+  if (value === before) return false;
   if (dragStart === null) dragStart = snapshot();
-  const channels = document.querySelector("input[name=channel]:checked").value === "all" ? [0, 1, 2] : [channel];
+  const all = document.querySelector("input[name=channel]:checked").value === "all";
   const at = (t) => Math.exp(-0.5 * ((t - HANDLES[handle]) / FALLOFF_DEG) ** 2) * (1 - (t / 90) ** 6);
   const peak = at(HANDLES[handle]);
+  // One channel: the point moves by delta and its neighbours by less. All
+  // three: the three channels are scaled (brightness changes, hue stays),
+  // by value / before at the point and proportionally less around it.
+  const delta = value - before;
+  const ratio = before > 1e-6 ? value / before : null;
   for (let j = 0; j < state.theta.length; j++) {
     // Grazing (90 degrees) stays 1: the model meets 1 there whatever its coefficients.
     const w = at(state.theta[j]) / peak;
-    for (const c of channels) current[j][c] = Math.min(1, Math.max(0, current[j][c] + delta * w));
+    if (all) {
+      const scale = ratio === null ? null : 1 + (ratio - 1) * w;
+      for (let c = 0; c < 3; c++) {
+        const next = scale === null ? current[j][c] + delta * w : current[j][c] * scale;
+        current[j][c] = Math.min(1, Math.max(0, next));
+      }
+    } else {
+      current[j][channel] = Math.min(1, Math.max(0, current[j][channel] + delta * w));
+    }
   }
   state.edits[k] = current;
   redraw();
+  requestRefit();
   return true;
 }
 
-async function refit() {
+function dragEnd() {
   if (dragStart !== null) {
-    state.undo.push(dragStart);
-    state.redo = [];
+    if (dragStart !== snapshot()) {
+      state.undo.push(dragStart);
+      state.redo = [];
+    }
     dragStart = null;
   }
-  await fitEdits();
+  redraw();
+  requestRefit();
 }
 
-// Refit the edits; true when the fit of the current edits is shown, false
-// when the service refused (reported with `prefix`; `retry` after a 401).
-async function fitEdits(prefix = "The service refused the edit: ", retry = fitEdits) {
-  const etas = Object.keys(state.edits).sort();
-  const request = ++state.request;
-  if (!etas.length) {
-    state.fit = state.base;
-  } else {
-    const body = {
-      name: $("name").value.trim() || "edited",
-      base: { fit: state.base.id },
-      curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: state.theta, rgb: state.edits[eta] })),
-    };
-    try {
-      const fit = await busy("Fitting…", () => api.fitFromCurves(body));
-      if (request !== state.request) return false;
-      state.fit = fit;
-      say("");
-    } catch (error) {
-      if (request === state.request) report(error, retry, prefix);
-      redraw();
-      return false;
+// ---------------------------------------------------------------- refits
+
+function requestBody(edits) {
+  const etas = Object.keys(edits).sort();
+  return {
+    name: $("name").value.trim() || "edited",
+    base: { fit: state.base.id },
+    curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: state.theta, rgb: edits[eta] })),
+  };
+}
+
+// Ask for a fit of the edits on screen; the answer shows when it comes
+// (await whenFitted() for it).
+function requestRefit() {
+  live.wanted = snapshot();
+  live.failed = null;
+  updating(true);
+  pump();
+}
+
+const sleep = (ms) => new Promise((resolve) => { live.timer = setTimeout(resolve, ms); });
+
+async function pump() {
+  if (live.inFlight || live.wanted === null) return;
+  const wanted = live.wanted;
+  const edits = JSON.parse(wanted);
+  const base = state.base;
+  live.wanted = null;
+  live.inFlight = true;
+  const seq = ++live.seq;
+  let delay = 0;
+  try {
+    await busy("Fitting…", async () => {
+      const fit = Object.keys(edits).length ? await api.fitFromCurves(requestBody(edits)) : base;
+      const curves = await api.curves(fit.id, state.eta, SAMPLES);
+      live.attempt = 0;
+      if ($("message").dataset.kind === "retry") say("");
+      if (seq > live.shown && base === state.base) {
+        live.shown = seq;
+        present(fit, curves, wanted);
+      }
+    });
+  } catch (error) {
+    if (error.status === 503 && base === state.base) {
+      // Busy: the same edit (unless a newer one is waiting) again, later.
+      delay = error.retryAfter ? error.retryAfter * 1000 : RETRY_MS[Math.min(live.attempt, RETRY_MS.length - 1)];
+      live.attempt += 1;
+      if (live.wanted === null) live.wanted = wanted;
+      say(`The service is busy; retrying in ${(delay / 1000).toFixed(1)} s…`, false, "retry");
+    } else if (base === state.base) {
+      live.failed = error;
+      report(error, requestRefit, "The service refused the edit: ");
     }
+  } finally {
+    if (delay) await sleep(delay);
+    live.inFlight = false;
   }
-  await showEta();
-  await showFit();
-  return request === state.request;
+  if (live.wanted !== null) {
+    pump();
+  } else {
+    if (!live.failed) updating(false);
+    const waiters = live.waiters.splice(0);
+    for (const resolve of waiters) resolve(!live.failed && state.fit && live.shownEdits === snapshot());
+  }
+}
+
+// Resolves once no refit is pending: true when the fit on screen is the fit
+// of the edits on screen.
+function whenFitted() {
+  if (!live.inFlight && live.wanted === null) return Promise.resolve(!live.failed && live.shownEdits === snapshot());
+  return new Promise((resolve) => live.waiters.push(resolve));
 }
 
 // ---------------------------------------------------------------- fit views
 
-async function showFit() {
-  const fit = state.fit;
+// Everything that names a fit is set here, together: id, figures,
+// coefficients, curve, download and preview.
+function present(fit, curves, edits = "{}") {
+  state.fit = fit;
+  live.shownEdits = edits;
   const edited = fit.kind === "curves";
-  const model = fit.metrics.model || {};
+  const model = (fit.metrics.details && fit.metrics.details.target) || fit.metrics.model || {};
   $("de-label").textContent = edited ? "Fit vs edited curves, mean ΔE00" : "Fit vs measured reference, mean ΔE00";
   $("de-mean").textContent = model.delta_E_mean != null ? model.delta_E_mean.toFixed(3) : "–";
   $("de-max").textContent = model.delta_E_max != null ? model.delta_E_max.toFixed(3) : "–";
@@ -287,34 +407,35 @@ async function showFit() {
   download.href = api.packURL(fit.id, $("format").value);
   download.setAttribute("aria-disabled", "false");
   download.setAttribute("download", "");
-  await Promise.all([showPreview(), showErrorMap()]);
+  if (key(curves.eta_i) === key(state.eta)) {
+    state.model = curves.model;
+    redraw();
+  } else {
+    showEta().catch((error) => say(error.message));
+  }
+  if (ball) ball.setFit(fit);
+  scheduleErrorMap();
 }
 
-let previewURL = null;
-async function showPreview() {
-  const fit = state.fit;
-  const compare = fit.has_nk ? $("compare").value : "none";
-  const img = $("preview");
-  try {
-    const blob = await busy("Rendering the preview…", () => api.preview(fit.id, state.eta, compare));
-    if (previewURL) URL.revokeObjectURL(previewURL);
-    previewURL = URL.createObjectURL(blob);
-    img.src = previewURL;
-    img.dataset.fit = fit.id;
-    img.alt = `Preview sphere of ${fit.name} at eta_i ${key(state.eta)}` + (compare !== "none" ? `, split with ${compare}` : "");
-  } catch (error) {
-    img.removeAttribute("src");
-    img.alt = `Preview unavailable: ${error.message}`;
-    say(`Preview unavailable: ${error.message}`);
-  }
+// The heat map costs a request: drawn for the fit on screen once refits pause.
+let mapTimer = null;
+function scheduleErrorMap() {
+  clearTimeout(mapTimer);
+  mapTimer = setTimeout(() => {
+    if (live.inFlight || live.wanted !== null) return scheduleErrorMap();
+    showErrorMap().catch(() => {});
+  }, 150);
 }
 
 async function showErrorMap() {
+  const fit = state.fit;
   try {
-    const map = await api.errorMap(state.fit.id);
+    const map = await api.errorMap(fit.id);
+    if (fit !== state.fit) return;
     drawErrorMap($("heatmap"), map);
+    $("heatmap").dataset.fit = fit.id;
     $("heatmap-caption").textContent =
-      `Against the ${map.against}: mean ${map.delta_E_mean.toFixed(3)}, max ${map.delta_E_max.toFixed(3)}.`;
+      `Against the ${map.against}: largest ${map.delta_E_max.toFixed(3)}.`;
   } catch (error) {
     $("heatmap-caption").textContent = `Error map unavailable: ${error.message}`;
   }
@@ -327,9 +448,10 @@ function setEta(eta) {
   state.eta = eta;
   $("eta").value = eta;
   $("eta-value").textContent = key(eta);
+  if (ball) ball.set({ eta });
   clearTimeout(etaTimer);
   etaTimer = setTimeout(() => {
-    showEta().then(showPreview).catch((error) => say(error.message));
+    showEta().catch((error) => say(error.message));
   }, 120);
 }
 
@@ -338,14 +460,17 @@ async function undoRedo(from, to) {
   to.push(snapshot());
   state.edits = JSON.parse(from.pop());
   redraw();
-  await fitEdits();
+  requestRefit();
+  await whenFitted();
 }
 
 async function reset() {
   state.undo.push(snapshot());
   state.redo = [];
   state.edits = {};
-  await fitEdits();
+  redraw();
+  requestRefit();
+  await whenFitted();
 }
 
 async function save() {
@@ -355,8 +480,12 @@ async function save() {
     $("name").focus();
     return;
   }
-  // A refused refit (401, 503, 422) is reported by fitEdits: nothing was saved.
-  if (!(await fitEdits("Not saved: ", save))) return;
+  requestRefit();
+  // A refused refit (401, 422) is reported by the pipeline: nothing was saved.
+  if (!(await whenFitted())) {
+    if (live.failed) say(`Not saved: ${live.failed.message}`);
+    return;
+  }
   if (state.fit.kind !== "curves") return;
   await loadMaterials($("material").value);
   say(`Saved “${state.fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
@@ -369,6 +498,13 @@ async function upload(file) {
     await setBase(fit);
     say(`Fitted ${fit.name} from ${file.name}.`, true);
   });
+}
+
+function previewSettings() {
+  $("exposure-value").textContent = Number($("exposure").value).toFixed(1);
+  if (!ball) return;
+  ball.set({ environment: ENVIRONMENT[$("environment").value], exposure: Number($("exposure").value) });
+  applyPanels();
 }
 
 $("token").value = api.getToken();
@@ -389,7 +525,7 @@ $("undo").addEventListener("click", guard(() => undoRedo(state.undo, state.redo)
 $("redo").addEventListener("click", guard(() => undoRedo(state.redo, state.undo)));
 $("reset").addEventListener("click", guard(reset));
 $("save").addEventListener("click", guard(save));
-$("compare").addEventListener("change", guard(showPreview));
+for (const id of ["compare", "environment", "exposure"]) $(id).addEventListener("input", previewSettings);
 $("format").addEventListener("change", () => {
   if (state.fit) $("download").href = api.packURL(state.fit.id, $("format").value);
 });
@@ -403,10 +539,25 @@ document.addEventListener("keydown", (event) => {
   if ((k === "z" && event.shiftKey) || k === "y") { event.preventDefault(); guard(() => undoRedo(state.redo, state.undo))(); }
 });
 
+// The preview's shaders compile while the material list and first fit load.
+const preview = ShaderBall.create($("preview"), $("preview-labels")).then((made) => {
+  ball = made;
+  window.cfPreview = made; // for the parity tests and benchmarks
+  previewSettings();
+  ball.set({ eta: state.eta });
+  return made;
+}).catch((error) => {
+  const box = $("preview-error");
+  box.hidden = false;
+  box.textContent = `The real-time preview is unavailable: ${error.message}`;
+  return null;
+});
+
 guard(async () => {
   await loadMaterials();
   const picker = $("material");
   picker.value = "library:Au";
+  await preview;
   await pickMaterial(picker.value);
   document.body.dataset.ready = "true";
 })();
