@@ -300,7 +300,13 @@ def _de2000_weights(Lab_ref: np.ndarray) -> np.ndarray:
 class _Problem:
     """Residuals and Jacobian of one fit (flattened samples S, 3 outputs each)."""
 
-    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None):
+    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None,
+                 range_check=None):
+        # range_check: (mu, eta, weight) of points where the model must stay
+        # in [0, 1]: one hinge residual weight * (min(F, 0) + max(F - 1, 0))
+        # per point and channel, 0 while the model is inside.
+        self.check = None if range_check is None else (
+            np.ravel(range_check[0]), np.ravel(range_check[1]), float(range_check[2]))
         self.mu = np.ravel(cos_theta)
         self.eta = np.ravel(eta_i)
         self.range = eta_i_range
@@ -324,12 +330,29 @@ class _Problem:
             G = self.A @ G
         return d, G
 
+    def _range_residuals(self, x):
+        mu, eta, weight = self.check
+        F = coated_conductor_model(mu, eta, x.reshape(self.shape), self.range)
+        return weight * (np.minimum(F, 0.0) + np.maximum(F - 1.0, 0.0))
+
     def residuals(self, x):
         F = coated_conductor_model(self.mu, self.eta, x.reshape(self.shape), self.range)
         r, _ = self._outputs(F)
         if self.sqrt_w is not None:
             r = r * self.sqrt_w
+        if self.check is not None:
+            return np.concatenate([r.ravel(), self._range_residuals(x).ravel()])
         return r.ravel()
+
+    def _range_jacobian(self, x):
+        mu, eta, weight = self.check
+        F, Jm = model_jacobian(mu, eta, x.reshape(self.shape), self.range)
+        active = ((F < 0.0) | (F > 1.0)).astype(np.float64)  # (K, 3)
+        K, d1 = Jm.shape[0], self.shape[2]
+        J = np.zeros((K, 3, 3, 3, d1))
+        idx = np.arange(3)
+        J[:, idx, :, idx, :] = (weight * active.T[:, :, None, None] * Jm.transpose(1, 0, 2, 3))
+        return J.reshape(K * 3, -1)
 
     def jacobian(self, x):
         F, Jm = model_jacobian(self.mu, self.eta, x.reshape(self.shape), self.range)
@@ -344,6 +367,8 @@ class _Problem:
             J = np.einsum("soc,scpj->sopcj", G, Jm)
         if self.sqrt_w is not None:
             J = J * self.sqrt_w[:, :, None, None, None]
+        if self.check is not None:
+            return np.concatenate([J.reshape(S * 3, -1), self._range_jacobian(x)])
         return J.reshape(S * 3, -1)
 
 
@@ -420,6 +445,7 @@ def fit_coefficients(
     quantise: bool = True,
     weights=None,
     irls_rounds: int = 2,
+    range_check=None,
 ) -> FitResult:
     """
     Fit the coated-conductor model to linear ACEScg samples.
@@ -474,6 +500,11 @@ def fit_coefficients(
     irls_rounds
         For ``de2000``: rounds of reweighting by :math:`1/\\Delta E_s` that
         turn the sum of squares into the mean Delta E.
+    range_check
+        Optional ``(cos_theta, eta_i, weight)``: points where the model must
+        stay in [0, 1]; each adds the residual ``weight * (min(F, 0) +
+        max(F - 1, 0))`` per channel (zero inside), in the solves and in the
+        float16 quantisation (a penalty constraint, not a clip).
 
     Returns
     -------
@@ -501,7 +532,16 @@ def fit_coefficients(
         weights = np.ravel(np.asarray(weights, dtype=np.float64))
         if weights.size != mu.size or np.any(weights < 0) or not np.all(np.isfinite(weights)):
             raise ValueError("`weights` must be one finite value >= 0 per sample")
-    problem = _Problem(target, mu, eta, eta_i_range, degree, objective, weights)
+    if range_check is not None:
+        check_mu, check_eta, check_weight = range_check
+        check_mu = np.ravel(np.asarray(check_mu, dtype=np.float64))
+        check_eta = np.ravel(np.asarray(check_eta, dtype=np.float64))
+        if check_mu.size != check_eta.size or not (np.all(np.isfinite(check_mu)) and np.all(np.isfinite(check_eta))):
+            raise ValueError("`range_check` must give finite cos_theta and eta_i of one size")
+        if not (np.isfinite(check_weight) and check_weight > 0):
+            raise ValueError(f"`range_check` weight must be a finite number > 0, got {check_weight!r}")
+        range_check = (check_mu, check_eta, float(check_weight))
+    problem = _Problem(target, mu, eta, eta_i_range, degree, objective, weights, range_check)
     bounds = _bounds(degree)
     x0 = np.clip(_initial_guess(target, mu, eta, eta_i_range, degree).ravel(), *bounds)
     result = _solve(problem, x0, bounds, 1e-10, max_nfev)
@@ -511,12 +551,13 @@ def fit_coefficients(
         # w_s = 1 / max(dE_s, floor) turns sum w_s dE_s^2 into sum dE_s.
         base = np.ones(mu.size) if weights is None else weights
         for _ in range(irls_rounds):
-            dE = np.linalg.norm(problem.residuals(result.x).reshape(-1, 3), axis=1)
+            dE = np.linalg.norm(problem.residuals(result.x)[: 3 * mu.size].reshape(-1, 3), axis=1)
             if weights is not None:
                 dE = dE / np.sqrt(np.maximum(weights, 1e-300))
             floor = max(_IRLS_FLOOR, 1e-3 * float(dE.max()))
             problem = _Problem(
-                target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor)
+                target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor),
+                range_check,
             )
             result = _solve(problem, result.x, bounds, 1e-8, max_nfev)
             nfev, njev = nfev + result.nfev, njev + (result.njev or 0)

@@ -126,10 +126,12 @@ class MaterialRow:
 class Store(Protocol):
     """The store interface of the service (thread-safe implementations)."""
 
-    def put_fit(self, record: FitRecord) -> FitRecord:
+    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
         """
         Save ``record`` unless its id exists, and log the save (the fit
-        becomes its material's latest); return the stored record.
+        becomes its material's latest); return the stored record. With
+        ``save`` False (a draft) the record is stored but not logged: it is
+        reachable by id and lists under no material until saved.
         """
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
@@ -203,7 +205,7 @@ class SQLiteStore:
                 self._connections.append(connection)
         return connection
 
-    def put_fit(self, record: FitRecord) -> FitRecord:
+    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
         if not record.created_at:
             record = FitRecord(**{**asdict(record), "created_at": time.time()})
         connection = self._connection()
@@ -213,11 +215,12 @@ class SQLiteStore:
                 "VALUES (?, ?, ?, ?, ?)",
                 (record.id, record.kind, record.material_id, record.created_at, record.to_json()),
             )
-            connection.execute(
-                "INSERT INTO saves (material_id, fit_id, saved_at) "
-                "SELECT material_id, id, ? FROM fits WHERE id = ?",
-                (time.time(), record.id),
-            )
+            if save:
+                connection.execute(
+                    "INSERT INTO saves (material_id, fit_id, saved_at) "
+                    "SELECT material_id, id, ? FROM fits WHERE id = ?",
+                    (time.time(), record.id),
+                )
         stored = self.get_fit(record.id)
         assert stored is not None
         return stored

@@ -63,9 +63,10 @@ export const fitLibrary = (name, etaRange) => postJSON("/fits", { material: name
 export const fitFromCurves = (body) => postJSON("/fits/from-curves", body);
 export const errorMap = (fitId) => getJSON(`/fits/${fitId}/error-map?angles=46&rows=31`);
 
-export function uploadNK(file) {
+export function uploadNK(file, name = "") {
   const form = new FormData();
   form.append("file", file, file.name);
+  if (name) form.append("name", name);
   return postForm("/fits/upload", form);
 }
 

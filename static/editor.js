@@ -17,6 +17,7 @@ const SAMPLES = 46; // 0, 2, ..., 90 degrees
 const HANDLES = [0, 20, 36, 50, 60, 70, 78, 84];
 const FALLOFF_DEG = 9; // width of the bump a dragged point makes
 const RETRY_MS = [250, 500, 1000, 2000, 4000]; // backoff after a 503 (or Retry-After)
+const LAST_KEY = "coated-editor-material"; // localStorage: the material open last
 
 const $ = (id) => document.getElementById(id);
 
@@ -45,6 +46,12 @@ let ball = null; // the WebGL2 preview, once its shaders compiled
 
 // `kind` tags a message so that it can be cleared by what resolves it
 // ("retry": cleared by the next answer).
+function sayUpload(text, ok = false) {
+  const box = $("upload-message");
+  box.textContent = text;
+  box.classList.toggle("ok", ok);
+}
+
 function say(text, ok = false, kind = "") {
   const box = $("message");
   box.textContent = text;
@@ -139,6 +146,7 @@ async function pickMaterial(value) {
 
 async function setBase(fit) {
   state.base = fit;
+  state.savedId = null;
   state.edits = {};
   state.undo = [];
   state.redo = [];
@@ -231,6 +239,7 @@ function redraw() {
     model: state.model,
     lazanyi: $("show-lazanyi").checked ? state.baseCurves.lazanyi_adjusted : null,
     handles: HANDLES,
+    criticalDeg: state.eta > 1 ? (Math.asin(1 / state.eta) * 180) / Math.PI : null,
     channel: document.querySelector("input[name=channel]:checked").value,
     edited,
   });
@@ -255,6 +264,7 @@ function redraw() {
   $("redo").disabled = !state.redo.length;
   $("reset").disabled = !etas.length;
   $("save").disabled = !etas.length;
+  showDirty();
 }
 
 function snapshot() {
@@ -316,12 +326,13 @@ function dragEnd() {
 
 // ---------------------------------------------------------------- refits
 
-function requestBody(edits) {
+function requestBody(edits, draft = true) {
   const etas = Object.keys(edits).sort();
   return {
     name: $("name").value.trim() || "edited",
     base: { fit: state.base.id },
     curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: state.theta, rgb: edits[eta] })),
+    draft,
   };
 }
 
@@ -357,7 +368,7 @@ async function pump() {
       }
     });
   } catch (error) {
-    if (error.status === 503 && base === state.base) {
+    if (error.status === 503 && base === state.base && live.attempt < RETRY_MS.length) {
       // Busy: the same edit (unless a newer one is waiting) again, later.
       delay = error.retryAfter ? error.retryAfter * 1000 : RETRY_MS[Math.min(live.attempt, RETRY_MS.length - 1)];
       live.attempt += 1;
@@ -365,6 +376,7 @@ async function pump() {
       say(`The service is busy; retrying in ${(delay / 1000).toFixed(1)} s…`, false, "retry");
     } else if (base === state.base) {
       live.failed = error;
+      live.attempt = 0;
       report(error, requestRefit, "The service refused the edit: ");
     }
   } finally {
@@ -396,9 +408,8 @@ function present(fit, curves, edits = "{}") {
   live.shownEdits = edits;
   const edited = fit.kind === "curves";
   const model = (fit.metrics.details && fit.metrics.details.target) || fit.metrics.model || {};
-  $("de-label").textContent = edited ? "Fit vs edited curves, mean ΔE00" : "Fit vs measured reference, mean ΔE00";
+  $("de-label").firstChild.textContent = edited ? "Fit vs edited curves, mean ΔE" : "Fit vs measured reference, mean ΔE";
   $("de-mean").textContent = model.delta_E_mean != null ? model.delta_E_mean.toFixed(3) : "–";
-  $("de-max").textContent = model.delta_E_max != null ? model.delta_E_max.toFixed(3) : "–";
   $("fit-id").textContent = fit.id;
   const rows = ["F0", "a", "alpha"].map((p) =>
     `${p.padEnd(5)} ` + fit.coefficients[p].map((row, c) => `${"RGB"[c]} [${row.map((v) => v.toFixed(5)).join(", ")}]`).join("  "));
@@ -414,7 +425,62 @@ function present(fit, curves, edits = "{}") {
     showEta().catch((error) => say(error.message));
   }
   if (ball) ball.setFit(fit);
+  warnIfUnfollowable(fit);
+  showDirty();
   scheduleErrorMap();
+}
+
+// ---------------------------------------------------------------- reach
+
+// An edit is beyond what the model can follow when the fit misses the
+// blended target by more than this (Delta E 2000) somewhere.
+const REACH_DE = 3.0;
+
+function warnIfUnfollowable(fit) {
+  const box = $("reach");
+  const target = fit.kind === "curves" && fit.metrics.details && fit.metrics.details.target;
+  if (!target || target.delta_E_max <= REACH_DE) {
+    box.hidden = true;
+    return;
+  }
+  $("reach-text").textContent =
+    `The model cannot follow this edit everywhere: it misses the edited curves by up to ` +
+    `ΔE ${target.delta_E_max.toFixed(1)} at ${target.at_theta_deg.toFixed(0)}° and ` +
+    `ηᵢ ${target.at_eta_i.toFixed(2)} (1 is a just-visible difference). The fit stays a valid ` +
+    `reflectance (0 to 1); the curve shows what you will get.`;
+  box.hidden = false;
+}
+
+// "Make it gentler": every edit moved halfway back to where it started (undoable).
+function gentler() {
+  if (!state.baseCurves) return;
+  state.undo.push(snapshot());
+  state.redo = [];
+  const from = state.base.kind === "curves" ? "model" : "reference";
+  const etas = Object.keys(state.edits);
+  Promise.all(etas.map((eta) => api.curves(state.base.id, Number(eta), SAMPLES))).then((bases) => {
+    etas.forEach((eta, k) => {
+      const start = bases[k][from] || bases[k].model;
+      state.edits[eta] = state.edits[eta].map((rgb, j) =>
+        rgb.map((v, c) => Math.min(1, Math.max(0, start[j][c] + 0.5 * (v - start[j][c])))));
+    });
+    redraw();
+    requestRefit();
+  }).catch((error) => say(error.message));
+}
+
+// ---------------------------------------------------------------- saved state
+
+// Unsaved: there are edits and the fit on screen is not the one last saved
+// (a refit is a draft; only Save stores it under the name).
+function unsaved() {
+  return Object.keys(state.edits).length > 0 && state.fit && state.savedId !== state.fit.id;
+}
+
+function showDirty() {
+  $("save-state").textContent = unsaved() ? "Unsaved changes (drafts are not saved)" :
+    (state.savedId && state.fit && state.savedId === state.fit.id ? "Saved" : "");
+  document.body.dataset.unsaved = unsaved() ? "true" : "false";
 }
 
 // The heat map costs a request: drawn for the fit on screen once refits pause.
@@ -434,8 +500,7 @@ async function showErrorMap() {
     if (fit !== state.fit) return;
     drawErrorMap($("heatmap"), map);
     $("heatmap").dataset.fit = fit.id;
-    $("heatmap-caption").textContent =
-      `Against the ${map.against}: largest ${map.delta_E_max.toFixed(3)}.`;
+    $("heatmap-caption").textContent = `Against the ${map.against}; dark is close, bright is a visible difference.`;
   } catch (error) {
     $("heatmap-caption").textContent = `Error map unavailable: ${error.message}`;
   }
@@ -480,23 +545,55 @@ async function save() {
     $("name").focus();
     return;
   }
+  if (!Object.keys(state.edits).length) {
+    say("Nothing to save: edit a curve first.");
+    return;
+  }
+  // Saving under the name of another saved material replaces its latest fit: asked first.
+  const { materials } = await api.listMaterials();
+  const clash = materials.find((m) => m.kind === "curves" && m.name === name);
+  const opened = state.base.kind === "curves" && state.base.name === name;
+  if (clash && !opened && !window.confirm(`A saved material is called “${name}”. Replace it with this edit?`)) {
+    say("Not saved: choose another name, or Save again and confirm to replace it.");
+    $("name").focus();
+    return;
+  }
   requestRefit();
   // A refused refit (401, 422) is reported by the pipeline: nothing was saved.
   if (!(await whenFitted())) {
     if (live.failed) say(`Not saved: ${live.failed.message}`);
     return;
   }
-  if (state.fit.kind !== "curves") return;
-  await loadMaterials($("material").value);
-  say(`Saved “${state.fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
+  let fit;
+  try {
+    fit = await busy("Saving…", () => api.fitFromCurves(requestBody(state.edits, false)));
+  } catch (error) {
+    report(error, save, "Not saved: ");
+    return;
+  }
+  state.savedId = fit.id;
+  const opening = `saved:${fit.material_id}`;
+  await loadMaterials(opening);
+  remember(opening);
+  showDirty();
+  say(`Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
+}
+
+function remember(value) {
+  try {
+    localStorage.setItem(LAST_KEY, value);
+  } catch (_) {
+    // storage disabled: the editor opens Au next time
+  }
 }
 
 async function upload(file) {
   await busy("Fitting the uploaded n, k…", async () => {
-    const fit = await api.uploadNK(file);
+    const fit = await api.uploadNK(file, $("upload-name").value.trim());
     await loadMaterials(`saved:${fit.material_id}`);
+    remember(`saved:${fit.material_id}`);
     await setBase(fit);
-    say(`Fitted ${fit.name} from ${file.name}.`, true);
+    sayUpload(`Fitted “${fit.name}” from ${file.name}; saved under that name.`, true);
   });
 }
 
@@ -516,8 +613,32 @@ $("token-form").addEventListener("submit", (event) => {
   retryAfterToken = null;
   if (retry) guard(retry)();
 });
-$("material").addEventListener("change", guard((event) => pickMaterial(event.target.value)));
-$("upload").addEventListener("change", guard((event) => event.target.files[0] && upload(event.target.files[0])));
+let pickedValue = null; // the material open, to return to when a switch is cancelled
+$("material").addEventListener("change", guard(async (event) => {
+  const value = event.target.value;
+  if (unsaved() && !window.confirm("Discard the unsaved edits of this material?")) {
+    event.target.value = pickedValue;
+    return;
+  }
+  await pickMaterial(value);
+  pickedValue = value;
+  remember(value);
+}));
+$("upload").addEventListener("change", (event) => {
+  const file = event.target.files[0];
+  if (!file) return;
+  sayUpload("");
+  upload(file).catch((error) => {
+    if (error.status === 401) report(error, () => upload(file));
+    else sayUpload(`Not uploaded: ${error.message}`);
+  });
+});
+$("reach-gentler").addEventListener("click", gentler);
+window.addEventListener("beforeunload", (event) => {
+  if (!unsaved()) return;
+  event.preventDefault();
+  event.returnValue = "";
+});
 $("eta").addEventListener("input", (event) => setEta(Number(event.target.value)));
 $("show-lazanyi").addEventListener("change", redraw);
 for (const radio of document.querySelectorAll("input[name=channel]")) radio.addEventListener("change", redraw);
@@ -556,8 +677,16 @@ const preview = ShaderBall.create($("preview"), $("preview-labels")).then((made)
 guard(async () => {
   await loadMaterials();
   const picker = $("material");
-  picker.value = "library:Au";
+  let last = null;
+  try {
+    last = localStorage.getItem(LAST_KEY);
+  } catch (_) {
+    // storage disabled
+  }
+  picker.value = last || "library:Au";
+  if (!picker.value) picker.value = "library:Au"; // the remembered material is gone
   await preview;
   await pickMaterial(picker.value);
+  pickedValue = picker.value;
   document.body.dataset.ready = "true";
 })();

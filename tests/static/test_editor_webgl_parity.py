@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import open_editor
+from editor_pages import editor_url, open_editor, pages  # noqa: F401 (fixtures)
 
 from fitting.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.curves import curve_base_from_nk

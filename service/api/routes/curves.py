@@ -56,7 +56,7 @@ from .fits import FitIdPath, fit_answer, stored_fit
 
 router = APIRouter(prefix="/api/v1", tags=["curves"])
 
-CURVES_FORMAT = "curves/v1"
+CURVES_FORMAT = "curves/v2"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 _DEFAULTS = CurveFitSettings()
 
@@ -142,6 +142,8 @@ class CurveFitRequest(BaseModel):
     curves: list[CurveIn] = Field(min_length=1, max_length=CURVE_MAX_COUNT)
     objective: Objective = _DEFAULTS.objective
     blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False)
+    draft: bool = Field(False, description="Store the fit without saving it under `name` (the editor's "
+                                           "refits while editing); the same request with false saves it")
 
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":
@@ -295,7 +297,7 @@ async def create_fit_from_curves(
         if stored is not None:
             # An earlier state saved again (undo, then save): it becomes the
             # material's latest.
-            record = await asyncio.to_thread(store.put_fit, stored)
+            record = stored if request.draft else await asyncio.to_thread(store.put_fit, stored)
         else:
             # The measured data behind the edit (for the reference curves and
             # previews): the base's, or, for an edited base, the data it had.
@@ -320,7 +322,7 @@ async def create_fit_from_curves(
                     base_fit_id=base_record.id if base_record else None,
                     provenance={
                         "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
-                        "request": request.model_dump(mode="json", exclude={"base"}),
+                        "request": request.model_dump(mode="json", exclude={"base", "draft"}),
                         "base": None if base is None else {
                             "kind": base.kind, "name": base.name, "eta_i_range": list(base.eta_i_range),
                             "library_material": base.library_material,
@@ -329,9 +331,14 @@ async def create_fit_from_curves(
                         "settings": {k: getattr(_DEFAULTS, k) for k in _DEFAULTS.__dataclass_fields__},
                     },
                 )
-                return await asyncio.to_thread(store.put_fit, record)
+                return await asyncio.to_thread(store.put_fit, record, not request.draft)
 
             record = await runner.once(fit_id, make)
+            if not request.draft:
+                # The fit was shared with a draft request in flight: saved now.
+                latest = await asyncio.to_thread(store.latest_fit, record.material_id)
+                if latest is None or latest.id != record.id:
+                    record = await asyncio.to_thread(store.put_fit, record)
     return fit_answer(record, created, response)
 
 
@@ -370,6 +377,20 @@ def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
     grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
     E, M = np.meshgrid(eta, mu, indexing="ij")
     return eta, grid.rgb(M, E), "reference"
+
+
+def target_at(record: FitRecord, mu: np.ndarray, eta_i: float) -> list[list[float]]:
+    """
+    A curve fit's target at one eta_i: the blended edited target (with a
+    base), or the curve at that eta_i (without; ValueError if none is there).
+    """
+    rows, target, against = _target_of(record, mu, np.array([float(eta_i)]))
+    if against == "curves":
+        matches = np.flatnonzero(np.abs(rows - eta_i) < 1e-6)
+        if not matches.size:
+            raise ValueError(f"fit {record.id} has no curve at eta_i {eta_i:g}")
+        return target[matches[0]].tolist()
+    return target[0].tolist()
 
 
 def _measured_nk_or_refuse(record: FitRecord) -> SpectralNK:

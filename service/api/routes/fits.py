@@ -234,7 +234,15 @@ def get_curves(
         reference = reference_ACEScg(nk, mu, eta_i).tolist()
         inputs = baseline_inputs(nk)
         baseline = lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist()
+    target = reference
+    if record.kind == "curves":
+        from .curves import target_at  # the curve routes import this module
+
+        try:
+            target = target_at(record, mu, eta_i)
+        except ValueError:
+            target = None  # no curve at this eta_i and no base to blend into
     return CurvesPublic(
         fit_id=record.id, eta_i=eta_i, theta_deg=theta.tolist(), cos_theta=mu.tolist(),
-        model=model.tolist(), reference=reference, lazanyi_adjusted=baseline,
+        model=model.tolist(), target=target, reference=reference, lazanyi_adjusted=baseline,
     )

@@ -1,5 +1,5 @@
 """
-Fixtures of the editor's browser tests: Debian's Chromium through the
+Shared fixtures of the editor's browser tests (import them: `from editor_pages import pages, open_editor`): Debian's Chromium through the
 Python playwright package (never a downloaded browser), a real server
 process (tests/conftest.py's live_server), and a check that the page logged
 no error (uncaught exceptions and console errors).
