@@ -4,14 +4,14 @@ Curve edits: the default refit against the paper's own fitting method
 
 For a set of edits (several materials, one to four edited curves, gentle
 and extreme), both fits are scored on the whole blended target
-(fitting.curves.whole_target_error: mean Delta E 2000 over 46 angles x 31
-eta_i of fitting.curves.edited_target):
+(fitting.fits.curves.whole_target_error: mean Delta E 2000 over 46 angles x 31
+eta_i of fitting.fits.curves_base.edited_target):
 
--   ``default``: fitting.curves.fit_curves with its default settings (what
+-   ``default``: fitting.fits.curves.fit_curves with its default settings (what
     the editor and POST /fits/from-curves run);
 -   ``paper``: the paper's method (Vernooij 2024, Section 4: plain rgb
     least squares of the model) fitted to the blended target sampled on the
-    scoring grid itself (fitting.fit.fit_coefficients, objective "rgb",
+    scoring grid itself (fitting.fits.solver.fit_coefficients, objective "rgb",
     float16 quantised).
 
 Also reported: the default fit's range over the grid (it must stay in
@@ -22,15 +22,18 @@ Also reported: the default fit's range over the grid (it must stay in
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import time
 
 import numpy as np
 
-from fitting.curves import (
-    CurveFitSettings, RGBCurve, curve_base_from_nk, edited_target, fit_curves, score_grid, whole_target_error,
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from fitting import (  # noqa: E402
+    CurveFitSettings, RGBCurve, curve_base_from_nk, edited_target, fit_coefficients, fit_curves, library_material,
 )
-from fitting.fit import fit_coefficients
-from fitting.library import library_material
+from fitting.fits.curves import score_grid, whole_target_error  # noqa: E402
 
 ANGLES = np.linspace(0.0, 90.0, 46)
 MU = np.where(ANGLES == 90.0, 0.0, np.cos(np.radians(ANGLES)))

@@ -2,7 +2,7 @@
 Fit-from-curves speed and accuracy
 ==================================
 
-Times :func:`fitting.curves.fit_curves` (fitting and float16 quantisation
+Times :func:`fitting.fits.curves.fit_curves` (fitting and float16 quantisation
 only: the base grid is cached and the target built before the clock starts
 in the service too) for sampling and solver settings, over library materials
 and typical edits, and prints one table row per setting: median and 90th
@@ -12,7 +12,7 @@ other processes sharing the cores), and the Delta E 2000 of the float16 fit
 against the edited curves (mean of means, worst max) and, with a base,
 against the whole blended target.
 
-The default of :class:`fitting.curves.CurveFitSettings` is the setting with
+The default of :class:`fitting.fits.curves.CurveFitSettings` is the setting with
 the lowest mean Delta E whose median is at most 10 ms on the reference
 machine (docs/editor.md).
 
@@ -31,8 +31,10 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from fitting.curves import CurveFitSettings, curve_base_from_nk, fit_curves  # noqa: E402
-from fitting.library import library_material  # noqa: E402
+from fitting.domain import cos_theta_from_angle
+from fitting.fits.curves import CurveFitSettings, fit_curves
+from fitting.fits.curves_base import curve_base_from_nk
+from fitting.optics.library import library_material
 
 SETTINGS = [
     dict(mu_samples=m, eta_samples=e, objective=o, irls_rounds=r, quantise=True, max_nfev=n)
@@ -45,7 +47,7 @@ SETTINGS = [
 def scenarios(materials: list[str]):
     """(label, base or None, curves) for each material: the edits an artist makes."""
     angle = np.linspace(0.0, 90.0, 46)
-    mu = np.cos(np.radians(angle))
+    mu = cos_theta_from_angle(angle)
     for name in materials:
         base = curve_base_from_nk(library_material(name))
         ref15 = base.rgb(mu, 1.5)

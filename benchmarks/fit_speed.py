@@ -26,12 +26,13 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from fitting import LIBRARY_NAMES, fit_material, library_material  # noqa: E402
-from fitting.metrics import error_metrics  # noqa: E402
-from fitting.model import coated_conductor_model, model_from_parameters  # noqa: E402
-from fitting.reference import evaluation_grid, reference_ACEScg  # noqa: E402
+from fitting import LIBRARY_NAMES, fit_material, library_material
+from fitting.colour.reference import evaluation_grid, reference_ACEScg
+from fitting.domain import DEFAULT_ETA_I_RANGE
+from fitting.fits.metrics import error_metrics
+from fitting.models.coated_conductor import coated_conductor_model, model_from_parameters
 
-ETA_I_RANGE = (1.0, 2.5)
+ETA_I_RANGE = DEFAULT_ETA_I_RANGE
 
 
 def naive_model(x, mu, eta):

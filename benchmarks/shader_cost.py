@@ -39,10 +39,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from fitting.baselines import baseline_inputs  # noqa: E402
-from fitting.fit import fit_material  # noqa: E402
-from fitting.library import library_material  # noqa: E402
-from fitting.rgb_fresnel import rgb_nk  # noqa: E402
+from fitting.fits.material import fit_material
+from fitting.fits.rgb_conductor import rgb_nk
+from fitting.models.baselines import baseline_inputs
+from fitting.optics.library import library_material
 from preview_shaders.evaluate import (  # noqa: E402
     FIXED,
     LAZANYI_SCENE,
@@ -75,7 +75,7 @@ def main() -> None:
     nk = library_material(args.material)
     packed = fit_material(nk).packed
     air = baseline_inputs(nk)
-    # The exact RGB Fresnel gets the project's per-channel index (fitting.rgb_fresnel).
+    # The exact RGB Fresnel gets the project's per-channel index (fitting.models.rgb_conductor).
     n_rgb, k_rgb = rgb_nk(nk)
     inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
     with RenderThread("shader-cost") as thread:

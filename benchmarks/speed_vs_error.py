@@ -11,7 +11,7 @@ and ``docs/images/speed_vs_error_fit_settings.png``.
 
 Models: Schlick in air, Schlick with exact F0, adjusted Lazanyi, ours float32,
 ours float16, ours scene-specialised (a degree-0 fit at each eta_i row), the
-exact RGB conductor Fresnel (``fitting.rgb_fresnel``) and the exact spectral
+exact RGB conductor Fresnel (``fitting.models.rgb_conductor``) and the exact spectral
 reference. Error: Delta E 2000 against the 1 nm reference on the paper's
 100 x 100 grid (cos theta in [0, 1], eta_i in [1, 2.5]). Shader cost: wall
 time of full-screen 2560 x 1440 RGBA32F renders on this machine's GL
@@ -40,14 +40,20 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from fitting.baselines import baseline_inputs, lazanyi_adjusted, schlick  # noqa: E402
-from fitting.fit import OBJECTIVES, FitSettings, fit_material  # noqa: E402
-from fitting.library import LIBRARY_NAMES, library_material  # noqa: E402
-from fitting.metrics import delta_E_map  # noqa: E402
-from fitting.model import coated_conductor_model, collapse_to_eta_i, model_from_parameters  # noqa: E402
-from fitting.pack import to_float16  # noqa: E402
-from fitting.reference import evaluation_grid, reference_ACEScg, spectral_grid  # noqa: E402
-from fitting.rgb_fresnel import rgb_fresnel_conductor, rgb_nk  # noqa: E402
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour.reference import evaluation_grid, reference_ACEScg, spectral_grid
+from fitting.fits.material import fit_material
+from fitting.fits.rgb_conductor import rgb_nk
+from fitting.fits.settings import OBJECTIVES, FitSettings
+from fitting.models.baselines import baseline_inputs, lazanyi_adjusted, schlick
+from fitting.models.coated_conductor import (
+    coated_conductor_model,
+    collapse_to_eta_i,
+    model_from_parameters,
+)
+from fitting.models.pack import to_float16
+from fitting.models.rgb_conductor import rgb_fresnel_conductor
+from fitting.optics.library import LIBRARY_NAMES, library_material
 
 IMAGES = ROOT / "docs" / "images"
 GRID = 100

@@ -1,7 +1,7 @@
-"""``python -m fitting``: see :mod:`fitting.cli`."""
+"""``python -m fitting``: see :mod:`fitting.cli.main`."""
 
 import sys
 
-from .cli import main
+from .cli.main import main
 
 sys.exit(main())

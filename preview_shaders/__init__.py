@@ -2,7 +2,7 @@
 preview_shaders: the coated-conductor model as a renderer runs it
 =================================================================
 
-GLSL mirrors of :mod:`fitting.model` and its baselines (``glsl/``), the
+GLSL mirrors of :mod:`fitting.models.coated_conductor` and its baselines (``glsl/``), the
 headless GL machinery that runs them on one dedicated render thread, and the
 preview sphere the service and the editor show.
 

@@ -6,7 +6,7 @@ Command line: ``python -m preview_shaders render ...``.
     python -m preview_shaders render --fit pack.cfpk --eta-i 2.0 -o out.png
 
 Without ``--fit`` the built-in material is fitted on the spot
-(:func:`fitting.fit.fit_material`); with it, the material is read from a
+(:func:`fitting.fits.material.fit_material`); with it, the material is read from a
 binary or JSON pack (``--material`` picks one by name, else the first). The
 comparisons need n, k: those of the built-in material of that name.
 """
@@ -17,8 +17,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.pack import PACK_MAGIC, decode_pack, pack_from_json
+from fitting.models.pack import PACK_MAGIC, decode_pack, pack_from_json
+from fitting.optics.library import LIBRARY_NAMES, library_material
 
 from .display import encode_png, false_colour
 from .preview import COMPARISONS, ENVIRONMENTS, PreviewRenderer
@@ -44,7 +44,7 @@ def _render(args) -> int:
             raise ValueError(
                 f"`--material` must be one of {', '.join(LIBRARY_NAMES)}, got {args.material!r}"
             )
-        from fitting.fit import fit_material
+        from fitting.fits.material import fit_material
 
         nk = library_material(args.material)
         packed = fit_material(nk).packed

@@ -23,9 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fitting.baselines import external_medium_F0, lazanyi_a
-from fitting.model import collapse_to_eta_i
-from fitting.pack import PackedMaterial, halves_to_uint32
+from fitting.models.baselines import external_medium_F0, lazanyi_a
+from fitting.models.coated_conductor import collapse_to_eta_i
+from fitting.models.pack import PackedMaterial, halves_to_uint32
 
 from .gl import GLState, RenderThread, check_gl_error
 

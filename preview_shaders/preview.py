@@ -13,8 +13,8 @@ thread, the spectral reference and metrics on the caller's)::
 
     renderer = PreviewRenderer()
     result = renderer.render_preview(
-        packed,                 # fitting.pack.PackedMaterial (float16 coefficients)
-        nk,                     # fitting.nk.SpectralNK or None; needed by
+        packed,                 # fitting.models.pack.PackedMaterial (float16 coefficients)
+        nk,                     # fitting.optics.nk.SpectralNK or None; needed by
                                 # compare="lazanyi" | "reference"
         eta_i=1.5,              # coating index, [1, 3]
         size=512,               # pixels per side, 64..2048
@@ -48,10 +48,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fitting.colorimetry import ACEScg_to_Lab, delta_E_2000
-from fitting.baselines import baseline_inputs
-from fitting.pack import PackedMaterial, halves_to_uint32
-from fitting.reference import reference_ACEScg
+from fitting.colour.colorimetry import ACEScg_to_Lab
+from fitting.colour.delta_e import delta_E_2000
+from fitting.colour.reference import reference_ACEScg
+from fitting.domain import ETA_I_MAX, ETA_I_MIN, check_eta_i
+from fitting.models.baselines import baseline_inputs
+from fitting.models.pack import PackedMaterial, halves_to_uint32
 
 from .display import ACEScg_to_sRGB, encode_png, to_uint8
 from .evaluate import padded_coefficients
@@ -74,7 +76,7 @@ __all__ = [
 COMPARISONS = ("none", "lazanyi", "reference")
 ENVIRONMENTS = ("white_sky", "studio")
 SIZE_RANGE = (64, 2048)
-ETA_I_LIMITS = (1.0, 3.0)
+ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 SPHERE_RADIUS = 0.45
 """Sphere radius as a fraction of the image size."""
 
@@ -88,13 +90,7 @@ def _check_size(size) -> int:
 
 
 def _check_eta_i(eta_i) -> float:
-    try:
-        value = float(eta_i)
-    except (TypeError, ValueError):
-        raise ValueError(f"`eta_i` must be a number in [1, 3], got {eta_i!r}") from None
-    if not (np.isfinite(value) and ETA_I_LIMITS[0] <= value <= ETA_I_LIMITS[1]):
-        raise ValueError(f"`eta_i` must lie in [1, 3], got {value:g}")
-    return value
+    return check_eta_i(eta_i)
 
 
 def _check_choice(name: str, value, choices) -> str:
@@ -183,7 +179,7 @@ def _render_layers(state: GLState, words, eta_i_range, F0_air, F82_air, eta_i, s
 def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0) -> np.ndarray:
     """
     The spectral reference of a rendered view: on the sphere, the exact
-    reflectance of ``nk`` (:func:`fitting.reference.reference_ACEScg`) at
+    reflectance of ``nk`` (:func:`fitting.colour.reference.reference_ACEScg`) at
     each pixel's cos theta times the radiance the pixel sees; elsewhere the
     radiance. float32 linear ACEScg.
     """

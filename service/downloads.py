@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fitting.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
+from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
 from .fitting_jobs import FIT_FORMAT_VERSION

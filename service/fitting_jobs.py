@@ -40,19 +40,16 @@ from typing import Any, Awaitable, Callable
 
 import numpy as np
 
-from fitting.fit import (
-    DEFAULT_OBJECTIVE,
-    FitSettings,
-    content_id,
-    evaluate_material,
-    fit_material,
-)
-from fitting.library import library_material
-from fitting.model import check_eta_i_range
-from fitting.nk import DEFAULT_MIN_COVERAGE, SpectralNK, resample_nk
-from fitting.pack import PackedMaterial, material_to_json
-from fitting.reference import spectral_grid, spectral_weights
+from fitting.colour.reference import spectral_grid, spectral_weights
+from fitting.domain import DEFAULT_MIN_COVERAGE, check_eta_i_range
+from fitting.fits.evaluate import evaluate_material
+from fitting.fits.material import fit_material
+from fitting.fits.settings import DEFAULT_OBJECTIVE, FitSettings
+from fitting.models.pack import PackedMaterial, material_to_json
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK, resample_nk
 
+from .ids import content_id
 from .store import FitRecord, Store
 
 __all__ = [

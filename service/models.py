@@ -20,8 +20,9 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.fit import DEFAULT_OBJECTIVE, OBJECTIVES
-from fitting.library import LIBRARY_NAMES
+from fitting.domain import DEFAULT_ETA_I_RANGE
+from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.optics.library import LIBRARY_NAMES
 
 from .store import FIT_KINDS, FitRecord
 
@@ -126,7 +127,7 @@ class FitRequest(BaseModel):
     source: str = Field("", max_length=2000, description="Citation of inline data")
     nk: NKData | None = None
     eta_i_range: tuple[EtaI, EtaI] = Field(
-        (1.0, 2.5), description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
+        DEFAULT_ETA_I_RANGE, description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
     )
     objective: Objective = DEFAULT_OBJECTIVE
 

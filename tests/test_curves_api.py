@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting.curves import curve_base_from_nk
-from fitting.library import library_material
-from fitting.model import coated_conductor_model
-from fitting.pack import decode_pack
+from fitting.fits.curves_base import curve_base_from_nk
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import decode_pack
+from fitting.optics.library import library_material
 from conftest import app_client
 
 ANGLE = np.linspace(0.0, 90.0, 31)
@@ -54,7 +54,7 @@ class TestFromCurves:
         curve = body["curves"][0]
         mu = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))
         model = coated_conductor_model(mu, 1.5, material.coefficients, material.eta_i_range)
-        from fitting.metrics import delta_E_map
+        from fitting.colour.delta_e import delta_E_map
 
         dE = delta_E_map(np.array(curve["rgb"]), model)
         assert fit["metrics"]["model"]["delta_E_mean"] == pytest.approx(dE.mean(), rel=1e-6)

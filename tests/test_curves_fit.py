@@ -1,26 +1,23 @@
-"""Tests of :mod:`fitting.curves`: curves, bases, blending and fits from curves."""
+"""Tests of :mod:`fitting.fits.curves`: curves, bases, blending and fits from curves."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from fitting.curves import (
-    CURVE_MIN_SAMPLES,
-    CurveFitSettings,
-    RGBCurve,
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour.reference import reference_ACEScg
+from fitting.fits.curves import CurveFitSettings, fit_curves
+from fitting.fits.curves_base import (
     blend_weights,
-    check_curves,
     curve_base_from_coefficients,
     curve_base_from_nk,
     edited_target,
-    fit_curves,
 )
-from fitting.library import library_material
-from fitting.metrics import delta_E_map
-from fitting.model import coated_conductor_model
-from fitting.pack import decode_pack, encode_pack
-from fitting.reference import reference_ACEScg
+from fitting.fits.curves_input import CURVE_MIN_SAMPLES, RGBCurve, check_curves
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import decode_pack, encode_pack
+from fitting.optics.library import library_material
 
 ANGLE = np.linspace(0.0, 90.0, 46)
 MU = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))

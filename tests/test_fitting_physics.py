@@ -3,18 +3,18 @@
 import numpy as np
 import pytest
 
-from fitting.colorimetry import (
+from fitting.colour.colorimetry import (
     ACES_WHITE_XY,
     ACEScg_to_Lab,
     ACEScg_to_Lab_jacobian,
     ACEScg_to_XYZ,
-    delta_E_2000,
     spectral_to_ACEScg_weights,
 )
-from fitting.fresnel import fresnel_conductor, fresnel_dielectric
-from fitting.library import library_material
-from fitting.nk import SpectralNK
-from fitting.reference import reference_ACEScg, spectral_grid, spectral_weights
+from fitting.colour.delta_e import delta_E_2000
+from fitting.colour.reference import reference_ACEScg, spectral_grid, spectral_weights
+from fitting.optics.fresnel import fresnel_conductor, fresnel_dielectric
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
 
 
 class TestFresnelConductor:

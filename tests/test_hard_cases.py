@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from benchmarks.hard_cases import HARD_CASES, critical_cos_theta, run_case, tir_band
-from fitting.fit import fit_material
-from fitting.fresnel import fresnel_conductor
-from fitting.library import library_material
-from fitting.model import coated_conductor_model
-from fitting.pack import FLOAT16_MAX, PackedMaterial, decode_pack, encode_pack, to_float16
-from fitting.reference import reference_ACEScg
+from fitting.colour.reference import reference_ACEScg
+from fitting.fits.material import fit_material
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import FLOAT16_MAX, PackedMaterial, decode_pack, encode_pack, to_float16
+from fitting.optics.fresnel import fresnel_conductor
+from fitting.optics.library import library_material
 
 REFUSED = {"TiO2", "Au 400-900 nm"}
 TIR = {"SiO2", "water", "diamond"}

@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from fitting.baselines import baseline_inputs, lazanyi_adjusted
-from fitting.library import library_material
-from fitting.model import coated_conductor_model
-from fitting.pack import encode_pack, pack_from_json
-from fitting.reference import reference_ACEScg
+from fitting.colour.reference import reference_ACEScg
+from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import encode_pack, pack_from_json
+from fitting.optics.library import library_material
 from preview_shaders.gl import RenderThread
 from preview_shaders.preview import PreviewRenderer, sphere_cos_theta
 

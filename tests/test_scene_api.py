@@ -4,8 +4,8 @@ import base64
 
 import pytest
 
-from fitting.library import library_material
-from fitting.pack import decode_pack, pack_from_json
+from fitting.models.pack import decode_pack, pack_from_json
+from fitting.optics.library import library_material
 from conftest import app_client
 
 API = "/api/v1"

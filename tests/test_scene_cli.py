@@ -1,4 +1,4 @@
-"""``python -m fitting scene FILE [-o PACK] [--json]`` (fitting.scene.scene_command)."""
+"""``python -m fitting scene FILE [-o PACK] [--json]`` (fitting.cli.scene.scene_command)."""
 
 import argparse
 import json
@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from fitting.pack import decode_pack, pack_from_json
-from fitting.scene import add_scene_parser
+from fitting.cli.scene import add_scene_parser
+from fitting.models.pack import decode_pack, pack_from_json
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = {"name": "desk", "materials": [

@@ -1,4 +1,4 @@
-"""Scene descriptions, scene fits and their report (fitting.scene)."""
+"""Scene descriptions, scene fits and their report (fitting.fits.scene_schema)."""
 
 import json
 import math
@@ -6,27 +6,34 @@ import math
 import numpy as np
 import pytest
 
-from fitting.library import library_material
-from fitting.metrics import delta_E_map
-from fitting.model import coated_conductor_model
-from fitting.pack import PackedMaterial, decode_pack, encode_pack, pack_from_json
-from fitting.reference import reference_ACEScg
-from fitting.scene import (
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour.reference import reference_ACEScg
+from fitting.fits.scene_fit import (
     DEGREE_TOLERANCE_MAX,
     DEGREE_TOLERANCE_MEAN,
+    choose_degree,
+    fit_scene,
+    fit_scene_material,
+    general_domain,
+)
+from fitting.fits.scene_schema import (
     EVALUATION_ETA_ROWS,
     EVALUATION_MU_SAMPLES,
     MAX_ETA_I_VALUES,
     MAX_SCENE_MATERIALS,
     EtaSpec,
-    choose_degree,
-    fit_scene,
-    fit_scene_material,
-    general_domain,
-    material_record_bytes,
     parse_eta_i,
     parse_scene,
 )
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import (
+    PackedMaterial,
+    decode_pack,
+    encode_pack,
+    material_record_bytes,
+    pack_from_json,
+)
+from fitting.optics.library import library_material
 
 SCENE = {
     "name": "showroom",

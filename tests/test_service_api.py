@@ -9,12 +9,12 @@ import time
 import numpy as np
 import pytest
 
-from fitting.fit import fit_material
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.model import coated_conductor_model
-from fitting.pack import decode_pack, pack_from_json
-from fitting.reference import reference_ACEScg
-from fitting.metrics import delta_E_map
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour.reference import reference_ACEScg
+from fitting.fits.material import fit_material
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import decode_pack, pack_from_json
+from fitting.optics.library import LIBRARY_NAMES, library_material
 from service.config import Settings
 from conftest import app_client
 

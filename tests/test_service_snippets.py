@@ -8,8 +8,8 @@ import moderngl
 import numpy as np
 import pytest
 
-from fitting.model import coated_conductor_model
-from fitting.pack import PackedMaterial, material_to_json
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import PackedMaterial, material_to_json
 from service.downloads import glsl_identifier, render_pack
 from service.store import FitRecord
 

@@ -9,10 +9,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting.baselines import lazanyi_adjusted, schlick
-from fitting.fresnel import fresnel_conductor
-from fitting.model import coated_conductor_model, collapse_to_eta_i, model_from_parameters
-from fitting.pack import PackedMaterial, halves_to_uint32, to_float16
+from fitting.models.baselines import lazanyi_adjusted, schlick
+from fitting.models.coated_conductor import (
+    coated_conductor_model,
+    collapse_to_eta_i,
+    model_from_parameters,
+)
+from fitting.models.pack import PackedMaterial, halves_to_uint32, to_float16
+from fitting.optics.fresnel import fresnel_conductor
 from preview_shaders.evaluate import (
     TIMING_VARIANTS,
     time_variants,

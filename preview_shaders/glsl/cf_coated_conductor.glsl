@@ -1,5 +1,5 @@
 // The coated-conductor Fresnel model of Vernooij (2024), Eq. 1 and 2: the
-// GLSL mirror of fitting/model.py, term by term.
+// GLSL mirror of fitting/models/coated_conductor.py, term by term.
 //
 // Coefficient layout (fitting.model): coefficients[p][c][j], parameter p in
 // (F0, a, alpha), channel c in (R, G, B), power j in (1, t, t^2); 27 values

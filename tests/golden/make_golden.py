@@ -17,8 +17,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from fitting.library import library_material  # noqa: E402
-from fitting.pack import pack_from_json, pack_to_json  # noqa: E402
+from fitting.models.pack import pack_from_json, pack_to_json
+from fitting.optics.library import library_material
 from preview_shaders.preview import PreviewRenderer  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
@@ -34,7 +34,7 @@ CASES = {
 def main() -> None:
     nk = library_material("Au")
     if "--refit" in sys.argv or not PACK.exists():
-        from fitting.fit import fit_material
+        from fitting.fits.material import fit_material
 
         PACK.write_text(pack_to_json([fit_material(nk).packed]))
     packed = pack_from_json(PACK.read_text())[0]

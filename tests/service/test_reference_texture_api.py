@@ -10,9 +10,7 @@ import numpy as np
 import pytest
 from conftest import app_client
 
-from fitting.baselines import baseline_inputs
-from fitting.curves import curve_base_from_nk
-from fitting.library import library_material
+from fitting import baseline_inputs, curve_base_from_nk, library_material
 
 
 @pytest.fixture(scope="module")

@@ -14,7 +14,7 @@ import pytest
 from conftest import server_process
 from playwright.sync_api import expect, sync_playwright
 
-from fitting.pack import decode_pack
+from fitting.models.pack import decode_pack
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 

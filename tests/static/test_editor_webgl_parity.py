@@ -5,8 +5,8 @@ includes, loaded as GLSL ES 3.00) rendered into an RGBA32F target
 (EXT_color_buffer_float) and read back; at every pixel of a 96 x 64 view the
 camera geometry, the model from its packed float16 halves, adjusted
 Lazanyi, the spectral reference from the service's texture and the display
-transform agree with numpy (fitting.model, fitting.baselines,
-fitting.curves, preview_shaders.display).
+transform agree with numpy (fitting.models, fitting.fits.curves_base,
+preview_shaders.display).
 """
 
 from __future__ import annotations
@@ -15,11 +15,10 @@ import numpy as np
 import pytest
 from editor_pages import editor_url, open_editor, pages  # noqa: F401 (fixtures)
 
-from fitting.baselines import baseline_inputs, lazanyi_adjusted
-from fitting.curves import curve_base_from_nk
-from fitting.library import library_material
-from fitting.model import coated_conductor_model
-from fitting.pack import halves_to_uint32
+from fitting import (
+    baseline_inputs, coated_conductor_model, curve_base_from_nk, halves_to_uint32, lazanyi_adjusted,
+    library_material,
+)
 from preview_shaders.display import ACEScg_to_sRGB
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]

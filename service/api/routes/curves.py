@@ -5,7 +5,7 @@ Fits from edited RGB curves
 -   ``POST /api/v1/fits/from-curves``: fit the model to RGB reflectance
     curves (linear ACEScg) at one or more eta_i, alone or as edits of a base
     (a built-in material, a stored fit or inline n, k); stored and
-    downloadable like any fit (:func:`fitting.curves.fit_curves`).
+    downloadable like any fit (:func:`fitting.fits.curves.fit_curves`).
 -   ``GET /api/v1/fits/{fit_id}/error-map``: Delta E 2000 of a stored fit
     over (angle, eta_i) against what it was fitted to, for the editor's heat
     map.
@@ -29,25 +29,27 @@ from fastapi import APIRouter, HTTPException, Query, Response, status
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.curves import (
-    CURVE_MAX_COUNT,
-    CURVE_MAX_SAMPLES,
-    CURVE_MIN_SAMPLES,
+from fitting.colour.delta_e import delta_E_map
+from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, cos_theta_from_angle
+from fitting.fits.curves import CurveFitSettings, fit_curves
+from fitting.fits.curves_base import (
     CurveBase,
-    CurveFitSettings,
-    check_curves,
     curve_base_from_coefficients,
     curve_base_from_nk,
     edited_target,
-    fit_curves,
 )
-from fitting.fit import content_id
-from fitting.library import library_material
-from fitting.metrics import delta_E_map
-from fitting.model import check_eta_i_range, coated_conductor_model
-from fitting.nk import SpectralNK
-from fitting.pack import material_from_json, material_to_json
+from fitting.fits.curves_input import (
+    CURVE_MAX_COUNT,
+    CURVE_MAX_SAMPLES,
+    CURVE_MIN_SAMPLES,
+    check_curves,
+)
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import material_from_json, material_to_json
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
 
+from ...ids import content_id
 from ...fitting_jobs import FIT_FORMAT_VERSION, check_finite, fit_record, measured_nk
 from ...models import FIT_ID_PATTERN, ErrorBody, EtaI, FitPublic, LibraryName, NKData, Objective
 from ...store import FitRecord, Store
@@ -222,10 +224,10 @@ def _base_spec(request: CurveFitRequest, store: Store) -> tuple[_BaseSpec | None
     requested = None if request.eta_i_range is None else check_eta_i_range(request.eta_i_range)
     if ref.material is not None:
         return _BaseSpec("nk", ref.material, library_material(ref.material).source,
-                         requested or (1.0, 2.5), library_material=ref.material), None
+                         requested or DEFAULT_ETA_I_RANGE, library_material=ref.material), None
     if ref.nk is not None:
         data = ref.nk
-        return _BaseSpec("nk", f"{request.name} base", "user n, k", requested or (1.0, 2.5),
+        return _BaseSpec("nk", f"{request.name} base", "user n, k", requested or DEFAULT_ETA_I_RANGE,
                          nk=(tuple(data.wavelength_nm), tuple(data.n), tuple(data.k))), None
     record = stored_fit(store, ref.fit)
     packed = material_from_json(record.material)
@@ -286,7 +288,7 @@ async def create_fit_from_curves(
         base, base_record = await run_in_threadpool(_base_spec, request, store)
         # Checked here, before any work is queued: names the place of a refusal.
         check_curves(curves)
-        eta_i_range = check_eta_i_range(request.eta_i_range or (1.0, 2.5))
+        eta_i_range = check_eta_i_range(request.eta_i_range or DEFAULT_ETA_I_RANGE)
         fit_id = content_id(
             FIT_FORMAT_VERSION, CURVES_FORMAT, request.name.strip(), base.key() if base else "",
             repr(curves), repr(eta_i_range if base is None else base.eta_i_range),
@@ -404,7 +406,7 @@ def _error_map(record: FitRecord, angles: int, rows: int) -> ErrorMap:
     packed = material_from_json(record.material)
     lo, hi = packed.eta_i_range
     theta = np.linspace(0.0, 90.0, angles)
-    mu = np.where(theta == 90.0, 0.0, np.cos(np.radians(theta)))
+    mu = cos_theta_from_angle(theta)
     eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
     eta, target, against = _target_of(record, mu, eta)
     E, M = np.meshgrid(eta, mu, indexing="ij")

@@ -23,13 +23,14 @@ import numpy as np
 from fastapi import APIRouter, File, Form, HTTPException, Path, Query, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
-from fitting.baselines import baseline_inputs, lazanyi_adjusted
-from fitting.fit import DEFAULT_OBJECTIVE
-from fitting.model import coated_conductor_model
-from fitting.nk import SpectralNK
-from fitting.pack import material_from_json
-from fitting.reference import reference_ACEScg
-from fitting.sources import FORMATS, read_nk
+from fitting.colour.reference import reference_ACEScg
+from fitting.domain import cos_theta_from_angle
+from fitting.fits.settings import DEFAULT_OBJECTIVE
+from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.pack import material_from_json
+from fitting.optics.nk import SpectralNK
+from fitting.optics.readers import FORMATS, read_nk
 
 from ...downloads import PACK_MEDIA_TYPES, download_name, render_pack
 from ...fitting_jobs import NKFitSpec, fit_nk, measured_nk
@@ -226,7 +227,7 @@ def get_curves(
     record = stored_fit(store, fit_id)
     packed = material_from_json(record.material)
     theta = np.linspace(0.0, 90.0, samples)
-    mu = np.clip(np.cos(np.radians(theta)), 0.0, 1.0)
+    mu = cos_theta_from_angle(theta)
     model = coated_conductor_model(mu, eta_i, packed.coefficients, packed.eta_i_range)
     reference = baseline = None
     nk = measured_nk(record)

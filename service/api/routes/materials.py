@@ -14,8 +14,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, HTTPException, Path, status
 
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.nk import visible_coverage
+from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.optics.nk import visible_coverage
 
 from ...models import (
     API_PREFIX,

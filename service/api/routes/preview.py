@@ -19,7 +19,7 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 
-from fitting.pack import material_from_json
+from fitting.models.pack import material_from_json
 
 from ...models import API_PREFIX, FIT_ID_PATTERN, ErrorBody
 from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep

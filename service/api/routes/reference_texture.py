@@ -17,7 +17,7 @@ The body is little-endian float32 RGB (linear ACEScg), row-major
     ACEScg, ``r,g,b``), the inputs of adjusted Lazanyi.
 
 It is the grid the curve fits blend their edits into
-(:func:`fitting.curves.curve_base_from_nk`, 5 nm spectral step), so a pixel
+(:func:`fitting.fits.curves_base.curve_base_from_nk`, 5 nm spectral step), so a pixel
 of the preview and a sample of an edited target agree; between samples the
 shader interpolates bilinearly (``cf_reference_texture.glsl``). The texture
 depends only on the fit, whose id is content-addressed: it is cacheable.
@@ -28,9 +28,9 @@ from __future__ import annotations
 from fastapi import APIRouter, HTTPException, Response, status
 from fastapi.concurrency import run_in_threadpool
 
-from fitting.baselines import baseline_inputs
-from fitting.curves import curve_base_from_nk
-from fitting.pack import material_from_json
+from fitting.fits.curves_base import curve_base_from_nk
+from fitting.models.baselines import baseline_inputs
+from fitting.models.pack import material_from_json
 
 from ...fitting_jobs import measured_nk
 from ...models import API_PREFIX, ErrorBody

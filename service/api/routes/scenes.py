@@ -26,9 +26,10 @@ from fastapi import APIRouter
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.library import LIBRARY_NAMES, library_material
-from fitting.nk import SpectralNK
-from fitting.scene import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS, fit_scene, parse_scene
+from fitting.fits.scene_fit import fit_scene
+from fitting.fits.scene_schema import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS, parse_scene
+from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.optics.nk import SpectralNK
 
 from ...fitting_jobs import measured_nk
 from ...models import API_PREFIX, NKData

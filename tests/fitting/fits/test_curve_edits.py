@@ -1,5 +1,5 @@
 """
-Curve edits the model can follow (fitting.curves): the fit stays within
+Curve edits the model can follow (fitting.fits.curves): the fit stays within
 [0, 1] over its whole domain, also for extreme edits (a penalty constraint
 in the least squares, fitting.fit.fit_coefficients ``range_check``); the
 reported figures are over the whole blended target with the place of the
@@ -13,12 +13,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting.curves import (
-    SCORE_GRID, RGBCurve, curve_base_from_nk, edited_target, fit_curves, score_grid, whole_target_error,
+from fitting import (
+    RGBCurve, coated_conductor_model, curve_base_from_nk, delta_E_map, edited_target, fit_coefficients,
+    fit_curves, library_material,
 )
-from fitting.fit import fit_coefficients
-from fitting.library import library_material
-from fitting.model import coated_conductor_model
+from fitting.fits.curves import SCORE_GRID, score_grid, whole_target_error
 
 ANGLES = np.linspace(0.0, 90.0, 46)
 MU = np.where(ANGLES == 90.0, 0.0, np.cos(np.radians(ANGLES)))
@@ -75,10 +74,7 @@ def test_reported_figures_are_over_the_whole_blended_target():
     again = whole_target_error(base, curves, result.packed.coefficients, 0.5)
     assert result.metrics["target"] == again
     target = edited_target(base, curves, M, E, 0.5)
-    from fitting.colorimetry import ACEScg_to_Lab, delta_E_2000
-
-    dE = delta_E_2000(ACEScg_to_Lab(target), ACEScg_to_Lab(
-        coated_conductor_model(M, E, result.packed.coefficients, base.eta_i_range)))
+    dE = delta_E_map(target, coated_conductor_model(M, E, result.packed.coefficients, base.eta_i_range))
     assert again["delta_E_mean"] == pytest.approx(float(dE.mean()))
     assert again["delta_E_max"] == pytest.approx(float(dE.max()))
 
@@ -92,11 +88,9 @@ def test_single_curve_edit_leaves_far_rows_at_the_base():
     E, M = np.meshgrid(far, MU, indexing="ij")
     np.testing.assert_allclose(edited_target(base, curves, M, E, 0.5), np.clip(base.rgb(M, E), 0, 1), atol=1e-12)
     # ... and the fit stays close to it there (well under a visible difference).
-    from fitting.colorimetry import ACEScg_to_Lab, delta_E_2000
-
     E, M = np.meshgrid(np.linspace(2.1, 2.5, 5), MU, indexing="ij")
     model = coated_conductor_model(M, E, result.packed.coefficients, base.eta_i_range)
-    dE = delta_E_2000(ACEScg_to_Lab(base.rgb(M, E)), ACEScg_to_Lab(model))
+    dE = delta_E_map(base.rgb(M, E), model)
     assert dE.mean() < 1.0, dE.mean()
 
 

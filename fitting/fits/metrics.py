@@ -6,9 +6,9 @@ Error metrics
     reference and an approximation on the scoring grid, with the breakdown per
     eta_i row.
 -   :func:`baseline_metrics`: the same for every baseline of
-    :mod:`fitting.baselines`.
+    :mod:`fitting.models.baselines`.
 
-Lab uses the ACES white as reference white (:func:`fitting.colorimetry.ACEScg_to_Lab`).
+Lab uses the ACES white as reference white (:func:`fitting.colour.colorimetry.ACEScg_to_Lab`).
 
 References
 ----------
@@ -20,17 +20,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .baselines import BASELINES, baseline_ACEScg
-from .colorimetry import ACEScg_to_Lab, delta_E_2000
+from ..colour.delta_e import delta_E_map
+from ..domain import DEFAULT_MIN_COVERAGE
+from ..models.baselines import BASELINES, baseline_ACEScg
 
 __all__ = ["BREAKDOWN_ETA_I", "delta_E_map", "error_metrics", "baseline_metrics"]
 
 BREAKDOWN_ETA_I = (1.0, 1.5, 2.0, 2.5)
-
-
-def delta_E_map(reference_RGB, model_RGB) -> np.ndarray:
-    """Delta E 2000 per sample between two linear ACEScg arrays (..., 3)."""
-    return delta_E_2000(ACEScg_to_Lab(reference_RGB), ACEScg_to_Lab(model_RGB))
 
 
 def error_metrics(reference_RGB, model_RGB, eta_i_rows=None) -> dict:
@@ -68,9 +64,9 @@ def error_metrics(reference_RGB, model_RGB, eta_i_rows=None) -> dict:
     return out
 
 
-def baseline_metrics(nk, cos_theta, eta_i, reference_RGB, min_coverage: float = 0.9) -> dict:
+def baseline_metrics(nk, cos_theta, eta_i, reference_RGB, min_coverage: float = DEFAULT_MIN_COVERAGE) -> dict:
     """
-    :func:`error_metrics` of every baseline (:data:`fitting.baselines.BASELINES`)
+    :func:`error_metrics` of every baseline (:data:`fitting.models.baselines.BASELINES`)
     of ``nk`` against ``reference_RGB`` on the grid (cos_theta, eta_i), both
     (E, M) indexed [eta_i, cos_theta]; keyed by baseline name.
     """

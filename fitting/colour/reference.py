@@ -3,8 +3,8 @@ Spectral reference
 ==================
 
 The exact reflectance of a conductor under a clear coating in linear ACEScg:
-Fresnel per wavelength (:func:`fitting.fresnel.fresnel_conductor`) integrated
-with the weights of :func:`fitting.colorimetry.spectral_to_ACEScg_weights`.
+Fresnel per wavelength (:func:`fitting.optics.fresnel.fresnel_conductor`) integrated
+with the weights of :func:`fitting.colour.colorimetry.spectral_to_ACEScg_weights`.
 
 -   :func:`spectral_grid`: the wavelength nodes for a spectral step.
 -   :func:`reference_ACEScg`: the reference at any (cos theta, eta_i).
@@ -22,10 +22,12 @@ import functools
 
 import numpy as np
 
+from ..domain import (
+    DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, ETA_I_MIN, VISIBLE_RANGE_NM, as_finite_array, check_step_nm,
+)
+from ..optics.fresnel import fresnel_conductor
+from ..optics.nk import SpectralNK, resample_nk
 from .colorimetry import spectral_to_ACEScg_weights
-from .fresnel import fresnel_conductor
-from .validation import as_finite_array
-from .nk import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM, SpectralNK, resample_nk
 
 __all__ = ["spectral_grid", "spectral_weights", "reference_ACEScg", "evaluation_grid"]
 
@@ -35,9 +37,7 @@ def spectral_grid(step_nm: float = 1.0) -> np.ndarray:
     Wavelength nodes in nm from 360 to 830 with about ``step_nm`` spacing
     (the last interval is shortened to end exactly at 830 nm).
     """
-    step = float(step_nm)
-    if not (np.isfinite(step) and 0.5 <= step <= 100.0):
-        raise ValueError(f"`step_nm` must lie in [0.5, 100], got {step_nm}")
+    step = check_step_nm(step_nm)
     lo, hi = VISIBLE_RANGE_NM
     nodes = np.arange(lo, hi, step)
     return np.append(nodes, hi)
@@ -91,8 +91,8 @@ def reference_ACEScg(
     mu, eta = np.broadcast_arrays(
         as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
     )
-    if np.any(eta < 1.0):
-        raise ValueError(f"`eta_i` must be >= 1, got {eta.min():g}")
+    if np.any(eta < ETA_I_MIN):
+        raise ValueError(f"`eta_i` must be >= {ETA_I_MIN:g}, got {eta.min():g}")
     shape = mu.shape
     mu, eta = mu.reshape(-1, 1), eta.reshape(-1, 1)
     out = np.empty((mu.shape[0], 3))
@@ -106,7 +106,7 @@ def reference_ACEScg(
 
 
 def evaluation_grid(
-    samples: int = 100, eta_i_range: tuple[float, float] = (1.0, 2.5)
+    samples: int = 100, eta_i_range: tuple[float, float] = DEFAULT_ETA_I_RANGE
 ) -> tuple[np.ndarray, np.ndarray]:
     """
     The scoring grid of the paper (Section 4.1): ``samples`` values of

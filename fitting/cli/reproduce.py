@@ -21,18 +21,21 @@ from pathlib import Path
 
 import numpy as np
 
-from .fit import DEFAULT_OBJECTIVE, fit_material
-from .library import LIBRARY, LIBRARY_NAMES, library_material
-from .metrics import BREAKDOWN_ETA_I, baseline_metrics, error_metrics
-from .model import coated_conductor_model
-from .reference import evaluation_grid, reference_ACEScg
+from ..colour.reference import evaluation_grid, reference_ACEScg
+from ..domain import DEFAULT_ETA_I_RANGE
+from ..fits.material import fit_material
+from ..fits.metrics import BREAKDOWN_ETA_I, baseline_metrics, error_metrics
+from ..fits.settings import DEFAULT_OBJECTIVE
+from ..models.coated_conductor import coated_conductor_model
+from ..optics.library import LIBRARY, LIBRARY_NAMES, library_material
 
 __all__ = ["PAPER_TABLE_1", "reproduce_material", "run"]
 
 PAPER_TABLE_1 = {"Al": 0.09, "Au": 0.14, "Cu": 0.10, "Ta": 0.47, "Cr": 0.31}
 """Mean Delta E 2000 of the paper's model (Vernooij 2024, Table 1)."""
 
-ETA_I_RANGE = (1.0, 2.5)
+ETA_I_RANGE = DEFAULT_ETA_I_RANGE
+"""The paper's domain (Vernooij 2024, Section 4.1)."""
 
 
 def _progress(done: int, total: int, label: str) -> None:

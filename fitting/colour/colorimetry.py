@@ -2,14 +2,14 @@
 Colorimetry
 ===========
 
-Spectral reflectance to linear ACEScg, and the perceptual metrics.
+Spectral reflectance to linear ACEScg, and CIE 1976 L*a*b*.
 
 -   :func:`spectral_to_ACEScg_weights`: the matrix that maps a reflectance
     spectrum sampled at given wavelengths to linear ACEScg, computed once.
 -   :func:`reflectance_to_ACEScg`: applies those weights.
 -   :func:`ACEScg_to_XYZ`, :func:`ACEScg_to_Lab`, :func:`ACEScg_to_Lab_jacobian`:
     CIE 1976 L*a*b* with the ACES white as reference white, and its derivative.
--   :func:`delta_E_2000`: CIE Delta E 2000 through colour-science.
+-   CIE Delta E 2000 and its linearisation: :mod:`fitting.colour.delta_e`.
 
 Conventions: CIE 1931 2 degree observer; illuminant the CIE D series at the
 ACES white point (D60, xy = 0.32168, 0.33767); CAT02 adaptation to the ACEScg
@@ -31,7 +31,7 @@ import threading
 
 import numpy as np
 
-from .nk import VISIBLE_RANGE_NM
+from ..domain import VISIBLE_RANGE_NM
 
 __all__ = [
     "ACES_WHITE_XY",
@@ -40,7 +40,6 @@ __all__ = [
     "ACEScg_to_XYZ",
     "ACEScg_to_Lab",
     "ACEScg_to_Lab_jacobian",
-    "delta_E_2000",
 ]
 
 ACES_WHITE_XY = np.array([0.32168, 0.33767])
@@ -199,9 +198,3 @@ def ACEScg_to_Lab_jacobian(RGB) -> np.ndarray:
     a = 500.0 * (dF[..., 0, :] - dF[..., 1, :])
     b = 200.0 * (dF[..., 1, :] - dF[..., 2, :])
     return np.stack([L, a, b], axis=-2)
-
-
-def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
-    """CIE Delta E 2000 between two CIE Lab arrays (colour-science)."""
-    colour = _colour()
-    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 2000"), dtype=np.float64)

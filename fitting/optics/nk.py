@@ -8,7 +8,7 @@ The validated type for the measured complex index of refraction
 -   :class:`SpectralNK`: spectral *n*, *k* with wavelengths in nm.
 -   :func:`resample_nk`: *n*, *k* on a target wavelength grid, held flat past
     the ends of the data, with the covered fraction of the visible range.
--   :data:`VISIBLE_RANGE_NM`: the integration range of the reference, 360-830 nm.
+-   :data:`VISIBLE_RANGE_NM` (from :mod:`fitting.domain`): the integration range of the reference, 360-830 nm.
 
 References
 ----------
@@ -23,6 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from ..domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM, check_min_coverage
+
 __all__ = [
     "VISIBLE_RANGE_NM",
     "DEFAULT_MIN_COVERAGE",
@@ -31,13 +33,6 @@ __all__ = [
     "resample_nk",
     "visible_coverage",
 ]
-
-VISIBLE_RANGE_NM: tuple[float, float] = (360.0, 830.0)
-"""Integration range of the reference in nm (Vernooij 2024, Section 3.1)."""
-
-DEFAULT_MIN_COVERAGE: float = 0.9
-"""Smallest fraction of :data:`VISIBLE_RANGE_NM` the data must cover."""
-
 
 def _format_value(value: float) -> str:
     return f"{value:.6g}"
@@ -187,8 +182,7 @@ def resample_nk(
         If ``min_coverage`` is outside [0, 1] or the data cover less of the
         visible range than ``min_coverage``.
     """
-    if not 0.0 <= float(min_coverage) <= 1.0:
-        raise ValueError(f"`min_coverage` must lie in [0, 1], got {min_coverage}")
+    check_min_coverage(min_coverage)
     coverage = visible_coverage(nk.wavelength_range_nm)
     if coverage < min_coverage:
         lo, hi = nk.wavelength_range_nm

@@ -26,8 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .nk import SpectralNK
-from .reference import reference_ACEScg
+from ..domain import DEFAULT_MIN_COVERAGE
+from ..colour.reference import reference_ACEScg
+from ..optics.nk import SpectralNK
 
 __all__ = [
     "BASELINES",
@@ -110,7 +111,7 @@ def lazanyi_adjusted(cos_theta, eta_i, F0_air, F82_air, exact_F0=None) -> np.nda
     return F0 + (1.0 - F0) * (1.0 - m) ** 5 - a * m * (1.0 - m) ** 6
 
 
-def baseline_inputs(nk: SpectralNK, step_nm: float = 1.0, min_coverage: float = 0.9) -> dict:
+def baseline_inputs(nk: SpectralNK, step_nm: float = 1.0, min_coverage: float = DEFAULT_MIN_COVERAGE) -> dict:
     """
     F0 (mu = 1) and F82 (mu = 1/7) of the metal in air from the spectral
     reference, linear ACEScg, shape (3,) each.
@@ -121,7 +122,7 @@ def baseline_inputs(nk: SpectralNK, step_nm: float = 1.0, min_coverage: float = 
 
 def baseline_ACEScg(
     name: str, nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
-    min_coverage: float = 0.9,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
 ) -> np.ndarray:
     """
     A baseline by name on (cos_theta, eta_i):

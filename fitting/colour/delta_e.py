@@ -1,0 +1,76 @@
+"""
+Delta E 2000
+============
+
+-   :func:`delta_E_2000`: CIE Delta E 2000 between CIE Lab arrays
+    (colour-science).
+-   :func:`delta_E_map`: the same per sample between two linear ACEScg arrays.
+-   :func:`de2000_weights`: the first-order CIEDE2000 metric at a reference
+    colour, the linearisation the ``de2000`` fitting objective is built on.
+
+Lab uses the ACES white as reference white
+(:func:`fitting.colour.colorimetry.ACEScg_to_Lab`).
+
+References
+----------
+Sharma, G., Wu, W., & Dalal, E. N. (2005). The CIEDE2000 color-difference
+formula. Color Research & Application, 30(1), 21-30.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .colorimetry import ACEScg_to_Lab, _colour
+
+__all__ = ["delta_E_2000", "delta_E_map", "de2000_weights"]
+
+
+def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
+    """CIE Delta E 2000 between two CIE Lab arrays (colour-science)."""
+    colour = _colour()
+    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 2000"), dtype=np.float64)
+
+
+def delta_E_map(reference_RGB, model_RGB) -> np.ndarray:
+    """Delta E 2000 per sample between two linear ACEScg arrays (..., 3)."""
+    return delta_E_2000(ACEScg_to_Lab(reference_RGB), ACEScg_to_Lab(model_RGB))
+
+
+def de2000_weights(Lab_ref: np.ndarray) -> np.ndarray:
+    """
+    Per-sample 3 x 3 maps A with ``|A dLab|`` the CIEDE2000 difference to
+    first order around the reference colour (Sharma et al. 2005, Eq. 1-22):
+    rows dL'/S_L, dC'/S_C + R_T/2 dH'/S_H and sqrt(1 - R_T^2/4) dH'/S_H.
+    """
+    L, a, b = Lab_ref[:, 0], Lab_ref[:, 1], Lab_ref[:, 2]
+    C = np.hypot(a, b)
+    C7 = C**7
+    G = 0.5 * (1.0 - np.sqrt(C7 / (C7 + 25.0**7)))
+    a1 = (1.0 + G) * a
+    C1 = np.hypot(a1, b)
+    h = np.arctan2(b, a1)
+    h_deg = np.degrees(h) % 360.0
+    # Achromatic colours have no hue direction: any orthonormal pair serves.
+    safe = C1 > 1e-9
+    cos_h = np.where(safe, a1 / np.where(safe, C1, 1.0), 1.0)
+    sin_h = np.where(safe, b / np.where(safe, C1, 1.0), 0.0)
+    SL = 1.0 + 0.015 * (L - 50.0) ** 2 / np.sqrt(20.0 + (L - 50.0) ** 2)
+    SC = 1.0 + 0.045 * C1
+    T = (
+        1.0 - 0.17 * np.cos(np.radians(h_deg - 30.0)) + 0.24 * np.cos(np.radians(2.0 * h_deg))
+        + 0.32 * np.cos(np.radians(3.0 * h_deg + 6.0)) - 0.20 * np.cos(np.radians(4.0 * h_deg - 63.0))
+    )
+    SH = 1.0 + 0.015 * C1 * T
+    C17 = C1**7
+    RT = -np.sin(np.radians(2.0 * 30.0 * np.exp(-(((h_deg - 275.0) / 25.0) ** 2)))) * 2.0 * np.sqrt(
+        C17 / (C17 + 25.0**7)
+    )
+    A = np.zeros((L.size, 3, 3))
+    A[:, 0, 0] = 1.0 / SL
+    # dC' = cos_h da' + sin_h db, dH' = -sin_h da' + cos_h db, da' = (1 + G) da.
+    dC = np.stack([np.zeros_like(L), (1.0 + G) * cos_h, sin_h], axis=-1)
+    dH = np.stack([np.zeros_like(L), -(1.0 + G) * sin_h, cos_h], axis=-1)
+    A[:, 1, :] = dC / SC[:, None] + (RT / 2.0)[:, None] * dH / SH[:, None]
+    A[:, 2, :] = np.sqrt(np.clip(1.0 - RT**2 / 4.0, 0.0, 1.0))[:, None] * dH / SH[:, None]
+    return A

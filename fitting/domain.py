@@ -1,0 +1,197 @@
+"""
+Domain: the constants and rules of the fitting core
+===================================================
+
+Layer 0 of :mod:`fitting` (see ``docs/architecture.md``): every rule that more
+than one module, the command line or the service applies is written here
+once, and everything else imports it. Nothing here imports from the rest of
+the package.
+
+-   :data:`ETA_I_MIN`, :data:`ETA_I_MAX`: the coating indices the model is
+    defined for, [1, 3] (1 is uncoated).
+-   :data:`DEFAULT_ETA_I_RANGE`: the default fitted domain [1, 2.5], the
+    paper's (Vernooij 2024, Section 4.1).
+-   :data:`VISIBLE_RANGE_NM`, :data:`DEFAULT_MIN_COVERAGE`: the integration
+    range of the reference and the least fraction of it data must cover.
+-   :func:`check_eta_i`, :func:`check_eta_i_range`: one index, a domain.
+-   :func:`cos_theta_from_angle`: angle theta in degrees to :math:`\\mu`.
+-   :func:`as_finite_array`, :func:`check_int`, :func:`check_choice`,
+    :func:`check_number`, :func:`check_min_coverage`, :func:`check_step_nm`:
+    the argument checks shared by the settings and the public functions.
+
+Every check raises ``ValueError`` naming the argument, the rule and the
+offending value ("`eta_i` must lie in [1, 3], got 0.8").
+
+References
+----------
+Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics,
+Sections 3.1 and 4.1.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "ETA_I_MIN",
+    "ETA_I_MAX",
+    "DEFAULT_ETA_I_RANGE",
+    "VISIBLE_RANGE_NM",
+    "DEFAULT_MIN_COVERAGE",
+    "STEP_NM_LIMITS",
+    "ANGLE_LIMITS_DEG",
+    "as_finite_array",
+    "check_eta_i",
+    "check_eta_i_range",
+    "cos_theta_from_angle",
+    "check_int",
+    "check_choice",
+    "check_number",
+    "check_min_coverage",
+    "check_step_nm",
+    "constants",
+]
+
+ETA_I_MIN: float = 1.0
+"""Lowest coating index: 1 is no coating (air)."""
+
+ETA_I_MAX: float = 3.0
+"""Highest coating index the model and its fits accept."""
+
+DEFAULT_ETA_I_RANGE: tuple[float, float] = (1.0, 2.5)
+"""The default fitted domain [lo, hi] of eta_i (Vernooij 2024, Section 4.1)."""
+
+VISIBLE_RANGE_NM: tuple[float, float] = (360.0, 830.0)
+"""Integration range of the reference in nm (Vernooij 2024, Section 3.1)."""
+
+DEFAULT_MIN_COVERAGE: float = 0.9
+"""Smallest fraction of :data:`VISIBLE_RANGE_NM` the data must cover."""
+
+STEP_NM_LIMITS: tuple[float, float] = (0.5, 100.0)
+"""Accepted spectral steps of the reference in nm."""
+
+ANGLE_LIMITS_DEG: tuple[float, float] = (0.0, 90.0)
+"""Angles theta in the coating, degrees: normal to grazing incidence."""
+
+_ETA_I_RULE = f"[{ETA_I_MIN:g}, {ETA_I_MAX:g}]"
+
+
+def as_finite_array(name: str, values) -> np.ndarray:
+    """``values`` as a float64 array; refuses non-numbers, NaN and infinity."""
+    try:
+        array = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be numbers, got {values!r:.60}") from None
+    if not np.all(np.isfinite(array)):
+        bad = array[~np.isfinite(array)].ravel()[0]
+        raise ValueError(f"`{name}` must be finite, got {bad}")
+    return array
+
+
+def check_eta_i(value: Any, name: str = "eta_i") -> float:
+    """
+    One coating index in [:data:`ETA_I_MIN`, :data:`ETA_I_MAX`], as a float.
+    (JSON readers that accept numbers only check the type first.)
+    """
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a number, got {value!r}") from None
+    if not (math.isfinite(x) and ETA_I_MIN <= x <= ETA_I_MAX):
+        raise ValueError(f"`{name}` must lie in {_ETA_I_RULE}, got {x:g}")
+    return x
+
+
+def check_eta_i_range(eta_i_range) -> tuple[float, float]:
+    """Validate ``eta_i_range`` = (lo, hi) with 1 <= lo <= hi <= 3."""
+    try:
+        lo, hi = (float(v) for v in eta_i_range)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"`eta_i_range` must be two numbers [lo, hi], got {eta_i_range!r}"
+        ) from None
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        raise ValueError(f"`eta_i_range` must be finite, got [{lo}, {hi}]")
+    if not (ETA_I_MIN <= lo <= hi <= ETA_I_MAX):
+        raise ValueError(
+            f"`eta_i_range` must satisfy {ETA_I_MIN:g} <= lo <= hi <= {ETA_I_MAX:g}, "
+            f"got [{lo:g}, {hi:g}]"
+        )
+    return lo, hi
+
+
+def cos_theta_from_angle(angle_deg) -> np.ndarray:
+    """
+    :math:`\\mu = \\cos\\theta` of angles theta in degrees, in [0, 1].
+
+    The one rule: grazing (90 degrees) is exactly 0, although
+    ``cos(radians(90))`` is 6e-17 in floating point, and angles past the
+    ends of [0, 90] are held at 1 or 0 (callers validate their inputs).
+    """
+    angle = np.asarray(angle_deg, dtype=np.float64)
+    return np.clip(np.where(angle >= 90.0, 0.0, np.cos(np.radians(angle))), 0.0, 1.0)
+
+
+def check_int(name: str, value: Any, lo: int, hi: int | None = None) -> int:
+    """An ``int`` in [lo, hi] (hi None: no upper limit; lo = 1: "positive")."""
+    if isinstance(value, int) and not isinstance(value, bool) and lo <= value and (hi is None or value <= hi):
+        return value
+    if hi is None:
+        rule = "a positive integer" if lo == 1 else f"an integer >= {lo}"
+    else:
+        rule = f"an integer in [{lo}, {hi}]"
+    raise ValueError(f"`{name}` must be {rule}, got {value!r}")
+
+
+def check_choice(name: str, value: Any, choices) -> Any:
+    """One of ``choices``."""
+    if value not in choices:
+        raise ValueError(f"`{name}` must be one of {', '.join(choices)}, got {value!r}")
+    return value
+
+
+def check_number(name: str, value: Any, lo: float, hi: float | None = None) -> float:
+    """
+    A finite real number (int or float) in [lo, hi]; with ``hi`` None, > lo
+    (the "finite number > 0" rule for lo = 0).
+    """
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and np.isfinite(value)
+    if hi is None:
+        if ok and value > lo:
+            return float(value)
+        raise ValueError(f"`{name}` must be a finite number > {lo:g}, got {value!r}")
+    if ok and lo <= value <= hi:
+        return float(value)
+    raise ValueError(f"`{name}` must be a number in [{lo:g}, {hi:g}], got {value!r}")
+
+
+def check_min_coverage(value: Any) -> float:
+    """The least covered fraction of the visible range, in [0, 1]."""
+    if not 0.0 <= float(value) <= 1.0:
+        raise ValueError(f"`min_coverage` must lie in [0, 1], got {value!r}")
+    return float(value)
+
+
+def check_step_nm(value: Any) -> float:
+    """A spectral step in nm within :data:`STEP_NM_LIMITS`."""
+    step = float(value)
+    lo, hi = STEP_NM_LIMITS
+    if not (np.isfinite(step) and lo <= step <= hi):
+        raise ValueError(f"`step_nm` must lie in [{lo:g}, {hi:g}], got {value!r}")
+    return step
+
+
+def constants() -> dict[str, Any]:
+    """The domain's constants as JSON, for clients that must not repeat them."""
+    return {
+        "eta_i_min": ETA_I_MIN,
+        "eta_i_max": ETA_I_MAX,
+        "default_eta_i_range": list(DEFAULT_ETA_I_RANGE),
+        "visible_range_nm": list(VISIBLE_RANGE_NM),
+        "default_min_coverage": DEFAULT_MIN_COVERAGE,
+        "step_nm_limits": list(STEP_NM_LIMITS),
+        "angle_limits_deg": list(ANGLE_LIMITS_DEG),
+    }

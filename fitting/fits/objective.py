@@ -1,0 +1,116 @@
+"""
+The objective of a fit
+======================
+
+-   :class:`Problem`: the residuals and analytic Jacobian of one fit of the
+    coated-conductor model (:mod:`fitting.models.coated_conductor`) to RGB
+    samples, in linear RGB (``rgb``), CIE Lab (``lab``) or the first-order
+    CIEDE2000 metric (``de2000``, :func:`fitting.colour.delta_e.de2000_weights`).
+-   :func:`coefficient_bounds`: the box the solver keeps the coefficients in.
+
+References
+----------
+Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
+Sharma, G., Wu, W., & Dalal, E. N. (2005). The CIEDE2000 color-difference formula.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_jacobian
+from ..colour.delta_e import de2000_weights
+from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian
+
+__all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds"]
+
+
+# Box bounds of the coefficients: F0, a, alpha. Generous for every measured
+# conductor (on the 22 of the library |c| < 1 for F0, < 12 for a, < 9 for
+# alpha), they keep parameters the data cannot identify (alpha where a ~ 0)
+# from running away, and every coefficient far inside the float16 range.
+# alpha's constant term stays at or above the model's clamp.
+COEFFICIENT_BOUND = np.array([16.0, 64.0, 256.0])
+
+
+class Problem:
+    """Residuals and Jacobian of one fit (flattened samples S, 3 outputs each)."""
+
+    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None,
+                 range_check=None):
+        # range_check: (mu, eta, weight) of points where the model must stay
+        # in [0, 1]: one hinge residual weight * (min(F, 0) + max(F - 1, 0))
+        # per point and channel, 0 while the model is inside.
+        self.check = None if range_check is None else (
+            np.ravel(range_check[0]), np.ravel(range_check[1]), float(range_check[2]))
+        self.mu = np.ravel(cos_theta)
+        self.eta = np.ravel(eta_i)
+        self.range = eta_i_range
+        self.shape = (3, 3, degree + 1)
+        self.objective = objective
+        self.target = np.asarray(target_RGB, dtype=np.float64).reshape(-1, 3)
+        self.sqrt_w = None if weights is None else np.sqrt(np.ravel(weights))[:, None]
+        if objective == "rgb":
+            self.target_out = self.target
+        else:
+            self.target_out = ACEScg_to_Lab(self.target)
+            self.A = de2000_weights(self.target_out) if objective == "de2000" else None
+
+    def _outputs(self, F):
+        if self.objective == "rgb":
+            return F - self.target_out, None
+        d = ACEScg_to_Lab(F) - self.target_out
+        G = ACEScg_to_Lab_jacobian(F)
+        if self.A is not None:
+            d = np.einsum("sij,sj->si", self.A, d)
+            G = self.A @ G
+        return d, G
+
+    def _range_residuals(self, x):
+        mu, eta, weight = self.check
+        F = coated_conductor_model(mu, eta, x.reshape(self.shape), self.range)
+        return weight * (np.minimum(F, 0.0) + np.maximum(F - 1.0, 0.0))
+
+    def residuals(self, x):
+        F = coated_conductor_model(self.mu, self.eta, x.reshape(self.shape), self.range)
+        r, _ = self._outputs(F)
+        if self.sqrt_w is not None:
+            r = r * self.sqrt_w
+        if self.check is not None:
+            return np.concatenate([r.ravel(), self._range_residuals(x).ravel()])
+        return r.ravel()
+
+    def _range_jacobian(self, x):
+        mu, eta, weight = self.check
+        F, Jm = model_jacobian(mu, eta, x.reshape(self.shape), self.range)
+        active = ((F < 0.0) | (F > 1.0)).astype(np.float64)  # (K, 3)
+        K, d1 = Jm.shape[0], self.shape[2]
+        J = np.zeros((K, 3, 3, 3, d1))
+        idx = np.arange(3)
+        J[:, idx, :, idx, :] = weight * active.T[:, :, None, None] * Jm.transpose(1, 0, 2, 3)
+        return J.reshape(K * 3, -1)
+
+    def jacobian(self, x):
+        F, Jm = model_jacobian(self.mu, self.eta, x.reshape(self.shape), self.range)
+        _, G = self._outputs(F)
+        S, d1 = Jm.shape[0], self.shape[2]
+        if G is None:
+            J = np.zeros((S, 3, 3, 3, d1))
+            idx = np.arange(3)
+            J[:, idx, :, idx, :] = Jm.transpose(1, 0, 2, 3)
+        else:
+            # J[s, o, p, c, j] = G[s, o, c] * Jm[s, c, p, j]
+            J = np.einsum("soc,scpj->sopcj", G, Jm)
+        if self.sqrt_w is not None:
+            J = J * self.sqrt_w[:, :, None, None, None]
+        if self.check is not None:
+            return np.concatenate([J.reshape(S * 3, -1), self._range_jacobian(x)])
+        return J.reshape(S * 3, -1)
+
+
+def coefficient_bounds(degree: int) -> tuple[np.ndarray, np.ndarray]:
+    """Box bounds (lower, upper) of the flattened coefficients, see ``COEFFICIENT_BOUND``."""
+    upper = np.broadcast_to(COEFFICIENT_BOUND[:, None, None], (3, 3, degree + 1)).copy()
+    lower = -upper
+    lower[2, :, 0] = ALPHA_MIN
+    return lower.ravel(), upper.ravel()

@@ -1,0 +1,89 @@
+"""
+The result of a fit
+===================
+
+-   :class:`FitResult`: coefficients (float64 and the shipped float16), the
+    solver's convergence report, timings, and, filled by the pipeline that
+    made it, the pack and the metrics.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..models.pack import PackedMaterial
+
+__all__ = ["FitResult"]
+
+
+@dataclass
+class FitResult:
+    """
+    Result of a fit.
+
+    Attributes
+    ----------
+    coefficients
+        Float64 least-squares optimum, (3, 3, degree + 1).
+    coefficients_float16
+        The shipped float16 coefficients (same shape).
+    eta_i_range, degree, objective
+        The fitted domain, polynomial degree and objective.
+    success, status, message, nfev, njev
+        Convergence report of :func:`scipy.optimize.least_squares`
+        (``status`` > 0 is convergence, 0 is the evaluation budget).
+    cost
+        Half the sum of squared (weighted) residuals of the last solve at the
+        float64 optimum.
+    cost_float16
+        The same for the float16 coefficients.
+    timings
+        Seconds: ``reference``, ``fit``, ``quantise``, ``total``.
+    coverage
+        Fraction of 360-830 nm covered by the data (n, k fits).
+    packed
+        The :class:`fitting.models.pack.PackedMaterial` (n, k fits).
+    metrics
+        Filled by :func:`evaluate_material` or the caller.
+    """
+
+    coefficients: np.ndarray
+    coefficients_float16: np.ndarray
+    eta_i_range: tuple[float, float]
+    degree: int
+    objective: str
+    success: bool
+    status: int
+    message: str
+    nfev: int
+    njev: int
+    cost: float
+    cost_float16: float
+    timings: dict[str, float] = field(default_factory=dict)
+    coverage: float = 1.0
+    packed: PackedMaterial | None = None
+    metrics: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def iterations(self) -> int:
+        """Jacobian evaluations, one per accepted trust-region step."""
+        return self.njev
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly report of the convergence and timings."""
+        return {
+            "success": self.success,
+            "status": self.status,
+            "message": self.message,
+            "iterations": self.iterations,
+            "nfev": self.nfev,
+            "cost": self.cost,
+            "cost_float16": self.cost_float16,
+            "objective": self.objective,
+            "degree": self.degree,
+            "coverage": self.coverage,
+            "timings": dict(self.timings),
+        }

