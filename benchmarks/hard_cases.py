@@ -15,7 +15,7 @@ of the dielectrics with the TIR boundary drawn on
 
     .venv/bin/python benchmarks/hard_cases.py [--figure]
 
-The case definitions are shared with ``tests/test_hard_cases.py``.
+The case definitions are shared with ``tests/fitting/test_hard_cases.py``.
 """
 
 from __future__ import annotations

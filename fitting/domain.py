@@ -43,7 +43,9 @@ __all__ = [
     "DEFAULT_MIN_COVERAGE",
     "STEP_NM_LIMITS",
     "ANGLE_LIMITS_DEG",
+    "as_float_array",
     "as_finite_array",
+    "INDEX_LIMITS",
     "check_eta_i",
     "check_eta_i_range",
     "cos_theta_from_angle",
@@ -76,7 +78,26 @@ STEP_NM_LIMITS: tuple[float, float] = (0.5, 100.0)
 ANGLE_LIMITS_DEG: tuple[float, float] = (0.0, 90.0)
 """Angles theta in the coating, degrees: normal to grazing incidence."""
 
+INDEX_LIMITS: tuple[float, float] = (1.0e-6, 1.0e8)
+"""Where the physics kernels clamp a refractive index or extinction
+coefficient (:mod:`fitting.optics.fresnel`). Measured indices lie far inside
+(n > 0.01 and k < 100 for every material of the database); past 1e8 the
+reflectance is 1 to 1e-8, and the clamp keeps every square inside float64
+(1e8 squared twice is 1e32), so a finite input never gives inf / inf = NaN."""
+
 _ETA_I_RULE = f"[{ETA_I_MIN:g}, {ETA_I_MAX:g}]"
+
+
+def as_float_array(name: str, values) -> np.ndarray:
+    """
+    ``values`` as a float64 array, as the physics kernels take their input:
+    refuses what is not numbers, and keeps NaN and infinity (a kernel
+    documents what they give; the boundaries refuse them).
+    """
+    try:
+        return np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be numbers, got {values!r:.60}") from None
 
 
 def as_finite_array(name: str, values) -> np.ndarray:

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..domain import DEFAULT_MIN_COVERAGE
+from ..domain import DEFAULT_MIN_COVERAGE, as_float_array
 from ..colour.reference import reference_ACEScg
 from ..optics.nk import SpectralNK
 
@@ -54,9 +54,13 @@ def schlick(cos_theta, F0) -> np.ndarray:
     """
     Schlick (1994): :math:`F_0 + (1 - F_0)(1 - \\mu)^5`; ``F0`` broadcast
     against ``cos_theta[..., None]`` for RGB.
+
+    Never raises on numeric input, never NaN for finite input: cos theta is
+    clamped to [0, 1] (below the surface is grazing) and F0 to [0, 1] (it is
+    a reflectance), so the result lies in [0, 1]. NaN in gives NaN.
     """
-    mu = np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)[..., None]
-    F0 = np.asarray(F0, dtype=np.float64)
+    mu = np.clip(as_float_array("cos_theta", cos_theta), 0.0, 1.0)[..., None]
+    F0 = np.clip(as_float_array("F0", F0), 0.0, 1.0)
     return F0 + (1.0 - F0) * (1.0 - mu) ** 5
 
 

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..domain import DEFAULT_ETA_I_RANGE, as_finite_array
+from ..domain import DEFAULT_ETA_I_RANGE, as_float_array
 
 __all__ = [
     "PARAMETERS",
@@ -54,6 +54,12 @@ __all__ = [
 
 PARAMETERS = ("F0", "a", "alpha")
 CHANNELS = ("R", "G", "B")
+
+PARAMETER_LIMIT = 1.0e6
+"""Where F0, a and alpha are clamped (magnitude). A float16 pack cannot reach
+it (each parameter is at most 3 x 65504 in magnitude), so packs are never
+affected; the clamp keeps the sum of Eq. 1 finite for any finite
+coefficients (inf - inf would be NaN)."""
 
 ALPHA_MIN = 1.0e-3
 """Lower clamp of the exponent alpha: keeps (1 - mu)^alpha finite at mu = 1
@@ -109,7 +115,10 @@ def model_parameters(coefficients, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> np
     C = np.asarray(coefficients, dtype=np.float64)
     t = normalised_eta_i(eta_i, eta_i_range)
     T = _powers(t, C.shape[2] - 1)
-    P = np.einsum("...j,pcj->...pc", T, C)
+    with np.errstate(over="ignore", invalid="ignore"):
+        P = np.einsum("...j,pcj->...pc", T, C)
+    # Clamped, not refused (see PARAMETER_LIMIT); np.clip keeps NaN.
+    P = np.clip(P, -PARAMETER_LIMIT, PARAMETER_LIMIT)
     P[..., 2, :] = np.maximum(P[..., 2, :], ALPHA_MIN)
     return P
 
@@ -158,14 +167,20 @@ def coated_conductor_model(
     numpy.ndarray
         Reflectance in linear ACEScg, shape ``broadcast(cos_theta, eta_i) + (3,)``.
 
+    Never raises on numeric input and never returns NaN for finite input:
+    cos theta is clamped to [0, 1], eta_i to the domain, the parameters to
+    +/- :data:`PARAMETER_LIMIT` and alpha to at least :data:`ALPHA_MIN`. A
+    NaN in ``cos_theta`` or ``eta_i`` gives NaN at its position (the API,
+    the CLI and the curve readers refuse NaN before it gets here).
+
     Raises
     ------
     ValueError
-        If ``cos_theta`` or ``eta_i`` is not finite.
+        If ``cos_theta`` or ``eta_i`` is not numbers.
     """
     C = np.asarray(coefficients, dtype=np.float64)
     mu, eta_i = np.broadcast_arrays(
-        as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
+        as_float_array("cos_theta", cos_theta), as_float_array("eta_i", eta_i)
     )
     P = model_parameters(C, eta_i, eta_i_range)
     return model_from_parameters(mu[..., None], P[..., 0, :], P[..., 1, :], P[..., 2, :])

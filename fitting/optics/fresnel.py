@@ -7,6 +7,16 @@ Exact Fresnel reflectance
     :math:`\\eta_i`, vectorised over any broadcastable shapes.
 -   :func:`fresnel_dielectric`: the real-index special case in closed form.
 
+Numeric policy (as pbrt-v4's ``FrComplex``): these kernels never raise on
+numeric input and never return NaN for finite input. cos theta is clamped to
+[0, 1] (a direction below the surface is grazing); indices and extinction
+coefficients are clamped to :data:`fitting.domain.INDEX_LIMITS` (an index
+<= 0 or a negative k is no material; past 1e8 the reflectance is 1 to 1e-8
+and the clamp keeps the arithmetic inside float64). A NaN input gives NaN at
+its position, so a bad value is seen rather than hidden; +/-inf is clamped
+like any large value. Data are validated where they enter: ``SpectralNK``,
+the readers, ``reference_ACEScg``, the CLI and the API.
+
 References
 ----------
 Born, M., & Wolf, E. (1999). Principles of Optics (7th ed.), Section 1.5.
@@ -18,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..domain import as_finite_array
+from ..domain import INDEX_LIMITS, as_float_array
 
 __all__ = ["fresnel_conductor", "fresnel_dielectric"]
 
@@ -52,15 +62,18 @@ def fresnel_conductor(cos_theta, eta_i, n, k) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Reflectance in [0, 1], broadcast over the inputs (a non-finite input
-        raises ``ValueError``). Never NaN: grazing
+        Reflectance in [0, 1], broadcast over the inputs. Never NaN for
+        finite input (see the module docstring for the clamps): grazing
         incidence gives 1, total internal reflection (k = 0, eta_i > n) gives
-        1, an index-matched interface gives 0.
+        1, an index-matched interface gives 0. NaN in any input gives NaN.
     """
-    mu = np.clip(as_finite_array("cos_theta", cos_theta), 0.0, 1.0)
-    eta = (as_finite_array("n", n) + 1j * as_finite_array("k", k)) / as_finite_array(
-        "eta_i", eta_i
-    )
+    lo, hi = INDEX_LIMITS
+    # Clamped, not refused: see the module docstring. np.clip keeps NaN.
+    mu = np.clip(as_float_array("cos_theta", cos_theta), 0.0, 1.0)
+    n = np.clip(as_float_array("n", n), lo, hi)
+    k = np.clip(as_float_array("k", k), 0.0, hi)
+    eta_i = np.clip(as_float_array("eta_i", eta_i), lo, hi)
+    eta = (n + 1j * k) / eta_i
     sin2_t = (1.0 - mu * mu) / (eta * eta)
     # Principal complex square root: for k = 0 past the critical angle the
     # argument is negative real, cos_t is imaginary and |r_s| = |r_p| = 1 (TIR).
@@ -92,11 +105,14 @@ def fresnel_dielectric(cos_theta, eta_i, eta_t) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        Reflectance in [0, 1]; 1 under total internal reflection.
+        Reflectance in [0, 1]; 1 under total internal reflection. Never NaN
+        for finite input (indices clamped to :data:`fitting.domain.INDEX_LIMITS`,
+        cos theta to [0, 1]); NaN in any input gives NaN.
     """
-    mu = np.clip(as_finite_array("cos_theta", cos_theta), 0.0, 1.0)
-    eta_i = as_finite_array("eta_i", eta_i)
-    eta_t = as_finite_array("eta_t", eta_t)
+    lo, hi = INDEX_LIMITS
+    mu = np.clip(as_float_array("cos_theta", cos_theta), 0.0, 1.0)
+    eta_i = np.clip(as_float_array("eta_i", eta_i), lo, hi)
+    eta_t = np.clip(as_float_array("eta_t", eta_t), lo, hi)
     sin2_t = (eta_i / eta_t) ** 2 * (1.0 - mu * mu)
     tir = sin2_t >= 1.0
     cos_t = np.sqrt(np.clip(1.0 - sin2_t, 0.0, 1.0))

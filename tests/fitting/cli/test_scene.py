@@ -11,7 +11,7 @@ import pytest
 from fitting.cli.scene import add_scene_parser
 from fitting.models.pack import decode_pack, pack_from_json
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 SCENE = {"name": "desk", "materials": [
     {"material": "Cu", "eta_i": 1.5},
     {"material": "Au", "name": "uncoated gold", "eta_i": 1},

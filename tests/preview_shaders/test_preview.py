@@ -25,7 +25,7 @@ from preview_shaders.preview import PreviewRenderer, sphere_cos_theta
 
 pytestmark = pytest.mark.gl
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = ROOT / "tests" / "golden"
 sys.path.insert(0, str(GOLDEN))
 from make_golden import CASES  # noqa: E402

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from fitting.models.pack import decode_pack
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def run(*args, check=True):

@@ -1,0 +1,82 @@
+"""fitting.colour (colorimetry, delta_e): against colour-science."""
+
+import numpy as np
+import pytest
+
+from fitting.colour.colorimetry import (
+    ACES_WHITE_XY,
+    ACEScg_to_Lab,
+    ACEScg_to_Lab_jacobian,
+    ACEScg_to_XYZ,
+    spectral_to_ACEScg_weights,
+)
+from fitting.colour.delta_e import delta_E_2000
+from fitting.colour.reference import spectral_grid, spectral_weights
+
+
+class TestColorimetry:
+    def test_white_maps_to_one(self):
+        nodes, W = spectral_weights(1.0)
+        np.testing.assert_allclose(W @ np.ones(nodes.size), 1.0, atol=1e-12)
+        nodes5, W5 = spectral_weights(5.0)
+        np.testing.assert_allclose(W5 @ np.ones(nodes5.size), 1.0, atol=1e-12)
+
+    def test_against_colour_sd_to_XYZ(self):
+        import colour
+
+        nodes = spectral_grid(1.0)
+        reflectance = 0.2 + 0.6 * np.exp(-(((nodes - 600.0) / 60.0) ** 2))
+        sd = colour.SpectralDistribution(dict(zip(nodes, reflectance)))
+        cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+        illuminant = colour.sd_CIE_illuminant_D_series(ACES_WHITE_XY)
+        XYZ = colour.sd_to_XYZ(sd, cmfs, illuminant, method="Integration") / 100.0
+        # Same white on both sides: adapt colour's XYZ to ACEScg, normalise by white.
+        W = spectral_weights(1.0)[1]
+        white_XYZ = colour.sd_to_XYZ(
+            colour.SpectralDistribution(dict(zip(nodes, np.ones_like(nodes)))),
+            cmfs, illuminant, method="Integration",
+        ) / 100.0
+        RGB_colour = colour.XYZ_to_RGB(
+            XYZ, colour.RGB_COLOURSPACES["ACEScg"], illuminant=colour.XYZ_to_xy(white_XYZ),
+            chromatic_adaptation_transform="CAT02",
+        )
+        RGB_white = colour.XYZ_to_RGB(
+            white_XYZ, colour.RGB_COLOURSPACES["ACEScg"], illuminant=colour.XYZ_to_xy(white_XYZ),
+            chromatic_adaptation_transform="CAT02",
+        )
+        np.testing.assert_allclose(W @ reflectance, RGB_colour / RGB_white, rtol=2e-3)
+
+    def test_coarse_weights_exact_for_linear_spectra(self):
+        fine, W1 = spectral_weights(1.0)
+        coarse, W10 = spectral_weights(10.0)
+        line = lambda x: 0.1 + 0.8 * (x - 360.0) / 470.0  # noqa: E731
+        np.testing.assert_allclose(W10 @ line(coarse), W1 @ line(fine), atol=1e-12)
+
+    def test_weights_refuse_wrong_span(self):
+        with pytest.raises(ValueError, match="must span 360-830"):
+            spectral_to_ACEScg_weights(np.linspace(380, 780, 41))
+
+    def test_lab_matches_colour(self):
+        import colour
+
+        rgb = np.array([[0.9, 0.6, 0.3], [1.0, 1.0, 1.0], [-0.01, 0.2, 0.1], [0.0, 0.0, 0.0]])
+        expected = colour.XYZ_to_Lab(ACEScg_to_XYZ(rgb), ACES_WHITE_XY)
+        np.testing.assert_allclose(ACEScg_to_Lab(rgb), expected, atol=1e-9)
+        np.testing.assert_allclose(ACEScg_to_Lab([1.0, 1.0, 1.0]), [100.0, 0.0, 0.0], atol=1e-9)
+
+    def test_lab_jacobian_matches_finite_differences(self):
+        rng = np.random.default_rng(1)
+        rgb = rng.uniform(0.02, 1.0, size=(20, 3))
+        J = ACEScg_to_Lab_jacobian(rgb)
+        h = 1e-7
+        for j in range(3):
+            step = np.zeros(3)
+            step[j] = h
+            numeric = (ACEScg_to_Lab(rgb + step) - ACEScg_to_Lab(rgb - step)) / (2 * h)
+            np.testing.assert_allclose(J[:, :, j], numeric, rtol=1e-5, atol=1e-5)
+
+    def test_delta_E_2000_published_pair(self):
+        # Sharma, Wu & Dalal (2005), Table 1, pair 1: 2.0425.
+        assert delta_E_2000([50.0, 2.6772, -79.7751], [50.0, 0.0, -82.7485]) == pytest.approx(
+            2.0425, abs=1e-4
+        )

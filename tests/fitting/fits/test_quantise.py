@@ -1,0 +1,57 @@
+"""fitting.fits.quantise: float16 coefficients."""
+
+import numpy as np
+import pytest
+
+from fitting.colour.reference import reference_ACEScg
+from fitting.domain import DEFAULT_ETA_I_RANGE
+from fitting.fits.objective import Problem
+from fitting.fits.quantise import quantise_coefficients
+from fitting.fits.settings import fit_grid
+from fitting.fits.solver import fit_coefficients
+from fitting.models.pack import PackedMaterial, decode_pack, encode_pack
+from fitting.optics.library import library_material
+
+
+@pytest.fixture(scope="module", params=["Nb", "Cu"])
+def real_problem(request):
+    """
+    A real fit and exactly the problem it solved: the weighted ``lab``
+    objective on the Gauss grid of a library conductor (no reweighting
+    rounds, so the last problem of the solver is this one).
+    """
+    nk = library_material(request.param)
+    mu, eta, weights = fit_grid(DEFAULT_ETA_I_RANGE)
+    target = reference_ACEScg(nk, mu, eta, 5.0)
+    result = fit_coefficients(target, mu, eta, DEFAULT_ETA_I_RANGE, objective="lab", weights=weights)
+    problem = Problem(target, mu, eta, DEFAULT_ETA_I_RANGE, 2, "lab", weights)
+    return result, problem
+
+
+def _cost(problem, C) -> float:
+    return float(np.sum(problem.residuals(np.asarray(C, dtype=np.float64).ravel()) ** 2))
+
+
+class TestQuantisation:
+    def test_float16_never_worse_than_rounding(self, real_problem):
+        result, problem = real_problem
+        rounded = result.coefficients.astype(np.float16)
+        assert result.coefficients_float16.dtype == np.float16
+        # Strict: the quantiser keeps nearest rounding unless it does better.
+        assert _cost(problem, result.coefficients_float16) <= _cost(problem, rounded)
+
+    def test_quantiser_on_the_public_problem(self, real_problem):
+        result, problem = real_problem
+        again = quantise_coefficients(problem, result.coefficients)
+        np.testing.assert_array_equal(again, result.coefficients_float16)
+        # What the fit reports as its float16 cost is the cost of what it ships.
+        assert result.cost_float16 == pytest.approx(0.5 * _cost(problem, again), rel=1e-12)
+
+    def test_quantised_coefficients_are_shipped_bit_for_bit(self, real_problem):
+        result, _ = real_problem
+        C16 = result.coefficients_float16
+        # Within a few float16 steps of the optimum, not anywhere on the lattice.
+        step = np.spacing(np.abs(result.coefficients).astype(np.float16)).astype(np.float64)
+        assert np.all(np.abs(C16.astype(np.float64) - result.coefficients) <= 64 * step)
+        packed = decode_pack(encode_pack([PackedMaterial("q", C16, DEFAULT_ETA_I_RANGE)]))[0]
+        assert packed.coefficients.tobytes() == C16.tobytes()

@@ -1,0 +1,27 @@
+"""fitting.fits.settings: the fitting grid and settings."""
+
+import numpy as np
+import pytest
+
+from fitting.fits.settings import FitSettings, fit_grid
+
+
+class TestFitGrid:
+    def test_gauss_weights_integrate_polynomials(self):
+        mu, eta, w = fit_grid((1.0, 2.5), 4, 3)
+        # Mean of w f over the grid = the mean of f over the domain, exactly
+        # for degree <= 2n - 1 per axis.
+        f = mu**7 * (eta - 1.0) ** 5
+        exact = (1.0 / 8.0) * (1.5**6 / 6.0) / 1.5
+        assert np.mean(w * f) == pytest.approx(exact, rel=1e-12)
+
+    def test_uniform_and_single_eta(self):
+        mu, eta, w = fit_grid((1.0, 2.5), 5, 3, "uniform")
+        np.testing.assert_array_equal(w, 1.0)
+        assert mu[:5].tolist() == [0.0, 0.25, 0.5, 0.75, 1.0]
+        mu, eta, w = fit_grid((1.7, 1.7), 8, 6)
+        assert mu.size == 8 and np.all(eta == 1.7)
+        with pytest.raises(ValueError, match="`kind` must be one of"):
+            fit_grid((1.0, 2.5), kind="random")
+        with pytest.raises(ValueError, match="`grid` must be one of"):
+            FitSettings(grid="random")

@@ -1,0 +1,69 @@
+"""fitting.fits.solver: fit_coefficients on known models."""
+
+import numpy as np
+import pytest
+
+from fitting.colour.reference import reference_ACEScg
+from fitting.fits.material import fit_material
+from fitting.fits.settings import FitSettings, fit_grid
+from fitting.fits.solver import fit_coefficients
+from fitting.models.coated_conductor import coated_conductor_model
+from fitting.optics.library import library_material
+
+KNOWN = np.array(
+    [
+        [[0.9, -0.1, 0.04], [0.75, -0.18, 0.1], [0.42, -0.2, 0.12]],
+        [[0.3, -0.4, 0.2], [0.5, -0.8, 0.3], [0.6, -1.0, 0.4]],
+        [[6.0, -1.0, 0.5], [5.0, 0.5, -0.2], [4.0, 1.0, 0.3]],
+    ]
+)
+
+
+class TestFitCoefficients:
+    @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
+    def test_recovers_known_coefficients(self, objective):
+        mu, eta, _ = fit_grid((1.0, 2.5), 32, 9, "uniform")
+        target = coated_conductor_model(mu, eta, KNOWN)
+        result = fit_coefficients(target, mu, eta, (1.0, 2.5), objective=objective)
+        assert result.success
+        recovered = coated_conductor_model(mu, eta, result.coefficients)
+        np.testing.assert_allclose(recovered, target, atol=1e-6)
+        np.testing.assert_allclose(result.coefficients[:2], KNOWN[:2], atol=1e-3)
+
+    def test_deterministic(self):
+        nk = library_material("Cr")
+        a, b = fit_material(nk), fit_material(nk)
+        assert a.coefficients_float16.tobytes() == b.coefficients_float16.tobytes()
+
+    def test_non_convergence_is_reported(self):
+        mu, eta, _ = fit_grid((1.0, 2.5))
+        target = reference_ACEScg(library_material("Au"), mu, eta, 5.0)
+        result = fit_coefficients(target, mu, eta, max_nfev=1, objective="rgb")
+        assert not result.success and result.status == 0
+        assert "function evaluations" in result.message
+        assert np.all(np.isfinite(result.coefficients_float16.astype(float)))
+
+    def test_validation(self):
+        mu, eta, _ = fit_grid((1.0, 2.5))
+        target = np.full((mu.size, 3), 0.5)
+        with pytest.raises(ValueError, match="`objective` must be one of"):
+            fit_coefficients(target, mu, eta, objective="l1")
+        with pytest.raises(ValueError, match="`eta_i_range` must satisfy"):
+            fit_coefficients(target, mu, eta, eta_i_range=(2.0, 1.0))
+        with pytest.raises(ValueError, match="same number of samples"):
+            fit_coefficients(target[:-1], mu, eta)
+        bad = target.copy()
+        bad[3, 1] = np.nan
+        with pytest.raises(ValueError, match="`target_RGB` must be finite"):
+            fit_coefficients(bad, mu, eta)
+        with pytest.raises(ValueError, match="`weights`"):
+            fit_coefficients(target, mu, eta, weights=-np.ones(mu.size))
+        with pytest.raises(ValueError, match="`mu_samples`"):
+            FitSettings(mu_samples=2)
+        with pytest.raises(ValueError, match="`step_nm`"):
+            FitSettings(step_nm=0.0)
+
+    def test_single_eta_gives_degree_zero(self):
+        result = fit_material(library_material("Au"), (1.5, 1.5))
+        assert result.degree == 0 and result.coefficients_float16.shape == (3, 3, 1)
+        assert result.packed.eta_i_range == (1.5, 1.5)

@@ -1,0 +1,50 @@
+"""fitting.models.baselines: Schlick and adjusted Lazanyi."""
+
+import numpy as np
+import pytest
+
+from fitting.colour.reference import reference_ACEScg
+from fitting.models.baselines import (
+    MU_BAR,
+    baseline_ACEScg,
+    baseline_inputs,
+    external_medium_F0,
+    lazanyi_a,
+    lazanyi_adjusted,
+    schlick,
+)
+from fitting.optics.library import library_material
+
+
+class TestBaselines:
+    def test_schlick_clamps_and_keeps_nan(self):
+        # Never raises on numbers, never NaN for finite input: mu and F0 clamped to [0, 1].
+        F = schlick(np.array([-1.0, 0.5, 2.0]), [1e300, -1e300, 0.5])
+        assert np.all(np.isfinite(F)) and np.all((F >= 0) & (F <= 1))
+        np.testing.assert_array_equal(F[1], schlick(0.5, [1.0, 0.0, 0.5]))
+        assert np.isnan(schlick(np.nan, [0.5, 0.5, 0.5])).all()
+
+    def test_schlick(self):
+        assert schlick(1.0, [0.5, 0.5, 0.5]) == pytest.approx([0.5, 0.5, 0.5])
+        assert schlick(0.0, [0.5, 0.2, 0.1]) == pytest.approx([1, 1, 1])
+
+    def test_external_medium_F0_identity_in_air(self):
+        F0 = np.array([0.9, 0.7, 0.4])
+        np.testing.assert_allclose(external_medium_F0(F0, 1.0), F0, rtol=1e-12)
+        # A dielectric with n = 1.5 has F0 = 0.04; under eta_i = 1.5 it vanishes.
+        assert external_medium_F0([0.04], 1.5)[0] == pytest.approx(0.0, abs=1e-12)
+
+    def test_lazanyi_passes_through_F82_in_air(self):
+        F0, F82 = np.array([0.9, 0.75, 0.4]), np.array([0.8, 0.7, 0.5])
+        assert lazanyi_adjusted(MU_BAR, 1.0, F0, F82) == pytest.approx(F82, rel=1e-12)
+        assert lazanyi_adjusted(1.0, 1.0, F0, F82) == pytest.approx(F0)
+        assert lazanyi_a(F0, F82).shape == (3,)
+
+    def test_baseline_inputs_and_names(self):
+        nk = library_material("Au")
+        inputs = baseline_inputs(nk)
+        np.testing.assert_allclose(inputs["F0_air"], reference_ACEScg(nk, 1.0, 1.0))
+        with pytest.raises(ValueError, match="`name` must be one of"):
+            baseline_ACEScg("phong", nk, 0.5, 1.5)
+        out = baseline_ACEScg("schlick_exact_F0", nk, np.array([1.0, 1.0]), np.array([1.0, 2.0]))
+        np.testing.assert_allclose(out, reference_ACEScg(nk, 1.0, np.array([1.0, 2.0])), atol=1e-12)

@@ -1,0 +1,88 @@
+"""fitting.optics.fresnel: closed forms, limits, NaN policy."""
+
+import numpy as np
+import pytest
+
+from fitting.colour.reference import reference_ACEScg
+from fitting.optics.fresnel import fresnel_conductor, fresnel_dielectric
+from fitting.optics.nk import SpectralNK
+
+
+class TestFresnelConductor:
+    def test_normal_incidence_closed_form(self):
+        # R(0) = ((n - eta_i)^2 + k^2) / ((n + eta_i)^2 + k^2)
+        for n, k, eta in [(0.2, 3.5, 1.0), (1.5, 0.0, 1.0), (0.3, 2.4, 1.7), (2.9, 0.4, 2.5)]:
+            expected = ((n - eta) ** 2 + k**2) / ((n + eta) ** 2 + k**2)
+            assert fresnel_conductor(1.0, eta, n, k) == pytest.approx(expected, rel=1e-12)
+
+    def test_grazing_is_one(self):
+        assert fresnel_conductor(0.0, [1.0, 1.5, 2.5], 0.2, 3.0) == pytest.approx([1, 1, 1])
+
+    def test_total_internal_reflection(self):
+        n, eta_i = 1.33, 2.0
+        critical = np.sqrt(1.0 - (n / eta_i) ** 2)
+        mu = np.linspace(0.0, critical * 0.999, 50)
+        np.testing.assert_allclose(fresnel_conductor(mu, eta_i, n, 0.0), 1.0, atol=1e-12)
+        assert fresnel_conductor(1.0, eta_i, n, 0.0) < 1.0
+
+    def test_index_matched_is_zero_everywhere(self):
+        mu = np.linspace(0.0, 1.0, 101)
+        R = fresnel_conductor(mu, 1.5, 1.5, 0.0)
+        np.testing.assert_allclose(R, 0.0, atol=1e-15)
+        assert np.all(np.isfinite(R))
+
+    def test_dielectric_formula_matches_k_zero(self):
+        mu = np.linspace(0.0, 1.0, 201)
+        for eta_i, n in [(1.0, 1.5), (1.5, 1.0), (2.0, 1.33), (1.2, 2.4)]:
+            np.testing.assert_allclose(
+                fresnel_conductor(mu, eta_i, n, 0.0), fresnel_dielectric(mu, eta_i, n), atol=1e-12
+            )
+
+    def test_n_dimensional_broadcast(self):
+        mu = np.linspace(0, 1, 7)[:, None, None]
+        eta = np.linspace(1, 2.5, 5)[None, :, None]
+        n = np.linspace(0.2, 1.5, 3)
+        R = fresnel_conductor(mu, eta, n, 2.0)
+        assert R.shape == (7, 5, 3)
+        assert R[3, 2, 1] == pytest.approx(fresnel_conductor(mu[3, 0, 0], eta[0, 2, 0], n[1], 2.0))
+
+    def test_never_nan_on_extremes(self):
+        mu = np.array([-1.0, 0.0, 1e-300, 0.5, 1.0, 2.0])
+        R = fresnel_conductor(mu, 1.0, 1e-9, 1e9)
+        assert np.all(np.isfinite(R)) and np.all((R >= 0) & (R <= 1))
+
+    def test_kernels_never_raise_and_clamp_to_the_physical_limit(self):
+        # Finite but unphysical input: clamped, never raised, never NaN.
+        mu = np.array([-1.0, 0.0, 0.3, 1.0, 2.0])
+        for n, k, eta_i in [(0.0, 0.0, 1.0), (-2.0, -1.0, 1.5), (1e300, 1e300, 1.0), (1.5, 0.0, 0.0),
+                            (1e-300, 0.0, 1e300), (2.0, 3.0, -1.0)]:
+            R = fresnel_conductor(mu, eta_i, n, k)
+            assert np.all(np.isfinite(R)) and np.all((R >= 0) & (R <= 1)), (n, k, eta_i)
+        # A huge index is a perfect mirror; a negative k is clamped to k = 0.
+        assert fresnel_conductor(0.7, 1.0, 1e300, 1e300) == pytest.approx(1.0, abs=1e-7)
+        assert fresnel_conductor(0.7, 1.2, 1.6, -5.0) == fresnel_conductor(0.7, 1.2, 1.6, 0.0)
+        for eta_i, eta_t in [(0.0, 1.5), (1.5, -3.0), (1e300, 1.0), (1.0, 1e-300)]:
+            R = fresnel_dielectric(mu, eta_i, eta_t)
+            assert np.all(np.isfinite(R)) and np.all((R >= 0) & (R <= 1)), (eta_i, eta_t)
+
+    def test_nan_in_gives_nan_out_where_it_is(self):
+        R = fresnel_conductor([0.5, np.nan], 1.0, 0.2, 3.0)
+        assert np.isfinite(R[0]) and np.isnan(R[1])
+        assert np.isnan(fresnel_dielectric(0.5, 1.0, np.nan))
+        # +/-inf is clamped like any large value.
+        assert fresnel_conductor(0.5, 1.0, 0.2, np.inf) == pytest.approx(1.0, abs=1e-7)
+
+    def test_non_numbers_refused(self):
+        with pytest.raises(ValueError, match="`k` must be numbers"):
+            fresnel_conductor(0.5, 1.0, 0.2, "gold")
+
+    def test_the_boundaries_refuse_non_finite_data(self):
+        # What the kernels would turn into NaN never reaches them: the data
+        # types and the reference refuse it where it enters.
+        with pytest.raises(ValueError, match="`k` must be finite, got inf at index 1"):
+            SpectralNK([400.0, 500.0, 600.0], [0.2, 0.2, 0.2], [3.0, np.inf, 3.0], name="x")
+        nk = SpectralNK([300.0, 900.0], [0.2, 0.2], [3.0, 3.0], name="flat")
+        with pytest.raises(ValueError, match="`cos_theta` must be finite, got nan"):
+            reference_ACEScg(nk, [0.5, np.nan], 1.0)
+        with pytest.raises(ValueError, match="`eta_i` must be finite"):
+            reference_ACEScg(nk, 0.5, np.nan)
