@@ -32,6 +32,7 @@ from fitting.models.pack import material_from_json
 from fitting.optics.nk import SpectralNK
 from fitting.optics.readers import FORMATS, read_nk
 
+from .targets import target_at
 from ...downloads import PACK_MEDIA_TYPES, download_name, render_pack
 from ...fitting_jobs import NKFitSpec, fit_nk, measured_nk
 from ...models import (
@@ -237,8 +238,6 @@ def get_curves(
         baseline = lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist()
     target = reference
     if record.kind == "curves":
-        from .curves import target_at  # the curve routes import this module
-
         try:
             target = target_at(record, mu, eta_i)
         except ValueError:
