@@ -39,6 +39,12 @@ const state = {
 // screen, and an answer older than it is dropped.
 const live = { wanted: null, inFlight: false, seq: 0, shown: 0, attempt: 0, waiters: [], timer: null, failed: null };
 
+// Timings for benchmarks/editor_speed.py: when the last edit happened, and
+// for each fit shown, the edit it answers and when its curve and its first
+// preview frame were drawn (performance.now(), ms).
+const telemetry = { lastEditAt: 0, shown: [] };
+window.cfTelemetry = telemetry;
+
 const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: dragEnd });
 let ball = null; // the WebGL2 preview, once its shaders compiled
 
@@ -307,6 +313,7 @@ function drag(channel, handle, value) {
     }
   }
   state.edits[k] = current;
+  telemetry.lastEditAt = performance.now();
   redraw();
   requestRefit();
   return true;
@@ -352,6 +359,7 @@ async function pump() {
   const wanted = live.wanted;
   const edits = JSON.parse(wanted);
   const base = state.base;
+  const editAt = telemetry.lastEditAt;
   live.wanted = null;
   live.inFlight = true;
   const seq = ++live.seq;
@@ -365,6 +373,8 @@ async function pump() {
       if (seq > live.shown && base === state.base) {
         live.shown = seq;
         present(fit, curves, wanted);
+        telemetry.shown.push({ fit: fit.id, editAt, curveAt: performance.now(), frameAt: null });
+        if (telemetry.shown.length > 1000) telemetry.shown.shift();
       }
     });
   } catch (error) {
@@ -664,6 +674,10 @@ document.addEventListener("keydown", (event) => {
 const preview = ShaderBall.create($("preview"), $("preview-labels")).then((made) => {
   ball = made;
   window.cfPreview = made; // for the parity tests and benchmarks
+  ball.onFrame = (drawn) => {
+    const last = telemetry.shown[telemetry.shown.length - 1];
+    if (last && last.fit === drawn.fitId && last.frameAt === null) last.frameAt = performance.now();
+  };
   previewSettings();
   ball.set({ eta: state.eta });
   return made;
