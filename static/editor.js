@@ -135,19 +135,17 @@ async function loadMaterials(select = null) {
   if (select) picker.value = select;
 }
 
-async function pickMaterial(value) {
-  if (!value) return;
+// The fit of a material-picker value (a library fit is made or served from the store).
+async function fitOf(value) {
   const [kind, id] = value.split(/:(.*)/s);
-  await busy("Fitting the material…", async () => {
-    let fit;
-    if (kind === "library") {
-      fit = await api.fitLibrary(id, [1.0, 2.5]);
-    } else {
-      const material = await api.getMaterial(id);
-      fit = material.latest_fit;
-    }
-    await setBase(fit);
-  });
+  if (kind === "library") return api.fitLibrary(id, [1.0, 2.5]);
+  const material = await api.getMaterial(id);
+  return material.latest_fit;
+}
+
+async function pickMaterial(value, pending = null) {
+  if (!value) return;
+  await busy("Fitting the material…", async () => setBase(await (pending || fitOf(value))));
 }
 
 async function setBase(fit) {
@@ -689,18 +687,24 @@ const preview = ShaderBall.create($("preview"), $("preview-labels")).then((made)
 });
 
 guard(async () => {
-  await loadMaterials();
-  const picker = $("material");
   let last = null;
   try {
     last = localStorage.getItem(LAST_KEY);
   } catch (_) {
     // storage disabled
   }
-  picker.value = last || "library:Au";
-  if (!picker.value) picker.value = "library:Au"; // the remembered material is gone
+  // Cold start: the material list, the first fit and the preview's shaders
+  // load at the same time.
+  const wanted = last || "library:Au";
+  const first = fitOf(wanted);
+  first.catch(() => {}); // reported below, if it is used
+  await loadMaterials();
+  const picker = $("material");
+  picker.value = wanted;
+  const found = picker.value === wanted;
+  if (!found) picker.value = "library:Au"; // the remembered material is gone
   await preview;
-  await pickMaterial(picker.value);
+  await pickMaterial(picker.value, found ? first : null);
   pickedValue = picker.value;
   document.body.dataset.ready = "true";
 })();

@@ -60,6 +60,7 @@ __all__ = ["CurveFitSettings", "SCORE_GRID", "score_grid", "whole_target_error",
 
 _RANGE_TOLERANCE = 1e-4  # float16 rounding of a fit on the boundary
 _RGB_GRID = (24, 16)  # the paper-method candidate's samples: every other angle and eta_i of SCORE_GRID
+_RGB_MAX_NFEV = 200  # as the paper-method fits (fit_coefficients' default): rgb solves are cheap
 
 SCORE_GRID = (46, 31)
 """(angles evenly over [0, 90] degrees, eta_i rows evenly over the domain):
@@ -282,7 +283,7 @@ def fit_curves(
             CM, CE = _check_grid(eta_i_range, *check_samples)
             range_check = (CM.ravel(), CE.ravel(), range_weight)
         if dense is not None:  # the paper's method: rgb on the whole target, unweighted
-            return fit_coefficients(*dense, eta_i_range, degree, "rgb", 3 * settings.max_nfev,
+            return fit_coefficients(*dense, eta_i_range, degree, "rgb", _RGB_MAX_NFEV,
                                     settings.quantise, irls_rounds=0, range_check=range_check)
         return fit_coefficients(
             target, mu, eta, eta_i_range, degree, objective, settings.max_nfev,
