@@ -79,14 +79,14 @@ def main(argv=None) -> int:
         C16, naive_ref, naive_fit_s = naive_fit(nk)
         naive_dE = error_metrics(
             ref, naive_model(C16.astype(np.float64), M.ravel(), E.ravel()).reshape(ref.shape)
-        )["delta_E_mean"]
+        ).mean
         runs = [fit_material(nk, ETA_I_RANGE) for _ in range(args.repeats)]
         best = min(runs, key=lambda r: r.timings["total"])
         ours_total = float(np.median([r.timings["total"] for r in runs]))
         ours_ref = float(np.median([r.timings["reference"] for r in runs]))
         ours_dE = error_metrics(
             ref, coated_conductor_model(M, E, best.coefficients_float16, ETA_I_RANGE)
-        )["delta_E_mean"]
+        ).mean
         rows.append((naive_ref, naive_fit_s, naive_dE, ours_ref, ours_total - ours_ref, ours_total, ours_dE))
         print(f"{name:8s} {naive_ref*1e3:8.1f}ms {naive_fit_s*1e3:8.1f}ms {naive_dE:9.4f} "
               f"{ours_ref*1e3:7.1f}ms {(ours_total-ours_ref)*1e3:7.1f}ms {ours_total*1e3:8.1f}ms {ours_dE:8.4f}",

@@ -38,7 +38,7 @@ from .fits.curves_base import (
 from .fits.curves_input import RGBCurve, check_curves
 from .fits.evaluate import evaluate_material
 from .fits.material import fit_material
-from .fits.metrics import error_metrics
+from .fits.metrics import ErrorMetrics, error_metrics
 from .fits.result import FitResult
 from .fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES, FitSettings
 from .fits.solver import fit_coefficients
@@ -68,7 +68,7 @@ __all__ = [
     "evaluate_material", "fit_coefficients", "fit_material",
     "fresnel_conductor", "fresnel_dielectric",
     "LIBRARY", "LIBRARY_NAMES", "library_material",
-    "delta_E_map", "error_metrics",
+    "delta_E_map", "error_metrics", "ErrorMetrics",
     "DEFAULT_ETA_I_RANGE", "coated_conductor_model", "collapse_to_eta_i", "model_parameters",
     "DEFAULT_MIN_COVERAGE", "VISIBLE_RANGE_NM", "SpectralNK", "resample_nk",
     "PackedMaterial", "decode_pack", "encode_pack", "halves_to_uint32",

@@ -51,21 +51,23 @@ def reproduce_material(name: str, samples: int = 100) -> dict:
     M, E = evaluation_grid(samples, ETA_I_RANGE)
     rows = E[:, 0]
     ref = reference_ACEScg(nk, M, E)
+    against = f"spectral reference 1 nm, {samples} x {samples}"
     out: dict = {"name": name, "page": "/".join(LIBRARY[name])}
     fits = {}
     for objective in sorted({DEFAULT_OBJECTIVE, "rgb"}):
         fit = fit_material(nk, ETA_I_RANGE, objective=objective)
         fits[objective] = fit
         out[f"ours_f16_{objective}"] = error_metrics(
-            ref, coated_conductor_model(M, E, fit.coefficients_float16, ETA_I_RANGE), rows
+            ref, coated_conductor_model(M, E, fit.coefficients_float16, ETA_I_RANGE), rows, against
         )
         out[f"ours_f32_{objective}"] = error_metrics(
             ref,
             coated_conductor_model(M, E, fit.coefficients.astype(np.float32), ETA_I_RANGE),
             rows,
+            against,
         )
         out[f"fit_ms_{objective}"] = 1e3 * fit.timings["total"]
-    out.update(baseline_metrics(nk, M, E, ref))
+    out.update(baseline_metrics(nk, M, E, ref, against=against))
     out["coverage"] = fits[DEFAULT_OBJECTIVE].coverage
     return out
 
@@ -82,11 +84,11 @@ def _table(results: list[dict]) -> list[str]:
     ]
 
     def cell(m):
-        return f"{m['delta_E_mean']:.3f} / {m['delta_E_max']:.2f}"
+        return f"{m.mean:.3f} / {m.max:.2f}"
 
     for r in results:
-        ours = r[f"ours_f16_{d}"]["delta_E_mean"]
-        beats = all(ours < r[k]["delta_E_mean"] for k in BASELINE_KEYS)
+        ours = r[f"ours_f16_{d}"].mean
+        beats = all(ours < r[k].mean for k in BASELINE_KEYS)
         paper = PAPER_TABLE_1.get(r["name"])
         lines.append(
             f"| {r['name']} | {cell(r[f'ours_f16_{d}'])} | {cell(r[f'ours_f32_{d}'])} | "
@@ -106,10 +108,7 @@ def _float16_study(results: list[dict]) -> list[str]:
         cells = []
         for e in BREAKDOWN_ETA_I:
             key = f"{e:g}"
-            inc = (
-                r[f"ours_f16_{d}"]["by_eta_i"][key]["delta_E_mean"]
-                - r[f"ours_f32_{d}"]["by_eta_i"][key]["delta_E_mean"]
-            )
+            inc = r[f"ours_f16_{d}"].row(e).mean - r[f"ours_f32_{d}"].row(e).mean
             cells.append(f"{inc:+.4f}")
             if inc > worst[key][0]:
                 worst[key] = (inc, r["name"])
@@ -135,9 +134,9 @@ def run(args) -> int:
     _progress(len(names), len(names), "done")
     sys.stderr.write("\n")
     d = DEFAULT_OBJECTIVE
-    mean = lambda key: float(np.mean([r[key]["delta_E_mean"] for r in results]))  # noqa: E731
+    mean = lambda key: float(np.mean([r[key].mean for r in results]))  # noqa: E731
     all_beat = all(
-        all(r[f"ours_f16_{d}"]["delta_E_mean"] < r[k]["delta_E_mean"] for k in BASELINE_KEYS)
+        all(r[f"ours_f16_{d}"].mean < r[k].mean for k in BASELINE_KEYS)
         for r in results
     )
     lines = [

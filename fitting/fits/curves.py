@@ -46,12 +46,13 @@ from typing import Any
 
 import numpy as np
 
-from ..colour.delta_e import delta_E_map
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_int, check_number
 from ..models.coated_conductor import coated_conductor_model
 from ..models.pack import PackedMaterial
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve, check_curves
+from ..colour.delta_e import delta_E_map
+from .metrics import curve_metrics
 from .result import FitResult
 from .settings import check_fit_options
 from .solver import fit_coefficients
@@ -215,7 +216,9 @@ def fit_curves(
     -------
     FitResult
         With ``packed`` (the float16 material), ``timings`` (``target``,
-        ``fit``, ``quantise``, ``total`` in seconds) and ``metrics``:
+        ``fit``, ``quantise``, ``total`` in seconds), ``error`` (the
+        :class:`~fitting.fits.metrics.ErrorMetrics` against the curves, one
+        row per curve) and ``metrics``, its JSON:
         ``delta_E_mean`` and ``delta_E_max`` (CIE Delta E 2000 of the float16
         model against the curves at their own samples), ``by_curve`` (the same
         per curve, with its ``eta_i``), ``samples`` (the number of fitted
@@ -326,23 +329,19 @@ def fit_curves(
         chosen = min(scores, key=scores.get)
         result = candidates[chosen]
     C16 = result.coefficients_float16
-    dE_curves = [
-        delta_E_map(c.rgb, coated_conductor_model(c.cos_theta, c.eta_i, C16, eta_i_range)) for c in curves
-    ]
-    dE_all = np.concatenate(dE_curves)
+    error = curve_metrics(
+        curves, lambda c: coated_conductor_model(c.cos_theta, c.eta_i, C16, eta_i_range),
+        "the edited curves at their samples",
+    )
     metrics: dict[str, Any] = {
-        "delta_E_mean": float(dE_all.mean()),
-        "delta_E_max": float(dE_all.max()),
-        "by_curve": [
-            {"eta_i": c.eta_i, "delta_E_mean": float(d.mean()), "delta_E_max": float(d.max())}
-            for c, d in zip(curves, dE_curves)
-        ],
+        **error.to_dict(),
         "samples": int(mu.size),
         "base": None if base is None else base.name,
         "objective": chosen,
     }
     if base is not None:
         metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width)
+    result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(
         name=name, coefficients=C16, eta_i_range=eta_i_range, source=source[:4000], metrics=metrics

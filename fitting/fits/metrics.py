@@ -2,10 +2,16 @@
 Error metrics
 =============
 
--   :func:`error_metrics`: mean and max CIE Delta E 2000 and RMSE between a
-    reference and an approximation on the scoring grid, with the breakdown per
-    eta_i row.
--   :func:`baseline_metrics`: the same for every baseline of
+One typed result for every error the project reports:
+
+-   :class:`ErrorMetrics`: mean and max CIE Delta E 2000, the breakdown per
+    eta_i row, and what they were measured against; :meth:`ErrorMetrics.to_dict`
+    gives the JSON the packs and the API have always carried.
+-   :func:`error_metrics`: the metrics between a reference and an
+    approximation on a grid indexed [eta_i, cos_theta] (material fits).
+-   :func:`curve_metrics`: the metrics of a model against edited curves.
+-   :func:`delta_E_summary`: mean and max of a Delta E map (scenes).
+-   :func:`baseline_metrics`: :func:`error_metrics` of every baseline of
     :mod:`fitting.models.baselines`.
 
 Lab uses the ACES white as reference white (:func:`fitting.colour.colorimetry.ACEScg_to_Lab`).
@@ -18,53 +24,172 @@ Sections 4.1 and 4.3.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
 from ..colour.delta_e import delta_E_map
 from ..domain import DEFAULT_MIN_COVERAGE
 from ..models.baselines import BASELINES, baseline_ACEScg
 
-__all__ = ["BREAKDOWN_ETA_I", "delta_E_map", "error_metrics", "baseline_metrics"]
+__all__ = [
+    "BREAKDOWN_ETA_I",
+    "LAYOUTS",
+    "EtaRow",
+    "ErrorMetrics",
+    "delta_E_map",
+    "error_metrics",
+    "curve_metrics",
+    "delta_E_summary",
+    "baseline_metrics",
+]
 
 BREAKDOWN_ETA_I = (1.0, 1.5, 2.0, 2.5)
+"""The eta_i of the per-row breakdown of material fits (Vernooij 2024, Section 4.3)."""
+
+LAYOUTS = ("grid", "curves", "summary")
+"""JSON layouts of :meth:`ErrorMetrics.to_dict`, one per kind of fit (see there)."""
 
 
-def error_metrics(reference_RGB, model_RGB, eta_i_rows=None) -> dict:
+@dataclass(frozen=True)
+class EtaRow:
+    """Mean and max Delta E 2000 of one eta_i row (or one edited curve)."""
+
+    eta_i: float
+    mean: float
+    max: float
+
+
+@dataclass(frozen=True)
+class ErrorMetrics:
+    """
+    CIE Delta E 2000 of a model against what it approximates.
+
+    Attributes
+    ----------
+    mean, max
+        Over every sample.
+    rows
+        Per eta_i row (material fits: the rows of :data:`BREAKDOWN_ETA_I`
+        inside the grid; curve fits: one per edited curve); None when not
+        broken down.
+    against
+        What the model was measured against, in words
+        (``"spectral reference 1 nm, 100 x 100"``).
+    rmse
+        Root mean square difference in linear RGB, where measured.
+    layout
+        The JSON layout of :meth:`to_dict`, one of :data:`LAYOUTS`.
+    """
+
+    mean: float
+    max: float
+    against: str
+    rows: tuple[EtaRow, ...] | None = None
+    rmse: float | None = None
+    layout: str = "grid"
+
+    def __post_init__(self) -> None:
+        if self.layout not in LAYOUTS:
+            raise ValueError(f"`layout` must be one of {', '.join(LAYOUTS)}, got {self.layout!r}")
+
+    def row(self, eta_i: float) -> EtaRow:
+        """The row at ``eta_i``; ``LookupError`` if there is none."""
+        for row in self.rows or ():
+            if abs(row.eta_i - eta_i) < 1e-9:
+                return row
+        raise LookupError(f"no row at eta_i {eta_i:g}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """
+        The JSON of this result, in the layout packs and API answers carry:
+
+        -   ``grid``: ``delta_E_mean``, ``delta_E_max``, ``rmse`` and, with
+            rows, ``by_eta_i`` keyed by eta_i (``"1.5"``) of
+            ``{delta_E_mean, delta_E_max}``.
+        -   ``curves``: ``delta_E_mean``, ``delta_E_max`` and ``by_curve``, a
+            list of ``{eta_i, delta_E_mean, delta_E_max}``.
+        -   ``summary``: ``mean`` and ``max``.
+        """
+        if self.layout == "summary":
+            return {"mean": self.mean, "max": self.max}
+        out: dict[str, Any] = {"delta_E_mean": self.mean, "delta_E_max": self.max}
+        if self.layout == "curves":
+            out["by_curve"] = [
+                {"eta_i": r.eta_i, "delta_E_mean": r.mean, "delta_E_max": r.max}
+                for r in self.rows or ()
+            ]
+            return out
+        if self.rmse is not None:
+            out["rmse"] = self.rmse
+        if self.rows is not None:
+            out["by_eta_i"] = {
+                f"{r.eta_i:g}": {"delta_E_mean": r.mean, "delta_E_max": r.max} for r in self.rows
+            }
+        return out
+
+
+def error_metrics(reference_RGB, model_RGB, eta_i_rows=None, against: str = "") -> ErrorMetrics:
     """
     Metrics between ``reference_RGB`` and ``model_RGB``, both (E, M, 3)
     linear ACEScg on a grid indexed [eta_i, cos_theta].
 
     Returns
     -------
-    dict
-        ``delta_E_mean``, ``delta_E_max``, ``rmse`` (linear RGB), and, when
-        ``eta_i_rows`` (the eta_i of each row) is given, ``by_eta_i``: for
-        each of :data:`BREAKDOWN_ETA_I` inside the grid, the mean and max
-        Delta E of the nearest row.
+    ErrorMetrics
+        Mean and max Delta E 2000, ``rmse`` (linear RGB), and, when
+        ``eta_i_rows`` (the eta_i of each row) is given, ``rows``: for each of
+        :data:`BREAKDOWN_ETA_I` inside the grid, the mean and max Delta E of
+        the nearest row.
     """
     reference_RGB = np.asarray(reference_RGB, dtype=np.float64)
     model_RGB = np.asarray(model_RGB, dtype=np.float64)
     dE = delta_E_map(reference_RGB, model_RGB)
-    out = {
-        "delta_E_mean": float(dE.mean()),
-        "delta_E_max": float(dE.max()),
-        "rmse": float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
-    }
+    rows: list[EtaRow] | None = None
     if eta_i_rows is not None:
-        rows = np.asarray(eta_i_rows, dtype=np.float64)
-        by = {}
+        rows = []
+        grid = np.asarray(eta_i_rows, dtype=np.float64)
         for eta in BREAKDOWN_ETA_I:
-            if rows.min() - 1e-9 <= eta <= rows.max() + 1e-9:
-                i = int(np.argmin(np.abs(rows - eta)))
-                by[f"{eta:g}"] = {
-                    "delta_E_mean": float(dE[i].mean()),
-                    "delta_E_max": float(dE[i].max()),
-                }
-        out["by_eta_i"] = by
-    return out
+            if grid.min() - 1e-9 <= eta <= grid.max() + 1e-9:
+                i = int(np.argmin(np.abs(grid - eta)))
+                rows.append(EtaRow(eta, float(dE[i].mean()), float(dE[i].max())))
+    return ErrorMetrics(
+        mean=float(dE.mean()),
+        max=float(dE.max()),
+        against=against,
+        rows=None if rows is None else tuple(rows),
+        rmse=float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
+    )
 
 
-def baseline_metrics(nk, cos_theta, eta_i, reference_RGB, min_coverage: float = DEFAULT_MIN_COVERAGE) -> dict:
+def curve_metrics(curves, model_of, against: str = "the edited curves") -> ErrorMetrics:
+    """
+    Delta E 2000 of a model against curves at their own samples: ``curves``
+    have ``eta_i``, ``cos_theta`` and ``rgb``; ``model_of(curve)`` is the
+    model's RGB at the curve's samples. One row per curve, in order.
+    """
+    maps = [delta_E_map(c.rgb, model_of(c)) for c in curves]
+    every = np.concatenate(maps)
+    return ErrorMetrics(
+        mean=float(every.mean()),
+        max=float(every.max()),
+        against=against,
+        rows=tuple(EtaRow(c.eta_i, float(d.mean()), float(d.max())) for c, d in zip(curves, maps)),
+        layout="curves",
+    )
+
+
+def delta_E_summary(reference_RGB, model_RGB, against: str = "", layout: str = "summary") -> ErrorMetrics:
+    """Mean and max Delta E 2000 of two linear ACEScg arrays, without breakdown."""
+    dE = delta_E_map(reference_RGB, model_RGB)
+    return ErrorMetrics(mean=float(dE.mean()), max=float(dE.max()), against=against, layout=layout)
+
+
+def baseline_metrics(
+    nk, cos_theta, eta_i, reference_RGB, min_coverage: float = DEFAULT_MIN_COVERAGE,
+    against: str = "",
+) -> dict[str, ErrorMetrics]:
     """
     :func:`error_metrics` of every baseline (:data:`fitting.models.baselines.BASELINES`)
     of ``nk`` against ``reference_RGB`` on the grid (cos_theta, eta_i), both
@@ -73,7 +198,8 @@ def baseline_metrics(nk, cos_theta, eta_i, reference_RGB, min_coverage: float = 
     rows = np.asarray(eta_i)[:, 0]
     return {
         name: error_metrics(
-            reference_RGB, baseline_ACEScg(name, nk, cos_theta, eta_i, 1.0, min_coverage), rows
+            reference_RGB, baseline_ACEScg(name, nk, cos_theta, eta_i, 1.0, min_coverage), rows,
+            against,
         )
         for name in BASELINES
     }

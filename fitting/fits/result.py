@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..models.pack import PackedMaterial
+from .metrics import ErrorMetrics
 
 __all__ = ["FitResult"]
 
@@ -47,7 +48,11 @@ class FitResult:
     packed
         The :class:`fitting.models.pack.PackedMaterial` (n, k fits).
     metrics
-        Filled by :func:`evaluate_material` or the caller.
+        Filled by :func:`fitting.fits.evaluate.evaluate_material` or the
+        caller: the JSON of the errors (and, for curve fits, the counts).
+    error
+        The float16 model's error as :class:`fitting.fits.metrics.ErrorMetrics`,
+        where it was measured (``metrics`` holds its JSON).
     """
 
     coefficients: np.ndarray
@@ -66,6 +71,7 @@ class FitResult:
     coverage: float = 1.0
     packed: PackedMaterial | None = None
     metrics: dict[str, Any] = field(default_factory=dict)
+    error: ErrorMetrics | None = None
 
     @property
     def iterations(self) -> int:

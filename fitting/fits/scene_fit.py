@@ -24,12 +24,12 @@ import time
 
 import numpy as np
 
-from ..colour.delta_e import delta_E_map
 from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE
 from ..models.coated_conductor import coated_conductor_model
 from ..models.pack import PackedMaterial
 from .material import fit_material
+from .metrics import ErrorMetrics, delta_E_summary
 from .result import FitResult
 from .scene_report import SceneMaterialResult, SceneResult
 from .scene_schema import EVALUATION_MU_SAMPLES, EtaSpec, Scene, SceneMaterial
@@ -54,9 +54,8 @@ DEGREE_TOLERANCE_MAX = 0.5
 """... and its max Delta E 2000 at most this much above (half a JND)."""
 
 
-def _error(ref: np.ndarray, model: np.ndarray) -> dict[str, float]:
-    dE = delta_E_map(ref, model)
-    return {"mean": float(dE.mean()), "max": float(dE.max())}
+def _error(ref: np.ndarray, model: np.ndarray, against: str) -> ErrorMetrics:
+    return delta_E_summary(ref, model, against)
 
 
 def _fit_degree(entry: SceneMaterial, degree: int, settings: FitSettings) -> FitResult:
@@ -81,7 +80,7 @@ def _fit_degree(entry: SceneMaterial, degree: int, settings: FitSettings) -> Fit
 
 
 def choose_degree(
-    by_degree: dict[int, dict[str, float]], general_error: dict[str, float]
+    by_degree: dict[int, ErrorMetrics], general_error: ErrorMetrics
 ) -> int:
     """
     The degree rule: the lowest degree whose mean Delta E is at most
@@ -91,12 +90,12 @@ def choose_degree(
     qualifies, the degree with the lowest mean.
     """
     top = by_degree[max(by_degree)]
-    bound_mean = min(top["mean"] + DEGREE_TOLERANCE_MEAN, general_error["mean"])
+    bound_mean = min(top.mean + DEGREE_TOLERANCE_MEAN, general_error.mean)
     for degree in sorted(by_degree):
         error = by_degree[degree]
-        if error["mean"] <= bound_mean and error["max"] <= top["max"] + DEGREE_TOLERANCE_MAX:
+        if error.mean <= bound_mean and error.max <= top.max + DEGREE_TOLERANCE_MAX:
             return degree
-    return min(by_degree, key=lambda d: (by_degree[d]["mean"], d))
+    return min(by_degree, key=lambda d: (by_degree[d].mean, d))
 
 
 def general_domain(spec: EtaSpec) -> tuple[float, float]:
@@ -122,37 +121,38 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
     mu = np.linspace(0.0, 1.0, EVALUATION_MU_SAMPLES)
     E, M = np.meshgrid(eta_rows, mu, indexing="ij")
     ref = reference_ACEScg(entry.nk, M, E, 1.0, settings.min_coverage)
+    against = f"spectral reference 1 nm, {M.shape[1]} x {M.shape[0]} (cos theta x the scene's eta_i)"
     general_fit = fit_material(entry.nk, general_domain(spec), settings, degree=2)
     general = PackedMaterial(
         entry.name, general_fit.coefficients_float16, general_fit.eta_i_range,
         source=entry.nk.source,
     )
     general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
-    general_error = _error(ref, general_model)
+    general_error = _error(ref, general_model, against)
     fits, by_degree = {}, {}
     for degree in range(spec.max_degree + 1):
         fit = _fit_degree(entry, degree, settings)
         fits[degree] = fit
         # Scored as shipped: float16 coefficients, the pack's float32 domain.
         by_degree[degree] = _error(
-            ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range)
+            ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range), against
         )
     chosen = choose_degree(by_degree, general_error)
     scene_error = by_degree[chosen]
-    if scene_error["mean"] > general_error["mean"]:
+    if scene_error.mean > general_error.mean:
         # No scene fit beats the general fit on the scene's eta_i (a narrow
         # range the general fit already follows as well as its own fit can):
         # the general fit itself serves it, never a worse one.
         packed = PackedMaterial(
             entry.name, general.coefficients, general.eta_i_range, source=entry.nk.source,
-            metrics={"delta_E_2000": general_error, "eta_i": spec.to_json(),
+            metrics={"delta_E_2000": general_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": True},
         )
         scene_error = general_error
     else:
         packed = PackedMaterial(
             entry.name, fits[chosen].packed.coefficients, spec.domain, source=entry.nk.source,
-            metrics={"delta_E_2000": scene_error, "eta_i": spec.to_json(),
+            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": False},
         )
     fit = fits[chosen]
@@ -165,7 +165,7 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
         by_degree=by_degree,
         scene=scene_error,
         general_error=general_error,
-        scene_vs_general=_error(general_model, scene_model),
+        scene_vs_general=_error(general_model, scene_model, "the general fit's model"),
         seconds=time.perf_counter() - t0,
     )
 

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..models.pack import PackedMaterial, encode_pack, material_record_bytes, pack_to_json
+from .metrics import ErrorMetrics
 from .result import FitResult
 from .scene_schema import Scene, SceneMaterial
 
@@ -40,10 +41,10 @@ class SceneMaterialResult:
     packed: PackedMaterial
     fit: FitResult
     general: PackedMaterial
-    by_degree: dict[int, dict[str, float]]
-    scene: dict[str, float]
-    general_error: dict[str, float]
-    scene_vs_general: dict[str, float]
+    by_degree: dict[int, ErrorMetrics]
+    scene: ErrorMetrics
+    general_error: ErrorMetrics
+    scene_vs_general: ErrorMetrics
     seconds: float
 
     @property
@@ -73,16 +74,16 @@ class SceneMaterialResult:
             "coefficients": 9 * (self.degree + 1),
             "shader_variant": self.shader_variant,
             "bytes": self.bytes,
-            "delta_E_2000": self.scene,
-            "by_degree": {str(d): v for d, v in self.by_degree.items()},
+            "delta_E_2000": self.scene.to_dict(),
+            "by_degree": {str(d): v.to_dict() for d, v in self.by_degree.items()},
             "general": {
                 "eta_i_range": list(self.general.eta_i_range),
                 "degree": self.general.degree,
                 "coefficients": 9 * (self.general.degree + 1),
                 "bytes": self.general_bytes,
-                "delta_E_2000": self.general_error,
+                "delta_E_2000": self.general_error.to_dict(),
             },
-            "scene_vs_general_delta_E_2000": self.scene_vs_general,
+            "scene_vs_general_delta_E_2000": self.scene_vs_general.to_dict(),
             "fit": self.fit.summary(),
             "seconds": self.seconds,
         }
@@ -118,9 +119,9 @@ class SceneResult:
                 "general_pack_bytes": len(general_pack),
                 "coefficients": sum(9 * (m.degree + 1) for m in self.materials),
                 "general_coefficients": 27 * len(self.materials),
-                "delta_E_2000_mean": float(np.mean([m.scene["mean"] for m in self.materials])),
+                "delta_E_2000_mean": float(np.mean([m.scene.mean for m in self.materials])),
                 "general_delta_E_2000_mean": float(
-                    np.mean([m.general_error["mean"] for m in self.materials])
+                    np.mean([m.general_error.mean for m in self.materials])
                 ),
             },
         }

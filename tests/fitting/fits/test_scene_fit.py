@@ -8,6 +8,7 @@ import pytest
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg
+from fitting.fits.metrics import ErrorMetrics
 from fitting.fits.scene_fit import (
     DEGREE_TOLERANCE_MAX,
     DEGREE_TOLERANCE_MEAN,
@@ -42,28 +43,33 @@ def showroom():
     return fit_scene(parse_scene(SCENE))
 
 
+def E(mean: float, max_: float) -> ErrorMetrics:
+    """Delta E 2000 (mean, max) of one candidate, as the scene fit scores it."""
+    return ErrorMetrics(mean, max_, "a test grid", layout="summary")
+
+
 class TestChooseDegree:
     def test_lowest_degree_within_tolerance(self):
-        by = {0: {"mean": 0.30, "max": 1.0}, 1: {"mean": 0.12, "max": 0.5},
-              2: {"mean": 0.10, "max": 0.4}}
-        assert choose_degree(by, {"mean": 0.5, "max": 2.0}) == 1
+        by = {0: E(0.30, 1.0), 1: E(0.12, 0.5),
+              2: E(0.10, 0.4)}
+        assert choose_degree(by, E(0.5, 2.0)) == 1
 
     def test_tolerances_are_inclusive_bounds(self):
-        by = {0: {"mean": 0.10 + DEGREE_TOLERANCE_MEAN, "max": 0.4 + DEGREE_TOLERANCE_MAX},
-              1: {"mean": 0.10, "max": 0.4}}
-        assert choose_degree(by, {"mean": 1.0, "max": 1.0}) == 0
-        by[0]["max"] += 0.01
-        assert choose_degree(by, {"mean": 1.0, "max": 1.0}) == 1
+        by = {0: E(0.10 + DEGREE_TOLERANCE_MEAN, 0.4 + DEGREE_TOLERANCE_MAX),
+              1: E(0.10, 0.4)}
+        assert choose_degree(by, E(1.0, 1.0)) == 0
+        by[0] = E(by[0].mean, by[0].max + 0.01)
+        assert choose_degree(by, E(1.0, 1.0)) == 1
 
     def test_never_worse_than_the_general_fit(self):
-        by = {0: {"mean": 0.04, "max": 0.2}, 1: {"mean": 0.02, "max": 0.1},
-              2: {"mean": 0.01, "max": 0.1}}
-        assert choose_degree(by, {"mean": 0.03, "max": 0.1}) == 1
+        by = {0: E(0.04, 0.2), 1: E(0.02, 0.1),
+              2: E(0.01, 0.1)}
+        assert choose_degree(by, E(0.03, 0.1)) == 1
 
     def test_falls_back_to_the_lowest_mean(self):
-        by = {0: {"mean": 0.5, "max": 3.0}, 1: {"mean": 0.2, "max": 0.3},
-              2: {"mean": 0.3, "max": 0.3}}
-        assert choose_degree(by, {"mean": 0.1, "max": 0.2}) == 1
+        by = {0: E(0.5, 3.0), 1: E(0.2, 0.3),
+              2: E(0.3, 0.3)}
+        assert choose_degree(by, E(0.1, 0.2)) == 1
 
 
 class TestFitScene:
@@ -109,8 +115,8 @@ class TestFitScene:
             packed = decoded[result.packed.name]
             dE = delta_E_map(ref, coated_conductor_model(M, E, packed.coefficients,
                                                          packed.eta_i_range))
-            assert result.scene["mean"] == pytest.approx(dE.mean(), rel=1e-9)
-            assert result.scene["max"] == pytest.approx(dE.max(), rel=1e-9)
+            assert result.scene.mean == pytest.approx(dE.mean(), rel=1e-9)
+            assert result.scene.max == pytest.approx(dE.max(), rel=1e-9)
 
     def test_pack_round_trips(self, showroom):
         assert decode_pack(showroom.pack_bytes()) == showroom.packed
