@@ -32,6 +32,7 @@ general model <= 1.15x, scene-specialised <= 1.05x of adjusted Lazanyi.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -40,8 +41,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from fitting.fits.material import fit_material
-from fitting.fits.rgb_conductor import rgb_nk
-from fitting.models.baselines import baseline_inputs
+from fitting.fits.rgb_conductor import fit_rgb_conductor, rgb_nk
+from fitting.models.baselines import baseline_inputs, external_medium_F0, lazanyi_a
+from fitting.models.coated_conductor import collapse_to_eta_i
+from fitting.models.pack import halves_to_uint32
+from fitting.shading.ibl import default_lut
 from fitting.optics.library import library_material
 from preview_shaders.evaluate import (  # noqa: E402
     FIXED,
@@ -51,6 +55,7 @@ from preview_shaders.evaluate import (  # noqa: E402
     time_variants,
 )
 from preview_shaders.gl import RenderThread  # noqa: E402
+from preview_shaders.shading import SPLIT_SUM_VARIANTS, time_split_sum  # noqa: E402
 
 LABELS = {
     "packed": "model, float16 halves (general)",
@@ -59,8 +64,15 @@ LABELS = {
     "lazanyi": "adjusted Lazanyi",
     "schlick": "Schlick",
     "exact": "exact RGB conductor Fresnel",
+    "rgb_conductor": "rgb-conductor kind, float16 halves",
     LAZANYI_SCENE: "adjusted Lazanyi, scene eta_i (F0, a from CPU)",
     FIXED: "no Fresnel term (fixed cost of the pass)",
+}
+SPLIT_LABELS = {
+    "split_sum_model": "split sum, model (3 alpha lookups, 24 fetches)",
+    "split_sum_lazanyi": "split sum, adjusted Lazanyi (alpha = 6, 8 fetches)",
+    "split_sum_schlick": "split sum, Schlick (8 fetches)",
+    "split_sum_fixed": "no split sum (fixed cost of the pass)",
 }
 
 
@@ -78,12 +90,22 @@ def main() -> None:
     # The exact RGB Fresnel gets the project's per-channel index (fitting.models.rgb_conductor).
     n_rgb, k_rgb = rgb_nk(nk)
     inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
+    # The rgb-conductor kind decodes its own fitted float16 n, k (3 words).
+    rgb_words = halves_to_uint32(fit_rgb_conductor(nk).coefficients_float16)
+    inputs = dataclasses.replace(inputs, rgb_words=rgb_words)
+    lut = default_lut()
+    F0, a, alpha = collapse_to_eta_i(packed.coefficients.astype(np.float64), 1.5, packed.eta_i_range)[..., 0]
     with RenderThread("shader-cost") as thread:
         print(f"device: {thread.renderer}, {thread.version}")
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
               f"{args.repeats} (one warm-up render before each; variants interleaved); "
               f"scene eta_i {inputs.collapse_eta_i}\n")
         samples = time_variants(thread, inputs, TIMING_VARIANTS, args.width, args.height, args.repeats)
+        split = time_split_sum(
+            thread, lut, F0, a, alpha, external_medium_F0(air["F0_air"], 1.5),
+            lazanyi_a(air["F0_air"], air["F82_air"]), air["F0_air"],
+            args.width, args.height, args.repeats,
+        )
 
     # Medians in ms (timer query in us); quartiles of the wall time.
     query = {v: np.median(s[:, 0]) / 1e3 for v, s in samples.items()}
@@ -109,6 +131,22 @@ def main() -> None:
           f"wall {ratio(wall, 'collapsed', LAZANYI_SCENE):.2f}x, "
           f"net {ratio(wall, 'collapsed', LAZANYI_SCENE, net=True):.2f}x; "
           f"CPU net {ratio(cpu, 'collapsed', LAZANYI_SCENE, net=True):.2f}x")
+
+    # The split-sum passes (NdotV across, roughness down; eta_i 1.5 collapsed on the CPU).
+    sq = {v: np.median(s[:, 0]) / 1e3 for v, s in split.items()}
+    sw = {v: np.median(s[:, 1]) * 1e3 for v, s in split.items()}
+    sc = {v: np.median(s[:, 2]) * 1e3 for v, s in split.items()}
+    fixed = "split_sum_fixed"
+    print("\nSplit-sum lookups (fitting.shading.ibl LUT, 16 x 64 x 64 RGB32F 3D texture, "
+          "texelFetch); net ratio to adjusted Lazanyi's split sum, fixed cost subtracted.\n")
+    print("| variant | timer query (us) | wall (ms) | wall net ratio | CPU (ms) | CPU net ratio |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for v in SPLIT_SUM_VARIANTS:
+        def net(times):
+            return (times[v] - times[fixed]) / (times["split_sum_lazanyi"] - times[fixed])
+        wn = "" if v == fixed else f"{net(sw):.2f}x"
+        cn = "" if v == fixed else f"{net(sc):.2f}x"
+        print(f"| {SPLIT_LABELS[v]} | {sq[v]:.0f} | {sw[v]:.1f} | {wn} | {sc[v]:.1f} | {cn} |")
 
 
 if __name__ == "__main__":

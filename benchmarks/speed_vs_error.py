@@ -7,12 +7,14 @@ plane, and the fitting settings on the fit-time-against-error plane; prints
 Markdown tables and (``--figure``) writes ``docs/images/speed_vs_error.png``
 and ``docs/images/speed_vs_error_fit_settings.png``.
 
-    .venv/bin/python benchmarks/speed_vs_error.py [--figure] [--repeats 7]
+    .venv/bin/python benchmarks/speed_vs_error.py [--figure] [--repeats 7] [--models-only]
 
 Models: Schlick in air, Schlick with exact F0, adjusted Lazanyi, ours float32,
 ours float16, ours scene-specialised (a degree-0 fit at each eta_i row), the
-exact RGB conductor Fresnel (``fitting.models.rgb_conductor``) and the exact spectral
-reference. Error: Delta E 2000 against the 1 nm reference on the paper's
+exact RGB conductor Fresnel with n, k fitted in air (``fitting.fits.rgb_conductor.rgb_nk``),
+the ``rgb-conductor`` model kind (the same Fresnel, n, k fitted under the coat
+over the whole domain, float16: ``fitting.fits.rgb_conductor.fit_rgb_conductor``)
+and the exact spectral reference. Error: Delta E 2000 against the 1 nm reference on the paper's
 100 x 100 grid (cos theta in [0, 1], eta_i in [1, 2.5]). Shader cost: wall
 time of full-screen 2560 x 1440 RGBA32F renders on this machine's GL
 (llvmpipe without a GPU), measured with ``preview_shaders.evaluate.time_variants``
@@ -30,6 +32,7 @@ the summed fit time of the 22 conductors and their mean float16 Delta E.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import itertools
 import sys
 import time
@@ -43,7 +46,7 @@ sys.path.insert(0, str(ROOT))
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import evaluation_grid, reference_ACEScg, spectral_grid
 from fitting.fits.material import fit_material
-from fitting.fits.rgb_conductor import rgb_nk
+from fitting.fits.rgb_conductor import fit_rgb_conductor, rgb_nk
 from fitting.fits.settings import OBJECTIVES, FitSettings
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted, schlick
 from fitting.models.coated_conductor import (
@@ -51,8 +54,8 @@ from fitting.models.coated_conductor import (
     collapse_to_eta_i,
     model_from_parameters,
 )
-from fitting.models.pack import to_float16
-from fitting.models.rgb_conductor import rgb_fresnel_conductor
+from fitting.models.pack import halves_to_uint32, to_float16
+from fitting.models.rgb_conductor import rgb_conductor_model, rgb_fresnel_conductor
 from fitting.optics.library import LIBRARY_NAMES, library_material
 
 IMAGES = ROOT / "docs" / "images"
@@ -69,6 +72,8 @@ MODELS = {
     "ours_float16": ("ours, float16", "packed", 54, "27 float16"),
     "ours_scene": ("ours, scene-specialised", "collapsed", 18, "9 float16 at one eta_i"),
     "exact_rgb": ("exact RGB conductor Fresnel", "exact", 24, "n, k RGB, 6 float32"),
+    "rgb_conductor": ("rgb-conductor kind, float16", "rgb_conductor", 12,
+                      "n, k RGB fitted under the coat, 6 float16"),
     "spectral": ("exact spectral reference", None, 2 * 4 * spectral_grid(1.0).size,
                  "n, k at 471 wavelengths (1 nm), float32"),
 }
@@ -103,6 +108,7 @@ def model_outputs(name: str) -> dict[str, np.ndarray]:
     fit = fit_material(nk)
     P = _scene_rows(nk, E[:, 0], fit)
     n_rgb, k_rgb = rgb_nk(nk)
+    rgb = fit_rgb_conductor(nk)
     return {
         "reference": ref,
         "schlick_air": schlick(M, air["F0_air"]),
@@ -112,6 +118,7 @@ def model_outputs(name: str) -> dict[str, np.ndarray]:
         "ours_float16": coated_conductor_model(M, E, fit.coefficients_float16),
         "ours_scene": model_from_parameters(M[..., None], P[:, None, 0], P[:, None, 1], P[:, None, 2]),
         "exact_rgb": rgb_fresnel_conductor(M, E, n_rgb, k_rgb),
+        "rgb_conductor": rgb_conductor_model(M, E, rgb.coefficients_float16),
         "spectral": ref,
         "_fit": fit,
         "_air": air,
@@ -125,6 +132,7 @@ def cpu_cost_ns(repeats: int = 3) -> dict[str, float]:
     fit = fit_material(nk)
     air = baseline_inputs(nk)
     n_rgb, k_rgb = rgb_nk(nk)
+    C16 = fit_rgb_conductor(nk).coefficients_float16
     rng = np.random.default_rng(0)
     count = 1_000_000
     mu, eta = rng.uniform(0, 1, count), rng.uniform(1, 2.5, count)
@@ -139,6 +147,7 @@ def cpu_cost_ns(repeats: int = 3) -> dict[str, float]:
         "ours_float16": lambda: coated_conductor_model(mu, eta, fit.coefficients_float16),
         "ours_scene": lambda: model_from_parameters(mu[:, None], P[0], P[1], P[2]),
         "exact_rgb": lambda: rgb_fresnel_conductor(mu, eta, n_rgb, k_rgb),
+        "rgb_conductor": lambda: rgb_conductor_model(mu, eta, C16),
     }
     out = {}
     for name, call in calls.items():
@@ -168,6 +177,9 @@ def shader_cost(repeats: int) -> dict[str, float]:
     air = baseline_inputs(nk)
     n_rgb, k_rgb = rgb_nk(nk)
     inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
+    inputs = dataclasses.replace(
+        inputs, rgb_words=halves_to_uint32(fit_rgb_conductor(nk).coefficients_float16)
+    )
     with RenderThread("speed-vs-error") as thread:
         samples = time_variants(thread, inputs, VARIANTS, WIDTH, HEIGHT, repeats)
     return {v: float(np.median(s[:, 1])) * 1e6 for v, s in samples.items()}
@@ -295,6 +307,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description="Speed against error for the 22 conductors.")
     parser.add_argument("--figure", action="store_true", help="write the two PNGs to docs/images/")
     parser.add_argument("--repeats", type=int, default=7, help="shader timing rounds")
+    parser.add_argument("--models-only", action="store_true",
+                        help="the models table only (skip the fitting-settings sweep)")
     args = parser.parse_args()
 
     t0 = time.perf_counter()
@@ -326,6 +340,9 @@ def main() -> None:
               + ", ".join(f"{v} {t:.0f}" for v, t in shader.items()))
     print("\nBytes: " + "; ".join(f"{MODELS[m][0]}: {MODELS[m][3]}" for m in MODELS))
 
+    if args.models_only:
+        print(f"\nRun time: {time.perf_counter() - t0:.0f} s")
+        return
     fit_rows = fit_settings_table()
     fit_front = pareto_front({_key(r): (r["seconds"], r["mean"]) for r in fit_rows})
     print(f"\n## Fitting settings: fit time against error, {len(LIBRARY_NAMES)} conductors\n")

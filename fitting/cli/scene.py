@@ -40,6 +40,9 @@ def _format_table(report: dict[str, Any]) -> str:
             f"{m['general']['delta_E_2000']['mean']:>8.3f} {m['delta_E_2000']['max']:>7.3f} "
             f"{m['general']['delta_E_2000']['max']:>8.3f}"
         )
+    for m in report["materials"]:
+        if "choice" in m:
+            rows.append(f"{m['name']}: {m['model']}: {m['choice']['reason']}")
     totals = report["totals"]
     rows.append(
         f"pack {totals['pack_bytes']} bytes (general {totals['general_pack_bytes']}), "

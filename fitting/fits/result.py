@@ -48,6 +48,10 @@ class FitResult:
     packed
         The :class:`fitting.models.pack.PackedMaterial` (n, k fits).
     metrics
+        Filled by :func:`evaluate_material` or the caller.
+    model
+        The model kind (:data:`fitting.models.kinds.MODEL_KINDS`); an
+        ``rgb-conductor`` fit has coefficients of shape (2, 3) and degree 0.
         Filled by :func:`fitting.fits.evaluate.evaluate_material` or the
         caller: the JSON of the errors (and, for curve fits, the counts).
     error
@@ -71,6 +75,7 @@ class FitResult:
     coverage: float = 1.0
     packed: PackedMaterial | None = None
     metrics: dict[str, Any] = field(default_factory=dict)
+    model: str = "coated-conductor"
     error: ErrorMetrics | None = None
 
     @property
@@ -81,6 +86,7 @@ class FitResult:
     def summary(self) -> dict[str, Any]:
         """JSON-friendly report of the convergence and timings."""
         return {
+            "model": self.model,
             "success": self.success,
             "status": self.status,
             "message": self.message,

@@ -11,6 +11,8 @@ for the rule in words.
 -   :func:`fit_scene_material`: one material, a :class:`~fitting.fits.scene_report.SceneMaterialResult`.
 -   :func:`fit_scene`: every material, a :class:`~fitting.fits.scene_report.SceneResult`.
 -   :func:`choose_degree`, :func:`general_domain`: the rules.
+-   :data:`CANDIDATES`, :func:`choose_candidate`: the model kind and degree
+    for a scene's ``max_delta_e`` or ``prefer``.
 
 References
 ----------
@@ -27,10 +29,13 @@ import numpy as np
 from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE
 from ..models.coated_conductor import coated_conductor_model
+from ..models.kinds import model_ACEScg
 from ..models.pack import PackedMaterial
 from .material import fit_material
 from .metrics import ErrorMetrics, delta_E_summary
 from .result import FitResult
+from .rgb_conductor import DEFAULT_SETTINGS as RGB_SETTINGS
+from .rgb_conductor import fit_rgb_conductor_coefficients
 from .scene_report import SceneMaterialResult, SceneResult
 from .scene_schema import EVALUATION_MU_SAMPLES, EtaSpec, Scene, SceneMaterial
 from .settings import FitSettings, fit_grid
@@ -39,7 +44,9 @@ from .solver import fit_coefficients
 __all__ = [
     "DEGREE_TOLERANCE_MEAN",
     "DEGREE_TOLERANCE_MAX",
+    "CANDIDATES",
     "choose_degree",
+    "choose_candidate",
     "general_domain",
     "fit_scene_material",
     "fit_scene",
@@ -52,6 +59,74 @@ the highest degree's (a twentieth of a just-noticeable difference)."""
 
 DEGREE_TOLERANCE_MAX = 0.5
 """... and its max Delta E 2000 at most this much above (half a JND)."""
+
+
+CANDIDATES = (
+    ("coated-conductor", 0),
+    ("rgb-conductor", 0),
+    ("coated-conductor", 1),
+    ("coated-conductor", 2),
+)
+"""(kind, degree) from the cheapest to the dearest to shade. Shader cost
+relative to adjusted Lazanyi on llvmpipe (docs/speed-vs-error.md): a degree-0
+coated-conductor is Eq. 1 with constant parameters (9 halves, 1.04x); the
+rgb-conductor a complex square root per channel (6 halves, 1.60x); degrees 1
+and 2 the general model's polynomial in t (18 and 27 halves, 2.9x), degree 1
+first for its fewer bytes."""
+
+
+def _label(kind: str, degree: int) -> str:
+    return kind if kind == "rgb-conductor" else f"{kind} degree {degree}"
+
+
+def choose_candidate(
+    errors: dict[tuple[str, int], ErrorMetrics], max_delta_e: float | None, prefer: str | None
+) -> tuple[tuple[str, int], str]:
+    """
+    The (kind, degree) a scene material gets, and why: with ``max_delta_e``
+    the first of :data:`CANDIDATES` (among ``errors``) whose mean Delta E
+    2000 is at most it, else the most accurate; with ``prefer="accuracy"``
+    the most accurate (lowest mean, the cheaper on a tie).
+    """
+    ordered = [c for c in CANDIDATES if c in errors]
+    best = min(ordered, key=lambda c: errors[c].mean)
+    if prefer == "accuracy":
+        return best, (
+            f"prefer accuracy: {_label(*best)} has the lowest mean Delta E 2000 "
+            f"({errors[best].mean:.4f}) of {len(ordered)} candidates"
+        )
+    for candidate in ordered:
+        if errors[candidate].mean <= max_delta_e:
+            cheaper = ordered[: ordered.index(candidate)]
+            why = "" if not cheaper else "; cheaper candidates miss it: " + ", ".join(
+                f"{_label(*c)} {errors[c].mean:.4f}" for c in cheaper
+            )
+            return candidate, (
+                f"max_delta_e {max_delta_e:g}: {_label(*candidate)} is the cheapest candidate within it "
+                f"(mean Delta E 2000 {errors[candidate].mean:.4f}){why}"
+            )
+    return best, (
+        f"max_delta_e {max_delta_e:g}: no candidate is within it; {_label(*best)} is the most "
+        f"accurate (mean Delta E 2000 {errors[best].mean:.4f})"
+    )
+
+
+def _fit_rgb_conductor(entry: SceneMaterial) -> tuple[PackedMaterial, FitResult]:
+    """The float16 rgb-conductor over the scene's eta_i (a set: rows at its values)."""
+    spec, settings = entry.eta_i, RGB_SETTINGS
+    if spec.kind == "set":
+        rows = [fit_grid((v, v), settings.mu_samples, 1, settings.grid) for v in spec.values]
+        mu, eta, weights = (np.concatenate(parts) for parts in zip(*rows))
+    else:
+        mu, eta, weights = fit_grid(spec.domain, settings.mu_samples, settings.eta_samples, settings.grid)
+    target = reference_ACEScg(entry.nk, mu, eta, settings.step_nm, settings.min_coverage)
+    result = fit_rgb_conductor_coefficients(
+        target, mu, eta, spec.domain, settings.objective, settings.max_nfev, settings.quantise,
+        weights=weights, irls_rounds=settings.irls_rounds,
+    )
+    packed = PackedMaterial(entry.name, result.coefficients_float16, spec.domain,
+                            source=entry.nk.source, model="rgb-conductor")
+    return packed, result
 
 
 def _error(ref: np.ndarray, model: np.ndarray, against: str) -> ErrorMetrics:
@@ -104,10 +179,14 @@ def general_domain(spec: EtaSpec) -> tuple[float, float]:
     return (min(DEFAULT_ETA_I_RANGE[0], lo), max(DEFAULT_ETA_I_RANGE[1], hi))
 
 
-def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None) -> SceneMaterialResult:
+def fit_scene_material(
+    entry: SceneMaterial, settings: FitSettings | None = None,
+    max_delta_e: float | None = None, prefer: str | None = None,
+) -> SceneMaterialResult:
     """
-    Fit one scene material with the degree rule of the module docstring and
-    score it against the general fit.
+    Fit one scene material with the degree rule of the module docstring, or
+    with ``max_delta_e`` / ``prefer`` the kind and degree of
+    :func:`choose_candidate`, and score it against the general fit.
 
     Raises
     ------
@@ -137,9 +216,31 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
         by_degree[degree] = _error(
             ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range), against
         )
-    chosen = choose_degree(by_degree, general_error)
+    choice = None
+    if max_delta_e is not None or prefer is not None:
+        rgb_packed, rgb_fit = _fit_rgb_conductor(entry)
+        errors = {("coated-conductor", d): e for d, e in by_degree.items()}
+        errors[("rgb-conductor", 0)] = _error(ref, model_ACEScg(
+            "rgb-conductor", M, E, rgb_packed.coefficients, rgb_packed.eta_i_range), against)
+        (kind, chosen), reason = choose_candidate(errors, max_delta_e, prefer)
+        choice = {
+            "rule": "prefer accuracy" if prefer == "accuracy" else f"max_delta_e {max_delta_e:g}",
+            "model": kind, "degree": chosen, "reason": reason,
+            "candidates": {_label(*c): errors[c].to_dict() for c in CANDIDATES if c in errors},
+        }
+    else:
+        chosen = choose_degree(by_degree, general_error)
     scene_error = by_degree[chosen]
-    if scene_error.mean > general_error.mean:
+    if choice is not None and choice["model"] == "rgb-conductor":
+        fits[chosen] = rgb_fit
+        scene_error = errors[("rgb-conductor", 0)]
+        packed = PackedMaterial(
+            entry.name, rgb_packed.coefficients, spec.domain, source=entry.nk.source,
+            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
+                     "from_general_fit": False},
+            model="rgb-conductor",
+        )
+    elif choice is None and scene_error.mean > general_error.mean:
         # No scene fit beats the general fit on the scene's eta_i (a narrow
         # range the general fit already follows as well as its own fit can):
         # the general fit itself serves it, never a worse one.
@@ -156,7 +257,7 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
                      "from_general_fit": False},
         )
     fit = fits[chosen]
-    scene_model = coated_conductor_model(M, E, packed.coefficients, packed.eta_i_range)
+    scene_model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
     return SceneMaterialResult(
         material=entry,
         packed=packed,
@@ -167,6 +268,7 @@ def fit_scene_material(entry: SceneMaterial, settings: FitSettings | None = None
         general_error=general_error,
         scene_vs_general=_error(general_model, scene_model, "the general fit's model"),
         seconds=time.perf_counter() - t0,
+        choice=choice,
     )
 
 
@@ -175,7 +277,9 @@ def fit_scene(scene: Scene, settings: FitSettings | None = None) -> SceneResult:
     result = SceneResult(scene)
     for entry in scene.materials:
         try:
-            result.materials.append(fit_scene_material(entry, settings))
+            result.materials.append(
+                fit_scene_material(entry, settings, scene.max_delta_e, scene.prefer)
+            )
         except ValueError as error:
             raise ValueError(f"material {entry.name!r}: {error}") from None
     return result

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from ..models.kinds import coefficient_count
 from ..models.pack import PackedMaterial, encode_pack, material_record_bytes, pack_to_json
 from .metrics import ErrorMetrics
 from .result import FitResult
@@ -34,7 +35,9 @@ class SceneMaterialResult:
     is compared with; ``by_degree`` the Delta E 2000 (mean, max) of each
     candidate degree, ``scene`` and ``general_error`` those of the chosen and
     the general float16 model, ``scene_vs_general`` the Delta E between the
-    two models; all on the same evaluation grid.
+    two models; all on the same evaluation grid. ``choice`` (with a scene's
+    ``max_delta_e`` or ``prefer``): the rule, the chosen kind and degree, why,
+    and every candidate's Delta E 2000.
     """
 
     material: SceneMaterial
@@ -46,6 +49,7 @@ class SceneMaterialResult:
     general_error: ErrorMetrics
     scene_vs_general: ErrorMetrics
     seconds: float
+    choice: dict[str, Any] | None = None
 
     @property
     def degree(self) -> int:
@@ -53,7 +57,7 @@ class SceneMaterialResult:
 
     @property
     def bytes(self) -> int:
-        return material_record_bytes(self.packed.name, self.packed.source, self.degree)
+        return material_record_bytes(self.packed.name, self.packed.source, self.degree, self.packed.model)
 
     @property
     def general_bytes(self) -> int:
@@ -61,8 +65,14 @@ class SceneMaterialResult:
 
     @property
     def shader_variant(self) -> str:
-        """``collapsed`` (Eq. 1 with constant F0, a, alpha) or ``packed``."""
+        """``rgb_conductor``, ``collapsed`` (Eq. 1 with constant F0, a, alpha) or ``packed``."""
+        if self.packed.model == "rgb-conductor":
+            return "rgb_conductor"
         return "collapsed" if self.degree == 0 else "packed"
+
+    @property
+    def coefficients(self) -> int:
+        return coefficient_count(self.packed.model, self.degree)
 
     def report(self) -> dict[str, Any]:
         return {
@@ -70,8 +80,9 @@ class SceneMaterialResult:
             "material": self.material.material,
             "eta_i": self.material.eta_i.to_json(),
             "eta_i_range": list(self.packed.eta_i_range),
+            "model": self.packed.model,
             "degree": self.degree,
-            "coefficients": 9 * (self.degree + 1),
+            "coefficients": self.coefficients,
             "shader_variant": self.shader_variant,
             "bytes": self.bytes,
             "delta_E_2000": self.scene.to_dict(),
@@ -86,6 +97,7 @@ class SceneMaterialResult:
             "scene_vs_general_delta_E_2000": self.scene_vs_general.to_dict(),
             "fit": self.fit.summary(),
             "seconds": self.seconds,
+            **({"choice": self.choice} if self.choice is not None else {}),
         }
 
 
@@ -117,7 +129,7 @@ class SceneResult:
             "totals": {
                 "pack_bytes": len(self.pack_bytes()),
                 "general_pack_bytes": len(general_pack),
-                "coefficients": sum(9 * (m.degree + 1) for m in self.materials),
+                "coefficients": sum(m.coefficients for m in self.materials),
                 "general_coefficients": 27 * len(self.materials),
                 "delta_E_2000_mean": float(np.mean([m.scene.mean for m in self.materials])),
                 "general_delta_E_2000_mean": float(

@@ -11,6 +11,7 @@ Scene description (JSON)::
 
     {
       "name": "showroom",                                  (optional)
+      "max_delta_e": 0.05,        (optional) or "prefer": "accuracy"
       "materials": [
         {"material": "Au", "eta_i": 1.0},                  one eta_i (1 = uncoated)
         {"material": "Cu", "eta_i": [1.33, 1.5]},          a set
@@ -37,6 +38,17 @@ scene's eta_i (a narrow range the general fit already follows as closely),
 the general fit itself is shipped for that material
 (``metrics["from_general_fit"]``), so a scene material is never worse than
 the general fit.
+
+Model kinds (:data:`fitting.models.kinds.MODEL_KINDS`): without
+``max_delta_e`` or ``prefer`` every material is a coated-conductor chosen by
+the degree rule above. With ``max_delta_e`` (a mean Delta E 2000 on the
+scene's eta_i, > 0), each material gets the cheapest candidate to shade whose
+error is at most that, candidates being the coated-conductor of each degree
+and the rgb-conductor, all fitted over the scene's eta_i
+(:data:`fitting.fits.scene_fit.CANDIDATES` gives the order); where none is
+within it, the most accurate. With ``"prefer": "accuracy"`` each material
+gets the most accurate candidate. The report says per material what was
+chosen and why (``choice``).
 
 Each material is compared with the general fit (degree 2, 27 coefficients,
 over the default domain [1, 2.5], widened to hold the scene's eta_i): bytes in
@@ -72,6 +84,7 @@ __all__ = [
     "MAX_ETA_I_VALUES",
     "EVALUATION_MU_SAMPLES",
     "EVALUATION_ETA_ROWS",
+    "PREFERENCES",
     "EtaSpec",
     "SceneMaterial",
     "Scene",
@@ -95,6 +108,9 @@ EVALUATION_ETA_ROWS = 50
 
 
 _NAME_MAX = 200
+
+PREFERENCES = ("accuracy",)
+"""Values of a scene's ``prefer``."""
 
 
 @dataclass(frozen=True)
@@ -151,6 +167,8 @@ class Scene:
 
     name: str
     materials: tuple[SceneMaterial, ...]
+    max_delta_e: float | None = None
+    prefer: str | None = None
 
 
 def _check_eta_value(value: Any, where: str) -> float:
@@ -238,9 +256,22 @@ def parse_scene(
             raise ValueError(f"scene is not valid JSON: {error}") from None
     if not isinstance(data, dict):
         raise ValueError("scene must be a JSON object with a `materials` list")
-    unknown = set(data) - {"name", "materials"}
+    unknown = set(data) - {"name", "materials", "max_delta_e", "prefer"}
     if unknown:
-        raise ValueError(f"scene has unknown keys {sorted(unknown)}; allowed: name, materials")
+        raise ValueError(
+            f"scene has unknown keys {sorted(unknown)}; allowed: name, materials, max_delta_e, prefer"
+        )
+    max_delta_e, prefer = data.get("max_delta_e"), data.get("prefer")
+    if max_delta_e is not None and prefer is not None:
+        raise ValueError("give at most one of `max_delta_e` and `prefer`")
+    if max_delta_e is not None:
+        if isinstance(max_delta_e, bool) or not isinstance(max_delta_e, (int, float)) or not (
+            np.isfinite(max_delta_e) and 0.0 < max_delta_e <= 100.0
+        ):
+            raise ValueError(f"`max_delta_e` must be a number in (0, 100], got {max_delta_e!r}")
+        max_delta_e = float(max_delta_e)
+    if prefer is not None and prefer not in PREFERENCES:
+        raise ValueError(f"`prefer` must be one of {', '.join(PREFERENCES)}, got {prefer!r}")
     scene_name = data.get("name", "scene")
     if not isinstance(scene_name, str) or not scene_name.strip() or len(scene_name) > _NAME_MAX:
         raise ValueError(f"`name` must be a non-empty string of at most {_NAME_MAX} characters")
@@ -289,4 +320,4 @@ def parse_scene(
             except ValueError as error:
                 raise ValueError(f"`{where}.material`: {error}") from None
         materials.append(SceneMaterial(name, material or name, nk, eta))
-    return Scene(scene_name, tuple(materials))
+    return Scene(scene_name, tuple(materials), max_delta_e, prefer)

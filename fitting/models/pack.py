@@ -12,14 +12,20 @@ The float16 coefficient pack a renderer loads: a documented binary format
 -   :func:`halves_to_uint32`: the 14 uint32 words a shader reads with
     ``unpackHalf2x16``.
 
-Binary layout (little-endian)::
+Binary layout (little-endian), version 2::
 
-    magic "CFPK" | version u16 = 1 | count u16 | total_length u32
+    magic "CFPK" | version u16 = 2 | count u16 | total_length u32
     count x material:
         name_len u16 | name utf-8 | source_len u16 | source utf-8
-        eta_lo f32 | eta_hi f32 | degree u8 | reserved u8 (0) x 3
-        9 * (degree + 1) float16 coefficients, order [parameter][channel][power]
+        eta_lo f32 | eta_hi f32 | degree u8 | kind u8 | reserved u8 (0) x 2
+        coefficients, float16:
+            kind 0, coated-conductor: 9 * (degree + 1), order [parameter][channel][power]
+            kind 1, rgb-conductor: 6 (degree 0), order [n, k][channel]
     crc32 u32 of every byte before it
+
+Version 1 is the same with the kind byte reserved (0): every material a
+coated-conductor. Version 1 packs still decode; :func:`encode_pack` writes
+version 2 (or version 1 on request, for coated-conductor materials only).
 """
 
 from __future__ import annotations
@@ -33,11 +39,14 @@ from typing import Any
 import numpy as np
 
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
-from .coated_conductor import CHANNELS, PARAMETERS, check_coefficients
+from .coated_conductor import CHANNELS, PARAMETERS
+from .kinds import DEFAULT_MODEL, MODEL_KINDS, check_model, check_model_coefficients, coefficient_count
+from .rgb_conductor import NK_PARAMETERS
 
 __all__ = [
     "PACK_MAGIC",
     "PACK_VERSION",
+    "PACK_VERSIONS",
     "FLOAT16_MAX",
     "PackedMaterial",
     "to_float16",
@@ -52,7 +61,10 @@ __all__ = [
 ]
 
 PACK_MAGIC = b"CFPK"
-PACK_VERSION = 1
+PACK_VERSION = 2
+PACK_VERSIONS = (1, 2)
+"""Versions :func:`decode_pack` and :func:`pack_from_json` read."""
+_KIND_CODES = {kind: code for code, kind in enumerate(MODEL_KINDS)}
 FLOAT16_MAX = float(np.finfo(np.float16).max)
 _HEADER = struct.Struct("<4sHHI")
 _MAX_TEXT = 65535
@@ -81,8 +93,11 @@ class PackedMaterial:
     """
     One material of a pack.
 
-    ``coefficients`` is a float16 array of shape (3, 3, degree + 1), see
-    :mod:`fitting.models.coated_conductor` for the layout; ``eta_i_range`` is the fitted domain.
+    ``model`` is its kind (:data:`fitting.models.kinds.MODEL_KINDS`);
+    ``coefficients`` a float16 array of shape (3, 3, degree + 1) for a
+    ``coated-conductor`` (layout of :mod:`fitting.models.coated_conductor`) or (2, 3), n and k
+    per channel, for an ``rgb-conductor``; ``eta_i_range`` is the fitted
+    domain.
     """
 
     name: str
@@ -90,6 +105,7 @@ class PackedMaterial:
     eta_i_range: tuple[float, float] = DEFAULT_ETA_I_RANGE
     source: str = ""
     metrics: dict[str, Any] = field(default_factory=dict, compare=False)
+    model: str = DEFAULT_MODEL
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
@@ -97,7 +113,7 @@ class PackedMaterial:
         for label, text in (("name", self.name), ("source", self.source)):
             if len(text.encode("utf-8")) > _MAX_TEXT:
                 raise ValueError(f"`{label}` must be at most {_MAX_TEXT} bytes of UTF-8")
-        C = check_coefficients(self.coefficients)
+        C = check_model_coefficients(check_model(self.model), self.coefficients)
         halves = to_float16(C)
         if not np.array_equal(halves.astype(np.float64), C):
             raise ValueError(
@@ -113,13 +129,15 @@ class PackedMaterial:
 
     @property
     def degree(self) -> int:
-        return self.coefficients.shape[2] - 1
+        """Polynomial degree in t of a coated-conductor; 0 for an rgb-conductor."""
+        return self.coefficients.shape[2] - 1 if self.model == "coated-conductor" else 0
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, PackedMaterial):
             return NotImplemented
         return (
-            self.name == other.name
+            self.model == other.model
+            and self.name == other.name
             and self.source == other.source
             and self.eta_i_range == other.eta_i_range
             and self.coefficients.shape == other.coefficients.shape
@@ -129,18 +147,24 @@ class PackedMaterial:
     __hash__ = None  # type: ignore[assignment]
 
 
-def material_record_bytes(name: str, source: str, degree: int) -> int:
+def material_record_bytes(name: str, source: str, degree: int, model: str = DEFAULT_MODEL) -> int:
     """
     Bytes of one material in the binary pack (see the layout above): name and
-    source with their u16 lengths, the f32 domain, degree and padding, and
-    9 (degree + 1) float16 coefficients.
+    source with their u16 lengths, the f32 domain, degree, kind and padding,
+    and the float16 coefficients (9 (degree + 1), or 6 for an rgb-conductor).
     """
-    return 2 + len(name.encode()) + 2 + len(source.encode()) + 12 + 18 * (degree + 1)
+    return 2 + len(name.encode()) + 2 + len(source.encode()) + 12 + 2 * coefficient_count(model, degree)
 
 
-def encode_pack(materials: list[PackedMaterial]) -> bytes:
-    """Encode materials into the binary pack format (see module docstring)."""
+def encode_pack(materials: list[PackedMaterial], version: int = PACK_VERSION) -> bytes:
+    """
+    Encode materials into the binary pack format (see module docstring):
+    version 2, or version 1 (readers older than the model kinds) when every
+    material is a coated-conductor.
+    """
     materials = list(materials)
+    if version not in PACK_VERSIONS:
+        raise ValueError(f"`version` must be one of {PACK_VERSIONS}, got {version!r}")
     if not materials:
         raise ValueError("`materials` must hold at least one material")
     if len(materials) > 65535:
@@ -149,14 +173,18 @@ def encode_pack(materials: list[PackedMaterial]) -> bytes:
     for material in materials:
         if not isinstance(material, PackedMaterial):
             raise ValueError("`materials` must hold PackedMaterial instances")
+        if version == 1 and material.model != "coated-conductor":
+            raise ValueError(
+                f"`version` 1 holds only coated-conductor materials, {material.name!r} is an {material.model}"
+            )
         for text in (material.name, material.source):
             raw = text.encode("utf-8")
             body += struct.pack("<H", len(raw)) + raw
         lo, hi = material.eta_i_range
-        body += struct.pack("<ffB3x", lo, hi, material.degree)
+        body += struct.pack("<ffBB2x", lo, hi, material.degree, _KIND_CODES[material.model])
         body += material.coefficients.astype("<f2").tobytes()
     total = _HEADER.size + len(body) + 4
-    head = _HEADER.pack(PACK_MAGIC, PACK_VERSION, len(materials), total)
+    head = _HEADER.pack(PACK_MAGIC, version, len(materials), total)
     data = head + bytes(body)
     return data + struct.pack("<I", zlib.crc32(data))
 
@@ -189,8 +217,10 @@ def decode_pack(data: bytes) -> list[PackedMaterial]:
     magic, version, count, total = _HEADER.unpack_from(data)
     if magic != PACK_MAGIC:
         raise ValueError(f"`data` is not a coefficient pack: magic {magic!r}, expected {PACK_MAGIC!r}")
-    if version != PACK_VERSION:
-        raise ValueError(f"`data` has pack version {version}, only version {PACK_VERSION} is supported")
+    if version not in PACK_VERSIONS:
+        raise ValueError(
+            f"`data` has pack version {version}, only versions {', '.join(map(str, PACK_VERSIONS))} are supported"
+        )
     if total != len(data):
         raise ValueError(
             f"`data` has the wrong length: the header says {total} bytes, got {len(data)}"
@@ -209,16 +239,24 @@ def decode_pack(data: bytes) -> list[PackedMaterial]:
                 texts.append(reader.take(size, what).decode("utf-8"))
             except UnicodeDecodeError:
                 raise ValueError(f"`data` has a {what} that is not UTF-8") from None
-        lo, hi, degree = struct.unpack("<ffB3x", reader.take(12, "eta_i range"))
-        if degree > 2:
-            raise ValueError(f"`data` has polynomial degree {degree}, must be 0, 1 or 2")
-        count_c = 9 * (degree + 1)
-        raw = reader.take(2 * count_c, "coefficients")
-        halves = np.frombuffer(raw, dtype="<f2").astype(np.float16).reshape(3, 3, degree + 1)
+        lo, hi, degree, code = struct.unpack("<ffBB2x", reader.take(12, "eta_i range"))
+        # Version 1 reserved the kind byte: every material is a coated-conductor.
+        if version == 1:
+            code = 0
+        if code >= len(MODEL_KINDS):
+            raise ValueError(f"`data` has model kind code {code}, must be below {len(MODEL_KINDS)}")
+        model = MODEL_KINDS[code]
+        if degree > 2 or (model == "rgb-conductor" and degree != 0):
+            raise ValueError(
+                f"`data` has polynomial degree {degree}, must be 0, 1 or 2 (0 for an rgb-conductor)"
+            )
+        shape = (2, 3) if model == "rgb-conductor" else (3, 3, degree + 1)
+        raw = reader.take(2 * int(np.prod(shape)), "coefficients")
+        halves = np.frombuffer(raw, dtype="<f2").astype(np.float16).reshape(shape)
         if not np.all(np.isfinite(halves)):
             raise ValueError("`data` holds a coefficient that is not finite")
         materials.append(
-            PackedMaterial(texts[0], halves, (lo, hi), source=texts[1])
+            PackedMaterial(texts[0], halves, (lo, hi), source=texts[1], model=model)
         )
     if reader.offset != reader.end:
         raise ValueError(
@@ -228,35 +266,50 @@ def decode_pack(data: bytes) -> list[PackedMaterial]:
 
 
 def material_to_json(material: PackedMaterial) -> dict[str, Any]:
-    """The JSON view of one material (values exactly as stored in float16)."""
+    """
+    The JSON view of one material (values exactly as stored in float16):
+    ``"model"``, and ``"coefficients"`` ``{"F0", "a", "alpha"}`` (three rows
+    R, G, B of degree + 1 powers each) for a coated-conductor, ``{"n": [R,
+    G, B], "k": [R, G, B]}`` for an rgb-conductor.
+    """
     C = material.coefficients.astype(np.float64)
-    return {
+    view: dict[str, Any] = {
         "name": material.name,
+        "model": material.model,
         "eta_i_range": list(material.eta_i_range),
         "colour_space": "ACEScg",
-        "degree": material.degree,
-        "coefficients": {
+    }
+    if material.model == "rgb-conductor":
+        view["coefficients"] = {p: [float(v) for v in C[i]] for i, p in enumerate(NK_PARAMETERS)}
+    else:
+        view["degree"] = material.degree
+        view["coefficients"] = {
             p: [[float(v) for v in C[i, c]] for c in range(3)]
             for i, p in enumerate(PARAMETERS)
-        },
-        "source": material.source,
-        "metrics": material.metrics,
-    }
+        }
+    view["source"] = material.source
+    view["metrics"] = material.metrics
+    return view
 
 
 def material_from_json(view: dict[str, Any]) -> PackedMaterial:
     """Inverse of :func:`material_to_json`; values must be exact float16."""
     if not isinstance(view, dict):
         raise ValueError("material must be a JSON object")
+    model = check_model(view.get("model", DEFAULT_MODEL))
+    parameters = NK_PARAMETERS if model == "rgb-conductor" else PARAMETERS
+    what = "three numbers" if model == "rgb-conductor" else "three rows of numbers"
     try:
         coefficients = np.array(
-            [[view["coefficients"][p][c] for c in range(3)] for p in PARAMETERS],
+            [[view["coefficients"][p][c] for c in range(3)] for p in parameters],
             dtype=np.float64,
         )
+        if model == "rgb-conductor" and coefficients.ndim != 2:
+            raise ValueError("not one number per channel")
     except (KeyError, IndexError, TypeError, ValueError) as error:
         raise ValueError(
-            "`coefficients` must hold F0, a and alpha, each three rows "
-            f"({', '.join(CHANNELS)}) of numbers: {error!r}"
+            f"`coefficients` must hold {', '.join(parameters[:-1])} and {parameters[-1]}, each {what} "
+            f"({', '.join(CHANNELS)}) for an {model}: {error!r}"
         ) from None
     if view.get("colour_space", "ACEScg") != "ACEScg":
         raise ValueError(f"`colour_space` must be 'ACEScg', got {view.get('colour_space')!r}")
@@ -266,6 +319,7 @@ def material_from_json(view: dict[str, Any]) -> PackedMaterial:
         eta_i_range=tuple(view.get("eta_i_range", DEFAULT_ETA_I_RANGE)),
         source=view.get("source", "") or "",
         metrics=view.get("metrics") or {},
+        model=model,
     )
 
 
@@ -289,8 +343,15 @@ def pack_from_json(text: str | bytes) -> list[PackedMaterial]:
         raise ValueError(f"pack JSON is not valid JSON: {error}") from None
     if not isinstance(view, dict) or view.get("format") != "coated-fresnel-pack":
         raise ValueError("pack JSON must be an object with `format` 'coated-fresnel-pack'")
-    if view.get("version") != PACK_VERSION:
-        raise ValueError(f"pack JSON `version` must be {PACK_VERSION}, got {view.get('version')!r}")
+    if view.get("version") not in PACK_VERSIONS:
+        raise ValueError(
+            f"pack JSON `version` must be one of {', '.join(map(str, PACK_VERSIONS))}, got {view.get('version')!r}"
+        )
+    if view["version"] == 1 and any(
+        isinstance(m, dict) and m.get("model", DEFAULT_MODEL) != "coated-conductor"
+        for m in view.get("materials") or []
+    ):
+        raise ValueError("pack JSON `version` 1 holds only coated-conductor materials")
     materials = view.get("materials")
     if not isinstance(materials, list) or not materials:
         raise ValueError("pack JSON `materials` must be a non-empty list")
@@ -301,7 +362,8 @@ def halves_to_uint32(coefficients) -> np.ndarray:
     """
     Pack float16 coefficients in layout order into uint32 words, two halves
     per word, the earlier one in the low 16 bits (GLSL ``unpackHalf2x16``
-    returns it in ``.x``). 27 halves give 14 words, the last padded with 0.
+    returns it in ``.x``). 27 halves give 14 words, the last padded with 0;
+    the 6 of an rgb-conductor give 3.
     """
     halves = np.ascontiguousarray(np.asarray(coefficients, dtype=np.float16).ravel())
     bits = halves.view(np.uint16).astype(np.uint32)

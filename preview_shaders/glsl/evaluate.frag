@@ -3,11 +3,12 @@
 // (cos theta, eta_i): column i has NdotV = grid.x + i grid.y, row j has
 // eta_i = grid.z + j grid.w. CF_VARIANT is set by the host:
 // 0 model from packed halves, 1 model from floats, 2 scene-specialised model,
-// 3 adjusted Lazanyi, 4 Schlick, 5 exact RGB conductor Fresnel; for the cost
-// benchmark only: 6 Lazanyi at a scene-constant eta_i (F0 and a from the CPU),
-// 7 no Fresnel term (the pass's fixed cost: rasterisation, the grid inputs,
-// the store).
+// 3 adjusted Lazanyi, 4 Schlick, 5 exact RGB conductor Fresnel from floats,
+// 6 the rgb-conductor kind from packed halves; for the cost benchmark only:
+// 7 Lazanyi at a scene-constant eta_i (F0 and a from the CPU), 8 no Fresnel
+// term (the pass's fixed cost: rasterisation, the grid inputs, the store).
 #include "cf_coated_conductor.glsl"
+#include "cf_rgb_conductor.glsl"
 #include "cf_fresnel_baselines.glsl"
 
 uniform vec4 u_grid;
@@ -34,6 +35,8 @@ uniform vec3 cf_F0;
 uniform vec3 cf_n;
 uniform vec3 cf_k;
 #elif CF_VARIANT == 6
+uniform uint cf_rgb_words[3];
+#elif CF_VARIANT == 7
 uniform vec3 cf_F0;
 uniform vec3 cf_a;
 #endif
@@ -61,8 +64,10 @@ void main()
 #elif CF_VARIANT == 5
     vec3 F = cf_fresnel_conductor(NdotV, eta_i, cf_n, cf_k);
 #elif CF_VARIANT == 6
-    vec3 F = cf_lazanyi(NdotV, cf_F0, cf_a);
+    vec3 F = cf_rgb_conductor_packed(NdotV, eta_i, cf_rgb_words);
 #elif CF_VARIANT == 7
+    vec3 F = cf_lazanyi(NdotV, cf_F0, cf_a);
+#elif CF_VARIANT == 8
     // Depends on both inputs, so neither is optimised away.
     vec3 F = vec3(NdotV, eta_i, 0.0);
 #endif

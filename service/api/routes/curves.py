@@ -44,7 +44,7 @@ from fitting.fits.curves_input import (
     CURVE_MIN_SAMPLES,
     check_curves,
 )
-from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import material_from_json, material_to_json
 from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
@@ -365,7 +365,7 @@ def _error_map(record: FitRecord, angles: int, rows: int) -> ErrorMap:
     eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
     eta, target, against = _target_of(record, mu, eta)
     E, M = np.meshgrid(eta, mu, indexing="ij")
-    model = coated_conductor_model(M, E, packed.coefficients, packed.eta_i_range)
+    model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
     dE = delta_E_map(target, model)
     return ErrorMap(
         fit_id=record.id, against=against, theta_deg=theta.tolist(), eta_i=eta.tolist(),

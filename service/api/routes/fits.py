@@ -6,7 +6,8 @@ Fits
 -   ``POST /api/v1/fits/upload``: fit an uploaded n, k file (CSV, JSON or
     refractiveindex.info YAML), multipart.
 -   ``GET /api/v1/fits/{fit_id}``: a stored fit.
--   ``GET /api/v1/fits/{fit_id}/pack``: its download (binary, json, glsl, hlsl).
+-   ``GET /api/v1/fits/{fit_id}/pack``: its download (binary, json, glsl,
+    hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf).
 -   ``GET /api/v1/fits/{fit_id}/curves``: reference, model and baseline RGB
     against the angle, for plotting.
 
@@ -17,23 +18,28 @@ from the store (200) without refitting; a new fit answers 201.
 from __future__ import annotations
 
 from pathlib import PurePath
-from typing import Annotated
+from typing import Annotated, Literal
 
 import numpy as np
 from fastapi import APIRouter, File, Form, HTTPException, Path, Query, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
 from fitting.colour.reference import reference_ACEScg
-from fitting.domain import cos_theta_from_angle
+from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN, cos_theta_from_angle
 from fitting.fits.settings import DEFAULT_OBJECTIVE
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
-from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import material_from_json
 from fitting.optics.nk import SpectralNK
 from fitting.optics.readers import FORMATS, read_nk
 
-from .targets import target_at
-from ...downloads import PACK_MEDIA_TYPES, download_name, render_pack
+from ...downloads import (
+    EXPORT_MEDIA_TYPES,
+    PACK_MEDIA_TYPES,
+    download_name,
+    render_export,
+    render_pack,
+)
 from ...fitting_jobs import NKFitSpec, fit_nk, measured_nk
 from ...models import (
     API_PREFIX,
@@ -43,11 +49,12 @@ from ...models import (
     ErrorBody,
     FitPublic,
     FitRequest,
+    PACK_FORMATS,
     Objective,
-    PackFormat,
     fit_public,
 )
 from ...store import FitRecord, Store
+from .targets import target_at
 from ..deps import (
     ERROR_RESPONSES,
     FIT_ERROR_RESPONSES,
@@ -66,7 +73,11 @@ PACK_CONTENT = {
     "application/octet-stream": {"schema": {"type": "string", "format": "binary"}},
     "application/json": {"schema": {"type": "object"}},
     "text/plain": {"schema": {"type": "string"}},
+    "application/xml": {"schema": {"type": "string"}},
+    "text/x-python": {"schema": {"type": "string"}},
+    "model/gltf+json": {"schema": {"type": "object"}},
 }
+DownloadFormat = Literal[(*PACK_FORMATS, *EXPORT_MEDIA_TYPES)]  # type: ignore[valid-type]
 CREATED = {
     status.HTTP_200_OK: {"model": FitPublic, "description": "Served from the store"},
     status.HTTP_201_CREATED: {"model": FitPublic, "description": "Fitted and saved"},
@@ -113,6 +124,7 @@ async def create_fit(
             kind="library", name=request.material, source="",
             eta_i_range=request.eta_i_range, objective=request.objective,
             library_material=request.material, metrics_samples=settings.metrics_samples,
+            model=request.model,
         )
     else:
         spec = NKFitSpec(
@@ -120,6 +132,7 @@ async def create_fit(
             eta_i_range=request.eta_i_range, objective=request.objective,
             wavelength_nm=tuple(request.nk.wavelength_nm), n=tuple(request.nk.n),
             k=tuple(request.nk.k), metrics_samples=settings.metrics_samples,
+            model=request.model,
         )
     return await _answer(spec, store, runner, response)
 
@@ -136,8 +149,8 @@ async def upload_fit(
         Form(pattern=r"^(csv|json|yaml|yml)$", description="Default: from the file name"),
     ] = None,
     name: Annotated[str | None, Form(min_length=1, max_length=200, pattern=r"\S")] = None,
-    eta_i_min: Annotated[float, Form(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.0,
-    eta_i_max: Annotated[float, Form(ge=1.0, le=3.0, allow_inf_nan=False)] = 2.5,
+    eta_i_min: Annotated[float, Form(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)] = DEFAULT_ETA_I_RANGE[0],
+    eta_i_max: Annotated[float, Form(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)] = DEFAULT_ETA_I_RANGE[1],
     objective: Annotated[Objective, Form()] = DEFAULT_OBJECTIVE,
 ) -> FitPublic:
     """
@@ -190,15 +203,32 @@ def get_fit(fit_id: FitIdPath, store: StoreDep) -> FitPublic:
 )
 def get_pack(
     fit_id: FitIdPath, store: StoreDep,
-    format: Annotated[PackFormat, Query(description="binary | json | glsl | hlsl")] = "binary",
+    format: Annotated[DownloadFormat, Query(
+        description="binary | json | glsl | hlsl | mtlx | openpbr | blender | gltf")] = "binary",
+    eta_i: Annotated[float, Query(
+        ge=1.0, le=3.0, allow_inf_nan=False,
+        description="Coating index of an export (mtlx, openpbr, blender, gltf), [1, 3]")] = 1.5,
 ) -> Response:
     """
     The fit as a download: ``binary`` (docs/pack-format.md), ``json``, or a
     ready-to-paste ``glsl`` / ``hlsl`` snippet with the coefficients and the
-    evaluation function.
+    evaluation function; or, for one coating index ``eta_i``, an export
+    (docs/exports.md): a MaterialX document (``mtlx``: conductor under a
+    dielectric coat; ``openpbr``: ``open_pbr_surface``), a Blender script
+    (``blender``) or a glTF asset (``gltf``). Exports need the fit's measured
+    n, k (422 for a fit made from curves alone).
     """
     record = stored_fit(store, fit_id)
-    return pack_response([record], format, f"{record.name}-{record.id[:8]}")
+    stem = f"{record.name}-{record.id[:8]}"
+    if format not in EXPORT_MEDIA_TYPES:
+        return pack_response([record], format, stem)
+    with fit_errors():
+        body = render_export(record, format, eta_i)
+    stem = f"{stem}-eta{eta_i:g}"
+    return Response(
+        body, media_type=EXPORT_MEDIA_TYPES[format][0],
+        headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
+    )
 
 
 def pack_response(records: list[FitRecord], format: str, stem: str) -> Response:
@@ -216,7 +246,7 @@ def pack_response(records: list[FitRecord], format: str, stem: str) -> Response:
 )
 def get_curves(
     fit_id: FitIdPath, store: StoreDep,
-    eta_i: Annotated[float, Query(ge=1.0, le=3.0, allow_inf_nan=False,
+    eta_i: Annotated[float, Query(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False,
                                   description="Coating index")] = 1.5,
     samples: Annotated[int, Query(ge=2, le=1024, description="Angles from 0 to 90 degrees")] = 91,
 ) -> CurvesPublic:
@@ -229,7 +259,7 @@ def get_curves(
     packed = material_from_json(record.material)
     theta = np.linspace(0.0, 90.0, samples)
     mu = cos_theta_from_angle(theta)
-    model = coated_conductor_model(mu, eta_i, packed.coefficients, packed.eta_i_range)
+    model = model_ACEScg(packed.model, mu, eta_i, packed.coefficients, packed.eta_i_range)
     reference = baseline = None
     nk = measured_nk(record)
     if nk is not None:

@@ -19,6 +19,7 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 
+from fitting.domain import ETA_I_MAX, ETA_I_MIN
 from fitting.models.pack import material_from_json
 
 from ...models import API_PREFIX, FIT_ID_PATTERN, ErrorBody
@@ -63,7 +64,7 @@ def _slots(request: Request, settings) -> threading.BoundedSemaphore:
 def preview_png(
     request: Request, store: StoreDep, settings: SettingsDep,
     fit: Annotated[str, Query(pattern=FIT_ID_PATTERN, description="A stored fit's id")],
-    eta_i: Annotated[float, Query(ge=1.0, le=3.0, allow_inf_nan=False)] = 1.5,
+    eta_i: Annotated[float, Query(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)] = 1.5,
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
     compare: Annotated[Literal["none", "lazanyi", "reference"], Query()] = "none",
     environment: Annotated[Literal["white_sky", "studio"], Query()] = "white_sky",

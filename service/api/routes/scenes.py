@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import base64
 import json
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter
 from fastapi.concurrency import run_in_threadpool
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from fitting.domain import ETA_I_MAX, ETA_I_MIN
 from fitting.fits.scene_fit import fit_scene
 from fitting.fits.scene_schema import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS, parse_scene
 from fitting.optics.library import LIBRARY_NAMES, library_material
@@ -38,7 +39,7 @@ from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess, fit_er
 
 router = APIRouter(prefix=API_PREFIX, tags=["scenes"])
 
-EtaValue = Annotated[float, Field(ge=1.0, le=3.0, allow_inf_nan=False, description="1 is uncoated")]
+EtaValue = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False, description="1 is uncoated")]
 Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
@@ -81,6 +82,14 @@ class SceneRequest(BaseModel):
 
     name: Name = "scene"
     materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS)
+    max_delta_e: float | None = Field(
+        default=None, gt=0.0, le=100.0, allow_inf_nan=False,
+        description="Each material gets the cheapest model kind and degree whose mean Delta E 2000 "
+        "on its eta_i is at most this",
+    )
+    prefer: Literal["accuracy"] | None = Field(
+        default=None, description="Each material gets its most accurate model kind and degree"
+    )
 
 
 class ScenePublic(BaseModel):
@@ -122,9 +131,11 @@ def _inline_scene(request: SceneRequest, store: Store) -> dict[str, Any]:
         if entry.nk is not None:
             view["nk"] = {**entry.nk.model_dump(), "source": entry.source}
         entries.append(view)
-    scene = parse_scene({"name": request.name, "materials": entries}, _resolver(store))
+    options = request.model_dump(include={"max_delta_e", "prefer"}, exclude_none=True)
+    scene = parse_scene({"name": request.name, "materials": entries, **options}, _resolver(store))
     return {
         "name": scene.name,
+        **options,
         "materials": [
             {
                 "name": m.name,

@@ -1,0 +1,107 @@
+"""
+Exports
+=======
+
+A coated metal as the documents the tools users already have take, each for
+one coating index eta_i, each saying what it was made from:
+
+-   ``mtlx``: MaterialX, ``conductor_bsdf`` at the relative index under a
+    ``dielectric_bsdf`` coat (:mod:`fitting.exports.mtlx`);
+-   ``openpbr``: MaterialX ``open_pbr_surface``, F0 and F82 tint fitted under
+    the coat (:mod:`fitting.exports.openpbr`);
+-   ``blender``: a Blender Python script, Principled BSDF with coat and a
+    Metallic BSDF in Physical Conductor mode (:mod:`fitting.exports.blender`);
+-   ``gltf``: glTF 2.0 with ``KHR_materials_clearcoat`` and a sphere
+    (:mod:`fitting.exports.gltf`).
+
+The values come from :mod:`fitting.exports.values`, their loss against the
+spectral reference from :mod:`fitting.exports.tool_fresnel`.
+
+-   :data:`EXPORT_FORMATS`: media type and file suffix per format.
+-   :func:`export_material`: the document of a material in a format.
+"""
+
+from __future__ import annotations
+
+from .blender import blender_script
+from .gltf import gltf_document
+from .mtlx import mtlx_document
+from .openpbr import openpbr_document
+from .tool_fresnel import TOOL_MODELS, export_fidelity, tool_curve
+from ..domain import check_eta_i
+from .values import ETA_I_LIMITS, ExportValues, export_values
+
+__all__ = [
+    "EXPORT_FORMATS",
+    "ETA_I_LIMITS",
+    "ExportValues",
+    "TOOL_MODELS",
+    "check_format",
+    "export_fidelity",
+    "export_material",
+    "export_values",
+    "tool_curve",
+]
+
+EXPORT_FORMATS = {
+    "mtlx": ("application/xml", "mtlx"),
+    "openpbr": ("application/xml", "openpbr.mtlx"),
+    "blender": ("text/x-python; charset=utf-8", "py"),
+    "gltf": ("model/gltf+json", "gltf"),
+}
+"""Format -> (media type, file suffix)."""
+
+_WRITERS = {
+    "mtlx": mtlx_document,
+    "openpbr": openpbr_document,
+    "blender": blender_script,
+    "gltf": gltf_document,
+}
+
+
+def check_format(format: str) -> str:
+    """``format`` if it is one of :data:`EXPORT_FORMATS`, else ``ValueError``."""
+    if format not in EXPORT_FORMATS:
+        raise ValueError(f"`format` must be one of {', '.join(EXPORT_FORMATS)}, got {format!r}")
+    return format
+
+
+def export_material(
+    fit_or_nk, format: str, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03
+) -> bytes:
+    """
+    The export of a material for one coating index, as UTF-8 bytes.
+
+    Parameters
+    ----------
+    fit_or_nk
+        Measured n, k (:class:`fitting.optics.nk.SpectralNK`), a mapping
+        ``{"name", "source", "n", "k"}`` of per-channel n, k (an
+        ``rgb-conductor`` fit, linear ACEScg), a mapping with a
+        ``reflectance(cos_theta, eta_i)`` model curve (see
+        :func:`export_values`), or :class:`ExportValues` already computed
+        (then ``eta_i`` must be theirs).
+    format
+        One of :data:`EXPORT_FORMATS`.
+    eta_i
+        Coating index, [1, 3].
+    roughness, coat_roughness
+        Perceptual roughness of the metal and the coat, [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For an unknown format, eta_i outside [1, 3], a roughness outside
+        [0, 1], or unusable n, k; the message names the argument.
+    """
+    check_format(format)
+    eta = check_eta_i(eta_i)
+    if isinstance(fit_or_nk, ExportValues):
+        if abs(fit_or_nk.eta_i - eta) > 1e-12:
+            raise ValueError(
+                f"`eta_i` must be the values' own {fit_or_nk.eta_i:g} for ExportValues, got {eta_i}"
+            )
+        values = fit_or_nk
+    else:
+        values = export_values(fit_or_nk, eta, roughness, coat_roughness)
+    return _WRITERS[format](values).encode("utf-8")

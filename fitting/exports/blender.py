@@ -1,0 +1,175 @@
+"""
+Blender export
+==============
+
+A Python script that builds the material's node tree in Blender (4.3 or
+later; checked with the ``bpy`` 5.0 module). Run it in Blender's Text Editor
+or ``blender --python FILE``; it calls :func:`build_material` in the script,
+which makes a material with two outputs:
+
+-   the active ``Material Output``: a Principled BSDF, ``Metallic`` 1, with
+    ``Base Color`` and ``Specular Tint`` the F0 and F82 tint fitted to the
+    metal's reflectance under the coat (Cycles and EEVEE evaluate a metallic
+    Principled BSDF with the F82-tint model), ``Coat Weight`` 1 and ``Coat
+    IOR`` eta_i;
+-   a second ``Material Output (Physical Conductor)``: a Metallic BSDF in
+    Physical Conductor mode with ``IOR`` and ``Extinction`` the per-channel
+    relative index (n + i k) / eta_i, under a coat made of a Glossy BSDF
+    mixed in by the Fresnel of eta_i. Make it the active output to use it.
+
+The script uses only ``bpy`` and the standard library; its values are
+literals, and its provenance is in the header comment and in the material's
+custom property ``coated_fresnel`` (JSON).
+
+-   :func:`blender_script`: the script as text.
+"""
+
+from __future__ import annotations
+
+import json
+
+from .tool_fresnel import export_fidelity
+from .values import ExportValues
+
+__all__ = ["MODEL_KIND", "blender_script", "NODE_NAMES"]
+
+MODEL_KIND = (
+    "f82-tint (Principled BSDF, active output) and rgb-conductor "
+    "(Metallic BSDF, Physical Conductor, second output)"
+)
+
+NODE_NAMES = {
+    "principled": "Coated Metal (Principled)",
+    "output": "Material Output",
+    "metallic": "Metal (Physical Conductor)",
+    "coat_glossy": "Coat (Physical Conductor)",
+    "coat_fresnel": "Coat Fresnel (Physical Conductor)",
+    "coat_mix": "Coated Metal (Physical Conductor)",
+    "conductor_output": "Material Output (Physical Conductor)",
+}
+"""The names of the nodes the script makes (tests read the values back by them)."""
+
+_SCRIPT = '''\
+# Blender: a coated metal, made by coated-fresnel. Run in Blender's Text Editor
+# or with `blender --python THIS_FILE`; needs only bpy.
+#
+{header}
+import json
+
+import bpy
+
+MATERIAL_NAME = {material_name!r}
+PROVENANCE = {provenance_json!r}
+ETA_I = {eta_i!r}
+ROUGHNESS = {roughness!r}
+COAT_ROUGHNESS = {coat_roughness!r}
+# F82-tint model, linear Rec.709 (Blender's scene linear), fitted under the coat.
+BASE_COLOR = {F0!r}
+SPECULAR_TINT = {tint!r}
+# Relative index (n + i k) / eta_i per channel, linear Rec.709.
+CONDUCTOR_IOR = {n_rel!r}
+CONDUCTOR_EXTINCTION = {k_rel!r}
+NODE_NAMES = {node_names!r}
+
+
+def _node(tree, kind, name, location):
+    node = tree.nodes.new(kind)
+    node.name = node.label = name
+    node.location = location
+    return node
+
+
+def build_material(name=MATERIAL_NAME):
+    """Make the material and return it (a new one each call)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    tree.nodes.clear()
+    material["coated_fresnel"] = PROVENANCE
+
+    principled = _node(tree, "ShaderNodeBsdfPrincipled", NODE_NAMES["principled"], (0, 300))
+    principled.inputs["Base Color"].default_value = (*BASE_COLOR, 1.0)
+    principled.inputs["Metallic"].default_value = 1.0
+    principled.inputs["Roughness"].default_value = ROUGHNESS
+    principled.inputs["Specular Tint"].default_value = (*SPECULAR_TINT, 1.0)
+    principled.inputs["Coat Weight"].default_value = 1.0
+    principled.inputs["Coat Roughness"].default_value = COAT_ROUGHNESS
+    principled.inputs["Coat IOR"].default_value = ETA_I
+    principled.inputs["Coat Tint"].default_value = (1.0, 1.0, 1.0, 1.0)
+    output = _node(tree, "ShaderNodeOutputMaterial", NODE_NAMES["output"], (300, 300))
+    tree.links.new(principled.outputs["BSDF"], output.inputs["Surface"])
+
+    metallic = _node(tree, "ShaderNodeBsdfMetallic", NODE_NAMES["metallic"], (0, -300))
+    metallic.fresnel_type = "PHYSICAL_CONDUCTOR"
+    metallic.distribution = "MULTI_GGX"
+    metallic.inputs["IOR"].default_value = CONDUCTOR_IOR
+    metallic.inputs["Extinction"].default_value = CONDUCTOR_EXTINCTION
+    metallic.inputs["Roughness"].default_value = ROUGHNESS
+    glossy = _node(tree, "ShaderNodeBsdfAnisotropic", NODE_NAMES["coat_glossy"], (0, -650))
+    glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    glossy.inputs["Roughness"].default_value = COAT_ROUGHNESS
+    fresnel = _node(tree, "ShaderNodeFresnel", NODE_NAMES["coat_fresnel"], (0, -100))
+    fresnel.inputs["IOR"].default_value = ETA_I
+    # The coat: its own Fresnel reflection, and the metal with what it lets through.
+    mix = _node(tree, "ShaderNodeMixShader", NODE_NAMES["coat_mix"], (300, -300))
+    tree.links.new(fresnel.outputs["Fac"], mix.inputs["Fac"])
+    tree.links.new(metallic.outputs["BSDF"], mix.inputs[1])
+    tree.links.new(glossy.outputs["BSDF"], mix.inputs[2])
+    conductor_output = _node(
+        tree, "ShaderNodeOutputMaterial", NODE_NAMES["conductor_output"], (600, -300)
+    )
+    tree.links.new(mix.outputs["Shader"], conductor_output.inputs["Surface"])
+
+    conductor_output.is_active_output = False
+    output.is_active_output = True
+    return material
+
+
+def use_output(material, which):
+    """Make ``"principled"`` or ``"conductor"`` the material's active output."""
+    if which not in ("principled", "conductor"):
+        raise ValueError(f"`which` must be 'principled' or 'conductor', got {{which!r}}")
+    nodes = material.node_tree.nodes
+    nodes[NODE_NAMES["output"]].is_active_output = which == "principled"
+    nodes[NODE_NAMES["conductor_output"]].is_active_output = which == "conductor"
+
+
+if __name__ == "__main__":
+    made = build_material()
+    target = bpy.context.active_object if hasattr(bpy.context, "active_object") else None
+    if target is not None and getattr(target, "type", None) == "MESH":
+        target.data.materials.clear()
+        target.data.materials.append(made)
+    print(f"coated-fresnel: made material {{made.name!r}}: {{json.loads(PROVENANCE)['material']}}")
+'''
+
+
+def _floats(values) -> tuple[float, ...]:
+    return tuple(round(float(v), 6) for v in values)
+
+
+def blender_script(values: ExportValues) -> str:
+    """The Blender Python script of ``values``, UTF-8 text."""
+    provenance = values.provenance(MODEL_KIND, export_fidelity(values, "blender"))
+    provenance["delta_E_2000_under_coat_physical_conductor"] = (
+        "mean {delta_E_mean:.3f}, max {delta_E_max:.3f}".format(
+            **export_fidelity(values, "blender-conductor")
+        )
+    )
+    header = "\n".join(
+        "# " + "".join(ch if 32 <= ord(ch) < 127 else " " for ch in f"{key}: {value}")
+        for key, value in provenance.items()
+    )
+    return _SCRIPT.format(
+        header=header,
+        material_name=f"{values.name} coated (eta_i {values.eta_i:g})",
+        provenance_json=json.dumps(provenance, sort_keys=True),
+        eta_i=round(values.eta_i, 6),
+        roughness=round(values.roughness, 6),
+        coat_roughness=round(values.coat_roughness, 6),
+        F0=_floats(values.F0),
+        tint=_floats(values.F82_tint),
+        n_rel=_floats(values.n_rel),
+        k_rel=_floats(values.k_rel),
+        node_names=NODE_NAMES,
+    )

@@ -1,0 +1,11 @@
+
+// ${name}: ${source}
+// Fit ${fit_id} (rgb-conductor); Delta E 2000 against the spectral reference: ${quality}.
+// n and k per channel (R, G, B) are the shipped float16 values.
+static const float3 ${prefix}_N = float3(${n});
+static const float3 ${prefix}_K = float3(${k});
+
+float3 cf_material_${ident}(float NdotV, float eta_i)
+{
+    return cf_rgb_conductor(NdotV, eta_i, ${prefix}_N, ${prefix}_K);
+}

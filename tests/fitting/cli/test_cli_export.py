@@ -1,0 +1,44 @@
+"""``python -m fitting fit MATERIAL --export FORMAT --eta-i X -o FILE``."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from fitting.exports import export_material
+from fitting.optics.library import library_material
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "fitting", *args], capture_output=True, text=True, cwd=ROOT,
+        timeout=300,
+    )
+
+
+class TestExportOption:
+    def test_writes_the_export(self, tmp_path):
+        out = tmp_path / "au.mtlx"
+        result = cli("fit", "Au", "--export", "mtlx", "--eta-i", "1.5", "-o", str(out))
+        assert result.returncode == 0, result.stderr
+        assert out.read_bytes() == export_material(library_material("Au"), "mtlx", 1.5)
+
+    def test_stdout_and_roughness(self):
+        result = cli("fit", "Cr", "--export", "gltf", "--eta-i", "2", "--roughness", "0.5")
+        assert result.returncode == 0, result.stderr
+        material = json.loads(result.stdout)["materials"][0]
+        assert material["pbrMetallicRoughness"]["roughnessFactor"] == 0.5
+        assert material["extras"]["coated_fresnel"]["eta_i"] == 2.0
+
+    def test_bad_eta_i(self):
+        result = cli("fit", "Au", "--export", "openpbr", "--eta-i", "0.8")
+        assert result.returncode == 2
+        assert "`eta_i` must lie in [1, 3], got 0.8" in result.stderr
+
+    def test_bad_format(self):
+        result = cli("fit", "Au", "--export", "usd")
+        assert result.returncode == 2 and "invalid choice: 'usd'" in result.stderr

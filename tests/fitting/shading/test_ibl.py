@@ -1,0 +1,118 @@
+"""The split-sum LUT: pre-integration, lookup, file format, average Fresnel."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from fitting.models.baselines import lazanyi_adjusted, external_medium_F0, lazanyi_a
+from fitting.models.coated_conductor import model_from_parameters
+from fitting.shading.ibl import (
+    SplitSumLUT,
+    _hammersley,
+    _node_terms,
+    average_fresnel,
+    decode_lut,
+    encode_lut,
+    energy_compensation,
+    generate_lut,
+    split_sum_lazanyi,
+    split_sum_model,
+    split_sum_schlick,
+)
+
+
+@pytest.fixture(scope="module")
+def lut():
+    return generate_lut(shape=(16, 24, 32), samples=512)
+
+
+class TestAverageFresnel:
+    @pytest.mark.parametrize("F0, a, alpha", [(0.5, 1.2, 4.0), (0.9, -0.3, 0.9), (0.2, 3.0, 8.0), (1.0, 0.0, 6.0)])
+    def test_closed_form_matches_quadrature(self, F0, a, alpha):
+        value, _ = quad(lambda mu: 2.0 * mu * model_from_parameters(mu, F0, a, alpha), 0.0, 1.0, epsabs=1e-13)
+        assert average_fresnel(F0, a, alpha) == pytest.approx(value, abs=1e-12)
+
+    def test_n_dimensional(self):
+        F0 = np.full((4, 3), 0.5)
+        assert average_fresnel(F0, 1.0, 5.0).shape == (4, 3)
+
+    def test_perfect_mirror_compensation(self):
+        # F = 1 everywhere: average 1, and the factor restores the white lobe to 1.
+        assert average_fresnel(1.0, 0.0, 6.0) == 1.0
+        assert energy_compensation(0.8, 1.0) * 0.8 == pytest.approx(1.0)
+
+
+class TestLUT:
+    def test_nodes_reproduced_exactly(self, lut):
+        n_alpha, n_r, n_mu = lut.shape
+        mu = (np.arange(n_mu) / (n_mu - 1)) ** 2
+        r = np.arange(n_r) / (n_r - 1)
+        alphas = lut.alpha_nodes()
+        got = lut.lookup(mu[None, :], r[:, None], alphas[7])
+        np.testing.assert_allclose(got, lut.data[7].astype(np.float64), rtol=1e-6, atol=1e-12)
+
+    def test_deterministic(self):
+        a = generate_lut(shape=(2, 3, 4), samples=64)
+        b = generate_lut(shape=(2, 3, 4), samples=64)
+        assert a.data.tobytes() == b.data.tobytes()
+
+    def test_terms_are_physical(self, lut):
+        A, B, G = lut.data[..., 0], lut.data[..., 1], lut.data[..., 2]
+        assert np.all(A >= 0) and np.all(B >= 0) and np.all(G >= 0)
+        assert np.all(A + B <= 1.0 + 1e-6)
+
+    def test_split_sum_matches_direct_quadrature(self, lut):
+        u1, u2 = _hammersley(8192)
+        F0, a, alpha = np.array([0.6, 0.5, 0.4]), np.array([1.0, 0.7, 0.2]), np.array([5.0, 3.5, 2.0])
+        mu = np.array([0.1, 0.37, 0.8])
+        for r in (0.15, 0.55, 0.9):
+            terms = _node_terms(mu, r, alpha, u1, u2)
+            expected = F0 * terms[..., 0] + terms[..., 1] - a * terms[..., 2]
+            got = split_sum_model(mu, r, F0, a, alpha, lut)
+            np.testing.assert_allclose(got, expected, rtol=0.01)
+
+    def test_baselines_are_the_same_form(self, lut):
+        F0_air, F82_air = np.array([0.95, 0.64, 0.29]), np.array([0.91, 0.70, 0.45])
+        mu = np.linspace(0.05, 1, 7)
+        lz = split_sum_lazanyi(mu, 0.4, 1.5, F0_air, F82_air, lut)
+        ref = split_sum_model(mu, 0.4, external_medium_F0(F0_air, 1.5), lazanyi_a(F0_air, F82_air), 6.0, lut)
+        np.testing.assert_allclose(lz, ref)
+        sch = split_sum_schlick(mu, 0.4, F0_air, lut)
+        np.testing.assert_allclose(sch, split_sum_model(mu, 0.4, F0_air, 0.0, 3.0, lut))
+        # At roughness 0 the albedo is the Fresnel itself (up to shadowing at grazing).
+        np.testing.assert_allclose(
+            split_sum_lazanyi(0.8, 0.0, 1.5, F0_air, F82_air, lut),
+            lazanyi_adjusted(0.8, 1.5, F0_air, F82_air), rtol=2e-3,
+        )
+
+    def test_rejects_non_finite(self, lut):
+        with pytest.raises(ValueError, match="`NdotV` must be finite"):
+            split_sum_model(np.nan, 0.3, 0.5, 0.1, 5.0, lut)
+
+
+class TestFileFormat:
+    def test_round_trip(self, lut):
+        blob = encode_lut(lut)
+        back = decode_lut(blob)
+        assert back.data.tobytes() == lut.data.tobytes() and back.alpha_range == lut.alpha_range
+        assert len(blob) == 32 + 4 + lut.data.nbytes
+
+    def test_damaged(self, lut):
+        blob = bytearray(encode_lut(lut))
+        blob[100] ^= 1
+        with pytest.raises(ValueError, match="CRC-32 mismatch"):
+            decode_lut(bytes(blob))
+        with pytest.raises(ValueError, match="truncated"):
+            decode_lut(b"CFIBLUT1")
+        with pytest.raises(ValueError, match="not a split-sum LUT"):
+            decode_lut(b"X" * 100)
+        with pytest.raises(ValueError, match="must be"):
+            decode_lut(bytes(blob[:-8]))
+
+    def test_rejects_bad_shape(self):
+        with pytest.raises(ValueError, match="`shape` must hold"):
+            generate_lut(shape=(1, 4, 4))
+        with pytest.raises(ValueError, match="`samples` must lie"):
+            generate_lut(samples=3)

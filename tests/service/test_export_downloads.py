@@ -1,0 +1,104 @@
+"""``GET /api/v1/fits/{id}/pack?format=mtlx|openpbr|blender|gltf&eta_i=...``."""
+
+from __future__ import annotations
+
+import json
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from conftest import app_client
+from fitting.fits.curves_base import curve_base_from_nk
+from fitting.exports import export_material
+from fitting.optics.library import library_material
+
+API = "/api/v1"
+
+
+@pytest.fixture(scope="module")
+def shared(tmp_path_factory):
+    with app_client(tmp_path_factory.mktemp("exports"), metrics_samples=30) as client:
+        response = client.post(f"{API}/fits", json={"material": "Cu"})
+        assert response.status_code == 201, response.text
+        yield client, response.json()["id"]
+
+
+def pack(client, fit_id, query):
+    return client.get(f"{API}/fits/{fit_id}/pack?{query}")
+
+
+class TestExportDownloads:
+    @pytest.mark.parametrize("format, media_type, suffix", [
+        ("mtlx", "application/xml", ".mtlx"), ("openpbr", "application/xml", ".openpbr.mtlx"),
+        ("blender", "text/x-python; charset=utf-8", ".py"), ("gltf", "model/gltf+json", ".gltf"),
+    ])
+    def test_each_format_is_the_library_export(self, shared, format, media_type, suffix):
+        client, fit_id = shared
+        response = pack(client, fit_id, f"format={format}&eta_i=1.7")
+        assert response.status_code == 200, response.text
+        assert response.headers["content-type"] == media_type
+        assert response.headers["content-disposition"] == (
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.7{suffix}"')
+        assert response.content == export_material(library_material("Cu"), format, 1.7)
+
+    def test_default_eta_i_is_1_5(self, shared):
+        client, fit_id = shared
+        root = ET.fromstring(pack(client, fit_id, "format=openpbr").content)
+        (coat_ior,) = [e for e in root.iter("input") if e.get("name") == "coat_ior"]
+        assert coat_ior.get("value") == "1.5"
+
+    @pytest.mark.parametrize("query, words", [
+        ("format=mtlx&eta_i=0.8", ["eta_i", "greater than or equal to 1"]),
+        ("format=gltf&eta_i=3.5", ["eta_i", "less than or equal to 3"]),
+        ("format=blender&eta_i=nan", ["eta_i", "finite"]),
+        ("format=mtlx&eta_i=abc", ["eta_i", "number"]),
+        ("format=usd&eta_i=1.5", ["format", "'mtlx'", "'gltf'"]),
+    ])
+    def test_bad_query_422(self, shared, query, words):
+        client, fit_id = shared
+        response = pack(client, fit_id, query)
+        assert response.status_code == 422, response.text
+        detail = response.json()["detail"]
+        assert all(word in detail for word in words), detail
+
+    def test_unknown_fit_404(self, shared):
+        client, _ = shared
+        assert pack(client, "0" * 32, "format=mtlx").status_code == 404
+
+    def test_old_formats_unchanged(self, shared):
+        client, fit_id = shared
+        response = pack(client, fit_id, "format=json&eta_i=2")
+        assert response.status_code == 200 and response.json()["format"]
+
+
+@pytest.fixture(scope="module")
+def curve_fit(shared):
+    client, _ = shared
+    angle = np.linspace(0.0, 90.0, 31)
+    mu = np.where(angle == 90.0, 0.0, np.cos(np.radians(angle)))
+    curves = []
+    for eta_i in (1.3, 1.9):
+        rgb = np.clip(curve_base_from_nk(library_material("Cu")).rgb(mu, eta_i), 0, 1)
+        rgb[:, 2] *= 0.8
+        curves.append({"eta_i": eta_i, "angle_deg": angle.tolist(), "rgb": rgb.tolist()})
+    response = client.post(f"{API}/fits/from-curves", json={"name": "edited copper",
+                                                             "curves": curves})
+    assert response.status_code == 201, response.text
+    return response.json()
+
+
+class TestCurveFitExports:
+    def test_export_from_the_model_curve(self, shared, curve_fit):
+        client, _ = shared
+        response = pack(client, curve_fit["id"], "format=gltf&eta_i=1.5")
+        assert response.status_code == 200, response.text
+        provenance = json.loads(response.content)["materials"][0]["extras"]["coated_fresnel"]
+        assert "edited curves" in provenance["fitted_to"] and provenance["eta_i"] == 1.5
+
+    def test_outside_the_fit_domain_422(self, shared, curve_fit):
+        client, _ = shared
+        lo, hi = curve_fit["eta_i_range"]
+        response = pack(client, curve_fit["id"], f"format=mtlx&eta_i={hi + 0.3:g}")
+        assert response.status_code == 422
+        assert "`eta_i` must lie in the fit's domain" in response.json()["detail"]
