@@ -24,7 +24,7 @@ from fastapi.staticfiles import StaticFiles
 
 from .api.errors import install_error_handlers
 from .api.middleware import HostAllowList, RequestLimits
-from .api.routes import curves, fits, health, materials, packs, preview, scenes
+from .api.routes import curves, fits, health, materials, packs, preview, reference_texture, scenes
 from .config import Settings
 from .pool import FitRunner
 from .schemas import API_PREFIX
@@ -32,8 +32,27 @@ from .store import SQLiteStore
 
 STATIC_DIR = Path(__file__).resolve().parents[1] / "static"
 """The browser editor, served at ``/``."""
+GLSL_DIR = Path(__file__).resolve().parents[1] / "preview_shaders" / "glsl"
+"""The project's GLSL, served at ``/glsl/`` for the editor's WebGL2 preview."""
 
 __all__ = ["create_app"]
+
+
+def _offline_docs(app: FastAPI) -> None:
+    """``/docs``: Swagger UI from the ``swagger_ui_bundle`` package, not a CDN."""
+    import swagger_ui_bundle
+    from fastapi.openapi.docs import get_swagger_ui_html
+
+    app.mount("/docs-assets", StaticFiles(directory=swagger_ui_bundle.swagger_ui_path), name="docs-assets")
+
+    @app.get("/docs", include_in_schema=False)
+    async def docs():
+        return get_swagger_ui_html(
+            openapi_url=app.openapi_url, title=f"{app.title} - API docs",
+            swagger_js_url="/docs-assets/swagger-ui-bundle.js",
+            swagger_css_url="/docs-assets/swagger-ui.css",
+            swagger_favicon_url="/docs-assets/favicon-32x32.png",
+        )
 
 
 def create_app(settings: Settings | None = None) -> FastAPI:
@@ -70,12 +89,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         summary="Fit the coated-conductor Fresnel model (Vernooij 2024) to measured n, k "
                 "and download float16 coefficient packs.",
         lifespan=lifespan,
+        docs_url=None,  # served below from local Swagger UI assets (works offline)
     )
     app.state.settings = settings
     app.state.preview_renderer = None
     install_error_handlers(app)
-    for module in (health, materials, fits, packs, preview, curves, scenes):
+    for module in (health, materials, fits, packs, preview, reference_texture, curves, scenes):
         app.include_router(module.router)
+    _offline_docs(app)
+    app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")
     # The browser editor (static/), after the API so that /api, /docs and
     # /openapi.json keep their routes; html=True serves index.html at /.
     app.mount("/", StaticFiles(directory=STATIC_DIR, html=True), name="editor")

@@ -54,9 +54,9 @@ from .common import (
     stored_fit,
 )
 
-__all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map"]
+__all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
 
-CURVES_FORMAT = "curves/v1"
+CURVES_FORMAT = "curves/v2"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 DEFAULTS = CurveFitSettings()
 DEFAULT_DOMAIN = DEFAULT_ETA_I_RANGE
@@ -111,6 +111,7 @@ class CurveFit:
     blend_width: float
     request: dict[str, Any]
     fit_id: str
+    draft: bool = False
 
 
 def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
@@ -165,7 +166,7 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
                       base_fit: str | None = None, base_nk: tuple | None = None,
                       eta_i_range=None, objective: str = DEFAULTS.objective,
                       blend_width: float = DEFAULTS.blend_width,
-                      request: dict[str, Any] | None = None) -> CurveFit:
+                      request: dict[str, Any] | None = None, draft: bool = False) -> CurveFit:
     """
     Resolve the base (``LookupError`` for a base fit not stored), check the
     curves and the domain (``ValueError``), and compute the id. Runs in a
@@ -183,7 +184,7 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
         list(domain), objective, blend_width, repr(DEFAULTS),
     )
     return CurveFit(name, base, base_record, curves, domain, objective, blend_width,
-                    request or {}, fit_id)
+                    request or {}, fit_id, draft)
 
 
 def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: str,
@@ -215,9 +216,16 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
 
 
 async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tuple[FitRecord, bool]:
-    """The stored fit of ``fit`` (an earlier state saved again becomes the latest), else fitted and saved."""
+    """
+    The stored fit of ``fit`` (an earlier state saved again becomes the
+    latest), else fitted and saved; a draft (the editor's refits while
+    editing) is stored but not saved under its material until the same
+    request comes without ``draft``.
+    """
     stored = await asyncio.to_thread(store.get_fit, fit.fit_id)
     if stored is not None:
+        if fit.draft:
+            return stored, False
         return await asyncio.to_thread(store.put_fit, stored), False
     await asyncio.to_thread(checked_writable, store)
     base, base_record = fit.base, fit.base_record
@@ -246,9 +254,15 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
                 "settings": {k: getattr(DEFAULTS, k) for k in DEFAULTS.__dataclass_fields__},
             },
         )
-        return await asyncio.to_thread(store.put_fit, record)
+        return await asyncio.to_thread(store.put_fit, record, not fit.draft)
 
-    return await runner.once(fit.fit_id, make), True
+    record = await runner.once(fit.fit_id, make)
+    if not fit.draft:
+        # The fit was shared with a draft request in flight: saved now.
+        latest = await asyncio.to_thread(store.latest_fit, record.material_id)
+        if latest is None or latest.id != record.id:
+            record = await asyncio.to_thread(store.put_fit, record)
+    return record, True
 
 
 def _measured_nk_or_refuse(record: FitRecord) -> SpectralNK:
@@ -280,6 +294,20 @@ def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
     grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
     E, M = np.meshgrid(eta, mu, indexing="ij")
     return eta, grid.rgb(M, E), "reference"
+
+
+def target_at(record: FitRecord, mu: np.ndarray, eta_i: float) -> list[list[float]]:
+    """
+    A curve fit's target at one eta_i: the blended edited target (with a
+    base), or the curve at that eta_i (without; ValueError if none is there).
+    """
+    rows, target, against = _target_of(record, mu, np.array([float(eta_i)]))
+    if against == "curves":
+        matches = np.flatnonzero(np.abs(rows - eta_i) < 1e-6)
+        if not matches.size:
+            raise ValueError(f"fit {record.id} has no curve at eta_i {eta_i:g}")
+        return target[matches[0]].tolist()
+    return target[0].tolist()
 
 
 def error_map(record: FitRecord, angles: int, rows: int) -> dict[str, Any]:

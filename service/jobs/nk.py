@@ -35,6 +35,7 @@ from fitting.optics.readers import FORMATS, read_nk
 
 from ..pool import FitRunner
 from ..store import FitRecord, Store
+from .curves import target_at
 from .common import (
     FIT_FORMAT_VERSION,
     check_finite,
@@ -207,7 +208,14 @@ def angle_curves(record: FitRecord, eta_i: float, samples: int) -> dict[str, Any
         reference = reference_ACEScg(nk, mu, eta_i).tolist()
         inputs = baseline_inputs(nk)
         baseline = lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist()
+    target = reference
+    if record.kind == "curves":
+        try:
+            target = target_at(record, mu, eta_i)
+        except ValueError:
+            target = None  # no curve at this eta_i and no base to blend into
     return {
         "fit_id": record.id, "eta_i": eta_i, "theta_deg": theta.tolist(), "cos_theta": mu.tolist(),
-        "model": model.tolist(), "reference": reference, "lazanyi_adjusted": baseline,
+        "model": model.tolist(), "target": target, "reference": reference,
+        "lazanyi_adjusted": baseline,
     }

@@ -114,6 +114,8 @@ class CurveFitRequest(RequestModel):
     curves: list[CurveIn] = Field(min_length=1, max_length=CURVE_MAX_COUNT)
     objective: Objective = _DEFAULTS.objective
     blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False, strict=True)
+    draft: bool = Field(False, description="Store the fit without saving it under `name` (the editor's "
+                                           "refits while editing); the same request with false saves it")
 
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":

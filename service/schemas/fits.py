@@ -190,6 +190,9 @@ class CurvesPublic(BaseModel):
     theta_deg: list[float]
     cos_theta: list[float]
     model: list[list[float]]
+    target: list[list[float]] | None = Field(
+        None, description="What the fit was fitted to at this eta_i: for a curve fit the blended "
+                          "edited target (or its curve), else the reference")
     reference: list[list[float]] | None = None
     lazanyi_adjusted: list[list[float]] | None = None
 

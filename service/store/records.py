@@ -144,10 +144,12 @@ class RecordDamaged(StoreError):
 class Store(Protocol):
     """The store interface of the service (thread-safe implementations)."""
 
-    def put_fit(self, record: FitRecord) -> FitRecord:
+    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
         """
         Save ``record`` unless its id exists, and log the save (the fit
-        becomes its material's latest); return the stored record.
+        becomes its material's latest); return the stored record. With
+        ``save`` False (a draft) the record is stored but not logged: it is
+        reachable by id and lists under no material until saved.
         """
 
     def get_fit(self, fit_id: str) -> FitRecord | None:

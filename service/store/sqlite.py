@@ -180,7 +180,7 @@ class SQLiteStore:
 
     # -- the interface -----------------------------------------------------
 
-    def put_fit(self, record: FitRecord) -> FitRecord:
+    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
         if not record.created_at:
             record = FitRecord(**{**asdict(record), "created_at": time.time()})
         text = record.to_json()
@@ -196,6 +196,8 @@ class SQLiteStore:
                 stored_text = connection.execute(
                     "SELECT record FROM fits WHERE id = ?", (record.id,)).fetchone()[0]
                 stored = self._decode(record.id, stored_text)
+                if not save:  # a draft: stored, reachable by id, listed under no material
+                    return stored
                 now = time.time()
                 seq = connection.execute(
                     "INSERT INTO saves (material_id, fit_id, saved_at) VALUES (?, ?, ?)",
