@@ -11,19 +11,28 @@ data directory, then runs a bounded load generator against it:
 -   ``--readers`` closed-loop clients that download the binary pack of a
     stored fit at the same time.
 
-Prints one table: fits per second (answered 201), 503 refusals, and the
-latency percentiles of pack downloads with no fits running (idle) and while
-the fits run (under load).
+First, one client alone POSTs ``--latency-fits`` fits of data the service has
+not seen, one after the other: half a library metal over a new eta_i range,
+half an upload of perturbed n, k (metrics on the paper's grid included).
+
+Prints one table: the REST fit latency of unseen data (first, p50, p90),
+fits per second (answered 201), 503 refusals, and the latency percentiles of
+pack downloads with no fits running (idle) and while the fits run (under
+load). Then a burst: ``--burst`` (200) fits posted at
+once (each its own connection), while a *separate process* (``--probe``)
+times ``/healthz`` and pack downloads back to back; their p99 is the number
+the issue asks for (target < 100 ms).
 
 Usage::
 
     .venv/bin/python benchmarks/service_load.py [--duration 20] [--fit-clients 4]
-        [--readers 2] [--workers N] [--metrics-samples 100]
+        [--readers 2] [--workers N] [--metrics-samples 100] [--burst 200] [--latency-fits 40]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import socket
 import subprocess
@@ -59,6 +68,35 @@ def percentiles(samples: list[float]) -> tuple[float, float, float, float]:
     return tuple(float(np.percentile(ms, q)) for q in (50, 95, 99)) + (float(ms.max()),)
 
 
+def unseen_fit_bodies(count: int) -> list[dict]:
+    """Fits the service cannot have stored: library metals over new eta_i ranges, perturbed uploads."""
+    metals = ("Au", "Cu", "Ag", "Al", "Cr", "Ni", "W", "Pd")
+    rng = np.random.default_rng(14)
+    bodies = []
+    for j in range(count):
+        if j % 2 == 0:
+            lo = round(1.0 + 0.01 * (j // 2 % 50), 3)
+            hi = round(lo + 0.6 + 0.01 * (j % 37), 3)
+            bodies.append({"material": metals[j // 2 % len(metals)], "eta_i_range": [lo, min(hi, 3.0)]})
+        else:
+            body = nk_body(f"unseen {j}")
+            body["nk"]["n"] = (np.asarray(body["nk"]["n"]) * (1.0 + 0.02 * rng.random(26))).tolist()
+            bodies.append(body)
+    return bodies
+
+
+def fit_latencies(url: str, bodies: list[dict]) -> list[float]:
+    out = []
+    with httpx.Client(base_url=url, timeout=300) as http:
+        for body in bodies:
+            start = time.perf_counter()
+            response = http.post(f"{API}/fits", json=body)
+            out.append(time.perf_counter() - start)
+            if response.status_code != 201:
+                raise SystemExit(f"unseen fit answered {response.status_code}: {response.text[:200]}")
+    return out
+
+
 def read_packs(url: str, fit_id: str, stop: threading.Event, out: list[float]) -> None:
     with httpx.Client(base_url=url, timeout=60) as http:
         while not stop.is_set():
@@ -81,7 +119,53 @@ def post_fits(url: str, client: int, stop: threading.Event, counts: dict, lock: 
                 time.sleep(float(response.headers.get("retry-after", "1")))
 
 
+def probe(url: str, fit_id: str, seconds: float) -> int:
+    """Separate process: time /healthz and a pack download back to back; print JSON."""
+    out: dict[str, list[float]] = {"healthz": [], "pack": []}
+    errors = 0
+    with httpx.Client(base_url=url, timeout=30) as http:
+        deadline = time.monotonic() + seconds
+        while time.monotonic() < deadline:
+            for key, path in (("healthz", "/healthz"), ("pack", f"{API}/fits/{fit_id}/pack")):
+                start = time.perf_counter()
+                response = http.get(path)
+                out[key].append(time.perf_counter() - start)
+                errors += response.status_code != 200
+    print(json.dumps({**out, "errors": errors}))
+    return 0
+
+
+def burst(url: str, fit_id: str, count: int) -> tuple[dict, dict, float]:
+    """``count`` fits posted at once while a separate process probes; (probe, status counts, s)."""
+    prober = subprocess.Popen(
+        [sys.executable, __file__, "--probe", url, fit_id, "--duration", "12"],
+        stdout=subprocess.PIPE, text=True)
+    time.sleep(1.0)  # the probe runs before, during and after the burst
+    counts: dict = {}
+    lock = threading.Lock()
+    start_gate = threading.Barrier(count)
+
+    def one(i: int) -> None:
+        with httpx.Client(base_url=url, timeout=300) as http:
+            start_gate.wait()
+            response = http.post(f"{API}/fits", json=nk_body(f"burst {i}"))
+            with lock:
+                counts[response.status_code] = counts.get(response.status_code, 0) + 1
+
+    threads = [threading.Thread(target=one, args=(i,)) for i in range(count)]
+    start = time.perf_counter()
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    elapsed = time.perf_counter() - start
+    result = json.loads(prober.communicate(timeout=120)[0])
+    return result, counts, elapsed
+
+
 def main() -> int:
+    if len(sys.argv) > 1 and sys.argv[1] == "--probe":
+        return probe(sys.argv[2], sys.argv[3], float(sys.argv[5]))
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--duration", type=float, default=20.0, help="seconds of load (default 20)")
     parser.add_argument("--idle", type=float, default=5.0, help="seconds of idle pack reads (default 5)")
@@ -89,6 +173,9 @@ def main() -> int:
     parser.add_argument("--readers", type=int, default=2)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--metrics-samples", type=int, default=100)
+    parser.add_argument("--burst", type=int, default=200, help="fits posted at once (default 200)")
+    parser.add_argument("--latency-fits", type=int, default=40,
+                        help="sequential fits of unseen data for the REST fit latency (default 40)")
     args = parser.parse_args()
 
     with tempfile.TemporaryDirectory() as data:
@@ -111,6 +198,7 @@ def main() -> int:
                 if time.monotonic() > deadline or server.poll() is not None:
                     raise SystemExit("the server did not start")
                 time.sleep(0.2)
+            latency = fit_latencies(url, unseen_fit_bodies(args.latency_fits))
             fit_id = httpx.post(f"{url}{API}/fits", json={"material": "Au"}, timeout=120).json()["id"]
 
             def run(seconds: float, fit_clients: int) -> tuple[list[float], dict, float]:
@@ -132,6 +220,7 @@ def main() -> int:
 
             idle, _, _ = run(args.idle, 0)
             loaded, counts, elapsed = run(args.duration, args.fit_clients)
+            probed, burst_counts, burst_s = burst(url, fit_id, args.burst) if args.burst else ({}, {}, 0.0)
         finally:
             server.terminate()
             server.wait(timeout=60)
@@ -143,6 +232,10 @@ def main() -> int:
     print()
     print("| quantity | value |")
     print("|---|---|")
+    ms = np.asarray(latency) * 1e3
+    print(f"| REST fit of unseen data, one client: fits | {ms.size} |")
+    print(f"| REST fit of unseen data: first / p50 / p90 ms | {ms[0]:.0f} / "
+          f"{np.percentile(ms, 50):.0f} / {np.percentile(ms, 90):.0f} |")
     print(f"| fits answered 201 | {fits} |")
     print(f"| fits per second | {fits / elapsed:.2f} |")
     print(f"| fits refused 503 (Retry-After) | {counts.get(503, 0)} |")
@@ -152,6 +245,15 @@ def main() -> int:
         print(f"| pack download {label}: requests | {len(samples)} |")
         print(f"| pack download {label}: p50 / p95 / p99 / max ms | "
               f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+    if args.burst:
+        print(f"| burst: {args.burst} fits at once, answers | "
+              f"{', '.join(f'{k}: {v}' for k, v in sorted(burst_counts.items()))} ({burst_s:.1f} s) |")
+        for key, label in (("healthz", "/healthz"), ("pack", "pack download")):
+            p50, p95, p99, worst = percentiles(probed[key])
+            print(f"| burst, separate process: {label} requests | {len(probed[key])} |")
+            print(f"| burst, separate process: {label} p50 / p95 / p99 / max ms | "
+                  f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+        print(f"| burst, separate process: answers other than 200 | {probed['errors']} |")
     return 0
 
 

@@ -8,6 +8,13 @@ Markdown tables and (``--figure``) writes ``docs/images/speed_vs_error.png``
 and ``docs/images/speed_vs_error_fit_settings.png``.
 
     .venv/bin/python benchmarks/speed_vs_error.py [--figure] [--repeats 7] [--models-only]
+        [--batch-report DIR/report.json] [--batch-only]
+
+``--batch-report`` adds the accuracy summary of a ``python -m fitting batch``
+report (e.g. ``--shelf main``): over every fitted page, the distribution of
+the mean Delta E 2000 of each model kind and baseline (mean, median, p90,
+max, share of pages in bins), and the share of pages where each kind beats
+adjusted Lazanyi; ``--batch-only`` prints only that.
 
 Models: Schlick in air, Schlick with exact F0, adjusted Lazanyi, ours float32,
 ours float16, ours scene-specialised (a degree-0 fit at each eta_i row), the
@@ -303,13 +310,54 @@ def _key(row) -> str:
     return f"{row['grid']} {row['step_nm']:g} nm {row['objective']}"
 
 
+BATCH_BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, float("inf"))
+
+
+def batch_report_table(path: Path) -> None:
+    """Print the accuracy summary of a batch report (``report.json``)."""
+    import json
+
+    report = json.loads(Path(path).read_text(encoding="utf-8"))
+    summary, config = report["summary"], report["config"]
+    fitted = [p for p in report["pages"] if p["status"] == "fitted"]
+    names = list(config["model_kinds"]) + list(config["baselines"])
+    print(f"## Database batch: {summary['fitted']} of {summary['pages']} pages fitted "
+          f"({summary['skipped']} skipped, {summary['failed']} failed), grid {config['grid']}, "
+          f"eta_i {config['eta_i_range'][0]:g}-{config['eta_i_range'][1]:g}\n")
+    bins = [f"{lo:g}-{hi:g}" if hi != float("inf") else f">{lo:g}"
+            for lo, hi in zip(BATCH_BINS[:-1], BATCH_BINS[1:])]
+    print("| model | mean | median | p90 | max | " + " | ".join(f"share {b}" for b in bins)
+          + " | beats adj. Lazanyi |")
+    print("|---|" + "---:|" * (4 + len(bins) + 1))
+    for name in names:
+        e = summary["delta_E_mean"][name]
+        if not e["pages"]:
+            continue
+        values = np.array([p[f"{name}_delta_E_mean"] for p in fitted])
+        shares = np.histogram(values, bins=np.array(BATCH_BINS))[0] / values.size
+        beats = e.get("beats_lazanyi_adjusted")
+        print(f"| {name} | {e['mean']:.3f} | {e['median']:.3f} | {e['p90']:.3f} | {e['max']:.2f} | "
+              + " | ".join(f"{v:.0%}" for v in shares)
+              + f" | {'' if beats is None else format(beats, '.1%')} |")
+    print()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description="Speed against error for the 22 conductors.")
+    parser.add_argument("--batch-report", type=Path, metavar="REPORT_JSON",
+                        help="add the accuracy summary of a python -m fitting batch report.json")
+    parser.add_argument("--batch-only", action="store_true", help="print only the batch summary")
     parser.add_argument("--figure", action="store_true", help="write the two PNGs to docs/images/")
     parser.add_argument("--repeats", type=int, default=7, help="shader timing rounds")
     parser.add_argument("--models-only", action="store_true",
                         help="the models table only (skip the fitting-settings sweep)")
     args = parser.parse_args()
+    if args.batch_report is not None:
+        batch_report_table(args.batch_report)
+        if args.batch_only:
+            return
+    elif args.batch_only:
+        parser.error("--batch-only needs --batch-report")
 
     t0 = time.perf_counter()
     rows = model_table(args.repeats)

@@ -40,7 +40,8 @@ radius.
 
 -   :data:`COMPARISONS`, :data:`ENVIRONMENTS`: the accepted values.
 -   :class:`PreviewRenderer`, :class:`PreviewResult`.
--   :func:`reference_image`: the spectral reference of a rendered view.
+-   :func:`reference_image`: the spectral reference of a rendered view,
+    through :func:`reference_table` (cos theta -> ACEScg, one per eta_i).
 -   :func:`difference_maps`: Delta E 2000 and FLIP maps and means.
 Rough spheres and the coated mode (issue 11) are drawn by
 ``glsl/preview_rough.frag`` through the split sum with a prefiltered
@@ -57,7 +58,7 @@ import numpy as np
 
 from fitting.colour.colorimetry import ACEScg_to_Lab
 from fitting.colour.delta_e import delta_E_2000
-from fitting.colour.reference import reference_ACEScg
+from fitting.colour.reference import reference_ACEScg, reference_ACEScg_grid
 from fitting.domain import ETA_I_MAX, ETA_I_MIN, check_eta_i
 from fitting.models.baselines import baseline_inputs
 from fitting.models.kinds import MODEL_KINDS
@@ -77,6 +78,9 @@ __all__ = [
     "PreviewResult",
     "PreviewRenderer",
     "reference_image",
+    "reference_table",
+    "REFERENCE_TABLE_SIZE",
+    "REFERENCE_TABLE_TOLERANCE",
     "difference_maps",
     "sphere_cos_theta",
     "padded_words",
@@ -201,15 +205,64 @@ def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, s
     return layers
 
 
-def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0) -> np.ndarray:
+REFERENCE_TABLE_SIZE = 513
+"""Nodes of the cos theta table of the spectral reference (uniform over [0, 1])."""
+REFERENCE_TABLE_TOLERANCE = 1e-7
+"""Largest error of the table (linear ACEScg) at the check points, below float32 rounding of 1."""
+
+
+def reference_table(nk, eta_i, step_nm: float = 1.0, nodes: int = REFERENCE_TABLE_SIZE):
+    """
+    The spectral reference of ``nk`` under the coating ``eta_i`` as a
+    function of cos theta alone, a callable ``table(cos_theta) -> (..., 3)``
+    (linear ACEScg): a cubic spline (not-a-knot) through the exact values
+    (:func:`fitting.colour.reference.reference_ACEScg_grid`) at ``nodes``
+    cos theta uniform over [0, 1].
+
+    On a smooth sphere the reference depends on the pixel only through cos
+    theta, so one table serves every pixel and its cost does not grow with
+    the image. The table checks itself: the exact values at the midpoints
+    of its nodes must lie within :data:`REFERENCE_TABLE_TOLERANCE` of the
+    spline (they do for every conductor; the error is fourth order in the
+    node spacing). Where they do not, which happens for a lossless
+    dielectric past its critical angle (a kink in cos theta), the callable
+    integrates the exact reference at each distinct cos theta instead.
+    """
+    from scipy.interpolate import CubicSpline
+
+    fine = np.linspace(0.0, 1.0, 2 * int(nodes) - 1)
+    F = reference_ACEScg_grid(nk, fine, [float(eta_i)], step_nm)[0]
+    spline = CubicSpline(fine[::2], F[::2], axis=0, extrapolate=False)
+    if np.max(np.abs(spline(fine[1::2]) - F[1::2])) <= REFERENCE_TABLE_TOLERANCE:
+        return spline
+
+    def exact(cos_theta):
+        mu = np.asarray(cos_theta, dtype=np.float64)
+        unique, inverse = np.unique(mu, return_inverse=True)
+        values = reference_ACEScg_grid(nk, unique, [float(eta_i)], step_nm)[0]
+        return values[inverse.reshape(mu.shape)]
+
+    return exact
+
+
+def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0,
+                    per_pixel: bool = False) -> np.ndarray:
     """
     The spectral reference of a rendered view: on the sphere, the exact
-    reflectance of ``nk`` (:func:`fitting.colour.reference.reference_ACEScg`) at
-    each pixel's cos theta times the radiance the pixel sees; elsewhere the
-    radiance. float32 linear ACEScg.
+    reflectance of ``nk`` at each pixel's cos theta times the radiance the
+    pixel sees; elsewhere the radiance. float32 linear ACEScg.
+
+    The reflectance comes from :func:`reference_table` (one table per
+    eta_i); ``per_pixel=True`` integrates the reference at every pixel
+    instead (:func:`fitting.colour.reference.reference_ACEScg`), the
+    definition the table is tested against.
     """
     image = np.array(radiance[..., :3], dtype=np.float64)
-    F = reference_ACEScg(nk, cos_theta[mask].astype(np.float64), eta_i, step_nm)
+    mu = np.clip(cos_theta[mask].astype(np.float64), 0.0, 1.0)
+    if per_pixel:
+        F = reference_ACEScg(nk, mu, eta_i, step_nm)
+    else:
+        F = reference_table(nk, eta_i, step_nm)(mu)
     image[mask] = F * image[mask]
     return image.astype(np.float32)
 
@@ -269,12 +322,16 @@ class PreviewRenderer:
         compare: str = "none",
         environment: str = "white_sky",
         step_nm: float = 1.0,
+        differences: bool = True,
         roughness: float = 0.0,
         mode: str = "immersed",
         coat_roughness: float = 0.0,
     ) -> PreviewResult:
         """
-        Render the preview sphere (see the module docstring).
+        Render the preview sphere (see the module docstring). With
+        compare="reference", ``differences`` adds the Delta E 2000 and FLIP
+        maps (:func:`difference_maps`; they cost several times the render, so
+        a caller that only shows the PNG passes False).
 
         Raises
         ------
@@ -309,7 +366,7 @@ class PreviewRenderer:
                     f"got {packed.model!r}"
                 )
             return self._render_rough(packed, nk, eta_i, size, compare, environment, step_nm,
-                                      roughness, mode, coat_roughness)
+                                      roughness, mode, coat_roughness, differences)
 
         baseline = baseline_inputs(nk) if nk is not None else None
         F0_air = baseline["F0_air"] if baseline else np.zeros(3)
@@ -340,14 +397,14 @@ class PreviewRenderer:
             eta_i=eta_i,
             environment=environment,
         )
-        if compare == "reference":
+        if compare == "reference" and differences:
             (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
                 difference_maps(model, comparison, mask)
             )
         return result
 
     def _render_rough(self, packed, nk, eta_i, size, compare, environment, step_nm,
-                      roughness, mode, coat_roughness) -> PreviewResult:
+                      roughness, mode, coat_roughness, differences=True) -> PreviewResult:
         from fitting.shading.ibl import default_lut
 
         from .rough import prefiltered_environment, render_rough_layers, rough_reference_image
@@ -392,7 +449,7 @@ class PreviewRenderer:
             compare=compare, eta_i=eta_i, environment=environment,
             roughness=roughness, mode=mode, coat_roughness=coat_roughness,
         )
-        if compare == "reference":
+        if compare == "reference" and differences:
             (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
                 difference_maps(model, comparison, mask)
             )

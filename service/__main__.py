@@ -1,7 +1,9 @@
 """
 ``python -m service [--host 127.0.0.1] [--port 8000] [--data-dir DIR]``:
-start the HTTP service with uvicorn. Other settings come from ``COATED_*``
-environment variables (:class:`service.config.Settings`).
+start the HTTP service (:func:`service.server.serve`). Other settings come
+from ``COATED_*`` environment variables (:class:`service.config.Settings`).
+A store that cannot be opened, is damaged or cannot be written stops the
+start with one line on stderr (exit status 1).
 """
 
 from __future__ import annotations
@@ -9,11 +11,28 @@ from __future__ import annotations
 import argparse
 import sys
 
-import uvicorn
 from pydantic import ValidationError
 
 from .config import Settings
 from .main import create_app
+from .server import serve
+from .store import SQLiteStore, StoreError
+
+
+def check_store(settings: Settings) -> str | None:
+    """None when the store opens, is sound and can be written; else why not, in one line."""
+    try:
+        store = SQLiteStore(settings.store_path, settings.store_max_bytes, settings.store_min_free_bytes)
+    except StoreError as error:
+        return str(error)
+    try:
+        store.check()
+        problem = store.writable()
+        return None if problem is None or "free" in problem or "quota" in problem else problem
+    except StoreError as error:
+        return str(error)
+    finally:
+        store.close()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -33,7 +52,11 @@ def main(argv: list[str] | None = None) -> int:
         messages = "; ".join(e["msg"].removeprefix("Value error, ") for e in error.errors())
         print(f"python -m service: {messages}", file=sys.stderr)
         return 2
-    uvicorn.run(create_app(settings), host=args.host, port=args.port, log_level="info")
+    problem = check_store(settings)
+    if problem is not None:
+        print(f"python -m service: cannot start: {problem}", file=sys.stderr)
+        return 1
+    serve(create_app(settings), settings, args.host, args.port)
     return 0
 
 

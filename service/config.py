@@ -72,6 +72,25 @@ class Settings(BaseSettings):
     max_previews_in_flight
         Previews rendered at once (a spectral-reference preview is seconds of
         CPU); past it a preview request is answered 503 with Retry-After.
+    allowed_hosts
+        ``Host`` names the service answers (DNS-rebinding guard); default the
+        loopback names and addresses. ``.example.com`` allows a domain and
+        its subdomains, ``*`` any (only behind a proxy that checks it).
+    header_timeout_s, body_timeout_s
+        A request's header must arrive within ``header_timeout_s`` of its
+        first byte (else the connection is closed), its body within
+        ``body_timeout_s`` (else 408).
+    keep_alive_s
+        An idle keep-alive connection is closed after this many seconds.
+    max_connections
+        Connections (and requests) at once; past it uvicorn answers 503.
+    store_max_bytes
+        Quota of the store file (unset: none); a save past it is answered 507.
+    store_min_free_bytes
+        Free disk space below which the store counts as full: fits are
+        refused 507 before any CPU is spent, ``/healthz`` says so.
+    materials_page_max
+        Most saved materials in one page of ``GET /api/v1/materials``.
     """
 
     model_config = SettingsConfigDict(env_prefix="COATED_", extra="ignore")
@@ -90,6 +109,14 @@ class Settings(BaseSettings):
     max_upload_bytes: int = Field(default=2_000_000, ge=1_000)
     max_preview_size: int = Field(default=1024, ge=64, le=2048)
     max_previews_in_flight: int = Field(default=2, ge=1, le=64)
+    allowed_hosts: list[str] = Field(default_factory=lambda: ["localhost", "127.0.0.1", "::1"])
+    header_timeout_s: float = Field(default=10.0, gt=0.0, le=600.0)
+    body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
+    keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
+    max_connections: int = Field(default=512, ge=8, le=100_000)
+    store_max_bytes: int | None = Field(default=None, ge=100_000)
+    store_min_free_bytes: int = Field(default=16_000_000, ge=0)
+    materials_page_max: int = Field(default=500, ge=1, le=10_000)
 
     @model_validator(mode="after")
     def _check_token(self) -> "Settings":

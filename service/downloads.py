@@ -47,15 +47,20 @@ from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
 from preview_shaders.gl import GLSL_DIR
 
-from .fitting_jobs import FIT_FORMAT_VERSION, measured_nk
+from .jobs.common import FIT_FORMAT_VERSION, measured_nk
 from .store import FitRecord
 
 __all__ = [
-    "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "TEMPLATE_DIR", "render_pack", "render_export",
-    "download_name", "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
+    "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
+    "render_export", "pack_response", "export_response", "download_name", "glsl_identifier",
+    "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
 
 IBL_LUT_FILENAME = "cf_ibl_lut.cflut"
+SPLIT_SUM_FUNCTIONS = (
+    "cf_split_sum_model", "cf_split_sum_schlick", "cf_split_sum_lazanyi", "cf_average_fresnel",
+)
+"""The split-sum functions a coated-conductor snippet carries (cf_ibl)."""
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
 PACK_MEDIA_TYPES = {
@@ -96,7 +101,58 @@ def _model_source(language: str, kinds: tuple[str, ...]) -> str:
         return _INCLUDE.sub(lambda m: expand(m.group(1)), (GLSL_DIR / file_name).read_text())
 
     files = [f"{_MODEL_FILES[k]}.glsl" for k in kinds] + [f"{f}.glsl" for f in _split_sum(kinds)]
-    return "\n".join(expand(f).strip() for f in files)
+    source = "\n".join(expand(f).strip() for f in files)
+    return _only_reachable(source, kinds).strip()
+
+
+_FUNCTION_START = re.compile(r"^[A-Za-z_]\w*(?:\s+[A-Za-z_]\w*)*\s+([A-Za-z_]\w*)\s*\(")
+
+
+def _only_reachable(source: str, kinds: tuple[str, ...]) -> str:
+    """
+    ``source`` without the top-level functions that the model functions of
+    ``kinds`` (``cf_coated_conductor``, ``cf_rgb_conductor``) never call
+    (with the comment just above each): the snippet ships only what its
+    materials use, so no unused helper can need a newer GLSL version or an
+    extension (``cf_unpack_coefficients`` needs ``unpackHalf2x16``, GLSL
+    4.20 or ES 3.00).
+    """
+    lines = source.splitlines()
+    items: list[tuple[str | None, list[str]]] = []  # (function name or None, lines)
+    i = 0
+    while i < len(lines):
+        match = _FUNCTION_START.match(lines[i])
+        if match and not lines[i].rstrip().endswith(";") and not lines[i].startswith("#"):
+            comment: list[str] = []
+            while items and items[-1][0] is None and items[-1][1] and items[-1][1][-1].startswith("//"):
+                comment.insert(0, items[-1][1].pop())
+            body, depth, opened = [], 0, False
+            while i < len(lines):
+                body.append(lines[i])
+                depth += lines[i].count("{") - lines[i].count("}")
+                opened = opened or "{" in lines[i]
+                i += 1
+                if opened and depth == 0:
+                    break
+            items.append((match.group(1), comment + body))
+            continue
+        if items and items[-1][0] is None:
+            items[-1][1].append(lines[i])
+        else:
+            items.append((None, [lines[i]]))
+        i += 1
+    functions = {name: "\n".join(text) for name, text in items if name}
+    keep, todo = set(), [_MODEL_FILES[k] for k in kinds]
+    if _split_sum(kinds):
+        todo += list(SPLIT_SUM_FUNCTIONS)
+    while todo:
+        name = todo.pop()
+        if name in keep or name not in functions:
+            continue
+        keep.add(name)
+        todo.extend(set(re.findall(r"\b([A-Za-z_]\w*)\s*\(", functions[name])) - keep)
+    out = [line for name, text in items if name is None or name in keep for line in text]
+    return re.sub(r"\n{3,}", "\n\n", "\n".join(out))
 
 
 def _split_sum(kinds: tuple[str, ...]) -> list[str]:
@@ -169,20 +225,29 @@ def _material_block(language: str, record: FitRecord, packed: PackedMaterial, id
     )
 
 
+def _symbols(language: str, ident: str, packed: PackedMaterial) -> set[str]:
+    """Every identifier the material block of ``ident`` (of ``packed``'s kind) defines."""
+    block = "material_rgb" if packed.model == "rgb-conductor" else "material"
+    text = (TEMPLATE_DIR / f"{block}.{language}").read_text()
+    suffixes = set(re.findall(r"\$\{prefix\}(\w+)", text))
+    return {f"cf_{ident}{s}" for s in suffixes} | {f"cf_material_{ident}"}
+
+
 def _snippet(language: str, records: list[FitRecord], pack_name: str) -> str:
-    used: set[str] = set()
+    materials = [(record, material_from_json(record.material)) for record in records]
+    model = _model_source(language, tuple(k for k in _MODEL_FILES if any(p.model == k for _, p in materials)))
+    # Symbols are unique within the pack: a material whose symbols would meet
+    # another's (``material x`` and ``x F0`` both define cf_material_x_F0) or
+    # the model's gets the next free suffix.
+    used = set(re.findall(r"\b[A-Za-z_]\w*", model))
     blocks = []
-    kinds = set()
-    for record in records:
+    for record, packed in materials:
         ident = base = glsl_identifier(record.name)
         suffix = 2
-        while ident in used:
+        while _symbols(language, ident, packed) & used:
             ident, suffix = f"{base}_{suffix}", suffix + 1
-        used.add(ident)
-        packed = material_from_json(record.material)
-        kinds.add(packed.model)
+        used |= _symbols(language, ident, packed)
         blocks.append(_material_block(language, record, packed, ident))
-    model = _model_source(language, tuple(k for k in _MODEL_FILES if k in kinds))
     return _template(f"pack.{language}").substitute(
         pack_name=_comment(pack_name, 80), count=len(records), fit_format=FIT_FORMAT_VERSION,
         model=model, materials="".join(blocks),
@@ -259,3 +324,38 @@ def download_name(stem: str, format: str) -> str:
     safe = re.sub(r"[^A-Za-z0-9._-]", "_", stem).strip("._") or "material"
     suffix = {**PACK_MEDIA_TYPES, **EXPORT_MEDIA_TYPES}[format][1]
     return f"{safe[:80]}.{suffix}"
+
+
+def pack_response(records: list[FitRecord], format: str, stem: str):
+    """A download with its media type and Content-Disposition file name."""
+    from fastapi import Response
+
+    body = render_pack(records, format, stem)
+    media_type, _ = PACK_MEDIA_TYPES[format]
+    return Response(
+        body, media_type=media_type,
+        headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
+    )
+
+
+def export_response(record: FitRecord, format: str, eta_i: float, stem: str):
+    """An export of one fit (:func:`render_export`) as a download for ``eta_i``."""
+    from fastapi import Response
+
+    body = render_export(record, format, eta_i)
+    return Response(
+        body, media_type=EXPORT_MEDIA_TYPES[format][0],
+        headers={"Content-Disposition":
+                 f'attachment; filename="{download_name(f"{stem}-eta{eta_i:g}", format)}"'},
+    )
+
+
+PACK_CONTENT = {
+    "application/octet-stream": {"schema": {"type": "string", "format": "binary"}},
+    "application/json": {"schema": {"type": "object"}},
+    "text/plain": {"schema": {"type": "string"}},
+    "application/xml": {"schema": {"type": "string"}},
+    "text/x-python": {"schema": {"type": "string"}},
+    "model/gltf+json": {"schema": {"type": "object"}},
+}
+"""The OpenAPI content of a download."""

@@ -36,6 +36,8 @@ async function answer(response, read = (r) => r.json()) {
   }
   const error = new Error(detail);
   error.status = response.status;
+  const retryAfter = Number(response.headers.get("Retry-After"));
+  error.retryAfter = Number.isFinite(retryAfter) && retryAfter > 0 ? Math.min(retryAfter, 10) : null;
   throw error;
 }
 
@@ -61,9 +63,10 @@ export const fitLibrary = (name, etaRange) => postJSON("/fits", { material: name
 export const fitFromCurves = (body) => postJSON("/fits/from-curves", body);
 export const errorMap = (fitId) => getJSON(`/fits/${fitId}/error-map?angles=46&rows=31`);
 
-export function uploadNK(file) {
+export function uploadNK(file, name = "") {
   const form = new FormData();
   form.append("file", file, file.name);
+  if (name) form.append("name", name);
   return postForm("/fits/upload", form);
 }
 
@@ -79,4 +82,22 @@ export async function preview(fitId, etaI, compare) {
 
 export function packURL(fitId, format) {
   return `${API}/fits/${fitId}/pack?format=${format}`;
+}
+
+// The spectral reference of a fit with n, k as a float texture over
+// (cos theta, eta_i) (GET /fits/{id}/reference-texture): float32 RGB,
+// [eta_i row][cos theta column][channel], sizes and ranges in the headers.
+export async function referenceTexture(fitId) {
+  const response = await fetch(`${API}/fits/${fitId}/reference-texture`, { headers: headers() });
+  const buffer = await answer(response, (r) => r.arrayBuffer());
+  const triple = (name) => response.headers.get(name).split(",").map(Number);
+  return {
+    fitId,
+    data: new Float32Array(buffer),
+    width: Number(response.headers.get("X-Texture-Width")),
+    height: Number(response.headers.get("X-Texture-Height")),
+    eta_i_range: triple("X-Eta-I-Range"),
+    F0_air: triple("X-F0-Air"),
+    F82_air: triple("X-F82-Air"),
+  };
 }

@@ -2,41 +2,67 @@
 // or more coating indices, refit on the service (POST /fits/from-curves),
 // see the fit, its preview and its error map, save and download it.
 //
-// The page never evaluates the model itself: every curve, metric and image
-// comes from the service, so the model has one definition per language.
+// Curves and metrics come from the service; the preview runs the project's
+// own GLSL in WebGL2 (preview.js), so the model has one definition per
+// language. Refits run while a point is dragged: one request in flight, the
+// latest edit sent next, answers older than the one shown dropped; the fit
+// id, figures, curves and preview always show the same fit (present()).
 
 import * as api from "./api.js";
 import { drawErrorMap } from "./heatmap.js";
 import { ReflectancePlot } from "./plot.js";
+import { ENVIRONMENT, PANEL, ShaderBall } from "./preview.js";
 
 const SAMPLES = 46; // 0, 2, ..., 90 degrees
 const HANDLES = [0, 20, 36, 50, 60, 70, 78, 84];
 const FALLOFF_DEG = 9; // width of the bump a dragged point makes
+const RETRY_MS = [250, 500, 1000, 2000, 4000]; // backoff after a 503 (or Retry-After)
+const LAST_KEY = "coated-editor-material"; // localStorage: the material open last
 
 const $ = (id) => document.getElementById(id);
 
 const state = {
   base: null,       // the fit being edited (its curves are the starting point)
-  fit: null,        // the current fit (the base's until the first edit)
+  fit: null,        // the fit on screen (id, figures, curves and preview)
   eta: 1.5,
   edits: {},        // eta_i (2 decimals) -> target rgb, SAMPLES x 3
   undo: [],
   redo: [],
   theta: [],
   baseCurves: null, // reference, lazanyi and base model at the current eta_i
-  model: null,      // the current fit at the current eta_i
-  request: 0,       // drops answers of superseded refits
+  model: null,      // the fit on screen at the current eta_i
   etaRequest: 0,    // drops curves of superseded eta_i (or fits)
 };
 
-const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: guard(refit) });
+// The refit pipeline: `wanted` is the latest edit not yet sent; one request
+// in flight at a time; `shown` is the sequence number of the answer on
+// screen, and an answer older than it is dropped.
+const live = { wanted: null, inFlight: false, seq: 0, shown: 0, attempt: 0, waiters: [], timer: null, failed: null };
+
+// Timings for benchmarks/editor_speed.py: when the last edit happened, and
+// for each fit shown, the edit it answers and when its curve and its first
+// preview frame were drawn (performance.now(), ms).
+const telemetry = { lastEditAt: 0, shown: [] };
+window.cfTelemetry = telemetry;
+
+const plot = new ReflectancePlot($("plot"), { onDrag: drag, onDragEnd: dragEnd });
+let ball = null; // the WebGL2 preview, once its shaders compiled
 
 // ---------------------------------------------------------------- messages
 
-function say(text, ok = false) {
+// `kind` tags a message so that it can be cleared by what resolves it
+// ("retry": cleared by the next answer).
+function sayUpload(text, ok = false) {
+  const box = $("upload-message");
+  box.textContent = text;
+  box.classList.toggle("ok", ok);
+}
+
+function say(text, ok = false, kind = "") {
   const box = $("message");
   box.textContent = text;
   box.classList.toggle("ok", ok);
+  box.dataset.kind = text ? kind : "";
 }
 
 // A refusal, shown; a 401 (the service wants its API token) opens the token
@@ -76,6 +102,14 @@ async function busy(text, work) {
   }
 }
 
+// "updating…" on the preview and plot while the fit on screen is not the
+// fit of the edits on screen.
+function updating(on) {
+  $("preview-state").hidden = !on;
+  document.querySelector(".side").classList.toggle("updating", on);
+  $("plot").classList.toggle("updating", on);
+}
+
 // ---------------------------------------------------------------- materials
 
 async function loadMaterials(select = null) {
@@ -101,27 +135,27 @@ async function loadMaterials(select = null) {
   if (select) picker.value = select;
 }
 
-async function pickMaterial(value) {
-  if (!value) return;
+// The fit of a material-picker value (a library fit is made or served from the store).
+async function fitOf(value) {
   const [kind, id] = value.split(/:(.*)/s);
-  await busy("Fitting the material…", async () => {
-    let fit;
-    if (kind === "library") {
-      fit = await api.fitLibrary(id, [1.0, 2.5]);
-    } else {
-      const material = await api.getMaterial(id);
-      fit = material.latest_fit;
-    }
-    await setBase(fit);
-  });
+  if (kind === "library") return api.fitLibrary(id, [1.0, 2.5]);
+  const material = await api.getMaterial(id);
+  return material.latest_fit;
 }
 
-function setBase(fit) {
+async function pickMaterial(value, pending = null) {
+  if (!value) return;
+  await busy("Fitting the material…", async () => setBase(await (pending || fitOf(value))));
+}
+
+async function setBase(fit) {
   state.base = fit;
-  state.fit = fit;
+  state.savedId = null;
   state.edits = {};
   state.undo = [];
   state.redo = [];
+  live.wanted = null;
+  live.shown = ++live.seq; // answers for the previous material are dropped
   const [lo, hi] = fit.eta_i_range;
   const slider = $("eta");
   slider.min = lo;
@@ -132,10 +166,39 @@ function setBase(fit) {
   $("name").value = fit.kind === "curves" ? fit.name : `${fit.name} edited`;
   $("material-source").textContent = fit.source ? fit.source.split("\n")[0].slice(0, 160) : "";
   $("compare").disabled = !fit.has_nk;
-  if (!fit.has_nk) $("compare").value = "none";
   $("reset").title = fit.kind === "curves" ? "Back to the saved edit as opened" : "Back to the measured data";
   say("");
-  return showEta().then(showFit);
+  const [curves] = await Promise.all([api.curves(fit.id, state.eta, SAMPLES), loadReference(fit)]);
+  state.baseCurves = curves;
+  state.theta = curves.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
+  present(fit, curves);
+}
+
+// The spectral reference texture of the base (its measured n, k) for the
+// preview; fits without n, k show the model alone.
+async function loadReference(fit) {
+  if (!ball || !fit.has_nk) {
+    applyPanels();
+    return;
+  }
+  try {
+    ball.setReference(await api.referenceTexture(fit.id));
+  } catch (error) {
+    say(`Spectral reference unavailable: ${error.message}`);
+  }
+  applyPanels();
+}
+
+function applyPanels() {
+  if (!ball) return;
+  const split = state.base && state.base.has_nk ? $("compare").value : "none";
+  const panels = {
+    all: [PANEL.model, PANEL.lazanyi, PANEL.reference],
+    reference: [PANEL.model, PANEL.reference],
+    lazanyi: [PANEL.model, PANEL.lazanyi],
+    none: [PANEL.model],
+  }[split];
+  ball.set({ panels });
 }
 
 // ---------------------------------------------------------------- curves
@@ -152,14 +215,17 @@ function target() {
   return state.baseCurves.reference || state.baseCurves.model;
 }
 
+// The curves at the current eta_i: the base's (reference, Lazanyi) and the
+// shown fit's model.
 async function showEta() {
   $("eta-value").textContent = key(state.eta);
   const request = ++state.etaRequest;
+  const fit = state.fit;
   const [base, current] = await Promise.all([
     api.curves(state.base.id, state.eta, SAMPLES),
-    state.fit.id === state.base.id ? null : api.curves(state.fit.id, state.eta, SAMPLES),
+    fit.id === state.base.id ? null : api.curves(fit.id, state.eta, SAMPLES),
   ]);
-  if (request !== state.etaRequest) return; // a later eta_i (or fit) asked since
+  if (request !== state.etaRequest || fit !== state.fit) return; // a later eta_i (or fit) since
   state.theta = base.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
   state.baseCurves = base;
   state.model = current ? current.model : base.model;
@@ -167,6 +233,7 @@ async function showEta() {
 }
 
 function redraw() {
+  if (!state.baseCurves) return;
   const edited = Boolean(state.edits[key(state.eta)]);
   $("plot").dataset.eta = key(state.eta);
   plot.draw({
@@ -176,6 +243,7 @@ function redraw() {
     model: state.model,
     lazanyi: $("show-lazanyi").checked ? state.baseCurves.lazanyi_adjusted : null,
     handles: HANDLES,
+    criticalDeg: state.eta > 1 ? (Math.asin(1 / state.eta) * 180) / Math.PI : null,
     channel: document.querySelector("input[name=channel]:checked").value,
     edited,
   });
@@ -200,6 +268,7 @@ function redraw() {
   $("redo").disabled = !state.redo.length;
   $("reset").disabled = !etas.length;
   $("save").disabled = !etas.length;
+  showDirty();
 }
 
 function snapshot() {
@@ -208,7 +277,8 @@ function snapshot() {
 
 let dragStart = null;
 
-// Move a control point; true when the target changed (then a refit follows).
+// Move a control point; true when the target changed (a refit follows at
+// once, throttled by the pipeline).
 function drag(channel, handle, value) {
   const k = key(state.eta);
   // The slider moved and its curves are not in yet: the plot shows another eta_i.
@@ -216,69 +286,138 @@ function drag(channel, handle, value) {
   // Clamped: the reference can exceed 1 by rounding (1.0000000000000002 at 90 degrees).
   const current = target().map((rgb) => rgb.map((v) => Math.min(1, Math.max(0, v))));
   const i = state.theta.indexOf(HANDLES[handle]);
-  const delta = value - current[i][channel];
-  if (delta === 0) return false;
+  const before = current[i][channel];
+  if (value === before) return false;
   if (dragStart === null) dragStart = snapshot();
-  const channels = document.querySelector("input[name=channel]:checked").value === "all" ? [0, 1, 2] : [channel];
+  const all = document.querySelector("input[name=channel]:checked").value === "all";
   const at = (t) => Math.exp(-0.5 * ((t - HANDLES[handle]) / FALLOFF_DEG) ** 2) * (1 - (t / 90) ** 6);
   const peak = at(HANDLES[handle]);
+  // One channel: the point moves by delta and its neighbours by less. All
+  // three: the three channels are scaled (brightness changes, hue stays),
+  // by value / before at the point and proportionally less around it.
+  const delta = value - before;
+  const ratio = before > 1e-6 ? value / before : null;
   for (let j = 0; j < state.theta.length; j++) {
     // Grazing (90 degrees) stays 1: the model meets 1 there whatever its coefficients.
     const w = at(state.theta[j]) / peak;
-    for (const c of channels) current[j][c] = Math.min(1, Math.max(0, current[j][c] + delta * w));
+    if (all) {
+      const scale = ratio === null ? null : 1 + (ratio - 1) * w;
+      for (let c = 0; c < 3; c++) {
+        const next = scale === null ? current[j][c] + delta * w : current[j][c] * scale;
+        current[j][c] = Math.min(1, Math.max(0, next));
+      }
+    } else {
+      current[j][channel] = Math.min(1, Math.max(0, current[j][channel] + delta * w));
+    }
   }
   state.edits[k] = current;
+  telemetry.lastEditAt = performance.now();
   redraw();
+  requestRefit();
   return true;
 }
 
-async function refit() {
+function dragEnd() {
   if (dragStart !== null) {
-    state.undo.push(dragStart);
-    state.redo = [];
+    if (dragStart !== snapshot()) {
+      state.undo.push(dragStart);
+      state.redo = [];
+    }
     dragStart = null;
   }
-  await fitEdits();
+  redraw();
+  requestRefit();
 }
 
-// Refit the edits; true when the fit of the current edits is shown, false
-// when the service refused (reported with `prefix`; `retry` after a 401).
-async function fitEdits(prefix = "The service refused the edit: ", retry = fitEdits) {
-  const etas = Object.keys(state.edits).sort();
-  const request = ++state.request;
-  if (!etas.length) {
-    state.fit = state.base;
-  } else {
-    const body = {
-      name: $("name").value.trim() || "edited",
-      base: { fit: state.base.id },
-      curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: state.theta, rgb: state.edits[eta] })),
-    };
-    try {
-      const fit = await busy("Fitting…", () => api.fitFromCurves(body));
-      if (request !== state.request) return false;
-      state.fit = fit;
-      say("");
-    } catch (error) {
-      if (request === state.request) report(error, retry, prefix);
-      redraw();
-      return false;
+// ---------------------------------------------------------------- refits
+
+function requestBody(edits, draft = true) {
+  const etas = Object.keys(edits).sort();
+  return {
+    name: $("name").value.trim() || "edited",
+    base: { fit: state.base.id },
+    curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: state.theta, rgb: edits[eta] })),
+    draft,
+  };
+}
+
+// Ask for a fit of the edits on screen; the answer shows when it comes
+// (await whenFitted() for it).
+function requestRefit() {
+  live.wanted = snapshot();
+  live.failed = null;
+  updating(true);
+  pump();
+}
+
+const sleep = (ms) => new Promise((resolve) => { live.timer = setTimeout(resolve, ms); });
+
+async function pump() {
+  if (live.inFlight || live.wanted === null) return;
+  const wanted = live.wanted;
+  const edits = JSON.parse(wanted);
+  const base = state.base;
+  const editAt = telemetry.lastEditAt;
+  live.wanted = null;
+  live.inFlight = true;
+  const seq = ++live.seq;
+  let delay = 0;
+  try {
+    await busy("Fitting…", async () => {
+      const fit = Object.keys(edits).length ? await api.fitFromCurves(requestBody(edits)) : base;
+      const curves = await api.curves(fit.id, state.eta, SAMPLES);
+      live.attempt = 0;
+      if ($("message").dataset.kind === "retry") say("");
+      if (seq > live.shown && base === state.base) {
+        live.shown = seq;
+        present(fit, curves, wanted);
+        telemetry.shown.push({ fit: fit.id, editAt, curveAt: performance.now(), frameAt: null });
+        if (telemetry.shown.length > 1000) telemetry.shown.shift();
+      }
+    });
+  } catch (error) {
+    if (error.status === 503 && base === state.base && live.attempt < RETRY_MS.length) {
+      // Busy: the same edit (unless a newer one is waiting) again, later.
+      delay = error.retryAfter ? error.retryAfter * 1000 : RETRY_MS[Math.min(live.attempt, RETRY_MS.length - 1)];
+      live.attempt += 1;
+      if (live.wanted === null) live.wanted = wanted;
+      say(`The service is busy; retrying in ${(delay / 1000).toFixed(1)} s…`, false, "retry");
+    } else if (base === state.base) {
+      live.failed = error;
+      live.attempt = 0;
+      report(error, requestRefit, "The service refused the edit: ");
     }
+  } finally {
+    if (delay) await sleep(delay);
+    live.inFlight = false;
   }
-  await showEta();
-  await showFit();
-  return request === state.request;
+  if (live.wanted !== null) {
+    pump();
+  } else {
+    if (!live.failed) updating(false);
+    const waiters = live.waiters.splice(0);
+    for (const resolve of waiters) resolve(!live.failed && state.fit && live.shownEdits === snapshot());
+  }
+}
+
+// Resolves once no refit is pending: true when the fit on screen is the fit
+// of the edits on screen.
+function whenFitted() {
+  if (!live.inFlight && live.wanted === null) return Promise.resolve(!live.failed && live.shownEdits === snapshot());
+  return new Promise((resolve) => live.waiters.push(resolve));
 }
 
 // ---------------------------------------------------------------- fit views
 
-async function showFit() {
-  const fit = state.fit;
+// Everything that names a fit is set here, together: id, figures,
+// coefficients, curve, download and preview.
+function present(fit, curves, edits = "{}") {
+  state.fit = fit;
+  live.shownEdits = edits;
   const edited = fit.kind === "curves";
-  const model = fit.metrics.model || {};
-  $("de-label").textContent = edited ? "Fit vs edited curves, mean ΔE00" : "Fit vs measured reference, mean ΔE00";
+  const model = (fit.metrics.details && fit.metrics.details.target) || fit.metrics.model || {};
+  $("de-label").firstChild.textContent = edited ? "Fit vs edited curves, mean ΔE" : "Fit vs measured reference, mean ΔE";
   $("de-mean").textContent = model.delta_E_mean != null ? model.delta_E_mean.toFixed(3) : "–";
-  $("de-max").textContent = model.delta_E_max != null ? model.delta_E_max.toFixed(3) : "–";
   $("fit-id").textContent = fit.id;
   const rows = ["F0", "a", "alpha"].map((p) =>
     `${p.padEnd(5)} ` + fit.coefficients[p].map((row, c) => `${"RGB"[c]} [${row.map((v) => v.toFixed(5)).join(", ")}]`).join("  "));
@@ -287,34 +426,89 @@ async function showFit() {
   download.href = api.packURL(fit.id, $("format").value);
   download.setAttribute("aria-disabled", "false");
   download.setAttribute("download", "");
-  await Promise.all([showPreview(), showErrorMap()]);
+  if (key(curves.eta_i) === key(state.eta)) {
+    state.model = curves.model;
+    redraw();
+  } else {
+    showEta().catch((error) => say(error.message));
+  }
+  if (ball) ball.setFit(fit);
+  warnIfUnfollowable(fit);
+  showDirty();
+  scheduleErrorMap();
 }
 
-let previewURL = null;
-async function showPreview() {
-  const fit = state.fit;
-  const compare = fit.has_nk ? $("compare").value : "none";
-  const img = $("preview");
-  try {
-    const blob = await busy("Rendering the preview…", () => api.preview(fit.id, state.eta, compare));
-    if (previewURL) URL.revokeObjectURL(previewURL);
-    previewURL = URL.createObjectURL(blob);
-    img.src = previewURL;
-    img.dataset.fit = fit.id;
-    img.alt = `Preview sphere of ${fit.name} at eta_i ${key(state.eta)}` + (compare !== "none" ? `, split with ${compare}` : "");
-  } catch (error) {
-    img.removeAttribute("src");
-    img.alt = `Preview unavailable: ${error.message}`;
-    say(`Preview unavailable: ${error.message}`);
+// ---------------------------------------------------------------- reach
+
+// An edit is beyond what the model can follow when the fit misses the
+// blended target by more than this (Delta E 2000) somewhere.
+const REACH_DE = 3.0;
+
+function warnIfUnfollowable(fit) {
+  const box = $("reach");
+  const target = fit.kind === "curves" && fit.metrics.details && fit.metrics.details.target;
+  if (!target || target.delta_E_max <= REACH_DE) {
+    box.hidden = true;
+    return;
   }
+  $("reach-text").textContent =
+    `The model cannot follow this edit everywhere: it misses the edited curves by up to ` +
+    `ΔE ${target.delta_E_max.toFixed(1)} at ${target.at_theta_deg.toFixed(0)}° and ` +
+    `ηᵢ ${target.at_eta_i.toFixed(2)} (1 is a just-visible difference). The fit stays a valid ` +
+    `reflectance (0 to 1); the curve shows what you will get.`;
+  box.hidden = false;
+}
+
+// "Make it gentler": every edit moved halfway back to where it started (undoable).
+function gentler() {
+  if (!state.baseCurves) return;
+  state.undo.push(snapshot());
+  state.redo = [];
+  const from = state.base.kind === "curves" ? "model" : "reference";
+  const etas = Object.keys(state.edits);
+  Promise.all(etas.map((eta) => api.curves(state.base.id, Number(eta), SAMPLES))).then((bases) => {
+    etas.forEach((eta, k) => {
+      const start = bases[k][from] || bases[k].model;
+      state.edits[eta] = state.edits[eta].map((rgb, j) =>
+        rgb.map((v, c) => Math.min(1, Math.max(0, start[j][c] + 0.5 * (v - start[j][c])))));
+    });
+    redraw();
+    requestRefit();
+  }).catch((error) => say(error.message));
+}
+
+// ---------------------------------------------------------------- saved state
+
+// Unsaved: there are edits and the fit on screen is not the one last saved
+// (a refit is a draft; only Save stores it under the name).
+function unsaved() {
+  return Object.keys(state.edits).length > 0 && state.fit && state.savedId !== state.fit.id;
+}
+
+function showDirty() {
+  $("save-state").textContent = unsaved() ? "Unsaved changes (drafts are not saved)" :
+    (state.savedId && state.fit && state.savedId === state.fit.id ? "Saved" : "");
+  document.body.dataset.unsaved = unsaved() ? "true" : "false";
+}
+
+// The heat map costs a request: drawn for the fit on screen once refits pause.
+let mapTimer = null;
+function scheduleErrorMap() {
+  clearTimeout(mapTimer);
+  mapTimer = setTimeout(() => {
+    if (live.inFlight || live.wanted !== null) return scheduleErrorMap();
+    showErrorMap().catch(() => {});
+  }, 150);
 }
 
 async function showErrorMap() {
+  const fit = state.fit;
   try {
-    const map = await api.errorMap(state.fit.id);
+    const map = await api.errorMap(fit.id);
+    if (fit !== state.fit) return;
     drawErrorMap($("heatmap"), map);
-    $("heatmap-caption").textContent =
-      `Against the ${map.against}: mean ${map.delta_E_mean.toFixed(3)}, max ${map.delta_E_max.toFixed(3)}.`;
+    $("heatmap").dataset.fit = fit.id;
+    $("heatmap-caption").textContent = `Against the ${map.against}; dark is close, bright is a visible difference.`;
   } catch (error) {
     $("heatmap-caption").textContent = `Error map unavailable: ${error.message}`;
   }
@@ -327,9 +521,10 @@ function setEta(eta) {
   state.eta = eta;
   $("eta").value = eta;
   $("eta-value").textContent = key(eta);
+  if (ball) ball.set({ eta });
   clearTimeout(etaTimer);
   etaTimer = setTimeout(() => {
-    showEta().then(showPreview).catch((error) => say(error.message));
+    showEta().catch((error) => say(error.message));
   }, 120);
 }
 
@@ -338,14 +533,17 @@ async function undoRedo(from, to) {
   to.push(snapshot());
   state.edits = JSON.parse(from.pop());
   redraw();
-  await fitEdits();
+  requestRefit();
+  await whenFitted();
 }
 
 async function reset() {
   state.undo.push(snapshot());
   state.redo = [];
   state.edits = {};
-  await fitEdits();
+  redraw();
+  requestRefit();
+  await whenFitted();
 }
 
 async function save() {
@@ -355,20 +553,63 @@ async function save() {
     $("name").focus();
     return;
   }
-  // A refused refit (401, 503, 422) is reported by fitEdits: nothing was saved.
-  if (!(await fitEdits("Not saved: ", save))) return;
-  if (state.fit.kind !== "curves") return;
-  await loadMaterials($("material").value);
-  say(`Saved “${state.fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
+  if (!Object.keys(state.edits).length) {
+    say("Nothing to save: edit a curve first.");
+    return;
+  }
+  // Saving under the name of another saved material replaces its latest fit: asked first.
+  const { materials } = await api.listMaterials();
+  const clash = materials.find((m) => m.kind === "curves" && m.name === name);
+  const opened = state.base.kind === "curves" && state.base.name === name;
+  if (clash && !opened && !window.confirm(`A saved material is called “${name}”. Replace it with this edit?`)) {
+    say("Not saved: choose another name, or Save again and confirm to replace it.");
+    $("name").focus();
+    return;
+  }
+  requestRefit();
+  // A refused refit (401, 422) is reported by the pipeline: nothing was saved.
+  if (!(await whenFitted())) {
+    if (live.failed) say(`Not saved: ${live.failed.message}`);
+    return;
+  }
+  let fit;
+  try {
+    fit = await busy("Saving…", () => api.fitFromCurves(requestBody(state.edits, false)));
+  } catch (error) {
+    report(error, save, "Not saved: ");
+    return;
+  }
+  state.savedId = fit.id;
+  const opening = `saved:${fit.material_id}`;
+  await loadMaterials(opening);
+  remember(opening);
+  showDirty();
+  say(`Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
+}
+
+function remember(value) {
+  try {
+    localStorage.setItem(LAST_KEY, value);
+  } catch (_) {
+    // storage disabled: the editor opens Au next time
+  }
 }
 
 async function upload(file) {
   await busy("Fitting the uploaded n, k…", async () => {
-    const fit = await api.uploadNK(file);
+    const fit = await api.uploadNK(file, $("upload-name").value.trim());
     await loadMaterials(`saved:${fit.material_id}`);
+    remember(`saved:${fit.material_id}`);
     await setBase(fit);
-    say(`Fitted ${fit.name} from ${file.name}.`, true);
+    sayUpload(`Fitted “${fit.name}” from ${file.name}; saved under that name.`, true);
   });
+}
+
+function previewSettings() {
+  $("exposure-value").textContent = Number($("exposure").value).toFixed(1);
+  if (!ball) return;
+  ball.set({ environment: ENVIRONMENT[$("environment").value], exposure: Number($("exposure").value) });
+  applyPanels();
 }
 
 $("token").value = api.getToken();
@@ -380,8 +621,32 @@ $("token-form").addEventListener("submit", (event) => {
   retryAfterToken = null;
   if (retry) guard(retry)();
 });
-$("material").addEventListener("change", guard((event) => pickMaterial(event.target.value)));
-$("upload").addEventListener("change", guard((event) => event.target.files[0] && upload(event.target.files[0])));
+let pickedValue = null; // the material open, to return to when a switch is cancelled
+$("material").addEventListener("change", guard(async (event) => {
+  const value = event.target.value;
+  if (unsaved() && !window.confirm("Discard the unsaved edits of this material?")) {
+    event.target.value = pickedValue;
+    return;
+  }
+  await pickMaterial(value);
+  pickedValue = value;
+  remember(value);
+}));
+$("upload").addEventListener("change", (event) => {
+  const file = event.target.files[0];
+  if (!file) return;
+  sayUpload("");
+  upload(file).catch((error) => {
+    if (error.status === 401) report(error, () => upload(file));
+    else sayUpload(`Not uploaded: ${error.message}`);
+  });
+});
+$("reach-gentler").addEventListener("click", gentler);
+window.addEventListener("beforeunload", (event) => {
+  if (!unsaved()) return;
+  event.preventDefault();
+  event.returnValue = "";
+});
 $("eta").addEventListener("input", (event) => setEta(Number(event.target.value)));
 $("show-lazanyi").addEventListener("change", redraw);
 for (const radio of document.querySelectorAll("input[name=channel]")) radio.addEventListener("change", redraw);
@@ -389,7 +654,7 @@ $("undo").addEventListener("click", guard(() => undoRedo(state.undo, state.redo)
 $("redo").addEventListener("click", guard(() => undoRedo(state.redo, state.undo)));
 $("reset").addEventListener("click", guard(reset));
 $("save").addEventListener("click", guard(save));
-$("compare").addEventListener("change", guard(showPreview));
+for (const id of ["compare", "environment", "exposure"]) $(id).addEventListener("input", previewSettings);
 $("format").addEventListener("change", () => {
   if (state.fit) $("download").href = api.packURL(state.fit.id, $("format").value);
 });
@@ -403,10 +668,43 @@ document.addEventListener("keydown", (event) => {
   if ((k === "z" && event.shiftKey) || k === "y") { event.preventDefault(); guard(() => undoRedo(state.redo, state.undo))(); }
 });
 
+// The preview's shaders compile while the material list and first fit load.
+const preview = ShaderBall.create($("preview"), $("preview-labels")).then((made) => {
+  ball = made;
+  window.cfPreview = made; // for the parity tests and benchmarks
+  ball.onFrame = (drawn) => {
+    const last = telemetry.shown[telemetry.shown.length - 1];
+    if (last && last.fit === drawn.fitId && last.frameAt === null) last.frameAt = performance.now();
+  };
+  previewSettings();
+  ball.set({ eta: state.eta });
+  return made;
+}).catch((error) => {
+  const box = $("preview-error");
+  box.hidden = false;
+  box.textContent = `The real-time preview is unavailable: ${error.message}`;
+  return null;
+});
+
 guard(async () => {
+  let last = null;
+  try {
+    last = localStorage.getItem(LAST_KEY);
+  } catch (_) {
+    // storage disabled
+  }
+  // Cold start: the material list, the first fit and the preview's shaders
+  // load at the same time.
+  const wanted = last || "library:Au";
+  const first = fitOf(wanted);
+  first.catch(() => {}); // reported below, if it is used
   await loadMaterials();
   const picker = $("material");
-  picker.value = "library:Au";
-  await pickMaterial(picker.value);
+  picker.value = wanted;
+  const found = picker.value === wanted;
+  if (!found) picker.value = "library:Au"; // the remembered material is gone
+  await preview;
+  await pickMaterial(picker.value, found ? first : null);
+  pickedValue = picker.value;
   document.body.dataset.ready = "true";
 })();

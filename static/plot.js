@@ -24,7 +24,7 @@ export class ReflectancePlot {
     this.yMin = 0;
     this.yMax = 1;
     this.layers = {};
-    for (const name of ["grid", "axis", "lazanyi", "reference", "target", "model", "handles"]) {
+    for (const name of ["grid", "axis", "critical", "lazanyi", "reference", "target", "model", "handles"]) {
       this.layers[name] = el("g", { class: name }, this.svg);
     }
     this.dragging = null;
@@ -51,7 +51,7 @@ export class ReflectancePlot {
       el("line", { x1: M.left, x2: W - M.right, y1: this.y(v), y2: this.y(v) }, grid);
       el("text", { x: M.left - 6, y: this.y(v) + 4, "text-anchor": "end" }, axis).textContent = v.toFixed(2);
     }
-    el("text", { x: (M.left + W - M.right) / 2, y: H - 4, "text-anchor": "middle" }, axis).textContent = "angle θ in the coating";
+    el("text", { x: (M.left + W - M.right) / 2, y: H - 4, "text-anchor": "middle" }, axis).textContent = "angle θ inside the coating";
   }
 
   #path(layer, theta, rgb, className) {
@@ -74,6 +74,14 @@ export class ReflectancePlot {
     if (!this.dragging) this.yMin = Math.max(0, Math.floor((Math.min(...all) - 0.05) * 10) / 10);
     this.yMax = 1.0;
     this.#axes();
+    const critical = this.layers.critical;
+    critical.replaceChildren();
+    if (data.criticalDeg) {
+      // The largest angle inside a flat coat seen from air: asin(1 / eta_i).
+      const x = this.x(data.criticalDeg);
+      el("line", { x1: x, x2: x, y1: M.top, y2: H - M.bottom }, critical);
+      el("text", { x: x + 4, y: M.top + 12 }, critical).textContent = `max from air ${data.criticalDeg.toFixed(1)}°`;
+    }
     for (const name of ["lazanyi", "reference", "target", "model"]) {
       this.layers[name].replaceChildren();
       if (data[name]) this.#path(this.layers[name], data.theta, data[name], name);

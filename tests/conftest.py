@@ -121,7 +121,9 @@ def app_client(tmp_path: Path, **overrides):
     from service.config import Settings
     from service.main import create_app
 
-    options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False, **overrides}
+    # TestClient sends `Host: testserver`; it is allowed here as a deployment would name its host.
+    options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False,
+               "allowed_hosts": ["localhost", "127.0.0.1", "::1", "testserver"], **overrides}
     return TestClient(create_app(Settings(**options)))
 
 

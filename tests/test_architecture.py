@@ -165,31 +165,20 @@ def test_no_import_cycles():
 ROUTES = sorted(n for n in ALL if n.startswith("service.api.routes.") and n != "service.api.routes")
 
 
-# The service rules of issue 9, for helper H2's service branch to enable by
-# renaming each ``service_rule_*`` to ``test_*`` when the reorganised service
-# lands (today routes/curves.py has 416 lines and imports routes/fits.py).
-# They are plain functions, so they are neither collected nor skipped.
-def service_rule_module_size():
+# The service rules of issue 9 (the reorganised service, helper H2's branch).
+def test_service_module_size():
     """No module of service/ over 400 lines."""
     wrong = [f"{ALL[n].relative_to(ROOT)}: {_lines(n)}" for n in SERVICE if _lines(n) > MAX_MODULE_LINES]
     assert not wrong, wrong
 
 
-def service_rule_route_module_size():
+def test_service_route_module_size():
     """No route module (service/api/routes/*) over 160 lines."""
     wrong = [f"{ALL[n].relative_to(ROOT)}: {_lines(n)}" for n in ROUTES if _lines(n) > MAX_ROUTE_LINES]
-    assert not wrong, wrong
+    assert ROUTES and not wrong, wrong
 
 
-def service_rule_no_route_imports_another_route():
+def test_service_no_route_imports_another_route():
     """Routes share code through service modules, never through another route."""
     wrong = [f"{n} imports {sorted(GRAPH[n] & set(ROUTES))}" for n in ROUTES if GRAPH[n] & set(ROUTES)]
-    assert not wrong, wrong
-
-
-def test_service_rules_are_read():
-    """The service rules above judge real modules: each fails on today's service."""
-    assert ROUTES and "service.api.routes.fits" in GRAPH["service.api.routes.curves"]
-    for rule in (service_rule_route_module_size, service_rule_no_route_imports_another_route):
-        with pytest.raises(AssertionError):
-            rule()
+    assert ROUTES and not wrong, wrong

@@ -11,6 +11,8 @@ Command line
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
+-   ``batch --shelf main``: a selection of the refractiveindex.info database
+    into one pack and report (:mod:`fitting.cli.batch`).
 -   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
     Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
@@ -65,6 +67,13 @@ def _cmd_fit(args) -> int:
         return _write_export(nk, args)
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
                        evaluate=not args.no_metrics)
+    if not result.success:
+        what = (f"the fit of {nk.name!r} did not converge (solver status {result.status}: "
+                f"{result.message}); its coefficients are the best found")
+        if args.strict:
+            print(f"error: {what}; nothing written (--strict)", file=sys.stderr)
+            return 3
+        print(f"warning: {what}", file=sys.stderr)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -89,6 +98,7 @@ def _write_export(nk, args) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+    from .batch import add_batch_parser
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
@@ -123,6 +133,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
     p.add_argument("--coat-roughness", type=float, default=0.03,
                    help="coat roughness of --export, [0, 1]")
+    p.add_argument("--strict", action="store_true",
+                   help="exit with status 3 (writing nothing) when the fit does not converge")
     p.set_defaults(func=_cmd_fit)
 
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
@@ -131,6 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
     add_scene_parser(sub)
+    add_batch_parser(sub, parse_eta_range)
     add_ibl_parsers(sub)
     return parser
 

@@ -8,6 +8,9 @@ with the weights of :func:`fitting.colour.colorimetry.spectral_to_ACEScg_weights
 
 -   :func:`spectral_grid`: the wavelength nodes for a spectral step.
 -   :func:`reference_ACEScg`: the reference at any (cos theta, eta_i).
+-   :func:`reference_ACEScg_grid`: the same on a product grid (cos theta
+    values x eta_i values), the same numbers at a fraction of the cost:
+    what the scoring grid and the preview tables use.
 -   :func:`evaluation_grid`: the paper's N x N scoring grid.
 
 References
@@ -29,7 +32,10 @@ from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, resample_nk
 from .colorimetry import spectral_to_ACEScg_weights
 
-__all__ = ["spectral_grid", "spectral_weights", "reference_ACEScg", "evaluation_grid"]
+__all__ = [
+    "spectral_grid", "spectral_weights", "reference_ACEScg", "reference_ACEScg_grid",
+    "evaluation_grid",
+]
 
 
 def spectral_grid(step_nm: float = 1.0) -> np.ndarray:
@@ -103,6 +109,119 @@ def reference_ACEScg(
         R = fresnel_conductor(mu[start:stop], eta[start:stop], sampled.n, sampled.k)
         out[start:stop] = R @ W.T
     return out.reshape(shape + (3,))
+
+
+_TINY = np.finfo(np.float64).tiny
+# Rows of cos theta per block: small enough that the block's five buffers stay
+# in cache, large enough that numpy's per-call overhead does not dominate.
+_BLOCK_MU = 32
+
+
+def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out) -> None:
+    """
+    Fresnel reflectance of ``n + i k`` (L,) for cos theta ``mu`` (M,) under
+    each real ``eta_i`` (E,), integrated by the weights ``WT`` (L, 3) into
+    ``out`` (E, M, 3), in real arithmetic with preallocated buffers.
+
+    With :math:`c = \\mu^2`, :math:`s = 1 - c`, the relative index
+    :math:`\\eta = (n + ik)/\\eta_i`, :math:`t_0 = \\mathrm{Re}(\\eta^2) - s`,
+    :math:`B = \\mathrm{Im}(\\eta^2)^2`, :math:`X = |\\eta^2 - s| = \\sqrt{t_0^2 + B}`
+    and :math:`a = \\mathrm{Re}\\sqrt{\\eta^2 - s}`:
+
+    .. math::
+
+        R_s = \\frac{X + c - 2\\mu a}{X + c + 2\\mu a},\\quad
+        \\frac{R_p}{R_s} = \\frac{cX + s^2 - 2\\mu a s}{cX + s^2 + 2\\mu a s},\\quad
+        R = \\frac{R_s + R_p}{2} = R_s \\frac{cX + s^2}{cX + s^2 + 2\\mu a s},
+
+    the unpolarised reflectance of :func:`fitting.fresnel.fresnel_conductor`
+    (whose complex form is the definition; agreement to 1e-14 is tested).
+    float64 care: :math:`2a^2 = X + t_0` cancels where :math:`t_0 < 0` (every
+    metal, and a dielectric past its critical angle), so there it is taken
+    as :math:`B/(X + |t_0|)` (from :math:`4a^2b^2 = B`), and :math:`X + |t_0|`
+    never cancels. Total internal reflection (k = 0) gives a = 0 and R = 1;
+    the index-matched interface at grazing incidence (every term 0) gives 0,
+    as in the complex form.
+    """
+    L = n.size
+    re0, im0 = n * n - k * k, (2.0 * n * k) ** 2
+    for m0 in range(0, mu.size, _BLOCK_MU):
+        m = mu[m0:m0 + _BLOCK_MU]
+        c = (m * m)[:, None]
+        s = 1.0 - c
+        s2 = s * s
+        sqrt2_mu = (np.sqrt(2.0) * m)[:, None]
+        t0, X, P, Q, R = (np.empty((m.size, L)) for _ in range(5))
+        positive = np.empty((m.size, L), dtype=bool)
+        for i, e in enumerate(eta_i):
+            e2 = e * e
+            B = im0 / (e2 * e2)
+            np.subtract(re0 / e2, s, out=t0)
+            np.multiply(t0, t0, out=X)
+            X += B
+            np.sqrt(X, out=X)                      # X = |eta^2 - s|
+            np.abs(t0, out=P)
+            P += X
+            np.maximum(P, _TINY, out=P)            # 0 only when index matched at grazing
+            np.divide(B, P, out=Q)
+            np.greater_equal(t0, 0.0, out=positive)
+            np.copyto(Q, P, where=positive)        # Q = 2 a^2
+            np.sqrt(Q, out=Q)
+            Q *= sqrt2_mu                          # Q = 2 mu a
+            np.add(X, c, out=P)                    # P = X + c
+            X *= c
+            X += s2                                # X = c X + s^2
+            np.multiply(Q, s, out=t0)
+            t0 += X                                # t0 = c X + s^2 + 2 mu a s
+            np.subtract(P, Q, out=R)
+            R *= X                                 # numerator
+            P += Q
+            P *= t0                                # denominator
+            # Zero only for the index-matched interface at grazing, where the
+            # numerator is 0 too: R = 0, as the complex form gives.
+            np.maximum(P, _TINY, out=P)
+            R /= P
+            np.dot(R, WT, out=out[i, m0:m0 + m.size])
+
+
+def reference_ACEScg_grid(
+    nk: SpectralNK,
+    cos_theta,
+    eta_i,
+    step_nm: float = 1.0,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+) -> np.ndarray:
+    """
+    :func:`reference_ACEScg` on the product grid of the 1-D ``cos_theta``
+    (M,) and ``eta_i`` (E,) values: shape (E, M, 3) indexed [eta_i,
+    cos_theta], as ``reference_ACEScg(nk, M, E)`` of :func:`evaluation_grid`,
+    at about a fifth of the cost.
+
+    Exact reductions first: repeated cos theta or eta_i values are computed
+    once, and wavelengths with the same *n*, *k* (data held constant past
+    their range) are merged, their weights summed. Then Fresnel in real
+    arithmetic (:func:`_fresnel_ACEScg_block`), block by block in cache,
+    each block reduced to ACEScg by the wavelength weights at once. The
+    numbers equal the complex-arithmetic reference to rounding (about 1e-15).
+    """
+    nodes, W = spectral_weights(step_nm)
+    sampled = resample_nk(nk, nodes, min_coverage)
+    mu = np.clip(as_finite_array("cos_theta", cos_theta), 0.0, 1.0)
+    eta = as_finite_array("eta_i", eta_i)
+    if mu.ndim != 1 or eta.ndim != 1:
+        raise ValueError("`cos_theta` and `eta_i` must be 1-D arrays of grid values")
+    if np.any(eta < 1.0):
+        raise ValueError(f"`eta_i` must be >= 1, got {eta.min():g}")
+    mu_u, mu_inverse = np.unique(mu, return_inverse=True)
+    eta_u, eta_inverse = np.unique(eta, return_inverse=True)
+    nk_u, nk_inverse = np.unique(
+        np.stack([sampled.n, sampled.k], axis=1), axis=0, return_inverse=True
+    )
+    WT = np.zeros((nk_u.shape[0], 3))
+    np.add.at(WT, nk_inverse.reshape(-1), W.T)
+    out = np.empty((eta_u.size, mu_u.size, 3))
+    _fresnel_ACEScg_block(mu_u, eta_u, nk_u[:, 0].copy(), nk_u[:, 1].copy(), WT, out)
+    return out[eta_inverse.reshape(-1)][:, mu_inverse.reshape(-1)]
 
 
 def evaluation_grid(

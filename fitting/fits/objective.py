@@ -36,7 +36,13 @@ COEFFICIENT_BOUND = np.array([16.0, 64.0, 256.0])
 class Problem:
     """Residuals and Jacobian of one fit (flattened samples S, 3 outputs each)."""
 
-    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None):
+    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None,
+                 range_check=None):
+        # range_check: (mu, eta, weight) of points where the model must stay
+        # in [0, 1]: one hinge residual weight * (min(F, 0) + max(F - 1, 0))
+        # per point and channel, 0 while the model is inside.
+        self.check = None if range_check is None else (
+            np.ravel(range_check[0]), np.ravel(range_check[1]), float(range_check[2]))
         self.mu = np.ravel(cos_theta)
         self.eta = np.ravel(eta_i)
         self.range = eta_i_range
@@ -60,12 +66,29 @@ class Problem:
             G = self.A @ G
         return d, G
 
+    def _range_residuals(self, x):
+        mu, eta, weight = self.check
+        F = coated_conductor_model(mu, eta, x.reshape(self.shape), self.range)
+        return weight * (np.minimum(F, 0.0) + np.maximum(F - 1.0, 0.0))
+
     def residuals(self, x):
         F = coated_conductor_model(self.mu, self.eta, x.reshape(self.shape), self.range)
         r, _ = self._outputs(F)
         if self.sqrt_w is not None:
             r = r * self.sqrt_w
+        if self.check is not None:
+            return np.concatenate([r.ravel(), self._range_residuals(x).ravel()])
         return r.ravel()
+
+    def _range_jacobian(self, x):
+        mu, eta, weight = self.check
+        F, Jm = model_jacobian(mu, eta, x.reshape(self.shape), self.range)
+        active = ((F < 0.0) | (F > 1.0)).astype(np.float64)  # (K, 3)
+        K, d1 = Jm.shape[0], self.shape[2]
+        J = np.zeros((K, 3, 3, 3, d1))
+        idx = np.arange(3)
+        J[:, idx, :, idx, :] = weight * active.T[:, :, None, None] * Jm.transpose(1, 0, 2, 3)
+        return J.reshape(K * 3, -1)
 
     def jacobian(self, x):
         F, Jm = model_jacobian(self.mu, self.eta, x.reshape(self.shape), self.range)
@@ -80,6 +103,8 @@ class Problem:
             J = np.einsum("soc,scpj->sopcj", G, Jm)
         if self.sqrt_w is not None:
             J = J * self.sqrt_w[:, :, None, None, None]
+        if self.check is not None:
+            return np.concatenate([J.reshape(S * 3, -1), self._range_jacobian(x)])
         return J.reshape(S * 3, -1)
 
 

@@ -84,6 +84,7 @@ def fit_coefficients(
     quantise: bool = True,
     weights=None,
     irls_rounds: int = 2,
+    range_check=None,
 ) -> FitResult:
     """
     Fit the coated-conductor model to linear ACEScg samples.
@@ -138,6 +139,11 @@ def fit_coefficients(
     irls_rounds
         For ``de2000``: rounds of reweighting by :math:`1/\\Delta E_s` that
         turn the sum of squares into the mean Delta E.
+    range_check
+        Optional ``(cos_theta, eta_i, weight)``: points where the model must
+        stay in [0, 1]; each adds the residual ``weight * (min(F, 0) +
+        max(F - 1, 0))`` per channel (zero inside), in the solves and in the
+        float16 quantisation (a penalty constraint, not a clip).
 
     Returns
     -------
@@ -163,7 +169,16 @@ def fit_coefficients(
         weights = np.ravel(np.asarray(weights, dtype=np.float64))
         if weights.size != mu.size or np.any(weights < 0) or not np.all(np.isfinite(weights)):
             raise ValueError("`weights` must be one finite value >= 0 per sample")
-    problem = Problem(target, mu, eta, eta_i_range, degree, objective, weights)
+    if range_check is not None:
+        check_mu, check_eta, check_weight = range_check
+        check_mu = np.ravel(np.asarray(check_mu, dtype=np.float64))
+        check_eta = np.ravel(np.asarray(check_eta, dtype=np.float64))
+        if check_mu.size != check_eta.size or not (np.all(np.isfinite(check_mu)) and np.all(np.isfinite(check_eta))):
+            raise ValueError("`range_check` must give finite cos_theta and eta_i of one size")
+        if not (np.isfinite(check_weight) and check_weight > 0):
+            raise ValueError(f"`range_check` weight must be a finite number > 0, got {check_weight!r}")
+        range_check = (check_mu, check_eta, float(check_weight))
+    problem = Problem(target, mu, eta, eta_i_range, degree, objective, weights, range_check)
     bounds = coefficient_bounds(degree)
     x0 = np.clip(initial_guess(target, mu, eta, eta_i_range, degree).ravel(), *bounds)
     result = solve(problem, x0, bounds, 1e-10, max_nfev)
@@ -173,12 +188,13 @@ def fit_coefficients(
         # w_s = 1 / max(dE_s, floor) turns sum w_s dE_s^2 into sum dE_s.
         base = np.ones(mu.size) if weights is None else weights
         for _ in range(irls_rounds):
-            dE = np.linalg.norm(problem.residuals(result.x).reshape(-1, 3), axis=1)
+            dE = np.linalg.norm(problem.residuals(result.x)[: 3 * mu.size].reshape(-1, 3), axis=1)
             if weights is not None:
                 dE = dE / np.sqrt(np.maximum(weights, 1e-300))
             floor = max(_IRLS_FLOOR, 1e-3 * float(dE.max()))
             problem = Problem(
-                target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor)
+                target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor),
+                range_check,
             )
             result = solve(problem, result.x, bounds, 1e-8, max_nfev)
             nfev, njev = nfev + result.nfev, njev + (result.njev or 0)

@@ -4,38 +4,40 @@ Dependencies
 
 ``Annotated`` dependencies shared by the routers:
 
--   :data:`SettingsDep`: the app's :class:`service.config.Settings`.
--   :data:`StoreDep`: the app's :class:`service.store.Store`.
--   :data:`RunnerDep`: the app's :class:`service.fitting_jobs.FitRunner`.
--   :data:`WriteAccess`: the bearer-token check of the write endpoints
-    (a no-op unless the settings require a token).
--   :func:`fit_errors`: a context manager that turns the fitting core's
-    ``ValueError`` into 422 and the runner's refusals into 503/504.
--   :data:`ERROR_RESPONSES`: the error answers for the OpenAPI document.
+-   :data:`SettingsDep`, :data:`StoreDep`, :data:`RunnerDep`: the app's
+    settings, store and fitting pool.
+-   :data:`StoredFit`: the stored fit named by the path's ``fit_id`` (404
+    when it is not stored), read in a worker thread.
+-   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
+    endpoints.
+-   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
+    :data:`NOT_FOUND`: the error answers for the OpenAPI document.
 """
 
 from __future__ import annotations
 
-import contextlib
 import hmac
-from typing import Annotated, Iterator
+from typing import Annotated
 
-from fastapi import Depends, HTTPException, Request, status
+from fastapi import Depends, HTTPException, Path, Request, status
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
-from ..fitting_jobs import FitRunner, FitTimeout, Overloaded, WorkerLost
-from ..models import ErrorBody
-from ..store import Store
+from ..jobs.common import stored_fit
+from ..pool import FitRunner
+from ..schemas import FIT_ID_PATTERN, ErrorBody
+from ..store import FitRecord, Store
 
 __all__ = [
     "SettingsDep",
     "StoreDep",
     "RunnerDep",
+    "FitIdPath",
+    "StoredFit",
     "WriteAccess",
-    "fit_errors",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
+    "NOT_FOUND",
 ]
 
 
@@ -54,6 +56,15 @@ def get_runner(request: Request) -> FitRunner:
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 StoreDep = Annotated[Store, Depends(get_store)]
 RunnerDep = Annotated[FitRunner, Depends(get_runner)]
+FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
+
+
+def get_stored_fit(fit_id: FitIdPath, store: StoreDep) -> FitRecord:
+    """The record of the path's ``fit_id`` (LookupError -> 404)."""
+    return stored_fit(store, fit_id)
+
+
+StoredFit = Annotated[FitRecord, Depends(get_stored_fit)]
 
 _bearer = HTTPBearer(auto_error=False, description="COATED_API_TOKEN, when the service requires one")
 
@@ -69,8 +80,11 @@ def require_write_access(
 
     A browser names the page that sends a request in ``Origin``; a write
     from a page of another site (a multipart upload needs no CORS
-    preflight) is refused unless that origin is in ``cors_origins``.
-    Pipelines (curl, scripts) send no ``Origin``.
+    preflight) is refused unless that origin is in ``cors_origins``. The
+    ``Host`` it is compared with has passed the allow-list
+    (:class:`service.api.middleware.HostAllowList`), so a DNS-rebinding page
+    (whose ``Host`` is its own name) never gets this far. Pipelines (curl,
+    scripts) send no ``Origin``.
     """
     origin = request.headers.get("origin")
     if origin is not None:
@@ -78,7 +92,7 @@ def require_write_access(
         if origin != own and origin not in settings.cors_origins:
             raise HTTPException(
                 status.HTTP_403_FORBIDDEN,
-                f"cross-site writes are refused: `Origin` {origin!r} is neither this service "
+                f"cross-site writes are refused: `Origin` {origin[:100]!r} is neither this service "
                 f"({own}) nor in COATED_CORS_ORIGINS",
             )
     if not settings.token_required:
@@ -97,38 +111,25 @@ def require_write_access(
 WriteAccess = Depends(require_write_access)
 
 
-@contextlib.contextmanager
-def fit_errors() -> Iterator[None]:
-    """Map the core's and the runner's exceptions to HTTP answers."""
-    try:
-        yield
-    except ValueError as error:
-        raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
-    except Overloaded as error:
-        raise HTTPException(
-            status.HTTP_503_SERVICE_UNAVAILABLE, str(error),
-            headers={"Retry-After": str(error.retry_after)},
-        ) from None
-    except WorkerLost as error:
-        raise HTTPException(
-            status.HTTP_503_SERVICE_UNAVAILABLE, str(error), headers={"Retry-After": "1"}
-        ) from None
-    except FitTimeout as error:
-        raise HTTPException(status.HTTP_504_GATEWAY_TIMEOUT, str(error)) from None
-
-
 def _error(description: str) -> dict:
     return {"model": ErrorBody, "description": description}
 
 
 ERROR_RESPONSES = {
+    status.HTTP_400_BAD_REQUEST: _error("The `Host` is not in COATED_ALLOWED_HOSTS"),
     status.HTTP_422_UNPROCESSABLE_CONTENT: _error("A field broke a rule (named in `detail`)"),
+    status.HTTP_503_SERVICE_UNAVAILABLE: _error("The store is unavailable, or the service is busy; see Retry-After"),
 }
+NOT_FOUND = {status.HTTP_404_NOT_FOUND: _error("Not stored")}
 FIT_ERROR_RESPONSES = {
     **ERROR_RESPONSES,
     status.HTTP_401_UNAUTHORIZED: _error("Missing or wrong bearer token (when required)"),
     status.HTTP_403_FORBIDDEN: _error("A cross-site write from a browser (Origin of another site)"),
+    status.HTTP_408_REQUEST_TIMEOUT: _error("The body arrived slower than COATED_BODY_TIMEOUT_S"),
     status.HTTP_413_CONTENT_TOO_LARGE: _error("The body is larger than the limit"),
-    status.HTTP_503_SERVICE_UNAVAILABLE: _error("Too many fits in flight; see Retry-After"),
-    status.HTTP_504_GATEWAY_TIMEOUT: _error("The fit ran past its time limit"),
+    status.HTTP_503_SERVICE_UNAVAILABLE: _error("Too many fits in flight, a worker died twice, "
+                                                "or the store is unavailable; see Retry-After"),
+    status.HTTP_504_GATEWAY_TIMEOUT: _error("The fit ran past its time limit; it goes on, retry "
+                                            "after Retry-After for its result"),
+    status.HTTP_507_INSUFFICIENT_STORAGE: _error("The store is full; nothing was fitted"),
 }

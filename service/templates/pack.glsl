@@ -6,7 +6,7 @@
 // in t = clamp((eta_i - lo) / (hi - lo), 0, 1); rgb-conductor, the exact
 // Fresnel equations per channel of the relative index (n + i k) / eta_i.
 // Reflectance is linear ACEScg.
-// Needs GLSL 4.20 or later (unpackHalf2x16 in cf_unpack_coefficients).
+// Compiles as GLSL 3.30 and GLSL ES 3.00 or later.
 //
 // Usage: vec3 F = cf_material_<name>(NdotV, eta_i);
 // NdotV is cos theta inside the coating, eta_i the coating's index.

@@ -110,6 +110,12 @@ class TestDownloads:
         )
         assert result.returncode == 0, result.stdout + result.stderr
 
+    def test_exports_of_an_rgb_conductor_fit(self, fitted):
+        client, rgb, _ = fitted
+        response = client.get(f"{API}/fits/{rgb['id']}/pack", params={"format": "mtlx", "eta_i": 1.5})
+        assert response.status_code == 200
+        assert b"conductor_bsdf" in response.content
+
     def test_bad_format_is_422(self, fitted):
         client, rgb, _ = fitted
         response = client.get(f"{API}/fits/{rgb['id']}/pack", params={"format": "usd"})

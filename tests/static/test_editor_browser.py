@@ -189,10 +189,11 @@ def test_refusal_is_shown(page, editor_url, tmp_path):
     broken = tmp_path / "broken.csv"
     broken.write_text("wavelength_nm,n,k\n500,1.0\n")
     page.set_input_files("#upload", str(broken))
-    expect(page.locator("#message")).not_to_be_empty()
+    # The refusal is shown next to the upload control.
+    expect(page.locator("#upload-message")).to_contain_text("Not uploaded")
     wait_idle(page)
     assert "500" not in page.inner_text("#fit-id")  # nothing was fitted
-    assert page.locator("#message").get_attribute("role") == "alert"
+    assert page.locator("#upload-message").get_attribute("aria-live") == "polite"
 
 
 def test_refused_save_is_not_claimed(page, editor_url):
@@ -201,11 +202,12 @@ def test_refused_save_is_not_claimed(page, editor_url):
     edit_by_keyboard(page)
     edited_id = wait_fit(page, base_id)
 
-    # The refit behind Save is refused (503): the page says so, names the
-    # service's reason, and neither claims nor lists a saved material.
-    detail = "too many fits in flight (2 queued); retry after 1 s"
+    # The refit behind Save is refused (422; a 503 is retried, see
+    # test_editor_live.py): the page says so, names the service's reason,
+    # and neither claims nor lists a saved material.
+    detail = "`name` must not be this one (a test's refusal)"
     page.route("**/api/v1/fits/from-curves", lambda route: route.fulfill(
-        status=503, content_type="application/json", body=json.dumps({"detail": detail})))
+        status=422, content_type="application/json", body=json.dumps({"detail": detail})))
     page.fill("#name", "Refused browser test")
     page.click("#save")
     expect(page.locator("#message")).to_have_text(f"Not saved: {detail}")

@@ -1,31 +1,71 @@
 """
-Health
-======
+Health and domain
+=================
 
-``GET /healthz``: answers once the service is ready (store open, fitting
-pool started); 503 if the store has become unusable.
+-   ``GET /healthz``: answers once the service is ready (store open, fitting
+    pool started), and says whether the store can take a save now; 503 if
+    the store cannot be read. Cheap (no integrity scan, no write), and its
+    store probe runs in a worker thread, so it answers while fits run.
+-   ``GET /api/v1/domain``: the eta_i limits, the default domain and the
+    other constants a client checks before sending, from the core.
 """
 
-from fastapi import APIRouter, HTTPException, status
+import asyncio
+from concurrent.futures import ThreadPoolExecutor
 
-from ...models import ErrorBody, Health
-from ..deps import RunnerDep, SettingsDep, StoreDep
+from fastapi import APIRouter, status
+
+from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
+from fitting.fits.settings import OBJECTIVES
+from fitting.optics.library import LIBRARY_NAMES
+
+from ...schemas import (
+    API_PREFIX,
+    DEFAULT_ETA_I_RANGE,
+    DEFAULT_OBJECTIVE,
+    ETA_I_LIMITS,
+    MAX_NK_SAMPLES,
+    PACK_FORMATS,
+    Domain,
+    ErrorBody,
+    Health,
+)
+from ...store import Store
+from ..deps import RunnerDep, StoreDep
 
 router = APIRouter(tags=["health"])
 
 
-@router.get(
-    "/healthz",
-    response_model=Health,
-    responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}},
-)
-def healthz(store: StoreDep, runner: RunnerDep, settings: SettingsDep) -> Health:
-    """Readiness: the store answers and the fitting pool is up."""
-    try:
-        store.check()
-    except RuntimeError as error:
-        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, str(error)) from None
+# Its own thread: the probe never queues behind the requests' thread work.
+_PROBE_THREAD = ThreadPoolExecutor(1, thread_name_prefix="healthz")
+
+
+def _probe(store: Store) -> str | None:
+    store.ping()  # StoreError -> 503
+    return store.writable()
+
+
+@router.get("/healthz", response_model=Health,
+            responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
+async def healthz(store: StoreDep, runner: RunnerDep) -> Health:
+    """Readiness: the store answers and the fitting pool is up; whether a save can be written."""
+    problem = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
         status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
-        max_in_flight=runner.max_in_flight,
+        max_in_flight=runner.max_in_flight, store_writable=problem is None, store_problem=problem,
+        pool_restarts=runner.restarts,
     )
+
+
+DOMAIN = Domain(
+    eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE), objectives=list(OBJECTIVES),
+    default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES), pack_formats=list(PACK_FORMATS),
+    curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
+    max_nk_samples=MAX_NK_SAMPLES,
+)
+
+
+@router.get(f"{API_PREFIX}/domain", response_model=Domain)
+async def domain() -> Domain:
+    """The rules and defaults of the API's inputs (the editor reads them instead of repeating them)."""
+    return DOMAIN

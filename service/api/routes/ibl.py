@@ -15,7 +15,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Response, status
 
 from ...downloads import IBL_LUT_FILENAME, ibl_lut_file
-from ...models import API_PREFIX
+from ...schemas import API_PREFIX
 from ..deps import ERROR_RESPONSES
 
 router = APIRouter(prefix=API_PREFIX, tags=["downloads"])

@@ -6,24 +6,20 @@ Packs
 materials together), in any pack format. Reads only; saves nothing.
 """
 
-from fastapi import APIRouter, HTTPException, Response, status
+from fastapi import APIRouter, Response, status
 
-from ...models import API_PREFIX, ErrorBody, PackRequest
-from ..deps import ERROR_RESPONSES, StoreDep
-from .fits import PACK_CONTENT, pack_response
+from ...downloads import PACK_CONTENT, pack_response
+from ...jobs.common import stored_fit
+from ...schemas import API_PREFIX, PackRequest
+from ..deps import ERROR_RESPONSES, NOT_FOUND, StoreDep
 
 router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 
 
-@router.post(
-    "",
-    response_class=Response,
-    responses={
-        status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
-        status.HTTP_404_NOT_FOUND: {"model": ErrorBody, "description": "An id is not stored"},
-        **ERROR_RESPONSES,
-    },
-)
+@router.post("", response_class=Response, responses={
+    status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
+    **NOT_FOUND, **ERROR_RESPONSES,
+})
 def create_pack(request: PackRequest, store: StoreDep) -> Response:
     """
     The fits named by ``fit_ids``, in that order, as one pack. A renderer
@@ -32,16 +28,11 @@ def create_pack(request: PackRequest, store: StoreDep) -> Response:
     """
     records, names = [], {}
     for index, fit_id in enumerate(request.fit_ids):
-        record = store.get_fit(fit_id)
-        if record is None:
-            raise HTTPException(
-                status.HTTP_404_NOT_FOUND, f"`fit_ids[{index}]` {fit_id} is not a stored fit"
-            )
+        record = stored_fit(store, fit_id, f"fit_ids[{index}]")
         if record.name in names:
-            raise HTTPException(
-                status.HTTP_422_UNPROCESSABLE_CONTENT,
+            raise ValueError(
                 f"`fit_ids[{index}]` is named {record.name!r} like `fit_ids[{names[record.name]}]`: "
-                "names in a pack must be unique",
+                "names in a pack must be unique"
             )
         names[record.name] = index
         records.append(record)

@@ -20,13 +20,11 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, HTTPException, Query, Request, Response, status
 
-from fitting.domain import ETA_I_MAX, ETA_I_MIN
 from fitting.models.pack import material_from_json
 
-from ...models import API_PREFIX, FIT_ID_PATTERN, ErrorBody
+from ...jobs.common import measured_nk, stored_fit
+from ...schemas import API_PREFIX, ETA_I_LIMITS, FIT_ID_PATTERN, ErrorBody
 from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep
-from ...fitting_jobs import measured_nk
-from .fits import stored_fit
 
 router = APIRouter(prefix=API_PREFIX, tags=["preview"])
 _lock = threading.Lock()
@@ -65,7 +63,7 @@ def _slots(request: Request, settings) -> threading.BoundedSemaphore:
 def preview_png(
     request: Request, store: StoreDep, settings: SettingsDep,
     fit: Annotated[str, Query(pattern=FIT_ID_PATTERN, description="A stored fit's id")],
-    eta_i: Annotated[float, Query(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False)] = 1.5,
+    eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)] = 1.5,
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
     compare: Annotated[Literal["none", "lazanyi", "reference"], Query()] = "none",
     environment: Annotated[Literal["white_sky", "studio"], Query()] = "white_sky",
@@ -80,15 +78,13 @@ def preview_png(
     """The preview sphere as an 8-bit sRGB PNG: smooth (roughness 0, immersed),
     or rough / coated through the split sum with a prefiltered environment."""
     if size > settings.max_preview_size:
-        raise HTTPException(
-            status.HTTP_422_UNPROCESSABLE_CONTENT,
+        raise ValueError(
             f"`size` must be at most {settings.max_preview_size} (COATED_MAX_PREVIEW_SIZE), got {size}",
         )
     record = stored_fit(store, fit)
     nk = measured_nk(record)
     if compare != "none" and nk is None:
-        raise HTTPException(
-            status.HTTP_422_UNPROCESSABLE_CONTENT,
+        raise ValueError(
             f"`compare`={compare!r} needs measured n, k; fit {fit} was made from curves",
         )
     slots = _slots(request, settings)
@@ -106,14 +102,11 @@ def preview_png(
             raise HTTPException(
                 status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
             ) from None
-        try:
-            result = active.render_preview(
-                material_from_json(record.material), nk, eta_i=eta_i, size=size,
-                compare=compare, environment=environment, roughness=roughness, mode=mode,
-                coat_roughness=coat_roughness,
-            )
-        except ValueError as error:
-            raise HTTPException(status.HTTP_422_UNPROCESSABLE_CONTENT, str(error)) from None
+        result = active.render_preview(
+            material_from_json(record.material), nk, eta_i=eta_i, size=size,
+            compare=compare, environment=environment, differences=False,
+            roughness=roughness, mode=mode, coat_roughness=coat_roughness,
+        )
     finally:
         slots.release()
     return Response(result.png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})

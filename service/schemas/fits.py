@@ -1,17 +1,11 @@
 """
-Request and response models
-===========================
+n, k fits, packs and plotted curves
+===================================
 
-Pydantic v2 models of the HTTP API. Constraints live on the fields so that
-bad input is refused by the schema and shows in the OpenAPI document.
-
--   Requests: :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`.
--   Responses: :class:`FitPublic` (with :class:`Coefficients`,
-    :class:`FitMetrics`, :class:`FitLinks`), :class:`MaterialSummary`,
-    :class:`MaterialList`, :class:`MaterialDetail`, :class:`CurvesPublic`,
-    :class:`Health`, :class:`ErrorBody`.
--   :func:`fit_public`: a stored :class:`service.store.FitRecord` as
-    :class:`FitPublic`.
+Requests :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`;
+responses :class:`FitPublic` (with :class:`Coefficients`,
+:class:`service.schemas.metrics.FitMetrics`, :class:`FitLinks`) and
+:class:`CurvesPublic`; :func:`fit_public` is a stored record's view.
 """
 
 from __future__ import annotations
@@ -20,89 +14,30 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
-from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
-from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
-from fitting.optics.bounded import excerpt
-from fitting.optics.library import LIBRARY_NAMES
+from ..store import FIT_KINDS, FitRecord
+from .common import (
+    API_PREFIX,
+    DEFAULT_ETA_I_RANGE,
+    DEFAULT_MODEL,
+    DEFAULT_OBJECTIVE,
+    MAX_NK_SAMPLES,
+    EtaI,
+    FitId,
+    LibraryName,
+    ModelKind,
+    Objective,
+    PackFormat,
+    RequestModel,
+    Text,
+)
+from .metrics import FitDetails, FitMetrics
 
-from .store import FIT_KINDS, FitRecord
+__all__ = ["NKData", "FitRequest", "PackRequest", "Coefficients", "RGBConductorCoefficients", "FitLinks", "FitPublic",
+           "CurvesPublic", "fit_public"]
 
-_MAX_UNKNOWN_LISTED = 5
-
-__all__ = [
-    "API_PREFIX",
-    "MAX_NK_SAMPLES",
-    "FIT_ID_PATTERN",
-    "MATERIAL_ID_PATTERN",
-    "PACK_FORMATS",
-    "FitId",
-    "LibraryName",
-    "Objective",
-    "ModelKind",
-    "PackFormat",
-    "RequestModel",
-    "NKData",
-    "FitRequest",
-    "PackRequest",
-    "Coefficients",
-    "RGBConductorCoefficients",
-    "DeltaE",
-    "FitMetrics",
-    "FitLinks",
-    "FitPublic",
-    "MaterialSummary",
-    "MaterialList",
-    "MaterialDetail",
-    "CurvesPublic",
-    "Health",
-    "ErrorItem",
-    "ErrorBody",
-    "fit_public",
-]
-
-API_PREFIX = "/api/v1"
-MAX_NK_SAMPLES = 20_000
-"""Most wavelength samples accepted in one n, k table."""
-FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
-MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
-PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
-
-FiniteFloat = Annotated[float, Field(allow_inf_nan=False, strict=True)]
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
 IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True)]
 IndexK = Annotated[float, Field(ge=0.0, allow_inf_nan=False, strict=True)]
-EtaI = Annotated[float, Field(ge=ETA_I_MIN, le=ETA_I_MAX, allow_inf_nan=False, strict=True)]
-FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
-LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
-Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
-ModelKind = Literal[MODEL_KINDS]  # type: ignore[valid-type]
-PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
-Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
-
-
-class RequestModel(BaseModel):
-    """
-    Base of the request models: unknown fields are refused, and a body with
-    many of them is refused in one error naming the first few (pydantic
-    would make one error per field, tens of thousands from a 1 MB body, all
-    on the event loop).
-    """
-
-    model_config = ConfigDict(extra="forbid")
-
-    @model_validator(mode="before")
-    @classmethod
-    def _few_unknown_fields(cls, data: Any) -> Any:
-        fields = cls.model_fields
-        if isinstance(data, dict) and len(data) > len(fields) + _MAX_UNKNOWN_LISTED:
-            unknown = [key for key in data if key not in fields]
-            if len(unknown) > _MAX_UNKNOWN_LISTED:
-                shown = ", ".join(excerpt(key, 30) for key in unknown[:_MAX_UNKNOWN_LISTED])
-                raise ValueError(
-                    f"extra fields are not permitted: {len(unknown)} unknown fields ({shown}, ...)"
-                )
-        return data
 
 
 class NKData(RequestModel):
@@ -132,6 +67,9 @@ class NKData(RequestModel):
                     f"{self.wavelength_nm[i]:g} after {self.wavelength_nm[i - 1]:g} at index {i}"
                 )
         return self
+
+    def arrays(self) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+        return tuple(self.wavelength_nm), tuple(self.n), tuple(self.k)
 
 
 class FitRequest(RequestModel):
@@ -209,24 +147,6 @@ class RGBConductorCoefficients(BaseModel):
     k: list[float]
 
 
-class DeltaE(BaseModel):
-    """CIE Delta E 2000 against the reference on the scoring grid."""
-
-    model_config = ConfigDict(extra="allow")
-
-    delta_E_mean: float
-    delta_E_max: float
-
-
-class FitMetrics(BaseModel):
-    """Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
-
-    grid: str | None = None
-    model: DeltaE | None = None
-    lazanyi_adjusted: DeltaE | None = None
-    details: dict[str, Any] = Field(default_factory=dict)
-
-
 class FitLinks(BaseModel):
     self: str
     pack_binary: str
@@ -261,24 +181,6 @@ class FitPublic(BaseModel):
     links: FitLinks
 
 
-class MaterialSummary(BaseModel):
-    id: str
-    name: str
-    kind: Literal[FIT_KINDS]  # type: ignore[valid-type]
-    source: str
-    coverage: float | None = None
-    latest_fit_id: str | None = None
-
-
-class MaterialList(BaseModel):
-    materials: list[MaterialSummary]
-
-
-class MaterialDetail(MaterialSummary):
-    wavelength_range_nm: tuple[float, float] | None = None
-    latest_fit: FitPublic | None = None
-
-
 class CurvesPublic(BaseModel):
     """RGB curves against the angle, linear ACEScg; None where there is no n, k."""
 
@@ -288,28 +190,11 @@ class CurvesPublic(BaseModel):
     theta_deg: list[float]
     cos_theta: list[float]
     model: list[list[float]]
+    target: list[list[float]] | None = Field(
+        None, description="What the fit was fitted to at this eta_i: for a curve fit the blended "
+                          "edited target (or its curve), else the reference")
     reference: list[list[float]] | None = None
     lazanyi_adjusted: list[list[float]] | None = None
-
-
-class Health(BaseModel):
-    status: Literal["ok"]
-    fits_in_flight: int
-    fit_workers: int
-    max_in_flight: int
-
-
-class ErrorItem(BaseModel):
-    loc: list[str | int]
-    msg: str
-    type: str
-
-
-class ErrorBody(BaseModel):
-    """Every 4xx and 5xx answer: what broke which rule."""
-
-    detail: str
-    errors: list[ErrorItem] = Field(default_factory=list)
 
 
 def fit_public(record: FitRecord) -> FitPublic:
@@ -337,7 +222,7 @@ def fit_public(record: FitRecord) -> FitPublic:
             grid=metrics.get("grid"),
             model=metrics.get("model_float16"),
             lazanyi_adjusted=metrics.get("lazanyi_adjusted"),
-            details=metrics,
+            details=FitDetails.model_validate(metrics),
         ),
         timings=record.timings,
         convergence=record.convergence,

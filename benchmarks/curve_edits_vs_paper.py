@@ -1,0 +1,107 @@
+"""
+Curve edits: the default refit against the paper's own fitting method
+======================================================================
+
+For a set of edits (several materials, one to four edited curves, gentle
+and extreme), both fits are scored on the whole blended target
+(fitting.fits.curves.whole_target_error: mean Delta E 2000 over 46 angles x 31
+eta_i of fitting.fits.curves_base.edited_target):
+
+-   ``default``: fitting.fits.curves.fit_curves with its default settings (what
+    the editor and POST /fits/from-curves run);
+-   ``paper``: the paper's method (Vernooij 2024, Section 4: plain rgb
+    least squares of the model) fitted to the blended target sampled on the
+    scoring grid itself (fitting.fits.solver.fit_coefficients, objective "rgb",
+    float16 quantised).
+
+Also reported: the default fit's range over the grid (it must stay in
+[0, 1]) and its time. Run: ``.venv/bin/python benchmarks/curve_edits_vs_paper.py``
+(``--quick`` for every fourth edit).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from fitting import (  # noqa: E402
+    CurveFitSettings, RGBCurve, curve_base_from_nk, edited_target, fit_coefficients, fit_curves, library_material,
+)
+from fitting.fits.curves import score_grid, whole_target_error  # noqa: E402
+
+ANGLES = np.linspace(0.0, 90.0, 46)
+MU = np.where(ANGLES == 90.0, 0.0, np.cos(np.radians(ANGLES)))
+
+
+def bump(centre_deg: float, width_deg: float = 9.0) -> np.ndarray:
+    w = np.exp(-0.5 * ((ANGLES - centre_deg) / width_deg) ** 2) * (1 - (ANGLES / 90) ** 6)
+    return w / w.max()
+
+
+def edit_curve(base, eta_i, kind, channel, centre, amount):
+    rgb = base.rgb(MU, eta_i).copy()
+    w = bump(centre)
+    if kind == "add":
+        rgb[:, channel] += amount * w
+    elif kind == "scale":  # "All three": the three channels scaled
+        rgb *= 1.0 + amount * w[:, None]
+    elif kind == "to":  # pull a point to a value
+        rgb[:, channel] += (amount - rgb[np.argmin(np.abs(ANGLES - centre)), channel]) * w
+    return RGBCurve.from_angles(eta_i, ANGLES, np.clip(rgb, 0.0, 1.0))
+
+
+def edits():
+    """(label, material, [curve specs]) of the benchmark's edits."""
+    out = []
+    etas = [1.5, 1.2, 2.0, 2.4]
+    for material in ("Au", "Cu", "Al", "Cr", "Ag"):
+        for n in (1, 2, 4):
+            at = etas[:n]
+            out.append((f"{material} {n} gentle", material,
+                        [("add", k % 3, 50 + 5 * k, -0.06) for k in range(n)], at))
+            out.append((f"{material} {n} scale", material, [("scale", 0, 36, -0.25)] * n, at))
+            out.append((f"{material} {n} extreme", material,
+                        [("to", k % 3, 60 + 6 * k, 0.0) for k in range(n)], at))
+    return out
+
+
+def paper_fit(base, curves, blend_width):
+    _, _, M, E = score_grid(base.eta_i_range)
+    target = edited_target(base, curves, M, E, blend_width)
+    result = fit_coefficients(target.reshape(-1, 3), M.ravel(), E.ravel(), base.eta_i_range, 2, "rgb")
+    return result.coefficients_float16
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--quick", action="store_true", help="every fourth edit")
+    args = parser.parse_args()
+    settings = CurveFitSettings()
+    cases = edits()[:: 4 if args.quick else 1]
+    print(f"{'edit':<18} {'default dE':>10} {'paper dE':>9} {'default max':>11} {'at (deg, eta)':>14}"
+          f" {'range':>15} {'kept':>7} {'ms':>6}")
+    worse = 0
+    for label, material, specs, at in cases:
+        base = curve_base_from_nk(library_material(material), (1.0, 2.5))
+        curves = [edit_curve(base, e, *spec) for e, spec in zip(at, specs)]
+        t0 = time.perf_counter()
+        result = fit_curves(curves, base)
+        ms = 1e3 * (time.perf_counter() - t0)
+        ours = result.metrics["target"]
+        paper = whole_target_error(base, curves, paper_fit(base, curves, settings.blend_width),
+                                   settings.blend_width)
+        worse += ours["delta_E_mean"] > paper["delta_E_mean"] + 1e-9
+        print(f"{label:<18} {ours['delta_E_mean']:>10.3f} {paper['delta_E_mean']:>9.3f}"
+              f" {ours['delta_E_max']:>11.2f} {ours['at_theta_deg']:>7.0f}, {ours['at_eta_i']:.2f}"
+              f" [{ours['model_min']:.3f}, {ours['model_max']:.3f}] {result.metrics['objective']:>7} {ms:>6.0f}")
+    print(f"\n{len(cases)} edits; default worse than the paper's method on {worse}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,143 @@
+"""
+Editor speed in Chromium against a real server
+==============================================
+
+Debian's Chromium (headless, software WebGL2 through SwiftShader) drives
+the editor served by a real ``python -m service`` process on 127.0.0.1:
+
+-   ``cold start``: a fresh browser page to a usable editor with its WebGL
+    preview drawn (``body[data-ready]`` and the canvas's ``data-fit`` equal
+    to the fit on screen), on a server just started (its fitting pool
+    warmed); then a second load of the same server;
+-   ``drag step``: during a continuous drag of a control point (a pointer
+    move every 40 ms), from the edit a refit answers to its refitted curve
+    drawn and to the first WebGL frame of that fit
+    (``window.cfTelemetry``); median and p90 over the refits of the drags;
+-   ``orbit fps``: preview frames drawn per second while the orbit changes
+    every animation frame for 3 s (each frame read back, so it is rendered),
+    studio environment, three-way split, at a 1024 x 768 viewport.
+
+Run: ``.venv/bin/python benchmarks/editor_speed.py [--drags 3]``. The
+numbers depend on the machine's load (2 shared cores here).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from conftest import server_process  # noqa: E402
+from playwright.sync_api import sync_playwright  # noqa: E402
+
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"]
+READY = ("() => document.body.dataset.ready === 'true' && document.getElementById('preview').dataset.fit"
+         " === document.getElementById('fit-id').textContent")
+
+
+def percentile(values, q):
+    values = sorted(values)
+    return values[min(len(values) - 1, int(round(q * (len(values) - 1))))]
+
+
+def cold_start(browser, url):
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    t0 = time.perf_counter()
+    page.goto(url)
+    page.wait_for_function(READY, timeout=120_000)
+    seconds = time.perf_counter() - t0
+    page.close()
+    return seconds
+
+
+def drag_latencies(page, drags):
+    out = []
+    for d in range(drags):
+        page.evaluate("window.cfTelemetry.shown.length = 0")
+        handle = page.locator(f"circle.handle.c{d % 3}[data-angle='50']")
+        page.locator(f"input[name=channel][value='{d % 3}']").check()
+        box = handle.bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.mouse.move(x, y)
+        page.mouse.down()
+        for step in range(1, 41):
+            page.mouse.move(x, y + (2 if d % 2 == 0 else -2) * step)
+            page.wait_for_timeout(40)
+        page.mouse.up()
+        page.wait_for_function("document.getElementById('preview-state').hidden", timeout=60_000)
+        page.wait_for_timeout(200)
+        shown = page.evaluate("window.cfTelemetry.shown")
+        out += [(s["curveAt"] - s["editAt"], s["frameAt"] - s["editAt"]) for s in shown if s["frameAt"]]
+    return out
+
+
+def orbit_fps(browser, url):
+    """Frames drawn per second while the orbit changes every animation frame (in the page)."""
+    page = browser.new_page(viewport={"width": 1024, "height": 768})
+    page.goto(url)
+    page.wait_for_function(READY, timeout=120_000)
+    page.select_option("#environment", "studio")
+    fps = page.evaluate("""() => new Promise((resolve) => {
+        const ball = window.cfPreview, gl = ball.gl, pixel = new Uint8Array(4);
+        const start = performance.now(), frames0 = ball.frames;
+        function step(now) {
+            const [yaw, pitch, distance] = ball.state.orbit;
+            ball.set({ orbit: [yaw + 0.02, pitch, distance] });
+            // Wait for the GPU each frame, so frames are counted only when rendered.
+            gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, pixel);
+            if (now - start < 3000) requestAnimationFrame(step);
+            else resolve((ball.frames - frames0) / ((now - start) / 1000));
+        }
+        requestAnimationFrame(step);
+    })""")
+    size = page.evaluate("[window.cfPreview.canvas.width, window.cfPreview.canvas.height]")
+    page.close()
+    return fps, size
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--drags", type=int, default=3, help="continuous drags measured")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data", COATED_WARM_POOL="true") as server:
+        url = server.url + "/"
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
+            first = cold_start(browser, url)
+            second = cold_start(browser, url)
+            page = browser.new_page(viewport={"width": 1400, "height": 900})
+            page.goto(url)
+            page.wait_for_function(READY, timeout=120_000)
+            # One edit first, as an artist's first touch: it warms the worker's base grid.
+            page.locator("circle.handle.c1[data-angle='20']").focus()
+            page.locator("input[name=channel][value='1']").check()
+            page.locator("circle.handle.c1[data-angle='20']").focus()
+            page.keyboard.press("ArrowUp")
+            page.wait_for_function("document.getElementById('preview-state').hidden", timeout=60_000)
+            latencies = drag_latencies(page, args.drags)
+            page.close()
+            fps, size = orbit_fps(browser, url)
+            browser.close()
+    curve = [c for c, _ in latencies]
+    frame = [f for _, f in latencies]
+    print(f"{'measure':<44} {'median':>9} {'p90':>9} {'n':>4}")
+    print(f"{'cold start to editor + preview (s), first':<44} {first:>9.2f} {'':>9} {1:>4}")
+    print(f"{'cold start to editor + preview (s), second':<44} {second:>9.2f} {'':>9} {1:>4}")
+    if latencies:
+        print(f"{'drag edit -> refitted curve (ms)':<44} {statistics.median(curve):>9.0f} {percentile(curve, 0.9):>9.0f} {len(curve):>4}")
+        print(f"{'drag edit -> WebGL frame of the refit (ms)':<44} {statistics.median(frame):>9.0f} {percentile(frame, 0.9):>9.0f} {len(frame):>4}")
+    print(f"{'orbit fps at 1024 x 768 (canvas %d x %d)' % tuple(size):<44} {fps:>9.1f}")
+    print(f"\nload average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+
+
+if __name__ == "__main__":
+    main()

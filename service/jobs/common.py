@@ -1,0 +1,107 @@
+"""
+What every job shares
+=====================
+
+-   :data:`FIT_FORMAT_VERSION`: part of every id.
+-   :func:`content_address`: an id from an unambiguous encoding of parts.
+-   :func:`check_finite`: refuse a result holding NaN or infinity.
+-   :func:`measured_nk`: the n, k behind a stored fit, if any.
+-   :func:`nk_view`: a :class:`fitting.nk.SpectralNK` as the record's lists.
+-   :func:`stored_fit`: a stored fit or ``LookupError``.
+-   :func:`fit_record`: the record of a finished job.
+-   :func:`checked_writable`: refuse (:class:`service.store.StoreError`)
+    before any CPU is spent when the store cannot take the save.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
+
+from ..ids import content_address
+from ..store import FitRecord, Store, StoreFull, StoreUnavailable
+
+__all__ = [
+    "FIT_FORMAT_VERSION",
+    "content_address",
+    "check_finite",
+    "measured_nk",
+    "nk_view",
+    "stored_fit",
+    "fit_record",
+    "checked_writable",
+]
+
+FIT_FORMAT_VERSION = "fit/v2"
+"""Part of every fit id: bump it when a change to the fit (or to the id's encoding) changes ids."""
+
+
+def check_finite(what: str, values: Any) -> None:
+    """Refuse (ValueError) a result whose ``values`` hold NaN or infinity anywhere."""
+
+    def walk(value):
+        if isinstance(value, dict):
+            return all(walk(v) for v in value.values())
+        if isinstance(value, (list, tuple)):
+            return all(walk(v) for v in value)
+        if isinstance(value, float):
+            return math.isfinite(value)
+        return True
+
+    if not walk(values):
+        raise ValueError(f"the fit gave non-finite {what}: the data cannot be fitted")
+
+
+def measured_nk(record: FitRecord) -> SpectralNK | None:
+    """
+    The measured n, k behind a stored fit: its library material's, or its
+    stored data; None for a fit made from curves alone.
+    """
+    if record.library_material is not None:
+        return library_material(record.library_material)
+    if record.nk is None:
+        return None
+    return SpectralNK(
+        np.asarray(record.nk["wavelength_nm"]), np.asarray(record.nk["n"]),
+        np.asarray(record.nk["k"]), name=record.name, source=record.source,
+    )
+
+
+def nk_view(nk: SpectralNK) -> dict[str, list[float]]:
+    """The n, k of a record: ``{"wavelength_nm", "n", "k"}`` as lists."""
+    return {"wavelength_nm": nk.wavelength_nm.tolist(), "n": nk.n.tolist(), "k": nk.k.tolist()}
+
+
+def stored_fit(store: Store, fit_id: str, where: str = "fit_id") -> FitRecord:
+    """The record of ``fit_id``; ``LookupError`` naming ``where`` when it is not stored."""
+    record = store.get_fit(fit_id)
+    if record is None:
+        raise LookupError(f"`{where}` {fit_id} is not a stored fit")
+    return record
+
+
+def checked_writable(store: Store) -> None:
+    """Raise StoreFull / StoreUnavailable when the store cannot take a save now."""
+    reason = store.writable()
+    if reason is None:
+        return
+    if "full" in reason or "free" in reason or "quota" in reason:
+        raise StoreFull(f"{reason}; nothing was fitted")
+    raise StoreUnavailable(f"{reason}; nothing was fitted")
+
+
+def fit_record(fit_id: str, kind: str, material_id: str, name: str, source: str,
+               job: dict[str, Any], objective: str, **extra: Any) -> FitRecord:
+    """The record of a finished fitting job (material, metrics, timings, convergence)."""
+    return FitRecord(
+        id=fit_id, kind=kind, material_id=material_id, name=name, source=source,
+        material=job["material"], metrics=job["metrics"], timings=job["timings"],
+        convergence=job["convergence"], objective=objective, coverage=job.get("coverage"),
+        created_at=time.time(), **extra,
+    )

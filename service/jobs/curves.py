@@ -1,0 +1,332 @@
+"""
+Fits from edited RGB curves
+===========================
+
+-   :func:`prepare_curve_fit`: a validated :class:`CurveFit` (the base
+    resolved, the curves checked, the id computed), before any work is queued.
+-   :func:`fit_from_curves`: the stored fit of a :class:`CurveFit`, else
+    fitted in the pool and saved; ``(record, created)``.
+-   :func:`error_map`: Delta E 2000 of a stored fit over (eta_i, angle)
+    against what it was fitted to.
+
+A curve fit belongs to the material named by its ``name`` and keeps its
+base's n, k when there is one (for an edited base: the n, k it had), so that
+its curves, preview comparison and error map are against the measured data.
+The request is kept in the fit's provenance, so the edited target can be
+rebuilt. The base's domain is stored as float32 (the pack's type); a request
+naming the base's domain, or a curve at its bound, is compared after the
+same rounding.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from fitting.colour.delta_e import delta_E_map
+from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, cos_theta_from_angle
+from fitting.fits.curves import CurveFitSettings, fit_curves
+from fitting.fits.curves_base import (
+    CurveBase,
+    curve_base_from_coefficients,
+    curve_base_from_nk,
+    edited_target,
+)
+from fitting.fits.curves_input import check_curves
+from fitting.models.kinds import model_ACEScg
+from fitting.models.pack import material_from_json, material_to_json
+from fitting.optics.library import library_material
+from fitting.optics.nk import SpectralNK
+
+from ..pool import FitRunner
+from ..store import FitRecord, Store
+from .common import (
+    FIT_FORMAT_VERSION,
+    check_finite,
+    checked_writable,
+    content_address,
+    fit_record,
+    measured_nk,
+    stored_fit,
+)
+
+__all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
+
+CURVES_FORMAT = "curves/v2"
+"""Part of every curve fit's id: bump it when a change to fit_curves changes results."""
+DEFAULTS = CurveFitSettings()
+DEFAULT_DOMAIN = DEFAULT_ETA_I_RANGE
+
+
+@dataclass(frozen=True)
+class BaseSpec:
+    """What a worker needs to build the base: picklable plain data."""
+
+    kind: Literal["nk", "model"]
+    name: str
+    source: str
+    eta_i_range: tuple[float, float]
+    library_material: str | None = None
+    nk: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] | None = None
+    coefficients: tuple | None = None
+
+    def build(self) -> CurveBase:
+        if self.kind == "model":
+            return curve_base_from_coefficients(
+                np.asarray(self.coefficients), self.eta_i_range, self.name, self.source
+            )
+        return curve_base_from_nk(self.spectral_nk(), self.eta_i_range)
+
+    def spectral_nk(self) -> SpectralNK:
+        if self.library_material is not None:
+            return library_material(self.library_material)
+        wavelength, n, k = (np.asarray(a, dtype=np.float64) for a in self.nk)
+        return SpectralNK(wavelength, n, k, name=self.name, source=self.source)
+
+    def key(self) -> list:
+        return [self.kind, self.name, self.source, self.library_material,
+                None if self.nk is None else [np.asarray(a) for a in self.nk],
+                None if self.coefficients is None else np.asarray(self.coefficients).ravel(),
+                list(self.eta_i_range)]
+
+    def provenance(self) -> dict[str, Any]:
+        return {"kind": self.kind, "name": self.name, "eta_i_range": list(self.eta_i_range),
+                "library_material": self.library_material, "coefficients": self.coefficients}
+
+
+@dataclass(frozen=True)
+class CurveFit:
+    """A validated curve fit: its base, curves, domain, id and provenance."""
+
+    name: str
+    base: BaseSpec | None
+    base_record: FitRecord | None
+    curves: list[dict]
+    eta_i_range: tuple[float, float]
+    objective: str
+    blend_width: float
+    request: dict[str, Any]
+    fit_id: str
+    draft: bool = False
+
+
+def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
+    return bool(np.all(np.float32(a) == np.float32(b)))
+
+
+def _snap_to_domain(curves: list[dict], domain: tuple[float, float]) -> list[dict]:
+    """Curves within float32 rounding of a bound of ``domain`` moved onto it."""
+    lo, hi = domain
+    out = []
+    for curve in curves:
+        eta = curve["eta_i"]
+        for bound in (lo, hi):
+            if eta != bound and np.float32(eta) == np.float32(bound):
+                curve = {**curve, "eta_i": bound}
+        out.append(curve)
+    return out
+
+
+def _base_spec(store: Store, name: str, material: str | None, fit: str | None,
+               nk: tuple | None, requested) -> tuple[BaseSpec | None, FitRecord | None]:
+    if material is not None:
+        return BaseSpec("nk", material, library_material(material).source,
+                        requested or DEFAULT_DOMAIN, library_material=material), None
+    if nk is not None:
+        return BaseSpec("nk", f"{name} base", "user n, k", requested or DEFAULT_DOMAIN, nk=nk), None
+    if fit is None:
+        return None, None
+    record = stored_fit(store, fit, "base.fit")
+    domain = material_from_json(record.material).eta_i_range
+    if requested is not None and not _float32_equal(requested, domain):
+        raise ValueError(
+            f"`eta_i_range` must be the base fit's domain [{domain[0]:g}, {domain[1]:g}] or "
+            f"omitted, got [{requested[0]:g}, {requested[1]:g}]"
+        )
+    if record.kind == "curves":
+        # An edited material: its edits live in its stored model, not in the
+        # n, k it started from.
+        packed = material_from_json(record.material)
+        spec = BaseSpec("model", record.name, record.source, domain,
+                        coefficients=packed.coefficients.astype(np.float64).tolist())
+    elif record.library_material is not None:
+        spec = BaseSpec("nk", record.library_material, record.source, domain,
+                        library_material=record.library_material)
+    else:  # an n, k fit
+        spec = BaseSpec("nk", record.name, record.source, domain,
+                        nk=(tuple(record.nk["wavelength_nm"]), tuple(record.nk["n"]), tuple(record.nk["k"])))
+    return spec, record
+
+
+def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_material: str | None = None,
+                      base_fit: str | None = None, base_nk: tuple | None = None,
+                      eta_i_range=None, objective: str = DEFAULTS.objective,
+                      blend_width: float = DEFAULTS.blend_width,
+                      request: dict[str, Any] | None = None, draft: bool = False) -> CurveFit:
+    """
+    Resolve the base (``LookupError`` for a base fit not stored), check the
+    curves and the domain (``ValueError``), and compute the id. Runs in a
+    thread (it reads the store).
+    """
+    name = name.strip()
+    requested = None if eta_i_range is None else check_eta_i_range(eta_i_range)
+    base, base_record = _base_spec(store, name, base_material, base_fit, base_nk, requested)
+    if base is not None:
+        curves = _snap_to_domain(curves, base.eta_i_range)
+    check_curves(curves)
+    domain = base.eta_i_range if base is not None else check_eta_i_range(requested or DEFAULT_DOMAIN)
+    fit_id = content_address(
+        FIT_FORMAT_VERSION, CURVES_FORMAT, name, None if base is None else base.key(), curves,
+        list(domain), objective, blend_width, repr(DEFAULTS),
+    )
+    return CurveFit(name, base, base_record, curves, domain, objective, blend_width,
+                    request or {}, fit_id, draft)
+
+
+def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: str,
+                objective: str, blend_width: float) -> dict[str, Any]:
+    """Worker process: build (or reuse) the base grid, fit, score."""
+    t0 = time.perf_counter()
+    base_grid = None if base is None else base.build()
+    t_base = time.perf_counter() - t0
+    result = fit_curves(
+        curves, base_grid, None if base is not None else eta_i_range, name,
+        objective=objective, blend_width=blend_width,
+    )
+    metrics = result.metrics
+    summary = result.summary()
+    summary.pop("timings")
+    return {
+        "material": material_to_json(result.packed),
+        "metrics": {
+            "grid": f"{sum(len(c['rgb']) for c in curves)} samples on {len(curves)} curve(s)",
+            "model_float16": {"delta_E_mean": metrics["delta_E_mean"], "delta_E_max": metrics["delta_E_max"]},
+            "by_curve": metrics["by_curve"],
+            "fitted_samples": metrics["samples"],
+            **({"target": metrics["target"]} if "target" in metrics else {}),
+        },
+        "timings": {**result.timings, "base": t_base},
+        "convergence": summary,
+        "source": result.packed.source,
+    }
+
+
+async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tuple[FitRecord, bool]:
+    """
+    The stored fit of ``fit`` (an earlier state saved again becomes the
+    latest), else fitted and saved; a draft (the editor's refits while
+    editing) is stored but not saved under its material until the same
+    request comes without ``draft``.
+    """
+    stored = await asyncio.to_thread(store.get_fit, fit.fit_id)
+    if stored is not None:
+        if fit.draft:
+            return stored, False
+        return await asyncio.to_thread(store.put_fit, stored), False
+    await asyncio.to_thread(checked_writable, store)
+    base, base_record = fit.base, fit.base_record
+    # The measured data behind the edit (for the reference curves and
+    # previews): the base's, or, for an edited base, the data it had.
+    measured_library = base.library_material if base else None
+    measured = None if base is None or base.nk is None else {
+        "wavelength_nm": list(base.nk[0]), "n": list(base.nk[1]), "k": list(base.nk[2]),
+    }
+    if base_record is not None and base_record.kind == "curves":
+        measured_library, measured = base_record.library_material, base_record.nk
+
+    async def make() -> FitRecord:
+        job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
+                               fit.objective, fit.blend_width)
+        check_finite("metrics", job["metrics"])
+        record = fit_record(
+            fit.fit_id, "curves", content_address("edited material", fit.name), fit.name,
+            job["source"], job, fit.objective,
+            library_material=measured_library, nk=measured,
+            base_fit_id=base_record.id if base_record else None,
+            provenance={
+                "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
+                "request": fit.request,
+                "base": None if base is None else base.provenance(),
+                "settings": {k: getattr(DEFAULTS, k) for k in DEFAULTS.__dataclass_fields__},
+            },
+        )
+        return await asyncio.to_thread(store.put_fit, record, not fit.draft)
+
+    record = await runner.once(fit.fit_id, make)
+    if not fit.draft:
+        # The fit was shared with a draft request in flight: saved now.
+        latest = await asyncio.to_thread(store.latest_fit, record.material_id)
+        if latest is None or latest.id != record.id:
+            record = await asyncio.to_thread(store.put_fit, record)
+    return record, True
+
+
+def _measured_nk_or_refuse(record: FitRecord) -> SpectralNK:
+    nk = measured_nk(record)
+    if nk is None:
+        raise ValueError(f"fit {record.id} has no n, k to compare against")
+    return nk
+
+
+def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
+    """(eta_i rows, target (E, M, 3), against) for a stored fit."""
+    domain = material_from_json(record.material).eta_i_range
+    provenance = record.provenance or {}
+    if record.kind == "curves":
+        request = provenance.get("request", {})
+        curves = check_curves(_snap_to_domain(request.get("curves", []), domain))
+        base = provenance.get("base")
+        if base is None:
+            rows = np.array(sorted(c.eta_i for c in curves))
+            target = np.stack([next(c for c in curves if c.eta_i == e).sampled(mu) for e in rows])
+            return rows, target, "curves"
+        if base["kind"] == "model":
+            grid = curve_base_from_coefficients(np.asarray(base["coefficients"]), domain, base["name"])
+        else:
+            grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
+        E, M = np.meshgrid(eta, mu, indexing="ij")
+        width = request.get("blend_width", DEFAULTS.blend_width)
+        return eta, edited_target(grid, curves, M, E, width), "edited target"
+    grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
+    E, M = np.meshgrid(eta, mu, indexing="ij")
+    return eta, grid.rgb(M, E), "reference"
+
+
+def target_at(record: FitRecord, mu: np.ndarray, eta_i: float) -> list[list[float]]:
+    """
+    A curve fit's target at one eta_i: the blended edited target (with a
+    base), or the curve at that eta_i (without; ValueError if none is there).
+    """
+    rows, target, against = _target_of(record, mu, np.array([float(eta_i)]))
+    if against == "curves":
+        matches = np.flatnonzero(np.abs(rows - eta_i) < 1e-6)
+        if not matches.size:
+            raise ValueError(f"fit {record.id} has no curve at eta_i {eta_i:g}")
+        return target[matches[0]].tolist()
+    return target[0].tolist()
+
+
+def error_map(record: FitRecord, angles: int, rows: int) -> dict[str, Any]:
+    """
+    Delta E 2000 of the fit's float16 model against what it was fitted to:
+    the spectral reference (5 nm) of its n, k, or for a curve fit the edited
+    target (with a base) or the curves themselves (rows at their eta_i).
+    """
+    packed = material_from_json(record.material)
+    lo, hi = packed.eta_i_range
+    theta = np.linspace(0.0, 90.0, angles)
+    mu = cos_theta_from_angle(theta)
+    eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
+    eta, target, against = _target_of(record, mu, eta)
+    E, M = np.meshgrid(eta, mu, indexing="ij")
+    model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
+    dE = delta_E_map(target, model)
+    return {
+        "fit_id": record.id, "against": against, "theta_deg": theta.tolist(), "eta_i": eta.tolist(),
+        "delta_E": np.round(dE, 4).tolist(), "delta_E_mean": float(dE.mean()),
+        "delta_E_max": float(dE.max()),
+    }

@@ -1,0 +1,210 @@
+"""
+Scene packs
+===========
+
+-   :func:`prepare_scene`: the scene of a request, validated and converted
+    once: each material resolved (a built-in conductor, a saved material by
+    id, or inline n, k) into a :class:`fitting.scene.SceneMaterial`, or, for
+    a saved *edited* material, a :class:`StoredModel` (its edits live in its
+    stored model, not in the n, k it started from).
+-   :func:`scene_pack`: fit it in the pool; the report and the pack.
+
+A material measured as n, k is fitted over the eta_i the scene uses with the
+lowest degree that serves it (:func:`fitting.scene.fit_scene_material`). An
+edited material is shipped as stored (its degree, coefficients and domain),
+and the scene's eta_i must lie in its domain; its report says so
+(``from_stored_model``) and its Delta E against itself is 0.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fitting.fits.scene_fit import fit_scene_material
+from fitting.fits.scene_schema import EtaSpec, SceneMaterial, parse_eta_i, parse_scene
+from fitting.models.pack import (
+    PackedMaterial,
+    encode_pack,
+    material_from_json,
+    material_record_bytes,
+    pack_to_json,
+)
+from fitting.optics.library import LIBRARY_NAMES, library_material
+
+from ..pool import FitRunner
+from ..store import Store
+from .common import content_address, measured_nk
+
+__all__ = ["StoredModel", "PreparedScene", "prepare_scene", "scene_pack"]
+
+
+@dataclass(frozen=True)
+class StoredModel:
+    """A saved edited material in a scene: shipped as its stored model."""
+
+    name: str
+    material: str
+    eta_i: EtaSpec
+    packed: PackedMaterial
+    fit_id: str
+
+
+@dataclass(frozen=True)
+class PreparedScene:
+    """
+    A validated scene: its name, its materials in order, its id, and how
+    each material's kind and degree is chosen (``max_delta_e`` or ``prefer``,
+    :func:`fitting.fits.scene_fit.choose_candidate`).
+    """
+
+    name: str
+    materials: tuple[SceneMaterial | StoredModel, ...]
+    key: str
+    max_delta_e: float | None = None
+    prefer: str | None = None
+
+
+def _renumber(error: ValueError, index: int) -> ValueError:
+    return ValueError(str(error).replace("materials[0]", f"materials[{index}]"))
+
+
+def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
+    """
+    ``scene`` (``{"name", "materials": [...]}``, entries as
+    :func:`fitting.scene.parse_scene` reads them, inline ``nk`` with its
+    ``source``) resolved against the library and ``store``. Runs in a
+    thread (it reads the store).
+
+    Raises
+    ------
+    ValueError
+        Naming the entry and the rule.
+    """
+    name = scene["name"]
+    options = {key: scene[key] for key in ("max_delta_e", "prefer") if scene.get(key) is not None}
+    materials: list[SceneMaterial | StoredModel] = []
+    seen: set[str] = set()
+    used_fits: list[str] = []
+
+    def resolve(material: str):
+        if material in LIBRARY_NAMES:
+            return library_material(material)
+        record = store.latest_fit(material)
+        nk = None if record is None else measured_nk(record)
+        if nk is None:
+            raise ValueError(
+                f"`material` must be a built-in conductor ({', '.join(LIBRARY_NAMES)}) "
+                f"or the id of a saved material, got {material!r}"
+            )
+        used_fits.append(record.id)
+        return nk
+
+    for i, entry in enumerate(scene["materials"]):
+        where = f"materials[{i}]"
+        entry_name = entry.get("name", entry.get("material"))
+        if entry_name in seen:
+            raise ValueError(f"`{where}.name` {entry_name!r} is used twice; names in a pack are unique")
+        seen.add(entry_name)
+        material = entry.get("material")
+        record = None
+        if material is not None and material not in LIBRARY_NAMES:
+            record = store.latest_fit(material)
+        if record is not None and record.kind == "curves":
+            eta = parse_eta_i(entry["eta_i"], f"{where}.eta_i")
+            packed = material_from_json(record.material)
+            lo, hi = packed.eta_i_range
+            if not (np.float32(lo) <= np.float32(eta.domain[0]) and np.float32(eta.domain[1]) <= np.float32(hi)):
+                raise ValueError(
+                    f"`{where}.eta_i` must lie in the domain [{lo:g}, {hi:g}] of the edited "
+                    f"material {material!r}, got [{eta.domain[0]:g}, {eta.domain[1]:g}]"
+                )
+            stored = PackedMaterial(entry_name, packed.coefficients, packed.eta_i_range,
+                                    source=packed.source, model=packed.model)
+            materials.append(StoredModel(entry_name, material, eta, stored, record.id))
+            used_fits.append(record.id)
+            continue
+        try:
+            (parsed,) = parse_scene({"name": name, "materials": [entry], **options}, resolve).materials
+        except ValueError as error:
+            raise _renumber(error, i) from None
+        materials.append(parsed)
+    key = content_address("scene", scene, used_fits)
+    return PreparedScene(name, tuple(materials), key, options.get("max_delta_e"), options.get("prefer"))
+
+
+def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
+    packed = entry.packed
+    bytes_ = material_record_bytes(packed.name, packed.source, packed.degree)
+    zero = {"mean": 0.0, "max": 0.0}
+    return {
+        "name": packed.name,
+        "material": entry.material,
+        "eta_i": entry.eta_i.to_json(),
+        "eta_i_range": list(packed.eta_i_range),
+        "degree": packed.degree,
+        "coefficients": 9 * (packed.degree + 1),
+        "shader_variant": "collapsed" if packed.degree == 0 else "packed",
+        "bytes": bytes_,
+        "delta_E_2000": zero,
+        "by_degree": {str(packed.degree): zero},
+        "general": {
+            "eta_i_range": list(packed.eta_i_range), "degree": packed.degree,
+            "coefficients": 9 * (packed.degree + 1), "bytes": bytes_, "delta_E_2000": zero,
+        },
+        "scene_vs_general_delta_E_2000": zero,
+        "fit": {"from_stored_model": True, "fit_id": entry.fit_id},
+        "seconds": 0.0,
+    }
+
+
+def _scene_job(scene: PreparedScene) -> dict[str, Any]:
+    """Runs in a fitting worker: fit the scene, return the report and the pack."""
+    reports, packed, general = [], [], []
+    for entry in scene.materials:
+        if isinstance(entry, StoredModel):
+            reports.append(_stored_model_report(entry))
+            packed.append(entry.packed)
+            general.append(entry.packed)
+            continue
+        try:
+            result = fit_scene_material(entry, None, scene.max_delta_e, scene.prefer)
+        except ValueError as error:
+            raise ValueError(f"material {entry.name!r}: {error}") from None
+        report = result.report()
+        reports.append(report)
+        packed.append(result.packed)
+        general.append(result.general)
+    pack = encode_pack(packed)
+    return {
+        "scene": scene.name,
+        "materials": reports,
+        "totals": {
+            "pack_bytes": len(pack),
+            "general_pack_bytes": len(encode_pack(general)),
+            "coefficients": sum(r["coefficients"] for r in reports),
+            "general_coefficients": 27 * len(reports),
+            "delta_E_2000_mean": float(np.mean([r["delta_E_2000"]["mean"] for r in reports])),
+            "general_delta_E_2000_mean": float(
+                np.mean([r["general"]["delta_E_2000"]["mean"] for r in reports])
+            ),
+        },
+        "pack": json.loads(pack_to_json(packed)),
+        "pack_base64": base64.b64encode(pack).decode("ascii"),
+    }
+
+
+async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
+    """The report and pack of ``scene`` (a retry after a timeout gets the kept result)."""
+
+    async def make() -> dict[str, Any]:
+        return await runner.run(_scene_job, scene)
+
+    return await runner.once(scene.key, make)
+
+

@@ -1,0 +1,42 @@
+"""
+Reference textures
+==================
+
+-   :func:`reference_texture`: the spectral reference of a stored fit's
+    measured n, k as a float32 texture over (cos theta, eta_i), with the
+    headers that describe it (``GET /api/v1/fits/{fit_id}/reference-texture``,
+    :mod:`service.api.routes.reference_texture`).
+"""
+
+from __future__ import annotations
+
+from fitting.fits.curves_base import curve_base_from_nk
+from fitting.models.baselines import baseline_inputs
+from fitting.models.pack import material_from_json
+
+from ..store import FitRecord
+from .common import measured_nk
+
+__all__ = ["reference_texture"]
+
+
+def reference_texture(record: FitRecord) -> tuple[bytes, dict[str, str]]:
+    """The texture bytes and headers of a stored fit (ValueError without n, k)."""
+    nk = measured_nk(record)
+    if nk is None:
+        raise ValueError(f"fit {record.id} was made from curves alone: it has no n, k to take a reference from")
+    packed = material_from_json(record.material)
+    base = curve_base_from_nk(nk, packed.eta_i_range)
+    inputs = baseline_inputs(nk)
+    body = base.RGB.astype("<f4").tobytes()
+    triple = lambda v: ",".join(f"{float(x):.9g}" for x in v)  # noqa: E731
+    lo, hi = base.eta_i_range
+    headers = {
+        "X-Texture-Width": str(base.cos_theta.size),
+        "X-Texture-Height": str(base.eta_i.size),
+        "X-Eta-I-Range": f"{lo:.9g},{hi:.9g}",
+        "X-F0-Air": triple(inputs["F0_air"]),
+        "X-F82-Air": triple(inputs["F82_air"]),
+        "Cache-Control": "max-age=86400, immutable",
+    }
+    return body, headers

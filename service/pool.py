@@ -1,0 +1,260 @@
+"""
+Fitting pool
+============
+
+The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
+
+-   :class:`FitRunner`: worker processes (``spawn``), a bound on jobs in
+    flight, a time limit per request, shared identical jobs, and recovery
+    from a dead worker.
+-   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`: why a job
+    was not answered (the HTTP edge answers 503, 504 and 503, each with
+    ``Retry-After``).
+
+Fitting is CPU-bound (numpy, scipy): it runs in worker processes started
+with ``spawn`` (forking a process that already runs threads or holds a GL
+context is unsafe), never on the event loop. The number of jobs running or
+waiting is bounded; past the bound a job is refused at once with a
+``Retry-After`` estimate instead of growing a backlog.
+
+Faults:
+
+-   A worker that dies breaks the whole ``ProcessPoolExecutor`` (every job in
+    it fails with ``BrokenProcessPool``). The runner replaces the pool, warms
+    the new workers at once, and runs each interrupted job once more there;
+    only a job that fails twice is answered :class:`WorkerLost`. So a dead
+    worker fails at most its own job (when it kills its worker again).
+-   A request that waits past the time limit gets :class:`FitTimeout`, but
+    its job keeps running: its result is saved (fits) or kept (scenes) for
+    the retry, which :meth:`FitRunner.once` then answers at once.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import collections
+import concurrent.futures
+import logging
+import math
+import multiprocessing
+import threading
+import time
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any, Awaitable, Callable
+
+__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost"]
+
+log = logging.getLogger("service.pool")
+
+
+class Overloaded(Exception):
+    """Too many jobs in flight; ``retry_after`` is a wait estimate in seconds."""
+
+    def __init__(self, retry_after: int, limit: int) -> None:
+        super().__init__(
+            f"the service is fitting {limit} materials already (the limit); "
+            f"retry in about {retry_after} s"
+        )
+        self.retry_after = retry_after
+
+
+class FitTimeout(Exception):
+    """A request waited past the time limit; its job goes on and keeps its result."""
+
+    def __init__(self, limit_s: float, retry_after: int = 1) -> None:
+        super().__init__(
+            f"the fit did not finish within the time limit of {limit_s:g} s "
+            "(COATED_FIT_TIMEOUT_S); it goes on, and the same request retried later "
+            "gets its result"
+        )
+        self.retry_after = retry_after
+
+
+class WorkerLost(Exception):
+    """A worker process died during the job twice (it was retried once)."""
+
+    retry_after = 1
+
+    def __init__(self) -> None:
+        super().__init__("a fitting worker process stopped during the fit (twice); retry")
+
+
+def _warm_worker() -> None:
+    """
+    Worker start-up: import the fitting core and compute the spectral
+    weights of the fit (5 nm) and of the metrics (1 nm) once, seconds that
+    would otherwise land on the first fit.
+    """
+    from fitting.colour.reference import spectral_weights
+    from fitting.fits.settings import FitSettings
+
+    spectral_weights(FitSettings().step_nm)
+    spectral_weights(1.0)
+
+
+def _ping() -> float:
+    time.sleep(0.05)  # long enough that each warm-up ping lands on its own worker
+    return time.time()
+
+
+class FitRunner:
+    """
+    The bounded fitting pool.
+
+    ``max_in_flight`` jobs may run or wait at once; the next is refused with
+    :class:`Overloaded`. A request waits at most ``timeout_s`` seconds
+    (:meth:`once`); its job's slot stays taken until the job ends, so the
+    bound stays true. Up to ``keep`` results of jobs whose requests timed
+    out are kept for their retries.
+    """
+
+    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, keep: int = 64) -> None:
+        if workers < 1 or max_in_flight < workers:
+            raise ValueError(
+                f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1"
+            )
+        self.workers = workers
+        self.max_in_flight = max_in_flight
+        self.timeout_s = timeout_s
+        self._keep = keep
+        self._lock = threading.Lock()
+        self._in_flight = 0
+        self._mean_s = 2.0  # running estimate of one job's duration, for Retry-After
+        self._pool: concurrent.futures.ProcessPoolExecutor | None = None
+        self._pending: dict[str, asyncio.Task] = {}
+        self._kept: collections.OrderedDict[str, Any] = collections.OrderedDict()
+        self._warming: set[asyncio.Task] = set()
+        self.completed = 0
+        self.restarts = 0
+
+    @property
+    def in_flight(self) -> int:
+        return self._in_flight
+
+    def _executor(self) -> concurrent.futures.ProcessPoolExecutor:
+        with self._lock:
+            if self._pool is None:
+                self._pool = concurrent.futures.ProcessPoolExecutor(
+                    max_workers=self.workers,
+                    mp_context=multiprocessing.get_context("spawn"),
+                    initializer=_warm_worker,
+                )
+            return self._pool
+
+    def _restart(self, broken: concurrent.futures.ProcessPoolExecutor) -> None:
+        """Replace a broken pool (once, however many jobs saw it break) and warm the new one."""
+        with self._lock:
+            replaced = self._pool is broken
+            if replaced:
+                self._pool = None
+                self.restarts += 1
+        broken.shutdown(wait=False, cancel_futures=True)
+        if replaced:
+            log.warning("a fitting worker died; the pool was restarted (interrupted jobs run once more)")
+            try:
+                task = asyncio.get_running_loop().create_task(self.warm_up())
+            except RuntimeError:
+                return
+            self._warming.add(task)
+            task.add_done_callback(self._warming.discard)
+
+    async def warm_up(self) -> None:
+        """Start every worker process and wait until each has imported the core."""
+        loop = asyncio.get_running_loop()
+        pool = self._executor()
+        try:
+            await asyncio.gather(*(loop.run_in_executor(pool, _ping) for _ in range(self.workers)))
+        except (BrokenProcessPool, RuntimeError):
+            pass  # a pool that broke while warming is replaced by the job that sees it
+
+    def _retry_after(self) -> int:
+        waves = math.ceil(max(self._in_flight, 1) / self.workers)
+        return max(1, math.ceil(waves * self._mean_s))
+
+    def check_capacity(self) -> None:
+        """
+        Refuse (:class:`Overloaded`) at once when the pool is full, before a
+        request spends CPU on validating its input; :meth:`run` checks again.
+        """
+        if self._in_flight >= self.max_in_flight:
+            raise Overloaded(self._retry_after(), self.max_in_flight)
+
+    def _acquire(self) -> None:
+        with self._lock:
+            if self._in_flight >= self.max_in_flight:
+                raise Overloaded(self._retry_after(), self.max_in_flight)
+            self._in_flight += 1
+
+    def _release(self, started: float | None) -> None:
+        with self._lock:
+            self._in_flight -= 1
+            if started is not None:
+                self.completed += 1
+                self._mean_s = 0.8 * self._mean_s + 0.2 * (time.perf_counter() - started)
+
+    async def run(self, function: Callable[..., Any], *args: Any) -> Any:
+        """
+        Run ``function(*args)`` in a worker, without a time limit (the
+        request's limit is :meth:`once`'s); its exceptions (ValueError for
+        bad input) are raised here. A job interrupted by a dead worker runs
+        once more on the replacement pool.
+
+        Raises
+        ------
+        Overloaded, WorkerLost
+        """
+        self._acquire()
+        started = time.perf_counter()
+        done = None
+        try:
+            for attempt in (1, 2):
+                pool = self._executor()
+                try:
+                    future = pool.submit(function, *args)
+                    result = await asyncio.wrap_future(future)
+                except (BrokenProcessPool, RuntimeError) as error:
+                    if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
+                        raise
+                    self._restart(pool)
+                    if attempt == 2:
+                        raise WorkerLost() from None
+                    continue
+                done = started
+                return result
+        finally:
+            self._release(done)
+
+    async def once(self, key: str, make: Callable[[], Awaitable[Any]]) -> Any:
+        """
+        Await ``make()`` for at most ``timeout_s`` seconds, shared by
+        concurrent calls with the same ``key``. Past the limit the caller
+        gets :class:`FitTimeout` and the job goes on: its result is kept
+        for the next call with this ``key``.
+        """
+        if key in self._kept:
+            return self._kept.pop(key)
+        task = self._pending.get(key)
+        if task is None:
+            task = asyncio.ensure_future(make())
+            self._pending[key] = task
+            task.add_done_callback(lambda t: self._pending.pop(key, None))
+        try:
+            return await asyncio.wait_for(asyncio.shield(task), self.timeout_s)
+        except asyncio.TimeoutError:
+            task.add_done_callback(lambda t: self._keep_result(key, t))
+            raise FitTimeout(self.timeout_s, self._retry_after()) from None
+
+    def _keep_result(self, key: str, task: asyncio.Task) -> None:
+        if task.cancelled() or task.exception() is not None:
+            return
+        self._kept[key] = task.result()
+        while len(self._kept) > self._keep:
+            self._kept.popitem(last=False)
+
+    def close(self) -> None:
+        for task in [*self._pending.values(), *self._warming]:
+            task.cancel()
+        with self._lock:
+            pool, self._pool = self._pool, None
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)

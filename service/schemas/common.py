@@ -1,0 +1,107 @@
+"""
+Shared types and the error body
+===============================
+
+Constants and constrained field types of the API, built from the core's
+rules (eta_i limits, objectives, library names), and the one error shape
+every 4xx and 5xx answer has (:class:`ErrorBody`). :class:`Mirror` is the
+base of response models that mirror a core result: extra keys kept, keys the
+result did not have left out, so the JSON is the core's, key for key.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
+from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
+from fitting.optics.bounded import excerpt
+from fitting.optics.library import LIBRARY_NAMES
+
+from ..jobs.nk import MAX_NK_SAMPLES
+
+__all__ = [
+    "API_PREFIX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
+    "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
+    "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
+    "PackFormat", "Text", "RequestModel",
+    "Mirror", "absent", "ErrorItem", "ErrorBody",
+]
+
+API_PREFIX = "/api/v1"
+FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
+MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
+PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
+ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
+"""Every coating index lies in [1, 3] (fitting.domain)."""
+
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False, strict=True)]
+EtaI = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False, strict=True)]
+FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
+LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
+Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
+ModelKind = Literal[MODEL_KINDS]  # type: ignore[valid-type]
+PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
+Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
+
+
+_MAX_UNKNOWN_LISTED = 5
+
+
+class RequestModel(BaseModel):
+    """
+    Base of the request models: unknown fields are refused, and a body with
+    many of them is refused in one error naming the first few (pydantic
+    would make one error per field, tens of thousands from a 1 MB body, all
+    on the event loop).
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _few_unknown_fields(cls, data: Any) -> Any:
+        fields = cls.model_fields
+        if isinstance(data, dict) and len(data) > len(fields) + _MAX_UNKNOWN_LISTED:
+            unknown = [key for key in data if key not in fields]
+            if len(unknown) > _MAX_UNKNOWN_LISTED:
+                shown = ", ".join(excerpt(key, 30) for key in unknown[:_MAX_UNKNOWN_LISTED])
+                raise ValueError(
+                    f"extra fields are not permitted: {len(unknown)} unknown fields ({shown}, ...)"
+                )
+        return data
+
+
+class Mirror(BaseModel):
+    """
+    A response model mirroring a core result: extra keys kept; optional
+    fields declared with :func:`absent` are left out when the result did not
+    have them, so the JSON is the core's key for key.
+    """
+
+    model_config = ConfigDict(extra="allow")
+
+
+def _is_none(value: Any) -> bool:
+    return value is None
+
+
+def absent(description: str | None = None) -> Any:
+    """An optional field of a :class:`Mirror`: None, and then not in the JSON."""
+    return Field(None, exclude_if=_is_none, description=description)
+
+
+class ErrorItem(BaseModel):
+    loc: list[str | int]
+    msg: str
+    type: str
+
+
+class ErrorBody(BaseModel):
+    """Every 4xx and 5xx answer: what broke which rule."""
+
+    detail: str
+    errors: list[ErrorItem] = Field(default_factory=list)

@@ -1,0 +1,137 @@
+"""
+Curve fits and error maps
+=========================
+
+Requests :class:`CurveIn`, :class:`CurveBaseIn`, :class:`CurveFitRequest`;
+response :class:`ErrorMap`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from fitting.fits.curves import CurveFitSettings
+from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
+
+from .common import FIT_ID_PATTERN, EtaI, LibraryName, Objective, RequestModel
+from .fits import NKData
+
+__all__ = ["CurveIn", "CurveBaseIn", "CurveFitRequest", "ErrorMap"]
+
+_DEFAULTS = CurveFitSettings()
+CosTheta = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=True)]
+Angle = Annotated[float, Field(ge=0.0, le=90.0, allow_inf_nan=False, strict=True)]
+Reflectance = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=True)]
+
+
+class CurveIn(RequestModel):
+    """
+    One RGB reflectance curve at coating index ``eta_i``: linear ACEScg in
+    [0, 1] against cos theta in [0, 1] (or the angle in degrees, [0, 90]).
+    """
+
+    model_config = ConfigDict(extra="forbid")
+
+    eta_i: EtaI
+    cos_theta: list[CosTheta] | None = Field(None, min_length=CURVE_MIN_SAMPLES,
+                                             max_length=CURVE_MAX_SAMPLES, fail_fast=True)
+    angle_deg: list[Angle] | None = Field(None, min_length=CURVE_MIN_SAMPLES,
+                                          max_length=CURVE_MAX_SAMPLES, fail_fast=True)
+    rgb: list[tuple[Reflectance, Reflectance, Reflectance]] = Field(
+        min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES, fail_fast=True,
+        description="[R, G, B] per sample, linear ACEScg",
+    )
+
+    @model_validator(mode="after")
+    def _check_samples(self) -> "CurveIn":
+        if (self.cos_theta is None) == (self.angle_deg is None):
+            raise ValueError("give exactly one of `cos_theta` or `angle_deg`")
+        samples = self.cos_theta if self.cos_theta is not None else self.angle_deg
+        if len(samples) != len(self.rgb):
+            raise ValueError(
+                f"`rgb` must hold one [R, G, B] per sample ({len(samples)}), got {len(self.rgb)}"
+            )
+        return self
+
+    def as_dict(self) -> dict:
+        """The curve as :func:`fitting.curves.check_curves` reads it."""
+        item = {"eta_i": self.eta_i, "rgb": [list(v) for v in self.rgb]}
+        if self.cos_theta is not None:
+            item["cos_theta"] = list(self.cos_theta)
+        else:
+            item["angle_deg"] = list(self.angle_deg)
+        return item
+
+
+class CurveBaseIn(RequestModel):
+    """The material being edited: exactly one of a built-in name, a stored fit or n, k."""
+
+    model_config = ConfigDict(extra="forbid")
+
+    material: LibraryName | None = Field(None, description="A built-in conductor")
+    fit: Annotated[str, Field(pattern=FIT_ID_PATTERN)] | None = Field(None, description="A stored fit's id")
+    nk: NKData | None = Field(None, description="Measured n, k")
+
+    @model_validator(mode="after")
+    def _check_choice(self) -> "CurveBaseIn":
+        given = [k for k in ("material", "fit", "nk") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError("`base` must give exactly one of `material`, `fit` or `nk`")
+        return self
+
+
+class CurveFitRequest(RequestModel):
+    """
+    Curves to fit, alone (``base`` null: the eta_i dependence is what the
+    curves determine) or as edits of ``base`` (each curve replaces the base
+    at its eta_i, the change fading over ``blend_width`` in eta_i).
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+        json_schema_extra={
+            "examples": [{
+                "name": "warm gold",
+                "base": {"material": "Au"},
+                "curves": [{
+                    "eta_i": 1.5,
+                    "angle_deg": [0, 30, 60, 75, 90],
+                    "rgb": [[0.9, 0.7, 0.35], [0.9, 0.7, 0.35], [0.88, 0.69, 0.36],
+                            [0.85, 0.7, 0.45], [1, 1, 1]],
+                }],
+            }]
+        },
+    )
+
+    name: str = Field("edited", min_length=1, max_length=200, pattern=r"\S",
+                      description="The material's name; refits under one name are one material")
+    base: CurveBaseIn | None = None
+    eta_i_range: tuple[EtaI, EtaI] | None = Field(
+        None, description="Domain [lo, hi]: default the base fit's, else [1, 2.5]"
+    )
+    curves: list[CurveIn] = Field(min_length=1, max_length=CURVE_MAX_COUNT)
+    objective: Objective = _DEFAULTS.objective
+    blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False, strict=True)
+    draft: bool = Field(False, description="Store the fit without saving it under `name` (the editor's "
+                                           "refits while editing); the same request with false saves it")
+
+    @model_validator(mode="after")
+    def _check_range(self) -> "CurveFitRequest":
+        if self.eta_i_range is not None and self.eta_i_range[0] > self.eta_i_range[1]:
+            lo, hi = self.eta_i_range
+            raise ValueError(f"`eta_i_range` must not be empty: lo {lo:g} > hi {hi:g}")
+        return self
+
+
+class ErrorMap(BaseModel):
+    """Delta E 2000 of a fit's float16 model over (eta_i, angle) against its target."""
+
+    fit_id: str
+    against: Literal["reference", "edited target", "curves"]
+    theta_deg: list[float]
+    eta_i: list[float]
+    delta_E: list[list[float]] = Field(description="[eta_i row][angle column]")
+    delta_E_mean: float
+    delta_E_max: float

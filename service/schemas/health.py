@@ -1,0 +1,43 @@
+"""
+Health and domain
+=================
+
+:class:`Health` (``GET /healthz``) and :class:`Domain` (``GET
+/api/v1/domain``: the limits and defaults clients need, from the core's
+constants, so that no client repeats them).
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, Field
+
+__all__ = ["Health", "Domain"]
+
+
+class Health(BaseModel):
+    status: Literal["ok"]
+    fits_in_flight: int
+    fit_workers: int
+    max_in_flight: int
+    store_writable: bool = Field(description="Whether a save can be written now")
+    store_problem: str | None = Field(None, description="Why not, when it cannot")
+    pool_restarts: int = Field(0, description="Times a dead worker made the pool restart")
+
+
+class Domain(BaseModel):
+    """The rules a client checks before sending (the service checks them again)."""
+
+    eta_i_limits: list[float] = Field(min_length=2, max_length=2,
+                                      description="Every coating index lies in [lo, hi]")
+    default_eta_i_range: list[float] = Field(min_length=2, max_length=2,
+                                             description="The default fitted domain")
+    objectives: list[str]
+    default_objective: str
+    library: list[str] = Field(description="The built-in conductors")
+    pack_formats: list[str]
+    curve_samples: list[int] = Field(min_length=2, max_length=2,
+                                     description="Samples per edited curve, [min, max]")
+    max_curves: int
+    max_nk_samples: int

@@ -1,0 +1,67 @@
+"""
+Error metrics
+=============
+
+The response mirror of the core's typed error metrics (``ErrorMetrics`` of
+the fitting core: Delta E 2000 mean and max, RMSE, per eta_i row, and what
+they were measured against), and of the metrics a fit record carries.
+The JSON keys are the core's.
+"""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, Field
+
+from .common import Mirror, absent
+
+__all__ = ["RowError", "DeltaE", "CurveError", "FitDetails", "FitMetrics"]
+
+
+class RowError(Mirror):
+    """Delta E 2000 of one eta_i row."""
+
+    delta_E_mean: float
+    delta_E_max: float
+
+
+class DeltaE(Mirror):
+    """CIE Delta E 2000 against the reference on the scoring grid (``ErrorMetrics``)."""
+
+    delta_E_mean: float
+    delta_E_max: float
+    rmse: float | None = absent()
+    by_eta_i: dict[str, RowError] | None = absent("Nearest row to each of eta_i 1, 1.5, 2, 2.5")
+    against: str | None = absent()
+
+
+class CurveError(Mirror):
+    """Delta E 2000 of a curve fit at one edited curve's samples."""
+
+    eta_i: float
+    delta_E_mean: float
+    delta_E_max: float
+
+
+class FitDetails(Mirror):
+    """Every metric of a fit, as the core gave it."""
+
+    grid: str | None = absent()
+    model_float16: DeltaE | None = absent()
+    model_float64: DeltaE | None = absent()
+    schlick_air: DeltaE | None = absent()
+    schlick_exact_F0: DeltaE | None = absent()
+    lazanyi_adjusted: DeltaE | None = absent()
+    lazanyi_exact_F0: DeltaE | None = absent()
+    coverage: float | None = absent()
+    by_curve: list[CurveError] | None = absent()
+    fitted_samples: int | None = absent()
+    target: DeltaE | None = absent()
+
+
+class FitMetrics(BaseModel):
+    """Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
+
+    grid: str | None = None
+    model: DeltaE | None = None
+    lazanyi_adjusted: DeltaE | None = None
+    details: FitDetails = Field(default_factory=FitDetails)

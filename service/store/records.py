@@ -1,0 +1,179 @@
+"""
+Records, rows, errors and the store interface
+=============================================
+
+:class:`FitRecord` (one stored fit), :class:`MaterialRow` and
+:class:`MaterialPage` (the listing), the :class:`StoreError` family (what a
+failed store call means, with its HTTP status) and :class:`Store`, the
+interface every store implements (:mod:`service.store.sqlite`).
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from dataclasses import asdict, dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+FIT_KINDS = ("library", "nk", "curves")
+"""How a fit was made: a built-in material, measured n, k, edited curves."""
+
+
+@dataclass(frozen=True)
+class FitRecord:
+    """
+    One stored fit.
+
+    Attributes
+    ----------
+    id
+        Content address of the inputs, 32 lowercase hex digits.
+    kind
+        One of :data:`FIT_KINDS`.
+    material_id
+        The material the fit belongs to: the library name for library fits,
+        a content address of the n, k for uploads, any id for curve fits.
+    name, source
+        Display name and citation of the data.
+    material
+        The pack JSON view of the fitted material
+        (:func:`fitting.pack.material_to_json`, float16 coefficients).
+    metrics, timings, convergence
+        Metrics against the reference, seconds per stage, solver report.
+    objective
+        The fitted objective.
+    coverage
+        Covered fraction of 360-830 nm (None for fits without n, k).
+    library_material
+        Name of the built-in material (library fits).
+    nk
+        ``{"wavelength_nm", "n", "k"}`` as lists (fits of measured data).
+    base_fit_id
+        The fit a curve fit started from, if any.
+    provenance
+        Free-form JSON about how the fit was made.
+    created_at
+        Unix time of the first save.
+    """
+
+    id: str
+    kind: str
+    material_id: str
+    name: str
+    source: str
+    material: dict[str, Any]
+    metrics: dict[str, Any] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+    convergence: dict[str, Any] = field(default_factory=dict)
+    objective: str = ""
+    coverage: float | None = None
+    library_material: str | None = None
+    nk: dict[str, list[float]] | None = None
+    base_fit_id: str | None = None
+    provenance: dict[str, Any] = field(default_factory=dict)
+    created_at: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.kind not in FIT_KINDS:
+            raise ValueError(f"`kind` must be one of {', '.join(FIT_KINDS)}, got {self.kind!r}")
+
+    def to_json(self) -> str:
+        return json.dumps(asdict(self), allow_nan=False, separators=(",", ":"))
+
+    @classmethod
+    def from_json(cls, text: str) -> "FitRecord":
+        return cls(**json.loads(text))
+
+
+@dataclass(frozen=True)
+class MaterialRow:
+    """A material's summary row: its latest fit's name, source, coverage and id."""
+
+    material_id: str
+    name: str
+    source: str
+    coverage: float | None
+    kind: str
+    latest_fit_id: str
+    created_at: float
+    seq: int = 0
+
+
+@dataclass(frozen=True)
+class MaterialPage:
+    """
+    One page of saved materials, oldest first; ``next_cursor`` continues
+    after the last row (None at the end); ``skipped`` names rows that could
+    not be read (reported, not fatal to the rest).
+    """
+
+    rows: list[MaterialRow]
+    next_cursor: int | None
+    skipped: list[str] = field(default_factory=list)
+
+
+class StoreError(RuntimeError):
+    """The store cannot do what was asked; ``status`` is the HTTP answer."""
+
+    status = 503
+
+
+class StoreFull(StoreError):
+    """No room for the save: the disk (or the store's quota) is full (507)."""
+
+    status = 507
+
+
+class StoreUnavailable(StoreError):
+    """The store cannot be read or written (read-only, missing, I/O error) (503)."""
+
+    status = 503
+
+
+class StoreDamaged(StoreUnavailable, sqlite3.DatabaseError):
+    """The store's file is not a sound SQLite database (503; at start-up: exit)."""
+
+
+class RecordDamaged(StoreError):
+    """A stored record could not be decoded (500; the rest of the store is fine)."""
+
+    status = 500
+
+
+@runtime_checkable
+class Store(Protocol):
+    """The store interface of the service (thread-safe implementations)."""
+
+    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
+        """
+        Save ``record`` unless its id exists, and log the save (the fit
+        becomes its material's latest); return the stored record. With
+        ``save`` False (a draft) the record is stored but not logged: it is
+        reachable by id and lists under no material until saved.
+        """
+
+    def get_fit(self, fit_id: str) -> FitRecord | None:
+        """The record of ``fit_id``, or None."""
+
+    def latest_fit(self, material_id: str) -> FitRecord | None:
+        """The fit of a material saved last, or None."""
+
+    def saved_materials(self) -> list[MaterialRow]:
+        """Materials with at least one non-library fit, oldest first."""
+
+    def material_page(self, after: int | None, limit: int) -> MaterialPage:
+        """Saved materials after cursor ``after`` (None: from the first), at most ``limit``."""
+
+    def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
+        """The latest fit id of each of ``material_ids`` that has one."""
+
+    def check(self) -> None:
+        """Raise :class:`StoreError` if the store is unusable or damaged."""
+
+    def writable(self) -> str | None:
+        """None when a save can be written now, else why not (cheap; no write)."""
+
+    def close(self) -> None:
+        """Release connections."""
+
+

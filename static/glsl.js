@@ -1,0 +1,52 @@
+// Loads the project's own GLSL (preview_shaders/glsl/, served at /glsl/) as
+// GLSL ES 3.00 for WebGL2: the files are shared with the Python renderer
+// (moderngl, GLSL 4.30), never copied. A main shader's `#version` line is
+// replaced by `#version 300 es` and precision statements; `#include "f"`
+// lines are replaced by the file, each file once (its include guard covers
+// repeats), as preview_shaders.gl.load_shader_source does.
+
+const INCLUDE = /^\s*#include\s+"([^"]+)"\s*$/gm;
+const ES_HEADER = [
+  "#version 300 es",
+  "precision highp float;",
+  "precision highp int;",
+  "precision highp sampler2D;",
+].join("\n");
+
+const files = new Map(); // name -> Promise<string>
+
+function fetchFile(base, name) {
+  if (!/^[A-Za-z0-9_.-]+$/.test(name)) throw new Error(`not a shader file name: ${name}`);
+  if (!files.has(name)) {
+    files.set(name, fetch(`${base}/${name}`).then((r) => {
+      if (!r.ok) throw new Error(`shader ${name}: ${r.status} ${r.statusText}`);
+      return r.text();
+    }));
+  }
+  return files.get(name);
+}
+
+// Every file `name` includes, fetched in parallel level by level.
+async function expand(base, name, seen) {
+  if (seen.has(name)) return "";
+  seen.add(name);
+  const text = await fetchFile(base, name);
+  const names = [...text.matchAll(INCLUDE)].map((m) => m[1]);
+  const bodies = new Map();
+  for (const included of names) bodies.set(included, await expand(base, included, seen));
+  return text.replace(INCLUDE, (_, included) => bodies.get(included) ?? "");
+}
+
+/** The GLSL ES 3.00 source of `name` with its includes resolved. */
+export async function loadShader(name, base = "/glsl") {
+  const source = await expand(base, name, new Set());
+  const newline = source.indexOf("\n");
+  const head = source.slice(0, newline);
+  if (!head.startsWith("#version")) throw new Error(`${name} must start with a #version line`);
+  return `${ES_HEADER}\n${source.slice(newline + 1)}`;
+}
+
+/** Fetch the files of `names` (and what they include) ahead of use. */
+export function prefetch(names, base = "/glsl") {
+  for (const name of names) fetchFile(base, name).catch(() => {});
+}

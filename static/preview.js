@@ -1,0 +1,289 @@
+// The real-time preview: WebGL2 running preview_shaders/glsl/shader_ball.frag
+// (the project's own GLSL, loaded by glsl.js) on a sphere with an orbiting
+// camera. Split on screen into labelled bands: the coated-conductor model
+// from its packed float16 halves, adjusted Lazanyi, and the spectral
+// reference, which the service sends as a float texture over
+// (cos theta, eta_i) (GET /api/v1/fits/{id}/reference-texture).
+
+import { loadShader } from "./glsl.js";
+
+export const PANEL = { model: 0, lazanyi: 1, reference: 2 };
+export const OUTPUT = { display: 0, linear: 1, fresnel: 2, geometry: 3 };
+export const ENVIRONMENT = { white_sky: 0, studio: 1, outdoor: 2 };
+const LABELS = ["Model", "Adjusted Lazanyi", "Spectral reference"];
+
+// ------------------------------------------------------------ float16 halves
+
+const f32 = new Float32Array(1);
+const u32 = new Uint32Array(f32.buffer);
+
+/** IEEE half bits of `x`, rounded to nearest even (exact for float16 values). */
+export function halfBits(x) {
+  f32[0] = x;
+  const bits = u32[0];
+  const sign = (bits >>> 16) & 0x8000;
+  const exponent = (bits >>> 23) & 0xff;
+  let mantissa = bits & 0x7fffff;
+  if (exponent === 0xff) return sign | 0x7c00 | (mantissa ? 0x200 : 0);
+  const e = exponent - 112;
+  if (e >= 0x1f) return sign | 0x7c00;
+  if (e <= 0) {
+    if (e < -10) return sign;
+    mantissa |= 0x800000;
+    const shift = 14 - e;
+    let h = mantissa >>> shift;
+    const rest = mantissa & ((1 << shift) - 1), half = 1 << (shift - 1);
+    if (rest > half || (rest === half && (h & 1))) h += 1;
+    return sign | h;
+  }
+  let h = (e << 10) | (mantissa >>> 13);
+  const rest = mantissa & 0x1fff;
+  if (rest > 0x1000 || (rest === 0x1000 && (h & 1))) h += 1;
+  return sign | h;
+}
+
+/**
+ * The 14 uint32 words a renderer uploads (fitting.pack.halves_to_uint32):
+ * coefficients[p][c][j] for p in (F0, a, alpha), two halves a word, the
+ * earlier in the low 16 bits; powers beyond the fit's degree are 0.
+ */
+export function packedWords(coefficients) {
+  const halves = [];
+  for (const p of ["F0", "a", "alpha"]) {
+    for (let c = 0; c < 3; c++) {
+      for (let j = 0; j < 3; j++) halves.push(halfBits(coefficients[p][c][j] ?? 0));
+    }
+  }
+  halves.push(0);
+  const words = new Uint32Array(14);
+  for (let k = 0; k < 14; k++) words[k] = (halves[2 * k] | (halves[2 * k + 1] << 16)) >>> 0;
+  return words;
+}
+
+// ------------------------------------------------------------ renderer
+
+function compile(gl, type, source, name) {
+  const shader = gl.createShader(type);
+  gl.shaderSource(shader, source);
+  gl.compileShader(shader);
+  if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
+    throw new Error(`${name} does not compile as GLSL ES 3.00: ${gl.getShaderInfoLog(shader)}`);
+  }
+  return shader;
+}
+
+/**
+ * The orbit camera: eye on a sphere of radius `distance` around the unit
+ * sphere (yaw about y, pitch above the equator), looking at the origin, y
+ * up; right and up scaled by tan(fov / 2). In double precision here, once
+ * per frame (GPU trigonometry can be coarse).
+ */
+export function orbitCamera([yaw, pitch, distance], fov) {
+  const eye = [distance * Math.cos(pitch) * Math.sin(yaw), distance * Math.sin(pitch), distance * Math.cos(pitch) * Math.cos(yaw)];
+  const forward = eye.map((v) => -v / distance);
+  // right = forward x (0, 1, 0), normalised
+  let right = [-forward[2], 0, forward[0]];
+  const length = Math.hypot(...right);
+  right = right.map((v) => v / length);
+  const up = [
+    right[1] * forward[2] - right[2] * forward[1],
+    right[2] * forward[0] - right[0] * forward[2],
+    right[0] * forward[1] - right[1] * forward[0],
+  ];
+  const focal = Math.tan(0.5 * fov);
+  return { eye, forward, right: right.map((v) => v * focal), up: up.map((v) => v * focal) };
+}
+
+export class ShaderBall {
+  /** Use `await ShaderBall.create(canvas, labels)`. */
+  constructor(canvas, labels, gl, program) {
+    this.canvas = canvas;
+    this.labels = labels;
+    this.gl = gl;
+    this.program = program;
+    this.uniforms = {};
+    const count = gl.getProgramParameter(program, gl.ACTIVE_UNIFORMS);
+    for (let i = 0; i < count; i++) {
+      const name = gl.getActiveUniform(program, i).name.replace(/\[0\]$/, "");
+      this.uniforms[name] = gl.getUniformLocation(program, name);
+    }
+    this.vao = gl.createVertexArray();
+    this.state = {
+      orbit: [0.5, 0.25, 4.2], fov: 0.52, panels: [PANEL.model], environment: ENVIRONMENT.studio,
+      exposure: 0, eta: 1.5, words: new Uint32Array(14), etaRange: [1, 2.5],
+      F0: [0, 0, 0], F82: [0, 0, 0], fitId: null, referenceFor: null, referenceRange: [1, 2.5],
+    };
+    this.reference = this.#texture(new Float32Array(6), 2, 1);
+    this.frames = 0;
+    this.pending = false;
+    this.onFrame = null;
+    this.#bindOrbit();
+    new ResizeObserver(() => this.draw()).observe(canvas);
+  }
+
+  static async create(canvas, labels) {
+    const gl = canvas.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true });
+    if (!gl) throw new Error("this browser has no WebGL2");
+    const [vertex, fragment] = await Promise.all([loadShader("fullscreen.vert"), loadShader("shader_ball.frag")]);
+    const program = gl.createProgram();
+    gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, vertex, "fullscreen.vert"));
+    gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragment, "shader_ball.frag"));
+    gl.linkProgram(program);
+    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
+      throw new Error(`shader_ball does not link: ${gl.getProgramInfoLog(program)}`);
+    }
+    return new ShaderBall(canvas, labels, gl, program);
+  }
+
+  #texture(data, width, height) {
+    const gl = this.gl;
+    const texture = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 4);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGB32F, width, height, 0, gl.RGB, gl.FLOAT, data);
+    for (const p of [gl.TEXTURE_MIN_FILTER, gl.TEXTURE_MAG_FILTER]) gl.texParameteri(gl.TEXTURE_2D, p, gl.NEAREST);
+    for (const p of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T]) gl.texParameteri(gl.TEXTURE_2D, p, gl.CLAMP_TO_EDGE);
+    return texture;
+  }
+
+  /** The fit to show (its FitPublic answer): words, domain; drawn at once. */
+  setFit(fit) {
+    Object.assign(this.state, { words: packedWords(fit.coefficients), etaRange: fit.eta_i_range, fitId: fit.id });
+    this.draw();
+  }
+
+  /** The spectral reference texture and Lazanyi inputs (see api.referenceTexture). */
+  setReference(texture) {
+    const gl = this.gl;
+    gl.deleteTexture(this.reference);
+    this.reference = this.#texture(texture.data, texture.width, texture.height);
+    Object.assign(this.state, {
+      F0: texture.F0_air, F82: texture.F82_air, referenceRange: texture.eta_i_range, referenceFor: texture.fitId,
+    });
+    this.draw();
+  }
+
+  /** Change settings ({eta, environment, exposure, panels, orbit}) and draw. */
+  set(changes) {
+    Object.assign(this.state, changes);
+    this.draw();
+  }
+
+  #uniforms(output, width, height) {
+    const gl = this.gl, u = this.uniforms, s = this.state;
+    gl.useProgram(this.program);
+    gl.uniform2f(u.u_resolution, width, height);
+    const camera = orbitCamera(s.orbit, s.fov);
+    for (const name of ["eye", "forward", "right", "up"]) gl.uniform3f(u[`u_${name}`], ...camera[name]);
+    const kinds = [...s.panels, PANEL.model, PANEL.model].slice(0, 3);
+    gl.uniform1i(u.u_panels, s.panels.length);
+    gl.uniform3i(u.u_panel_kind, ...kinds);
+    gl.uniform1i(u.u_environment, s.environment);
+    gl.uniform1f(u.u_exposure, s.exposure);
+    gl.uniform1i(u.u_output, output);
+    gl.uniform1f(u.u_eta_i, s.eta);
+    gl.uniform1uiv(u.cf_words, s.words);
+    gl.uniform2f(u.cf_eta_i_range, ...s.etaRange);
+    gl.uniform3f(u.cf_F0_air, ...s.F0);
+    gl.uniform3f(u.cf_F82_air, ...s.F82);
+    gl.uniform2f(u.u_reference_eta_i_range, ...s.referenceRange);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, this.reference);
+    gl.uniform1i(u.u_reference, 0);
+  }
+
+  /** Ask for a frame (drawn on the next animation frame, once). */
+  draw() {
+    if (this.pending) return;
+    this.pending = true;
+    requestAnimationFrame(() => {
+      this.pending = false;
+      this.drawNow();
+    });
+  }
+
+  /** Draw the canvas now; the canvas's data-fit names the fit drawn. */
+  drawNow() {
+    const gl = this.gl, canvas = this.canvas;
+    const scale = Math.min(window.devicePixelRatio || 1, 2);
+    const width = Math.max(1, Math.round(canvas.clientWidth * scale));
+    const height = Math.max(1, Math.round(canvas.clientHeight * scale));
+    if (canvas.width !== width || canvas.height !== height) {
+      canvas.width = width;
+      canvas.height = height;
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.viewport(0, 0, width, height);
+    this.#uniforms(OUTPUT.display, width, height);
+    gl.bindVertexArray(this.vao);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    this.frames += 1;
+    canvas.dataset.fit = this.state.fitId || "";
+    canvas.dataset.eta = this.state.eta.toFixed(2);
+    this.#label();
+    if (this.onFrame) this.onFrame(this.state);
+  }
+
+  #label() {
+    if (!this.labels) return;
+    const panels = this.state.panels;
+    const wanted = panels.map((kind) => LABELS[kind]).join("|");
+    if (this.labels.dataset.panels === wanted) return;
+    this.labels.dataset.panels = wanted;
+    this.labels.replaceChildren(...panels.map((kind) => {
+      const span = document.createElement("span");
+      span.textContent = LABELS[kind];
+      return span;
+    }));
+  }
+
+  /**
+   * Render `output` (OUTPUT.*) at width x height into an RGBA32F target
+   * (EXT_color_buffer_float) and read it back: (height x width x 4) floats,
+   * bottom row first, as GL stores it. For the parity tests.
+   */
+  readFloat(output, width, height) {
+    const gl = this.gl;
+    if (!gl.getExtension("EXT_color_buffer_float")) throw new Error("no EXT_color_buffer_float");
+    const texture = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, texture);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, width, height);
+    const fbo = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, 0);
+    gl.viewport(0, 0, width, height);
+    this.#uniforms(output, width, height);
+    gl.bindVertexArray(this.vao);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    const pixels = new Float32Array(width * height * 4);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.FLOAT, pixels);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.deleteFramebuffer(fbo);
+    gl.deleteTexture(texture);
+    return pixels;
+  }
+
+  #bindOrbit() {
+    const canvas = this.canvas;
+    let last = null;
+    canvas.addEventListener("pointerdown", (event) => {
+      canvas.setPointerCapture(event.pointerId);
+      last = [event.clientX, event.clientY];
+    });
+    canvas.addEventListener("pointermove", (event) => {
+      if (!last) return;
+      const [yaw, pitch, distance] = this.state.orbit;
+      const dx = event.clientX - last[0], dy = event.clientY - last[1];
+      last = [event.clientX, event.clientY];
+      this.set({ orbit: [yaw - dx * 0.01, Math.max(-1.45, Math.min(1.45, pitch + dy * 0.01)), distance] });
+    });
+    const release = () => { last = null; };
+    canvas.addEventListener("pointerup", release);
+    canvas.addEventListener("pointercancel", release);
+    canvas.addEventListener("wheel", (event) => {
+      event.preventDefault();
+      const [yaw, pitch, distance] = this.state.orbit;
+      this.set({ orbit: [yaw, pitch, Math.max(1.6, Math.min(10, distance * Math.exp(event.deltaY * 0.001)))] });
+    }, { passive: false });
+  }
+}

@@ -1,0 +1,43 @@
+"""Issue 10, item 6: the CLI says so when a fit does not converge, and --strict makes it an error."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def glass_csv(tmp_path):
+    wavelength = np.linspace(350.0, 850.0, 26)
+    rows = "\n".join(f"{w},1.5,0" for w in wavelength)
+    path = tmp_path / "glass.csv"
+    path.write_text("wavelength_nm,n,k\n" + rows + "\n")
+    return path
+
+
+def fit(*args):
+    return subprocess.run([sys.executable, "-m", "fitting", "fit", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+
+
+def test_non_converged_fit_warns_and_strict_fails(tmp_path):
+    path = glass_csv(tmp_path)
+    out = tmp_path / "glass.cfpk"
+    result = fit("--nk", str(path), "--no-metrics", "-o", str(out))
+    assert result.returncode == 0
+    assert "warning: the fit of 'glass' did not converge" in result.stderr
+    assert out.read_bytes()[:4] == b"CFPK"
+    strict_out = tmp_path / "strict.cfpk"
+    strict = fit("--nk", str(path), "--no-metrics", "--strict", "-o", str(strict_out))
+    assert strict.returncode == 3 and "(--strict)" in strict.stderr
+    assert not strict_out.exists()
+
+
+def test_converged_fit_is_quiet_under_strict(tmp_path):
+    result = fit("Au", "--no-metrics", "--strict", "-o", str(tmp_path / "au.cfpk"))
+    assert result.returncode == 0, result.stderr
+    assert "warning" not in result.stderr and "did not converge" not in result.stderr

@@ -1,0 +1,89 @@
+"""
+The product-grid spectral reference (:func:`fitting.reference.reference_ACEScg_grid`)
+against its definition, the complex-arithmetic :func:`reference_ACEScg`, and
+the metrics the service reports against the 1 nm / 100 x 100 definition.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fitting import (
+    LIBRARY_NAMES,
+    SpectralNK,
+    coated_conductor_model,
+    error_metrics,
+    evaluate_material,
+    fit_material,
+    library_material,
+)
+from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid
+
+WAVELENGTH = np.linspace(300.0, 900.0, 61)
+
+
+def constant_nk(n: float, k: float) -> SpectralNK:
+    return SpectralNK(WAVELENGTH, np.full(61, n), np.full(61, k), name=f"n{n}k{k}")
+
+
+class TestReferenceGrid:
+    @pytest.mark.parametrize("name", LIBRARY_NAMES)
+    def test_metrics_match_the_slow_definition(self, name):
+        """Every conductor: Delta E of the fit within 0.001 of the 1 nm / 100 x 100 definition."""
+        nk = library_material(name)
+        result = fit_material(nk)
+        fast = evaluate_material(nk, result, baselines=False)
+        M, E = evaluation_grid(100, result.eta_i_range)
+        slow_ref = reference_ACEScg(nk, M, E, 1.0)
+        assert np.max(np.abs(reference_ACEScg_grid(nk, M[0], E[:, 0]) - slow_ref)) < 1e-13
+        slow = error_metrics(
+            slow_ref, coated_conductor_model(M, E, result.coefficients_float16, result.eta_i_range)
+        )
+        for key, value in (("delta_E_mean", slow.mean), ("delta_E_max", slow.max)):
+            assert abs(fast["model_float16"][key] - value) < 1e-3
+            # In fact they agree to rounding.
+            assert abs(fast["model_float16"][key] - value) < 1e-9
+
+    @pytest.mark.parametrize("n, k", [
+        (1.5, 0.0),    # dielectric: total internal reflection for eta_i > 1.5
+        (1.0, 0.0),    # index matched at eta_i = 1, grazing row included
+        (2.5, 0.0),
+        (1.2, 1e-9),   # weak absorber past the critical angle: the cancelling branch
+        (0.05, 4.0),   # silver-like
+        (3.0, 3.0),
+    ])
+    def test_limits_and_edge_cases(self, n, k):
+        nk = constant_nk(n, k)
+        mu = np.linspace(0.0, 1.0, 37)
+        eta = np.linspace(1.0, 3.0, 23)
+        fast = reference_ACEScg_grid(nk, mu, eta)
+        E, M = np.meshgrid(eta, mu, indexing="ij")
+        slow = reference_ACEScg(nk, M, E)
+        assert fast.shape == (23, 37, 3) and np.all(np.isfinite(fast))
+        assert np.max(np.abs(fast - slow)) < 1e-10
+
+    def test_physical_limits(self):
+        tir = reference_ACEScg_grid(constant_nk(1.2, 0.0), [0.0, 0.1], [2.0])
+        np.testing.assert_allclose(tir, 1.0, atol=1e-12)  # total internal reflection
+        matched = reference_ACEScg_grid(constant_nk(1.0, 0.0), [0.0, 0.5, 1.0], [1.0])
+        np.testing.assert_allclose(matched, 0.0, atol=1e-15)  # no interface, even at grazing
+
+    def test_repeated_values_and_order(self):
+        nk = library_material("Cu")
+        mu = np.array([0.7, 0.1, 0.7, 1.0])
+        eta = np.array([2.0, 1.3, 2.0])
+        fast = reference_ACEScg_grid(nk, mu, eta)
+        E, M = np.meshgrid(eta, mu, indexing="ij")
+        np.testing.assert_allclose(fast, reference_ACEScg(nk, M, E), rtol=0, atol=1e-14)
+        assert np.array_equal(fast[0], fast[2]) and np.array_equal(fast[:, 0], fast[:, 2])
+
+    @pytest.mark.parametrize("mu, eta, message", [
+        ([[0.5]], [1.5], "1-D"),
+        ([0.5], [0.8], "`eta_i` must be >= 1, got 0.8"),
+        ([np.nan], [1.5], "cos_theta"),
+        ([0.5], [np.inf], "eta_i"),
+    ])
+    def test_refusals(self, mu, eta, message):
+        with pytest.raises(ValueError, match=message):
+            reference_ACEScg_grid(library_material("Au"), mu, eta)

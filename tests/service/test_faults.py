@@ -1,0 +1,310 @@
+"""
+Issue 10 (items 3-9) against the service: host allow-list, slow clients,
+paged listing, storage faults, worker death, generated code and ids, edits
+in scenes and float32 bounds. Server tests run a real ``python -m service``
+on 127.0.0.1; every loop is bounded.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import socket
+import sqlite3
+import subprocess
+import sys
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import httpx
+import numpy as np
+import pytest
+
+from conftest import ROOT, app_client, server_process
+
+API = "/api/v1"
+
+
+def gold_like_nk(shift: float = 0.0) -> dict:
+    wavelength = np.linspace(350.0, 850.0, 26)
+    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + shift
+    k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
+    return {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}
+
+
+# -- 3. DNS rebinding ---------------------------------------------------------
+
+@pytest.mark.server
+def test_rebinding_host_refused_400_loopback_allowed(tmp_path):
+    with server_process(tmp_path / "data") as server:
+        evil = {"Host": f"attacker.example:{server.port}", "Origin": f"http://attacker.example:{server.port}"}
+        with httpx.Client(base_url=server.url, timeout=60) as http:
+            write = http.post(f"{API}/fits", json={"material": "Au"}, headers=evil)
+            assert write.status_code == 400
+            assert write.headers["content-type"] == "application/json"
+            assert "COATED_ALLOWED_HOSTS" in write.json()["detail"]
+            assert http.get(f"{API}/materials", headers={"Host": "attacker.example"}).status_code == 400
+            for host in (f"localhost:{server.port}", f"127.0.0.1:{server.port}", "LOCALHOST"):
+                assert http.get("/healthz", headers={"Host": host}).status_code == 200
+            listed = http.get(f"{API}/materials").json()["materials"]
+            assert not [m for m in listed if m["latest_fit_id"]]
+
+
+def test_allowed_hosts_configured(tmp_path):
+    from service.api.middleware import host_allowed
+
+    assert host_allowed("[::1]:8000", ("localhost",)) and host_allowed("127.0.0.5", ("localhost",))
+    assert host_allowed("api.example.com", (".example.com",)) and not host_allowed("example.org", (".example.com",))
+    assert not host_allowed("", ("localhost",))
+    with app_client(tmp_path, allowed_hosts=["fresnel.example"]) as client:
+        assert client.get("/healthz").status_code == 400  # testserver is no longer allowed
+        assert client.get("/healthz", headers={"Host": "fresnel.example"}).status_code == 200
+
+
+# -- 4. slow clients ------------------------------------------------------------
+
+@pytest.mark.server
+def test_slow_clients_are_cut_off_and_healthz_answers(tmp_path):
+    with server_process(tmp_path / "data", COATED_HEADER_TIMEOUT_S="1", COATED_BODY_TIMEOUT_S="1") as server:
+        slow = []
+        for _ in range(40):
+            sock = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+            sock.sendall(b"GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # header never finished
+            slow.append(sock)
+        body = socket.create_connection(("127.0.0.1", server.port), timeout=10)
+        body.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+                     b"Content-Length: 100\r\n\r\n{")
+        started = time.monotonic()
+        assert httpx.get(f"{server.url}/healthz", timeout=5).status_code == 200
+        answer = body.recv(4096)
+        assert b" 408 " in answer.split(b"\r\n")[0] and b"COATED_BODY_TIMEOUT_S" in answer
+        assert time.monotonic() - started < 10
+        closed = 0
+        for sock in slow:
+            sock.settimeout(5)
+            try:
+                closed += sock.recv(1) == b""
+            except (ConnectionResetError, socket.timeout):
+                closed += 1
+            sock.close()
+        body.close()
+        assert closed == len(slow)
+        time.sleep(0.5)
+        log = server.log_text()
+        assert log.count("did not arrive within 1 s") == 1  # the flood is logged once
+
+
+# -- 5. paged listing -----------------------------------------------------------
+
+def test_materials_paged_by_summary(tmp_path):
+    from service.store import FitRecord, SQLiteStore
+
+    store = SQLiteStore(tmp_path / "data" / "store.sqlite3")
+    material = {"name": "m", "degree": 2, "eta_i_range": [1.0, 2.5], "source": "",
+                "coefficients": {"F0": [[0.5] * 3] * 3, "a": [[0.0] * 3] * 3, "alpha": [[1.0] * 3] * 3}}
+    for i in range(30):
+        store.put_fit(FitRecord(id=f"{i:032x}", kind="nk", material_id=f"{i + 100:032x}", name=f"m{i}",
+                                source="s", material=material))
+    store.close()
+    with app_client(tmp_path, materials_page_max=12) as client:
+        first = client.get(f"{API}/materials").json()
+        assert len(first["materials"]) == 22 + 12 and first["next_cursor"] is not None
+        names, cursor = [m["name"] for m in first["materials"][22:]], first["next_cursor"]
+        for _ in range(10):
+            page = client.get(f"{API}/materials", params={"cursor": cursor, "limit": 12}).json()
+            assert all(m["kind"] != "library" for m in page["materials"])
+            names += [m["name"] for m in page["materials"]]
+            cursor = page["next_cursor"]
+            if cursor is None:
+                break
+        assert names == [f"m{i}" for i in range(30)]
+
+
+# -- 6. storage faults -------------------------------------------------------------
+
+def test_corrupt_record_reported_and_skipped(tmp_path):
+    with app_client(tmp_path, metrics_samples=10) as client:
+        a = client.post(f"{API}/fits", json={"name": "a", "nk": gold_like_nk(0.0)}).json()
+        b = client.post(f"{API}/fits", json={"name": "b", "nk": gold_like_nk(0.1)}).json()
+        with sqlite3.connect(tmp_path / "data" / "store.sqlite3") as db:
+            db.execute("UPDATE fits SET record = '{broken' WHERE id = ?", (a["id"],))
+            db.execute("UPDATE materials SET kind = 'garbage' WHERE material_id = ?", (b["material_id"],))
+        damaged = client.get(f"{API}/fits/{a['id']}")
+        assert damaged.status_code == 500 and "damaged" in damaged.json()["detail"]
+        listing = client.get(f"{API}/materials")
+        assert listing.status_code == 200
+        body = listing.json()
+        assert body["skipped"] == [b["material_id"]]
+        assert a["material_id"] in [m["id"] for m in body["materials"]]
+        assert client.get(f"{API}/fits/{b['id']}").status_code == 200
+
+
+def test_store_quota_full_507_and_healthz(tmp_path):
+    with app_client(tmp_path, metrics_samples=10, store_max_bytes=200_000) as client:
+        statuses = []
+        for i in range(60):  # each record is several KiB: the quota is reached well within 60
+            response = client.post(f"{API}/fits", json={"name": f"m{i}", "nk": gold_like_nk(i / 100)})
+            assert response.headers["content-type"] == "application/json"
+            statuses.append(response.status_code)
+            if response.status_code == 507:
+                break
+        assert statuses[-1] == 507 and set(statuses[:-1]) == {201}
+        assert "COATED_STORE_MAX_BYTES" in response.json()["detail"]
+        health = client.get("/healthz").json()
+        assert health["store_writable"] is False and "quota" in health["store_problem"]
+        for i, status in enumerate(statuses[:-1]):  # every acknowledged save is there
+            assert client.get(f"{API}/materials").status_code == 200
+        assert len([m for m in client.get(f"{API}/materials").json()["materials"] if m["kind"] == "nk"]) == len(statuses) - 1
+
+
+def test_disk_below_free_space_refused_507_before_fitting(tmp_path):
+    free = os.statvfs(tmp_path).f_bavail * os.statvfs(tmp_path).f_frsize
+    with app_client(tmp_path, store_min_free_bytes=free * 2 + 10**9) as client:
+        assert client.get("/healthz").json()["store_writable"] is False
+        response = client.post(f"{API}/fits", json={"material": "Au"})
+        assert response.status_code == 507 and "nothing was fitted" in response.json()["detail"]
+        assert client.app.state.runner.completed == 0
+
+
+def test_read_only_store_503(tmp_path):
+    with app_client(tmp_path) as client:
+        store = client.app.state.store
+        path = store.path
+
+        def read_only():
+            return sqlite3.connect(f"file:{path}?mode=ro", uri=True, check_same_thread=False)
+
+        store._connection = read_only  # the store as SQLite sees a read-only file
+        health = client.get("/healthz").json()
+        assert health["store_writable"] is False and "readonly" in health["store_problem"]
+        response = client.post(f"{API}/fits", json={"material": "Au"})
+        assert response.status_code == 503 and response.json()["detail"]
+
+
+@pytest.mark.parametrize("damage", ["corrupt", "not a directory"])
+def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
+    data = tmp_path / "data"
+    if damage == "corrupt":
+        data.mkdir()
+        (data / "store.sqlite3").write_bytes(b"this is not a database" * 200)
+    else:
+        data.write_text("a file where the directory should be")
+    result = subprocess.run([sys.executable, "-m", "service", "--data-dir", str(data), "--port", "0"],
+                            cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert result.returncode == 1
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("python -m service: cannot start: the store")
+    assert "Traceback" not in result.stderr
+
+
+# -- 7. worker death -------------------------------------------------------------
+
+def _worker_pids(server_pid: int) -> list[int]:
+    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(server_pid)], capture_output=True, text=True).stdout
+    pids = []
+    for pid in map(int, out.split()):
+        cmd = open(f"/proc/{pid}/cmdline", "rb").read()
+        if b"spawn_main" in cmd:
+            pids.append(pid)
+    return pids
+
+
+@pytest.mark.server
+def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path):
+    with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server:
+        with httpx.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(4) as pool:
+            futures = [pool.submit(http.post, f"{API}/fits", json={"name": f"k{i}", "nk": gold_like_nk(i / 50)})
+                       for i in range(4)]
+            deadline = time.monotonic() + 60
+            while http.get("/healthz").json()["fits_in_flight"] < 2 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            workers = _worker_pids(server.process.pid)
+            assert workers
+            os.kill(workers[0], signal.SIGKILL)
+            answers = [f.result() for f in futures]
+            assert all(a.headers["content-type"] == "application/json" for a in answers)
+            assert [a.status_code for a in answers].count(201) >= 3, [a.text for a in answers]
+            health = http.get("/healthz").json()
+            assert health["pool_restarts"] == 1
+            after = http.post(f"{API}/fits", json={"name": "after", "nk": gold_like_nk(0.3)})
+            assert after.status_code == 201
+            saved = {a.json()["id"] for a in answers if a.status_code == 201} | {after.json()["id"]}
+        server.kill()
+    with server_process(tmp_path / "data") as again, httpx.Client(base_url=again.url, timeout=60) as http:
+        for fit_id in saved:
+            assert http.get(f"{API}/fits/{fit_id}").status_code == 200
+
+
+def test_timed_out_fit_keeps_its_result_for_the_retry(tmp_path):
+    with app_client(tmp_path, fit_timeout_s=0.2, metrics_samples=10) as client:
+        body = {"name": "slow", "nk": gold_like_nk(0.2)}
+        first = client.post(f"{API}/fits", json=body)
+        assert first.status_code == 504 and int(first.headers["retry-after"]) >= 1
+        runner = client.app.state.runner
+        deadline = time.monotonic() + 120
+        while runner.in_flight and time.monotonic() < deadline:
+            time.sleep(0.05)
+        retry = client.post(f"{API}/fits", json=body)
+        assert retry.status_code == 200  # the first run's result, saved: no second fit
+        assert runner.completed == 1
+
+
+# -- 8. generated code and ids ---------------------------------------------------
+
+def test_symbols_unique_and_every_download_compiles(tmp_path):
+    with app_client(tmp_path, metrics_samples=10) as client:
+        ids = [client.post(f"{API}/fits", json={"name": name, "nk": gold_like_nk(i / 10)}).json()["id"]
+               for i, name in enumerate(["material x", "x F0", "x"])]
+        sources = {fmt: client.post(f"{API}/packs", json={"fit_ids": ids, "format": fmt}).text
+                   for fmt in ("glsl", "hlsl")}
+    glsl = sources["glsl"]
+    functions = re.findall(r"vec3 (cf_material_\w+)\(float NdotV", glsl)
+    assert len(functions) == 3
+    for head in ("#version 330\n", "#version 300 es\nprecision highp float;\n"):
+        path = tmp_path / "pack.frag"
+        path.write_text(head + glsl + "\nout vec4 o;\nvoid main() { o = vec4(%s, 1.0); }\n"
+                        % " + ".join(f"{f}(0.5, 1.5)" for f in functions))
+        result = subprocess.run(["glslangValidator", str(path)], capture_output=True, text=True, timeout=60)
+        assert result.returncode == 0, head + result.stdout
+    hlsl = sources["hlsl"]
+    calls = " + ".join(f"{f}(0.5, 1.5)" for f in re.findall(r"float3 (cf_material_\w+)\(float NdotV", hlsl))
+    path = tmp_path / "pack.hlsl"
+    path.write_text(hlsl + "\nfloat4 main() : SV_Target { return float4(%s, 1.0); }\n" % calls)
+    result = subprocess.run(["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o",
+                             str(tmp_path / "p.spv"), str(path)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stdout
+
+
+# -- 9. edits in scenes, float32 bounds --------------------------------------------
+
+def test_scene_uses_the_edited_model(tmp_path):
+    with app_client(tmp_path, metrics_samples=10) as client:
+        edit = {"name": "warm gold", "base": {"material": "Au"}, "curves": [{
+            "eta_i": 1.5, "angle_deg": [0, 30, 60, 75, 90],
+            "rgb": [[0.2, 0.9, 0.2], [0.2, 0.9, 0.2], [0.2, 0.88, 0.22], [0.3, 0.85, 0.4], [1, 1, 1]]}]}
+        edited = client.post(f"{API}/fits/from-curves", json=edit)
+        assert edited.status_code == 201, edited.text
+        fit = edited.json()
+        scene = client.post(f"{API}/scenes", json={"materials": [
+            {"name": "w", "material": fit["material_id"], "eta_i": 1.5}]})
+        assert scene.status_code == 200, scene.text
+        report = scene.json()["materials"][0]
+        assert report["fit"]["from_stored_model"] is True and report["material"] == fit["material_id"]
+        shipped = scene.json()["pack"]["materials"][0]["coefficients"]
+        assert shipped == fit["coefficients"]  # the edits, not gold's n, k
+        outside = client.post(f"{API}/scenes", json={"materials": [
+            {"name": "w", "material": fit["material_id"], "eta_i": 2.9}]})
+        assert outside.status_code == 422 and "materials[0].eta_i" in outside.json()["detail"]
+
+
+def test_edit_at_the_float32_rounded_upper_end(tmp_path):
+    with app_client(tmp_path, metrics_samples=10) as client:
+        base = client.post(f"{API}/fits", json={"material": "Cu", "eta_i_range": [2.9999999, 3.0]})
+        assert base.status_code == 201, base.text
+        edit = {"name": "edge", "base": {"fit": base.json()["id"]}, "eta_i_range": [2.9999999, 3.0],
+                "curves": [{"eta_i": 2.9999999, "cos_theta": [1.0, 0.7, 0.4, 0.1, 0.0],
+                            "rgb": [[0.9, 0.6, 0.5], [0.9, 0.6, 0.5], [0.9, 0.62, 0.52],
+                                    [0.93, 0.8, 0.75], [1, 1, 1]]}]}
+        response = client.post(f"{API}/fits/from-curves", json=edit)
+        assert response.status_code == 201, response.text
