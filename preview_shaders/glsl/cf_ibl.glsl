@@ -13,6 +13,12 @@
 
 #include "cf_common.glsl"
 
+// GLSL ES 3.00 gives sampler3D no default precision (the pack downloads are
+// checked against ES 3.00 and GLSL 3.30).
+#ifdef GL_ES
+precision highp sampler3D;
+#endif
+
 // As fitting.shading.ibl._G_FLOOR: keeps log2(G) finite where G = 0
 // (NdotV = 0), above FLT_MIN.
 const float CF_IBL_G_FLOOR = 1.0e-30;

@@ -150,3 +150,24 @@ def test_hlsl_pack_split_sum_compiles(tmp_path):
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert (tmp_path / "p.spv").stat().st_size > 0
+
+
+@pytest.mark.parametrize("head", ["#version 330\n", "#version 300 es\nprecision highp float;\n"])
+def test_glsl_pack_split_sum_compiles_for_330_and_es_300(tmp_path, head):
+    source = render_pack(materials(), "glsl", "test pack").decode()
+    body = """
+uniform highp sampler3D cf_lut;
+out vec4 o;
+void main()
+{
+    vec3 F = cf_material_gold_1(0.5, 1.5);
+    vec3 E = cf_split_sum_model(cf_lut, vec2(0.5, 12.0), 0.5, 0.3, F, F, vec3(2.0, 3.0, 4.0))
+        + cf_split_sum_lazanyi(cf_lut, vec2(0.5, 12.0), 0.5, 0.3, F, F)
+        + cf_split_sum_schlick(cf_lut, vec2(0.5, 12.0), 0.5, 0.3, F);
+    o = vec4(E * cf_average_fresnel(F, F, F), 1.0);
+}
+"""
+    path = tmp_path / "pack.frag"
+    path.write_text(head + source + body)
+    result = subprocess.run(["glslangValidator", str(path)], capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, head + result.stdout
