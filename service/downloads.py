@@ -36,8 +36,10 @@ from the fit's measured n, k, or for a fit of edited curves from its model:
 from __future__ import annotations
 
 import functools
+import io
 import re
 import string
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -52,8 +54,8 @@ from .store import FitRecord
 
 __all__ = [
     "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
-    "render_export", "pack_response", "export_response", "download_name", "glsl_identifier",
-    "IBL_LUT_FILENAME", "ibl_lut_file",
+    "render_export", "render_export_pack", "pack_response", "export_response", "download_name",
+    "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
 
 IBL_LUT_FILENAME = "cf_ibl_lut.cflut"
@@ -319,6 +321,22 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
     return export_material(model, format, eta_i)
 
 
+def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:
+    """
+    The exports of several fits for one ``eta_i``: a zip archive with one
+    ``<name>.<suffix>`` per fit, in order, byte-for-byte deterministic (fixed
+    time stamps), so the same request gives the same archive.
+    """
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for record in records:
+            info = zipfile.ZipInfo(download_name(f"{record.name}-eta{eta_i:g}", format),
+                                   date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            archive.writestr(info, render_export(record, format, eta_i))
+    return buffer.getvalue()
+
+
 def download_name(stem: str, format: str) -> str:
     """``<stem>.<suffix>`` with only [A-Za-z0-9._-] in the stem (a safe header value)."""
     safe = re.sub(r"[^A-Za-z0-9._-]", "_", stem).strip("._") or "material"
@@ -357,5 +375,6 @@ PACK_CONTENT = {
     "application/xml": {"schema": {"type": "string"}},
     "text/x-python": {"schema": {"type": "string"}},
     "model/gltf+json": {"schema": {"type": "object"}},
+    "application/zip": {"schema": {"type": "string", "format": "binary"}},
 }
 """The OpenAPI content of a download."""

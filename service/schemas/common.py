@@ -25,6 +25,7 @@ from ..jobs.nk import MAX_NK_SAMPLES
 
 __all__ = [
     "API_PREFIX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
+    "EXPORT_FORMAT_NAMES", "MAX_EXPORT_PACK",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
     "PackFormat", "Text", "RequestModel",
@@ -35,6 +36,10 @@ API_PREFIX = "/api/v1"
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
+EXPORT_FORMAT_NAMES = ("mtlx", "openpbr", "blender", "gltf")
+"""Exports for one coating index (docs/exports.md); a pack of them is a zip archive."""
+MAX_EXPORT_PACK = 16
+"""Most fits in one pack of exports (each export fits its tool's values, about 1 s)."""
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 """Every coating index lies in [1, 3] (fitting.domain)."""
 

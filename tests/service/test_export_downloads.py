@@ -102,3 +102,53 @@ class TestCurveFitExports:
         response = pack(client, curve_fit["id"], f"format=mtlx&eta_i={hi + 0.3:g}")
         assert response.status_code == 422
         assert "`eta_i` must lie in the fit's domain" in response.json()["detail"]
+
+
+@pytest.fixture(scope="module")
+def two_fits(shared):
+    client, cu = shared
+    response = client.post(f"{API}/fits", json={"material": "Au"})
+    assert response.status_code == 201, response.text
+    return client, [cu, response.json()["id"]]
+
+
+class TestExportPacks:
+    """``POST /api/v1/packs`` with an export format: a zip of one export per fit."""
+
+    @pytest.mark.parametrize("format, suffix", [("mtlx", ".mtlx"), ("gltf", ".gltf")])
+    def test_zip_holds_each_fits_export_in_order(self, two_fits, format, suffix):
+        import io
+        import zipfile
+
+        client, ids = two_fits
+        body = {"fit_ids": ids, "format": format, "eta_i": 1.3, "name": "scene"}
+        response = client.post(f"{API}/packs", json=body)
+        assert response.status_code == 200, response.text
+        assert response.headers["content-type"] == "application/zip"
+        assert response.headers["content-disposition"] == (
+            f'attachment; filename="scene-{format}-eta1.3.zip"')
+        archive = zipfile.ZipFile(io.BytesIO(response.content))
+        assert archive.namelist() == [f"Cu-eta1.3{suffix}", f"Au-eta1.3{suffix}"]
+        for name, material in zip(archive.namelist(), ("Cu", "Au")):
+            assert archive.read(name) == export_material(library_material(material), format, 1.3)
+        # Deterministic: the same request, the same bytes.
+        assert client.post(f"{API}/packs", json=body).content == response.content
+
+    @pytest.mark.parametrize("body, words", [
+        ({"format": "mtlx", "eta_i": 0.5}, ["eta_i", "greater than or equal to 1"]),
+        ({"format": "usdz"}, ["format", "'mtlx'"]),
+        ({"format": "gltf", "eta_i": True}, ["eta_i"]),
+    ])
+    def test_bad_export_pack_422(self, two_fits, body, words):
+        client, ids = two_fits
+        response = client.post(f"{API}/packs", json={"fit_ids": ids, **body})
+        assert response.status_code == 422, response.text
+        detail = json.dumps(response.json())
+        for word in words:
+            assert word in detail
+
+    def test_too_many_fits_for_an_export_pack_422(self, two_fits):
+        client, ids = two_fits
+        response = client.post(f"{API}/packs", json={"fit_ids": ids * 9, "format": "blender"})
+        assert response.status_code == 422, response.text
+        assert "at most 16 fits for an export pack" in response.json()["detail"]

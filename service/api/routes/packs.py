@@ -3,12 +3,14 @@ Packs
 =====
 
 ``POST /api/v1/packs``: several stored fits in one download (a scene's
-materials together), in any pack format. Reads only; saves nothing.
+materials together), in any pack format, or their exports for one coating
+index as a zip archive (mtlx, openpbr, blender, gltf). Reads only; saves
+nothing.
 """
 
 from fastapi import APIRouter, Response, status
 
-from ...downloads import PACK_CONTENT, pack_response
+from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, pack_response, render_export_pack
 from ...jobs.common import stored_fit
 from ...schemas import API_PREFIX, PackRequest
 from ..deps import ERROR_RESPONSES, NOT_FOUND, StoreDep
@@ -36,4 +38,8 @@ def create_pack(request: PackRequest, store: StoreDep) -> Response:
             )
         names[record.name] = index
         records.append(record)
+    if request.format in EXPORT_MEDIA_TYPES:
+        body = render_export_pack(records, request.format, request.eta_i)
+        return Response(body, media_type="application/zip", headers={
+            "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
     return pack_response(records, request.format, request.name)
