@@ -6,7 +6,10 @@ Artistic control over a material (Vernooij 2024, Section 6, "a curve editor,
 allowing modifications to the RGB reflectance dataset, and subsequently
 fitting coefficients to the adjusted data"): RGB reflectance curves against
 cos theta, at one or more coating indices eta_i, in linear ACEScg, fitted by
-the coated-conductor model (:mod:`fitting.models.coated_conductor`).
+the coated-conductor model (:mod:`fitting.models.coated_conductor`) or, with
+``model="rgb-conductor"``, by the exact Fresnel of a per-channel relative
+index (:mod:`fitting.models.rgb_conductor`: always a reflectance in [0, 1],
+so it needs no range constraint).
 
 -   The curves: :mod:`fitting.fits.curves_input` (:class:`RGBCurve`,
     :func:`check_curves`).
@@ -48,12 +51,14 @@ import numpy as np
 
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_int, check_number
 from ..models.coated_conductor import coated_conductor_model
+from ..models.kinds import DEFAULT_MODEL, check_model, model_ACEScg
 from ..models.pack import PackedMaterial
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve, check_curves
 from ..colour.delta_e import delta_E_map
 from .metrics import curve_metrics
 from .result import FitResult
+from .rgb_conductor import fit_rgb_conductor_coefficients
 from .settings import check_fit_options
 from .solver import fit_coefficients
 
@@ -96,21 +101,21 @@ def _check_grid(eta_i_range, angles: int, rows: int) -> tuple[np.ndarray, np.nda
 
 
 def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients, blend_width: float,
-                       shape=SCORE_GRID) -> dict[str, Any]:
+                       shape=SCORE_GRID, model: str = DEFAULT_MODEL) -> dict[str, Any]:
     """
-    Delta E 2000 of the model of ``coefficients`` against the whole blended
+    Delta E 2000 of the model (of kind ``model``) of ``coefficients`` against the whole blended
     target (:func:`edited_target`) on the scoring grid: mean, max and where
     the max is (``at_theta_deg``, ``at_eta_i``), and the model's range there.
     """
     theta, rows, M, E = score_grid(base.eta_i_range, shape)
     target = edited_target(base, curves, M, E, blend_width)
-    model = coated_conductor_model(M, E, coefficients, base.eta_i_range)
-    dE = delta_E_map(target, model)
+    RGB = model_ACEScg(model, M, E, coefficients, base.eta_i_range)
+    dE = delta_E_map(target, RGB)
     j, i = np.unravel_index(int(np.argmax(dE)), dE.shape)
     return {
         "delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max()),
         "at_theta_deg": float(theta[i]), "at_eta_i": float(rows[j]),
-        "model_min": float(model.min()), "model_max": float(model.max()),
+        "model_min": float(RGB.min()), "model_max": float(RGB.max()),
         "grid": f"{theta.size} angles x {rows.size} eta_i",
     }
 
@@ -186,10 +191,11 @@ def fit_curves(
     eta_i_range=None,
     name: str = "edited",
     settings: CurveFitSettings | None = None,
+    model: str = DEFAULT_MODEL,
     **overrides,
 ) -> FitResult:
     """
-    Fit the coated-conductor model to RGB reflectance curves.
+    Fit the coated-conductor model (or another kind, ``model``) to RGB reflectance curves.
 
     With a ``base``, the target is :func:`edited_target` on ``mu_samples``
     values of cos theta evenly over [0, 1] at ``eta_samples`` rows evenly over
@@ -211,6 +217,13 @@ def fit_curves(
         Name of the packed material.
     settings, overrides
         :class:`CurveFitSettings`, individual fields replaced by ``overrides``.
+    model
+        The model kind (:data:`fitting.models.kinds.MODEL_KINDS`): for
+        ``rgb-conductor`` the per-channel n, k are fitted to the same target
+        with the same objective, weights and float16-aware rounding
+        (:func:`fitting.fits.rgb_conductor.fit_rgb_conductor_coefficients`);
+        its n, k do not depend on eta_i, so without a base the degree rule
+        does not apply.
 
     Returns
     -------
@@ -238,6 +251,7 @@ def fit_curves(
     if overrides:
         settings = CurveFitSettings(**{**settings.__dict__, **overrides})
     curves = check_curves(curves)
+    model = check_model(model)
     if not isinstance(name, str) or not name.strip():
         raise ValueError("`name` must be a non-empty string")
     if base is not None:
@@ -310,9 +324,15 @@ def fit_curves(
             result = fit(objective, weight, check, dense)
         return result
 
-    result = constrained(settings.objective)
     chosen = settings.objective
-    if base is not None and settings.compare_rgb and settings.objective != "rgb":
+    if model == "rgb-conductor":
+        result = fit_rgb_conductor_coefficients(
+            target, mu, eta, eta_i_range, settings.objective, max(settings.max_nfev, _RGB_MAX_NFEV),
+            settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
+        )
+    else:
+        result = constrained(settings.objective)
+    if model != "rgb-conductor" and base is not None and settings.compare_rgb and settings.objective != "rgb":
         # The paper's own method (plain rgb least squares) on the whole
         # blended target (every other point of the scoring grid: the target
         # is smooth, and it halves the cost): kept when it is closer on the
@@ -330,7 +350,7 @@ def fit_curves(
         result = candidates[chosen]
     C16 = result.coefficients_float16
     error = curve_metrics(
-        curves, lambda c: coated_conductor_model(c.cos_theta, c.eta_i, C16, eta_i_range),
+        curves, lambda c: model_ACEScg(model, c.cos_theta, c.eta_i, C16, eta_i_range),
         "the edited curves at their samples",
     )
     metrics: dict[str, Any] = {
@@ -340,11 +360,12 @@ def fit_curves(
         "objective": chosen,
     }
     if base is not None:
-        metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width)
+        metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)
     result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(
-        name=name, coefficients=C16, eta_i_range=eta_i_range, source=source[:4000], metrics=metrics
+        name=name, coefficients=C16, eta_i_range=eta_i_range, source=source[:4000], metrics=metrics,
+        model=model,
     )
     result.timings["target"] = t_target - t0
     result.timings["total"] = time.perf_counter() - t0

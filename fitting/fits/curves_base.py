@@ -24,7 +24,7 @@ import numpy as np
 
 from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_number
-from ..models.coated_conductor import check_coefficients, coated_conductor_model
+from ..models.kinds import DEFAULT_MODEL, check_model_coefficients, model_ACEScg
 from ..optics.nk import SpectralNK
 from .curves_input import RGBCurve
 
@@ -154,27 +154,29 @@ def curve_base_from_nk(nk: SpectralNK, eta_i_range=DEFAULT_ETA_I_RANGE) -> Curve
 
 
 def curve_base_from_coefficients(
-    coefficients, eta_i_range=DEFAULT_ETA_I_RANGE, name: str = "fit", source: str = ""
+    coefficients, eta_i_range=DEFAULT_ETA_I_RANGE, name: str = "fit", source: str = "",
+    model: str = DEFAULT_MODEL,
 ) -> CurveBase:
     """
-    The model of fitted ``coefficients`` (3, 3, d + 1) over its domain
-    ``eta_i_range`` on the base grid (for a stored fit without *n*, *k*).
+    The model of fitted ``coefficients`` of kind ``model`` ((3, 3, d + 1)
+    for the coated-conductor, (2, 3) n, k for the rgb-conductor) over its
+    domain ``eta_i_range`` on the base grid (for a stored fit without *n*, *k*).
 
     Raises
     ------
     ValueError
         For invalid coefficients or domain.
     """
-    C = check_coefficients(coefficients)
+    C = check_model_coefficients(model, coefficients)
     eta_i_range = check_eta_i_range(eta_i_range)
 
     def build() -> CurveBase:
         mu, eta = _base_grid(eta_i_range)
-        RGB = coated_conductor_model(mu[None, :], eta[:, None], C, eta_i_range)
+        RGB = model_ACEScg(model, mu[None, :], eta[:, None], C, eta_i_range)
         RGB.setflags(write=False)
         return CurveBase(name, source, eta_i_range, mu, eta, RGB, "model")
 
-    key = ("model", np.ascontiguousarray(C, dtype="<f8").tobytes(), C.shape, eta_i_range, name, source)
+    key = ("model", model, np.ascontiguousarray(C, dtype="<f8").tobytes(), C.shape, eta_i_range, name, source)
     return _cached(key, build)
 
 

@@ -37,7 +37,7 @@ from fitting.fits.curves_base import (
     edited_target,
 )
 from fitting.fits.curves_input import check_curves
-from fitting.models.kinds import model_ACEScg
+from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
 from fitting.models.pack import material_from_json, material_to_json
 from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
@@ -73,11 +73,12 @@ class BaseSpec:
     library_material: str | None = None
     nk: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] | None = None
     coefficients: tuple | None = None
+    model: str = DEFAULT_MODEL
 
     def build(self) -> CurveBase:
         if self.kind == "model":
             return curve_base_from_coefficients(
-                np.asarray(self.coefficients), self.eta_i_range, self.name, self.source
+                np.asarray(self.coefficients), self.eta_i_range, self.name, self.source, self.model
             )
         return curve_base_from_nk(self.spectral_nk(), self.eta_i_range)
 
@@ -91,11 +92,12 @@ class BaseSpec:
         return [self.kind, self.name, self.source, self.library_material,
                 None if self.nk is None else [np.asarray(a) for a in self.nk],
                 None if self.coefficients is None else np.asarray(self.coefficients).ravel(),
-                list(self.eta_i_range)]
+                list(self.eta_i_range), *(() if self.model == DEFAULT_MODEL else (self.model,))]
 
     def provenance(self) -> dict[str, Any]:
         return {"kind": self.kind, "name": self.name, "eta_i_range": list(self.eta_i_range),
-                "library_material": self.library_material, "coefficients": self.coefficients}
+                "library_material": self.library_material, "coefficients": self.coefficients,
+                "model": self.model}
 
 
 @dataclass(frozen=True)
@@ -112,6 +114,7 @@ class CurveFit:
     request: dict[str, Any]
     fit_id: str
     draft: bool = False
+    model: str = DEFAULT_MODEL
 
 
 def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
@@ -152,7 +155,7 @@ def _base_spec(store: Store, name: str, material: str | None, fit: str | None,
         # n, k it started from.
         packed = material_from_json(record.material)
         spec = BaseSpec("model", record.name, record.source, domain,
-                        coefficients=packed.coefficients.astype(np.float64).tolist())
+                        coefficients=packed.coefficients.astype(np.float64).tolist(), model=packed.model)
     elif record.library_material is not None:
         spec = BaseSpec("nk", record.library_material, record.source, domain,
                         library_material=record.library_material)
@@ -166,7 +169,8 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
                       base_fit: str | None = None, base_nk: tuple | None = None,
                       eta_i_range=None, objective: str = DEFAULTS.objective,
                       blend_width: float = DEFAULTS.blend_width,
-                      request: dict[str, Any] | None = None, draft: bool = False) -> CurveFit:
+                      request: dict[str, Any] | None = None, draft: bool = False,
+                      model: str = DEFAULT_MODEL) -> CurveFit:
     """
     Resolve the base (``LookupError`` for a base fit not stored), check the
     curves and the domain (``ValueError``), and compute the id. Runs in a
@@ -182,20 +186,22 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
     fit_id = content_address(
         FIT_FORMAT_VERSION, CURVES_FORMAT, name, None if base is None else base.key(), curves,
         list(domain), objective, blend_width, repr(DEFAULTS),
+        # The default kind adds nothing, so coated-conductor ids stay as they were.
+        *(() if model == DEFAULT_MODEL else (model,)),
     )
     return CurveFit(name, base, base_record, curves, domain, objective, blend_width,
-                    request or {}, fit_id, draft)
+                    request or {}, fit_id, draft, model)
 
 
 def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: str,
-                objective: str, blend_width: float) -> dict[str, Any]:
+                objective: str, blend_width: float, model: str = DEFAULT_MODEL) -> dict[str, Any]:
     """Worker process: build (or reuse) the base grid, fit, score."""
     t0 = time.perf_counter()
     base_grid = None if base is None else base.build()
     t_base = time.perf_counter() - t0
     result = fit_curves(
         curves, base_grid, None if base is not None else eta_i_range, name,
-        objective=objective, blend_width=blend_width,
+        objective=objective, blend_width=blend_width, model=model,
     )
     metrics = result.metrics
     summary = result.summary()
@@ -240,7 +246,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
 
     async def make() -> FitRecord:
         job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
-                               fit.objective, fit.blend_width)
+                               fit.objective, fit.blend_width, fit.model)
         check_finite("metrics", job["metrics"])
         record = fit_record(
             fit.fit_id, "curves", content_address("edited material", fit.name), fit.name,
@@ -285,7 +291,8 @@ def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
             target = np.stack([next(c for c in curves if c.eta_i == e).sampled(mu) for e in rows])
             return rows, target, "curves"
         if base["kind"] == "model":
-            grid = curve_base_from_coefficients(np.asarray(base["coefficients"]), domain, base["name"])
+            grid = curve_base_from_coefficients(np.asarray(base["coefficients"]), domain, base["name"],
+                                                model=base.get("model", DEFAULT_MODEL))
         else:
             grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
         E, M = np.meshgrid(eta, mu, indexing="ij")

@@ -15,7 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from fitting.fits.curves import CurveFitSettings
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 
-from .common import FIT_ID_PATTERN, EtaI, LibraryName, Objective, RequestModel
+from .common import DEFAULT_MODEL, FIT_ID_PATTERN, EtaI, LibraryName, ModelKind, Objective, RequestModel
 from .fits import NKData
 
 __all__ = ["CurveIn", "CurveBaseIn", "CurveFitRequest", "ErrorMap"]
@@ -114,6 +114,9 @@ class CurveFitRequest(RequestModel):
     curves: list[CurveIn] = Field(min_length=1, max_length=CURVE_MAX_COUNT)
     objective: Objective = _DEFAULTS.objective
     blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False, strict=True)
+    model: ModelKind = Field(
+        DEFAULT_MODEL, description="Model kind of the refit: coated-conductor (Vernooij 2024) or "
+        "rgb-conductor (per-channel n, k; always within [0, 1])")
     draft: bool = Field(False, description="Store the fit without saving it under `name` (the editor's "
                                            "refits while editing); the same request with false saves it")
 

@@ -50,6 +50,7 @@ async def create_fit_from_curves(request: CurveFitRequest, store: StoreDep, runn
             eta_i_range=request.eta_i_range, objective=request.objective,
             blend_width=request.blend_width,
             request=request.model_dump(mode="json", exclude={"base", "draft"}), draft=request.draft,
+            model=request.model,
         ))
     record, created = await fit_from_curves(fit, store, runner)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
