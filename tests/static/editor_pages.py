@@ -44,8 +44,12 @@ class Pages:
 
 
 @pytest.fixture
-def pages():
-    """``pages.new(width, height)``: a fresh page; no page may log an error."""
+def pages(live_server):
+    """
+    ``pages.new(width, height)``: a fresh page; no page may log an error.
+    It depends on the server so that the browser closes before the server
+    stops (a page still fetching then would log a refused connection).
+    """
     with sync_playwright() as p:
         browser = launch(p)
         made = Pages(browser)
