@@ -45,6 +45,7 @@ from .metrics import baseline_metrics, error_metrics
 from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
 from .settings import OBJECTIVES, FitSettings, fit_grid
+from .solver import check_samples
 
 __all__ = [
     "DEFAULT_SETTINGS",
@@ -152,22 +153,10 @@ def fit_rgb_conductor_coefficients(
     eta_i_range = check_eta_i_range(eta_i_range)
     if objective not in OBJECTIVES:
         raise ValueError(f"`objective` must be one of {', '.join(OBJECTIVES)}, got {objective!r}")
-    target = np.asarray(target_RGB, dtype=np.float64).reshape(-1, 3)
-    mu = np.ravel(np.asarray(cos_theta, dtype=np.float64))
-    eta = np.ravel(np.asarray(eta_i, dtype=np.float64))
-    if not (mu.size == eta.size == target.shape[0]):
-        raise ValueError("`target_RGB`, `cos_theta` and `eta_i` must have the same number of samples")
-    for name, values in (("target_RGB", target), ("cos_theta", mu), ("eta_i", eta)):
-        if not np.all(np.isfinite(values)):
-            raise ValueError(f"`{name}` must be finite")
+    target, mu, eta, weights = check_samples(target_RGB, cos_theta, eta_i, weights)
     if np.any(eta < 1.0):
         raise ValueError(f"`eta_i` must be >= 1, got {eta.min():g}")
-    if weights is None:
-        base = np.ones(mu.size)
-    else:
-        base = np.ravel(np.asarray(weights, dtype=np.float64))
-        if base.size != mu.size or np.any(base < 0) or not np.all(np.isfinite(base)):
-            raise ValueError("`weights` must be one finite value >= 0 per sample")
+    base = np.ones(mu.size) if weights is None else weights
     bounds = nk_bounds()
     x = _initial_guess(target, mu, eta, base).ravel()
     problem = RGBConductorObjective(target, mu, eta, objective, base)

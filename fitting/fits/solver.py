@@ -35,7 +35,7 @@ from .result import FitResult
 from .settings import DEFAULT_OBJECTIVE, OBJECTIVES, check_degree
 from .start import initial_guess
 
-__all__ = ["fit_coefficients", "solve"]
+__all__ = ["fit_coefficients", "solve", "check_samples"]
 
 # The fit's matrices are tiny (hundreds x 27): BLAS threads only add
 # synchronisation cost, and oversubscribe the pool's worker processes.
@@ -73,6 +73,27 @@ def _single_threaded_blas(function):
 
 
 @_single_threaded_blas
+def check_samples(target_RGB, cos_theta, eta_i, weights=None):
+    """
+    The fitted samples as float64 arrays ``(target (S, 3), mu (S,), eta (S,),
+    weights (S,) or None)``, every one finite and of one size, weights >= 0
+    (the sample checks of every fit of RGB samples).
+    """
+    target = np.asarray(target_RGB, dtype=np.float64).reshape(-1, 3)
+    mu = np.ravel(np.asarray(cos_theta, dtype=np.float64))
+    eta = np.ravel(np.asarray(eta_i, dtype=np.float64))
+    if not (mu.size == eta.size == target.shape[0]):
+        raise ValueError("`target_RGB`, `cos_theta` and `eta_i` must have the same number of samples")
+    for name, values in (("target_RGB", target), ("cos_theta", mu), ("eta_i", eta)):
+        if not np.all(np.isfinite(values)):
+            raise ValueError(f"`{name}` must be finite")
+    if weights is not None:
+        weights = np.ravel(np.asarray(weights, dtype=np.float64))
+        if weights.size != mu.size or np.any(weights < 0) or not np.all(np.isfinite(weights)):
+            raise ValueError("`weights` must be one finite value >= 0 per sample")
+    return target, mu, eta, weights
+
+
 def fit_coefficients(
     target_RGB,
     cos_theta,
@@ -157,18 +178,7 @@ def fit_coefficients(
     check_degree(degree)
     if eta_i_range[1] <= eta_i_range[0]:
         degree = 0
-    target = np.asarray(target_RGB, dtype=np.float64).reshape(-1, 3)
-    mu = np.ravel(np.asarray(cos_theta, dtype=np.float64))
-    eta = np.ravel(np.asarray(eta_i, dtype=np.float64))
-    if not (mu.size == eta.size == target.shape[0]):
-        raise ValueError("`target_RGB`, `cos_theta` and `eta_i` must have the same number of samples")
-    for name, values in (("target_RGB", target), ("cos_theta", mu), ("eta_i", eta)):
-        if not np.all(np.isfinite(values)):
-            raise ValueError(f"`{name}` must be finite")
-    if weights is not None:
-        weights = np.ravel(np.asarray(weights, dtype=np.float64))
-        if weights.size != mu.size or np.any(weights < 0) or not np.all(np.isfinite(weights)):
-            raise ValueError("`weights` must be one finite value >= 0 per sample")
+    target, mu, eta, weights = check_samples(target_RGB, cos_theta, eta_i, weights)
     if range_check is not None:
         check_mu, check_eta, check_weight = range_check
         check_mu = np.ravel(np.asarray(check_mu, dtype=np.float64))
