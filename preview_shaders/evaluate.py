@@ -27,7 +27,7 @@ from fitting.models.baselines import external_medium_F0, lazanyi_a
 from fitting.models.coated_conductor import collapse_to_eta_i
 from fitting.models.pack import PackedMaterial, halves_to_uint32
 
-from .gl import GLState, RenderThread, check_gl_error
+from .gl import GLState, RenderThread, check_gl_error, read_float_target
 
 __all__ = [
     "VARIANTS",
@@ -178,11 +178,7 @@ def _evaluate_grid(state: GLState, variant, inputs, grid, width, height):
     try:
         fbo.use()
         vao.render(mode=ctx.TRIANGLES, vertices=3)
-        F, inputs_out = (
-            np.frombuffer(fbo.read(components=4, dtype="f4", attachment=i), np.float32)
-            .reshape(height, width, 4)
-            for i in range(2)
-        )
+        F, inputs_out = (read_float_target(fbo, i, width, height) for i in range(2))
         check_gl_error(ctx)
     finally:
         state.release_targets(fbo, targets)

@@ -14,6 +14,7 @@ silently reads zeros), so every GL call of the package runs on a
 -   :class:`GLState`: what a callable gets on the render thread: the context
     and cached programs.
 -   :func:`check_gl_error`: raises if the GL error state is not clean.
+-   :func:`read_float_target`: an RGBA32F colour attachment as a numpy array.
 """
 
 from __future__ import annotations
@@ -26,12 +27,14 @@ from pathlib import Path
 from typing import Any, Callable
 
 import moderngl
+import numpy as np
 
 __all__ = [
     "GLSL_DIR",
     "GL_VERSION",
     "load_shader_source",
     "check_gl_error",
+    "read_float_target",
     "GLState",
     "RenderThread",
 ]
@@ -66,6 +69,15 @@ def load_shader_source(name: str, defines: dict[str, int] | None = None) -> str:
         raise ValueError(f"`{name}` must start with a #version line")
     lines = [f"#define {key} {int(value)}" for key, value in (defines or {}).items()]
     return "\n".join([head, *lines, body])
+
+
+def read_float_target(fbo: moderngl.Framebuffer, index: int, width: int, height: int) -> np.ndarray:
+    """
+    Colour attachment ``index`` of an RGBA32F framebuffer as a (height, width,
+    4) float32 array, rows bottom-up as GL stores them (a read-only view).
+    """
+    data = np.frombuffer(fbo.read(components=4, dtype="f4", attachment=index), np.float32)
+    return data.reshape(height, width, 4)
 
 
 def check_gl_error(ctx: moderngl.Context) -> None:

@@ -66,7 +66,7 @@ from fitting.models.pack import PackedMaterial, halves_to_uint32
 
 from .display import ACEScg_to_sRGB, encode_png, to_uint8
 from .evaluate import padded_coefficients
-from .gl import GLState, RenderThread, check_gl_error
+from .gl import GLState, RenderThread, check_gl_error, read_float_target
 
 __all__ = [
     "COMPARISONS",
@@ -193,12 +193,7 @@ def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, s
     try:
         fbo.use()
         vao.render(mode=ctx.TRIANGLES, vertices=3)
-        layers = [
-            np.frombuffer(fbo.read(components=4, dtype="f4", attachment=i), np.float32)
-            .reshape(size, size, 4)[::-1]
-            .copy()
-            for i in range(3)
-        ]
+        layers = [read_float_target(fbo, i, size, size)[::-1].copy() for i in range(3)]
         check_gl_error(ctx)
     finally:
         state.release_targets(fbo, targets)

@@ -47,7 +47,7 @@ from fitting.shading.microfacet import (
     smith_G2,
 )
 
-from .gl import GLState, check_gl_error, load_shader_source
+from .gl import GLState, check_gl_error, load_shader_source, read_float_target
 
 __all__ = [
     "MODES",
@@ -295,12 +295,7 @@ def render_rough_layers(state: GLState, lut_data, alpha_range, prefiltered, unif
         env.use(location=1)
         fbo.use()
         vao.render(mode=ctx.TRIANGLES, vertices=3)
-        layers = [
-            np.frombuffer(fbo.read(components=4, dtype="f4", attachment=i), np.float32)
-            .reshape(size, size, 4)[::-1]
-            .copy()
-            for i in range(4)
-        ]
+        layers = [read_float_target(fbo, i, size, size)[::-1].copy() for i in range(4)]
         check_gl_error(ctx)
     finally:
         state.release_targets(fbo, targets)

@@ -25,7 +25,7 @@ import numpy as np
 from fitting.shading.ibl import SplitSumLUT
 from fitting.shading.microfacet import check_mode
 
-from .gl import GLState, RenderThread, check_gl_error
+from .gl import GLState, RenderThread, check_gl_error, read_float_target
 
 __all__ = [
     "evaluate_brdf_grid",
@@ -41,8 +41,7 @@ SPLIT_SUM_VARIANTS = ("split_sum_model", "split_sum_lazanyi", "split_sum_schlick
 
 
 def _read(fbo, index: int, width: int, height: int) -> np.ndarray:
-    data = np.frombuffer(fbo.read(components=4, dtype="f4", attachment=index), np.float32)
-    return data.reshape(height, width, 4)[..., :3].copy()
+    return read_float_target(fbo, index, width, height)[..., :3].copy()
 
 
 def _brdf_grid(state: GLState, mode, uniforms, grid, phi, width, height):
