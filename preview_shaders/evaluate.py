@@ -18,7 +18,6 @@ compare it with numpy, the cost benchmark times it.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -27,7 +26,7 @@ from fitting.models.baselines import external_medium_F0, lazanyi_a
 from fitting.models.coated_conductor import collapse_to_eta_i
 from fitting.models.pack import PackedMaterial, halves_to_uint32
 
-from .gl import GLState, RenderThread, check_gl_error, read_float_target
+from .gl import GLState, RenderThread, check_gl_error, read_float_target, time_renders
 
 __all__ = [
     "VARIANTS",
@@ -255,28 +254,14 @@ def _time_variants(state: GLState, inputs, variants, width, height, rounds):
     ctx = state.ctx
     programs = {v: _timing_program(state, v, inputs) for v in variants}
     fbo, targets = state.float_targets((width, height), 1)
-    query = ctx.query(time=True)
-    samples = {variant: [] for variant in variants}
+    for program, _ in programs.values():
+        # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
+        program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
     try:
         fbo.use()
-        for _ in range(rounds):
-            for variant, (program, vao) in programs.items():
-                # mu over [0, 1] across the screen, eta_i over [1, 2.5] down it.
-                program["u_grid"].value = (0.0, 1.0 / (width - 1), 1.0, 1.5 / (height - 1))
-                for timed in (False, True):  # one warm-up render before each timed one
-                    ctx.finish()
-                    wall, cpu = time.perf_counter(), time.process_time()
-                    with query:
-                        vao.render(mode=ctx.TRIANGLES, vertices=3)
-                        # llvmpipe's query covers only completed work: finish inside.
-                        ctx.finish()
-                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-                    if timed:
-                        samples[variant].append((query.elapsed, wall, cpu))
-        check_gl_error(ctx)
+        return time_renders(ctx, {variant: vao for variant, (_, vao) in programs.items()}, rounds)
     finally:
         state.release_targets(fbo, targets)
-    return {variant: np.array(s, dtype=np.float64) for variant, s in samples.items()}
 
 
 def time_variants(

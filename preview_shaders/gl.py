@@ -15,6 +15,7 @@ silently reads zeros), so every GL call of the package runs on a
     and cached programs.
 -   :func:`check_gl_error`: raises if the GL error state is not clean.
 -   :func:`read_float_target`: an RGBA32F colour attachment as a numpy array.
+-   :func:`time_renders`: timed full-screen renders, interleaved by round.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from __future__ import annotations
 import queue
 import re
 import threading
+import time
 from concurrent.futures import Future
 from pathlib import Path
 from typing import Any, Callable
@@ -35,6 +37,7 @@ __all__ = [
     "load_shader_source",
     "check_gl_error",
     "read_float_target",
+    "time_renders",
     "GLState",
     "RenderThread",
 ]
@@ -78,6 +81,32 @@ def read_float_target(fbo: moderngl.Framebuffer, index: int, width: int, height:
     """
     data = np.frombuffer(fbo.read(components=4, dtype="f4", attachment=index), np.float32)
     return data.reshape(height, width, 4)
+
+
+def time_renders(ctx: moderngl.Context, vaos: dict[str, moderngl.VertexArray], rounds: int) -> dict[str, np.ndarray]:
+    """
+    Time a full-screen triangle of each of ``vaos`` into the bound
+    framebuffer, interleaved round by round so drifting machine load hits
+    every one alike, one warm-up render before each timed one. Per name, a
+    (rounds, 3) array: GL timer query (ns), wall time (s) and process CPU
+    time (s) of each timed render. Raises if the GL error state is not clean.
+    """
+    query = ctx.query(time=True)
+    samples: dict[str, list] = {name: [] for name in vaos}
+    for _ in range(rounds):
+        for name, vao in vaos.items():
+            for timed in (False, True):  # one warm-up render before each timed one
+                ctx.finish()
+                wall, cpu = time.perf_counter(), time.process_time()
+                with query:
+                    vao.render(mode=ctx.TRIANGLES, vertices=3)
+                    # llvmpipe's query covers only completed work: finish inside.
+                    ctx.finish()
+                wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+                if timed:
+                    samples[name].append((query.elapsed, wall, cpu))
+    check_gl_error(ctx)
+    return {name: np.array(s, dtype=np.float64) for name, s in samples.items()}
 
 
 def check_gl_error(ctx: moderngl.Context) -> None:

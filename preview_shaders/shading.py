@@ -18,14 +18,13 @@ read back, for the parity tests.
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 
 from fitting.shading.ibl import SplitSumLUT
 from fitting.shading.microfacet import check_mode
 
-from .gl import GLState, RenderThread, check_gl_error, read_float_target
+from .gl import GLState, RenderThread, check_gl_error, read_float_target, time_renders
 
 __all__ = [
     "evaluate_brdf_grid",
@@ -191,28 +190,13 @@ def _time_split_sum(state: GLState, lut, per_variant, width, height, rounds):
                 program[name].value = value
         programs[variant] = vao
     fbo, targets = state.float_targets((width, height), 2)
-    query = ctx.query(time=True)
-    samples = {variant: [] for variant in SPLIT_SUM_VARIANTS}
     try:
         texture.use(location=0)
         fbo.use()
-        for _ in range(rounds):
-            for variant, vao in programs.items():
-                for timed in (False, True):  # one warm-up render before each timed one
-                    ctx.finish()
-                    wall, cpu = time.perf_counter(), time.process_time()
-                    with query:
-                        vao.render(mode=ctx.TRIANGLES, vertices=3)
-                        # llvmpipe's query covers only completed work: finish inside.
-                        ctx.finish()
-                    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-                    if timed:
-                        samples[variant].append((query.elapsed, wall, cpu))
-        check_gl_error(ctx)
+        return time_renders(ctx, programs, rounds)
     finally:
         state.release_targets(fbo, targets)
         texture.release()
-    return {variant: np.array(s, dtype=np.float64) for variant, s in samples.items()}
 
 
 def time_split_sum(
