@@ -10,9 +10,11 @@ the editor served by a real ``python -m service`` process on 127.0.0.1:
     to the fit on screen), on a server just started (its fitting pool
     warmed); then a second load of the same server;
 -   ``drag step``: during a continuous drag of a control point (a pointer
-    move every 40 ms), from the edit a refit answers to its refitted curve
-    drawn and to the first WebGL frame of that fit
-    (``window.cfTelemetry``); median and p90 over the refits of the drags;
+    move every 40 ms), from the edit a live refit answers to its refitted
+    curve drawn and to the first WebGL frame of that fit
+    (``window.cfTelemetry``); median and p90 over the live refits of the
+    drags; then, from the last edit of a drag, to the frame of the full
+    refit sent on release;
 -   ``orbit fps``: preview frames drawn per second while the orbit changes
     every animation frame for 3 s (each frame read back, so it is rendered),
     studio environment, three-way split, at a 1024 x 768 viewport.
@@ -76,7 +78,11 @@ def drag_latencies(page, drags):
         page.wait_for_function("document.getElementById('preview-state').hidden", timeout=60_000)
         page.wait_for_timeout(200)
         shown = page.evaluate("window.cfTelemetry.shown")
-        out += [(s["curveAt"] - s["editAt"], s["frameAt"] - s["editAt"]) for s in shown if s["frameAt"]]
+        if os.environ.get("EDITOR_SPEED_TRACE"):
+            for s in shown:
+                print({k: round(v - s["editAt"]) if k.endswith("At") and v else v for k, v in s.items()})
+        out += [(s["curveAt"] - s["editAt"], s["frameAt"] - s["editAt"], s.get("live", False))
+                for s in shown if s["frameAt"]]
     return out
 
 
@@ -127,14 +133,17 @@ def main() -> None:
             page.close()
             fps, size = orbit_fps(browser, url)
             browser.close()
-    curve = [c for c, _ in latencies]
-    frame = [f for _, f in latencies]
+    curve = [c for c, _, live in latencies if live]
+    frame = [f for _, f, live in latencies if live]
+    release = [f for _, f, live in latencies if not live]
     print(f"{'measure':<44} {'median':>9} {'p90':>9} {'n':>4}")
     print(f"{'cold start to editor + preview (s), first':<44} {first:>9.2f} {'':>9} {1:>4}")
     print(f"{'cold start to editor + preview (s), second':<44} {second:>9.2f} {'':>9} {1:>4}")
-    if latencies:
+    if curve:
         print(f"{'drag edit -> refitted curve (ms)':<44} {statistics.median(curve):>9.0f} {percentile(curve, 0.9):>9.0f} {len(curve):>4}")
         print(f"{'drag edit -> WebGL frame of the refit (ms)':<44} {statistics.median(frame):>9.0f} {percentile(frame, 0.9):>9.0f} {len(frame):>4}")
+    if release:
+        print(f"{'release -> WebGL frame of the full refit (ms)':<44} {statistics.median(release):>9.0f} {percentile(release, 0.9):>9.0f} {len(release):>4}")
     print(f"{'orbit fps at 1024 x 768 (canvas %d x %d)' % tuple(size):<44} {fps:>9.1f}")
     print(f"\nload average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 

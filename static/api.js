@@ -60,7 +60,12 @@ export async function postForm(path, form) {
 export const listMaterials = () => getJSON("/materials");
 export const getMaterial = (id) => getJSON(`/materials/${encodeURIComponent(id)}`);
 export const fitLibrary = (name, etaRange) => postJSON("/fits", { material: name, eta_i_range: etaRange });
-export const fitFromCurves = (body) => postJSON("/fits/from-curves", body);
+// With `curvesAt` ({ etaI, samples }), the answer also holds the fit's curves
+// there (`curves`, as curves() gives): one round trip per refit.
+export function fitFromCurves(body, curvesAt = null) {
+  const query = curvesAt ? `?curves_eta_i=${curvesAt.etaI.toFixed(3)}&curves_samples=${curvesAt.samples}` : "";
+  return postJSON(`/fits/from-curves${query}`, body);
+}
 export const errorMap = (fitId) => getJSON(`/fits/${fitId}/error-map?angles=46&rows=31`);
 
 export function uploadNK(file, name = "") {

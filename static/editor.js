@@ -276,10 +276,11 @@ function snapshot() {
 }
 
 let dragStart = null;
+let pointerDrag = false; // a pointer is dragging a point: refits are live
 
 // Move a control point; true when the target changed (a refit follows at
 // once, throttled by the pipeline).
-function drag(channel, handle, value) {
+function drag(channel, handle, value, pointer = false) {
   const k = key(state.eta);
   // The slider moved and its curves are not in yet: the plot shows another eta_i.
   if (!state.baseCurves || key(state.baseCurves.eta_i) !== k) return false;
@@ -289,6 +290,7 @@ function drag(channel, handle, value) {
   const before = current[i][channel];
   if (value === before) return false;
   if (dragStart === null) dragStart = snapshot();
+  pointerDrag = pointer;
   const all = document.querySelector("input[name=channel]:checked").value === "all";
   const at = (t) => Math.exp(-0.5 * ((t - HANDLES[handle]) / FALLOFF_DEG) ** 2) * (1 - (t / 90) ** 6);
   const peak = at(HANDLES[handle]);
@@ -318,6 +320,7 @@ function drag(channel, handle, value) {
 }
 
 function dragEnd() {
+  pointerDrag = false;
   if (dragStart !== null) {
     if (dragStart !== snapshot()) {
       state.undo.push(dragStart);
@@ -331,14 +334,19 @@ function dragEnd() {
 
 // ---------------------------------------------------------------- refits
 
-function requestBody(edits, draft = true) {
+// A refit of `edits`: a draft unless saved; while a point is dragged, a live
+// refit (one short solve started from the fit on screen, fast enough to
+// follow the pointer), replaced by a full refit on release.
+function requestBody(edits, draft = true, startFit = null) {
   const etas = Object.keys(edits).sort();
-  return {
+  const body = {
     name: $("name").value.trim() || "edited",
     base: { fit: state.base.id },
     curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: state.theta, rgb: edits[eta] })),
     draft,
   };
+  if (startFit) Object.assign(body, { live: true, start_fit: startFit });
+  return body;
 }
 
 // Ask for a fit of the edits on screen; the answer shows when it comes
@@ -358,20 +366,27 @@ async function pump() {
   const edits = JSON.parse(wanted);
   const base = state.base;
   const editAt = telemetry.lastEditAt;
+  // Live while a pointer drags a point, from the fit on screen (of this base).
+  const startFit = pointerDrag ? (state.fit || base).id : null;
   live.wanted = null;
   live.inFlight = true;
   const seq = ++live.seq;
   let delay = 0;
   try {
     await busy("Fitting…", async () => {
-      const fit = Object.keys(edits).length ? await api.fitFromCurves(requestBody(edits)) : base;
-      const curves = await api.curves(fit.id, state.eta, SAMPLES);
+      const sentAt = performance.now();
+      const curvesAt = { etaI: state.eta, samples: SAMPLES };
+      const fit = Object.keys(edits).length ? await api.fitFromCurves(requestBody(edits, true, startFit), curvesAt) : base;
+      const fittedAt = performance.now();
+      const curves = fit.curves && key(fit.curves.eta_i) === key(curvesAt.etaI)
+        ? fit.curves : await api.curves(fit.id, state.eta, SAMPLES);
       live.attempt = 0;
       if ($("message").dataset.kind === "retry") say("");
       if (seq > live.shown && base === state.base) {
         live.shown = seq;
         present(fit, curves, wanted);
-        telemetry.shown.push({ fit: fit.id, editAt, curveAt: performance.now(), frameAt: null });
+        telemetry.shown.push({ fit: fit.id, editAt, sentAt, fittedAt, curveAt: performance.now(), frameAt: null,
+                               live: !!startFit, serverMs: fit.timings ? 1e3 * fit.timings.total : null });
         if (telemetry.shown.length > 1000) telemetry.shown.shift();
       }
     });

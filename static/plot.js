@@ -15,7 +15,8 @@ function el(name, attributes = {}, parent = null) {
 export class ReflectancePlot {
   /**
    * @param {HTMLElement} container
-   * @param {object} hooks  onDrag(channel, handleIndex, value) -> whether the point moved, onDragEnd()
+   * @param {object} hooks  onDrag(channel, handleIndex, value, pointer) -> whether the point moved
+   *   (pointer: true while a pointer drags it, false for a key press), onDragEnd()
    */
   constructor(container, hooks) {
     this.hooks = hooks;
@@ -148,7 +149,7 @@ export class ReflectancePlot {
     if (!(event.key in steps)) return;
     event.preventDefault();
     const step = steps[event.key] * (event.shiftKey ? 5 : 1);
-    if (this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)))) this.keyMoved = true;
+    if (this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)), false)) this.keyMoved = true;
   }
 
   #move(event) {
@@ -158,7 +159,7 @@ export class ReflectancePlot {
     point.y = event.clientY;
     const local = point.matrixTransform(this.svg.getScreenCTM().inverse());
     const value = Math.min(1, Math.max(0, this.value(local.y)));
-    if (this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value)) this.dragging.moved = true;
+    if (this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value, true)) this.dragging.moved = true;
   }
 
   #release() {

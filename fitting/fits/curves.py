@@ -62,7 +62,7 @@ from .rgb_conductor import fit_rgb_conductor_coefficients
 from .settings import check_fit_options
 from .solver import fit_coefficients
 
-__all__ = ["CurveFitSettings", "SCORE_GRID", "score_grid", "whole_target_error", "fit_curves"]
+__all__ = ["CurveFitSettings", "LIVE_SETTINGS", "SCORE_GRID", "score_grid", "whole_target_error", "fit_curves"]
 
 _RANGE_TOLERANCE = 1e-4  # float16 rounding of a fit on the boundary
 _RGB_GRID = (24, 16)  # the paper-method candidate's samples: every other angle and eta_i of SCORE_GRID
@@ -181,6 +181,15 @@ class CurveFitSettings:
             raise ValueError(f"`check_samples` must be two integers in [2, 256], got {check!r}")
 
 
+LIVE_SETTINGS = CurveFitSettings(irls_rounds=0, max_nfev=8, compare_rgb=False, quantise=False)
+"""The settings of a live refit, while a curve is being dragged: one solve of
+at most 8 evaluations (no reweighting round, no paper-method candidate,
+float16 by rounding to nearest),
+meant to start from the fit on screen (``start``), so that it follows the
+pointer; the [0, 1] constraint is the same as the default's. The editor
+replaces it with a default refit when the drag ends."""
+
+
 def _describe(curves: Sequence[RGBCurve]) -> str:
     return ", ".join(f"{c.eta_i:g}" for c in sorted(curves, key=lambda c: c.eta_i))
 
@@ -192,6 +201,7 @@ def fit_curves(
     name: str = "edited",
     settings: CurveFitSettings | None = None,
     model: str = DEFAULT_MODEL,
+    start=None,
     **overrides,
 ) -> FitResult:
     """
@@ -217,6 +227,11 @@ def fit_curves(
         Name of the packed material.
     settings, overrides
         :class:`CurveFitSettings`, individual fields replaced by ``overrides``.
+    start
+        Coefficients (3, 3, degree + 1) to start the solve from instead of
+        the variable-projection guess (a warm start from the fit on screen,
+        see :data:`LIVE_SETTINGS`) for the coated-conductor kind; the
+        paper-method candidate always starts from its own guess.
     model
         The model kind (:data:`fitting.models.kinds.MODEL_KINDS`): for
         ``rgb-conductor`` the per-channel n, k are fitted to the same target
@@ -294,7 +309,8 @@ def fit_curves(
         source = f"RGB curves at eta_i {_describe(curves)}"
     t_target = time.perf_counter()
 
-    def fit(objective: str, range_weight: float, check_samples: tuple[int, int], dense=None) -> FitResult:
+    def fit(objective: str, range_weight: float, check_samples: tuple[int, int], dense=None,
+            start=start) -> FitResult:
         range_check = None
         if range_weight > 0:
             CM, CE = _check_grid(eta_i_range, *check_samples)
@@ -305,6 +321,7 @@ def fit_curves(
         return fit_coefficients(
             target, mu, eta, eta_i_range, degree, objective, settings.max_nfev,
             settings.quantise, weights=weights, irls_rounds=settings.irls_rounds, range_check=range_check,
+            start=start,
         )
 
     _, _, score_M, score_E = score_grid(eta_i_range)
@@ -321,7 +338,10 @@ def fit_curves(
             if weight == 0 or in_range(result.coefficients_float16):
                 break
             weight, check = 10.0 * weight, (max(check[0], 46), max(check[1], 16))
-            result = fit(objective, weight, check, dense)
+            # A warm-started (live) fit goes on from where it is; a fit from
+            # its own guess starts again, as it always has (same results).
+            result = fit(objective, weight, check, dense,
+                         start if start is None or dense is not None else result.coefficients)
         return result
 
     chosen = settings.objective

@@ -106,6 +106,7 @@ def fit_coefficients(
     weights=None,
     irls_rounds: int = 2,
     range_check=None,
+    start=None,
 ) -> FitResult:
     """
     Fit the coated-conductor model to linear ACEScg samples.
@@ -165,6 +166,10 @@ def fit_coefficients(
         stay in [0, 1]; each adds the residual ``weight * (min(F, 0) +
         max(F - 1, 0))`` per channel (zero inside), in the solves and in the
         float16 quantisation (a penalty constraint, not a clip).
+    start
+        Optional coefficients (3, 3, degree + 1) to start from instead of the
+        variable-projection guess (a warm start from a nearby fit; the result
+        is as deterministic as the start).
 
     Returns
     -------
@@ -190,7 +195,13 @@ def fit_coefficients(
         range_check = (check_mu, check_eta, float(check_weight))
     problem = Problem(target, mu, eta, eta_i_range, degree, objective, weights, range_check)
     bounds = coefficient_bounds(degree)
-    x0 = np.clip(initial_guess(target, mu, eta, eta_i_range, degree).ravel(), *bounds)
+    if start is None:
+        x0 = initial_guess(target, mu, eta, eta_i_range, degree)
+    else:
+        x0 = np.asarray(start, dtype=np.float64)
+        if x0.shape != problem.shape or not np.all(np.isfinite(x0)):
+            raise ValueError(f"`start` must be finite coefficients of shape {problem.shape}, got shape {x0.shape}")
+    x0 = np.clip(x0.ravel(), *bounds)
     result = solve(problem, x0, bounds, 1e-10, max_nfev)
     nfev, njev = result.nfev, result.njev or 0
     if objective == "de2000":

@@ -29,7 +29,7 @@ import numpy as np
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, cos_theta_from_angle
-from fitting.fits.curves import CurveFitSettings, fit_curves
+from fitting.fits.curves import LIVE_SETTINGS, CurveFitSettings, fit_curves
 from fitting.fits.curves_base import (
     CurveBase,
     curve_base_from_coefficients,
@@ -115,6 +115,8 @@ class CurveFit:
     fit_id: str
     draft: bool = False
     model: str = DEFAULT_MODEL
+    live: bool = False
+    start: tuple | None = None  # with live: the coefficients the solve starts from
 
 
 def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
@@ -170,12 +172,19 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
                       eta_i_range=None, objective: str = DEFAULTS.objective,
                       blend_width: float = DEFAULTS.blend_width,
                       request: dict[str, Any] | None = None, draft: bool = False,
-                      model: str = DEFAULT_MODEL) -> CurveFit:
+                      model: str = DEFAULT_MODEL, live: bool = False,
+                      start_fit: str | None = None) -> CurveFit:
     """
     Resolve the base (``LookupError`` for a base fit not stored), check the
-    curves and the domain (``ValueError``), and compute the id. Runs in a
-    thread (it reads the store).
+    curves and the domain (``ValueError``), and compute the id. A ``live``
+    refit (a draft, :data:`fitting.fits.curves.LIVE_SETTINGS`) starts from
+    the coefficients of the stored ``start_fit`` when given (of the same
+    kind and domain). Runs in a thread (it reads the store).
     """
+    if live and not draft:
+        raise ValueError("`live` refits are drafts: set `draft` to true (a live refit is never saved)")
+    if start_fit is not None and not live:
+        raise ValueError("`start_fit` is for `live` refits only")
     name = name.strip()
     requested = None if eta_i_range is None else check_eta_i_range(eta_i_range)
     base, base_record = _base_spec(store, name, base_material, base_fit, base_nk, requested)
@@ -183,25 +192,56 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
         curves = _snap_to_domain(curves, base.eta_i_range)
     check_curves(curves)
     domain = base.eta_i_range if base is not None else check_eta_i_range(requested or DEFAULT_DOMAIN)
+    start = None if start_fit is None else _start_coefficients(store, start_fit, domain, model, base, curves)
     fit_id = content_address(
         FIT_FORMAT_VERSION, CURVES_FORMAT, name, None if base is None else base.key(), curves,
         list(domain), objective, blend_width, repr(DEFAULTS),
         # The default kind adds nothing, so coated-conductor ids stay as they were.
         *(() if model == DEFAULT_MODEL else (model,)),
+        # Nor does a full refit.
+        *(() if not live else ("live", repr(LIVE_SETTINGS), None if start is None else np.ravel(start))),
     )
     return CurveFit(name, base, base_record, curves, domain, objective, blend_width,
-                    request or {}, fit_id, draft, model)
+                    request or {}, fit_id, draft, model, live,
+                    None if start is None else tuple(np.ravel(start).tolist()))
+
+
+def _start_coefficients(store: Store, start_fit: str, domain, model: str, base, curves) -> np.ndarray | None:
+    """The float16 coefficients of ``start_fit`` as float64 (None for the rgb-conductor kind,
+    whose solve has no warm start); ValueError when its kind, domain or degree differ."""
+    packed = material_from_json(stored_fit(store, start_fit, "start_fit").material)
+    if packed.model != model:
+        raise ValueError(f"`start_fit` must be a fit of the model kind {model!r}, got {packed.model!r}")
+    if not _float32_equal(packed.eta_i_range, domain):
+        lo, hi = packed.eta_i_range
+        raise ValueError(
+            f"`start_fit` must have the refit's domain [{domain[0]:g}, {domain[1]:g}], got [{lo:g}, {hi:g}]"
+        )
+    if model != DEFAULT_MODEL:
+        return None
+    coefficients = packed.coefficients.astype(np.float64)
+    if base is None:
+        degree = 0 if domain[1] <= domain[0] else min(2, len({float(c["eta_i"]) for c in curves}) - 1)
+    else:
+        degree = 0 if domain[1] <= domain[0] else 2
+    if coefficients.shape != (3, 3, degree + 1):
+        raise ValueError(
+            f"`start_fit` must have degree {degree} in eta_i as the refit has, got {coefficients.shape[2] - 1}"
+        )
+    return coefficients
 
 
 def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: str,
-                objective: str, blend_width: float, model: str = DEFAULT_MODEL) -> dict[str, Any]:
+                objective: str, blend_width: float, model: str = DEFAULT_MODEL,
+                live: bool = False, start: tuple | None = None) -> dict[str, Any]:
     """Worker process: build (or reuse) the base grid, fit, score."""
     t0 = time.perf_counter()
     base_grid = None if base is None else base.build()
     t_base = time.perf_counter() - t0
     result = fit_curves(
         curves, base_grid, None if base is not None else eta_i_range, name,
-        objective=objective, blend_width=blend_width, model=model,
+        settings=LIVE_SETTINGS if live else DEFAULTS, objective=objective, blend_width=blend_width,
+        model=model, start=None if start is None else np.reshape(start, (3, 3, -1)),
     )
     metrics = result.metrics
     summary = result.summary()
@@ -244,9 +284,11 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
     if base_record is not None and base_record.kind == "curves":
         measured_library, measured = base_record.library_material, base_record.nk
 
+    settings = LIVE_SETTINGS if fit.live else DEFAULTS
+
     async def make() -> FitRecord:
         job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
-                               fit.objective, fit.blend_width, fit.model)
+                               fit.objective, fit.blend_width, fit.model, fit.live, fit.start)
         check_finite("metrics", job["metrics"])
         record = fit_record(
             fit.fit_id, "curves", content_address("edited material", fit.name), fit.name,
@@ -257,7 +299,8 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
                 "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
                 "request": fit.request,
                 "base": None if base is None else base.provenance(),
-                "settings": {k: getattr(DEFAULTS, k) for k in DEFAULTS.__dataclass_fields__},
+                "settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
+                **({"live": {"start": fit.start}} if fit.live else {}),
             },
         )
         return await asyncio.to_thread(store.put_fit, record, not fit.draft)

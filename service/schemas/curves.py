@@ -15,7 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from fitting.fits.curves import CurveFitSettings
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 
-from .common import DEFAULT_MODEL, FIT_ID_PATTERN, EtaI, LibraryName, ModelKind, Objective, RequestModel
+from .common import DEFAULT_MODEL, FIT_ID_PATTERN, EtaI, FitId, LibraryName, ModelKind, Objective, RequestModel
 from .fits import NKData
 
 __all__ = ["CurveIn", "CurveBaseIn", "CurveFitRequest", "ErrorMap"]
@@ -119,12 +119,21 @@ class CurveFitRequest(RequestModel):
         "rgb-conductor (per-channel n, k; always within [0, 1])")
     draft: bool = Field(False, description="Store the fit without saving it under `name` (the editor's "
                                            "refits while editing); the same request with false saves it")
+    live: bool = Field(False, description="A live refit while a curve is dragged: one short solve "
+                                          "(fitting.fits.curves.LIVE_SETTINGS) started from `start_fit`, "
+                                          "a draft only; the editor replaces it with a full refit on release")
+    start_fit: FitId | None = Field(None, description="With `live`: the stored fit (of the same kind and "
+                                                      "domain) whose coefficients the solve starts from")
 
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":
         if self.eta_i_range is not None and self.eta_i_range[0] > self.eta_i_range[1]:
             lo, hi = self.eta_i_range
             raise ValueError(f"`eta_i_range` must not be empty: lo {lo:g} > hi {hi:g}")
+        if self.live and not self.draft:
+            raise ValueError("`live` refits are drafts: set `draft` to true (a live refit is never saved)")
+        if self.start_fit is not None and not self.live:
+            raise ValueError("`start_fit` is for `live` refits only")
         return self
 
 

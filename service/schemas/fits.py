@@ -36,7 +36,7 @@ from .common import (
 from .metrics import FitDetails, FitMetrics
 
 __all__ = ["NKData", "FitRequest", "PackRequest", "Coefficients", "RGBConductorCoefficients", "FitLinks", "FitPublic",
-           "CurvesPublic", "fit_public"]
+           "CurvesPublic", "CurveFitPublic", "fit_public"]
 
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
 IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True)]
@@ -210,6 +210,14 @@ class CurvesPublic(BaseModel):
                           "edited target (or its curve), else the reference")
     reference: list[list[float]] | None = None
     lazanyi_adjusted: list[list[float]] | None = None
+
+
+class CurveFitPublic(FitPublic):
+    """A curve fit, with its curves at one eta_i when the request asked (``curves_eta_i``)."""
+
+    curves: CurvesPublic | None = Field(
+        None, description="`GET /fits/{id}/curves` of this fit at `curves_eta_i`, in the same answer "
+                          "(the editor's live refits: one round trip per drag step)")
 
 
 def fit_public(record: FitRecord) -> FitPublic:

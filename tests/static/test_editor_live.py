@@ -9,6 +9,7 @@ backoff, its message shown while it lasts and cleared by the next answer.
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -16,7 +17,7 @@ from editor_pages import editor_url, open_editor, pages  # noqa: F401 (fixtures)
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 
-FROM_CURVES = "**/api/v1/fits/from-curves"
+FROM_CURVES = re.compile(r".*/api/v1/fits/from-curves(\?.*)?$")  # with or without its query
 
 
 def settled(page):
@@ -45,8 +46,9 @@ def test_continuous_drag_refits_and_ends_on_the_shown_fit(pages, editor_url):
     settled(page)
     page.locator("input[name=channel][value='0']").check()
     posted, answered = [], []
-    page.on("request", lambda r: posted.append(r) if r.url.endswith("/fits/from-curves") else None)
-    page.on("response", lambda r: answered.append(r) if r.url.endswith("/fits/from-curves") else None)
+    refit = lambda url: url.split("?")[0].endswith("/fits/from-curves")  # noqa: E731
+    page.on("request", lambda r: posted.append(r) if refit(r.url) else None)
+    page.on("response", lambda r: answered.append(r) if refit(r.url) else None)
 
     handle = page.locator("circle.handle.c0[data-angle='50']")
     box = handle.bounding_box()
@@ -71,6 +73,13 @@ def test_continuous_drag_refits_and_ends_on_the_shown_fit(pages, editor_url):
     # carried the edited target as the page holds it.
     last = posted[-1].post_data_json
     assert answered[-1].json()["id"] == final_id
+    # Live refits (warm-started from the fit on screen) while the pointer
+    # moved, a full refit on release; each answer carried its curves.
+    live = [r.post_data_json for r in posted[:-1]]
+    assert sum(1 for b in live if b.get("live")) >= 2, live
+    assert all(b["start_fit"] for b in live if b.get("live"))
+    assert "live" not in last and last["draft"] is True
+    assert answered[-1].json()["curves"]["fit_id"] == final_id
     target = page.evaluate("(() => { const d = document.querySelector('path.target.c0').getAttribute('d');"
                            " return d; })()")
     assert len(last["curves"]) == 1 and last["curves"][0]["eta_i"] == 1.5

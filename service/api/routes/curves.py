@@ -20,26 +20,33 @@ from fastapi.concurrency import run_in_threadpool
 
 from ...jobs.common import stored_fit
 from ...jobs.curves import error_map, fit_from_curves, prepare_curve_fit
-from ...schemas import API_PREFIX, CurveFitRequest, ErrorMap, FitPublic, fit_public
+from ...jobs.nk import angle_curves
+from ...schemas import API_PREFIX, ETA_I_LIMITS, CurveFitPublic, CurveFitRequest, CurvesPublic, ErrorMap, fit_public
 from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, StoreDep, WriteAccess
 
 router = APIRouter(prefix=API_PREFIX, tags=["curves"])
 
 
-@router.post("/fits/from-curves", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
+@router.post("/fits/from-curves", response_model=CurveFitPublic, status_code=status.HTTP_201_CREATED,
              responses={
-                 status.HTTP_200_OK: {"model": FitPublic, "description": "Served from the store"},
-                 status.HTTP_201_CREATED: {"model": FitPublic, "description": "Fitted and saved"},
+                 status.HTTP_200_OK: {"model": CurveFitPublic, "description": "Served from the store"},
+                 status.HTTP_201_CREATED: {"model": CurveFitPublic, "description": "Fitted and saved"},
                  **NOT_FOUND, **FIT_ERROR_RESPONSES,
              }, dependencies=[WriteAccess])
-async def create_fit_from_curves(request: CurveFitRequest, store: StoreDep, runner: RunnerDep,
-                                 response: Response) -> FitPublic:
+async def create_fit_from_curves(
+    request: CurveFitRequest, store: StoreDep, runner: RunnerDep, response: Response,
+    curves_eta_i: Annotated[float | None, Query(
+        ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
+        description="Also answer `GET /fits/{id}/curves` of the fit at this coating index")] = None,
+    curves_samples: Annotated[int, Query(ge=2, le=1024, description="Angles of `curves`")] = 91,
+) -> CurveFitPublic:
     """
     Fit the model to edited RGB curves and save the fit under the
     material ``name``. The answer is like ``POST /fits``; ``metrics.model``
     is the mean and max Delta E 2000 of the float16 fit against the curves
     at their samples (``metrics.details.target``: against the whole edited
-    target, with a base).
+    target, with a base); with ``curves_eta_i``, ``curves`` holds the fit's
+    curves there (one round trip for the editor).
     """
     base = request.base
     fit = await run_in_threadpool(
@@ -49,13 +56,16 @@ async def create_fit_from_curves(request: CurveFitRequest, store: StoreDep, runn
             base_nk=base.nk.arrays() if base and base.nk else None,
             eta_i_range=request.eta_i_range, objective=request.objective,
             blend_width=request.blend_width,
-            request=request.model_dump(mode="json", exclude={"base", "draft"}), draft=request.draft,
-            model=request.model,
+            request=request.model_dump(mode="json", exclude={"base", "draft", "live", "start_fit"}), draft=request.draft,
+            model=request.model, live=request.live, start_fit=request.start_fit,
         ))
     record, created = await fit_from_curves(fit, store, runner)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
-    return fit_public(record)
+    curves = None
+    if curves_eta_i is not None:
+        curves = CurvesPublic(**await run_in_threadpool(angle_curves, record, curves_eta_i, curves_samples))
+    return CurveFitPublic(**dict(fit_public(record)), curves=curves)
 
 
 @router.get("/fits/{fit_id}/error-map", response_model=ErrorMap, responses={**ERROR_RESPONSES, **NOT_FOUND})

@@ -99,3 +99,37 @@ class TestFitCurves:
     def test_name_rule(self):
         with pytest.raises(ValueError, match=r"`name` must be a non-empty string"):
             fit_curves([curve_of(KNOWN, 1.5)], name=" ")
+
+
+class TestLiveRefit:
+    """LIVE_SETTINGS with a warm start: what the editor fits while a point is dragged."""
+
+    def test_warm_start_follows_a_drag_within_range(self, gold_base):
+        from fitting.fits.curves import LIVE_SETTINGS
+        from fitting.fits.material import fit_material
+
+        base = gold_base
+        start = fit_material(library_material("Au")).coefficients_float16.astype(np.float64)
+        reference = base.rgb(MU, 1.5)
+        bump = np.exp(-(((ANGLE - 45.0) / 15.0) ** 2))
+        for amount in np.linspace(0.02, 0.2, 6):
+            rgb = reference.copy()
+            rgb[:, 0] = np.clip(rgb[:, 0] + amount * bump, 0.0, 1.0)
+            curves = [{"eta_i": 1.5, "cos_theta": MU.tolist(), "rgb": rgb.tolist()}]
+            live = fit_curves(curves, base, settings=LIVE_SETTINGS, start=start)
+            target = live.metrics["target"]
+            assert -1e-4 <= target["model_min"] and target["model_max"] <= 1.0 + 1e-4
+            assert live.nfev <= 3 * LIVE_SETTINGS.max_nfev  # one solve, escalated at most twice
+            start = live.coefficients_float16.astype(np.float64)
+        full = fit_curves(curves, base)
+        # Close to the full refit that replaces it on release, and never better than it.
+        assert full.metrics["target"]["delta_E_mean"] <= target["delta_E_mean"] + 1e-9
+        assert target["delta_E_mean"] < 2.0 * full.metrics["target"]["delta_E_mean"] + 0.2
+
+    def test_start_of_the_wrong_shape_is_refused(self, gold_base):
+        rgb = gold_base.rgb(MU, 1.5)
+        curves = [{"eta_i": 1.5, "cos_theta": MU.tolist(), "rgb": rgb.tolist()}]
+        with pytest.raises(ValueError, match="`start` must be finite coefficients of shape"):
+            fit_curves(curves, gold_base, start=np.zeros((3, 3, 2)))
+        with pytest.raises(ValueError, match="`start` must be finite"):
+            fit_curves(curves, gold_base, start=np.full((3, 3, 3), np.nan))
