@@ -3,7 +3,7 @@ Application
 ===========
 
 :func:`create_app` builds the FastAPI application: settings, the store and
-the fitting pool (made in the lifespan, the pool warmed), the routers, and
+the fitting pool (made in the lifespan, the pool and this process warmed), the routers, and
 the edge: the ``Host`` allow-list, the body size and time limits, CORS
 (closed unless origins are configured) and the error answers
 (:mod:`service.api.errors`: every 4xx and 5xx is ``{"detail": ...,
@@ -15,6 +15,7 @@ is :mod:`service.server`.
 
 from __future__ import annotations
 
+import asyncio
 from contextlib import asynccontextmanager
 from pathlib import Path
 
@@ -28,7 +29,7 @@ from .api.routes import (
     curves, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
 )
 from .config import Settings
-from .pool import FitRunner
+from .pool import FitRunner, warm_process
 from .schemas import API_PREFIX
 from .store import SQLiteStore
 
@@ -76,7 +77,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.state.store, app.state.runner = store, runner
         try:
             if settings.warm_pool:
-                await runner.warm_up()
+                # The workers and this process (curves, reference textures) at once.
+                await asyncio.gather(runner.warm_up(), asyncio.to_thread(warm_process))
             yield
         finally:
             if app.state.preview_renderer is not None:

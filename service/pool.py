@@ -79,11 +79,13 @@ class WorkerLost(Exception):
         super().__init__("a fitting worker process stopped during the fit (twice); retry")
 
 
-def _warm_worker() -> None:
+def warm_process() -> None:
     """
-    Worker start-up: import the fitting core and compute the spectral
+    Process start-up (each worker's initializer, and the server process at
+    start-up, which computes curves and reference textures in threads):
+    import the fitting core and colour-science and compute the spectral
     weights of the fit (5 nm) and of the metrics (1 nm) once, seconds that
-    would otherwise land on the first fit.
+    would otherwise land on the first request.
     """
     from fitting.colour.reference import spectral_weights
     from fitting.fits.settings import FitSettings
@@ -137,7 +139,7 @@ class FitRunner:
                 self._pool = concurrent.futures.ProcessPoolExecutor(
                     max_workers=self.workers,
                     mp_context=multiprocessing.get_context("spawn"),
-                    initializer=_warm_worker,
+                    initializer=warm_process,
                 )
             return self._pool
 

@@ -148,6 +148,20 @@ async function pickMaterial(value, pending = null) {
   await busy("Fitting the material…", async () => setBase(await (pending || fitOf(value))));
 }
 
+// Cold start: the first fit's curves and reference texture, asked for as
+// soon as the fit is known, while the preview's shaders still compile.
+const prefetched = new Map(); // fit id -> { eta, curves, texture } promises
+
+function prefetch(fit) {
+  const early = {
+    eta: state.eta,
+    curves: api.curves(fit.id, state.eta, SAMPLES),
+    texture: fit.has_nk ? api.referenceTexture(fit.id) : null,
+  };
+  for (const promise of [early.curves, early.texture]) if (promise) promise.catch(() => {}); // used, or asked again
+  prefetched.set(fit.id, early);
+}
+
 async function setBase(fit) {
   state.base = fit;
   state.savedId = null;
@@ -168,7 +182,10 @@ async function setBase(fit) {
   $("compare").disabled = !fit.has_nk;
   $("reset").title = fit.kind === "curves" ? "Back to the saved edit as opened" : "Back to the measured data";
   say("");
-  const [curves] = await Promise.all([api.curves(fit.id, state.eta, SAMPLES), loadReference(fit)]);
+  const early = prefetched.get(fit.id);
+  prefetched.clear();
+  const curves$ = early && early.eta === state.eta ? early.curves : api.curves(fit.id, state.eta, SAMPLES);
+  const [curves] = await Promise.all([curves$, loadReference(fit, early && early.texture)]);
   state.baseCurves = curves;
   state.theta = curves.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
   present(fit, curves);
@@ -176,13 +193,13 @@ async function setBase(fit) {
 
 // The spectral reference texture of the base (its measured n, k) for the
 // preview; fits without n, k show the model alone.
-async function loadReference(fit) {
+async function loadReference(fit, pending = null) {
   if (!ball || !fit.has_nk) {
     applyPanels();
     return;
   }
   try {
-    ball.setReference(await api.referenceTexture(fit.id));
+    ball.setReference(await (pending || api.referenceTexture(fit.id)));
   } catch (error) {
     say(`Spectral reference unavailable: ${error.message}`);
   }
@@ -712,7 +729,7 @@ guard(async () => {
   // load at the same time.
   const wanted = last || "library:Au";
   const first = fitOf(wanted);
-  first.catch(() => {}); // reported below, if it is used
+  first.then(prefetch, () => {}); // a failure is reported below, if the fit is used
   await loadMaterials();
   const picker = $("material");
   picker.value = wanted;

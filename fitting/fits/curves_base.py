@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..colour.reference import reference_ACEScg
+from ..colour.reference import reference_ACEScg_grid
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_number
 from ..models.kinds import DEFAULT_MODEL, check_model_coefficients, model_ACEScg
 from ..optics.nk import SpectralNK
@@ -146,7 +146,8 @@ def curve_base_from_nk(nk: SpectralNK, eta_i_range=DEFAULT_ETA_I_RANGE) -> Curve
 
     def build() -> CurveBase:
         mu, eta = _base_grid(eta_i_range)
-        RGB = reference_ACEScg(nk, mu[None, :], eta[:, None], _BASE_STEP_NM)
+        # The product-grid form: reference_ACEScg's numbers (to rounding), faster.
+        RGB = reference_ACEScg_grid(nk, mu, eta, _BASE_STEP_NM)
         RGB.setflags(write=False)
         return CurveBase(nk.name, nk.source, eta_i_range, mu, eta, RGB, "nk")
 
