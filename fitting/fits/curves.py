@@ -181,12 +181,14 @@ class CurveFitSettings:
             raise ValueError(f"`check_samples` must be two integers in [2, 256], got {check!r}")
 
 
-LIVE_SETTINGS = CurveFitSettings(irls_rounds=0, max_nfev=8, compare_rgb=False, quantise=False)
+LIVE_SETTINGS = CurveFitSettings(irls_rounds=0, max_nfev=4, compare_rgb=False, quantise=False,
+                                 check_samples=(10, 4))
 """The settings of a live refit, while a curve is being dragged: one solve of
-at most 8 evaluations (no reweighting round, no paper-method candidate,
-float16 by rounding to nearest),
+at most 4 evaluations (no reweighting round, no paper-method candidate,
+float16 by rounding to nearest, the [0, 1] check grid coarser at first),
 meant to start from the fit on screen (``start``), so that it follows the
-pointer; the [0, 1] constraint is the same as the default's. The editor
+pointer; the [0, 1] constraint is the same as the default's (made stiffer
+on the fine grid while the fit leaves [0, 1]). The editor
 replaces it with a default refit when the drag ends."""
 
 
