@@ -67,6 +67,7 @@ from benchmarks.speed_vs_error_report import (  # noqa: E402
     figure_fit_settings,
     figure_speed_vs_error,
     kinds_table,
+    load_average,
     models_table,
     pareto_front,
     read_batch_report,
@@ -360,7 +361,7 @@ def main() -> None:
         print("\nwrote docs/images/speed_vs_error.png" + (", docs/images/speed_vs_error_batch.png" if reports else ""))
 
     if args.models_only:
-        print(f"\nRun time: {time.perf_counter() - t0:.0f} s")
+        print(f"\nRun time: {time.perf_counter() - t0:.0f} s; load average at the end {load_average()}")
         return
     fit_rows = fit_settings_table()
     fit_front = pareto_front({_key(r): (r["seconds"], r["mean"]) for r in fit_rows})
@@ -381,7 +382,7 @@ def main() -> None:
         figure_fit_settings(IMAGES / "speed_vs_error_fit_settings.png", fit_rows, fit_front, _key,
                             len(LIBRARY_NAMES))
         print("\nwrote docs/images/speed_vs_error_fit_settings.png")
-    print(f"\n(total {time.perf_counter() - t0:.0f} s)")
+    print(f"\n(total {time.perf_counter() - t0:.0f} s; load average at the end {load_average()})")
 
 
 if __name__ == "__main__":

@@ -6,7 +6,8 @@ The pure half of ``benchmarks/speed_vs_error.py``: what it measured, turned
 into Markdown tables and PNGs. Nothing here times or fits anything, so the
 tests run it on small inputs (``tests/benchmarks/test_speed_vs_error.py``).
 
--   :func:`run_header`: the command, the date and the load average of a run.
+-   :func:`run_header`: the command, the date and the load average of a run;
+    :func:`load_average`: the load average now.
 -   :func:`error_summary`: Delta E 2000 maps per conductor to the mean of the
     means, the largest sample and the worst conductor.
 -   :func:`pareto_front`: the names not dominated in (cost, error).
@@ -36,6 +37,7 @@ import numpy as np
 
 __all__ = [
     "run_header",
+    "load_average",
     "error_summary",
     "pareto_front",
     "models_table",
@@ -56,12 +58,16 @@ BATCH_BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, float("inf"))
 """Edges of the per-page mean Delta E 2000 bins of the batch table."""
 
 
+def load_average() -> str:
+    """The 1, 5 and 15 minute load averages, as ``uptime`` prints them."""
+    return " ".join(f"{v:.2f}" for v in os.getloadavg())
+
+
 def run_header(argv: list[str], renderer: str | None = None) -> list[str]:
     """Lines naming the command, the date (UTC), the load average and the cores of this run."""
     command = " ".join([".venv/bin/python benchmarks/speed_vs_error.py", *map(shlex.quote, argv)])
-    load = " ".join(f"{v:.2f}" for v in os.getloadavg())
     lines = [f"Command: `{command}`",
-             f"Run: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average {load} "
+             f"Run: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average {load_average()} "
              f"(1, 5, 15 min) at the start, {os.cpu_count()} cores"]
     if renderer:
         lines[-1] += f", GL: {renderer}"
