@@ -167,7 +167,9 @@ def read_batch_report(path: str | Path) -> dict[str, Any]:
     the file when it is not one."""
     path = Path(path)
     report = json.loads(path.read_text(encoding="utf-8"))
-    missing = [k for k in ("config", "summary", "pages") if k not in report] if isinstance(report, dict) else ["config"]
+    if not isinstance(report, dict):
+        raise ValueError(f"`{path}` is not a batch report.json: not a JSON object")
+    missing = [k for k in ("config", "summary", "pages") if k not in report]
     if missing:
         raise ValueError(f"`{path}` is not a batch report.json: no {', '.join(missing)}")
     return {**report, "path": str(path)}

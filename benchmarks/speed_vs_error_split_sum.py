@@ -47,6 +47,7 @@ from fitting.models.baselines import baseline_inputs, external_medium_F0, lazany
 from fitting.models.coated_conductor import collapse_to_eta_i
 from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.shading.ibl import default_lut, split_sum_lazanyi, split_sum_model, split_sum_schlick
+from preview_shaders.rough import reference_albedo_table
 
 from benchmarks.speed_vs_error_report import error_summary
 
@@ -91,10 +92,8 @@ def split_sum_albedos(nk, coefficients, eta_i_range, eta_i: float, roughness: fl
     fit over ``eta_i_range``; ``air``: :func:`fitting.models.baselines.baseline_inputs`
     of ``nk`` (computed when None).
     """
-    from preview_shaders.rough import reference_albedo_table
-
     lut = lut or default_lut()
-    air = air or baseline_inputs(nk)
+    air = baseline_inputs(nk) if air is None else air
     mu = np.asarray(NdotV, dtype=np.float64)
     nodes, E = reference_albedo_table(nk, eta_i, roughness)
     F0, a, alpha = collapse_to_eta_i(np.asarray(coefficients, dtype=np.float64), eta_i, eta_i_range)[..., 0]

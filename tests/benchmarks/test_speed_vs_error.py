@@ -225,7 +225,10 @@ class TestBatchSummary:
     def test_not_a_report_is_refused_by_file(self, tmp_path):
         path = tmp_path / "pack.json"
         path.write_text('{"materials": []}', encoding="utf-8")
-        with pytest.raises(ValueError, match="pack.json.*not a batch report"):
+        with pytest.raises(ValueError, match="pack.json.*not a batch report.*no config, summary, pages"):
+            read_batch_report(path)
+        path.write_text("[]", encoding="utf-8")
+        with pytest.raises(ValueError, match="not a JSON object"):
             read_batch_report(path)
 
     def test_batch_figure_is_a_png(self, report, tmp_path):
