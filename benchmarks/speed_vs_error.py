@@ -3,32 +3,42 @@ Speed against error
 ===================
 
 For all 22 library conductors, every Fresnel model on the speed-against-error
-plane, and the fitting settings on the fit-time-against-error plane; prints
-Markdown tables and (``--figure``) writes ``docs/images/speed_vs_error.png``
-and ``docs/images/speed_vs_error_fit_settings.png``.
+plane, every model kind side by side, the split-sum variants of image-based
+lighting, the accuracy summary of database batch reports, and the fitting
+settings on the fit-time-against-error plane; prints Markdown tables (headed
+by the command, the date and the load average) and (``--figure``) writes
+``docs/images/speed_vs_error.png``, ``docs/images/speed_vs_error_fit_settings.png``
+and, with ``--batch-report``, ``docs/images/speed_vs_error_batch.png``.
 
     .venv/bin/python benchmarks/speed_vs_error.py [--figure] [--repeats 7] [--models-only]
-        [--batch-report DIR/report.json] [--batch-only]
+        [--batch-report DIR/report.json ...] [--batch-only]
 
-``--batch-report`` adds the accuracy summary of a ``python -m fitting batch``
-report (e.g. ``--shelf main``): over every fitted page, the distribution of
-the mean Delta E 2000 of each model kind and baseline (mean, median, p90,
-max, share of pages in bins), and the share of pages where each kind beats
-adjusted Lazanyi; ``--batch-only`` prints only that.
+``--batch-report`` (repeatable) adds the accuracy summary of a ``python -m
+fitting batch`` report (e.g. ``--shelf main``): over every fitted page, the
+distribution of the mean Delta E 2000 of each model kind and baseline (mean,
+median, p90, max, share of pages in bins), and the share of pages where each
+kind beats adjusted Lazanyi; the model-kinds table gets one column per
+report. ``--batch-only`` prints only the batch summaries.
 
 Models: Schlick in air, Schlick with exact F0, adjusted Lazanyi, ours float32,
-ours float16, ours scene-specialised (a degree-0 fit at each eta_i row), the
-exact RGB conductor Fresnel with n, k fitted in air (``fitting.fits.rgb_conductor.rgb_nk``),
-the ``rgb-conductor`` model kind (the same Fresnel, n, k fitted under the coat
-over the whole domain, float16: ``fitting.fits.rgb_conductor.fit_rgb_conductor``)
-and the exact spectral reference. Error: Delta E 2000 against the 1 nm reference on the paper's
+every model kind of :data:`fitting.models.kinds.MODEL_KINDS` as shipped
+(float16, fitted by :func:`fitting.fits.kinds.fit_model`, evaluated by
+:func:`fitting.models.kinds.model_ACEScg`, drawn by the variant
+:data:`preview_shaders.evaluate.MODEL_VARIANTS` names), ours scene-specialised
+(a degree-0 fit at each eta_i row), the exact RGB conductor Fresnel with n, k
+fitted in air (``fitting.fits.rgb_conductor.rgb_nk``) and the exact spectral
+reference. Error: Delta E 2000 against the 1 nm reference on the paper's
 100 x 100 grid (cos theta in [0, 1], eta_i in [1, 2.5]). Shader cost: wall
 time of full-screen 2560 x 1440 RGBA32F renders on this machine's GL
 (llvmpipe without a GPU), measured with ``preview_shaders.evaluate.time_variants``
 as ``benchmarks/shader_cost.py`` does, variants interleaved, median, relative
-to adjusted Lazanyi. CPU cost: numpy evaluation per sample (median of 3 runs
-over 10^6 samples; 10^4 for the spectral reference). Bytes: per material as a
-renderer stores it.
+to adjusted Lazanyi and per pixel. CPU cost: numpy evaluation per sample
+(median of 3 runs over 10^6 samples; 10^4 for the spectral reference).
+Bytes: per material as a renderer stores it.
+
+Split sum: ``benchmarks/speed_vs_error_split_sum.py`` (the albedo through the
+LUT against the albedo with the spectral Fresnel). Tables and figures:
+``benchmarks/speed_vs_error_report.py``.
 
 Fitting settings: the grid size (cos theta x eta_i samples, Gauss-Legendre or
 uniform), the spectral step
@@ -50,24 +60,54 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from fitting.colour.delta_e import delta_E_map
-from fitting.colour.reference import evaluation_grid, reference_ACEScg, spectral_grid
-from fitting.fits.material import fit_material
-from fitting.fits.rgb_conductor import fit_rgb_conductor, rgb_nk
-from fitting.fits.settings import OBJECTIVES, FitSettings
-from fitting.models.baselines import baseline_inputs, lazanyi_adjusted, schlick
-from fitting.models.coated_conductor import (
+from benchmarks.speed_vs_error_report import (  # noqa: E402
+    batch_table,
+    error_summary,
+    figure_batch,
+    figure_fit_settings,
+    figure_speed_vs_error,
+    kinds_table,
+    load_average,
+    models_table,
+    pareto_front,
+    read_batch_report,
+    run_header,
+    split_sum_table_lines,
+)
+from benchmarks.speed_vs_error_split_sum import (  # noqa: E402
+    KIND_SPLIT_SUM,
+    SPLIT_ETA_I,
+    SPLIT_NDOTV,
+    SPLIT_ROUGHNESS,
+    SPLIT_VARIANTS,
+    split_sum_cpu_ns,
+    split_sum_shader_us,
+    split_sum_table,
+)
+from fitting.colour.delta_e import delta_E_map  # noqa: E402
+from fitting.colour.reference import evaluation_grid, reference_ACEScg, spectral_grid  # noqa: E402
+from fitting.fits.kinds import fit_model  # noqa: E402
+from fitting.fits.material import fit_material  # noqa: E402
+from fitting.fits.rgb_conductor import rgb_nk  # noqa: E402
+from fitting.fits.settings import OBJECTIVES, FitSettings  # noqa: E402
+from fitting.models.baselines import baseline_inputs, lazanyi_adjusted, schlick  # noqa: E402
+from fitting.models.coated_conductor import (  # noqa: E402
     coated_conductor_model,
     collapse_to_eta_i,
     model_from_parameters,
 )
-from fitting.models.pack import halves_to_uint32, to_float16
-from fitting.models.rgb_conductor import rgb_conductor_model, rgb_fresnel_conductor
-from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.models.kinds import MODEL_KINDS, coefficient_count, model_ACEScg  # noqa: E402
+from fitting.models.pack import halves_to_uint32, to_float16  # noqa: E402
+from fitting.models.rgb_conductor import rgb_fresnel_conductor  # noqa: E402
+from fitting.optics.library import LIBRARY_NAMES, library_material  # noqa: E402
+from preview_shaders.evaluate import MODEL_VARIANTS  # noqa: E402
 
 IMAGES = ROOT / "docs" / "images"
 GRID = 100
 WIDTH, HEIGHT = 2560, 1440
+
+KIND_LABELS = {"coated-conductor": "coated-conductor kind (ours), float16"}
+"""Labels of the model kinds where "<kind> kind, float16" would not say enough."""
 
 MODELS = {
     # name: (label, shader variant or None, bytes per material, how stored)
@@ -76,11 +116,12 @@ MODELS = {
                          "F0 RGB at the scene's eta_i, 3 float32 (a table for varying eta_i)"),
     "lazanyi_adjusted": ("adjusted Lazanyi", "lazanyi", 24, "F0, F82 RGB, 6 float32"),
     "ours_float32": ("ours, float32", "floats", 108, "27 float32"),
-    "ours_float16": ("ours, float16", "packed", 54, "27 float16"),
+    # Every model kind as shipped: float16, named as the batch names it.
+    **{kind: (KIND_LABELS.get(kind, f"{kind} kind, float16"), MODEL_VARIANTS[kind],
+              2 * coefficient_count(kind), f"{coefficient_count(kind)} float16")
+       for kind in MODEL_KINDS},
     "ours_scene": ("ours, scene-specialised", "collapsed", 18, "9 float16 at one eta_i"),
-    "exact_rgb": ("exact RGB conductor Fresnel", "exact", 24, "n, k RGB, 6 float32"),
-    "rgb_conductor": ("rgb-conductor kind, float16", "rgb_conductor", 12,
-                      "n, k RGB fitted under the coat, 6 float16"),
+    "exact_rgb": ("exact RGB conductor Fresnel (n, k in air)", "exact", 24, "n, k RGB, 6 float32"),
     "spectral": ("exact spectral reference", None, 2 * 4 * spectral_grid(1.0).size,
                  "n, k at 471 wavelengths (1 nm), float32"),
 }
@@ -112,70 +153,66 @@ def model_outputs(name: str) -> dict[str, np.ndarray]:
     ref = reference_ACEScg(nk, M, E)
     air = baseline_inputs(nk)
     exact_F0 = reference_ACEScg(nk, np.ones_like(E), E)
-    fit = fit_material(nk)
+    fits = {kind: fit_model(nk, model=kind) for kind in MODEL_KINDS}
+    fit = fits["coated-conductor"]
     P = _scene_rows(nk, E[:, 0], fit)
     n_rgb, k_rgb = rgb_nk(nk)
-    rgb = fit_rgb_conductor(nk)
     return {
         "reference": ref,
         "schlick_air": schlick(M, air["F0_air"]),
         "schlick_exact_F0": schlick(M, exact_F0),
         "lazanyi_adjusted": lazanyi_adjusted(M, E, air["F0_air"], air["F82_air"]),
         "ours_float32": coated_conductor_model(M, E, fit.coefficients.astype(np.float32)),
-        "ours_float16": coated_conductor_model(M, E, fit.coefficients_float16),
+        **{kind: model_ACEScg(kind, M, E, f.coefficients_float16, f.eta_i_range) for kind, f in fits.items()},
         "ours_scene": model_from_parameters(M[..., None], P[:, None, 0], P[:, None, 1], P[:, None, 2]),
         "exact_rgb": rgb_fresnel_conductor(M, E, n_rgb, k_rgb),
-        "rgb_conductor": rgb_conductor_model(M, E, rgb.coefficients_float16),
         "spectral": ref,
-        "_fit": fit,
-        "_air": air,
-        "_rgb": (n_rgb, k_rgb),
     }
+
+
+def _median_ns(call, count: int, repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - start)
+    return float(np.median(times)) / count * 1e9
 
 
 def cpu_cost_ns(repeats: int = 3) -> dict[str, float]:
     """numpy evaluation cost per sample (ns), median of ``repeats``."""
     nk = library_material("Au")
-    fit = fit_material(nk)
+    fits = {kind: fit_model(nk, model=kind) for kind in MODEL_KINDS}
+    fit = fits["coated-conductor"]
     air = baseline_inputs(nk)
     n_rgb, k_rgb = rgb_nk(nk)
-    C16 = fit_rgb_conductor(nk).coefficients_float16
     rng = np.random.default_rng(0)
     count = 1_000_000
     mu, eta = rng.uniform(0, 1, count), rng.uniform(1, 2.5, count)
     P = fit.coefficients_float16[..., 0].astype(np.float64)
     F0_table = reference_ACEScg(nk, np.ones(64), np.linspace(1, 2.5, 64))
+
+    def kind_call(kind, f):
+        return lambda: model_ACEScg(kind, mu, eta, f.coefficients_float16, f.eta_i_range)
+
     calls = {
         "schlick_air": lambda: schlick(mu, air["F0_air"]),
         # Exact F0 looked up from a 64-entry table per eta_i.
         "schlick_exact_F0": lambda: schlick(mu, F0_table[np.minimum((eta - 1) / 1.5 * 63, 63).astype(int)]),
         "lazanyi_adjusted": lambda: lazanyi_adjusted(mu, eta, air["F0_air"], air["F82_air"]),
         "ours_float32": lambda: coated_conductor_model(mu, eta, fit.coefficients.astype(np.float32)),
-        "ours_float16": lambda: coated_conductor_model(mu, eta, fit.coefficients_float16),
+        **{kind: kind_call(kind, f) for kind, f in fits.items()},
         "ours_scene": lambda: model_from_parameters(mu[:, None], P[0], P[1], P[2]),
         "exact_rgb": lambda: rgb_fresnel_conductor(mu, eta, n_rgb, k_rgb),
-        "rgb_conductor": lambda: rgb_conductor_model(mu, eta, C16),
     }
-    out = {}
-    for name, call in calls.items():
-        times = []
-        for _ in range(repeats):
-            start = time.perf_counter()
-            call()
-            times.append(time.perf_counter() - start)
-        out[name] = float(np.median(times)) / count * 1e9
+    out = {name: _median_ns(call, count, repeats) for name, call in calls.items()}
     small = 10_000
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        reference_ACEScg(nk, mu[:small], eta[:small])
-        times.append(time.perf_counter() - start)
-    out["spectral"] = float(np.median(times)) / small * 1e9
+    out["spectral"] = _median_ns(lambda: reference_ACEScg(nk, mu[:small], eta[:small]), small, repeats)
     return out
 
 
-def shader_cost(repeats: int) -> dict[str, float]:
-    """Median wall time (us) of each shader variant at 2560 x 1440."""
+def shader_cost(repeats: int) -> tuple[dict[str, float], str]:
+    """Median wall time (us) of each shader variant at 2560 x 1440, and the GL renderer."""
     from preview_shaders.evaluate import VARIANTS, shader_inputs, time_variants
     from preview_shaders.gl import RenderThread
 
@@ -185,47 +222,21 @@ def shader_cost(repeats: int) -> dict[str, float]:
     n_rgb, k_rgb = rgb_nk(nk)
     inputs = shader_inputs(packed, 1.5, air["F0_air"], air["F82_air"], n_rgb, k_rgb)
     inputs = dataclasses.replace(
-        inputs, rgb_words=halves_to_uint32(fit_rgb_conductor(nk).coefficients_float16)
+        inputs, rgb_words=halves_to_uint32(fit_model(nk, model="rgb-conductor").coefficients_float16)
     )
     with RenderThread("speed-vs-error") as thread:
         samples = time_variants(thread, inputs, VARIANTS, WIDTH, HEIGHT, repeats)
-    return {v: float(np.median(s[:, 1])) * 1e6 for v, s in samples.items()}
+        renderer = thread.renderer
+    return {v: float(np.median(s[:, 1])) * 1e6 for v, s in samples.items()}, renderer
 
 
-def pareto_front(points: dict[str, tuple[float, float]]) -> list[str]:
-    """Names not dominated in (cost, error): nothing else is no worse in both and better in one."""
-    front = []
-    for name, (cost, error) in points.items():
-        dominated = any(
-            (c <= cost and e <= error) and (c < cost or e < error)
-            for other, (c, e) in points.items() if other != name
-        )
-        if not dominated:
-            front.append(name)
-    return sorted(front, key=lambda n: points[n][0])
-
-
-def model_table(repeats: int):
+def model_table() -> dict[str, dict]:
+    """Per model: :func:`error_summary` of its Delta E 2000 on the 22 conductors."""
     per_material = {}
     for name in LIBRARY_NAMES:
         out = model_outputs(name)
-        ref = out["reference"]
-        per_material[name] = {
-            model: delta_E_map(ref, out[model]) for model in MODELS
-        }
-    rows = {}
-    for model in MODELS:
-        means = {m: float(per_material[m][model].mean()) for m in LIBRARY_NAMES}
-        maxes = {m: float(per_material[m][model].max()) for m in LIBRARY_NAMES}
-        worst = max(means, key=means.get)
-        rows[model] = {
-            "mean": float(np.mean(list(means.values()))),
-            "max": max(maxes.values()),
-            "worst": worst,
-            "worst_mean": means[worst],
-            "worst_max": maxes[worst],
-        }
-    return rows
+        per_material[name] = {model: delta_E_map(out["reference"], out[model]) for model in MODELS}
+    return {model: error_summary({m: per_material[m][model] for m in LIBRARY_NAMES}) for model in MODELS}
 
 
 def fit_settings_table():
@@ -254,142 +265,103 @@ def fit_settings_table():
     return rows
 
 
-def _figures(rows, cpu, shader, fit_rows, front_shader, front_cpu, fit_front) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    IMAGES.mkdir(parents=True, exist_ok=True)
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6), constrained_layout=True)
-    floor = 1e-3  # the reference has zero error: drawn on the floor of the log axis
-    for ax, costs, front, xlabel in (
-        (axes[0], {m: shader[MODELS[m][1]] / shader["lazanyi"] for m in MODELS if MODELS[m][1]} if shader else {},
-         front_shader, f"shader cost at {WIDTH} x {HEIGHT}, relative to adjusted Lazanyi (llvmpipe)"),
-        (axes[1], cpu, front_cpu, "CPU cost per sample (ns, numpy)"),
-    ):
-        for model, cost in costs.items():
-            error = max(rows[model]["mean"], floor)
-            ax.scatter(cost, error, s=20 + MODELS[model][2] / 8, zorder=3)
-            ax.annotate(MODELS[model][0], (cost, error), textcoords="offset points", xytext=(5, 4), fontsize=8)
-        if front:
-            ax.plot([costs[m] for m in front], [max(rows[m]["mean"], floor) for m in front],
-                    "k--", lw=1, zorder=2, label="Pareto front")
-            ax.legend(loc="upper right", fontsize=8)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(xlabel, fontsize=9)
-        ax.set_ylabel("mean Delta E 2000, 22 conductors")
-        ax.grid(True, which="both", alpha=0.3)
-    fig.suptitle("Speed against error (marker area grows with bytes per material)", fontsize=10)
-    fig.savefig(IMAGES / "speed_vs_error.png", dpi=110)
-
-    fig, ax = plt.subplots(figsize=(7.5, 4.8), constrained_layout=True)
-    markers = {"rgb": "s", "lab": "^", "de2000": "o"}
-    for objective in OBJECTIVES:
-        pts = [r for r in fit_rows if r["objective"] == objective]
-        ax.scatter([r["seconds"] / len(LIBRARY_NAMES) * 1e3 for r in pts], [r["mean"] for r in pts],
-                   marker=markers[objective], label=objective, alpha=0.8)
-    front_rows = [r for r in fit_rows if _key(r) in fit_front]
-    front_rows.sort(key=lambda r: r["seconds"])
-    ax.plot([r["seconds"] / len(LIBRARY_NAMES) * 1e3 for r in front_rows], [r["mean"] for r in front_rows],
-            "k--", lw=1, label="Pareto front")
-    default = next(r for r in fit_rows if r["default"])
-    ax.scatter([default["seconds"] / len(LIBRARY_NAMES) * 1e3], [default["mean"]], s=160,
-               facecolors="none", edgecolors="red", label="default setting")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("fit time per conductor (ms)")
-    ax.set_ylabel("mean Delta E 2000 (float16), 22 conductors")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.savefig(IMAGES / "speed_vs_error_fit_settings.png", dpi=110)
-
-
 def _key(row) -> str:
     return f"{row['grid']} {row['step_nm']:g} nm {row['objective']}"
 
 
-BATCH_BINS = (0.0, 0.5, 1.0, 2.0, 5.0, 10.0, float("inf"))
+def _kind_rows(rows, cpu, shader, models, split, split_costs) -> list[dict]:
+    """The model kinds (and adjusted Lazanyi, the yardstick) for :func:`kinds_table`."""
+    out = []
+    for name, split_variant in (*KIND_SPLIT_SUM.items(), ("lazanyi_adjusted", "split_sum_lazanyi")):
+        label, variant, size, _ = MODELS[name]
+        out.append({
+            "name": name, "label": label, "bytes": size, "mean": rows[name]["mean"], "max": rows[name]["max"],
+            "shader_ns_px": shader[variant] * 1e3 / (WIDTH * HEIGHT), "shader_ratio": models["ratio"][name],
+            "cpu_ns": cpu[name],
+            "split_mean": split[split_variant]["mean"] if split_variant else None,
+            "split_ratio": split_costs["raw"][split_variant] if split_variant else None,
+        })
+    return out
 
 
-def batch_report_table(path: Path) -> None:
-    """Print the accuracy summary of a batch report (``report.json``)."""
-    import json
-
-    report = json.loads(Path(path).read_text(encoding="utf-8"))
-    summary, config = report["summary"], report["config"]
-    fitted = [p for p in report["pages"] if p["status"] == "fitted"]
-    names = list(config["model_kinds"]) + list(config["baselines"])
-    print(f"## Database batch: {summary['fitted']} of {summary['pages']} pages fitted "
-          f"({summary['skipped']} skipped, {summary['failed']} failed), grid {config['grid']}, "
-          f"eta_i {config['eta_i_range'][0]:g}-{config['eta_i_range'][1]:g}\n")
-    bins = [f"{lo:g}-{hi:g}" if hi != float("inf") else f">{lo:g}"
-            for lo, hi in zip(BATCH_BINS[:-1], BATCH_BINS[1:])]
-    print("| model | mean | median | p90 | max | " + " | ".join(f"share {b}" for b in bins)
-          + " | beats adj. Lazanyi |")
-    print("|---|" + "---:|" * (4 + len(bins) + 1))
-    for name in names:
-        e = summary["delta_E_mean"][name]
-        if not e["pages"]:
-            continue
-        values = np.array([p[f"{name}_delta_E_mean"] for p in fitted])
-        shares = np.histogram(values, bins=np.array(BATCH_BINS))[0] / values.size
-        beats = e.get("beats_lazanyi_adjusted")
-        print(f"| {name} | {e['mean']:.3f} | {e['median']:.3f} | {e['p90']:.3f} | {e['max']:.2f} | "
-              + " | ".join(f"{v:.0%}" for v in shares)
-              + f" | {'' if beats is None else format(beats, '.1%')} |")
-    print()
+def _figures(rows, cpu, models, split, split_costs, reports) -> None:
+    size = {m: 20 + MODELS[m][2] / 8 for m in MODELS}
+    panels = [
+        {"title": "Fresnel term, shader", "front": [MODELS[m][0] for m in models["shader"]],
+         "xlabel": f"shader cost at {WIDTH} x {HEIGHT}, relative to adjusted Lazanyi (llvmpipe)",
+         "points": {MODELS[m][0]: (models["ratio"][m], rows[m]["mean"], size[m]) for m in MODELS if models["ratio"][m]}},
+        {"title": "Fresnel term, numpy", "front": [MODELS[m][0] for m in models["cpu"]],
+         "xlabel": "CPU cost per sample (ns, numpy)",
+         "points": {MODELS[m][0]: (cpu[m], rows[m]["mean"], size[m]) for m in MODELS}},
+        {"title": f"split sum: directional albedo, {len(SPLIT_ETA_I)} eta_i x {len(SPLIT_ROUGHNESS)} roughness",
+         "front": [SPLIT_VARIANTS[v][0] for v in split_costs["front"]],
+         "xlabel": "split-sum shader cost, relative to adjusted Lazanyi's (llvmpipe)",
+         "points": {SPLIT_VARIANTS[v][0]: (split_costs["raw"][v], split[v]["mean"], 30) for v in SPLIT_VARIANTS}},
+    ]
+    figure_speed_vs_error(IMAGES / "speed_vs_error.png", panels)
+    if reports:
+        figure_batch(IMAGES / "speed_vs_error_batch.png", reports, [*MODEL_KINDS, "lazanyi_adjusted"])
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description="Speed against error for the 22 conductors.")
-    parser.add_argument("--batch-report", type=Path, metavar="REPORT_JSON",
-                        help="add the accuracy summary of a python -m fitting batch report.json")
-    parser.add_argument("--batch-only", action="store_true", help="print only the batch summary")
-    parser.add_argument("--figure", action="store_true", help="write the two PNGs to docs/images/")
+    parser.add_argument("--batch-report", type=Path, metavar="REPORT_JSON", action="append", default=[],
+                        help="add the accuracy summary of a python -m fitting batch report.json (repeatable)")
+    parser.add_argument("--batch-only", action="store_true", help="print only the batch summaries")
+    parser.add_argument("--figure", action="store_true", help="write the PNGs to docs/images/")
     parser.add_argument("--repeats", type=int, default=7, help="shader timing rounds")
     parser.add_argument("--models-only", action="store_true",
-                        help="the models table only (skip the fitting-settings sweep)")
+                        help="the models, kinds and split-sum tables only (skip the fitting-settings sweep)")
     args = parser.parse_args()
-    if args.batch_report is not None:
-        batch_report_table(args.batch_report)
-        if args.batch_only:
-            return
-    elif args.batch_only:
+    if args.batch_only and not args.batch_report:
         parser.error("--batch-only needs --batch-report")
-
+    reports = [read_batch_report(path) for path in args.batch_report]
     t0 = time.perf_counter()
-    rows = model_table(args.repeats)
-    cpu = cpu_cost_ns()
-    shader = shader_cost(args.repeats)
-    shader_ratio = {
-        m: (shader[MODELS[m][1]] / shader["lazanyi"] if shader and MODELS[m][1] else None) for m in MODELS
-    }
-    front_shader = pareto_front({m: (shader_ratio[m], rows[m]["mean"]) for m in MODELS if shader_ratio[m]})
-    front_cpu = pareto_front({m: (cpu[m], rows[m]["mean"]) for m in MODELS})
-    front_bytes = pareto_front({m: (MODELS[m][2], rows[m]["mean"]) for m in MODELS})
+    if args.batch_only:
+        print("\n".join(run_header(sys.argv[1:])) + "\n")
+        for report in reports:
+            print("\n".join(batch_table(report)) + "\n")
+        if args.figure:
+            figure_batch(IMAGES / "speed_vs_error_batch.png", reports, [*MODEL_KINDS, "lazanyi_adjusted"])
+            print("wrote docs/images/speed_vs_error_batch.png")
+        return
 
-    print(f"## Models: {len(LIBRARY_NAMES)} conductors, {GRID} x {GRID} grid, Delta E 2000 against the 1 nm reference\n")
-    print("| model | mean dE (22) | max dE (22) | worst conductor: mean / max | shader cost vs adj. Lazanyi "
-          "| CPU ns/sample | bytes/material | on front (shader / CPU / bytes) |")
-    print("|---|---:|---:|---|---:|---:|---:|---|")
-    for m, (label, _, size, _) in MODELS.items():
-        r = rows[m]
-        ratio = f"{shader_ratio[m]:.2f}x" if shader_ratio[m] else "n/a (no shader)"
-        fronts = " / ".join("yes" if m in f else "no" for f in (front_shader, front_cpu, front_bytes))
-        print(f"| {label} | {r['mean']:.3f} | {r['max']:.2f} | {r['worst']}: {r['worst_mean']:.3f} / "
-              f"{r['worst_max']:.2f} | {ratio} | {cpu[m]:.0f} | {size} | {fronts} |")
+    header = run_header(sys.argv[1:])
+    rows = model_table()
+    cpu = cpu_cost_ns()
+    shader, renderer = shader_cost(args.repeats)
+    split = split_sum_table()
+    split_cpu = split_sum_cpu_ns()
+    split_shader = split_sum_shader_us(args.repeats, WIDTH, HEIGHT)
+    pixels = WIDTH * HEIGHT
+    print("\n".join(header) + f", GL: {renderer}\n")
+    lines, models = models_table(MODELS, rows, cpu, shader, pixels)
+    print(f"## Models: {len(LIBRARY_NAMES)} conductors, {GRID} x {GRID} grid, Delta E 2000 against the 1 nm "
+          "reference\n\n" + "\n".join(lines))
     if FIT_FAILURES:
         print(f"\nDegree-0 fits refused by the fitting core ({len(FIT_FAILURES)}; the general fit "
               "collapsed to that eta_i is used instead): " + "; ".join(FIT_FAILURES))
-    if shader:
-        print(f"\nShader wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
-              + ", ".join(f"{v} {t:.0f}" for v, t in shader.items()))
+    print(f"\nShader wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
+          + ", ".join(f"{v} {t:.0f}" for v, t in shader.items()))
     print("\nBytes: " + "; ".join(f"{MODELS[m][0]}: {MODELS[m][3]}" for m in MODELS))
+    lines, split_costs = split_sum_table_lines(SPLIT_VARIANTS, split, split_cpu, split_shader, pixels,
+                                               SPLIT_ROUGHNESS)
+    print(f"\n## Split-sum variants: {len(LIBRARY_NAMES)} conductors x eta_i {', '.join(map(str, SPLIT_ETA_I))} "
+          f"x roughness {', '.join(map(str, SPLIT_ROUGHNESS))} x {len(SPLIT_NDOTV)} NdotV, Delta E 2000 of the "
+          "directional albedo against the spectral one\n\n" + "\n".join(lines))
+    print(f"\nSplit-sum pass wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
+          + ", ".join(f"{v} {t:.0f}" for v, t in split_shader.items())
+          + "; net: the pass with no split sum (split_sum_fixed) subtracted from both sides.")
+    print("\n## Model kinds side by side\n")
+    print("\n".join(kinds_table(_kind_rows(rows, cpu, shader, models, split, split_costs), reports)))
+    for report in reports:
+        print("\n" + "\n".join(batch_table(report)))
+    if args.figure:
+        _figures(rows, cpu, models, split, split_costs, reports)
+        print("\nwrote docs/images/speed_vs_error.png" + (", docs/images/speed_vs_error_batch.png" if reports else ""))
 
     if args.models_only:
-        print(f"\nRun time: {time.perf_counter() - t0:.0f} s")
+        print(f"\nRun time: {time.perf_counter() - t0:.0f} s; load average at the end {load_average()}")
         return
     fit_rows = fit_settings_table()
     fit_front = pareto_front({_key(r): (r["seconds"], r["mean"]) for r in fit_rows})
@@ -407,9 +379,10 @@ def main() -> None:
     print(f"\nDefault setting ({_key(default)}) on the front: "
           f"**{'yes' if _key(default) in fit_front else 'no'}**")
     if args.figure:
-        _figures(rows, cpu, shader, fit_rows, front_shader, front_cpu, fit_front)
-        print("\nwrote docs/images/speed_vs_error.png, docs/images/speed_vs_error_fit_settings.png")
-    print(f"\n(total {time.perf_counter() - t0:.0f} s)")
+        figure_fit_settings(IMAGES / "speed_vs_error_fit_settings.png", fit_rows, fit_front, _key,
+                            len(LIBRARY_NAMES))
+        print("\nwrote docs/images/speed_vs_error_fit_settings.png")
+    print(f"\n(total {time.perf_counter() - t0:.0f} s; load average at the end {load_average()})")
 
 
 if __name__ == "__main__":
