@@ -9,9 +9,8 @@
 import * as api from "./api.js";
 import { drawInto, floatTarget, fullscreenProgram, readTarget } from "./glpass.js";
 
-// NdotV nodes (i / 127)^2 of every albedo table; the reference's with 2048
-// Hammersley points (preview_shaders.rough.reference_albedo_table's).
-export const ALBEDO_NODES = 128;
+// The reference's albedo with 2048 Hammersley points a node
+// (preview_shaders.rough.reference_albedo_table's).
 export const REFERENCE_SAMPLES = 2048;
 export const ENVIRONMENT_NAMES = ["white_sky", "studio", "outdoor"];
 // Texture units, each sampler type on its own (WebGL2 refuses a draw whose
@@ -58,8 +57,11 @@ export class SplitSum {
     this.lut = null;
     this.alphaRange = null;
     this.prefiltered = new Map(); // environment index -> 2D array texture
-    this.albedo = null; // ALBEDO_NODES x 3: model, Lazanyi, coat
-    this.referenceAlbedo = null; // ALBEDO_NODES x 1
+    // The tables' NdotV nodes (i / (n - 1))^2, n - 1 twice the LUT's: its
+    // nodes are among them, so the model's table reproduces its lookup.
+    this.nodes = 0;
+    this.albedo = null; // nodes x 3: model, Lazanyi, coat
+    this.referenceAlbedo = null; // nodes x 1
     this.albedoFor = null;
     this.referenceAlbedoFor = null;
   }
@@ -78,14 +80,15 @@ export class SplitSum {
         fullscreenProgram(gl, "albedo_table.frag"),
         fullscreenProgram(gl, "reference_albedo.frag"),
       ]);
-      this.albedo = floatTarget(gl, ALBEDO_NODES, 3);
-      this.referenceAlbedo = floatTarget(gl, ALBEDO_NODES, 1);
       Object.assign(this, { program, tablePass, referencePass });
     });
     const lut = this.#once("lut", async () => {
       const table = await api.iblLut();
       this.lut = texture3D(gl, gl.TEXTURE_3D, gl.RGB32F, table.data, table.width, table.height, table.depth, gl.NEAREST);
       this.alphaRange = table.alphaRange;
+      this.nodes = 2 * (table.width - 1) + 1;
+      this.albedo = floatTarget(gl, this.nodes, 3);
+      this.referenceAlbedo = floatTarget(gl, this.nodes, 1);
     });
     const name = ENVIRONMENT_NAMES[environment];
     const slices = this.#once(name, async () => {
@@ -116,26 +119,26 @@ export class SplitSum {
     if (key !== this.albedoFor) {
       const u = this.tablePass.uniforms;
       gl.useProgram(this.tablePass.program);
-      gl.uniform2f(u.u_resolution, ALBEDO_NODES, 3);
+      gl.uniform2f(u.u_resolution, this.nodes, 3);
       setMaterial(gl, u, s);
       gl.uniform2f(u.cf_alpha_range, ...this.alphaRange);
       gl.activeTexture(gl.TEXTURE0 + UNIT.lut);
       gl.bindTexture(gl.TEXTURE_3D, this.lut);
       gl.uniform1i(u.cf_lut, UNIT.lut);
-      drawInto(gl, this.vao, [this.albedo], ALBEDO_NODES, 3);
+      drawInto(gl, this.vao, [this.albedo], this.nodes, 3);
       this.albedoFor = key;
     }
     const referenceKey = JSON.stringify([s.referenceFor, s.referenceRange, s.eta, s.roughness]);
     if (withReference && referenceKey !== this.referenceAlbedoFor) {
       const u = this.referencePass.uniforms;
       gl.useProgram(this.referencePass.program);
-      gl.uniform2f(u.u_resolution, ALBEDO_NODES, 1);
+      gl.uniform2f(u.u_resolution, this.nodes, 1);
       setMaterial(gl, u, s);
       gl.uniform1i(u.u_samples, REFERENCE_SAMPLES);
       gl.activeTexture(gl.TEXTURE0 + UNIT.reference);
       gl.bindTexture(gl.TEXTURE_2D, reference);
       gl.uniform1i(u.u_reference, UNIT.reference);
-      drawInto(gl, this.vao, [this.referenceAlbedo], ALBEDO_NODES, 1);
+      drawInto(gl, this.vao, [this.referenceAlbedo], this.nodes, 1);
       this.referenceAlbedoFor = referenceKey;
     }
   }
@@ -155,11 +158,12 @@ export class SplitSum {
     }
   }
 
-  /** The albedo tables as integrated last ({albedo: 3 rows, reference: 1}), RGBA floats, for the parity tests. */
+  /** The albedo tables as integrated last ({nodes, albedo: 3 rows, reference: 1 row}, RGBA floats), for the parity tests. */
   readTables() {
     return {
-      albedo: Array.from(readTarget(this.gl, this.albedo, ALBEDO_NODES, 3)),
-      reference: Array.from(readTarget(this.gl, this.referenceAlbedo, ALBEDO_NODES, 1)),
+      nodes: this.nodes,
+      albedo: Array.from(readTarget(this.gl, this.albedo, this.nodes, 3)),
+      reference: Array.from(readTarget(this.gl, this.referenceAlbedo, this.nodes, 1)),
     };
   }
 }

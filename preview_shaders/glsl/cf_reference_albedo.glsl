@@ -41,21 +41,19 @@ vec3 cf_reference_albedo(sampler2D reference, float NdotV, float eta_i, vec2 eta
 
 // Row `row` of a table of directional albedos at NdotV nodes
 // mu_i = (i / (n - 1))^2, n texels a row (albedo_table.frag and
-// reference_albedo.frag write them), interpolated linearly in mu between
-// the nodes around NdotV, as numpy.interp.
+// reference_albedo.frag write them), interpolated linearly in sqrt(mu)
+// between the nodes around NdotV, as the LUT's NdotV axis (cf_ibl_terms):
+// with n - 1 a multiple of the LUT's, the LUT's own nodes are among the
+// table's and a table of its split sum reproduces the LUT's lookup.
 vec3 cf_albedo_table_lookup(sampler2D table, int row, float NdotV)
 {
     int n = textureSize(table, 0).x;
-    float mu = cf_saturate(NdotV);
-    // The node below mu, kept <= n - 2 so that the one above exists.
-    int i = min(int(floor(sqrt(mu) * float(n - 1))), n - 2);
-    float lo = float(i) / float(n - 1);
-    float hi = float(i + 1) / float(n - 1);
-    lo *= lo;
-    hi *= hi;
-    // sqrt may round mu just past a node: the fraction is clamped.
-    float t = clamp((mu - lo) / (hi - lo), 0.0, 1.0);
-    return mix(texelFetch(table, ivec2(i, row), 0).rgb, texelFetch(table, ivec2(i + 1, row), 0).rgb, t);
+    float x = sqrt(cf_saturate(NdotV)) * float(n - 1);
+    // The node below x, kept <= n - 2 so that the one above exists; the
+    // fraction then reaches 1 at the last node, which is exact.
+    int i = min(int(floor(x)), n - 2);
+    return mix(texelFetch(table, ivec2(i, row), 0).rgb, texelFetch(table, ivec2(i + 1, row), 0).rgb,
+               x - float(i));
 }
 
 #endif

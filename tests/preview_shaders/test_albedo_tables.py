@@ -30,7 +30,7 @@ from preview_shaders.shading import upload_lut
 pytestmark = pytest.mark.gl
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "Au_golden.json"
-NODES = 128
+NODES = 127  # as the editor's: twice the LUT's 64 NdotV nodes, less one
 MU = (np.arange(NODES) / (NODES - 1)) ** 2
 TOLERANCE = 2.0e-5
 """As the LUT's own parity (test_ibl_parity): float32 lookups and sums
