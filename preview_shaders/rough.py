@@ -16,7 +16,8 @@ prefiltered environment and the spectral reference under the same lighting.
     roughness node, in numpy (Karis 2013's N = V = R assumption: the
     weight of a direction L around R is D(R.h) max(R.L, 0) dOmega).
 -   :func:`prefiltered_environment`: the prefiltered slices of a preview
-    environment, computed once per process.
+    environment (:data:`ENVIRONMENTS`), computed once per process; the
+    editor's WebGL preview gets them from the service.
 -   :func:`reference_albedo_table`: the spectral directional albedo over
     cos theta (the same GGX lobe with the exact Fresnel of the measured
     n, k), a 1-D table per eta_i and roughness.
@@ -39,18 +40,14 @@ import numpy as np
 
 from fitting.colour.reference import reference_ACEScg
 from fitting.optics.fresnel import fresnel_dielectric
-from fitting.shading.ibl import _hammersley, cache_dir, split_sum_schlick
-from fitting.shading.microfacet import (
-    alpha_g_from_roughness,
-    sample_visible_normal,
-    smith_G1,
-    smith_G2,
-)
+from fitting.shading.ibl import cache_dir, directional_albedo, split_sum_schlick
+from fitting.shading.microfacet import alpha_g_from_roughness
 
 from .gl import GLState, check_gl_error, load_shader_source, read_float_target
 
 __all__ = [
     "MODES",
+    "ENVIRONMENTS",
     "EQUIRECT_SIZE",
     "ROUGHNESS_NODES",
     "equirect_directions",
@@ -63,6 +60,9 @@ __all__ = [
 ]
 
 MODES = ("immersed", "coated")
+ENVIRONMENTS = ("white_sky", "studio", "outdoor")
+"""The environments that can be prefiltered, by their index in
+``cf_environment.glsl`` (CF_ENVIRONMENT_*)."""
 EQUIRECT_SIZE = (128, 64)
 """(width, height) of the prefiltered equirect slices."""
 PREFILTER_VERSION = 1
@@ -70,7 +70,6 @@ PREFILTER_VERSION = 1
 ROUGHNESS_NODES = 9
 """Prefiltered slices at roughness 0, 1/8, ..., 1 (the shader interpolates)."""
 _ALBEDO_NODES = 128
-_ALBEDO_SAMPLES = 2048
 
 
 def equirect_directions(width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
@@ -216,7 +215,8 @@ def reference_albedo_table(nk, eta_i: float, roughness: float, step_nm: float = 
     The spectral directional albedo E(mu) of the GGX lobe of ``roughness``
     with the exact Fresnel of ``nk`` seen from ``eta_i``
     (:func:`fitting.colour.reference.reference_ACEScg` at the microfacet's
-    v.h), at NdotV nodes mu_i = (i/127)^2, by the LUT's quadrature
+    v.h, interpolated from 1025 cos theta nodes), at NdotV nodes
+    mu_i = (i/127)^2, by :func:`fitting.shading.ibl.directional_albedo`
     (2048 Hammersley points through visible-normal sampling).
 
     Returns
@@ -225,19 +225,13 @@ def reference_albedo_table(nk, eta_i: float, roughness: float, step_nm: float = 
         (mu nodes (128,), albedo (128, 3)), linear ACEScg.
     """
     mu = (np.arange(_ALBEDO_NODES) / (_ALBEDO_NODES - 1)) ** 2
-    # The exact Fresnel on a fine cos table, interpolated per sample.
     cos_nodes = np.linspace(0.0, 1.0, 1025)
     F_nodes = reference_ACEScg(nk, cos_nodes, eta_i, step_nm)
-    alpha_g = alpha_g_from_roughness(roughness)
-    u1, u2 = _hammersley(_ALBEDO_SAMPLES)
-    m = np.maximum(mu, 1.0e-6)
-    v = np.stack([np.sqrt(1.0 - m * m), np.zeros_like(m), m], axis=-1)[:, None, :]
-    h = sample_visible_normal(v, alpha_g, u1[None, :], u2[None, :])
-    VdotH = np.clip(np.sum(v * h, axis=-1), 0.0, 1.0)
-    NdotL = 2.0 * VdotH * h[..., 2] - v[..., 2]
-    w = np.where(NdotL > 0.0, smith_G2(m[:, None], NdotL, alpha_g) / smith_G1(m[:, None], alpha_g), 0.0)
-    F = np.stack([np.interp(VdotH, cos_nodes, F_nodes[:, c]) for c in range(3)], axis=-1)
-    return mu, np.mean(w[..., None] * F, axis=1)
+
+    def fresnel(VdotH):
+        return np.stack([np.interp(VdotH, cos_nodes, F_nodes[:, c]) for c in range(3)], axis=-1)
+
+    return mu, directional_albedo(mu, roughness, fresnel)
 
 
 def _albedo_at(table, cos_theta):

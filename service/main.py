@@ -26,7 +26,7 @@ from fastapi.staticfiles import StaticFiles
 from .api.errors import install_error_handlers
 from .api.middleware import HostAllowList, RequestLimits
 from .api.routes import (
-    curves, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
+    curves, environments, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
@@ -98,7 +98,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.preview_renderer = None
     install_error_handlers(app)
-    for module in (health, materials, fits, packs, preview, reference_texture, curves, scenes, ibl):
+    for module in (health, materials, fits, packs, preview, reference_texture, environments, curves, scenes,
+                   ibl):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")

@@ -106,3 +106,65 @@ export async function referenceTexture(fitId) {
     F82_air: triple("X-F82-Air"),
   };
 }
+
+// ---------------------------------------------------------------- split sum
+
+const LUT_MAGIC = "CFIBLUT1";
+const LUT_HEADER_BYTES = 32;
+
+let crcTable = null;
+
+// CRC-32 (zlib's, reflected 0xEDB88320) of a byte array.
+function crc32(bytes) {
+  if (!crcTable) {
+    crcTable = new Uint32Array(256);
+    for (let n = 0; n < 256; n++) {
+      let c = n;
+      for (let k = 0; k < 8; k++) c = c & 1 ? 0xedb88320 ^ (c >>> 1) : c >>> 1;
+      crcTable[n] = c >>> 0;
+    }
+  }
+  let crc = 0xffffffff;
+  for (let i = 0; i < bytes.length; i++) crc = crcTable[(crc ^ bytes[i]) & 0xff] ^ (crc >>> 8);
+  return (crc ^ 0xffffffff) >>> 0;
+}
+
+/**
+ * The split-sum LUT file (docs/shading.md: magic CFIBLUT1, uint32 n_mu,
+ * n_r, n_alpha, channels, float32 alpha range, float32 (A, B, G) texels
+ * [alpha slice][roughness][NdotV][channel], CRC-32), read as
+ * fitting.shading.lut.decode_lut does; a damaged file is refused with why.
+ */
+export function decodeLut(buffer) {
+  const view = new DataView(buffer);
+  if (buffer.byteLength < LUT_HEADER_BYTES + 4) throw new Error(`the LUT is truncated: ${buffer.byteLength} bytes`);
+  const magic = String.fromCharCode(...new Uint8Array(buffer, 0, 8));
+  if (magic !== LUT_MAGIC) throw new Error(`not a split-sum LUT (magic ${JSON.stringify(magic)})`);
+  const [width, height, depth, channels] = [8, 12, 16, 20].map((offset) => view.getUint32(offset, true));
+  const alphaRange = [view.getFloat32(24, true), view.getFloat32(28, true)];
+  const size = LUT_HEADER_BYTES + 4 * channels * width * height * depth;
+  if (channels !== 3 || buffer.byteLength !== size + 4) {
+    throw new Error(`the LUT header (${width} x ${height} x ${depth} x ${channels}) does not match its ${buffer.byteLength} bytes`);
+  }
+  if (crc32(new Uint8Array(buffer, 0, size)) !== view.getUint32(size, true)) throw new Error("the LUT is damaged: CRC-32 mismatch");
+  // The texels are little-endian, as typed arrays are on every WebGL platform.
+  return { width, height, depth, alphaRange, data: new Float32Array(buffer.slice(LUT_HEADER_BYTES, size)) };
+}
+
+// GET /ibl-lut, decoded.
+export async function iblLut() {
+  const response = await fetch(`${API}/ibl-lut`, { headers: headers() });
+  return decodeLut(await answer(response, (r) => r.arrayBuffer()));
+}
+
+// A preview environment prefiltered per roughness (GET
+// /environments/{name}/prefiltered): float32 RGB [slice][row][column][channel].
+export async function prefilteredEnvironment(name) {
+  const response = await fetch(`${API}/environments/${encodeURIComponent(name)}/prefiltered`, { headers: headers() });
+  const buffer = await answer(response, (r) => r.arrayBuffer());
+  const [width, height, layers] = ["Width", "Height", "Layers"].map((k) => Number(response.headers.get(`X-Texture-${k}`)));
+  if (buffer.byteLength !== 12 * width * height * layers) {
+    throw new Error(`the prefiltered ${name} environment has ${buffer.byteLength} bytes for ${width} x ${height} x ${layers}`);
+  }
+  return { name, width, height, layers, data: new Float32Array(buffer) };
+}

@@ -639,8 +639,14 @@ async function upload(file) {
 
 function previewSettings() {
   $("exposure-value").textContent = Number($("exposure").value).toFixed(1);
+  $("roughness-value").textContent = Number($("roughness").value).toFixed(2);
+  $("coat-roughness-value").textContent = Number($("coat-roughness").value).toFixed(2);
+  $("coat-roughness").disabled = !$("coat").checked;
   if (!ball) return;
-  ball.set({ environment: ENVIRONMENT[$("environment").value], exposure: Number($("exposure").value) });
+  ball.set({
+    environment: ENVIRONMENT[$("environment").value], exposure: Number($("exposure").value),
+    roughness: Number($("roughness").value), coated: $("coat").checked, coatRoughness: Number($("coat-roughness").value),
+  });
   applyPanels();
 }
 
@@ -686,7 +692,9 @@ $("undo").addEventListener("click", guard(() => undoRedo(state.undo, state.redo)
 $("redo").addEventListener("click", guard(() => undoRedo(state.redo, state.undo)));
 $("reset").addEventListener("click", guard(reset));
 $("save").addEventListener("click", guard(save));
-for (const id of ["compare", "environment", "exposure"]) $(id).addEventListener("input", previewSettings);
+for (const id of ["compare", "environment", "exposure", "roughness", "coat", "coat-roughness"]) {
+  $(id).addEventListener("input", previewSettings);
+}
 $("format").addEventListener("change", () => {
   if (state.fit) $("download").href = api.packURL(state.fit.id, $("format").value);
 });
@@ -701,7 +709,7 @@ document.addEventListener("keydown", (event) => {
 });
 
 // The preview's shaders compile while the material list and first fit load.
-const preview = ShaderBall.create($("preview"), $("preview-labels")).then((made) => {
+const preview = ShaderBall.create($("preview"), $("preview-labels"), $("preview-lighting")).then((made) => {
   ball = made;
   window.cfPreview = made; // for the parity tests and benchmarks
   ball.onFrame = (drawn) => {

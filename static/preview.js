@@ -4,12 +4,19 @@
 // from its packed float16 halves, adjusted Lazanyi, and the spectral
 // reference, which the service sends as a float texture over
 // (cos theta, eta_i) (GET /api/v1/fits/{id}/reference-texture).
+//
+// Roughness and the clear coat: while every lobe is a mirror the program
+// is shader_ball.frag as it stands; once a lobe is rough, its split-sum
+// variant (splitsum.js: the LUT and the prefiltered environment fetched on
+// first use, albedo tables integrated when the settings change). Frames
+// wait for those textures (the last frame stays, and `status` says so).
 
-import { loadShader } from "./glsl.js";
+import { drawInto, floatTarget, fullscreenProgram, readTarget } from "./glpass.js";
+import { ENVIRONMENT_NAMES, SplitSum, UNIT, setMaterial } from "./splitsum.js";
 
 export const PANEL = { model: 0, lazanyi: 1, reference: 2 };
-export const OUTPUT = { display: 0, linear: 1, fresnel: 2, geometry: 3 };
-export const ENVIRONMENT = { white_sky: 0, studio: 1, outdoor: 2 };
+export const OUTPUT = { display: 0, linear: 1, fresnel: 2, geometry: 3, baseLight: 4, coatLight: 5, coat: 6 };
+export const ENVIRONMENT = Object.fromEntries(ENVIRONMENT_NAMES.map((name, i) => [name, i]));
 const LABELS = ["Model", "Adjusted Lazanyi", "Spectral reference"];
 
 // ------------------------------------------------------------ float16 halves
@@ -62,16 +69,6 @@ export function packedWords(coefficients) {
 
 // ------------------------------------------------------------ renderer
 
-function compile(gl, type, source, name) {
-  const shader = gl.createShader(type);
-  gl.shaderSource(shader, source);
-  gl.compileShader(shader);
-  if (!gl.getShaderParameter(shader, gl.COMPILE_STATUS)) {
-    throw new Error(`${name} does not compile as GLSL ES 3.00: ${gl.getShaderInfoLog(shader)}`);
-  }
-  return shader;
-}
-
 /**
  * The orbit camera: eye on a sphere of radius `distance` around the unit
  * sphere (yaw about y, pitch above the equator), looking at the origin, y
@@ -95,23 +92,21 @@ export function orbitCamera([yaw, pitch, distance], fov) {
 }
 
 export class ShaderBall {
-  /** Use `await ShaderBall.create(canvas, labels)`. */
-  constructor(canvas, labels, gl, program) {
+  /** Use `await ShaderBall.create(canvas, labels, status)`. */
+  constructor(canvas, labels, status, gl, mirror) {
     this.canvas = canvas;
     this.labels = labels;
+    this.status = status;
     this.gl = gl;
-    this.program = program;
-    this.uniforms = {};
-    const count = gl.getProgramParameter(program, gl.ACTIVE_UNIFORMS);
-    for (let i = 0; i < count; i++) {
-      const name = gl.getActiveUniform(program, i).name.replace(/\[0\]$/, "");
-      this.uniforms[name] = gl.getUniformLocation(program, name);
-    }
+    this.mirror = mirror; // shader_ball.frag: every lobe a mirror
     this.vao = gl.createVertexArray();
+    this.splitSum = new SplitSum(gl, this.vao);
+    this.lightingError = null;
     this.state = {
       orbit: [0.5, 0.25, 4.2], fov: 0.52, panels: [PANEL.model], environment: ENVIRONMENT.studio,
       exposure: 0, eta: 1.5, words: new Uint32Array(14), etaRange: [1, 2.5],
       F0: [0, 0, 0], F82: [0, 0, 0], fitId: null, referenceFor: null, referenceRange: [1, 2.5],
+      roughness: 0, coated: false, coatRoughness: 0,
     };
     this.reference = this.#texture(new Float32Array(6), 2, 1);
     this.frames = 0;
@@ -121,18 +116,10 @@ export class ShaderBall {
     new ResizeObserver(() => this.draw()).observe(canvas);
   }
 
-  static async create(canvas, labels) {
+  static async create(canvas, labels, status = null) {
     const gl = canvas.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true });
     if (!gl) throw new Error("this browser has no WebGL2");
-    const [vertex, fragment] = await Promise.all([loadShader("fullscreen.vert"), loadShader("shader_ball.frag")]);
-    const program = gl.createProgram();
-    gl.attachShader(program, compile(gl, gl.VERTEX_SHADER, vertex, "fullscreen.vert"));
-    gl.attachShader(program, compile(gl, gl.FRAGMENT_SHADER, fragment, "shader_ball.frag"));
-    gl.linkProgram(program);
-    if (!gl.getProgramParameter(program, gl.LINK_STATUS)) {
-      throw new Error(`shader_ball does not link: ${gl.getProgramInfoLog(program)}`);
-    }
-    return new ShaderBall(canvas, labels, gl, program);
+    return new ShaderBall(canvas, labels, status, gl, await fullscreenProgram(gl, "shader_ball.frag"));
   }
 
   #texture(data, width, height) {
@@ -163,15 +150,70 @@ export class ShaderBall {
     this.draw();
   }
 
-  /** Change settings ({eta, environment, exposure, panels, orbit}) and draw. */
+  /**
+   * Change settings ({eta, environment, exposure, panels, orbit, roughness
+   * in [0, 1], coated, coatRoughness in [0, 1]}) and draw.
+   */
   set(changes) {
     Object.assign(this.state, changes);
     this.draw();
   }
 
-  #uniforms(output, width, height) {
-    const gl = this.gl, u = this.uniforms, s = this.state;
-    gl.useProgram(this.program);
+  // ---------------------------------------------------------- split sum
+
+  /** Whether a lobe is rough (the split sum), unless its textures are out of reach. */
+  #rough() {
+    const s = this.state;
+    return !this.lightingError && (s.roughness > 0 || (s.coated && s.coatRoughness > 0));
+  }
+
+  /**
+   * A promise of the split sum's textures and programs for the current
+   * settings, each fetched or compiled once; resolved at once while every
+   * lobe is a mirror. A failure is reported in `status`, and the preview
+   * then draws every lobe as a mirror.
+   */
+  lightingReady() {
+    if (!this.#rough()) return Promise.resolve();
+    return this.splitSum.load(this.state.environment).then(() => this.draw(), (error) => {
+      this.lightingError = error;
+      this.#say(`Rough lighting unavailable, every surface is drawn smooth: ${error.message}`);
+      this.draw();
+    });
+  }
+
+  #say(text) {
+    if (!this.status) return;
+    this.status.textContent = text;
+    this.status.hidden = !text;
+  }
+
+  // The program of this frame, its albedo tables integrated; null while
+  // the split sum's textures are on their way.
+  #program() {
+    if (!this.#rough()) {
+      if (!this.lightingError) this.#say("");
+      return this.mirror;
+    }
+    const s = this.state;
+    if (!this.splitSum.loaded(s.environment)) {
+      this.#say("Preparing the rough lighting…");
+      this.lightingReady();
+      return null;
+    }
+    this.#say("");
+    this.splitSum.integrate(s, this.reference, s.panels.includes(PANEL.reference));
+    return this.splitSum.program;
+  }
+
+  /** The split sum's albedo tables as last integrated, for the parity tests. */
+  readTables() {
+    return this.splitSum.readTables();
+  }
+
+  #uniforms(ball, output, width, height) {
+    const gl = this.gl, u = ball.uniforms, s = this.state;
+    gl.useProgram(ball.program);
     gl.uniform2f(u.u_resolution, width, height);
     const camera = orbitCamera(s.orbit, s.fov);
     for (const name of ["eye", "forward", "right", "up"]) gl.uniform3f(u[`u_${name}`], ...camera[name]);
@@ -181,15 +223,11 @@ export class ShaderBall {
     gl.uniform1i(u.u_environment, s.environment);
     gl.uniform1f(u.u_exposure, s.exposure);
     gl.uniform1i(u.u_output, output);
-    gl.uniform1f(u.u_eta_i, s.eta);
-    gl.uniform1uiv(u.cf_words, s.words);
-    gl.uniform2f(u.cf_eta_i_range, ...s.etaRange);
-    gl.uniform3f(u.cf_F0_air, ...s.F0);
-    gl.uniform3f(u.cf_F82_air, ...s.F82);
-    gl.uniform2f(u.u_reference_eta_i_range, ...s.referenceRange);
-    gl.activeTexture(gl.TEXTURE0);
+    setMaterial(gl, u, s);
+    gl.activeTexture(gl.TEXTURE0 + UNIT.reference);
     gl.bindTexture(gl.TEXTURE_2D, this.reference);
-    gl.uniform1i(u.u_reference, 0);
+    gl.uniform1i(u.u_reference, UNIT.reference);
+    if (ball !== this.mirror) this.splitSum.bind(u, s.environment);
   }
 
   /** Ask for a frame (drawn on the next animation frame, once). */
@@ -204,6 +242,8 @@ export class ShaderBall {
 
   /** Draw the canvas now; the canvas's data-fit names the fit drawn. */
   drawNow() {
+    const ball = this.#program();
+    if (!ball) return;
     const gl = this.gl, canvas = this.canvas;
     const scale = Math.min(window.devicePixelRatio || 1, 2);
     const width = Math.max(1, Math.round(canvas.clientWidth * scale));
@@ -214,12 +254,13 @@ export class ShaderBall {
     }
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, width, height);
-    this.#uniforms(OUTPUT.display, width, height);
+    this.#uniforms(ball, OUTPUT.display, width, height);
     gl.bindVertexArray(this.vao);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     this.frames += 1;
     canvas.dataset.fit = this.state.fitId || "";
     canvas.dataset.eta = this.state.eta.toFixed(2);
+    canvas.dataset.program = ball === this.mirror ? "mirror" : "split-sum";
     this.#label();
     if (this.onFrame) this.onFrame(this.state);
   }
@@ -243,23 +284,14 @@ export class ShaderBall {
    * bottom row first, as GL stores it. For the parity tests.
    */
   readFloat(output, width, height) {
+    const ball = this.#program();
+    if (!ball) throw new Error("the split sum's textures are not in yet: await lightingReady()");
     const gl = this.gl;
-    if (!gl.getExtension("EXT_color_buffer_float")) throw new Error("no EXT_color_buffer_float");
-    const texture = gl.createTexture();
-    gl.bindTexture(gl.TEXTURE_2D, texture);
-    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, width, height);
-    const fbo = gl.createFramebuffer();
-    gl.bindFramebuffer(gl.FRAMEBUFFER, fbo);
-    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, texture, 0);
-    gl.viewport(0, 0, width, height);
-    this.#uniforms(output, width, height);
-    gl.bindVertexArray(this.vao);
-    gl.drawArrays(gl.TRIANGLES, 0, 3);
-    const pixels = new Float32Array(width * height * 4);
-    gl.readPixels(0, 0, width, height, gl.RGBA, gl.FLOAT, pixels);
-    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
-    gl.deleteFramebuffer(fbo);
-    gl.deleteTexture(texture);
+    const target = floatTarget(gl, width, height);
+    this.#uniforms(ball, output, width, height);
+    drawInto(gl, this.vao, [target], width, height);
+    const pixels = readTarget(gl, target, width, height);
+    gl.deleteTexture(target);
     return pixels;
   }
 

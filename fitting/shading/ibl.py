@@ -34,6 +34,9 @@ varies per channel and with eta_i. The slices are spaced evenly in
     :func:`split_sum_lazanyi`: the albedo of the model and the baselines.
 -   :func:`split_sum_coated`: an approximate pre-integrated albedo of the
     ``coated`` mode from the same LUT.
+-   :func:`directional_albedo`: the albedo of the GGX lobe with any Fresnel
+    function (a tabulated one: the spectral reference), by the LUT's
+    quadrature.
 -   :func:`average_fresnel`: the closed-form hemispherical average
     :math:`2\\int_0^1 F\\mu\\,d\\mu` of the model.
 -   :func:`energy_compensation`: the multiple-scattering factor from it.
@@ -64,6 +67,7 @@ from ..domain import as_finite_array
 from ..models.baselines import external_medium_F0, lazanyi_a
 from ..models.coated_conductor import ALPHA_MIN
 from ..optics.fresnel import fresnel_dielectric
+from .microfacet import alpha_g_from_roughness, sample_visible_normal, smith_G1, smith_G2
 from .lut import (  # noqa: F401  (the LUT's names, re-exported from their old home)
     ALPHA_RANGE,
     CACHE_ENV,
@@ -100,6 +104,8 @@ __all__ = [
     "split_sum_schlick",
     "split_sum_lazanyi",
     "split_sum_coated",
+    "directional_albedo",
+    "DIRECTIONAL_ALBEDO_SAMPLES",
     "average_fresnel",
     "energy_compensation",
 ]
@@ -184,6 +190,54 @@ def split_sum_coated(
     T = (1.0 - fresnel_dielectric(mu, 1.0, eta))[..., None]
     mu_t = np.sqrt(1.0 - (1.0 - mu * mu) / (eta * eta))
     return coat + T * T * split_sum_model(mu_t, r, F0, a, alpha, lut)
+
+
+DIRECTIONAL_ALBEDO_SAMPLES = 2048
+"""Hammersley points of :func:`directional_albedo` by default."""
+
+
+def directional_albedo(NdotV, roughness, fresnel, samples: int = DIRECTIONAL_ALBEDO_SAMPLES) -> np.ndarray:
+    """
+    Directional albedo of the GGX lobe of perceptual ``roughness`` with the
+    Fresnel function ``fresnel`` of :math:`\\mathbf{v}\\cdot\\mathbf{h}`,
+
+    .. math::
+
+        E(\\mu_v) = \\frac{1}{n} \\sum_i F(\\mathbf{v}\\cdot\\mathbf{h}_i)\\,
+        \\frac{G_2(\\mathbf{v}, \\mathbf{l}_i)}{G_1(\\mathbf{v})}
+
+    over ``samples`` Hammersley points through visible-normal sampling (the
+    quadrature of :func:`generate_lut`; a light below the surface scores 0).
+    For a Fresnel that is a table rather than the model's form, such as
+    the spectral reference; ``cf_reference_albedo.glsl`` is its GLSL twin.
+
+    Parameters
+    ----------
+    NdotV
+        Cosines (n,), clamped to [0, 1]; 0 is taken as the limit from above.
+    roughness
+        Scalar in [0, 1] (clamped to ``ROUGHNESS_MIN`` as the BRDF is).
+    fresnel
+        ``fresnel(VdotH) -> (..., 3)`` for VdotH of any shape, linear.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 3), linear in the Fresnel's colour space.
+    """
+    mu = np.clip(as_finite_array("NdotV", NdotV).reshape(-1), 0.0, 1.0)
+    samples = int(samples)
+    if not 1 <= samples <= 1 << 20:
+        raise ValueError(f"`samples` must lie in [1, 1048576], got {samples}")
+    alpha_g = alpha_g_from_roughness(float(as_finite_array("roughness", roughness)))
+    u1, u2 = _hammersley(samples)
+    m = np.maximum(mu, 1.0e-6)  # NdotV = 0: the limit from above (G1 -> 0 cancels)
+    v = np.stack([np.sqrt(1.0 - m * m), np.zeros_like(m), m], axis=-1)[:, None, :]
+    h = sample_visible_normal(v, alpha_g, u1[None, :], u2[None, :])
+    VdotH = np.clip(np.sum(v * h, axis=-1), 0.0, 1.0)
+    NdotL = 2.0 * VdotH * h[..., 2] - v[..., 2]
+    w = np.where(NdotL > 0.0, smith_G2(m[:, None], NdotL, alpha_g) / smith_G1(m[:, None], alpha_g), 0.0)
+    return np.mean(w[..., None] * np.asarray(fresnel(VdotH), dtype=np.float64), axis=1)
 
 
 def average_fresnel(F0, a, alpha) -> np.ndarray:

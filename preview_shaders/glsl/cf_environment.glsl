@@ -3,6 +3,8 @@
 #ifndef CF_ENVIRONMENT_GLSL
 #define CF_ENVIRONMENT_GLSL
 
+#include "cf_outdoor.glsl"
+
 const int CF_ENVIRONMENT_WHITE_SKY = 0;
 const int CF_ENVIRONMENT_STUDIO = 1;
 
@@ -62,8 +64,12 @@ vec3 cf_studio_environment(vec3 direction)
     return L;
 }
 
+// CF_ENVIRONMENT_* (CF_ENVIRONMENT_OUTDOOR from cf_outdoor.glsl); any
+// other value is the white sky.
 vec3 cf_environment(int environment, vec3 direction)
 {
+    if (environment == CF_ENVIRONMENT_OUTDOOR)
+        return cf_outdoor_environment(direction);
     if (environment == CF_ENVIRONMENT_STUDIO)
         return cf_studio_environment(direction);
     return cf_white_sky(direction);

@@ -4,7 +4,8 @@
 // from the surface; V the view, L the light, H their half vector.
 //
 // References: Walter et al. 2007 (GGX, EGSR); Heitz 2014 (Smith
-// masking-shadowing, JCGT 3(2)); Weidlich & Wilkie 2007 (layered microfacet
+// masking-shadowing, JCGT 3(2)); Heitz 2018 (sampling the visible normals,
+// JCGT 7(4)); Weidlich & Wilkie 2007 (layered microfacet
 // surfaces, GRAPHITE) as the OpenPBR Surface coat describes it; Vernooij
 // 2024 (the model, Eurographics).
 #ifndef CF_MICROFACET_GLSL
@@ -133,6 +134,47 @@ vec3 cf_microfacet_coated(vec3 V, vec3 L, float roughness, vec3 F0, vec3 a, vec3
                                        roughness, F0, a, alpha);
     vec3 f = vec3(coat) + transmission / (eta * eta) * base;
     return (V.z > 0.0 && L.z > 0.0) ? f : vec3(0.0);
+}
+
+// The Hammersley point i of n (fitting.shading.lut._hammersley):
+// ((i + 1/2) / n, the base-2 radical inverse of i), the pre-integration's
+// deterministic quadrature. GLSL ES 3.00 has no bitfieldReverse: the 32
+// bits are swapped in halves, bytes, nibbles, pairs and single bits.
+vec2 cf_hammersley(int i, int n)
+{
+    uint bits = uint(i);
+    bits = (bits << 16u) | (bits >> 16u);
+    bits = ((bits & 0x00FF00FFu) << 8u) | ((bits & 0xFF00FF00u) >> 8u);
+    bits = ((bits & 0x0F0F0F0Fu) << 4u) | ((bits & 0xF0F0F0F0u) >> 4u);
+    bits = ((bits & 0x33333333u) << 2u) | ((bits & 0xCCCCCCCCu) >> 2u);
+    bits = ((bits & 0x55555555u) << 1u) | ((bits & 0xAAAAAAAAu) >> 1u);
+    // 2^-32; float(bits) rounds to 24 bits, 6e-8 relative.
+    return vec2((float(i) + 0.5) / float(n), float(bits) * 2.3283064365386963e-10);
+}
+
+// Heitz 2018, Listing 1: a GGX microfacet normal drawn from the normals
+// visible from V by the uniform numbers u in [0, 1)^2
+// (fitting.shading.microfacet.sample_visible_normal). With the mirrored
+// light L = 2 (V.H) H - V the directional albedo's estimator is
+// F(V.H) G2 / G1(V).
+vec3 cf_sample_visible_normal(vec3 V, float alpha_g, vec2 u)
+{
+    // The view stretched to the hemisphere configuration.
+    vec3 Vh = normalize(vec3(alpha_g * V.xy, V.z));
+    float lensq = dot(Vh.xy, Vh.xy);
+    // Normal view (lensq = 0): any tangent will do, take +x.
+    vec3 T1 = lensq > 0.0 ? vec3(-Vh.y, Vh.x, 0.0) * inversesqrt(lensq) : vec3(1.0, 0.0, 0.0);
+    vec3 T2 = cross(Vh, T1);
+    float r = sqrt(u.x);
+    float phi = 2.0 * CF_PI * u.y;
+    float t1 = r * cos(phi);
+    float t2 = r * sin(phi);
+    float s = 0.5 * (1.0 + Vh.z);
+    // The saturates absorb rounding of t1^2 + t2^2 past 1.
+    t2 = (1.0 - s) * sqrt(cf_saturate(1.0 - t1 * t1)) + s * t2;
+    vec3 Nh = t1 * T1 + t2 * T2 + sqrt(cf_saturate(1.0 - t1 * t1 - t2 * t2)) * Vh;
+    // Back to the ellipsoid; z >= 0 keeps the normal above the surface.
+    return normalize(vec3(alpha_g * Nh.xy, max(Nh.z, 0.0)));
 }
 
 #endif

@@ -6,8 +6,8 @@
 // lobe's roughness (u_prefiltered: equirect slices, one per roughness node,
 // made by preview_shaders/rough.py). Modes: u_mode 0 immersed (the camera
 // in the medium of index u_eta_i), 1 coated (a clear coat of index u_eta_i
-// seen from air, fitting.shading.ibl.split_sum_coated: the coat's Schlick
-// lobe at u_coat_roughness plus the base's albedo at the refracted cosine,
+// seen from air, cf_ibl_coated.glsl: the coat's Schlick lobe at
+// u_coat_roughness plus the base's albedo at the refracted cosine,
 // transmitted in and out). Columns left of u_split_column show the model,
 // the others adjusted Lazanyi under the same lighting. Output linear ACEScg.
 #include "cf_coated_conductor.glsl"
@@ -15,6 +15,8 @@
 #include "cf_environment.glsl"
 #include "cf_microfacet.glsl"
 #include "cf_ibl.glsl"
+#include "cf_ibl_coated.glsl"
+#include "cf_prefiltered_environment.glsl"
 
 uniform vec2 u_centre;        // sphere centre in pixels
 uniform float u_radius;       // sphere radius in pixels
@@ -37,16 +39,6 @@ layout(location = 0) out vec4 out_colour;    // linear ACEScg
 layout(location = 1) out vec4 out_geometry;  // (NdotV, 1 on the sphere, 0, 1)
 layout(location = 2) out vec4 out_radiance;  // prefiltered at u_roughness
 layout(location = 3) out vec4 out_coat_radiance; // prefiltered at u_coat_roughness
-
-// Equirect coordinates of a direction (y up, u = 0.5 towards -z):
-// preview_shaders.rough.equirect_directions is the inverse.
-vec2 cf_equirect_uv(vec3 d)
-{
-    d = normalize(d);
-    float u = 0.5 + atan(d.x, -d.z) / (2.0 * CF_PI);
-    float v = acos(clamp(d.y, -1.0, 1.0)) / CF_PI;
-    return vec2(u, v);
-}
 
 vec3 cf_prefiltered(vec3 R, float roughness)
 {
@@ -97,16 +89,10 @@ void main()
     }
     else
     {
-        float eta = max(u_eta_i, 1.0);
-        float F0c = (eta - 1.0) / (eta + 1.0);
-        F0c *= F0c;
-        vec3 coat = eta > 1.0
-            ? cf_split_sum_schlick(cf_lut, cf_alpha_range, NdotV, u_coat_roughness, vec3(F0c))
-            : vec3(0.0);
-        float T = 1.0 - cf_fresnel_dielectric(NdotV, eta);
-        float mu_t = sqrt(max(1.0 - (1.0 - NdotV * NdotV) / (eta * eta), 0.0));
+        float coat = cf_split_sum_coat(cf_lut, cf_alpha_range, NdotV, u_coat_roughness, u_eta_i);
+        float mu_t = cf_cos_in_coat(NdotV, u_eta_i);
         vec3 base = cf_split_sum_model(cf_lut, cf_alpha_range, mu_t, u_roughness, F0, a, alpha);
-        colour = coat * L_coat + T * T * base * L_base;
+        colour = coat * L_coat + cf_coat_transmission(NdotV, u_eta_i) * base * L_base;
     }
     out_colour = vec4(colour, 1.0);
     out_geometry = vec4(NdotV, 1.0, 0.0, 1.0);

@@ -10,6 +10,8 @@ Dependencies
     when it is not stored), read in a worker thread.
 -   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
     endpoints.
+-   :data:`PreviewRendererDep`: the app's GL preview renderer, made on first
+    use (503 when the machine has no GL driver).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
     :data:`NOT_FOUND`: the error answers for the OpenAPI document.
 """
@@ -17,6 +19,7 @@ Dependencies
 from __future__ import annotations
 
 import hmac
+import threading
 from typing import Annotated
 
 from fastapi import Depends, HTTPException, Path, Request, status
@@ -35,6 +38,7 @@ __all__ = [
     "FitIdPath",
     "StoredFit",
     "WriteAccess",
+    "PreviewRendererDep",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
     "NOT_FOUND",
@@ -109,6 +113,32 @@ def require_write_access(
 
 
 WriteAccess = Depends(require_write_access)
+
+_renderer_lock = threading.Lock()
+
+
+def get_preview_renderer(request: Request):
+    """
+    The app's preview renderer (:class:`preview_shaders.preview.PreviewRenderer`),
+    made on first use; it owns its GL thread, so concurrent requests are
+    serialised there. A machine without a GL driver answers 503 here; the
+    rest of the service still works.
+    """
+    state = request.app.state
+    with _renderer_lock:
+        if state.preview_renderer is None:
+            try:
+                from preview_shaders.preview import PreviewRenderer
+
+                state.preview_renderer = PreviewRenderer()
+            except Exception as error:
+                raise HTTPException(
+                    status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
+                ) from None
+        return state.preview_renderer
+
+
+PreviewRendererDep = Depends(get_preview_renderer)
 
 
 def _error(description: str) -> dict:

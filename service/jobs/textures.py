@@ -6,6 +6,10 @@ Reference textures
     measured n, k as a float32 texture over (cos theta, eta_i), with the
     headers that describe it (``GET /api/v1/fits/{fit_id}/reference-texture``,
     :mod:`service.api.routes.reference_texture`).
+-   :func:`prefiltered_environment_texture`: a preview environment
+    prefiltered per roughness for the split sum, as float32 equirect slices
+    (``GET /api/v1/environments/{name}/prefiltered``,
+    :mod:`service.api.routes.environments`).
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from fitting.models.pack import material_from_json
 from ..store import FitRecord
 from .common import measured_nk
 
-__all__ = ["reference_texture"]
+__all__ = ["reference_texture", "prefiltered_environment_texture"]
 
 
 def reference_texture(record: FitRecord) -> tuple[bytes, dict[str, str]]:
@@ -40,3 +44,24 @@ def reference_texture(record: FitRecord) -> tuple[bytes, dict[str, str]]:
         "Cache-Control": "max-age=86400, immutable",
     }
     return body, headers
+
+
+def prefiltered_environment_texture(renderer, environment: str) -> tuple[bytes, dict[str, str]]:
+    """
+    The slices of :func:`preview_shaders.rough.prefiltered_environment` for
+    ``environment`` (one of :data:`preview_shaders.rough.ENVIRONMENTS`),
+    drawn on ``renderer``'s GL thread and prefiltered once per process (and
+    cached on disk), as little-endian float32 RGB ``[slice][row][column]``
+    with their sizes in the headers.
+    """
+    from preview_shaders.rough import ENVIRONMENTS, prefiltered_environment
+
+    data = prefiltered_environment(renderer.thread, ENVIRONMENTS.index(environment))
+    nodes, height, width, _ = data.shape
+    headers = {
+        "X-Texture-Width": str(width),
+        "X-Texture-Height": str(height),
+        "X-Texture-Layers": str(nodes),
+        "Cache-Control": "max-age=86400",
+    }
+    return data.astype("<f4").tobytes(), headers

@@ -2,11 +2,14 @@
 Shared fixtures of the editor's browser tests (import them: `from editor_pages import pages, open_editor`): Debian's Chromium through the
 Python playwright package (never a downloaded browser), a real server
 process (tests/conftest.py's live_server), and a check that the page logged
-no error (uncaught exceptions and console errors).
+no error (uncaught exceptions and console errors). :func:`camera_rays` is
+numpy's twin of the preview's camera (shader_ball.frag), for the WebGL
+parity tests.
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from playwright.sync_api import sync_playwright
 
@@ -63,3 +66,32 @@ def open_editor(page, url):
     page.goto(url)
     page.wait_for_selector("body[data-ready=true]")
     page.wait_for_function("!document.body.hasAttribute('aria-busy')")
+
+
+def camera_rays(yaw, pitch, distance, fov, width, height, bands=3):
+    """
+    numpy of shader_ball.frag's camera at width x height pixels (top row
+    first): NdotV, the hit mask, the band index of each pixel and the
+    mirror direction R (world, unit) on the unit sphere.
+    """
+    y, x = np.mgrid[0:height, 0:width]
+    frag = np.stack([x + 0.5, (height - 1 - y) + 0.5], axis=-1)
+    eye = distance * np.array([np.cos(pitch) * np.sin(yaw), np.sin(pitch), np.cos(pitch) * np.cos(yaw)])
+    forward = -eye / np.linalg.norm(eye)
+    right = np.cross(forward, [0.0, 1.0, 0.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    ndc = (2.0 * frag - np.array([width, height])) / height
+    focal = np.tan(0.5 * fov)
+    d = forward + focal * (ndc[..., :1] * right + ndc[..., 1:] * up)
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    b = d @ eye
+    disc = b * b - (eye @ eye - 1.0)
+    hit = disc > 0
+    t = -b - np.sqrt(np.maximum(disc, 0.0))
+    N = eye + t[..., None] * d
+    N /= np.linalg.norm(N, axis=-1, keepdims=True)
+    cos = np.sum(N * -d, axis=-1)
+    R = d + 2.0 * cos[..., None] * N
+    band = np.clip(np.floor(frag[..., 0] * bands / width), 0, bands - 1).astype(int)
+    return np.clip(cos, 0.0, 1.0), hit, band, R

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from editor_pages import editor_url, open_editor, pages  # noqa: F401 (fixtures)
+from editor_pages import camera_rays, editor_url, open_editor, pages  # noqa: F401 (fixtures)
 
 from fitting import (
     baseline_inputs, coated_conductor_model, curve_base_from_nk, halves_to_uint32, lazanyi_adjusted,
@@ -37,30 +37,6 @@ def read(page, output: str):
     return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1]
 
 
-def camera_geometry(yaw, pitch, distance, fov):
-    """numpy of shader_ball.frag's camera: NdotV, hit mask, band index (3 bands)."""
-    y, x = np.mgrid[0:H, 0:W]
-    frag = np.stack([x + 0.5, (H - 1 - y) + 0.5], axis=-1)
-    eye = distance * np.array([np.cos(pitch) * np.sin(yaw), np.sin(pitch), np.cos(pitch) * np.cos(yaw)])
-    forward = -eye / np.linalg.norm(eye)
-    right = np.cross(forward, [0.0, 1.0, 0.0])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    ndc = (2.0 * frag - np.array([W, H])) / H
-    focal = np.tan(0.5 * fov)
-    d = forward + focal * (ndc[..., :1] * right + ndc[..., 1:] * up)
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
-    b = d @ eye
-    disc = b * b - (eye @ eye - 1.0)
-    hit = disc > 0
-    t = -b - np.sqrt(np.maximum(disc, 0.0))
-    N = eye + t[..., None] * d
-    N /= np.linalg.norm(N, axis=-1, keepdims=True)
-    NdotV = np.clip(np.sum(N * -d, axis=-1), 0.0, 1.0)
-    band = np.clip(np.floor(frag[..., 0] * 3 / W), 0, 2).astype(int)
-    return NdotV, hit, band
-
-
 def test_preview_matches_numpy(pages, editor_url):
     page = pages.new()
     open_editor(page, editor_url)
@@ -78,7 +54,7 @@ def test_preview_matches_numpy(pages, editor_url):
     assert state["words"] == halves_to_uint32(C.astype(np.float16)).tolist()
 
     geometry, fresnel, linear, display = (read(page, o) for o in ("geometry", "fresnel", "linear", "display"))
-    NdotV, hit, band = camera_geometry(*state["orbit"], state["fov"])
+    NdotV, hit, band, _ = camera_rays(*state["orbit"], state["fov"], W, H)
     gl_hit = geometry[..., 1] > 0.5
     # Pixels whose centre is this close to the silhouette may round either way.
     assert np.mean(gl_hit != hit) < 0.01

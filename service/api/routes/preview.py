@@ -6,8 +6,9 @@ Preview
 (``&roughness=0.3&mode=coated&coat_roughness=0.1``): the
 preview sphere of a stored fit (``preview_shaders.preview``), optionally
 split with adjusted Lazanyi or the spectral reference (these need the
-fit's n, k). One renderer per app, made on first use; it owns its GL
-thread, so concurrent requests are serialised there. At most
+fit's n, k). One renderer per app (:func:`service.api.deps.get_preview_renderer`),
+made on first use; it owns its GL thread, so concurrent requests are
+serialised there. At most
 ``max_previews_in_flight`` previews are computed at once (the spectral
 reference of a large preview is seconds of CPU); past it a request is
 answered 503 with Retry-After rather than queued.
@@ -24,21 +25,10 @@ from fitting.models.pack import material_from_json
 
 from ...jobs.common import measured_nk, stored_fit
 from ...schemas import API_PREFIX, ETA_I_LIMITS, FIT_ID_PATTERN, ErrorBody
-from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep
+from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep, get_preview_renderer
 
 router = APIRouter(prefix=API_PREFIX, tags=["preview"])
 _lock = threading.Lock()
-
-
-def renderer(request: Request):
-    """The app's preview renderer, made on first use."""
-    state = request.app.state
-    with _lock:
-        if state.preview_renderer is None:
-            from preview_shaders.preview import PreviewRenderer
-
-            state.preview_renderer = PreviewRenderer()
-        return state.preview_renderer
 
 
 def _slots(request: Request, settings) -> threading.BoundedSemaphore:
@@ -96,12 +86,7 @@ def preview_png(
             headers={"Retry-After": "2"},
         )
     try:
-        try:
-            active = renderer(request)
-        except Exception as error:  # no GL driver: the rest of the service still works
-            raise HTTPException(
-                status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
-            ) from None
+        active = get_preview_renderer(request)
         result = active.render_preview(
             material_from_json(record.material), nk, eta_i=eta_i, size=size,
             compare=compare, environment=environment, differences=False,

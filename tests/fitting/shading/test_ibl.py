@@ -1,4 +1,5 @@
-"""The split-sum LUT: pre-integration, lookup, file format, average Fresnel."""
+"""The split-sum LUT: pre-integration, lookup, file format, average Fresnel,
+the directional albedo of any Fresnel function."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from fitting.shading.ibl import (
     _node_terms,
     average_fresnel,
     decode_lut,
+    directional_albedo,
     encode_lut,
     energy_compensation,
     generate_lut,
@@ -116,3 +118,32 @@ class TestFileFormat:
             generate_lut(shape=(1, 4, 4))
         with pytest.raises(ValueError, match="`samples` must lie"):
             generate_lut(samples=3)
+
+
+class TestDirectionalAlbedo:
+    def test_model_fresnel_is_the_lut_terms(self):
+        # The same quadrature as the LUT's nodes: E = F0 A + B - a G exactly.
+        mu = np.array([0.0, 0.04, 0.3, 0.81, 1.0])
+        F0, a, alpha = np.array([0.9, 0.6, 0.3]), np.array([0.5, 0.2, -0.1]), np.array([6.0, 3.0, 1.5])
+        u1, u2 = _hammersley(256)
+        got = directional_albedo(mu, 0.4, lambda c: model_from_parameters(c[..., None], F0, a, alpha), 256)
+        for c in range(3):
+            A, B, G = np.moveaxis(_node_terms(mu, 0.4, np.array([alpha[c]]), u1, u2)[:, 0], -1, 0)
+            np.testing.assert_allclose(got[:, c], F0[c] * A + B - a[c] * G, rtol=1e-12, atol=1e-15)
+
+    def test_white_lobe_loses_energy_only_when_rough(self):
+        white = lambda c: np.ones(c.shape + (3,))  # noqa: E731
+        np.testing.assert_allclose(directional_albedo([1.0, 0.5], 0.0, white), 1.0, atol=1e-6)
+        rough = directional_albedo([1.0, 0.5, 0.1], 1.0, white)
+        assert np.all((rough > 0.2) & (rough < 0.9))
+
+    def test_n_dimensional_input_is_flattened(self):
+        got = directional_albedo(np.full((2, 3), 0.5), 0.3, lambda c: np.ones(c.shape + (3,)), 64)
+        assert got.shape == (6, 3)
+
+    @pytest.mark.parametrize("NdotV, roughness, samples, message", [
+        ([0.5, np.nan], 0.3, 64, "NdotV"), ([0.5], np.inf, 64, "roughness"), ([0.5], 0.3, 0, "samples"),
+    ])
+    def test_refusals_name_the_argument(self, NdotV, roughness, samples, message):
+        with pytest.raises(ValueError, match=message):
+            directional_albedo(NdotV, roughness, lambda c: np.ones(c.shape + (3,)), samples)

@@ -1,0 +1,61 @@
+"""
+``GET /api/v1/environments/{environment}/prefiltered``: the preview
+environments prefiltered per roughness for the editor's WebGL split sum,
+the same slices as the server's own rough preview.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from conftest import app_client
+
+API = "/api/v1"
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory):
+    with app_client(tmp_path_factory.mktemp("environments")) as test_client:
+        yield test_client
+
+
+@pytest.mark.gl
+@pytest.mark.parametrize("environment", ["white_sky", "studio", "outdoor"])
+def test_slices_are_the_rough_preview_s(client, environment):
+    from preview_shaders.rough import ENVIRONMENTS, ROUGHNESS_NODES, prefiltered_environment
+
+    response = client.get(f"{API}/environments/{environment}/prefiltered")
+    assert response.status_code == 200, response.text
+    assert response.headers["content-type"] == "application/octet-stream"
+    layers, height, width = (int(response.headers[f"x-texture-{k}"]) for k in ("layers", "height", "width"))
+    assert (layers, height, width) == (ROUGHNESS_NODES, 64, 128)
+    data = np.frombuffer(response.content, "<f4").reshape(layers, height, width, 3)
+    renderer = client.app.state.preview_renderer
+    expected = prefiltered_environment(renderer.thread, ENVIRONMENTS.index(environment))
+    np.testing.assert_array_equal(data, expected)
+    if environment == "white_sky":
+        np.testing.assert_array_equal(data, 1.0)
+    else:
+        # Lit unevenly; the blur of the roughest slice narrows the range.
+        assert data[0].max() > 1.0 and data[0].min() < 0.2
+        assert data[-1].max() < data[0].max() and data[-1].min() > data[0].min()
+
+
+def test_unknown_environment_422(client):
+    response = client.get(f"{API}/environments/beach/prefiltered")
+    assert response.status_code == 422
+    assert "environment" in response.text
+
+
+def test_no_gl_driver_503(tmp_path, monkeypatch):
+    import preview_shaders.preview
+
+    def refuse(*args, **kwargs):
+        raise RuntimeError("no EGL display")
+
+    monkeypatch.setattr(preview_shaders.preview, "PreviewRenderer", refuse)
+    with app_client(tmp_path) as other:
+        response = other.get(f"{API}/environments/studio/prefiltered")
+    assert response.status_code == 503
+    assert "no EGL display" in response.json()["detail"]
