@@ -268,12 +268,18 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
     editing) is stored but not saved under its material until the same
     request comes without ``draft``.
     """
-    stored = await asyncio.to_thread(store.get_fit, fit.fit_id)
+    def stored_or_writable() -> FitRecord | None:
+        # One trip to a thread for both (a live refit is a round trip per drag step).
+        stored = store.get_fit(fit.fit_id)
+        if stored is None:
+            checked_writable(store)
+        return stored
+
+    stored = await asyncio.to_thread(stored_or_writable)
     if stored is not None:
         if fit.draft:
             return stored, False
         return await asyncio.to_thread(store.put_fit, stored), False
-    await asyncio.to_thread(checked_writable, store)
     base, base_record = fit.base, fit.base_record
     # The measured data behind the edit (for the reference curves and
     # previews): the base's, or, for an edited base, the data it had.
