@@ -14,7 +14,9 @@ n, k fits
 from __future__ import annotations
 
 import asyncio
+import threading
 import time
+from collections import OrderedDict
 from pathlib import PurePath
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -192,6 +194,34 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord
     return await runner.once(fit.fit_id, make), True
 
 
+_CURVES_CACHE: "OrderedDict[tuple, tuple[list, list]]" = OrderedDict()
+_CURVES_CACHE_SIZE = 64
+_CURVES_LOCK = threading.Lock()
+
+
+def _measured_curves(nk: SpectralNK, eta_i: float, samples: int) -> tuple[list, list]:
+    """
+    (1 nm reference, adjusted Lazanyi) of ``nk`` at ``eta_i`` against the
+    angle: they depend on the measured data alone, not on the fit, so every
+    refit of one material (an editor drag asks for one per step) reuses
+    them; the most recent few are kept.
+    """
+    key = (nk.content_key(), eta_i, samples)
+    with _CURVES_LOCK:
+        if key in _CURVES_CACHE:
+            _CURVES_CACHE.move_to_end(key)
+            return _CURVES_CACHE[key]
+    mu = cos_theta_from_angle(np.linspace(0.0, 90.0, samples))
+    inputs = baseline_inputs(nk)
+    curves = (reference_ACEScg(nk, mu, eta_i).tolist(),
+              lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist())
+    with _CURVES_LOCK:
+        _CURVES_CACHE[key] = curves
+        while len(_CURVES_CACHE) > _CURVES_CACHE_SIZE:
+            _CURVES_CACHE.popitem(last=False)
+    return curves
+
+
 def angle_curves(record: FitRecord, eta_i: float, samples: int) -> dict[str, Any]:
     """
     Linear ACEScg reflectance of a stored fit against the angle theta in the
@@ -205,9 +235,7 @@ def angle_curves(record: FitRecord, eta_i: float, samples: int) -> dict[str, Any
     reference = baseline = None
     nk = measured_nk(record)
     if nk is not None:
-        reference = reference_ACEScg(nk, mu, eta_i).tolist()
-        inputs = baseline_inputs(nk)
-        baseline = lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist()
+        reference, baseline = _measured_curves(nk, float(eta_i), int(samples))
     target = reference
     if record.kind == "curves":
         try:

@@ -98,3 +98,19 @@ def test_curves_in_the_answer_equal_the_curves_route(shared):
     for query in ("curves_eta_i=0.5", "curves_eta_i=nan", "curves_eta_i=1.5&curves_samples=1"):
         refused = client.post(f"{ROUTE}?{query}", json=body(base["id"], 0.85))
         assert refused.status_code == 422, (query, refused.text)
+
+
+def test_measured_curves_are_cached_and_exact():
+    from fitting.colour.reference import reference_ACEScg
+    from fitting.domain import cos_theta_from_angle
+    from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
+    from service.jobs.nk import _measured_curves
+
+    nk = library_material("Cu")
+    mu = cos_theta_from_angle(np.linspace(0.0, 90.0, 19))
+    first = _measured_curves(nk, 1.7, 19)
+    inputs = baseline_inputs(nk)
+    assert first[0] == reference_ACEScg(nk, mu, 1.7).tolist()
+    assert first[1] == lazanyi_adjusted(mu, 1.7, inputs["F0_air"], inputs["F82_air"]).tolist()
+    assert _measured_curves(nk, 1.7, 19) is first  # the same material, eta_i and angles: reused
+    assert _measured_curves(nk, 1.8, 19)[0] != first[0]
