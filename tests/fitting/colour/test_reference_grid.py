@@ -78,6 +78,28 @@ class TestReferenceGrid:
         np.testing.assert_allclose(fast, reference_ACEScg(nk, M, E), rtol=0, atol=1e-14)
         assert np.array_equal(fast[0], fast[2]) and np.array_equal(fast[:, 0], fast[:, 2])
 
+    @pytest.mark.parametrize("mu_count, eta_count", [
+        (100, 100),  # the scoring grid: loop over cos theta, eta_i in blocks
+        (41, 15),    # few eta_i: loop over eta_i, cos theta in blocks
+        (9, 16),
+        (9, 33),     # blocks of unequal size
+        (1025, 1),   # a preview table
+    ])
+    def test_threads_give_the_same_numbers(self, mu_count, eta_count):
+        nk = library_material("Au")
+        mu = np.linspace(0.0, 1.0, mu_count)
+        eta = np.linspace(1.0, 3.0, eta_count)
+        one = reference_ACEScg_grid(nk, mu, eta)
+        for workers in (2, 3, 8):
+            np.testing.assert_array_equal(reference_ACEScg_grid(nk, mu, eta, workers=workers), one)
+        E, M = np.meshgrid(eta, mu, indexing="ij")
+        assert np.max(np.abs(one - reference_ACEScg(nk, M, E))) < 1e-13
+
+    @pytest.mark.parametrize("workers", [0, -1, 1.5, True, "2", 65])
+    def test_refuses_bad_workers(self, workers):
+        with pytest.raises(ValueError, match="`workers` must be an integer in \\[1, 64\\]"):
+            reference_ACEScg_grid(library_material("Au"), [0.5], [1.5], workers=workers)
+
     @pytest.mark.parametrize("mu, eta, message", [
         ([[0.5]], [1.5], "1-D"),
         ([0.5], [0.8], "`eta_i` must be >= 1, got 0.8"),
