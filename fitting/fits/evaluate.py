@@ -5,7 +5,10 @@ Evaluation of a material fit
 -   :func:`evaluate_errors`: Delta E 2000 of the model and the baselines
     against the 1 nm reference on the paper's 100 x 100 grid, as
     :class:`fitting.fits.metrics.ErrorMetrics`.
--   :func:`evaluate_material`: the same as the JSON a fit carries.
+-   :func:`score_on_grid`: the same for any models on the grid (the
+    coated-conductor and rgb-conductor fits share it).
+-   :func:`evaluate_material`, :func:`metrics_json`: the same as the JSON a
+    fit carries.
 
 References
 ----------
@@ -17,49 +20,68 @@ from __future__ import annotations
 
 from typing import Any
 
+from threadpoolctl import ThreadpoolController
+
 from ..colour.reference import evaluation_grid, reference_ACEScg_grid
 from ..domain import DEFAULT_MIN_COVERAGE
+from ..models.baselines import baselines_ACEScg
 from ..models.coated_conductor import coated_conductor_model
 from ..optics.nk import SpectralNK
-from .metrics import ErrorMetrics, baseline_metrics, error_metrics
+from .metrics import ErrorMetrics, grid_metrics
 from .result import FitResult
 
-__all__ = ["evaluate_errors", "evaluate_material"]
+__all__ = ["evaluate_errors", "score_on_grid", "evaluate_material", "metrics_json"]
+
+_THREADPOOLS = ThreadpoolController()
 
 
 def evaluate_errors(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1,
 ) -> dict[str, ErrorMetrics]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
     (``samples`` x ``samples`` over [0, 1] x the fitted domain), for the
     float16 model (``model_float16``), the float64 fit (``model_float64``)
     and (optionally) the adjusted Lazanyi and Schlick baselines (by name),
-    with the breakdown at eta_i = 1, 1.5, 2, 2.5.
+    with the breakdown at eta_i = 1, 1.5, 2, 2.5. ``workers``: threads for
+    the reference (:func:`fitting.colour.reference.reference_ACEScg_grid`;
+    the numbers do not depend on it).
     """
     lo, hi = result.eta_i_range
     M, E = evaluation_grid(samples, (lo, hi))
-    # The grid form: the same numbers as reference_ACEScg(nk, M, E), faster.
-    ref = reference_ACEScg_grid(nk, M[0], E[:, 0], 1.0, min_coverage)
-    rows = E[:, 0]
-    against = f"spectral reference 1 nm, {samples} x {samples}"
-    out = {
-        "model_float16": error_metrics(
-            ref, coated_conductor_model(M, E, result.coefficients_float16, (lo, hi)), rows, against
-        ),
-        "model_float64": error_metrics(
-            ref, coated_conductor_model(M, E, result.coefficients, (lo, hi)), rows, against
-        ),
+    models = {
+        "model_float16": coated_conductor_model(M, E, result.coefficients_float16, (lo, hi)),
+        "model_float64": coated_conductor_model(M, E, result.coefficients, (lo, hi)),
     }
-    if baselines:
-        out.update(baseline_metrics(nk, M, E, ref, min_coverage, against))
-    return out
+    return score_on_grid(nk, M, E, models, baselines, min_coverage, workers)
+
+
+def score_on_grid(
+    nk: SpectralNK, cos_theta, eta_i, models, baselines: bool = True,
+    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1,
+) -> dict[str, ErrorMetrics]:
+    """
+    :func:`fitting.fits.metrics.grid_metrics` of ``models`` (name to (E, M, 3)
+    linear ACEScg) and, with ``baselines``, of every baseline, against the
+    1 nm reference on the grid (``cos_theta``, ``eta_i``) of
+    :func:`fitting.colour.reference.evaluation_grid`; keyed by name, models
+    first.
+    """
+    # The grid form: the same numbers as reference_ACEScg(nk, M, E), faster.
+    # The matrix products of the reference and the models are small: BLAS
+    # threads would only oversubscribe the reference's own threads.
+    with _THREADPOOLS.limit(limits=1, user_api="blas"):
+        ref = reference_ACEScg_grid(nk, cos_theta[0], eta_i[:, 0], 1.0, min_coverage, workers)
+        if baselines:
+            models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
+        return grid_metrics(ref, models, eta_i[:, 0],
+                            f"spectral reference 1 nm, {eta_i.shape[0]} x {eta_i.shape[1]}")
 
 
 def evaluate_material(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1,
 ) -> dict[str, Any]:
     """
     :func:`evaluate_errors` as the JSON a fit carries (``FitResult.metrics``,
@@ -67,7 +89,17 @@ def evaluate_material(
     :meth:`~fitting.fits.metrics.ErrorMetrics.to_dict` by name, ``coverage``.
     Sets ``result.error`` to the float16 model's :class:`ErrorMetrics`.
     """
-    errors = evaluate_errors(nk, result, samples, baselines, min_coverage)
+    return metrics_json(evaluate_errors(nk, result, samples, baselines, min_coverage, workers),
+                        result, samples)
+
+
+def metrics_json(errors: dict[str, ErrorMetrics], result: FitResult, samples: int) -> dict[str, Any]:
+    """
+    The JSON of :func:`evaluate_material` from the ``errors`` of
+    :func:`score_on_grid` (``model_float16``, ``model_float64``, baselines);
+    sets ``result.error`` to the float16 model's.
+    """
+    errors = dict(errors)
     result.error = errors["model_float16"]
     out: dict[str, Any] = {"grid": f"{samples}x{samples}"}
     out["model_float16"] = errors.pop("model_float16").to_dict()

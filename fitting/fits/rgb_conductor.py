@@ -41,7 +41,7 @@ from ..models.pack import PackedMaterial, to_float16
 from ..models.rgb_conductor import MODEL_KIND, rgb_conductor_model
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, resample_nk
-from .metrics import baseline_metrics, error_metrics
+from .evaluate import metrics_json, score_on_grid
 from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
 from .settings import OBJECTIVES, FitSettings, fit_grid
@@ -248,7 +248,7 @@ def fit_rgb_conductor(
 
 def evaluate_rgb_conductor(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1,
 ) -> dict[str, Any]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
@@ -257,21 +257,13 @@ def evaluate_rgb_conductor(
     :func:`fitting.fits.evaluate.evaluate_material`. Sets ``result.error``
     to the float16 model's :class:`fitting.fits.metrics.ErrorMetrics`.
     """
-    lo, hi = result.eta_i_range
-    M, E = evaluation_grid(samples, (lo, hi))
-    ref = reference_ACEScg(nk, M, E, 1.0, min_coverage)
-    rows = E[:, 0]
-    against = f"spectral reference 1 nm, {samples} x {samples}"
-    result.error = error_metrics(ref, rgb_conductor_model(M, E, result.coefficients_float16), rows, against)
-    out: dict[str, Any] = {
-        "grid": f"{samples}x{samples}",
-        "model_float16": result.error.to_dict(),
-        "model_float64": error_metrics(ref, rgb_conductor_model(M, E, result.coefficients), rows, against).to_dict(),
-        "coverage": result.coverage,
+    M, E = evaluation_grid(samples, result.eta_i_range)
+    models = {
+        "model_float16": rgb_conductor_model(M, E, result.coefficients_float16),
+        "model_float64": rgb_conductor_model(M, E, result.coefficients),
     }
-    if baselines:
-        out.update({name: m.to_dict() for name, m in baseline_metrics(nk, M, E, ref, min_coverage, against).items()})
-    return out
+    return metrics_json(score_on_grid(nk, M, E, models, baselines, min_coverage, workers),
+                        result, samples)
 
 
 RGB_NK_SAMPLES = 64
