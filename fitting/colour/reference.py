@@ -21,7 +21,6 @@ Sections 3.1 and 4.1.
 
 from __future__ import annotations
 
-import concurrent.futures
 import functools
 import math
 
@@ -29,7 +28,7 @@ import numpy as np
 
 from ..domain import (
     DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, ETA_I_MIN, VISIBLE_RANGE_NM, as_finite_array, check_choice,
-    check_int, check_step_nm,
+    check_step_nm,
 )
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, resample_nk
@@ -116,14 +115,12 @@ def reference_ACEScg(
 
 # Values per block of one numpy call: small enough that the block's buffers
 # stay in cache, large enough that numpy's per-call overhead does not dominate.
-_BLOCK = 32
+_BLOCK = 50
 # From this many eta_i values on, the kernel loops over cos theta and
 # vectorises over (eta_i, wavelength), a quarter faster than broadcasting a
 # column of cos theta terms; with fewer (a preview table: one eta_i, a
 # thousand cos theta) it loops over eta_i.
 _MIN_ETA_FOR_MU_LOOP = 16
-# Bound on `workers`: threads past the cores only add switching.
-_MAX_WORKERS = 64
 DTYPES = ("float64", "float32")
 """Arithmetic of :func:`reference_ACEScg_grid`: float64 is the definition."""
 
@@ -246,7 +243,6 @@ def reference_ACEScg_grid(
     eta_i,
     step_nm: float = 1.0,
     min_coverage: float = DEFAULT_MIN_COVERAGE,
-    workers: int = 1,
     dtype="float64",
 ) -> np.ndarray:
     """
@@ -263,11 +259,6 @@ def reference_ACEScg_grid(
         :math:`\\mu` values in the coating (M,), clipped to [0, 1].
     eta_i
         Real coating indices (E,), >= 1.
-    workers
-        Threads the eta_i rows are split between (numpy releases the GIL in
-        the kernel); each thread has its own buffers, and the numbers do not
-        depend on ``workers``. The caller bounds BLAS threads (the kernel's
-        matrix products are small).
     dtype
         The arithmetic, one of :data:`DTYPES`. ``float64`` is the
         definition. ``float32`` runs the kernel in float32 (about 40 %
@@ -293,7 +284,6 @@ def reference_ACEScg_grid(
         raise ValueError("`cos_theta` and `eta_i` must be 1-D arrays of grid values")
     if np.any(eta < 1.0):
         raise ValueError(f"`eta_i` must be >= 1, got {eta.min():g}")
-    workers = check_int("workers", workers, 1, _MAX_WORKERS)
     try:
         dtype = np.dtype(dtype)
     except TypeError:
@@ -310,26 +300,13 @@ def reference_ACEScg_grid(
     np.add.at(WT, nk_inverse.reshape(-1), W.T)
     n, k = nk_u[:, 0].copy(), nk_u[:, 1].copy()
     out = np.empty((eta_u.size, mu_u.size, 3))
-    loop_mu = eta_u.size >= _MIN_ETA_FOR_MU_LOOP
-    # The blocks of eta_i rows depend on the grid alone, never on `workers`,
-    # so every row meets the same matrix products: the numbers are the same
-    # for any number of threads. Equal blocks, dealt out in turn.
-    count = math.ceil(eta_u.size / _BLOCK) if loop_mu else eta_u.size
-    blocks = [(r[0], r[-1] + 1) for r in np.array_split(np.arange(eta_u.size), count)]
-    shares = [blocks[w::workers] for w in range(min(workers, len(blocks)))]
-
-    def run(share) -> None:
-        for lo, hi in share:
-            _fresnel_ACEScg_block(mu_u, eta_u[lo:hi], n, k, WT, out[lo:hi], loop_mu, dtype)
-
-    if len(shares) == 1:
-        run(shares[0])
+    if eta_u.size < _MIN_ETA_FOR_MU_LOOP:
+        _fresnel_ACEScg_block(mu_u, eta_u, n, k, WT, out, False, dtype)
     else:
-        with concurrent.futures.ThreadPoolExecutor(len(shares) - 1) as pool:
-            others = [pool.submit(run, share) for share in shares[1:]]
-            run(shares[0])
-            for future in others:
-                future.result()
+        # Blocks of equal size, none larger than _BLOCK.
+        for rows in np.array_split(np.arange(eta_u.size), math.ceil(eta_u.size / _BLOCK)):
+            lo, hi = rows[0], rows[-1] + 1
+            _fresnel_ACEScg_block(mu_u, eta_u[lo:hi], n, k, WT, out[lo:hi], True, dtype)
     return out[eta_inverse.reshape(-1)][:, mu_inverse.reshape(-1)]
 
 

@@ -20,8 +20,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from threadpoolctl import ThreadpoolController
-
 from ..colour.reference import evaluation_grid, reference_ACEScg_grid
 from ..domain import DEFAULT_MIN_COVERAGE
 from ..models.baselines import baselines_ACEScg
@@ -32,22 +30,19 @@ from .result import FitResult
 
 __all__ = ["evaluate_errors", "score_on_grid", "evaluate_material", "metrics_json"]
 
-_THREADPOOLS = ThreadpoolController()
-
 
 def evaluate_errors(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1, dtype: str = "float64",
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
 ) -> dict[str, ErrorMetrics]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
     (``samples`` x ``samples`` over [0, 1] x the fitted domain), for the
     float16 model (``model_float16``), the float64 fit (``model_float64``)
     and (optionally) the adjusted Lazanyi and Schlick baselines (by name),
-    with the breakdown at eta_i = 1, 1.5, 2, 2.5. ``workers`` and ``dtype``:
-    the threads and the arithmetic of the reference
-    (:func:`fitting.colour.reference.reference_ACEScg_grid`: the numbers do
-    not depend on ``workers``; ``float32`` moves Delta E by less than 1e-4).
+    with the breakdown at eta_i = 1, 1.5, 2, 2.5. ``dtype``: the arithmetic
+    of the reference (:func:`fitting.colour.reference.reference_ACEScg_grid`;
+    ``float32`` moves Delta E by less than 1e-4).
     """
     lo, hi = result.eta_i_range
     M, E = evaluation_grid(samples, (lo, hi))
@@ -55,35 +50,31 @@ def evaluate_errors(
         "model_float16": coated_conductor_model(M, E, result.coefficients_float16, (lo, hi)),
         "model_float64": coated_conductor_model(M, E, result.coefficients, (lo, hi)),
     }
-    return score_on_grid(nk, M, E, models, baselines, min_coverage, workers, dtype)
+    return score_on_grid(nk, M, E, models, baselines, min_coverage, dtype)
 
 
 def score_on_grid(
     nk: SpectralNK, cos_theta, eta_i, models, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1, dtype: str = "float64",
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
 ) -> dict[str, ErrorMetrics]:
     """
     :func:`fitting.fits.metrics.grid_metrics` of ``models`` (name to (E, M, 3)
     linear ACEScg) and, with ``baselines``, of every baseline, against the
     1 nm reference on the grid (``cos_theta``, ``eta_i``) of
     :func:`fitting.colour.reference.evaluation_grid`; keyed by name, models
-    first; ``workers``, ``dtype`` as :func:`evaluate_errors`.
+    first; ``dtype`` as :func:`evaluate_errors`.
     """
     # The grid form: the same numbers as reference_ACEScg(nk, M, E), faster.
-    # The matrix products of the reference and the models are small: BLAS
-    # threads would only oversubscribe the reference's own threads.
-    with _THREADPOOLS.limit(limits=1, user_api="blas"):
-        ref = reference_ACEScg_grid(nk, cos_theta[0], eta_i[:, 0], 1.0, min_coverage, workers,
-                                    dtype)
-        if baselines:
-            models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
-        return grid_metrics(ref, models, eta_i[:, 0],
-                            f"spectral reference 1 nm, {eta_i.shape[0]} x {eta_i.shape[1]}")
+    ref = reference_ACEScg_grid(nk, cos_theta[0], eta_i[:, 0], 1.0, min_coverage, dtype)
+    if baselines:
+        models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
+    return grid_metrics(ref, models, eta_i[:, 0],
+                        f"spectral reference 1 nm, {eta_i.shape[0]} x {eta_i.shape[1]}")
 
 
 def evaluate_material(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1, dtype: str = "float64",
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
 ) -> dict[str, Any]:
     """
     :func:`evaluate_errors` as the JSON a fit carries (``FitResult.metrics``,
@@ -92,7 +83,7 @@ def evaluate_material(
     Sets ``result.error`` to the float16 model's :class:`ErrorMetrics`.
     """
     return metrics_json(
-        evaluate_errors(nk, result, samples, baselines, min_coverage, workers, dtype), result, samples
+        evaluate_errors(nk, result, samples, baselines, min_coverage, dtype), result, samples
     )
 
 

@@ -248,7 +248,7 @@ def fit_rgb_conductor(
 
 def evaluate_rgb_conductor(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, workers: int = 1, dtype: str = "float64",
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
 ) -> dict[str, Any]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
@@ -263,7 +263,7 @@ def evaluate_rgb_conductor(
         "model_float64": rgb_conductor_model(M, E, result.coefficients),
     }
     return metrics_json(
-        score_on_grid(nk, M, E, models, baselines, min_coverage, workers, dtype), result, samples
+        score_on_grid(nk, M, E, models, baselines, min_coverage, dtype), result, samples
     )
 
 

@@ -51,17 +51,10 @@ __all__ = ["NKFit", "fit_nk", "angle_curves", "MAX_NK_SAMPLES"]
 MAX_NK_SAMPLES = 20_000
 """Most wavelength samples accepted in one n, k table."""
 
-METRICS_THREADS = 2
-"""
-Threads for the spectral reference of a fit's metrics (the numbers do not
-depend on it): a lone request gets the idle core; under full load the pool's
-processes share the cores either way.
-"""
-
 METRICS_DTYPE = "float32"
 """
-Arithmetic of that reference: float32, about 40 % faster than the float64
-definition, its Delta E within 5e-5 of it (see
+Arithmetic of the spectral reference of a fit's metrics: float32, about 40 %
+faster than the float64 definition, its Delta E within 5e-5 of it (see
 :func:`fitting.colour.reference.reference_ACEScg_grid`; docs/service.md).
 """
 
@@ -156,8 +149,7 @@ def _nk_job(fit: NKFit) -> dict[str, Any]:
     """Worker process: fit, quantise and score one material."""
     result = fit_model(fit.nk, fit.eta_i_range, fit.model, objective=fit.objective)
     t0 = time.perf_counter()
-    metrics = evaluate_model(fit.nk, result, samples=fit.metrics_samples, workers=METRICS_THREADS,
-                             dtype=METRICS_DTYPE)
+    metrics = evaluate_model(fit.nk, result, samples=fit.metrics_samples, dtype=METRICS_DTYPE)
     timings = {**result.timings, "evaluate": time.perf_counter() - t0}
     packed = PackedMaterial(
         name=fit.name, coefficients=result.coefficients_float16,
