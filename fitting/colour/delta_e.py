@@ -27,6 +27,7 @@ __all__ = ["delta_E_2000", "delta_E_map", "de2000_weights"]
 
 
 _25_7 = 25.0**7
+_TINY = np.finfo(np.float64).tiny
 _RAD = np.pi / 180.0
 # cos and sin of the phase shifts of T (Sharma et al. 2005, Eq. 15).
 _COS30, _SIN30 = np.cos(30.0 * _RAD), np.sin(30.0 * _RAD)
@@ -67,28 +68,25 @@ def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
     ap1, ap2 = g * a1, g * a2
     Cp1, Cp2 = np.sqrt(ap1 * ap1 + bb1), np.sqrt(ap2 * ap2 + bb2)
     CC = Cp1 * Cp2
-    chromatic = CC > 0.0
-    # Unit hue vectors; an achromatic colour has none (its Delta H' is 0,
-    # and then neither T nor R_T changes the result).
-    r1 = np.where(chromatic, 1.0 / np.where(chromatic, Cp1, 1.0), 0.0)
-    r2 = np.where(chromatic, 1.0 / np.where(chromatic, Cp2, 1.0), 0.0)
+    # Unit hue vectors. An achromatic colour (C' = 0) has none: its vector
+    # is 0, so Delta H' is 0, and then neither T nor R_T changes the result.
+    r1, r2 = 1.0 / np.maximum(Cp1, _TINY), 1.0 / np.maximum(Cp2, _TINY)
     x1, y1, x2, y2 = ap1 * r1, b1 * r1, ap2 * r2, b2 * r2
     dx, dy = x2 - x1, y2 - y1
     dH = np.copysign(np.sqrt(CC * (dx * dx + dy * dy)), x1 * y2 - y1 * x2)
     wx, wy = x1 + x2, y1 + y2
     # Opposite hues (|Delta h'| = 180 degrees): the paper's rule gives the
-    # smaller hue + 90 degrees, the quarter turn of the vector at hue < 180.
+    # smaller hue + 90 degrees, the quarter turn of the vector at hue < 180;
     # Delta h' is then +180 from the smaller hue (Delta H' > 0), else -180.
-    opposite = (wx == 0.0) & (wy == 0.0) & chromatic
+    opposite = (wx == 0.0) & (wy == 0.0) & (CC > 0.0)
     if np.any(opposite):
         upper = (y1 > 0.0) | ((y1 == 0.0) & (x1 > 0.0))
         wx = np.where(opposite, -np.where(upper, y1, y2), wx)
         wy = np.where(opposite, np.where(upper, x1, x2), wy)
         dH = np.where(opposite, np.where(upper, 1.0, -1.0) * np.abs(dH), dH)
-    h = np.arctan2(wy, wx)
-    h += np.where(h < 0.0, 2.0 * np.pi, 0.0)  # mean hue in [0, 2 pi)
-    w = np.sqrt(wx * wx + wy * wy)
-    w = np.where(w > 0.0, w, 1.0)  # achromatic: any direction
+    h = np.arctan2(wy, wx) / _RAD
+    h += 360.0 * (h < 0.0)  # mean hue in [0, 360) degrees
+    w = np.maximum(np.sqrt(wx * wx + wy * wy), _TINY)  # 0 when achromatic: T is then 1
     c, s = wx / w, wy / w
     c2, s2 = c * c - s * s, 2.0 * c * s  # cos 2h, sin 2h
     T = (
@@ -98,7 +96,7 @@ def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
         + 0.32 * ((c * c2 - s * s2) * _COS6 - (s * c2 + c * s2) * _SIN6)
         - 0.20 * ((c2 * c2 - s2 * s2) * _COS63 + 2.0 * s2 * c2 * _SIN63)
     )
-    q = (h / _RAD - 275.0) / 25.0
+    q = (h - 275.0) / 25.0
     C_bar = (Cp1 + Cp2) / 2.0
     C_bar7 = _pow7(C_bar)
     R_T = -np.sin(60.0 * _RAD * np.exp(-q * q)) * 2.0 * np.sqrt(C_bar7 / (C_bar7 + _25_7))
