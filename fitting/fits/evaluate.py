@@ -5,6 +5,7 @@ Evaluation of a material fit
 -   :func:`evaluate_errors`: Delta E 2000 of the model and the baselines
     against the 1 nm reference on the paper's 100 x 100 grid, as
     :class:`fitting.fits.metrics.ErrorMetrics`.
+-   :func:`grid_models`: a fit of either kind on the grid.
 -   :func:`score_on_grid`: the same for any models on the grid (the
     coated-conductor and rgb-conductor fits share it).
 -   :func:`evaluate_material`, :func:`metrics_json`: the same as the JSON a
@@ -20,15 +21,17 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from ..colour.reference import evaluation_grid, reference_ACEScg_grid
 from ..domain import DEFAULT_MIN_COVERAGE
 from ..models.baselines import baselines_ACEScg
-from ..models.coated_conductor import coated_conductor_model
+from ..models.kinds import model_ACEScg
 from ..optics.nk import SpectralNK
 from .metrics import ErrorMetrics, grid_metrics
 from .result import FitResult
 
-__all__ = ["evaluate_errors", "score_on_grid", "evaluate_material", "metrics_json"]
+__all__ = ["evaluate_errors", "grid_models", "score_on_grid", "evaluate_material", "metrics_json"]
 
 
 def evaluate_errors(
@@ -44,28 +47,42 @@ def evaluate_errors(
     of the reference (:func:`fitting.colour.reference.reference_ACEScg_grid`;
     ``float32`` moves Delta E by less than 1e-4).
     """
-    lo, hi = result.eta_i_range
-    M, E = evaluation_grid(samples, (lo, hi))
-    models = {
-        "model_float16": coated_conductor_model(M, E, result.coefficients_float16, (lo, hi)),
-        "model_float64": coated_conductor_model(M, E, result.coefficients, (lo, hi)),
+    M, E = evaluation_grid(samples, result.eta_i_range)
+    return score_on_grid(nk, M, E, grid_models(result, M, E), baselines, min_coverage, dtype)
+
+
+def grid_models(result: FitResult, cos_theta, eta_i) -> dict[str, np.ndarray]:
+    """
+    The float16 model (``model_float16``) and the float64 fit
+    (``model_float64``) of ``result``, of either kind
+    (:func:`fitting.models.kinds.model_ACEScg`), on the grid (``cos_theta``,
+    ``eta_i``): linear ACEScg, shape ``cos_theta.shape + (3,)``.
+    """
+    return {
+        name: model_ACEScg(result.model, cos_theta, eta_i, coefficients, result.eta_i_range)
+        for name, coefficients in (("model_float16", result.coefficients_float16),
+                                   ("model_float64", result.coefficients))
     }
-    return score_on_grid(nk, M, E, models, baselines, min_coverage, dtype)
 
 
 def score_on_grid(
     nk: SpectralNK, cos_theta, eta_i, models, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64", reference=None,
 ) -> dict[str, ErrorMetrics]:
     """
     :func:`fitting.fits.metrics.grid_metrics` of ``models`` (name to (E, M, 3)
     linear ACEScg) and, with ``baselines``, of every baseline, against the
     1 nm reference on the grid (``cos_theta``, ``eta_i``) of
     :func:`fitting.colour.reference.evaluation_grid`; keyed by name, models
-    first; ``dtype`` as :func:`evaluate_errors`.
+    first; ``dtype`` as :func:`evaluate_errors`. ``reference``: that
+    reference when already computed (``reference_ACEScg_grid(nk,
+    cos_theta[0], eta_i[:, 0], 1.0, min_coverage, dtype)``), so that it can
+    be computed beside the fit, which does not need it.
     """
     # The grid form: the same numbers as reference_ACEScg(nk, M, E), faster.
-    ref = reference_ACEScg_grid(nk, cos_theta[0], eta_i[:, 0], 1.0, min_coverage, dtype)
+    ref = reference
+    if ref is None:
+        ref = reference_ACEScg_grid(nk, cos_theta[0], eta_i[:, 0], 1.0, min_coverage, dtype)
     if baselines:
         models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
     return grid_metrics(ref, models, eta_i[:, 0],

@@ -35,13 +35,13 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..colour.reference import evaluation_grid, reference_ACEScg, spectral_weights
+from ..colour.reference import reference_ACEScg, spectral_weights
 from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, check_eta_i_range
 from ..models.pack import PackedMaterial, to_float16
-from ..models.rgb_conductor import MODEL_KIND, rgb_conductor_model
+from ..models.rgb_conductor import MODEL_KIND
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, resample_nk
-from .evaluate import metrics_json, score_on_grid
+from .evaluate import evaluate_material
 from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
 from .settings import OBJECTIVES, FitSettings, fit_grid
@@ -255,16 +255,10 @@ def evaluate_rgb_conductor(
     (``samples`` x ``samples`` over [0, 1] x the fitted domain) for the
     float16 and float64 n, k, and (optionally) the baselines; the JSON of
     :func:`fitting.fits.evaluate.evaluate_material`. Sets ``result.error``
-    to the float16 model's :class:`fitting.fits.metrics.ErrorMetrics`.
+    to the float16 model's :class:`fitting.fits.metrics.ErrorMetrics`
+    (:func:`fitting.fits.evaluate.evaluate_material`, which scores either kind).
     """
-    M, E = evaluation_grid(samples, result.eta_i_range)
-    models = {
-        "model_float16": rgb_conductor_model(M, E, result.coefficients_float16),
-        "model_float64": rgb_conductor_model(M, E, result.coefficients),
-    }
-    return metrics_json(
-        score_on_grid(nk, M, E, models, baselines, min_coverage, dtype), result, samples
-    )
+    return evaluate_material(nk, result, samples, baselines, min_coverage, dtype)
 
 
 RGB_NK_SAMPLES = 64
