@@ -261,11 +261,11 @@ def reference_ACEScg_grid(
         Real coating indices (E,), >= 1.
     dtype
         The arithmetic, one of :data:`DTYPES`. ``float64`` is the
-        definition. ``float32`` runs the kernel in float32 (about 40 %
-        faster), except :math:`\\mathrm{Re}(\\eta^2) - \\sin^2\\theta`, the
+        definition. ``float32`` runs the kernel in float32 (nearly twice as
+        fast), except :math:`\\mathrm{Re}(\\eta^2) - \\sin^2\\theta`, the
         one difference that can cancel, formed in float64: every other
         operation rounds relative to its terms, so the reference stays within
-        about 1e-6 of float64 and its Delta E 2000 from it below 5e-5 on
+        2e-7 of float64 and its Delta E 2000 from it below 5e-5 on
         every library conductor, on dielectrics past their critical angle,
         weak absorbers and index-matched data (tested to < 1e-4). The result
         is float64 either way.

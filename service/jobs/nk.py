@@ -56,8 +56,8 @@ MAX_NK_SAMPLES = 20_000
 
 METRICS_DTYPE = "float32"
 """
-Arithmetic of the spectral reference of a fit's metrics: float32, about 40 %
-faster than the float64 definition, its Delta E within 5e-5 of it (see
+Arithmetic of the spectral reference of a fit's metrics: float32, nearly
+twice as fast as the float64 definition, its Delta E within 5e-5 of it (see
 :func:`fitting.colour.reference.reference_ACEScg_grid`; docs/service.md).
 """
 
