@@ -21,9 +21,10 @@ Faults:
 
 -   A worker that dies breaks the whole ``ProcessPoolExecutor`` (every job in
     it fails with ``BrokenProcessPool``). The runner replaces the pool, warms
-    the new workers at once, and runs each interrupted job once more there;
-    only a job that fails twice is answered :class:`WorkerLost`. So a dead
-    worker fails at most its own job (when it kills its worker again).
+    the new workers at once, and runs each interrupted job (or part of one)
+    once more there; only a job that fails twice is answered
+    :class:`WorkerLost`. So a dead worker fails at most its own job (when it
+    kills its worker again).
 -   A request that waits past the time limit gets :class:`FitTimeout`, but
     its job keeps running: its result is saved (fits) or kept (scenes) for
     the retry, which :meth:`FitRunner.once` then answers at once.
