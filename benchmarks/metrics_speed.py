@@ -9,11 +9,15 @@ other work on a shared machine) of
 -   the fit alone (``fit_material``),
 -   the 1 nm reference on the paper's 100 x 100 grid as defined
     (``reference_ACEScg``, complex Fresnel per sample) and on the product
-    grid (``reference_ACEScg_grid``, what ``evaluate_material`` uses),
+    grid (``reference_ACEScg_grid``, what ``evaluate_material`` uses), in
+    float64 and in float32 (what the service uses),
 -   ``evaluate_material`` (reference, float16 / float64 model, 4 baselines),
+    float64 and float32,
 
 and the largest difference of the reported Delta E (mean and max, float16
-model) between the two references. Prints a Markdown table.
+model) from the definition's, for the float64 and the float32 reference.
+One thread (CPU time does not show the service's second thread). Prints a
+Markdown table.
 
     .venv/bin/python benchmarks/metrics_speed.py [--materials Au,Cu,Cr] [--repeat 3]
 """
@@ -52,9 +56,10 @@ def main() -> int:
     parser.add_argument("--materials", default="Au,Cu,Cr")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    print("| material | fit ms | reference as defined ms | grid reference ms | evaluate_material ms "
-          "| fit + evaluate ms | max abs diff of Delta E mean / max |")
-    print("|---|---:|---:|---:|---:|---:|---|")
+    print("| material | fit ms | reference as defined ms | grid reference ms (float32) "
+          "| evaluate_material ms (float32) | fit + evaluate ms (float32) "
+          "| Delta E mean / max minus the definition's: float64 | float32 |")
+    print("|---|---:|---:|---:|---:|---:|---|---|")
     with threadpool_limits(limits=1):
         for name in args.materials.split(","):
             nk = library_material(name)
@@ -62,14 +67,23 @@ def main() -> int:
             M, E = evaluation_grid(100, result.eta_i_range)
             fit = cpu_ms(lambda: fit_material(nk), args.repeat)
             slow = cpu_ms(lambda: reference_ACEScg(nk, M, E, 1.0), args.repeat)
-            grid = cpu_ms(lambda: reference_ACEScg_grid(nk, M[0], E[:, 0], 1.0), args.repeat)
-            evaluate = cpu_ms(lambda: evaluate_material(nk, result), args.repeat)
+            grid, grid32 = (
+                cpu_ms(lambda: reference_ACEScg_grid(nk, M[0], E[:, 0], 1.0, dtype=dtype), args.repeat)
+                for dtype in ("float64", "float32")
+            )
+            evaluate, evaluate32 = (
+                cpu_ms(lambda: evaluate_material(nk, result, dtype=dtype), args.repeat)
+                for dtype in ("float64", "float32")
+            )
             model = coated_conductor_model(M, E, result.coefficients_float16, result.eta_i_range)
             a = error_metrics(reference_ACEScg(nk, M, E, 1.0), model)
-            b = evaluate_material(nk, result, baselines=False)["model_float16"]
-            print(f"| {name} | {fit:.1f} | {slow:.1f} | {grid:.1f} | {evaluate:.1f} | "
-                  f"{fit + evaluate:.1f} | {abs(a.mean - b['delta_E_mean']):.1e} / "
-                  f"{abs(a.max - b['delta_E_max']):.1e} |")
+            diffs = []
+            for dtype in ("float64", "float32"):
+                b = evaluate_material(nk, result, baselines=False, dtype=dtype)["model_float16"]
+                diffs.append(f"{abs(a.mean - b['delta_E_mean']):.1e} / {abs(a.max - b['delta_E_max']):.1e}")
+            print(f"| {name} | {fit:.1f} | {slow:.1f} | {grid:.1f} ({grid32:.1f}) | {evaluate:.1f} "
+                  f"({evaluate32:.1f}) | {fit + evaluate:.1f} ({fit + evaluate32:.1f}) | "
+                  f"{diffs[0]} | {diffs[1]} |")
     return 0
 
 

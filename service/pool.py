@@ -5,8 +5,8 @@ Fitting pool
 The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
 
 -   :class:`FitRunner`: worker processes (``spawn``), a bound on jobs in
-    flight, a time limit per request, shared identical jobs, and recovery
-    from a dead worker.
+    flight, a time limit per request, shared identical jobs, jobs of parts
+    run side by side, and recovery from a dead worker.
 -   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`: why a job
     was not answered (the HTTP edge answers 503, 504 and 503, each with
     ``Retry-After``).
@@ -21,9 +21,10 @@ Faults:
 
 -   A worker that dies breaks the whole ``ProcessPoolExecutor`` (every job in
     it fails with ``BrokenProcessPool``). The runner replaces the pool, warms
-    the new workers at once, and runs each interrupted job once more there;
-    only a job that fails twice is answered :class:`WorkerLost`. So a dead
-    worker fails at most its own job (when it kills its worker again).
+    the new workers at once, and runs each interrupted job (or part of one)
+    once more there; only a job that fails twice is answered
+    :class:`WorkerLost`. So a dead worker fails at most its own job (when it
+    kills its worker again).
 -   A request that waits past the time limit gets :class:`FitTimeout`, but
     its job keeps running: its result is saved (fits) or kept (scenes) for
     the retry, which :meth:`FitRunner.once` then answers at once.
@@ -34,13 +35,14 @@ from __future__ import annotations
 import asyncio
 import collections
 import concurrent.futures
+import contextlib
 import logging
 import math
 import multiprocessing
 import threading
 import time
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any, Awaitable, Callable
+from typing import Any, AsyncIterator, Awaitable, Callable
 
 __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost"]
 
@@ -106,8 +108,10 @@ class FitRunner:
     ``max_in_flight`` jobs may run or wait at once; the next is refused with
     :class:`Overloaded`. A request waits at most ``timeout_s`` seconds
     (:meth:`once`); its job's slot stays taken until the job ends, so the
-    bound stays true. Up to ``keep`` results of jobs whose requests timed
-    out are kept for their retries.
+    bound stays true. A job is one function (:meth:`run`) or parts
+    submitted under one slot (:meth:`slot`, :meth:`submit`), which idle
+    workers run side by side. Up to ``keep`` results of jobs whose requests
+    timed out are kept for their retries.
     """
 
     def __init__(self, workers: int, max_in_flight: int, timeout_s: float, keep: int = 64) -> None:
@@ -194,37 +198,61 @@ class FitRunner:
                 self.completed += 1
                 self._mean_s = 0.8 * self._mean_s + 0.2 * (time.perf_counter() - started)
 
-    async def run(self, function: Callable[..., Any], *args: Any) -> Any:
+    @contextlib.asynccontextmanager
+    async def slot(self) -> AsyncIterator[None]:
         """
-        Run ``function(*args)`` in a worker, without a time limit (the
-        request's limit is :meth:`once`'s); its exceptions (ValueError for
-        bad input) are raised here. A job interrupted by a dead worker runs
-        once more on the replacement pool.
+        One place in the bound for a job of one or more parts
+        (:meth:`submit`), held until the job ends; a job that ends without
+        an exception counts as completed and updates the wait estimate.
 
         Raises
         ------
-        Overloaded, WorkerLost
+        Overloaded
         """
         self._acquire()
         started = time.perf_counter()
         done = None
         try:
-            for attempt in (1, 2):
-                pool = self._executor()
-                try:
-                    future = pool.submit(function, *args)
-                    result = await asyncio.wrap_future(future)
-                except (BrokenProcessPool, RuntimeError) as error:
-                    if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
-                        raise
-                    self._restart(pool)
-                    if attempt == 2:
-                        raise WorkerLost() from None
-                    continue
-                done = started
-                return result
+            yield
+            done = started
         finally:
             self._release(done)
+
+    async def submit(self, function: Callable[..., Any], *args: Any) -> Any:
+        """
+        Run ``function(*args)`` in a worker as one part of a job that holds
+        a :meth:`slot`; its exceptions (ValueError for bad input) are raised
+        here. A part interrupted by a dead worker runs once more on the
+        replacement pool.
+
+        Raises
+        ------
+        WorkerLost
+        """
+        for attempt in (1, 2):
+            pool = self._executor()
+            try:
+                future = pool.submit(function, *args)
+                return await asyncio.wrap_future(future)
+            except (BrokenProcessPool, RuntimeError) as error:
+                if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
+                    raise
+                self._restart(pool)
+                if attempt == 2:
+                    raise WorkerLost() from None
+
+    async def run(self, function: Callable[..., Any], *args: Any) -> Any:
+        """
+        Run ``function(*args)`` in a worker as a job of one part (a
+        :meth:`slot` and :meth:`submit`), without a time limit (the
+        request's limit is :meth:`once`'s).
+
+        Raises
+        ------
+        Overloaded, WorkerLost
+        """
+        async with self.slot():
+            return await self.submit(function, *args)
 
     async def once(self, key: str, make: Callable[[], Awaitable[Any]]) -> Any:
         """

@@ -53,9 +53,12 @@ def fit_model(
 
 def evaluate_model(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
 ) -> dict[str, Any]:
-    """:func:`fitting.fits.evaluate.evaluate_material` for a fit of either kind."""
+    """
+    :func:`fitting.fits.evaluate.evaluate_material` for a fit of either kind;
+    ``dtype``: the arithmetic of the reference.
+    """
     if result.model == "rgb-conductor":
-        return evaluate_rgb_conductor(nk, result, samples, baselines, min_coverage)
-    return evaluate_material(nk, result, samples, baselines, min_coverage)
+        return evaluate_rgb_conductor(nk, result, samples, baselines, min_coverage, dtype)
+    return evaluate_material(nk, result, samples, baselines, min_coverage, dtype)

@@ -9,6 +9,8 @@ One typed result for every error the project reports:
     gives the JSON the packs and the API have always carried.
 -   :func:`error_metrics`: the metrics between a reference and an
     approximation on a grid indexed [eta_i, cos_theta] (material fits).
+-   :func:`grid_metrics`: :func:`error_metrics` of several models against
+    one reference, its Lab computed once.
 -   :func:`curve_metrics`: the metrics of a model against edited curves.
 -   :func:`delta_E_summary`: mean and max of a Delta E map (scenes).
 -   :func:`baseline_metrics`: :func:`error_metrics` of every baseline of
@@ -29,9 +31,10 @@ from typing import Any
 
 import numpy as np
 
-from ..colour.delta_e import delta_E_map
+from ..colour.colorimetry import ACEScg_to_Lab
+from ..colour.delta_e import delta_E_2000, delta_E_map
 from ..domain import DEFAULT_MIN_COVERAGE
-from ..models.baselines import BASELINES, baseline_ACEScg
+from ..models.baselines import baselines_ACEScg
 
 __all__ = [
     "BREAKDOWN_ETA_I",
@@ -40,6 +43,7 @@ __all__ = [
     "ErrorMetrics",
     "delta_E_map",
     "error_metrics",
+    "grid_metrics",
     "curve_metrics",
     "delta_E_summary",
     "baseline_metrics",
@@ -143,24 +147,40 @@ def error_metrics(reference_RGB, model_RGB, eta_i_rows=None, against: str = "") 
         :data:`BREAKDOWN_ETA_I` inside the grid, the mean and max Delta E of
         the nearest row.
     """
+    return grid_metrics(reference_RGB, {"model": model_RGB}, eta_i_rows, against)["model"]
+
+
+def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> dict[str, ErrorMetrics]:
+    """
+    :func:`error_metrics` of each of ``models`` (a mapping of name to (E, M,
+    3) linear ACEScg) against the one ``reference_RGB``, keyed as
+    ``models``: the reference is converted to Lab once for all of them.
+    """
     reference_RGB = np.asarray(reference_RGB, dtype=np.float64)
-    model_RGB = np.asarray(model_RGB, dtype=np.float64)
-    dE = delta_E_map(reference_RGB, model_RGB)
-    rows: list[EtaRow] | None = None
+    reference_Lab = ACEScg_to_Lab(reference_RGB)
+    breakdown: list[tuple[float, int]] = []
     if eta_i_rows is not None:
-        rows = []
         grid = np.asarray(eta_i_rows, dtype=np.float64)
-        for eta in BREAKDOWN_ETA_I:
-            if grid.min() - 1e-9 <= eta <= grid.max() + 1e-9:
-                i = int(np.argmin(np.abs(grid - eta)))
-                rows.append(EtaRow(eta, float(dE[i].mean()), float(dE[i].max())))
-    return ErrorMetrics(
-        mean=float(dE.mean()),
-        max=float(dE.max()),
-        against=against,
-        rows=None if rows is None else tuple(rows),
-        rmse=float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
-    )
+        breakdown = [
+            (eta, int(np.argmin(np.abs(grid - eta)))) for eta in BREAKDOWN_ETA_I
+            if grid.min() - 1e-9 <= eta <= grid.max() + 1e-9
+        ]
+    out = {}
+    # One map per model: stacked into one call they fall out of cache, and
+    # take twice as long.
+    for name, model_RGB in models.items():
+        model_RGB = np.asarray(model_RGB, dtype=np.float64)
+        dE = delta_E_2000(reference_Lab, ACEScg_to_Lab(model_RGB))
+        out[name] = ErrorMetrics(
+            mean=float(dE.mean()),
+            max=float(dE.max()),
+            against=against,
+            rows=None if eta_i_rows is None else tuple(
+                EtaRow(eta, float(dE[i].mean()), float(dE[i].max())) for eta, i in breakdown
+            ),
+            rmse=float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
+        )
+    return out
 
 
 def curve_metrics(curves, model_of, against: str = "the edited curves") -> ErrorMetrics:
@@ -196,10 +216,6 @@ def baseline_metrics(
     (E, M) indexed [eta_i, cos_theta]; keyed by baseline name.
     """
     rows = np.asarray(eta_i)[:, 0]
-    return {
-        name: error_metrics(
-            reference_RGB, baseline_ACEScg(name, nk, cos_theta, eta_i, 1.0, min_coverage), rows,
-            against,
-        )
-        for name in BASELINES
-    }
+    return grid_metrics(
+        reference_RGB, baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage), rows, against
+    )

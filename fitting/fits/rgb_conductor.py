@@ -35,13 +35,13 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..colour.reference import evaluation_grid, reference_ACEScg, spectral_weights
+from ..colour.reference import reference_ACEScg, spectral_weights
 from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, check_eta_i_range
 from ..models.pack import PackedMaterial, to_float16
-from ..models.rgb_conductor import MODEL_KIND, rgb_conductor_model
+from ..models.rgb_conductor import MODEL_KIND
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, resample_nk
-from .metrics import baseline_metrics, error_metrics
+from .evaluate import evaluate_material
 from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
 from .settings import OBJECTIVES, FitSettings, fit_grid
@@ -248,30 +248,17 @@ def fit_rgb_conductor(
 
 def evaluate_rgb_conductor(
     nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
 ) -> dict[str, Any]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
     (``samples`` x ``samples`` over [0, 1] x the fitted domain) for the
     float16 and float64 n, k, and (optionally) the baselines; the JSON of
     :func:`fitting.fits.evaluate.evaluate_material`. Sets ``result.error``
-    to the float16 model's :class:`fitting.fits.metrics.ErrorMetrics`.
+    to the float16 model's :class:`fitting.fits.metrics.ErrorMetrics`
+    (:func:`fitting.fits.evaluate.evaluate_material`, which scores either kind).
     """
-    lo, hi = result.eta_i_range
-    M, E = evaluation_grid(samples, (lo, hi))
-    ref = reference_ACEScg(nk, M, E, 1.0, min_coverage)
-    rows = E[:, 0]
-    against = f"spectral reference 1 nm, {samples} x {samples}"
-    result.error = error_metrics(ref, rgb_conductor_model(M, E, result.coefficients_float16), rows, against)
-    out: dict[str, Any] = {
-        "grid": f"{samples}x{samples}",
-        "model_float16": result.error.to_dict(),
-        "model_float64": error_metrics(ref, rgb_conductor_model(M, E, result.coefficients), rows, against).to_dict(),
-        "coverage": result.coverage,
-    }
-    if baselines:
-        out.update({name: m.to_dict() for name, m in baseline_metrics(nk, M, E, ref, min_coverage, against).items()})
-    return out
+    return evaluate_material(nk, result, samples, baselines, min_coverage, dtype)
 
 
 RGB_NK_SAMPLES = 64

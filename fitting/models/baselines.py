@@ -11,7 +11,8 @@ linear ACEScg and per RGB channel.
 -   :func:`lazanyi_adjusted`: Hoffman's F82 form of Lazanyi's error term with
     the external-medium adjustment ("adjusted Lazanyi", Vernooij 2024).
 -   :func:`baseline_inputs`: the metal's F0 and F82 in air from its n, k.
--   :func:`baseline_ACEScg`: every baseline on a grid, by name.
+-   :func:`baseline_ACEScg`: a baseline on a grid, by name;
+    :func:`baselines_ACEScg`: all of them at once.
 
 References
 ----------
@@ -27,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..domain import DEFAULT_MIN_COVERAGE, as_float_array
-from ..colour.reference import reference_ACEScg
+from ..colour.reference import reference_ACEScg, reference_ACEScg_grid
 from ..optics.nk import SpectralNK
 
 __all__ = [
@@ -39,6 +40,7 @@ __all__ = [
     "lazanyi_adjusted",
     "baseline_inputs",
     "baseline_ACEScg",
+    "baselines_ACEScg",
 ]
 
 MU_BAR = 1.0 / 7.0
@@ -124,12 +126,28 @@ def baseline_inputs(nk: SpectralNK, step_nm: float = 1.0, min_coverage: float = 
     return {"F0_air": values[0], "F82_air": values[1]}
 
 
+def _exact_F0(nk: SpectralNK, eta: np.ndarray, step_nm: float, min_coverage: float) -> np.ndarray:
+    """The exact F0 (mu = 1) at each eta_i of ``eta``, shape eta.shape + (3,)."""
+    # F0 depends on eta_i alone: evaluated once per distinct eta_i.
+    unique, inverse = np.unique(eta, return_inverse=True)
+    F0 = reference_ACEScg_grid(nk, [1.0], unique, step_nm, min_coverage)[:, 0]
+    return F0[inverse.reshape(eta.shape)]
+
+
+def _baseline(name: str, mu: np.ndarray, eta: np.ndarray, inputs: dict, exact_F0) -> np.ndarray:
+    if name.startswith("schlick"):
+        F0 = inputs["F0_air"] if exact_F0 is None else exact_F0
+        return np.broadcast_to(schlick(mu, F0), mu.shape + (3,)).copy()
+    return lazanyi_adjusted(mu, eta, inputs["F0_air"], inputs["F82_air"], exact_F0)
+
+
 def baseline_ACEScg(
     name: str, nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
     min_coverage: float = DEFAULT_MIN_COVERAGE,
 ) -> np.ndarray:
     """
-    A baseline by name on (cos_theta, eta_i):
+    A baseline by name on (cos_theta, eta_i), linear ACEScg, shape
+    ``broadcast(cos_theta, eta_i).shape + (3,)``:
 
     -   ``schlick_air``: Schlick with the metal's F0 in air.
     -   ``schlick_exact_F0``: Schlick with the exact F0 at each eta_i.
@@ -142,13 +160,25 @@ def baseline_ACEScg(
         np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
     )
     inputs = baseline_inputs(nk, step_nm, min_coverage)
-    exact_F0 = None
-    if name.endswith("exact_F0"):
-        # F0 depends on eta_i alone: evaluate it once per distinct eta_i.
-        unique, inverse = np.unique(eta, return_inverse=True)
-        F0 = reference_ACEScg(nk, np.ones_like(unique), unique, step_nm, min_coverage)
-        exact_F0 = F0[inverse.reshape(eta.shape)]
-    if name.startswith("schlick"):
-        F0 = inputs["F0_air"] if exact_F0 is None else exact_F0
-        return np.broadcast_to(schlick(mu, F0), mu.shape + (3,)).copy()
-    return lazanyi_adjusted(mu, eta, inputs["F0_air"], inputs["F82_air"], exact_F0)
+    exact_F0 = _exact_F0(nk, eta, step_nm, min_coverage) if name.endswith("exact_F0") else None
+    return _baseline(name, mu, eta, inputs, exact_F0)
+
+
+def baselines_ACEScg(
+    nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+) -> dict[str, np.ndarray]:
+    """
+    Every baseline of :data:`BASELINES` on (cos_theta, eta_i), keyed by name:
+    :func:`baseline_ACEScg` of each, with the metal's F0 and F82 in air and
+    the exact F0 per eta_i computed once for all four.
+    """
+    mu, eta = np.broadcast_arrays(
+        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
+    )
+    inputs = baseline_inputs(nk, step_nm, min_coverage)
+    exact_F0 = _exact_F0(nk, eta, step_nm, min_coverage)
+    return {
+        name: _baseline(name, mu, eta, inputs, exact_F0 if name.endswith("exact_F0") else None)
+        for name in BASELINES
+    }

@@ -11,11 +11,13 @@ import pytest
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg
+from fitting.fits.kinds import evaluate_model, fit_model
 from fitting.fits.material import fit_material
 from fitting.models.coated_conductor import coated_conductor_model
 from fitting.models.pack import decode_pack, pack_from_json
 from fitting.optics.library import LIBRARY_NAMES, library_material
 from service.config import Settings
+from service.jobs.nk import METRICS_DTYPE
 from conftest import app_client
 
 API = "/api/v1"
@@ -119,6 +121,16 @@ class TestFits:
         assert metrics["model"]["delta_E_mean"] <= metrics["model"]["delta_E_max"]
         assert {"reference", "fit", "quantise", "total", "evaluate"} <= set(fit["timings"])
         assert fit["convergence"]["success"] is True
+
+    def test_metrics_are_the_core_evaluation(self, shared):
+        # The pool's three parts (the fit, the reference beside it, the score)
+        # give the numbers of the core's evaluation on the service's reference.
+        client, fit = shared
+        record = client.app.state.store.get_fit(fit["id"])
+        nk = library_material("Au")
+        expected = evaluate_model(nk, fit_model(nk, (1.0, 2.5)), samples=30, dtype=METRICS_DTYPE)
+        assert record.metrics == expected
+        assert record.timings["evaluate"] > 0.0
 
     def test_same_input_same_id_no_refit(self, shared):
         client, fit = shared

@@ -18,6 +18,8 @@ from fitting import (
     fit_material,
     library_material,
 )
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour import reference as reference_module
 from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid
 
 WAVELENGTH = np.linspace(300.0, 900.0, 61)
@@ -78,6 +80,23 @@ class TestReferenceGrid:
         np.testing.assert_allclose(fast, reference_ACEScg(nk, M, E), rtol=0, atol=1e-14)
         assert np.array_equal(fast[0], fast[2]) and np.array_equal(fast[:, 0], fast[:, 2])
 
+    @pytest.mark.parametrize("mu_count, eta_count", [
+        (100, 100),  # the scoring grid: loop over cos theta, eta_i in blocks
+        (41, 15),    # few eta_i: loop over eta_i, cos theta in blocks
+        (9, 16),
+        (9, 101),    # blocks of unequal size
+        (1025, 1),   # a preview table
+    ])
+    def test_both_orientations_give_the_definition(self, mu_count, eta_count, monkeypatch):
+        nk = library_material("Au")
+        mu = np.linspace(0.0, 1.0, mu_count)
+        eta = np.linspace(1.0, 3.0, eta_count)
+        E, M = np.meshgrid(eta, mu, indexing="ij")
+        slow = reference_ACEScg(nk, M, E)
+        for least in (1, 10**9):  # always loop over cos theta, never
+            monkeypatch.setattr(reference_module, "_MIN_ETA_FOR_MU_LOOP", least)
+            assert np.max(np.abs(reference_ACEScg_grid(nk, mu, eta) - slow)) < 1e-13
+
     @pytest.mark.parametrize("mu, eta, message", [
         ([[0.5]], [1.5], "1-D"),
         ([0.5], [0.8], "`eta_i` must be >= 1, got 0.8"),
@@ -87,3 +106,48 @@ class TestReferenceGrid:
     def test_refusals(self, mu, eta, message):
         with pytest.raises(ValueError, match=message):
             reference_ACEScg_grid(library_material("Au"), mu, eta)
+
+
+class TestReferenceGridFloat32:
+    """The float32 arithmetic (``dtype="float32"``) against the float64 definition."""
+
+    @pytest.mark.parametrize("name", LIBRARY_NAMES)
+    def test_delta_E_within_tolerance_on_every_conductor(self, name):
+        nk = library_material(name)
+        result = fit_material(nk)
+        exact = evaluate_material(nk, result)
+        fast = evaluate_material(nk, result, dtype="float32")
+        for model in ("model_float16", "model_float64", "lazanyi_adjusted", "schlick_exact_F0"):
+            for key in ("delta_E_mean", "delta_E_max"):
+                assert abs(fast[model][key] - exact[model][key]) < 1e-3
+                assert abs(fast[model][key] - exact[model][key]) < 1e-4  # in fact
+        M, E = evaluation_grid(100, (1.0, 3.0))
+        ref = reference_ACEScg_grid(nk, M[0], E[:, 0])
+        ref32 = reference_ACEScg_grid(nk, M[0], E[:, 0], dtype="float32")
+        assert ref32.dtype == np.float64 and np.max(np.abs(ref32 - ref)) < 2e-6
+        assert np.max(delta_E_map(ref, ref32)) < 1e-4
+
+    @pytest.mark.parametrize("n", [0.05, 0.5, 1.0, 1.2, 1.5, 2.2, 5.0])
+    @pytest.mark.parametrize("k", [0.0, 1e-6, 1e-2, 1.0, 50.0])
+    def test_dielectrics_weak_absorbers_and_index_matched(self, n, k):
+        # Near the critical angle of a weak absorber Re(eta^2) - sin^2 theta
+        # cancels: formed in float32 it alone would move Delta E by 1e-2.
+        wavelength = np.linspace(300.0, 900.0, 61)
+        nk = SpectralNK(wavelength, n * (1.0 + 0.1 * np.sin(wavelength / 50.0)),
+                        np.full(61, k) * (1.0 + 0.1 * np.cos(wavelength / 40.0)), name="test")
+        mu, eta = np.linspace(0.0, 1.0, 100), np.linspace(1.0, 3.0, 100)
+        ref = reference_ACEScg_grid(nk, mu, eta)
+        ref32 = reference_ACEScg_grid(nk, mu, eta, dtype=np.float32)
+        assert np.all(np.isfinite(ref32))
+        assert np.max(delta_E_map(ref, ref32)) < 1e-4
+
+    def test_few_eta_i(self):
+        nk = library_material("Cr")
+        mu = np.linspace(0.0, 1.0, 513)
+        ref32 = reference_ACEScg_grid(nk, mu, [1.0, 1.7], dtype="float32")
+        np.testing.assert_allclose(ref32, reference_ACEScg_grid(nk, mu, [1.0, 1.7]), rtol=0, atol=2e-6)
+
+    @pytest.mark.parametrize("dtype", ["float16", "int64", "banana", complex])
+    def test_refuses_other_dtypes(self, dtype):
+        with pytest.raises(ValueError, match="`dtype` must be one of float64, float32"):
+            reference_ACEScg_grid(library_material("Au"), [0.5], [1.5], dtype=dtype)

@@ -13,6 +13,7 @@ from fitting.fits.metrics import (
     curve_metrics,
     delta_E_summary,
     error_metrics,
+    grid_metrics,
 )
 from fitting.fits.curves_input import RGBCurve
 
@@ -67,6 +68,17 @@ class TestErrorMetrics:
             m.mean = 0.0
         with pytest.raises(ValueError, match="`layout` must be one of grid, curves, summary"):
             ErrorMetrics(0.1, 0.2, "x", layout="table")
+
+
+class TestGridMetrics:
+    def test_each_model_as_error_metrics(self):
+        rows = np.array([1.0, 1.5, 2.0, 2.5])
+        other = np.clip(REF * 1.03, 0.0, 1.0)
+        every = grid_metrics(REF, {"b": other, "a": MODEL}, rows, "grid")
+        assert list(every) == ["b", "a"]
+        assert every["a"] == error_metrics(REF, MODEL, rows, "grid")
+        assert every["b"] == error_metrics(REF, other, rows, "grid")
+        assert grid_metrics(REF, {}) == {}
 
 
 def m_mean(ref, model) -> float:

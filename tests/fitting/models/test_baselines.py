@@ -5,9 +5,11 @@ import pytest
 
 from fitting.colour.reference import reference_ACEScg
 from fitting.models.baselines import (
+    BASELINES,
     MU_BAR,
     baseline_ACEScg,
     baseline_inputs,
+    baselines_ACEScg,
     external_medium_F0,
     lazanyi_a,
     lazanyi_adjusted,
@@ -48,3 +50,12 @@ class TestBaselines:
             baseline_ACEScg("phong", nk, 0.5, 1.5)
         out = baseline_ACEScg("schlick_exact_F0", nk, np.array([1.0, 1.0]), np.array([1.0, 2.0]))
         np.testing.assert_allclose(out, reference_ACEScg(nk, 1.0, np.array([1.0, 2.0])), atol=1e-12)
+
+    def test_all_at_once_equal_one_by_one(self):
+        nk = library_material("Cu")
+        mu, eta = np.meshgrid(np.linspace(0.0, 1.0, 9), np.linspace(1.0, 2.5, 5))
+        every = baselines_ACEScg(nk, mu, eta)
+        assert tuple(every) == BASELINES
+        for name in BASELINES:
+            np.testing.assert_array_equal(every[name], baseline_ACEScg(name, nk, mu, eta))
+            assert every[name].shape == (5, 9, 3)
