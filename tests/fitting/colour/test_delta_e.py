@@ -1,11 +1,11 @@
-"""fitting.colour.delta_e: CIE Delta E 2000 against colour-science and Sharma et al. (2005)."""
+"""fitting.colour.delta_e: CIE Delta E 2000 (colour-science's, as called here) against Sharma et al. (2005)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from fitting.colour.colorimetry import ACEScg_to_Lab, _colour
+from fitting.colour.colorimetry import ACEScg_to_Lab
 from fitting.colour.delta_e import delta_E_2000, delta_E_map
 
 # Sharma, Wu & Dalal (2005), Table 1: the 34 test pairs and their Delta E 2000
@@ -42,10 +42,6 @@ SHARMA_DELTA_E = [
 ]
 
 
-def colour_science(Lab_1, Lab_2) -> np.ndarray:
-    return np.asarray(_colour().delta_E(Lab_1, Lab_2, method="CIE 2000"), dtype=np.float64)
-
-
 class TestDeltaE2000:
     def test_sharma_pairs(self):
         dE = delta_E_2000(SHARMA_LAB_1, SHARMA_LAB_2)
@@ -53,33 +49,13 @@ class TestDeltaE2000:
         # Symmetric, as the formula is.
         np.testing.assert_allclose(delta_E_2000(SHARMA_LAB_2, SHARMA_LAB_1), dE, rtol=1e-13)
 
-    def test_equals_colour_science_on_random_pairs(self):
-        rng = np.random.default_rng(2005)
-        lo, hi = [0.0, -128.0, -128.0], [100.0, 128.0, 128.0]
-        Lab_1 = rng.uniform(lo, hi, (20_000, 3))
-        far = rng.uniform(lo, hi, (20_000, 3))
-        near = Lab_1 + rng.normal(0.0, 0.5, Lab_1.shape)  # the differences fits report
-        for Lab_2 in (far, near):
-            np.testing.assert_allclose(delta_E_2000(Lab_1, Lab_2), colour_science(Lab_1, Lab_2),
-                                       rtol=1e-12, atol=1e-12)
-
-    def test_achromatic_and_axis_colours(self):
-        # Grey, hues on the axes and opposite hues (Delta h' = 180 degrees exactly).
-        lab = np.array([[50, 0, 0], [50, 0, 2], [50, 0, -2], [50, 2, 0], [50, -2, 0],
-                        [50, 1, 1], [50, -1, -1], [0, 0, 0], [100, 0, 0]], dtype=np.float64)
-        i, j = np.meshgrid(range(len(lab)), range(len(lab)))
-        np.testing.assert_allclose(delta_E_2000(lab[i], lab[j]), colour_science(lab[i], lab[j]),
-                                   rtol=1e-12, atol=1e-12)
-        assert delta_E_2000([50, 2, 3], [50, 2, 3]) == 0.0
-
     def test_n_dimensional_broadcast(self):
         rng = np.random.default_rng(3)
         Lab_1 = rng.uniform([0, -50, -50], [100, 50, 50], (4, 5, 3))
         Lab_2 = Lab_1 + rng.normal(0.0, 2.0, (2, 4, 5, 3))
         dE = delta_E_2000(Lab_1, Lab_2)
         assert dE.shape == (2, 4, 5)
-        np.testing.assert_allclose(dE, colour_science(np.broadcast_to(Lab_1, Lab_2.shape), Lab_2),
-                                   rtol=1e-12)
+        np.testing.assert_allclose(dE[1], delta_E_2000(Lab_1, Lab_2[1]), rtol=1e-13)
         assert np.ndim(delta_E_2000(SHARMA_LAB_1[0], SHARMA_LAB_2[0])) == 0
 
     @pytest.mark.parametrize("bad", [np.nan, np.inf])
@@ -97,8 +73,4 @@ class TestDeltaEMap:
         model = reference * (1.0 + 0.05 * rng.standard_normal((6, 7, 3)))
         np.testing.assert_array_equal(
             delta_E_map(reference, model), delta_E_2000(ACEScg_to_Lab(reference), ACEScg_to_Lab(model))
-        )
-        np.testing.assert_allclose(
-            delta_E_map(reference, model),
-            colour_science(ACEScg_to_Lab(reference), ACEScg_to_Lab(model)), rtol=1e-12
         )
