@@ -188,7 +188,8 @@ at most 4 evaluations (no reweighting round, no paper-method candidate,
 float16 by rounding to nearest, the [0, 1] check grid coarser at first),
 meant to start from the fit on screen (``start``), so that it follows the
 pointer; the [0, 1] constraint is the same as the default's (made stiffer
-on the fine grid while the fit leaves [0, 1]). The editor
+on the fine grid while the fit leaves [0, 1]; a live solve that still
+leaves it is replaced by the full refit). The editor
 replaces it with a default refit when the drag ends."""
 
 
@@ -354,6 +355,12 @@ def fit_curves(
         )
     else:
         result = constrained(settings.objective)
+        if start is not None and not in_range(result.coefficients_float16):
+            # A warm-started (live) solve that cannot hold [0, 1] in its
+            # short budget: the full refit instead (rare: an edit far past
+            # what the model can follow), so that no fit leaves [0, 1].
+            full = CurveFitSettings(objective=settings.objective, blend_width=settings.blend_width)
+            return fit_curves(curves, base, None if base is not None else eta_i_range, name, full, model)
     if model != "rgb-conductor" and base is not None and settings.compare_rgb and settings.objective != "rgb":
         # The paper's own method (plain rgb least squares) on the whole
         # blended target (every other point of the scoring grid: the target

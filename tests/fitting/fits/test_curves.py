@@ -133,3 +133,21 @@ class TestLiveRefit:
             fit_curves(curves, gold_base, start=np.zeros((3, 3, 2)))
         with pytest.raises(ValueError, match="`start` must be finite"):
             fit_curves(curves, gold_base, start=np.full((3, 3, 3), np.nan))
+
+    def test_a_live_solve_that_cannot_hold_the_range_gives_the_full_refit(self, gold_base):
+        # Green pulled up at 50 degrees on gold: the short warm-started solve
+        # ends above 1 near grazing (0.012 measured), so the full refit answers.
+        from fitting.fits.curves import LIVE_SETTINGS
+        from fitting.fits.material import fit_material
+
+        start = fit_material(library_material("Au")).coefficients_float16.astype(np.float64)
+        reference = gold_base.rgb(MU, 1.5)
+        lobe = np.exp(-0.5 * ((ANGLE - 50.0) / 12.0) ** 2) * (1.0 - (ANGLE / 90.0) ** 6)
+        for step in range(1, 41):  # a pointer move per step, as the editor sends them
+            rgb = reference.copy()
+            rgb[:, 1] = np.clip(rgb[:, 1] + 0.012 * step * lobe, 0.0, 1.0)
+            curves = [{"eta_i": 1.5, "cos_theta": MU.tolist(), "rgb": rgb.tolist()}]
+            live = fit_curves(curves, gold_base, settings=LIVE_SETTINGS, start=start)
+            target = live.metrics["target"]
+            assert -1e-4 <= target["model_min"] and target["model_max"] <= 1.0 + 1e-4, step
+            start = live.coefficients_float16.astype(np.float64)
