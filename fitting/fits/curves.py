@@ -313,11 +313,14 @@ def fit_curves(
     t_target = time.perf_counter()
 
     def fit(objective: str, range_weight: float, check_samples: tuple[int, int], dense=None,
-            start=start) -> FitResult:
+            start=start, extra_check=None) -> FitResult:
         range_check = None
         if range_weight > 0:
             CM, CE = _check_grid(eta_i_range, *check_samples)
-            range_check = (CM.ravel(), CE.ravel(), range_weight)
+            CM, CE = CM.ravel(), CE.ravel()
+            if extra_check is not None:
+                CM, CE = np.concatenate([CM, extra_check[0]]), np.concatenate([CE, extra_check[1]])
+            range_check = (CM, CE, range_weight)
         if dense is not None:  # the paper's method: rgb on the whole target, unweighted
             return fit_coefficients(*dense, eta_i_range, degree, "rgb", _RGB_MAX_NFEV,
                                     settings.quantise, irls_rounds=0, range_check=range_check)
@@ -330,21 +333,33 @@ def fit_curves(
     _, _, score_M, score_E = score_grid(eta_i_range)
     range_M, range_E = _check_grid(eta_i_range, *SCORE_GRID)
 
-    def in_range(C16) -> bool:
+    def outside(C16) -> np.ndarray:
+        """Mask of the range grid's points where the float16 fit leaves [0, 1]."""
         values = coated_conductor_model(range_M, range_E, C16, eta_i_range)
-        return bool(values.min() >= -_RANGE_TOLERANCE and values.max() <= 1.0 + _RANGE_TOLERANCE)
+        return np.any((values < -_RANGE_TOLERANCE) | (values > 1.0 + _RANGE_TOLERANCE), axis=-1)
+
+    def in_range(C16) -> bool:
+        return not outside(C16).any()
 
     def constrained(objective: str, dense=None) -> FitResult:
-        weight, check = settings.range_weight, settings.check_samples
+        weight, check, extra = settings.range_weight, settings.check_samples, None
         result = fit(objective, weight, check, dense)
         for _ in range(2):
             if weight == 0 or in_range(result.coefficients_float16):
                 break
-            weight, check = 10.0 * weight, (max(check[0], 46), max(check[1], 16))
-            # A warm-started (live) fit goes on from where it is; a fit from
-            # its own guess starts again, as it always has (same results).
-            result = fit(objective, weight, check, dense,
-                         start if start is None or dense is not None else result.coefficients)
+            if start is None or dense is not None:
+                # A fit from its own guess: stiffer on a finer grid, started
+                # again, as it always has (same results).
+                weight, check = 10.0 * weight, (max(check[0], 46), max(check[1], 16))
+                result = fit(objective, weight, check, dense)
+            else:
+                # A warm-started (live) fit goes on from where it is, stiffer
+                # and with the points where it leaves [0, 1] added to its check.
+                mask = outside(result.coefficients_float16)
+                extra = (range_M[mask], range_E[mask]) if extra is None else (
+                    np.concatenate([extra[0], range_M[mask]]), np.concatenate([extra[1], range_E[mask]]))
+                weight = 10.0 * weight
+                result = fit(objective, weight, check, start=result.coefficients, extra_check=extra)
         return result
 
     chosen = settings.objective
