@@ -401,10 +401,13 @@ async function pump() {
       if ($("message").dataset.kind === "retry") say("");
       if (seq > live.shown && base === state.base) {
         live.shown = seq;
-        present(fit, curves, wanted);
-        telemetry.shown.push({ fit: fit.id, editAt, sentAt, fittedAt, curveAt: performance.now(), frameAt: null,
-                               live: !!startFit, serverMs: fit.timings ? 1e3 * fit.timings.total : null });
+        // Recorded before present(): the preview draws the new fit at once, in it.
+        const shown = { fit: fit.id, editAt, sentAt, fittedAt, curveAt: null, frameAt: null,
+                        live: !!startFit, serverMs: fit.timings ? 1e3 * fit.timings.total : null };
+        telemetry.shown.push(shown);
         if (telemetry.shown.length > 1000) telemetry.shown.shift();
+        present(fit, curves, wanted);
+        shown.curveAt = performance.now();
       }
     });
   } catch (error) {

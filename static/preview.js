@@ -133,10 +133,14 @@ export class ShaderBall {
     return texture;
   }
 
-  /** The fit to show (its FitPublic answer): words, domain; drawn at once. */
+  /**
+   * The fit to show (its FitPublic answer): words, domain; drawn at once,
+   * not on the next animation frame (a refit's frame follows its curve
+   * without waiting up to a display interval; orbiting still coalesces).
+   */
   setFit(fit) {
     Object.assign(this.state, { words: packedWords(fit.coefficients), etaRange: fit.eta_i_range, fitId: fit.id });
-    this.draw();
+    this.drawNow();
   }
 
   /** The spectral reference texture and Lazanyi inputs (see api.referenceTexture). */
