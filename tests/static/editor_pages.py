@@ -68,6 +68,17 @@ def open_editor(page, url):
     page.wait_for_function("!document.body.hasAttribute('aria-busy')")
 
 
+def read_float(page, output: str, width: int, height: int) -> np.ndarray:
+    """(height, width, 4) floats of the preview's OUTPUT.<output> (a float target), top row first."""
+    flat = page.evaluate(
+        f"""async () => {{
+            const {{ OUTPUT }} = await import('/preview.js');
+            return Array.from(window.cfPreview.readFloat(OUTPUT.{output}, {width}, {height}));
+        }}"""
+    )
+    return np.asarray(flat, dtype=np.float64).reshape(height, width, 4)[::-1]
+
+
 def camera_rays(yaw, pitch, distance, fov, width, height, bands=3):
     """
     numpy of shader_ball.frag's camera at width x height pixels (top row

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from editor_pages import camera_rays, editor_url, open_editor, pages  # noqa: F401 (fixtures)
+from editor_pages import camera_rays, editor_url, open_editor, pages, read_float  # noqa: F401 (fixtures)
 
 from fitting import (
     baseline_inputs, coated_conductor_model, curve_base_from_nk, halves_to_uint32, lazanyi_adjusted,
@@ -28,13 +28,7 @@ W, H = 96, 64
 
 def read(page, output: str):
     """(H, W, 4) floats of OUTPUT.<output>, top row first."""
-    flat = page.evaluate(
-        f"""async () => {{
-            const {{ OUTPUT }} = await import('/preview.js');
-            return Array.from(window.cfPreview.readFloat(OUTPUT.{output}, {W}, {H}));
-        }}"""
-    )
-    return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1]
+    return read_float(page, output, W, H)
 
 
 def test_preview_matches_numpy(pages, editor_url):

@@ -45,7 +45,7 @@ from __future__ import annotations
 import httpx
 import numpy as np
 import pytest
-from editor_pages import camera_rays, editor_url, open_editor, pages  # noqa: F401 (fixtures)
+from editor_pages import camera_rays, editor_url, open_editor, pages, read_float  # noqa: F401 (fixtures)
 
 from fitting import baseline_inputs, coated_conductor_model, curve_base_from_nk, library_material
 from fitting.models.coated_conductor import collapse_to_eta_i
@@ -70,13 +70,7 @@ BRDF = 1.0e-5
 
 def read(page, output: str):
     """(H, W, 4) floats of OUTPUT.<output>, top row first."""
-    flat = page.evaluate(
-        f"""async () => {{
-            const {{ OUTPUT }} = await import('/preview.js');
-            return Array.from(window.cfPreview.readFloat(OUTPUT.{output}, {W}, {H}));
-        }}"""
-    )
-    return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1]
+    return read_float(page, output, W, H)
 
 
 def tables(page):
