@@ -20,8 +20,11 @@ so it needs no range constraint).
 -   :class:`CurveFitSettings`: sampling and solver settings of
     :func:`fit_curves` (defaults measured by ``benchmarks/curves_fit.py``
     and ``benchmarks/curve_edits_vs_paper.py``).
+-   :data:`LIVE_SETTINGS`: the editor's warm-started refit while a point is
+    dragged.
 -   :func:`whole_target_error`: Delta E 2000 over the whole blended target
-    on :data:`SCORE_GRID`, where a fit's reported figures are measured.
+    on :data:`SCORE_GRID`, where a fit's reported figures are measured
+    (:mod:`fitting.fits.curves_score`, with the [0, 1] check grid).
 
 The fit stays a reflectance: [0, 1] over its whole domain is a penalty
 constraint of the least squares (hinge residuals at a check grid,
@@ -55,7 +58,7 @@ from ..models.kinds import DEFAULT_MODEL, check_model, model_ACEScg
 from ..models.pack import PackedMaterial
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve, check_curves
-from ..colour.delta_e import delta_E_map
+from .curves_score import SCORE_GRID, angle_mu, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
 from .result import FitResult
 from .rgb_conductor import fit_rgb_conductor_coefficients
@@ -67,58 +70,6 @@ __all__ = ["CurveFitSettings", "LIVE_SETTINGS", "SCORE_GRID", "score_grid", "who
 _RANGE_TOLERANCE = 1e-4  # float16 rounding of a fit on the boundary
 _RGB_GRID = (24, 16)  # the paper-method candidate's samples: every other angle and eta_i of SCORE_GRID
 _RGB_MAX_NFEV = 200  # as the paper-method fits (fit_coefficients' default): rgb solves are cheap
-
-SCORE_GRID = (46, 31)
-"""(angles evenly over [0, 90] degrees, eta_i rows evenly over the domain):
-where a curve fit's ``target`` figures are measured, the whole blended
-target, as the editor's error map."""
-
-
-def _angle_mu(theta_deg: np.ndarray) -> np.ndarray:
-    return np.where(theta_deg == 90.0, 0.0, np.cos(np.radians(theta_deg)))
-
-
-def score_grid(eta_i_range, shape=SCORE_GRID) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(theta_deg (A,), eta_i (E,), and the meshes mu, eta (E, A)) of the scoring grid."""
-    lo, hi = eta_i_range
-    theta = np.linspace(0.0, 90.0, shape[0])
-    rows = np.linspace(lo, hi, shape[1]) if hi > lo else np.array([lo])
-    E, T = np.meshgrid(rows, theta, indexing="ij")
-    return theta, rows, _angle_mu(T), E
-
-
-def _check_grid(eta_i_range, angles: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
-    """
-    (mu, eta) meshes where the fit must stay in [0, 1]: ``angles`` evenly
-    over [0, 90] degrees plus every 0.5 degree from 80 to 89.5 (the model
-    can overshoot 1 just before grazing, where it meets 1), ``rows`` eta_i.
-    """
-    lo, hi = eta_i_range
-    theta = np.union1d(np.linspace(0.0, 90.0, angles), np.arange(80.0, 90.0, 0.5))
-    eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
-    E, T = np.meshgrid(eta, theta, indexing="ij")
-    return _angle_mu(T), E
-
-
-def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients, blend_width: float,
-                       shape=SCORE_GRID, model: str = DEFAULT_MODEL) -> dict[str, Any]:
-    """
-    Delta E 2000 of the model (of kind ``model``) of ``coefficients`` against the whole blended
-    target (:func:`edited_target`) on the scoring grid: mean, max and where
-    the max is (``at_theta_deg``, ``at_eta_i``), and the model's range there.
-    """
-    theta, rows, M, E = score_grid(base.eta_i_range, shape)
-    target = edited_target(base, curves, M, E, blend_width)
-    RGB = model_ACEScg(model, M, E, coefficients, base.eta_i_range)
-    dE = delta_E_map(target, RGB)
-    j, i = np.unravel_index(int(np.argmax(dE)), dE.shape)
-    return {
-        "delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max()),
-        "at_theta_deg": float(theta[i]), "at_eta_i": float(rows[j]),
-        "model_min": float(RGB.min()), "model_max": float(RGB.max()),
-        "grid": f"{theta.size} angles x {rows.size} eta_i",
-    }
-
 
 @dataclass(frozen=True)
 class CurveFitSettings:
@@ -289,7 +240,7 @@ def fit_curves(
                 f"`curves[{i}].eta_i` must lie in the domain [{lo:g}, {hi:g}], got {curve.eta_i:g}"
             )
     if base is not None:
-        mu_row = _angle_mu(np.linspace(0.0, 90.0, settings.mu_samples))
+        mu_row = angle_mu(np.linspace(0.0, 90.0, settings.mu_samples))
         rows = np.linspace(lo, hi, settings.eta_samples) if hi > lo else np.array([lo])
         edited = np.array([c.eta_i for c in curves])
         rows = rows[np.all(np.abs(rows[:, None] - edited[None, :]) > 1e-6, axis=1)]
@@ -316,7 +267,7 @@ def fit_curves(
             start=start, extra_check=None) -> FitResult:
         range_check = None
         if range_weight > 0:
-            CM, CE = _check_grid(eta_i_range, *check_samples)
+            CM, CE = check_grid(eta_i_range, *check_samples)
             CM, CE = CM.ravel(), CE.ravel()
             if extra_check is not None:
                 CM, CE = np.concatenate([CM, extra_check[0]]), np.concatenate([CE, extra_check[1]])
@@ -331,7 +282,7 @@ def fit_curves(
         )
 
     _, _, score_M, score_E = score_grid(eta_i_range)
-    range_M, range_E = _check_grid(eta_i_range, *SCORE_GRID)
+    range_M, range_E = check_grid(eta_i_range, *SCORE_GRID)
 
     def outside(C16) -> np.ndarray:
         """Mask of the range grid's points where the float16 fit leaves [0, 1]."""

@@ -1,0 +1,76 @@
+"""
+Scoring of curve fits
+=====================
+
+-   :data:`SCORE_GRID`, :func:`score_grid`: where a curve fit's figures are
+    measured, the whole blended target (as the editor's error map).
+-   :func:`whole_target_error`: Delta E 2000 of a model against the whole
+    blended target there.
+-   :func:`check_grid`: where a curve fit must stay in [0, 1].
+-   :func:`angle_mu`: cos theta of angles in degrees, exactly 0 at 90.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..colour.delta_e import delta_E_map
+from ..models.kinds import DEFAULT_MODEL, model_ACEScg
+from .curves_base import CurveBase, edited_target
+from .curves_input import RGBCurve
+
+__all__ = ["SCORE_GRID", "score_grid", "whole_target_error", "check_grid", "angle_mu"]
+
+SCORE_GRID = (46, 31)
+"""(angles evenly over [0, 90] degrees, eta_i rows evenly over the domain):
+where a curve fit's ``target`` figures are measured, the whole blended
+target, as the editor's error map."""
+
+
+def angle_mu(theta_deg: np.ndarray) -> np.ndarray:
+    return np.where(theta_deg == 90.0, 0.0, np.cos(np.radians(theta_deg)))
+
+
+def score_grid(eta_i_range, shape=SCORE_GRID) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(theta_deg (A,), eta_i (E,), and the meshes mu, eta (E, A)) of the scoring grid."""
+    lo, hi = eta_i_range
+    theta = np.linspace(0.0, 90.0, shape[0])
+    rows = np.linspace(lo, hi, shape[1]) if hi > lo else np.array([lo])
+    E, T = np.meshgrid(rows, theta, indexing="ij")
+    return theta, rows, angle_mu(T), E
+
+
+def check_grid(eta_i_range, angles: int, rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """
+    (mu, eta) meshes where the fit must stay in [0, 1]: ``angles`` evenly
+    over [0, 90] degrees plus every 0.5 degree from 80 to 89.5 (the model
+    can overshoot 1 just before grazing, where it meets 1), ``rows`` eta_i.
+    """
+    lo, hi = eta_i_range
+    theta = np.union1d(np.linspace(0.0, 90.0, angles), np.arange(80.0, 90.0, 0.5))
+    eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
+    E, T = np.meshgrid(eta, theta, indexing="ij")
+    return angle_mu(T), E
+
+
+def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients, blend_width: float,
+                       shape=SCORE_GRID, model: str = DEFAULT_MODEL) -> dict[str, Any]:
+    """
+    Delta E 2000 of the model (of kind ``model``) of ``coefficients`` against the whole blended
+    target (:func:`edited_target`) on the scoring grid: mean, max and where
+    the max is (``at_theta_deg``, ``at_eta_i``), and the model's range there.
+    """
+    theta, rows, M, E = score_grid(base.eta_i_range, shape)
+    target = edited_target(base, curves, M, E, blend_width)
+    RGB = model_ACEScg(model, M, E, coefficients, base.eta_i_range)
+    dE = delta_E_map(target, RGB)
+    j, i = np.unravel_index(int(np.argmax(dE)), dE.shape)
+    return {
+        "delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max()),
+        "at_theta_deg": float(theta[i]), "at_eta_i": float(rows[j]),
+        "model_min": float(RGB.min()), "model_max": float(RGB.max()),
+        "grid": f"{theta.size} angles x {rows.size} eta_i",
+    }
