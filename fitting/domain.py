@@ -15,6 +15,8 @@ the package.
     range of the reference and the least fraction of it data must cover.
 -   :func:`check_eta_i`, :func:`check_eta_i_range`: one index, a domain.
 -   :func:`cos_theta_from_angle`: angle theta in degrees to :math:`\\mu`.
+-   :class:`BoundedCache`: the most recently used values by key, thread-safe
+    (curve bases, the service's measured curves).
 -   :func:`as_finite_array`, :func:`check_int`, :func:`check_choice`,
     :func:`check_number`, :func:`check_min_coverage`, :func:`check_step_nm`:
     the argument checks shared by the settings and the public functions.
@@ -31,6 +33,9 @@ Sections 3.1 and 4.1.
 from __future__ import annotations
 
 import math
+import threading
+from collections import OrderedDict
+from collections.abc import Callable, Hashable
 from typing import Any
 
 import numpy as np
@@ -55,6 +60,7 @@ __all__ = [
     "check_min_coverage",
     "check_step_nm",
     "constants",
+    "BoundedCache",
 ]
 
 ETA_I_MIN: float = 1.0
@@ -216,3 +222,29 @@ def constants() -> dict[str, Any]:
         "step_nm_limits": list(STEP_NM_LIMITS),
         "angle_limits_deg": list(ANGLE_LIMITS_DEG),
     }
+
+
+class BoundedCache:
+    """
+    The ``size`` most recently used values by key, safe across threads:
+    :meth:`get` returns the value of ``key``, built by ``build()`` (outside
+    the lock, so one slow build blocks no other key) when it is not kept,
+    the least recently used dropped beyond ``size``.
+    """
+
+    def __init__(self, size: int) -> None:
+        self.size = check_int("size", size, 1)
+        self._values: OrderedDict[Hashable, Any] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def get(self, key: Hashable, build: Callable[[], Any]) -> Any:
+        with self._lock:
+            if key in self._values:
+                self._values.move_to_end(key)
+                return self._values[key]
+        value = build()
+        with self._lock:
+            self._values[key] = value
+            while len(self._values) > self.size:
+                self._values.popitem(last=False)
+        return value

@@ -281,7 +281,6 @@ def fit_curves(
             start=start,
         )
 
-    _, _, score_M, score_E = score_grid(eta_i_range)
     range_M, range_E = check_grid(eta_i_range, *SCORE_GRID)
 
     def outside(C16) -> np.ndarray:
@@ -296,7 +295,10 @@ def fit_curves(
         weight, check, extra = settings.range_weight, settings.check_samples, None
         result = fit(objective, weight, check, dense)
         for _ in range(2):
-            if weight == 0 or in_range(result.coefficients_float16):
+            if weight == 0:
+                break
+            mask = outside(result.coefficients_float16)
+            if not mask.any():
                 break
             if start is None or dense is not None:
                 # A fit from its own guess: stiffer on a finer grid, started
@@ -306,7 +308,6 @@ def fit_curves(
             else:
                 # A warm-started (live) fit goes on from where it is, stiffer
                 # and with the points where it leaves [0, 1] added to its check.
-                mask = outside(result.coefficients_float16)
                 extra = (range_M[mask], range_E[mask]) if extra is None else (
                     np.concatenate([extra[0], range_M[mask]]), np.concatenate([extra[1], range_E[mask]]))
                 weight = 10.0 * weight

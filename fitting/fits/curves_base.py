@@ -15,15 +15,13 @@ The material an edit starts from, and how edits blend into it
 
 from __future__ import annotations
 
-import threading
-from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..colour.reference import reference_ACEScg_grid
-from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_number
+from ..domain import DEFAULT_ETA_I_RANGE, BoundedCache, check_eta_i_range, check_number
 from ..models.kinds import DEFAULT_MODEL, check_model_coefficients, model_ACEScg
 from ..optics.nk import SpectralNK
 from .curves_input import RGBCurve
@@ -103,23 +101,7 @@ class CurveBase:
         return top * (1.0 - fv) + bottom * fv
 
 
-_cache: OrderedDict[tuple, CurveBase] = OrderedDict()
-
-
-_cache_lock = threading.Lock()
-
-
-def _cached(key: tuple, build) -> CurveBase:
-    with _cache_lock:
-        if key in _cache:
-            _cache.move_to_end(key)
-            return _cache[key]
-    base = build()
-    with _cache_lock:
-        _cache[key] = base
-        while len(_cache) > _BASE_CACHE_SIZE:
-            _cache.popitem(last=False)
-    return base
+_BASES = BoundedCache(_BASE_CACHE_SIZE)
 
 
 def _base_grid(eta_i_range: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -151,7 +133,7 @@ def curve_base_from_nk(nk: SpectralNK, eta_i_range=DEFAULT_ETA_I_RANGE) -> Curve
         RGB.setflags(write=False)
         return CurveBase(nk.name, nk.source, eta_i_range, mu, eta, RGB, "nk")
 
-    return _cached(("nk", nk.content_key(), eta_i_range), build)
+    return _BASES.get(("nk", nk.content_key(), eta_i_range), build)
 
 
 def curve_base_from_coefficients(
@@ -178,7 +160,7 @@ def curve_base_from_coefficients(
         return CurveBase(name, source, eta_i_range, mu, eta, RGB, "model")
 
     key = ("model", model, np.ascontiguousarray(C, dtype="<f8").tobytes(), C.shape, eta_i_range, name, source)
-    return _cached(key, build)
+    return _BASES.get(key, build)
 
 
 def _smoothstep(x: np.ndarray) -> np.ndarray:

@@ -14,9 +14,7 @@ n, k fits
 from __future__ import annotations
 
 import asyncio
-import threading
 import time
-from collections import OrderedDict
 from pathlib import PurePath
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -24,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid, spectral_grid
-from fitting.domain import DEFAULT_MIN_COVERAGE, check_eta_i_range, cos_theta_from_angle
+from fitting.domain import DEFAULT_MIN_COVERAGE, BoundedCache, check_eta_i_range, cos_theta_from_angle
 from fitting.fits.evaluate import grid_models, metrics_json, score_on_grid
 from fitting.fits.kinds import fit_model
 from fitting.fits.metrics import ErrorMetrics
@@ -242,9 +240,7 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord
     return await runner.once(fit.fit_id, make), True
 
 
-_CURVES_CACHE: "OrderedDict[tuple, tuple[list, list]]" = OrderedDict()
-_CURVES_CACHE_SIZE = 64
-_CURVES_LOCK = threading.Lock()
+_MEASURED_CURVES = BoundedCache(64)
 
 
 def _measured_curves(nk: SpectralNK, eta_i: float, samples: int) -> tuple[list, list]:
@@ -254,20 +250,13 @@ def _measured_curves(nk: SpectralNK, eta_i: float, samples: int) -> tuple[list, 
     refit of one material (an editor drag asks for one per step) reuses
     them; the most recent few are kept.
     """
-    key = (nk.content_key(), eta_i, samples)
-    with _CURVES_LOCK:
-        if key in _CURVES_CACHE:
-            _CURVES_CACHE.move_to_end(key)
-            return _CURVES_CACHE[key]
-    mu = cos_theta_from_angle(np.linspace(0.0, 90.0, samples))
-    inputs = baseline_inputs(nk)
-    curves = (reference_ACEScg(nk, mu, eta_i).tolist(),
-              lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist())
-    with _CURVES_LOCK:
-        _CURVES_CACHE[key] = curves
-        while len(_CURVES_CACHE) > _CURVES_CACHE_SIZE:
-            _CURVES_CACHE.popitem(last=False)
-    return curves
+    def build() -> tuple[list, list]:
+        mu = cos_theta_from_angle(np.linspace(0.0, 90.0, samples))
+        inputs = baseline_inputs(nk)
+        return (reference_ACEScg(nk, mu, eta_i).tolist(),
+                lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist())
+
+    return _MEASURED_CURVES.get((nk.content_key(), eta_i, samples), build)
 
 
 def angle_curves(record: FitRecord, eta_i: float, samples: int) -> dict[str, Any]:
