@@ -96,6 +96,20 @@ def warm_process() -> None:
     spectral_weights(1.0)
 
 
+def start_worker() -> None:
+    """
+    A worker's initializer: one BLAS thread (a worker is one of ``workers``
+    processes on as many cores, and its matrices are small: two OpenBLAS
+    threads per worker oversubscribe the cores and make small products
+    several times slower, ``benchmarks/blas_threads.py``), then
+    :func:`warm_process`.
+    """
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")  # for the process's life
+    warm_process()
+
+
 def _ping() -> float:
     time.sleep(0.05)  # long enough that each warm-up ping lands on its own worker
     return time.time()
@@ -143,7 +157,7 @@ class FitRunner:
                 self._pool = concurrent.futures.ProcessPoolExecutor(
                     max_workers=self.workers,
                     mp_context=multiprocessing.get_context("spawn"),
-                    initializer=warm_process,
+                    initializer=start_worker,
                 )
             return self._pool
 

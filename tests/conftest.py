@@ -16,11 +16,22 @@ Shared fixtures of the test suite.
     tests that need their own data directory, environment or a restart
     (``with server_process(data_dir, COATED_FIT_QUEUE="0") as server: ...``;
     ``server.url``, ``server.process``, ``server.kill()``).
+
+The ``slow`` marker (``scripts/test --quick`` leaves those tests out) is on
+every test that starts a process, a GL context or a browser, or that took
+over 2 s in a ``--durations=0`` run. The ``gl``, ``server`` and ``browser``
+markers imply it. What cannot be forgotten is checked: a test not marked
+``slow`` that starts a process (``subprocess``, ``multiprocessing``: a CLI,
+a server, the fitting pool, Chromium, Blender, Dask) or a GL context fails
+with a message saying so. A run lists, at its end, the tests not marked
+``slow`` that took over 2 s.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
+import multiprocessing.process
 import os
 import signal
 import socket
@@ -31,6 +42,7 @@ from pathlib import Path
 from typing import Iterator
 
 import httpx
+import moderngl
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -137,3 +149,90 @@ def client(tmp_path):
 def live_server(tmp_path) -> Iterator[str]:
     with server_process(tmp_path / "data") as server:
         yield server.url
+
+
+# -- the slow marker ---------------------------------------------------------
+
+SLOW_S = 2.0
+"""A test taking longer than this (setup, call and teardown) is ``slow``."""
+
+_IMPLY_SLOW = ("gl", "server", "browser")
+PROCESS_FIXTURES = frozenset({
+    "shared", "fitted", "live_server", "editor_url", "pages", "page", "curve_fit", "rgb_fit",
+    "hostile_run",
+})
+"""
+Fixtures (by name, in any module) that start a process: the fitting pool's
+workers on their first fit, a server, Chromium. A test using one, directly
+or through another fixture, is ``slow``. The list is measured: a fixture
+not in it that starts a process fails the test that set it up, naming it.
+"""
+_started: list[str] = []      # what the running test started
+_fixture_started: dict[str, list[str]] = {}  # fixture name -> what its set-up started
+_unmarked_slow: list[tuple[float, str]] = []
+
+
+def _watch(what: str, function):
+    @functools.wraps(function)
+    def wrapper(*args, **kwargs):
+        _started.append(what)
+        return function(*args, **kwargs)
+    return wrapper
+
+
+subprocess.Popen.__init__ = _watch("a process (subprocess)", subprocess.Popen.__init__)
+multiprocessing.process.BaseProcess.start = _watch(
+    "a process (multiprocessing)", multiprocessing.process.BaseProcess.start)
+moderngl.create_context = _watch("a GL context", moderngl.create_context)
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if any(item.get_closest_marker(name) for name in _IMPLY_SLOW) \
+                or PROCESS_FIXTURES.intersection(item.fixturenames):
+            item.add_marker(pytest.mark.slow)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_fixture_setup(fixturedef, request):
+    before = len(_started)
+    yield
+    if len(_started) > before:
+        _fixture_started[fixturedef.argname] = _started[before:]
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    _started.clear()
+    item.stash[_DURATION] = 0.0
+    yield
+    if item.get_closest_marker("slow") is None and item.stash[_DURATION] > SLOW_S:
+        _unmarked_slow.append((item.stash[_DURATION], item.nodeid))
+
+
+_DURATION = pytest.StashKey[float]()
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    item.stash[_DURATION] = item.stash.get(_DURATION, 0.0) + report.duration
+    if call.when == "teardown" and _started and item.get_closest_marker("slow") is None \
+            and report.passed:
+        fixtures = sorted(name for name in item.fixturenames if name in _fixture_started)
+        where = f" in the set-up of the fixture(s) {', '.join(fixtures)} (add them to " \
+                "tests/conftest.py's PROCESS_FIXTURES)" if fixtures else ""
+        report.outcome = "failed"
+        report.longrepr = (
+            f"{item.nodeid} started {', '.join(sorted(set(_started)))}{where} but is not "
+            "marked `slow` (@pytest.mark.slow): scripts/test --quick must start no process, "
+            "GL context or browser"
+        )
+
+
+def pytest_terminal_summary(terminalreporter):
+    if _unmarked_slow:
+        terminalreporter.write_sep("-", f"not marked slow, over {SLOW_S:g} s")
+        for seconds, nodeid in sorted(_unmarked_slow, reverse=True):
+            terminalreporter.write_line(f"{seconds:6.2f}s {nodeid}")

@@ -137,7 +137,7 @@ def _fresnel_ACEScg_into(RE, s_t0, B, c, s, s2, sqrt2_mu, WT, buffers) -> np.nda
     on the same values in either orientation, so the numbers do not depend
     on it.
     """
-    t0, X, P, Q, R, positive, rgb, tiny = buffers
+    t0, X, P, Q, R, positive, R64, rgb, tiny = buffers
     np.subtract(RE, s_t0, out=t0, casting="same_kind")
     np.multiply(t0, t0, out=X)
     X += B
@@ -163,13 +163,27 @@ def _fresnel_ACEScg_into(RE, s_t0, B, c, s, s2, sqrt2_mu, WT, buffers) -> np.nda
     # numerator is 0 too: R = 0, as the complex form gives.
     np.maximum(P, tiny, out=P)
     R /= P
+    # The wavelength sum in float64 whatever the buffers' dtype: a float32
+    # sum over ~470 nodes rounds by up to L * 2^-24 relative to the sum of
+    # |terms|, and how much depends on the BLAS kernel (sgemm's FMA kernels
+    # differ between OpenBLAS core types). Every operation above is a single
+    # correctly rounded IEEE operation, identical on every CPU and SIMD width.
+    if R64 is not None:
+        np.copyto(R64, R)
+        R = R64
     return np.dot(R, WT, out=rgb)
 
 
 def _buffers(rows: int, L: int, dtype) -> tuple:
-    """The kernel's work arrays for ``rows`` x ``L`` values, its (rows, 3) result, its floor."""
+    """
+    The kernel's work arrays for ``rows`` x ``L`` values, a float64 copy of
+    the reflectance for the wavelength sum (None when ``dtype`` is float64),
+    its (rows, 3) float64 result, its floor.
+    """
+    dtype = np.dtype(dtype)
+    R64 = None if dtype == np.float64 else np.empty((rows, L))
     return (*(np.empty((rows, L), dtype) for _ in range(5)), np.empty((rows, L), dtype=bool),
-            np.empty((rows, 3), dtype), np.finfo(dtype).tiny)
+            R64, np.empty((rows, 3)), np.finfo(dtype).tiny)
 
 
 def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out, loop_mu: bool, dtype=np.float64) -> None:
@@ -212,7 +226,7 @@ def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out, loop_mu: bool, dtype=np.floa
     """
     L = n.size
     re0, im0 = n * n - k * k, (2.0 * n * k) ** 2
-    WT = WT.astype(dtype, copy=False)
+    WT = np.ascontiguousarray(WT, dtype=np.float64)
     if loop_mu:
         e2 = (eta_i * eta_i)[:, None]
         RE, B = re0 / e2, (im0 / (e2 * e2)).astype(dtype, copy=False)

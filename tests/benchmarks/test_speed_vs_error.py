@@ -68,6 +68,7 @@ def gold():
 
 
 class TestSplitSum:
+    @pytest.mark.slow  # 7.0 s (all cases 7.0 s) in a --durations=0 run
     def test_mirror_lobe_gives_the_fresnel_error(self, gold):
         # At roughness 0 (raised to ROUGHNESS_MIN) the lobe is a mirror: the albedo is F(NdotV),
         # so the split sum's Delta E is the Fresnel term's, up to the LUT's interpolation.

@@ -18,6 +18,8 @@ from fitting.models.pack import FLOAT16_MAX, PackedMaterial, decode_pack, encode
 from fitting.optics.fresnel import fresnel_conductor
 from fitting.optics.library import library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 REFUSED = {"TiO2", "Au 400-900 nm"}
 TIR = {"SiO2", "water", "diamond"}
 SAMPLES = 40

@@ -27,7 +27,7 @@ from preview_shaders.gl import RenderThread, check_gl_error, read_float_target
 from preview_shaders.preview import padded_words
 from preview_shaders.shading import upload_lut
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "Au_golden.json"
 NODES = 127  # as the editor's: twice the LUT's 64 NdotV nodes, less one

@@ -14,7 +14,7 @@ from fitting.shading.ibl import SplitSumLUT, generate_lut, split_sum_model
 from preview_shaders.gl import RenderThread
 from preview_shaders.shading import decode_lut_in_shader, evaluate_split_sum_grid
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 TOLERANCE = 1.0e-5
 

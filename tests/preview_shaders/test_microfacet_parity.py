@@ -14,7 +14,7 @@ from fitting.shading.microfacet import microfacet_brdf
 from preview_shaders.gl import RenderThread
 from preview_shaders.shading import evaluate_brdf_grid
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 TOLERANCE = 1.0e-5
 """Float32 shader against float64 numpy: absolute below 1/sr, relative above

@@ -23,7 +23,7 @@ from fitting.optics.library import library_material
 from preview_shaders.gl import RenderThread
 from preview_shaders.preview import PreviewRenderer, sphere_cos_theta
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 ROOT = Path(__file__).resolve().parents[2]
 GOLDEN = ROOT / "tests" / "golden"

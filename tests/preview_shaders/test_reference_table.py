@@ -18,6 +18,8 @@ from preview_shaders.preview import (
     sphere_cos_theta,
 )
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 # The distinct cos theta of a 256 px sphere, as float32 like the GL geometry.
 _COS, _MASK = sphere_cos_theta(256)
 MU = np.unique(_COS[_MASK].astype(np.float32).astype(np.float64))

@@ -17,7 +17,7 @@ from fitting.models.pack import PackedMaterial, to_float16
 from preview_shaders.evaluate import MODEL_VARIANTS, evaluate_grid, shader_inputs
 from preview_shaders.gl import RenderThread, load_shader_source
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 TOLERANCE = 1.0e-5
 """Absolute: float32 arithmetic in the shader against float64 numpy."""

@@ -27,7 +27,7 @@ from preview_shaders.evaluate import (
 )
 from preview_shaders.gl import RenderThread, load_shader_source
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 TOLERANCE = 1.0e-5
 """Absolute: float32 arithmetic in the shader against float64 numpy."""

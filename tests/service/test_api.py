@@ -107,7 +107,9 @@ class TestMaterials:
             assert "`material_id`" in response.json()["detail"]
 
 
+@pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestFits:
+    @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
     def test_library_fit_is_the_core_fit(self, shared):
         client, fit = shared
         assert fit["name"] == "Au" and fit["kind"] == "library" and fit["degree"] == 2
@@ -122,6 +124,7 @@ class TestFits:
         assert {"reference", "fit", "quantise", "total", "evaluate"} <= set(fit["timings"])
         assert fit["convergence"]["success"] is True
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_metrics_are_the_core_evaluation(self, shared):
         # The pool's three parts (the fit, the reference beside it, the score)
         # give the numbers of the core's evaluation on the service's reference.
@@ -132,6 +135,7 @@ class TestFits:
         assert record.metrics == expected
         assert record.timings["evaluate"] > 0.0
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_same_input_same_id_no_refit(self, shared):
         client, fit = shared
         runner = client.app.state.runner
@@ -428,6 +432,7 @@ class TestPreview:
 
 
 class TestLoadLimits:
+    @pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
     def test_overload_503_with_retry_after(self, tmp_path):
         with app_client(tmp_path, fit_queue=0) as client:
             runner = client.app.state.runner
@@ -447,6 +452,7 @@ class TestLoadLimits:
             assert "limit" in response.json()["detail"]
             assert first["r"].status_code == 201
 
+    @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
     def test_timeout_504(self, tmp_path):
         with app_client(tmp_path, fit_timeout_s=0.001) as client:
             response = client.post(f"{API}/fits", json={"material": "Ni"})
@@ -488,6 +494,7 @@ class TestSecurity:
             response = client.get(f"{API}/materials", headers={"Origin": "https://editor.example"})
             assert response.headers["access-control-allow-origin"] == "https://editor.example"
 
+    @pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
     def test_cross_site_writes_refused(self, client):
         # A multipart upload needs no CORS preflight: without this check any
         # page a user visits could plant materials in the store.
@@ -502,6 +509,7 @@ class TestSecurity:
         same = client.post(f"{API}/fits/upload", files=files, headers={"Origin": "http://testserver"})
         assert same.status_code == 201, same.text
 
+    @pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
     def test_configured_origin_may_write(self, tmp_path):
         with app_client(tmp_path, cors_origins=["https://editor.example"]) as client:
             response = client.post(f"{API}/fits/upload", files={"file": ("x.csv", csv_text(gold_like_nk()), "text/csv")},
@@ -520,6 +528,7 @@ class TestPackNames:
 
 
 class TestPreviewBound:
+    @pytest.mark.slow  # 3.1 s (all cases 3.1 s) in a --durations=0 run
     def test_previews_past_the_bound_get_503(self, tmp_path, monkeypatch):
         import threading
 

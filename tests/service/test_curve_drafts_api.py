@@ -37,6 +37,7 @@ def saved_names(client):
     return [m["name"] for m in client.get("/api/v1/materials").json()["materials"] if m["kind"] == "curves"]
 
 
+@pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
 def test_a_draft_is_not_saved_until_saved(shared):
     draft = shared.post("/api/v1/fits/from-curves", json=body("Draft gold", True))
     assert draft.status_code == 201, draft.text
@@ -52,6 +53,7 @@ def test_a_draft_is_not_saved_until_saved(shared):
     assert material["latest_fit"]["id"] == fit_id
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_curves_return_the_blended_target(shared):
     fit = shared.post("/api/v1/fits/from-curves", json=body("Target gold", True)).json()
     base = curve_base_from_nk(library_material("Au"), (1.0, 2.5))

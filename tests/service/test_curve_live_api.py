@@ -37,6 +37,7 @@ def saved_names(client):
     return [m["name"] for m in client.get("/api/v1/materials").json()["materials"] if m["kind"] == "curves"]
 
 
+@pytest.mark.slow  # 3.1 s (all cases 3.1 s) in a --durations=0 run
 def test_a_drag_of_live_refits_stays_in_range_and_is_never_saved(shared):
     client, base = shared
     start = base["id"]
@@ -57,6 +58,7 @@ def test_a_drag_of_live_refits_stays_in_range_and_is_never_saved(shared):
     assert full.json()["metrics"]["details"]["target"]["delta_E_mean"] <= live_error + 1e-6
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_the_start_is_part_of_the_id(shared):
     client, base = shared
     first = client.post(ROUTE, json=body(base["id"], 0.9, live=True, start_fit=base["id"])).json()
@@ -67,6 +69,7 @@ def test_the_start_is_part_of_the_id(shared):
     assert same.status_code == 200 and same.json()["id"] == first["id"]
 
 
+@pytest.mark.slow  # its module fixture's fits start the fitting pool's processes
 @pytest.mark.parametrize("extra, status, needle", [
     ({"live": True, "draft": False}, 422, "`live` refits are drafts"),
     ({"start_fit": "0" * 32}, 422, "`start_fit` is for `live` refits only"),

@@ -11,6 +11,9 @@ from fitting.models.pack import decode_pack
 from fitting.models.rgb_conductor import rgb_conductor_model
 from fitting.optics.library import library_material
 
+# Its module-scoped `client` fits (the fitting pool's processes) or renders (GL).
+pytestmark = pytest.mark.slow
+
 URL = "/api/v1/fits/from-curves"
 ANGLE = np.linspace(0.0, 90.0, 19)
 
@@ -37,13 +40,16 @@ def rgb_fit(client):
     return body, response.json()
 
 
+@pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestCurveFitKinds:
+    @pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
     def test_answer_is_an_rgb_conductor(self, rgb_fit):
         _, fit = rgb_fit
         assert fit["model"] == "rgb-conductor"
         assert set(fit["coefficients"]) == {"n", "k"}
         assert all(len(fit["coefficients"][key]) == 3 for key in ("n", "k"))
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_kind_is_part_of_the_id(self, client, rgb_fit):
         body, fit = rgb_fit
         coated = client.post(URL, json={**body, "model": "coated-conductor"})
@@ -52,6 +58,7 @@ class TestCurveFitKinds:
         again = client.post(URL, json=body)
         assert again.status_code == 200 and again.json()["id"] == fit["id"]
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_curves_route_and_pack_are_the_kinds_model(self, client, rgb_fit):
         _, fit = rgb_fit
         curves = client.get(f"/api/v1/fits/{fit['id']}/curves?eta_i=1.5&samples=10")

@@ -11,6 +11,9 @@ import pytest
 
 from conftest import app_client
 
+# Its module-scoped `client` fits (the fitting pool's processes) or renders (GL).
+pytestmark = pytest.mark.slow
+
 API = "/api/v1"
 
 
@@ -20,6 +23,7 @@ def client(tmp_path_factory):
         yield test_client
 
 
+@pytest.mark.slow  # 3.4 s (all cases 3.4 s) in a --durations=0 run
 @pytest.mark.gl
 @pytest.mark.parametrize("environment", ["white_sky", "studio", "outdoor"])
 def test_slices_are_the_rough_preview_s(client, environment):
@@ -42,6 +46,7 @@ def test_slices_are_the_rough_preview_s(client, environment):
         assert data[-1].max() < data[0].max() and data[-1].min() > data[0].min()
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_unknown_environment_422(client):
     response = client.get(f"{API}/environments/beach/prefiltered")
     assert response.status_code == 422

@@ -28,7 +28,9 @@ def pack(client, fit_id, query):
     return client.get(f"{API}/fits/{fit_id}/pack?{query}")
 
 
+@pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestExportDownloads:
+    @pytest.mark.slow  # 2.7 s (all cases 2.8 s) in a --durations=0 run
     @pytest.mark.parametrize("format, media_type, suffix", [
         ("mtlx", "application/xml", ".mtlx"), ("openpbr", "application/xml", ".openpbr.mtlx"),
         ("blender", "text/x-python; charset=utf-8", ".py"), ("gltf", "model/gltf+json", ".gltf"),
@@ -42,12 +44,14 @@ class TestExportDownloads:
             f'attachment; filename="Cu-{fit_id[:8]}-eta1.7{suffix}"')
         assert response.content == export_material(library_material("Cu"), format, 1.7)
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_default_eta_i_is_1_5(self, shared):
         client, fit_id = shared
         root = ET.fromstring(pack(client, fit_id, "format=openpbr").content)
         (coat_ior,) = [e for e in root.iter("input") if e.get("name") == "coat_ior"]
         assert coat_ior.get("value") == "1.5"
 
+    @pytest.mark.slow  # starts a process or GL context
     @pytest.mark.parametrize("query, words", [
         ("format=mtlx&eta_i=0.8", ["eta_i", "greater than or equal to 1"]),
         ("format=gltf&eta_i=3.5", ["eta_i", "less than or equal to 3"]),

@@ -35,6 +35,7 @@ def gold_like_nk(shift: float = 0.0) -> dict:
 
 # -- 3. DNS rebinding ---------------------------------------------------------
 
+@pytest.mark.slow  # 4.8 s (all cases 4.8 s) in a --durations=0 run
 @pytest.mark.server
 def test_rebinding_host_refused_400_loopback_allowed(tmp_path):
     with server_process(tmp_path / "data") as server:
@@ -64,6 +65,7 @@ def test_allowed_hosts_configured(tmp_path):
 
 # -- 4. slow clients ------------------------------------------------------------
 
+@pytest.mark.slow  # 6.2 s (all cases 6.2 s) in a --durations=0 run
 @pytest.mark.server
 def test_slow_clients_are_cut_off_and_healthz_answers(tmp_path):
     with server_process(tmp_path / "data", COATED_HEADER_TIMEOUT_S="1", COATED_BODY_TIMEOUT_S="1") as server:
@@ -125,6 +127,7 @@ def test_materials_paged_by_summary(tmp_path):
 
 # -- 6. storage faults -------------------------------------------------------------
 
+@pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
 def test_corrupt_record_reported_and_skipped(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
         a = client.post(f"{API}/fits", json={"name": "a", "nk": gold_like_nk(0.0)}).json()
@@ -142,6 +145,7 @@ def test_corrupt_record_reported_and_skipped(tmp_path):
         assert client.get(f"{API}/fits/{b['id']}").status_code == 200
 
 
+@pytest.mark.slow  # 3.8 s (all cases 3.8 s) in a --durations=0 run
 def test_store_quota_full_507_and_healthz(tmp_path):
     with app_client(tmp_path, metrics_samples=10, store_max_bytes=200_000) as client:
         statuses = []
@@ -184,6 +188,7 @@ def test_read_only_store_503(tmp_path):
         assert response.status_code == 503 and response.json()["detail"]
 
 
+@pytest.mark.slow  # starts a process or GL context
 @pytest.mark.parametrize("damage", ["corrupt", "not a directory"])
 def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
     data = tmp_path / "data"
@@ -212,6 +217,7 @@ def _worker_pids(server_pid: int) -> list[int]:
     return pids
 
 
+@pytest.mark.slow  # 13.1 s (all cases 13.1 s) in a --durations=0 run
 @pytest.mark.server
 def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path):
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server:
@@ -238,6 +244,7 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
             assert http.get(f"{API}/fits/{fit_id}").status_code == 200
 
 
+@pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
 def test_timed_out_fit_keeps_its_result_for_the_retry(tmp_path):
     with app_client(tmp_path, fit_timeout_s=0.2, metrics_samples=10) as client:
         body = {"name": "slow", "nk": gold_like_nk(0.2)}
@@ -254,6 +261,7 @@ def test_timed_out_fit_keeps_its_result_for_the_retry(tmp_path):
 
 # -- 8. generated code and ids ---------------------------------------------------
 
+@pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
 def test_symbols_unique_and_every_download_compiles(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
         ids = [client.post(f"{API}/fits", json={"name": name, "nk": gold_like_nk(i / 10)}).json()["id"]
@@ -280,6 +288,7 @@ def test_symbols_unique_and_every_download_compiles(tmp_path):
 
 # -- 9. edits in scenes, float32 bounds --------------------------------------------
 
+@pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run
 def test_scene_uses_the_edited_model(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
         edit = {"name": "warm gold", "base": {"material": "Au"}, "curves": [{
@@ -300,6 +309,7 @@ def test_scene_uses_the_edited_model(tmp_path):
         assert outside.status_code == 422 and "materials[0].eta_i" in outside.json()["detail"]
 
 
+@pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
 def test_edit_at_the_float32_rounded_upper_end(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
         base = client.post(f"{API}/fits", json={"material": "Cu", "eta_i_range": [2.9999999, 3.0]})

@@ -29,6 +29,7 @@ def shared(tmp_path_factory):
         yield client, response.json()
 
 
+@pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
 def test_lut_download(shared):
     client, _ = shared
     response = client.get(f"{API}/ibl-lut")
@@ -139,6 +140,7 @@ float4 main(float4 position : SV_Position) : SV_Target
 """
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_hlsl_pack_split_sum_compiles(tmp_path):
     source = render_pack(materials(), "hlsl", "test pack").decode()
     assert "float3 cf_split_sum_model(Texture3D<float4> lut" in source
@@ -152,6 +154,7 @@ def test_hlsl_pack_split_sum_compiles(tmp_path):
     assert (tmp_path / "p.spv").stat().st_size > 0
 
 
+@pytest.mark.slow  # starts a GL context
 @pytest.mark.parametrize("head", ["#version 330\n", "#version 300 es\nprecision highp float;\n"])
 def test_glsl_pack_split_sum_compiles_for_330_and_es_300(tmp_path, head):
     source = render_pack(materials(), "glsl", "test pack").decode()

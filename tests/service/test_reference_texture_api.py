@@ -26,6 +26,7 @@ def gold(shared):
     return response.json()
 
 
+@pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
 def test_texture_is_the_reference_grid(shared, gold):
     response = shared.get(f"/api/v1/fits/{gold['id']}/reference-texture")
     assert response.status_code == 200, response.text
@@ -44,6 +45,7 @@ def test_texture_is_the_reference_grid(shared, gold):
         np.testing.assert_allclose([float(v) for v in response.headers[header].split(",")], inputs[key], rtol=1e-8)
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_texture_refusals(shared):
     curves = {"eta_i": 1.5, "angle_deg": [0, 30, 60, 80, 90],
               "rgb": [[0.9, 0.6, 0.3], [0.9, 0.6, 0.3], [0.9, 0.62, 0.35], [0.93, 0.8, 0.6], [1, 1, 1]]}

@@ -30,7 +30,9 @@ def fitted(tmp_path_factory):
         yield client, rgb.json(), coated.json()
 
 
+@pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestCreateFit:
+    @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
     def test_rgb_conductor_view(self, fitted):
         _, rgb, _ = fitted
         assert rgb["model"] == "rgb-conductor"
@@ -42,12 +44,14 @@ class TestCreateFit:
         assert np.array_equal(k.astype(np.float16).astype(np.float64), k)
         assert rgb["metrics"]["model"]["delta_E_mean"] < rgb["metrics"]["lazanyi_adjusted"]["delta_E_mean"]
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_default_kind_unchanged(self, fitted):
         _, rgb, coated = fitted
         assert coated["model"] == "coated-conductor"
         assert set(coated["coefficients"]) == {"F0", "a", "alpha"}
         assert coated["id"] != rgb["id"]
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_same_request_served_from_store(self, fitted):
         client, rgb, _ = fitted
         again = client.post(f"{API}/fits", json={"material": "Au", "model": "rgb-conductor"})
@@ -93,6 +97,7 @@ class TestDownloads:
         assert view["coefficients"] == rgb["coefficients"]
         assert pack_from_json(response.content)[0].model == "rgb-conductor"
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_glsl_and_hlsl(self, fitted, tmp_path):
         client, rgb, _ = fitted
         glsl = client.get(f"{API}/fits/{rgb['id']}/pack", params={"format": "glsl"})

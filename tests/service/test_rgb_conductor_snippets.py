@@ -95,6 +95,7 @@ def test_mixed_glsl_snippet_matches_numpy(index):
     assert error.max() <= 2e-5
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_mixed_hlsl_snippet_compiles(tmp_path):
     source = render_pack(mixed(), "hlsl", "mixed").decode()
     assert source.count("float3 cf_rgb_conductor(") == 1 and source.count("float3 cf_coated_conductor(") == 1

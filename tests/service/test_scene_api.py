@@ -24,7 +24,9 @@ def shared(tmp_path_factory):
         yield client, response.json()
 
 
+@pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestScenePack:
+    @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
     def test_report_and_pack(self, shared):
         _, body = shared
         assert body["scene"] == "desk"
@@ -42,6 +44,7 @@ class TestScenePack:
         assert [m.name for m in packed] == ["Cu", "lamp"]
         assert pack_from_json(__import__("json").dumps(body["pack"])) == packed
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_inline_nk_matches_the_library(self, shared):
         client, body = shared
         Cu = library_material("Cu")
@@ -54,6 +57,7 @@ class TestScenePack:
         assert response.json()["pack"]["materials"][0]["coefficients"] == \
             body["pack"]["materials"][0]["coefficients"]
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_saved_material_by_id(self, shared):
         client, _ = shared
         Cu = library_material("Cu")
@@ -109,6 +113,7 @@ class TestRefusals:
                 runner._in_flight = 0
             assert response.status_code == 503 and int(response.headers["retry-after"]) >= 1
 
+    @pytest.mark.slow  # 3.0 s (all cases 3.0 s) in a --durations=0 run
     def test_504_past_the_time_limit(self, tmp_path):
         with app_client(tmp_path, fit_timeout_s=0.001) as client:
             response = client.post(f"{API}/scenes", json=SCENE)

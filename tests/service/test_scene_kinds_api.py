@@ -9,6 +9,9 @@ import pytest
 from conftest import app_client
 from fitting.models.pack import decode_pack
 
+# Its module-scoped `client` fits (the fitting pool's processes) or renders (GL).
+pytestmark = pytest.mark.slow
+
 API = "/api/v1"
 
 
@@ -18,6 +21,7 @@ def client(tmp_path_factory):
         yield test_client
 
 
+@pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
 def test_max_delta_e_chooses_per_material(client):
     response = client.post(f"{API}/scenes", json={"name": "ring", "max_delta_e": 0.05, "materials": [
         {"material": "Au", "eta_i": 1.5}, {"material": "Ag", "name": "band", "eta_i": 1.2}]})
@@ -31,6 +35,7 @@ def test_max_delta_e_chooses_per_material(client):
     assert body["pack"]["materials"][0]["model"] == "rgb-conductor"
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_prefer_accuracy(client):
     response = client.post(f"{API}/scenes", json={"prefer": "accuracy", "materials": [
         {"material": "Cu", "eta_i": 1.33}]})

@@ -97,6 +97,7 @@ float4 main(float4 position : SV_Position) : SV_Target
 """
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_hlsl_snippet_compiles(tmp_path):
     # glslang's HLSL front end (Debian glslang-tools) compiles the snippet to
     # SPIR-V as a pixel shader calling every material function.

@@ -11,13 +11,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from playwright.sync_api import sync_playwright
+from playwright.sync_api import expect, sync_playwright
 
 CHROMIUM_ARGS = [
     "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
     "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
 ]
 TIMEOUT_MS = 120_000  # first fits start worker processes
+# expect() waits as long as the page's own calls: its 5 s default is a
+# guess at the machine's speed (a save behind a refit on a loaded 2-core
+# machine takes longer), and waiting longer asserts the same thing.
+expect.set_options(timeout=TIMEOUT_MS)
 
 
 @pytest.fixture

@@ -13,24 +13,14 @@ import re
 
 import pytest
 from conftest import server_process
+from editor_pages import CHROMIUM_ARGS, TIMEOUT_MS, editor_url  # noqa: F401 (fixture; expect's timeout)
 from playwright.sync_api import expect, sync_playwright
 
 from fitting.models.pack import decode_pack
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 
-CHROMIUM_ARGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
-]
-TIMEOUT_MS = 120_000  # first fits and previews start worker processes and a GL context
-
 FROM_CURVES = re.compile(r".*/api/v1/fits/from-curves(\?.*)?$")  # with or without its query
-
-
-@pytest.fixture
-def editor_url(live_server):
-    return live_server + "/"
 
 
 @pytest.fixture

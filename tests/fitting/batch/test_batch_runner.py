@@ -175,6 +175,7 @@ class TestRunBatch:
         with pytest.raises(ValueError, match="journal of a different batch"):
             run_batch(PAGES[:1], tmp_path, workers=1, samples=SAMPLES, progress=False)
 
+    @pytest.mark.slow  # 3.3 s (all cases 3.3 s) in a --durations=0 run
     def test_local_worker_processes_same_bytes(self, serial, tmp_path):
         run_batch(PAGES, tmp_path, workers=2, samples=SAMPLES, progress=False)
         assert outputs(tmp_path) == serial[1]
@@ -191,6 +192,7 @@ class TestRunBatch:
 
 
 class TestDaskCluster:
+    @pytest.mark.slow  # 6.5 s (all cases 6.5 s) in a --durations=0 run
     def test_local_cluster_worker_killed_mid_batch(self, serial, tmp_path):
         from distributed import Client, LocalCluster
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+
+import pytest
 from pathlib import Path
 
 from fitting.exports import export_material
@@ -21,12 +23,14 @@ def cli(*args: str) -> subprocess.CompletedProcess:
 
 
 class TestExportOption:
+    @pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
     def test_writes_the_export(self, tmp_path):
         out = tmp_path / "au.mtlx"
         result = cli("fit", "Au", "--export", "mtlx", "--eta-i", "1.5", "-o", str(out))
         assert result.returncode == 0, result.stderr
         assert out.read_bytes() == export_material(library_material("Au"), "mtlx", 1.5)
 
+    @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
     def test_stdout_and_roughness(self):
         result = cli("fit", "Cr", "--export", "gltf", "--eta-i", "2", "--roughness", "0.5")
         assert result.returncode == 0, result.stderr
@@ -34,11 +38,13 @@ class TestExportOption:
         assert material["pbrMetallicRoughness"]["roughnessFactor"] == 0.5
         assert material["extras"]["coated_fresnel"]["eta_i"] == 2.0
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_bad_eta_i(self):
         result = cli("fit", "Au", "--export", "openpbr", "--eta-i", "0.8")
         assert result.returncode == 2
         assert "`eta_i` must lie in [1, 3], got 0.8" in result.stderr
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_bad_format(self):
         result = cli("fit", "Au", "--export", "usd")
         assert result.returncode == 2 and "invalid choice: 'usd'" in result.stderr

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[3]
 
 
@@ -24,6 +26,7 @@ def fit(*args):
                           capture_output=True, text=True, timeout=600)
 
 
+@pytest.mark.slow  # 5.9 s (all cases 5.9 s) in a --durations=0 run
 def test_non_converged_fit_warns_and_strict_fails(tmp_path):
     path = glass_csv(tmp_path)
     out = tmp_path / "glass.cfpk"
@@ -37,6 +40,7 @@ def test_non_converged_fit_warns_and_strict_fails(tmp_path):
     assert not strict_out.exists()
 
 
+@pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
 def test_converged_fit_is_quiet_under_strict(tmp_path):
     result = fit("Au", "--no-metrics", "--strict", "-o", str(tmp_path / "au.cfpk"))
     assert result.returncode == 0, result.stderr

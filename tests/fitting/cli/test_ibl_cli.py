@@ -8,6 +8,8 @@ import sys
 
 import numpy as np
 
+import pytest
+
 from fitting.shading.ibl import decode_lut
 
 
@@ -17,6 +19,7 @@ def _run(*args, timeout=600):
     )
 
 
+@pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run
 def test_ibl_json_shape_and_agreement():
     out = _run("ibl", "Cr", "--eta-i", "1.5", "--roughness", "0.4", "--json",
                "--n-dot-v", "0.05,0.3,0.8", "--samples", "8192")
@@ -32,6 +35,7 @@ def test_ibl_json_shape_and_agreement():
     assert np.all(np.abs(ref - mc) <= 0.05 * ref)
 
 
+@pytest.mark.slow  # 5.2 s (all cases 5.2 s) in a --durations=0 run
 def test_ibl_coated_at_eta_1_and_bad_input():
     out = _run("ibl", "Au", "--eta-i", "1", "--roughness", "0.2", "--mode", "coated", "--json",
                "--n-dot-v", "0.5", "--samples", "1024")
@@ -43,6 +47,7 @@ def test_ibl_coated_at_eta_1_and_bad_input():
     assert bad.returncode == 2 and "--roughness must lie in [0, 1]" in bad.stderr
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_ibl_lut_file(tmp_path):
     path = tmp_path / "lut.bin"
     out = _run("ibl-lut", "-o", str(path))

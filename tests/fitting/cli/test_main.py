@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from fitting.models.pack import decode_pack
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -19,11 +21,13 @@ def run(*args, check=True):
     return result
 
 
+@pytest.mark.slow  # starts a process or GL context
 def test_library_lists_22():
     lines = run("library").stdout.strip().splitlines()
     assert len(lines) == 22 and lines[2].startswith("Au") and "Johnson" in lines[2]
 
 
+@pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
 def test_fit_writes_binary_pack(tmp_path):
     out = tmp_path / "au.cfpk"
     run("fit", "Au", "--eta-range", "1:2", "--no-metrics", "-o", str(out))
@@ -31,12 +35,14 @@ def test_fit_writes_binary_pack(tmp_path):
     assert material.name == "Au" and material.eta_i_range == (1.0, 2.0)
 
 
+@pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
 def test_fit_json_with_metrics():
     view = json.loads(run("fit", "Cu", "--json").stdout)
     assert view["colour_space"] == "ACEScg" and view["fit"]["success"]
     assert view["metrics"]["model_float16"]["delta_E_mean"] < 0.2
 
 
+@pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
 def test_fit_user_file(tmp_path):
     path = tmp_path / "metal.csv"
     path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n600,0.6,3.0\n850,0.8,4.5\n")
@@ -44,11 +50,13 @@ def test_fit_user_file(tmp_path):
     assert view["name"] == "metal" and view["source"] == "user CSV"
 
 
+@pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
 def test_fit_any_database_page():
     view = json.loads(run("fit", "--page", "main/Ni/Johnson", "--no-metrics").stdout)
     assert view["name"] == "Ni (Johnson)" and "main/Ni/Johnson" in view["source"]
 
 
+@pytest.mark.slow  # 4.2 s (all cases 4.2 s) in a --durations=0 run
 def test_errors_are_clear():
     result = run("fit", "--page", "main/Ni", check=False)
     assert result.returncode == 2 and "SHELF/BOOK/PAGE" in result.stderr
@@ -60,6 +68,7 @@ def test_errors_are_clear():
     assert result.returncode == 2 and "--eta-range must be LO:HI" in result.stderr
 
 
+@pytest.mark.slow  # 4.3 s (all cases 4.3 s) in a --durations=0 run
 def test_reproduce_subset(tmp_path):
     out = tmp_path / "results.md"
     result = run("reproduce", "--materials", "Au,Ta", "-o", str(out))

@@ -80,6 +80,7 @@ class TestSceneCommand:
         assert not out.parent.exists()
 
 
+@pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
 def test_python_m_fitting_scene(scene_file, tmp_path):
     out = tmp_path / "desk.cfpk"
     done = subprocess.run(

@@ -13,6 +13,8 @@ from fitting.colour.colorimetry import (
 from fitting.colour.delta_e import delta_E_2000
 from fitting.colour.reference import spectral_grid, spectral_weights
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 class TestColorimetry:
     def test_white_maps_to_one(self):

@@ -8,6 +8,8 @@ import pytest
 from fitting.colour.colorimetry import ACEScg_to_Lab
 from fitting.colour.delta_e import delta_E_2000, delta_E_map
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 # Sharma, Wu & Dalal (2005), Table 1: the 34 test pairs and their Delta E 2000
 # (pair 14, whose hue difference is 180 degrees to the last bit, is left out
 # as colour-science leaves it out: arctan2 rounds it either way by platform).

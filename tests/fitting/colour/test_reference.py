@@ -7,6 +7,8 @@ from fitting.colour.reference import reference_ACEScg, spectral_grid
 from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 class TestReference:
     def test_shape_and_limits(self):

@@ -62,6 +62,7 @@ def conductor(values, tmp_path_factory):
 
 
 class TestPrincipled:
+    @pytest.mark.slow  # 4.4 s (all cases 4.4 s) in a --durations=0 run
     def test_node_values(self, values, principled):
         nodes = principled[0]["nodes"]
         node = nodes[NODE_NAMES["principled"]]
@@ -79,6 +80,7 @@ class TestPrincipled:
         provenance = json.loads(principled[0]["custom"]["coated_fresnel"])
         assert provenance["material"] == "Cu" and provenance["eta_i"] == 1.6
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_render(self, principled):
         pixels = principled[1]
         assert pixels.shape == (SIZE, SIZE, 3)
@@ -91,6 +93,7 @@ class TestPrincipled:
 
 
 class TestPhysicalConductor:
+    @pytest.mark.slow  # 2.0 s (all cases 2.0 s) in a --durations=0 run
     def test_node_values(self, values, conductor):
         nodes = conductor[0]["nodes"]
         metallic = nodes[NODE_NAMES["metallic"]]
@@ -105,6 +108,7 @@ class TestPhysicalConductor:
         assert [NODE_NAMES["coat_mix"], "Shader", NODE_NAMES["conductor_output"], "Surface"] in links
         assert [NODE_NAMES["coat_fresnel"], "Factor", NODE_NAMES["coat_mix"], "Fac"] in links
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_render(self, conductor):
         pixels = conductor[1]
         centre = pixels[SIZE // 2 - 2: SIZE // 2 + 2, SIZE // 2 - 2: SIZE // 2 + 2].mean(axis=(0, 1))

@@ -96,6 +96,7 @@ class TestMtlx:
         assert f"material: {values.name}" in material.getDocString()
         assert f"eta_i: {values.eta_i}" in material.getDocString()
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_glsl_compiles(self, values, stdlib, tmp_path):
         doc = load(export_material(values, "mtlx", values.eta_i).decode(), stdlib)
         pixel, _ = glsl_compiles(doc, tmp_path)
@@ -126,11 +127,13 @@ class TestOpenPBR:
             assert value_of(shader, name) == pytest.approx(expected)
         assert "f82-tint" in material.getDocString()
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_glsl_compiles(self, values, stdlib, tmp_path):
         doc = load(export_material(values, "openpbr", values.eta_i).decode(), stdlib)
         pixel, _ = glsl_compiles(doc, tmp_path)
         assert "mx_fresnel_hoffman_schlick" in pixel
 
+    @pytest.mark.slow  # starts a process or GL context
     def test_compile_check_is_not_a_formality(self, tmp_path):
         bad = tmp_path / "bad.frag"
         bad.write_text("#version 400\nvoid main() { vec3 x = undefined_thing; }\n")

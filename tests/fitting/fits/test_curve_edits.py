@@ -48,6 +48,7 @@ def dense_range(result):
     return F.min(), F.max()
 
 
+@pytest.mark.slow  # 22.5 s (all cases 33.1 s) in a --durations=0 run
 @pytest.mark.parametrize("material, edits", [
     ("Au", [(1.5, 0, 60, 0.0)]),                       # a point pulled to 0
     ("Ag", [(1.5, 2, 40, 0.2), (2.4, 1, 70, 1.0)]),    # a bright metal darkened, and pulled to 1
@@ -66,6 +67,7 @@ def test_extreme_edits_stay_in_range(material, edits):
     assert target["grid"] == f"{SCORE_GRID[0]} angles x {SCORE_GRID[1]} eta_i"
 
 
+@pytest.mark.slow  # 4.3 s in a --durations=0 run under load
 def test_reported_figures_are_over_the_whole_blended_target():
     base = base_of("Au")
     curves = [pulled(base, 1.5, 0, 50, 0.6)]
@@ -107,6 +109,7 @@ def paper_method(base, curves):
     ("Al", [(1.5, 2, 60, 0.5)]),
     ("Cr", [(1.5, 0, 55, 0.5), (1.2, 1, 60, 0.4), (2.0, 2, 66, 0.3), (2.4, 0, 72, 0.2)]),
 ])
+@pytest.mark.slow  # 1.6-7.4 s a case (refits of four metals) in a --durations=0 run under load
 def test_default_refit_is_at_least_as_close_as_the_papers_method(material, edits):
     base = base_of(material)
     curves = [pulled(base, *edit) for edit in edits]

@@ -13,6 +13,8 @@ from fitting.models.coated_conductor import coated_conductor_model
 from fitting.models.pack import decode_pack, encode_pack
 from fitting.optics.library import library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 ANGLE = np.linspace(0.0, 90.0, 46)
 
 MU = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))

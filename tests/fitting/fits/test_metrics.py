@@ -17,6 +17,8 @@ from fitting.fits.metrics import (
 )
 from fitting.fits.curves_input import RGBCurve
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 RNG = np.random.default_rng(9)
 REF = RNG.uniform(0.05, 0.9, (4, 7, 3))
 MODEL = np.clip(REF + RNG.normal(0.0, 0.02, REF.shape), 0.0, 1.0)

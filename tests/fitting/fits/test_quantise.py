@@ -12,6 +12,8 @@ from fitting.fits.solver import fit_coefficients
 from fitting.models.pack import PackedMaterial, decode_pack, encode_pack
 from fitting.optics.library import library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 @pytest.fixture(scope="module", params=["Nb", "Cu"])
 def real_problem(request):

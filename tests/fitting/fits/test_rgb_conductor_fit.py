@@ -24,6 +24,8 @@ from fitting.models.pack import decode_pack
 from fitting.models.rgb_conductor import rgb_conductor_model
 from fitting.optics.library import library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 ROOT = Path(__file__).resolve().parents[3]
 
 
@@ -118,6 +120,7 @@ def run(*args):
 
 
 class TestCommandLine:
+    @pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
     def test_fit_json_view(self, tmp_path):
         out = tmp_path / "au.cfpk"
         result = run("fit", "Au", "--model", "rgb-conductor", "--json", "-o", str(out))
@@ -130,6 +133,7 @@ class TestCommandLine:
         assert material.model == "rgb-conductor"
         assert material.coefficients.astype(np.float64).tolist() == [view["coefficients"]["n"], view["coefficients"]["k"]]
 
+    @pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run
     def test_default_kind_unchanged_and_bad_kind_refused(self):
         view = json.loads(run("fit", "Ag", "--eta-range", "1.5", "--no-metrics", "--json").stdout)
         assert view["model"] == "coated-conductor" and "F0" in view["coefficients"]

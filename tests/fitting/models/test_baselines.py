@@ -17,6 +17,8 @@ from fitting.models.baselines import (
 )
 from fitting.optics.library import library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 class TestBaselines:
     def test_schlick_clamps_and_keeps_nan(self):

@@ -14,6 +14,8 @@ from fitting.models.coated_conductor import (
     normalised_eta_i,
 )
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 KNOWN = np.array(
     [
         [[0.9, -0.1, 0.04], [0.75, -0.18, 0.1], [0.42, -0.2, 0.12]],

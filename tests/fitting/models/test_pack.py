@@ -17,6 +17,8 @@ from fitting.models.pack import (
     to_float16,
 )
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 def _material(name="Au", degree=2, source="test source"):
     rng = np.random.default_rng(len(name) + degree)

@@ -7,6 +7,8 @@ from fitting.colour.reference import reference_ACEScg
 from fitting.optics.fresnel import fresnel_conductor, fresnel_dielectric
 from fitting.optics.nk import SpectralNK
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 class TestFresnelConductor:
     def test_normal_incidence_closed_form(self):

@@ -24,6 +24,8 @@ from fitting.shading.ibl import (
     split_sum_schlick,
 )
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 @pytest.fixture(scope="module")
 def lut():

@@ -18,6 +18,8 @@ from fitting.shading.microfacet import (
     specular_brdf,
 )
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 CR = ((0.37, 0.38, 0.39), (0.6, 0.55, 0.0), (4.8, 4.8, 5.0))
 
 

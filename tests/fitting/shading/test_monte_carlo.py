@@ -21,6 +21,8 @@ from fitting.shading.monte_carlo import (
     spectral_fresnel,
 )
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 MIRROR = lambda VdotH: np.ones(np.shape(VdotH) + (1,))  # noqa: E731  (F = 1: a perfect mirror base)
 
 
