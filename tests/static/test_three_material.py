@@ -64,7 +64,10 @@ def test_plugin_matches_preview_and_physics(pages, live_server, kind, material, 
 
 
 def test_roughness_and_coat_change_the_render(pages, live_server):
-    """The material follows its roughness (the table is redrawn), and the canvas shows both balls."""
+    """
+    The material follows its roughness (the table is redrawn), the canvas
+    shows both balls, and a direct light adds to the render.
+    """
     fit = create_fit(live_server, "Cu", "coated-conductor")
     page = pages.new(900, 700)
     open_example(page, live_server, fit["id"], 1.5)
@@ -79,6 +82,17 @@ def test_roughness_and_coat_change_the_render(pages, live_server):
         return Array.from(px); })""")
     for rgba in shown:
         assert rgba[3] == 255 and rgba[0] > rgba[2] > 0, shown
+    # A punctual light: the patched BRDF_GGX (the model at v.h) compiles and adds light.
+    lit = page.evaluate("""async () => {
+        const THREE = await import('three');
+        const ball = window.cfThree.balls.model;
+        const centre = () => { const px = ball.readFloat(32, 32, {}); return px[4 * (16 * 32 + 16)]; };
+        const before = centre();
+        const light = new THREE.DirectionalLight(0xffffff, 3);
+        light.position.set(...ball.camera.position.toArray());
+        ball.scene.add(light);
+        return [before, centre()]; }""")
+    assert lit[1] > lit[0] + 0.05, lit
 
 
 def test_material_refuses_malformed_extensions(pages, live_server):
