@@ -15,7 +15,9 @@ about 10 800 pixels), each with headroom over what it measured here
     Au mirrors at eta_i 1.5, Cu rough at 1.8; 0.006-0.012 for the
     rgb-conductor), 99th percentile < 0.25 (measured 0.09-0.11: the
     outermost pixels, where three's mesh and the exact sphere differ), centre
-    < 0.01 (measured 0.0004-0.008), ring near grazing < 0.15 (0.05-0.07);
+    < 0.02 (measured 0.0004-0.004; 0.008 for the rgb-conductor's rough
+    table, a 2048-point quadrature on SwiftShader's coarse sin and cos),
+    ring near grazing < 0.15 (0.01-0.07);
 -   against the physics (the spectral reference under the coat): mean <
     0.25, centre and ring < 0.3 (measured 0.11 / 0.19 / 0.09 for Au mirrors,
     the model's own float16 error, the paper's 0.14 for Au);
@@ -34,7 +36,7 @@ from fitting.optics.library import library_material
 
 pytestmark = [pytest.mark.server, pytest.mark.browser, pytest.mark.slow]
 
-PARITY_MEAN, PARITY_P99, PARITY_CENTRE, PARITY_RING = 0.05, 0.25, 0.01, 0.15
+PARITY_MEAN, PARITY_P99, PARITY_CENTRE, PARITY_RING = 0.05, 0.25, 0.02, 0.15
 PHYSICS_MEAN, PHYSICS_CENTRE, PHYSICS_RING = 0.25, 0.3, 0.3
 FALLBACK_CENTRE = 4.0
 
