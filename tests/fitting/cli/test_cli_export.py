@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from fitting.exports import export_material
 from fitting.optics.library import library_material
 
@@ -36,6 +38,7 @@ class TestExportOption:
         extension = material["extensions"]["EXT_materials_coated_conductor"]
         assert extension["kind"] == "coated-conductor" and extension["coatIor"] == 2.0
 
+    @pytest.mark.slow
     def test_gltf_carries_the_kind(self):
         result = cli("fit", "Cu", "--export", "gltf", "--model", "rgb-conductor", "--eta-i", "1.33")
         assert result.returncode == 0, result.stderr
