@@ -293,7 +293,8 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
-    model curve, which it defines only on its eta_i domain.
+    model curve, which it defines only on its eta_i domain. The fit's
+    float16 model travels too (glTF: ``EXT_materials_coated_conductor``).
 
     Raises
     ------
@@ -301,11 +302,11 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
         For an unknown format, eta_i outside [1, 3], or, for a curve fit,
         eta_i outside the fit's domain.
     """
+    packed = material_from_json(record.material)
     if record.kind != "curves":
         nk = measured_nk(record)
         if nk is not None:
-            return export_material(nk, format, eta_i)
-    packed = material_from_json(record.material)
+            return export_material(nk, format, eta_i, model=packed)
     lo, hi = packed.eta_i_range
     if not lo <= eta_i <= hi:
         raise ValueError(
@@ -318,7 +319,7 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
         "reflectance": lambda mu, eta: model_ACEScg(
             packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
-    return export_material(model, format, eta_i)
+    return export_material(model, format, eta_i, model=packed)
 
 
 def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:

@@ -37,6 +37,10 @@ STATIC_DIR = Path(__file__).resolve().parents[1] / "static"
 """The browser editor, served at ``/``."""
 GLSL_DIR = Path(__file__).resolve().parents[1] / "preview_shaders" / "glsl"
 """The project's GLSL, served at ``/glsl/`` for the editor's WebGL2 preview."""
+THREE_DIR = Path(__file__).resolve().parents[1] / "scripts" / "three" / "node_modules" / "three"
+"""three.js as pinned in scripts/three/package-lock.json (``scripts/bootstrap``
+installs it): its ``build/`` and ``examples/jsm/`` served at ``/vendor/three/``
+for the three.js material (static/three/) and its example page."""
 
 __all__ = ["create_app"]
 
@@ -103,6 +107,14 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")
+    # check_dir=False: without scripts/bootstrap's three the service still
+    # starts, and only the three.js example's files answer 404.
+    for part in ("build", "examples/jsm"):
+        app.mount(f"/vendor/three/{part}", StaticFiles(directory=THREE_DIR / part, check_dir=False),
+                  name=f"three-{part}")
+    # /static/...: the page's modules at a path of their own for other pages
+    # (the three.js material at /static/three/coated_conductor.js).
+    app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
     # The browser editor (static/), after the API so that /api, /docs and
     # /openapi.json keep their routes; html=True serves index.html at /.
     app.mount("/", StaticFiles(directory=STATIC_DIR, html=True), name="editor")

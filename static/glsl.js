@@ -46,6 +46,19 @@ export async function loadShader(name, base = "/glsl") {
   return `${ES_HEADER}\n${source.slice(newline + 1)}`;
 }
 
+/**
+ * The include files `names` (no #version line), each with its includes
+ * resolved, concatenated in order, every file once: GLSL to paste into
+ * another program's source (static/three/coated_conductor.js patches
+ * three.js's shader chunks with it).
+ */
+export async function loadIncludes(names, base = "/glsl") {
+  const seen = new Set();
+  const parts = [];
+  for (const name of names) parts.push(await expand(base, name, seen));
+  return parts.join("\n");
+}
+
 /** Fetch the files of `names` (and what they include) ahead of use. */
 export function prefetch(names, base = "/glsl") {
   for (const name of names) fetchFile(base, name).catch(() => {});

@@ -86,8 +86,11 @@ def _cmd_fit(args) -> int:
 
 def _write_export(nk, args) -> int:
     from ..exports import export_material
+    from ..fits.kinds import fit_model
 
-    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness)
+    # The fit's own float16 model travels in the glTF export's extension.
+    model = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=False).packed
+    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model)
     if args.output:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)

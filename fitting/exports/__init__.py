@@ -12,7 +12,8 @@ one coating index eta_i, each saying what it was made from:
 -   ``blender``: a Blender Python script, Principled BSDF with coat and a
     Metallic BSDF in Physical Conductor mode (:mod:`fitting.exports.blender`);
 -   ``gltf``: glTF 2.0 with ``KHR_materials_clearcoat`` and a sphere
-    (:mod:`fitting.exports.gltf`).
+    (:mod:`fitting.exports.gltf`), and the model itself in
+    ``EXT_materials_coated_conductor`` (:mod:`fitting.exports.gltf_coated`).
 
 The values come from :mod:`fitting.exports.values`, their loss against the
 spectral reference from :mod:`fitting.exports.tool_fresnel`.
@@ -67,7 +68,8 @@ def check_format(format: str) -> str:
 
 
 def export_material(
-    fit_or_nk, format: str, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03
+    fit_or_nk, format: str, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
+    model=None,
 ) -> bytes:
     """
     The export of a material for one coating index, as UTF-8 bytes.
@@ -87,6 +89,10 @@ def export_material(
         Coating index, [1, 3].
     roughness, coat_roughness
         Perceptual roughness of the metal and the coat, [0, 1].
+    model
+        The fit's float16 model (:class:`fitting.models.pack.PackedMaterial`),
+        or ``None``: the glTF export then also carries it in
+        ``EXT_materials_coated_conductor`` (:mod:`fitting.exports.gltf_coated`).
 
     Raises
     ------
@@ -103,5 +109,5 @@ def export_material(
             )
         values = fit_or_nk
     else:
-        values = export_values(fit_or_nk, eta, roughness, coat_roughness)
+        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model)
     return _WRITERS[format](values).encode("utf-8")

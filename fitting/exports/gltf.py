@@ -14,6 +14,12 @@ for eta_i = 1.5; for another eta_i the base colour still carries that coat's
 effect, and ``extras`` says so. Provenance is in the material's and the
 asset's ``extras``.
 
+When the values carry the fit's own model (:attr:`ExportValues.model`), the
+material also has ``EXT_materials_coated_conductor``
+(:mod:`fitting.exports.gltf_coated`), the model and the coat index for a
+viewer that implements it, listed in ``extensionsUsed`` only: the values
+above are its fallback.
+
 -   :func:`gltf_document`: the asset as JSON text.
 -   :func:`uv_sphere`: the sphere's positions, normals and indices.
 
@@ -29,6 +35,7 @@ import json
 
 import numpy as np
 
+from .gltf_coated import EXTENSION_NAME, coated_conductor_extension
 from .tool_fresnel import export_fidelity
 from .values import ExportValues
 
@@ -111,13 +118,21 @@ def gltf_document(values: ExportValues) -> str:
         },
         "extras": {"coated_fresnel": provenance},
     }
+    used = ["KHR_materials_clearcoat"]
+    if values.model is not None:
+        extension, why_not = coated_conductor_extension(values.model, values.eta_i, values.coat_roughness)
+        if extension is None:
+            provenance["coated_conductor_extension"] = why_not
+        else:
+            material["extensions"][EXTENSION_NAME] = extension
+            used.append(EXTENSION_NAME)
     asset = {
         "asset": {
             "version": "2.0",
             "generator": provenance["generator"],
             "extras": {"coated_fresnel": provenance},
         },
-        "extensionsUsed": ["KHR_materials_clearcoat"],
+        "extensionsUsed": used,
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0, "name": "sphere"}],

@@ -50,6 +50,7 @@ from scipy.optimize import least_squares
 
 from ..colour.reference import reference_ACEScg
 from ..domain import ETA_I_MAX, ETA_I_MIN, check_eta_i, check_number
+from ..models.pack import PackedMaterial
 from ..models.rgb_conductor import rgb_fresnel_conductor
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK
@@ -122,6 +123,10 @@ class ExportValues:
         Schlick F0, shape (3,), in [0, 1].
     roughness, coat_roughness
         Perceptual roughness of the metal and of the coat, [0, 1].
+    model
+        The fit's own float16 model (:class:`fitting.models.pack.PackedMaterial`),
+        when the export carries it as well as the tool's values (glTF's
+        ``EXT_materials_coated_conductor``); ``None`` otherwise.
     """
 
     name: str
@@ -138,6 +143,7 @@ class ExportValues:
     F0_schlick: np.ndarray
     roughness: float = 0.2
     coat_roughness: float = 0.03
+    model: PackedMaterial | None = None
     version: str = field(default_factory=project_version)
 
     def provenance(self, model_kind: str, fidelity: dict | None = None) -> dict:
@@ -200,7 +206,8 @@ def _fit_schlick(mu: np.ndarray, T: np.ndarray) -> np.ndarray:
 
 
 def export_values(
-    fit_or_nk, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03
+    fit_or_nk, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
+    model: PackedMaterial | None = None,
 ) -> ExportValues:
     """
     The values of every export of a material at one coating index.
@@ -219,16 +226,21 @@ def export_values(
         Coating index, in [1, 3].
     roughness, coat_roughness
         Perceptual roughness of the metal and the coat, [0, 1].
+    model
+        The fit's float16 model, carried as is (:attr:`ExportValues.model`).
 
     Raises
     ------
     ValueError
         For eta_i or a roughness outside its range, an input of another
-        type, or n, k covering too little of 360-830 nm.
+        type, ``model`` not a ``PackedMaterial``, or n, k covering too little
+        of 360-830 nm.
     """
     eta = check_eta_i(eta_i)
     roughness = check_roughness("roughness", roughness)
     coat_roughness = check_roughness("coat_roughness", coat_roughness)
+    if model is not None and not isinstance(model, PackedMaterial):
+        raise ValueError(f"`model` must be a PackedMaterial or None, got {type(model).__name__}")
     mu = np.linspace(0.0, 1.0, EXPORT_SAMPLES)
     if isinstance(fit_or_nk, SpectralNK):
         name, source = fit_or_nk.name, fit_or_nk.source
@@ -262,4 +274,5 @@ def export_values(
         name=name, source=source, eta_i=eta, origin=origin, cos_theta=mu, target=target,
         target_ACEScg=target_ACEScg, n_rel=n_rel, k_rel=k_rel, F0=F0, F82_tint=tint,
         F0_schlick=_fit_schlick(mu, target), roughness=roughness, coat_roughness=coat_roughness,
+        model=model,
     )

@@ -11,6 +11,7 @@ import pytest
 from conftest import app_client
 from fitting.fits.curves_base import curve_base_from_nk
 from fitting.exports import export_material
+from fitting.models.pack import pack_from_json
 from fitting.optics.library import library_material
 
 API = "/api/v1"
@@ -28,6 +29,11 @@ def pack(client, fit_id, query):
     return client.get(f"{API}/fits/{fit_id}/pack?{query}")
 
 
+def stored_model(client, fit_id):
+    """The stored fit's float16 model (its JSON pack), which the export carries (glTF)."""
+    return pack_from_json(pack(client, fit_id, "format=json").text)[0]
+
+
 @pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestExportDownloads:
     @pytest.mark.slow  # 2.7 s (all cases 2.8 s) in a --durations=0 run
@@ -42,7 +48,9 @@ class TestExportDownloads:
         assert response.headers["content-type"] == media_type
         assert response.headers["content-disposition"] == (
             f'attachment; filename="Cu-{fit_id[:8]}-eta1.7{suffix}"')
-        assert response.content == export_material(library_material("Cu"), format, 1.7)
+        expected = export_material(library_material("Cu"), format, 1.7, model=stored_model(client, fit_id))
+        assert response.content == expected
+        assert (b"EXT_materials_coated_conductor" in response.content) == (format == "gltf")
 
     @pytest.mark.slow  # starts a process or GL context
     def test_default_eta_i_is_1_5(self, shared):
@@ -133,8 +141,9 @@ class TestExportPacks:
             f'attachment; filename="scene-{format}-eta1.3.zip"')
         archive = zipfile.ZipFile(io.BytesIO(response.content))
         assert archive.namelist() == [f"Cu-eta1.3{suffix}", f"Au-eta1.3{suffix}"]
-        for name, material in zip(archive.namelist(), ("Cu", "Au")):
-            assert archive.read(name) == export_material(library_material(material), format, 1.3)
+        for name, material, fit_id in zip(archive.namelist(), ("Cu", "Au"), ids):
+            model = stored_model(client, fit_id)
+            assert archive.read(name) == export_material(library_material(material), format, 1.3, model=model)
         # Deterministic: the same request, the same bytes.
         assert client.post(f"{API}/packs", json=body).content == response.content
 

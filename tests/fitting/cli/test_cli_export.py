@@ -9,6 +9,8 @@ import sys
 import pytest
 from pathlib import Path
 
+import pytest
+
 from fitting.exports import export_material
 from fitting.optics.library import library_material
 
@@ -37,6 +39,15 @@ class TestExportOption:
         material = json.loads(result.stdout)["materials"][0]
         assert material["pbrMetallicRoughness"]["roughnessFactor"] == 0.5
         assert material["extras"]["coated_fresnel"]["eta_i"] == 2.0
+        extension = material["extensions"]["EXT_materials_coated_conductor"]
+        assert extension["kind"] == "coated-conductor" and extension["coatIor"] == 2.0
+
+    @pytest.mark.slow
+    def test_gltf_carries_the_kind(self):
+        result = cli("fit", "Cu", "--export", "gltf", "--model", "rgb-conductor", "--eta-i", "1.33")
+        assert result.returncode == 0, result.stderr
+        extension = json.loads(result.stdout)["materials"][0]["extensions"]["EXT_materials_coated_conductor"]
+        assert extension["kind"] == "rgb-conductor" and set(extension["coefficients"]) == {"n", "k"}
 
     @pytest.mark.slow  # starts a process or GL context
     def test_bad_eta_i(self):

@@ -1,0 +1,131 @@
+// The three.js example page (/examples/three.html?fit=ID): a stored fit's
+// glTF export (GET /api/v1/fits/{id}/pack?format=gltf) loaded twice, once
+// with the CoatedConductorExtension plugin and once without (the fallback
+// every glTF viewer draws), each material on the same shader ball, camera
+// and environment as the editor's preview (static/preview.js: orbit
+// (0.5, 0.25, 4.2), vertical field of view 0.52 rad). The asset's material
+// goes on a finer sphere than the asset's own 24 x 12 one, so that the ball
+// is round to the pixel. `window.cfThree` renders either into a float
+// target for the parity tests.
+
+import * as THREE from "three";
+import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
+import { RoomEnvironment } from "three/addons/environments/RoomEnvironment.js";
+import { CoatedConductorExtension } from "/static/three/coated_conductor.js";
+import { orbitCamera } from "/static/preview.js";
+
+const ORBIT = [0.5, 0.25, 4.2];
+const FOV = 0.52; // radians, vertical
+
+const query = new URLSearchParams(location.search);
+const fitId = query.get("fit");
+const etaI = Number(query.get("eta_i") ?? 1.5);
+const environmentName = query.get("env") ?? "room";
+
+function say(text) {
+  const status = document.getElementById("status");
+  status.textContent = text;
+  status.hidden = !text;
+}
+
+async function loadMaterial(url, withPlugin) {
+  const loader = new GLTFLoader();
+  if (withPlugin) loader.register((parser) => new CoatedConductorExtension(parser));
+  const gltf = await loader.loadAsync(url);
+  let material = null;
+  gltf.scene.traverse((object) => { if (object.isMesh) material = object.material; });
+  if (!material) throw new Error("the asset has no mesh");
+  return material;
+}
+
+// The environment: three's RoomEnvironment, or the preview's white sky
+// (radiance 1 in every direction), prefiltered by three's PMREM.
+function environment(renderer) {
+  const pmrem = new THREE.PMREMGenerator(renderer);
+  let target;
+  if (environmentName === "white_sky") {
+    const white = new THREE.DataTexture(new Float32Array([1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1]), 2, 2,
+      THREE.RGBAFormat, THREE.FloatType);
+    white.mapping = THREE.EquirectangularReflectionMapping;
+    white.needsUpdate = true;
+    target = pmrem.fromEquirectangular(white);
+  } else {
+    target = pmrem.fromScene(new RoomEnvironment(), 0.04);
+  }
+  pmrem.dispose();
+  return target.texture;
+}
+
+class Ball {
+  constructor(canvas, material) {
+    this.canvas = canvas;
+    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true, alpha: true });
+    this.renderer.setClearColor(0x000000, 0);
+    this.scene = new THREE.Scene();
+    this.scene.environment = environment(this.renderer);
+    this.material = material;
+    this.mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 512, 256), material);
+    this.scene.add(this.mesh);
+    const { eye } = orbitCamera(ORBIT, FOV);
+    this.camera = new THREE.PerspectiveCamera(THREE.MathUtils.radToDeg(FOV), 1, 0.1, 100);
+    this.camera.position.set(...eye);
+    this.camera.lookAt(0, 0, 0);
+  }
+
+  draw() {
+    const width = this.canvas.clientWidth, height = this.canvas.clientHeight;
+    this.renderer.setPixelRatio(1);
+    this.renderer.setSize(width, height, false);
+    this.camera.aspect = width / height;
+    this.camera.updateProjectionMatrix();
+    this.renderer.render(this.scene, this.camera);
+  }
+
+  /**
+   * Linear radiance (three's working space, linear Rec.709) at width x
+   * height, RGBA floats, bottom row first; alpha 0 off the ball.
+   * `settings`: {roughness, clearcoatRoughness} set on the material first.
+   */
+  readFloat(width, height, settings = {}) {
+    Object.assign(this.material, settings);
+    const target = new THREE.WebGLRenderTarget(width, height, { type: THREE.FloatType });
+    this.camera.aspect = width / height;
+    this.camera.updateProjectionMatrix();
+    this.renderer.setRenderTarget(target);
+    this.renderer.render(this.scene, this.camera);
+    const pixels = new Float32Array(4 * width * height);
+    this.renderer.readRenderTargetPixels(target, 0, 0, width, height, pixels);
+    this.renderer.setRenderTarget(null);
+    target.dispose();
+    return Array.from(pixels);
+  }
+}
+
+async function main() {
+  if (!fitId) throw new Error("no fit: open /examples/three.html?fit=ID");
+  const url = `/api/v1/fits/${encodeURIComponent(fitId)}/pack?format=gltf&eta_i=${etaI}`;
+  const [model, fallback] = await Promise.all([loadMaterial(url, true), loadMaterial(url, false)]);
+  const info = model.userData.coatedConductor;
+  if (!info) throw new Error("the export carries no EXT_materials_coated_conductor (eta_i outside the fit's range?)");
+  document.getElementById("material").textContent =
+    `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}; environment ${environmentName}.`;
+  const balls = {
+    model: new Ball(document.getElementById("model"), model),
+    fallback: new Ball(document.getElementById("fallback"), fallback),
+  };
+  for (const ball of Object.values(balls)) ball.draw();
+  window.cfThree = {
+    balls,
+    orbit: ORBIT,
+    fov: FOV,
+    readFloat: (which, width, height, settings) => balls[which].readFloat(width, height, settings),
+    readTable: () => info.readTable(balls.model.renderer),
+  };
+  document.body.dataset.ready = "true";
+}
+
+main().catch((error) => {
+  say(`Could not draw the fit: ${error.message}`);
+  document.body.dataset.ready = "error";
+  console.error(error);
+});

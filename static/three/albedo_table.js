@@ -1,0 +1,131 @@
+// The split-sum albedo table of a coated-conductor material in three.js:
+// the project's own albedo_table.frag (coated-conductor kind: the model's
+// split sum F0 A + B - a G(alpha) from the LUT) or rgb_albedo_table.frag
+// (rgb-conductor kind: the GGX lobe of the exact Fresnel by quadrature),
+// drawn by three into an n x 3 float target: row 0 the metal's lobe, row 2
+// the coat's, at NdotV = (i / (n - 1))^2 (cf_albedo_table_lookup reads it).
+// The same tables, from the same GLSL and LUT, as the editor's preview
+// (static/splitsum.js), so the two agree to float rounding.
+
+import * as THREE from "three";
+import { decodeLut } from "../api.js";
+import { loadShader } from "../glsl.js";
+
+// Quadrature points per node of the rgb-conductor's table: the editor's
+// REFERENCE_SAMPLES (static/splitsum.js), the preview's reference albedo.
+export const RGB_SAMPLES = 2048;
+
+const VERTEX = `in vec3 position;
+void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }`;
+
+// three's RawShaderMaterial puts its own #define lines first and the
+// #version line before them (glslVersion), so the file's own goes.
+function withoutVersion(source) {
+  return source.slice(source.indexOf("\n") + 1);
+}
+
+/** The LUT file (GET /api/v1/ibl-lut, docs/shading.md) as an RGBA float 3D texture. */
+export function lutTexture(buffer) {
+  const lut = decodeLut(buffer);
+  const texels = lut.width * lut.height * lut.depth;
+  const rgba = new Float32Array(4 * texels);
+  for (let i = 0; i < texels; i++) {
+    rgba.set(lut.data.subarray(3 * i, 3 * i + 3), 4 * i);
+    rgba[4 * i + 3] = 1;
+  }
+  const texture = new THREE.Data3DTexture(rgba, lut.width, lut.height, lut.depth);
+  Object.assign(texture, {
+    format: THREE.RGBAFormat, type: THREE.FloatType, minFilter: THREE.NearestFilter,
+    magFilter: THREE.NearestFilter, generateMipmaps: false, unpackAlignment: 4, needsUpdate: true,
+  });
+  return { texture, width: lut.width, alphaRange: lut.alphaRange };
+}
+
+/** The two table programs' sources (GLSL ES 3.00 without the #version line). */
+export async function tableSources(glslBase) {
+  const [model, rgb] = await Promise.all([
+    loadShader("albedo_table.frag", glslBase), loadShader("rgb_albedo_table.frag", glslBase),
+  ]);
+  return { "coated-conductor": withoutVersion(model), "rgb-conductor": withoutVersion(rgb) };
+}
+
+/**
+ * One material's table: `draw(renderer, settings)` renders it for
+ * {roughness, coatRoughness} when they (or the model) changed since the
+ * last time; `texture` is the table.
+ */
+export class AlbedoTable {
+  constructor(resources, model, words) {
+    this.model = model;
+    this.nodes = 2 * (resources.lut.width - 1) + 1;
+    this.target = new THREE.WebGLRenderTarget(this.nodes, 3, {
+      type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter,
+      magFilter: THREE.NearestFilter, depthBuffer: false, generateMipmaps: false,
+    });
+    this.texture = this.target.texture;
+    const uniforms = {
+      u_resolution: { value: new THREE.Vector2(this.nodes, 3) },
+      u_eta_i: { value: model.coatIor },
+      u_roughness: { value: 0 },
+      u_coat_roughness: { value: 0 },
+      cf_lut: { value: resources.lut.texture },
+      cf_alpha_range: { value: new THREE.Vector2(...resources.lut.alphaRange) },
+    };
+    if (model.kind === "rgb-conductor") {
+      Object.assign(uniforms, {
+        cf_n: { value: new THREE.Vector3(...model.coefficients.n) },
+        cf_k: { value: new THREE.Vector3(...model.coefficients.k) },
+        u_samples: { value: RGB_SAMPLES },
+      });
+    } else {
+      Object.assign(uniforms, {
+        cf_words: { value: words },
+        cf_eta_i_range: { value: new THREE.Vector2(...model.etaIRange) },
+        // The Lazanyi row is not read here; its inputs stay 0.
+        cf_F0_air: { value: new THREE.Vector3() },
+        cf_F82_air: { value: new THREE.Vector3() },
+      });
+    }
+    this.uniforms = uniforms;
+    const material = new THREE.RawShaderMaterial({
+      glslVersion: THREE.GLSL3, vertexShader: VERTEX, fragmentShader: resources.tables[model.kind],
+      uniforms, depthTest: false, depthWrite: false,
+    });
+    this.mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
+    this.mesh.frustumCulled = false;
+    this.scene = new THREE.Scene();
+    this.scene.add(this.mesh);
+    this.camera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
+    this.drawnFor = null;
+  }
+
+  /** Render the table if {roughness, coatRoughness} differ from the last drawn. */
+  draw(renderer, { roughness, coatRoughness }) {
+    const key = `${roughness} ${coatRoughness}`;
+    if (key === this.drawnFor) return false;
+    this.uniforms.u_roughness.value = roughness;
+    this.uniforms.u_coat_roughness.value = coatRoughness;
+    const previous = renderer.getRenderTarget();
+    const autoClear = renderer.autoClear;
+    renderer.autoClear = false;
+    renderer.setRenderTarget(this.target);
+    renderer.render(this.scene, this.camera);
+    renderer.setRenderTarget(previous);
+    renderer.autoClear = autoClear;
+    this.drawnFor = key;
+    return true;
+  }
+
+  /** The table as drawn ({nodes, data: nodes x 3 RGBA floats, row 0 first}), for the tests. */
+  read(renderer) {
+    const data = new Float32Array(4 * this.nodes * 3);
+    renderer.readRenderTargetPixels(this.target, 0, 0, this.nodes, 3, data);
+    return { nodes: this.nodes, data: Array.from(data) };
+  }
+
+  dispose() {
+    this.target.dispose();
+    this.mesh.geometry.dispose();
+    this.mesh.material.dispose();
+  }
+}

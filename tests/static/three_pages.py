@@ -1,0 +1,158 @@
+"""
+The three.js example page (/examples/three.html) against the editor's WebGL
+preview and the physics, in one Chromium page (import it: ``from
+three_pages import measure_three``); shared by
+tests/static/test_three_material.py and benchmarks/three_parity.py.
+
+Set-up, the same for both renders: the white sky (radiance 1 in every
+direction, so that the two environment filters, the project's prefiltered
+slices and three's PMREM, drop out and what is compared is the material),
+the preview's camera (orbit (0.5, 0.25, 4.2), vertical field of view 0.52
+rad) at W x H pixels, a clear coat of index eta_i over the metal. Both read
+back as float32 linear radiance: the preview in ACEScg (OUTPUT.linear),
+three in linear Rec.709 (its working space), converted back to ACEScg with
+the inverse of the very matrix the shader used (CF_ACESCG_TO_SRGB).
+
+Pixels compared: on the ball in both, with NdotV >= :data:`NDOTV_MIN` (the
+outermost pixels differ by geometry alone: three rasterises a 512 x 256
+sphere mesh, the preview intersects the exact sphere). The centre is
+NdotV >= :data:`CENTRE`, the ring near grazing NdotV in :data:`RING`.
+
+The physics: under the white sky the ball's radiance is the directional
+albedo of the coated metal, E_c(mu) + [1 - F_c(mu)]^2 E_m(mu_t) (the
+project's coated split sum, fitting.shading.ibl.split_sum_coated), with the
+metal's lobe E_m the 1 nm spectral reference under the coat (at roughness 0
+its Fresnel; else its GGX albedo by fitting.shading.ibl.directional_albedo)
+and the coat's lobe E_c the exact dielectric (mirror coat) or Schlick's
+split sum at the coat's F0.
+"""
+
+from __future__ import annotations
+
+import httpx
+import numpy as np
+from editor_pages import camera_rays
+
+from fitting.colour.delta_e import delta_E_map
+from fitting.colour.reference import reference_ACEScg
+from fitting.models.rgb_conductor import rgb_fresnel_conductor
+from fitting.optics.fresnel import fresnel_dielectric
+from fitting.shading.ibl import directional_albedo, split_sum_schlick
+from preview_shaders.display import ACEScg_to_sRGB_matrix
+
+W, H = 128, 128
+ORBIT, FOV = (0.5, 0.25, 4.2), 0.52
+NDOTV_MIN = 0.1
+CENTRE = 0.97
+RING = (0.1, 0.25)
+_NODES = np.linspace(0.0, 1.0, 65) ** 2  # the physics' NdotV nodes, interpolated per pixel
+
+
+def create_fit(server: str, material: str, model: str) -> dict:
+    """POST /api/v1/fits for a library material and kind; the FitPublic answer."""
+    response = httpx.post(f"{server}/api/v1/fits", json={"material": material, "model": model}, timeout=300)
+    response.raise_for_status()
+    return response.json()
+
+
+def open_example(page, server: str, fit_id: str, eta_i: float, env: str = "white_sky") -> None:
+    page.goto(f"{server}/examples/three.html?fit={fit_id}&eta_i={eta_i}&env={env}")
+    page.wait_for_function("document.body.dataset.ready")
+    state = page.evaluate("document.body.dataset.ready")
+    assert state == "true", page.evaluate("document.getElementById('status').textContent")
+
+
+def three_ACEScg(page, which: str, roughness: float, coat_roughness: float) -> tuple[np.ndarray, np.ndarray]:
+    """(H, W, 3) linear ACEScg of ball ``which`` (model or fallback), top row first, and its mask."""
+    flat = page.evaluate(
+        "([which, w, h, s]) => window.cfThree.readFloat(which, w, h, s)",
+        [which, W, H, {"roughness": roughness, "clearcoatRoughness": coat_roughness}],
+    )
+    pixels = np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1]
+    rec709 = pixels[..., :3]
+    return rec709 @ np.linalg.inv(ACEScg_to_sRGB_matrix()).T, pixels[..., 3] > 0.5
+
+
+def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughness: float) -> np.ndarray:
+    """(H, W, 3) linear ACEScg of the editor's preview (static/preview.js) at the same settings."""
+    flat = page.evaluate(
+        """async ([fit, eta, roughness, coatRoughness, orbit, fov, w, h]) => {
+            const { ShaderBall, OUTPUT, ENVIRONMENT } = await import('/preview.js');
+            const canvas = document.createElement('canvas');
+            Object.assign(canvas.style, { width: w + 'px', height: h + 'px' });
+            document.body.appendChild(canvas);
+            const ball = await ShaderBall.create(canvas, null);
+            ball.setFit(fit);
+            ball.set({ eta, roughness, coated: true, coatRoughness, environment: ENVIRONMENT.white_sky, orbit, fov });
+            await ball.lightingReady();
+            const pixels = Array.from(ball.readFloat(OUTPUT.linear, w, h));
+            canvas.remove();
+            return pixels;
+        }""",
+        [fit, eta_i, roughness, coat_roughness, list(ORBIT), FOV, W, H],
+    )
+    return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1][..., :3]
+
+
+def coated_albedo(metal_fresnel, eta_i: float, roughness: float, coat_roughness: float) -> np.ndarray:
+    """
+    E_c(mu) + [1 - F_c(mu)]^2 E_m(mu_t) at the physics' NdotV nodes, (n, 3)
+    linear ACEScg; ``metal_fresnel(cos) -> (..., 3)`` the metal under the coat.
+    """
+    mu = _NODES
+    F0c = ((eta_i - 1.0) / (eta_i + 1.0)) ** 2
+    coat = (fresnel_dielectric(mu, 1.0, eta_i)[:, None] if coat_roughness == 0
+            else split_sum_schlick(mu, coat_roughness, np.full(3, F0c)))
+    T = (1.0 - fresnel_dielectric(mu, 1.0, eta_i))[:, None] ** 2
+    mu_t = np.sqrt(1.0 - (1.0 - mu * mu) / eta_i**2)
+    metal = (metal_fresnel(mu_t) if roughness == 0 else directional_albedo(mu_t, roughness, metal_fresnel))
+    return coat + T * metal
+
+
+def per_pixel(nodes_rgb: np.ndarray, NdotV: np.ndarray) -> np.ndarray:
+    """A curve over the physics' nodes at each pixel's NdotV (linear in sqrt(NdotV))."""
+    s = np.sqrt(NdotV)
+    return np.stack([np.interp(s, np.sqrt(_NODES), nodes_rgb[:, c]) for c in range(3)], axis=-1)
+
+
+def _stats(dE: np.ndarray, NdotV: np.ndarray, region: np.ndarray) -> dict:
+    centre, ring = region & (NdotV >= CENTRE), region & (NdotV >= RING[0]) & (NdotV <= RING[1])
+    return {
+        "mean": float(dE[region].mean()), "p99": float(np.percentile(dE[region], 99)),
+        "max": float(dE[region].max()), "centre": float(dE[centre].mean()), "ring": float(dE[ring].mean()),
+    }
+
+
+def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: float,
+                  coat_roughness: float) -> dict:
+    """
+    Delta E 2000 figures ({mean, p99, max, centre, ring} each) of the
+    three.js ball through the plugin against: the WebGL preview
+    (``preview``; the coated-conductor kind only, the preview has no other)
+    or numpy's twin of the rgb-conductor material (``twin``); the physics
+    (``physics``); and the fallback ball against the physics
+    (``fallback``). The example page must be open on ``fit`` at ``eta_i``.
+    """
+    NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
+    three, three_mask = three_ACEScg(page, "model", roughness, coat_roughness)
+    fallback, fallback_mask = three_ACEScg(page, "fallback", roughness, coat_roughness)
+    region = hit & three_mask & fallback_mask & (NdotV >= NDOTV_MIN)
+    physics = per_pixel(coated_albedo(
+        lambda c: reference_ACEScg(nk, np.asarray(c).reshape(-1), eta_i, 1.0).reshape(np.shape(c) + (3,)),
+        eta_i, roughness, coat_roughness), NdotV)
+    figures = {
+        "pixels": int(region.sum()),
+        "physics": _stats(delta_E_map(physics, three), NdotV, region),
+        "fallback": _stats(delta_E_map(physics, fallback), NdotV, region),
+        "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
+        "fallback_centre_rgb": fallback[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
+    }
+    if fit["model"] == "coated-conductor":
+        preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness)
+        figures["preview"] = _stats(delta_E_map(preview, three), NdotV, region)
+    else:
+        n, k = (np.asarray(fit["coefficients"][p], dtype=np.float64) for p in ("n", "k"))
+        twin = per_pixel(coated_albedo(lambda c: rgb_fresnel_conductor(c, eta_i, n, k),
+                                       eta_i, roughness, coat_roughness), NdotV)
+        figures["twin"] = _stats(delta_E_map(twin, three), NdotV, region)
+    return figures
