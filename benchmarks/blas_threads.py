@@ -5,8 +5,9 @@ BLAS threads in the fitting pool's workers
 The service's pool runs ``workers`` processes (one per core). Each imports
 numpy, whose OpenBLAS starts as many threads as the machine has cores, so a
 2-core machine runs 2 workers x 2 BLAS threads. This benchmark runs the same
-jobs (the three parts of a REST fit of every library conductor:
-``service.jobs.nk``'s fit, reference and metrics parts, in that order) through
+jobs (the three parts of a REST fit of every library conductor, of both
+model kinds: ``service.jobs.nk``'s fit, reference and metrics parts, in that
+order; the rgb-conductor kind's fit calls scipy's least_squares directly) through
 two pools of 2 ``spawn`` workers, both cores busy:
 
 -   ``before``: the workers as started before (``warm_process`` only: BLAS
@@ -49,11 +50,12 @@ def _blas_threads() -> int:
     return max((p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"), default=0)
 
 
-def _job(name: str) -> tuple[float, int]:
+def _job(name_kind: tuple[str, str]) -> tuple[float, int]:
     """The three parts of one REST fit, in one process; (seconds, BLAS threads)."""
     from service.jobs import nk as nk_jobs
 
-    fit = nk_jobs.NKFit.library(name, (1.0, 2.5), "de2000", 100)
+    name, kind = name_kind
+    fit = nk_jobs.NKFit.library(name, (1.0, 2.5), "de2000", 100, kind)
     start = time.perf_counter()
     result = nk_jobs._fit_part(fit)
     reference, baselines, _ = nk_jobs._reference_part(fit)
@@ -77,11 +79,12 @@ def run(initializer, names: list[str]) -> dict:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--rounds", type=int, default=2, help="passes over the 22 conductors")
+    parser.add_argument("--rounds", type=int, default=1, help="passes over the 22 conductors")
     args = parser.parse_args(argv)
     from fitting.optics.library import LIBRARY_NAMES
 
-    names = list(LIBRARY_NAMES) * args.rounds
+    names = [(name, kind) for name in LIBRARY_NAMES for kind in ("coated-conductor", "rgb-conductor")]
+    names *= args.rounds
     load_start = os.getloadavg()[0]
     rows = {}
     # Interleaved so that other load on the machine falls on both alike.

@@ -98,16 +98,17 @@ def warm_process() -> None:
 
 def start_worker() -> None:
     """
-    A worker's initializer: one BLAS thread (a worker is one of ``workers``
-    processes on as many cores, and its matrices are small: two OpenBLAS
-    threads per worker oversubscribe the cores and make small products
-    several times slower, ``benchmarks/blas_threads.py``), then
-    :func:`warm_process`.
+    A worker's initializer: :func:`warm_process`, then one BLAS thread for
+    the process's life (a worker is one of ``workers`` processes on as many
+    cores, and its matrices are small: more OpenBLAS threads per worker
+    oversubscribe the cores, ``benchmarks/blas_threads.py``). After the
+    warm-up, because a limit applies only to the BLAS libraries already
+    loaded (numpy's OpenBLAS, loaded by the warm-up's imports).
     """
     from threadpoolctl import threadpool_limits
 
-    threadpool_limits(limits=1, user_api="blas")  # for the process's life
     warm_process()
+    threadpool_limits(limits=1, user_api="blas")
 
 
 def _ping() -> float:

@@ -139,6 +139,27 @@ def app_client(tmp_path: Path, **overrides):
     return TestClient(create_app(Settings(**options)))
 
 
+SHOWROOM_SCENE = {
+    "name": "showroom",
+    "materials": [
+        {"material": "Au", "eta_i": 1.0},
+        {"material": "Cu", "eta_i": [1.5, 1.33]},
+        {"material": "Al", "eta_i": {"min": 1.3, "max": 1.6}},
+        {"material": "Cr", "name": "trim", "eta_i": 2.8},
+    ],
+}
+"""One scene of every kind of eta_i specification (one value, a set, a range, a high one)."""
+
+
+@pytest.fixture(scope="session")
+def showroom():
+    """:data:`SHOWROOM_SCENE` fitted (``fitting.fits.scene_fit.fit_scene``), once a session."""
+    from fitting.fits.scene_fit import fit_scene
+    from fitting.fits.scene_schema import parse_scene
+
+    return fit_scene(parse_scene(SHOWROOM_SCENE))
+
+
 @pytest.fixture
 def client(tmp_path):
     with app_client(tmp_path, metrics_samples=30) as test_client:

@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import SHOWROOM_SCENE
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg
@@ -27,20 +28,7 @@ from fitting.models.coated_conductor import coated_conductor_model
 from fitting.models.pack import decode_pack, pack_from_json
 from fitting.optics.library import library_material
 
-SCENE = {
-    "name": "showroom",
-    "materials": [
-        {"material": "Au", "eta_i": 1.0},
-        {"material": "Cu", "eta_i": [1.5, 1.33]},
-        {"material": "Al", "eta_i": {"min": 1.3, "max": 1.6}},
-        {"material": "Cr", "name": "trim", "eta_i": 2.8},
-    ],
-}
-
-
-@pytest.fixture(scope="module")
-def showroom():
-    return fit_scene(parse_scene(SCENE))
+SCENE = SHOWROOM_SCENE  # and the `showroom` fixture: its fit, once a session (tests/conftest.py)
 
 
 def E(mean: float, max_: float) -> ErrorMetrics:

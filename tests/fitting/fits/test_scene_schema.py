@@ -2,8 +2,8 @@
 
 import json
 import pytest
+from conftest import SHOWROOM_SCENE
 
-from fitting.fits.scene_fit import fit_scene
 from fitting.fits.scene_schema import (
     EVALUATION_ETA_ROWS,
     MAX_ETA_I_VALUES,
@@ -14,20 +14,7 @@ from fitting.fits.scene_schema import (
 )
 from fitting.optics.library import library_material
 
-SCENE = {
-    "name": "showroom",
-    "materials": [
-        {"material": "Au", "eta_i": 1.0},
-        {"material": "Cu", "eta_i": [1.5, 1.33]},
-        {"material": "Al", "eta_i": {"min": 1.3, "max": 1.6}},
-        {"material": "Cr", "name": "trim", "eta_i": 2.8},
-    ],
-}
-
-
-@pytest.fixture(scope="module")
-def showroom():
-    return fit_scene(parse_scene(SCENE))
+SCENE = SHOWROOM_SCENE  # and the `showroom` fixture: its fit, once a session (tests/conftest.py)
 
 
 class TestParseEtaI:

@@ -1,0 +1,79 @@
+"""
+Test suite wall time
+====================
+
+Runs the README's test command in its modes, one after another, and
+records each one's wall time, test count and the load average around it in
+``benchmarks/results/suite_time.json`` (quoted by docs/testing.md):
+
+-   ``scripts/test --quick`` (target: under 2 minutes on 2 cores);
+-   ``scripts/test`` (the full suite on both cores; target: under 6 minutes);
+-   ``scripts/test --other-cpus`` (the numeric tests under three other
+    kernels' settings), unless ``--no-other-cpus``.
+
+    .venv/bin/python benchmarks/suite_time.py [--no-other-cpus]
+
+A run with other work on the machine is slower; the load average says how
+busy it was (1 minute average at the start and the end of each mode).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
+SUMMARY = re.compile(r"^=*\s*(\d+ passed.*?) in [\d.]+s", re.M)
+
+
+def run(args: list[str]) -> dict:
+    load_start = os.getloadavg()[0]
+    start = time.perf_counter()
+    done = subprocess.run(["scripts/test", *args], cwd=ROOT, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    output = done.stdout + done.stderr
+    summaries = SUMMARY.findall(output)
+    return {"command": " ".join(["scripts/test", *args]), "seconds": round(seconds, 1),
+            "returncode": done.returncode, "summaries": summaries,
+            "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)]}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--no-other-cpus", action="store_true", help="leave out --other-cpus")
+    args = parser.parse_args(argv)
+    modes = [["--quick"], []] + ([] if args.no_other_cpus else [["--other-cpus"]])
+    rows = [run(mode) for mode in modes]
+    print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11}  tests")
+    for r in rows:
+        print(f"{r['command']:<28} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
+              f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f}  {'; '.join(r['summaries'])}")
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    RESULTS.write_text(json.dumps({
+        "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+        "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+        "cpu": _cpu(), "rows": rows,
+    }, indent=2) + "\n")
+    return max(r["returncode"] for r in rows)
+
+
+def _cpu() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return f"{line.split(':', 1)[1].strip()}, {os.cpu_count()} cores"
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores"
+
+
+if __name__ == "__main__":
+    sys.exit(main())
