@@ -180,7 +180,7 @@ SLOW_S = 2.0
 _IMPLY_SLOW = ("gl", "server", "browser")
 PROCESS_FIXTURES = frozenset({
     "shared", "fitted", "live_server", "editor_url", "pages", "page", "curve_fit", "rgb_fit",
-    "hostile_run",
+    "hostile_run", "chromium",
 })
 """
 Fixtures (by name, in any module) that start a process: the fitting pool's

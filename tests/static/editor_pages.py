@@ -1,8 +1,11 @@
 """
 Shared fixtures of the editor's browser tests (import them: `from editor_pages import pages, open_editor`): Debian's Chromium through the
 Python playwright package (never a downloaded browser), a real server
-process (tests/conftest.py's live_server), and a check that the page logged
-no error (uncaught exceptions and console errors). :func:`camera_rays` is
+process, and a check that the page logged no error (uncaught exceptions
+and console errors). A module that imports them shares one server
+(``live_server`` here is module-scoped, overriding tests/conftest.py's) and
+one Chromium; each test gets fresh browser contexts (no cookies, storage or
+cache from another test). :func:`camera_rays` is
 numpy's twin of the preview's camera (shader_ball.frag), for the WebGL
 parity tests.
 """
@@ -11,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import server_process
 from playwright.sync_api import expect, sync_playwright
 
 CHROMIUM_ARGS = [
@@ -24,9 +28,25 @@ TIMEOUT_MS = 120_000  # first fits start worker processes
 expect.set_options(timeout=TIMEOUT_MS)
 
 
+@pytest.fixture(scope="module")
+def live_server(tmp_path_factory):
+    """One server process for the module's tests (a test that saves must not assume an empty list)."""
+    with server_process(tmp_path_factory.mktemp("editor") / "data") as server:
+        yield server.url
+
+
 @pytest.fixture
 def editor_url(live_server):
     return live_server + "/"
+
+
+@pytest.fixture(scope="module")
+def chromium(live_server):
+    """One Chromium for the module; it closes before the server stops."""
+    with sync_playwright() as p:
+        browser = launch(p)
+        yield browser
+        browser.close()
 
 
 def launch(p):
@@ -40,9 +60,11 @@ class Pages:
         self.browser = browser
         self.errors: list[str] = []
         self.expected: list[str] = []  # substrings of console errors a test provokes on purpose
+        self.contexts: list = []
 
     def new(self, width: int = 1400, height: int = 900):
         context = self.browser.new_context(viewport={"width": width, "height": height}, accept_downloads=True)
+        self.contexts.append(context)
         page = context.new_page()
         page.set_default_timeout(TIMEOUT_MS)
         page.on("pageerror", lambda error: self.errors.append(f"uncaught: {error}"))
@@ -51,19 +73,18 @@ class Pages:
 
 
 @pytest.fixture
-def pages(live_server):
+def pages(chromium):
     """
-    ``pages.new(width, height)``: a fresh page; no page may log an error.
-    It depends on the server so that the browser closes before the server
-    stops (a page still fetching then would log a refused connection).
+    ``pages.new(width, height)``: a fresh page in a fresh context; no page
+    may log an error. Its contexts close at the end of the test (before the
+    server stops: a page still fetching then would log a refused connection).
     """
-    with sync_playwright() as p:
-        browser = launch(p)
-        made = Pages(browser)
-        yield made
-        browser.close()
-        unexpected = [e for e in made.errors if not any(s in e for s in made.expected)]
-        assert not unexpected, unexpected
+    made = Pages(chromium)
+    yield made
+    for context in made.contexts:
+        context.close()
+    unexpected = [e for e in made.errors if not any(s in e for s in made.expected)]
+    assert not unexpected, unexpected
 
 
 def open_editor(page, url):

@@ -10,7 +10,7 @@ preview in view together.
 from __future__ import annotations
 
 import pytest
-from editor_pages import editor_url, open_editor, pages  # noqa: F401 (fixtures)
+from editor_pages import editor_url, open_editor, pages, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 from playwright.sync_api import expect
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]

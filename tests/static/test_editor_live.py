@@ -13,7 +13,7 @@ import re
 
 import numpy as np
 import pytest
-from editor_pages import editor_url, open_editor, pages  # noqa: F401 (fixtures)
+from editor_pages import editor_url, open_editor, pages, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 

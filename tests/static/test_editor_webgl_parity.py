@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from editor_pages import camera_rays, editor_url, open_editor, pages, read_float  # noqa: F401 (fixtures)
+from editor_pages import camera_rays, editor_url, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 from fitting import (
     baseline_inputs, coated_conductor_model, curve_base_from_nk, halves_to_uint32, lazanyi_adjusted,

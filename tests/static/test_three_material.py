@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from editor_pages import pages  # noqa: F401 (fixture)
+from editor_pages import pages, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 from three_pages import create_fit, measure_three, open_example
 
 from fitting.optics.library import library_material
