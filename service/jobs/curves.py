@@ -261,12 +261,15 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
     }
 
 
-async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tuple[FitRecord, bool]:
+async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
+                          expected_version: int | None = None) -> tuple[FitRecord, bool]:
     """
     The stored fit of ``fit`` (an earlier state saved again becomes the
     latest), else fitted and saved; a draft (the editor's refits while
     editing) is stored but not saved under its material until the same
-    request comes without ``draft``.
+    request comes without ``draft``. ``expected_version``: the save is
+    refused (:class:`service.store.StoreConflict`, 409) unless the material
+    is at that version (see :meth:`service.store.Store.put_fit`).
     """
     def stored_or_writable() -> FitRecord | None:
         # One trip to a thread for both (a live refit is a round trip per drag step).
@@ -279,7 +282,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
     if stored is not None:
         if fit.draft:
             return stored, False
-        return await asyncio.to_thread(store.put_fit, stored), False
+        return await asyncio.to_thread(store.put_fit, stored, True, expected_version), False
     base, base_record = fit.base, fit.base_record
     # The measured data behind the edit (for the reference curves and
     # previews): the base's, or, for an edited base, the data it had.
@@ -309,14 +312,14 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
                 **({"live": {"start": fit.start}} if fit.live else {}),
             },
         )
-        return await asyncio.to_thread(store.put_fit, record, not fit.draft)
+        return await asyncio.to_thread(store.put_fit, record, not fit.draft, expected_version)
 
     record = await runner.once(fit.fit_id, make)
     if not fit.draft:
         # The fit was shared with a draft request in flight: saved now.
         latest = await asyncio.to_thread(store.latest_fit, record.material_id)
         if latest is None or latest.id != record.id:
-            record = await asyncio.to_thread(store.put_fit, record)
+            record = await asyncio.to_thread(store.put_fit, record, True, expected_version)
     return record, True
 
 
