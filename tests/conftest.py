@@ -16,6 +16,11 @@ Shared fixtures of the test suite.
     tests that need their own data directory, environment or a restart
     (``with server_process(data_dir, COATED_FIT_QUEUE="0") as server: ...``;
     ``server.url``, ``server.process``, ``server.kill()``).
+-   ``postgres_server``: one throwaway PostgreSQL server for the session
+    (:class:`postgres_server.PostgresServer`: temporary directory, free
+    loopback port, run as the ``postgres`` user when the tests run as
+    root); ``postgres_url``: a fresh empty database on it per test. Tests
+    that use them belong to ``@pytest.mark.xdist_group("postgres")``.
 """
 
 from __future__ import annotations
@@ -125,6 +130,22 @@ def app_client(tmp_path: Path, **overrides):
     options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False,
                "allowed_hosts": ["localhost", "127.0.0.1", "::1", "testserver"], **overrides}
     return TestClient(create_app(Settings(**options)))
+
+
+@pytest.fixture(scope="session")
+def postgres_server():
+    from postgres_server import PostgresServer
+
+    server = PostgresServer()
+    try:
+        yield server
+    finally:
+        server.close()
+
+
+@pytest.fixture
+def postgres_url(postgres_server) -> str:
+    return postgres_server.database()
 
 
 @pytest.fixture

@@ -126,8 +126,14 @@ class PostgresStore:
             name="coated-store",
         )
         try:
+            # One plain connection first: its refusal is the server's own message (the pool's is a timeout).
+            psycopg.connect(url, connect_timeout=max(1, int(connect_timeout_s))).close()
             self._pool.open(wait=True, timeout=connect_timeout_s + pool_timeout_s)
         except (PoolTimeout, psycopg.Error) as error:
+            if "too many connections" in str(error):
+                error = psycopg.OperationalError(
+                    f"{str(error).strip()}: this replica's COATED_STORE_POOL_MIN connections exceed what "
+                    "the role's CONNECTION LIMIT or max_connections leaves (docs/deploy.md)")
             self._pool.close(timeout=1.0)
             raise StoreUnavailable(f"the store at {self.where} cannot be reached: "
                                    f"{str(error).strip()}") from None

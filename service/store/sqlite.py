@@ -82,7 +82,11 @@ class SQLiteStore:
             connection.execute("PRAGMA journal_mode=WAL")
             return _migrate(connection, "sqlite", apply=migrate)
 
-        self.migrated = self._guard(setup)
+        try:
+            self.migrated = self._guard(setup)
+        except BaseException:
+            self.close()
+            raise
 
     # -- plumbing ----------------------------------------------------------
 
