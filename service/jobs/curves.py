@@ -43,7 +43,7 @@ from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
 
 from ..pool import FitRunner
-from ..store import FitRecord, Store
+from ..store import FitRecord, Store, StoreConflict
 from .common import (
     FIT_FORMAT_VERSION,
     check_finite,
@@ -271,11 +271,20 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     refused (:class:`service.store.StoreConflict`, 409) unless the material
     is at that version (see :meth:`service.store.Store.put_fit`).
     """
+    material_id = content_address("edited material", fit.name)
+
     def stored_or_writable() -> FitRecord | None:
-        # One trip to a thread for both (a live refit is a round trip per drag step).
+        # One trip to a thread for all (a live refit is a round trip per drag step).
         stored = store.get_fit(fit.fit_id)
         if stored is None:
             checked_writable(store)
+            version = None if expected_version is None else store.material_version(material_id)
+            if version is not None and version != expected_version:
+                # Refused before any CPU is spent; the save itself checks again (a race).
+                raise StoreConflict(
+                    f"material {fit.name!r} ({material_id}) is at version {version}, not the expected "
+                    f"version {expected_version}: another save came first; nothing was fitted; reload "
+                    f"it and save again with `expected_version` {version}", version=version)
         return stored
 
     stored = await asyncio.to_thread(stored_or_writable)
@@ -300,7 +309,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
                                fit.objective, fit.blend_width, fit.model, fit.live, fit.start)
         check_finite("metrics", job["metrics"])
         record = fit_record(
-            fit.fit_id, "curves", content_address("edited material", fit.name), fit.name,
+            fit.fit_id, "curves", material_id, fit.name,
             job["source"], job, fit.objective,
             library_material=measured_library, nk=measured,
             base_fit_id=base_record.id if base_record else None,

@@ -25,7 +25,11 @@ schema and every query are those of the SQLite store
     connection busy past ``pool_timeout_s``) leave as
     :class:`StoreUnavailable` with ``retry_after`` of a few seconds (503 +
     Retry-After); a pooled connection is checked before use, so after a
-    server restart the pool reconnects by itself.
+    server restart the pool reconnects by itself (within about a second;
+    a failed reconnection is given up after ``2 * pool_timeout_s`` and
+    tried afresh on the next call, so its back-off never grows long).
+    While the server is down, calls fail at once (one plain connection
+    attempt each, beside the pool: at most ``pool_max + 1`` connections).
 """
 
 from __future__ import annotations
@@ -114,13 +118,15 @@ class PostgresStore:
                  statement_timeout_s: float = 30.0, connect_timeout_s: float = 5.0,
                  max_bytes: int | None = None, migrate: bool = True) -> None:
         self.where = redacted(url)
+        self._url, self._down = url, False
+        self._connect_timeout = max(1, int(connect_timeout_s))
         self.max_bytes = max_bytes
         self.pool_max = pool_max
         name = f"coated-service {socket.gethostname()}:{os.getpid()}"[:63]
         options = f"-c statement_timeout={int(statement_timeout_s * 1000)} -c lock_timeout={int(statement_timeout_s * 1000)}"
         self._pool = ConnectionPool(
             url, min_size=pool_min, max_size=pool_max, timeout=pool_timeout_s, open=False,
-            check=ConnectionPool.check_connection, reconnect_timeout=3600.0, max_waiting=256,
+            check=ConnectionPool.check_connection, reconnect_timeout=2 * pool_timeout_s, max_waiting=256,
             kwargs={"application_name": name, "connect_timeout": max(1, int(connect_timeout_s)),
                     "options": options},
             name="coated-store",
@@ -152,9 +158,32 @@ class PostgresStore:
             raise _translate(error, self.where) from None
 
     def _run(self, function: Callable[[psycopg.Connection], _T]) -> _T:
-        """``function`` on a pooled connection, one transaction (rolled back on error)."""
-        with self._pool.connection() as connection:
-            return function(connection)
+        """
+        ``function`` on a pooled connection, one transaction (rolled back on
+        error). After a connection fault, each call first tries one plain
+        connection (refused at once while the server is down, so a 503 is
+        quick instead of a wait of ``pool_timeout_s``) until one succeeds.
+        """
+        if self._down:
+            self._probe()
+        try:
+            with self._pool.connection() as connection:
+                return function(connection)
+        except PoolTimeout:
+            self._probe()  # the server's own refusal when it is down; else the pool is busy
+            raise
+        except psycopg.OperationalError:
+            self._down = True
+            raise
+
+    def _probe(self) -> None:
+        """One plain connection: raises (and marks the server down) when the server refuses it."""
+        try:
+            psycopg.connect(self._url, connect_timeout=self._connect_timeout).close()
+        except psycopg.OperationalError:
+            self._down = True
+            raise
+        self._down = False
 
     def _read(self, function: Callable[[psycopg.Connection], _T]) -> _T:
         return self._guard(lambda: self._run(function))
@@ -248,10 +277,8 @@ class PostgresStore:
                             f"({self.max_bytes})")
             return None
 
-        try:
-            return self._read(probe)
-        except StoreError as error:
-            return str(error)
+        # A server that cannot be reached raises (503 + Retry-After), as every other call does.
+        return self._read(probe)
 
     def close(self) -> None:
         self._pool.close(timeout=5.0)

@@ -213,7 +213,10 @@ class Store(Protocol):
         """What ``/healthz`` reports of the store: ``kind``, ``schema_version``, connections."""
 
     def writable(self) -> str | None:
-        """None when a save can be written now, else why not (cheap; no write)."""
+        """
+        None when a save can be written now, else why not (cheap; no write);
+        raises :class:`StoreUnavailable` when the store cannot be reached.
+        """
 
     def close(self) -> None:
         """Release connections."""

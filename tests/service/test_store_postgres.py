@@ -11,6 +11,7 @@ import sqlite3
 import subprocess
 import sys
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 
 import pytest
@@ -186,9 +187,17 @@ class TestFaults:
         with pytest.raises(StoreUnavailable) as down:
             store.put_fit(record("2" * 32, material_id="b" * 32))
         assert down.value.retry_after <= 5
-        assert "unavailable" in store.writable()
+        with pytest.raises(StoreUnavailable, match="unavailable"):
+            store.writable()
         postgres_server.start()
-        store.put_fit(record("2" * 32, material_id="b" * 32))  # no reopening: the pool reconnects
+        deadline = time.monotonic() + 10
+        while True:  # no reopening: the pool reconnects by itself within a few seconds
+            try:
+                store.put_fit(record("2" * 32, material_id="b" * 32))
+                break
+            except StoreUnavailable:
+                assert time.monotonic() < deadline, "the store did not recover within 10 s"
+                time.sleep(0.2)
         assert [m.material_id for m in store.saved_materials()] == ["m" * 32, "b" * 32]
         store.close()
 
