@@ -43,10 +43,11 @@ from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
 
 from ..pool import FitRunner
-from ..store import FitRecord, Store, StoreConflict
+from ..store import FitRecord, Store
 from .common import (
     FIT_FORMAT_VERSION,
     check_finite,
+    checked_version,
     checked_writable,
     content_address,
     fit_record,
@@ -278,13 +279,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         stored = store.get_fit(fit.fit_id)
         if stored is None:
             checked_writable(store)
-            version = None if expected_version is None else store.material_version(material_id)
-            if version is not None and version != expected_version:
-                # Refused before any CPU is spent; the save itself checks again (a race).
-                raise StoreConflict(
-                    f"material {fit.name!r} ({material_id}) is at version {version}, not the expected "
-                    f"version {expected_version}: another save came first; nothing was fitted; reload "
-                    f"it and save again with `expected_version` {version}", version=version)
+            checked_version(store, material_id, fit.name, expected_version)
         return stored
 
     stored = await asyncio.to_thread(stored_or_writable)
