@@ -79,22 +79,27 @@ def redacted(url: str) -> str:
     return f"postgresql://{user + '@' if user else ''}{host}:{port}/{db}"
 
 
+def _message(error: Exception) -> str:
+    """libpq's message on one line (it spreads a refusal over several)."""
+    return " ".join(str(error).split())
+
+
 def _translate(error: Exception, where: str) -> StoreError:
     """A psycopg or pool error as the store error it means."""
     if isinstance(error, PoolTimeout):
         return StoreUnavailable(
             f"the store at {where} is unavailable: no database connection within the pool timeout "
             f"(COATED_STORE_POOL_TIMEOUT_S; all COATED_STORE_POOL_MAX connections busy, or the server "
-            f"is down): {error}", retry_after=RETRY_AFTER_S)
+            f"is down): {_message(error)}", retry_after=RETRY_AFTER_S)
     if isinstance(error, pg_errors.DiskFull):
-        return StoreFull(f"the store at {where} is full ({error}): free disk space on the database "
+        return StoreFull(f"the store at {where} is full ({_message(error)}): free disk space on the database "
                          "server or raise COATED_STORE_MAX_BYTES, then retry")
     if isinstance(error, pg_errors.TooManyConnections):
         return StoreUnavailable(
-            f"the store at {where} refused a connection ({error}): the replicas' connections exceed "
+            f"the store at {where} refused a connection ({_message(error)}): the replicas' connections exceed "
             "the role's CONNECTION LIMIT or the server's max_connections (docs/deploy.md)",
             retry_after=RETRY_AFTER_S)
-    return StoreUnavailable(f"the store at {where} is unavailable: {str(error).strip()}",
+    return StoreUnavailable(f"the store at {where} is unavailable: {_message(error)}",
                             retry_after=RETRY_AFTER_S)
 
 
@@ -138,11 +143,11 @@ class PostgresStore:
         except (PoolTimeout, psycopg.Error) as error:
             if "too many connections" in str(error):
                 error = psycopg.OperationalError(
-                    f"{str(error).strip()}: this replica's COATED_STORE_POOL_MIN connections exceed what "
+                    f"{_message(error)}: this replica's COATED_STORE_POOL_MIN connections exceed what "
                     "the role's CONNECTION LIMIT or max_connections leaves (docs/deploy.md)")
             self._pool.close(timeout=1.0)
             raise StoreUnavailable(f"the store at {self.where} cannot be reached: "
-                                   f"{str(error).strip()}") from None
+                                   f"{_message(error)}") from None
         try:
             self.migrated = self._guard(lambda: self._run(lambda c: _migrate(c, "postgresql", migrate)))
         except StoreError:

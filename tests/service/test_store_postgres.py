@@ -82,6 +82,22 @@ class TestMigrations:
         assert store.material_version(r.material_id) == 1 and store.latest_fit(r.material_id) == r
         store.close()
 
+    def test_bad_store_settings_refused_at_start(self):
+        for env, message in (({"COATED_STORE_URL": "mysql://x/y"}, "must be a postgresql:// URL"),
+                             ({"COATED_STORE_POOL_MIN": "5", "COATED_STORE_POOL_MAX": "2"}, "must not exceed")):
+            result = run_service("--port", "0", env=env)
+            assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
+
+    def test_unreachable_server_refused_at_start(self):
+        from conftest import free_port
+
+        url = f"postgresql://coated:secret-pw@127.0.0.1:{free_port()}/none"
+        result = run_service("--port", "0", env={"COATED_STORE_URL": url})
+        assert result.returncode == 1
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("python -m service: cannot start: the store at postgresql://coated@127.0.0.1")
+        assert "cannot be reached" in line and "secret-pw" not in result.stderr
+
     def test_replicas_migrate_at_once(self, postgres_url):
         with ThreadPoolExecutor(4) as pool:
             stores = list(pool.map(lambda _: PostgresStore(postgres_url), range(4)))
