@@ -27,7 +27,8 @@ class Health(BaseModel):
     store: dict[str, Any] = Field(default_factory=dict, description=(
         "The store: `kind` (sqlite | postgresql), `schema_version`, its `path` or password-free "
         "`url`, and for PostgreSQL this replica's pool: `connections` open, `connections_max`, "
-        "`connections_idle`, `requests_waiting`"))
+        "`connections_idle`, `requests_waiting`, the role's `role_connection_limit` (-1: none) and "
+        "the server's `server_connection_limit` (max_connections less the superusers' reserve)"))
 
 
 class Domain(BaseModel):

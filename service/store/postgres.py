@@ -150,9 +150,16 @@ class PostgresStore:
                                    f"{_message(error)}") from None
         try:
             self.migrated = self._guard(lambda: self._run(lambda c: _migrate(c, "postgresql", migrate)))
+            self.role_limit, self.server_limit = self._read(lambda c: c.execute(
+                "SELECT (SELECT rolconnlimit FROM pg_roles WHERE rolname = current_user), "
+                "current_setting('max_connections')::int - current_setting('superuser_reserved_connections')::int"
+            ).fetchone())
         except StoreError:
             self._pool.close(timeout=1.0)
             raise
+        if self.role_limit < 0:
+            log.warning("the role of %s has no CONNECTION LIMIT: N replicas may take up to the server's "
+                        "%d connections (docs/deploy.md)", self.where, self.server_limit)
 
     # -- plumbing ----------------------------------------------------------
 
@@ -268,7 +275,8 @@ class PostgresStore:
         return {"kind": self.kind, "schema_version": SCHEMA_VERSION, "url": self.where,
                 "connections": stats.get("pool_size", 0), "connections_max": self.pool_max,
                 "connections_idle": stats.get("pool_available", 0),
-                "requests_waiting": stats.get("requests_waiting", 0)}
+                "requests_waiting": stats.get("requests_waiting", 0),
+                "role_connection_limit": self.role_limit, "server_connection_limit": self.server_limit}
 
     def writable(self) -> str | None:
         def probe(connection: psycopg.Connection) -> str | None:

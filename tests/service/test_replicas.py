@@ -68,6 +68,7 @@ def test_saves_on_either_replica_are_everyone_s(replicas, postgres_server):
     a, b = replicas
     health = httpx.get(f"{a.url}/healthz", timeout=10).json()
     assert health["store"]["kind"] == "postgresql" and health["store"]["connections_max"] == 4
+    assert health["store"]["role_connection_limit"] == 40 and health["store"]["server_connection_limit"] == 57
     assert "password" not in str(health) and postgres_server.password not in str(health)
     pairs = [(a, b), (b, a)]
     misses: list[str] = []
