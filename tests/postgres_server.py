@@ -67,7 +67,11 @@ class PostgresServer:
         self._admin_password = secrets.token_hex(12)
         self._as: list[str] = []
         if os.getuid() == 0:  # postgres refuses root: run it as the Debian package's system user
-            account = pwd.getpwnam(user)
+            try:
+                account = pwd.getpwnam(user)
+            except KeyError:
+                raise RuntimeError(f"no system user {user!r} to run PostgreSQL as (it refuses root): "
+                                   "run scripts/bootstrap, whose Debian package `postgresql` makes it") from None
             os.chown(self.root, account.pw_uid, account.pw_gid)
             self._as = ["setpriv", f"--reuid={account.pw_uid}", f"--regid={account.pw_gid}", "--clear-groups"]
         self.root.chmod(0o700)
