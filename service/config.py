@@ -39,7 +39,23 @@ class Settings(BaseSettings):
     Attributes
     ----------
     data_dir
-        Directory of the SQLite store (``store.sqlite3``), created if missing.
+        Directory of the SQLite store (``store.sqlite3``), created if missing
+        (not used when ``store_url`` names a PostgreSQL server).
+    store_url
+        ``postgresql://user:password@host:port/db``: the PostgreSQL store
+        shared by every replica (unset: SQLite under ``data_dir``).
+    store_pool_min, store_pool_max
+        Connections to PostgreSQL this process keeps open at least and
+        opens at most (the pool); N replicas open at most N x
+        ``store_pool_max``, which must stay below the role's CONNECTION
+        LIMIT (docs/deploy.md).
+    store_pool_timeout_s
+        Longest wait for a pooled connection (then 503 + Retry-After).
+    store_statement_timeout_s
+        Longest statement on the PostgreSQL server (``statement_timeout``).
+    store_migrate
+        Bring the store's schema to this code's version at start-up (false:
+        refuse to start on an older schema; ``python -m service migrate``).
     host
         The address the server binds to; decides whether write endpoints
         need a token by default (see ``require_token``).
@@ -117,6 +133,12 @@ class Settings(BaseSettings):
     store_max_bytes: int | None = Field(default=None, ge=100_000)
     store_min_free_bytes: int = Field(default=16_000_000, ge=0)
     materials_page_max: int = Field(default=500, ge=1, le=10_000)
+    store_url: SecretStr | None = None
+    store_pool_min: int = Field(default=1, ge=0, le=100)
+    store_pool_max: int = Field(default=4, ge=1, le=100)
+    store_pool_timeout_s: float = Field(default=5.0, gt=0.0, le=600.0)
+    store_statement_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
+    store_migrate: bool = True
 
     @model_validator(mode="after")
     def _check_token(self) -> "Settings":
@@ -126,6 +148,17 @@ class Settings(BaseSettings):
                 f"bearer token when the service binds to the non-loopback address "
                 f"{self.host!r} (or set COATED_REQUIRE_TOKEN=false explicitly)"
             )
+        return self
+
+    @model_validator(mode="after")
+    def _check_store(self) -> "Settings":
+        url = self.store_url.get_secret_value() if self.store_url else ""
+        if self.store_url is not None and not url.startswith(("postgresql://", "postgres://")):
+            raise ValueError("`store_url` (COATED_STORE_URL) must be a postgresql:// URL, or unset "
+                             "for the SQLite store under the data directory")
+        if self.store_pool_min > self.store_pool_max:
+            raise ValueError(f"`store_pool_min` ({self.store_pool_min}) must not exceed "
+                             f"`store_pool_max` ({self.store_pool_max})")
         return self
 
     @property

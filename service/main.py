@@ -31,7 +31,7 @@ from .api.routes import (
 from .config import Settings
 from .pool import FitRunner, warm_process
 from .schemas import API_PREFIX
-from .store import SQLiteStore
+from .store import open_store
 
 STATIC_DIR = Path(__file__).resolve().parents[1] / "static"
 """The browser editor, served at ``/``."""
@@ -67,16 +67,17 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     The service application.
 
     ``settings`` default to :class:`service.config.Settings` from the
-    environment (``COATED_*``). The lifespan opens the SQLite store under
-    ``settings.data_dir`` and the fitting pool (warmed at start-up when
+    environment (``COATED_*``). The lifespan opens the store
+    (:func:`service.store.open_store`: PostgreSQL at ``COATED_STORE_URL``, else
+    SQLite under ``settings.data_dir``; schema migrated) and the fitting pool (warmed at start-up when
     ``settings.warm_pool``), and closes both at shutdown.
     """
     settings = settings or Settings()
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        store = SQLiteStore(settings.store_path, settings.store_max_bytes, settings.store_min_free_bytes)
-        store.check()
+        store = await asyncio.to_thread(open_store, settings)
+        await asyncio.to_thread(store.check)
         runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s)
         app.state.store, app.state.runner = store, runner
         try:

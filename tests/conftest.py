@@ -16,6 +16,11 @@ Shared fixtures of the test suite.
     tests that need their own data directory, environment or a restart
     (``with server_process(data_dir, COATED_FIT_QUEUE="0") as server: ...``;
     ``server.url``, ``server.process``, ``server.kill()``).
+-   ``postgres_server``: one throwaway PostgreSQL server for the session
+    (:class:`postgres_server.PostgresServer`: temporary directory, free
+    loopback port, run as the ``postgres`` user when the tests run as
+    root); ``postgres_url``: a fresh empty database on it per test. Tests
+    that use them belong to ``@pytest.mark.xdist_group("postgres")``.
 
 The ``slow`` marker (``scripts/test --quick`` leaves those tests out) is on
 every test that starts a process, a GL context or a browser, or that took
@@ -160,6 +165,22 @@ def showroom():
     return fit_scene(parse_scene(SHOWROOM_SCENE))
 
 
+@pytest.fixture(scope="session")
+def postgres_server():
+    from postgres_server import PostgresServer
+
+    server = PostgresServer()
+    try:
+        yield server
+    finally:
+        server.close()
+
+
+@pytest.fixture
+def postgres_url(postgres_server) -> str:
+    return postgres_server.database()
+
+
 @pytest.fixture
 def client(tmp_path):
     with app_client(tmp_path, metrics_samples=30) as test_client:
@@ -180,7 +201,7 @@ SLOW_S = 2.0
 _IMPLY_SLOW = ("gl", "server", "browser")
 PROCESS_FIXTURES = frozenset({
     "shared", "fitted", "live_server", "editor_url", "pages", "page", "curve_fit", "rgb_fit",
-    "hostile_run", "chromium",
+    "hostile_run", "chromium", "postgres_server", "postgres_url",
 })
 """
 Fixtures (by name, in any module) that start a process: the fitting pool's

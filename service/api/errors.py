@@ -12,7 +12,8 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``Overloaded`` / ``WorkerLost``        503 with ``Retry-After``
 ``FitTimeout``                         504 with ``Retry-After``
 ``StoreFull``                          507
-``StoreUnavailable``                   503
+``StoreUnavailable``                   503 with ``Retry-After``
+``StoreConflict``                      409 (another save of the material came first)
 ``RecordDamaged``                      500 (only that record)
 anything else                          500, logged with its traceback
 =====================================  ======================================
@@ -122,8 +123,11 @@ async def _timeout(request: Request, error: FitTimeout) -> JSONResponse:
 
 
 async def _store_error(request: Request, error: StoreError) -> JSONResponse:
+    if error.status == status.HTTP_409_CONFLICT:
+        errors = [{"loc": ["body", "expected_version"], "msg": str(error)[:500], "type": "version_conflict"}]
+        return error_response(error.status, str(error), errors)
     log.error("store: %s", error)
-    headers = {"Retry-After": "30"} if error.status in (503, 507) else None
+    headers = {"Retry-After": str(error.retry_after)} if error.status in (503, 507) else None
     return error_response(error.status, str(error), headers=headers)
 
 

@@ -11,6 +11,8 @@ What every job shares
 -   :func:`fit_record`: the record of a finished job.
 -   :func:`checked_writable`: refuse (:class:`service.store.StoreError`)
     before any CPU is spent when the store cannot take the save.
+-   :func:`checked_version`: refuse (:class:`service.store.StoreConflict`)
+    before any CPU is spent a save that expects another version.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
 
 from ..ids import content_address
-from ..store import FitRecord, Store, StoreFull, StoreUnavailable
+from ..store import FitRecord, Store, StoreConflict, StoreFull, StoreUnavailable
 
 __all__ = [
     "FIT_FORMAT_VERSION",
@@ -36,6 +38,7 @@ __all__ = [
     "stored_fit",
     "fit_record",
     "checked_writable",
+    "checked_version",
 ]
 
 FIT_FORMAT_VERSION = "fit/v2"
@@ -94,6 +97,22 @@ def checked_writable(store: Store) -> None:
     if "full" in reason or "free" in reason or "quota" in reason:
         raise StoreFull(f"{reason}; nothing was fitted")
     raise StoreUnavailable(f"{reason}; nothing was fitted")
+
+
+def checked_version(store: Store, material_id: str, name: str, expected_version: int | None) -> None:
+    """
+    Raise StoreConflict (409) when ``expected_version`` is given and the
+    material is at another version now: nothing is fitted for a save that
+    would be refused (the save itself checks again, in its transaction).
+    """
+    if expected_version is None:
+        return
+    version = store.material_version(material_id)
+    if version != expected_version:
+        raise StoreConflict(
+            f"material {name!r} ({material_id}) is at version {version}, not the expected version "
+            f"{expected_version}: another save came first; nothing was fitted; reload it and save "
+            f"again with `expected_version` {version}", version=version)
 
 
 def fit_record(fit_id: str, kind: str, material_id: str, name: str, source: str,

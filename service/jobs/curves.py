@@ -47,6 +47,7 @@ from ..store import FitRecord, Store
 from .common import (
     FIT_FORMAT_VERSION,
     check_finite,
+    checked_version,
     checked_writable,
     content_address,
     fit_record,
@@ -261,25 +262,31 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
     }
 
 
-async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tuple[FitRecord, bool]:
+async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
+                          expected_version: int | None = None) -> tuple[FitRecord, bool]:
     """
     The stored fit of ``fit`` (an earlier state saved again becomes the
     latest), else fitted and saved; a draft (the editor's refits while
     editing) is stored but not saved under its material until the same
-    request comes without ``draft``.
+    request comes without ``draft``. ``expected_version``: the save is
+    refused (:class:`service.store.StoreConflict`, 409) unless the material
+    is at that version (see :meth:`service.store.Store.put_fit`).
     """
+    material_id = content_address("edited material", fit.name)
+
     def stored_or_writable() -> FitRecord | None:
-        # One trip to a thread for both (a live refit is a round trip per drag step).
+        # One trip to a thread for all (a live refit is a round trip per drag step).
         stored = store.get_fit(fit.fit_id)
         if stored is None:
             checked_writable(store)
+            checked_version(store, material_id, fit.name, expected_version)
         return stored
 
     stored = await asyncio.to_thread(stored_or_writable)
     if stored is not None:
         if fit.draft:
             return stored, False
-        return await asyncio.to_thread(store.put_fit, stored), False
+        return await asyncio.to_thread(store.put_fit, stored, True, expected_version), False
     base, base_record = fit.base, fit.base_record
     # The measured data behind the edit (for the reference curves and
     # previews): the base's, or, for an edited base, the data it had.
@@ -297,7 +304,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
                                fit.objective, fit.blend_width, fit.model, fit.live, fit.start)
         check_finite("metrics", job["metrics"])
         record = fit_record(
-            fit.fit_id, "curves", content_address("edited material", fit.name), fit.name,
+            fit.fit_id, "curves", material_id, fit.name,
             job["source"], job, fit.objective,
             library_material=measured_library, nk=measured,
             base_fit_id=base_record.id if base_record else None,
@@ -309,14 +316,14 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
                 **({"live": {"start": fit.start}} if fit.live else {}),
             },
         )
-        return await asyncio.to_thread(store.put_fit, record, not fit.draft)
+        return await asyncio.to_thread(store.put_fit, record, not fit.draft, expected_version)
 
     record = await runner.once(fit.fit_id, make)
     if not fit.draft:
         # The fit was shared with a draft request in flight: saved now.
         latest = await asyncio.to_thread(store.latest_fit, record.material_id)
         if latest is None or latest.id != record.id:
-            record = await asyncio.to_thread(store.put_fit, record)
+            record = await asyncio.to_thread(store.put_fit, record, True, expected_version)
     return record, True
 
 

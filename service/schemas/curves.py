@@ -125,6 +125,12 @@ class CurveFitRequest(RequestModel):
     start_fit: FitId | None = Field(None, description="With `live`: the stored fit (of the same kind and "
                                                       "domain) whose coefficients the solve starts from")
 
+    expected_version: int | None = Field(
+        None, ge=0, le=2**62, strict=True,
+        description="Save only if the material `name` is at this version now (0: not saved yet; the "
+                    "`version` of `GET /materials/{id}`); else 409, nothing saved. Unset: the save "
+                    "becomes the next version whatever came before")
+
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":
         if self.eta_i_range is not None and self.eta_i_range[0] > self.eta_i_range[1]:
@@ -132,6 +138,8 @@ class CurveFitRequest(RequestModel):
             raise ValueError(f"`eta_i_range` must not be empty: lo {lo:g} > hi {hi:g}")
         if self.live and not self.draft:
             raise ValueError("`live` refits are drafts: set `draft` to true (a live refit is never saved)")
+        if self.expected_version is not None and self.draft:
+            raise ValueError("`expected_version` is for saves: a draft is not saved under `name`")
         if self.start_fit is not None and not self.live:
             raise ValueError("`start_fit` is for `live` refits only")
         return self

@@ -9,7 +9,7 @@ constants, so that no client repeats them).
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import BaseModel, Field
 
@@ -24,6 +24,11 @@ class Health(BaseModel):
     store_writable: bool = Field(description="Whether a save can be written now")
     store_problem: str | None = Field(None, description="Why not, when it cannot")
     pool_restarts: int = Field(0, description="Times a dead worker made the pool restart")
+    store: dict[str, Any] = Field(default_factory=dict, description=(
+        "The store: `kind` (sqlite | postgresql), `schema_version`, its `path` or password-free "
+        "`url`, and for PostgreSQL this replica's pool: `connections` open, `connections_max`, "
+        "`connections_idle`, `requests_waiting`, the role's `role_connection_limit` (-1: none) and "
+        "the server's `server_connection_limit` (max_connections less the superusers' reserve)"))
 
 
 class Domain(BaseModel):

@@ -25,6 +25,9 @@ class MaterialSummary(BaseModel):
     source: str
     coverage: float | None = None
     latest_fit_id: str | None = None
+    version: int = Field(0, description="Saves of the material so far (0: never saved); a save of "
+                                        "edited curves may name it as `expected_version` (409 when "
+                                        "another save came first)")
 
 
 class MaterialList(BaseModel):

@@ -2,14 +2,20 @@
 Fit store
 =========
 
-Where fits are kept: one small interface, :class:`Store`, and its embedded
-implementation on SQLite in WAL mode, :class:`SQLiteStore`.
+Where fits are kept: one small interface, :class:`Store`, its embedded
+implementation on SQLite in WAL mode, :class:`SQLiteStore`, and the shared
+one on PostgreSQL for any number of service replicas, :class:`PostgresStore`
+(``service.store.postgres``, imported on use: psycopg loads only then).
 
 -   :class:`FitRecord`: one stored fit, with or without measured n, k (fits
     from edited curves have none).
 -   :class:`MaterialRow`: a saved material as listed by ``GET /materials``.
 -   :class:`Store`: the interface the routes use.
 -   :class:`SQLiteStore`: the embedded store.
+-   :func:`open_store`: the store the settings name (``COATED_STORE_URL``).
+-   :data:`SCHEMA_VERSION`, :func:`migrate`: the versioned schema of both
+    (``service.store.migrations``); :mod:`service.store.queries` the SQL
+    both run; :mod:`service.store.move` SQLite to PostgreSQL.
 
 Records are content addressed (the id is a hash of the fit's inputs) and
 written once: ``put_fit`` of an existing id keeps the first record, nothing
@@ -20,11 +26,10 @@ fit saved again (an artist's undo, then save). Each save is one transaction
 committed with ``synchronous=FULL`` before the request is answered, so it
 survives a crash of the process (and of the machine) once answered.
 
-Replacing SQLite by a server database (several service instances sharing one
-store) means a second class with the same methods, e.g. on PostgreSQL
-with ``INSERT ... ON CONFLICT (id) DO NOTHING`` for the record and a
-``BIGSERIAL`` save log in ``put_fit``, and a JSONB column for the record;
-see ``docs/service.md``.
+Saves are serialised (SQLite's write lock; an advisory lock on
+PostgreSQL), so the save log's order is the commit order on both, and a
+save that names the version it expects (``expected_version``) is refused
+with :class:`StoreConflict` (409) when another save came first.
 """
 
 from .records import (
@@ -33,12 +38,16 @@ from .records import (
     MaterialPage,
     MaterialRow,
     RecordDamaged,
+    SchemaMismatch,
     Store,
+    StoreConflict,
     StoreDamaged,
     StoreError,
     StoreFull,
     StoreUnavailable,
 )
+from .migrations import SCHEMA_VERSION, migrate
+from .opening import open_store
 from .sqlite import SQLiteStore
 
 __all__ = [
@@ -53,4 +62,9 @@ __all__ = [
     "StoreUnavailable",
     "StoreDamaged",
     "RecordDamaged",
+    "StoreConflict",
+    "SchemaMismatch",
+    "SCHEMA_VERSION",
+    "migrate",
+    "open_store",
 ]

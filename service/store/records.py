@@ -5,7 +5,8 @@ Records, rows, errors and the store interface
 :class:`FitRecord` (one stored fit), :class:`MaterialRow` and
 :class:`MaterialPage` (the listing), the :class:`StoreError` family (what a
 failed store call means, with its HTTP status) and :class:`Store`, the
-interface every store implements (:mod:`service.store.sqlite`).
+interface every store implements (:mod:`service.store.sqlite`,
+:mod:`service.store.postgres`).
 """
 
 from __future__ import annotations
@@ -97,6 +98,7 @@ class MaterialRow:
     latest_fit_id: str
     created_at: float
     seq: int = 0
+    version: int = 0
 
 
 @dataclass(frozen=True)
@@ -113,9 +115,18 @@ class MaterialPage:
 
 
 class StoreError(RuntimeError):
-    """The store cannot do what was asked; ``status`` is the HTTP answer."""
+    """
+    The store cannot do what was asked; ``status`` is the HTTP answer,
+    ``retry_after`` the seconds a client should wait (503 and 507).
+    """
 
     status = 503
+    retry_after = 30
+
+    def __init__(self, message: str, retry_after: int | None = None) -> None:
+        super().__init__(message)
+        if retry_after is not None:
+            self.retry_after = retry_after
 
 
 class StoreFull(StoreError):
@@ -134,6 +145,23 @@ class StoreDamaged(StoreUnavailable, sqlite3.DatabaseError):
     """The store's file is not a sound SQLite database (503; at start-up: exit)."""
 
 
+class SchemaMismatch(StoreUnavailable):
+    """The store's schema is not the one this code knows (503; at start-up: exit)."""
+
+
+class StoreConflict(StoreError):
+    """
+    A save that expected another version of its material: another save
+    came first (409). ``version`` and ``latest_fit_id`` are the material's now.
+    """
+
+    status = 409
+
+    def __init__(self, message: str, version: int = 0, latest_fit_id: str | None = None) -> None:
+        super().__init__(message)
+        self.version, self.latest_fit_id = version, latest_fit_id
+
+
 class RecordDamaged(StoreError):
     """A stored record could not be decoded (500; the rest of the store is fine)."""
 
@@ -144,12 +172,17 @@ class RecordDamaged(StoreError):
 class Store(Protocol):
     """The store interface of the service (thread-safe implementations)."""
 
-    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
+    def put_fit(self, record: FitRecord, save: bool = True,
+                expected_version: int | None = None) -> FitRecord:
         """
         Save ``record`` unless its id exists, and log the save (the fit
-        becomes its material's latest); return the stored record. With
-        ``save`` False (a draft) the record is stored but not logged: it is
-        reachable by id and lists under no material until saved.
+        becomes its material's latest, the material's version one more);
+        return the stored record. With ``save`` False (a draft) the record
+        is stored but not logged: it is reachable by id and lists under no
+        material until saved. With ``expected_version`` (0: a material not
+        saved yet) the save is refused with :class:`StoreConflict` unless
+        the material is at that version now, or its latest fit already is
+        this record (a retried save: answered, not logged again).
         """
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
@@ -167,11 +200,23 @@ class Store(Protocol):
     def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
         """The latest fit id of each of ``material_ids`` that has one."""
 
+    def material_version(self, material_id: str) -> int:
+        """The number of saves of a material (0: never saved)."""
+
     def check(self) -> None:
         """Raise :class:`StoreError` if the store is unusable or damaged."""
 
+    def ping(self) -> None:
+        """A cheap read (no integrity scan): raise :class:`StoreError` if the store cannot answer."""
+
+    def describe(self) -> dict[str, Any]:
+        """What ``/healthz`` reports of the store: ``kind``, ``schema_version``, connections."""
+
     def writable(self) -> str | None:
-        """None when a save can be written now, else why not (cheap; no write)."""
+        """
+        None when a save can be written now, else why not (cheap; no write);
+        raises :class:`StoreUnavailable` when the store cannot be reached.
+        """
 
     def close(self) -> None:
         """Release connections."""

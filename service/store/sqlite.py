@@ -17,8 +17,10 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Callable, TypeVar
 
+from . import queries
+from .migrations import SCHEMA_VERSION
+from .migrations import migrate as _migrate
 from .records import (
-    FIT_KINDS,
     FitRecord,
     MaterialPage,
     MaterialRow,
@@ -31,50 +33,6 @@ from .records import (
 
 log = logging.getLogger("service.store")
 _T = TypeVar("_T")
-
-
-_SCHEMA = """
-CREATE TABLE IF NOT EXISTS fits (
-    id TEXT PRIMARY KEY,
-    kind TEXT NOT NULL,
-    material_id TEXT NOT NULL,
-    created_at REAL NOT NULL,
-    record TEXT NOT NULL
-);
-CREATE INDEX IF NOT EXISTS fits_by_material ON fits (material_id, created_at);
-CREATE TABLE IF NOT EXISTS saves (
-    seq INTEGER PRIMARY KEY AUTOINCREMENT,
-    material_id TEXT NOT NULL,
-    fit_id TEXT NOT NULL REFERENCES fits (id),
-    saved_at REAL NOT NULL
-);
-CREATE INDEX IF NOT EXISTS saves_by_material ON saves (material_id, seq);
--- Stores written before the save log: each fit counts as saved once, in order.
-INSERT INTO saves (material_id, fit_id, saved_at)
-    SELECT material_id, id, created_at FROM fits
-    WHERE id NOT IN (SELECT fit_id FROM saves) ORDER BY created_at, rowid;
--- One summary row per material (its first save and its latest fit), kept by
--- put_fit, so that a listing reads one short row per material it returns.
-CREATE TABLE IF NOT EXISTS materials (
-    material_id TEXT PRIMARY KEY,
-    first_seq INTEGER NOT NULL,
-    first_saved_at REAL NOT NULL,
-    latest_fit_id TEXT NOT NULL,
-    kind TEXT NOT NULL,
-    name TEXT NOT NULL,
-    source TEXT NOT NULL,
-    coverage REAL
-);
-CREATE INDEX IF NOT EXISTS materials_by_first ON materials (kind, first_seq);
-"""
-
-_UPSERT_MATERIAL = (
-    "INSERT INTO materials (material_id, first_seq, first_saved_at, latest_fit_id, kind, name, "
-    "source, coverage) VALUES (?, ?, ?, ?, ?, ?, ?, ?) "
-    "ON CONFLICT (material_id) DO UPDATE SET latest_fit_id = excluded.latest_fit_id, "
-    "kind = excluded.kind, name = excluded.name, source = excluded.source, "
-    "coverage = excluded.coverage"
-)
 
 
 def _translate(error: sqlite3.Error, path: Path) -> StoreError:
@@ -98,10 +56,14 @@ class SQLiteStore:
     is :class:`StoreFull`); ``min_free_bytes`` is the free disk space below
     which :meth:`writable` reports the store full before any work is done.
     Every SQLite error leaves as a :class:`StoreError` naming what happened.
+    The schema is brought to :data:`SCHEMA_VERSION` on opening (``migrate``
+    False: refused with :class:`SchemaMismatch` unless it is there).
     """
 
+    kind = "sqlite"
+
     def __init__(self, path: str | Path, max_bytes: int | None = None,
-                 min_free_bytes: int = 0) -> None:
+                 min_free_bytes: int = 0, migrate: bool = True) -> None:
         self.path = Path(path)
         self.max_bytes = max_bytes
         self.min_free_bytes = min_free_bytes
@@ -115,14 +77,16 @@ class SQLiteStore:
             raise StoreUnavailable(f"the store directory {self.path.parent} cannot be made: "
                                    f"{error.strerror or error}") from None
 
-        def setup() -> None:
+        def setup() -> tuple[int, int]:
             connection = self._connection()
             connection.execute("PRAGMA journal_mode=WAL")
-            with connection:
-                connection.executescript(_SCHEMA)
-            self._backfill_materials(connection)
+            return _migrate(connection, "sqlite", apply=migrate)
 
-        self._guard(setup)
+        try:
+            self.migrated = self._guard(setup)
+        except BaseException:
+            self.close()
+            raise
 
     # -- plumbing ----------------------------------------------------------
 
@@ -156,31 +120,10 @@ class SQLiteStore:
             raise RecordDamaged(f"the stored record of fit {fit_id} is damaged and cannot be "
                                 "read; the rest of the store is unaffected") from None
 
-    def _backfill_materials(self, connection: sqlite3.Connection) -> None:
-        """Summary rows for materials saved before the summary table existed."""
-        missing = connection.execute(
-            "SELECT s.material_id, MIN(s.seq), MIN(s.saved_at), MAX(s.seq) FROM saves s "
-            "WHERE s.material_id NOT IN (SELECT material_id FROM materials) GROUP BY s.material_id"
-        ).fetchall()
-        for material_id, first_seq, first_at, last_seq in missing:
-            for (fit_id, text) in connection.execute(
-                "SELECT f.id, f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
-                "WHERE s.material_id = ? AND s.seq <= ? ORDER BY s.seq DESC", (material_id, last_seq)
-            ).fetchall():
-                try:
-                    record = FitRecord.from_json(text)
-                except (TypeError, ValueError) as error:
-                    log.error("stored fit %s cannot be decoded, skipped: %s", fit_id, error)
-                    continue
-                with connection:
-                    connection.execute(_UPSERT_MATERIAL, (
-                        material_id, first_seq, first_at, record.id, record.kind, record.name,
-                        record.source, record.coverage))
-                break
-
     # -- the interface -----------------------------------------------------
 
-    def put_fit(self, record: FitRecord, save: bool = True) -> FitRecord:
+    def put_fit(self, record: FitRecord, save: bool = True,
+                expected_version: int | None = None) -> FitRecord:
         if not record.created_at:
             record = FitRecord(**{**asdict(record), "created_at": time.time()})
         text = record.to_json()
@@ -188,39 +131,19 @@ class SQLiteStore:
         def write() -> FitRecord:
             connection = self._connection()
             with connection:
-                connection.execute(
-                    "INSERT OR IGNORE INTO fits (id, kind, material_id, created_at, record) "
-                    "VALUES (?, ?, ?, ?, ?)",
-                    (record.id, record.kind, record.material_id, record.created_at, text),
-                )
-                stored_text = connection.execute(
-                    "SELECT record FROM fits WHERE id = ?", (record.id,)).fetchone()[0]
-                stored = self._decode(record.id, stored_text)
-                if not save:  # a draft: stored, reachable by id, listed under no material
-                    return stored
-                now = time.time()
-                seq = connection.execute(
-                    "INSERT INTO saves (material_id, fit_id, saved_at) VALUES (?, ?, ?)",
-                    (stored.material_id, stored.id, now),
-                ).lastrowid
-                connection.execute(_UPSERT_MATERIAL, (
-                    stored.material_id, seq, now, stored.id, stored.kind, stored.name,
-                    stored.source, stored.coverage))
-            return stored
+                # BEGIN IMMEDIATE: the write lock first, so the version read is the one written after.
+                connection.execute("BEGIN IMMEDIATE")
+                return queries.save(connection, "?", record, text, save, expected_version, self._decode)
 
         return self._guard(write)
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
-        row = self._guard(lambda: self._connection().execute(
-            "SELECT record FROM fits WHERE id = ?", (fit_id,)).fetchone())
-        return None if row is None else self._decode(fit_id, row[0])
+        text = self._guard(lambda: queries.get_text(self._connection(), "?", fit_id))
+        return None if text is None else self._decode(fit_id, text)
 
     def latest_fit(self, material_id: str) -> FitRecord | None:
         """The latest decodable fit of a material (a damaged one is logged and passed over)."""
-        rows = self._guard(lambda: self._connection().execute(
-            "SELECT f.id, f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
-            "WHERE s.material_id = ? ORDER BY s.seq DESC LIMIT 16", (material_id,)).fetchall())
-        for fit_id, text in rows:
+        for fit_id, text in self._guard(lambda: queries.latest_texts(self._connection(), "?", material_id)):
             try:
                 return self._decode(fit_id, text)
             except RecordDamaged:
@@ -228,31 +151,14 @@ class SQLiteStore:
         return None
 
     def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
-        if not material_ids:
-            return {}
-        marks = ",".join("?" * len(material_ids))
-        rows = self._guard(lambda: self._connection().execute(
-            f"SELECT material_id, latest_fit_id FROM materials WHERE material_id IN ({marks})",
-            list(material_ids)).fetchall())
-        return dict(rows)
+        return self._guard(lambda: queries.latest_ids(self._connection(), "?", material_ids))
+
+    def material_version(self, material_id: str) -> int:
+        return self._guard(lambda: queries.version_of(self._connection(), "?", material_id))
 
     def material_page(self, after: int | None, limit: int) -> MaterialPage:
-        rows = self._guard(lambda: self._connection().execute(
-            "SELECT material_id, name, source, coverage, kind, latest_fit_id, first_saved_at, "
-            "first_seq FROM materials WHERE kind != 'library' AND first_seq > ? "
-            "ORDER BY first_seq LIMIT ?", (after or 0, limit + 1)).fetchall())
-        out, skipped = [], []
-        for material_id, name, source, coverage, kind, latest, first_at, seq in rows[:limit]:
-            if (kind not in FIT_KINDS or not isinstance(name, str) or not isinstance(source, str)
-                    or not (coverage is None or isinstance(coverage, float))):
-                log.error("the summary of material %r cannot be read, skipped", material_id)
-                skipped.append(str(material_id))
-                continue
-            out.append(MaterialRow(material_id=material_id, name=name, source=source,
-                                   coverage=coverage, kind=kind, latest_fit_id=latest,
-                                   created_at=first_at, seq=seq))
-        next_cursor = rows[limit - 1][7] if len(rows) > limit else None
-        return MaterialPage(out, next_cursor, skipped)
+        rows = self._guard(lambda: queries.page_rows(self._connection(), "?", after, limit))
+        return queries.page_of(rows, limit)
 
     def saved_materials(self) -> list[MaterialRow]:
         rows: list[MaterialRow] = []
@@ -277,6 +183,10 @@ class SQLiteStore:
     def ping(self) -> None:
         """A cheap read (no integrity scan): raises :class:`StoreError` if the store cannot answer."""
         self._guard(lambda: self._connection().execute("SELECT 1 FROM saves LIMIT 1").fetchall())
+
+    def describe(self) -> dict[str, Any]:
+        return {"kind": self.kind, "schema_version": SCHEMA_VERSION, "path": str(self.path),
+                "connections": len(self._connections)}
 
     def writable(self) -> str | None:
         try:

@@ -22,7 +22,7 @@ from ...jobs.common import stored_fit
 from ...jobs.curves import error_map, fit_from_curves, prepare_curve_fit
 from ...jobs.nk import angle_curves
 from ...schemas import API_PREFIX, ETA_I_LIMITS, CurveFitPublic, CurveFitRequest, CurvesPublic, ErrorMap, fit_public
-from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, StoreDep, WriteAccess
+from ..deps import CONFLICT, ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, StoreDep, WriteAccess
 
 router = APIRouter(prefix=API_PREFIX, tags=["curves"])
 
@@ -31,7 +31,7 @@ router = APIRouter(prefix=API_PREFIX, tags=["curves"])
              responses={
                  status.HTTP_200_OK: {"model": CurveFitPublic, "description": "Served from the store"},
                  status.HTTP_201_CREATED: {"model": CurveFitPublic, "description": "Fitted and saved"},
-                 **NOT_FOUND, **FIT_ERROR_RESPONSES,
+                 **NOT_FOUND, **FIT_ERROR_RESPONSES, **CONFLICT,
              }, dependencies=[WriteAccess])
 async def create_fit_from_curves(
     request: CurveFitRequest, store: StoreDep, runner: RunnerDep, response: Response,
@@ -56,10 +56,10 @@ async def create_fit_from_curves(
             base_nk=base.nk.arrays() if base and base.nk else None,
             eta_i_range=request.eta_i_range, objective=request.objective,
             blend_width=request.blend_width,
-            request=request.model_dump(mode="json", exclude={"base", "draft", "live", "start_fit"}), draft=request.draft,
+            request=request.model_dump(mode="json", exclude={"base", "draft", "live", "start_fit", "expected_version"}), draft=request.draft,
             model=request.model, live=request.live, start_fit=request.start_fit,
         ))
-    record, created = await fit_from_curves(fit, store, runner)
+    record, created = await fit_from_curves(fit, store, runner, request.expected_version)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
     curves = None

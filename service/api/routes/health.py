@@ -3,8 +3,9 @@ Health and domain
 =================
 
 -   ``GET /healthz``: answers once the service is ready (store open, fitting
-    pool started), and says whether the store can take a save now; 503 if
-    the store cannot be read. Cheap (no integrity scan, no write), and its
+    pool started), says whether the store can take a save now and which
+    store it is (kind, schema version, this replica's connections); 503
+    with Retry-After if the store cannot be read (the database restarting). Cheap (no integrity scan, no write), and its
     store probe runs in a worker thread, so it answers while fits run.
 -   ``GET /api/v1/domain``: the eta_i limits, the default domain and the
     other constants a client checks before sending, from the core.
@@ -40,20 +41,20 @@ router = APIRouter(tags=["health"])
 _PROBE_THREAD = ThreadPoolExecutor(1, thread_name_prefix="healthz")
 
 
-def _probe(store: Store) -> str | None:
-    store.ping()  # StoreError -> 503
-    return store.writable()
+def _probe(store: Store) -> tuple[str | None, dict]:
+    store.ping()  # StoreError -> 503 + Retry-After
+    return store.writable(), store.describe()
 
 
 @router.get("/healthz", response_model=Health,
             responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
 async def healthz(store: StoreDep, runner: RunnerDep) -> Health:
     """Readiness: the store answers and the fitting pool is up; whether a save can be written."""
-    problem = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
+    problem, described = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
         status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
         max_in_flight=runner.max_in_flight, store_writable=problem is None, store_problem=problem,
-        pool_restarts=runner.restarts,
+        pool_restarts=runner.restarts, store=described,
     )
 
 

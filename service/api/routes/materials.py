@@ -51,7 +51,7 @@ def list_materials(
     for row in page.rows:
         materials.append(MaterialSummary(
             id=row.material_id, name=row.name, kind=row.kind, source=row.source,
-            coverage=row.coverage, latest_fit_id=row.latest_fit_id,
+            coverage=row.coverage, latest_fit_id=row.latest_fit_id, version=row.version,
         ))
     return MaterialList(materials=materials, next_cursor=page.next_cursor, skipped=page.skipped)
 
@@ -64,11 +64,12 @@ def get_material(
 ) -> MaterialDetail:
     """One material with its latest fit (None for a library material not fitted yet)."""
     latest = store.latest_fit(material_id)
+    version = store.material_version(material_id)
     if material_id in LIBRARY_NAMES:
         source, coverage, wavelength_range = _library_entry(material_id)
         return MaterialDetail(
             id=material_id, name=material_id, kind="library", source=source,
-            coverage=coverage, latest_fit_id=latest.id if latest else None,
+            coverage=coverage, latest_fit_id=latest.id if latest else None, version=version,
             wavelength_range_nm=wavelength_range,
             latest_fit=fit_public(latest) if latest else None,
         )
@@ -79,6 +80,6 @@ def get_material(
         wavelength_range = (latest.nk["wavelength_nm"][0], latest.nk["wavelength_nm"][-1])
     return MaterialDetail(
         id=material_id, name=latest.name, kind=latest.kind, source=latest.source,
-        coverage=latest.coverage, latest_fit_id=latest.id,
+        coverage=latest.coverage, latest_fit_id=latest.id, version=version,
         wavelength_range_nm=wavelength_range, latest_fit=fit_public(latest),
     )

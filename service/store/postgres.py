@@ -1,0 +1,297 @@
+"""
+The PostgreSQL store
+====================
+
+:class:`PostgresStore`: the :class:`service.store.Store` on a PostgreSQL
+server shared by any number of service replicas, through a bounded psycopg
+3 connection pool per replica. The tables, the version numbers of the
+schema and every query are those of the SQLite store
+(:mod:`service.store.migrations`, :mod:`service.store.queries`).
+
+-   Records are the same JSON text as in SQLite (``record TEXT``): a move
+    from SQLite is byte for byte (its checksum compares the texts), and JSON
+    that ``JSONB`` refuses (a ``\\u0000`` in a name) stays storable.
+-   Every save takes one transaction-scoped advisory lock
+    (:data:`SAVE_LOCK`), so saves from all replicas are serialised as
+    SQLite's are: the save log's ``seq`` grows in commit order (a page
+    cursor never skips a save that committed late), a material's latest
+    fit is the one saved last, and the expected-version check of
+    ``put_fit`` cannot race. A save holds the lock for a few milliseconds;
+    the fitting, the expensive part, is outside it.
+-   A commit returns after PostgreSQL has flushed it (``synchronous_commit``
+    as the server has it, on by default): an answered save survives the
+    replica and the server.
+-   Connection faults (the server restarting, unreachable, every pooled
+    connection busy past ``pool_timeout_s``) leave as
+    :class:`StoreUnavailable` with ``retry_after`` of a few seconds (503 +
+    Retry-After); a pooled connection is checked before use, so after a
+    server restart the pool reconnects by itself (within about a second;
+    a failed reconnection is given up after ``2 * pool_timeout_s`` and
+    tried afresh on the next call, so its back-off never grows long).
+    While the server is down, calls fail at once (one plain connection
+    attempt each, beside the pool: at most ``pool_max + 1`` connections).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import time
+from dataclasses import asdict
+from typing import Any, Callable, TypeVar
+
+import psycopg
+from psycopg import errors as pg_errors
+from psycopg_pool import ConnectionPool, PoolTimeout
+
+from . import queries
+from .migrations import SCHEMA_VERSION
+from .migrations import migrate as _migrate
+from .records import (
+    FitRecord,
+    MaterialPage,
+    MaterialRow,
+    RecordDamaged,
+    StoreError,
+    StoreFull,
+    StoreUnavailable,
+)
+
+__all__ = ["PostgresStore", "SAVE_LOCK", "redacted"]
+
+log = logging.getLogger("service.store")
+_T = TypeVar("_T")
+
+SAVE_LOCK = 0x636F617465645F73  # the advisory lock every save takes (pg_advisory_xact_lock)
+RETRY_AFTER_S = 2
+"""Retry-After of a 503 for a connection fault: the pool reconnects within a few seconds."""
+
+
+def redacted(url: str) -> str:
+    """``url`` without its password, for messages and ``/healthz``."""
+    try:
+        info = psycopg.conninfo.conninfo_to_dict(url)
+    except psycopg.ProgrammingError:
+        return "postgresql://(unparsable URL)"
+    host, port, db = info.get("host", "localhost"), info.get("port", "5432"), info.get("dbname", "")
+    user = info.get("user", "")
+    return f"postgresql://{user + '@' if user else ''}{host}:{port}/{db}"
+
+
+def _message(error: Exception) -> str:
+    """libpq's message on one line (it spreads a refusal over several)."""
+    return " ".join(str(error).split())
+
+
+def _translate(error: Exception, where: str) -> StoreError:
+    """A psycopg or pool error as the store error it means."""
+    if isinstance(error, PoolTimeout):
+        return StoreUnavailable(
+            f"the store at {where} is unavailable: no database connection within the pool timeout "
+            f"(COATED_STORE_POOL_TIMEOUT_S; all COATED_STORE_POOL_MAX connections busy, or the server "
+            f"is down): {_message(error)}", retry_after=RETRY_AFTER_S)
+    if isinstance(error, pg_errors.DiskFull):
+        return StoreFull(f"the store at {where} is full ({_message(error)}): free disk space on the database "
+                         "server or raise COATED_STORE_MAX_BYTES, then retry")
+    if isinstance(error, pg_errors.TooManyConnections):
+        return StoreUnavailable(
+            f"the store at {where} refused a connection ({_message(error)}): the replicas' connections exceed "
+            "the role's CONNECTION LIMIT or the server's max_connections (docs/deploy.md)",
+            retry_after=RETRY_AFTER_S)
+    return StoreUnavailable(f"the store at {where} is unavailable: {_message(error)}",
+                            retry_after=RETRY_AFTER_S)
+
+
+class PostgresStore:
+    """
+    :class:`Store` on PostgreSQL at ``url`` (``postgresql://user:password@host:port/db``).
+
+    ``pool_min`` / ``pool_max`` bound the connections this process opens
+    (each replica's share of the server's connections, see
+    ``docs/deploy.md``); a call waits at most ``pool_timeout_s`` for one
+    (then 503). ``statement_timeout_s`` bounds every statement on the
+    server. ``max_bytes`` is a quota of the database
+    (``pg_database_size``); a save past it is refused 507 before fitting.
+    The schema is migrated on opening unless ``migrate`` is False (then a
+    schema other than :data:`SCHEMA_VERSION` is refused).
+    """
+
+    kind = "postgresql"
+
+    def __init__(self, url: str, pool_min: int = 1, pool_max: int = 4, pool_timeout_s: float = 5.0,
+                 statement_timeout_s: float = 30.0, connect_timeout_s: float = 5.0,
+                 max_bytes: int | None = None, migrate: bool = True) -> None:
+        self.where = redacted(url)
+        self._url, self._down = url, False
+        self._connect_timeout = max(1, int(connect_timeout_s))
+        self.max_bytes = max_bytes
+        self.pool_max = pool_max
+        name = f"coated-service {socket.gethostname()}:{os.getpid()}"[:63]
+        options = f"-c statement_timeout={int(statement_timeout_s * 1000)} -c lock_timeout={int(statement_timeout_s * 1000)}"
+        self._pool = ConnectionPool(
+            url, min_size=pool_min, max_size=pool_max, timeout=pool_timeout_s, open=False,
+            check=ConnectionPool.check_connection, reconnect_timeout=2 * pool_timeout_s, max_waiting=256,
+            kwargs={"application_name": name, "connect_timeout": max(1, int(connect_timeout_s)),
+                    "options": options},
+            name="coated-store",
+        )
+        try:
+            # One plain connection first: its refusal is the server's own message (the pool's is a timeout).
+            psycopg.connect(url, connect_timeout=max(1, int(connect_timeout_s))).close()
+            self._pool.open(wait=True, timeout=connect_timeout_s + pool_timeout_s)
+        except (PoolTimeout, psycopg.Error) as error:
+            if "too many connections" in str(error):
+                error = psycopg.OperationalError(
+                    f"{_message(error)}: this replica's COATED_STORE_POOL_MIN connections exceed what "
+                    "the role's CONNECTION LIMIT or max_connections leaves (docs/deploy.md)")
+            self._pool.close(timeout=1.0)
+            raise StoreUnavailable(f"the store at {self.where} cannot be reached: "
+                                   f"{_message(error)}") from None
+        try:
+            self.migrated = self._guard(lambda: self._run(lambda c: _migrate(c, "postgresql", migrate)))
+            self.role_limit, self.server_limit = self._read(lambda c: c.execute(
+                "SELECT (SELECT rolconnlimit FROM pg_roles WHERE rolname = current_user), "
+                "current_setting('max_connections')::int - current_setting('superuser_reserved_connections')::int"
+            ).fetchone())
+        except StoreError:
+            self._pool.close(timeout=1.0)
+            raise
+        if self.role_limit < 0:
+            log.warning("the role of %s has no CONNECTION LIMIT: N replicas may take up to the server's "
+                        "%d connections (docs/deploy.md)", self.where, self.server_limit)
+
+    # -- plumbing ----------------------------------------------------------
+
+    def _guard(self, function: Callable[[], _T]) -> _T:
+        try:
+            return function()
+        except (psycopg.Error, PoolTimeout) as error:
+            raise _translate(error, self.where) from None
+
+    def _run(self, function: Callable[[psycopg.Connection], _T]) -> _T:
+        """
+        ``function`` on a pooled connection, one transaction (rolled back on
+        error). After a connection fault, each call first tries one plain
+        connection (refused at once while the server is down, so a 503 is
+        quick instead of a wait of ``pool_timeout_s``) until one succeeds.
+        """
+        if self._down:
+            self._probe()
+        try:
+            with self._pool.connection() as connection:
+                return function(connection)
+        except PoolTimeout:
+            self._probe()  # the server's own refusal when it is down; else the pool is busy
+            raise
+        except psycopg.OperationalError:
+            self._down = True
+            raise
+
+    def _probe(self) -> None:
+        """One plain connection: raises (and marks the server down) when the server refuses it."""
+        try:
+            psycopg.connect(self._url, connect_timeout=self._connect_timeout).close()
+        except psycopg.OperationalError:
+            self._down = True
+            raise
+        self._down = False
+
+    def _read(self, function: Callable[[psycopg.Connection], _T]) -> _T:
+        return self._guard(lambda: self._run(function))
+
+    def transaction(self, function: Callable[[psycopg.Connection], _T]) -> _T:
+        """``function(connection)`` in one transaction on a pooled connection; errors as :class:`StoreError`."""
+        return self._read(function)
+
+    def _decode(self, fit_id: str, text: Any) -> FitRecord:
+        try:
+            return FitRecord.from_json(text)
+        except (TypeError, ValueError) as error:
+            log.error("stored fit %s cannot be decoded: %s", fit_id, error)
+            raise RecordDamaged(f"the stored record of fit {fit_id} is damaged and cannot be "
+                                "read; the rest of the store is unaffected") from None
+
+    # -- the interface -----------------------------------------------------
+
+    def put_fit(self, record: FitRecord, save: bool = True,
+                expected_version: int | None = None) -> FitRecord:
+        if not record.created_at:
+            record = FitRecord(**{**asdict(record), "created_at": time.time()})
+        text = record.to_json()
+
+        def write(connection: psycopg.Connection) -> FitRecord:
+            if save:
+                connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))
+            return queries.save(connection, "%s", record, text, save, expected_version, self._decode)
+
+        return self._read(write)
+
+    def get_fit(self, fit_id: str) -> FitRecord | None:
+        text = self._read(lambda c: queries.get_text(c, "%s", fit_id))
+        return None if text is None else self._decode(fit_id, text)
+
+    def latest_fit(self, material_id: str) -> FitRecord | None:
+        """The latest decodable fit of a material (a damaged one is logged and passed over)."""
+        for fit_id, text in self._read(lambda c: queries.latest_texts(c, "%s", material_id)):
+            try:
+                return self._decode(fit_id, text)
+            except RecordDamaged:
+                continue
+        return None
+
+    def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
+        return self._read(lambda c: queries.latest_ids(c, "%s", material_ids))
+
+    def material_version(self, material_id: str) -> int:
+        return self._read(lambda c: queries.version_of(c, "%s", material_id))
+
+    def material_page(self, after: int | None, limit: int) -> MaterialPage:
+        return queries.page_of(self._read(lambda c: queries.page_rows(c, "%s", after, limit)), limit)
+
+    def saved_materials(self) -> list[MaterialRow]:
+        rows: list[MaterialRow] = []
+        cursor = None
+        while True:
+            page = self.material_page(cursor, 1000)
+            rows.extend(page.rows)
+            if page.next_cursor is None:
+                return rows
+            cursor = page.next_cursor
+
+    def check(self) -> None:
+        """The server answers and the schema is this code's (PostgreSQL checks its own pages)."""
+        (version,) = self._read(lambda c: c.execute(
+            "SELECT COALESCE(MAX(version), 0) FROM schema_migrations").fetchone())
+        if version != SCHEMA_VERSION:
+            raise StoreUnavailable(f"the store at {self.where} has schema version {version}, "
+                                   f"this code needs {SCHEMA_VERSION}")
+
+    def ping(self) -> None:
+        self._read(lambda c: c.execute("SELECT 1 FROM saves LIMIT 1").fetchall())
+
+    def describe(self) -> dict[str, Any]:
+        stats = self._pool.get_stats()
+        return {"kind": self.kind, "schema_version": SCHEMA_VERSION, "url": self.where,
+                "connections": stats.get("pool_size", 0), "connections_max": self.pool_max,
+                "connections_idle": stats.get("pool_available", 0),
+                "requests_waiting": stats.get("requests_waiting", 0),
+                "role_connection_limit": self.role_limit, "server_connection_limit": self.server_limit}
+
+    def writable(self) -> str | None:
+        def probe(connection: psycopg.Connection) -> str | None:
+            (read_only,) = connection.execute("SHOW transaction_read_only").fetchone()
+            if read_only == "on":
+                return f"the store at {self.where} is read-only (a standby, or default_transaction_read_only)"
+            if self.max_bytes:
+                (size,) = connection.execute("SELECT pg_database_size(current_database())").fetchone()
+                if size >= self.max_bytes:
+                    return (f"the store holds {size} bytes, at its quota COATED_STORE_MAX_BYTES "
+                            f"({self.max_bytes})")
+            return None
+
+        # A server that cannot be reached raises (503 + Retry-After), as every other call does.
+        return self._read(probe)
+
+    def close(self) -> None:
+        self._pool.close(timeout=5.0)

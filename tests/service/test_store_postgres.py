@@ -1,0 +1,238 @@
+"""
+What the PostgreSQL store adds: the schema migrations (both stores), the
+move from SQLite with its count and checksum, the connection bound, the
+server restarting, and saves from several store instances (replicas) at
+once. Against a real PostgreSQL server the tests start (``postgres_server``).
+"""
+
+from __future__ import annotations
+
+import sqlite3
+import subprocess
+import sys
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import pytest
+
+from conftest import ROOT
+from service.store import SCHEMA_VERSION, FitRecord, SchemaMismatch, SQLiteStore, StoreConflict, StoreUnavailable
+from service.store.move import move_sqlite_to_postgres, store_checksum
+from service.store.postgres import PostgresStore, redacted
+
+pytestmark = [pytest.mark.xdist_group("postgres"), pytest.mark.slow]
+
+
+def record(fit_id: str, material_id: str = "m" * 32, name: str = "gold", kind: str = "nk") -> FitRecord:
+    return FitRecord(id=fit_id, kind=kind, material_id=material_id, name=name, source="lab",
+                     material={"name": name, "coefficients": {"F0": [[0.5]] * 3}}, metrics={"x": 1.0},
+                     coverage=0.95)
+
+
+def run_service(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    import os
+
+    return subprocess.run([sys.executable, "-m", "service", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=120, env={**os.environ, **(env or {})})
+
+
+class TestMigrations:
+    def test_newer_schema_refused_on_both(self, tmp_path, postgres_url):
+        lite = SQLiteStore(tmp_path / "s.sqlite3")
+        with sqlite3.connect(lite.path) as connection:
+            connection.execute("INSERT INTO schema_migrations VALUES (?, 'from the future', 0)",
+                               (SCHEMA_VERSION + 1,))
+        lite.close()
+        with pytest.raises(SchemaMismatch, match=f"version {SCHEMA_VERSION + 1}, newer than this code"):
+            SQLiteStore(tmp_path / "s.sqlite3")
+        store = PostgresStore(postgres_url)
+        store.transaction(lambda c: c.execute(
+            "INSERT INTO schema_migrations VALUES (%s, 'from the future', 0)", (SCHEMA_VERSION + 1,)))
+        store.close()
+        with pytest.raises(SchemaMismatch, match="newer than this code"):
+            PostgresStore(postgres_url)
+        # The service refuses to start, in one line.
+        result = run_service("--port", "0", env={"COATED_STORE_URL": postgres_url})
+        assert result.returncode == 1
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("python -m service: cannot start: the store's schema is version")
+        assert "password" not in result.stderr and postgres_url.split(":")[2].split("@")[0] not in result.stderr
+
+    def test_older_schema_by_command(self, tmp_path, postgres_url):
+        data = tmp_path / "data"
+        data.mkdir()
+        path = data / "store.sqlite3"
+        old = sqlite3.connect(path)  # a store of the schema before versions (version 0)
+        old.executescript(
+            "CREATE TABLE fits (id TEXT PRIMARY KEY, kind TEXT NOT NULL, material_id TEXT NOT NULL,"
+            " created_at REAL NOT NULL, record TEXT NOT NULL);")
+        r = record("1" * 32)
+        old.execute("INSERT INTO fits VALUES (?, ?, ?, ?, ?)", (r.id, r.kind, r.material_id, 1.0, r.to_json()))
+        old.commit()
+        old.close()
+        with pytest.raises(SchemaMismatch, match="run `python -m service migrate`"):
+            SQLiteStore(path, migrate=False)
+        result = run_service("migrate", "--data-dir", str(data))
+        assert result.returncode == 0, result.stderr
+        assert f"schema version 0 -> {SCHEMA_VERSION}" in result.stdout
+        again = run_service("migrate", "--data-dir", str(data))
+        assert f"schema version {SCHEMA_VERSION} -> {SCHEMA_VERSION}" in again.stdout
+        store = SQLiteStore(data / "store.sqlite3", migrate=False)
+        assert store.material_version(r.material_id) == 1 and store.latest_fit(r.material_id) == r
+        store.close()
+
+    def test_bad_store_settings_refused_at_start(self):
+        for env, message in (({"COATED_STORE_URL": "mysql://x/y"}, "must be a postgresql:// URL"),
+                             ({"COATED_STORE_POOL_MIN": "5", "COATED_STORE_POOL_MAX": "2"}, "must not exceed")):
+            result = run_service("--port", "0", env=env)
+            assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
+
+    def test_unreachable_server_refused_at_start(self):
+        from conftest import free_port
+
+        url = f"postgresql://coated:secret-pw@127.0.0.1:{free_port()}/none"
+        result = run_service("--port", "0", env={"COATED_STORE_URL": url})
+        assert result.returncode == 1
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("python -m service: cannot start: the store at postgresql://coated@127.0.0.1")
+        assert "cannot be reached" in line and "secret-pw" not in result.stderr
+
+    def test_replicas_migrate_at_once(self, postgres_url):
+        with ThreadPoolExecutor(4) as pool:
+            stores = list(pool.map(lambda _: PostgresStore(postgres_url), range(4)))
+        assert sorted(s.migrated for s in stores) == [(0, SCHEMA_VERSION)] + [(SCHEMA_VERSION,) * 2] * 3
+        for store in stores:
+            store.close()
+
+
+class TestMove:
+    def test_sqlite_to_postgres_count_and_checksum(self, tmp_path, postgres_server):
+        lite = SQLiteStore(tmp_path / "data" / "store.sqlite3")
+        for i in range(30):
+            lite.put_fit(record(f"{i:032x}", material_id=f"{i % 7:032x}", name=f"m{i % 7}"))
+        lite.put_fit(record(f"{3:032x}"), save=False)
+        lite.put_fit(record(f"{100:032x}", material_id="Au", kind="library"))
+        lite.close()
+        url = postgres_server.database()
+        result = run_service("migrate", "--from-sqlite", str(tmp_path / "data" / "store.sqlite3"),
+                             env={"COATED_STORE_URL": url})
+        assert result.returncode == 0, result.stderr
+        with sqlite3.connect(tmp_path / "data" / "store.sqlite3") as connection:
+            checksum, counts = store_checksum(connection)
+        assert counts == {"fits": 31, "saves": 31, "materials": 8}
+        assert f"moved 31 fits, 31 saves, 8 materials from {tmp_path}" in result.stdout
+        assert f"checksum {checksum} (source and target agree)" in result.stdout
+        assert url not in result.stdout and redacted(url) in result.stdout
+        target = PostgresStore(url)
+        assert [m.name for m in target.saved_materials()] == [f"m{i}" for i in range(7)]
+        assert target.material_version(f"{1:032x}") == 5
+        target.put_fit(record("f" * 32, material_id="new" * 10))  # seq continues after the moved log
+        assert target.saved_materials()[-1].material_id == "new" * 10
+        # A second move into the now non-empty store is refused and changes nothing.
+        with pytest.raises(StoreUnavailable, match="already holds 32 fits"):
+            move_sqlite_to_postgres(tmp_path / "data" / "store.sqlite3", target)
+        target.close()
+
+    def test_move_needs_a_target(self, tmp_path):
+        result = run_service("migrate", "--from-sqlite", str(tmp_path / "x.sqlite3"))
+        assert result.returncode == 2 and "needs COATED_STORE_URL" in result.stderr
+
+
+class TestConnections:
+    def test_pool_bound_holds_under_load(self, postgres_server, postgres_url):
+        store = PostgresStore(postgres_url, pool_min=1, pool_max=3, pool_timeout_s=30)
+        dbname = postgres_url.rsplit("/", 1)[1]
+        peak, stop = [0], threading.Event()
+
+        def watch():
+            while not stop.is_set():
+                peak[0] = max(peak[0], postgres_server.connections(dbname))
+
+        watcher = threading.Thread(target=watch)
+        watcher.start()
+        with ThreadPoolExecutor(24) as pool:
+            list(pool.map(lambda i: store.put_fit(record(f"{i:032x}", material_id=f"{i:032x}")), range(300)))
+        stop.set()
+        watcher.join()
+        assert 1 <= peak[0] <= 3
+        assert len(store.saved_materials()) == 300
+        assert store.describe()["connections_max"] == 3
+        store.close()
+
+    def test_pool_timeout_is_503_with_retry_after(self, postgres_url):
+        store = PostgresStore(postgres_url, pool_min=1, pool_max=1, pool_timeout_s=0.3)
+        held = threading.Event()
+        release = threading.Event()
+
+        def hold(connection):
+            held.set()
+            release.wait(10)
+
+        worker = threading.Thread(target=store.transaction, args=(hold,))
+        worker.start()
+        held.wait(10)
+        with pytest.raises(StoreUnavailable, match="COATED_STORE_POOL_TIMEOUT_S") as refused:
+            store.get_fit("1" * 32)
+        assert refused.value.status == 503 and refused.value.retry_after <= 5
+        release.set()
+        worker.join()
+        store.close()
+
+    def test_role_connection_limit_enforced_by_the_server(self, postgres_server):
+        from postgres_server import ROLE_CONNECTION_LIMIT
+
+        url = postgres_server.database()
+        with postgres_server.admin() as admin:
+            admin.execute("ALTER ROLE coated CONNECTION LIMIT 2")
+        try:
+            first = PostgresStore(url, pool_min=2, pool_max=2)
+            with pytest.raises(StoreUnavailable, match="CONNECTION LIMIT|too many connections"):
+                PostgresStore(url, pool_min=1, pool_max=1, pool_timeout_s=1)
+            first.close()
+        finally:
+            with postgres_server.admin() as admin:
+                admin.execute(f"ALTER ROLE coated CONNECTION LIMIT {ROLE_CONNECTION_LIMIT}")
+
+
+class TestFaults:
+    def test_server_restart_503_then_recovers(self, postgres_server, postgres_url):
+        store = PostgresStore(postgres_url, pool_timeout_s=1)
+        store.put_fit(record("1" * 32))
+        postgres_server.stop()
+        with pytest.raises(StoreUnavailable) as down:
+            store.put_fit(record("2" * 32, material_id="b" * 32))
+        assert down.value.retry_after <= 5
+        with pytest.raises(StoreUnavailable, match="unavailable"):
+            store.writable()
+        postgres_server.start()
+        deadline = time.monotonic() + 10
+        while True:  # no reopening: the pool reconnects by itself within a few seconds
+            try:
+                store.put_fit(record("2" * 32, material_id="b" * 32))
+                break
+            except StoreUnavailable:
+                assert time.monotonic() < deadline, "the store did not recover within 10 s"
+                time.sleep(0.2)
+        assert [m.material_id for m in store.saved_materials()] == ["m" * 32, "b" * 32]
+        store.close()
+
+    def test_two_instances_one_winner(self, postgres_url):
+        replicas = [PostgresStore(postgres_url, pool_max=4) for _ in range(2)]
+        m = "c" * 32
+        barrier = threading.Barrier(20)
+
+        def save(i: int):
+            barrier.wait()
+            try:
+                replicas[i % 2].put_fit(record(f"{i:032x}", material_id=m, kind="curves"), expected_version=0)
+                return "won"
+            except StoreConflict:
+                return "409"
+
+        with ThreadPoolExecutor(20) as pool:
+            answers = list(pool.map(save, range(20)))
+        assert answers.count("won") == 1 and answers.count("409") == 19
+        assert replicas[0].material_version(m) == replicas[1].material_version(m) == 1
+        for store in replicas:
+            store.close()
