@@ -59,7 +59,10 @@ class Settings(BaseSettings):
         fits in flight a new fit is answered 503 with ``Retry-After``.
     fit_timeout_s
         Time limit of one fit, seconds, waiting included; past it the
-        request is answered 504.
+        request is answered 504 and its job cancelled.
+    job_cpu_limit_s
+        CPU time one part of a job may use in its worker, seconds; past it
+        the job stops and is answered 422.
     warm_pool
         Start the worker processes at start-up (so the first fit is fast).
     metrics_samples
@@ -103,6 +106,7 @@ class Settings(BaseSettings):
     fit_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1, le=256)
     fit_queue: int = Field(default=8, ge=0, le=10_000)
     fit_timeout_s: float = Field(default=120.0, gt=0.0, le=3600.0)
+    job_cpu_limit_s: float = Field(default=60.0, gt=0.0, le=3600.0)
     warm_pool: bool = True
     metrics_samples: int = Field(default=100, ge=10, le=400)
     max_body_bytes: int = Field(default=1_000_000, ge=1_000)

@@ -73,7 +73,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def lifespan(app: FastAPI):
         store = SQLiteStore(settings.store_path, settings.store_max_bytes, settings.store_min_free_bytes)
         store.check()
-        runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s)
+        runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
+                           settings.job_cpu_limit_s)
         app.state.store, app.state.runner = store, runner
         try:
             if settings.warm_pool:

@@ -7,9 +7,9 @@ The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
 -   :class:`FitRunner`: worker processes (``spawn``), a bound on jobs in
     flight, a time limit per request, shared identical jobs, jobs of parts
     run side by side, and recovery from a dead worker.
--   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`: why a job
-    was not answered (the HTTP edge answers 503, 504 and 503, each with
-    ``Retry-After``).
+-   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`,
+    :class:`JobCPULimit`: why a job was not answered (the HTTP edge answers
+    503, 504, 503 and 422, the first three with ``Retry-After``).
 
 Fitting is CPU-bound (numpy, scipy): it runs in worker processes started
 with ``spawn`` (forking a process that already runs threads or holds a GL
@@ -25,9 +25,14 @@ Faults:
     once more there; only a job that fails twice is answered
     :class:`WorkerLost`. So a dead worker fails at most its own job (when it
     kills its worker again).
--   A request that waits past the time limit gets :class:`FitTimeout`, but
-    its job keeps running: its result is saved (fits) or kept (scenes) for
-    the retry, which :meth:`FitRunner.once` then answers at once.
+-   A request that waits past the time limit gets :class:`FitTimeout`, and
+    its job is cancelled when no other request waits for it (as when every
+    client waiting for it has gone): its worker checks every 0.1 s and is
+    free within a second.
+-   Each part of a job has a CPU-time limit (``cpu_limit_s``), checked by
+    its worker every 0.1 s: past it the part stops with
+    :class:`JobCPULimit`. BLAS runs one thread per worker (the fits'
+    matrices are tiny; threads there only contend for the cores).
 """
 
 from __future__ import annotations
@@ -39,12 +44,13 @@ import contextlib
 import logging
 import math
 import multiprocessing
+import signal
 import threading
 import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
-__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost"]
+__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "JobCPULimit"]
 
 log = logging.getLogger("service.pool")
 
@@ -66,10 +72,27 @@ class FitTimeout(Exception):
     def __init__(self, limit_s: float, retry_after: int = 1) -> None:
         super().__init__(
             f"the fit did not finish within the time limit of {limit_s:g} s "
-            "(COATED_FIT_TIMEOUT_S); it goes on, and the same request retried later "
-            "gets its result"
+            "(COATED_FIT_TIMEOUT_S); it was cancelled"
         )
         self.retry_after = retry_after
+
+
+class JobCPULimit(ValueError):
+    """A part of a job used more CPU time than its limit (raised in the worker, re-raised here; a 422)."""
+
+    def __init__(self, limit_s: float) -> None:
+        super().__init__(
+            f"the job used more than its CPU-time limit of {limit_s:g} s (COATED_JOB_CPU_LIMIT_S) "
+            "and was stopped; make the request smaller"
+        )
+        self.limit_s = limit_s
+
+    def __reduce__(self):
+        return JobCPULimit, (self.limit_s,)
+
+
+class _Cancelled(Exception):
+    """Raised in a worker whose job was cancelled by the server."""
 
 
 class WorkerLost(Exception):
@@ -96,6 +119,44 @@ def warm_process() -> None:
     spectral_weights(1.0)
 
 
+_CANCEL_SLOTS = 256  # cancelled job serials remembered (a ring); far more than jobs in flight
+_CHECK_S = 0.1  # how often a worker checks its job's CPU time and cancellation
+_cancelled = None  # in a worker: the server's shared ring of cancelled job serials
+
+
+def _worker_start(cancelled) -> None:
+    """Each worker's initializer: one BLAS thread, the shared cancellation ring, warm-up."""
+    global _cancelled
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
+    _cancelled = cancelled
+    warm_process()
+
+
+def _run_part(serial: int, cpu_limit_s: float, function: Callable[..., Any], *args: Any) -> Any:
+    """
+    Worker: ``function(*args)`` with a check every 0.1 s (SIGALRM, in the
+    worker's main thread, where the job runs) that stops it past
+    ``cpu_limit_s`` of CPU time or once the server cancelled ``serial``.
+    """
+    cpu0 = time.process_time()
+
+    def check(signum, frame) -> None:
+        if _cancelled is not None and serial in _cancelled[:]:
+            raise _Cancelled()
+        if time.process_time() - cpu0 > cpu_limit_s:
+            raise JobCPULimit(cpu_limit_s)
+
+    previous = signal.signal(signal.SIGALRM, check)
+    signal.setitimer(signal.ITIMER_REAL, _CHECK_S, _CHECK_S)
+    try:
+        return function(*args)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def _ping() -> float:
     time.sleep(0.05)  # long enough that each warm-up ping lands on its own worker
     return time.time()
@@ -110,11 +171,11 @@ class FitRunner:
     (:meth:`once`); its job's slot stays taken until the job ends, so the
     bound stays true. A job is one function (:meth:`run`) or parts
     submitted under one slot (:meth:`slot`, :meth:`submit`), which idle
-    workers run side by side. Up to ``keep`` results of jobs whose requests
-    timed out are kept for their retries.
+    workers run side by side. Each part may use ``cpu_limit_s`` seconds
+    of CPU time (:class:`JobCPULimit`).
     """
 
-    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, keep: int = 64) -> None:
+    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0) -> None:
         if workers < 1 or max_in_flight < workers:
             raise ValueError(
                 f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1"
@@ -122,13 +183,18 @@ class FitRunner:
         self.workers = workers
         self.max_in_flight = max_in_flight
         self.timeout_s = timeout_s
-        self._keep = keep
+        self.cpu_limit_s = cpu_limit_s
+        context = multiprocessing.get_context("spawn")
+        self._context = context
+        self._cancelled = context.Array("q", [-1] * _CANCEL_SLOTS, lock=False)
+        self._cancel_next = 0
+        self._serial = 0
+        self._waiters: collections.Counter[str] = collections.Counter()
         self._lock = threading.Lock()
         self._in_flight = 0
         self._mean_s = 2.0  # running estimate of one job's duration, for Retry-After
         self._pool: concurrent.futures.ProcessPoolExecutor | None = None
         self._pending: dict[str, asyncio.Task] = {}
-        self._kept: collections.OrderedDict[str, Any] = collections.OrderedDict()
         self._warming: set[asyncio.Task] = set()
         self.completed = 0
         self.restarts = 0
@@ -142,8 +208,9 @@ class FitRunner:
             if self._pool is None:
                 self._pool = concurrent.futures.ProcessPoolExecutor(
                     max_workers=self.workers,
-                    mp_context=multiprocessing.get_context("spawn"),
-                    initializer=warm_process,
+                    mp_context=self._context,
+                    initializer=_worker_start,
+                    initargs=(self._cancelled,),
                 )
             return self._pool
 
@@ -231,15 +298,29 @@ class FitRunner:
         """
         for attempt in (1, 2):
             pool = self._executor()
+            with self._lock:
+                self._serial += 1
+                serial = self._serial
             try:
-                future = pool.submit(function, *args)
+                future = pool.submit(_run_part, serial, self.cpu_limit_s, function, *args)
                 return await asyncio.wrap_future(future)
+            except asyncio.CancelledError:
+                self._cancel(serial, future)
+                raise
             except (BrokenProcessPool, RuntimeError) as error:
                 if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                     raise
                 self._restart(pool)
                 if attempt == 2:
                     raise WorkerLost() from None
+
+    def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
+        """Stop a part: dropped if still queued, else its worker stops at its next check."""
+        if future.cancel():
+            return
+        with self._lock:
+            self._cancelled[self._cancel_next % _CANCEL_SLOTS] = serial
+            self._cancel_next += 1
 
     async def run(self, function: Callable[..., Any], *args: Any) -> Any:
         """
@@ -258,28 +339,26 @@ class FitRunner:
         """
         Await ``make()`` for at most ``timeout_s`` seconds, shared by
         concurrent calls with the same ``key``. Past the limit the caller
-        gets :class:`FitTimeout` and the job goes on: its result is kept
-        for the next call with this ``key``.
+        gets :class:`FitTimeout`; a job that no caller waits for any more
+        (each timed out or was cancelled, as when its client went away) is
+        cancelled, its worker free within a second.
         """
-        if key in self._kept:
-            return self._kept.pop(key)
         task = self._pending.get(key)
         if task is None:
             task = asyncio.ensure_future(make())
             self._pending[key] = task
             task.add_done_callback(lambda t: self._pending.pop(key, None))
+        self._waiters[key] += 1
         try:
             return await asyncio.wait_for(asyncio.shield(task), self.timeout_s)
         except asyncio.TimeoutError:
-            task.add_done_callback(lambda t: self._keep_result(key, t))
             raise FitTimeout(self.timeout_s, self._retry_after()) from None
-
-    def _keep_result(self, key: str, task: asyncio.Task) -> None:
-        if task.cancelled() or task.exception() is not None:
-            return
-        self._kept[key] = task.result()
-        while len(self._kept) > self._keep:
-            self._kept.popitem(last=False)
+        finally:
+            self._waiters[key] -= 1
+            if self._waiters[key] <= 0:
+                del self._waiters[key]
+                if not task.done():
+                    task.cancel()
 
     def close(self) -> None:
         for task in [*self._pending.values(), *self._warming]:

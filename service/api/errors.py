@@ -7,7 +7,7 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 
 =====================================  ======================================
 ``RequestValidationError``             422, naming each field and rule
-``ValueError`` (the core's refusals)   422
+``ValueError`` (the core's refusals)   422 (also ``JobCPULimit``)
 ``LookupError`` (not stored)           404
 ``Overloaded`` / ``WorkerLost``        503 with ``Retry-After``
 ``FitTimeout``                         504 with ``Retry-After``

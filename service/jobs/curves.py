@@ -253,6 +253,7 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
             "model_float16": {"delta_E_mean": metrics["delta_E_mean"], "delta_E_max": metrics["delta_E_max"]},
             "by_curve": metrics["by_curve"],
             "fitted_samples": metrics["samples"],
+            "best_effort": metrics["best_effort"],
             **({"target": metrics["target"]} if "target" in metrics else {}),
         },
         "timings": {**result.timings, "base": t_base},
