@@ -24,7 +24,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from fastapi.staticfiles import StaticFiles
 
 from .api.errors import install_error_handlers
-from .api.middleware import HostAllowList, RequestLimits
+from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
     curves, environments, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
 )
@@ -117,6 +117,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         max_upload_bytes=settings.max_upload_bytes, upload_paths=(f"{API_PREFIX}/fits/upload",),
         body_timeout_s=settings.body_timeout_s,
     )
-    # Outermost: a request for another host name is refused before anything else.
+    # Outermost: a request for another host name is refused before anything else,
+    # and every answer (refusals too) forbids framing.
     app.add_middleware(HostAllowList, allowed=tuple(settings.allowed_hosts))
+    app.add_middleware(FrameDenial)
     return app

@@ -11,9 +11,11 @@ client cannot get past:
     closed; uvicorn has no such timeout of its own;
 -   the body deadline and size limits of
     :class:`service.api.middleware.RequestLimits` (408, 413);
+-   a header size bound (:data:`MAX_HEADER_BYTES`, 16 KiB; past it 431
+    and the connection closed): h11 bounds only a header still incomplete,
+    so one that arrives whole in one read is counted here;
 -   ``limit_concurrency`` (``max_connections``: past it, 503) and the
-    keep-alive timeout (``keep_alive_s``); header size stays bounded by
-    h11 (16 KiB);
+    keep-alive timeout (``keep_alive_s``);
 -   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
     closed, the concurrency limit, invalid requests) are logged once, then
     counted once a minute, so a flood cannot grow the log.
@@ -22,6 +24,7 @@ client cannot get past:
 from __future__ import annotations
 
 import asyncio
+import json
 import logging
 import threading
 import time
@@ -32,9 +35,15 @@ from uvicorn.protocols.http.h11_impl import H11Protocol
 
 from .config import Settings
 
-__all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve"]
+__all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES"]
 
 log = logging.getLogger("uvicorn.error")
+MAX_HEADER_BYTES = 16 * 1024
+"""Largest request line and header fields together (h11's own bound for an incomplete one)."""
+_HEADER_END = b"\r\n\r\n"
+_TOO_LARGE = json.dumps({
+    "detail": f"the request header must be at most {MAX_HEADER_BYTES} bytes", "errors": [],
+}).encode()
 SLOW_CLIENT = "closed a connection whose request header did not arrive within %g s (COATED_HEADER_TIMEOUT_S)"
 
 
@@ -74,6 +83,7 @@ class DeadlineH11Protocol(H11Protocol):
 
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._header_deadline: asyncio.TimerHandle | None = None
+        self._header_seen, self._header_tail = 0, b""
         super().connection_made(transport)
         self._arm_header_deadline()
 
@@ -92,15 +102,36 @@ class DeadlineH11Protocol(H11Protocol):
             log.warning(SLOW_CLIENT, self.header_timeout_s)
             self.transport.close()
 
+    def _header_too_large(self, data: bytes) -> bool:
+        """Count a header's bytes as they arrive; past the bound answer 431 and close."""
+        joined = self._header_tail + data
+        end = joined.find(_HEADER_END)
+        size = self._header_seen + (len(data) if end < 0 else end + len(_HEADER_END) - len(self._header_tail))
+        if size > MAX_HEADER_BYTES:
+            self.transport.write(
+                b"HTTP/1.1 431 Request Header Fields Too Large\r\ncontent-type: application/json\r\n"
+                b"content-length: " + str(len(_TOO_LARGE)).encode() + b"\r\nconnection: close\r\n\r\n"
+                + _TOO_LARGE)
+            self.transport.close()
+            return True
+        if end < 0:
+            self._header_seen, self._header_tail = size, joined[-3:]
+        else:
+            self._header_seen, self._header_tail = 0, b""
+        return False
+
     def data_received(self, data: bytes) -> None:
         if self.conn.their_state is h11.IDLE:
             self._arm_header_deadline()
+            if self._header_too_large(data):
+                return
         super().data_received(data)
         if self.conn.their_state is not h11.IDLE:
             self._disarm_header_deadline()
 
     def on_response_complete(self) -> None:
         super().on_response_complete()
+        self._header_seen, self._header_tail = 0, b""
         if self.conn.their_state is h11.IDLE and self.conn.trailing_data[0]:
             self._arm_header_deadline()  # a pipelined request has begun
 

@@ -88,6 +88,11 @@ def _translate(error: sqlite3.Error, path: Path) -> StoreError:
     return StoreUnavailable(f"the store at {path} is unavailable: {error}")
 
 
+
+_WRITE_FLOOR_BYTES = 1_000_000
+"""Free disk below which the store is not writable even with COATED_STORE_MIN_FREE_BYTES=0
+(a save writes its record, the journal and the index pages)."""
+
 class SQLiteStore:
     """
     :class:`Store` on one SQLite file in WAL mode: one connection per
@@ -287,6 +292,9 @@ class SQLiteStore:
         if free_bytes < self.min_free_bytes:
             return (f"the disk of the store has {free_bytes} bytes free, less than "
                     f"COATED_STORE_MIN_FREE_BYTES ({self.min_free_bytes})")
+        if free_bytes < _WRITE_FLOOR_BYTES:  # whatever the setting, even 0: a full disk takes no save
+            return (f"the disk of the store has {free_bytes} bytes free, less than one save needs "
+                    f"({_WRITE_FLOOR_BYTES})")
         try:
             connection = self._connection()
             if self.max_bytes:
