@@ -200,7 +200,7 @@ def _scene_job(scene: PreparedScene) -> dict[str, Any]:
 
 
 async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
-    """The report and pack of ``scene`` (a retry after a timeout gets the kept result)."""
+    """The report and pack of ``scene`` (cancelled when no request waits for it any more)."""
 
     async def make() -> dict[str, Any]:
         return await runner.run(_scene_job, scene)
