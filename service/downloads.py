@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fitting.domain import cached_once
 from fitting.exports import EXPORT_FORMATS, export_material
 from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
@@ -163,7 +164,7 @@ def _split_sum(kinds: tuple[str, ...]) -> list[str]:
     return ["cf_ibl"] if "coated-conductor" in kinds else []
 
 
-@functools.cache
+@cached_once
 def ibl_lut_file() -> bytes:
     """The default split-sum LUT as its file (:func:`fitting.shading.lut.encode_lut`),
     from the on-disk cache, once per process."""
