@@ -86,7 +86,11 @@ class Settings(BaseSettings):
     keep_alive_s
         An idle keep-alive connection is closed after this many seconds.
     max_connections
-        Connections (and requests) at once; past it uvicorn answers 503.
+        Connections at once. A new connection past it closes the longest
+        idle one (no request in progress); with none idle it is admitted
+        only for ``/healthz`` (16 more are kept for it), else answered 503.
+    max_connections_per_client
+        Connections at once from one client address, by the same rule.
     store_max_bytes
         Quota of the store file (unset: none); a save past it is answered 507.
     store_min_free_bytes
@@ -118,6 +122,7 @@ class Settings(BaseSettings):
     body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
     keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
     max_connections: int = Field(default=512, ge=8, le=100_000)
+    max_connections_per_client: int = Field(default=128, ge=1, le=100_000)
     store_max_bytes: int | None = Field(default=None, ge=100_000)
     store_min_free_bytes: int = Field(default=16_000_000, ge=0)
     materials_page_max: int = Field(default=500, ge=1, le=10_000)
