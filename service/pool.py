@@ -22,9 +22,11 @@ Faults:
 -   A worker that dies breaks the whole ``ProcessPoolExecutor`` (every job in
     it fails with ``BrokenProcessPool``). The runner replaces the pool, warms
     the new workers at once, and runs each interrupted job (or part of one)
-    once more there; only a job that fails twice is answered
-    :class:`WorkerLost`. So a dead worker fails at most its own job (when it
-    kills its worker again).
+    once more there. A part interrupted twice runs a third time alone, in a
+    worker of its own (one such part at a time): only a part that kills that
+    worker too is answered :class:`WorkerLost`, and its job's content id is
+    refused for ``quarantine_s`` (:class:`Quarantined`, before any work). So
+    a job that kills its workers fails only itself, however often it does.
 -   A request that waits past the time limit gets :class:`FitTimeout`, and
     its job is cancelled when no other request waits for it (as when every
     client waiting for it has gone): its worker checks every 0.1 s and is
@@ -41,16 +43,18 @@ import asyncio
 import collections
 import concurrent.futures
 import contextlib
+import contextvars
 import logging
 import math
 import multiprocessing
-import signal
 import threading
 import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
-__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "JobCPULimit"]
+from .worker import CANCEL_SLOTS, JobCPULimit, ping, run_part, warm_process, worker_start
+
+__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "Quarantined", "JobCPULimit", "warm_process"]
 
 log = logging.getLogger("service.pool")
 
@@ -77,89 +81,29 @@ class FitTimeout(Exception):
         self.retry_after = retry_after
 
 
-class JobCPULimit(ValueError):
-    """A part of a job used more CPU time than its limit (raised in the worker, re-raised here; a 422)."""
-
-    def __init__(self, limit_s: float) -> None:
-        super().__init__(
-            f"the job used more than its CPU-time limit of {limit_s:g} s (COATED_JOB_CPU_LIMIT_S) "
-            "and was stopped; make the request smaller"
-        )
-        self.limit_s = limit_s
-
-    def __reduce__(self):
-        return JobCPULimit, (self.limit_s,)
-
-
-class _Cancelled(Exception):
-    """Raised in a worker whose job was cancelled by the server."""
-
-
 class WorkerLost(Exception):
-    """A worker process died during the job twice (it was retried once)."""
+    """The job's worker process died in the pool twice and then once more alone: the job is the cause."""
 
-    retry_after = 1
-
-    def __init__(self) -> None:
-        super().__init__("a fitting worker process stopped during the fit (twice); retry")
-
-
-def warm_process() -> None:
-    """
-    Process start-up (each worker's initializer, and the server process at
-    start-up, which computes curves and reference textures in threads):
-    import the fitting core and colour-science and compute the spectral
-    weights of the fit (5 nm) and of the metrics (1 nm) once, seconds that
-    would otherwise land on the first request.
-    """
-    from fitting.colour.reference import spectral_weights
-    from fitting.fits.settings import FitSettings
-
-    spectral_weights(FitSettings().step_nm)
-    spectral_weights(1.0)
+    def __init__(self, quarantine_s: float) -> None:
+        super().__init__(
+            "this job stopped its fitting worker process three times (twice in the pool, then alone); "
+            f"it is refused for {quarantine_s:g} s"
+        )
+        self.retry_after = max(1, math.ceil(quarantine_s))
 
 
-_CANCEL_SLOTS = 256  # cancelled job serials remembered (a ring); far more than jobs in flight
-_CHECK_S = 0.1  # how often a worker checks its job's CPU time and cancellation
-_cancelled = None  # in a worker: the server's shared ring of cancelled job serials
+class Quarantined(WorkerLost):
+    """A job whose content id stopped its worker recently is refused before it runs (503)."""
+
+    def __init__(self, left_s: float) -> None:
+        Exception.__init__(
+            self, f"this job stopped its fitting worker process three times; it is refused for {left_s:.0f} s more"
+        )
+        self.retry_after = max(1, math.ceil(left_s))
 
 
-def _worker_start(cancelled) -> None:
-    """Each worker's initializer: one BLAS thread, the shared cancellation ring, warm-up."""
-    global _cancelled
-    from threadpoolctl import threadpool_limits
-
-    threadpool_limits(limits=1)
-    _cancelled = cancelled
-    warm_process()
-
-
-def _run_part(serial: int, cpu_limit_s: float, function: Callable[..., Any], *args: Any) -> Any:
-    """
-    Worker: ``function(*args)`` with a check every 0.1 s (SIGALRM, in the
-    worker's main thread, where the job runs) that stops it past
-    ``cpu_limit_s`` of CPU time or once the server cancelled ``serial``.
-    """
-    cpu0 = time.process_time()
-
-    def check(signum, frame) -> None:
-        if _cancelled is not None and serial in _cancelled[:]:
-            raise _Cancelled()
-        if time.process_time() - cpu0 > cpu_limit_s:
-            raise JobCPULimit(cpu_limit_s)
-
-    previous = signal.signal(signal.SIGALRM, check)
-    signal.setitimer(signal.ITIMER_REAL, _CHECK_S, _CHECK_S)
-    try:
-        return function(*args)
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, previous)
-
-
-def _ping() -> float:
-    time.sleep(0.05)  # long enough that each warm-up ping lands on its own worker
-    return time.time()
+_JOB_KEY: contextvars.ContextVar[str | None] = contextvars.ContextVar("job_key", default=None)
+_QUARANTINE_KEYS = 1024  # content ids remembered at most
 
 
 class FitRunner:
@@ -175,7 +119,8 @@ class FitRunner:
     of CPU time (:class:`JobCPULimit`).
     """
 
-    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0) -> None:
+    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
+                 quarantine_s: float = 600.0) -> None:
         if workers < 1 or max_in_flight < workers:
             raise ValueError(
                 f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1"
@@ -184,9 +129,13 @@ class FitRunner:
         self.max_in_flight = max_in_flight
         self.timeout_s = timeout_s
         self.cpu_limit_s = cpu_limit_s
+        self.quarantine_s = quarantine_s
+        self._quarantine: dict[str, float] = {}  # content id -> monotonic time it is refused until
+        self._alone: concurrent.futures.ProcessPoolExecutor | None = None
+        self._alone_lock = asyncio.Lock()
         context = multiprocessing.get_context("spawn")
         self._context = context
-        self._cancelled = context.Array("q", [-1] * _CANCEL_SLOTS, lock=False)
+        self._cancelled = context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
         self._cancel_next = 0
         self._serial = 0
         self._waiters: collections.Counter[str] = collections.Counter()
@@ -209,7 +158,7 @@ class FitRunner:
                 self._pool = concurrent.futures.ProcessPoolExecutor(
                     max_workers=self.workers,
                     mp_context=self._context,
-                    initializer=_worker_start,
+                    initializer=worker_start,
                     initargs=(self._cancelled,),
                 )
             return self._pool
@@ -236,7 +185,7 @@ class FitRunner:
         loop = asyncio.get_running_loop()
         pool = self._executor()
         try:
-            await asyncio.gather(*(loop.run_in_executor(pool, _ping) for _ in range(self.workers)))
+            await asyncio.gather(*(loop.run_in_executor(pool, ping) for _ in range(self.workers)))
         except (BrokenProcessPool, RuntimeError):
             pass  # a pool that broke while warming is replaced by the job that sees it
 
@@ -296,30 +245,62 @@ class FitRunner:
         ------
         WorkerLost
         """
-        for attempt in (1, 2):
+        for _ in (1, 2):
             pool = self._executor()
-            with self._lock:
-                self._serial += 1
-                serial = self._serial
             try:
-                future = pool.submit(_run_part, serial, self.cpu_limit_s, function, *args)
-                return await asyncio.wrap_future(future)
-            except asyncio.CancelledError:
-                self._cancel(serial, future)
-                raise
+                return await self._run_in(pool, function, args)
             except (BrokenProcessPool, RuntimeError) as error:
                 if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                     raise
                 self._restart(pool)
-                if attempt == 2:
-                    raise WorkerLost() from None
+        # Interrupted twice: run alone in a worker of its own, where a death is its own.
+        async with self._alone_lock:
+            with self._lock:
+                if self._alone is None:
+                    self._alone = concurrent.futures.ProcessPoolExecutor(
+                        max_workers=1, mp_context=self._context, initializer=worker_start,
+                        initargs=(self._cancelled,))
+                alone = self._alone
+            try:
+                return await self._run_in(alone, function, args)
+            except BrokenProcessPool:
+                with self._lock:
+                    self._alone = None
+                alone.shutdown(wait=False, cancel_futures=True)
+                self._quarantine_current()
+                raise WorkerLost(self.quarantine_s) from None
+
+    async def _run_in(self, pool: concurrent.futures.ProcessPoolExecutor, function, args) -> Any:
+        with self._lock:
+            self._serial += 1
+            serial = self._serial
+        future = pool.submit(run_part, serial, self.cpu_limit_s, function, *args)
+        try:
+            return await asyncio.wrap_future(future)
+        except asyncio.CancelledError:
+            self._cancel(serial, future)
+            raise
+
+    def _quarantine_current(self) -> None:
+        """Refuse the content id of the job in this context for ``quarantine_s``."""
+        key = _JOB_KEY.get()
+        if key is None:
+            return
+        now = time.monotonic()
+        with self._lock:
+            for old in [k for k, until in self._quarantine.items() if until <= now]:
+                del self._quarantine[old]
+            if len(self._quarantine) >= _QUARANTINE_KEYS:
+                self._quarantine.pop(next(iter(self._quarantine)))
+            self._quarantine[key] = now + self.quarantine_s
+        log.warning("job %s stopped its worker three times; refused for %g s", key[:40], self.quarantine_s)
 
     def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
         """Stop a part: dropped if still queued, else its worker stops at its next check."""
         if future.cancel():
             return
         with self._lock:
-            self._cancelled[self._cancel_next % _CANCEL_SLOTS] = serial
+            self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
             self._cancel_next += 1
 
     async def run(self, function: Callable[..., Any], *args: Any) -> Any:
@@ -343,9 +324,16 @@ class FitRunner:
         (each timed out or was cancelled, as when its client went away) is
         cancelled, its worker free within a second.
         """
+        left = self._quarantine.get(key, 0.0) - time.monotonic()
+        if left > 0:
+            raise Quarantined(left)
         task = self._pending.get(key)
         if task is None:
-            task = asyncio.ensure_future(make())
+            token = _JOB_KEY.set(key)  # the job's task (a copy of this context) knows its content id
+            try:
+                task = asyncio.ensure_future(make())
+            finally:
+                _JOB_KEY.reset(token)
             self._pending[key] = task
             task.add_done_callback(lambda t: self._pending.pop(key, None))
         self._waiters[key] += 1
@@ -364,6 +352,7 @@ class FitRunner:
         for task in [*self._pending.values(), *self._warming]:
             task.cancel()
         with self._lock:
-            pool, self._pool = self._pool, None
-        if pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
+            pools, self._pool, self._alone = (self._pool, self._alone), None, None
+        for pool in pools:
+            if pool is not None:
+                pool.shutdown(wait=True, cancel_futures=True)

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from service.pool import FitRunner, FitTimeout, JobCPULimit
+from service.pool import FitRunner, FitTimeout, JobCPULimit, Quarantined, WorkerLost
 
 pytestmark = pytest.mark.slow
 
@@ -82,3 +82,30 @@ def test_a_shared_job_runs_on_while_one_waiter_remains():
         return await second
 
     asyncio.run(_with_runner(body, timeout_s=60.0))
+
+
+def test_a_job_that_kills_its_workers_fails_only_itself_and_is_quarantined():
+    import os
+
+    async def body(runner):
+        others = [asyncio.ensure_future(runner.once(f"other{i}", lambda i=i: runner.run(time.sleep, 0.4)))
+                  for i in range(5)]
+        await asyncio.sleep(0.1)
+        with pytest.raises(WorkerLost, match="three times"):
+            await runner.once("killer", lambda: runner.run(os._exit, 1))
+        results = await asyncio.gather(*others, return_exceptions=True)
+        with pytest.raises(Quarantined):
+            await runner.once("killer", lambda: runner.run(time.time))
+        return results, await runner.run(time.time)
+
+    async def with_two_workers():
+        runner = FitRunner(2, 16, timeout_s=60.0, quarantine_s=30.0)
+        try:
+            await runner.warm_up()
+            return await body(runner)
+        finally:
+            runner.close()
+
+    results, after = asyncio.run(with_two_workers())
+    assert results == [None] * 5, results  # every unrelated job answered
+    assert after > 0
