@@ -96,6 +96,13 @@ class Settings(BaseSettings):
     store_min_free_bytes
         Free disk space below which the store counts as full: fits are
         refused 507 before any CPU is spent, ``/healthz`` says so.
+    draft_ttl_s
+        Drafts (the editor's refits while editing, never saved) are removed
+        this long after they were made (default a day), in the background.
+    draft_max_bytes
+        The drafts' quota: past it the oldest drafts are removed first.
+    draft_sweep_s
+        How often drafts are swept (past their time to live, then the quota).
     materials_page_max
         Most saved materials in one page of ``GET /api/v1/materials``.
     """
@@ -125,6 +132,9 @@ class Settings(BaseSettings):
     max_connections_per_client: int = Field(default=128, ge=1, le=100_000)
     store_max_bytes: int | None = Field(default=None, ge=100_000)
     store_min_free_bytes: int = Field(default=16_000_000, ge=0)
+    draft_ttl_s: float = Field(default=86_400.0, gt=0.0)
+    draft_max_bytes: int = Field(default=64_000_000, ge=0)
+    draft_sweep_s: float = Field(default=60.0, gt=0.0, le=86_400.0)
     materials_page_max: int = Field(default=500, ge=1, le=10_000)
 
     @model_validator(mode="after")

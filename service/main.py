@@ -16,6 +16,8 @@ is :mod:`service.server`.
 from __future__ import annotations
 
 import asyncio
+import logging
+import time
 from contextlib import asynccontextmanager
 from pathlib import Path
 
@@ -31,7 +33,9 @@ from .api.routes import (
 from .config import Settings
 from .pool import FitRunner, warm_process
 from .schemas import API_PREFIX
-from .store import SQLiteStore
+from .store import SQLiteStore, StoreError
+
+log = logging.getLogger("service.store")
 
 STATIC_DIR = Path(__file__).resolve().parents[1] / "static"
 """The browser editor, served at ``/``."""
@@ -58,6 +62,19 @@ def _offline_docs(app: FastAPI) -> None:
         )
 
 
+async def _sweep_drafts(store, settings: Settings) -> None:
+    """Every ``draft_sweep_s``: drafts past their time to live, then past the quota, removed."""
+    while True:
+        try:
+            removed = await asyncio.to_thread(
+                store.expire_drafts, time.time() - settings.draft_ttl_s, settings.draft_max_bytes)
+            if removed:
+                log.info("removed %d drafts (COATED_DRAFT_TTL_S, COATED_DRAFT_MAX_BYTES)", removed)
+        except StoreError as error:
+            log.warning("draft sweep: %s", error)
+        await asyncio.sleep(settings.draft_sweep_s)
+
+
 def create_app(settings: Settings | None = None) -> FastAPI:
     """
     The service application.
@@ -76,12 +93,14 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
                            settings.job_cpu_limit_s)
         app.state.store, app.state.runner = store, runner
+        sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:
                 # The workers and this process (curves, reference textures) at once.
                 await asyncio.gather(runner.warm_up(), asyncio.to_thread(warm_process))
             yield
         finally:
+            sweeper.cancel()
             if app.state.preview_renderer is not None:
                 app.state.preview_renderer.close()
                 app.state.preview_renderer = None

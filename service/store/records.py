@@ -167,6 +167,13 @@ class Store(Protocol):
     def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
         """The latest fit id of each of ``material_ids`` that has one."""
 
+    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
+        """
+        Remove drafts (fits never saved) created before ``older_than`` (a
+        ``time.time()``), then the oldest drafts until all left hold at most
+        ``max_bytes`` of records; return how many were removed.
+        """
+
     def check(self) -> None:
         """Raise :class:`StoreError` if the store is unusable or damaged."""
 

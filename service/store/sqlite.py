@@ -49,6 +49,7 @@ CREATE TABLE IF NOT EXISTS saves (
     saved_at REAL NOT NULL
 );
 CREATE INDEX IF NOT EXISTS saves_by_material ON saves (material_id, seq);
+CREATE INDEX IF NOT EXISTS saves_by_fit ON saves (fit_id);
 -- Stores written before the save log: each fit counts as saved once, in order.
 INSERT INTO saves (material_id, fit_id, saved_at)
     SELECT material_id, id, created_at FROM fits
@@ -214,6 +215,26 @@ class SQLiteStore:
             return stored
 
         return self._guard(write)
+
+    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
+        def sweep() -> int:
+            connection = self._connection()
+            with connection:
+                rows = connection.execute(
+                    "SELECT id, created_at, length(record) FROM fits WHERE NOT EXISTS "
+                    "(SELECT 1 FROM saves WHERE saves.fit_id = fits.id) ORDER BY created_at DESC").fetchall()
+                kept, doomed = 0, []
+                for fit_id, created_at, size in rows:  # newest first: the oldest go past the quota
+                    if created_at < older_than or kept + size > max_bytes:
+                        doomed.append((fit_id, fit_id))
+                    else:
+                        kept += size
+                # A draft saved meanwhile (by another connection) stays.
+                connection.executemany(
+                    "DELETE FROM fits WHERE id = ? AND NOT EXISTS (SELECT 1 FROM saves WHERE fit_id = ?)", doomed)
+            return len(doomed)
+
+        return self._guard(sweep)
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
         row = self._guard(lambda: self._connection().execute(

@@ -20,6 +20,7 @@ from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.optics.nk import visible_coverage
 
 from ...schemas import API_PREFIX, INT64_MAX, MATERIAL_ID_PATTERN, MaterialDetail, MaterialList, MaterialSummary, fit_public
+from ...jobs.common import with_measured_nk
 from ..deps import ERROR_RESPONSES, NOT_FOUND, SettingsDep, StoreDep
 
 router = APIRouter(prefix=f"{API_PREFIX}/materials", tags=["materials"])
@@ -64,7 +65,7 @@ def get_material(
     store: StoreDep,
 ) -> MaterialDetail:
     """One material with its latest fit (None for a library material not fitted yet)."""
-    latest = store.latest_fit(material_id)
+    latest = with_measured_nk(store, store.latest_fit(material_id))
     if material_id in LIBRARY_NAMES:
         source, coverage, wavelength_range = _library_entry(material_id)
         return MaterialDetail(
