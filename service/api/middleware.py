@@ -8,7 +8,8 @@ Pure ASGI middleware that answers before the application sees a request:
     answered 400 (DNS rebinding: a hostile page that makes its own name
     resolve to 127.0.0.1 sends its own name as ``Host``).
 -   :class:`RequestLimits`: a body larger than the limit is answered 413,
-    and one that arrives slower than the body deadline 408.
+    and one that arrives slower than the body deadline 408; a client that
+    goes away before its answer cancels its request (and the job it waits for).
 -   :class:`FrameDenial`: every answer forbids framing (``X-Frame-Options:
     DENY``, CSP ``frame-ancestors 'none'``): a page framed by another site
     would be same-origin for the editor, and clicks tricked through it
@@ -18,6 +19,7 @@ Pure ASGI middleware that answers before the application sees a request:
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import ipaddress
 import json
 import re
@@ -167,17 +169,53 @@ class RequestLimits:
             chunks.append(chunk)
             if not message.get("more_body", False):
                 break
-        body = b"".join(chunks)
-        sent = False
+        await _cancel_on_disconnect(self.app, scope, b"".join(chunks), receive, send)
 
-        async def replay() -> Message:
-            nonlocal sent
-            if not sent:
-                sent = True
-                return {"type": "http.request", "body": body, "more_body": False}
-            return await receive()
 
-        await self.app(scope, replay, send)
+async def _cancel_on_disconnect(app: ASGIApp, scope: Scope, body: bytes, receive: Receive, send: Send) -> None:
+    """
+    Run ``app`` on the read ``body`` while watching the connection: a client
+    that goes away before its answer is complete cancels the request's task
+    (and with it the job it waits for, :meth:`service.pool.FitRunner.once`).
+    """
+    disconnected = asyncio.Event()
+    answered = False
+    sent = False
+
+    async def replay() -> Message:
+        nonlocal sent
+        if not sent:
+            sent = True
+            return {"type": "http.request", "body": body, "more_body": False}
+        await disconnected.wait()
+        return {"type": "http.disconnect"}
+
+    async def sending(message: Message) -> None:
+        nonlocal answered
+        if message["type"] == "http.response.body" and not message.get("more_body", False):
+            answered = True
+        await send(message)
+
+    async def watch() -> None:
+        while (await receive())["type"] != "http.disconnect":
+            pass
+        disconnected.set()
+
+    task = asyncio.ensure_future(app(scope, replay, sending))
+    watcher = asyncio.ensure_future(watch())
+    try:
+        await asyncio.wait({task, watcher}, return_when=asyncio.FIRST_COMPLETED)
+        if not task.done() and not answered:
+            task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await task
+            return
+        await task
+    except asyncio.CancelledError:
+        task.cancel()
+        raise
+    finally:
+        watcher.cancel()
 
 
 class FrameDenial:

@@ -310,3 +310,32 @@ def test_edit_at_the_float32_rounded_upper_end(tmp_path):
                                     [0.93, 0.8, 0.75], [1, 1, 1]]}]}
         response = client.post(f"{API}/fits/from-curves", json=edit)
         assert response.status_code == 201, response.text
+
+
+# -- issue 20: a client that goes away cancels its job ------------------------------
+
+@pytest.mark.slow
+@pytest.mark.server
+def test_a_job_whose_client_went_away_is_cancelled_within_a_second(tmp_path):
+    import json
+
+    scene = {"name": "big", "materials": [
+        {"name": f"m{i}", "nk": gold_like_nk(i / 100), "eta_i": np.linspace(1.0, 2.5, 32).tolist()}
+        for i in range(64)]}
+    payload = json.dumps(scene).encode()
+    with server_process(tmp_path / "data") as server, httpx.Client(base_url=server.url, timeout=30) as http:
+        with socket.create_connection(("127.0.0.1", server.port), timeout=10) as raw:
+            raw.sendall(b"POST /api/v1/scenes HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+                        + f"content-length: {len(payload)}\r\n\r\n".encode() + payload)
+            deadline = time.monotonic() + 30
+            while http.get("/healthz").json()["fits_in_flight"] == 0 and time.monotonic() < deadline:
+                time.sleep(0.05)
+            assert http.get("/healthz").json()["fits_in_flight"] == 1
+        gone = time.monotonic()  # the client closed its connection
+        while http.get("/healthz").json()["fits_in_flight"] and time.monotonic() - gone < 10:
+            time.sleep(0.05)
+        assert time.monotonic() - gone < 1.5
+        # The worker is free: the next fit is answered at once.
+        t0 = time.monotonic()
+        assert http.post(f"{API}/fits", json={"material": "Cu"}).status_code in (200, 201)
+        assert time.monotonic() - t0 < 10
