@@ -52,6 +52,7 @@ import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
+from .turns import Turns
 from .worker import CANCEL_SLOTS, JobCPULimit, ping, run_part, warm_process, worker_start
 
 __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "Quarantined", "JobCPULimit", "warm_process"]
@@ -133,6 +134,7 @@ class FitRunner:
         self._quarantine: dict[str, float] = {}  # content id -> monotonic time it is refused until
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
+        self._turns = Turns(workers)
         context = multiprocessing.get_context("spawn")
         self._context = context
         self._cancelled = context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
@@ -234,12 +236,14 @@ class FitRunner:
         finally:
             self._release(done)
 
-    async def submit(self, function: Callable[..., Any], *args: Any) -> Any:
+    async def submit(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
         Run ``function(*args)`` in a worker as one part of a job that holds
         a :meth:`slot`; its exceptions (ValueError for bad input) are raised
-        here. A part interrupted by a dead worker runs once more on the
-        replacement pool.
+        here. Parts take turns in the workers, the cheapest waiting first
+        (``cost_s``, its estimated seconds: :class:`service.turns.Turns`). A
+        part interrupted by a dead worker runs once more on the replacement
+        pool.
 
         Raises
         ------
@@ -248,7 +252,8 @@ class FitRunner:
         for _ in (1, 2):
             pool = self._executor()
             try:
-                return await self._run_in(pool, function, args)
+                async with self._turns.turn(cost_s):
+                    return await self._run_in(pool, function, args)
             except (BrokenProcessPool, RuntimeError) as error:
                 if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                     raise
@@ -303,7 +308,7 @@ class FitRunner:
             self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
             self._cancel_next += 1
 
-    async def run(self, function: Callable[..., Any], *args: Any) -> Any:
+    async def run(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
         Run ``function(*args)`` in a worker as a job of one part (a
         :meth:`slot` and :meth:`submit`), without a time limit (the
@@ -314,7 +319,7 @@ class FitRunner:
         Overloaded, WorkerLost
         """
         async with self.slot():
-            return await self.submit(function, *args)
+            return await self.submit(function, *args, cost_s=cost_s)
 
     async def once(self, key: str, make: Callable[[], Awaitable[Any]]) -> Any:
         """

@@ -304,7 +304,8 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner) -> tup
 
     async def make() -> FitRecord:
         job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
-                               fit.objective, fit.blend_width, fit.model, fit.live, fit.start)
+                               fit.objective, fit.blend_width, fit.model, fit.live, fit.start,
+                               cost_s=0.03 if fit.live else 0.5)  # its turn: live steps first
         check_finite("metrics", job["metrics"])
         record = fit_record(
             fit.fit_id, "curves", content_address("edited material", fit.name), fit.name,

@@ -203,7 +203,8 @@ async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
     """The report and pack of ``scene`` (cancelled when no request waits for it any more)."""
 
     async def make() -> dict[str, Any]:
-        return await runner.run(_scene_job, scene)
+        # Its turn in the pool: about 0.2 s a material (a fit and its candidates).
+        return await runner.run(_scene_job, scene, cost_s=0.2 * len(scene.materials))
 
     return await runner.once(scene.key, make)
 

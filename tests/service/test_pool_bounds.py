@@ -109,3 +109,27 @@ def test_a_job_that_kills_its_workers_fails_only_itself_and_is_quarantined():
     results, after = asyncio.run(with_two_workers())
     assert results == [None] * 5, results  # every unrelated job answered
     assert after > 0
+
+
+def test_turns_let_the_cheapest_waiting_part_go_first():
+    from service.turns import Turns
+
+    async def body():
+        turns, order = Turns(1), []
+
+        async def part(name, cost):
+            async with turns.turn(cost):
+                order.append(name)
+                await asyncio.sleep(0.01)
+
+        first = asyncio.ensure_future(part("first", 5.0))
+        await asyncio.sleep(0)
+        waiting = [asyncio.ensure_future(part(n, c)) for n, c in (("slow", 5.0), ("cancelled", 0.01),
+                                                                   ("cheap", 0.1), ("slow2", 5.0))]
+        await asyncio.sleep(0)
+        waiting[1].cancel()
+        await asyncio.gather(first, *waiting, return_exceptions=True)
+        return order, turns.running
+
+    order, running = asyncio.run(body())
+    assert order == ["first", "cheap", "slow", "slow2"] and running == 0
