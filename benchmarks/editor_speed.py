@@ -69,12 +69,13 @@ def cold_start(browser, url):
     return seconds
 
 
-def drag_latencies(page, drags, extreme=False):
+def drag_latencies(page, drags, extreme=False, variant=0):
     """
     (edit -> curve, edit -> frame, live) per refit shown during ``drags``
     drags: gentle (channel d % 3 at 50 degrees, 2 px per move), or
-    ``extreme`` (green at 60 degrees pulled down, 4 px per move, until the
-    handle reads 0.10 or less).
+    ``extreme`` (green at 60 degrees pulled down, 4 + ``variant`` px per
+    move, until the handle reads 0.10 or less: each variant ends on another
+    curve, so that no full refit is served from the store).
     """
     out = []
     for d in range(drags):
@@ -87,7 +88,7 @@ def drag_latencies(page, drags, extreme=False):
         page.mouse.move(x, y)
         page.mouse.down()
         for step in range(1, 121 if extreme else 41):
-            page.mouse.move(x, y + (4 * step if extreme else (2 if d % 2 == 0 else -2) * step))
+            page.mouse.move(x, y + ((4 + variant) * step if extreme else (2 if d % 2 == 0 else -2) * step))
             page.wait_for_timeout(40)
             if extreme and float(handle.get_attribute("aria-valuenow")) <= 0.10:
                 break
@@ -184,9 +185,9 @@ def main() -> None:
                 page = fresh_editor(browser, url)
                 latencies = drag_latencies(page, args.drags)
                 page.close()
-                for _ in range(args.extreme):
+                for variant in range(args.extreme):
                     page = fresh_editor(browser, url)
-                    extremes += drag_latencies(page, 1, extreme=True)
+                    extremes += drag_latencies(page, 1, extreme=True, variant=variant)
                     page.close()
             if not args.drags_only:
                 orbits, size = orbit_fps(browser, url)
