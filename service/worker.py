@@ -61,13 +61,17 @@ def warm_process() -> None:
 
 
 def worker_start(cancelled) -> None:
-    """Each worker's initializer: one BLAS thread, the shared cancellation ring, warm-up."""
+    """
+    Each worker's initializer: the shared cancellation ring, the warm-up,
+    then one BLAS thread for the process's life (after the warm-up: a limit
+    applies only to the BLAS libraries already loaded).
+    """
     global _cancelled
     from threadpoolctl import threadpool_limits
 
-    threadpool_limits(limits=1)
     _cancelled = cancelled
     warm_process()
+    threadpool_limits(limits=1, user_api="blas")
 
 
 def run_part(serial: int, cpu_limit_s: float, function: Callable[..., Any], *args: Any) -> Any:
