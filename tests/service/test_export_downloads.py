@@ -154,6 +154,7 @@ class TestExportPacks:
         assert "at most 16 fits for an export pack" in response.json()["detail"]
 
 
+@pytest.mark.slow
 class TestExportPackNames:
     """Issue 20, item 6: names that make one file name, and long names with one prefix."""
 

@@ -238,6 +238,7 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
             assert http.get(f"{API}/fits/{fit_id}").status_code == 200
 
 
+@pytest.mark.slow
 def test_timed_out_fit_is_cancelled_and_its_worker_freed(tmp_path):
     # Issue 20: a job whose request was answered 504 no longer runs on.
     with app_client(tmp_path, fit_timeout_s=0.2, metrics_samples=10) as client:

@@ -27,6 +27,7 @@ def plant(directory, victim):
     os.symlink(victim, directory / "report.csv")
 
 
+@pytest.mark.slow
 def test_planted_links_are_never_written_through(tmp_path):
     victim = tmp_path / "victim.txt"
     victim.write_text("precious\n")
