@@ -13,7 +13,7 @@ two pools of 2 ``spawn`` workers, both cores busy:
 -   ``before``: the workers as started before (``warm_process`` only: BLAS
     threads = cores);
 -   ``after``: the workers as the service starts them now
-    (``service.pool.start_worker``: one BLAS thread each).
+    (``service.worker.worker_start``: one BLAS thread each).
 
 It prints a table of per-job wall time (median, p90, max) and the total, and
 records it in ``benchmarks/results/blas_threads.json`` with the command, the
@@ -44,7 +44,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from service.pool import start_worker, warm_process  # noqa: E402
+from service.worker import warm_process, worker_start  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "blas_threads.json"
 
@@ -66,6 +66,10 @@ def _job(name_kind: tuple[str, str]) -> tuple[float, int]:
     reference, baselines, _ = nk_jobs._reference_part(fit)
     nk_jobs._metrics_part(fit, result, reference, baselines, 0.0)
     return time.perf_counter() - start, _blas_threads()
+
+
+def _after() -> None:
+    worker_start(None)  # no cancellation ring: nothing here cancels
 
 
 def run(initializer, names: list[str]) -> dict:
@@ -105,8 +109,8 @@ def main(argv=None) -> None:
             p.start()
         try:
             # Interleaved so that other load on the machine falls on both alike.
-            for label, init in (("before", warm_process), ("after", start_worker),
-                                ("before", warm_process), ("after", start_worker)):
+            for label, init in (("before", warm_process), ("after", _after),
+                                ("before", warm_process), ("after", _after)):
                 r = run(init, names)
                 key = f"{label}, {busy} busy"
                 best = rows.get(key)
@@ -120,7 +124,7 @@ def main(argv=None) -> None:
           f"{'max ms':>8} {'total s':>8}")
     for key, r in rows.items():
         label, busy = key.split(", ")
-        what = ("before (warm_process)" if label == "before" else "after (start_worker)") + f", {busy}"
+        what = ("before (warm_process)" if label == "before" else "after (worker_start)") + f", {busy}"
         print(f"{what:<44} {r['blas_threads']:>12} {r['jobs']:>5} {r['median_ms']:>10.1f} "
               f"{r['p90_ms']:>8.1f} {r['max_ms']:>8.1f} {r['total_s']:>8.2f}")
     print(f"load average {load_start:.2f} at the start, {load_end:.2f} at the end (best of 2 each)")

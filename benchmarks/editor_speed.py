@@ -14,7 +14,10 @@ the editor served by a real ``python -m service`` process on 127.0.0.1:
     curve drawn and to the first WebGL frame of that fit
     (``window.cfTelemetry``); median and p90 over the live refits of the
     drags; then, from the last edit of a drag, to the frame of the full
-    refit sent on release;
+    refit sent on release; for gentle drags (a point moved 80 px over 40
+    pointer moves) and extreme ones (Au's green pulled to 0.10 at 60
+    degrees, an edit the model cannot follow, each on a fresh page) side by
+    side, median and p99;
 -   ``orbit fps``: preview frames drawn per second while the orbit changes
     every animation frame for 3 s (each frame read back, so it is rendered),
     studio environment, three-way split, at a 1024 x 768 viewport: smooth
@@ -23,9 +26,9 @@ the editor served by a real ``python -m service`` process on 127.0.0.1:
     set through the page's controls; one page, the rows interleaved over
     three rounds of 2 s, the median of each.
 
-Run: ``.venv/bin/python benchmarks/editor_speed.py [--drags 3] [--orbit-only]``
+Run: ``.venv/bin/python benchmarks/editor_speed.py [--drags 3] [--extreme 2] [--orbit-only | --drags-only]``
 (``--orbit-only``: the three orbit rows alone, without the cold starts and
-drags). The numbers depend on the machine's load (2 shared cores here).
+drags; ``--drags-only``: the drags alone). The numbers depend on the machine's load (2 shared cores here).
 """
 
 from __future__ import annotations
@@ -66,19 +69,29 @@ def cold_start(browser, url):
     return seconds
 
 
-def drag_latencies(page, drags):
+def drag_latencies(page, drags, extreme=False, variant=0):
+    """
+    (edit -> curve, edit -> frame, live) per refit shown during ``drags``
+    drags: gentle (channel d % 3 at 50 degrees, 2 px per move), or
+    ``extreme`` (green at 60 degrees pulled down, 4 + ``variant`` px per
+    move, until the handle reads 0.10 or less: each variant ends on another
+    curve, so that no full refit is served from the store).
+    """
     out = []
     for d in range(drags):
         page.evaluate("window.cfTelemetry.shown.length = 0")
-        handle = page.locator(f"circle.handle.c{d % 3}[data-angle='50']")
-        page.locator(f"input[name=channel][value='{d % 3}']").check()
+        channel, angle = (1, 60) if extreme else (d % 3, 50)
+        handle = page.locator(f"circle.handle.c{channel}[data-angle='{angle}']")
+        page.locator(f"input[name=channel][value='{channel}']").check()
         box = handle.bounding_box()
         x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
         page.mouse.move(x, y)
         page.mouse.down()
-        for step in range(1, 41):
-            page.mouse.move(x, y + (2 if d % 2 == 0 else -2) * step)
+        for step in range(1, 121 if extreme else 41):
+            page.mouse.move(x, y + ((4 + variant) * step if extreme else (2 if d % 2 == 0 else -2) * step))
             page.wait_for_timeout(40)
+            if extreme and float(handle.get_attribute("aria-valuenow")) <= 0.10:
+                break
         page.mouse.up()
         page.wait_for_function("document.getElementById('preview-state').hidden", timeout=60_000)
         page.wait_for_timeout(200)
@@ -140,45 +153,60 @@ def orbit_fps(browser, url, rounds=3, seconds=2.0):
     return {name: statistics.median(values) for name, values in runs.items()}, size
 
 
+def fresh_editor(browser, url):
+    """A new page on the editor, ready, after one edit (an artist's first touch: it warms the worker's base grid)."""
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    page.goto(url)
+    page.wait_for_function(READY, timeout=120_000)
+    page.locator("input[name=channel][value='1']").check()
+    page.locator("circle.handle.c1[data-angle='20']").focus()
+    page.keyboard.press("ArrowUp")
+    page.wait_for_function("document.getElementById('preview-state').hidden", timeout=60_000)
+    return page
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--drags", type=int, default=3, help="continuous drags measured")
+    parser.add_argument("--extreme", type=int, default=2, help="extreme drags measured (a fresh page each)")
     parser.add_argument("--orbit-only", action="store_true", help="only the orbit rows")
+    parser.add_argument("--drags-only", action="store_true", help="only the drag rows")
     args = parser.parse_args()
     first = second = None
-    latencies = []
+    latencies, extremes, orbits = [], [], {}
     with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data", COATED_WARM_POOL="true") as server:
         url = server.url + "/"
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
             if not args.orbit_only:
-                first = cold_start(browser, url)
-                second = cold_start(browser, url)
-                page = browser.new_page(viewport={"width": 1400, "height": 900})
-                page.goto(url)
-                page.wait_for_function(READY, timeout=120_000)
-                # One edit first, as an artist's first touch: it warms the worker's base grid.
-                page.locator("circle.handle.c1[data-angle='20']").focus()
-                page.locator("input[name=channel][value='1']").check()
-                page.locator("circle.handle.c1[data-angle='20']").focus()
-                page.keyboard.press("ArrowUp")
-                page.wait_for_function("document.getElementById('preview-state').hidden", timeout=60_000)
+                if not args.drags_only:
+                    first = cold_start(browser, url)
+                    second = cold_start(browser, url)
+                page = fresh_editor(browser, url)
                 latencies = drag_latencies(page, args.drags)
                 page.close()
-            orbits, size = orbit_fps(browser, url)
+                for variant in range(args.extreme):
+                    page = fresh_editor(browser, url)
+                    extremes += drag_latencies(page, 1, extreme=True, variant=variant)
+                    page.close()
+            if not args.drags_only:
+                orbits, size = orbit_fps(browser, url)
             browser.close()
-    curve = [c for c, _, live in latencies if live]
-    frame = [f for _, f, live in latencies if live]
-    release = [f for _, f, live in latencies if not live]
-    print(f"{'measure':<52} {'median':>9} {'p90':>9} {'n':>4}")
     if first is not None:
+        print(f"{'measure':<52} {'median':>9} {'p90':>9} {'n':>4}")
         print(f"{'cold start to editor + preview (s), first':<52} {first:>9.2f} {'':>9} {1:>4}")
         print(f"{'cold start to editor + preview (s), second':<52} {second:>9.2f} {'':>9} {1:>4}")
-    if curve:
-        print(f"{'drag edit -> refitted curve (ms)':<52} {statistics.median(curve):>9.0f} {percentile(curve, 0.9):>9.0f} {len(curve):>4}")
-        print(f"{'drag edit -> WebGL frame of the refit (ms)':<52} {statistics.median(frame):>9.0f} {percentile(frame, 0.9):>9.0f} {len(frame):>4}")
-    if release:
-        print(f"{'release -> WebGL frame of the full refit (ms)':<52} {statistics.median(release):>9.0f} {percentile(release, 0.9):>9.0f} {len(release):>4}")
+    if latencies:
+        print(f"\n{'drags (ms)':<44} {'gentle':>8} {'p99':>7} {'n':>4}   {'extreme':>8} {'p99':>7} {'n':>4}")
+        rows = [("edit -> refitted curve, live", 0, True), ("edit -> WebGL frame of the refit, live", 1, True),
+                ("release -> WebGL frame of the full refit", 1, False)]
+        for label, column, live in rows:
+            cells = []
+            for runs in (latencies, extremes):
+                values = [r[column] for r in runs if r[2] == live]
+                cells.append(f"{statistics.median(values):>8.0f} {percentile(values, 0.99):>7.0f} {len(values):>4}"
+                             if values else f"{'-':>8} {'-':>7} {0:>4}")
+            print(f"{label:<44} {cells[0]}   {cells[1]}")
     for name, fps in orbits.items():
         label = f"orbit fps at 1024 x 768 (canvas {size[0]} x {size[1]}), {name}"
         print(f"{label:<52} {fps:>9.1f}")

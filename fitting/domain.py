@@ -15,8 +15,10 @@ the package.
     range of the reference and the least fraction of it data must cover.
 -   :func:`check_eta_i`, :func:`check_eta_i_range`: one index, a domain.
 -   :func:`cos_theta_from_angle`: angle theta in degrees to :math:`\\mu`.
--   :class:`BoundedCache`: the most recently used values by key, thread-safe
-    (curve bases, the service's measured curves).
+-   :class:`BoundedCache`: the most recently used values by key, thread-safe,
+    one build per key however many ask at once (curve bases, the service's
+    measured curves); :func:`cached_once`, the same for a value computed
+    once per process (the split-sum LUT and its file).
 -   :func:`as_finite_array`, :func:`check_int`, :func:`check_choice`,
     :func:`check_number`, :func:`check_min_coverage`, :func:`check_step_nm`:
     the argument checks shared by the settings and the public functions.
@@ -61,6 +63,7 @@ __all__ = [
     "check_step_nm",
     "constants",
     "BoundedCache",
+    "cached_once",
 ]
 
 ETA_I_MIN: float = 1.0
@@ -224,17 +227,29 @@ def constants() -> dict[str, Any]:
     }
 
 
+class _Flight:
+    """One build in progress: those who asked for the same key meanwhile wait for it."""
+
+    def __init__(self) -> None:
+        self.done = threading.Event()
+        self.value: Any = None
+        self.error: BaseException | None = None
+
+
 class BoundedCache:
     """
     The ``size`` most recently used values by key, safe across threads:
     :meth:`get` returns the value of ``key``, built by ``build()`` (outside
     the lock, so one slow build blocks no other key) when it is not kept,
-    the least recently used dropped beyond ``size``.
+    the least recently used dropped beyond ``size``. One flight per key:
+    concurrent gets of a key not yet kept share one build (the others wait
+    for it, and get its exception if it fails; a later get builds again).
     """
 
     def __init__(self, size: int) -> None:
         self.size = check_int("size", size, 1)
         self._values: OrderedDict[Hashable, Any] = OrderedDict()
+        self._flights: dict[Hashable, _Flight] = {}
         self._lock = threading.Lock()
 
     def get(self, key: Hashable, build: Callable[[], Any]) -> Any:
@@ -242,9 +257,38 @@ class BoundedCache:
             if key in self._values:
                 self._values.move_to_end(key)
                 return self._values[key]
-        value = build()
-        with self._lock:
-            self._values[key] = value
-            while len(self._values) > self.size:
-                self._values.popitem(last=False)
-        return value
+            flight = self._flights.get(key)
+            leader = flight is None
+            if leader:
+                flight = self._flights[key] = _Flight()
+        if not leader:
+            flight.done.wait()
+            if flight.error is not None:
+                raise flight.error
+            return flight.value
+        try:
+            flight.value = build()
+        except BaseException as error:
+            flight.error = error
+            raise
+        finally:
+            with self._lock:
+                del self._flights[key]
+                if flight.error is None:
+                    self._values[key] = flight.value
+                    while len(self._values) > self.size:
+                        self._values.popitem(last=False)
+            flight.done.set()
+        return flight.value
+
+
+def cached_once(function: Callable[[], Any]) -> Callable[[], Any]:
+    """``function`` (no arguments) computed once per process, by one caller however many ask at once."""
+    cache = BoundedCache(1)
+
+    def once() -> Any:
+        return cache.get(None, function)
+
+    once.__wrapped__ = function  # type: ignore[attr-defined]
+    once.__doc__, once.__name__ = function.__doc__, function.__name__
+    return once

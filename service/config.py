@@ -75,7 +75,10 @@ class Settings(BaseSettings):
         fits in flight a new fit is answered 503 with ``Retry-After``.
     fit_timeout_s
         Time limit of one fit, seconds, waiting included; past it the
-        request is answered 504.
+        request is answered 504 and its job cancelled.
+    job_cpu_limit_s
+        CPU time one part of a job may use in its worker, seconds; past it
+        the job stops and is answered 422.
     warm_pool
         Start the worker processes at start-up (so the first fit is fast).
     metrics_samples
@@ -99,12 +102,23 @@ class Settings(BaseSettings):
     keep_alive_s
         An idle keep-alive connection is closed after this many seconds.
     max_connections
-        Connections (and requests) at once; past it uvicorn answers 503.
+        Connections at once. A new connection past it closes the longest
+        idle one (no request in progress); with none idle it is admitted
+        only for ``/healthz`` (16 more are kept for it), else answered 503.
+    max_connections_per_client
+        Connections at once from one client address, by the same rule.
     store_max_bytes
         Quota of the store file (unset: none); a save past it is answered 507.
     store_min_free_bytes
         Free disk space below which the store counts as full: fits are
         refused 507 before any CPU is spent, ``/healthz`` says so.
+    draft_ttl_s
+        Drafts (the editor's refits while editing, never saved) are removed
+        this long after they were made (default a day), in the background.
+    draft_max_bytes
+        The drafts' quota: past it the oldest drafts are removed first.
+    draft_sweep_s
+        How often drafts are swept (past their time to live, then the quota).
     materials_page_max
         Most saved materials in one page of ``GET /api/v1/materials``.
     """
@@ -119,6 +133,7 @@ class Settings(BaseSettings):
     fit_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1, le=256)
     fit_queue: int = Field(default=8, ge=0, le=10_000)
     fit_timeout_s: float = Field(default=120.0, gt=0.0, le=3600.0)
+    job_cpu_limit_s: float = Field(default=60.0, gt=0.0, le=3600.0)
     warm_pool: bool = True
     metrics_samples: int = Field(default=100, ge=10, le=400)
     max_body_bytes: int = Field(default=1_000_000, ge=1_000)
@@ -130,8 +145,12 @@ class Settings(BaseSettings):
     body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
     keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
     max_connections: int = Field(default=512, ge=8, le=100_000)
+    max_connections_per_client: int = Field(default=128, ge=1, le=100_000)
     store_max_bytes: int | None = Field(default=None, ge=100_000)
     store_min_free_bytes: int = Field(default=16_000_000, ge=0)
+    draft_ttl_s: float = Field(default=86_400.0, gt=0.0)
+    draft_max_bytes: int = Field(default=64_000_000, ge=0)
+    draft_sweep_s: float = Field(default=60.0, gt=0.0, le=86_400.0)
     materials_page_max: int = Field(default=500, ge=1, le=10_000)
     store_url: SecretStr | None = None
     store_pool_min: int = Field(default=1, ge=0, le=100)

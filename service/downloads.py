@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fitting.domain import cached_once
 from fitting.exports import EXPORT_FORMATS, export_material
 from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json, pack_to_json
@@ -54,7 +55,7 @@ from .store import FitRecord
 
 __all__ = [
     "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
-    "render_export", "render_export_pack", "pack_response", "export_response", "download_name",
+    "render_export", "render_export_pack", "pack_response", "export_response", "download_name", "unique_names",
     "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
 
@@ -163,7 +164,7 @@ def _split_sum(kinds: tuple[str, ...]) -> list[str]:
     return ["cf_ibl"] if "coated-conductor" in kinds else []
 
 
-@functools.cache
+@cached_once
 def ibl_lut_file() -> bytes:
     """The default split-sum LUT as its file (:func:`fitting.shading.lut.encode_lut`),
     from the on-disk cache, once per process."""
@@ -325,17 +326,35 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
 def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:
     """
     The exports of several fits for one ``eta_i``: a zip archive with one
-    ``<name>.<suffix>`` per fit, in order, byte-for-byte deterministic (fixed
-    time stamps), so the same request gives the same archive.
+    ``<name>-eta<eta_i>.<suffix>`` per fit, in order, byte-for-byte
+    deterministic (fixed time stamps), so the same request gives the same
+    archive. Entry names are unique (:func:`unique_names`), so that no
+    material overwrites another when the archive is unpacked.
     """
     buffer = io.BytesIO()
+    names = unique_names([download_name(f"{record.name}-eta{eta_i:g}", format) for record in records])
     with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
-        for record in records:
-            info = zipfile.ZipInfo(download_name(f"{record.name}-eta{eta_i:g}", format),
-                                   date_time=(1980, 1, 1, 0, 0, 0))
+        for record, name in zip(records, names):
+            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
             info.compress_type = zipfile.ZIP_DEFLATED
             archive.writestr(info, render_export(record, format, eta_i))
     return buffer.getvalue()
+
+
+def unique_names(names: list[str]) -> list[str]:
+    """``names``, each that repeats an earlier one ignoring case (``gold alloy`` and ``gold_alloy``
+    both make ``gold_alloy``; a case-insensitive disk unpacks ``Gold`` over ``gold``) with ``-2``, ... added."""
+    seen: set[str] = set()
+    out = []
+    for name in names:
+        stem, dot, suffix = name.rpartition(".")
+        candidate, k = name, 1
+        while candidate.lower() in seen:
+            k += 1
+            candidate = f"{stem}-{k}{dot}{suffix}"
+        seen.add(candidate.lower())
+        out.append(candidate)
+    return out
 
 
 def download_name(stem: str, format: str) -> str:

@@ -16,6 +16,8 @@ is :mod:`service.server`.
 from __future__ import annotations
 
 import asyncio
+import logging
+import time
 from contextlib import asynccontextmanager
 from pathlib import Path
 
@@ -24,14 +26,16 @@ from fastapi.middleware.cors import CORSMiddleware
 from fastapi.staticfiles import StaticFiles
 
 from .api.errors import install_error_handlers
-from .api.middleware import HostAllowList, RequestLimits
+from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
     curves, environments, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
 from .schemas import API_PREFIX
-from .store import open_store
+from .store import StoreError, open_store
+
+log = logging.getLogger("service.store")
 
 STATIC_DIR = Path(__file__).resolve().parents[1] / "static"
 """The browser editor, served at ``/``."""
@@ -62,6 +66,19 @@ def _offline_docs(app: FastAPI) -> None:
         )
 
 
+async def _sweep_drafts(store, settings: Settings) -> None:
+    """Every ``draft_sweep_s``: drafts past their time to live, then past the quota, removed."""
+    while True:
+        try:
+            removed = await asyncio.to_thread(
+                store.expire_drafts, time.time() - settings.draft_ttl_s, settings.draft_max_bytes)
+            if removed:
+                log.info("removed %d drafts (COATED_DRAFT_TTL_S, COATED_DRAFT_MAX_BYTES)", removed)
+        except StoreError as error:
+            log.warning("draft sweep: %s", error)
+        await asyncio.sleep(settings.draft_sweep_s)
+
+
 def create_app(settings: Settings | None = None) -> FastAPI:
     """
     The service application.
@@ -78,14 +95,17 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def lifespan(app: FastAPI):
         store = await asyncio.to_thread(open_store, settings)
         await asyncio.to_thread(store.check)
-        runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s)
+        runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
+                           settings.job_cpu_limit_s)
         app.state.store, app.state.runner = store, runner
+        sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:
                 # The workers and this process (curves, reference textures) at once.
                 await asyncio.gather(runner.warm_up(), asyncio.to_thread(warm_process))
             yield
         finally:
+            sweeper.cancel()
             if app.state.preview_renderer is not None:
                 app.state.preview_renderer.close()
                 app.state.preview_renderer = None
@@ -129,6 +149,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         max_upload_bytes=settings.max_upload_bytes, upload_paths=(f"{API_PREFIX}/fits/upload",),
         body_timeout_s=settings.body_timeout_s,
     )
-    # Outermost: a request for another host name is refused before anything else.
+    # Outermost: a request for another host name is refused before anything else,
+    # and every answer (refusals too) forbids framing.
     app.add_middleware(HostAllowList, allowed=tuple(settings.allowed_hosts))
+    app.add_middleware(FrameDenial)
     return app

@@ -7,9 +7,9 @@ The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
 -   :class:`FitRunner`: worker processes (``spawn``), a bound on jobs in
     flight, a time limit per request, shared identical jobs, jobs of parts
     run side by side, and recovery from a dead worker.
--   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`: why a job
-    was not answered (the HTTP edge answers 503, 504 and 503, each with
-    ``Retry-After``).
+-   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`,
+    :class:`JobCPULimit`: why a job was not answered (the HTTP edge answers
+    503, 504, 503 and 422, the first three with ``Retry-After``).
 
 Fitting is CPU-bound (numpy, scipy): it runs in worker processes started
 with ``spawn`` (forking a process that already runs threads or holds a GL
@@ -22,12 +22,19 @@ Faults:
 -   A worker that dies breaks the whole ``ProcessPoolExecutor`` (every job in
     it fails with ``BrokenProcessPool``). The runner replaces the pool, warms
     the new workers at once, and runs each interrupted job (or part of one)
-    once more there; only a job that fails twice is answered
-    :class:`WorkerLost`. So a dead worker fails at most its own job (when it
-    kills its worker again).
--   A request that waits past the time limit gets :class:`FitTimeout`, but
-    its job keeps running: its result is saved (fits) or kept (scenes) for
-    the retry, which :meth:`FitRunner.once` then answers at once.
+    once more there. A part interrupted twice runs a third time alone, in a
+    worker of its own (one such part at a time): only a part that kills that
+    worker too is answered :class:`WorkerLost`, and its job's content id is
+    refused for ``quarantine_s`` (:class:`Quarantined`, before any work). So
+    a job that kills its workers fails only itself, however often it does.
+-   A request that waits past the time limit gets :class:`FitTimeout`, and
+    its job is cancelled when no other request waits for it (as when every
+    client waiting for it has gone): its worker checks every 0.1 s and is
+    free within a second.
+-   Each part of a job has a CPU-time limit (``cpu_limit_s``), checked by
+    its worker every 0.1 s: past it the part stops with
+    :class:`JobCPULimit`. BLAS runs one thread per worker (the fits'
+    matrices are tiny; threads there only contend for the cores).
 """
 
 from __future__ import annotations
@@ -36,6 +43,7 @@ import asyncio
 import collections
 import concurrent.futures
 import contextlib
+import contextvars
 import logging
 import math
 import multiprocessing
@@ -44,7 +52,10 @@ import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
-__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost"]
+from .turns import Turns
+from .worker import CANCEL_SLOTS, JobCPULimit, ping, run_part, warm_process, worker_start
+
+__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "Quarantined", "JobCPULimit", "warm_process"]
 
 log = logging.getLogger("service.pool")
 
@@ -66,54 +77,34 @@ class FitTimeout(Exception):
     def __init__(self, limit_s: float, retry_after: int = 1) -> None:
         super().__init__(
             f"the fit did not finish within the time limit of {limit_s:g} s "
-            "(COATED_FIT_TIMEOUT_S); it goes on, and the same request retried later "
-            "gets its result"
+            "(COATED_FIT_TIMEOUT_S); it was cancelled"
         )
         self.retry_after = retry_after
 
 
 class WorkerLost(Exception):
-    """A worker process died during the job twice (it was retried once)."""
+    """The job's worker process died in the pool twice and then once more alone: the job is the cause."""
 
-    retry_after = 1
-
-    def __init__(self) -> None:
-        super().__init__("a fitting worker process stopped during the fit (twice); retry")
-
-
-def warm_process() -> None:
-    """
-    Process start-up (each worker's initializer, and the server process at
-    start-up, which computes curves and reference textures in threads):
-    import the fitting core and colour-science and compute the spectral
-    weights of the fit (5 nm) and of the metrics (1 nm) once, seconds that
-    would otherwise land on the first request.
-    """
-    from fitting.colour.reference import spectral_weights
-    from fitting.fits.settings import FitSettings
-
-    spectral_weights(FitSettings().step_nm)
-    spectral_weights(1.0)
+    def __init__(self, quarantine_s: float) -> None:
+        super().__init__(
+            "this job stopped its fitting worker process three times (twice in the pool, then alone); "
+            f"it is refused for {quarantine_s:g} s"
+        )
+        self.retry_after = max(1, math.ceil(quarantine_s))
 
 
-def start_worker() -> None:
-    """
-    A worker's initializer: :func:`warm_process`, then one BLAS thread for
-    the process's life (a worker is one of ``workers`` processes on as many
-    cores, and its matrices are small: more OpenBLAS threads per worker
-    oversubscribe the cores, ``benchmarks/blas_threads.py``). After the
-    warm-up, because a limit applies only to the BLAS libraries already
-    loaded (numpy's OpenBLAS, loaded by the warm-up's imports).
-    """
-    from threadpoolctl import threadpool_limits
+class Quarantined(WorkerLost):
+    """A job whose content id stopped its worker recently is refused before it runs (503)."""
 
-    warm_process()
-    threadpool_limits(limits=1, user_api="blas")
+    def __init__(self, left_s: float) -> None:
+        Exception.__init__(
+            self, f"this job stopped its fitting worker process three times; it is refused for {left_s:.0f} s more"
+        )
+        self.retry_after = max(1, math.ceil(left_s))
 
 
-def _ping() -> float:
-    time.sleep(0.05)  # long enough that each warm-up ping lands on its own worker
-    return time.time()
+_JOB_KEY: contextvars.ContextVar[str | None] = contextvars.ContextVar("job_key", default=None)
+_QUARANTINE_KEYS = 1024  # content ids remembered at most
 
 
 class FitRunner:
@@ -125,11 +116,12 @@ class FitRunner:
     (:meth:`once`); its job's slot stays taken until the job ends, so the
     bound stays true. A job is one function (:meth:`run`) or parts
     submitted under one slot (:meth:`slot`, :meth:`submit`), which idle
-    workers run side by side. Up to ``keep`` results of jobs whose requests
-    timed out are kept for their retries.
+    workers run side by side. Each part may use ``cpu_limit_s`` seconds
+    of CPU time (:class:`JobCPULimit`).
     """
 
-    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, keep: int = 64) -> None:
+    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
+                 quarantine_s: float = 600.0) -> None:
         if workers < 1 or max_in_flight < workers:
             raise ValueError(
                 f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1"
@@ -137,13 +129,23 @@ class FitRunner:
         self.workers = workers
         self.max_in_flight = max_in_flight
         self.timeout_s = timeout_s
-        self._keep = keep
+        self.cpu_limit_s = cpu_limit_s
+        self.quarantine_s = quarantine_s
+        self._quarantine: dict[str, float] = {}  # content id -> monotonic time it is refused until
+        self._alone: concurrent.futures.ProcessPoolExecutor | None = None
+        self._alone_lock = asyncio.Lock()
+        self._turns = Turns(workers)
+        context = multiprocessing.get_context("spawn")
+        self._context = context
+        self._cancelled = context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
+        self._cancel_next = 0
+        self._serial = 0
+        self._waiters: collections.Counter[str] = collections.Counter()
         self._lock = threading.Lock()
         self._in_flight = 0
         self._mean_s = 2.0  # running estimate of one job's duration, for Retry-After
         self._pool: concurrent.futures.ProcessPoolExecutor | None = None
         self._pending: dict[str, asyncio.Task] = {}
-        self._kept: collections.OrderedDict[str, Any] = collections.OrderedDict()
         self._warming: set[asyncio.Task] = set()
         self.completed = 0
         self.restarts = 0
@@ -157,8 +159,9 @@ class FitRunner:
             if self._pool is None:
                 self._pool = concurrent.futures.ProcessPoolExecutor(
                     max_workers=self.workers,
-                    mp_context=multiprocessing.get_context("spawn"),
-                    initializer=start_worker,
+                    mp_context=self._context,
+                    initializer=worker_start,
+                    initargs=(self._cancelled,),
                 )
             return self._pool
 
@@ -184,7 +187,7 @@ class FitRunner:
         loop = asyncio.get_running_loop()
         pool = self._executor()
         try:
-            await asyncio.gather(*(loop.run_in_executor(pool, _ping) for _ in range(self.workers)))
+            await asyncio.gather(*(loop.run_in_executor(pool, ping) for _ in range(self.workers)))
         except (BrokenProcessPool, RuntimeError):
             pass  # a pool that broke while warming is replaced by the job that sees it
 
@@ -233,30 +236,79 @@ class FitRunner:
         finally:
             self._release(done)
 
-    async def submit(self, function: Callable[..., Any], *args: Any) -> Any:
+    async def submit(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
         Run ``function(*args)`` in a worker as one part of a job that holds
         a :meth:`slot`; its exceptions (ValueError for bad input) are raised
-        here. A part interrupted by a dead worker runs once more on the
-        replacement pool.
+        here. Parts take turns in the workers, the cheapest waiting first
+        (``cost_s``, its estimated seconds: :class:`service.turns.Turns`). A
+        part interrupted by a dead worker runs once more on the replacement
+        pool.
 
         Raises
         ------
         WorkerLost
         """
-        for attempt in (1, 2):
+        for _ in (1, 2):
             pool = self._executor()
             try:
-                future = pool.submit(function, *args)
-                return await asyncio.wrap_future(future)
+                async with self._turns.turn(cost_s):
+                    return await self._run_in(pool, function, args)
             except (BrokenProcessPool, RuntimeError) as error:
                 if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                     raise
                 self._restart(pool)
-                if attempt == 2:
-                    raise WorkerLost() from None
+        # Interrupted twice: run alone in a worker of its own, where a death is its own.
+        async with self._alone_lock:
+            with self._lock:
+                if self._alone is None:
+                    self._alone = concurrent.futures.ProcessPoolExecutor(
+                        max_workers=1, mp_context=self._context, initializer=worker_start,
+                        initargs=(self._cancelled,))
+                alone = self._alone
+            try:
+                return await self._run_in(alone, function, args)
+            except BrokenProcessPool:
+                with self._lock:
+                    self._alone = None
+                alone.shutdown(wait=False, cancel_futures=True)
+                self._quarantine_current()
+                raise WorkerLost(self.quarantine_s) from None
 
-    async def run(self, function: Callable[..., Any], *args: Any) -> Any:
+    async def _run_in(self, pool: concurrent.futures.ProcessPoolExecutor, function, args) -> Any:
+        with self._lock:
+            self._serial += 1
+            serial = self._serial
+        future = pool.submit(run_part, serial, self.cpu_limit_s, function, *args)
+        try:
+            return await asyncio.wrap_future(future)
+        except asyncio.CancelledError:
+            self._cancel(serial, future)
+            raise
+
+    def _quarantine_current(self) -> None:
+        """Refuse the content id of the job in this context for ``quarantine_s``."""
+        key = _JOB_KEY.get()
+        if key is None:
+            return
+        now = time.monotonic()
+        with self._lock:
+            for old in [k for k, until in self._quarantine.items() if until <= now]:
+                del self._quarantine[old]
+            if len(self._quarantine) >= _QUARANTINE_KEYS:
+                self._quarantine.pop(next(iter(self._quarantine)))
+            self._quarantine[key] = now + self.quarantine_s
+        log.warning("job %s stopped its worker three times; refused for %g s", key[:40], self.quarantine_s)
+
+    def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
+        """Stop a part: dropped if still queued, else its worker stops at its next check."""
+        if future.cancel():
+            return
+        with self._lock:
+            self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
+            self._cancel_next += 1
+
+    async def run(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
         Run ``function(*args)`` in a worker as a job of one part (a
         :meth:`slot` and :meth:`submit`), without a time limit (the
@@ -267,39 +319,45 @@ class FitRunner:
         Overloaded, WorkerLost
         """
         async with self.slot():
-            return await self.submit(function, *args)
+            return await self.submit(function, *args, cost_s=cost_s)
 
     async def once(self, key: str, make: Callable[[], Awaitable[Any]]) -> Any:
         """
         Await ``make()`` for at most ``timeout_s`` seconds, shared by
         concurrent calls with the same ``key``. Past the limit the caller
-        gets :class:`FitTimeout` and the job goes on: its result is kept
-        for the next call with this ``key``.
+        gets :class:`FitTimeout`; a job that no caller waits for any more
+        (each timed out or was cancelled, as when its client went away) is
+        cancelled, its worker free within a second.
         """
-        if key in self._kept:
-            return self._kept.pop(key)
+        left = self._quarantine.get(key, 0.0) - time.monotonic()
+        if left > 0:
+            raise Quarantined(left)
         task = self._pending.get(key)
         if task is None:
-            task = asyncio.ensure_future(make())
+            token = _JOB_KEY.set(key)  # the job's task (a copy of this context) knows its content id
+            try:
+                task = asyncio.ensure_future(make())
+            finally:
+                _JOB_KEY.reset(token)
             self._pending[key] = task
             task.add_done_callback(lambda t: self._pending.pop(key, None))
+        self._waiters[key] += 1
         try:
             return await asyncio.wait_for(asyncio.shield(task), self.timeout_s)
         except asyncio.TimeoutError:
-            task.add_done_callback(lambda t: self._keep_result(key, t))
             raise FitTimeout(self.timeout_s, self._retry_after()) from None
-
-    def _keep_result(self, key: str, task: asyncio.Task) -> None:
-        if task.cancelled() or task.exception() is not None:
-            return
-        self._kept[key] = task.result()
-        while len(self._kept) > self._keep:
-            self._kept.popitem(last=False)
+        finally:
+            self._waiters[key] -= 1
+            if self._waiters[key] <= 0:
+                del self._waiters[key]
+                if not task.done():
+                    task.cancel()
 
     def close(self) -> None:
         for task in [*self._pending.values(), *self._warming]:
             task.cancel()
         with self._lock:
-            pool, self._pool = self._pool, None
-        if pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
+            pools, self._pool, self._alone = (self._pool, self._alone), None, None
+        for pool in pools:
+            if pool is not None:
+                pool.shutdown(wait=True, cancel_futures=True)

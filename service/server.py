@@ -11,9 +11,17 @@ client cannot get past:
     closed; uvicorn has no such timeout of its own;
 -   the body deadline and size limits of
     :class:`service.api.middleware.RequestLimits` (408, 413);
--   ``limit_concurrency`` (``max_connections``: past it, 503) and the
-    keep-alive timeout (``keep_alive_s``); header size stays bounded by
-    h11 (16 KiB);
+-   a header size bound (:data:`MAX_HEADER_BYTES`, 16 KiB; past it 431
+    and the connection closed): h11 bounds only a header still incomplete,
+    so one that arrives whole in one read is counted here;
+-   admission (:meth:`DeadlineH11Protocol.connection_made`): at most
+    ``max_connections`` connections, ``max_connections_per_client`` from one
+    address; a connection past a bound closes the longest idle one (no
+    request in progress: a flood of idle connections only churns itself),
+    and with none idle it is admitted for ``/healthz`` alone (uvicorn's
+    ``limit_concurrency`` keeps :data:`HEALTH_RESERVE` more for it), every
+    other request on it answered 503; so ``/healthz`` is always answered;
+-   the keep-alive timeout (``keep_alive_s``);
 -   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
     closed, the concurrency limit, invalid requests) are logged once, then
     counted once a minute, so a flood cannot grow the log.
@@ -22,6 +30,7 @@ client cannot get past:
 from __future__ import annotations
 
 import asyncio
+import json
 import logging
 import threading
 import time
@@ -32,9 +41,30 @@ from uvicorn.protocols.http.h11_impl import H11Protocol
 
 from .config import Settings
 
-__all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve"]
+__all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
+           "HEALTH_RESERVE"]
 
 log = logging.getLogger("uvicorn.error")
+MAX_HEADER_BYTES = 16 * 1024
+"""Largest request line and header fields together (h11's own bound for an incomplete one)."""
+HEALTH_RESERVE = 16
+"""Connections past ``max_connections`` kept for ``/healthz``."""
+_HEALTH_REQUESTS = (b"GET /healthz", b"HEAD /healthz")
+_HEADER_END = b"\r\n\r\n"
+_TOO_LARGE = json.dumps({
+    "detail": f"the request header must be at most {MAX_HEADER_BYTES} bytes", "errors": [],
+}).encode()
+_FULL = json.dumps({
+    "detail": "the service has as many connections as it accepts, all busy "
+              "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT); retry shortly", "errors": [],
+}).encode()
+
+
+def _raw_answer(transport: asyncio.Transport, status: bytes, body: bytes, extra: bytes = b"") -> None:
+    """A JSON answer written straight to ``transport``, which is then closed."""
+    transport.write(b"HTTP/1.1 " + status + b"\r\ncontent-type: application/json\r\ncontent-length: "
+                    + str(len(body)).encode() + b"\r\nconnection: close\r\n" + extra + b"\r\n" + body)
+    transport.close()
 SLOW_CLIENT = "closed a connection whose request header did not arrive within %g s (COATED_HEADER_TIMEOUT_S)"
 
 
@@ -71,11 +101,35 @@ class DeadlineH11Protocol(H11Protocol):
     """uvicorn's h11 protocol with a deadline on each request's header."""
 
     header_timeout_s = 10.0
+    max_connections = 512
+    max_connections_per_client = 128
 
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._header_deadline: asyncio.TimerHandle | None = None
+        self._header_seen, self._header_tail = 0, b""
+        self._health_only = False
         super().connection_made(transport)
+        self._last_active = self.loop.time()
         self._arm_header_deadline()
+        host = self.client[0] if self.client else None
+        mine = [c for c in self.connections if c is not self and getattr(c, "client", None)
+                and c.client[0] == host]
+        if len(mine) >= self.max_connections_per_client and not self._evict(mine):
+            self._health_only = True
+        if len(self.connections) > self.max_connections and not self._evict(self.connections):
+            self._health_only = True
+
+    def _idle(self) -> bool:
+        return (self.conn.their_state is h11.IDLE and not self.transport.is_closing()
+                and (self.cycle is None or self.cycle.response_complete))
+
+    def _evict(self, candidates) -> bool:
+        """Close the longest idle connection of ``candidates`` (not this one); False when none is idle."""
+        idle = [c for c in candidates if c is not self and isinstance(c, DeadlineH11Protocol) and c._idle()]
+        if not idle:
+            return False
+        min(idle, key=lambda c: c._last_active).transport.close()
+        return True
 
     def _arm_header_deadline(self) -> None:
         if self._header_deadline is None:
@@ -92,15 +146,38 @@ class DeadlineH11Protocol(H11Protocol):
             log.warning(SLOW_CLIENT, self.header_timeout_s)
             self.transport.close()
 
+    def _header_too_large(self, data: bytes) -> bool:
+        """Count a header's bytes as they arrive; past the bound answer 431 and close."""
+        joined = self._header_tail + data
+        end = joined.find(_HEADER_END)
+        size = self._header_seen + (len(data) if end < 0 else end + len(_HEADER_END) - len(self._header_tail))
+        if size > MAX_HEADER_BYTES:
+            _raw_answer(self.transport, b"431 Request Header Fields Too Large", _TOO_LARGE)
+            return True
+        if end < 0:
+            self._header_seen, self._header_tail = size, joined[-3:]
+        else:
+            self._header_seen, self._header_tail = 0, b""
+        return False
+
     def data_received(self, data: bytes) -> None:
+        self._last_active = self.loop.time()
         if self.conn.their_state is h11.IDLE:
             self._arm_header_deadline()
+            start = self._header_tail + data if self._header_seen == 0 else b""
+            if self._health_only and len(start) >= len(_HEALTH_REQUESTS[1]) and not start.startswith(_HEALTH_REQUESTS):
+                _raw_answer(self.transport, b"503 Service Unavailable", _FULL, b"retry-after: 2\r\n")
+                return
+            if self._header_too_large(data):
+                return
         super().data_received(data)
         if self.conn.their_state is not h11.IDLE:
             self._disarm_header_deadline()
 
     def on_response_complete(self) -> None:
         super().on_response_complete()
+        self._last_active = self.loop.time()
+        self._header_seen, self._header_tail = 0, b""
         if self.conn.their_state is h11.IDLE and self.conn.trailing_data[0]:
             self._arm_header_deadline()  # a pipelined request has begun
 
@@ -109,17 +186,22 @@ class DeadlineH11Protocol(H11Protocol):
         super().connection_lost(exc)
 
 
-def protocol_with_deadline(header_timeout_s: float) -> type[DeadlineH11Protocol]:
-    """A :class:`DeadlineH11Protocol` subclass with its deadline set."""
-    return type("DeadlineH11Protocol", (DeadlineH11Protocol,), {"header_timeout_s": header_timeout_s})
+def protocol_with_deadline(header_timeout_s: float, max_connections: int = 512,
+                           max_connections_per_client: int = 128) -> type[DeadlineH11Protocol]:
+    """A :class:`DeadlineH11Protocol` subclass with its deadline and connection bounds set."""
+    return type("DeadlineH11Protocol", (DeadlineH11Protocol,), {
+        "header_timeout_s": header_timeout_s, "max_connections": max_connections,
+        "max_connections_per_client": max_connections_per_client,
+    })
 
 
 def serve(app, settings: Settings, host: str, port: int) -> None:
     """Run ``app`` on ``host``:``port`` until stopped (SIGINT/SIGTERM)."""
     config = uvicorn.Config(
         app, host=host, port=port, log_level="info",
-        http=protocol_with_deadline(settings.header_timeout_s),
-        limit_concurrency=settings.max_connections,
+        http=protocol_with_deadline(settings.header_timeout_s, settings.max_connections,
+                                    settings.max_connections_per_client),
+        limit_concurrency=settings.max_connections + HEALTH_RESERVE,
         timeout_keep_alive=settings.keep_alive_s,
         ws="none", lifespan="on",
     )

@@ -10,20 +10,30 @@ page's finished record, written and flushed to disk (``fsync``) before the
 page counts as done. A batch started again over the same directory reads the
 journal, keeps every complete record and fits only the pages without one:
 nothing is fitted twice and nothing finished is lost. A line cut short by an
-interrupt (the only way a line can be incomplete) is dropped and its page
-fitted again.
+interrupt is dropped and its page fitted again; a damaged line anywhere else
+(not JSON, or JSON but not a page's record) is skipped, and every valid
+record before and after it is kept.
+
+The journal holds an exclusive lock on the directory (``flock`` on
+``.lock``) while it is open: a second batch on the same directory is
+refused at once instead of fitting every page again beside the first. The
+journal and the lock file are opened with ``O_NOFOLLOW``: a link planted
+under their names is refused, never written through.
 """
 
 from __future__ import annotations
 
+import errno
+import fcntl
 import json
 import os
 from pathlib import Path
 from typing import Any
 
-__all__ = ["JOURNAL_NAME", "Journal"]
+__all__ = ["JOURNAL_NAME", "LOCK_NAME", "Journal"]
 
 JOURNAL_NAME = "journal.jsonl"
+LOCK_NAME = ".lock"
 _FORMAT = "fitting-batch-journal/1"
 
 
@@ -42,18 +52,25 @@ class Journal:
         self.config = config
         self.records: dict[str, dict[str, Any]] = {}
         header = {"format": _FORMAT, "config": config}
-        if self.path.exists():
-            self._load(header)
-        else:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            with open(self.path, "w", encoding="utf-8") as f:
-                f.write(json.dumps(header, sort_keys=True) + "\n")
-                f.flush()
-                os.fsync(f.fileno())
-        self._file = open(self.path, "a", encoding="utf-8")
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._lock = _lock_directory(self.path.parent)
+        try:
+            try:
+                fd = _open_nofollow(self.path, os.O_RDWR | os.O_APPEND)
+            except FileNotFoundError:
+                fd = _open_nofollow(self.path, os.O_RDWR | os.O_APPEND | os.O_CREAT | os.O_EXCL)
+                os.write(fd, (json.dumps(header, sort_keys=True) + "\n").encode("utf-8"))
+                os.fsync(fd)
+            else:
+                self._load(fd, header)
+            self._file = os.fdopen(fd, "a", encoding="utf-8")
+        except BaseException:
+            os.close(self._lock)
+            raise
 
-    def _load(self, header: dict[str, Any]) -> None:
-        data = self.path.read_bytes()
+    def _load(self, fd: int, header: dict[str, Any]) -> None:
+        with os.fdopen(os.dup(fd), "rb") as f:
+            data = f.read()
         lines = data.split(b"\n")
         try:
             found = json.loads(lines[0])
@@ -64,20 +81,18 @@ class Journal:
                 f"`output` {self.path.parent} holds the journal of a different batch "
                 "(other selection, model kinds or settings); choose another output directory"
             )
-        kept = len(lines[0]) + 1
         # Only lines ended by a newline are complete: the last piece is either
         # empty or a record cut short by an interrupt.
         for line in lines[1:-1]:
             try:
                 record = json.loads(line)
             except ValueError:
-                break
-            self.records[record["page"]] = record
-            kept += len(line) + 1
-        if kept < len(data):
+                continue  # a torn line: the records around it stand
+            if isinstance(record, dict) and isinstance(record.get("page"), str):
+                self.records.setdefault(record["page"], record)
+        if lines[-1]:
             # Drop the incomplete tail so that new records start on a fresh line.
-            with open(self.path, "r+b") as f:
-                f.truncate(kept)
+            os.ftruncate(fd, len(data) - len(lines[-1]))
 
     def append(self, record: dict[str, Any]) -> None:
         """Write one finished page durably; a page already journaled is ignored."""
@@ -90,9 +105,33 @@ class Journal:
 
     def close(self) -> None:
         self._file.close()
+        os.close(self._lock)  # and the lock with it
 
     def __enter__(self) -> "Journal":
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _open_nofollow(path: Path, flags: int) -> int:
+    """``os.open`` that refuses a link at ``path`` (``ValueError`` naming it)."""
+    try:
+        return os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+    except OSError as error:
+        if error.errno == errno.ELOOP:
+            raise ValueError(f"`output` {path} is a symbolic link; a batch writes only its own files") from None
+        raise
+
+
+def _lock_directory(directory: Path) -> int:
+    """An exclusive ``flock`` on ``directory/.lock`` (its descriptor), or ``ValueError`` if taken."""
+    fd = _open_nofollow(directory / LOCK_NAME, os.O_RDWR | os.O_CREAT)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise ValueError(
+            f"`output` {directory} is in use by another batch run; wait for it or choose another directory"
+        ) from None
+    return fd

@@ -28,11 +28,13 @@ renamed into place):
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import io
 import json
 import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -47,9 +49,24 @@ OUTPUT_FILES = ("pack.cfpk", "pack.json", "report.csv", "report.json", "timings.
 
 
 def _write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
+    """
+    ``data`` as ``path``, atomically: a new file of a unique name in the same
+    directory (``mkstemp``: ``O_CREAT | O_EXCL``, so never through a link
+    planted there), synced, then renamed over ``path`` (a rename replaces a
+    link at ``path`` itself, never its target).
+    """
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as f:
+            os.fchmod(f.fileno(), 0o644)
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
 
 
 def _columns(kinds, baselines) -> list[str]:

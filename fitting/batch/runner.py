@@ -223,6 +223,7 @@ def run_batch(
             else:
                 _local_pool(todo, args, sink, min(workers, len(todo)))
         records = [journal.records[p] for p in pages]
-    wall = time.perf_counter() - t0
-    summary = write_outputs(output, records, config, kinds, tuple(REPORTED_BASELINES), wall)
+        wall = time.perf_counter() - t0
+        # Still under the journal's lock: two runs never write the outputs at once.
+        summary = write_outputs(output, records, config, kinds, tuple(REPORTED_BASELINES), wall)
     return BatchResult(len(pages), fitted_now, summary, wall, output, records)

@@ -53,11 +53,11 @@ from typing import Any
 import numpy as np
 
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_int, check_number
-from ..models.coated_conductor import coated_conductor_model
 from ..models.kinds import DEFAULT_MODEL, check_model, model_ACEScg
-from ..models.pack import PackedMaterial
+from ..models.pack import PackedMaterial, to_float16
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve, check_curves
+from .curves_range import EvaluationBudget, in_range_fallback, outside_range
 from .curves_score import SCORE_GRID, angle_mu, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
 from .result import FitResult
@@ -67,9 +67,9 @@ from .solver import fit_coefficients
 
 __all__ = ["CurveFitSettings", "LIVE_SETTINGS", "SCORE_GRID", "score_grid", "whole_target_error", "fit_curves"]
 
-_RANGE_TOLERANCE = 1e-4  # float16 rounding of a fit on the boundary
 _RGB_GRID = (24, 16)  # the paper-method candidate's samples: every other angle and eta_i of SCORE_GRID
 _RGB_MAX_NFEV = 200  # as the paper-method fits (fit_coefficients' default): rgb solves are cheap
+_MIN_ESCALATION_NFEV = 10  # an escalation round with fewer evaluations left is not started
 
 @dataclass(frozen=True)
 class CurveFitSettings:
@@ -105,6 +105,13 @@ class CurveFitSettings:
         eta_i, every other point of :data:`SCORE_GRID`), and keep, of the two float16 fits, the one closer
         to it (mean Delta E 2000 there): the refit is never farther from the
         target than that method.
+    max_evaluations
+        Model evaluations (residuals and Jacobians) of the whole refit, over
+        every solve, escalation round and candidate: its CPU bound. A solve
+        gets at most its share of what is left; a round is not started with
+        fewer than 10 left. A fit the budget leaves outside [0, 1] is made
+        in range (:func:`fitting.fits.curves_range.in_range_fallback`), and
+        the metrics say ``best_effort``.
     """
 
     mu_samples: int = 12
@@ -118,6 +125,7 @@ class CurveFitSettings:
     range_weight: float = 300.0
     check_samples: tuple[int, int] = (19, 7)
     compare_rgb: bool = True
+    max_evaluations: int = 300
 
     def __post_init__(self) -> None:
         check_int("mu_samples", self.mu_samples, 4, 256)
@@ -126,6 +134,7 @@ class CurveFitSettings:
         check_number("blend_width", self.blend_width, 0.0)
         check_number("edit_weight", self.edit_weight, 1.0, 1000.0)
         check_number("range_weight", self.range_weight, 0.0, 1e6)
+        check_int("max_evaluations", self.max_evaluations, 1, 100_000)
         check = self.check_samples
         if not (isinstance(check, tuple) and len(check) == 2
                 and all(isinstance(n, int) and 2 <= n <= 256 for n in check)):
@@ -133,15 +142,16 @@ class CurveFitSettings:
 
 
 LIVE_SETTINGS = CurveFitSettings(irls_rounds=0, max_nfev=4, compare_rgb=False, quantise=False,
-                                 check_samples=(10, 4))
+                                 check_samples=(10, 4), max_evaluations=24)
 """The settings of a live refit, while a curve is being dragged: one solve of
 at most 4 evaluations (no reweighting round, no paper-method candidate,
 float16 by rounding to nearest, the [0, 1] check grid coarser at first),
 meant to start from the fit on screen (``start``), so that it follows the
 pointer; the [0, 1] constraint is the same as the default's (made stiffer
-on the fine grid while the fit leaves [0, 1]; a live solve that still
-leaves it is replaced by the full refit). The editor
-replaces it with a default refit when the drag ends."""
+on the fine grid while the fit leaves [0, 1]). A live solve that still
+leaves it answers the closer to the edit of its in-range fallback and the
+fit it started from (``best_effort``): it never waits for a full refit. The
+editor replaces it with a default refit when the drag ends."""
 
 
 def _describe(curves: Sequence[RGBCurve]) -> str:
@@ -262,6 +272,7 @@ def fit_curves(
         weights = None
         source = f"RGB curves at eta_i {_describe(curves)}"
     t_target = time.perf_counter()
+    budget = EvaluationBudget(settings.max_evaluations)
 
     def fit(objective: str, range_weight: float, check_samples: tuple[int, int], dense=None,
             start=start, extra_check=None) -> FitResult:
@@ -273,20 +284,27 @@ def fit_curves(
                 CM, CE = np.concatenate([CM, extra_check[0]]), np.concatenate([CE, extra_check[1]])
             range_check = (CM, CE, range_weight)
         if dense is not None:  # the paper's method: rgb on the whole target, unweighted
-            return fit_coefficients(*dense, eta_i_range, degree, "rgb", _RGB_MAX_NFEV,
-                                    settings.quantise, irls_rounds=0, range_check=range_check)
-        return fit_coefficients(
-            target, mu, eta, eta_i_range, degree, objective, settings.max_nfev,
-            settings.quantise, weights=weights, irls_rounds=settings.irls_rounds, range_check=range_check,
-            start=start,
-        )
+            # An unbounded and a bounded solve at most (fitting.fits.solver.solve).
+            wanted = _RGB_MAX_NFEV
+            max_nfev = budget.per_solve(wanted, 2)
+            result = fit_coefficients(*dense, eta_i_range, degree, "rgb", max_nfev,
+                                      settings.quantise, irls_rounds=0, range_check=range_check)
+        else:
+            wanted, rounds = settings.max_nfev, 1 + (settings.irls_rounds if objective == "de2000" else 0)
+            max_nfev = budget.per_solve(wanted, 2 * rounds)
+            result = fit_coefficients(
+                target, mu, eta, eta_i_range, degree, objective, max_nfev,
+                settings.quantise, weights=weights, irls_rounds=settings.irls_rounds, range_check=range_check,
+                start=start,
+            )
+        budget.spend(result, max_nfev, wanted)
+        return result
 
     range_M, range_E = check_grid(eta_i_range, *SCORE_GRID)
 
     def outside(C16) -> np.ndarray:
         """Mask of the range grid's points where the float16 fit leaves [0, 1]."""
-        values = coated_conductor_model(range_M, range_E, C16, eta_i_range)
-        return np.any((values < -_RANGE_TOLERANCE) | (values > 1.0 + _RANGE_TOLERANCE), axis=-1)
+        return outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
 
     def in_range(C16) -> bool:
         return not outside(C16).any()
@@ -298,7 +316,7 @@ def fit_curves(
             if weight == 0:
                 break
             mask = outside(result.coefficients_float16)
-            if not mask.any():
+            if not mask.any() or not budget.allows(_MIN_ESCALATION_NFEV):
                 break
             if start is None or dense is not None:
                 # A fit from its own guess: stiffer on a finer grid, started
@@ -314,6 +332,13 @@ def fit_curves(
                 result = fit(objective, weight, check, start=result.coefficients, extra_check=extra)
         return result
 
+    def held(result: FitResult) -> FitResult:
+        """``result`` with float16 coefficients in [0, 1] (its fallback when the budget left it outside)."""
+        if settings.range_weight > 0 and not in_range(result.coefficients_float16):
+            result.coefficients_float16 = in_range_fallback(result.coefficients_float16, eta_i_range)
+            result.best_effort = True
+        return result
+
     chosen = settings.objective
     if model == "rgb-conductor":
         result = fit_rgb_conductor_coefficients(
@@ -321,13 +346,18 @@ def fit_curves(
             settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
         )
     else:
-        result = constrained(settings.objective)
-        if start is not None and not in_range(result.coefficients_float16):
+        result = held(constrained(settings.objective))
+        if start is not None and result.best_effort and base is not None:
             # A warm-started (live) solve that cannot hold [0, 1] in its
-            # short budget: the full refit instead (rare: an edit far past
-            # what the model can follow), so that no fit leaves [0, 1].
-            full = CurveFitSettings(objective=settings.objective, blend_width=settings.blend_width)
-            return fit_curves(curves, base, None if base is not None else eta_i_range, name, full, model)
+            # short budget (an edit far past what the model can follow):
+            # the closer to the edit of its fallback and the fit on screen,
+            # at once; the full refit on release replaces it.
+            on_screen = to_float16(np.asarray(start, dtype=np.float64))
+            if in_range(on_screen) and (
+                whole_target_error(base, curves, on_screen, settings.blend_width)["delta_E_mean"]
+                < whole_target_error(base, curves, result.coefficients_float16,
+                                     settings.blend_width)["delta_E_mean"]):
+                result.coefficients_float16 = on_screen
     if model != "rgb-conductor" and base is not None and settings.compare_rgb and settings.objective != "rgb":
         # The paper's own method (plain rgb least squares) on the whole
         # blended target (every other point of the scoring grid: the target
@@ -336,7 +366,7 @@ def fit_curves(
         _, _, rgb_M, rgb_E = score_grid(eta_i_range, _RGB_GRID)
         dense_target = edited_target(base, curves, rgb_M, rgb_E, settings.blend_width)
         dense = (dense_target.reshape(-1, 3), rgb_M.ravel(), rgb_E.ravel())
-        candidates = {settings.objective: result, "rgb": constrained("rgb", dense)}
+        candidates = {settings.objective: result, "rgb": held(constrained("rgb", dense))}
         scores = {
             objective: whole_target_error(base, curves, candidate.coefficients_float16,
                                           settings.blend_width)["delta_E_mean"]
@@ -354,6 +384,7 @@ def fit_curves(
         "samples": int(mu.size),
         "base": None if base is None else base.name,
         "objective": chosen,
+        "best_effort": bool(result.best_effort or budget.cut),
     }
     if base is not None:
         metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)

@@ -57,6 +57,10 @@ class FitResult:
     error
         The float16 model's error as :class:`fitting.fits.metrics.ErrorMetrics`,
         where it was measured (``metrics`` holds its JSON).
+    best_effort
+        True when the fit's evaluation budget ran out before it met its
+        constraints, and ``coefficients_float16`` were then made to meet
+        them (curve fits: :func:`fitting.fits.curves_range.in_range_fallback`).
     """
 
     coefficients: np.ndarray
@@ -77,6 +81,7 @@ class FitResult:
     metrics: dict[str, Any] = field(default_factory=dict)
     model: str = "coated-conductor"
     error: ErrorMetrics | None = None
+    best_effort: bool = False
 
     @property
     def iterations(self) -> int:

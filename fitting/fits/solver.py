@@ -72,7 +72,6 @@ def _single_threaded_blas(function):
     return wrapper
 
 
-@_single_threaded_blas
 def check_samples(target_RGB, cos_theta, eta_i, weights=None):
     """
     The fitted samples as float64 arrays ``(target (S, 3), mu (S,), eta (S,),
@@ -94,6 +93,7 @@ def check_samples(target_RGB, cos_theta, eta_i, weights=None):
     return target, mu, eta, weights
 
 
+@_single_threaded_blas
 def fit_coefficients(
     target_RGB,
     cos_theta,

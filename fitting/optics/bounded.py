@@ -49,6 +49,8 @@ __all__ = [
     "load_yaml_bounded",
     "csv_rows_bounded",
     "check_sample_count",
+    "is_number",
+    "parse_number",
 ]
 
 MAX_TEXT_CHARS = 4_000_000
@@ -123,6 +125,32 @@ class _NonFiniteLiteral(ValueError):
     pass
 
 
+_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf(?:inity)?|nan)",
+                     re.IGNORECASE | re.ASCII)
+
+
+def is_number(text: str) -> bool:
+    """Whether ``text`` is a number :func:`parse_number` reads."""
+    return isinstance(text, str) and _NUMBER.fullmatch(text.strip()) is not None
+
+
+def parse_number(text: str, what: str) -> float:
+    """
+    ``text`` (surrounding spaces allowed) as a float when it is a decimal
+    number in ASCII digits, e.g. ``-1.5e3`` (``inf`` and ``nan`` too, for the
+    finiteness checks to name): Python's ``float`` also reads full-width and
+    Arabic-Indic digits and ``6_00``, which no n, k file means as numbers.
+
+    Raises
+    ------
+    ValueError
+        ``"`what` must be a number in ASCII digits, got ..."``.
+    """
+    if not is_number(text):
+        raise ValueError(f"{what} must be a number in ASCII digits, got {excerpt(text, 40)}")
+    return float(text)
+
+
 def _refuse_constant(name: str) -> float:
     raise _NonFiniteLiteral(f"JSON numbers must be finite: the literal `{name}` is not accepted")
 
@@ -167,6 +195,11 @@ def load_json_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
 
 class _YamlLimit(ValueError):
     """A bound of the YAML loader (aliases, depth, nodes): its message is final."""
+
+
+def _check_plain_number(value: str) -> None:
+    if "_" in value:
+        raise _YamlLimit(f"YAML number {excerpt(value, 40)} must be written without `_`")
 
 
 def _yaml_loader(max_depth: int, max_nodes: int):
@@ -214,11 +247,24 @@ def _yaml_loader(max_depth: int, max_nodes: int):
                     self._depth -= 1
 
     class BoundedSafeConstructor(yaml.constructor.SafeConstructor):
+        def construct_yaml_int(self, node):
+            # YAML 1.1 reads `6_00` as 600: refused, as in every other number read.
+            _check_plain_number(self.construct_scalar(node))
+            return super().construct_yaml_int(node)
+
+        def construct_yaml_float(self, node):
+            _check_plain_number(self.construct_scalar(node))
+            return super().construct_yaml_float(node)
+
         def flatten_mapping(self, node):
             for key, _ in node.value:
                 if key.tag == "tag:yaml.org,2002:merge":
                     raise _YamlLimit("YAML merge keys (`<<`) are not accepted")
             super().flatten_mapping(node)
+
+    # The tag table holds SafeConstructor's functions: the overrides are registered anew.
+    BoundedSafeConstructor.add_constructor("tag:yaml.org,2002:int", BoundedSafeConstructor.construct_yaml_int)
+    BoundedSafeConstructor.add_constructor("tag:yaml.org,2002:float", BoundedSafeConstructor.construct_yaml_float)
 
     # The composer comes first, so that compose_* and get_*node are its own,
     # not libyaml's (which composes natively and expands aliases).
@@ -292,7 +338,7 @@ def csv_rows_bounded(text: str, max_rows: int = MAX_SAMPLES + 1,
     checked before the rows are built, the others row by row.
     """
     check_text_size(text, "CSV")
-    lines = text.count("\n") + 1
+    lines = text.rstrip().count("\n") + 1  # a final newline (or blank lines) ends the last row
     if lines > max_rows:
         raise ValueError(f"CSV must have at most {max_rows} lines, got {lines}")
     longest = max(map(len, text.splitlines()), default=0)

@@ -34,6 +34,8 @@ from .bounded import (
     kind_of,
     load_json_bounded,
     load_yaml_bounded,
+    is_number,
+    parse_number,
 )
 from .database import clean_citation, merge_nk
 from .formulas import formula_from_yaml, sample_model
@@ -88,7 +90,8 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV",
         if len(row) < 3:
             raise ValueError(f"CSV line {line} must have 3 columns, got {len(row)}")
         try:
-            values.append([float(row[0]), float(row[1]), float(row[2])])
+            values.append([parse_number(cell, f"CSV line {line} column {i + 1}")
+                           for i, cell in enumerate(row[:3])])
         except ValueError:
             raise ValueError(
                 f"CSV line {line} must hold three numbers, got {excerpt(','.join(row[:3]))}"
@@ -167,11 +170,11 @@ def _numbers(text: Any, what: str, max_samples: int) -> np.ndarray:
         raise ValueError(
             f"YAML `{what}` `data` rows must be at most {MAX_LINE_CHARS} characters, got {longest}"
         )
-    try:
-        rows = [[float(v) for v in line.split()] for line in lines]
-    except ValueError as error:
-        bad = str(error).rpartition(": ")[2]
-        raise ValueError(f"YAML `{what}` data must be rows of numbers, got {bad[:60]}") from None
+    words = [line.split() for line in lines]
+    bad_word = next((v for row in words for v in row if not is_number(v)), None)
+    if bad_word is not None:
+        raise ValueError(f"YAML `{what}` data must be rows of numbers, got {excerpt(bad_word, 60)}")
+    rows = [[float(v) for v in row] for row in words]
     widths = {len(r) for r in rows}
     if not rows or len(widths) != 1:
         raise ValueError(f"YAML `{what}` data must be rows of equal length")
@@ -273,7 +276,7 @@ def _yaml_floats(item: dict, key: str, kind: str) -> list[float]:
         raise ValueError(f"YAML `{kind}` `{key}` must have at most {_MAX_COEFFICIENTS} numbers, "
                          f"got {len(words)}")
     try:
-        return [float(v) for v in words]
+        return [parse_number(v, f"YAML `{kind}` `{key}`") for v in words]
     except ValueError:
         raise ValueError(f"YAML `{kind}` `{key}` must be numbers, got {excerpt(value)}") from None
 

@@ -22,7 +22,6 @@ Heitz, E. (2018). Sampling the GGX distribution of visible normals. JCGT 7(4).
 from __future__ import annotations
 
 import contextlib
-import functools
 import hashlib
 import os
 import struct
@@ -33,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..domain import cached_once
 from .microfacet import alpha_g_from_roughness, sample_visible_normal, smith_G1, smith_G2
 
 __all__ = [
@@ -319,7 +319,7 @@ def cached_lut(
     return decode_lut(encode_lut(lut))
 
 
-@functools.cache
+@cached_once
 def default_lut() -> SplitSumLUT:
     """The LUT at the default shape and sample count, from the on-disk cache
     (:func:`cached_lut`), once per process."""

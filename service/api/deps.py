@@ -10,6 +10,8 @@ Dependencies
     when it is not stored), read in a worker thread.
 -   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
     endpoints.
+-   :data:`SingleFormFields`: a form field given twice (two ``file`` parts)
+    is refused (422), not resolved silently to the last.
 -   :data:`PreviewRendererDep`: the app's GL preview renderer, made on first
     use (503 when the machine has no GL driver).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
@@ -38,6 +40,7 @@ __all__ = [
     "FitIdPath",
     "StoredFit",
     "WriteAccess",
+    "SingleFormFields",
     "PreviewRendererDep",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
@@ -114,6 +117,18 @@ def require_write_access(
 
 
 WriteAccess = Depends(require_write_access)
+
+
+async def refuse_repeated_form_fields(request: Request) -> None:
+    """ValueError (422) naming the first form field given more than once."""
+    form = await request.form()  # parsed once for the route's fields: cached
+    repeated = sorted({key for key in form.keys() if len(form.getlist(key)) > 1})
+    if repeated:
+        raise ValueError(f"each form field must be given once, got {len(form.getlist(repeated[0]))} "
+                         f"`{repeated[0][:40]}` parts")
+
+
+SingleFormFields = Depends(refuse_repeated_form_fields)
 
 _renderer_lock = threading.Lock()
 

@@ -7,7 +7,7 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 
 =====================================  ======================================
 ``RequestValidationError``             422, naming each field and rule
-``ValueError`` (the core's refusals)   422
+``ValueError`` (the core's refusals)   422 (also ``JobCPULimit``)
 ``LookupError`` (not stored)           404
 ``Overloaded`` / ``WorkerLost``        503 with ``Retry-After``
 ``FitTimeout``                         504 with ``Retry-After``
@@ -92,6 +92,14 @@ _UNPARSABLE_BODY = "There was an error parsing the body"
 
 
 async def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
+    if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail != _UNPARSABLE_BODY:
+        # Starlette's multipart parser (a missing boundary, too many fields
+        # or files): the body is invalid, as every other unparsable body.
+        return error_response(
+            status.HTTP_422_UNPROCESSABLE_CONTENT,
+            f"the multipart body is invalid: {str(error.detail)[:200]}",
+            [{"loc": ["body"], "msg": str(error.detail)[:200], "type": "body_unparsable"}],
+        )
     if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail == _UNPARSABLE_BODY:
         media_type = request.headers.get("content-type", "none").split(";")[0][:100]
         return error_response(

@@ -8,19 +8,26 @@ Pure ASGI middleware that answers before the application sees a request:
     answered 400 (DNS rebinding: a hostile page that makes its own name
     resolve to 127.0.0.1 sends its own name as ``Host``).
 -   :class:`RequestLimits`: a body larger than the limit is answered 413,
-    and one that arrives slower than the body deadline 408.
+    and one that arrives slower than the body deadline 408; a client that
+    goes away before its answer cancels its request (and the job it waits for).
+-   :class:`FrameDenial`: every answer forbids framing (``X-Frame-Options:
+    DENY``, CSP ``frame-ancestors 'none'``): a page framed by another site
+    would be same-origin for the editor, and clicks tricked through it
+    would pass the Origin check.
 """
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import ipaddress
 import json
+import re
 
 from fastapi import status
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-__all__ = ["HostAllowList", "RequestLimits", "host_allowed", "LOOPBACK_HOSTS"]
+__all__ = ["HostAllowList", "RequestLimits", "FrameDenial", "host_allowed", "LOOPBACK_HOSTS"]
 
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "::1")
 """The default allow-list: names and addresses that only reach this machine."""
@@ -37,13 +44,23 @@ async def _refuse(send: Send, status_code: int, detail: str) -> None:
     await send({"type": "http.response.body", "body": body})
 
 
+_PORT = re.compile(r":[0-9]{1,5}", re.ASCII)
+
+
 def _host_name(host: str) -> str:
-    """``Host`` without its port, lower case: ``[::1]:8000`` -> ``::1``."""
+    """
+    ``Host`` without its port, lower case: ``[::1]:8000`` -> ``::1``; ``""``
+    (never allowed) when what follows the name is not ``:`` and digits
+    (``[::1]evil.example``, ``localhost:80x``).
+    """
     host = host.strip().lower()
     if host.startswith("["):
-        return host[1:].split("]", 1)[0]
+        name, bracket, rest = host[1:].partition("]")
+        return name if bracket and (not rest or _PORT.fullmatch(rest)) else ""
     if host.count(":") == 1:
-        host = host.split(":", 1)[0]
+        host, port = host.split(":", 1)
+        if not _PORT.fullmatch(":" + port):
+            return ""
     return host.rstrip(".")
 
 
@@ -152,14 +169,73 @@ class RequestLimits:
             chunks.append(chunk)
             if not message.get("more_body", False):
                 break
-        body = b"".join(chunks)
-        sent = False
+        await _cancel_on_disconnect(self.app, scope, b"".join(chunks), receive, send)
 
-        async def replay() -> Message:
-            nonlocal sent
-            if not sent:
-                sent = True
-                return {"type": "http.request", "body": body, "more_body": False}
-            return await receive()
 
-        await self.app(scope, replay, send)
+async def _cancel_on_disconnect(app: ASGIApp, scope: Scope, body: bytes, receive: Receive, send: Send) -> None:
+    """
+    Run ``app`` on the read ``body`` while watching the connection: a client
+    that goes away before its answer is complete cancels the request's task
+    (and with it the job it waits for, :meth:`service.pool.FitRunner.once`).
+    """
+    disconnected = asyncio.Event()
+    answered = False
+    sent = False
+
+    async def replay() -> Message:
+        nonlocal sent
+        if not sent:
+            sent = True
+            return {"type": "http.request", "body": body, "more_body": False}
+        await disconnected.wait()
+        return {"type": "http.disconnect"}
+
+    async def sending(message: Message) -> None:
+        nonlocal answered
+        if message["type"] == "http.response.body" and not message.get("more_body", False):
+            answered = True
+        await send(message)
+
+    async def watch() -> None:
+        while (await receive())["type"] != "http.disconnect":
+            pass
+        disconnected.set()
+
+    task = asyncio.ensure_future(app(scope, replay, sending))
+    watcher = asyncio.ensure_future(watch())
+    try:
+        await asyncio.wait({task, watcher}, return_when=asyncio.FIRST_COMPLETED)
+        if not task.done() and not answered:
+            task.cancel()
+            with contextlib.suppress(asyncio.CancelledError):
+                await task
+            return
+        await task
+    except asyncio.CancelledError:
+        task.cancel()
+        raise
+    finally:
+        watcher.cancel()
+
+
+class FrameDenial:
+    """ASGI middleware: ``X-Frame-Options: DENY`` and CSP ``frame-ancestors 'none'`` on every answer."""
+
+    HEADERS = [(b"x-frame-options", b"DENY"), (b"content-security-policy", b"frame-ancestors 'none'")]
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+
+        async def framed(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                names = {name.lower() for name, _ in message.get("headers", [])}
+                extra = [(n, v) for n, v in self.HEADERS if n not in names]
+                message = {**message, "headers": [*message.get("headers", []), *extra]}
+            await send(message)
+
+        await self.app(scope, receive, framed)

@@ -7,7 +7,9 @@ What every job shares
 -   :func:`check_finite`: refuse a result holding NaN or infinity.
 -   :func:`measured_nk`: the n, k behind a stored fit, if any.
 -   :func:`nk_view`: a :class:`fitting.nk.SpectralNK` as the record's lists.
--   :func:`stored_fit`: a stored fit or ``LookupError``.
+-   :func:`stored_fit`: a stored fit or ``LookupError``, with its n, k.
+-   :func:`with_measured_nk`, :func:`nk_holder`: a draft refers to the
+    record holding its n, k (``provenance.nk_of``) instead of a copy.
 -   :func:`fit_record`: the record of a finished job.
 -   :func:`checked_writable`: refuse (:class:`service.store.StoreError`)
     before any CPU is spent when the store cannot take the save.
@@ -17,6 +19,7 @@ What every job shares
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -36,6 +39,8 @@ __all__ = [
     "measured_nk",
     "nk_view",
     "stored_fit",
+    "with_measured_nk",
+    "nk_holder",
     "fit_record",
     "checked_writable",
     "checked_version",
@@ -82,11 +87,33 @@ def nk_view(nk: SpectralNK) -> dict[str, list[float]]:
 
 
 def stored_fit(store: Store, fit_id: str, where: str = "fit_id") -> FitRecord:
-    """The record of ``fit_id``; ``LookupError`` naming ``where`` when it is not stored."""
+    """The record of ``fit_id`` (:func:`with_measured_nk`); ``LookupError`` naming ``where`` when it is not stored."""
     record = store.get_fit(fit_id)
     if record is None:
         raise LookupError(f"`{where}` {fit_id} is not a stored fit")
-    return record
+    return with_measured_nk(store, record)
+
+
+def nk_holder(record: FitRecord) -> str | None:
+    """The id of the record that holds ``record``'s n, k (itself, or the one it refers to)."""
+    if record.nk is not None:
+        return record.id
+    return (record.provenance or {}).get("nk_of")
+
+
+def with_measured_nk(store: Store, record: FitRecord | None) -> FitRecord | None:
+    """
+    ``record`` with its n, k: a draft stores the id of the record holding
+    them (``provenance.nk_of``), not a copy; an n, k whose holder is gone
+    (an expired draft) stays absent.
+    """
+    if record is None or record.nk is not None:
+        return record
+    holder_id = (record.provenance or {}).get("nk_of")
+    holder = None if holder_id is None else store.get_fit(holder_id)
+    if holder is None or holder.nk is None:
+        return record
+    return dataclasses.replace(record, nk=holder.nk)
 
 
 def checked_writable(store: Store) -> None:

@@ -52,7 +52,9 @@ from .common import (
     content_address,
     fit_record,
     measured_nk,
+    nk_holder,
     stored_fit,
+    with_measured_nk,
 )
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
@@ -254,6 +256,7 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
             "model_float16": {"delta_E_mean": metrics["delta_E_mean"], "delta_E_max": metrics["delta_E_max"]},
             "by_curve": metrics["by_curve"],
             "fitted_samples": metrics["samples"],
+            "best_effort": metrics["best_effort"],
             **({"target": metrics["target"]} if "target" in metrics else {}),
         },
         "timings": {**result.timings, "base": t_base},
@@ -275,18 +278,21 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     material_id = content_address("edited material", fit.name)
 
     def stored_or_writable() -> FitRecord | None:
-        # One trip to a thread for all (a live refit is a round trip per drag step).
-        stored = store.get_fit(fit.fit_id)
+        # One trip to a thread for both (a live refit is a round trip per drag step).
+        stored = with_measured_nk(store, store.get_fit(fit.fit_id))
         if stored is None:
             checked_writable(store)
             checked_version(store, material_id, fit.name, expected_version)
         return stored
 
+    def put(record: FitRecord, save: bool = True, expected: int | None = None) -> FitRecord:
+        return with_measured_nk(store, store.put_fit(record, save, expected))
+
     stored = await asyncio.to_thread(stored_or_writable)
     if stored is not None:
         if fit.draft:
             return stored, False
-        return await asyncio.to_thread(store.put_fit, stored, True, expected_version), False
+        return await asyncio.to_thread(put, stored, True, expected_version), False
     base, base_record = fit.base, fit.base_record
     # The measured data behind the edit (for the reference curves and
     # previews): the base's, or, for an edited base, the data it had.
@@ -296,12 +302,17 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     }
     if base_record is not None and base_record.kind == "curves":
         measured_library, measured = base_record.library_material, base_record.nk
+    # A draft refers to the stored record holding its n, k, not a copy (~400 KB a step for 20,000 samples).
+    nk_of = nk_holder(base_record) if fit.draft and measured is not None and base_record is not None else None
+    if nk_of is not None:
+        measured = None
 
     settings = LIVE_SETTINGS if fit.live else DEFAULTS
 
     async def make() -> FitRecord:
         job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
-                               fit.objective, fit.blend_width, fit.model, fit.live, fit.start)
+                               fit.objective, fit.blend_width, fit.model, fit.live, fit.start,
+                               cost_s=0.03 if fit.live else 0.5)  # its turn: live steps first
         check_finite("metrics", job["metrics"])
         record = fit_record(
             fit.fit_id, "curves", material_id, fit.name,
@@ -314,16 +325,17 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
                 "base": None if base is None else base.provenance(),
                 "settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},
                 **({"live": {"start": fit.start}} if fit.live else {}),
+                **({"nk_of": nk_of} if nk_of is not None else {}),
             },
         )
-        return await asyncio.to_thread(store.put_fit, record, not fit.draft, expected_version)
+        return await asyncio.to_thread(put, record, not fit.draft, expected_version)
 
     record = await runner.once(fit.fit_id, make)
     if not fit.draft:
         # The fit was shared with a draft request in flight: saved now.
         latest = await asyncio.to_thread(store.latest_fit, record.material_id)
         if latest is None or latest.id != record.id:
-            record = await asyncio.to_thread(store.put_fit, record, True, expected_version)
+            record = await asyncio.to_thread(put, record, True, expected_version)
     return record, True
 
 

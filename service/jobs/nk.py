@@ -62,6 +62,9 @@ twice as fast as the float64 definition, its Delta E within 0.001 of it
 :func:`fitting.colour.reference.reference_ACEScg_grid`; docs/service.md).
 """
 
+PART_COST_S = 0.1
+"""Estimated seconds of each part of an n, k fit: its turn in the pool (:class:`service.turns.Turns`)."""
+
 
 @dataclass(frozen=True)
 class NKFit:
@@ -199,14 +202,14 @@ async def _nk_job(fit: NKFit, runner: FitRunner) -> dict[str, Any]:
     """
     async with runner.slot():
         parts = await asyncio.gather(
-            runner.submit(_fit_part, fit), runner.submit(_reference_part, fit),
+            runner.submit(_fit_part, fit, cost_s=PART_COST_S), runner.submit(_reference_part, fit, cost_s=PART_COST_S),
             return_exceptions=True,
         )
         for part in parts:
             if isinstance(part, BaseException):
                 raise part
         result, (reference, baselines, seconds) = parts
-        return await runner.submit(_metrics_part, fit, result, reference, baselines, seconds)
+        return await runner.submit(_metrics_part, fit, result, reference, baselines, seconds, cost_s=PART_COST_S)
 
 
 async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord, bool]:

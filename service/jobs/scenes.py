@@ -39,7 +39,7 @@ from fitting.optics.library import LIBRARY_NAMES, library_material
 
 from ..pool import FitRunner
 from ..store import Store
-from .common import content_address, measured_nk
+from .common import content_address, measured_nk, with_measured_nk
 
 __all__ = ["StoredModel", "PreparedScene", "prepare_scene", "scene_pack"]
 
@@ -95,7 +95,7 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
     def resolve(material: str):
         if material in LIBRARY_NAMES:
             return library_material(material)
-        record = store.latest_fit(material)
+        record = with_measured_nk(store, store.latest_fit(material))
         nk = None if record is None else measured_nk(record)
         if nk is None:
             raise ValueError(
@@ -114,7 +114,7 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
         material = entry.get("material")
         record = None
         if material is not None and material not in LIBRARY_NAMES:
-            record = store.latest_fit(material)
+            record = with_measured_nk(store, store.latest_fit(material))
         if record is not None and record.kind == "curves":
             eta = parse_eta_i(entry["eta_i"], f"{where}.eta_i")
             packed = material_from_json(record.material)
@@ -200,10 +200,11 @@ def _scene_job(scene: PreparedScene) -> dict[str, Any]:
 
 
 async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
-    """The report and pack of ``scene`` (a retry after a timeout gets the kept result)."""
+    """The report and pack of ``scene`` (cancelled when no request waits for it any more)."""
 
     async def make() -> dict[str, Any]:
-        return await runner.run(_scene_job, scene)
+        # Its turn in the pool: about 0.2 s a material (a fit and its candidates).
+        return await runner.run(_scene_job, scene, cost_s=0.2 * len(scene.materials))
 
     return await runner.once(scene.key, make)
 

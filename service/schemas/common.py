@@ -24,7 +24,7 @@ from fitting.optics.library import LIBRARY_NAMES
 from ..jobs.nk import MAX_NK_SAMPLES
 
 __all__ = [
-    "API_PREFIX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
+    "API_PREFIX", "INT64_MAX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
     "EXPORT_FORMAT_NAMES", "MAX_EXPORT_PACK",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
@@ -33,6 +33,8 @@ __all__ = [
 ]
 
 API_PREFIX = "/api/v1"
+INT64_MAX = 2**63 - 1
+"""Largest integer a query may give where it reaches the store (SQLite integers are 64-bit)."""
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")

@@ -55,6 +55,7 @@ class FitDetails(Mirror):
     coverage: float | None = absent()
     by_curve: list[CurveError] | None = absent()
     fitted_samples: int | None = absent()
+    best_effort: bool | None = absent("True when the refit's evaluation budget ran out and the fit was made to stay in [0, 1]")
     target: DeltaE | None = absent()
 
 

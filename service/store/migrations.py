@@ -22,6 +22,8 @@ columns. Versions:
 2.  ``materials.version``: the number of saves of the material, the
     version a save may expect (``put_fit(..., expected_version=)``; 409
     when another save came first).
+3.  the index ``saves_by_fit``: the drafts' sweep finds the records no
+    save refers to (``expire_drafts``).
 """
 
 from __future__ import annotations
@@ -110,11 +112,17 @@ _V2: list[Step] = [
     "WHERE s.material_id = materials.material_id)",
 ]
 
+_V3: list[Step] = [
+    "CREATE INDEX IF NOT EXISTS saves_by_fit ON saves (fit_id)",
+]
+
 MIGRATIONS: dict[str, list[tuple[int, str, list[Step]]]] = {
     "sqlite": [(1, "fits, save log, material summaries", _SQLITE_V1),
-               (2, "material versions", _V2)],
+               (2, "material versions", _V2),
+               (3, "saves by fit (the drafts' sweep)", _V3)],
     "postgresql": [(1, "fits, save log, material summaries", _POSTGRES_V1),
-                   (2, "material versions", _V2)],
+                   (2, "material versions", _V2),
+                   (3, "saves by fit (the drafts' sweep)", _V3)],
 }
 SCHEMA_VERSION = max(version for version, _, _ in MIGRATIONS["sqlite"])
 """The schema version this code reads and writes."""

@@ -227,6 +227,13 @@ class PostgresStore:
 
         return self._read(write)
 
+    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
+        def sweep(connection: psycopg.Connection) -> int:
+            connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))  # no save half done
+            return queries.expire_drafts(connection, "%s", older_than, max_bytes)
+
+        return self._read(sweep)
+
     def get_fit(self, fit_id: str) -> FitRecord | None:
         text = self._read(lambda c: queries.get_text(c, "%s", fit_id))
         return None if text is None else self._decode(fit_id, text)

@@ -9,6 +9,7 @@ The caller owns the transaction and translates driver errors.
 
 -   :func:`save`: the body of ``put_fit`` (write-once record, save log,
     summary row, the expected-version check).
+-   :func:`expire_drafts`: the drafts' sweep (age, then quota).
 -   :func:`get_text`, :func:`latest_texts`, :func:`latest_ids`,
     :func:`version_of`, :func:`page_rows`, :func:`page_of`: the reads.
 """
@@ -22,7 +23,8 @@ from typing import Any, Callable
 from .migrations import UPSERT_MATERIAL
 from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, StoreConflict
 
-__all__ = ["save", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of"]
+__all__ = ["save", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
+           "expire_drafts"]
 
 log = logging.getLogger("service.store")
 
@@ -122,3 +124,24 @@ def page_of(rows: list[tuple], limit: int) -> MaterialPage:
                                created_at=first_at, seq=int(seq), version=int(version)))
     next_cursor = int(rows[limit - 1][7]) if len(rows) > limit else None
     return MaterialPage(out, next_cursor, skipped)
+
+
+def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) -> int:
+    """
+    Inside one write transaction that holds the saves' lock: remove the
+    drafts (records no save refers to) created before ``older_than``, then
+    the oldest drafts until those left hold at most ``max_bytes``; return
+    how many were removed.
+    """
+    rows = connection.execute(
+        "SELECT id, created_at, length(record) FROM fits WHERE NOT EXISTS "
+        "(SELECT 1 FROM saves WHERE saves.fit_id = fits.id) ORDER BY created_at DESC").fetchall()
+    kept, doomed = 0, []
+    for fit_id, created_at, size in rows:  # newest first: the oldest go past the quota
+        if created_at < older_than or kept + size > max_bytes:
+            doomed.append((fit_id,))
+        else:
+            kept += size
+    if doomed:
+        connection.executemany(f"DELETE FROM fits WHERE id = {p}", doomed)
+    return len(doomed)

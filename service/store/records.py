@@ -203,6 +203,13 @@ class Store(Protocol):
     def material_version(self, material_id: str) -> int:
         """The number of saves of a material (0: never saved)."""
 
+    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
+        """
+        Remove drafts (fits never saved) created before ``older_than`` (a
+        ``time.time()``), then the oldest drafts until all left hold at most
+        ``max_bytes`` of records; return how many were removed.
+        """
+
     def check(self) -> None:
         """Raise :class:`StoreError` if the store is unusable or damaged."""
 

@@ -46,6 +46,11 @@ def _translate(error: sqlite3.Error, path: Path) -> StoreError:
     return StoreUnavailable(f"the store at {path} is unavailable: {error}")
 
 
+
+_WRITE_FLOOR_BYTES = 1_000_000
+"""Free disk below which the store is not writable even with COATED_STORE_MIN_FREE_BYTES=0
+(a save writes its record, the journal and the index pages)."""
+
 class SQLiteStore:
     """
     :class:`Store` on one SQLite file in WAL mode: one connection per
@@ -137,6 +142,15 @@ class SQLiteStore:
 
         return self._guard(write)
 
+    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
+        def sweep() -> int:
+            connection = self._connection()
+            with connection:
+                connection.execute("BEGIN IMMEDIATE")  # the saves' write lock: none is half done
+                return queries.expire_drafts(connection, "?", older_than, max_bytes)
+
+        return self._guard(sweep)
+
     def get_fit(self, fit_id: str) -> FitRecord | None:
         text = self._guard(lambda: queries.get_text(self._connection(), "?", fit_id))
         return None if text is None else self._decode(fit_id, text)
@@ -197,6 +211,9 @@ class SQLiteStore:
         if free_bytes < self.min_free_bytes:
             return (f"the disk of the store has {free_bytes} bytes free, less than "
                     f"COATED_STORE_MIN_FREE_BYTES ({self.min_free_bytes})")
+        if free_bytes < _WRITE_FLOOR_BYTES:  # whatever the setting, even 0: a full disk takes no save
+            return (f"the disk of the store has {free_bytes} bytes free, less than one save needs "
+                    f"({_WRITE_FLOOR_BYTES})")
         try:
             connection = self._connection()
             if self.max_bytes:

@@ -165,3 +165,36 @@ class TestExportPacks:
         response = client.post(f"{API}/packs", json={"fit_ids": ids * 9, "format": "blender"})
         assert response.status_code == 422, response.text
         assert "at most 16 fits for an export pack" in response.json()["detail"]
+
+
+@pytest.mark.slow
+class TestExportPackNames:
+    """Issue 20, item 6: names that make one file name, and long names with one prefix."""
+
+    NAMES = ["gold alloy", "gold_alloy", "gold/alloy", "Gold Alloy", "p" * 90 + "one", "p" * 90 + "two"]
+
+    def test_every_material_has_its_own_entry(self, shared):
+        import io
+        import zipfile
+
+        client, _ = shared
+        wavelength = [350.0, 500.0, 650.0, 850.0]
+        ids = []
+        for i, name in enumerate(self.NAMES):
+            nk = {"wavelength_nm": wavelength, "n": [0.2 + 0.01 * i] * 4, "k": [3.0, 3.2, 3.4, 3.6]}
+            response = client.post(f"{API}/fits", json={"name": name, "nk": nk})
+            assert response.status_code == 201, response.text
+            ids.append(response.json()["id"])
+        response = client.post(f"{API}/packs", json={"fit_ids": ids, "format": "mtlx", "eta_i": 1.5})
+        assert response.status_code == 200, response.text
+        names = zipfile.ZipFile(io.BytesIO(response.content)).namelist()
+        assert len(names) == len(self.NAMES)
+        assert len({n.lower() for n in names}) == len(self.NAMES), names
+        assert names[:4] == ["gold_alloy-eta1.5.mtlx", "gold_alloy-eta1.5-2.mtlx", "gold_alloy-eta1.5-3.mtlx",
+                             "Gold_Alloy-eta1.5-4.mtlx"]
+
+
+def test_unique_names_suffix_repeats_ignoring_case():
+    from service.downloads import unique_names
+
+    assert unique_names(["a.x", "A.x", "a.x", "a-2.x", "b"]) == ["a.x", "A-2.x", "a-3.x", "a-2-2.x", "b"]

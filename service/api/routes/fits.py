@@ -3,8 +3,7 @@ Fits
 ====
 
 -   ``POST /api/v1/fits``: fit a built-in material or inline n, k (JSON).
--   ``POST /api/v1/fits/upload``: fit an uploaded n, k file (CSV, JSON or
-    refractiveindex.info YAML), multipart.
+-   ``POST /api/v1/fits/upload``: fit an uploaded n, k file (CSV, JSON, YAML), multipart.
 -   ``GET /api/v1/fits/{fit_id}``: a stored fit.
 -   ``GET /api/v1/fits/{fit_id}/pack``: its download (binary, json, glsl,
     hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf).
@@ -45,6 +44,7 @@ from ..deps import (
     FitIdPath,
     RunnerDep,
     SettingsDep,
+    SingleFormFields,
     StoredFit,
     StoreDep,
     WriteAccess,
@@ -89,7 +89,7 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
 
 
 @router.post("/upload", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
-             responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess])
+             responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess, SingleFormFields])
 async def upload_fit(
     file: Annotated[UploadFile, File(description="n, k as CSV, JSON or refractiveindex.info YAML")],
     store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response,

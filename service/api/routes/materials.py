@@ -19,7 +19,8 @@ from fastapi import APIRouter, Path, Query
 from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.optics.nk import visible_coverage
 
-from ...schemas import API_PREFIX, MATERIAL_ID_PATTERN, MaterialDetail, MaterialList, MaterialSummary, fit_public
+from ...schemas import API_PREFIX, INT64_MAX, MATERIAL_ID_PATTERN, MaterialDetail, MaterialList, MaterialSummary, fit_public
+from ...jobs.common import with_measured_nk
 from ..deps import ERROR_RESPONSES, NOT_FOUND, SettingsDep, StoreDep
 
 router = APIRouter(prefix=f"{API_PREFIX}/materials", tags=["materials"])
@@ -34,9 +35,10 @@ def _library_entry(name: str) -> tuple[str, float, tuple[float, float]]:
 @router.get("", response_model=MaterialList, responses=ERROR_RESPONSES)
 def list_materials(
     store: StoreDep, settings: SettingsDep,
-    limit: Annotated[int | None, Query(ge=1, description="Saved materials per page "
+    limit: Annotated[int | None, Query(ge=1, le=INT64_MAX, description="Saved materials per page "
                                        "(default and most: COATED_MATERIALS_PAGE_MAX)")] = None,
-    cursor: Annotated[int | None, Query(ge=0, description="`next_cursor` of the previous page")] = None,
+    cursor: Annotated[int | None, Query(ge=0, le=INT64_MAX,
+                                        description="`next_cursor` of the previous page")] = None,
 ) -> MaterialList:
     """The 22 built-in conductors (first page), then the saved materials, oldest first."""
     limit = min(limit or settings.materials_page_max, settings.materials_page_max)
@@ -63,7 +65,7 @@ def get_material(
     store: StoreDep,
 ) -> MaterialDetail:
     """One material with its latest fit (None for a library material not fitted yet)."""
-    latest = store.latest_fit(material_id)
+    latest = with_measured_nk(store, store.latest_fit(material_id))
     version = store.material_version(material_id)
     if material_id in LIBRARY_NAMES:
         source, coverage, wavelength_range = _library_entry(material_id)

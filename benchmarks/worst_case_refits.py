@@ -1,0 +1,129 @@
+"""
+Worst-case curve refits
+=======================
+
+Wall time of :func:`fitting.fits.curves.fit_curves` in this process for the
+edits of issue 20 against a gentle one (each the median of ``--repeats``),
+and of the live steps of a drag (``LIVE_SETTINGS``, warm-started from the
+fit before, 20 steps) for each, p50 and p99:
+
+-   ``gentle``: Au's red curve at eta_i 1.5 raised by 0.05 around 50 degrees;
+-   ``Au green 0.10 at 60``: Au's green pulled to 0.10 at 60 degrees (an
+    edit the model cannot follow), 16 and 46 curve samples;
+-   ``Cu green 0.10 at 60``: the same on Cu;
+-   ``degenerate base``: a base of n = 1, k = 0 (``{"wavelength_nm": [300,
+    900], "n": [1, 1], "k": [0, 0]}``) with a flat 0.5 curve of 16 samples.
+
+Each row also gives the model evaluations spent, whether the answer is a
+best effort, and the model's range over the scoring grid (it must stay in
+[0, 1]). Run: ``.venv/bin/python benchmarks/worst_case_refits.py
+[--repeats 3]``. The figures depend on the machine's load (printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from fitting.fits import curves as curves_module  # noqa: E402
+from fitting.fits.curves import LIVE_SETTINGS, fit_curves  # noqa: E402
+from fitting.fits.curves_base import curve_base_from_nk  # noqa: E402
+from fitting.fits.material import fit_material  # noqa: E402
+from fitting.optics.library import library_material  # noqa: E402
+from fitting.optics.nk import SpectralNK  # noqa: E402
+
+
+def pulled(base, channel, angle, value, samples, step=1.0):
+    theta = np.linspace(0.0, 90.0, samples)
+    mu = np.where(theta == 90.0, 0.0, np.cos(np.radians(theta)))
+    rgb = base.rgb(mu, 1.5).copy()
+    w = np.exp(-0.5 * ((theta - angle) / 9.0) ** 2) * (1 - (theta / 90) ** 6)
+    w /= w.max()
+    i = int(np.argmin(np.abs(theta - angle)))
+    rgb[:, channel] += step * (value - rgb[i, channel]) * w
+    return [{"eta_i": 1.5, "angle_deg": theta.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]
+
+
+def counted(function):
+    """``function()`` and the model evaluations its solves spent."""
+    spent = []
+    original = curves_module.fit_coefficients
+
+    def counting(*args, **kwargs):
+        result = original(*args, **kwargs)
+        spent.append(result.nfev + result.njev)
+        return result
+
+    curves_module.fit_coefficients = counting
+    try:
+        return function(), sum(spent)
+    finally:
+        curves_module.fit_coefficients = original
+
+
+def percentile(values, q):
+    values = sorted(values)
+    return values[min(len(values) - 1, int(round(q * (len(values) - 1))))]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    au = curve_base_from_nk(library_material("Au"))
+    cu = curve_base_from_nk(library_material("Cu"))
+    void = curve_base_from_nk(SpectralNK(np.array([300.0, 900.0]), np.ones(2), np.zeros(2), name="void"))
+    flat = [{"eta_i": 1.5, "angle_deg": np.linspace(0, 90, 16).tolist(), "rgb": np.full((16, 3), 0.5).tolist()}]
+
+    def gentle(s):
+        curves = pulled(au, 0, 50, 0.0, 16, 0.0)  # Au as measured, red then raised around 50 degrees
+        theta = np.array(curves[0]["angle_deg"])
+        bump = np.exp(-0.5 * ((theta - 50.0) / 9.0) ** 2)
+        rgb = np.array(curves[0]["rgb"])
+        rgb[:, 0] += 0.05 * s * bump
+        curves[0]["rgb"] = rgb.clip(0, 1).tolist()
+        return curves
+
+    cases = {
+        "gentle (Au red +0.05 at 50)": (au, "Au", gentle, 16),
+        "Au green 0.10 at 60, 16 samples": (au, "Au", lambda s: pulled(au, 1, 60, 0.10, 16, s), 16),
+        "Au green 0.10 at 60, 46 samples": (au, "Au", lambda s: pulled(au, 1, 60, 0.10, 46, s), 46),
+        "Cu green 0.10 at 60, 16 samples": (cu, "Cu", lambda s: pulled(cu, 1, 60, 0.10, 16, s), 16),
+        "degenerate base (n 1, k 0), 16 samples": (void, None, lambda s: flat, 16),
+    }
+    starts = {name: fit_material(library_material(name)).coefficients_float16.astype(np.float64)
+              for name in ("Au", "Cu")}
+    print(f"{'edit':<40} {'full s':>7} {'evals':>6} {'best':>5} {'range':>15}   {'live p50 ms':>11} {'p99 ms':>7}")
+    for label, (base, start_name, make, _) in cases.items():
+        seconds = []
+        for _ in range(args.repeats):
+            t0 = time.perf_counter()
+            (result, evals) = counted(lambda: fit_curves(make(1.0), base))
+            seconds.append(time.perf_counter() - t0)
+        target = result.metrics["target"]
+        live = []
+        start = starts.get(start_name)
+        if start is None:  # no library fit for the degenerate base: its own full refit
+            start = result.coefficients_float16.astype(np.float64)
+        for s in np.linspace(0.05, 1.0, 20):
+            t0 = time.perf_counter()
+            step = fit_curves(make(s), base, settings=LIVE_SETTINGS, start=start)
+            live.append(1000 * (time.perf_counter() - t0))
+            start = step.coefficients_float16.astype(np.float64)
+        span = f"[{target['model_min']:.3f}, {target['model_max']:.4f}]"
+        print(f"{label:<40} {statistics.median(seconds):>7.2f} {evals:>6} "
+              f"{str(result.metrics['best_effort']):>5} {span:>15}   "
+              f"{percentile(live, 0.5):>11.0f} {percentile(live, 0.99):>7.0f}")
+    print(f"\nload average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,102 @@
+"""
+Fitting workers
+===============
+
+What runs in each worker process of :class:`service.pool.FitRunner`:
+
+-   :func:`warm_process`: the start-up every worker (and the server process)
+    does once, so that no request pays for imports and spectral weights.
+-   :func:`worker_start`: a worker's initializer: one BLAS thread, the
+    server's shared ring of cancelled job serials, the warm-up.
+-   :func:`run_part`: one part of a job, checked every 0.1 s for its CPU
+    time (:class:`JobCPULimit`) and for cancellation by the server.
+"""
+
+from __future__ import annotations
+
+import signal
+import time
+from typing import Any, Callable
+
+__all__ = ["CANCEL_SLOTS", "JobCPULimit", "warm_process", "worker_start", "run_part", "ping"]
+
+CANCEL_SLOTS = 256
+"""Cancelled job serials remembered (a ring); far more than jobs in flight."""
+
+_CHECK_S = 0.1  # how often a worker checks its job's CPU time and cancellation
+_cancelled = None  # in a worker: the server's shared ring of cancelled job serials
+
+
+class JobCPULimit(ValueError):
+    """A part of a job used more CPU time than its limit (raised in the worker, re-raised here; a 422)."""
+
+    def __init__(self, limit_s: float) -> None:
+        super().__init__(
+            f"the job used more than its CPU-time limit of {limit_s:g} s (COATED_JOB_CPU_LIMIT_S) "
+            "and was stopped; make the request smaller"
+        )
+        self.limit_s = limit_s
+
+    def __reduce__(self):
+        return JobCPULimit, (self.limit_s,)
+
+
+class _Cancelled(Exception):
+    """Raised in a worker whose job was cancelled by the server."""
+
+
+def warm_process() -> None:
+    """
+    Process start-up (each worker's initializer, and the server process at
+    start-up, which computes curves and reference textures in threads):
+    import the fitting core and colour-science and compute the spectral
+    weights of the fit (5 nm) and of the metrics (1 nm) once, seconds that
+    would otherwise land on the first request.
+    """
+    from fitting.colour.reference import spectral_weights
+    from fitting.fits.settings import FitSettings
+
+    spectral_weights(FitSettings().step_nm)
+    spectral_weights(1.0)
+
+
+def worker_start(cancelled) -> None:
+    """
+    Each worker's initializer: the shared cancellation ring, the warm-up,
+    then one BLAS thread for the process's life (after the warm-up: a limit
+    applies only to the BLAS libraries already loaded).
+    """
+    global _cancelled
+    from threadpoolctl import threadpool_limits
+
+    _cancelled = cancelled
+    warm_process()
+    threadpool_limits(limits=1, user_api="blas")
+
+
+def run_part(serial: int, cpu_limit_s: float, function: Callable[..., Any], *args: Any) -> Any:
+    """
+    Worker: ``function(*args)`` with a check every 0.1 s (SIGALRM, in the
+    worker's main thread, where the job runs) that stops it past
+    ``cpu_limit_s`` of CPU time or once the server cancelled ``serial``.
+    """
+    cpu0 = time.process_time()
+
+    def check(signum, frame) -> None:
+        if _cancelled is not None and serial in _cancelled[:]:
+            raise _Cancelled()
+        if time.process_time() - cpu0 > cpu_limit_s:
+            raise JobCPULimit(cpu_limit_s)
+
+    previous = signal.signal(signal.SIGALRM, check)
+    signal.setitimer(signal.ITIMER_REAL, _CHECK_S, _CHECK_S)
+    try:
+        return function(*args)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0.0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def ping() -> float:
+    time.sleep(0.05)  # long enough that each warm-up ping lands on its own worker
+    return time.time()

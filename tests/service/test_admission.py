@@ -1,0 +1,88 @@
+"""
+Issue 20, item 2: connection admission against a real ``python -m service``
+on 127.0.0.1. A flood of idle connections only churns itself (a new
+connection closes the longest idle one), one address cannot hold more than
+its share, and ``/healthz`` is answered even when every connection is busy.
+Every socket is closed at the end; every loop is bounded.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import statistics
+import time
+
+import httpx
+import pytest
+
+from conftest import server_process
+
+pytestmark = [pytest.mark.slow, pytest.mark.server]
+
+
+def idle_sockets(port: int, count: int, source: str = "127.0.0.1") -> list[socket.socket]:
+    out = []
+    for _ in range(count):
+        s = socket.create_connection(("127.0.0.1", port), timeout=5, source_address=(source, 0))
+        out.append(s)
+    return out
+
+
+def still_open(sockets) -> int:
+    """Sockets the server has not closed (a closed one reads b'' at once)."""
+    time.sleep(0.3)
+    count = 0
+    for s in sockets:
+        s.setblocking(False)
+        try:
+            count += s.recv(1) != b""
+        except BlockingIOError:
+            count += 1
+        except OSError:
+            pass
+    return count
+
+
+def test_healthz_answers_fast_with_600_idle_connections_open(tmp_path):
+    with server_process(tmp_path / "data", COATED_WARM_POOL="false") as server, contextlib.ExitStack() as stack:
+        flood = idle_sockets(server.port, 600)
+        for s in flood:
+            stack.callback(s.close)
+        seconds = []
+        for _ in range(60):
+            t0 = time.perf_counter()
+            response = httpx.get(f"{server.url}/healthz", timeout=10)  # a new connection each time
+            seconds.append(time.perf_counter() - t0)
+            assert response.status_code == 200, response.text
+        p99 = statistics.quantiles(seconds, n=100)[98]
+        assert p99 < 0.5, (p99, max(seconds))
+        assert still_open(flood) <= 128  # COATED_MAX_CONNECTIONS_PER_CLIENT
+
+
+def test_one_address_cannot_shut_out_another(tmp_path):
+    with server_process(tmp_path / "data", COATED_WARM_POOL="false",
+                        COATED_MAX_CONNECTIONS_PER_CLIENT="20") as server, contextlib.ExitStack() as stack:
+        flood = idle_sockets(server.port, 60)
+        for s in flood:
+            stack.callback(s.close)
+        assert still_open(flood) <= 20
+        transport = httpx.HTTPTransport(local_address="127.0.0.2")
+        with httpx.Client(transport=transport, timeout=10) as other:
+            assert other.get(f"{server.url}/api/v1/materials").status_code == 200
+
+
+def test_with_every_connection_busy_healthz_is_still_answered(tmp_path):
+    with server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS="8",
+                        COATED_BODY_TIMEOUT_S="20") as server, contextlib.ExitStack() as stack:
+        busy = idle_sockets(server.port, 8)
+        for s in busy:
+            stack.callback(s.close)
+            # A request in progress: its header sent, its body still to come.
+            s.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+                      b"content-length: 100\r\n\r\n{")
+        time.sleep(0.3)
+        assert httpx.get(f"{server.url}/healthz", timeout=10).status_code == 200
+        refused = httpx.get(f"{server.url}/api/v1/materials", timeout=10)
+        assert refused.status_code == 503 and "COATED_MAX_CONNECTIONS" in refused.json()["detail"]
+        assert still_open(busy) == 8  # busy connections are never evicted

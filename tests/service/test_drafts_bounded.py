@@ -1,0 +1,89 @@
+"""
+Issue 20, item 4: drafts as references, with a life, against a real
+``python -m service`` on 127.0.0.1. A draft refers to the stored record
+holding its n, k (100 live steps on a 20,000-sample upload add under 2 MB);
+drafts past their time to live, or past the drafts' quota, are removed in
+the background, saved fits never.
+"""
+
+from __future__ import annotations
+
+import sqlite3
+import time
+
+import httpx
+import numpy as np
+import pytest
+
+from conftest import server_process
+
+pytestmark = [pytest.mark.slow, pytest.mark.server]
+API = "/api/v1"
+ANGLE = np.linspace(0.0, 90.0, 31)
+
+
+def big_csv(samples=20_000) -> bytes:
+    """A 20,000-sample n, k upload (CSV, under the upload limit)."""
+    wavelength = np.linspace(300.0, 900.0, samples)
+    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2)
+    k = 1.8 + 4.0 * (wavelength - 300.0) / 600.0
+    rows = "".join(f"{w:.4f},{a:.6f},{b:.6f}\n" for w, a, b in zip(wavelength, n, k))
+    return ("wavelength_nm,n,k\n" + rows).encode()
+
+
+def step(base_id, start, value, live=True):
+    rgb = np.full((ANGLE.size, 3), 0.6)
+    rgb[:, 1] = value
+    return {"name": "dragged", "base": {"fit": base_id}, "draft": True, "live": live,
+            **({"start_fit": start} if live else {}),
+            "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": rgb.tolist()}]}
+
+
+def stored_bytes(data_dir):
+    with sqlite3.connect(data_dir / "store.sqlite3") as db:
+        return db.execute("SELECT coalesce(sum(length(record)), 0) FROM fits").fetchone()[0]
+
+
+def test_100_live_steps_on_a_20000_sample_upload_add_under_2_mb(tmp_path):
+    data = tmp_path / "data"
+    with server_process(data) as server, httpx.Client(base_url=server.url, timeout=120) as http:
+        base = http.post(f"{API}/fits/upload", files={"file": ("big.csv", big_csv(), "text/csv")})
+        assert base.status_code == 201, base.text[:300]
+        base_id = start = base.json()["id"]
+        before = stored_bytes(data)
+        for i in range(100):
+            answer = http.post(f"{API}/fits/from-curves", json=step(base_id, start, 0.5 + 0.002 * i))
+            assert answer.status_code == 201, answer.text[:300]
+            start = answer.json()["id"]
+        grown = stored_bytes(data) - before
+        assert grown < 2_000_000, grown
+        # The draft still has its n, k (through its reference): curves against the measured data.
+        fit = http.get(f"{API}/fits/{start}").json()
+        assert fit["has_nk"] is True
+        curves = http.get(f"{API}/fits/{start}/curves", params={"eta_i": 1.5})
+        assert curves.status_code == 200, curves.text[:300]
+
+
+def test_drafts_expire_and_count_against_their_quota(tmp_path):
+    data = tmp_path / "data"
+    with server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server, \
+            httpx.Client(base_url=server.url, timeout=120) as http:
+        base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
+        draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5, live=False))
+        assert draft.status_code == 201, draft.text[:300]
+        draft_id = draft.json()["id"]
+        assert http.get(f"{API}/fits/{draft_id}").status_code == 200
+        deadline = time.monotonic() + 20
+        while http.get(f"{API}/fits/{draft_id}").status_code == 200 and time.monotonic() < deadline:
+            time.sleep(0.25)
+        assert http.get(f"{API}/fits/{draft_id}").status_code == 404
+        assert http.get(f"{API}/fits/{base}").status_code == 200  # saved fits never expire
+    with server_process(tmp_path / "quota", COATED_DRAFT_MAX_BYTES="20000", COATED_DRAFT_SWEEP_S="0.5") as server, \
+            httpx.Client(base_url=server.url, timeout=120) as http:
+        base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
+        ids = [http.post(f"{API}/fits/from-curves", json=step(base, None, 0.3 + 0.05 * i, live=False)).json()["id"]
+               for i in range(6)]
+        time.sleep(1.5)
+        kept = [http.get(f"{API}/fits/{i}").status_code == 200 for i in ids]
+        assert kept[-1] and not kept[0], kept  # the oldest went first
+        assert stored_bytes(tmp_path / "quota") - 0 < 200_000

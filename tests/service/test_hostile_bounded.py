@@ -1,0 +1,92 @@
+"""
+Issue 20, item 1, as a fresh corpus against a real ``python -m service`` on
+127.0.0.1: worst-case curve refits (degenerate bases, edits the model cannot
+follow), generated with a fixed seed, ten at once on two workers. Every one
+is answered 2xx within its budget, in [0, 1] (a best effort when flagged),
+and a library fit sent meanwhile is answered within 2 s: parts take turns
+in the workers cheapest first (service/turns.py).
+"""
+
+from __future__ import annotations
+
+import random
+import threading
+import time
+
+import httpx
+import numpy as np
+import pytest
+
+from conftest import server_process
+
+pytestmark = [pytest.mark.slow, pytest.mark.server]
+API = "/api/v1"
+SEED = 20261221
+
+
+def degenerate_base(rng: random.Random) -> dict:
+    """A base with (almost) no conductor: n near 1 or a plain dielectric, k 0."""
+    shape = rng.choice(["void", "dielectric", "two points"])
+    if shape == "void":
+        return {"nk": {"wavelength_nm": [300, 900], "n": [1.0, 1.0 + rng.random() * 1e-3], "k": [0, 0]}}
+    if shape == "dielectric":
+        n = rng.uniform(1.2, 2.5)
+        return {"nk": {"wavelength_nm": [300, 600, 900], "n": [n, n, n], "k": [0, 0, 0]}}
+    return {"nk": {"wavelength_nm": [350, 850], "n": [rng.uniform(0.1, 3), rng.uniform(0.1, 3)], "k": [0, 1e-6]}}
+
+
+def unreachable_curve(rng: random.Random, base_is_metal: bool) -> dict:
+    samples = rng.choice([8, 16, 31])
+    angles = np.linspace(0.0, 90.0, samples)
+    rgb = np.full((samples, 3), rng.uniform(0.3, 0.9))
+    channel, at = rng.randrange(3), rng.uniform(30.0, 80.0)
+    pull = np.exp(-0.5 * ((angles - at) / 8.0) ** 2)
+    rgb[:, channel] += (rng.choice([0.0, 0.02, 1.0]) - rgb[:, channel]) * pull
+    if not base_is_metal and rng.random() < 0.5:
+        rgb[:] = rng.uniform(0.2, 0.8)  # a flat curve on a base with no conductor
+    return {"eta_i": rng.choice([1.0, 1.33, 1.5, 2.0, 2.5]), "angle_deg": angles.tolist(),
+            "rgb": np.clip(rgb, 0.0, 1.0).tolist()}
+
+
+def corpus(seed: int = SEED, count: int = 10) -> list[dict]:
+    rng = random.Random(seed)
+    out = []
+    for i in range(count):
+        metal = i % 2 == 1
+        base = {"material": rng.choice(["Au", "Cu", "Ag", "Al", "Cr"])} if metal else degenerate_base(rng)
+        curves = [unreachable_curve(rng, metal) for _ in range(rng.choice([1, 1, 2]))]
+        if len({c["eta_i"] for c in curves}) < len(curves):
+            curves = curves[:1]
+        out.append({"name": f"worst {i}", "base": base, "curves": curves})
+    return out
+
+
+def test_worst_case_refits_are_bounded_and_do_not_hold_a_library_fit(tmp_path):
+    answers: list[tuple[int, float, dict]] = []
+    with server_process(tmp_path / "data", COATED_FIT_WORKERS="2", COATED_FIT_QUEUE="16") as server:
+        def send(body):
+            with httpx.Client(base_url=server.url, timeout=120) as http:
+                t0 = time.perf_counter()
+                response = http.post(f"{API}/fits/from-curves", json=body)
+                answers.append((response.status_code, time.perf_counter() - t0, response.json()))
+
+        threads = [threading.Thread(target=send, args=(body,)) for body in corpus()]
+        for thread in threads:
+            thread.start()
+        with httpx.Client(base_url=server.url, timeout=120) as http:
+            deadline = time.monotonic() + 30
+            while http.get("/healthz").json()["fits_in_flight"] < 6 and time.monotonic() < deadline:
+                time.sleep(0.02)
+            t0 = time.perf_counter()
+            library = http.post(f"{API}/fits", json={"material": "Ag", "eta_i_range": [1.0, 2.4]})
+            library_s = time.perf_counter() - t0
+        for thread in threads:
+            thread.join(120)
+    assert library.status_code == 201, library.text[:300]
+    assert library_s < 2.0, library_s
+    assert len(answers) == 10
+    for status, seconds, body in answers:
+        assert status in (200, 201), (status, str(body)[:300])
+        target = body["metrics"]["details"]["target"]
+        assert target["model_min"] >= -1e-4 and target["model_max"] <= 1.0 + 1e-4, target
+        assert seconds < 30.0

@@ -1,0 +1,135 @@
+"""
+service.pool (issue 20): every part of a job has a CPU-time limit, and a job
+no request waits for any more (timed out, or its client gone) is cancelled,
+its worker free within a second. Real worker processes (spawn).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+
+import numpy as np
+import pytest
+
+from service.pool import FitRunner, FitTimeout, JobCPULimit, Quarantined, WorkerLost
+
+pytestmark = pytest.mark.slow
+
+
+def degenerate_refit() -> float:
+    """A worst-case curve refit (a base with no conductor), ~0.5 s of CPU."""
+    from fitting.fits.curves import fit_curves
+    from fitting.fits.curves_base import curve_base_from_nk
+    from fitting.optics.nk import SpectralNK
+
+    base = curve_base_from_nk(SpectralNK(np.array([300.0, 900.0]), np.ones(2), np.zeros(2), name="void"))
+    angles = np.linspace(0.0, 90.0, 16)
+    curves = [{"eta_i": 1.5, "angle_deg": angles.tolist(), "rgb": np.full((16, 3), 0.5).tolist()}]
+    return fit_curves(curves, base).metrics["delta_E_mean"]
+
+
+async def _with_runner(body, **kwargs):
+    runner = FitRunner(1, 4, **kwargs)
+    try:
+        await runner.warm_up()
+        return await body(runner)
+    finally:
+        runner.close()
+
+
+def test_a_part_past_its_cpu_limit_is_stopped_with_a_clear_error():
+    async def body(runner):
+        with pytest.raises(JobCPULimit, match=r"CPU-time limit of 0\.05 s"):
+            await runner.run(degenerate_refit)
+        return await runner.run(time.time)  # the worker serves the next job
+
+    assert asyncio.run(_with_runner(body, timeout_s=60.0, cpu_limit_s=0.05)) > 0
+
+
+def test_a_timed_out_job_is_cancelled_and_its_worker_free_within_a_second():
+    async def body(runner):
+        with pytest.raises(FitTimeout):
+            await runner.once("sleeper", lambda: runner.run(time.sleep, 30.0))
+        t0 = time.perf_counter()
+        await runner.run(time.time)
+        return time.perf_counter() - t0
+
+    assert asyncio.run(_with_runner(body, timeout_s=0.3)) < 1.0
+
+
+def test_a_job_whose_waiter_is_cancelled_is_cancelled():
+    # A client that disconnects cancels its request's task.
+    async def body(runner):
+        waiter = asyncio.ensure_future(runner.once("sleeper", lambda: runner.run(time.sleep, 30.0)))
+        await asyncio.sleep(0.3)
+        waiter.cancel()
+        t0 = time.perf_counter()
+        await runner.run(time.time)
+        return time.perf_counter() - t0, runner.in_flight
+
+    seconds, in_flight = asyncio.run(_with_runner(body, timeout_s=60.0))
+    assert seconds < 1.0 and in_flight == 0
+
+
+def test_a_shared_job_runs_on_while_one_waiter_remains():
+    async def body(runner):
+        make = lambda: runner.run(time.sleep, 0.6)  # noqa: E731
+        first = asyncio.ensure_future(runner.once("shared", make))
+        second = asyncio.ensure_future(runner.once("shared", make))
+        await asyncio.sleep(0.2)
+        first.cancel()
+        return await second
+
+    asyncio.run(_with_runner(body, timeout_s=60.0))
+
+
+def test_a_job_that_kills_its_workers_fails_only_itself_and_is_quarantined():
+    import os
+
+    async def body(runner):
+        others = [asyncio.ensure_future(runner.once(f"other{i}", lambda i=i: runner.run(time.sleep, 0.4)))
+                  for i in range(5)]
+        await asyncio.sleep(0.1)
+        with pytest.raises(WorkerLost, match="three times"):
+            await runner.once("killer", lambda: runner.run(os._exit, 1))
+        results = await asyncio.gather(*others, return_exceptions=True)
+        with pytest.raises(Quarantined):
+            await runner.once("killer", lambda: runner.run(time.time))
+        return results, await runner.run(time.time)
+
+    async def with_two_workers():
+        runner = FitRunner(2, 16, timeout_s=60.0, quarantine_s=30.0)
+        try:
+            await runner.warm_up()
+            return await body(runner)
+        finally:
+            runner.close()
+
+    results, after = asyncio.run(with_two_workers())
+    assert results == [None] * 5, results  # every unrelated job answered
+    assert after > 0
+
+
+def test_turns_let_the_cheapest_waiting_part_go_first():
+    from service.turns import Turns
+
+    async def body():
+        turns, order = Turns(1), []
+
+        async def part(name, cost):
+            async with turns.turn(cost):
+                order.append(name)
+                await asyncio.sleep(0.01)
+
+        first = asyncio.ensure_future(part("first", 5.0))
+        await asyncio.sleep(0)
+        waiting = [asyncio.ensure_future(part(n, c)) for n, c in (("slow", 5.0), ("cancelled", 0.01),
+                                                                   ("cheap", 0.1), ("slow2", 5.0))]
+        await asyncio.sleep(0)
+        waiting[1].cancel()
+        await asyncio.gather(first, *waiting, return_exceptions=True)
+        return order, turns.running
+
+    order, running = asyncio.run(body())
+    assert order == ["first", "cheap", "slow", "slow2"] and running == 0
