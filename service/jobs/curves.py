@@ -30,12 +30,7 @@ import numpy as np
 from fitting.colour.delta_e import delta_E_map
 from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, cos_theta_from_angle
 from fitting.fits.curves import LIVE_SETTINGS, CurveFitSettings, fit_curves
-from fitting.fits.curves_base import (
-    CurveBase,
-    curve_base_from_coefficients,
-    curve_base_from_nk,
-    edited_target,
-)
+from fitting.fits.curves_base import CurveBase, curve_base_from_coefficients, curve_base_from_nk, edited_target
 from fitting.fits.curves_input import check_curves
 from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
 from fitting.models.pack import material_from_json, material_to_json
@@ -44,18 +39,8 @@ from fitting.optics.nk import SpectralNK
 
 from ..pool import FitRunner
 from ..store import FitRecord, Store
-from .common import (
-    FIT_FORMAT_VERSION,
-    check_finite,
-    checked_version,
-    checked_writable,
-    content_address,
-    fit_record,
-    measured_nk,
-    nk_holder,
-    stored_fit,
-    with_measured_nk,
-)
+from .common import (FIT_FORMAT_VERSION, check_finite, checked_version, checked_writable, content_address,
+                     fit_record, measured_nk, nk_holder, stored_fit, with_measured_nk)
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
 
