@@ -293,8 +293,10 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         measured = None
 
     settings = LIVE_SETTINGS if fit.live else DEFAULTS
+    made_here = []  # set when this request's own job ran (and, unless a draft, saved)
 
     async def make() -> FitRecord:
+        made_here.append(True)
         job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
                                fit.objective, fit.blend_width, fit.model, fit.live, fit.start,
                                cost_s=0.03 if fit.live else 0.5)  # its turn: live steps first
@@ -316,11 +318,10 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         return await asyncio.to_thread(put, record, not fit.draft, expected_version)
 
     record = await runner.once(fit.fit_id, make)
-    if not fit.draft:
-        # The fit was shared with a draft request in flight: saved now.
-        latest = await asyncio.to_thread(store.latest_fit, record.material_id)
-        if latest is None or latest.id != record.id:
-            record = await asyncio.to_thread(put, record, True, expected_version)
+    if not fit.draft and not made_here:
+        # Another request's flight made it (a draft's, or the same save's): saved now,
+        # once. (Asking whether it is the latest would race with other saves.)
+        record = await asyncio.to_thread(put, record, True, expected_version)
     return record, True
 
 

@@ -102,6 +102,7 @@ class TestSmallOnesByClass:
         assert refused.status_code == 400 and refused.headers.get("x-frame-options") == "DENY"
 
 
+@pytest.mark.slow  # starts a process (the guard in tests/conftest.py)
 def test_a_full_disk_is_not_writable_even_with_no_reserve(tmp_path, monkeypatch):
     with app_client(tmp_path, store_min_free_bytes=0) as client:
         assert client.get("/healthz").json()["store_writable"] is True
