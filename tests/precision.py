@@ -39,3 +39,15 @@ F64_FEW_OPS = 64 * U64
 # The user's promise for Delta E (docs/service.md): within 0.001 of the
 # 1 nm / 100 x 100 definition.
 DELTA_E_PROMISE = 1e-3
+
+# GLSL in float32 (llvmpipe here, SwiftShader in the browser tests) against
+# numpy's float64 at the same float32 inputs. GLSL ES 3.00 section 4.5.1
+# (highp): +, -, * correctly rounded (llvmpipe contracts a * b + c into one
+# FMA or not, by the host CPU: either is within the count below), / and
+# inversesqrt within 2.5 ulps, exp2 and log2 within 3 ulps (log2 within
+# 2^-21 absolute on [0.5, 2]), pow(x, y) inherited from exp2(y log2 x): a
+# relative error of |y| 2^-21 ln 2 + 3 ulps. The coated-conductor model's
+# longest path: ~30 roundings of terms <= 2 (30 * 2 u32 = 3.6e-6) plus two
+# pows with |y| <= ~6 on terms <= 1 (2 * (6 * 3.3e-7 + 3 u32) = 4.3e-6):
+# 7.9e-6 <= 1e-5 (absolute below 1, relative above, as each test states).
+GLSL_F32_BOUND = 1.0e-5
