@@ -45,9 +45,12 @@ DELTA_E_PROMISE = 1e-3
 # (highp): +, -, * correctly rounded (llvmpipe contracts a * b + c into one
 # FMA or not, by the host CPU: either is within the count below), / and
 # inversesqrt within 2.5 ulps, exp2 and log2 within 3 ulps (log2 within
-# 2^-21 absolute on [0.5, 2]), pow(x, y) inherited from exp2(y log2 x): a
-# relative error of |y| 2^-21 ln 2 + 3 ulps. The coated-conductor model's
-# longest path: ~30 roundings of terms <= 2 (30 * 2 u32 = 3.6e-6) plus two
-# pows with |y| <= ~6 on terms <= 1 (2 * (6 * 3.3e-7 + 3 u32) = 4.3e-6):
-# 7.9e-6 <= 1e-5 (absolute below 1, relative above, as each test states).
+# 2^-21 absolute on [0.5, 2]), pow(x, y) inherited from exp2(y log2 x). For a
+# term c x^y with x in [0, 1] that is an absolute error of at most
+# |c| x^y (3 u32 + |y| 2^-21 ln 2 + 3 u32 |y log2 x|), and x^y |y ln x| <= 1/e.
+# The coated-conductor model: ~30 roundings of terms <= 2 (30 * 2 u32 =
+# 3.6e-6); Schlick's (1 - mu)^5 (|c| <= 1): 5 * 3.3e-7 + 6 u32 = 2.0e-6;
+# the a mu (1 - mu)^alpha term (|a| <= 4, any alpha): 4 (6 u32 + 1/e 3.3e-7
+# + ...) <= 2e-6. In all <= 7.6e-6 <= 1e-5 (absolute below 1, relative
+# above, as each test states).
 GLSL_F32_BOUND = 1.0e-5
