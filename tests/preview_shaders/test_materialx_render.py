@@ -45,6 +45,9 @@ class TestRenderMaterialX:
         # Away from the silhouette, where a pixel's normal is well defined.
         inner = mask & (mu > 0.3)
         error = np.abs(image[inner] - mx_fresnel_conductor(mu[inner], values.n_rel, values.k_rel))
+        # The documented figure (docs/exports.md: mean 0.0008, max 0.007 away
+        # from the silhouette; asserted < 0.002 / < 0.02): MaterialX's GLSL
+        # renderer's pixel footprint and 8-bit target, not float32 rounding.
         assert error.mean() < 2e-3 and error.max() < 2e-2, (error.mean(), error.max())
 
     @pytest.mark.slow  # 3.1 s (all cases 3.7 s) in a --durations=0 run

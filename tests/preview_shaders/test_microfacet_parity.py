@@ -13,10 +13,11 @@ import pytest
 from fitting.shading.microfacet import microfacet_brdf
 from preview_shaders.gl import RenderThread
 from preview_shaders.shading import evaluate_brdf_grid
+from precision import GLSL_F32_BOUND
 
 pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
-TOLERANCE = 1.0e-5
+TOLERANCE = GLSL_F32_BOUND  # float32 GLSL against float64 numpy: derived in tests/precision.py
 """Float32 shader against float64 numpy: absolute below 1/sr, relative above
 (the GGX peak reaches 2e6/sr, where float32 holds ~7 significant digits)."""
 

@@ -22,6 +22,7 @@ from fitting.models.pack import encode_pack, pack_from_json
 from fitting.optics.library import library_material
 from preview_shaders.gl import RenderThread
 from preview_shaders.preview import PreviewRenderer, sphere_cos_theta
+from precision import GLSL_F32_BOUND
 
 pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
@@ -59,6 +60,8 @@ class TestSphereValues:
         # Odd size: the centre pixel's centre is the sphere's centre.
         result = renderer.render_preview(gold, None, 1.5, 65)
         assert result.cos_theta[32, 32] == 1.0
+        # mu = 1 exactly: pow(0, y) = 0, so only the t-polynomial's ~6 float32
+        # roundings of terms <= ~1 remain: 6 * 2 u32 = 7e-7 < 1e-6.
         np.testing.assert_allclose(result.image[32, 32], _model(gold, 1.0, 1.5), atol=1e-6, rtol=0)
 
     def test_rim_pixel_is_the_model_at_its_cos_theta(self, renderer, gold):
@@ -70,15 +73,21 @@ class TestSphereValues:
         column = int(np.flatnonzero(mask[row])[0])  # leftmost sphere pixel
         assert 0.0 < cos_theta[row, column] < 0.35
         np.testing.assert_allclose(
+            # Near the rim: GLSL_F32_BOUND plus the float32 cos theta's error
+            # (u32 / z, z >= ~0.1 here: 6e-7) times the model's slope there
+            # (<= ~10): 1e-5 + 6e-6 < 2e-5.
             result.image[row, column], _model(gold, cos_theta[row, column], 2.0), atol=2e-5, rtol=0
         )
 
     def test_every_sphere_pixel_is_the_model_under_the_white_sky(self, renderer, gold):
         result = renderer.render_preview(gold, None, 1.8, 64)
         cos_theta, mask = sphere_cos_theta(64)
+        # cos theta = sqrt(1 - x^2 - y^2) in float32 against float64: ~4
+        # roundings, the difference's condition 1 / z^2 near the rim: <= 1e-5
+        # for the rim pixels' z >= ~0.08.
         assert np.abs(result.cos_theta - cos_theta)[mask].max() < 1e-5
         expected = _model(gold, result.cos_theta[mask], 1.8)
-        assert np.abs(result.image[mask] - expected).max() <= 1e-5
+        assert np.abs(result.image[mask] - expected).max() <= GLSL_F32_BOUND
         np.testing.assert_array_equal(result.image[~mask], 1.0)
 
     def test_lazanyi_half_is_adjusted_lazanyi(self, renderer, gold, nk):
@@ -90,7 +99,7 @@ class TestSphereValues:
             result.cos_theta[result.mask & right].astype(np.float64), 2.5,
             inputs["F0_air"], inputs["F82_air"],
         )
-        assert np.abs(result.image[result.mask & right] - expected).max() <= 1e-5
+        assert np.abs(result.image[result.mask & right] - expected).max() <= GLSL_F32_BOUND
         left = result.mask & ~right
         np.testing.assert_array_equal(result.image[left], result.model[left])
 
@@ -103,7 +112,7 @@ class TestSphereValues:
         result = renderer.render_preview(gold, None, 1.5, 64, environment="studio")
         mask = result.mask
         expected = _model(gold, result.cos_theta[mask], 1.5) * result.radiance[mask]
-        assert np.abs(result.image[mask] - expected).max() <= 1e-5
+        assert np.abs(result.image[mask] - expected).max() <= GLSL_F32_BOUND
         # The studio is not uniform: it has lights and a floor.
         assert result.radiance[mask].max() > 1.0 and result.radiance[mask].min() < 0.1
 
@@ -130,11 +139,14 @@ class TestReference:
         result = renderer.render_preview(gold, nk, 1.5, 64, "reference")
         mask = result.mask
         expected = reference_ACEScg(nk, result.cos_theta[mask].astype(np.float64), 1.5)
+        # The reference table (a spline within REFERENCE_TABLE_TOLERANCE = 1e-7)
+        # stored in float32 (u32 of values <= 1) at float32 cos theta: 2e-7 < 1e-6.
         np.testing.assert_allclose(result.comparison[mask], expected, atol=1e-6, rtol=0)
         np.testing.assert_array_equal(result.comparison[~mask], 1.0)
         assert result.delta_E.shape == result.flip.shape == (64, 64)
         # Outside the sphere both images are the sky: no difference.
         assert np.all(result.delta_E[~mask] == 0.0)
+        # Product figures (the fit's quality on the sphere), not precision.
         assert 0.0 < result.delta_E_mean < 1.0
         assert 0.0 < result.flip_mean < 0.1
 

@@ -16,10 +16,11 @@ from fitting.models.rgb_conductor import rgb_conductor_model
 from fitting.models.pack import PackedMaterial, to_float16
 from preview_shaders.evaluate import MODEL_VARIANTS, evaluate_grid, shader_inputs
 from preview_shaders.gl import RenderThread, load_shader_source
+from precision import GLSL_F32_BOUND
 
 pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
-TOLERANCE = 1.0e-5
+TOLERANCE = GLSL_F32_BOUND  # float32 GLSL against float64 numpy: derived in tests/precision.py
 """Absolute: float32 arithmetic in the shader against float64 numpy."""
 
 MU_AXIS = (0.0, 1.0 / 255.0, 256)

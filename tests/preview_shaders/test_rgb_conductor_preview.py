@@ -11,7 +11,7 @@ from fitting.models.rgb_conductor import rgb_conductor_model
 from fitting.optics.library import library_material
 from preview_shaders.preview import PreviewRenderer
 
-pytestmark = pytest.mark.gl
+pytestmark = [pytest.mark.gl, pytest.mark.numeric]
 
 
 @pytest.fixture(scope="module")
@@ -33,4 +33,7 @@ def test_rgb_conductor_preview_against_reference(renderer):
     expected = rgb_conductor_model(
         ours.cos_theta[:, :32][mask].astype(np.float64), 1.5, rgb.coefficients.astype(np.float64)
     ) * ours.radiance[:, :32][mask]
+    # The exact rgb-conductor Fresnel in float32 GLSL: its cancelling
+    # 1 - sin^2 term near the critical angle (as in test_hard_cases' 1e-4:
+    # 6e-5 at the closest pixel) times the radiance; not the smooth model's 1e-5.
     assert np.abs(ours.model[:, :32][mask] - expected).max() < 1e-4

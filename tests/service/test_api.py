@@ -76,7 +76,8 @@ class TestMaterials:
         library = [m for m in materials if m["kind"] == "library"]
         assert [m["id"] for m in library] == list(LIBRARY_NAMES)
         gold = library[LIBRARY_NAMES.index("Au")]
-        assert "Johnson" in gold["source"] and gold["coverage"] == pytest.approx(1.0)
+        assert "Johnson" in gold["source"] and gold["coverage"] == pytest.approx(1.0)  # a ratio of
+        # equal sums, 1 to a few u64; approx's default rel=1e-6 is loose but harmless
         assert gold["latest_fit_id"] is None
 
     def test_library_material_detail(self, client):
@@ -169,6 +170,8 @@ class TestFits:
         assert response.status_code == 201, response.text
         fit = response.json()
         assert fit["kind"] == "nk" and fit["name"] == "my gold" and fit["source"] == "lab 2024"
+        # The pack keeps the range in float32 (u32 = 6e-8 relative): approx's
+        # default rel=1e-6 covers it 17x.
         assert fit["eta_i_range"] == pytest.approx([1.2, 1.8]) and fit["objective"] == "rgb" and fit["has_nk"]
         saved = [m for m in client.get(f"{API}/materials").json()["materials"] if m["kind"] == "nk"]
         assert fit["material_id"] in [m["id"] for m in saved]
@@ -382,9 +385,13 @@ class TestCurves:
         mu = np.cos(np.radians(theta))
         coefficients = np.array([fit["coefficients"][p] for p in ("F0", "a", "alpha")])
         np.testing.assert_allclose(
-            curves["model"], coated_conductor_model(np.clip(mu, 0, 1), 1.5, coefficients), atol=1e-12
+            curves["model"], coated_conductor_model(np.clip(mu, 0, 1), 1.5, coefficients), atol=1e-12  # the
+            # same float64 kernel on JSON-exact inputs; only cos(radians) rounds
+            # differently by <= 4 ulps, times the model's slope <= ~10: 5e-15
         )
         reference = np.array(curves["reference"])
+        # The float64 reference by another path: within F64_RGB_BOUND (1.3e-13,
+        # tests/precision.py); assert_allclose's default rtol=1e-7 holds it with room.
         np.testing.assert_allclose(reference, reference_ACEScg(library_material("Au"), np.clip(mu, 0, 1), 1.5))
         assert delta_E_map(reference, np.array(curves["model"])).mean() < 1.0
         assert np.array(curves["lazanyi_adjusted"]).shape == (19, 3)

@@ -122,6 +122,7 @@ def test_glsl_pack_split_sum_matches_numpy():
     mu = (np.arange(size[0]) / (size[0] - 1)).astype(np.float32)[None, :]
     r = (np.arange(size[1]) / (size[1] - 1)).astype(np.float32)[:, None]
     expected = split_sum_model(mu, r, F0, a, alpha, lut)
+    # GLSL float32 against float64 numpy: GLSL_F32_BOUND (tests/precision.py).
     np.testing.assert_allclose(got[..., :3], expected, atol=1e-5)
 
 

@@ -36,13 +36,16 @@ def test_texture_is_the_reference_grid(shared, gold):
     texture = np.frombuffer(response.content, dtype="<f4").reshape(height, width, 3)
     nk = library_material("Au")
     base = curve_base_from_nk(nk, (1.0, 2.5))
+    # The texture is base.RGB rounded to float32: u32 = 6e-8 relative
+    # (rtol 1e-6 = 17 u32; atol 1e-7 for values near 0).
     np.testing.assert_allclose(texture, base.RGB, rtol=1e-6, atol=1e-7)
     # Row j is eta_i = 1 + 0.05 j, column i is cos theta = i / 256.
-    np.testing.assert_allclose(texture[10, 256], base.rgb(1.0, 1.5), rtol=1e-6)
+    np.testing.assert_allclose(texture[10, 256], base.rgb(1.0, 1.5), rtol=1e-6)  # a node: float32, as above
     assert [float(v) for v in response.headers["x-eta-i-range"].split(",")] == [1.0, 2.5]
     inputs = baseline_inputs(nk)
     for header, key in (("x-f0-air", "F0_air"), ("x-f82-air", "F82_air")):
-        np.testing.assert_allclose([float(v) for v in response.headers[header].split(",")], inputs[key], rtol=1e-8)
+        np.testing.assert_allclose([float(v) for v in response.headers[header].split(",")], inputs[key], rtol=1e-8)  # headers
+        # print ~9 significant digits: within 5e-9 relative
 
 
 @pytest.mark.slow  # starts a process or GL context

@@ -84,6 +84,10 @@ def test_glsl_snippet_matches_numpy(index):
     mu = np.linspace(0.0, 1.0, image.shape[1])[None, :]
     eta = np.linspace(1.0, 3.0, image.shape[0])[:, None]
     expected = coated_conductor_model(mu, eta, coefficients, tuple(view["eta_i_range"]))
+    # The snippet in float32 GLSL against float64 numpy: GLSL_F32_BOUND
+    # (tests/precision.py) plus the float32 grid coordinates (u32 x the
+    # model's slope <= ~10 = 6e-7) and the JSON coefficients' float32
+    # literals in the source (u32 x terms <= ~6 = 4e-7): 2e-5 with room.
     np.testing.assert_allclose(image, expected, atol=2e-5)
 
 

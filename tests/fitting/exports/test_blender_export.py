@@ -47,7 +47,8 @@ def run_in_blender(values, tmp_path: Path, output: str) -> tuple[dict, np.ndarra
 
 
 def assert_rgb(actual, expected):
-    # Blender stores float32.
+    # Blender stores float32: u32 = 6e-8 relative; 1e-6 (17 u32) allows a
+    # float32 conversion on each side.
     np.testing.assert_allclose(actual[:3], expected, rtol=1e-6, atol=1e-6)
 
 
@@ -71,6 +72,7 @@ class TestPrincipled:
         assert_rgb(inputs["Base Color"], values.F0)
         assert_rgb(inputs["Specular Tint"], values.F82_tint)
         assert inputs["Metallic"] == 1.0 and inputs["Coat Weight"] == 1.0
+        # float32 storage, as assert_rgb.
         assert inputs["Coat IOR"] == pytest.approx(values.eta_i, rel=1e-6)
         assert inputs["Roughness"] == pytest.approx(0.3, rel=1e-6)
         assert inputs["Coat Roughness"] == pytest.approx(0.05, rel=1e-6)
@@ -101,7 +103,7 @@ class TestPhysicalConductor:
         assert metallic["fresnel_type"] == "PHYSICAL_CONDUCTOR"
         assert_rgb(metallic["inputs"]["IOR"], values.n_rel)
         assert_rgb(metallic["inputs"]["Extinction"], values.k_rel)
-        assert nodes[NODE_NAMES["coat_fresnel"]]["inputs"]["IOR"] == pytest.approx(1.6, rel=1e-6)
+        assert nodes[NODE_NAMES["coat_fresnel"]]["inputs"]["IOR"] == pytest.approx(1.6, rel=1e-6)  # float32, as assert_rgb
         assert nodes[NODE_NAMES["conductor_output"]]["is_active_output"] is True
         assert nodes[NODE_NAMES["output"]]["is_active_output"] is False
         links = conductor[0]["links"]

@@ -73,6 +73,9 @@ class TestRoundTrip:
         gltf = pygltflib.GLTF2().load(str(path))
         (material,) = gltf.materials
         pbr = material.pbrMetallicRoughness
+        # Written as float32 (glTF's component type): u32 = 6e-8 of values <= 1;
+        # 1e-6 allows a conversion on each side (approx's default rel=1e-6 below
+        # likewise, 17 u32).
         np.testing.assert_allclose(pbr.baseColorFactor[:3], values.F0_schlick, atol=1e-6)
         assert pbr.baseColorFactor[3] == 1.0 and pbr.metallicFactor == 1.0
         assert pbr.roughnessFactor == pytest.approx(0.35)
@@ -90,7 +93,8 @@ class TestRoundTrip:
         assert len(data) == gltf.buffers[0].byteLength
         view = gltf.bufferViews[gltf.accessors[0].bufferView]
         positions = np.frombuffer(data, np.float32, gltf.accessors[0].count * 3, view.byteOffset)
-        np.testing.assert_allclose(np.linalg.norm(positions.reshape(-1, 3), axis=1), 1.0, atol=1e-6)
+        np.testing.assert_allclose(np.linalg.norm(positions.reshape(-1, 3), axis=1), 1.0, atol=1e-6)  # float32
+        # unit vectors: 3 coordinates each within u32: the norm within ~3 u32 = 2e-7
 
     def test_sphere_faces_outward(self):
         positions, _, indices = uv_sphere()
@@ -118,7 +122,7 @@ class TestBlenderImport:
         material = json.loads(read_back.read_text())
         (principled,) = [n for n in material["nodes"].values() if n["type"] == "ShaderNodeBsdfPrincipled"]
         inputs = principled["inputs"]
-        np.testing.assert_allclose(inputs["Base Color"][:3], values.F0_schlick, atol=1e-6)
+        np.testing.assert_allclose(inputs["Base Color"][:3], values.F0_schlick, atol=1e-6)  # float32, as above
         assert inputs["Metallic"] == 1.0 and inputs["Coat Weight"] == 1.0
         # glTF's clear coat has index 1.5 whatever the export was fitted for.
         assert inputs["Coat IOR"] == pytest.approx(1.5)

@@ -77,6 +77,11 @@ class TestMtlx:
         assert valid, message
         (material,) = doc.getMaterialNodes()
         shader = material.getConnectedNode("surfaceshader")
+        # MaterialX values are written with 6 significant digits
+        # (fitting/exports/_xml.py): within 5e-6 relative; these inputs are
+        # short decimals (1.5, 0.2, 0.03), exact in 6 digits, so approx's
+        # default rel=1e-6 holds. Vectors: rtol 1e-5 = 2 x 5e-6; atol 1e-6 for
+        # values in [0, 1] (at most 5e-7 off).
         assert value_of(shader, "coat_ior") == pytest.approx(values.eta_i)
         assert value_of(shader, "base_roughness") == pytest.approx(values.roughness)
         assert value_of(shader, "coat_roughness") == pytest.approx(values.coat_roughness)

@@ -59,10 +59,13 @@ def test_extreme_edits_stay_in_range(material, edits):
     curves = [pulled(base, *edit) for edit in edits]
     result = fit_curves(curves, base)
     low, high = dense_range(result)
+    # The documented range promise is 1e-4 over on the fit's check grid
+    # (docs/editor.md); this dense 181 x 121 grid also samples between its
+    # points, where the float16 model may bulge by as much again: 2e-4.
     assert low >= -2e-4 and high <= 1.0 + 2e-4, (low, high)
     target = result.metrics["target"]
     # Beyond the model's reach: the largest miss is reported with its place.
-    assert target["delta_E_max"] > 3.0
+    assert target["delta_E_max"] > 3.0  # the warning threshold (docs/editor.md), not precision
     assert 0.0 <= target["at_theta_deg"] <= 90.0 and 1.0 <= target["at_eta_i"] <= 2.5
     assert target["grid"] == f"{SCORE_GRID[0]} angles x {SCORE_GRID[1]} eta_i"
 
@@ -77,8 +80,10 @@ def test_reported_figures_are_over_the_whole_blended_target():
     assert result.metrics["target"] == again
     target = edited_target(base, curves, M, E, 0.5)
     dE = delta_E_map(target, coated_conductor_model(M, E, result.packed.coefficients, base.eta_i_range))
-    assert again["delta_E_mean"] == pytest.approx(float(dE.mean()))
-    assert again["delta_E_max"] == pytest.approx(float(dE.max()))
+    # The same Delta E by another path (~1e-12 per sample): tightened from
+    # approx's default rel=1e-6 to the 1e-9 of the other recomputed figures.
+    assert again["delta_E_mean"] == pytest.approx(float(dE.mean()), rel=1e-9)
+    assert again["delta_E_max"] == pytest.approx(float(dE.max()), rel=1e-9)
 
 
 def test_single_curve_edit_leaves_far_rows_at_the_base():
@@ -88,12 +93,13 @@ def test_single_curve_edit_leaves_far_rows_at_the_base():
     # The blended target is the base beyond the blend width (0.5) ...
     far = np.array([1.0, 2.1, 2.5])
     E, M = np.meshgrid(far, MU, indexing="ij")
-    np.testing.assert_allclose(edited_target(base, curves, M, E, 0.5), np.clip(base.rgb(M, E), 0, 1), atol=1e-12)
+    np.testing.assert_allclose(edited_target(base, curves, M, E, 0.5), np.clip(base.rgb(M, E), 0, 1), atol=1e-12)  # blend
+    # weight exactly 0: only a few roundings of values <= 1
     # ... and the fit stays close to it there (well under a visible difference).
     E, M = np.meshgrid(np.linspace(2.1, 2.5, 5), MU, indexing="ij")
     model = coated_conductor_model(M, E, result.packed.coefficients, base.eta_i_range)
     dE = delta_E_map(base.rgb(M, E), model)
-    assert dE.mean() < 1.0, dE.mean()
+    assert dE.mean() < 1.0, dE.mean()  # fit-quality claim, not precision
 
 
 def paper_method(base, curves):

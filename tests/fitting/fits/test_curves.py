@@ -20,6 +20,10 @@ ANGLE = np.linspace(0.0, 90.0, 46)
 MU = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))
 
 # A gold-like model, quadratic in t (layout [parameter, channel, power]).
+# The documented promise (docs/editor.md): a fit stays within [0, 1] up to
+# the float16 rounding of its coefficients, at most 1e-4 over.
+FLOAT16_RANGE_SLACK = 1e-4
+
 KNOWN = np.array([
     [[0.90, -0.08, 0.03], [0.74, -0.17, 0.10], [0.42, -0.36, 0.22]],
     [[0.20, 0.05, 0.00], [0.15, 0.03, 0.01], [0.10, 0.02, 0.00]],
@@ -41,6 +45,8 @@ class TestFitCurves:
         result = fit_curves([curve_of(KNOWN, 1.5)], name="one")
         assert result.degree == 0 and result.coefficients_float16.shape == (3, 3, 1)
         assert result.packed.degree == 0 and result.packed.eta_i_range == (1.0, 2.5)
+        # A fit-quality figure (the fit of exact model curves; docs/editor.md), not a
+        # precision bound: another CPU's kernels move it by ~1e-10 (solver tol).
         assert result.metrics["delta_E_mean"] < 0.1 and result.metrics["base"] is None
 
     @pytest.mark.parametrize("etas, degree", [((1.2, 2.2), 1), ((1.0, 1.7, 2.5), 2), ((1.0, 1.4, 1.9, 2.5), 2)])
@@ -48,6 +54,8 @@ class TestFitCurves:
         result = fit_curves([curve_of(KNOWN, e) for e in etas])
         assert result.degree == degree
         assert [c["eta_i"] for c in result.metrics["by_curve"]] == list(etas)
+        # A fit-quality figure (the fit of exact model curves; docs/editor.md), not a
+        # precision bound: another CPU's kernels move it by ~1e-10 (solver tol).
         assert result.metrics["delta_E_mean"] < 0.3
 
     def test_three_curves_recover_the_model(self):
@@ -55,11 +63,15 @@ class TestFitCurves:
         result = fit_curves([curve_of(KNOWN, e) for e in etas], max_nfev=200)
         eta = np.linspace(1.0, 2.5, 16)[:, None]
         dE = delta_E_map(coated_conductor_model(MU, eta, KNOWN), coated_conductor_model(MU, eta, result.coefficients_float16))
+        # A fit-quality figure (the fit of exact model curves; docs/editor.md), not a
+        # precision bound: another CPU's kernels move it by ~1e-10 (solver tol).
         assert dE.mean() < 0.2
 
     def test_unedited_base_reproduces_the_material(self, gold_base):
         result = fit_curves([RGBCurve(1.5, MU, gold_base.rgb(MU, 1.5))], base=gold_base, name="Au copy")
         assert result.degree == 2
+        # A fit-quality figure (the fit of exact model curves; docs/editor.md), not a
+        # precision bound: another CPU's kernels move it by ~1e-10 (solver tol).
         assert result.metrics["delta_E_mean"] < 0.3 and result.metrics["target"]["delta_E_mean"] < 0.4
         assert "Au with RGB curves edited at eta_i 1.5" in result.packed.source
 
@@ -71,6 +83,8 @@ class TestFitCurves:
         edited = fit_curves([RGBCurve(1.5, MU, edit)], base=gold_base)
         red_plain = coated_conductor_model(MU, 1.5, plain.coefficients_float16)[:, 0]
         red_edit = coated_conductor_model(MU, 1.5, edited.coefficients_float16)[:, 0]
+        # Fit-quality claims (the edit is followed; far away the material
+        # stays), not precision bounds.
         assert np.mean(np.abs(red_edit - edit[:, 0])) < 0.25 * np.mean(np.abs(red_plain - edit[:, 0]))
         # Far from the edit the material stays close to what it was (blend width 1).
         green_far = coated_conductor_model(MU, 2.5, edited.coefficients_float16)[:, 1]
@@ -120,11 +134,15 @@ class TestLiveRefit:
             curves = [{"eta_i": 1.5, "cos_theta": MU.tolist(), "rgb": rgb.tolist()}]
             live = fit_curves(curves, base, settings=LIVE_SETTINGS, start=start)
             target = live.metrics["target"]
-            assert -1e-4 <= target["model_min"] and target["model_max"] <= 1.0 + 1e-4
+            assert -FLOAT16_RANGE_SLACK <= target["model_min"] and target["model_max"] <= 1.0 + FLOAT16_RANGE_SLACK
             assert live.nfev <= 3 * LIVE_SETTINGS.max_nfev  # one solve, escalated at most twice
             start = live.coefficients_float16.astype(np.float64)
         full = fit_curves(curves, base)
         # Close to the full refit that replaces it on release, and never better than it.
+        # 1e-9 is only a tie slack: two means of Delta E (each ~1e-12 from
+        # rounding: 1e4 Delta E per unit RGB times ~1e-16) of the same fit.
+        # The second line is a product claim (a live fit within 2x + 0.2 of
+        # the full refit), not precision.
         assert full.metrics["target"]["delta_E_mean"] <= target["delta_E_mean"] + 1e-9
         assert target["delta_E_mean"] < 2.0 * full.metrics["target"]["delta_E_mean"] + 0.2
 
@@ -152,6 +170,6 @@ class TestLiveRefit:
             curves = [{"eta_i": 1.5, "cos_theta": MU.tolist(), "rgb": rgb.tolist()}]
             live = fit_curves(curves, gold_base, settings=LIVE_SETTINGS, start=start)
             target = live.metrics["target"]
-            assert -1e-4 <= target["model_min"] and target["model_max"] <= 1.0 + 1e-4, step
+            assert -FLOAT16_RANGE_SLACK <= target["model_min"] and target["model_max"] <= 1.0 + FLOAT16_RANGE_SLACK, step
             assert live.nfev + live.njev <= LIVE_SETTINGS.max_evaluations, step
             start = live.coefficients_float16.astype(np.float64)

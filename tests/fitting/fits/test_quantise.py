@@ -47,7 +47,8 @@ class TestQuantisation:
         again = quantise_coefficients(problem, result.coefficients)
         np.testing.assert_array_equal(again, result.coefficients_float16)
         # What the fit reports as its float16 cost is the cost of what it ships.
-        assert result.cost_float16 == pytest.approx(0.5 * _cost(problem, again), rel=1e-12)
+        assert result.cost_float16 == pytest.approx(0.5 * _cost(problem, again), rel=1e-12)  # one cost,
+        # two summation orders of ~1e3 squared residuals: 1e3 u64 = 1.1e-13
 
     def test_quantised_coefficients_are_shipped_bit_for_bit(self, real_problem):
         result, _ = real_problem

@@ -5,6 +5,8 @@ import pytest
 
 from fitting.fits.settings import FitSettings, fit_grid
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 
 class TestFitGrid:
     def test_gauss_weights_integrate_polynomials(self):
@@ -13,7 +15,8 @@ class TestFitGrid:
         # for degree <= 2n - 1 per axis.
         f = mu**7 * (eta - 1.0) ** 5
         exact = (1.0 / 8.0) * (1.5**6 / 6.0) / 1.5
-        assert np.mean(w * f) == pytest.approx(exact, rel=1e-12)
+        assert np.mean(w * f) == pytest.approx(exact, rel=1e-12)  # Gauss
+        # nodes and weights to ~10 u64 each, 12 terms in the mean: < 1e3 u64 = 1.1e-13
 
     def test_uniform_and_single_eta(self):
         mu, eta, w = fit_grid((1.0, 2.5), 5, 3, "uniform")

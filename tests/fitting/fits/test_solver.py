@@ -10,6 +10,8 @@ from fitting.fits.solver import fit_coefficients
 from fitting.models.coated_conductor import coated_conductor_model
 from fitting.optics.library import library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 KNOWN = np.array(
     [
         [[0.9, -0.1, 0.04], [0.75, -0.18, 0.1], [0.42, -0.2, 0.12]],
@@ -27,6 +29,10 @@ class TestFitCoefficients:
         result = fit_coefficients(target, mu, eta, (1.0, 2.5), objective=objective)
         assert result.success
         recovered = coated_conductor_model(mu, eta, result.coefficients)
+        # Not rounding: the solver stops at ftol = xtol = gtol = 1e-10
+        # (fitting/fits/solver.py) on an exactly representable target; 1e-6
+        # in reflectance is the convergence claim. The coefficients are less
+        # well determined (only the F0 and a rows are checked): 1e-3 is that claim.
         np.testing.assert_allclose(recovered, target, atol=1e-6)
         np.testing.assert_allclose(result.coefficients[:2], KNOWN[:2], atol=1e-3)
 

@@ -13,6 +13,7 @@ from fitting.models.coated_conductor import (
     model_parameters,
     normalised_eta_i,
 )
+from precision import F64_FEW_OPS, U64
 
 pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
 
@@ -32,10 +33,13 @@ class TestModel:
         C[0], C[1], C[2] = F0, a, alpha
         mu = np.array([0.0, 0.25, 1.0])
         expected = F0 + (1 - F0) * (1 - mu) ** 5 - a * mu * (1 - mu) ** alpha
-        np.testing.assert_allclose(coated_conductor_model(mu, 1.7, C)[:, 0], expected)
+        # The same ~12 operations on [0, 1] (pow within 4 ulps): F64_FEW_OPS;
+        # tightened from assert_allclose's default rtol=1e-7 (no derivation).
+        np.testing.assert_allclose(coated_conductor_model(mu, 1.7, C)[:, 0], expected, rtol=0, atol=F64_FEW_OPS)
 
     def test_t_normalisation_and_clamp(self):
-        assert normalised_eta_i(1.75, (1.0, 2.5)) == pytest.approx(0.5)
+        # (1.75 - 1) / 1.5: two correctly rounded operations.
+        assert normalised_eta_i(1.75, (1.0, 2.5)) == pytest.approx(0.5, rel=4 * U64)
         assert normalised_eta_i(0.5, (1.0, 2.5)) == 0.0
         assert normalised_eta_i(3.0, (1.0, 2.5)) == 1.0
         assert normalised_eta_i(1.7, (1.5, 1.5)) == 0.0
@@ -61,6 +65,9 @@ class TestModel:
             numeric = (
                 coated_conductor_model(mu, eta, KNOWN + step) - coated_conductor_model(mu, eta, KNOWN - step)
             ) / (2 * h)
+            # Central difference, h = 1e-7: rounding u64 |F| / h = 1.1e-9
+            # (|F| <= ~1, coefficients up to 6) plus truncation h^2 |F'''| / 6
+            # <= 1e-14 * 6^3: < 1e-8; 1e-6 is that with a 100x margin.
             np.testing.assert_allclose(J[:, c, p, j], numeric[:, c], atol=1e-6)
 
     def test_collapse_matches_general(self):
@@ -68,7 +75,9 @@ class TestModel:
         assert collapsed.shape == (3, 3, 1)
         mu = np.linspace(0, 1, 17)
         np.testing.assert_allclose(
-            coated_conductor_model(mu, 1.9, collapsed), coated_conductor_model(mu, 1.9, KNOWN), atol=1e-14
+            coated_conductor_model(mu, 1.9, collapsed), coated_conductor_model(mu, 1.9, KNOWN), atol=1e-14  # the
+            # polynomial in t summed before or after: ~3 roundings of terms
+            # <= 6 (alpha's coefficients): 6 * 6 u64 = 4e-15 < 1e-14
         )
 
     def test_kernel_clamps_and_never_raises_on_numbers(self):

@@ -73,6 +73,11 @@ class TestExcerpt:
         assert excerpt("\x00\u202e") == "'\\x00\\u202e'"
 
 
+# The `seconds < ...` and `peak < ...` (MiB) checks in this module are the
+# parsers' resource budgets (docs/security.md), not numerical tolerances; the
+# `len(...) < 200` ones bound an error message's length.
+
+
 class TestLoadYamlBounded:
     def test_reads_a_plain_document(self):
         assert load_yaml_bounded("a: [1, 2, {b: c}]") == {"a": [1, 2, {"b": "c"}]}
