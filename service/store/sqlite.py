@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import os
 import sqlite3
+import contextlib
 import threading
 import time
 from dataclasses import asdict
@@ -75,6 +76,8 @@ class SQLiteStore:
         self._local = threading.local()
         self._connections: list[sqlite3.Connection] = []
         self._lock = threading.Lock()
+        self._idle = threading.Condition(self._lock)  # notified when no call uses a connection
+        self._active = 0
         self._closed = False
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -95,9 +98,29 @@ class SQLiteStore:
 
     # -- plumbing ----------------------------------------------------------
 
+    @contextlib.contextmanager
+    def _in_use(self):
+        """
+        A call that uses a connection: refused once the store is closed, and
+        :meth:`close` waits for it (closing a sqlite3 connection while another
+        thread runs a statement on it crashes the process).
+        """
+        with self._lock:
+            if self._closed:
+                raise StoreUnavailable("the store is closed")
+            self._active += 1
+        try:
+            yield
+        finally:
+            with self._lock:
+                self._active -= 1
+                if not self._active:
+                    self._idle.notify_all()
+
     def _guard(self, function: Callable[[], _T]) -> _T:
         try:
-            return function()
+            with self._in_use():
+                return function()
         except sqlite3.Error as error:
             raise _translate(error, self.path) from None
 
@@ -186,7 +209,8 @@ class SQLiteStore:
 
     def check(self) -> None:
         try:
-            (result,) = self._connection().execute("PRAGMA quick_check").fetchone()
+            with self._in_use():
+                (result,) = self._connection().execute("PRAGMA quick_check").fetchone()
         except StoreError:
             raise
         except sqlite3.Error as error:
@@ -215,28 +239,35 @@ class SQLiteStore:
             return (f"the disk of the store has {free_bytes} bytes free, less than one save needs "
                     f"({_WRITE_FLOOR_BYTES})")
         try:
-            connection = self._connection()
-            if self.max_bytes:
-                (pages,) = connection.execute("PRAGMA page_count").fetchone()
-                (page_size,) = connection.execute("PRAGMA page_size").fetchone()
-                if (pages + 4) * page_size > self.max_bytes:
-                    return (f"the store holds {pages * page_size} bytes, at its quota "
-                            f"COATED_STORE_MAX_BYTES ({self.max_bytes})")
-            # A write statement that changes nothing: refused by a read-only
-            # store; rolled back at once so that it holds no lock.
-            try:
-                connection.execute("DELETE FROM saves WHERE 0")
-            finally:
-                connection.rollback()
+            with self._in_use():
+                return self._writable_here()
         except StoreError as error:
             return str(error)
         except sqlite3.Error as error:
             return str(_translate(error, self.path))
+
+    def _writable_here(self) -> str | None:
+        """The quota and the read-only check of :meth:`writable`, on this thread's connection."""
+        connection = self._connection()
+        if self.max_bytes:
+            (pages,) = connection.execute("PRAGMA page_count").fetchone()
+            (page_size,) = connection.execute("PRAGMA page_size").fetchone()
+            if (pages + 4) * page_size > self.max_bytes:
+                return (f"the store holds {pages * page_size} bytes, at its quota "
+                        f"COATED_STORE_MAX_BYTES ({self.max_bytes})")
+        # A write statement that changes nothing: refused by a read-only
+        # store; rolled back at once so that it holds no lock.
+        try:
+            connection.execute("DELETE FROM saves WHERE 0")
+        finally:
+            connection.rollback()
         return None
 
     def close(self) -> None:
+        """Refuse new calls, wait up to 60 s for those under way, close every connection."""
         with self._lock:
             self._closed = True
+            self._idle.wait_for(lambda: not self._active, timeout=60.0)
             for connection in self._connections:
                 connection.close()
             self._connections.clear()
