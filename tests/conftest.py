@@ -28,7 +28,9 @@ over 2 s in a ``--durations=0`` run. The ``gl``, ``server`` and ``browser``
 markers imply it. What cannot be forgotten is checked: a test not marked
 ``slow`` that starts a process (``subprocess``, ``multiprocessing``: a CLI,
 a server, the fitting pool, Chromium, Blender, Dask) or a GL context fails
-with a message saying so. A run lists, at its end, the tests not marked
+with a message saying so (a start on the main thread or on a thread made
+during the test; threads left by earlier tests, such as a module's server
+or pool, are not the test's). A run lists, at its end, the tests not marked
 ``slow`` that took over 2 s.
 """
 
@@ -42,6 +44,7 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Iterator
@@ -214,10 +217,14 @@ _fixture_started: dict[str, list[str]] = {}  # fixture name -> what its set-up s
 _unmarked_slow: list[tuple[float, str]] = []
 
 
+_old_threads: set[int] = set()  # threads of earlier tests (their servers, pools): not this test's
+
+
 def _watch(what: str, function):
     @functools.wraps(function)
     def wrapper(*args, **kwargs):
-        _started.append(what)
+        if threading.get_ident() not in _old_threads:
+            _started.append(what)
         return function(*args, **kwargs)
     return wrapper
 
@@ -246,6 +253,8 @@ def pytest_fixture_setup(fixturedef, request):
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item, nextitem):
     _started.clear()
+    _old_threads.clear()
+    _old_threads.update(t.ident for t in threading.enumerate() if t is not threading.main_thread())
     item.stash[_DURATION] = 0.0
     yield
     if item.get_closest_marker("slow") is None and item.stash[_DURATION] > SLOW_S:
