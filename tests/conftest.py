@@ -235,11 +235,26 @@ multiprocessing.process.BaseProcess.start = _watch(
 moderngl.create_context = _watch("a GL context", moderngl.create_context)
 
 
+def _first_rank(item) -> int:
+    """Browser modules first, then server ones, then the rest (see pytest_collection_modifyitems)."""
+    if item.get_closest_marker("browser"):
+        return 0
+    return 1 if item.get_closest_marker("server") else 2
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if any(item.get_closest_marker(name) for name in _IMPLY_SLOW) \
                 or PROCESS_FIXTURES.intersection(item.fixturenames):
             item.add_marker(pytest.mark.slow)
+    # The longest modules first: pytest-xdist hands out modules in this order,
+    # so a long browser module collected last (tests/static/) would run on one
+    # worker after the other has finished. A stable sort by each module's
+    # rank keeps every module's tests together and in their order.
+    rank: dict[str, int] = {}
+    for item in items:
+        rank[item.module.__name__] = min(rank.get(item.module.__name__, 2), _first_rank(item))
+    items.sort(key=lambda item: rank[item.module.__name__])
 
 
 @pytest.hookimpl(hookwrapper=True)
