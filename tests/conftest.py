@@ -277,6 +277,7 @@ def pytest_runtest_protocol(item, nextitem):
 
 
 _DURATION = pytest.StashKey[float]()
+_STARTED = pytest.StashKey[list]()
 
 
 @pytest.hookimpl(hookwrapper=True)
@@ -284,14 +285,18 @@ def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
     item.stash[_DURATION] = item.stash.get(_DURATION, 0.0) + report.duration
-    if call.when == "teardown" and _started and item.get_closest_marker("slow") is None \
+    if call.when == "call":
+        # What the test's set-up and call started; a teardown may end a
+        # module's fixtures, whose processes belong to the tests that used them.
+        item.stash[_STARTED] = list(_started)
+    if call.when == "teardown" and item.stash.get(_STARTED, None) and item.get_closest_marker("slow") is None \
             and report.passed:
         fixtures = sorted(name for name in item.fixturenames if name in _fixture_started)
         where = f" in the set-up of the fixture(s) {', '.join(fixtures)} (add them to " \
                 "tests/conftest.py's PROCESS_FIXTURES)" if fixtures else ""
         report.outcome = "failed"
         report.longrepr = (
-            f"{item.nodeid} started {', '.join(sorted(set(_started)))}{where} but is not "
+            f"{item.nodeid} started {', '.join(sorted(set(item.stash[_STARTED])))}{where} but is not "
             "marked `slow` (@pytest.mark.slow): scripts/test --quick must start no process, "
             "GL context or browser"
         )
