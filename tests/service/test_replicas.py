@@ -55,8 +55,14 @@ def listed(url: str) -> dict[str, dict]:
     raise AssertionError("the listing did not end within 100 pages")
 
 
-@pytest.fixture
-def replicas(tmp_path, postgres_server):
+@pytest.fixture(scope="module")
+def replicas(tmp_path_factory, postgres_server):
+    """
+    Two replicas on one database, shared by the module's tests (a pair takes
+    about 16 s to start). Each test saves under names of its own and asserts
+    only about what it saved; the test that kills a replica runs last.
+    """
+    tmp_path = tmp_path_factory.mktemp("replicas")
     url = postgres_server.database("replicas")
     env = {"COATED_STORE_URL": url, "COATED_METRICS_SAMPLES": "10", "COATED_FIT_QUEUE": "64",
            "COATED_STORE_POOL_MAX": "4"}
@@ -126,6 +132,32 @@ def test_same_name_at_once_one_winner(replicas):
     assert stale.status_code == 409 and "nothing was fitted" in stale.json()["detail"]
 
 
+def test_postgres_restart_503_then_recovery(replicas, postgres_server):
+    a, b = replicas
+    before = httpx.post(f"{a.url}{API}/fits", json=nk_body(1, "p"), timeout=120)
+    assert before.status_code == 201
+    postgres_server.stop()
+    try:
+        for replica in (a, b):
+            health = httpx.get(f"{replica.url}/healthz", timeout=30)
+            assert health.status_code == 503 and 1 <= int(health.headers["retry-after"]) <= 5
+            refused = httpx.post(f"{replica.url}{API}/fits", json=nk_body(2, "p"), timeout=60)
+            assert refused.status_code == 503 and int(refused.headers["retry-after"]) <= 5
+            assert "unavailable" in refused.json()["detail"]
+            assert httpx.get(f"{replica.url}{API}/fits/{before.json()['id']}", timeout=30).status_code == 503
+    finally:
+        postgres_server.start()
+    for replica in (a, b):  # recovered by themselves, without a restart
+        deadline = time.monotonic() + 30
+        while httpx.get(f"{replica.url}/healthz", timeout=30).status_code != 200:
+            assert time.monotonic() < deadline, "the replica did not recover within 30 s"
+            time.sleep(0.2)
+    after = httpx.post(f"{b.url}{API}/fits", json=nk_body(2, "p"), timeout=120)
+    assert after.status_code == 201
+    assert {before.json()["material_id"], after.json()["material_id"]} <= set(listed(a.url))
+    assert a.process.poll() is None and b.process.poll() is None
+
+
 def test_replica_killed_during_saves_loses_nothing_answered(replicas):
     a, b = replicas
     answered: list[str] = []
@@ -161,29 +193,3 @@ def test_replica_killed_during_saves_loses_nothing_answered(replicas):
         missing = [fit_id for fit_id in answered if http.get(f"{API}/fits/{fit_id}").status_code != 200]
     assert missing == []
     assert len(listed(b.url)) >= len(set(answered))
-
-
-def test_postgres_restart_503_then_recovery(replicas, postgres_server):
-    a, b = replicas
-    before = httpx.post(f"{a.url}{API}/fits", json=nk_body(1, "p"), timeout=120)
-    assert before.status_code == 201
-    postgres_server.stop()
-    try:
-        for replica in (a, b):
-            health = httpx.get(f"{replica.url}/healthz", timeout=30)
-            assert health.status_code == 503 and 1 <= int(health.headers["retry-after"]) <= 5
-            refused = httpx.post(f"{replica.url}{API}/fits", json=nk_body(2, "p"), timeout=60)
-            assert refused.status_code == 503 and int(refused.headers["retry-after"]) <= 5
-            assert "unavailable" in refused.json()["detail"]
-            assert httpx.get(f"{replica.url}{API}/fits/{before.json()['id']}", timeout=30).status_code == 503
-    finally:
-        postgres_server.start()
-    for replica in (a, b):  # recovered by themselves, without a restart
-        deadline = time.monotonic() + 30
-        while httpx.get(f"{replica.url}/healthz", timeout=30).status_code != 200:
-            assert time.monotonic() < deadline, "the replica did not recover within 30 s"
-            time.sleep(0.2)
-    after = httpx.post(f"{b.url}{API}/fits", json=nk_body(2, "p"), timeout=120)
-    assert after.status_code == 201
-    assert {before.json()["material_id"], after.json()["material_id"]} <= set(listed(a.url))
-    assert a.process.poll() is None and b.process.poll() is None
