@@ -13,8 +13,8 @@ import re
 
 import pytest
 from conftest import server_process
-from editor_pages import CHROMIUM_ARGS, TIMEOUT_MS, editor_url  # noqa: F401 (fixture; expect's timeout)
-from playwright.sync_api import expect, sync_playwright
+from editor_pages import TIMEOUT_MS, chromium, editor_url, live_server  # noqa: F401 (fixtures; expect's timeout)
+from playwright.sync_api import expect
 
 from fitting.models.pack import decode_pack
 
@@ -24,17 +24,16 @@ FROM_CURVES = re.compile(r".*/api/v1/fits/from-curves(\?.*)?$")  # with or witho
 
 
 @pytest.fixture
-def page():
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
-        context = browser.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
-        page = context.new_page()
-        page.set_default_timeout(TIMEOUT_MS)
-        errors: list[str] = []
-        page.on("pageerror", lambda error: errors.append(str(error)))
-        yield page
-        browser.close()
-        assert not errors, errors
+def page(chromium):
+    """A page in a fresh context (no storage or cache from another test) of the module's one Chromium."""
+    context = chromium.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+    page = context.new_page()
+    page.set_default_timeout(TIMEOUT_MS)
+    errors: list[str] = []
+    page.on("pageerror", lambda error: errors.append(str(error)))
+    yield page
+    context.close()
+    assert not errors, errors
 
 
 def wait_idle(page):
