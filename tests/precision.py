@@ -22,7 +22,6 @@ U64 = 2.0**-53  # float64 unit roundoff
 U32 = 2.0**-24  # float32 unit roundoff
 # float16 (10-bit significand): a value in [2^e, 2^(e+1)) rounds to nearest
 # with error at most 2^(e-11); relative to the value, at most 2^-11.
-F16_REL = 2.0**-11
 
 # The 1 nm spectral weights (471 nodes): each channel's sum of |w| (1.147).
 _NODES, _W = _reference.spectral_weights(1.0)
