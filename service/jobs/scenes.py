@@ -7,7 +7,9 @@ Scene packs
     id, or inline n, k) into a :class:`fitting.scene.SceneMaterial`, or, for
     a saved *edited* material, a :class:`StoredModel` (its edits live in its
     stored model, not in the n, k it started from).
--   :func:`scene_pack`: fit it in the pool; the report and the pack.
+-   :func:`scene_pack`: fit it in the pool, one part per material under the
+    job's one slot (the parts take turns with other jobs'); the report and
+    the pack.
 
 A material measured as n, k is fitted over the eta_i the scene uses with the
 lowest degree that serves it (:func:`fitting.scene.fit_scene_material`). An
@@ -18,6 +20,7 @@ and the scene's eta_i must lie in its domain; its report says so
 
 from __future__ import annotations
 
+import asyncio
 import base64
 import json
 
@@ -163,23 +166,18 @@ def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
     }
 
 
-def _scene_job(scene: PreparedScene) -> dict[str, Any]:
-    """Runs in a fitting worker: fit the scene, return the report and the pack."""
-    reports, packed, general = [], [], []
-    for entry in scene.materials:
-        if isinstance(entry, StoredModel):
-            reports.append(_stored_model_report(entry))
-            packed.append(entry.packed)
-            general.append(entry.packed)
-            continue
-        try:
-            result = fit_scene_material(entry, None, scene.max_delta_e, scene.prefer)
-        except ValueError as error:
-            raise ValueError(f"material {entry.name!r}: {error}") from None
-        report = result.report()
-        reports.append(report)
-        packed.append(result.packed)
-        general.append(result.general)
+def _material_part(entry: SceneMaterial, max_delta_e, prefer) -> tuple[dict[str, Any], Any, Any]:
+    """Runs in a fitting worker: one material of a scene (its report, its packed and general models)."""
+    try:
+        result = fit_scene_material(entry, None, max_delta_e, prefer)
+    except ValueError as error:
+        raise ValueError(f"material {entry.name!r}: {error}") from None
+    return result.report(), result.packed, result.general
+
+
+def _scene_report(scene: PreparedScene, parts: list[tuple[dict[str, Any], Any, Any]]) -> dict[str, Any]:
+    """The report and pack of ``scene`` from its materials' parts, in the scene's order."""
+    reports, packed, general = (list(column) for column in zip(*parts))
     pack = encode_pack(packed)
     return {
         "scene": scene.name,
@@ -199,13 +197,45 @@ def _scene_job(scene: PreparedScene) -> dict[str, Any]:
     }
 
 
+MATERIAL_COST_S = 0.2
+"""A scene material's estimated seconds in a worker (a fit and its candidates): its turn in the pool."""
+
+
+async def _scene_parts(scene: PreparedScene, runner: FitRunner) -> list[tuple[dict[str, Any], Any, Any]]:
+    """
+    Every material of ``scene`` as a part of its own under the job's one
+    slot: parts take turns with other jobs' parts (a large scene does not
+    hold a worker for its whole length, and each part has the CPU-time
+    limit), and run side by side on idle workers. The first failure cancels
+    the parts still running or waiting, so their workers are freed at once.
+    """
+    tasks: dict[int, asyncio.Future] = {}
+    parts: list[Any] = []
+    for index, entry in enumerate(scene.materials):
+        if isinstance(entry, StoredModel):
+            parts.append((_stored_model_report(entry), entry.packed, entry.packed))
+        else:
+            parts.append(None)
+            tasks[index] = asyncio.ensure_future(runner.submit(
+                _material_part, entry, scene.max_delta_e, scene.prefer, cost_s=MATERIAL_COST_S))
+    try:
+        done = await asyncio.gather(*tasks.values())
+    except BaseException:
+        for task in tasks.values():
+            task.cancel()
+        await asyncio.gather(*tasks.values(), return_exceptions=True)
+        raise
+    for index, part in zip(tasks, done):
+        parts[index] = part
+    return parts
+
+
 async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
     """The report and pack of ``scene`` (cancelled when no request waits for it any more)."""
 
     async def make() -> dict[str, Any]:
-        # Its turn in the pool: about 0.2 s a material (a fit and its candidates).
-        return await runner.run(_scene_job, scene, cost_s=0.2 * len(scene.materials))
+        async with runner.slot():
+            parts = await _scene_parts(scene, runner)
+        return _scene_report(scene, parts)
 
     return await runner.once(scene.key, make)
-
-

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from conftest import server_process
+from fitting.optics.library import LIBRARY_NAMES
 
 pytestmark = [pytest.mark.slow, pytest.mark.server]
 API = "/api/v1"
@@ -90,3 +91,33 @@ def test_worst_case_refits_are_bounded_and_do_not_hold_a_library_fit(tmp_path):
         target = body["metrics"]["details"]["target"]
         assert target["model_min"] >= -1e-4 and target["model_max"] <= 1.0 + 1e-4, target
         assert seconds < 30.0
+
+
+def test_a_large_scene_takes_turns_with_a_library_fit(tmp_path):
+    """
+    A scene is one part per material (service/jobs/scenes.py): on one worker,
+    a library fit sent while a 22-material scene runs is answered before the
+    scene (it takes its turn between the scene's parts), and the scene's
+    report still lists every material in its order.
+    """
+    scene = {"name": "large", "materials": [
+        {"material": name, "eta_i": [1.0, 1.33, 1.5, 2.0]} for name in LIBRARY_NAMES]}
+    finished: list[tuple[str, int]] = []
+    with server_process(tmp_path / "data", COATED_FIT_WORKERS="1") as server:
+        def post(label: str, path: str, body: dict) -> None:
+            with httpx.Client(base_url=server.url, timeout=300) as http:
+                response = http.post(f"{API}{path}", json=body)
+                finished.append((label, response.status_code))
+                if label == "scene":
+                    report = response.json()
+                    assert [m["material"] for m in report["materials"]] == list(LIBRARY_NAMES)
+
+        scene_thread = threading.Thread(target=post, args=("scene", "/scenes", scene))
+        scene_thread.start()
+        with httpx.Client(base_url=server.url, timeout=60) as http:
+            deadline = time.monotonic() + 60
+            while http.get("/healthz").json()["fits_in_flight"] < 1 and time.monotonic() < deadline:
+                time.sleep(0.02)
+        post("library", "/fits", {"material": "Ag", "eta_i_range": [1.0, 2.4]})
+        scene_thread.join(300)
+    assert finished == [("library", 201), ("scene", 200)], finished
