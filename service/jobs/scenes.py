@@ -28,6 +28,7 @@ import numpy as np
 
 from fitting.fits.scene_fit import fit_scene_material
 from fitting.fits.scene_schema import EtaSpec, SceneMaterial, parse_eta_i, parse_scene
+from fitting.models.kinds import model_kind
 from fitting.models.pack import (
     PackedMaterial,
     encode_pack,
@@ -140,7 +141,8 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
 
 def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
     packed = entry.packed
-    bytes_ = material_record_bytes(packed.name, packed.source, packed.degree)
+    bytes_ = material_record_bytes(packed.name, packed.source, packed.degree, packed.model)
+    kind = model_kind(packed.model)
     zero = {"mean": 0.0, "max": 0.0}
     return {
         "name": packed.name,
@@ -148,14 +150,14 @@ def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
         "eta_i": entry.eta_i.to_json(),
         "eta_i_range": list(packed.eta_i_range),
         "degree": packed.degree,
-        "coefficients": 9 * (packed.degree + 1),
-        "shader_variant": "collapsed" if packed.degree == 0 else "packed",
+        "coefficients": kind.count(packed.degree),
+        "shader_variant": kind.variant(packed.degree),
         "bytes": bytes_,
         "delta_E_2000": zero,
         "by_degree": {str(packed.degree): zero},
         "general": {
             "eta_i_range": list(packed.eta_i_range), "degree": packed.degree,
-            "coefficients": 9 * (packed.degree + 1), "bytes": bytes_, "delta_E_2000": zero,
+            "coefficients": kind.count(packed.degree), "bytes": bytes_, "delta_E_2000": zero,
         },
         "scene_vs_general_delta_E_2000": zero,
         "fit": {"from_stored_model": True, "fit_id": entry.fit_id},
