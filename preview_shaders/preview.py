@@ -179,16 +179,20 @@ def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, s
     ctx = state.ctx
     program, vao = state.program(
         "preview.frag", sources={PREVIEW_MODEL_FILE: preview_model_source(model_kind(model[0]))})
-    program["u_centre"].value = (0.5 * size, 0.5 * size)
-    program["u_radius"].value = SPHERE_RADIUS * size
-    program["u_split_column"].value = float(split_column)
-    program["u_environment"].value = ENVIRONMENTS.index(environment)
-    program["u_eta_i"].value = eta_i
-    kind, words = model
-    program["cf_words"].value = [int(w) for w in words]
-    program["cf_eta_i_range"].value = tuple(float(v) for v in eta_i_range)
-    program["cf_F0_air"].value = tuple(float(v) for v in F0_air)
-    program["cf_F82_air"].value = tuple(float(v) for v in F82_air)
+    _, words = model
+    uniforms = {
+        "u_centre": (0.5 * size, 0.5 * size), "u_radius": SPHERE_RADIUS * size,
+        "u_split_column": float(split_column), "u_environment": ENVIRONMENTS.index(environment),
+        "u_eta_i": eta_i, "cf_eta_i_range": tuple(float(v) for v in eta_i_range),
+        "cf_F0_air": tuple(float(v) for v in F0_air), "cf_F82_air": tuple(float(v) for v in F82_air),
+    }
+    for name, value in uniforms.items():
+        # A kind that does not read a uniform (the rgb-conductor's domain) leaves it to the compiler.
+        if name in program:
+            program[name].value = value
+    # ... and of the words it reads fewer than 14 (the array is trimmed).
+    uniform = program["cf_words"]
+    uniform.value = [int(w) for w in words[: uniform.array_length]]
     fbo, targets = state.float_targets((size, size), 3)
     try:
         fbo.use()
