@@ -4,8 +4,8 @@ Pack downloads
 
 Stored fits as the files a renderer loads:
 
--   ``binary``: the documented binary pack (:func:`fitting.pack.encode_pack`).
--   ``json``: its JSON view (:func:`fitting.pack.pack_to_json`).
+-   ``binary``: the documented binary pack (:func:`fitting.models.pack.encode_pack`).
+-   ``json``: its JSON view (:func:`fitting.models.pack.pack_to_json`).
 -   ``glsl``, ``hlsl``: ready-to-paste snippets (:mod:`service.snippets`):
     the project's function of each model kind in the pack and per material
     its float16 coefficients and a ``cf_material_<name>(NdotV, eta_i)``.

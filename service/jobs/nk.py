@@ -3,7 +3,7 @@ n, k fits
 =========
 
 -   :class:`NKFit`: a validated fit of measured n, k (a built-in material or
-    data given by the user): the :class:`fitting.nk.SpectralNK` built and
+    data given by the user): the :class:`fitting.optics.nk.SpectralNK` built and
     checked once, and the ids computed once.
 -   :func:`fit_nk`: the stored fit of an :class:`NKFit`, else fitted in the
     pool and saved; ``(record, created)``.

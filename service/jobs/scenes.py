@@ -4,13 +4,13 @@ Scene packs
 
 -   :func:`prepare_scene`: the scene of a request, validated and converted
     once: each material resolved (a built-in conductor, a saved material by
-    id, or inline n, k) into a :class:`fitting.scene.SceneMaterial`, or, for
+    id, or inline n, k) into a :class:`fitting.fits.scene_schema.SceneMaterial`, or, for
     a saved *edited* material, a :class:`StoredModel` (its edits live in its
     stored model, not in the n, k it started from).
 -   :func:`scene_pack`: fit it in the pool; the report and the pack.
 
 A material measured as n, k is fitted over the eta_i the scene uses with the
-lowest degree that serves it (:func:`fitting.scene.fit_scene_material`). An
+lowest degree that serves it (:func:`fitting.fits.scene_fit.fit_scene_material`). An
 edited material is shipped as stored (its degree, coefficients and domain),
 and the scene's eta_i must lie in its domain; its report says so
 (``from_stored_model``) and its Delta E against itself is 0.
@@ -78,7 +78,7 @@ def _renumber(error: ValueError, index: int) -> ValueError:
 def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
     """
     ``scene`` (``{"name", "materials": [...]}``, entries as
-    :func:`fitting.scene.parse_scene` reads them, inline ``nk`` with its
+    :func:`fitting.fits.scene_schema.parse_scene` reads them, inline ``nk`` with its
     ``source``) resolved against the library and ``store``. Runs in a
     thread (it reads the store).
 
