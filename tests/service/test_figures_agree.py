@@ -84,3 +84,19 @@ def test_a_curve_fits_figure_is_the_whole_target_the_editor_shows(fits):
     assert figure["delta_E_max"] == details["target"]["delta_E_max"]
     assert figure["max_at"] == {"eta_i": details["target"]["at_eta_i"],
                                 "theta_deg": details["target"]["at_theta_deg"]}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("label", ["nk", "rgb-nk"])
+def test_provenance_is_the_settings_that_ran(client, fits, label):
+    """An n, k fit records its kind's settings (the rgb-conductor's 1 nm reference), not FitSettings()."""
+    from dataclasses import asdict
+
+    from fitting.fits.kinds import fit_kind
+
+    fit = fits[label]
+    record = client.app.state.store.get_fit(fit["id"])
+    expected = asdict(fit_kind(fit["model"]).settings)
+    assert record.provenance["settings"] == json.loads(json.dumps(expected))
+    # timings["total"] is the whole fit, its evaluation included, for every kind.
+    assert record.timings["total"] >= record.timings["evaluate"]
