@@ -46,6 +46,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from conftest import server_process  # noqa: E402
+
+from benchmarks.record import load_average, write_result  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
@@ -172,6 +174,8 @@ def main() -> None:
     parser.add_argument("--orbit-only", action="store_true", help="only the orbit rows")
     parser.add_argument("--drags-only", action="store_true", help="only the drag rows")
     args = parser.parse_args()
+    load_at_start = load_average()
+    figures: dict = {}
     first = second = None
     latencies, extremes, orbits = [], [], {}
     with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data", COATED_WARM_POOL="true") as server:
@@ -196,21 +200,29 @@ def main() -> None:
         print(f"{'measure':<52} {'median':>9} {'p90':>9} {'n':>4}")
         print(f"{'cold start to editor + preview (s), first':<52} {first:>9.2f} {'':>9} {1:>4}")
         print(f"{'cold start to editor + preview (s), second':<52} {second:>9.2f} {'':>9} {1:>4}")
+        figures["cold_start_s"] = {"first": first, "second": second}
     if latencies:
         print(f"\n{'drags (ms)':<44} {'gentle':>8} {'p99':>7} {'n':>4}   {'extreme':>8} {'p99':>7} {'n':>4}")
-        rows = [("edit -> refitted curve, live", 0, True), ("edit -> WebGL frame of the refit, live", 1, True),
-                ("release -> WebGL frame of the full refit", 1, False)]
-        for label, column, live in rows:
+        rows = [("edit -> refitted curve, live", 0, True, "drag_to_curve_ms"),
+                ("edit -> WebGL frame of the refit, live", 1, True, "drag_to_frame_ms"),
+                ("release -> WebGL frame of the full refit", 1, False, "release_to_frame_ms")]
+        for label, column, live, key in rows:
             cells = []
-            for runs in (latencies, extremes):
+            for kind, runs in (("gentle", latencies), ("extreme", extremes)):
                 values = [r[column] for r in runs if r[2] == live]
+                if values:
+                    figures.setdefault(key, {})[kind] = {
+                        "median_ms": statistics.median(values), "p90_ms": percentile(values, 0.9),
+                        "p99_ms": percentile(values, 0.99), "n": len(values)}
                 cells.append(f"{statistics.median(values):>8.0f} {percentile(values, 0.99):>7.0f} {len(values):>4}"
                              if values else f"{'-':>8} {'-':>7} {0:>4}")
             print(f"{label:<44} {cells[0]}   {cells[1]}")
     for name, fps in orbits.items():
         label = f"orbit fps at 1024 x 768 (canvas {size[0]} x {size[1]}), {name}"
         print(f"{label:<52} {fps:>9.1f}")
+        figures.setdefault("orbit_fps", {})[name] = fps
     print(f"\nload average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    write_result("editor_speed", figures, load_at_start)
 
 
 if __name__ == "__main__":

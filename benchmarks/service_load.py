@@ -55,7 +55,10 @@ import httpx
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 API = "/api/v1"
+
+from benchmarks.record import load_average, write_result  # noqa: E402
 
 
 def free_port() -> int:
@@ -213,6 +216,7 @@ def start_replicas(count: int, env: dict[str, str], data: str) -> list[tuple[sub
 def main() -> int:
     if len(sys.argv) > 1 and sys.argv[1] == "--probe":
         return probe(sys.argv[2], sys.argv[3], float(sys.argv[5]))
+    load_at_start = load_average()
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--duration", type=float, default=20.0, help="seconds of load (default 20)")
     parser.add_argument("--idle", type=float, default=5.0, help="seconds of idle pack reads (default 5)")
@@ -288,7 +292,10 @@ def main() -> int:
     print("| quantity | value |")
     print("|---|---|")
     ms = np.asarray(latency) * 1e3
+    figures: dict = {"fits_per_s": fits / elapsed}
     if ms.size:
+        figures["rest_fit_unseen_ms"] = {"first": float(ms[0]), "p50": float(np.percentile(ms, 50)),
+                                         "p90": float(np.percentile(ms, 90)), "n": int(ms.size)}
         print(f"| REST fit of unseen data, one client: fits | {ms.size} |")
         print(f"| REST fit of unseen data: first / p50 / p90 ms | {ms[0]:.0f} / "
               f"{np.percentile(ms, 50):.0f} / {np.percentile(ms, 90):.0f} |")
@@ -305,6 +312,7 @@ def main() -> int:
         print(f"| pack download {label}: requests | {len(samples)} |")
         print(f"| pack download {label}: p50 / p95 / p99 / max ms | "
               f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+        figures[f"pack_{label.replace(' ', '_')}_ms"] = {"p50": p50, "p95": p95, "p99": p99, "max": worst}
     if args.burst:
         print(f"| burst: {args.burst} fits at once, answers | "
               f"{', '.join(f'{k}: {v}' for k, v in sorted(burst_counts.items()))} ({burst_s:.1f} s) |")
@@ -314,6 +322,11 @@ def main() -> int:
             print(f"| burst, separate process: {label} p50 / p95 / p99 / max ms | "
                   f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
         print(f"| burst, separate process: answers other than 200 | {probed['errors']} |")
+        figures["burst_p99_ms"] = {key: percentiles(probed[key])[2] for key in ("healthz", "pack")}
+    # One record per store and replica count (the PostgreSQL runs do not overwrite the SQLite one).
+    name = "service_load" if args.store == "sqlite" and args.replicas == 1 else (
+        f"service_load_{args.store}_{args.replicas}")
+    write_result(name, figures, load_at_start)
     return 0
 
 

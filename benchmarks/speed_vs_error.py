@@ -96,7 +96,7 @@ from fitting.models.coated_conductor import (  # noqa: E402
     collapse_to_eta_i,
     model_from_parameters,
 )
-from fitting.models.kinds import MODEL_KINDS, coefficient_count, model_ACEScg  # noqa: E402
+from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS, coefficient_count, model_ACEScg  # noqa: E402
 from fitting.models.pack import halves_to_uint32, to_float16  # noqa: E402
 from fitting.models.rgb_conductor import rgb_fresnel_conductor  # noqa: E402
 from fitting.optics.library import LIBRARY_NAMES, library_material  # noqa: E402
@@ -106,8 +106,9 @@ IMAGES = ROOT / "docs" / "images"
 GRID = 100
 WIDTH, HEIGHT = 2560, 1440
 
-KIND_LABELS = {"coated-conductor": "coated-conductor kind (ours), float16"}
-"""Labels of the model kinds where "<kind> kind, float16" would not say enough."""
+def kind_label(kind: str) -> str:
+    """A model kind's label: "<kind> kind, float16", the default kind (the paper's) marked ours."""
+    return f"{kind} kind{' (ours)' if kind == DEFAULT_MODEL else ''}, float16"
 
 MODELS = {
     # name: (label, shader variant or None, bytes per material, how stored)
@@ -117,7 +118,7 @@ MODELS = {
     "lazanyi_adjusted": ("adjusted Lazanyi", "lazanyi", 24, "F0, F82 RGB, 6 float32"),
     "ours_float32": ("ours, float32", "floats", 108, "27 float32"),
     # Every model kind as shipped: float16, named as the batch names it.
-    **{kind: (KIND_LABELS.get(kind, f"{kind} kind, float16"), MODEL_VARIANTS[kind],
+    **{kind: (kind_label(kind), MODEL_VARIANTS[kind],
               2 * coefficient_count(kind), f"{coefficient_count(kind)} float16")
        for kind in MODEL_KINDS},
     "ours_scene": ("ours, scene-specialised", "collapsed", 18, "9 float16 at one eta_i"),

@@ -45,6 +45,7 @@ from fitting.colour.reference import reference_ACEScg
 from fitting.fits.kinds import fit_model
 from fitting.models.baselines import baseline_inputs, external_medium_F0, lazanyi_a
 from fitting.models.coated_conductor import collapse_to_eta_i
+from fitting.models.kinds import MODEL_KINDS
 from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.shading.ibl import default_lut, split_sum_lazanyi, split_sum_model, split_sum_schlick
 from preview_shaders.rough import reference_albedo_table
@@ -77,7 +78,7 @@ SPLIT_VARIANTS = {
     "split_sum_schlick_exact_F0": ("split sum, Schlick, exact F0", "split_sum_schlick", 8),
 }
 
-KIND_SPLIT_SUM = {"coated-conductor": "split_sum_model", "rgb-conductor": None}
+KIND_SPLIT_SUM = {name: "split_sum_model" if kind.split_sum else None for name, kind in MODEL_KINDS.items()}
 """Each model kind's split-sum variant; None: the kind has no split-sum
 table (its Fresnel is not linear in a few parameters the LUT could hold;
 the rough preview refuses it, docs/shading.md)."""

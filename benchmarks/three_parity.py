@@ -45,10 +45,11 @@ from editor_pages import CHROMIUM_ARGS  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 from three_pages import create_fit, measure_three, open_example  # noqa: E402
 
+from fitting.models.kinds import MODEL_KINDS, model_kind  # noqa: E402
 from fitting.optics.library import library_material  # noqa: E402
 
 SETTINGS = [(1.5, 0.0, 0.0), (1.5, 0.3, 0.1), (2.2, 0.5, 0.2)]
-KINDS = ("coated-conductor", "rgb-conductor")
+KINDS = tuple(MODEL_KINDS)
 RECORD = ROOT / "benchmarks" / "records" / "three_parity.md"
 
 
@@ -89,7 +90,8 @@ def main() -> None:
         "|---|---|---:|---:|---:|---|---|---|",
     ]
     for material, kind, eta_i, r, c, parity, physics, fallback in rows:
-        versus = "twin" if kind == "rgb-conductor" else "preview"
+        # A kind the rough preview cannot draw (no split sum) is compared with its twin.
+        versus = "preview" if model_kind(kind).split_sum else "twin"
         lines.append(
             f"| {material} | {kind} | {eta_i:g} | {r:g} | {c:g} | {versus} {parity['mean']:.4f} / "
             f"{parity['p99']:.3f} / {parity['centre']:.4f} / {parity['ring']:.3f} | {physics['mean']:.3f} / "

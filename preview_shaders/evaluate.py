@@ -24,6 +24,7 @@ import numpy as np
 
 from fitting.models.baselines import external_medium_F0, lazanyi_a
 from fitting.models.coated_conductor import collapse_to_eta_i
+from fitting.models.kinds import MODEL_KINDS, model_kind
 from fitting.models.pack import PackedMaterial, halves_to_uint32
 
 from .gl import GLState, RenderThread, check_gl_error, read_float_target, time_renders
@@ -54,8 +55,9 @@ evaluate.frag): adjusted Lazanyi at the scene's constant eta_i with F0 and a
 from the CPU (the like-for-like counterpart of the scene-specialised model),
 and a pass with no Fresnel term (the fixed cost every variant pays)."""
 
-MODEL_VARIANTS = {"coated-conductor": "packed", "rgb-conductor": "rgb_conductor"}
-"""The variant that evaluates a pack material of each model kind as shipped."""
+MODEL_VARIANTS = {name: kind.shader_variant for name, kind in MODEL_KINDS.items() if kind.shader_variant}
+"""The variant that evaluates a pack material of each model kind as shipped
+(``ModelKind.shader_variant`` of the kinds registered at import: the variants are evaluate.frag's)."""
 
 
 def padded_coefficients(coefficients) -> np.ndarray:
@@ -104,7 +106,7 @@ def shader_inputs(
     the coated-conductor uniforms are zero, ``rgb_words`` its packed halves,
     and ``n``, ``k`` default to its float16 values.
     """
-    if packed.model == "rgb-conductor":
+    if model_kind(packed.model).shader_variant == "rgb_conductor":  # a variant of evaluate.frag
         C = packed.coefficients
         return ShaderInputs(
             words=np.zeros(14, dtype=np.uint32),

@@ -49,22 +49,28 @@ GL_VERSION = 430
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 
-def load_shader_source(name: str, defines: dict[str, int] | None = None) -> str:
+def load_shader_source(name: str, defines: dict[str, int] | None = None,
+                       sources: dict[str, str] | None = None) -> str:
     """
     Source of ``glsl/<name>`` with ``#include "file"`` lines replaced by the
     file (recursively; each file is included once, its include guard covers
     repeats) and ``#define NAME value`` lines after the ``#version`` line.
+    ``sources`` gives the text of generated include files by name (the
+    preview's ``cf_preview_model.glsl``, :mod:`preview_shaders.kinds`); an
+    absolute file name is read as it is.
     """
     seen: set[str] = set()
+    sources = sources or {}
 
     def expand(file_name: str) -> str:
-        path = GLSL_DIR / file_name
-        if not path.is_file():
-            raise ValueError(f"`{file_name}` is not a shader in {GLSL_DIR}")
         if file_name in seen:
             return ""
+        path = GLSL_DIR / file_name
+        if file_name not in sources and not path.is_file():
+            raise ValueError(f"`{file_name}` is not a shader in {GLSL_DIR}")
         seen.add(file_name)
-        return _INCLUDE.sub(lambda m: expand(m.group(1)), path.read_text())
+        text = sources[file_name] if file_name in sources else path.read_text()
+        return _INCLUDE.sub(lambda m: expand(m.group(1)), text)
 
     source = expand(name)
     head, _, body = source.partition("\n")
@@ -140,14 +146,16 @@ class GLState:
             target.release()
 
     def program(
-        self, fragment: str, defines: dict[str, int] | None = None
+        self, fragment: str, defines: dict[str, int] | None = None,
+        sources: dict[str, str] | None = None,
     ) -> tuple[moderngl.Program, moderngl.VertexArray]:
-        """A full-screen program (``fullscreen.vert`` + ``fragment``) and its VAO."""
-        key = (fragment, tuple(sorted((defines or {}).items())))
+        """A full-screen program (``fullscreen.vert`` + ``fragment``, with the generated
+        include ``sources`` of :func:`load_shader_source`) and its VAO."""
+        key = (fragment, tuple(sorted((defines or {}).items())), tuple(sorted((sources or {}).items())))
         if key not in self._programs:
             program = self.ctx.program(
                 vertex_shader=load_shader_source("fullscreen.vert"),
-                fragment_shader=load_shader_source(fragment, defines),
+                fragment_shader=load_shader_source(fragment, defines, sources),
             )
             vao = self.ctx.vertex_array(program, [])
             self._programs[key] = (program, vao)

@@ -40,9 +40,11 @@ radius.
 
 -   :data:`COMPARISONS`, :data:`ENVIRONMENTS`: the accepted values.
 -   :class:`PreviewRenderer`, :class:`PreviewResult`.
--   :func:`reference_image`: the spectral reference of a rendered view,
-    through :func:`reference_table` (cos theta -> ACEScg, one per eta_i).
--   :func:`difference_maps`: Delta E 2000 and FLIP maps and means.
+-   :func:`reference_image`, :func:`reference_table`, :func:`difference_maps`:
+    the spectral reference of a view and the maps against it
+    (:mod:`preview_shaders.reference`, re-exported).
+-   How each model kind is drawn: :mod:`preview_shaders.kinds` (the kind's
+    ``preview_call`` in ``cf_preview_model``, one program per kind).
 Rough spheres and the coated mode (issue 11) are drawn by
 ``glsl/preview_rough.frag`` through the split sum with a prefiltered
 environment (:mod:`preview_shaders.rough`).
@@ -56,17 +58,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fitting.colour.colorimetry import ACEScg_to_Lab
-from fitting.colour.delta_e import delta_E_2000
-from fitting.colour.reference import reference_ACEScg, reference_ACEScg_grid
 from fitting.domain import ETA_I_MAX, ETA_I_MIN, check_eta_i
 from fitting.models.baselines import baseline_inputs
-from fitting.models.kinds import MODEL_KINDS
-from fitting.models.pack import PackedMaterial, halves_to_uint32
+from fitting.models.kinds import model_kind
+from fitting.models.pack import PackedMaterial
 
 from .display import ACEScg_to_sRGB, encode_png, to_uint8
-from .evaluate import padded_coefficients
 from .gl import GLState, RenderThread, check_gl_error, read_float_target
+from .kinds import PREVIEW_MODEL_FILE, padded_words, preview_model_source, preview_words
+from .reference import (REFERENCE_TABLE_SIZE, REFERENCE_TABLE_TOLERANCE, difference_maps, reference_image,
+                        reference_table)
 
 __all__ = [
     "COMPARISONS",
@@ -176,19 +177,22 @@ def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, s
                    environment, split_column):
     """On the render thread: colour, geometry and radiance, top row first."""
     ctx = state.ctx
-    program, vao = state.program("preview.frag")
-    program["u_centre"].value = (0.5 * size, 0.5 * size)
-    program["u_radius"].value = SPHERE_RADIUS * size
-    program["u_split_column"].value = float(split_column)
-    program["u_environment"].value = ENVIRONMENTS.index(environment)
-    program["u_eta_i"].value = eta_i
-    kind, words, rgb_words = model
-    program["u_model"].value = MODEL_KINDS.index(kind)
-    program["cf_words"].value = [int(w) for w in words]
-    program["cf_rgb_words"].value = [int(w) for w in rgb_words]
-    program["cf_eta_i_range"].value = tuple(float(v) for v in eta_i_range)
-    program["cf_F0_air"].value = tuple(float(v) for v in F0_air)
-    program["cf_F82_air"].value = tuple(float(v) for v in F82_air)
+    program, vao = state.program(
+        "preview.frag", sources={PREVIEW_MODEL_FILE: preview_model_source(model_kind(model[0]))})
+    _, words = model
+    uniforms = {
+        "u_centre": (0.5 * size, 0.5 * size), "u_radius": SPHERE_RADIUS * size,
+        "u_split_column": float(split_column), "u_environment": ENVIRONMENTS.index(environment),
+        "u_eta_i": eta_i, "cf_eta_i_range": tuple(float(v) for v in eta_i_range),
+        "cf_F0_air": tuple(float(v) for v in F0_air), "cf_F82_air": tuple(float(v) for v in F82_air),
+    }
+    for name, value in uniforms.items():
+        # A kind that does not read a uniform (the rgb-conductor's domain) leaves it to the compiler.
+        if name in program:
+            program[name].value = value
+    # ... and of the words it reads fewer than 14 (the array is trimmed).
+    uniform = program["cf_words"]
+    uniform.value = [int(w) for w in words[: uniform.array_length]]
     fbo, targets = state.float_targets((size, size), 3)
     try:
         fbo.use()
@@ -198,94 +202,6 @@ def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, s
     finally:
         state.release_targets(fbo, targets)
     return layers
-
-
-REFERENCE_TABLE_SIZE = 513
-"""Nodes of the cos theta table of the spectral reference (uniform over [0, 1])."""
-REFERENCE_TABLE_TOLERANCE = 1e-7
-"""Largest error of the table (linear ACEScg) at the check points, below float32 rounding of 1."""
-
-
-def reference_table(nk, eta_i, step_nm: float = 1.0, nodes: int = REFERENCE_TABLE_SIZE):
-    """
-    The spectral reference of ``nk`` under the coating ``eta_i`` as a
-    function of cos theta alone, a callable ``table(cos_theta) -> (..., 3)``
-    (linear ACEScg): a cubic spline (not-a-knot) through the exact values
-    (:func:`fitting.colour.reference.reference_ACEScg_grid`) at ``nodes``
-    cos theta uniform over [0, 1].
-
-    On a smooth sphere the reference depends on the pixel only through cos
-    theta, so one table serves every pixel and its cost does not grow with
-    the image. The table checks itself: the exact values at the midpoints
-    of its nodes must lie within :data:`REFERENCE_TABLE_TOLERANCE` of the
-    spline (they do for every conductor; the error is fourth order in the
-    node spacing). Where they do not, which happens for a lossless
-    dielectric past its critical angle (a kink in cos theta), the callable
-    integrates the exact reference at each distinct cos theta instead.
-    """
-    from scipy.interpolate import CubicSpline
-
-    fine = np.linspace(0.0, 1.0, 2 * int(nodes) - 1)
-    F = reference_ACEScg_grid(nk, fine, [float(eta_i)], step_nm)[0]
-    spline = CubicSpline(fine[::2], F[::2], axis=0, extrapolate=False)
-    if np.max(np.abs(spline(fine[1::2]) - F[1::2])) <= REFERENCE_TABLE_TOLERANCE:
-        return spline
-
-    def exact(cos_theta):
-        mu = np.asarray(cos_theta, dtype=np.float64)
-        unique, inverse = np.unique(mu, return_inverse=True)
-        values = reference_ACEScg_grid(nk, unique, [float(eta_i)], step_nm)[0]
-        return values[inverse.reshape(mu.shape)]
-
-    return exact
-
-
-def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0,
-                    per_pixel: bool = False) -> np.ndarray:
-    """
-    The spectral reference of a rendered view: on the sphere, the exact
-    reflectance of ``nk`` at each pixel's cos theta times the radiance the
-    pixel sees; elsewhere the radiance. float32 linear ACEScg.
-
-    The reflectance comes from :func:`reference_table` (one table per
-    eta_i); ``per_pixel=True`` integrates the reference at every pixel
-    instead (:func:`fitting.colour.reference.reference_ACEScg`), the
-    definition the table is tested against.
-    """
-    image = np.array(radiance[..., :3], dtype=np.float64)
-    mu = np.clip(cos_theta[mask].astype(np.float64), 0.0, 1.0)
-    if per_pixel:
-        F = reference_ACEScg(nk, mu, eta_i, step_nm)
-    else:
-        F = reference_table(nk, eta_i, step_nm)(mu)
-    image[mask] = F * image[mask]
-    return image.astype(np.float32)
-
-
-def difference_maps(test, reference, mask):
-    """
-    Per-pixel Delta E 2000 (CIE Lab with the ACES white) and FLIP (LDR,
-    flip-evaluator, on the display-encoded sRGB images) between two linear
-    ACEScg images, and the mean of each over ``mask``.
-
-    Returns
-    -------
-    tuple
-        (delta_E map, delta_E mean, FLIP map, FLIP mean).
-    """
-    import flip_evaluator
-
-    delta_E = delta_E_2000(ACEScg_to_Lab(test), ACEScg_to_Lab(reference)).astype(np.float32)
-    flip, _, _ = flip_evaluator.evaluate(
-        ACEScg_to_sRGB(reference).astype(np.float32),
-        ACEScg_to_sRGB(test).astype(np.float32),
-        "LDR",
-        inputsRGB=True,
-        applyMagma=False,
-        computeMeanError=False,
-    )
-    flip = np.asarray(flip, dtype=np.float32).reshape(mask.shape)
-    return delta_E, float(delta_E[mask].mean()), flip, float(flip[mask].mean())
 
 
 class PreviewRenderer:
@@ -355,10 +271,10 @@ class PreviewRenderer:
         coat_roughness = _check_unit("coat_roughness", coat_roughness)
         mode = _check_choice("mode", mode, MODES)
         if roughness > 0.0 or mode != "immersed":
-            if packed.model != "coated-conductor":
+            if not model_kind(packed.model).split_sum:
                 raise ValueError(
-                    f"`roughness` > 0 and `mode` coated need the coated-conductor model kind, "
-                    f"got {packed.model!r}"
+                    f"`roughness` > 0 and `mode` coated need a model kind with the split-sum lookup "
+                    f"(coated-conductor), got {packed.model!r}"
                 )
             return self._render_rough(packed, nk, eta_i, size, compare, environment, step_nm,
                                       roughness, mode, coat_roughness, differences)
@@ -464,13 +380,6 @@ class PreviewRenderer:
         return layers[0][..., :3]
 
 
-def _model_words(packed: PackedMaterial) -> tuple[str, np.ndarray, np.ndarray]:
-    """The kind and the uniform words of each kind (zero for the other kind)."""
-    if packed.model == "rgb-conductor":
-        return packed.model, np.zeros(14, dtype=np.uint32), halves_to_uint32(packed.coefficients)
-    return packed.model, padded_words(packed), np.zeros(3, dtype=np.uint32)
-
-
-def padded_words(packed: PackedMaterial) -> np.ndarray:
-    """The 14 uint32 words of a material's coefficients, padded to degree 2."""
-    return halves_to_uint32(padded_coefficients(packed.coefficients))
+def _model_words(packed: PackedMaterial) -> tuple[str, np.ndarray]:
+    """The kind and the preview's uniform words (:func:`preview_shaders.kinds.preview_words`)."""
+    return packed.model, preview_words(packed)

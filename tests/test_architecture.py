@@ -1,7 +1,7 @@
 """
 The house rules of ``docs/architecture.md``, read from the source with ``ast``:
-module sizes, the layers of ``fitting/`` and no import cycles in ``fitting/``
-or ``service/``.
+module sizes in every Python package, the layers of ``fitting/``, who may
+import whom, and no import cycles.
 """
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-PACKAGES = ("fitting", "service")
+PACKAGES = ("fitting", "service", "preview_shaders", "benchmarks")
+"""Every Python package of the house (``scripts/`` holds no Python; ``tests/`` are not a package)."""
 MAX_MODULE_LINES = 400
 MAX_ROUTE_LINES = 160
 
@@ -47,7 +48,7 @@ ALL = {name: path for package in PACKAGES for name, path in _modules(package).it
 
 
 def _imports(name: str, path: Path) -> set[str]:
-    """Modules of fitting/ and service/ that ``name`` imports (absolute names)."""
+    """Modules of the packages that ``name`` imports (absolute names)."""
     tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = set()
@@ -103,9 +104,27 @@ def _lines(name: str) -> int:
     return len(ALL[name].read_text(encoding="utf-8").splitlines())
 
 
-@pytest.mark.parametrize("name", FITTING)
-def test_fitting_module_size(name):
+@pytest.mark.parametrize("name", sorted(ALL))
+def test_module_size(name):
+    """No module of any package over 400 lines."""
     assert _lines(name) <= MAX_MODULE_LINES, f"{ALL[name].relative_to(ROOT)} has {_lines(name)} lines"
+
+
+def test_every_package_is_read():
+    """Each package of PACKAGES has modules in the graph, and no Python outside them goes unread."""
+    assert all(any(n == p or n.startswith(p + ".") for n in ALL) for p in PACKAGES)
+    outside = [p.relative_to(ROOT) for p in ROOT.glob("*/**/*.py")
+               if p.relative_to(ROOT).parts[0] not in (*PACKAGES, "tests", "static")
+               and not any(part.startswith(".") or part == "node_modules" for part in p.relative_to(ROOT).parts)]
+    assert not outside, outside
+
+
+def test_only_the_tools_import_the_benchmarks():
+    """fitting/, service/ and preview_shaders/ never import benchmarks/; fitting/ never preview_shaders/."""
+    wrong = [f"{n} imports {t}" for n, ts in GRAPH.items() for t in ts
+             if (t.startswith("benchmarks") and not n.startswith("benchmarks"))
+             or (n.startswith("fitting") and t.startswith("preview_shaders"))]
+    assert not wrong, "\n".join(wrong)
 
 
 def test_no_fitting_layer_imports_a_higher_one():

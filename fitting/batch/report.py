@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..models.pack import encode_pack, pack_to_json
-from .kinds import MODEL_KINDS
+from .kinds import decode_material
 
 __all__ = ["OUTPUT_FILES", "accuracy_summary", "report_rows", "write_outputs"]
 
@@ -148,7 +148,7 @@ def write_outputs(
         if r["status"] != "fitted":
             continue
         for kind in kinds:
-            material = MODEL_KINDS[kind].decode(r["materials"][kind])
+            material = decode_material(r["materials"][kind])
             if len(kinds) > 1:
                 material = dataclasses.replace(material, name=f"{r['page']} [{kind}]")
             materials.append(material)

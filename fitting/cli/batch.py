@@ -31,7 +31,9 @@ def _cmd_batch(args) -> int:
         pages = select_pages(page_list=read_page_list(args.page_list))
     else:
         pages = select_pages(shelf=args.shelf, book=args.book, pages_glob=args.pages)
-    kinds = args.model or ["coated-conductor"]
+    from ..batch import DEFAULT_MODEL_KIND
+
+    kinds = args.model or [DEFAULT_MODEL_KIND]
     print(f"batch: {len(pages)} pages, model kinds {', '.join(kinds)}, output {args.output}",
           file=sys.stderr)
     result = run_batch(
@@ -50,7 +52,7 @@ def add_batch_parser(sub, parse_eta_range) -> None:
     Add the ``batch`` sub-command to an argparse sub-parser group;
     ``parse_eta_range`` is the ``--eta-range`` type of the main parser.
     """
-    from ..batch import MODEL_KINDS
+    from ..batch import DEFAULT_MODEL_KIND, batch_kinds
     from ..domain import DEFAULT_ETA_I_RANGE
 
     p = sub.add_parser("batch", help="fit a selection of the refractiveindex.info database")
@@ -60,9 +62,9 @@ def add_batch_parser(sub, parse_eta_range) -> None:
     p.add_argument("--shelf", help="every page of this shelf, e.g. main")
     p.add_argument("--book", help="every page of this book (BOOK on --shelf, default main, or SHELF/BOOK)")
     p.add_argument("--pages", metavar="GLOB", help="pages matching SHELF/BOOK/PAGE glob, e.g. 'main/*/Johnson'")
-    p.add_argument("--model", action="append", choices=sorted(MODEL_KINDS), metavar="KIND",
-                   help=f"model kind to fit, repeatable (default coated-conductor; one of "
-                        f"{', '.join(sorted(MODEL_KINDS))})")
+    p.add_argument("--model", action="append", choices=sorted(batch_kinds()), metavar="KIND",
+                   help=f"model kind to fit, repeatable (default {DEFAULT_MODEL_KIND}; one of "
+                        f"{', '.join(sorted(batch_kinds()))})")
     p.add_argument("--eta-range", type=parse_eta_range, default=DEFAULT_ETA_I_RANGE, metavar="LO:HI",
                    help="eta_i domain of the fits (default 1:2.5)")
     p.add_argument("-o", "--output", default="batch-output", metavar="DIR",

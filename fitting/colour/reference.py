@@ -204,7 +204,7 @@ def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out, loop_mu: bool, dtype=np.floa
         \\frac{R_p}{R_s} = \\frac{cX + s^2 - 2\\mu a s}{cX + s^2 + 2\\mu a s},\\quad
         R = \\frac{R_s + R_p}{2} = R_s \\frac{cX + s^2}{cX + s^2 + 2\\mu a s},
 
-    the unpolarised reflectance of :func:`fitting.fresnel.fresnel_conductor`
+    the unpolarised reflectance of :func:`fitting.optics.fresnel.fresnel_conductor`
     (whose complex form is the definition; agreement to 1e-14 is tested).
     Rounding care: :math:`2a^2 = X + t_0` cancels where :math:`t_0 < 0` (every
     metal, and a dielectric past its critical angle), so there it is taken

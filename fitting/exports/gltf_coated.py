@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..models.kinds import model_kind
 from ..models.pack import PackedMaterial, material_to_json
 
 __all__ = ["EXTENSION_NAME", "SCHEMA_PATH", "coated_conductor_extension"]
@@ -60,7 +61,7 @@ def coated_conductor_extension(
     ``coatRoughnessFactor``.
     """
     lo, hi = material.eta_i_range
-    if material.model == "coated-conductor" and not lo - _RANGE_SLACK <= eta_i <= hi + _RANGE_SLACK:
+    if model_kind(material.model).polynomial and not lo - _RANGE_SLACK <= eta_i <= hi + _RANGE_SLACK:
         return None, (
             f"{EXTENSION_NAME} omitted: the coated-conductor fit is defined for eta_i in "
             f"[{lo:g}, {hi:g}], the export is for {eta_i:g}"

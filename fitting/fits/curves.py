@@ -23,12 +23,10 @@ so it needs no range constraint).
 -   :data:`LIVE_SETTINGS`: the editor's warm-started refit while a point is
     dragged.
 -   :func:`whole_target_error`: Delta E 2000 over the whole blended target
-    on :data:`SCORE_GRID`, where a fit's reported figures are measured
-    (:mod:`fitting.fits.curves_score`, with the [0, 1] check grid).
+    on :data:`SCORE_GRID` (:mod:`fitting.fits.curves_score`).
 
-The fit stays a reflectance: [0, 1] over its whole domain is a penalty
-constraint of the least squares (hinge residuals at a check grid,
-:func:`fitting.fits.solver.fit_coefficients` ``range_check``), not a clip.
+The fit stays a reflectance: [0, 1] is a penalty constraint of the least
+squares (hinge residuals at a check grid, ``range_check``), not a clip.
 
 With a base, an edited curve replaces the base's reflectance at its eta_i and
 the difference it makes fades smoothly across eta_i (:func:`blend_weights`);
@@ -53,17 +51,16 @@ from typing import Any
 import numpy as np
 
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_int, check_number
-from ..models.kinds import DEFAULT_MODEL, check_model, model_ACEScg
+from ..models.kinds import DEFAULT_MODEL, model_ACEScg, model_kind
 from ..models.pack import PackedMaterial, to_float16
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve, check_curves
 from .curves_range import EvaluationBudget, in_range_fallback, outside_range
 from .curves_score import SCORE_GRID, angle_mu, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
+from .kinds import fit_kind
 from .result import FitResult
-from .rgb_conductor import fit_rgb_conductor_coefficients
 from .settings import check_fit_options
-from .solver import fit_coefficients
 
 __all__ = ["CurveFitSettings", "LIVE_SETTINGS", "SCORE_GRID", "score_grid", "whole_target_error", "fit_curves"]
 
@@ -214,8 +211,9 @@ def fit_curves(
         ``delta_E_mean`` and ``delta_E_max`` (CIE Delta E 2000 of the float16
         model against the curves at their own samples), ``by_curve`` (the same
         per curve, with its ``eta_i``), ``samples`` (the number of fitted
-        samples), ``base`` (its name or None), ``objective`` (the one kept)
-        and, with a base, ``target`` (:func:`whole_target_error`: mean and
+        samples), ``base`` (its name or None), ``objective`` (the one kept),
+        ``figure`` (:meth:`fitting.fits.metrics.ErrorMetrics.figure`: with a
+        base the whole target's, else the curves') and, with a base, ``target`` (:func:`whole_target_error`: mean and
         max Delta E 2000 over the whole blended target on
         :data:`SCORE_GRID`, where the max is, and the model's range).
 
@@ -230,7 +228,8 @@ def fit_curves(
     if overrides:
         settings = CurveFitSettings(**{**settings.__dict__, **overrides})
     curves = check_curves(curves)
-    model = check_model(model)
+    kind, solver = model_kind(model), fit_kind(model)
+    model, solve = kind.name, solver.solve
     if not isinstance(name, str) or not name.strip():
         raise ValueError("`name` must be a non-empty string")
     if base is not None:
@@ -260,7 +259,7 @@ def fit_curves(
         target = edited_target(base, curves, mu, eta, settings.blend_width)
         is_edit = np.any(np.abs(eta[:, None] - edited[None, :]) <= 1e-6, axis=1)
         weights = np.where(is_edit, settings.edit_weight, 1.0)
-        degree = 2
+        degree = kind.max_degree
         source = f"{base.name} with RGB curves edited at eta_i {_describe(curves)}"
         if base.source:
             source += f"; base: {base.source}"
@@ -268,7 +267,7 @@ def fit_curves(
         mu = np.concatenate([np.linspace(c.cos_theta[0], c.cos_theta[-1], settings.mu_samples) for c in curves])
         eta = np.repeat([c.eta_i for c in curves], settings.mu_samples)
         target = np.concatenate([c.sampled(np.linspace(c.cos_theta[0], c.cos_theta[-1], settings.mu_samples)) for c in curves])
-        degree = min(2, len(curves) - 1)
+        degree = min(kind.max_degree, len(curves) - 1)
         weights = None
         source = f"RGB curves at eta_i {_describe(curves)}"
     t_target = time.perf_counter()
@@ -287,12 +286,12 @@ def fit_curves(
             # An unbounded and a bounded solve at most (fitting.fits.solver.solve).
             wanted = _RGB_MAX_NFEV
             max_nfev = budget.per_solve(wanted, 2)
-            result = fit_coefficients(*dense, eta_i_range, degree, "rgb", max_nfev,
-                                      settings.quantise, irls_rounds=0, range_check=range_check)
+            result = solve(*dense, eta_i_range, degree, "rgb", max_nfev,
+                           settings.quantise, irls_rounds=0, range_check=range_check)
         else:
             wanted, rounds = settings.max_nfev, 1 + (settings.irls_rounds if objective == "de2000" else 0)
             max_nfev = budget.per_solve(wanted, 2 * rounds)
-            result = fit_coefficients(
+            result = solve(
                 target, mu, eta, eta_i_range, degree, objective, max_nfev,
                 settings.quantise, weights=weights, irls_rounds=settings.irls_rounds, range_check=range_check,
                 start=start,
@@ -340,10 +339,12 @@ def fit_curves(
         return result
 
     chosen = settings.objective
-    if model == "rgb-conductor":
-        result = fit_rgb_conductor_coefficients(
-            target, mu, eta, eta_i_range, settings.objective, max(settings.max_nfev, _RGB_MAX_NFEV),
-            settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
+    if solver.bounded:
+        # A reflectance by construction: no range constraint, no candidates.
+        result = solve(
+            target, mu, eta, eta_i_range, degree, settings.objective,
+            max(settings.max_nfev, _RGB_MAX_NFEV), settings.quantise, weights=weights,
+            irls_rounds=settings.irls_rounds,
         )
     else:
         result = held(constrained(settings.objective))
@@ -358,7 +359,7 @@ def fit_curves(
                 < whole_target_error(base, curves, result.coefficients_float16,
                                      settings.blend_width)["delta_E_mean"]):
                 result.coefficients_float16 = on_screen
-    if model != "rgb-conductor" and base is not None and settings.compare_rgb and settings.objective != "rgb":
+    if not solver.bounded and base is not None and settings.compare_rgb and settings.objective != "rgb":
         # The paper's own method (plain rgb least squares) on the whole
         # blended target (every other point of the scoring grid: the target
         # is smooth, and it halves the cost): kept when it is closer on the
@@ -375,10 +376,7 @@ def fit_curves(
         chosen = min(scores, key=scores.get)
         result = candidates[chosen]
     C16 = result.coefficients_float16
-    error = curve_metrics(
-        curves, lambda c: model_ACEScg(model, c.cos_theta, c.eta_i, C16, eta_i_range),
-        "the edited curves at their samples",
-    )
+    error = curve_metrics(curves, lambda c: model_ACEScg(model, c.cos_theta, c.eta_i, C16, eta_i_range))
     metrics: dict[str, Any] = {
         **error.to_dict(),
         "samples": int(mu.size),
@@ -386,8 +384,11 @@ def fit_curves(
         "objective": chosen,
         "best_effort": bool(result.best_effort or budget.cut),
     }
+    metrics["figure"] = error.figure()
     if base is not None:
-        metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)
+        target = metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)
+        # With a base the figure is the whole edited target's (what the editor's error map shows).
+        metrics["figure"] = {key: target[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at")}
     result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(

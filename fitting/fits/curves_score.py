@@ -21,6 +21,7 @@ from ..colour.delta_e import delta_E_map
 from ..models.kinds import DEFAULT_MODEL, model_ACEScg
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve
+from .metrics import AGAINST_CURVES
 
 __all__ = ["SCORE_GRID", "score_grid", "whole_target_error", "check_grid", "angle_mu"]
 
@@ -60,17 +61,21 @@ def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients
                        shape=SCORE_GRID, model: str = DEFAULT_MODEL) -> dict[str, Any]:
     """
     Delta E 2000 of the model (of kind ``model``) of ``coefficients`` against the whole blended
-    target (:func:`edited_target`) on the scoring grid: mean, max and where
-    the max is (``at_theta_deg``, ``at_eta_i``), and the model's range there.
+    target (:func:`edited_target`) on the scoring grid: ``against`` in words,
+    mean, max and where the max is (``max_at``; also ``at_theta_deg``,
+    ``at_eta_i``), and the model's range there.
     """
     theta, rows, M, E = score_grid(base.eta_i_range, shape)
     target = edited_target(base, curves, M, E, blend_width)
     RGB = model_ACEScg(model, M, E, coefficients, base.eta_i_range)
     dE = delta_E_map(target, RGB)
     j, i = np.unravel_index(int(np.argmax(dE)), dE.shape)
+    grid = f"{theta.size} angles x {rows.size} eta_i"
     return {
+        "against": f"{AGAINST_CURVES} (the whole edited target, {grid})",
         "delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max()),
+        "max_at": {"eta_i": float(rows[j]), "theta_deg": float(theta[i])},
         "at_theta_deg": float(theta[i]), "at_eta_i": float(rows[j]),
         "model_min": float(RGB.min()), "model_max": float(RGB.max()),
-        "grid": f"{theta.size} angles x {rows.size} eta_i",
+        "grid": grid,
     }

@@ -28,7 +28,7 @@ from ..domain import DEFAULT_MIN_COVERAGE
 from ..models.baselines import baselines_ACEScg
 from ..models.kinds import model_ACEScg
 from ..optics.nk import SpectralNK
-from .metrics import ErrorMetrics, grid_metrics
+from .metrics import AGAINST_MEASURED, ErrorMetrics, grid_metrics
 from .result import FitResult
 
 __all__ = ["evaluate_errors", "grid_models", "score_on_grid", "evaluate_material", "metrics_json"]
@@ -86,7 +86,7 @@ def score_on_grid(
     if baselines:
         models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
     return grid_metrics(ref, models, eta_i[:, 0],
-                        f"spectral reference 1 nm, {eta_i.shape[0]} x {eta_i.shape[1]}")
+                        f"{AGAINST_MEASURED}, {eta_i.shape[0]} x {eta_i.shape[1]} grid", cos_theta[0])
 
 
 def evaluate_material(
@@ -95,7 +95,8 @@ def evaluate_material(
 ) -> dict[str, Any]:
     """
     :func:`evaluate_errors` as the JSON a fit carries (``FitResult.metrics``,
-    the pack, the API): ``grid``, then each result's
+    the pack, the API): ``grid``, ``figure`` (the float16 model's
+    :meth:`~fitting.fits.metrics.ErrorMetrics.figure`), then each result's
     :meth:`~fitting.fits.metrics.ErrorMetrics.to_dict` by name, ``coverage``.
     Sets ``result.error`` to the float16 model's :class:`ErrorMetrics`.
     """
@@ -112,7 +113,7 @@ def metrics_json(errors: dict[str, ErrorMetrics], result: FitResult, samples: in
     """
     errors = dict(errors)
     result.error = errors["model_float16"]
-    out: dict[str, Any] = {"grid": f"{samples}x{samples}"}
+    out: dict[str, Any] = {"grid": f"{samples}x{samples}", "figure": result.error.figure()}
     out["model_float16"] = errors.pop("model_float16").to_dict()
     out["model_float64"] = errors.pop("model_float64").to_dict()
     out["coverage"] = result.coverage

@@ -8,7 +8,9 @@ Material fits
 
 The pipeline: the spectral reference (:mod:`fitting.colour.reference`) on
 the fitting grid (:func:`fitting.fits.settings.fit_grid`), the solve and the
-quantisation (:func:`fitting.fits.solver.fit_coefficients`), the pack.
+quantisation (:func:`fitting.fits.solver.fit_coefficients`), the pack: the
+pipeline of :mod:`fitting.fits.pipeline`, with this kind's
+:data:`COATED_CONDUCTOR_FIT`.
 
 References
 ----------
@@ -17,18 +19,18 @@ Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
 
 from __future__ import annotations
 
-import time
-
-from ..colour.reference import reference_ACEScg, spectral_weights
-from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
-from ..models.pack import PackedMaterial
-from ..optics.nk import SpectralNK, resample_nk
-from .evaluate import evaluate_material
+from ..domain import DEFAULT_ETA_I_RANGE
+from ..models.kinds import DEFAULT_MODEL
+from ..optics.nk import SpectralNK
+from .pipeline import FitKind, fit_spectral
 from .result import FitResult
-from .settings import FitSettings, fit_grid
+from .settings import FitSettings
 from .solver import fit_coefficients
 
-__all__ = ["fit_material"]
+__all__ = ["COATED_CONDUCTOR_FIT", "fit_material"]
+
+COATED_CONDUCTOR_FIT = FitKind(name=DEFAULT_MODEL, settings=FitSettings(), solve=fit_coefficients)
+"""The coated-conductor's fit (:mod:`fitting.fits.pipeline`; registered in :mod:`fitting.fits.kinds`)."""
 
 
 def fit_material(
@@ -44,15 +46,16 @@ def fit_material(
     The reference on the fitting grid (:class:`FitSettings`) comes from the
     exact Fresnel equations integrated to linear ACEScg at ``step_nm``;
     :func:`fit_coefficients` fits and quantises. ``overrides`` replace
-    individual settings (``objective="rgb"``, ``step_nm=1``, ...).
+    individual settings (``objective="rgb"``, ``step_nm=1``, ...). The
+    pipeline of every kind: :func:`fitting.fits.pipeline.fit_spectral`.
 
     Returns
     -------
     FitResult
         With ``packed`` (float16 :class:`fitting.models.pack.PackedMaterial`, the
-        citation of ``nk`` as source), ``coverage`` and ``timings``
-        (``reference``, ``fit``, ``quantise``, ``total``); with ``metrics``
-        from :func:`evaluate_material` when ``evaluate`` is true.
+        citation of ``nk`` as source), ``coverage``, ``settings`` and ``timings``
+        (``reference``, ``fit``, ``quantise``, ``evaluate``, ``total``); with
+        ``metrics`` from :func:`evaluate_material` when ``evaluate`` is true.
 
     Raises
     ------
@@ -60,34 +63,4 @@ def fit_material(
         For an invalid domain or setting, or data covering too little of
         the visible range.
     """
-    t0 = time.perf_counter()
-    settings = settings or FitSettings()
-    if overrides:
-        settings = FitSettings(**{**settings.__dict__, **overrides})
-    eta_i_range = check_eta_i_range(eta_i_range)
-    nodes, _ = spectral_weights(settings.step_nm)
-    coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    mu, eta, weights = fit_grid(
-        eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid
-    )
-    target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
-    t_ref = time.perf_counter()
-    result = fit_coefficients(
-        target, mu, eta, eta_i_range, settings.degree, settings.objective,
-        settings.max_nfev, settings.quantise, weights=weights,
-        irls_rounds=settings.irls_rounds,
-    )
-    result.coverage = coverage
-    result.timings["reference"] = t_ref - t0
-    result.packed = PackedMaterial(
-        name=nk.name, coefficients=result.coefficients_float16,
-        eta_i_range=eta_i_range, source=nk.source,
-    )
-    result.timings["total"] = time.perf_counter() - t0
-    if evaluate:
-        result.metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
-        result.packed = PackedMaterial(
-            name=nk.name, coefficients=result.coefficients_float16,
-            eta_i_range=eta_i_range, source=nk.source, metrics=result.metrics,
-        )
-    return result
+    return fit_spectral(COATED_CONDUCTOR_FIT, nk, eta_i_range, settings, evaluate, **overrides)

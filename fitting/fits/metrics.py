@@ -15,6 +15,13 @@ One typed result for every error the project reports:
 -   :func:`delta_E_summary`: mean and max of a Delta E map (scenes).
 -   :func:`baseline_metrics`: :func:`error_metrics` of every baseline of
     :mod:`fitting.models.baselines`.
+-   :class:`MaxAt`: where a maximum is (eta_i, angle in degrees).
+-   :meth:`ErrorMetrics.figure`, :func:`headline`: **the one figure** of a
+    fit, the same object in the core, its JSON (``metrics["figure"]``), the
+    API (``FitMetrics.figure``), the pack JSON and the shader headers:
+    ``{"against", "delta_E_mean", "delta_E_max", "max_at": {"eta_i",
+    "theta_deg"}}``, ``against`` in words a user reads
+    (:data:`AGAINST_MEASURED`, :data:`AGAINST_CURVES`).
 
 Lab uses the ACES white as reference white (:func:`fitting.colour.colorimetry.ACEScg_to_Lab`).
 
@@ -37,6 +44,10 @@ from ..domain import DEFAULT_MIN_COVERAGE
 from ..models.baselines import baselines_ACEScg
 
 __all__ = [
+    "AGAINST_MEASURED",
+    "AGAINST_CURVES",
+    "MaxAt",
+    "headline",
     "BREAKDOWN_ETA_I",
     "LAYOUTS",
     "EtaRow",
@@ -52,6 +63,11 @@ __all__ = [
 BREAKDOWN_ETA_I = (1.0, 1.5, 2.0, 2.5)
 """The eta_i of the per-row breakdown of material fits (Vernooij 2024, Section 4.3)."""
 
+AGAINST_MEASURED = "the measured metal (1 nm spectral reference)"
+"""What a fit of measured n, k is measured against, in words."""
+AGAINST_CURVES = "your edited curves"
+"""What a fit of edited curves is measured against, in words."""
+
 LAYOUTS = ("grid", "curves", "summary")
 """JSON layouts of :meth:`ErrorMetrics.to_dict`, one per kind of fit (see there)."""
 
@@ -63,6 +79,39 @@ class EtaRow:
     eta_i: float
     mean: float
     max: float
+
+
+@dataclass(frozen=True)
+class MaxAt:
+    """Where a maximum Delta E is: the coating index and the angle in the coating (degrees)."""
+
+    eta_i: float
+    theta_deg: float
+
+    def to_dict(self) -> dict[str, float]:
+        return {"eta_i": self.eta_i, "theta_deg": self.theta_deg}
+
+
+def _theta_deg(cos_theta) -> np.ndarray:
+    """The angle of cos theta in degrees (exactly 90 at 0)."""
+    return np.degrees(np.arccos(np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)))
+
+
+def headline(metrics: dict[str, Any] | None) -> str:
+    """
+    The one figure of a fit's metrics JSON (``metrics["figure"]``) in words:
+    ``"Delta E 2000 against <what>: mean m, max x at eta_i e, theta t deg"``;
+    ``"Delta E 2000: not measured"`` without one.
+    """
+    figure = (metrics or {}).get("figure")
+    if not figure:
+        return "Delta E 2000: not measured"
+    text = (f"Delta E 2000 against {figure['against']}: mean {figure['delta_E_mean']:.3f}, "
+            f"max {figure['delta_E_max']:.3f}")
+    at = figure.get("max_at")
+    if at:
+        text += f" at eta_i {at['eta_i']:.3g}, theta {at['theta_deg']:.1f} deg"
+    return text
 
 
 @dataclass(frozen=True)
@@ -80,11 +129,13 @@ class ErrorMetrics:
         broken down.
     against
         What the model was measured against, in words
-        (``"spectral reference 1 nm, 100 x 100"``).
+        (``"the measured metal (1 nm spectral reference), 100 x 100 grid"``).
     rmse
         Root mean square difference in linear RGB, where measured.
     layout
         The JSON layout of :meth:`to_dict`, one of :data:`LAYOUTS`.
+    max_at
+        Where the max is (:class:`MaxAt`), where known.
     """
 
     mean: float
@@ -93,6 +144,14 @@ class ErrorMetrics:
     rows: tuple[EtaRow, ...] | None = None
     rmse: float | None = None
     layout: str = "grid"
+    max_at: MaxAt | None = None
+
+    def figure(self) -> dict[str, Any]:
+        """The one figure (module docstring): what, mean, max and where the max is."""
+        return {
+            "against": self.against, "delta_E_mean": self.mean, "delta_E_max": self.max,
+            "max_at": None if self.max_at is None else self.max_at.to_dict(),
+        }
 
     def __post_init__(self) -> None:
         if self.layout not in LAYOUTS:
@@ -119,6 +178,10 @@ class ErrorMetrics:
         if self.layout == "summary":
             return {"mean": self.mean, "max": self.max}
         out: dict[str, Any] = {"delta_E_mean": self.mean, "delta_E_max": self.max}
+        if self.against:
+            out["against"] = self.against
+        if self.max_at is not None:
+            out["max_at"] = self.max_at.to_dict()
         if self.layout == "curves":
             out["by_curve"] = [
                 {"eta_i": r.eta_i, "delta_E_mean": r.mean, "delta_E_max": r.max}
@@ -150,11 +213,14 @@ def error_metrics(reference_RGB, model_RGB, eta_i_rows=None, against: str = "") 
     return grid_metrics(reference_RGB, {"model": model_RGB}, eta_i_rows, against)["model"]
 
 
-def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> dict[str, ErrorMetrics]:
+def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "",
+                 cos_theta_columns=None) -> dict[str, ErrorMetrics]:
     """
     :func:`error_metrics` of each of ``models`` (a mapping of name to (E, M,
     3) linear ACEScg) against the one ``reference_RGB``, keyed as
     ``models``: the reference is converted to Lab once for all of them.
+    With ``eta_i_rows`` and ``cos_theta_columns`` (the grid's axes), each
+    result says where its max is (``max_at``).
     """
     reference_RGB = np.asarray(reference_RGB, dtype=np.float64)
     reference_Lab = ACEScg_to_Lab(reference_RGB)
@@ -171,6 +237,10 @@ def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> d
     for name, model_RGB in models.items():
         model_RGB = np.asarray(model_RGB, dtype=np.float64)
         dE = delta_E_2000(reference_Lab, ACEScg_to_Lab(model_RGB))
+        max_at = None
+        if eta_i_rows is not None and cos_theta_columns is not None:
+            i, j = np.unravel_index(int(np.argmax(dE)), dE.shape)
+            max_at = MaxAt(float(np.ravel(eta_i_rows)[i]), float(_theta_deg(np.ravel(cos_theta_columns)[j])))
         out[name] = ErrorMetrics(
             mean=float(dE.mean()),
             max=float(dE.max()),
@@ -179,11 +249,12 @@ def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> d
                 EtaRow(eta, float(dE[i].mean()), float(dE[i].max())) for eta, i in breakdown
             ),
             rmse=float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
+            max_at=max_at,
         )
     return out
 
 
-def curve_metrics(curves, model_of, against: str = "the edited curves") -> ErrorMetrics:
+def curve_metrics(curves, model_of, against: str = f"{AGAINST_CURVES}, at their samples") -> ErrorMetrics:
     """
     Delta E 2000 of a model against curves at their own samples: ``curves``
     have ``eta_i``, ``cos_theta`` and ``rgb``; ``model_of(curve)`` is the
@@ -191,12 +262,16 @@ def curve_metrics(curves, model_of, against: str = "the edited curves") -> Error
     """
     maps = [delta_E_map(c.rgb, model_of(c)) for c in curves]
     every = np.concatenate(maps)
+    worst = int(np.argmax(every))
+    eta = np.concatenate([np.full(len(d), c.eta_i) for c, d in zip(curves, maps)])
+    mu = np.concatenate([np.asarray(c.cos_theta, dtype=np.float64) for c in curves])
     return ErrorMetrics(
         mean=float(every.mean()),
         max=float(every.max()),
         against=against,
         rows=tuple(EtaRow(c.eta_i, float(d.mean()), float(d.max())) for c, d in zip(curves, maps)),
         layout="curves",
+        max_at=MaxAt(float(eta[worst]), float(_theta_deg(mu[worst]))),
     )
 
 

@@ -4,7 +4,8 @@ The result of a fit
 
 -   :class:`FitResult`: coefficients (float64 and the shipped float16), the
     solver's convergence report, timings, and, filled by the pipeline that
-    made it, the pack and the metrics.
+    made it, the pack and the metrics; :meth:`FitResult.from_solve`, the one
+    constructor of a fit's result from the solver's.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from ..models.kinds import DEFAULT_MODEL
 from ..models.pack import PackedMaterial
 from .metrics import ErrorMetrics
 
@@ -57,6 +59,10 @@ class FitResult:
     error
         The float16 model's error as :class:`fitting.fits.metrics.ErrorMetrics`,
         where it was measured (``metrics`` holds its JSON).
+    settings
+        The settings that ran (:class:`fitting.fits.settings.FitSettings` of a
+        material fit; None where the caller set the samples itself): the
+        provenance a stored fit records.
     best_effort
         True when the fit's evaluation budget ran out before it met its
         constraints, and ``coefficients_float16`` were then made to meet
@@ -79,9 +85,38 @@ class FitResult:
     coverage: float = 1.0
     packed: PackedMaterial | None = None
     metrics: dict[str, Any] = field(default_factory=dict)
-    model: str = "coated-conductor"
+    model: str = DEFAULT_MODEL
     error: ErrorMetrics | None = None
     best_effort: bool = False
+    settings: Any = None
+
+    @classmethod
+    def from_solve(
+        cls, solution, coefficients, coefficients_float16, eta_i_range, degree: int, objective: str,
+        nfev: int, njev: int, cost_float16: float, timings: dict[str, float], model: str = DEFAULT_MODEL,
+    ) -> "FitResult":
+        """
+        The result of a least-squares fit of any kind: ``solution`` is the
+        last :func:`scipy.optimize.least_squares` result (its success,
+        status, message and cost), ``nfev`` / ``njev`` the totals over every
+        solve (reweighting rounds included).
+        """
+        return cls(
+            coefficients=coefficients,
+            coefficients_float16=coefficients_float16,
+            eta_i_range=eta_i_range,
+            degree=int(degree),
+            objective=objective,
+            success=bool(solution.success),
+            status=int(solution.status),
+            message=str(solution.message),
+            nfev=int(nfev),
+            njev=int(njev),
+            cost=float(solution.cost),
+            cost_float16=float(cost_float16),
+            timings=dict(timings),
+            model=model,
+        )
 
     @property
     def iterations(self) -> int:

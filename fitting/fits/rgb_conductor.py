@@ -35,17 +35,18 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..colour.reference import reference_ACEScg, spectral_weights
+from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, check_eta_i_range
-from ..models.pack import PackedMaterial, to_float16
+from ..models.pack import to_float16
 from ..models.rgb_conductor import MODEL_KIND
 from ..optics.fresnel import fresnel_conductor
-from ..optics.nk import SpectralNK, resample_nk
+from ..optics.nk import SpectralNK
 from .evaluate import evaluate_material
 from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
-from .settings import OBJECTIVES, FitSettings, fit_grid
-from .solver import check_samples
+from .settings import OBJECTIVES, FitSettings
+from .pipeline import FitKind, fit_spectral
+from .solver import check_samples, reweighted
 
 __all__ = [
     "DEFAULT_SETTINGS",
@@ -62,7 +63,6 @@ DEFAULT_SETTINGS = FitSettings(step_nm=1.0)
 accuracy (mean Delta E about 0.02) the 5 nm reference's own error is no
 longer negligible (``benchmarks/rgb_conductor.py``: 0.0191 at 1 nm)."""
 
-_IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight, as the material fit
 _N_STARTS = (0.2, 1.0, 3.0)  # starts of n per channel: the rgb problem has local minima
 
 
@@ -162,35 +162,25 @@ def fit_rgb_conductor_coefficients(
     problem = RGBConductorObjective(target, mu, eta, objective, base)
     options = dict(bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev)
     result = least_squares(problem.residuals, x, ftol=1e-10, xtol=1e-10, gtol=1e-10, **options)
-    nfev, njev = result.nfev, result.njev or 0
-    if objective == "de2000":
-        for _ in range(irls_rounds):
-            dE = np.linalg.norm(RGBConductorObjective(target, mu, eta, objective, None).residuals(result.x).reshape(-1, 3), axis=1)
-            floor = max(_IRLS_FLOOR, 1e-3 * float(dE.max()))
-            problem = RGBConductorObjective(target, mu, eta, objective, base / np.maximum(dE, floor))
-            result = least_squares(problem.residuals, result.x, ftol=1e-8, xtol=1e-8, gtol=1e-8, **options)
-            nfev, njev = nfev + result.nfev, njev + (result.njev or 0)
+    unweighted = RGBConductorObjective(target, mu, eta, objective, None)
+
+    def resolve(sample_weights, x):
+        again = RGBConductorObjective(target, mu, eta, objective, sample_weights)
+        return again, least_squares(again.residuals, x, ftol=1e-8, xtol=1e-8, gtol=1e-8, **options)
+
+    problem, result, nfev, njev = reweighted(
+        problem, result, irls_rounds if objective == "de2000" else 0,
+        lambda _, x: np.linalg.norm(unweighted.residuals(x).reshape(-1, 3), axis=1), base, resolve,
+    )
     t_fit = time.perf_counter()
     C = result.x.reshape(2, 3)
     scorer = RGBConductorObjective(target, mu, eta, objective, base)
     C16 = quantise_rgb_conductor(scorer, C) if quantise else to_float16(C)
     cost16 = 0.5 * float(np.sum(problem.residuals(C16.astype(np.float64).ravel()) ** 2))
     t_end = time.perf_counter()
-    return FitResult(
-        coefficients=C,
-        coefficients_float16=C16,
-        eta_i_range=eta_i_range,
-        degree=0,
-        objective=objective,
-        success=bool(result.success),
-        status=int(result.status),
-        message=str(result.message),
-        nfev=int(nfev),
-        njev=int(njev),
-        cost=float(result.cost),
-        cost_float16=cost16,
-        timings={"fit": t_fit - t_start, "quantise": t_end - t_fit},
-        model=MODEL_KIND,
+    return FitResult.from_solve(
+        result, C, C16, eta_i_range, 0, objective, nfev, njev, cost16,
+        {"fit": t_fit - t_start, "quantise": t_end - t_fit}, model=MODEL_KIND,
     )
 
 
@@ -220,30 +210,7 @@ def fit_rgb_conductor(
         For an invalid domain or setting, or data covering too little of
         the visible range.
     """
-    t0 = time.perf_counter()
-    settings = settings or DEFAULT_SETTINGS
-    if overrides:
-        settings = FitSettings(**{**settings.__dict__, **overrides})
-    eta_i_range = check_eta_i_range(eta_i_range)
-    nodes, _ = spectral_weights(settings.step_nm)
-    coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    mu, eta, weights = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
-    target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
-    t_ref = time.perf_counter()
-    result = fit_rgb_conductor_coefficients(
-        target, mu, eta, eta_i_range, settings.objective, settings.max_nfev,
-        settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
-    )
-    result.coverage = coverage
-    result.timings["reference"] = t_ref - t0
-    if evaluate:
-        result.metrics = evaluate_rgb_conductor(nk, result, min_coverage=settings.min_coverage)
-    result.packed = PackedMaterial(
-        name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
-        source=nk.source, metrics=result.metrics, model=MODEL_KIND,
-    )
-    result.timings["total"] = time.perf_counter() - t0
-    return result
+    return fit_spectral(RGB_CONDUCTOR_FIT, nk, eta_i_range, settings, evaluate, **overrides)
 
 
 def evaluate_rgb_conductor(
@@ -259,6 +226,18 @@ def evaluate_rgb_conductor(
     (:func:`fitting.fits.evaluate.evaluate_material`, which scores either kind).
     """
     return evaluate_material(nk, result, samples, baselines, min_coverage, dtype)
+
+
+RGB_CONDUCTOR_FIT = FitKind(
+    name=MODEL_KIND,
+    settings=DEFAULT_SETTINGS,
+    solve=lambda target, mu, eta, eta_i_range, degree, objective, max_nfev, quantise, weights=None,
+    irls_rounds=2: fit_rgb_conductor_coefficients(
+        target, mu, eta, eta_i_range, objective, max_nfev, quantise, weights=weights,
+        irls_rounds=irls_rounds),
+    bounded=True,
+)
+"""The rgb-conductor's fit (:mod:`fitting.fits.pipeline`; registered in :mod:`fitting.fits.kinds`)."""
 
 
 RGB_NK_SAMPLES = 64

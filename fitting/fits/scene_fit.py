@@ -29,17 +29,14 @@ import numpy as np
 from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE
 from ..models.coated_conductor import coated_conductor_model
-from ..models.kinds import model_ACEScg
+from ..models.kinds import DEFAULT_MODEL, model_ACEScg, model_kind
 from ..models.pack import PackedMaterial
-from .material import fit_material
+from .kinds import fit_kind, fit_model
 from .metrics import ErrorMetrics, delta_E_summary
 from .result import FitResult
-from .rgb_conductor import DEFAULT_SETTINGS as RGB_SETTINGS
-from .rgb_conductor import fit_rgb_conductor_coefficients
 from .scene_report import SceneMaterialResult, SceneResult
 from .scene_schema import EVALUATION_MU_SAMPLES, EtaSpec, Scene, SceneMaterial
 from .settings import FitSettings, fit_grid
-from .solver import fit_coefficients
 
 __all__ = [
     "DEGREE_TOLERANCE_MEAN",
@@ -76,7 +73,7 @@ first for its fewer bytes."""
 
 
 def _label(kind: str, degree: int) -> str:
-    return kind if kind == "rgb-conductor" else f"{kind} degree {degree}"
+    return f"{kind} degree {degree}" if model_kind(kind).polynomial else kind
 
 
 def choose_candidate(
@@ -111,47 +108,26 @@ def choose_candidate(
     )
 
 
-def _fit_rgb_conductor(entry: SceneMaterial) -> tuple[PackedMaterial, FitResult]:
-    """The float16 rgb-conductor over the scene's eta_i (a set: rows at its values)."""
-    spec, settings = entry.eta_i, RGB_SETTINGS
-    if spec.kind == "set":
-        rows = [fit_grid((v, v), settings.mu_samples, 1, settings.grid) for v in spec.values]
-        mu, eta, weights = (np.concatenate(parts) for parts in zip(*rows))
-    else:
-        mu, eta, weights = fit_grid(spec.domain, settings.mu_samples, settings.eta_samples, settings.grid)
-    target = reference_ACEScg(entry.nk, mu, eta, settings.step_nm, settings.min_coverage)
-    result = fit_rgb_conductor_coefficients(
-        target, mu, eta, spec.domain, settings.objective, settings.max_nfev, settings.quantise,
-        weights=weights, irls_rounds=settings.irls_rounds,
-    )
-    packed = PackedMaterial(entry.name, result.coefficients_float16, spec.domain,
-                            source=entry.nk.source, model="rgb-conductor")
-    return packed, result
-
-
 def _error(ref: np.ndarray, model: np.ndarray, against: str) -> ErrorMetrics:
     return delta_E_summary(ref, model, against)
 
 
-def _fit_degree(entry: SceneMaterial, degree: int, settings: FitSettings) -> FitResult:
-    """The float16 fit of one candidate degree over the scene's eta_i."""
+def _fit_candidate(entry: SceneMaterial, kind: str, degree: int, settings: FitSettings) -> FitResult:
+    """
+    The float16 fit of one candidate (kind, degree) over the scene's eta_i
+    (a set: the fitting grid's rows are exactly the scene's values), by the
+    one pipeline (:func:`fitting.fits.kinds.fit_model`); ``settings`` are
+    those of the default kind's fits, any other kind fits with its own.
+    """
     spec = entry.eta_i
-    if spec.kind != "set":
-        return fit_material(entry.nk, spec.domain, settings, degree=degree)
-    # A set: the fitting grid's rows are exactly the scene's values.
-    t0 = time.perf_counter()
-    rows = [fit_grid((v, v), settings.mu_samples, 1, settings.grid) for v in spec.values]
-    mu, eta, weights = (np.concatenate(parts) for parts in zip(*rows))
-    target = reference_ACEScg(entry.nk, mu, eta, settings.step_nm, settings.min_coverage)
-    result = fit_coefficients(
-        target, mu, eta, spec.domain, degree, settings.objective,
-        settings.max_nfev, settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
-    )
-    result.packed = PackedMaterial(
-        entry.name, result.coefficients_float16, spec.domain, source=entry.nk.source
-    )
-    result.timings["total"] = time.perf_counter() - t0
-    return result
+    if kind != DEFAULT_MODEL:
+        settings = fit_kind(kind).settings
+    samples = None
+    if spec.kind == "set":
+        rows = [fit_grid((v, v), settings.mu_samples, 1, settings.grid) for v in spec.values]
+        samples = tuple(np.concatenate(parts) for parts in zip(*rows))
+    extra = {"degree": degree} if model_kind(kind).polynomial else {}
+    return fit_model(entry.nk, spec.domain, kind, settings, samples=samples, **extra)
 
 
 def choose_degree(
@@ -201,7 +177,7 @@ def fit_scene_material(
     E, M = np.meshgrid(eta_rows, mu, indexing="ij")
     ref = reference_ACEScg(entry.nk, M, E, 1.0, settings.min_coverage)
     against = f"spectral reference 1 nm, {M.shape[1]} x {M.shape[0]} (cos theta x the scene's eta_i)"
-    general_fit = fit_material(entry.nk, general_domain(spec), settings, degree=2)
+    general_fit = fit_model(entry.nk, general_domain(spec), DEFAULT_MODEL, settings, degree=2)
     general = PackedMaterial(
         entry.name, general_fit.coefficients_float16, general_fit.eta_i_range,
         source=entry.nk.source,
@@ -210,18 +186,20 @@ def fit_scene_material(
     general_error = _error(ref, general_model, against)
     fits, by_degree = {}, {}
     for degree in range(spec.max_degree + 1):
-        fit = _fit_degree(entry, degree, settings)
+        fit = _fit_candidate(entry, DEFAULT_MODEL, degree, settings)
         fits[degree] = fit
         # Scored as shipped: float16 coefficients, the pack's float32 domain.
         by_degree[degree] = _error(
             ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range), against
         )
-    choice = None
+    choice, others = None, {}
     if max_delta_e is not None or prefer is not None:
-        rgb_packed, rgb_fit = _fit_rgb_conductor(entry)
-        errors = {("coated-conductor", d): e for d, e in by_degree.items()}
-        errors[("rgb-conductor", 0)] = _error(ref, model_ACEScg(
-            "rgb-conductor", M, E, rgb_packed.coefficients, rgb_packed.eta_i_range), against)
+        errors = {(DEFAULT_MODEL, d): e for d, e in by_degree.items()}
+        for candidate in CANDIDATES:
+            if candidate[0] != DEFAULT_MODEL:
+                other = others[candidate] = _fit_candidate(entry, *candidate, settings)
+                errors[candidate] = _error(ref, model_ACEScg(
+                    candidate[0], M, E, other.packed.coefficients, other.packed.eta_i_range), against)
         (kind, chosen), reason = choose_candidate(errors, max_delta_e, prefer)
         choice = {
             "rule": "prefer accuracy" if prefer == "accuracy" else f"max_delta_e {max_delta_e:g}",
@@ -231,14 +209,14 @@ def fit_scene_material(
     else:
         chosen = choose_degree(by_degree, general_error)
     scene_error = by_degree[chosen]
-    if choice is not None and choice["model"] == "rgb-conductor":
-        fits[chosen] = rgb_fit
-        scene_error = errors[("rgb-conductor", 0)]
+    if choice is not None and (kind, chosen) in others:
+        fits[chosen] = others[(kind, chosen)]
+        scene_error = errors[(kind, chosen)]
         packed = PackedMaterial(
-            entry.name, rgb_packed.coefficients, spec.domain, source=entry.nk.source,
+            entry.name, fits[chosen].packed.coefficients, spec.domain, source=entry.nk.source,
             metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": False},
-            model="rgb-conductor",
+            model=kind,
         )
     elif choice is None and scene_error.mean > general_error.mean:
         # No scene fit beats the general fit on the scene's eta_i (a narrow

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..models.kinds import coefficient_count
+from ..models.kinds import coefficient_count, model_kind
 from ..models.pack import PackedMaterial, encode_pack, material_record_bytes, pack_to_json
 from .metrics import ErrorMetrics
 from .result import FitResult
@@ -65,10 +65,9 @@ class SceneMaterialResult:
 
     @property
     def shader_variant(self) -> str:
-        """``rgb_conductor``, ``collapsed`` (Eq. 1 with constant F0, a, alpha) or ``packed``."""
-        if self.packed.model == "rgb-conductor":
-            return "rgb_conductor"
-        return "collapsed" if self.degree == 0 else "packed"
+        """The kind's ``evaluate.frag`` variant: ``rgb_conductor``, ``collapsed``
+        (Eq. 1 with constant F0, a, alpha) or ``packed`` (:meth:`fitting.models.kinds.ModelKind.variant`)."""
+        return model_kind(self.packed.model).variant(self.degree)
 
     @property
     def coefficients(self) -> int:

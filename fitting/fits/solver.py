@@ -9,6 +9,8 @@ float16 coefficients actually shipped.
 -   :func:`fit_coefficients`: the model fitted to RGB samples at
     (cos theta, eta_i); the core shared by material, curve and scene fits.
 -   :func:`solve`: one trust-region solve of a :class:`fitting.fits.objective.Problem`.
+-   :func:`reweighted`: the rounds of iteratively reweighted least squares
+    that turn a sum of squared Delta E into their mean (every kind's fit).
 
 References
 ----------
@@ -35,13 +37,38 @@ from .result import FitResult
 from .settings import DEFAULT_OBJECTIVE, OBJECTIVES, check_degree
 from .start import initial_guess
 
-__all__ = ["fit_coefficients", "solve", "check_samples"]
+__all__ = ["fit_coefficients", "solve", "check_samples", "reweighted", "IRLS_FLOOR"]
 
 # The fit's matrices are tiny (hundreds x 27): BLAS threads only add
 # synchronisation cost, and oversubscribe the pool's worker processes.
 _THREADPOOLS = ThreadpoolController()
 
-_IRLS_FLOOR = 0.02  # Delta E below which samples stop gaining weight
+IRLS_FLOOR = 0.02
+"""Delta E below which samples stop gaining weight in :func:`reweighted`."""
+
+
+def reweighted(problem, result, rounds: int, delta_E, base, resolve):
+    """
+    ``rounds`` rounds of iteratively reweighted least squares from
+    ``result``, the optimum of ``problem``: each round weights sample *s* by
+    ``base_s / max(dE_s, floor)`` with ``dE = delta_E(problem, x)`` and
+    ``floor = max(IRLS_FLOOR, 1e-3 max dE)``, so that the weighted sum of
+    squares approaches the sum of Delta E (its mean), and ``resolve(weights,
+    x) -> (problem, result)`` solves again from ``x``.
+
+    Returns
+    -------
+    tuple
+        ``(problem, result, nfev, njev)``: the last problem and solve, and the
+        evaluations of every solve from ``result`` on.
+    """
+    nfev, njev = result.nfev, result.njev or 0
+    for _ in range(rounds):
+        dE = delta_E(problem, result.x)
+        floor = max(IRLS_FLOOR, 1e-3 * float(dE.max()))
+        problem, result = resolve(base / np.maximum(dE, floor), result.x)
+        nfev, njev = nfev + result.nfev, njev + (result.njev or 0)
+    return problem, result, nfev, njev
 
 
 
@@ -203,22 +230,20 @@ def fit_coefficients(
             raise ValueError(f"`start` must be finite coefficients of shape {problem.shape}, got shape {x0.shape}")
     x0 = np.clip(x0.ravel(), *bounds)
     result = solve(problem, x0, bounds, 1e-10, max_nfev)
-    nfev, njev = result.nfev, result.njev or 0
-    if objective == "de2000":
-        # Mean Delta E, not its RMS: iteratively reweighted least squares with
-        # w_s = 1 / max(dE_s, floor) turns sum w_s dE_s^2 into sum dE_s.
-        base = np.ones(mu.size) if weights is None else weights
-        for _ in range(irls_rounds):
-            dE = np.linalg.norm(problem.residuals(result.x)[: 3 * mu.size].reshape(-1, 3), axis=1)
-            if weights is not None:
-                dE = dE / np.sqrt(np.maximum(weights, 1e-300))
-            floor = max(_IRLS_FLOOR, 1e-3 * float(dE.max()))
-            problem = Problem(
-                target, mu, eta, eta_i_range, degree, objective, base / np.maximum(dE, floor),
-                range_check,
-            )
-            result = solve(problem, result.x, bounds, 1e-8, max_nfev)
-            nfev, njev = nfev + result.nfev, njev + (result.njev or 0)
+
+    def delta_E(current, x):
+        dE = np.linalg.norm(current.residuals(x)[: 3 * mu.size].reshape(-1, 3), axis=1)
+        return dE if weights is None else dE / np.sqrt(np.maximum(weights, 1e-300))
+
+    def resolve(sample_weights, x):
+        again = Problem(target, mu, eta, eta_i_range, degree, objective, sample_weights, range_check)
+        return again, solve(again, x, bounds, 1e-8, max_nfev)
+
+    # Mean Delta E, not its RMS (de2000 only).
+    problem, result, nfev, njev = reweighted(
+        problem, result, irls_rounds if objective == "de2000" else 0, delta_E,
+        np.ones(mu.size) if weights is None else weights, resolve,
+    )
     t_fit = time.perf_counter()
     C = result.x.reshape(problem.shape)
     if quantise:
@@ -227,18 +252,7 @@ def fit_coefficients(
         C16 = to_float16(C)
     cost16 = 0.5 * float(np.sum(problem.residuals(C16.astype(np.float64).ravel()) ** 2))
     t_end = time.perf_counter()
-    return FitResult(
-        coefficients=C,
-        coefficients_float16=C16,
-        eta_i_range=eta_i_range,
-        degree=degree,
-        objective=objective,
-        success=bool(result.success),
-        status=int(result.status),
-        message=str(result.message),
-        nfev=int(nfev),
-        njev=int(njev),
-        cost=float(result.cost),
-        cost_float16=cost16,
-        timings={"fit": t_fit - t_start, "quantise": t_end - t_fit},
+    return FitResult.from_solve(
+        result, C, C16, eta_i_range, degree, objective, nfev, njev, cost16,
+        {"fit": t_fit - t_start, "quantise": t_end - t_fit},
     )

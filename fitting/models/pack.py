@@ -39,9 +39,8 @@ from typing import Any
 import numpy as np
 
 from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
-from .coated_conductor import CHANNELS, PARAMETERS
-from .kinds import DEFAULT_MODEL, MODEL_KINDS, check_model, check_model_coefficients, coefficient_count
-from .rgb_conductor import NK_PARAMETERS
+from .coated_conductor import CHANNELS
+from .kinds import DEFAULT_MODEL, kind_of_code, model_kind
 
 __all__ = [
     "PACK_MAGIC",
@@ -64,7 +63,6 @@ PACK_MAGIC = b"CFPK"
 PACK_VERSION = 2
 PACK_VERSIONS = (1, 2)
 """Versions :func:`decode_pack` and :func:`pack_from_json` read."""
-_KIND_CODES = {kind: code for code, kind in enumerate(MODEL_KINDS)}
 FLOAT16_MAX = float(np.finfo(np.float16).max)
 _HEADER = struct.Struct("<4sHHI")
 _MAX_TEXT = 65535
@@ -113,7 +111,7 @@ class PackedMaterial:
         for label, text in (("name", self.name), ("source", self.source)):
             if len(text.encode("utf-8")) > _MAX_TEXT:
                 raise ValueError(f"`{label}` must be at most {_MAX_TEXT} bytes of UTF-8")
-        C = check_model_coefficients(check_model(self.model), self.coefficients)
+        C = model_kind(self.model).check(self.coefficients)
         halves = to_float16(C)
         if not np.array_equal(halves.astype(np.float64), C):
             raise ValueError(
@@ -129,8 +127,8 @@ class PackedMaterial:
 
     @property
     def degree(self) -> int:
-        """Polynomial degree in t of a coated-conductor; 0 for an rgb-conductor."""
-        return self.coefficients.shape[2] - 1 if self.model == "coated-conductor" else 0
+        """Polynomial degree in t (0 for a kind without a power axis, e.g. an rgb-conductor)."""
+        return model_kind(self.model).degree_of(self.coefficients)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, PackedMaterial):
@@ -153,7 +151,7 @@ def material_record_bytes(name: str, source: str, degree: int, model: str = DEFA
     source with their u16 lengths, the f32 domain, degree, kind and padding,
     and the float16 coefficients (9 (degree + 1), or 6 for an rgb-conductor).
     """
-    return 2 + len(name.encode()) + 2 + len(source.encode()) + 12 + 2 * coefficient_count(model, degree)
+    return 2 + len(name.encode()) + 2 + len(source.encode()) + 12 + 2 * model_kind(model).count(degree)
 
 
 def encode_pack(materials: list[PackedMaterial], version: int = PACK_VERSION) -> bytes:
@@ -173,7 +171,7 @@ def encode_pack(materials: list[PackedMaterial], version: int = PACK_VERSION) ->
     for material in materials:
         if not isinstance(material, PackedMaterial):
             raise ValueError("`materials` must hold PackedMaterial instances")
-        if version == 1 and material.model != "coated-conductor":
+        if version == 1 and model_kind(material.model).code != 0:
             raise ValueError(
                 f"`version` 1 holds only coated-conductor materials, {material.name!r} is an {material.model}"
             )
@@ -181,7 +179,7 @@ def encode_pack(materials: list[PackedMaterial], version: int = PACK_VERSION) ->
             raw = text.encode("utf-8")
             body += struct.pack("<H", len(raw)) + raw
         lo, hi = material.eta_i_range
-        body += struct.pack("<ffBB2x", lo, hi, material.degree, _KIND_CODES[material.model])
+        body += struct.pack("<ffBB2x", lo, hi, material.degree, model_kind(material.model).code)
         body += material.coefficients.astype("<f2").tobytes()
     total = _HEADER.size + len(body) + 4
     head = _HEADER.pack(PACK_MAGIC, version, len(materials), total)
@@ -243,14 +241,13 @@ def decode_pack(data: bytes) -> list[PackedMaterial]:
         # Version 1 reserved the kind byte: every material is a coated-conductor.
         if version == 1:
             code = 0
-        if code >= len(MODEL_KINDS):
-            raise ValueError(f"`data` has model kind code {code}, must be below {len(MODEL_KINDS)}")
-        model = MODEL_KINDS[code]
-        if degree > 2 or (model == "rgb-conductor" and degree != 0):
+        kind = kind_of_code(code)
+        if degree > kind.max_degree:
             raise ValueError(
-                f"`data` has polynomial degree {degree}, must be 0, 1 or 2 (0 for an rgb-conductor)"
+                f"`data` has polynomial degree {degree}, must be at most {kind.max_degree} for an {kind.name}"
             )
-        shape = (2, 3) if model == "rgb-conductor" else (3, 3, degree + 1)
+        shape = kind.shape(degree)
+        model = kind.name
         raw = reader.take(2 * int(np.prod(shape)), "coefficients")
         halves = np.frombuffer(raw, dtype="<f2").astype(np.float16).reshape(shape)
         if not np.all(np.isfinite(halves)):
@@ -268,9 +265,11 @@ def decode_pack(data: bytes) -> list[PackedMaterial]:
 def material_to_json(material: PackedMaterial) -> dict[str, Any]:
     """
     The JSON view of one material (values exactly as stored in float16):
-    ``"model"``, and ``"coefficients"`` ``{"F0", "a", "alpha"}`` (three rows
-    R, G, B of degree + 1 powers each) for a coated-conductor, ``{"n": [R,
-    G, B], "k": [R, G, B]}`` for an rgb-conductor.
+    ``"model"``, and ``"coefficients"``: per parameter of the kind, three
+    rows R, G, B of degree + 1 powers each for a kind with a power axis (a
+    coated-conductor's ``{"F0", "a", "alpha"}``, with ``"degree"``), else
+    three numbers R, G, B (an rgb-conductor's ``{"n": [R, G, B], "k": [R,
+    G, B]}``).
     """
     C = material.coefficients.astype(np.float64)
     view: dict[str, Any] = {
@@ -279,14 +278,15 @@ def material_to_json(material: PackedMaterial) -> dict[str, Any]:
         "eta_i_range": list(material.eta_i_range),
         "colour_space": "ACEScg",
     }
-    if material.model == "rgb-conductor":
-        view["coefficients"] = {p: [float(v) for v in C[i]] for i, p in enumerate(NK_PARAMETERS)}
-    else:
+    kind = model_kind(material.model)
+    if kind.polynomial:
         view["degree"] = material.degree
         view["coefficients"] = {
             p: [[float(v) for v in C[i, c]] for c in range(3)]
-            for i, p in enumerate(PARAMETERS)
+            for i, p in enumerate(kind.parameters)
         }
+    else:
+        view["coefficients"] = {p: [float(v) for v in C[i]] for i, p in enumerate(kind.parameters)}
     view["source"] = material.source
     view["metrics"] = material.metrics
     return view
@@ -296,16 +296,16 @@ def material_from_json(view: dict[str, Any]) -> PackedMaterial:
     """Inverse of :func:`material_to_json`; values must be exact float16."""
     if not isinstance(view, dict):
         raise ValueError("material must be a JSON object")
-    model = check_model(view.get("model", DEFAULT_MODEL))
-    parameters = NK_PARAMETERS if model == "rgb-conductor" else PARAMETERS
-    what = "three numbers" if model == "rgb-conductor" else "three rows of numbers"
+    kind = model_kind(view.get("model", DEFAULT_MODEL))
+    model, parameters = kind.name, kind.parameters
+    what = "three rows of numbers" if kind.polynomial else "three numbers"
     try:
         coefficients = np.array(
             [[view["coefficients"][p][c] for c in range(3)] for p in parameters],
             dtype=np.float64,
         )
-        if model == "rgb-conductor" and coefficients.ndim != 2:
-            raise ValueError("not one number per channel")
+        if coefficients.ndim != len(kind.shape()):
+            raise ValueError("not the layout of the kind")
     except (KeyError, IndexError, TypeError, ValueError) as error:
         raise ValueError(
             f"`coefficients` must hold {', '.join(parameters[:-1])} and {parameters[-1]}, each {what} "
@@ -348,7 +348,7 @@ def pack_from_json(text: str | bytes) -> list[PackedMaterial]:
             f"pack JSON `version` must be one of {', '.join(map(str, PACK_VERSIONS))}, got {view.get('version')!r}"
         )
     if view["version"] == 1 and any(
-        isinstance(m, dict) and m.get("model", DEFAULT_MODEL) != "coated-conductor"
+        isinstance(m, dict) and _code(m.get("model", DEFAULT_MODEL)) != 0
         for m in view.get("materials") or []
     ):
         raise ValueError("pack JSON `version` 1 holds only coated-conductor materials")
@@ -356,6 +356,14 @@ def pack_from_json(text: str | bytes) -> list[PackedMaterial]:
     if not isinstance(materials, list) or not materials:
         raise ValueError("pack JSON `materials` must be a non-empty list")
     return [material_from_json(m) for m in materials]
+
+
+def _code(model) -> int | None:
+    """The pack code of a kind name, None for an unknown one (refused later, with its message)."""
+    try:
+        return model_kind(model).code
+    except ValueError:
+        return None
 
 
 def halves_to_uint32(coefficients) -> np.ndarray:

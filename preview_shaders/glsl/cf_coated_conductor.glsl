@@ -1,7 +1,7 @@
 // The coated-conductor Fresnel model of Vernooij (2024), Eq. 1 and 2: the
 // GLSL mirror of fitting/models/coated_conductor.py, term by term.
 //
-// Coefficient layout (fitting.model): coefficients[p][c][j], parameter p in
+// Coefficient layout (fitting.models.coated_conductor): coefficients[p][c][j], parameter p in
 // (F0, a, alpha), channel c in (R, G, B), power j in (1, t, t^2); 27 values
 // in that order. Here each parameter is one mat3 whose column c holds the
 // powers of channel c, so T * M (T = (1, t, t^2)) gives the three channels.
@@ -14,7 +14,7 @@
 #include "cf_common.glsl"
 
 // Normalised coating index t = (eta_i - lo) / (hi - lo), clamped to [0, 1]
-// (fitting.model.normalised_eta_i). A single-index fit (hi == lo) has t = 0.
+// (fitting.models.coated_conductor.normalised_eta_i). A single-index fit (hi == lo) has t = 0.
 float cf_normalised_eta_i(float eta_i, vec2 eta_i_range)
 {
     float width = eta_i_range.y - eta_i_range.x;
@@ -25,7 +25,7 @@ float cf_normalised_eta_i(float eta_i, vec2 eta_i_range)
 }
 
 // Vernooij 2024, Eq. 2 (in t instead of eta_i): F0, a and alpha per channel,
-// each c0 + c1 t + c2 t^2 (fitting.model.model_parameters). alpha is clamped
+// each c0 + c1 t + c2 t^2 (fitting.models.coated_conductor.model_parameters). alpha is clamped
 // to CF_ALPHA_MIN there, as in numpy.
 void cf_coated_conductor_parameters(float t, mat3 C_F0, mat3 C_a, mat3 C_alpha,
                                     out vec3 F0, out vec3 a, out vec3 alpha)
@@ -41,7 +41,7 @@ void cf_coated_conductor_parameters(float t, mat3 C_F0, mat3 C_a, mat3 C_alpha,
 
 // Vernooij 2024, Eq. 1 (Lazanyi & Szirmay-Kalos 2005 error term on Schlick):
 // F = F0 + (1 - F0)(1 - mu)^5 - a mu (1 - mu)^alpha per channel
-// (fitting.model.model_from_parameters). This alone is the scene-specialised
+// (fitting.models.coated_conductor.model_from_parameters). This alone is the scene-specialised
 // model: with eta_i constant, F0, a and alpha are collapsed on the CPU.
 vec3 cf_coated_conductor_eq1(float NdotV, vec3 F0, vec3 a, vec3 alpha)
 {
@@ -66,7 +66,7 @@ vec3 cf_coated_conductor(float NdotV, float eta_i, vec2 eta_i_range,
 }
 
 // Decodes the 27 float16 coefficients packed two per uint32, the earlier one
-// in the low 16 bits (fitting.pack.halves_to_uint32), so unpackHalf2x16(w).x
+// in the low 16 bits (fitting.models.pack.halves_to_uint32), so unpackHalf2x16(w).x
 // is the earlier half; the 28th half is padding. Written out rather than
 // looped through a float[27] so no compiler needs a local array for it.
 void cf_unpack_coefficients(uint words[14], out mat3 C_F0, out mat3 C_a, out mat3 C_alpha)

@@ -2,7 +2,7 @@
 #ifndef CF_COMMON_GLSL
 #define CF_COMMON_GLSL
 
-// Lower clamp of the exponent alpha, as fitting.model.ALPHA_MIN: keeps
+// Lower clamp of the exponent alpha, as fitting.models.coated_conductor.ALPHA_MIN: keeps
 // (1 - mu)^alpha finite at mu = 1 (GLSL pow(0, y) is undefined for y <= 0).
 const float CF_ALPHA_MIN = 1.0e-3;
 

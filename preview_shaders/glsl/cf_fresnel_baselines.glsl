@@ -21,7 +21,7 @@ vec3 cf_schlick(float NdotV, vec3 F0)
 vec3 cf_f0_in_medium(vec3 F0_air, float eta_i)
 {
     // sqrt(F0) -> 1 sends n to infinity: F0 is kept below 1 - 1e-6, as in
-    // fitting.baselines (n stays finite, F0' -> 1).
+    // fitting.models.baselines (n stays finite, F0' -> 1).
     vec3 s = sqrt(clamp(F0_air, 0.0, 1.0 - 1.0e-6));
     vec3 n = (1.0 + s) / (1.0 - s);
     vec3 r = (n - eta_i) / (n + eta_i);

@@ -77,7 +77,7 @@ vec3 cf_refract_into_coat(vec3 W, float eta_i)
 }
 
 // Born & Wolf 1999, Sec. 1.5.2: unpolarised Fresnel reflectance from air
-// into a dielectric of index eta_i (fitting.fresnel.fresnel_dielectric with
+// into a dielectric of index eta_i (fitting.optics.fresnel.fresnel_dielectric with
 // eta_i = 1, eta_t = eta_i); exactly 0 at eta_i = 1 (no interface).
 float cf_fresnel_dielectric(float NdotV, float eta_i)
 {

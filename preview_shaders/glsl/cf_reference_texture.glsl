@@ -8,7 +8,7 @@
 #include "cf_common.glsl"
 
 // Bilinear interpolation with texelFetch, exactly as
-// fitting.curves.CurveBase.rgb does it in numpy (eta_i clamped to the range;
+// fitting.fits.curves_base.CurveBase.rgb does it in numpy (eta_i clamped to the range;
 // a one-row texture is a single index). Float textures are not filterable
 // everywhere (OES_texture_float_linear), so the filter is written out.
 vec3 cf_reference_lookup(sampler2D lut, float NdotV, float eta_i, vec2 eta_i_range)

@@ -2,11 +2,11 @@
 // per RGB channel with one complex index n + i k per channel, seen from a
 // coating of index eta_i (the relative index (n + i k) / eta_i, as pbrt-v4's
 // CoatedConductor). The GLSL mirror of fitting/models/rgb_conductor.py and
-// fitting.fresnel.fresnel_conductor.
+// fitting.optics.fresnel.fresnel_conductor.
 //
 // Pack layout (fitting.models.rgb_conductor): coefficients[p][c], parameter
 // p in (n, k), channel c in (R, G, B); 6 float16 values in that order, two
-// per uint32 (fitting.pack.halves_to_uint32), so 3 words.
+// per uint32 (fitting.models.pack.halves_to_uint32), so 3 words.
 #ifndef CF_RGB_CONDUCTOR_GLSL
 #define CF_RGB_CONDUCTOR_GLSL
 
@@ -30,7 +30,7 @@ void cf_complex_sqrt(vec3 re, vec3 im, out vec3 root_re, out vec3 root_im)
 
 // Exact unpolarised Fresnel reflectance of a conductor n + i k seen from a
 // dielectric of index eta_i, RGB-wise (Born & Wolf 1999, Section 1.5; pbrt-v4
-// FrComplex); the GLSL mirror of fitting.fresnel.fresnel_conductor.
+// FrComplex); the GLSL mirror of fitting.optics.fresnel.fresnel_conductor.
 vec3 cf_fresnel_conductor(float NdotV, float eta_i, vec3 n, vec3 k)
 {
     float mu = cf_saturate(NdotV);

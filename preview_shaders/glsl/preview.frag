@@ -1,11 +1,11 @@
 #version 430
 // The preview sphere: a smooth sphere seen by an orthographic camera on +z,
 // reflecting the environment. Columns left of u_split_column show the
-// material's model kind (u_model: 0 coated-conductor from cf_words, 1
-// rgb-conductor from cf_rgb_words), the others the comparison (adjusted
-// Lazanyi), as in Vernooij 2024, Figure 2. Output in linear ACEScg.
-#include "cf_coated_conductor.glsl"
-#include "cf_rgb_conductor.glsl"
+// material's model kind (cf_preview_model from cf_words: the include is made
+// per kind by preview_shaders/kinds.py from fitting.models.kinds), the others
+// the comparison (adjusted Lazanyi), as in Vernooij 2024, Figure 2. Output in
+// linear ACEScg.
+#include "cf_preview_model.glsl"
 #include "cf_fresnel_baselines.glsl"
 #include "cf_environment.glsl"
 
@@ -15,9 +15,7 @@ uniform float u_split_column; // first column of the comparison
 uniform int u_environment;    // CF_ENVIRONMENT_*
 uniform float u_eta_i;        // index of the coating
 
-uniform int u_model;          // 0 coated-conductor, 1 rgb-conductor
-uniform uint cf_words[14];
-uniform uint cf_rgb_words[3];
+uniform uint cf_words[14];    // the kind's float16 coefficients, two per word, zero-padded
 uniform vec2 cf_eta_i_range;
 uniform vec3 cf_F0_air;
 uniform vec3 cf_F82_air;
@@ -47,11 +45,8 @@ void main()
     vec3 R = 2.0 * NdotV * N - V;
     vec3 L = cf_environment(u_environment, R);
     vec3 F;
-    // u_model is uniform: every pixel takes the same side of the branch.
-    if (gl_FragCoord.x < u_split_column && u_model == 1)
-        F = cf_rgb_conductor_packed(NdotV, u_eta_i, cf_rgb_words);
-    else if (gl_FragCoord.x < u_split_column)
-        F = cf_coated_conductor_packed(NdotV, u_eta_i, cf_eta_i_range, cf_words);
+    if (gl_FragCoord.x < u_split_column)
+        F = cf_preview_model(NdotV, u_eta_i, cf_eta_i_range, cf_words);
     else
         F = cf_lazanyi_adjusted(NdotV, u_eta_i, cf_F0_air, cf_F82_air);
     out_colour = vec4(F * L, 1.0);

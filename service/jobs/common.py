@@ -6,7 +6,7 @@ What every job shares
 -   :func:`content_address`: an id from an unambiguous encoding of parts.
 -   :func:`check_finite`: refuse a result holding NaN or infinity.
 -   :func:`measured_nk`: the n, k behind a stored fit, if any.
--   :func:`nk_view`: a :class:`fitting.nk.SpectralNK` as the record's lists.
+-   :func:`nk_view`: a :class:`fitting.optics.nk.SpectralNK` as the record's lists.
 -   :func:`stored_fit`: a stored fit or ``LookupError``, with its n, k.
 -   :func:`with_measured_nk`, :func:`nk_holder`: a draft refers to the
     record holding its n, k (``provenance.nk_of``) instead of a copy.

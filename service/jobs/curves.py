@@ -236,13 +236,14 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
     summary.pop("timings")
     return {
         "material": material_to_json(result.packed),
+        # The core's metrics JSON as fit_curves made it (its ``figure`` the
+        # one figure), with the keys every fit's record has: ``grid`` and
+        # ``model_float16`` (the figure at the curves' own samples).
         "metrics": {
+            **metrics,
             "grid": f"{sum(len(c['rgb']) for c in curves)} samples on {len(curves)} curve(s)",
-            "model_float16": {"delta_E_mean": metrics["delta_E_mean"], "delta_E_max": metrics["delta_E_max"]},
-            "by_curve": metrics["by_curve"],
-            "fitted_samples": metrics["samples"],
-            "best_effort": metrics["best_effort"],
-            **({"target": metrics["target"]} if "target" in metrics else {}),
+            "model_float16": {key: metrics[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at")
+                              if key in metrics},
         },
         "timings": {**result.timings, "base": t_base},
         "convergence": summary,

@@ -3,7 +3,7 @@ n, k fits
 =========
 
 -   :class:`NKFit`: a validated fit of measured n, k (a built-in material or
-    data given by the user): the :class:`fitting.nk.SpectralNK` built and
+    data given by the user): the :class:`fitting.optics.nk.SpectralNK` built and
     checked once, and the ids computed once.
 -   :func:`fit_nk`: the stored fit of an :class:`NKFit`, else fitted in the
     pool and saved; ``(record, created)``.
@@ -24,14 +24,14 @@ import numpy as np
 from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid, spectral_grid
 from fitting.domain import DEFAULT_MIN_COVERAGE, BoundedCache, check_eta_i_range, cos_theta_from_angle
 from fitting.fits.evaluate import grid_models, metrics_json, score_on_grid
-from fitting.fits.kinds import fit_model
+from fitting.fits.kinds import fit_kind, fit_model
 from fitting.fits.metrics import ErrorMetrics
+from fitting.fits.pipeline import with_metrics
 from fitting.fits.result import FitResult
-from fitting.fits.rgb_conductor import DEFAULT_SETTINGS as RGB_CONDUCTOR_SETTINGS
 from fitting.fits.settings import DEFAULT_OBJECTIVE, FitSettings
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
-from fitting.models.pack import PackedMaterial, material_from_json, material_to_json
+from fitting.models.pack import material_from_json, material_to_json
 from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK, resample_nk
 from fitting.optics.readers import FORMATS, read_nk
@@ -101,7 +101,7 @@ class NKFit:
             FIT_FORMAT_VERSION, kind, name, nk.source, arrays, [lo, hi], objective,
             repr(FitSettings()), metrics_samples,
             # The default kind adds nothing, so coated-conductor ids stay as they were.
-            *(() if model == DEFAULT_MODEL else (model, repr(RGB_CONDUCTOR_SETTINGS))),
+            *(() if model == DEFAULT_MODEL else (model, repr(fit_kind(model).settings))),
         )
         material_id = library or content_address("material", name, nk.source, arrays)
         return cls(kind, name, nk, (lo, hi), objective, metrics_samples, library, fit_id, material_id,
@@ -177,21 +177,21 @@ def _metrics_part(fit: NKFit, result: FitResult, reference: np.ndarray,
     # The fit's domain is the request's (checked once, in NKFit), so is the grid.
     M, E = evaluation_grid(fit.metrics_samples, fit.eta_i_range)
     errors = score_on_grid(fit.nk, M, E, grid_models(result, M, E), baselines=False, reference=reference)
-    metrics = metrics_json({**errors, **baselines}, result, fit.metrics_samples)
-    timings = {**result.timings, "evaluate": seconds + time.perf_counter() - t0}
-    packed = PackedMaterial(
-        name=fit.name, coefficients=result.coefficients_float16,
-        eta_i_range=result.eta_i_range, source=fit.nk.source, model=result.model,
-    )
+    # The pipeline's own steps (fitting.fits.pipeline): the metrics JSON and the record carrying it.
+    with_metrics(result, metrics_json({**errors, **baselines}, result, fit.metrics_samples), name=fit.name)
+    evaluate = seconds + time.perf_counter() - t0
+    # As fit_spectral's: "total" is the whole fit, its evaluation included.
+    timings = {**result.timings, "evaluate": evaluate, "total": result.timings["total"] + evaluate}
     summary = result.summary()
     summary.pop("timings")
-    check_finite("metrics", metrics)
+    check_finite("metrics", result.metrics)
     return {
-        "material": material_to_json(packed),
-        "metrics": metrics,
+        "material": material_to_json(result.packed),
+        "metrics": result.metrics,
         "timings": timings,
         "convergence": summary,
         "coverage": result.coverage,
+        "settings": asdict(result.settings),
     }
 
 
@@ -237,7 +237,8 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord
             fit.fit_id, fit.kind, fit.material_id, fit.name, fit.nk.source, job, fit.objective,
             library_material=fit.library_material,
             nk=None if fit.library_material else nk_view(fit.nk),
-            provenance={"fit_format": FIT_FORMAT_VERSION, "settings": asdict(FitSettings())},
+            # The settings that ran (the kind's, with the request's objective).
+            provenance={"fit_format": FIT_FORMAT_VERSION, "settings": job["settings"]},
         )
         return await asyncio.to_thread(store.put_fit, record)
 

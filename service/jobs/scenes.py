@@ -4,7 +4,7 @@ Scene packs
 
 -   :func:`prepare_scene`: the scene of a request, validated and converted
     once: each material resolved (a built-in conductor, a saved material by
-    id, or inline n, k) into a :class:`fitting.scene.SceneMaterial`, or, for
+    id, or inline n, k) into a :class:`fitting.fits.scene_schema.SceneMaterial`, or, for
     a saved *edited* material, a :class:`StoredModel` (its edits live in its
     stored model, not in the n, k it started from).
 -   :func:`scene_pack`: fit it in the pool, one part per material under the
@@ -12,7 +12,7 @@ Scene packs
     the pack.
 
 A material measured as n, k is fitted over the eta_i the scene uses with the
-lowest degree that serves it (:func:`fitting.scene.fit_scene_material`). An
+lowest degree that serves it (:func:`fitting.fits.scene_fit.fit_scene_material`). An
 edited material is shipped as stored (its degree, coefficients and domain),
 and the scene's eta_i must lie in its domain; its report says so
 (``from_stored_model``) and its Delta E against itself is 0.
@@ -31,6 +31,7 @@ import numpy as np
 
 from fitting.fits.scene_fit import fit_scene_material
 from fitting.fits.scene_schema import EtaSpec, SceneMaterial, parse_eta_i, parse_scene
+from fitting.models.kinds import model_kind
 from fitting.models.pack import (
     PackedMaterial,
     encode_pack,
@@ -80,7 +81,7 @@ def _renumber(error: ValueError, index: int) -> ValueError:
 def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
     """
     ``scene`` (``{"name", "materials": [...]}``, entries as
-    :func:`fitting.scene.parse_scene` reads them, inline ``nk`` with its
+    :func:`fitting.fits.scene_schema.parse_scene` reads them, inline ``nk`` with its
     ``source``) resolved against the library and ``store``. Runs in a
     thread (it reads the store).
 
@@ -143,7 +144,8 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
 
 def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
     packed = entry.packed
-    bytes_ = material_record_bytes(packed.name, packed.source, packed.degree)
+    bytes_ = material_record_bytes(packed.name, packed.source, packed.degree, packed.model)
+    kind = model_kind(packed.model)
     zero = {"mean": 0.0, "max": 0.0}
     return {
         "name": packed.name,
@@ -151,14 +153,14 @@ def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
         "eta_i": entry.eta_i.to_json(),
         "eta_i_range": list(packed.eta_i_range),
         "degree": packed.degree,
-        "coefficients": 9 * (packed.degree + 1),
-        "shader_variant": "collapsed" if packed.degree == 0 else "packed",
+        "coefficients": kind.count(packed.degree),
+        "shader_variant": kind.variant(packed.degree),
         "bytes": bytes_,
         "delta_E_2000": zero,
         "by_degree": {str(packed.degree): zero},
         "general": {
             "eta_i_range": list(packed.eta_i_range), "degree": packed.degree,
-            "coefficients": 9 * (packed.degree + 1), "bytes": bytes_, "delta_E_2000": zero,
+            "coefficients": kind.count(packed.degree), "bytes": bytes_, "delta_E_2000": zero,
         },
         "scene_vs_general_delta_E_2000": zero,
         "fit": {"from_stored_model": True, "fit_id": entry.fit_id},

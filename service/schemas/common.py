@@ -50,7 +50,7 @@ EtaI = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
-ModelKind = Literal[MODEL_KINDS]  # type: ignore[valid-type]
+ModelKind = Literal[tuple(MODEL_KINDS)]  # type: ignore[valid-type]
 PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
 Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 

@@ -56,7 +56,7 @@ class CurveIn(RequestModel):
         return self
 
     def as_dict(self) -> dict:
-        """The curve as :func:`fitting.curves.check_curves` reads it."""
+        """The curve as :func:`fitting.fits.curves_input.check_curves` reads it."""
         item = {"eta_i": self.eta_i, "rgb": [list(v) for v in self.rgb]}
         if self.cos_theta is not None:
             item["cos_theta"] = list(self.cos_theta)

@@ -14,6 +14,8 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from fitting.models.kinds import model_kind
+
 from ..store import FIT_KINDS, FitRecord
 from .common import (
     API_PREFIX,
@@ -237,11 +239,11 @@ def fit_public(record: FitRecord) -> FitPublic:
         objective=record.objective,
         model=view.get("model", DEFAULT_MODEL),
         degree=view.get("degree", 0),
-        coefficients=(
-            RGBConductorCoefficients(**view["coefficients"])
-            if view.get("model") == "rgb-conductor" else Coefficients(**view["coefficients"])
-        ),
+        # Rows of powers for a kind with a power axis, one value per channel otherwise.
+        coefficients=(Coefficients if model_kind(view.get("model", DEFAULT_MODEL)).polynomial
+                      else RGBConductorCoefficients)(**view["coefficients"]),
         metrics=FitMetrics(
+            figure=metrics.get("figure"),
             grid=metrics.get("grid"),
             model=metrics.get("model_float16"),
             lazanyi_adjusted=metrics.get("lazanyi_adjusted"),

@@ -14,7 +14,7 @@ from pydantic import BaseModel, Field
 
 from .common import Mirror, absent
 
-__all__ = ["RowError", "DeltaE", "CurveError", "FitDetails", "FitMetrics"]
+__all__ = ["RowError", "MaxAt", "Figure", "DeltaE", "CurveError", "FitDetails", "FitMetrics"]
 
 
 class RowError(Mirror):
@@ -22,6 +22,26 @@ class RowError(Mirror):
 
     delta_E_mean: float
     delta_E_max: float
+
+
+class MaxAt(Mirror):
+    """Where a maximum Delta E is (``fitting.fits.metrics.MaxAt``)."""
+
+    eta_i: float
+    theta_deg: float = Field(description="Angle in the coating, degrees (0 is normal incidence)")
+
+
+class Figure(Mirror):
+    """
+    The one figure of a fit (``ErrorMetrics.figure`` of the core): the same
+    numbers as the pack JSON's ``metrics.figure`` and the GLSL / HLSL headers.
+    """
+
+    against: str = Field(description="What it is measured against, in words: 'the measured metal "
+                                     "(1 nm spectral reference), ...' or 'your edited curves ...'")
+    delta_E_mean: float
+    delta_E_max: float
+    max_at: MaxAt | None = absent("Where the max is")
 
 
 class DeltaE(Mirror):
@@ -32,6 +52,7 @@ class DeltaE(Mirror):
     rmse: float | None = absent()
     by_eta_i: dict[str, RowError] | None = absent("Nearest row to each of eta_i 1, 1.5, 2, 2.5")
     against: str | None = absent()
+    max_at: MaxAt | None = absent("Where the max is")
 
 
 class CurveError(Mirror):
@@ -53,15 +74,18 @@ class FitDetails(Mirror):
     lazanyi_adjusted: DeltaE | None = absent()
     lazanyi_exact_F0: DeltaE | None = absent()
     coverage: float | None = absent()
+    figure: Figure | None = absent("The one figure (FitMetrics.figure)")
     by_curve: list[CurveError] | None = absent()
-    fitted_samples: int | None = absent()
+    samples: int | None = absent("Samples a curve fit fitted")
     best_effort: bool | None = absent("True when the refit's evaluation budget ran out and the fit was made to stay in [0, 1]")
     target: DeltaE | None = absent()
 
 
 class FitMetrics(BaseModel):
-    """Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
+    """The one figure, Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
 
+    figure: Figure | None = Field(None, description="The fit's figure: what it is measured against, "
+                                  "mean, max and where the max is; the pack JSON and shader headers quote it")
     grid: str | None = None
     model: DeltaE | None = None
     lazanyi_adjusted: DeltaE | None = None

@@ -59,7 +59,7 @@ class SceneMaterialRequest(RequestModel):
         return self
 
     def entry(self) -> dict[str, Any]:
-        """The entry as :func:`fitting.scene.parse_scene` reads it (inline n, k with its source)."""
+        """The entry as :func:`fitting.fits.scene_schema.parse_scene` reads it (inline n, k with its source)."""
         view = self.model_dump(exclude_none=True, exclude={"source", "nk"})
         if self.nk is not None:
             view["nk"] = {**self.nk.model_dump(), "source": self.source}
@@ -67,7 +67,7 @@ class SceneMaterialRequest(RequestModel):
 
 
 class SceneRequest(RequestModel):
-    """A scene description (see ``fitting.scene``)."""
+    """A scene description (see ``fitting.fits.scene_schema``)."""
 
     model_config = ConfigDict(extra="forbid")
 

@@ -38,7 +38,7 @@ class FitRecord:
         Display name and citation of the data.
     material
         The pack JSON view of the fitted material
-        (:func:`fitting.pack.material_to_json`, float16 coefficients).
+        (:func:`fitting.models.pack.material_to_json`, float16 coefficients).
     metrics, timings, convergence
         Metrics against the reference, seconds per stage, solver report.
     objective

@@ -1,14 +1,14 @@
 // The coated-conductor Fresnel model of Vernooij (2024), Eq. 1 and 2: the
-// HLSL mirror of fitting/model.py and preview_shaders/glsl/cf_coated_conductor.glsl.
+// HLSL mirror of fitting/models/coated_conductor.py and preview_shaders/glsl/cf_coated_conductor.glsl.
 #ifndef CF_COATED_CONDUCTOR_HLSL
 #define CF_COATED_CONDUCTOR_HLSL
 
-// Lower clamp of the exponent alpha, as fitting.model.ALPHA_MIN: keeps
+// Lower clamp of the exponent alpha, as fitting.models.coated_conductor.ALPHA_MIN: keeps
 // (1 - mu)^alpha finite at mu = 1 (pow(0, y) is undefined for y <= 0).
 static const float CF_ALPHA_MIN = 1.0e-3;
 
 // t = (eta_i - lo) / (hi - lo) clamped to [0, 1]; a single-index fit
-// (hi == lo) has t = 0 (fitting.model.normalised_eta_i).
+// (hi == lo) has t = 0 (fitting.models.coated_conductor.normalised_eta_i).
 float cf_normalised_eta_i(float eta_i, float2 eta_i_range)
 {
     float width = eta_i_range.y - eta_i_range.x;

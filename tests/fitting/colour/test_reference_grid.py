@@ -1,5 +1,5 @@
 """
-The product-grid spectral reference (:func:`fitting.reference.reference_ACEScg_grid`)
+The product-grid spectral reference (:func:`fitting.colour.reference.reference_ACEScg_grid`)
 against its definition, the complex-arithmetic :func:`reference_ACEScg`, and
 the metrics the service reports against the 1 nm / 100 x 100 definition.
 """

@@ -1,7 +1,7 @@
 """
 Curve edits the model can follow (fitting.fits.curves): the fit stays within
 [0, 1] over its whole domain, also for extreme edits (a penalty constraint
-in the least squares, fitting.fit.fit_coefficients ``range_check``); the
+in the least squares, fitting.fits.solver.fit_coefficients ``range_check``); the
 reported figures are over the whole blended target with the place of the
 largest miss; a single-curve edit leaves far eta_i rows at the base; and on
 a set of edits the default refit is at least as close to the whole blended

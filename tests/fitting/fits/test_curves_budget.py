@@ -46,18 +46,22 @@ def in_range(result, tolerance=1e-4):
 
 
 def evaluations_of(monkeypatch):
-    """Count every model evaluation of fit_curves' solves (wraps solver.fit_coefficients)."""
-    import fitting.fits.curves as curves
+    """Count every model evaluation of fit_curves' solves (wraps the coated-conductor's
+    registered solve, fitting.fits.solver.fit_coefficients)."""
+    import dataclasses
+
+    from fitting.fits.kinds import FIT_KINDS
+    from fitting.models.kinds import DEFAULT_MODEL
 
     counted = []
-    original = curves.fit_coefficients
+    kind = FIT_KINDS[DEFAULT_MODEL]
 
     def counting(*args, **kwargs):
-        result = original(*args, **kwargs)
+        result = kind.solve(*args, **kwargs)
         counted.append(result.nfev + result.njev)
         return result
 
-    monkeypatch.setattr(curves, "fit_coefficients", counting)
+    monkeypatch.setitem(FIT_KINDS, DEFAULT_MODEL, dataclasses.replace(kind, solve=counting))
     return counted
 
 

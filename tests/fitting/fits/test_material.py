@@ -52,4 +52,9 @@ class TestFitMaterial:
     def test_evaluate_material_without_baselines(self):
         nk = library_material("Ag")
         m = evaluate_material(nk, fit_material(nk), samples=20, baselines=False)
-        assert set(m) == {"grid", "model_float16", "model_float64", "coverage"}
+        assert set(m) == {"grid", "figure", "model_float16", "model_float64", "coverage"}
+        # The one figure is the float16 model's, against the measured metal, with where its max is.
+        assert m["figure"]["delta_E_mean"] == m["model_float16"]["delta_E_mean"]
+        assert m["figure"]["against"].startswith("the measured metal (1 nm spectral reference)")
+        assert m["figure"]["max_at"] == m["model_float16"]["max_at"]
+        assert 1.0 <= m["figure"]["max_at"]["eta_i"] <= 2.5 and 0.0 <= m["figure"]["max_at"]["theta_deg"] <= 90.0

@@ -34,7 +34,7 @@ class TestErrorMetrics:
         assert [r.eta_i for r in m.rows] == list(BREAKDOWN_ETA_I)
         assert m.row(2.0) == EtaRow(2.0, float(dE[2].mean()), float(dE[2].max()))
         view = m.to_dict()
-        assert list(view) == ["delta_E_mean", "delta_E_max", "rmse", "by_eta_i"]
+        assert list(view) == ["delta_E_mean", "delta_E_max", "against", "rmse", "by_eta_i"]
         assert list(view["by_eta_i"]) == ["1", "1.5", "2", "2.5"]
         assert view["by_eta_i"]["1.5"] == {"delta_E_mean": float(dE[1].mean()),
                                            "delta_E_max": float(dE[1].max())}
@@ -55,9 +55,15 @@ class TestErrorMetrics:
         models = {1.0: MODEL[0], 2.0: MODEL[2]}
         m = curve_metrics(curves, lambda c: models[c.eta_i])
         view = m.to_dict()
-        assert list(view) == ["delta_E_mean", "delta_E_max", "by_curve"]
+        assert list(view) == ["delta_E_mean", "delta_E_max", "against", "max_at", "by_curve"]
+        assert view["against"] == "your edited curves, at their samples"
         assert [c["eta_i"] for c in view["by_curve"]] == [1.0, 2.0]
         both = np.concatenate([delta_E_map(REF[0], MODEL[0]), delta_E_map(REF[2], MODEL[2])])
+        worst = int(np.argmax(both))  # the max's place: the curve and the angle of that sample
+        assert view["max_at"] == {"eta_i": [1.0, 2.0][worst // 7],
+                                  "theta_deg": float(np.degrees(np.arccos(mu[worst % 7])))}
+        assert m.figure() == {"against": view["against"], "delta_E_mean": m.mean, "delta_E_max": m.max,
+                              "max_at": view["max_at"]}
         assert view["delta_E_mean"] == float(both.mean())
         s = delta_E_summary(REF, MODEL, "x")
         assert s.to_dict() == {"mean": m_mean(REF, MODEL), "max": float(delta_E_map(REF, MODEL).max())}

@@ -155,7 +155,8 @@ class TestJSONView:
 
 class TestKinds:
     def test_names(self):
-        assert MODEL_KINDS == ("coated-conductor", "rgb-conductor")
+        assert tuple(MODEL_KINDS) == ("coated-conductor", "rgb-conductor")
+        assert [k.code for k in MODEL_KINDS.values()] == [0, 1]
         with pytest.raises(ValueError, match="`model` must be one of"):
             check_model("rgb")
         assert coefficient_count("rgb-conductor") == 6 and coefficient_count("coated-conductor", 1) == 18

@@ -1,0 +1,146 @@
+"""
+The fit pipeline
+================
+
+One pipeline for every model kind: settings -> the spectral reference on the
+fitting grid -> the kind's solve and float16 quantisation -> the pack
+material -> (on request) the metrics -> the :class:`~fitting.fits.result.FitResult`,
+whose ``settings`` are the settings that ran (its provenance) and whose
+``timings["total"]`` is the whole call, evaluation included, for every kind.
+
+-   :class:`FitKind`: a model kind's fit: its default settings and its
+    solve of RGB samples (one per kind, registered in
+    :mod:`fitting.fits.kinds`).
+-   :func:`fit_spectral`: measured *n*, *k* to a fitted, packed material.
+-   :func:`settings_with`: settings with individual fields replaced.
+-   :func:`with_metrics`: a result given its metrics JSON, its pack record rebuilt with them.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Callable
+
+from ..colour.reference import reference_ACEScg, spectral_weights
+from ..domain import check_eta_i_range
+from ..models.kinds import model_kind
+from ..models.pack import PackedMaterial
+from ..optics.nk import SpectralNK, resample_nk
+from .evaluate import evaluate_material
+from .result import FitResult
+from .settings import FitSettings, fit_grid
+
+__all__ = ["FitKind", "fit_spectral", "settings_with", "with_metrics"]
+
+
+@dataclass(frozen=True)
+class FitKind:
+    """
+    How one model kind is fitted.
+
+    Attributes
+    ----------
+    name
+        The model kind (:data:`fitting.models.kinds.MODEL_KINDS`).
+    settings
+        Default :class:`~fitting.fits.settings.FitSettings` of its material fits.
+    solve
+        ``solve(target (S, 3), cos_theta (S,), eta_i (S,), eta_i_range, degree,
+        objective, max_nfev, quantise, weights=None, irls_rounds=2, **extra)
+        -> FitResult``: the least-squares fit to linear ACEScg samples and its
+        float16 coefficients (``degree`` is ignored by a kind without a power
+        axis). A kind whose model can leave [0, 1] also takes ``range_check``
+        and ``start`` (:func:`fitting.fits.solver.fit_coefficients`).
+    bounded
+        True when the kind's model is a reflectance in [0, 1] by
+        construction (no range constraint in curve fits).
+    """
+
+    name: str
+    settings: FitSettings
+    solve: Callable[..., FitResult]
+    bounded: bool = False
+
+
+def settings_with(settings: FitSettings, overrides: dict[str, Any]) -> FitSettings:
+    """``settings`` with the fields of ``overrides`` replaced (checked again)."""
+    return FitSettings(**{**settings.__dict__, **overrides}) if overrides else settings
+
+
+def with_metrics(result: FitResult, metrics: dict[str, Any], name: str | None = None) -> FitResult:
+    """``result`` with ``metrics`` (its JSON) set, and its pack record carrying them (renamed to ``name``)."""
+    packed = result.packed
+    result.metrics = metrics
+    result.packed = PackedMaterial(
+        name=name or packed.name, coefficients=packed.coefficients, eta_i_range=packed.eta_i_range,
+        source=packed.source, metrics=metrics, model=packed.model,
+    )
+    return result
+
+
+def fit_spectral(
+    kind: FitKind,
+    nk: SpectralNK,
+    eta_i_range,
+    settings: FitSettings | None = None,
+    evaluate: bool = False,
+    samples=None,
+    **overrides,
+) -> FitResult:
+    """
+    Fit model kind ``kind`` to the spectral reference of ``nk`` over
+    ``eta_i_range``.
+
+    The reference on the fitting grid of ``settings`` (default
+    ``kind.settings``; ``overrides`` replace fields, ``degree`` only for a
+    kind with a power axis) comes from the exact Fresnel equations integrated
+    to linear ACEScg at ``step_nm``; ``samples``, ``(cos_theta, eta_i,
+    weights)``, replace that grid (a scene's own eta_i). ``kind.solve`` fits
+    and quantises.
+
+    Returns
+    -------
+    FitResult
+        With ``packed`` (float16, the citation of ``nk`` as source),
+        ``coverage``, ``settings`` (those that ran), ``timings``
+        (``reference``, ``fit``, ``quantise``, ``evaluate`` when evaluated,
+        ``total``: the whole call) and, when ``evaluate`` is true, ``metrics``
+        and ``error`` (:func:`fitting.fits.evaluate.evaluate_material`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown kind, an invalid domain or setting, or data covering
+        too little of the visible range.
+    """
+    t0 = time.perf_counter()
+    model = model_kind(kind.name)
+    if not model.polynomial:
+        overrides.pop("degree", None)
+    settings = settings_with(settings or kind.settings, overrides)
+    eta_i_range = check_eta_i_range(eta_i_range)
+    nodes, _ = spectral_weights(settings.step_nm)
+    coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
+    if samples is None:
+        samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
+    mu, eta, weights = samples
+    target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
+    t_ref = time.perf_counter()
+    result = kind.solve(
+        target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
+        settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
+    )
+    result.coverage = coverage
+    result.settings = settings
+    result.timings["reference"] = t_ref - t0
+    result.packed = PackedMaterial(
+        name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
+        source=nk.source, model=result.model,
+    )
+    if evaluate:
+        t_eval = time.perf_counter()
+        with_metrics(result, evaluate_material(nk, result, min_coverage=settings.min_coverage))
+        result.timings["evaluate"] = time.perf_counter() - t_eval
+    result.timings["total"] = time.perf_counter() - t0
+    return result
