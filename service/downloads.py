@@ -287,10 +287,18 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return _snippet(format, records, pack_name).encode("utf-8")
 
 
-def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
+EXPORT_ROUGHNESS = 0.2
+"""The metal's perceptual roughness of an export when none is asked for."""
+EXPORT_COAT_ROUGHNESS = 0.03
+"""The coat's perceptual roughness of an export when none is asked for."""
+
+
+def render_export(record: FitRecord, format: str, eta_i: float, roughness: float = EXPORT_ROUGHNESS,
+                  coat_roughness: float = EXPORT_COAT_ROUGHNESS) -> bytes:
     """
     The export of one stored fit in ``format`` (one of
-    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``.
+    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``, with the
+    metal's and the coat's perceptual ``roughness`` and ``coat_roughness``.
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
@@ -307,7 +315,7 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
     if record.kind != "curves":
         nk = measured_nk(record)
         if nk is not None:
-            return export_material(nk, format, eta_i, model=packed)
+            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed)
     lo, hi = packed.eta_i_range
     if not lo <= eta_i <= hi:
         raise ValueError(
@@ -320,7 +328,7 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
         "reflectance": lambda mu, eta: model_ACEScg(
             packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
-    return export_material(model, format, eta_i, model=packed)
+    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed)
 
 
 def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:
@@ -376,15 +384,20 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     )
 
 
-def export_response(record: FitRecord, format: str, eta_i: float, stem: str):
-    """An export of one fit (:func:`render_export`) as a download for ``eta_i``."""
+def export_response(record: FitRecord, format: str, eta_i: float, stem: str,
+                    roughness: float = EXPORT_ROUGHNESS, coat_roughness: float = EXPORT_COAT_ROUGHNESS):
+    """
+    An export of one fit (:func:`render_export`) as a download for
+    ``eta_i`` and the roughnesses, its file name saying all three
+    (``<name>-<id>-eta1.5-rough0.2-coat0.03.mtlx``; the suffix the format).
+    """
     from fastapi import Response
 
-    body = render_export(record, format, eta_i)
+    body = render_export(record, format, eta_i, roughness, coat_roughness)
+    stem = f"{stem}-eta{eta_i:g}-rough{roughness:g}-coat{coat_roughness:g}"
     return Response(
         body, media_type=EXPORT_MEDIA_TYPES[format][0],
-        headers={"Content-Disposition":
-                 f'attachment; filename="{download_name(f"{stem}-eta{eta_i:g}", format)}"'},
+        headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
     )
 
 
