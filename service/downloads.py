@@ -287,18 +287,10 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return _snippet(format, records, pack_name).encode("utf-8")
 
 
-EXPORT_ROUGHNESS = 0.2
-"""The metal's perceptual roughness of an export when none is asked for."""
-EXPORT_COAT_ROUGHNESS = 0.03
-"""The coat's perceptual roughness of an export when none is asked for."""
-
-
-def render_export(record: FitRecord, format: str, eta_i: float, roughness: float = EXPORT_ROUGHNESS,
-                  coat_roughness: float = EXPORT_COAT_ROUGHNESS) -> bytes:
+def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03) -> bytes:
     """
     The export of one stored fit in ``format`` (one of
-    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``, with the
-    metal's and the coat's perceptual ``roughness`` and ``coat_roughness``.
+    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i`` and roughnesses.
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
@@ -384,13 +376,8 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     )
 
 
-def export_response(record: FitRecord, format: str, eta_i: float, stem: str,
-                    roughness: float = EXPORT_ROUGHNESS, coat_roughness: float = EXPORT_COAT_ROUGHNESS):
-    """
-    An export of one fit (:func:`render_export`) as a download for
-    ``eta_i`` and the roughnesses, its file name saying all three
-    (``<name>-<id>-eta1.5-rough0.2-coat0.03.mtlx``; the suffix the format).
-    """
+def export_response(record: FitRecord, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03):
+    """An export of one fit (:func:`render_export`) as a download named for ``eta_i`` and the roughnesses."""
     from fastapi import Response
 
     body = render_export(record, format, eta_i, roughness, coat_roughness)

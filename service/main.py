@@ -28,7 +28,8 @@ from fastapi.staticfiles import StaticFiles
 from .api.errors import install_error_handlers
 from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
-    curves, environments, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
+    curves, environments, fits, health, ibl, library, materials, packs, preview, reference_texture, scenes,
+    versions,
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
@@ -141,8 +142,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.preview_renderer = None
     install_error_handlers(app)
-    for module in (health, materials, fits, packs, preview, reference_texture, environments, curves, scenes,
-                   ibl):
+    for module in (health, materials, versions, library, fits, packs, preview, reference_texture, environments,
+                   curves, scenes, ibl):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")
@@ -160,7 +161,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     if settings.cors_origins:
         app.add_middleware(
             CORSMiddleware, allow_origins=settings.cors_origins,
-            allow_methods=["GET", "POST"], allow_headers=["Authorization", "Content-Type"],
+            allow_methods=["GET", "POST", "PATCH", "DELETE"], allow_headers=["Authorization", "Content-Type"],
         )
     app.add_middleware(
         RequestLimits, max_body_bytes=settings.max_body_bytes,
