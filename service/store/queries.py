@@ -129,10 +129,12 @@ def page_rows(connection: Any, p: str, after: int | None, limit: int,
     one more than ``limit``: those not in the bin (or, ``deleted``, only
     those in it), with ``query`` only those whose name or source holds it.
     """
-    kinds = tuple(k for k in kinds if k != "library") or ("",)
-    where = [f"kind IN ({','.join([p] * len(kinds))})", f"first_seq > {p}",
+    # The kinds not asked for are left out, so a row of an unreadable kind is still read
+    # (and reported in ``skipped`` by page_of) whatever was asked for.
+    left_out = ("library", *(k for k in FIT_KINDS if k != "library" and k not in kinds))
+    where = [f"kind NOT IN ({','.join([p] * len(left_out))})", f"first_seq > {p}",
              "deleted_at IS NOT NULL" if deleted else "deleted_at IS NULL"]
-    params: list[Any] = [*kinds, after or 0]
+    params: list[Any] = [*left_out, after or 0]
     if query:
         where.append(f"(lower(name) LIKE {p} ESCAPE '\\' OR lower(source) LIKE {p} ESCAPE '\\')")
         params += [_like(query), _like(query)]
