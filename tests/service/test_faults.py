@@ -161,7 +161,8 @@ def test_store_quota_full_507_and_healthz(tmp_path):
         assert health["store_writable"] is False and "quota" in health["store_problem"]
         for i, status in enumerate(statuses[:-1]):  # every acknowledged save is there
             assert client.get(f"{API}/materials").status_code == 200
-        assert len([m for m in client.get(f"{API}/materials").json()["materials"] if m["kind"] == "nk"]) == len(statuses) - 1
+        uploads = client.get(f"{API}/materials", params={"kind": "nk"}).json()["materials"]
+        assert len([m for m in uploads if m["kind"] == "nk"]) == len(statuses) - 1
 
 
 def test_disk_below_free_space_refused_507_before_fitting(tmp_path):

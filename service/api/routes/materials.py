@@ -34,7 +34,7 @@ from fitting.optics.nk import visible_coverage
 from ...jobs.common import with_measured_nk
 from ...jobs.library import matches
 from ...jobs.materials import share_url as _share
-from ...schemas import (API_PREFIX, INT64_MAX, LISTING_KINDS, MaterialDetail, MaterialList, MaterialRename,
+from ...schemas import (API_PREFIX, INT64_MAX, LISTING_KINDS, ErrorBody, MaterialDetail, MaterialList, MaterialRename,
                         MaterialSummary, fit_public)
 from ...store import MaterialRow
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdPath, SettingsDep, StoreDep,
@@ -43,7 +43,7 @@ from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdP
 router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
 WRITE_RESPONSES = {**FIT_ERROR_RESPONSES, **NOT_FOUND,
-                   409: {"description": "Another saved edited material is called `name`"}}
+                   409: {"model": ErrorBody, "description": "Another saved edited material is called `name`"}}
 
 
 @functools.cache
