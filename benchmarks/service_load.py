@@ -183,7 +183,8 @@ def listing(url: str) -> list[str]:
     ids, cursor = [], None
     with httpx.Client(base_url=url, timeout=60) as http:
         while True:
-            page = http.get(f"{API}/materials", params={} if cursor is None else {"cursor": cursor}).json()
+            params = [("kind", "curves"), ("kind", "nk"), *([] if cursor is None else [("cursor", cursor)])]
+            page = http.get(f"{API}/materials", params=params).json()
             ids += [m["id"] for m in page["materials"] if m["kind"] != "library"]
             cursor = page["next_cursor"]
             if cursor is None:

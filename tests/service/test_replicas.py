@@ -43,11 +43,12 @@ def curves_body(i: int, name: str, **extra) -> dict:
 
 
 def listed(url: str) -> dict[str, dict]:
-    """Every saved material of a replica's listing, by id (all pages)."""
+    """Every saved material (edits and n, k fits) of a replica's listing, by id (all pages)."""
     out, cursor = {}, None
     with httpx.Client(base_url=url, timeout=60) as http:
         for _ in range(100):
-            page = http.get(f"{API}/materials", params={"cursor": cursor} if cursor is not None else {}).json()
+            params = [("kind", "curves"), ("kind", "nk"), *([("cursor", cursor)] if cursor is not None else [])]
+            page = http.get(f"{API}/materials", params=params).json()
             out.update({m["id"]: m for m in page["materials"] if m["kind"] != "library"})
             cursor = page["next_cursor"]
             if cursor is None:
