@@ -2,7 +2,8 @@
 The numpy mirrors of each tool's layering (fitting.exports.tool_layering)
 against the tool's own render of the export, at roughness 0 under a uniform
 white environment: MaterialX's generated GLSL (``mtlx``, ``openpbr``) on the
-project's EGL context (preview_shaders.materialx_render).
+project's EGL context (preview_shaders.materialx_render); Cycles (Blender's
+bpy, ``blender``, ``blender-conductor``) on a flat plane (cycles_angles.py).
 
 Compared at the pixels of the sphere whose cos theta is near each tested
 view angle (the mirror evaluated at each pixel's own cos theta), in Delta E
@@ -10,6 +11,10 @@ view angle (the mirror evaluated at each pixel's own cos theta), in Delta E
 """
 
 from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -66,3 +71,51 @@ def test_materialx_mirror_is_the_render(materialx_renders, fmt):
             worst = max(worst, float(dE.max()))
             assert dE.max() < BOUND, (name, eta, fmt, angle, dE.max())
     print(f"{fmt}: worst Delta E {worst:.4f}")
+
+
+# Cycles (Blender 5 as the bpy module, .venv-blender, one process per export
+# and output): a flat plane seen at each angle under a white world, 128
+# samples of 16 pixels (tests/fitting/exports/cycles_angles.py).
+ROOT = Path(__file__).resolve().parents[3]
+BLENDER_PYTHON = ROOT / ".venv-blender" / "bin" / "python"
+CYCLES_ANGLES = (0.0, 40.0, 70.0)
+CYCLES_CASES = [("Cu", 1.5), ("Cr", 1.0)]
+CYCLES_OUTPUTS = {"principled": "blender", "conductor": "blender-conductor"}
+
+
+@pytest.fixture(scope="module")
+def cycles_renders(tmp_path_factory):
+    assert BLENDER_PYTHON.exists(), "the Blender environment is missing: run scripts/bootstrap"
+    tmp = tmp_path_factory.mktemp("cycles")
+    out = {}
+    for name, eta in CYCLES_CASES:
+        values = export_values(library_material(name), eta, roughness=0.0, coat_roughness=0.0,
+                               tools=("blender", "blender-conductor"))
+        script = tmp / f"{name}.py"
+        script.write_bytes(export_material(values, "blender", eta))
+        for output in CYCLES_OUTPUTS:
+            result = subprocess.run(
+                [str(BLENDER_PYTHON), str(Path(__file__).with_name("cycles_angles.py")), str(script),
+                 "--output", output, "--angles", ",".join(f"{a:g}" for a in CYCLES_ANGLES),
+                 "--samples", "128"],
+                capture_output=True, text=True, timeout=600, cwd=tmp,
+            )
+            assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
+            line = [ln for ln in result.stdout.splitlines() if ln.startswith("CYCLES_ANGLES ")][-1]
+            out[name, eta, output] = (values, json.loads(line.split(" ", 1)[1]))
+    return out
+
+
+@pytest.mark.slow  # 4 Blender processes, ~12 s each
+@pytest.mark.numeric
+@pytest.mark.parametrize("output", list(CYCLES_OUTPUTS))
+def test_cycles_mirror_is_the_render(cycles_renders, output):
+    tool = CYCLES_OUTPUTS[output]
+    for name, eta in CYCLES_CASES:
+        values, rendered = cycles_renders[name, eta, output]
+        mu = np.cos(np.radians(CYCLES_ANGLES))
+        render = np.array([rendered[f"{a:g}"] for a in CYCLES_ANGLES])
+        mirror = tool_seen(tool, values.tools[tool], mu, eta)
+        dE = delta_E_map(lin_rec709_to_ACEScg(render), lin_rec709_to_ACEScg(mirror))
+        assert dE.max() < BOUND, (name, eta, output, dE)
+        print(f"{output} {name} {eta}: Delta E {np.round(dE, 4)}")
