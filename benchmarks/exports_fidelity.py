@@ -46,7 +46,7 @@ COLUMNS = ("mtlx / Metallic BSDF", "openpbr / Principled", "gltf", "rgb_nk ACESc
 
 def material_row(name: str, eta_i: float, air_nk: tuple) -> list[float]:
     nk = library_material(name)
-    values = export_values(nk, eta_i)
+    values = export_values(nk, eta_i, tools=())  # the naive values only (the seen fits: benchmarks/exports_seen.py)
     row = [export_fidelity(values, target)["delta_E_mean"] for target in ("mtlx", "openpbr", "gltf")]
     n, k = air_nk
     exact = mx_fresnel_conductor(values.cos_theta, n / eta_i, k / eta_i)

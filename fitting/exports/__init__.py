@@ -15,8 +15,13 @@ one coating index eta_i, each saying what it was made from:
     (:mod:`fitting.exports.gltf`), and the model itself in
     ``EXT_materials_coated_conductor`` (:mod:`fitting.exports.gltf_coated`).
 
-The values come from :mod:`fitting.exports.values`, their loss against the
-spectral reference from :mod:`fitting.exports.tool_fresnel`.
+The values come from :mod:`fitting.exports.values`: each fitted so that the
+tool's own layering of its coat over its base
+(:mod:`fitting.exports.tool_layering`) follows the physical coat on the
+metal seen from air (:mod:`fitting.exports.seen_fit`,
+:func:`fitting.colour.seen.seen_ACEScg`); at eta_i 1 no export has a coat.
+:mod:`fitting.exports.tool_fresnel` has the tools' base Fresnel terms and
+the earlier (naive) fidelity under the coat.
 
 -   :data:`EXPORT_FORMATS`: media type and file suffix per format.
 -   :func:`export_material`: the document of a material in a format.
@@ -28,17 +33,20 @@ from .blender import blender_script
 from .gltf import gltf_document
 from .mtlx import mtlx_document
 from .openpbr import openpbr_document
+from .seen_fit import seen_fidelity
 from .tool_fresnel import TOOL_MODELS, export_fidelity, tool_curve
 from ..domain import check_eta_i
 from .values import ETA_I_LIMITS, ExportValues, export_values
 
 __all__ = [
     "EXPORT_FORMATS",
+    "FORMAT_TOOLS",
     "ETA_I_LIMITS",
     "ExportValues",
     "TOOL_MODELS",
     "check_format",
     "export_fidelity",
+    "seen_fidelity",
     "export_material",
     "export_values",
     "tool_curve",
@@ -51,6 +59,14 @@ EXPORT_FORMATS = {
     "gltf": ("model/gltf+json", "gltf"),
 }
 """Format -> (media type, file suffix)."""
+
+FORMAT_TOOLS = {
+    "mtlx": ("mtlx",),
+    "openpbr": ("openpbr",),
+    "blender": ("blender", "blender-conductor"),
+    "gltf": ("gltf",),
+}
+"""Format -> the tools whose fitted values it carries (:mod:`fitting.exports.tool_layering`)."""
 
 _WRITERS = {
     "mtlx": mtlx_document,
@@ -108,6 +124,12 @@ def export_material(
                 f"`eta_i` must be the values' own {fit_or_nk.eta_i:g} for ExportValues, got {eta_i}"
             )
         values = fit_or_nk
+        missing = [tool for tool in FORMAT_TOOLS[format] if tool not in values.tools]
+        if missing:
+            raise ValueError(
+                f"`fit_or_nk` must carry the fitted values of {', '.join(missing)} for a "
+                f"{format} export (export_values(..., tools=None) fits them all)"
+            )
     else:
-        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model)
+        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, FORMAT_TOOLS[format])
     return _WRITERS[format](values).encode("utf-8")

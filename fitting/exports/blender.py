@@ -8,14 +8,19 @@ or ``blender --python FILE``; it calls :func:`build_material` in the script,
 which makes a material with two outputs:
 
 -   the active ``Material Output``: a Principled BSDF, ``Metallic`` 1, with
-    ``Base Color`` and ``Specular Tint`` the F0 and F82 tint fitted to the
-    metal's reflectance under the coat (Cycles and EEVEE evaluate a metallic
-    Principled BSDF with the F82-tint model), ``Coat Weight`` 1 and ``Coat
-    IOR`` eta_i;
+    ``Base Color`` and ``Specular Tint`` the F0 and F82 tint (Cycles and
+    EEVEE evaluate a metallic Principled BSDF with the F82-tint model),
+    ``Coat Weight`` 1 and ``Coat IOR`` eta_i;
 -   a second ``Material Output (Physical Conductor)``: a Metallic BSDF in
-    Physical Conductor mode with ``IOR`` and ``Extinction`` the per-channel
-    relative index (n + i k) / eta_i, under a coat made of a Glossy BSDF
-    mixed in by the Fresnel of eta_i. Make it the active output to use it.
+    Physical Conductor mode with per-channel ``IOR`` and ``Extinction``,
+    under a coat made of a Glossy BSDF mixed in by the Fresnel of eta_i.
+    Make it the active output to use it.
+
+Both sets of values are fitted so that Cycles' own layering (the coat's
+Fresnel plus the metal scaled by what the coat lets through, at the view
+angle in air) follows the physical coat on the metal seen from air
+(:mod:`fitting.exports.seen_fit`). At eta_i 1 there is no coat (``Coat
+Weight`` 0; the Metallic BSDF straight into its output).
 
 The script uses only ``bpy`` and the standard library; its values are
 literals, and its provenance is in the header comment and in the material's
@@ -28,14 +33,15 @@ from __future__ import annotations
 
 import json
 
-from .tool_fresnel import export_fidelity
+from .seen_fit import seen_fidelity
 from .values import ExportValues
 
 __all__ = ["MODEL_KIND", "blender_script", "NODE_NAMES"]
 
 MODEL_KIND = (
-    "f82-tint (Principled BSDF, active output) and rgb-conductor "
-    "(Metallic BSDF, Physical Conductor, second output)"
+    "f82-tint (Principled BSDF with coat, active output) and exact conductor "
+    "(Metallic BSDF, Physical Conductor, under a Fresnel-mixed Glossy coat, second output), "
+    "both fitted to the coated metal seen from air"
 )
 
 NODE_NAMES = {
@@ -61,12 +67,15 @@ import bpy
 MATERIAL_NAME = {material_name!r}
 PROVENANCE = {provenance_json!r}
 ETA_I = {eta_i!r}
+COAT = {coat!r}
 ROUGHNESS = {roughness!r}
 COAT_ROUGHNESS = {coat_roughness!r}
-# F82-tint model, linear Rec.709 (Blender's scene linear), fitted under the coat.
+# F82-tint model, linear Rec.709 (Blender's scene linear), fitted to the coated
+# metal seen from air under the Principled BSDF's coat.
 BASE_COLOR = {F0!r}
 SPECULAR_TINT = {tint!r}
-# Relative index (n + i k) / eta_i per channel, linear Rec.709.
+# Physical Conductor n, k per channel, linear Rec.709, fitted likewise under
+# the Fresnel-mixed coat.
 CONDUCTOR_IOR = {n_rel!r}
 CONDUCTOR_EXTINCTION = {k_rel!r}
 NODE_NAMES = {node_names!r}
@@ -82,7 +91,8 @@ def _node(tree, kind, name, location):
 def build_material(name=MATERIAL_NAME):
     """Make the material and return it (a new one each call)."""
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    if material.node_tree is None:  # Blender 4.x; from 5.0 every material has nodes
+        material.use_nodes = True
     tree = material.node_tree
     tree.nodes.clear()
     material["coated_fresnel"] = PROVENANCE
@@ -92,7 +102,7 @@ def build_material(name=MATERIAL_NAME):
     principled.inputs["Metallic"].default_value = 1.0
     principled.inputs["Roughness"].default_value = ROUGHNESS
     principled.inputs["Specular Tint"].default_value = (*SPECULAR_TINT, 1.0)
-    principled.inputs["Coat Weight"].default_value = 1.0
+    principled.inputs["Coat Weight"].default_value = 1.0 if COAT else 0.0
     principled.inputs["Coat Roughness"].default_value = COAT_ROUGHNESS
     principled.inputs["Coat IOR"].default_value = ETA_I
     principled.inputs["Coat Tint"].default_value = (1.0, 1.0, 1.0, 1.0)
@@ -118,7 +128,12 @@ def build_material(name=MATERIAL_NAME):
     conductor_output = _node(
         tree, "ShaderNodeOutputMaterial", NODE_NAMES["conductor_output"], (600, -300)
     )
-    tree.links.new(mix.outputs["Shader"], conductor_output.inputs["Surface"])
+    if COAT:
+        tree.links.new(mix.outputs["Shader"], conductor_output.inputs["Surface"])
+    else:
+        for node in (glossy, fresnel, mix):
+            tree.nodes.remove(node)
+        tree.links.new(metallic.outputs["BSDF"], conductor_output.inputs["Surface"])
 
     conductor_output.is_active_output = False
     output.is_active_output = True
@@ -150,12 +165,13 @@ def _floats(values) -> tuple[float, ...]:
 
 def blender_script(values: ExportValues) -> str:
     """The Blender Python script of ``values``, UTF-8 text."""
-    provenance = values.provenance(MODEL_KIND, export_fidelity(values, "blender"))
-    provenance["delta_E_2000_under_coat_physical_conductor"] = (
+    provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "blender"))
+    provenance["delta_E_2000_seen_physical_conductor"] = (
         "mean {delta_E_mean:.3f}, max {delta_E_max:.3f}".format(
-            **export_fidelity(values, "blender-conductor")
+            **seen_fidelity(values, "blender-conductor")
         )
     )
+    principled, conductor = values.tools["blender"], values.tools["blender-conductor"]
     header = "\n".join(
         "# " + "".join(ch if 32 <= ord(ch) < 127 else " " for ch in f"{key}: {value}")
         for key, value in provenance.items()
@@ -165,11 +181,12 @@ def blender_script(values: ExportValues) -> str:
         material_name=f"{values.name} coated (eta_i {values.eta_i:g})",
         provenance_json=json.dumps(provenance, sort_keys=True),
         eta_i=round(values.eta_i, 6),
+        coat=bool(principled["coat"]),
         roughness=round(values.roughness, 6),
         coat_roughness=round(values.coat_roughness, 6),
-        F0=_floats(values.F0),
-        tint=_floats(values.F82_tint),
-        n_rel=_floats(values.n_rel),
-        k_rel=_floats(values.k_rel),
+        F0=_floats(principled["base_color"]),
+        tint=_floats(principled["specular_tint"]),
+        n_rel=_floats(conductor["ior"]),
+        k_rel=_floats(conductor["extinction"]),
         node_names=NODE_NAMES,
     )

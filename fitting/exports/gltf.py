@@ -4,15 +4,15 @@ glTF export
 
 A glTF 2.0 asset (JSON, buffers embedded as a base64 data URI) with one
 material and a small UV sphere that uses it, so the file opens in any glTF
-viewer. The material is metallic (``metallicFactor`` 1) with
-``baseColorFactor`` the F0 of Schlick's approximation (the Fresnel glTF's
-metallic base evaluates) fitted to the metal's reflectance under the coat,
-``roughnessFactor`` the metal's roughness, and a ``KHR_materials_clearcoat``
-coat (``clearcoatFactor`` 1). glTF fixes the clear coat's index at 1.5 and
-lets neither index influence the other, so the export is exact in intent only
-for eta_i = 1.5; for another eta_i the base colour still carries that coat's
-effect, and ``extras`` says so. Provenance is in the material's and the
-asset's ``extras``.
+viewer. The material is metallic (``metallicFactor`` 1), ``roughnessFactor``
+the metal's roughness, with a ``KHR_materials_clearcoat`` coat; its
+``baseColorFactor`` and ``clearcoatFactor`` are fitted so that three.js's
+``MeshPhysicalMaterial`` (its metallic base and its clear coat of fixed
+index 1.5, layered at the view angle in air) follows the physical coat of
+index eta_i on the metal seen from air (:mod:`fitting.exports.seen_fit`): for
+a coat weaker than glTF's 1.5 the fit lowers ``clearcoatFactor``. At eta_i 1
+there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance is in the
+material's and the asset's ``extras``.
 
 When the values carry the fit's own model (:attr:`ExportValues.model`), the
 material also has ``EXT_materials_coated_conductor``
@@ -36,12 +36,15 @@ import json
 import numpy as np
 
 from .gltf_coated import EXTENSION_NAME, coated_conductor_extension
-from .tool_fresnel import export_fidelity
+from .seen_fit import seen_fidelity
 from .values import ExportValues
 
 __all__ = ["MODEL_KIND", "GLTF_COAT_IOR", "gltf_document", "uv_sphere"]
 
-MODEL_KIND = "schlick: metallic base colour (F0) fitted to the reflectance under the coat"
+MODEL_KIND = (
+    "metallic base colour and clear coat factor, fitted under three.js's clear coat to the "
+    "coated metal seen from air"
+)
 GLTF_COAT_IOR = 1.5
 """The index of refraction glTF's KHR_materials_clearcoat assumes."""
 
@@ -80,14 +83,17 @@ def _padded(data: bytes) -> bytes:
 
 def gltf_document(values: ExportValues) -> str:
     """The glTF 2.0 asset of ``values`` as JSON text."""
-    fidelity = export_fidelity(values, "gltf")
+    fidelity = seen_fidelity(values, "gltf")
     provenance = values.provenance(MODEL_KIND, fidelity)
-    provenance["clearcoat_ior_assumed_by_gltf"] = GLTF_COAT_IOR
-    if abs(values.eta_i - GLTF_COAT_IOR) > 1e-9:
+    fitted = values.tools["gltf"]
+    coat_on = fitted["coat"]
+    if coat_on:
+        provenance["clearcoat_ior_assumed_by_gltf"] = GLTF_COAT_IOR
+    if coat_on and abs(values.eta_i - GLTF_COAT_IOR) > 1e-9:
         provenance["note"] = (
             f"fitted for a coat of index {values.eta_i:g}; glTF renders its clear coat "
-            f"with index {GLTF_COAT_IOR:g}, the base colour is what the metal shows under "
-            f"the {values.eta_i:g} coat"
+            f"with index {GLTF_COAT_IOR:g}, so the base colour and clearcoatFactor are "
+            f"fitted to what the metal under the {values.eta_i:g} coat looks like"
         )
     positions, normals, indices = uv_sphere()
     blobs = [positions.tobytes(), normals.tobytes(), indices.tobytes()]
@@ -106,19 +112,20 @@ def gltf_document(values: ExportValues) -> str:
     material = {
         "name": f"{values.name} coated (eta_i {values.eta_i:g})",
         "pbrMetallicRoughness": {
-            "baseColorFactor": [round(float(v), 6) for v in values.F0_schlick] + [1.0],
+            "baseColorFactor": [round(float(v), 6) for v in fitted["base_color"]] + [1.0],
             "metallicFactor": 1.0,
             "roughnessFactor": round(values.roughness, 6),
         },
-        "extensions": {
-            "KHR_materials_clearcoat": {
-                "clearcoatFactor": 1.0,
-                "clearcoatRoughnessFactor": round(values.coat_roughness, 6),
-            }
-        },
+        "extensions": {},
         "extras": {"coated_fresnel": provenance},
     }
-    used = ["KHR_materials_clearcoat"]
+    used = []
+    if coat_on:
+        material["extensions"]["KHR_materials_clearcoat"] = {
+            "clearcoatFactor": round(float(fitted["clearcoat"]), 6),
+            "clearcoatRoughnessFactor": round(values.coat_roughness, 6),
+        }
+        used.append("KHR_materials_clearcoat")
     if values.model is not None:
         extension, why_not = coated_conductor_extension(values.model, values.eta_i, values.coat_roughness)
         if extension is None:
@@ -126,13 +133,15 @@ def gltf_document(values: ExportValues) -> str:
         else:
             material["extensions"][EXTENSION_NAME] = extension
             used.append(EXTENSION_NAME)
+    if not material["extensions"]:
+        del material["extensions"]
     asset = {
         "asset": {
             "version": "2.0",
             "generator": provenance["generator"],
             "extras": {"coated_fresnel": provenance},
         },
-        "extensionsUsed": used,
+        **({"extensionsUsed": used} if used else {}),
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0, "name": "sphere"}],

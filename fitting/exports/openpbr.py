@@ -4,13 +4,13 @@ OpenPBR export
 
 A MaterialX document with one ``open_pbr_surface`` (OpenPBR Surface 1.1 as
 shipped in MaterialX's ``bxdf`` library): a fully metallic base whose
-``base_color`` and ``specular_color`` are the F0 and F82 tint of the F82-tint
-model fitted to the metal's reflectance *under* the coat
-(:mod:`fitting.exports.values`), with ``coat_weight`` 1 and ``coat_ior``
-eta_i, ``coat_darkening`` 0. OpenPBR leaves the Fresnel of a metal under a coat undefined (the
-F82 model assumes air), so the fit to the curve under the coat is what lets
-it see the coat; ``specular_roughness`` and ``coat_roughness`` are the
-surface's own inputs.
+``base_color`` and ``specular_color`` are the F0 and F82 tint fitted so that
+OpenPBR's coat (``coat_weight`` 1, ``coat_ior`` eta_i, ``coat_darkening`` 1,
+the specification's default: the base darkened by the coat's internal
+reflections) over that metal, as MaterialX builds it, follows the physical
+coat on the metal seen from air (:mod:`fitting.exports.seen_fit`). At eta_i 1
+there is no coat (``coat_weight`` 0). ``specular_roughness`` and
+``coat_roughness`` are the surface's own inputs.
 
 -   :func:`openpbr_document`: the document as text.
 
@@ -24,35 +24,36 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from ._xml import add_input, document, element_name, number, to_text, triple
-from .tool_fresnel import export_fidelity
+from .seen_fit import seen_fidelity
 from .values import ExportValues
 
 __all__ = ["MODEL_KIND", "openpbr_document"]
 
-MODEL_KIND = "f82-tint: F0 and F82 tint fitted to the reflectance under the coat"
+MODEL_KIND = "f82-tint metal under OpenPBR's coat: F0 and F82 tint fitted to the coated metal seen from air"
 
 
 def openpbr_document(values: ExportValues) -> str:
     """The OpenPBR (MaterialX) document of ``values``, UTF-8 text."""
     ident = element_name(values.name)
-    provenance = values.provenance(MODEL_KIND, export_fidelity(values, "openpbr"))
+    provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "openpbr"))
     root = document(provenance)
+    fitted = values.tools["openpbr"]
+    coat_on = fitted["coat"]
     shader = ET.SubElement(root, "open_pbr_surface", name=f"{ident}_openpbr", type="surfaceshader")
     for name, type_, value in (
         ("base_weight", "float", number(1.0)),
-        ("base_color", "color3", triple(values.F0)),
+        ("base_color", "color3", triple(fitted["base_color"])),
         ("base_metalness", "float", number(1.0)),
         ("specular_weight", "float", number(1.0)),
-        ("specular_color", "color3", triple(values.F82_tint)),
+        ("specular_color", "color3", triple(fitted["specular_color"])),
         ("specular_roughness", "float", number(values.roughness)),
-        ("coat_weight", "float", number(1.0)),
+        ("coat_weight", "float", number(1.0 if coat_on else 0.0)),
         ("coat_color", "color3", triple((1.0, 1.0, 1.0))),
         ("coat_roughness", "float", number(values.coat_roughness)),
         ("coat_ior", "float", number(values.eta_i)),
-        # Off: the fitted F0 and tint already are the metal seen under the
-        # coat; OpenPBR's darkening (internal reflections in the coat, meant
-        # for rough or diffuse bases) would darken it a second time.
-        ("coat_darkening", "float", number(0.0)),
+        # The default, written out: the fit is made with it on (the physical
+        # bounces between coat and metal darken and tint the metal too).
+        ("coat_darkening", "float", number(fitted.get("coat_darkening", 1.0))),
     ):
         add_input(shader, name, type_, value=value)
     material = ET.SubElement(

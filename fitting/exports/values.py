@@ -7,7 +7,17 @@ working space of the target tools (linear Rec.709 primaries, D65 white: the
 default ``lin_rec709`` of MaterialX, Blender's scene linear, glTF's linear
 sRGB) to the reflectance of the metal under the coat.
 
-The target curve :math:`T(\\mu)` is the spectral reference under the coat
+Each export carries the values fitted to what the user sees
+(:mod:`fitting.exports.seen_fit`): the physical coat on the metal seen from
+air (:func:`fitting.colour.seen.seen_ACEScg`) at the view angles 0 to 83
+degrees, against the tool's own layering of its coat over its base
+(:mod:`fitting.exports.tool_layering`), in Delta E 2000; they are
+:attr:`ExportValues.tools`. The rest of this docstring is the earlier,
+naive fit, kept as the baseline the seen fit is measured against (today's
+values before issue 22): the base's Fresnel fitted to the metal under the
+coat at the same angle inside the coat.
+
+The naive target curve :math:`T(\\mu)` is the spectral reference under the coat
 (:func:`fitting.colour.reference.reference_ACEScg` at eta_i, 1 nm, linear ACEScg)
 converted to linear Rec.709 with CAT02 adaptation (a perfect reflector stays
 (1, 1, 1)), at :data:`EXPORT_SAMPLES` values of :math:`\\mu = \\cos\\theta`
@@ -46,16 +56,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..colour.reference import reference_ACEScg
+from ..colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
 from ..domain import ETA_I_MAX, ETA_I_MIN, check_eta_i, check_number
 from ..models.pack import PackedMaterial
 from ..models.rgb_conductor import rgb_fresnel_conductor
-from ..optics.fresnel import fresnel_conductor
+from ..optics.coated_stack import coated_stack, coated_stack_from_metal
 from ..optics.nk import SpectralNK
 from .colour_space import ACEScg_to_lin_rec709
-from .tool_fresnel import f82_tint, schlick
+from .seen_fit import fit_channel_conductor, fit_channel_f82, fit_channel_schlick, fit_tool_values
+from .tool_layering import TOOLS
 
 __all__ = [
     "EXPORT_SAMPLES",
@@ -64,6 +75,7 @@ __all__ = [
     "export_values",
     "project_version",
     "check_roughness",
+    "has_coat",
 ]
 
 EXPORT_SAMPLES = 100
@@ -71,12 +83,6 @@ EXPORT_SAMPLES = 100
 
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 """Accepted coating indices (the project's rule, :func:`fitting.domain.check_eta_i`)."""
-
-# Per-channel relative index bounds: n > 0 as for any conductor; above every
-# library conductor divided by eta_i >= 1 (n < 5, k < 12 in 360-830 nm).
-_N_BOUNDS = (1.0e-3, 20.0)
-_K_BOUNDS = (0.0, 50.0)
-
 
 @functools.cache
 def project_version() -> str:
@@ -123,6 +129,14 @@ class ExportValues:
         Schlick F0, shape (3,), in [0, 1].
     roughness, coat_roughness
         Perceptual roughness of the metal and of the coat, [0, 1].
+    view_cos, seen_ACEScg
+        cos theta of the view angles in air (:data:`fitting.colour.seen.SEEN_ANGLES_DEG`)
+        and the coated metal seen from air there, linear ACEScg (S, 3).
+    tools
+        Per tool (:data:`fitting.exports.tool_layering.TOOLS`) the values its
+        export carries, fitted to ``seen_ACEScg`` under the tool's layering,
+        and ``coat`` (False at eta_i 1). ``n_rel`` ... ``F0_schlick`` above
+        are the naive fits under the coat (the baseline).
     model
         The fit's own float16 model (:class:`fitting.models.pack.PackedMaterial`),
         when the export carries it as well as the tool's values (glTF's
@@ -145,6 +159,9 @@ class ExportValues:
     coat_roughness: float = 0.03
     model: PackedMaterial | None = None
     version: str = field(default_factory=project_version)
+    view_cos: np.ndarray | None = None
+    seen_ACEScg: np.ndarray | None = None
+    tools: dict = field(default_factory=dict)
 
     def provenance(self, model_kind: str, fidelity: dict | None = None) -> dict:
         """
@@ -159,55 +176,30 @@ class ExportValues:
             "eta_i": self.eta_i,
             "model_kind": model_kind,
             "fitted_to": self.origin,
+            "fitted_how": (
+                "the tool's coat over its base, against the physical coat on the metal seen "
+                "from air (both polarisations, metal at the refracted angle, bounces between "
+                "the interfaces), Delta E 2000 least squares"
+            ),
             "colour_space": "lin_rec709",
             "generator": f"coated-fresnel {self.version}",
         }
         if fidelity is not None:
-            info["delta_E_2000_under_coat"] = (
-                f"mean {fidelity['delta_E_mean']:.3f}, max {fidelity['delta_E_max']:.3f}"
+            info["delta_E_2000_seen"] = (
+                f"mean {fidelity['delta_E_mean']:.3f}, max {fidelity['delta_E_max']:.3f} "
+                f"over {SEEN_ANGLES_DEG[0]:g}-{SEEN_ANGLES_DEG[-1]:g} degrees in air, roughness 0"
             )
         return info
 
 
-def _fit_relative_index(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    n_out, k_out = np.empty(3), np.empty(3)
-    lo, hi = [_N_BOUNDS[0], _K_BOUNDS[0]], [_N_BOUNDS[1], _K_BOUNDS[1]]
-    for c in range(3):
-        R = T[:, c]
-        # At normal incidence with n = 1, R = k^2 / (4 + k^2): a start from F0.
-        F0 = float(np.clip(R[-1], 0.0, 0.999))
-        x0 = np.clip([1.0, np.sqrt(4.0 * F0 / (1.0 - F0))], lo, hi)
-        fit = least_squares(
-            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R, x0, bounds=(lo, hi),
-            method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
-        )
-        n_out[c], k_out[c] = fit.x
-    return n_out, k_out
-
-
-def _fit_f82_tint(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    F0, tint = np.empty(3), np.empty(3)
-    for c in range(3):
-        R = T[:, c]
-        x0 = np.clip([R[-1], 1.0], 0.0, 1.0)
-        fit = least_squares(
-            lambda x: f82_tint(mu, x[0], x[1]) - R, x0, bounds=([0.0, 0.0], [1.0, 1.0]),
-            method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
-        )
-        F0[c], tint[c] = fit.x
-    return F0, tint
-
-
-def _fit_schlick(mu: np.ndarray, T: np.ndarray) -> np.ndarray:
-    # Schlick is linear in F0: F - w = F0 (1 - w) with w = (1 - mu)^5.
-    w = schlick(mu, 0.0)[:, None]
-    F0 = np.sum((1.0 - w) * (T - w), axis=0) / np.sum((1.0 - w) ** 2)
-    return np.clip(F0, 0.0, 1.0)
+def has_coat(eta_i: float) -> bool:
+    """Whether an export at ``eta_i`` has a coat at all (eta_i 1: no coat, the bare metal)."""
+    return float(eta_i) > ETA_I_MIN
 
 
 def export_values(
     fit_or_nk, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
-    model: PackedMaterial | None = None,
+    model: PackedMaterial | None = None, tools=None,
 ) -> ExportValues:
     """
     The values of every export of a material at one coating index.
@@ -228,6 +220,9 @@ def export_values(
         Perceptual roughness of the metal and the coat, [0, 1].
     model
         The fit's float16 model, carried as is (:attr:`ExportValues.model`).
+    tools
+        The tools whose values to fit (keys of
+        :data:`fitting.exports.tool_layering.TOOLS`); all when ``None``.
 
     Raises
     ------
@@ -241,11 +236,17 @@ def export_values(
     coat_roughness = check_roughness("coat_roughness", coat_roughness)
     if model is not None and not isinstance(model, PackedMaterial):
         raise ValueError(f"`model` must be a PackedMaterial or None, got {type(model).__name__}")
+    tools = tuple(TOOLS) if tools is None else tuple(tools)
+    for tool in tools:
+        if tool not in TOOLS:
+            raise ValueError(f"`tools` must name tools of {', '.join(TOOLS)}, got {tool!r}")
     mu = np.linspace(0.0, 1.0, EXPORT_SAMPLES)
+    view = np.cos(np.radians(SEEN_ANGLES_DEG))
     if isinstance(fit_or_nk, SpectralNK):
         name, source = fit_or_nk.name, fit_or_nk.source
         target_ACEScg = reference_ACEScg(fit_or_nk, mu, eta, 1.0)
-        origin = f"spectral reference under the coat, 1 nm, {EXPORT_SAMPLES} cos theta"
+        seen = seen_ACEScg(fit_or_nk, view, eta)
+        origin = "spectral (1 nm) air / coat / metal stack seen from air"
     elif isinstance(fit_or_nk, dict) and callable(fit_or_nk.get("reflectance")):
         name = str(fit_or_nk.get("name", "material"))
         source = str(fit_or_nk.get("source", ""))
@@ -256,11 +257,17 @@ def export_values(
                 f"got shape {target_ACEScg.shape}"
             )
         origin = str(fit_or_nk.get("origin", "the fit's model curve under the coat"))
+        seen = coated_stack_from_metal(view, eta, lambda mc: fit_or_nk["reflectance"](mc, eta))
+        if seen.shape != (view.size, 3) or not np.all(np.isfinite(seen)):
+            raise ValueError(f"`fit_or_nk['reflectance']` must give finite (S, 3) RGB for S cos theta")
     elif isinstance(fit_or_nk, dict) and {"n", "k"} <= set(fit_or_nk):
         name = str(fit_or_nk.get("name", "material"))
         source = str(fit_or_nk.get("source", ""))
         target_ACEScg = rgb_fresnel_conductor(mu, eta, fit_or_nk["n"], fit_or_nk["k"])
-        origin = f"rgb-conductor model curve under the coat, {EXPORT_SAMPLES} cos theta"
+        n_c = np.asarray(fit_or_nk["n"], dtype=np.float64)
+        k_c = np.asarray(fit_or_nk["k"], dtype=np.float64)
+        seen = coated_stack(view[:, None], eta, n_c, k_c)
+        origin = "rgb-conductor n, k per channel under the coat, seen from air"
     else:
         raise ValueError(
             "`fit_or_nk` must be a SpectralNK or a mapping with per-channel `n` and `k` "
@@ -268,11 +275,14 @@ def export_values(
             f"got {type(fit_or_nk).__name__}"
         )
     target = ACEScg_to_lin_rec709(target_ACEScg)
-    n_rel, k_rel = _fit_relative_index(mu, target)
-    F0, tint = _fit_f82_tint(mu, target)
+    n_rel, k_rel = fit_channel_conductor(mu, target)
+    F0, tint = fit_channel_f82(mu, target)
+    coat = has_coat(eta)
+    fitted = {tool: fit_tool_values(tool, view, eta, seen, coat) for tool in tools}
     return ExportValues(
         name=name, source=source, eta_i=eta, origin=origin, cos_theta=mu, target=target,
         target_ACEScg=target_ACEScg, n_rel=n_rel, k_rel=k_rel, F0=F0, F82_tint=tint,
-        F0_schlick=_fit_schlick(mu, target), roughness=roughness, coat_roughness=coat_roughness,
-        model=model,
+        F0_schlick=fit_channel_schlick(mu, target), roughness=roughness,
+        coat_roughness=coat_roughness, model=model, view_cos=view, seen_ACEScg=seen,
+        tools=fitted,
     )

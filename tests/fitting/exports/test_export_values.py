@@ -15,13 +15,12 @@ from fitting.exports.tool_fresnel import (
     tool_curve,
 )
 from fitting.exports.colour_space import ACEScg_to_lin_rec709, lin_rec709_to_ACEScg
-from fitting.exports.values import (
-    EXPORT_SAMPLES,
-    _fit_f82_tint,
-    _fit_relative_index,
-    _fit_schlick,
-    project_version,
+from fitting.exports.seen_fit import (
+    fit_channel_conductor as _fit_relative_index,
+    fit_channel_f82 as _fit_f82_tint,
+    fit_channel_schlick as _fit_schlick,
 )
+from fitting.exports.values import EXPORT_SAMPLES, project_version
 from fitting.optics.fresnel import fresnel_conductor
 from fitting.optics.library import library_material
 from precision import F64_FEW_OPS
@@ -189,4 +188,4 @@ class TestInputs:
         assert info["material"] == "Cu" and info["eta_i"] == 1.5 and info["model_kind"] == "kind"
         assert "Johnson" in info["source"] and "\n" not in info["source"]
         assert info["generator"] == f"coated-fresnel {project_version()}" != "coated-fresnel unknown"
-        assert info["delta_E_2000_under_coat"].startswith("mean ")
+        assert info["delta_E_2000_seen"].startswith("mean ")

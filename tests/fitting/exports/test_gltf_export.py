@@ -76,11 +76,11 @@ class TestRoundTrip:
         # Written as float32 (glTF's component type): u32 = 6e-8 of values <= 1;
         # 1e-6 allows a conversion on each side (approx's default rel=1e-6 below
         # likewise, 17 u32).
-        np.testing.assert_allclose(pbr.baseColorFactor[:3], values.F0_schlick, atol=1e-6)
+        np.testing.assert_allclose(pbr.baseColorFactor[:3], values.tools["gltf"]["base_color"], atol=1e-6)
         assert pbr.baseColorFactor[3] == 1.0 and pbr.metallicFactor == 1.0
         assert pbr.roughnessFactor == pytest.approx(0.35)
         coat = material.extensions["KHR_materials_clearcoat"]
-        assert coat["clearcoatFactor"] == 1.0
+        assert coat["clearcoatFactor"] == pytest.approx(values.tools["gltf"]["clearcoat"], abs=1e-6)  # 6 decimals
         assert coat["clearcoatRoughnessFactor"] == pytest.approx(values.coat_roughness)
         provenance = material.extras["coated_fresnel"]
         assert provenance["material"] == "Au" and provenance["eta_i"] == values.eta_i
@@ -122,8 +122,10 @@ class TestBlenderImport:
         material = json.loads(read_back.read_text())
         (principled,) = [n for n in material["nodes"].values() if n["type"] == "ShaderNodeBsdfPrincipled"]
         inputs = principled["inputs"]
-        np.testing.assert_allclose(inputs["Base Color"][:3], values.F0_schlick, atol=1e-6)  # float32, as above
-        assert inputs["Metallic"] == 1.0 and inputs["Coat Weight"] == 1.0
+        np.testing.assert_allclose(inputs["Base Color"][:3], values.tools["gltf"]["base_color"], atol=1e-6)  # float32, as above
+        assert inputs["Metallic"] == 1.0
+        # The fitted clearcoatFactor (issue 22), float32 as above.
+        assert inputs["Coat Weight"] == pytest.approx(values.tools["gltf"]["clearcoat"], abs=1e-6)
         # glTF's clear coat has index 1.5 whatever the export was fitted for.
         assert inputs["Coat IOR"] == pytest.approx(1.5)
         assert material["custom"]["coated_fresnel"]["eta_i"] == values.eta_i

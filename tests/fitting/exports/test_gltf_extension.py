@@ -117,7 +117,8 @@ class TestExport:
         assert "extensionsRequired" not in asset
         material = asset["materials"][0]
         assert material["pbrMetallicRoughness"]["metallicFactor"] == 1.0
-        assert material["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] == 1.0
+        # Fitted with the base colour to the coated metal seen from air (issue 22).
+        assert 0.0 <= material["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] <= 1.0
         coat = material["extensions"]["KHR_materials_clearcoat"]["clearcoatRoughnessFactor"]
         assert material["extensions"][EXTENSION_NAME]["coatRoughnessFactor"] == coat
 

@@ -19,7 +19,7 @@ import pytest
 from fitting.exports import export_material, export_values
 from fitting.optics.library import library_material
 
-CASES = [("Cu", 1.5), ("Au", 2.0)]
+CASES = [("Cu", 1.5), ("Au", 2.0), ("Cr", 1.0)]
 
 
 @pytest.fixture(scope="module")
@@ -32,7 +32,7 @@ def stdlib() -> mx.Document:
 @pytest.fixture(scope="module", params=CASES, ids=[f"{m}-{e}" for m, e in CASES])
 def values(request):
     name, eta_i = request.param
-    return export_values(library_material(name), eta_i)
+    return export_values(library_material(name), eta_i, tools=("mtlx", "openpbr"))
 
 
 def load(text: str, stdlib: mx.Document) -> mx.Document:
@@ -82,22 +82,32 @@ class TestMtlx:
         # short decimals (1.5, 0.2, 0.03), exact in 6 digits, so approx's
         # default rel=1e-6 holds. Vectors: rtol 1e-5 = 2 x 5e-6; atol 1e-6 for
         # values in [0, 1] (at most 5e-7 off).
-        assert value_of(shader, "coat_ior") == pytest.approx(values.eta_i)
+        coated = values.eta_i > 1.0
         assert value_of(shader, "base_roughness") == pytest.approx(values.roughness)
-        assert value_of(shader, "coat_roughness") == pytest.approx(values.coat_roughness)
         (nodedef,) = [nd for nd in doc.getNodeDefs() if nd.getNodeString() == shader.getCategory()]
-        assert {i.getName() for i in nodedef.getActiveInputs()} == {
-            "base_roughness", "coat_roughness", "coat_ior"}
         graph = nodedef.getImplementation()
         metal = graph.getNode("metal")
         assert metal.getCategory() == "conductor_bsdf"
-        np.testing.assert_allclose(list(value_of(metal, "ior")), values.n_rel, rtol=1e-5)
-        np.testing.assert_allclose(list(value_of(metal, "extinction")), values.k_rel, rtol=1e-5)
+        # The values fitted to the coated metal seen from air (issue 22).
+        fitted = values.tools["mtlx"]
+        np.testing.assert_allclose(list(value_of(metal, "ior")), fitted["ior"], rtol=1e-5)
+        np.testing.assert_allclose(list(value_of(metal, "extinction")), fitted["extinction"], rtol=1e-5)
+        surface = graph.getNode("shader")
+        if not coated:
+            # eta_i 1: no coat at all, the conductor straight into the surface.
+            assert {i.getName() for i in nodedef.getActiveInputs()} == {"base_roughness"}
+            assert graph.getNode("coat") is None and surface.getConnectedNode("bsdf") == metal
+            return
+        assert value_of(shader, "coat_ior") == pytest.approx(values.eta_i)
+        assert value_of(shader, "coat_roughness") == pytest.approx(values.coat_roughness)
+        assert {i.getName() for i in nodedef.getActiveInputs()} == {
+            "base_roughness", "coat_roughness", "coat_ior"}
         coat = graph.getNode("coat")
         assert coat.getCategory() == "dielectric_bsdf"
         assert coat.getInput("ior").getInterfaceName() == "coat_ior"
         layer = graph.getNode("coated_metal")
         assert layer.getConnectedNode("top") == coat and layer.getConnectedNode("base") == metal
+        assert surface.getConnectedNode("bsdf") == layer
         assert f"material: {values.name}" in material.getDocString()
         assert f"eta_i: {values.eta_i}" in material.getDocString()
 
@@ -106,7 +116,7 @@ class TestMtlx:
         doc = load(export_material(values, "mtlx", values.eta_i).decode(), stdlib)
         pixel, _ = glsl_compiles(doc, tmp_path)
         # The conductor is called with the exported relative index as literals.
-        n_literal = "vec3(" + ", ".join(f"{float(f'{v:.6g}'):.6f}" for v in values.n_rel) + ")"
+        n_literal = "vec3(" + ", ".join(f"{float(f'{v:.6g}'):.6f}" for v in values.tools["mtlx"]["ior"]) + ")"
         assert "mx_fresnel_conductor" in pixel and n_literal in pixel
 
     def test_validation_is_not_a_formality(self, values, stdlib):
@@ -124,11 +134,15 @@ class TestOpenPBR:
         shader = material.getConnectedNode("surfaceshader")
         assert shader.getCategory() == "open_pbr_surface"
         assert shader.getNodeDef().getName() == "ND_open_pbr_surface_surfaceshader"
-        np.testing.assert_allclose(list(value_of(shader, "base_color")), values.F0, atol=1e-6)
-        np.testing.assert_allclose(list(value_of(shader, "specular_color")), values.F82_tint, atol=1e-6)
-        for name, expected in (("base_metalness", 1.0), ("coat_weight", 1.0),
+        fitted = values.tools["openpbr"]
+        np.testing.assert_allclose(list(value_of(shader, "base_color")), fitted["base_color"], atol=1e-6)
+        np.testing.assert_allclose(list(value_of(shader, "specular_color")), fitted["specular_color"], atol=1e-6)
+        # coat_darkening 1 (OpenPBR's default): the fit is made with it on;
+        # no coat at all at eta_i 1.
+        coat_weight = 1.0 if values.eta_i > 1.0 else 0.0
+        for name, expected in (("base_metalness", 1.0), ("coat_weight", coat_weight),
                                ("coat_ior", values.eta_i), ("specular_roughness", values.roughness),
-                               ("coat_darkening", 0.0)):
+                               ("coat_darkening", 1.0)):
             assert value_of(shader, name) == pytest.approx(expected)
         assert "f82-tint" in material.getDocString()
 

@@ -1,0 +1,90 @@
+"""
+Run inside Blender's Python (``.venv-blender``): render a Blender export's
+material with Cycles on a flat plane seen at given view angles, under a
+uniform white world of strength 1, and print the mean linear RGB per angle
+as JSON. Used by test_tool_layering_renders.py to check the numpy mirrors
+of Cycles' layering.
+
+    python cycles_angles.py EXPORT.py --output principled|conductor --angles 0,30,60 --samples 256
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import runpy
+import sys
+import tempfile
+from pathlib import Path
+
+import bpy
+
+SIZE = 4
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(prog="cycles_angles.py")
+    parser.add_argument("script")
+    parser.add_argument("--output", choices=("principled", "conductor"), default="principled")
+    parser.add_argument("--angles", default="0,30,60")
+    parser.add_argument("--samples", type=int, default=256)
+    args = parser.parse_args(argv)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    namespace = runpy.run_path(args.script, run_name="coated_fresnel_export")
+    material = namespace["build_material"]()
+    namespace["use_output"](material, args.output)
+
+    scene = bpy.context.scene
+    bpy.ops.mesh.primitive_plane_add(size=100.0)
+    plane = bpy.context.active_object
+    plane.data.materials.append(material)
+    camera_data = bpy.data.cameras.new("camera")
+    camera_data.type = "ORTHO"
+    camera_data.ortho_scale = 0.05
+    camera = bpy.data.objects.new("camera", camera_data)
+    camera.location = (0.0, -10.0, 0.0)
+    camera.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    world = bpy.data.worlds.new("white")
+    scene.world = world
+    if world.node_tree is None:
+        world.use_nodes = True
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = args.samples
+    scene.cycles.use_denoising = False
+    scene.cycles.blur_glossy = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.max_bounces = 16
+    scene.cycles.glossy_bounces = 16
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = 1
+    scene.render.resolution_x = scene.render.resolution_y = SIZE
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for angle in (float(a) for a in args.angles.split(",")):
+            # The plane's normal (sin t, -cos t, 0): at angle t to the camera's view.
+            plane.rotation_euler = (math.pi / 2, 0.0, math.radians(angle))
+            path = str(Path(tmp) / f"a{angle:g}.exr")
+            scene.render.filepath = path
+            bpy.ops.render.render(write_still=True)
+            image = bpy.data.images.load(path)
+            px = list(image.pixels)
+            rgb = [sum(px[c::4]) / (len(px) // 4) for c in range(3)]
+            bpy.data.images.remove(image)
+            out[f"{angle:g}"] = rgb
+    print("CYCLES_ANGLES " + json.dumps(out))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]))

@@ -1,0 +1,112 @@
+"""
+The seen fit (fitting.exports.seen_fit) and the tool mirrors' own algebra
+(fitting.exports.tool_layering): values inside the tools' limits, better
+than the naive fit under the coat, no coat at eta_i 1, the floor below any
+export, and the mirrors' limits.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fitting.colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
+from fitting.exports import export_material, export_values
+from fitting.exports.seen_fit import (
+    K_BOUNDS, N_BOUNDS, gltf_clearcoat_factor, layer_only, seen_delta_E, seen_fidelity, tool_floor,
+)
+from fitting.exports.tool_fresnel import f82_tint, mx_fresnel_conductor
+from fitting.exports.tool_layering import (
+    TOOLS, cycles_principled, materialx_layer, three_clearcoat, three_dfg, tool_seen,
+)
+from fitting.optics.library import library_material
+
+pytestmark = pytest.mark.numeric
+MU = np.cos(np.radians(SEEN_ANGLES_DEG))
+
+
+@pytest.fixture(scope="module")
+def cu():
+    return export_values(library_material("Cu"), 1.5)
+
+
+@pytest.fixture(scope="module")
+def cu_bare():
+    return export_values(library_material("Cu"), 1.0)
+
+
+def naive(values, tool):
+    if tool in ("mtlx", "blender-conductor"):
+        return {"ior": values.n_rel, "extinction": values.k_rel, "coat": True}
+    if tool == "openpbr":
+        return {"base_color": values.F0, "specular_color": values.F82_tint, "coat_darkening": 0.0, "coat": True}
+    if tool == "blender":
+        return {"base_color": values.F0, "specular_tint": values.F82_tint, "coat": True}
+    return {"base_color": values.F0_schlick, "clearcoat": 1.0, "coat": True}
+
+
+@pytest.mark.slow  # the seen fits: seconds each
+def test_values_in_the_tools_limits(cu):
+    assert set(cu.tools) == set(TOOLS)
+    for tool, fitted in cu.tools.items():
+        a, b = TOOLS[tool]
+        assert fitted["coat"] is True
+        if tool in ("mtlx", "blender-conductor"):
+            assert np.all((fitted[a] >= N_BOUNDS[0]) & (fitted[a] <= N_BOUNDS[1]))
+            assert np.all((fitted[b] >= K_BOUNDS[0]) & (fitted[b] <= K_BOUNDS[1]))
+        else:
+            assert np.all((np.asarray(fitted[a]) >= 0) & (np.asarray(fitted[a]) <= 1))
+            assert np.all((np.asarray(fitted[b]) >= 0) & (np.asarray(fitted[b]) <= 1))
+
+
+@pytest.mark.slow  # the seen fits: seconds each
+def test_seen_fit_beats_the_naive_fit_by_half(cu):
+    for tool in TOOLS:
+        seen = seen_fidelity(cu, tool)["delta_E_mean"]
+        before = seen_delta_E(tool, naive(cu, tool), cu.view_cos, 1.5, cu.seen_ACEScg).mean()
+        # The issue's criterion for every export (measured for Cu: 2.4-2.9 -> 0.3-0.9).
+        assert seen <= 0.5 * before, (tool, seen, before)
+        floor = tool_floor(tool, cu.view_cos, 1.5, cu.seen_ACEScg).mean()
+        assert floor <= seen + 1e-9
+
+
+@pytest.mark.slow  # the seen fits: seconds each
+def test_no_coat_at_eta_1(cu_bare):
+    for tool, fitted in cu_bare.tools.items():
+        assert fitted["coat"] is False
+        # Without a coat every mirror is its bare base: the layering adds nothing.
+        base = layer_only(tool, MU, 1.0, np.full((MU.size, 3), 0.5), coat=False)
+        assert np.all(base == 0.5)
+    assert cu_bare.tools["gltf"]["clearcoat"] == 0.0
+    assert b"KHR_materials_clearcoat" not in export_material(cu_bare, "gltf", 1.0)
+    assert b"<dielectric_bsdf" not in export_material(cu_bare, "mtlx", 1.0)
+    assert b'name="coat_weight" type="float" value="0"' in export_material(cu_bare, "openpbr", 1.0)
+    assert b"COAT = False" in export_material(cu_bare, "blender", 1.0)
+    # The seen target is the bare metal, and the conductor fits follow it.
+    assert seen_fidelity(cu_bare, "blender-conductor")["delta_E_mean"] < 0.1
+
+
+def test_mirror_algebra():
+    F = mx_fresnel_conductor(MU, [0.3, 0.6, 1.1], [3.0, 2.6, 2.4])
+    # No coat: the base as it is; a coat adds reflection at grazing.
+    assert np.array_equal(materialx_layer(MU, 1.5, F, coat=False), F)
+    # The coat's own reflection over a black base: MaterialX's F_d c_d, 0.04 at normal incidence.
+    assert materialx_layer(MU[:1], 1.5, np.zeros((1, 3)))[0, 0] == pytest.approx(0.04, abs=2e-3)
+    P = f82_tint(MU, [0.9, 0.6, 0.5], [1, 1, 1])
+    np.testing.assert_allclose(cycles_principled(MU, 1.0, [0.9, 0.6, 0.5], [1, 1, 1]), P, atol=1e-15)
+    # three's DFG table: at dotNV 1 and roughness 0 the scale is 1 and the bias 0 (float16).
+    np.testing.assert_allclose(three_dfg(np.array([1.0]), 0.0)[0], [1.0, 0.0], atol=2e-3)
+    # three's coat scales the base by 1 - F_schlick(0.04) and adds its reflection.
+    assert np.all(three_clearcoat(MU, np.ones(3))[0] <= 1.0 + 1e-3)
+    assert gltf_clearcoat_factor(MU, 1.5) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="tool"):
+        tool_seen("unknown", {}, MU, 1.5)
+
+
+@pytest.mark.slow  # the seen fits: seconds each
+def test_export_values_refuses_unknown_tools():
+    with pytest.raises(ValueError, match="`tools`"):
+        export_values(library_material("Cu"), 1.5, tools=("maya",))
+    values = export_values(library_material("Cu"), 1.5, tools=("mtlx",))
+    with pytest.raises(ValueError, match="fitted values of openpbr"):
+        export_material(values, "openpbr", 1.5)

@@ -1,0 +1,52 @@
+"""
+The glTF export as three.js renders it (``MeshPhysicalMaterial`` through
+``GLTFLoader``, the example page's fallback ball: base colour and
+``KHR_materials_clearcoat``, no plugin) against the numpy mirror of three's
+layering (fitting.exports.tool_layering.three_clearcoat), in Chromium
+(SwiftShader WebGL2) under the white sky, roughness 0: at the ball's pixels
+within 1 degree of each tested view angle, the mirror at each pixel's own
+NdotV, Delta E 2000 below the issue's 0.2.
+"""
+
+from __future__ import annotations
+
+import json
+
+import httpx
+import numpy as np
+import pytest
+from editor_pages import camera_rays, pages, chromium, live_server  # noqa: F401 (fixtures)
+from three_pages import FOV, H, ORBIT, W, create_fit, open_example, three_ACEScg
+
+from fitting.colour.delta_e import delta_E_map
+from fitting.exports.colour_space import lin_rec709_to_ACEScg
+from fitting.exports.tool_layering import three_clearcoat
+
+pytestmark = [pytest.mark.server, pytest.mark.browser, pytest.mark.slow, pytest.mark.numeric]
+
+ANGLES_DEG = (0.0, 20.0, 40.0, 60.0)
+BOUND = 0.2  # the issue's promise for a mirror against its tool
+
+
+@pytest.mark.parametrize("material, eta_i", [("Cu", 1.5), ("Au", 1.0)])
+def test_three_fallback_is_the_mirror(pages, live_server, material, eta_i):
+    fit = create_fit(live_server, material, "rgb-conductor")
+    response = httpx.get(f"{live_server}/api/v1/fits/{fit['id']}/pack",
+                         params={"format": "gltf", "eta_i": eta_i}, timeout=300)
+    response.raise_for_status()
+    gltf_material = json.loads(response.content)["materials"][0]
+    base = np.asarray(gltf_material["pbrMetallicRoughness"]["baseColorFactor"][:3])
+    coat = gltf_material.get("extensions", {}).get("KHR_materials_clearcoat")
+    assert (coat is None) == (eta_i == 1.0)  # no coat at all at eta_i 1
+    page = pages.new(900, 700)
+    open_example(page, live_server, fit["id"], eta_i)
+    rendered, mask = three_ACEScg(page, "fallback", 0.0, 0.0)
+    NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
+    theta = np.degrees(np.arccos(np.clip(NdotV, 0.0, 1.0)))
+    for angle in ANGLES_DEG:
+        at = hit & mask & (np.abs(theta - angle) <= 1.0)
+        assert at.sum() >= 1
+        mirror = three_clearcoat(NdotV[at], base, coat["clearcoatFactor"] if coat else 0.0, coat is not None)
+        dE = delta_E_map(rendered[at], lin_rec709_to_ACEScg(mirror))
+        print(f"{material} {eta_i} {angle:g} deg: Delta E max {dE.max():.4f} over {at.sum()} pixels")
+        assert dE.max() < BOUND, (material, eta_i, angle, dE.max())
