@@ -24,9 +24,11 @@ from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
 from ..models.pack import PackedMaterial
 from ..optics.nk import SpectralNK, resample_nk
 from .evaluate import evaluate_material
+from .guarded import guarded_fit
 from .result import FitResult
 from .settings import FitSettings, fit_grid
 from .solver import fit_coefficients
+from .worst_case import guard_reference
 
 __all__ = ["fit_material"]
 
@@ -71,12 +73,20 @@ def fit_material(
         eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid
     )
     target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
+    # Issue 21 hook: the guard points of the max (fitting.fits.worst_case).
+    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
     t_ref = time.perf_counter()
     result = fit_coefficients(
         target, mu, eta, eta_i_range, settings.degree, settings.objective,
         settings.max_nfev, settings.quantise, weights=weights,
         irls_rounds=settings.irls_rounds,
     )
+    if settings.guard_max:
+        result = guarded_fit(
+            target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
+            settings.quantise, weights, settings.irls_rounds, guard_target, guard_mu, guard_eta,
+            mean_fit=result,
+        )
     result.coverage = coverage
     result.timings["reference"] = t_ref - t0
     result.packed = PackedMaterial(

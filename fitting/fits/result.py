@@ -61,6 +61,9 @@ class FitResult:
         True when the fit's evaluation budget ran out before it met its
         constraints, and ``coefficients_float16`` were then made to meet
         them (curve fits: :func:`fitting.fits.curves_range.in_range_fallback`).
+    guard
+        The max's guard (:func:`fitting.fits.guarded.guard_report`): the
+        candidate kept and every candidate's mean, max and where the max is.
     """
 
     coefficients: np.ndarray
@@ -82,6 +85,7 @@ class FitResult:
     model: str = "coated-conductor"
     error: ErrorMetrics | None = None
     best_effort: bool = False
+    guard: dict[str, Any] | None = None  # issue 21: the worst-case guard's candidates (fitting.fits.guarded)
 
     @property
     def iterations(self) -> int:

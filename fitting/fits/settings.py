@@ -83,6 +83,10 @@ class FitSettings:
         Smallest covered fraction of 360-830 nm accepted.
     irls_rounds
         Reweighting rounds of the ``de2000`` objective (mean Delta E).
+    guard_max
+        Guard the max (:mod:`fitting.fits.guarded`): keep the mean fit only
+        when its mean and max are no worse than the paper method's on the
+        guard points, else a soft-maximum refit or the paper method's fit.
     """
 
     mu_samples: int = 12
@@ -95,6 +99,7 @@ class FitSettings:
     max_nfev: int = 200
     min_coverage: float = DEFAULT_MIN_COVERAGE
     irls_rounds: int = 2
+    guard_max: bool = True
 
     def __post_init__(self) -> None:
         check_int("mu_samples", self.mu_samples, 4, 1000)
@@ -104,6 +109,8 @@ class FitSettings:
         check_fit_options(self.objective, self.max_nfev, self.irls_rounds)
         check_min_coverage(self.min_coverage)
         check_step_nm(self.step_nm)
+        if not isinstance(self.guard_max, bool):
+            raise ValueError(f"`guard_max` must be true or false, got {self.guard_max!r}")
 
 
 def fit_grid(
