@@ -57,7 +57,8 @@ from ..models.kinds import DEFAULT_MODEL, check_model, model_ACEScg
 from ..models.pack import PackedMaterial, to_float16
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve, check_curves
-from .curves_range import EvaluationBudget, in_range_fallback, outside_range
+from .curves_range import RANGE_TOLERANCE, EvaluationBudget, in_range_fallback, outside_range, proven_in_range
+from ..models.range_bound import certify_range
 from .curves_score import SCORE_GRID, angle_mu, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
 from .result import FitResult
@@ -307,7 +308,22 @@ def fit_curves(
         return outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
 
     def in_range(C16) -> bool:
-        return not outside(C16).any()
+        # Issue 21: proven over the whole domain, not the grid only.
+        return not outside(C16).any() and proven_in_range(C16, eta_i_range)
+
+    def worst_points(C16):
+        """The grid points outside [0, 1] and the certificate's counterexample, as extra check points."""
+        mask = outside(C16)
+        certificate = certify_range(C16, eta_i_range, RANGE_TOLERANCE)
+        pm, pe = range_M[mask], range_E[mask]
+        if certificate.in_range is not True:
+            mu_w, eta_w = certificate.worst[0], certificate.worst[1]
+            # The point and its neighbours in cos theta, at every check row.
+            rows = np.unique(np.concatenate([check_grid(eta_i_range, 2, settings.check_samples[1])[1][:, 0], [eta_w]]))
+            near = np.clip(mu_w * np.array([0.5, 1.0, 1.5, 2.0]), 0.0, 1.0)
+            NM, NE = np.meshgrid(near, rows)
+            pm, pe = np.concatenate([pm, NM.ravel()]), np.concatenate([pe, NE.ravel()])
+        return pm, pe
 
     def constrained(objective: str, dense=None) -> FitResult:
         weight, check, extra = settings.range_weight, settings.check_samples, None
@@ -315,19 +331,19 @@ def fit_curves(
         for _ in range(2):
             if weight == 0:
                 break
-            mask = outside(result.coefficients_float16)
-            if not mask.any() or not budget.allows(_MIN_ESCALATION_NFEV):
+            if in_range(result.coefficients_float16) or not budget.allows(_MIN_ESCALATION_NFEV):
                 break
+            points = worst_points(result.coefficients_float16)
+            extra = points if extra is None else (
+                np.concatenate([extra[0], points[0]]), np.concatenate([extra[1], points[1]]))
             if start is None or dense is not None:
                 # A fit from its own guess: stiffer on a finer grid, started
-                # again, as it always has (same results).
+                # again, with the points where it left [0, 1] added.
                 weight, check = 10.0 * weight, (max(check[0], 46), max(check[1], 16))
-                result = fit(objective, weight, check, dense)
+                result = fit(objective, weight, check, dense, extra_check=extra)
             else:
                 # A warm-started (live) fit goes on from where it is, stiffer
                 # and with the points where it leaves [0, 1] added to its check.
-                extra = (range_M[mask], range_E[mask]) if extra is None else (
-                    np.concatenate([extra[0], range_M[mask]]), np.concatenate([extra[1], range_E[mask]]))
                 weight = 10.0 * weight
                 result = fit(objective, weight, check, start=result.coefficients, extra_check=extra)
         return result

@@ -29,6 +29,8 @@ from .result import FitResult
 from .settings import FitSettings, fit_grid
 from .solver import fit_coefficients
 from .worst_case import guard_reference
+from .fit_quality import fit_quality, provenance
+from ..optics.quality import check_gaps
 
 __all__ = ["fit_material"]
 
@@ -69,6 +71,7 @@ def fit_material(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
+    warnings = check_gaps(nk, settings.max_gap_nm)  # issue 21 hook: gaps inside the visible range
     mu, eta, weights = fit_grid(
         eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid
     )
@@ -89,15 +92,20 @@ def fit_material(
         )
     result.coverage = coverage
     result.timings["reference"] = t_ref - t0
+    result.quality = fit_quality(result.coefficients_float16, eta_i_range, warnings)
+    source = provenance(nk.source, result.quality)
     result.packed = PackedMaterial(
         name=nk.name, coefficients=result.coefficients_float16,
-        eta_i_range=eta_i_range, source=nk.source,
+        eta_i_range=eta_i_range, source=source,
     )
     result.timings["total"] = time.perf_counter() - t0
     if evaluate:
         result.metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
+        result.metrics["quality"] = result.quality
+        if result.guard is not None:
+            result.metrics["guard"] = result.guard
         result.packed = PackedMaterial(
             name=nk.name, coefficients=result.coefficients_float16,
-            eta_i_range=eta_i_range, source=nk.source, metrics=result.metrics,
+            eta_i_range=eta_i_range, source=source, metrics=result.metrics,
         )
     return result

@@ -64,6 +64,11 @@ class FitResult:
     guard
         The max's guard (:func:`fitting.fits.guarded.guard_report`): the
         candidate kept and every candidate's mean, max and where the max is.
+    quality
+        ``range`` (the proof that the float16 model stays in [0, 1] over the
+        whole domain, :func:`fitting.models.range_bound.certify_range`) and
+        ``warnings`` (sparse data fitted with the gap limit relaxed, a model
+        that leaves [0, 1]): :func:`fitting.fits.fit_quality.fit_quality`.
     """
 
     coefficients: np.ndarray
@@ -86,6 +91,7 @@ class FitResult:
     error: ErrorMetrics | None = None
     best_effort: bool = False
     guard: dict[str, Any] | None = None  # issue 21: the worst-case guard's candidates (fitting.fits.guarded)
+    quality: dict[str, Any] = field(default_factory=dict)  # issue 21: range proof and data warnings (fitting.fits.fit_quality)
 
     @property
     def iterations(self) -> int:
@@ -107,4 +113,6 @@ class FitResult:
             "degree": self.degree,
             "coverage": self.coverage,
             "timings": dict(self.timings),
+            **({"quality": self.quality} if self.quality else {}),
+            **({"guard": self.guard} if self.guard is not None else {}),
         }

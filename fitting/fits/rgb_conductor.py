@@ -41,7 +41,9 @@ from ..models.pack import PackedMaterial, to_float16
 from ..models.rgb_conductor import MODEL_KIND
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, resample_nk
+from ..optics.quality import check_gaps
 from .evaluate import evaluate_material
+from .fit_quality import provenance
 from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
 from .settings import OBJECTIVES, FitSettings, fit_grid
@@ -227,6 +229,7 @@ def fit_rgb_conductor(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
+    warnings = check_gaps(nk, settings.max_gap_nm)  # issue 21 hook: gaps inside the visible range
     mu, eta, weights = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
     target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
     t_ref = time.perf_counter()
@@ -236,11 +239,14 @@ def fit_rgb_conductor(
     )
     result.coverage = coverage
     result.timings["reference"] = t_ref - t0
+    # Exact Fresnel of a relative index: in [0, 1] by construction; the data's warnings only.
+    result.quality = {"warnings": warnings}
     if evaluate:
         result.metrics = evaluate_rgb_conductor(nk, result, min_coverage=settings.min_coverage)
+        result.metrics["quality"] = result.quality
     result.packed = PackedMaterial(
         name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
-        source=nk.source, metrics=result.metrics, model=MODEL_KIND,
+        source=provenance(nk.source, result.quality), metrics=result.metrics, model=MODEL_KIND,
     )
     result.timings["total"] = time.perf_counter() - t0
     return result
