@@ -26,9 +26,10 @@ so it needs no range constraint).
     on :data:`SCORE_GRID`, where a fit's reported figures are measured
     (:mod:`fitting.fits.curves_score`, with the [0, 1] check grid).
 
-The fit stays a reflectance: [0, 1] over its whole domain is a penalty
-constraint of the least squares (hinge residuals at a check grid,
-:func:`fitting.fits.solver.fit_coefficients` ``range_check``), not a clip.
+The fit stays a reflectance: [0, 1] is a penalty of the least squares (hinge
+residuals at a check grid and where :mod:`fitting.models.range_bound`'s proof
+fails), and the kept fit is proven inside over its whole domain, not clipped.
+The max is guarded against the paper's method (:mod:`fitting.fits.curves_guard`).
 
 With a base, an edited curve replaces the base's reflectance at its eta_i and
 the difference it makes fades smoothly across eta_i (:func:`blend_weights`);
@@ -56,9 +57,10 @@ from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_int, check_nu
 from ..models.kinds import DEFAULT_MODEL, check_model, model_ACEScg
 from ..models.pack import PackedMaterial, to_float16
 from .curves_base import CurveBase, edited_target
+from .curves_guard import guard_curve_choice
 from .curves_input import RGBCurve, check_curves
-from .curves_range import RANGE_TOLERANCE, EvaluationBudget, in_range_fallback, outside_range, proven_in_range
-from ..models.range_bound import certify_range
+from .curves_range import EvaluationBudget, escape_points, in_range_fallback, outside_range, proven_in_range
+from .curves_range import range_report
 from .curves_score import SCORE_GRID, angle_mu, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
 from .result import FitResult
@@ -101,11 +103,9 @@ class CurveFitSettings:
         ten times stiffer on a finer grid (at most twice) while the float16
         fit still leaves [0, 1] on the scoring grid; 0 turns it off.
     compare_rgb
-        With a base, also fit the paper's own method (plain rgb least
-        squares, unweighted) to the whole blended target (24 angles x 16
-        eta_i, every other point of :data:`SCORE_GRID`), and keep, of the two float16 fits, the one closer
-        to it (mean Delta E 2000 there): the refit is never farther from the
-        target than that method.
+        With a base, also fit the paper's method (plain rgb least squares)
+        to the whole blended target (24 x 16, every other point of
+        :data:`SCORE_GRID`); kept by :mod:`fitting.fits.curves_guard`.
     max_evaluations
         Model evaluations (residuals and Jacobians) of the whole refit, over
         every solve, escalation round and candidate: its CPU bound. A solve
@@ -211,14 +211,13 @@ def fit_curves(
         With ``packed`` (the float16 material), ``timings`` (``target``,
         ``fit``, ``quantise``, ``total`` in seconds), ``error`` (the
         :class:`~fitting.fits.metrics.ErrorMetrics` against the curves, one
-        row per curve) and ``metrics``, its JSON:
-        ``delta_E_mean`` and ``delta_E_max`` (CIE Delta E 2000 of the float16
-        model against the curves at their own samples), ``by_curve`` (the same
-        per curve, with its ``eta_i``), ``samples`` (the number of fitted
-        samples), ``base`` (its name or None), ``objective`` (the one kept)
-        and, with a base, ``target`` (:func:`whole_target_error`: mean and
-        max Delta E 2000 over the whole blended target on
-        :data:`SCORE_GRID`, where the max is, and the model's range).
+        row per curve) and ``metrics``, its JSON: ``delta_E_mean`` and
+        ``delta_E_max`` (CIE Delta E 2000 of the float16 model against the
+        curves at their own samples), ``by_curve`` (the same per curve, with
+        its ``eta_i``), ``samples``, ``base`` (its name or None),
+        ``objective`` (the one kept), ``range`` (the proof of [0, 1]) and,
+        with a base, ``target`` (:func:`whole_target_error`: mean, max and
+        where, over the whole blended target) and ``guard`` (every candidate).
 
     Raises
     ------
@@ -307,23 +306,8 @@ def fit_curves(
         """Mask of the range grid's points where the float16 fit leaves [0, 1]."""
         return outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
 
-    def in_range(C16) -> bool:
-        # Issue 21: proven over the whole domain, not the grid only.
+    def in_range(C16) -> bool:  # issue 21: proven over the whole domain, not the grid only
         return not outside(C16).any() and proven_in_range(C16, eta_i_range)
-
-    def worst_points(C16):
-        """The grid points outside [0, 1] and the certificate's counterexample, as extra check points."""
-        mask = outside(C16)
-        certificate = certify_range(C16, eta_i_range, RANGE_TOLERANCE)
-        pm, pe = range_M[mask], range_E[mask]
-        if certificate.in_range is not True:
-            mu_w, eta_w = certificate.worst[0], certificate.worst[1]
-            # The point and its neighbours in cos theta, at every check row.
-            rows = np.unique(np.concatenate([check_grid(eta_i_range, 2, settings.check_samples[1])[1][:, 0], [eta_w]]))
-            near = np.clip(mu_w * np.array([0.5, 1.0, 1.5, 2.0]), 0.0, 1.0)
-            NM, NE = np.meshgrid(near, rows)
-            pm, pe = np.concatenate([pm, NM.ravel()]), np.concatenate([pe, NE.ravel()])
-        return pm, pe
 
     def constrained(objective: str, dense=None) -> FitResult:
         weight, check, extra = settings.range_weight, settings.check_samples, None
@@ -333,7 +317,8 @@ def fit_curves(
                 break
             if in_range(result.coefficients_float16) or not budget.allows(_MIN_ESCALATION_NFEV):
                 break
-            points = worst_points(result.coefficients_float16)
+            C16 = result.coefficients_float16
+            points = escape_points(C16, eta_i_range, outside(C16), range_M, range_E, check[1])
             extra = points if extra is None else (
                 np.concatenate([extra[0], points[0]]), np.concatenate([extra[1], points[1]]))
             if start is None or dense is not None:
@@ -375,21 +360,17 @@ def fit_curves(
                                      settings.blend_width)["delta_E_mean"]):
                 result.coefficients_float16 = on_screen
     if model != "rgb-conductor" and base is not None and settings.compare_rgb and settings.objective != "rgb":
-        # The paper's own method (plain rgb least squares) on the whole
-        # blended target (every other point of the scoring grid: the target
-        # is smooth, and it halves the cost): kept when it is closer on the
-        # scoring grid (an edit the fewer de2000 samples miss).
+        # The paper's own method (plain rgb least squares) on the whole blended target
+        # (every other point of the scoring grid: the target is smooth, it halves the cost).
         _, _, rgb_M, rgb_E = score_grid(eta_i_range, _RGB_GRID)
         dense_target = edited_target(base, curves, rgb_M, rgb_E, settings.blend_width)
         dense = (dense_target.reshape(-1, 3), rgb_M.ravel(), rgb_E.ravel())
         candidates = {settings.objective: result, "rgb": held(constrained("rgb", dense))}
-        scores = {
-            objective: whole_target_error(base, curves, candidate.coefficients_float16,
-                                          settings.blend_width)["delta_E_mean"]
-            for objective, candidate in candidates.items()
-        }
-        chosen = min(scores, key=scores.get)
+        # Issue 21 hook: kept by mean and max against the paper method (fitting.fits.curves_guard).
+        chosen, guard = guard_curve_choice(base, curves, settings.blend_width, candidates, settings.objective,
+                                           "rgb", (target, mu, eta, weights), in_range)
         result = candidates[chosen]
+        result.guard, chosen = guard, result.objective
     C16 = result.coefficients_float16
     error = curve_metrics(
         curves, lambda c: model_ACEScg(model, c.cos_theta, c.eta_i, C16, eta_i_range),
@@ -404,6 +385,10 @@ def fit_curves(
     }
     if base is not None:
         metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)
+    if result.guard is not None:
+        metrics["guard"] = result.guard
+    if np.ndim(C16) == 3:  # issue 21: coated-conductor coefficients (3, 3, d + 1): [0, 1] proven or not
+        metrics["range"] = range_report(C16, eta_i_range)
     result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(

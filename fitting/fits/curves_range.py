@@ -24,7 +24,7 @@ from ..models.range_bound import certify_range
 from ..models.pack import to_float16
 from .curves_score import SCORE_GRID, check_grid
 
-__all__ = ["RANGE_TOLERANCE", "outside_range", "proven_in_range", "in_range_fallback", "EvaluationBudget"]
+__all__ = ["RANGE_TOLERANCE", "outside_range", "proven_in_range", "range_report", "escape_points", "in_range_fallback", "EvaluationBudget"]
 
 RANGE_TOLERANCE = 1e-4
 """float16 rounding of a fit on the boundary."""
@@ -60,6 +60,29 @@ def proven_in_range(C16, eta_i_range, channel: int | None = None) -> bool:
     """
     C = C16 if channel is None else _channel_only(C16, channel)
     return certify_range(C, eta_i_range, RANGE_TOLERANCE).in_range is True
+
+
+def range_report(C16, eta_i_range) -> dict:
+    """The JSON of :func:`fitting.models.range_bound.certify_range` at :data:`RANGE_TOLERANCE`."""
+    return certify_range(C16, eta_i_range, RANGE_TOLERANCE).to_dict()
+
+
+def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int):
+    """
+    Extra check points of a refit leaving [0, 1]: the scoring-grid points
+    of ``mask`` (over ``range_M``, ``range_E``) and, unless proven in
+    range, the certificate's counterexample with its neighbours in cos
+    theta (x 0.5, 1.5, 2) at every check row and its own eta_i.
+    """
+    pm, pe = range_M[mask], range_E[mask]
+    certificate = certify_range(C16, eta_i_range, RANGE_TOLERANCE)
+    if certificate.in_range is not True:
+        mu_w, eta_w = certificate.worst[0], certificate.worst[1]
+        rows = np.unique(np.concatenate([check_grid(eta_i_range, 2, check_rows)[1][:, 0], [eta_w]]))
+        near = np.clip(mu_w * np.array([0.5, 1.0, 1.5, 2.0]), 0.0, 1.0)
+        NM, NE = np.meshgrid(near, rows)
+        pm, pe = np.concatenate([pm, NM.ravel()]), np.concatenate([pe, NE.ravel()])
+    return pm, pe
 
 
 def in_range_fallback(C16, eta_i_range) -> np.ndarray:

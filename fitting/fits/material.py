@@ -76,15 +76,14 @@ def fit_material(
         eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid
     )
     target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
-    # Issue 21 hook: the guard points of the max (fitting.fits.worst_case).
-    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
     t_ref = time.perf_counter()
     result = fit_coefficients(
         target, mu, eta, eta_i_range, settings.degree, settings.objective,
         settings.max_nfev, settings.quantise, weights=weights,
         irls_rounds=settings.irls_rounds,
     )
-    if settings.guard_max:
+    if settings.guard_max:  # issue 21 hook: the max guarded on a subsample of the scoring grid
+        guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
         result = guarded_fit(
             target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
             settings.quantise, weights, settings.irls_rounds, guard_target, guard_mu, guard_eta,

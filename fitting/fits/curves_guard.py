@@ -1,0 +1,75 @@
+"""
+The max of curve refits, guarded
+================================
+
+A curve refit (:func:`fitting.fits.curves.fit_curves`) with a base has two
+candidates: its own objective's fit and the paper's method (plain rgb least
+squares on the whole blended target). Kept by the mean alone, the refit
+could end with the worse max (issue 21: 5 of 8 edits, one by 3 Delta E).
+
+-   :func:`guard_curve_choice`: the candidates scored on the whole blended
+    target on :data:`fitting.fits.curves_score.SCORE_GRID`; when the own
+    fit's max is not under the paper method's, the fits of least mean with
+    the max capped there (:func:`fitting.fits.guarded.constrained_refits`),
+    kept only when proven inside [0, 1]; the choice of
+    :func:`fitting.fits.worst_case.choose`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..colour.colorimetry import ACEScg_to_Lab
+from ..models.coated_conductor import coated_conductor_model
+from .curves_base import edited_target
+from .curves_score import score_grid
+from .guarded import _THREADPOOLS, constrained_refits, guard_report
+from .result import FitResult
+from .worst_case import GuardScore, choose, guard_score
+
+__all__ = ["guard_curve_choice"]
+
+
+@_THREADPOOLS.wrap(limits=1, user_api="blas")
+def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, FitResult], own: str,
+                       paper: str, samples, in_range) -> tuple[str, dict]:
+    """
+    The name of the candidate to keep, and the guard's report
+    (:func:`fitting.fits.guarded.guard_report`). ``candidates`` maps names
+    to fits, ``own`` and ``paper`` name the refit's and the paper method's;
+    ``samples`` = ``(target, mu, eta, weights)`` of the own fit (where the
+    mean is minimised); ``in_range(C16)`` says whether float16
+    coefficients are proven inside [0, 1]. Constrained candidates join
+    ``candidates``.
+    """
+    eta_i_range = base.eta_i_range
+    _, _, M, E = score_grid(eta_i_range)
+    gM, gE = M.ravel(), E.ravel()
+    gT = edited_target(base, curves, M, E, blend_width).reshape(-1, 3)
+    gLab = ACEScg_to_Lab(gT)
+
+    def score(C16) -> GuardScore:
+        return guard_score(gLab, coated_conductor_model(gM, gE, C16, eta_i_range), gM, gE)
+
+    scores = {name: score(c.coefficients_float16) for name, c in candidates.items()}
+    if choose(scores, paper) != own and scores[own].mean < scores[paper].mean:
+        target, mu, eta, weights = samples
+        own_fit, paper_fit = candidates[own], candidates[paper]
+        starts = (("", paper_fit.coefficients), ("-from-own", own_fit.coefficients))
+        for label, C, C16, s in constrained_refits(
+                target, mu, eta, weights, gT, gM, gE, eta_i_range, own_fit.degree, None, starts,
+                scores[paper].max, True, score):
+            if not in_range(C16):
+                continue
+            candidates[label] = FitResult(
+                coefficients=np.asarray(C, dtype=np.float64), coefficients_float16=C16,
+                eta_i_range=eta_i_range, degree=own_fit.degree, objective=own_fit.objective,
+                success=own_fit.success, status=own_fit.status, message=own_fit.message,
+                nfev=own_fit.nfev, njev=own_fit.njev, cost=own_fit.cost,
+                cost_float16=own_fit.cost_float16, timings=dict(own_fit.timings),
+            )
+            scores[label] = s
+            if choose(scores, paper) == label:
+                break
+    chosen = choose(scores, paper)
+    return chosen, guard_report(chosen, scores)
