@@ -86,7 +86,8 @@ def score_on_grid(
     if baselines:
         models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
     return grid_metrics(ref, models, eta_i[:, 0],
-                        f"spectral reference 1 nm, {eta_i.shape[0]} x {eta_i.shape[1]}")
+                        f"spectral reference 1 nm, {eta_i.shape[0]} x {eta_i.shape[1]}",
+                        cos_theta[0])  # issue 21: where the max is
 
 
 def evaluate_material(

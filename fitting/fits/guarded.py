@@ -22,11 +22,11 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import least_squares, minimize
 from threadpoolctl import ThreadpoolController
 
 from ..colour.colorimetry import ACEScg_to_Lab
-from ..models.coated_conductor import coated_conductor_model
+from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, normalised_eta_i
 from ..models.pack import to_float16
 from .objective import Problem, coefficient_bounds
 from .quantise import quantise_coefficients
@@ -179,6 +179,68 @@ def _quantise_capped(mean_problem, guard_problem, weights, C, cap, quantise: boo
     return options[min(range(len(options)), key=lambda i: scored[i][1])]
 
 
+def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int):
+    """
+    Plain rgb least squares, channel by channel (the channels of the model
+    are independent): Levenberg-Marquardt on the 3 (d + 1) unknowns of one
+    channel at a time (Eq. 1 and its derivative written out for one
+    channel), from ``start``; None when a channel does not converge or
+    leaves the box.
+    """
+    C = np.array(start, dtype=np.float64)
+    d1 = C.shape[2]
+    lower, upper = (b.reshape(C.shape) for b in coefficient_bounds(d1 - 1))
+    m = np.clip(np.ravel(mu), 0.0, 1.0)
+    T = np.stack([normalised_eta_i(np.ravel(eta), eta_i_range) ** j for j in range(d1)], axis=-1)
+    x = 1.0 - m
+    x5 = x**5
+    with np.errstate(divide="ignore"):
+        log_x = np.where(x > 0.0, np.log(np.where(x > 0.0, x, 1.0)), 0.0)
+
+    def parts(xc):
+        P = T @ xc.reshape(3, d1).T  # (S, 3): F0, a, alpha
+        alpha = np.maximum(P[:, 2], ALPHA_MIN)
+        mu_xa = m * np.where(x > 0.0, np.exp(alpha * log_x), 0.0)
+        return P, alpha, mu_xa
+
+    for c in range(3):
+        y = target[:, c]
+
+        def residuals(xc, y=y):
+            P, _, mu_xa = parts(xc)
+            return P[:, 0] + (1.0 - P[:, 0]) * x5 - P[:, 1] * mu_xa - y
+
+        def jacobian(xc):
+            P, _, mu_xa = parts(xc)
+            dalpha = np.where(P[:, 2] > ALPHA_MIN, -P[:, 1] * mu_xa * log_x, 0.0)
+            return np.concatenate([(1.0 - x5)[:, None] * T, -mu_xa[:, None] * T, dalpha[:, None] * T], axis=1)
+
+        fit = least_squares(residuals, C[:, c, :].ravel(), jac=jacobian, method="lm",
+                            xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+        xc = fit.x.reshape(3, d1)
+        if fit.status <= 0 or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
+            return None
+        C[:, c, :] = xc
+    return C
+
+
+def paper_fit(target, mu, eta, eta_i_range, degree, max_nfev, mean_fit: FitResult, range_check=None) -> FitResult:
+    """
+    The paper's method on the guard points: plain rgb least squares,
+    float16 by rounding to nearest (as the paper ships it). Warm-started
+    from the mean fit and solved channel by channel (a fifth of the cost of
+    the joint solve, the same optimum to 1e-5); the joint
+    :func:`fitting.fits.solver.fit_coefficients` when that fails or a
+    range constraint applies.
+    """
+    C = None if range_check is not None else _paper_channels(
+        target, mu, eta, eta_i_range, mean_fit.coefficients, max_nfev)
+    if C is None:
+        return fit_coefficients(target, mu, eta, eta_i_range, degree, "rgb", max_nfev, False,
+                                irls_rounds=0, range_check=range_check, start=mean_fit.coefficients)
+    return _candidate(mean_fit, C, to_float16(C), eta_i_range, degree, "rgb")
+
+
 def guard_report(chosen: str, scores: dict[str, GuardScore]) -> dict:
     """The JSON of a guarded choice: what was kept and every candidate's figures."""
     return {"chosen": chosen, "margin": MAX_MARGIN,
@@ -246,8 +308,7 @@ def guarded_fit(
     def score(C16) -> GuardScore:
         return guard_score(gLab, coated_conductor_model(gM, gE, C16, eta_i_range), gM, gE)
 
-    paper = fit_coefficients(gT, gM, gE, eta_i_range, degree, "rgb", max_nfev, False,
-                             irls_rounds=0, range_check=range_check)
+    paper = paper_fit(gT, gM, gE, eta_i_range, degree, max_nfev, mean_fit, range_check)
     candidates = {MEAN: mean_fit, PAPER: paper}
     scores = {name: score(c.coefficients_float16) for name, c in candidates.items()}
     if choose(scores, PAPER) != MEAN:

@@ -85,6 +85,9 @@ class ErrorMetrics:
         Root mean square difference in linear RGB, where measured.
     layout
         The JSON layout of :meth:`to_dict`, one of :data:`LAYOUTS`.
+    max_eta_i, max_angle_deg
+        Where the max is (issue 21), where known: the ``delta_E_max_at``
+        of the grid and curves layouts.
     """
 
     mean: float
@@ -93,6 +96,8 @@ class ErrorMetrics:
     rows: tuple[EtaRow, ...] | None = None
     rmse: float | None = None
     layout: str = "grid"
+    max_eta_i: float | None = None
+    max_angle_deg: float | None = None
 
     def __post_init__(self) -> None:
         if self.layout not in LAYOUTS:
@@ -119,6 +124,8 @@ class ErrorMetrics:
         if self.layout == "summary":
             return {"mean": self.mean, "max": self.max}
         out: dict[str, Any] = {"delta_E_mean": self.mean, "delta_E_max": self.max}
+        if self.max_eta_i is not None:
+            out["delta_E_max_at"] = {"eta_i": self.max_eta_i, "angle_deg": self.max_angle_deg}
         if self.layout == "curves":
             out["by_curve"] = [
                 {"eta_i": r.eta_i, "delta_E_mean": r.mean, "delta_E_max": r.max}
@@ -150,11 +157,14 @@ def error_metrics(reference_RGB, model_RGB, eta_i_rows=None, against: str = "") 
     return grid_metrics(reference_RGB, {"model": model_RGB}, eta_i_rows, against)["model"]
 
 
-def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> dict[str, ErrorMetrics]:
+def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "",
+                 cos_theta_columns=None) -> dict[str, ErrorMetrics]:
     """
     :func:`error_metrics` of each of ``models`` (a mapping of name to (E, M,
     3) linear ACEScg) against the one ``reference_RGB``, keyed as
     ``models``: the reference is converted to Lab once for all of them.
+    With ``eta_i_rows`` and ``cos_theta_columns`` (the grid's values), the
+    metrics say where the max is.
     """
     reference_RGB = np.asarray(reference_RGB, dtype=np.float64)
     reference_Lab = ACEScg_to_Lab(reference_RGB)
@@ -171,6 +181,11 @@ def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> d
     for name, model_RGB in models.items():
         model_RGB = np.asarray(model_RGB, dtype=np.float64)
         dE = delta_E_2000(reference_Lab, ACEScg_to_Lab(model_RGB))
+        where = {}
+        if eta_i_rows is not None and cos_theta_columns is not None:
+            j, i = np.unravel_index(int(np.argmax(dE)), dE.shape)
+            where = {"max_eta_i": float(np.ravel(eta_i_rows)[j]), "max_angle_deg": float(
+                np.degrees(np.arccos(np.clip(np.ravel(cos_theta_columns)[i], 0.0, 1.0))))}
         out[name] = ErrorMetrics(
             mean=float(dE.mean()),
             max=float(dE.max()),
@@ -179,6 +194,7 @@ def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "") -> d
                 EtaRow(eta, float(dE[i].mean()), float(dE[i].max())) for eta, i in breakdown
             ),
             rmse=float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
+            **where,
         )
     return out
 
@@ -191,12 +207,16 @@ def curve_metrics(curves, model_of, against: str = "the edited curves") -> Error
     """
     maps = [delta_E_map(c.rgb, model_of(c)) for c in curves]
     every = np.concatenate(maps)
+    k = int(np.argmax([d.max() for d in maps]))
+    i = int(np.argmax(maps[k]))
     return ErrorMetrics(
         mean=float(every.mean()),
         max=float(every.max()),
         against=against,
         rows=tuple(EtaRow(c.eta_i, float(d.mean()), float(d.max())) for c, d in zip(curves, maps)),
         layout="curves",
+        max_eta_i=float(curves[k].eta_i),
+        max_angle_deg=float(np.degrees(np.arccos(np.clip(np.ravel(curves[k].cos_theta)[i], 0.0, 1.0)))),
     )
 
 
