@@ -22,10 +22,14 @@ import numpy as np
 from ..colour.colorimetry import ACEScg_to_Lab
 from ..models.coated_conductor import coated_conductor_model
 from .curves_base import edited_target
-from .curves_score import score_grid
+from .curves_score import check_grid, score_grid
 from .guarded import _THREADPOOLS, constrained_refits, guard_report
 from .result import FitResult
-from .worst_case import GuardScore, choose, guard_score
+from .solver import fit_coefficients
+from .worst_case import MAX_MARGIN, GuardScore, choose, guard_score
+
+CHECK_SAMPLES = (19, 7)
+"""Where the constrained refits keep the model in [0, 1]: the refit's default check grid."""
 
 __all__ = ["guard_curve_choice"]
 
@@ -52,13 +56,21 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
         return guard_score(gLab, coated_conductor_model(gM, gE, C16, eta_i_range), gM, gE)
 
     scores = {name: score(c.coefficients_float16) for name, c in candidates.items()}
-    if choose(scores, paper) != own and scores[own].mean < scores[paper].mean:
+    # The paper's method as an auditor runs it: rgb on the whole scoring grid, no [0, 1]
+    # constraint. Not a candidate when it leaves [0, 1], but its max is the bar.
+    free = fit_coefficients(gT, gM, gE, eta_i_range, candidates[own].degree, "rgb")
+    bar = min(scores[paper].max, score(free.coefficients_float16).max)
+    if in_range(free.coefficients_float16):
+        candidates[f"{paper}-free"] = free
+        scores[f"{paper}-free"] = score(free.coefficients_float16)
+    if scores[own].max > bar * (1.0 - MAX_MARGIN) and scores[own].mean < scores[paper].mean:
         target, mu, eta, weights = samples
         own_fit, paper_fit = candidates[own], candidates[paper]
         starts = (("", paper_fit.coefficients), ("-from-own", own_fit.coefficients))
+        CM, CE = check_grid(eta_i_range, *CHECK_SAMPLES)
         for label, C, C16, s in constrained_refits(
                 target, mu, eta, weights, gT, gM, gE, eta_i_range, own_fit.degree, None, starts,
-                scores[paper].max, True, score):
+                bar, True, score, range_points=(CM.ravel(), CE.ravel())):
             if not in_range(C16):
                 continue
             candidates[label] = FitResult(
@@ -71,5 +83,13 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
             scores[label] = s
             if choose(scores, paper) == label:
                 break
-    chosen = choose(scores, paper)
-    return chosen, guard_report(chosen, scores)
+    # The bar is the lower of the two paper fits' max: choose against a score carrying it.
+    reference = GuardScore(scores[paper].mean, bar, scores[paper].eta_i, scores[paper].angle_deg)
+    chosen = choose({**scores, "bar": reference}, "bar")
+    if chosen == "bar":
+        # Nothing in [0, 1] under the free paper fit's max: the same rule against the
+        # in-range paper candidate (the free fit is out of range, so cannot ship).
+        chosen = choose(scores, paper)
+    report = guard_report(chosen, scores)
+    report["bar_max"] = bar
+    return chosen, report

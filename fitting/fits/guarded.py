@@ -26,7 +26,7 @@ from scipy.optimize import least_squares, minimize
 from threadpoolctl import ThreadpoolController
 
 from ..colour.colorimetry import ACEScg_to_Lab
-from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, normalised_eta_i
+from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
 from ..models.pack import to_float16
 from .objective import Problem, coefficient_bounds
 from .quantise import quantise_coefficients
@@ -45,12 +45,12 @@ MEAN = "mean"
 # SLSQP's small dense algebra: BLAS threads only synchronise (6x slower on 2 cores).
 _THREADPOOLS = ThreadpoolController()
 
-_SLSQP_ITERATIONS = 40  # SLSQP iterations of a constrained fit (27 unknowns)
-CAP_FACTORS = (0.93, 1.0 - MAX_MARGIN)
+_SLSQP_ITERATIONS = 25  # SLSQP iterations of a constrained fit (27 unknowns)
+CAP_FACTORS = (0.9, 1.0 - MAX_MARGIN)
 """Caps of the constrained fits relative to the paper method's max on the
 guard, tried in order: the paper method's own fit on the full 100 x 100
 grid can end a little lower than its fit on the guard (Na: 0.075 against
-0.081), so a cap 7 % under it is tried first, and kept when its mean is
+0.081), so a cap 10 % under it is tried first, and kept when its mean is
 still no worse than the paper's; then the cap of :data:`MAX_MARGIN`."""
 
 _CAP_ROUNDS = 3  # constrained solves of one candidate while its true max reads above the cap
@@ -83,7 +83,7 @@ class _Cached:
 
 
 def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0, cap: float,
-                     degree: int, max_iterations: int = _SLSQP_ITERATIONS):
+                     degree: int, max_iterations: int = _SLSQP_ITERATIONS, range_points=None):
     """
     Coefficients minimising the weighted mean of the first-order Delta E
     2000 over the fitting samples subject to Delta E <= ``cap`` at every
@@ -94,6 +94,8 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
     at the start, and any point the solution leaves above the cap joins
     them for another solve (at most :data:`_ACTIVE_ROUNDS`): the max is
     where a few points are, and each constraint costs the QP of every step.
+    ``range_points`` = (cos_theta, eta_i): points where the model must also
+    stay in [0, 1] (the same active-set rule: those within 0.05 of an end).
     """
     S = mean_problem.mu.size
     w = np.ravel(weights) / np.sum(weights)
@@ -105,6 +107,14 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
         return np.linalg.norm(guard_problem.residuals(x).reshape(-1, 3), axis=1)
 
     active = guard_dE(x) > 0.5 * cap
+    if range_points is not None:
+        rM, rE = np.ravel(range_points[0]), np.ravel(range_points[1])
+
+        def model_at(x):
+            return coated_conductor_model(rM, rE, x.reshape(3, 3, degree + 1), mean_problem.range)
+
+        F0 = model_at(x)
+        near = ((F0 > 0.95) | (F0 < 0.05)).any(axis=1)
     for _ in range(_ACTIVE_ROUNDS):
         both = _Cached(Problem(
             np.concatenate([mean_problem.target, gT[active]]),
@@ -127,19 +137,49 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
             r, J = both(x)
             return -2.0 * np.einsum("so,son->sn", r[S:], J[S:])
 
+        constraints = [{"type": "ineq", "fun": constraint, "jac": constraint_jac}]
+        if range_points is not None and near.any():
+            constraints.append(_range_constraint(rM[near], rE[near], mean_problem.range, degree))
         result = minimize(objective, x, jac=True, method="SLSQP", bounds=list(zip(lower, upper)),
-                          constraints=[{"type": "ineq", "fun": constraint, "jac": constraint_jac}],
-                          options={"maxiter": max_iterations, "ftol": 1e-9})
+                          constraints=constraints, options={"maxiter": max_iterations, "ftol": 1e-9})
         if not np.all(np.isfinite(result.x)):
             return None
         x = result.x
         over = guard_dE(x) > cap * (1.0 + 1e-6)
-        if not (over & ~active).any():
-            break
+        grown = (over & ~active).any()
         active |= over
+        if range_points is not None:
+            F = model_at(x)
+            leaving = ((F > 1.0) | (F < 0.0)).any(axis=1)
+            grown = grown or (leaving & ~near).any()
+            near |= leaving
+        if not grown:
+            break
     if guard_dE(x).max() > cap * (1.0 + 1e-3):
         return None
     return x.reshape(3, 3, degree + 1)
+
+
+def _range_constraint(mu, eta, eta_i_range, degree: int, margin: float = 1e-5) -> dict:
+    """SLSQP inequality ``margin <= F <= 1 - margin`` per point and channel, with its Jacobian."""
+    def values(x):
+        F, J = model_jacobian(mu, eta, x.reshape(3, 3, degree + 1), eta_i_range)
+        return F, J
+
+    def fun(x):
+        F, _ = values(x)
+        return np.concatenate([(F - margin).ravel(), (1.0 - margin - F).ravel()])
+
+    def jac(x):
+        _, Jm = values(x)  # (K, 3, 3, d1): channel c depends on coefficients [:, c, :]
+        K, d1 = Jm.shape[0], degree + 1
+        J = np.zeros((K, 3, 3, 3, d1))
+        idx = np.arange(3)
+        J[:, idx, :, idx, :] = Jm.transpose(1, 0, 2, 3)
+        J = J.reshape(K * 3, -1)
+        return np.concatenate([J, -J])
+
+    return {"type": "ineq", "fun": fun, "jac": jac}
 
 
 def _quantise_capped(mean_problem, guard_problem, weights, C, cap, quantise: bool):
@@ -248,14 +288,16 @@ def guard_report(chosen: str, scores: dict[str, GuardScore]) -> dict:
 
 
 def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_eta, eta_i_range,
-                       degree, range_check, starts, paper_max: float, quantise: bool, score):
+                       degree, range_check, starts, paper_max: float, quantise: bool, score,
+                       range_points=None):
     """
     Yield ``(label, C, C16, score(C16))`` of the fits of least mean Delta E
     over (``target``, ``mu``, ``eta``, ``weights``) with the first-order
     Delta E capped at every guard point: the caps of :data:`CAP_FACTORS`
     times ``paper_max`` in order, from each of ``starts`` (``(suffix,
     coefficients)``); the caller stops when one suits it. ``score`` maps
-    float16 coefficients to their :class:`GuardScore` (true CIEDE2000).
+    float16 coefficients to their :class:`GuardScore` (true CIEDE2000);
+    ``range_points``: as :func:`constrained_mean`.
     """
     base = np.ones(np.ravel(mu).size) if weights is None else np.ravel(weights)
     mean_problem = Problem(target, mu, eta, eta_i_range, degree, "de2000", None, range_check)
@@ -269,7 +311,8 @@ def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_e
                 # The constraint is on the first-order Delta E (the de2000
                 # objective's); the score is the true CIEDE2000, which can
                 # read a little higher: the cap is lowered by their ratio.
-                C = constrained_mean(mean_problem, guard_problem, base, x0, cap, degree)
+                C = constrained_mean(mean_problem, guard_problem, base, x0, cap, degree,
+                                     range_points=range_points)
                 if C is None:
                     break
                 C16 = _quantise_capped(mean_problem, guard_problem, base, C, cap, quantise)
