@@ -82,7 +82,7 @@ def fit_material(
         settings.max_nfev, settings.quantise, weights=weights,
         irls_rounds=settings.irls_rounds,
     )
-    if settings.guard_max:  # issue 21 hook: the max guarded on a subsample of the scoring grid
+    if settings.guard_max and settings.objective != "rgb":  # issue 21 hook (rgb is the paper's method itself)
         guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
         result = guarded_fit(
             target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,

@@ -87,7 +87,8 @@ class FitSettings:
     guard_max
         Guard the max (:mod:`fitting.fits.guarded`): keep the mean fit only
         when its mean and max are no worse than the paper method's on the
-        guard points, else a constrained refit or the paper method's fit.
+        guard points, else a constrained refit or the paper method's fit
+        (not for the ``rgb`` objective: that is the paper's method).
     max_gap_nm
         Largest spacing of the data's samples inside 360-830 nm accepted
         (:mod:`fitting.optics.quality`); past the default the fit carries a

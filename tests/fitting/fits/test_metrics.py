@@ -55,9 +55,13 @@ class TestErrorMetrics:
         models = {1.0: MODEL[0], 2.0: MODEL[2]}
         m = curve_metrics(curves, lambda c: models[c.eta_i])
         view = m.to_dict()
-        assert list(view) == ["delta_E_mean", "delta_E_max", "by_curve"]
+        assert list(view) == ["delta_E_mean", "delta_E_max", "delta_E_max_at", "by_curve"]
         assert [c["eta_i"] for c in view["by_curve"]] == [1.0, 2.0]
         both = np.concatenate([delta_E_map(REF[0], MODEL[0]), delta_E_map(REF[2], MODEL[2])])
+        # Where the max is (issue 21): the curve and the angle of the largest of both maps.
+        k = int(np.argmax(both))
+        assert view["delta_E_max_at"]["eta_i"] == [1.0, 2.0][k // mu.size]
+        assert view["delta_E_max_at"]["angle_deg"] == float(np.degrees(np.arccos(mu[k % mu.size])))
         assert view["delta_E_mean"] == float(both.mean())
         s = delta_E_summary(REF, MODEL, "x")
         assert s.to_dict() == {"mean": m_mean(REF, MODEL), "max": float(delta_E_map(REF, MODEL).max())}
