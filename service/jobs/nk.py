@@ -24,6 +24,7 @@ import numpy as np
 from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid, spectral_grid
 from fitting.domain import DEFAULT_MIN_COVERAGE, BoundedCache, check_eta_i_range, cos_theta_from_angle
 from fitting.fits.evaluate import grid_models, metrics_json, score_on_grid
+from fitting.fits.fit_quality import provenance
 from fitting.fits.kinds import fit_model
 from fitting.fits.metrics import ErrorMetrics
 from fitting.fits.result import FitResult
@@ -181,9 +182,9 @@ def _metrics_part(fit: NKFit, result: FitResult, reference: np.ndarray,
     timings = {**result.timings, "evaluate": seconds + time.perf_counter() - t0}
     packed = PackedMaterial(
         name=fit.name, coefficients=result.coefficients_float16,
-        eta_i_range=result.eta_i_range, source=fit.nk.source, model=result.model,
+        eta_i_range=result.eta_i_range, source=provenance(fit.nk.source, result.quality), model=result.model,
     )
-    summary = result.summary()
+    summary = result.summary()  # with ``quality`` (range proof, warnings) and ``guard`` (issue 21)
     summary.pop("timings")
     check_finite("metrics", metrics)
     return {
