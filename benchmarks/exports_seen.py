@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from datetime import datetime, timezone
 import os
 import sys
 import time
@@ -131,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
         RESULT.parent.mkdir(parents=True, exist_ok=True)
         RESULT.write_text(json.dumps({
             "command": "benchmarks/exports_seen.py " + " ".join(argv or sys.argv[1:]),
+            "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
             "angles_deg": [float(SEEN_ANGLES_DEG[0]), float(SEEN_ANGLES_DEG[-1])],
             "summary": summary, "per_material": results,
             "seconds": round(elapsed, 1), "load_average": round(load[0], 2),

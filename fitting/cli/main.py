@@ -56,6 +56,7 @@ def _cmd_library(args) -> int:
 
 
 def _cmd_fit(args) -> int:
+    from ..fits.fit_quality import in_range_verdict
     from ..fits.kinds import fit_model
     from ..models.pack import encode_pack, material_to_json
     from .materials import material_nk
@@ -65,8 +66,15 @@ def _cmd_fit(args) -> int:
         return 2
     if args.export is not None:
         return _write_export(nk, args)
+    extra = {} if args.max_gap_nm is None else {"max_gap_nm": args.max_gap_nm}
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
-                       evaluate=not args.no_metrics)
+                       evaluate=not args.no_metrics, **extra)
+    for warning in result.quality.get("warnings", []):
+        # Issue 21: sparse data or a model outside [0, 1] are said, and refused with --strict.
+        if args.strict and not in_range_verdict(result.quality):
+            print(f"error: the fit of {nk.name!r}: {warning}; nothing written (--strict)", file=sys.stderr)
+            return 3
+        print(f"warning: {warning}", file=sys.stderr)
     if not result.success:
         what = (f"the fit of {nk.name!r} did not converge (solver status {result.status}: "
                 f"{result.message}); its coefficients are the best found")
@@ -137,7 +145,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--coat-roughness", type=float, default=0.03,
                    help="coat roughness of --export, [0, 1]")
     p.add_argument("--strict", action="store_true",
-                   help="exit with status 3 (writing nothing) when the fit does not converge")
+                   help="exit with status 3 (writing nothing) when the fit does not converge "
+                        "or its model is not proven inside [0, 1]")
+    p.add_argument("--max-gap-nm", type=float, default=None, metavar="NM",
+                   help="largest gap between samples inside 360-830 nm accepted (default 120; "
+                        "larger fits sparse data with a warning in the result and the pack)")
     p.set_defaults(func=_cmd_fit)
 
     p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")

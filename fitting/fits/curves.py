@@ -25,8 +25,10 @@ so it needs no range constraint).
 -   :func:`whole_target_error`: Delta E 2000 over the whole blended target
     on :data:`SCORE_GRID` (:mod:`fitting.fits.curves_score`).
 
-The fit stays a reflectance: [0, 1] is a penalty constraint of the least
-squares (hinge residuals at a check grid, ``range_check``), not a clip.
+The fit stays a reflectance: [0, 1] is a penalty of the least squares (hinge
+residuals at a check grid and where :mod:`fitting.models.range_bound`'s proof
+fails), and the kept fit is proven inside over its whole domain, not clipped.
+The max is guarded against the paper's method (:mod:`fitting.fits.curves_guard`).
 
 With a base, an edited curve replaces the base's reflectance at its eta_i and
 the difference it makes fades smoothly across eta_i (:func:`blend_weights`);
@@ -45,111 +47,29 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, check_int, check_number
+from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
 from ..models.kinds import DEFAULT_MODEL, model_ACEScg, model_kind
 from ..models.pack import PackedMaterial, to_float16
 from .curves_base import CurveBase, edited_target
+from .curves_guard import guard_curve_choice
 from .curves_input import RGBCurve, check_curves
-from .curves_range import EvaluationBudget, in_range_fallback, outside_range
+from .curves_range import EvaluationBudget, escape_points, in_range_fallback, outside_range, proven_in_range
+from .curves_range import range_report
 from .curves_score import SCORE_GRID, angle_mu, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
 from .kinds import fit_kind
 from .result import FitResult
-from .settings import check_fit_options
+from .curves_settings import LIVE_SETTINGS, CurveFitSettings  # noqa: F401 (re-exported)
 
 __all__ = ["CurveFitSettings", "LIVE_SETTINGS", "SCORE_GRID", "score_grid", "whole_target_error", "fit_curves"]
 
 _RGB_GRID = (24, 16)  # the paper-method candidate's samples: every other angle and eta_i of SCORE_GRID
 _RGB_MAX_NFEV = 200  # as the paper-method fits (fit_coefficients' default): rgb solves are cheap
 _MIN_ESCALATION_NFEV = 10  # an escalation round with fewer evaluations left is not started
-
-@dataclass(frozen=True)
-class CurveFitSettings:
-    """
-    Settings of :func:`fit_curves`.
-
-    Attributes
-    ----------
-    mu_samples
-        cos theta samples per eta_i row: each curve is resampled linearly to
-        this many values evenly over its own span (without a base) or at
-        angles evenly over [0, 90] degrees (with a base).
-    eta_samples
-        Rows of the base evenly over the domain, besides the edited rows.
-    objective, irls_rounds, max_nfev, quantise
-        Passed to :func:`fitting.fits.solver.fit_coefficients`.
-    blend_width
-        Distance in eta_i over which an edit fades beyond the outermost
-        edited indices (:func:`blend_weights`).
-    edit_weight
-        Least-squares weight of each sample of an edited row relative to a
-        sample of a base row (with a base): the edited curves are what the
-        artist looks at (1: the whole blended target counts evenly, as it
-        is scored).
-    range_weight
-        Weight of the [0, 1] constraint: hinge residuals at a check grid of
-        ``check_samples`` = (angles, eta_i rows) over the whole domain, made
-        ten times stiffer on a finer grid (at most twice) while the float16
-        fit still leaves [0, 1] on the scoring grid; 0 turns it off.
-    compare_rgb
-        With a base, also fit the paper's own method (plain rgb least
-        squares, unweighted) to the whole blended target (24 angles x 16
-        eta_i, every other point of :data:`SCORE_GRID`), and keep, of the two float16 fits, the one closer
-        to it (mean Delta E 2000 there): the refit is never farther from the
-        target than that method.
-    max_evaluations
-        Model evaluations (residuals and Jacobians) of the whole refit, over
-        every solve, escalation round and candidate: its CPU bound. A solve
-        gets at most its share of what is left; a round is not started with
-        fewer than 10 left. A fit the budget leaves outside [0, 1] is made
-        in range (:func:`fitting.fits.curves_range.in_range_fallback`), and
-        the metrics say ``best_effort``.
-    """
-
-    mu_samples: int = 12
-    eta_samples: int = 7
-    objective: str = "de2000"
-    irls_rounds: int = 1
-    max_nfev: int = 20
-    quantise: bool = True
-    blend_width: float = 0.5
-    edit_weight: float = 1.0
-    range_weight: float = 300.0
-    check_samples: tuple[int, int] = (19, 7)
-    compare_rgb: bool = True
-    max_evaluations: int = 300
-
-    def __post_init__(self) -> None:
-        check_int("mu_samples", self.mu_samples, 4, 256)
-        check_int("eta_samples", self.eta_samples, 1, 64)
-        check_fit_options(self.objective, self.max_nfev, self.irls_rounds)
-        check_number("blend_width", self.blend_width, 0.0)
-        check_number("edit_weight", self.edit_weight, 1.0, 1000.0)
-        check_number("range_weight", self.range_weight, 0.0, 1e6)
-        check_int("max_evaluations", self.max_evaluations, 1, 100_000)
-        check = self.check_samples
-        if not (isinstance(check, tuple) and len(check) == 2
-                and all(isinstance(n, int) and 2 <= n <= 256 for n in check)):
-            raise ValueError(f"`check_samples` must be two integers in [2, 256], got {check!r}")
-
-
-LIVE_SETTINGS = CurveFitSettings(irls_rounds=0, max_nfev=4, compare_rgb=False, quantise=False,
-                                 check_samples=(10, 4), max_evaluations=24)
-"""The settings of a live refit, while a curve is being dragged: one solve of
-at most 4 evaluations (no reweighting round, no paper-method candidate,
-float16 by rounding to nearest, the [0, 1] check grid coarser at first),
-meant to start from the fit on screen (``start``), so that it follows the
-pointer; the [0, 1] constraint is the same as the default's (made stiffer
-on the fine grid while the fit leaves [0, 1]). A live solve that still
-leaves it answers the closer to the edit of its in-range fallback and the
-fit it started from (``best_effort``): it never waits for a full refit. The
-editor replaces it with a default refit when the drag ends."""
-
 
 def _describe(curves: Sequence[RGBCurve]) -> str:
     return ", ".join(f"{c.eta_i:g}" for c in sorted(curves, key=lambda c: c.eta_i))
@@ -215,7 +135,9 @@ def fit_curves(
         ``figure`` (:meth:`fitting.fits.metrics.ErrorMetrics.figure`: with a
         base the whole target's, else the curves') and, with a base, ``target`` (:func:`whole_target_error`: mean and
         max Delta E 2000 over the whole blended target on
-        :data:`SCORE_GRID`, where the max is, and the model's range).
+        :data:`SCORE_GRID`, where the max is, and the model's range), ``range``
+        (the proof of [0, 1], for a kind that can leave it) and ``guard`` (every
+        candidate of the worst-case guard, :mod:`fitting.fits.curves_guard`).
 
     Raises
     ------
@@ -305,8 +227,8 @@ def fit_curves(
         """Mask of the range grid's points where the float16 fit leaves [0, 1]."""
         return outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
 
-    def in_range(C16) -> bool:
-        return not outside(C16).any()
+    def in_range(C16) -> bool:  # issue 21: proven over the whole domain, not the grid only
+        return not outside(C16).any() and proven_in_range(C16, eta_i_range)
 
     def constrained(objective: str, dense=None) -> FitResult:
         weight, check, extra = settings.range_weight, settings.check_samples, None
@@ -314,19 +236,20 @@ def fit_curves(
         for _ in range(2):
             if weight == 0:
                 break
-            mask = outside(result.coefficients_float16)
-            if not mask.any() or not budget.allows(_MIN_ESCALATION_NFEV):
+            if in_range(result.coefficients_float16) or not budget.allows(_MIN_ESCALATION_NFEV):
                 break
+            C16 = result.coefficients_float16
+            points = escape_points(C16, eta_i_range, outside(C16), range_M, range_E, check[1])
+            extra = points if extra is None else (
+                np.concatenate([extra[0], points[0]]), np.concatenate([extra[1], points[1]]))
             if start is None or dense is not None:
                 # A fit from its own guess: stiffer on a finer grid, started
-                # again, as it always has (same results).
+                # again, with the points where it left [0, 1] added.
                 weight, check = 10.0 * weight, (max(check[0], 46), max(check[1], 16))
-                result = fit(objective, weight, check, dense)
+                result = fit(objective, weight, check, dense, extra_check=extra)
             else:
                 # A warm-started (live) fit goes on from where it is, stiffer
                 # and with the points where it leaves [0, 1] added to its check.
-                extra = (range_M[mask], range_E[mask]) if extra is None else (
-                    np.concatenate([extra[0], range_M[mask]]), np.concatenate([extra[1], range_E[mask]]))
                 weight = 10.0 * weight
                 result = fit(objective, weight, check, start=result.coefficients, extra_check=extra)
         return result
@@ -368,13 +291,11 @@ def fit_curves(
         dense_target = edited_target(base, curves, rgb_M, rgb_E, settings.blend_width)
         dense = (dense_target.reshape(-1, 3), rgb_M.ravel(), rgb_E.ravel())
         candidates = {settings.objective: result, "rgb": held(constrained("rgb", dense))}
-        scores = {
-            objective: whole_target_error(base, curves, candidate.coefficients_float16,
-                                          settings.blend_width)["delta_E_mean"]
-            for objective, candidate in candidates.items()
-        }
-        chosen = min(scores, key=scores.get)
+        # Issue 21 hook: kept by mean and max against the paper method (fitting.fits.curves_guard).
+        chosen, guard = guard_curve_choice(base, curves, settings.blend_width, candidates, settings.objective,
+                                           "rgb", (target, mu, eta, weights), in_range)
         result = candidates[chosen]
+        result.guard, chosen = guard, result.objective
     C16 = result.coefficients_float16
     error = curve_metrics(curves, lambda c: model_ACEScg(model, c.cos_theta, c.eta_i, C16, eta_i_range))
     metrics: dict[str, Any] = {
@@ -389,6 +310,10 @@ def fit_curves(
         target = metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)
         # With a base the figure is the whole edited target's (what the editor's error map shows).
         metrics["figure"] = {key: target[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at")}
+    if result.guard is not None:
+        metrics["guard"] = result.guard
+    if not solver.bounded:  # issue 21: [0, 1] proven or not over the whole domain
+        metrics["range"] = range_report(C16, eta_i_range)
     result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(

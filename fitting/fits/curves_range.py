@@ -20,10 +20,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..models.coated_conductor import coated_conductor_model, model_parameters
+from ..models.range_bound import certify_range
 from ..models.pack import to_float16
 from .curves_score import SCORE_GRID, check_grid
 
-__all__ = ["RANGE_TOLERANCE", "outside_range", "in_range_fallback", "EvaluationBudget"]
+__all__ = ["RANGE_TOLERANCE", "outside_range", "proven_in_range", "range_report", "escape_points", "in_range_fallback", "EvaluationBudget"]
 
 RANGE_TOLERANCE = 1e-4
 """float16 rounding of a fit on the boundary."""
@@ -42,9 +43,52 @@ def outside_range(C16, eta_i_range) -> np.ndarray:
     return (values < -RANGE_TOLERANCE) | (values > 1.0 + RANGE_TOLERANCE)
 
 
+def _channel_only(C, channel: int) -> np.ndarray:
+    """``C`` with every channel but ``channel`` replaced by the constant 0.5 (in range)."""
+    out = np.zeros_like(np.asarray(C, dtype=np.float64))
+    out[0, :, 0] = 0.5
+    out[:, channel, :] = np.asarray(C, dtype=np.float64)[:, channel, :]
+    return out
+
+
+def proven_in_range(C16, eta_i_range, channel: int | None = None) -> bool:
+    """
+    Whether the model of ``C16`` is proven inside [0, 1] (by
+    :data:`RANGE_TOLERANCE`) over the whole domain, every channel or one
+    (:func:`fitting.models.range_bound.certify_range`; unproven counts as
+    outside).
+    """
+    C = C16 if channel is None else _channel_only(C16, channel)
+    return certify_range(C, eta_i_range, RANGE_TOLERANCE).in_range is True
+
+
+def range_report(C16, eta_i_range) -> dict:
+    """The JSON of :func:`fitting.models.range_bound.certify_range` at :data:`RANGE_TOLERANCE`."""
+    return certify_range(C16, eta_i_range, RANGE_TOLERANCE).to_dict()
+
+
+def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int):
+    """
+    Extra check points of a refit leaving [0, 1]: the scoring-grid points
+    of ``mask`` (over ``range_M``, ``range_E``) and, unless proven in
+    range, the certificate's counterexample with its neighbours in cos
+    theta (x 0.5, 1.5, 2) at every check row and its own eta_i.
+    """
+    pm, pe = range_M[mask], range_E[mask]
+    certificate = certify_range(C16, eta_i_range, RANGE_TOLERANCE)
+    if certificate.in_range is not True:
+        mu_w, eta_w = certificate.worst[0], certificate.worst[1]
+        rows = np.unique(np.concatenate([check_grid(eta_i_range, 2, check_rows)[1][:, 0], [eta_w]]))
+        near = np.clip(mu_w * np.array([0.5, 1.0, 1.5, 2.0]), 0.0, 1.0)
+        NM, NE = np.meshgrid(near, rows)
+        pm, pe = np.concatenate([pm, NM.ravel()]), np.concatenate([pe, NE.ravel()])
+    return pm, pe
+
+
 def in_range_fallback(C16, eta_i_range) -> np.ndarray:
     """
-    Float16 coefficients in [0, 1] on the whole scoring grid, as close to
+    Float16 coefficients in [0, 1] over the whole domain (on the scoring
+    grid and proven by :func:`proven_in_range`), as close to
     ``C16`` as a shrink of each out-of-range channel's shape term allows.
 
     Per channel of Eq. 1, :math:`F = F_0 + (1 - F_0)(1 - \\mu)^5 - s\\,a\\,
@@ -57,6 +101,8 @@ def in_range_fallback(C16, eta_i_range) -> np.ndarray:
     """
     C = np.asarray(C16, dtype=np.float64).copy()
     bad = outside_range(to_float16(C), eta_i_range).any(axis=0)
+    # Issue 21: the whole domain, not the grid only.
+    bad |= np.array([not proven_in_range(to_float16(C), eta_i_range, c) for c in range(3)])
     if not bad.any():
         return to_float16(C)
     rows = check_grid(eta_i_range, 2, SCORE_GRID[1])[1][:, 0]
@@ -68,7 +114,8 @@ def in_range_fallback(C16, eta_i_range) -> np.ndarray:
         a = C[1, c, :].copy()
         for scale in _SHAPE_SCALES:
             C[1, c, :] = scale * a
-            if not outside_range(to_float16(C), eta_i_range)[:, c].any():
+            if (not outside_range(to_float16(C), eta_i_range)[:, c].any()
+                    and proven_in_range(to_float16(C), eta_i_range, c)):
                 break
     return to_float16(C)
 

@@ -26,10 +26,29 @@ from .pipeline import FitKind, fit_spectral
 from .result import FitResult
 from .settings import FitSettings
 from .solver import fit_coefficients
+from .fit_quality import fit_quality
+from .guarded import guarded_fit
+from .worst_case import guard_reference
 
 __all__ = ["COATED_CONDUCTOR_FIT", "fit_material"]
 
-COATED_CONDUCTOR_FIT = FitKind(name=DEFAULT_MODEL, settings=FitSettings(), solve=fit_coefficients)
+def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitResult) -> FitResult:
+    """Issue 21: the max guarded against the paper's method on a subsample of the scoring grid."""
+    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
+    return guarded_fit(
+        target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
+        settings.quantise, weights, settings.irls_rounds, guard_target, guard_mu, guard_eta,
+        mean_fit=mean_fit,
+    )
+
+
+def _quality(result: FitResult, eta_i_range, warnings) -> dict:
+    """Issue 21: the proof of [0, 1] over the whole domain and the data's warnings."""
+    return fit_quality(result.coefficients_float16, eta_i_range, warnings)
+
+
+COATED_CONDUCTOR_FIT = FitKind(name=DEFAULT_MODEL, settings=FitSettings(), solve=fit_coefficients,
+                               guard=_guard, quality=_quality)
 """The coated-conductor's fit (:mod:`fitting.fits.pipeline`; registered in :mod:`fitting.fits.kinds`)."""
 
 

@@ -27,7 +27,9 @@ from ..domain import check_eta_i_range
 from ..models.kinds import model_kind
 from ..models.pack import PackedMaterial
 from ..optics.nk import SpectralNK, resample_nk
+from ..optics.quality import check_gaps
 from .evaluate import evaluate_material
+from .fit_quality import provenance
 from .result import FitResult
 from .settings import FitSettings, fit_grid
 
@@ -55,12 +57,24 @@ class FitKind:
     bounded
         True when the kind's model is a reflectance in [0, 1] by
         construction (no range constraint in curve fits).
+    guard
+        ``guard(nk, target, cos_theta, eta_i, weights, eta_i_range, settings,
+        mean_fit) -> FitResult``: the fit with its max guarded against the
+        paper's method (issue 21; :mod:`fitting.fits.guarded`), or None for
+        a kind without one. Run when ``settings.guard_max`` and the objective
+        is not the paper's own ``rgb``.
+    quality
+        ``quality(result, eta_i_range, warnings) -> dict``: what the fit can be
+        trusted for (:mod:`fitting.fits.fit_quality`: the proof of [0, 1] and
+        the warnings), or None for the data's warnings only.
     """
 
     name: str
     settings: FitSettings
     solve: Callable[..., FitResult]
     bounded: bool = False
+    guard: Callable[..., FitResult] | None = None
+    quality: Callable[..., dict] | None = None
 
 
 def settings_with(settings: FitSettings, overrides: dict[str, Any]) -> FitSettings:
@@ -122,6 +136,7 @@ def fit_spectral(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
+    warnings = check_gaps(nk, settings.max_gap_nm)  # gaps inside the visible range (issue 21)
     if samples is None:
         samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
     mu, eta, weights = samples
@@ -131,16 +146,24 @@ def fit_spectral(
         target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
         settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
     )
+    if kind.guard is not None and settings.guard_max and settings.objective != "rgb":
+        result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result)
     result.coverage = coverage
     result.settings = settings
     result.timings["reference"] = t_ref - t0
+    result.quality = (kind.quality(result, eta_i_range, warnings) if kind.quality is not None
+                      else {"warnings": list(warnings)})
     result.packed = PackedMaterial(
         name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
-        source=nk.source, model=result.model,
+        source=provenance(nk.source, result.quality), model=result.model,
     )
     if evaluate:
         t_eval = time.perf_counter()
-        with_metrics(result, evaluate_material(nk, result, min_coverage=settings.min_coverage))
+        metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
+        metrics["quality"] = result.quality
+        if result.guard is not None:
+            metrics["guard"] = result.guard
+        with_metrics(result, metrics)
         result.timings["evaluate"] = time.perf_counter() - t_eval
     result.timings["total"] = time.perf_counter() - t0
     return result

@@ -10,6 +10,7 @@ The result of a fit
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -67,6 +68,14 @@ class FitResult:
         True when the fit's evaluation budget ran out before it met its
         constraints, and ``coefficients_float16`` were then made to meet
         them (curve fits: :func:`fitting.fits.curves_range.in_range_fallback`).
+    guard
+        The max's guard (:func:`fitting.fits.guarded.guard_report`): the
+        candidate kept and every candidate's mean, max and where the max is.
+    quality
+        ``range`` (the proof that the float16 model stays in [0, 1] over the
+        whole domain, :func:`fitting.models.range_bound.certify_range`) and
+        ``warnings`` (sparse data fitted with the gap limit relaxed, a model
+        that leaves [0, 1]): :func:`fitting.fits.fit_quality.fit_quality`.
     """
 
     coefficients: np.ndarray
@@ -117,6 +126,20 @@ class FitResult:
             timings=dict(timings),
             model=model,
         )
+    guard: dict[str, Any] | None = None  # issue 21: the worst-case guard's candidates (fitting.fits.guarded)
+    quality: dict[str, Any] = field(default_factory=dict)  # issue 21: range proof and data warnings (fitting.fits.fit_quality)
+
+    def with_coefficients(self, coefficients, coefficients_float16) -> "FitResult":
+        """
+        This result with other coefficients (a candidate of the same solve:
+        its report and timings kept), e.g. the worst-case guard's
+        (:mod:`fitting.fits.guarded`, :mod:`fitting.fits.curves_guard`).
+        """
+        return dataclasses.replace(
+            self, coefficients=np.asarray(coefficients, dtype=np.float64),
+            coefficients_float16=coefficients_float16, timings=dict(self.timings),
+            metrics={}, packed=None, error=None,
+        )
 
     @property
     def iterations(self) -> int:
@@ -138,4 +161,6 @@ class FitResult:
             "degree": self.degree,
             "coverage": self.coverage,
             "timings": dict(self.timings),
+            **({"quality": self.quality} if self.quality else {}),
+            **({"guard": self.guard} if self.guard is not None else {}),
         }

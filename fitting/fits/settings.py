@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..optics.quality import DEFAULT_MAX_GAP_NM, check_max_gap
 from ..domain import DEFAULT_MIN_COVERAGE, check_choice, check_int, check_min_coverage, check_step_nm
 
 __all__ = [
@@ -83,6 +84,15 @@ class FitSettings:
         Smallest covered fraction of 360-830 nm accepted.
     irls_rounds
         Reweighting rounds of the ``de2000`` objective (mean Delta E).
+    guard_max
+        Guard the max (:mod:`fitting.fits.guarded`): keep the mean fit only
+        when its mean and max are no worse than the paper method's on the
+        guard points, else a constrained refit or the paper method's fit
+        (not for the ``rgb`` objective: that is the paper's method).
+    max_gap_nm
+        Largest spacing of the data's samples inside 360-830 nm accepted
+        (:mod:`fitting.optics.quality`); past the default the fit carries a
+        warning.
     """
 
     mu_samples: int = 12
@@ -95,6 +105,8 @@ class FitSettings:
     max_nfev: int = 200
     min_coverage: float = DEFAULT_MIN_COVERAGE
     irls_rounds: int = 2
+    guard_max: bool = True
+    max_gap_nm: float = DEFAULT_MAX_GAP_NM
 
     def __post_init__(self) -> None:
         check_int("mu_samples", self.mu_samples, 4, 1000)
@@ -104,6 +116,9 @@ class FitSettings:
         check_fit_options(self.objective, self.max_nfev, self.irls_rounds)
         check_min_coverage(self.min_coverage)
         check_step_nm(self.step_nm)
+        check_max_gap(self.max_gap_nm)
+        if not isinstance(self.guard_max, bool):
+            raise ValueError(f"`guard_max` must be true or false, got {self.guard_max!r}")
 
 
 def fit_grid(

@@ -194,10 +194,10 @@ class TestExportPackNames:
         import zipfile
 
         client, _ = shared
-        wavelength = [350.0, 500.0, 650.0, 850.0]
+        wavelength = [350.0, 450.0, 550.0, 650.0, 750.0, 850.0]  # no gap over the 120 nm limit (issue 21)
         ids = []
         for i, name in enumerate(self.NAMES):
-            nk = {"wavelength_nm": wavelength, "n": [0.2 + 0.01 * i] * 4, "k": [3.0, 3.2, 3.4, 3.6]}
+            nk = {"wavelength_nm": wavelength, "n": [0.2 + 0.01 * i] * 6, "k": [3.0, 3.1, 3.2, 3.3, 3.4, 3.6]}
             response = client.post(f"{API}/fits", json={"name": name, "nk": nk})
             assert response.status_code == 201, response.text
             ids.append(response.json()["id"])

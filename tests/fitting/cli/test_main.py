@@ -47,9 +47,35 @@ def test_fit_json_with_metrics():
 @pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
 def test_fit_user_file(tmp_path):
     path = tmp_path / "metal.csv"
-    path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n600,0.6,3.0\n850,0.8,4.5\n")
+    path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n650,0.6,3.0\n"
+                    "750,0.7,3.8\n850,0.8,4.5\n")
     view = json.loads(run("fit", "--nk", str(path), "--no-metrics").stdout)
     assert view["name"] == "metal" and view["source"] == "user CSV"
+
+
+@pytest.mark.slow  # starts processes
+def test_sparse_file_refused_or_fitted_with_a_warning(tmp_path):
+    # Issue 21: three samples leave gaps of 250 nm inside 360-830 nm.
+    path = tmp_path / "sparse.csv"
+    path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n600,0.6,3.0\n850,0.8,4.5\n")
+    refused = run("fit", "--nk", str(path), "--no-metrics", check=False)
+    assert refused.returncode == 2 and "between 360 and 600 nm" in refused.stderr
+    relaxed = run("fit", "--nk", str(path), "--no-metrics", "--max-gap-nm", "300")
+    assert "warning: sparse data" in relaxed.stderr
+    assert "warning: sparse data" in json.loads(relaxed.stdout)["source"]
+
+
+@pytest.mark.slow  # starts processes
+def test_strict_refuses_a_model_outside_the_range(tmp_path):
+    # Constant n = 1.5 glass: the coated-conductor model leaves [0, 1] on it.
+    path = tmp_path / "glass.csv"
+    rows = "\n".join(f"{w},1.5,0" for w in range(300, 901, 10))
+    path.write_text("wavelength_nm,n,k\n" + rows + "\n")
+    loose = run("fit", "--nk", str(path), "--no-metrics")
+    assert "leaves [0, 1]" in loose.stderr
+    strict = run("fit", "--nk", str(path), "--no-metrics", "--strict", "-o", str(tmp_path / "g.cfpk"), check=False)
+    assert strict.returncode == 3 and "leaves [0, 1]" in strict.stderr
+    assert not (tmp_path / "g.cfpk").exists()
 
 
 @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run

@@ -72,7 +72,12 @@ class TestWorstEdits:
         result = fit_curves(green_pulled(gold_base, 0.10), gold_base)
         assert sum(counted) <= settings.max_evaluations
         assert in_range(result)
-        assert result.metrics["target"]["delta_E_mean"] < 5.0  # still follows the rest of the curves
+        # Still follows the rest of the curves: the refit's mean and max on the whole target
+        # are no worse than the paper method's candidate (issue 21's rule: the guard may
+        # trade mean for max, never lose on both).
+        guard = result.metrics["guard"]["candidates"]
+        target = result.metrics["target"]
+        assert target["delta_E_mean"] <= guard["rgb"]["delta_E_mean"] and target["delta_E_max"] <= guard["rgb"]["delta_E_max"]
 
     def test_a_degenerate_base_stays_in_budget_and_range(self, monkeypatch):
         # n = 1, k = 0: the base has no conductor at all.
