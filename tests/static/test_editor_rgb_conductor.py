@@ -17,14 +17,16 @@ inputs):
     |eta|^2 <= (k / eta_i)^2 ~ 10 for copper, a relative error of ~100 u32
     = 6e-6 on its terms, R in [0, 1]: 1e-5 absolute (tests/precision.py's
     GLSL_F32_BOUND), doubled for the one cancelling difference, 1 - sin^2
-    theta_t, of size >= 1 - 1 / |eta|^2 > 0.9 here. Measured 1e-7.
+    theta_t, of size >= 1 - 1 / |eta|^2 > 0.9 here. Measured 1.6e-7.
 -   ``TABLE`` 3e-4: its GGX table (2048 Hammersley points a node, the
     quadrature of the reference's table) against
     fitting.shading.ibl.directional_albedo: SwiftShader's sin and cos err by
     up to 1.9e-4, as for the reference band's table
-    (tests/static/test_editor_webgl_rough.py, docs/editor.md).
+    (tests/static/test_editor_webgl_rough.py, docs/editor.md). Measured
+    1.1e-4 (Cu, roughness 0.45).
 -   ``EXACT`` 2e-6: a pixel's albedo against its read-back table
-    interpolated at its read-back cosine (only float32 rounding).
+    interpolated at its read-back cosine (only float32 rounding); measured
+    3.5e-8.
 -   ``DISPLAY`` 2e-4: the sRGB-encoded canvas (the encoding's slope up to
     12.9 near black times the linear error, and pow's), as the
     coated-conductor parity (test_editor_webgl_parity.py).
