@@ -154,17 +154,19 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
     set_environment(page, env)
     NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
     three, three_mask = three_ACEScg(page, "model", roughness, coat_roughness)
+    preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness, env)
+    if env != "white_sky":  # the preview alone
+        region = hit & three_mask & (NdotV >= NDOTV_MIN)
+        return {"pixels": int(region.sum()), "preview": _stats(delta_E_map(preview, three), NdotV, region),
+                "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist()}
     fallback, fallback_mask = three_ACEScg(page, "fallback", roughness, coat_roughness)
     region = hit & three_mask & fallback_mask & (NdotV >= NDOTV_MIN)
-    preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness, env)
     figures = {
         "pixels": int(region.sum()),
         "preview": _stats(delta_E_map(preview, three), NdotV, region),
         "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
         "fallback_centre_rgb": fallback[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
     }
-    if env != "white_sky":
-        return figures
     physics = per_pixel(coated_albedo(
         lambda c: reference_ACEScg(nk, np.asarray(c).reshape(-1), eta_i, 1.0).reshape(np.shape(c) + (3,)),
         eta_i, roughness, coat_roughness), NdotV)
