@@ -66,6 +66,8 @@ def _row(material, kind, env, eta_i, r, c, f) -> str:
     p = f["preview"]
     cells = [material, kind, env, f"{eta_i:g}", f"{r:g}", f"{c:g}",
              f"{p['mean']:.4f} / {p['p99']:.3f} / {p['max']:.2f} / {p['centre']:.4f} / {p['ring']:.3f}"]
+    q = f.get("preview_rec709")
+    cells.append(f"{q['mean']:.4f} / {q['p99']:.3f} / {q['max']:.2f}" if q else "")
     if env == "white_sky":
         twin = f.get("twin")
         cells.append(f"{twin['mean']:.4f} / {twin['centre']:.4f}" if twin else "")
@@ -107,18 +109,19 @@ def main() -> None:
     load = max(load, os.getloadavg()[0])
     lines = [
         "| material | kind | environment | eta_i | roughness | coat | vs preview: mean / p99 / max / centre / ring "
+        "| vs preview lit in Rec.709: mean / p99 / max "
         "| vs twin: mean / centre | vs physics: mean / centre / ring | fallback vs physics: mean / centre |",
-        "|---|---|---|---:|---:|---:|---|---|---|---|",
+        "|---|---|---|---:|---:|---:|---|---|---|---|---|",
     ]
     lines += [_row(*row) for row in rows]
     for kind in KINDS:
         for env in environments:
             of = [row[6]["preview"] for row in rows if row[1] == kind and row[2] == env]
+            lit = [row[6]["preview_rec709"] for row in rows if row[1] == kind and row[2] == env and "preview_rec709" in row[6]]
             if of:
-                lines.append(
-                    f"| **{kind}** | | **{env}** | | | | **mean {sum(f['mean'] for f in of) / len(of):.4f}**, "
-                    f"worst mean {max(f['mean'] for f in of):.4f}, worst max {max(f['max'] for f in of):.2f} | | | |"
-                )
+                summary = lambda fs: (f"**mean {sum(f['mean'] for f in fs) / len(fs):.4f}**, worst mean "
+                                      f"{max(f['mean'] for f in fs):.4f}, worst max {max(f['max'] for f in fs):.2f}")
+                lines.append(f"| **{kind}** | | **{env}** | | | | {summary(of)} | {summary(lit) if lit else ''} | | | |")
     table = "\n".join(lines)
     print(table)
     if args.record != "-":
@@ -135,7 +138,10 @@ def main() -> None:
             f"{time.perf_counter() - started:.0f} s. Under the studio and outdoor skies both sides "
             "draw the same cf_environment.glsl, filtered each its own way (three's PMREM, with its "
             "roughness floor of 0.0525; the preview's analytic mirror or the project's prefiltered "
-            "slices), so those rows hold the filters' difference as well as the material's.\n\n"
+            "slices), so those rows hold the filters' difference as well as the material's; and three "
+            "multiplies albedo and radiance per channel in linear Rec.709, the preview in ACEScg: the "
+            "column 'lit in Rec.709' recomposes the preview's own parts as three lights them "
+            "(tests/static/three_pages.py preview_lit_in_rec709).\n\n"
             f"{table}\n"
         )
         print(f"recorded in {path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}", file=sys.stderr)

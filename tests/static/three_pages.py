@@ -11,7 +11,11 @@ what is compared is the material) or the studio or the outdoor sky (the
 same cf_environment.glsl on both sides: three draws it into a 1024 x 512
 equirect and prefilters it with its PMREM, the preview evaluates it per
 pixel for a mirror and reads the project's prefiltered slices for a rough
-lobe, so there the figures hold the two filters' difference too), the
+lobe, so there the figures hold the two filters' difference too; and three
+multiplies albedo by radiance per channel in its working space, linear
+Rec.709, where the preview does in ACEScg: for a coloured sky that is most
+of the difference, so :func:`preview_lit_in_rec709` recomposes the
+preview's own parts as three lights them, ``preview_rec709``), the
 preview's camera (orbit (0.5, 0.25, 4.2), vertical field of view 0.52
 rad) at W x H pixels, a clear coat of index eta_i over the metal. Both read
 back as float32 linear radiance: the preview in ACEScg (OUTPUT.linear),
@@ -111,6 +115,30 @@ def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughne
     return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1][..., :3]
 
 
+def preview_lit_in_rec709(page) -> np.ndarray:
+    """
+    (H, W, 3) linear ACEScg: the preview ball's last settings lit as three
+    lights them, the products of albedo and radiance taken per channel in
+    linear Rec.709 (three's working space) rather than in ACEScg (the
+    preview's): M^-1 [E_c M L_c + T (M F) (M L_m)] from the preview's own
+    parts (albedo F, lightings L_m and L_c, coat albedo E_c and transmission
+    T), M = CF_ACESCG_TO_SRGB. Under the white sky it is the preview itself.
+    """
+    flat = page.evaluate(
+        """async ([w, h]) => {
+            const { OUTPUT } = await import('/preview.js');
+            const ball = await window.cfParityBall;
+            return ['fresnel', 'baseLight', 'coatLight', 'coat'].map((o) => Array.from(ball.readFloat(OUTPUT[o], w, h)));
+        }""",
+        [W, H],
+    )
+    F, base, coat_light, coat = (np.asarray(f, dtype=np.float64).reshape(H, W, 4)[::-1] for f in flat)
+    M = ACEScg_to_sRGB_matrix()
+    E, T = coat[..., :1], coat[..., 1:2]
+    rec709 = E * (coat_light[..., :3] @ M.T) + T * (F[..., :3] @ M.T) * (base[..., :3] @ M.T)
+    return rec709 @ np.linalg.inv(M).T
+
+
 def coated_albedo(metal_fresnel, eta_i: float, roughness: float, coat_roughness: float) -> np.ndarray:
     """
     E_c(mu) + [1 - F_c(mu)]^2 E_m(mu_t) at the physics' NdotV nodes, (n, 3)
@@ -155,9 +183,11 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
     NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
     three, three_mask = three_ACEScg(page, "model", roughness, coat_roughness)
     preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness, env)
-    if env != "white_sky":  # the preview alone
+    if env != "white_sky":  # the preview alone, as it draws and lit in three's working space
         region = hit & three_mask & (NdotV >= NDOTV_MIN)
+        in_rec709 = preview_lit_in_rec709(page)
         return {"pixels": int(region.sum()), "preview": _stats(delta_E_map(preview, three), NdotV, region),
+                "preview_rec709": _stats(delta_E_map(in_rec709, three), NdotV, region),
                 "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist()}
     fallback, fallback_mask = three_ACEScg(page, "fallback", roughness, coat_roughness)
     region = hit & three_mask & fallback_mask & (NdotV >= NDOTV_MIN)
