@@ -27,10 +27,14 @@ benchmarks/records/three_parity.md):
 -   studio and outdoor, against the preview: there both draw the same
     cf_environment.glsl but filter it each its own way (three's PMREM of a
     1024 x 512 equirect with its roughness floor of 0.0525; the preview's
-    exact mirror or the project's prefiltered slices), so the figures hold
-    that difference as well as the material's. Mean < ``STUDIO_MEAN`` and
-    ``OUTDOOR_MEAN`` (measured up to the worst means of the record, see
-    ``ENVIRONMENT_BOUNDS``); the material's own agreement is the white sky's;
+    exact mirror or the project's prefiltered slices), and three multiplies
+    albedo by radiance per channel in linear Rec.709 where the preview does
+    in ACEScg, so the figures hold those differences as well as the
+    material's. Mean < ``ENVIRONMENT_BOUNDS`` (studio 1.5, outdoor 4.0;
+    measured worst means 1.22 and 3.14 over 4 materials, both kinds, 3
+    settings); against the preview lit as three lights it (its products in
+    Rec.709, ``preview_rec709``), mean < ``LIT_MEAN`` 1.5 (measured 0.33-1.15;
+    the rest is the filters and the highlights' edges);
 -   against the physics (the spectral reference under the coat): mean <
     0.25, centre and ring < 0.3 (measured 0.11 / 0.19 / 0.09 for Au mirrors,
     the model's own float16 error, the paper's 0.14 for Au);
@@ -53,7 +57,8 @@ PARITY_MEAN, PARITY_P99, PARITY_CENTRE, PARITY_RING = 0.05, 0.25, 0.02, 0.15
 PHYSICS_MEAN, PHYSICS_CENTRE, PHYSICS_RING = 0.25, 0.3, 0.3
 FALLBACK_CENTRE = 4.0
 # environment -> bound on the mean Delta E against the preview (see the docstring).
-ENVIRONMENT_BOUNDS = {"studio": 1.5, "outdoor": 5.0}
+ENVIRONMENT_BOUNDS = {"studio": 1.5, "outdoor": 4.0}
+LIT_MEAN = 1.5
 
 
 class Session:
@@ -131,6 +136,7 @@ def test_plugin_matches_preview_and_physics(session, kind, material, eta_i, env,
     figures = measure_three(page, session.server, nk, fit, eta_i, *lobe, env)
     assert figures["pixels"] > 10_000
     assert figures["preview"]["mean"] < ENVIRONMENT_BOUNDS[env], (env, figures["preview"])
+    assert figures["preview_rec709"]["mean"] < LIT_MEAN, (env, figures["preview_rec709"])
 
 
 def test_roughness_and_coat_change_the_render(session):
@@ -170,7 +176,8 @@ def test_roughness_and_coat_change_the_render(session):
 
 def test_material_refuses_malformed_extensions(session):
     """createCoatedConductorMaterial checks the extension object and names the field."""
-    page = session.example(session.fit("Au", "coated-conductor"), 1.5)
+    # Any example page will do: the one the test before left open (Cu at 1.8), no reload.
+    page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
     messages = page.evaluate("""async () => {
         const { checkModel } = await import('/static/three/coated_conductor.js');
         const good = { kind: 'rgb-conductor', colorSpace: 'ACEScg', etaIRange: [1, 2.5], coatIor: 1.5,
