@@ -2,33 +2,35 @@
 three.js through EXT_materials_coated_conductor against the preview and the physics
 ===================================================================================
 
-For each library material, model kind and setting (coat index eta_i, metal
-roughness, coat roughness): a fit stored on a server just started, its glTF
-export loaded on /examples/three.html with the plugin and without it, and
-both balls read back as float radiance in Chromium (SwiftShader WebGL2)
-under the white sky, 128 x 128, against
+For each library material, model kind, coat index eta_i, preview
+environment (white sky, studio, outdoor) and lobe setting (metal roughness,
+coat roughness): a fit stored on a server just started, its glTF export
+loaded on /examples/three.html with the plugin and without it (one page load
+per fit and eta_i: the page relights and the material takes each roughness
+in turn), and both balls read back as float radiance in Chromium
+(SwiftShader WebGL2), 128 x 128, against
 
--   the editor's WebGL preview at the same settings (coated-conductor; the
-    preview has no rgb-conductor band, so that kind is compared with numpy's
-    twin of the same material: split sum of its exact Fresnel, the same
-    coat);
--   the physics: the 1 nm spectral reference under the coat in the coated
-    split sum (tests/static/three_pages.py);
--   the fallback ball (no plugin: Schlick base colour and
-    KHR_materials_clearcoat) against the same physics.
+-   the editor's WebGL preview at the same settings, both kinds (the preview
+    draws the rgb-conductor kind too);
+-   under the white sky, also numpy's twin of an rgb-conductor material
+    (split sum of its exact Fresnel, the same coat), the physics (the 1 nm
+    spectral reference under the coat in the coated split sum,
+    tests/static/three_pages.py), and the fallback ball (no plugin: Schlick
+    base colour and KHR_materials_clearcoat) against the same physics.
 
 Mean Delta E 2000 over the ball's pixels with NdotV >= 0.1, its 99th
-percentile, the mean at the centre (NdotV >= 0.97) and on the ring near
+percentile, its max, the mean at the centre (NdotV >= 0.97) and on the ring near
 grazing (NdotV in [0.1, 0.25]). Prints a Markdown table and records it::
 
-    .venv/bin/python benchmarks/three_parity.py            # about 8 min here
-    .venv/bin/python benchmarks/three_parity.py --materials Au --record -
+    .venv/bin/python benchmarks/three_parity.py            # about 20 min here
+    .venv/bin/python benchmarks/three_parity.py --materials Au --environments studio --record -
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 import tempfile
@@ -48,7 +50,9 @@ from three_pages import create_fit, measure_three, open_example  # noqa: E402
 from fitting.models.kinds import MODEL_KINDS, model_kind  # noqa: E402
 from fitting.optics.library import library_material  # noqa: E402
 
-SETTINGS = [(1.5, 0.0, 0.0), (1.5, 0.3, 0.1), (2.2, 0.5, 0.2)]
+# (eta_i, [(metal roughness, coat roughness), ...]): the settings of one page load.
+SETTINGS = [(1.5, [(0.0, 0.0), (0.3, 0.1)]), (2.2, [(0.5, 0.2)])]
+ENVIRONMENTS = ("white_sky", "studio", "outdoor")
 KINDS = tuple(MODEL_KINDS)
 RECORD = ROOT / "benchmarks" / "records" / "three_parity.md"
 
@@ -59,13 +63,32 @@ def three_version() -> str:
     return lock["packages"]["node_modules/three"]["version"]
 
 
+def _row(material, kind, env, eta_i, r, c, f) -> str:
+    p = f["preview"]
+    cells = [material, kind, env, f"{eta_i:g}", f"{r:g}", f"{c:g}",
+             f"{p['mean']:.4f} / {p['p99']:.3f} / {p['max']:.2f} / {p['centre']:.4f} / {p['ring']:.3f}"]
+    q = f.get("preview_rec709")
+    cells.append(f"{q['mean']:.4f} / {q['p99']:.3f} / {q['max']:.2f}" if q else "")
+    if env == "white_sky":
+        twin = f.get("twin")
+        cells.append(f"{twin['mean']:.4f} / {twin['centre']:.4f}" if twin else "")
+        cells.append(f"{f['physics']['mean']:.3f} / {f['physics']['centre']:.3f} / {f['physics']['ring']:.3f}")
+        cells.append(f"{f['fallback']['mean']:.2f} / {f['fallback']['centre']:.2f}")
+    else:
+        cells += ["", "", ""]
+    return "| " + " | ".join(cells) + " |"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--materials", default="Au,Cu,Cr,Al", help="comma-separated library materials")
+    parser.add_argument("--environments", default=",".join(ENVIRONMENTS), help="comma-separated preview environments")
     parser.add_argument("--record", default=str(RECORD), help="file for the table ('-': none)")
     args = parser.parse_args()
+    environments = args.environments.split(",")
     rows = []
     started = time.perf_counter()
+    load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data") as server:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=shutil.which("chromium"), args=CHROMIUM_ARGS)
@@ -75,36 +98,31 @@ def main() -> None:
                 nk = library_material(material)
                 for kind in KINDS:
                     fit = create_fit(server.url, material, kind)
-                    for eta_i, roughness, coat_roughness in SETTINGS:
-                        open_example(page, server.url, fit["id"], eta_i)
-                        f = measure_three(page, server.url, nk, fit, eta_i, roughness, coat_roughness)
-                        parity = f.get("preview", f.get("twin"))
-                        rows.append((material, kind, eta_i, roughness, coat_roughness, parity, f["physics"], f["fallback"]))
-                        print(f"{material} {kind} {eta_i} {roughness} {coat_roughness}: "
-                              f"{parity['mean']:.4f} / {f['physics']['mean']:.4f} / {f['fallback']['mean']:.3f}",
-                              file=sys.stderr)
+                    for eta_i, lobes in SETTINGS:
+                        open_example(page, server.url, fit["id"], eta_i, environments[0])
+                        for env in environments:
+                            for roughness, coat_roughness in lobes:
+                                f = measure_three(page, server.url, nk, fit, eta_i, roughness, coat_roughness, env)
+                                rows.append((material, kind, env, eta_i, roughness, coat_roughness, f))
+                                print(f"{material} {kind} {env} {eta_i} {roughness} {coat_roughness}: "
+                                      f"{f['preview']['mean']:.4f} / max {f['preview']['max']:.3f}", file=sys.stderr)
             browser.close()
+    load = max(load, os.getloadavg()[0])
     lines = [
-        "| material | kind | eta_i | roughness | coat | vs preview (twin): mean / p99 / centre / ring "
-        "| vs physics: mean / centre / ring | fallback vs physics: mean / centre |",
-        "|---|---|---:|---:|---:|---|---|---|",
+        "| material | kind | environment | eta_i | roughness | coat | vs preview: mean / p99 / max / centre / ring "
+        "| vs preview lit in Rec.709: mean / p99 / max "
+        "| vs twin: mean / centre | vs physics: mean / centre / ring | fallback vs physics: mean / centre |",
+        "|---|---|---|---:|---:|---:|---|---|---|---|---|",
     ]
-    for material, kind, eta_i, r, c, parity, physics, fallback in rows:
-        # A kind the rough preview cannot draw (no split sum) is compared with its twin.
-        versus = "preview" if model_kind(kind).split_sum else "twin"
-        lines.append(
-            f"| {material} | {kind} | {eta_i:g} | {r:g} | {c:g} | {versus} {parity['mean']:.4f} / "
-            f"{parity['p99']:.3f} / {parity['centre']:.4f} / {parity['ring']:.3f} | {physics['mean']:.3f} / "
-            f"{physics['centre']:.3f} / {physics['ring']:.3f} | {fallback['mean']:.2f} / {fallback['centre']:.2f} |"
-        )
+    lines += [_row(*row) for row in rows]
     for kind in KINDS:
-        of = [row for row in rows if row[1] == kind]
-        if of:
-            lines.append(
-                f"| **mean, {kind}** | | | | | **{sum(r[5]['mean'] for r in of) / len(of):.4f}** "
-                f"(max of means {max(r[5]['mean'] for r in of):.4f}) | **{sum(r[6]['mean'] for r in of) / len(of):.3f}** "
-                f"| {sum(r[7]['mean'] for r in of) / len(of):.2f} |"
-            )
+        for env in environments:
+            of = [row[6]["preview"] for row in rows if row[1] == kind and row[2] == env]
+            lit = [row[6]["preview_rec709"] for row in rows if row[1] == kind and row[2] == env and "preview_rec709" in row[6]]
+            if of:
+                summary = lambda fs: (f"**mean {sum(f['mean'] for f in fs) / len(fs):.4f}**, worst mean "
+                                      f"{max(f['mean'] for f in fs):.4f}, worst max {max(f['max'] for f in fs):.2f}")
+                lines.append(f"| **{kind}** | | **{env}** | | | | {summary(of)} | {summary(lit) if lit else ''} | | | |")
     table = "\n".join(lines)
     print(table)
     if args.record != "-":
@@ -112,9 +130,20 @@ def main() -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(
             "# benchmarks/three_parity.py\n\n"
-            "Delta E 2000, 128 x 128, white sky, Chromium (SwiftShader WebGL2), three "
-            f"{three_version()} through EXT_materials_coated_conductor; "
-            f"{len(rows)} settings in {time.perf_counter() - started:.0f} s.\n\n{table}\n"
+            f"Command: `.venv/bin/python benchmarks/three_parity.py --materials {args.materials} "
+            f"--environments {args.environments}`; run {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
+            f"load average up to {load:.1f} on {os.cpu_count()} cores.\n\n"
+            "Delta E 2000, 128 x 128, Chromium (SwiftShader WebGL2), three "
+            f"{three_version()} through EXT_materials_coated_conductor against the editor's WebGL "
+            f"preview at the same settings (both kinds); {len(rows)} settings in "
+            f"{time.perf_counter() - started:.0f} s. Under the studio and outdoor skies both sides "
+            "draw the same cf_environment.glsl, filtered each its own way (three's PMREM, with its "
+            "roughness floor of 0.0525; the preview's analytic mirror or the project's prefiltered "
+            "slices), so those rows hold the filters' difference as well as the material's; and three "
+            "multiplies albedo and radiance per channel in linear Rec.709, the preview in ACEScg: the "
+            "column 'lit in Rec.709' recomposes the preview's own parts as three lights them "
+            "(tests/static/three_pages.py preview_lit_in_rec709).\n\n"
+            f"{table}\n"
         )
         print(f"recorded in {path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}", file=sys.stderr)
 

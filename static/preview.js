@@ -10,8 +10,14 @@
 // variant (splitsum.js: the LUT and the prefiltered environment fetched on
 // first use, albedo tables integrated when the settings change). Frames
 // wait for those textures (the last frame stays, and `status` says so).
+//
+// Model kinds (kinds.js): the model band draws the kind of the fit shown,
+// each kind its own variant of the programs (CF_RGB_CONDUCTOR 0: the
+// coated-conductor model from its 14 packed words; 1: the rgb-conductor's
+// exact Fresnel from its 3), compiled when a fit of that kind first shows.
 
 import { drawInto, floatTarget, fullscreenProgram, readTarget } from "./glpass.js";
+import { modelKind } from "./kinds.js";
 import { ENVIRONMENT_NAMES, SplitSum, UNIT, setMaterial } from "./splitsum.js";
 
 export const PANEL = { model: 0, lazanyi: 1, reference: 2 };
@@ -19,53 +25,9 @@ export const OUTPUT = { display: 0, linear: 1, fresnel: 2, geometry: 3, baseLigh
 export const ENVIRONMENT = Object.fromEntries(ENVIRONMENT_NAMES.map((name, i) => [name, i]));
 const LABELS = ["Model", "Adjusted Lazanyi", "Spectral reference"];
 
-// ------------------------------------------------------------ float16 halves
-
-const f32 = new Float32Array(1);
-const u32 = new Uint32Array(f32.buffer);
-
-/** IEEE half bits of `x`, rounded to nearest even (exact for float16 values). */
-export function halfBits(x) {
-  f32[0] = x;
-  const bits = u32[0];
-  const sign = (bits >>> 16) & 0x8000;
-  const exponent = (bits >>> 23) & 0xff;
-  let mantissa = bits & 0x7fffff;
-  if (exponent === 0xff) return sign | 0x7c00 | (mantissa ? 0x200 : 0);
-  const e = exponent - 112;
-  if (e >= 0x1f) return sign | 0x7c00;
-  if (e <= 0) {
-    if (e < -10) return sign;
-    mantissa |= 0x800000;
-    const shift = 14 - e;
-    let h = mantissa >>> shift;
-    const rest = mantissa & ((1 << shift) - 1), half = 1 << (shift - 1);
-    if (rest > half || (rest === half && (h & 1))) h += 1;
-    return sign | h;
-  }
-  let h = (e << 10) | (mantissa >>> 13);
-  const rest = mantissa & 0x1fff;
-  if (rest > 0x1000 || (rest === 0x1000 && (h & 1))) h += 1;
-  return sign | h;
-}
-
-/**
- * The 14 uint32 words a renderer uploads (fitting.pack.halves_to_uint32):
- * coefficients[p][c][j] for p in (F0, a, alpha), two halves a word, the
- * earlier in the low 16 bits; powers beyond the fit's degree are 0.
- */
-export function packedWords(coefficients) {
-  const halves = [];
-  for (const p of ["F0", "a", "alpha"]) {
-    for (let c = 0; c < 3; c++) {
-      for (let j = 0; j < 3; j++) halves.push(halfBits(coefficients[p][c][j] ?? 0));
-    }
-  }
-  halves.push(0);
-  const words = new Uint32Array(14);
-  for (let k = 0; k < 14; k++) words[k] = (halves[2 * k] | (halves[2 * k + 1] << 16)) >>> 0;
-  return words;
-}
+// The float16 halves and the kinds' words live in kinds.js (re-exported:
+// the three.js material and older callers import them from here).
+export { halfBits, packedWords } from "./kinds.js";
 
 // ------------------------------------------------------------ renderer
 
@@ -98,7 +60,10 @@ export class ShaderBall {
     this.labels = labels;
     this.status = status;
     this.gl = gl;
-    this.mirror = mirror; // shader_ball.frag: every lobe a mirror
+    // shader_ball.frag, every lobe a mirror, by shader kind (kinds.js):
+    // the program, or a promise while it compiles.
+    this.mirrors = new Map([[0, mirror]]);
+    this.mirror = mirror; // the coated-conductor's, for older callers
     this.vao = gl.createVertexArray();
     this.splitSum = new SplitSum(gl, this.vao);
     this.lightingError = null;
@@ -106,6 +71,7 @@ export class ShaderBall {
       orbit: [0.5, 0.25, 4.2], fov: 0.52, panels: [PANEL.model], environment: ENVIRONMENT.studio,
       exposure: 0, eta: 1.5, words: new Uint32Array(14), etaRange: [1, 2.5],
       F0: [0, 0, 0], F82: [0, 0, 0], fitId: null, referenceFor: null, referenceRange: [1, 2.5],
+      model: "coated-conductor", shaderKind: 0, nk: null,
       roughness: 0, coated: false, coatRoughness: 0,
     };
     this.reference = this.#texture(new Float32Array(6), 2, 1);
@@ -139,8 +105,38 @@ export class ShaderBall {
    * without waiting up to a display interval; orbiting still coalesces).
    */
   setFit(fit) {
-    Object.assign(this.state, { words: packedWords(fit.coefficients), etaRange: fit.eta_i_range, fitId: fit.id });
+    const kind = modelKind(fit);
+    Object.assign(this.state, {
+      words: kind.words(fit.coefficients), etaRange: fit.eta_i_range, fitId: fit.id,
+      model: kind.name, shaderKind: kind.shaderKind, nk: kind.nk(fit.coefficients),
+    });
     this.drawNow();
+  }
+
+  /** A promise of the mirror program of shader kind `shaderKind` (compiled once). */
+  #mirrorFor(shaderKind) {
+    const made = this.mirrors.get(shaderKind);
+    if (made && !(made instanceof Promise)) return Promise.resolve(made);
+    if (!made) {
+      const compiling = fullscreenProgram(this.gl, "shader_ball.frag", { CF_RGB_CONDUCTOR: shaderKind }).then((program) => {
+        this.mirrors.set(shaderKind, program);
+        return program;
+      }, (error) => {
+        this.mirrors.delete(shaderKind);
+        this.#say(`The preview cannot draw this kind: ${error.message}`);
+        throw error;
+      });
+      this.mirrors.set(shaderKind, compiling);
+    }
+    return this.mirrors.get(shaderKind);
+  }
+
+  /**
+   * A promise resolved once the current settings can be drawn: the fit's
+   * kind's programs, and for a rough lobe the split sum's textures.
+   */
+  ready() {
+    return this.#mirrorFor(this.state.shaderKind).then(() => this.lightingReady()).then(() => this.draw());
   }
 
   /** The spectral reference texture and Lazanyi inputs (see api.referenceTexture). */
@@ -178,8 +174,8 @@ export class ShaderBall {
    * then draws every lobe as a mirror.
    */
   lightingReady() {
-    if (!this.#rough()) return Promise.resolve();
-    return this.splitSum.load(this.state.environment).then(() => this.draw(), (error) => {
+    if (!this.#rough()) return this.#mirrorFor(this.state.shaderKind).then(() => this.draw());
+    return this.splitSum.load(this.state.environment, this.state.shaderKind).then(() => this.draw(), (error) => {
       this.lightingError = error;
       this.#say(`Rough lighting unavailable, every surface is drawn smooth: ${error.message}`);
       this.draw();
@@ -195,19 +191,24 @@ export class ShaderBall {
   // The program of this frame, its albedo tables integrated; null while
   // the split sum's textures are on their way.
   #program() {
-    if (!this.#rough()) {
-      if (!this.lightingError) this.#say("");
-      return this.mirror;
-    }
     const s = this.state;
-    if (!this.splitSum.loaded(s.environment)) {
+    if (!this.#rough()) {
+      const mirror = this.mirrors.get(s.shaderKind);
+      if (!mirror || mirror instanceof Promise) {
+        this.#mirrorFor(s.shaderKind).then(() => this.draw(), () => {});
+        return null;
+      }
+      if (!this.lightingError) this.#say("");
+      return mirror;
+    }
+    if (!this.splitSum.loaded(s.environment, s.shaderKind)) {
       this.#say("Preparing the rough lighting…");
       this.lightingReady();
       return null;
     }
     this.#say("");
     this.splitSum.integrate(s, this.reference, s.panels.includes(PANEL.reference));
-    return this.splitSum.program;
+    return this.splitSum.programFor(s.shaderKind);
   }
 
   /** The split sum's albedo tables as last integrated, for the parity tests. */
@@ -231,7 +232,7 @@ export class ShaderBall {
     gl.activeTexture(gl.TEXTURE0 + UNIT.reference);
     gl.bindTexture(gl.TEXTURE_2D, this.reference);
     gl.uniform1i(u.u_reference, UNIT.reference);
-    if (ball !== this.mirror) this.splitSum.bind(u, s.environment);
+    if (ball === this.splitSum.programFor(s.shaderKind)) this.splitSum.bind(u, s.environment);
   }
 
   /** Ask for a frame (drawn on the next animation frame, once). */
@@ -264,7 +265,8 @@ export class ShaderBall {
     this.frames += 1;
     canvas.dataset.fit = this.state.fitId || "";
     canvas.dataset.eta = this.state.eta.toFixed(2);
-    canvas.dataset.program = ball === this.mirror ? "mirror" : "split-sum";
+    canvas.dataset.program = ball === this.splitSum.programFor(this.state.shaderKind) ? "split-sum" : "mirror";
+    canvas.dataset.model = this.state.model;
     this.#label();
     if (this.onFrame) this.onFrame(this.state);
   }
@@ -289,7 +291,7 @@ export class ShaderBall {
    */
   readFloat(output, width, height) {
     const ball = this.#program();
-    if (!ball) throw new Error("the split sum's textures are not in yet: await lightingReady()");
+    if (!ball) throw new Error("the programs or the split sum's textures are not in yet: await ready()");
     const gl = this.gl;
     const target = floatTarget(gl, width, height);
     this.#uniforms(ball, output, width, height);

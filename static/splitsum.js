@@ -4,7 +4,10 @@
 // use; the split-sum variant of shader_ball.frag; and its albedo tables
 // over NdotV, which albedo_table.frag (model, Lazanyi, coat, from the LUT)
 // and reference_albedo.frag (the reference, from its texture) integrate
-// when the fit, eta_i or a roughness change, never per frame.
+// when the fit, eta_i or a roughness change, never per frame. For the
+// rgb-conductor kind (kinds.js) the model's row is the GGX lobe of its
+// exact Fresnel by quadrature (rgb_albedo_table.frag, the three.js
+// material's table), drawn over albedo_table.frag's row 0.
 
 import * as api from "./api.js";
 import { drawInto, floatTarget, fullscreenProgram, readTarget } from "./glpass.js";
@@ -32,6 +35,10 @@ export function setMaterial(gl, u, s) {
   gl.uniform1f(u.u_roughness, s.roughness);
   gl.uniform1i(u.u_coated, s.coated ? 1 : 0);
   gl.uniform1f(u.u_coat_roughness, s.coatRoughness);
+  if (s.nk) {
+    gl.uniform3f(u.cf_n, ...s.nk[0]);
+    gl.uniform3f(u.cf_k, ...s.nk[1]);
+  }
 }
 
 function texture3D(gl, target, format, data, width, height, depth, filter) {
@@ -51,8 +58,9 @@ export class SplitSum {
     this.gl = gl;
     this.vao = vao;
     this.loads = new Map(); // what -> Promise
-    this.program = null; // shader_ball.frag with CF_SPLIT_SUM 1
+    this.programs = new Map(); // shader kind -> shader_ball.frag with CF_SPLIT_SUM 1
     this.tablePass = null;
+    this.rgbTablePass = null; // rgb_albedo_table.frag, once an rgb-conductor is rough
     this.referencePass = null;
     this.lut = null;
     this.alphaRange = null;
@@ -71,16 +79,36 @@ export class SplitSum {
     return this.loads.get(what);
   }
 
-  /** A promise of the programs, the LUT and the slices of `environment` (an index). */
-  load(environment) {
+  /** The split-sum program of shader kind `shaderKind` (undefined until loaded). */
+  programFor(shaderKind) {
+    return this.programs.get(shaderKind);
+  }
+
+  /** The coated-conductor's split-sum program, for older callers. */
+  get program() {
+    return this.programs.get(0) ?? null;
+  }
+
+  /**
+   * A promise of the programs of shader kind `shaderKind` (kinds.js), the
+   * LUT and the slices of `environment` (an index).
+   */
+  load(environment, shaderKind = 0) {
     const gl = this.gl;
     const programs = this.#once("programs", async () => {
-      const [program, tablePass, referencePass] = await Promise.all([
-        fullscreenProgram(gl, "shader_ball.frag", { CF_SPLIT_SUM: 1 }),
+      const [tablePass, referencePass] = await Promise.all([
         fullscreenProgram(gl, "albedo_table.frag"),
         fullscreenProgram(gl, "reference_albedo.frag"),
       ]);
-      Object.assign(this, { program, tablePass, referencePass });
+      Object.assign(this, { tablePass, referencePass });
+    });
+    const program = this.#once(`program ${shaderKind}`, async () => {
+      const [made, rgbTablePass] = await Promise.all([
+        fullscreenProgram(gl, "shader_ball.frag", { CF_SPLIT_SUM: 1, CF_RGB_CONDUCTOR: shaderKind }),
+        shaderKind === 1 ? fullscreenProgram(gl, "rgb_albedo_table.frag") : null,
+      ]);
+      if (rgbTablePass) this.rgbTablePass = rgbTablePass;
+      this.programs.set(shaderKind, made);
     });
     const lut = this.#once("lut", async () => {
       const table = await api.iblLut();
@@ -100,12 +128,12 @@ export class SplitSum {
         gl, gl.TEXTURE_2D_ARRAY, format, env.data, env.width, env.height, env.layers, gl.LINEAR,
       ));
     });
-    return Promise.all([programs, lut, slices]).then(() => undefined);
+    return Promise.all([programs, program, lut, slices]).then(() => undefined);
   }
 
-  /** Whether load(environment) has completed. */
-  loaded(environment) {
-    return this.program !== null && this.lut !== null && this.prefiltered.has(environment);
+  /** Whether load(environment, shaderKind) has completed. */
+  loaded(environment, shaderKind = 0) {
+    return this.tablePass !== null && this.programs.has(shaderKind) && this.lut !== null && this.prefiltered.has(environment);
   }
 
   /**
@@ -115,7 +143,7 @@ export class SplitSum {
    */
   integrate(s, reference, withReference) {
     const gl = this.gl;
-    const key = JSON.stringify([Array.from(s.words), s.etaRange, s.F0, s.F82, s.eta, s.roughness, s.coatRoughness]);
+    const key = JSON.stringify([s.shaderKind, Array.from(s.words), s.nk, s.etaRange, s.F0, s.F82, s.eta, s.roughness, s.coatRoughness]);
     if (key !== this.albedoFor) {
       const u = this.tablePass.uniforms;
       gl.useProgram(this.tablePass.program);
@@ -126,6 +154,7 @@ export class SplitSum {
       gl.bindTexture(gl.TEXTURE_3D, this.lut);
       gl.uniform1i(u.cf_lut, UNIT.lut);
       drawInto(gl, this.vao, [this.albedo], this.nodes, 3);
+      if (s.shaderKind === 1) this.#rgbModelRow(s);
       this.albedoFor = key;
     }
     const referenceKey = JSON.stringify([s.referenceFor, s.referenceRange, s.eta, s.roughness]);
@@ -141,6 +170,25 @@ export class SplitSum {
       drawInto(gl, this.vao, [this.referenceAlbedo], this.nodes, 1);
       this.referenceAlbedoFor = referenceKey;
     }
+  }
+
+  // The rgb-conductor's model row (row 0) from rgb_albedo_table.frag, over
+  // albedo_table.frag's (rows 1 and 2, Lazanyi and the coat, are kept: the
+  // scissor lets the pass write row 0 only).
+  #rgbModelRow(s) {
+    const gl = this.gl, u = this.rgbTablePass.uniforms;
+    gl.useProgram(this.rgbTablePass.program);
+    gl.uniform2f(u.u_resolution, this.nodes, 3);
+    setMaterial(gl, u, s);
+    gl.uniform1i(u.u_samples, REFERENCE_SAMPLES);
+    gl.uniform2f(u.cf_alpha_range, ...this.alphaRange);
+    gl.activeTexture(gl.TEXTURE0 + UNIT.lut);
+    gl.bindTexture(gl.TEXTURE_3D, this.lut);
+    gl.uniform1i(u.cf_lut, UNIT.lut);
+    gl.enable(gl.SCISSOR_TEST);
+    gl.scissor(0, 0, this.nodes, 1);
+    drawInto(gl, this.vao, [this.albedo], this.nodes, 3);
+    gl.disable(gl.SCISSOR_TEST);
   }
 
   /** Bind the split-sum program's tables and slices (its program in use). */

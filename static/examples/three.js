@@ -12,6 +12,7 @@ import * as THREE from "three";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
 import { RoomEnvironment } from "three/addons/environments/RoomEnvironment.js";
 import { CoatedConductorExtension } from "/static/three/coated_conductor.js";
+import { loadIncludes } from "/static/glsl.js";
 import { orbitCamera } from "/static/preview.js";
 
 const ORBIT = [0.5, 0.25, 4.2];
@@ -38,12 +39,60 @@ async function loadMaterial(url, withPlugin) {
   return material;
 }
 
-// The environment: three's RoomEnvironment, or the preview's white sky
-// (radiance 1 in every direction), prefiltered by three's PMREM.
-function environment(renderer) {
+// The preview's environments (cf_environment.glsl: CF_ENVIRONMENT_* is
+// the index in static/splitsum.js ENVIRONMENT_NAMES), drawn by the
+// project's own GLSL into an equirect in three's convention (u from
+// atan(z, x), v from asin(y), v = 1 up) in three's working space (linear
+// Rec.709, CF_ACESCG_TO_SRGB of cf_display.glsl), EQUIRECT_W x EQUIRECT_W / 2.
+const PREVIEW_ENVIRONMENTS = { white_sky: 0, studio: 1, outdoor: 2 };
+const EQUIRECT_W = 1024;
+
+async function previewEquirect(renderer, index) {
+  const glsl = await loadIncludes(["cf_environment.glsl", "cf_display.glsl"]);
+  const material = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3,
+    vertexShader: "in vec3 position;\nvoid main() { gl_Position = vec4(position.xy, 0.0, 1.0); }",
+    fragmentShader: `precision highp float;\nprecision highp int;\n${glsl}
+uniform int u_environment;
+uniform vec2 u_size;
+out vec4 out_radiance;
+void main()
+{
+    vec2 uv = gl_FragCoord.xy / u_size;
+    float phi = (uv.x - 0.5) * 6.283185307179586;
+    float lat = (uv.y - 0.5) * 3.141592653589793;
+    vec3 d = vec3(cos(phi) * cos(lat), sin(lat), sin(phi) * cos(lat));
+    // Linear ACEScg to three's working space, linear Rec.709 (as the material's terms).
+    out_radiance = vec4(CF_ACESCG_TO_SRGB * cf_environment(u_environment, d), 1.0);
+}`,
+    uniforms: { u_environment: { value: index }, u_size: { value: new THREE.Vector2(EQUIRECT_W, EQUIRECT_W / 2) } },
+    depthTest: false, depthWrite: false,
+  });
+  const target = new THREE.WebGLRenderTarget(EQUIRECT_W, EQUIRECT_W / 2, { type: THREE.FloatType, depthBuffer: false });
+  const scene = new THREE.Scene();
+  const quad = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
+  quad.frustumCulled = false;
+  scene.add(quad);
+  renderer.setRenderTarget(target);
+  renderer.render(scene, new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1));
+  renderer.setRenderTarget(null);
+  quad.geometry.dispose();
+  material.dispose();
+  target.texture.mapping = THREE.EquirectangularReflectionMapping;
+  return target;
+}
+
+// The environment `name`: three's RoomEnvironment ("room"), the white sky
+// (radiance 1 in every direction) or the preview's studio or outdoor sky
+// (the project's GLSL), prefiltered by three's PMREM.
+async function environment(renderer, name) {
   const pmrem = new THREE.PMREMGenerator(renderer);
   let target;
-  if (environmentName === "white_sky") {
+  if (name === "studio" || name === "outdoor") {
+    const equirect = await previewEquirect(renderer, PREVIEW_ENVIRONMENTS[name]);
+    target = pmrem.fromEquirectangular(equirect.texture);
+    equirect.dispose();
+  } else if (name === "white_sky") {
     const white = new THREE.DataTexture(new Float32Array([1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1]), 2, 2,
       THREE.RGBAFormat, THREE.FloatType);
     white.mapping = THREE.EquirectangularReflectionMapping;
@@ -62,7 +111,6 @@ class Ball {
     this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true, alpha: true });
     this.renderer.setClearColor(0x000000, 0);
     this.scene = new THREE.Scene();
-    this.scene.environment = environment(this.renderer);
     this.material = material;
     this.mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 512, 256), material);
     this.scene.add(this.mesh);
@@ -70,6 +118,14 @@ class Ball {
     this.camera = new THREE.PerspectiveCamera(THREE.MathUtils.radToDeg(FOV), 1, 0.1, 100);
     this.camera.position.set(...eye);
     this.camera.lookAt(0, 0, 0);
+  }
+
+  /** Light the ball by environment `name` (see environment()). */
+  async setEnvironment(name) {
+    const previous = this.scene.environment;
+    this.scene.environment = await environment(this.renderer, name);
+    if (previous) previous.dispose();
+    this.environmentName = name;
   }
 
   draw() {
@@ -108,18 +164,26 @@ async function main() {
   const info = model.userData.coatedConductor;
   if (!info) throw new Error("the export carries no EXT_materials_coated_conductor (eta_i outside the fit's range?)");
   document.getElementById("material").textContent =
-    `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}; environment ${environmentName}.`;
+    `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}.`;
   const balls = {
     model: new Ball(document.getElementById("model"), model),
     fallback: new Ball(document.getElementById("fallback"), fallback),
   };
-  for (const ball of Object.values(balls)) ball.draw();
+  const light = (name) => Promise.all(Object.values(balls).map((ball) => ball.setEnvironment(name)))
+    .then(() => {
+      for (const ball of Object.values(balls)) ball.draw();
+      if (window.cfThree) window.cfThree.environment = name;
+    });
+  await light(environmentName);
   window.cfThree = {
     balls,
     orbit: ORBIT,
     fov: FOV,
     readFloat: (which, width, height, settings) => balls[which].readFloat(width, height, settings),
     readTable: () => info.readTable(balls.model.renderer),
+    // Relight both balls (room, white_sky, studio, outdoor) without reloading the asset.
+    setEnvironment: light,
+    environment: environmentName,
   };
   document.body.dataset.ready = "true";
 }

@@ -23,7 +23,7 @@
 
 import * as THREE from "three";
 import { loadIncludes } from "../glsl.js";
-import { packedWords } from "../preview.js";
+import { packedWords } from "../kinds.js";
 import { AlbedoTable, lutTexture, tableSources } from "./albedo_table.js";
 
 export const EXTENSION_NAME = "EXT_materials_coated_conductor";

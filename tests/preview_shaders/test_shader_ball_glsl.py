@@ -26,5 +26,15 @@ def test_shader_ball_compiles_as_desktop_glsl():
         names = set(program)
         assert {"cf_words", "u_reference", "u_eye", "u_panel_kind", "u_output"} <= names
         program.release()
+        # The rgb-conductor variants (static/kinds.js), mirror and split sum.
+        # The mirror reads the packed words, the split sum its albedo table.
+        for defines, used in (({"CF_RGB_CONDUCTOR": 1}, "cf_words"),
+                              ({"CF_RGB_CONDUCTOR": 1, "CF_SPLIT_SUM": 1}, "u_albedo")):
+            program = ctx.program(
+                vertex_shader=load_shader_source("fullscreen.vert"),
+                fragment_shader=load_shader_source("shader_ball.frag", defines),
+            )
+            assert used in set(program), defines
+            program.release()
     finally:
         ctx.release()

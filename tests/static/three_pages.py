@@ -4,10 +4,19 @@ preview and the physics, in one Chromium page (import it: ``from
 three_pages import measure_three``); shared by
 tests/static/test_three_material.py and benchmarks/three_parity.py.
 
-Set-up, the same for both renders: the white sky (radiance 1 in every
-direction, so that the two environment filters, the project's prefiltered
-slices and three's PMREM, drop out and what is compared is the material),
-the preview's camera (orbit (0.5, 0.25, 4.2), vertical field of view 0.52
+Set-up, the same for both renders: an environment of the preview, the
+white sky (radiance 1 in every direction, so that the two environment
+filters, the project's prefiltered slices and three's PMREM, drop out and
+what is compared is the material) or the studio or the outdoor sky (the
+same cf_environment.glsl on both sides: three draws it into a 1024 x 512
+equirect and prefilters it with its PMREM, the preview evaluates it per
+pixel for a mirror and reads the project's prefiltered slices for a rough
+lobe, so there the figures hold the two filters' difference too; and three
+multiplies albedo by radiance per channel in its working space, linear
+Rec.709, where the preview does in ACEScg: for a coloured sky that is most
+of the difference, so :func:`preview_lit_in_rec709` recomposes the
+preview's own parts as three lights them, ``preview_rec709``), the
+preview's camera (orbit (0.5, 0.25, 4.2), vertical field of view 0.52
 rad) at W x H pixels, a clear coat of index eta_i over the metal. Both read
 back as float32 linear radiance: the preview in ACEScg (OUTPUT.linear),
 three in linear Rec.709 (its working space), converted back to ACEScg with
@@ -17,6 +26,10 @@ Pixels compared: on the ball in both, with NdotV >= :data:`NDOTV_MIN` (the
 outermost pixels differ by geometry alone: three rasterises a 512 x 256
 sphere mesh, the preview intersects the exact sphere). The centre is
 NdotV >= :data:`CENTRE`, the ring near grazing NdotV in :data:`RING`.
+
+Several settings are measured on one page load (the example page relights
+its balls with ``cfThree.setEnvironment``, sets the material's roughness
+per read-back, and the preview's ball is made once per page).
 
 The physics: under the white sky the ball's radiance is the directional
 albedo of the coated metal, E_c(mu) + [1 - F_c(mu)]^2 E_m(mu_t) (the
@@ -73,25 +86,57 @@ def three_ACEScg(page, which: str, roughness: float, coat_roughness: float) -> t
     return rec709 @ np.linalg.inv(ACEScg_to_sRGB_matrix()).T, pixels[..., 3] > 0.5
 
 
-def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughness: float) -> np.ndarray:
-    """(H, W, 3) linear ACEScg of the editor's preview (static/preview.js) at the same settings."""
+def set_environment(page, env: str) -> None:
+    """Relight the example page's balls by ``env`` (room, white_sky, studio, outdoor) unless they are."""
+    if page.evaluate("window.cfThree.environment") != env:
+        page.evaluate("(env) => window.cfThree.setEnvironment(env)", env)
+
+
+def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughness: float,
+                   env: str = "white_sky") -> np.ndarray:
+    """(H, W, 3) linear ACEScg of the editor's preview (static/preview.js) at the same settings (one ball a page)."""
     flat = page.evaluate(
-        """async ([fit, eta, roughness, coatRoughness, orbit, fov, w, h]) => {
+        """async ([fit, eta, roughness, coatRoughness, env, orbit, fov, w, h]) => {
             const { ShaderBall, OUTPUT, ENVIRONMENT } = await import('/preview.js');
-            const canvas = document.createElement('canvas');
-            Object.assign(canvas.style, { width: w + 'px', height: h + 'px' });
-            document.body.appendChild(canvas);
-            const ball = await ShaderBall.create(canvas, null);
+            if (!window.cfParityBall) {
+                const canvas = document.createElement('canvas');
+                Object.assign(canvas.style, { width: w + 'px', height: h + 'px' });
+                document.body.appendChild(canvas);
+                window.cfParityBall = ShaderBall.create(canvas, null);
+            }
+            const ball = await window.cfParityBall;
             ball.setFit(fit);
-            ball.set({ eta, roughness, coated: true, coatRoughness, environment: ENVIRONMENT.white_sky, orbit, fov });
-            await ball.lightingReady();
-            const pixels = Array.from(ball.readFloat(OUTPUT.linear, w, h));
-            canvas.remove();
-            return pixels;
+            ball.set({ eta, roughness, coated: true, coatRoughness, environment: ENVIRONMENT[env], orbit, fov });
+            await ball.ready();
+            return Array.from(ball.readFloat(OUTPUT.linear, w, h));
         }""",
-        [fit, eta_i, roughness, coat_roughness, list(ORBIT), FOV, W, H],
+        [fit, eta_i, roughness, coat_roughness, env, list(ORBIT), FOV, W, H],
     )
     return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1][..., :3]
+
+
+def preview_lit_in_rec709(page) -> np.ndarray:
+    """
+    (H, W, 3) linear ACEScg: the preview ball's last settings lit as three
+    lights them, the products of albedo and radiance taken per channel in
+    linear Rec.709 (three's working space) rather than in ACEScg (the
+    preview's): M^-1 [E_c M L_c + T (M F) (M L_m)] from the preview's own
+    parts (albedo F, lightings L_m and L_c, coat albedo E_c and transmission
+    T), M = CF_ACESCG_TO_SRGB. Under the white sky it is the preview itself.
+    """
+    flat = page.evaluate(
+        """async ([w, h]) => {
+            const { OUTPUT } = await import('/preview.js');
+            const ball = await window.cfParityBall;
+            return ['fresnel', 'baseLight', 'coatLight', 'coat'].map((o) => Array.from(ball.readFloat(OUTPUT[o], w, h)));
+        }""",
+        [W, H],
+    )
+    F, base, coat_light, coat = (np.asarray(f, dtype=np.float64).reshape(H, W, 4)[::-1] for f in flat)
+    M = ACEScg_to_sRGB_matrix()
+    E, T = coat[..., :1], coat[..., 1:2]
+    rec709 = E * (coat_light[..., :3] @ M.T) + T * (F[..., :3] @ M.T) * (base[..., :3] @ M.T)
+    return rec709 @ np.linalg.inv(M).T
 
 
 def coated_albedo(metal_fresnel, eta_i: float, roughness: float, coat_roughness: float) -> np.ndarray:
@@ -124,33 +169,40 @@ def _stats(dE: np.ndarray, NdotV: np.ndarray, region: np.ndarray) -> dict:
 
 
 def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: float,
-                  coat_roughness: float) -> dict:
+                  coat_roughness: float, env: str = "white_sky") -> dict:
     """
     Delta E 2000 figures ({mean, p99, max, centre, ring} each) of the
-    three.js ball through the plugin against: the WebGL preview
-    (``preview``; the coated-conductor kind only, the preview has no other)
-    or numpy's twin of the rgb-conductor material (``twin``); the physics
-    (``physics``); and the fallback ball against the physics
-    (``fallback``). The example page must be open on ``fit`` at ``eta_i``.
+    three.js ball through the plugin against the editor's WebGL preview at
+    the same settings (``preview``, both kinds) under ``env``; under the
+    white sky also against numpy's twin of an rgb-conductor material
+    (``twin``), the physics (``physics``), and the fallback ball against the
+    physics (``fallback``). The example page must be open on ``fit`` at
+    ``eta_i``.
     """
+    set_environment(page, env)
     NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
     three, three_mask = three_ACEScg(page, "model", roughness, coat_roughness)
+    preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness, env)
+    if env != "white_sky":  # the preview alone, as it draws and lit in three's working space
+        region = hit & three_mask & (NdotV >= NDOTV_MIN)
+        in_rec709 = preview_lit_in_rec709(page)
+        return {"pixels": int(region.sum()), "preview": _stats(delta_E_map(preview, three), NdotV, region),
+                "preview_rec709": _stats(delta_E_map(in_rec709, three), NdotV, region),
+                "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist()}
     fallback, fallback_mask = three_ACEScg(page, "fallback", roughness, coat_roughness)
     region = hit & three_mask & fallback_mask & (NdotV >= NDOTV_MIN)
-    physics = per_pixel(coated_albedo(
-        lambda c: reference_ACEScg(nk, np.asarray(c).reshape(-1), eta_i, 1.0).reshape(np.shape(c) + (3,)),
-        eta_i, roughness, coat_roughness), NdotV)
     figures = {
         "pixels": int(region.sum()),
-        "physics": _stats(delta_E_map(physics, three), NdotV, region),
-        "fallback": _stats(delta_E_map(physics, fallback), NdotV, region),
+        "preview": _stats(delta_E_map(preview, three), NdotV, region),
         "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
         "fallback_centre_rgb": fallback[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
     }
-    if fit["model"] == "coated-conductor":
-        preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness)
-        figures["preview"] = _stats(delta_E_map(preview, three), NdotV, region)
-    else:
+    physics = per_pixel(coated_albedo(
+        lambda c: reference_ACEScg(nk, np.asarray(c).reshape(-1), eta_i, 1.0).reshape(np.shape(c) + (3,)),
+        eta_i, roughness, coat_roughness), NdotV)
+    figures["physics"] = _stats(delta_E_map(physics, three), NdotV, region)
+    figures["fallback"] = _stats(delta_E_map(physics, fallback), NdotV, region)
+    if fit["model"] == "rgb-conductor":
         n, k = (np.asarray(fit["coefficients"][p], dtype=np.float64) for p in ("n", "k"))
         twin = per_pixel(coated_albedo(lambda c: rgb_fresnel_conductor(c, eta_i, n, k),
                                        eta_i, roughness, coat_roughness), NdotV)

@@ -1,0 +1,34 @@
+// The page-wide inputs of the editor: the material picker (asks before
+// discarding unsaved edits), the n, k upload, leaving the page with unsaved
+// edits (beforeunload), and Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y). Each calls a
+// hook; none changes the state itself:
+//   unsaved() -> bool, picked() -> the picker value open,
+//   onPick(value) -> Promise, onUpload(file), onUndo(), onRedo().
+
+const $ = (id) => document.getElementById(id);
+
+export function bindPageInputs(hooks) {
+  $("material").addEventListener("change", (event) => {
+    const value = event.target.value;
+    if (hooks.unsaved() && !window.confirm("Discard the unsaved edits of this material?")) {
+      event.target.value = hooks.picked();
+      return;
+    }
+    hooks.onPick(value);
+  });
+  $("upload").addEventListener("change", (event) => {
+    const file = event.target.files[0];
+    if (file) hooks.onUpload(file);
+  });
+  window.addEventListener("beforeunload", (event) => {
+    if (!hooks.unsaved()) return;
+    event.preventDefault();
+    event.returnValue = "";
+  });
+  document.addEventListener("keydown", (event) => {
+    if (!(event.ctrlKey || event.metaKey) || event.target.matches("input[type=text], input[type=password]")) return;
+    const k = event.key.toLowerCase();
+    if (k === "z" && !event.shiftKey) { event.preventDefault(); hooks.onUndo(); }
+    if ((k === "z" && event.shiftKey) || k === "y") { event.preventDefault(); hooks.onRedo(); }
+  });
+}

@@ -1,0 +1,70 @@
+// The material picker: the library and saved materials (GET /materials) in
+// one <select>, the fit behind a picker value, and the material open last
+// (localStorage). No state of the editor: what it fetches it returns.
+
+import * as api from "../api.js";
+
+export const LAST_KEY = "coated-editor-material"; // localStorage: the material open last
+export const FIRST = "library:Au";
+
+/** Fill `picker` with the material list (Library, Saved), `select` chosen. */
+export async function loadMaterials(picker, select = null) {
+  const { materials } = await api.listMaterials();
+  picker.replaceChildren();
+  const nodes = {};
+  for (const [group, label] of Object.entries({ library: "Library", saved: "Saved" })) {
+    nodes[group] = document.createElement("optgroup");
+    nodes[group].label = label;
+    picker.appendChild(nodes[group]);
+  }
+  for (const m of materials) {
+    const option = document.createElement("option");
+    const saved = m.kind !== "library";
+    option.value = saved ? `saved:${m.id}` : `library:${m.id}`;
+    option.textContent = saved ? `${m.name} (${m.kind === "curves" ? "edited" : "n, k"})` : m.name;
+    option.dataset.source = m.source || "";
+    nodes[saved ? "saved" : "library"].appendChild(option);
+  }
+  if (!nodes.saved.children.length) nodes.saved.remove();
+  if (select) picker.value = select;
+  return materials;
+}
+
+/** The fit of a picker value (a library fit is made or served from the store; a saved material's latest fit). */
+export async function fitOf(value) {
+  const [kind, id] = value.split(/:(.*)/s);
+  if (kind === "library") return api.fitLibrary(id, [1.0, 2.5]);
+  const material = await api.getMaterial(id);
+  return material.latest_fit;
+}
+
+export function remember(value) {
+  try {
+    localStorage.setItem(LAST_KEY, value);
+  } catch (_) {
+    // storage disabled: the editor opens Au next time
+  }
+}
+
+export function recall() {
+  try {
+    return localStorage.getItem(LAST_KEY);
+  } catch (_) {
+    return null; // storage disabled
+  }
+}
+
+/**
+ * The curves at `eta` and the reference texture of `fit`, asked for at
+ * once (the cold start: while the preview's shaders compile); {eta, curves,
+ * texture} promises, each used or asked again (their failures are muted).
+ */
+export function prefetch(fit, eta, samples) {
+  const early = {
+    eta,
+    curves: api.curves(fit.id, eta, samples),
+    texture: fit.has_nk ? api.referenceTexture(fit.id) : null,
+  };
+  for (const promise of [early.curves, early.texture]) if (promise) promise.catch(() => {});
+  return early;
+}

@@ -1,0 +1,91 @@
+// The view of the curves: the reflectance plot (plot.js) of the base's
+// reference, the edited target, the fit on screen and adjusted Lazanyi at
+// the current eta_i; the eta_i slider and the chips of the edited eta_i;
+// the channel to drag; Undo, Redo, Reset and Save's enabled states.
+// Renders from the state (render(state)); its inputs call `hooks`:
+//   onDrag({channel, handle, value, pointer, all}) -> whether the point moved,
+//   onDragEnd(), onEta(eta), onUndo(), onRedo(), onReset(), onSave().
+
+import { ReflectancePlot } from "../plot.js";
+import { HANDLES, key, target } from "./state.js";
+
+const $ = (id) => document.getElementById(id);
+
+const channel = () => document.querySelector("input[name=channel]:checked").value;
+
+export class PlotView {
+  constructor(hooks) {
+    this.hooks = hooks;
+    this.state = null;
+    this.plot = new ReflectancePlot($("plot"), {
+      onDrag: (c, handle, value, pointer = false) =>
+        hooks.onDrag({ channel: c, handle, value, pointer, all: channel() === "all" }),
+      onDragEnd: () => hooks.onDragEnd(),
+    });
+    $("eta").addEventListener("input", (event) => hooks.onEta(Number(event.target.value)));
+    const again = () => this.state && this.render(this.state);
+    $("show-lazanyi").addEventListener("change", again);
+    for (const radio of document.querySelectorAll("input[name=channel]")) radio.addEventListener("change", again);
+    $("undo").addEventListener("click", () => hooks.onUndo());
+    $("redo").addEventListener("click", () => hooks.onRedo());
+    $("reset").addEventListener("click", () => hooks.onReset());
+    $("save").addEventListener("click", () => hooks.onSave());
+  }
+
+  /** The slider's domain and the labels that depend on the base (a new material opened). */
+  showBase(state) {
+    const fit = state.base;
+    const [lo, hi] = fit.eta_i_range;
+    const slider = $("eta");
+    slider.min = lo;
+    slider.max = hi;
+    slider.disabled = hi <= lo;
+    slider.value = state.eta;
+    $("reset").title = fit.kind === "curves" ? "Back to the saved edit as opened" : "Back to the measured data";
+  }
+
+  /** The slider's value and label. */
+  showEta(state) {
+    $("eta").value = state.eta;
+    $("eta-value").textContent = key(state.eta);
+  }
+
+  render(state) {
+    this.state = state;
+    if (!state.baseCurves) return;
+    $("plot").dataset.eta = key(state.eta);
+    $("eta-value").textContent = key(state.eta);
+    this.plot.draw({
+      theta: state.theta,
+      reference: state.baseCurves.reference || state.baseCurves.model,
+      target: target(state),
+      model: state.model,
+      lazanyi: $("show-lazanyi").checked ? state.baseCurves.lazanyi_adjusted : null,
+      handles: HANDLES,
+      criticalDeg: state.eta > 1 ? (Math.asin(1 / state.eta) * 180) / Math.PI : null,
+      channel: channel(),
+      edited: Boolean(state.edits[key(state.eta)]),
+    });
+    const etas = Object.keys(state.edits).sort();
+    const list = $("edited-etas");
+    list.replaceChildren();
+    if (!etas.length) {
+      list.textContent = "No edits yet.";
+    } else {
+      list.append("Edited at ηᵢ: ");
+      for (const eta of etas) {
+        const button = document.createElement("button");
+        button.type = "button";
+        button.className = "chip";
+        button.textContent = eta;
+        button.setAttribute("aria-label", `Go to the edit at eta_i ${eta}`);
+        button.addEventListener("click", () => this.hooks.onEta(Number(eta)));
+        list.append(button, " ");
+      }
+    }
+    $("undo").disabled = !state.undo.length;
+    $("redo").disabled = !state.redo.length;
+    $("reset").disabled = !etas.length;
+    $("save").disabled = !etas.length;
+  }
+}

@@ -1,0 +1,82 @@
+// The view of the preview: the WebGL2 shader ball (preview.js) of the fit
+// on screen, its bands (Split: model | Lazanyi | reference; the reference
+// bands only for a base with measured n, k), environment, exposure,
+// roughness and clear coat. It draws whatever kind the fit is (kinds.js).
+// `ready` resolves with the ShaderBall, or null when WebGL2 is missing (the
+// page says why and works without a preview).
+
+import { ENVIRONMENT, PANEL, ShaderBall } from "../preview.js";
+
+const $ = (id) => document.getElementById(id);
+
+const SPLITS = {
+  all: [PANEL.model, PANEL.lazanyi, PANEL.reference],
+  reference: [PANEL.model, PANEL.reference],
+  lazanyi: [PANEL.model, PANEL.lazanyi],
+  none: [PANEL.model],
+};
+
+export class PreviewView {
+  /** hooks: onFrame(drawn state) after every frame drawn. */
+  constructor(hooks = {}) {
+    this.ball = null;
+    this.hasReference = false;
+    this.ready = ShaderBall.create($("preview"), $("preview-labels"), $("preview-lighting")).then((ball) => {
+      this.ball = ball;
+      window.cfPreview = ball; // for the parity tests and benchmarks
+      ball.onFrame = (drawn) => hooks.onFrame && hooks.onFrame(drawn);
+      this.settings();
+      return ball;
+    }).catch((error) => {
+      const box = $("preview-error");
+      box.hidden = false;
+      box.textContent = `The real-time preview is unavailable: ${error.message}`;
+      return null;
+    });
+    for (const id of ["compare", "environment", "exposure", "roughness", "coat", "coat-roughness"]) {
+      $(id).addEventListener("input", () => this.settings());
+    }
+  }
+
+  /** The settings of the controls, on the ball. */
+  settings() {
+    $("exposure-value").textContent = Number($("exposure").value).toFixed(1);
+    $("roughness-value").textContent = Number($("roughness").value).toFixed(2);
+    $("coat-roughness-value").textContent = Number($("coat-roughness").value).toFixed(2);
+    $("coat-roughness").disabled = !$("coat").checked;
+    if (!this.ball) return;
+    this.ball.set({
+      environment: ENVIRONMENT[$("environment").value], exposure: Number($("exposure").value),
+      roughness: Number($("roughness").value), coated: $("coat").checked,
+      coatRoughness: Number($("coat-roughness").value),
+    });
+    this.#panels();
+  }
+
+  #panels() {
+    if (!this.ball) return;
+    this.ball.set({ panels: SPLITS[this.hasReference ? $("compare").value : "none"] });
+  }
+
+  /** A new base: whether it has a spectral reference (measured n, k) to compare with. */
+  showBase(base) {
+    this.hasReference = Boolean(base.has_nk);
+    $("compare").disabled = !base.has_nk;
+    this.#panels();
+  }
+
+  /** The base's reference texture (api.referenceTexture), once in. */
+  setReference(texture) {
+    if (this.ball) this.ball.setReference(texture);
+    this.#panels();
+  }
+
+  setEta(eta) {
+    if (this.ball) this.ball.set({ eta });
+  }
+
+  /** The fit on screen, drawn at once. */
+  showFit(fit) {
+    if (this.ball) this.ball.setFit(fit);
+  }
+}

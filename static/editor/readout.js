@@ -1,0 +1,89 @@
+// The view of the fit on screen (state.fit): its Delta E figure and label
+// (figures.js reads them), id, coefficients (as its kind writes them,
+// kinds.js), the pack download, the "cannot follow this edit" warning, the
+// saved/unsaved line and the error heat map. Renders from the state; its
+// only input is the "Make the edit gentler" button (onGentler).
+
+import * as api from "../api.js";
+import { drawErrorMap } from "../heatmap.js";
+import { modelKind } from "../kinds.js";
+import { formatMean, readFigures } from "./figures.js";
+import { unsaved } from "./state.js";
+
+const $ = (id) => document.getElementById(id);
+
+export class Readout {
+  /** hooks: onGentler(), pending() -> whether a refit is under way (the heat map waits for a pause). */
+  constructor(hooks) {
+    this.hooks = hooks;
+    this.mapTimer = null;
+    this.fit = null;
+    $("reach-gentler").addEventListener("click", () => hooks.onGentler());
+    $("format").addEventListener("change", () => {
+      if (this.fit) $("download").href = api.packURL(this.fit.id, $("format").value);
+    });
+    $("download").addEventListener("click", (event) => {
+      if (!this.fit) event.preventDefault();
+    });
+  }
+
+  /** Everything that names the fit on screen, set together. */
+  showFit(fit) {
+    this.fit = fit;
+    const figures = readFigures(fit);
+    $("de-label").firstChild.textContent = figures.label;
+    $("de-mean").textContent = formatMean(figures.mean);
+    $("fit-id").textContent = fit.id;
+    $("coefficients").textContent = modelKind(fit).describe(fit);
+    const download = $("download");
+    download.href = api.packURL(fit.id, $("format").value);
+    download.setAttribute("aria-disabled", "false");
+    download.setAttribute("download", "");
+    this.#reach(figures.reach);
+    this.scheduleErrorMap();
+  }
+
+  #reach(reach) {
+    const box = $("reach");
+    if (!reach) {
+      box.hidden = true;
+      return;
+    }
+    $("reach-text").textContent =
+      `The model cannot follow this edit everywhere: it misses the edited curves by up to ` +
+      `ΔE ${reach.max.toFixed(1)} at ${reach.thetaDeg.toFixed(0)}° and ` +
+      `ηᵢ ${reach.etaI.toFixed(2)} (1 is a just-visible difference). The fit stays a valid ` +
+      `reflectance (0 to 1); the curve shows what you will get.`;
+    box.hidden = false;
+  }
+
+  /** "Unsaved changes" while there are edits and the fit on screen is not the one saved. */
+  showSaved(state) {
+    const dirty = unsaved(state);
+    $("save-state").textContent = dirty ? "Unsaved changes (drafts are not saved)" :
+      (state.savedId && state.fit && state.savedId === state.fit.id ? "Saved" : "");
+    document.body.dataset.unsaved = dirty ? "true" : "false";
+  }
+
+  /** The heat map costs a request: drawn for the fit on screen once refits pause. */
+  scheduleErrorMap() {
+    clearTimeout(this.mapTimer);
+    this.mapTimer = setTimeout(() => {
+      if (this.hooks.pending()) return this.scheduleErrorMap();
+      this.#errorMap().catch(() => {});
+    }, 150);
+  }
+
+  async #errorMap() {
+    const fit = this.fit;
+    try {
+      const map = await api.errorMap(fit.id);
+      if (fit !== this.fit) return;
+      drawErrorMap($("heatmap"), map);
+      $("heatmap").dataset.fit = fit.id;
+      $("heatmap-caption").textContent = `Against the ${map.against}; dark is close, bright is a visible difference.`;
+    } catch (error) {
+      $("heatmap-caption").textContent = `Error map unavailable: ${error.message}`;
+    }
+  }
+}

@@ -1,0 +1,200 @@
+// The editor's state: one object, changed only by the named actions below
+// (store.dispatch(name, payload)); the views render from it. No DOM, no
+// fetch: node --test runs it (tests/static/js/state.test.mjs).
+//
+// Edits are target curves by coating index: edits[key(eta_i)] is SAMPLES x
+// 3 rgb at the angles `theta`. Undo and redo hold snapshots of the edits
+// (JSON strings), so every change of the edits is undoable and a snapshot
+// names exactly what a refit fitted.
+
+export const SAMPLES = 46; // 0, 2, ..., 90 degrees
+export const HANDLES = [0, 20, 36, 50, 60, 70, 78, 84]; // the control points' angles
+export const FALLOFF_DEG = 9; // width of the bump a dragged point makes
+
+/** The key of a coating index in `edits` (two decimals). */
+export const key = (eta) => Number(eta).toFixed(2);
+
+export function initialState() {
+  return {
+    base: null,       // the fit being edited (a FitPublic answer)
+    fit: null,        // the fit on screen: id, figures, curves and preview show it
+    shownEdits: "{}", // the snapshot of the edits the fit on screen was fitted to
+    savedId: null,    // the fit last saved from this base
+    eta: 1.5,
+    edits: {},
+    undo: [],
+    redo: [],
+    dragStart: null,  // the snapshot before the drag under way
+    pointerDrag: false, // a pointer drags a point: refits are live
+    theta: [],        // the angles of the curves (degrees)
+    baseCurves: null, // the base's curves at `eta` (reference, Lazanyi, model)
+    model: null,      // the fit on screen's curve at `eta`
+  };
+}
+
+/** The edits as a string: what undo keeps and what a refit is asked for. */
+export const snapshot = (s) => JSON.stringify(s.edits);
+
+/** Whether there are edits and the fit on screen is not the one saved (refits are drafts). */
+export const unsaved = (s) => Object.keys(s.edits).length > 0 && s.fit !== null && s.savedId !== s.fit.id;
+
+/** Whether the fit on screen is the fit of the edits on screen. */
+export const fitted = (s) => s.fit !== null && s.shownEdits === snapshot(s);
+
+/**
+ * The curve an edit at the current eta_i starts from: the edit itself, or
+ * for a saved edit (a curve fit) its own model, else the measured reference.
+ */
+export function target(s) {
+  const edit = s.edits[key(s.eta)];
+  if (edit) return edit;
+  if (!s.baseCurves) return null;
+  if (s.base.kind === "curves") return s.baseCurves.model;
+  return s.baseCurves.reference || s.baseCurves.model;
+}
+
+/** The live refit's start: the fit on screen (or the base) while a pointer drags, else null (a full refit). */
+export const liveStart = (s) => (s.pointerDrag ? (s.fit || s.base).id : null);
+
+const clamp01 = (v) => Math.min(1, Math.max(0, v));
+
+/**
+ * The curve `current` (rows of rgb at angles `theta`) with the point at
+ * `handleDeg` of `channel` moved to `value`: a smooth bump (Gaussian,
+ * FALLOFF_DEG wide, 0 at 90 degrees, where the model is 1 whatever its
+ * coefficients). One channel moves by the offset; `all` scales the three
+ * channels (brightness changes, hue stays). A new array; null when the
+ * point is already there.
+ */
+export function bump(current, theta, handleDeg, channel, value, all = false) {
+  const rows = current.map((rgb) => rgb.map(clamp01));
+  const i = theta.indexOf(handleDeg);
+  if (i < 0) throw new Error(`handle ${handleDeg} is not one of the curve's angles`);
+  const before = rows[i][channel];
+  if (value === before) return null;
+  const at = (t) => Math.exp(-0.5 * ((t - handleDeg) / FALLOFF_DEG) ** 2) * (1 - (t / 90) ** 6);
+  const peak = at(handleDeg);
+  const delta = value - before;
+  const ratio = before > 1e-6 ? value / before : null;
+  for (let j = 0; j < theta.length; j++) {
+    const w = at(theta[j]) / peak;
+    if (all) {
+      const scale = ratio === null ? null : 1 + (ratio - 1) * w;
+      for (let c = 0; c < 3; c++) rows[j][c] = clamp01(scale === null ? rows[j][c] + delta * w : rows[j][c] * scale);
+    } else {
+      rows[j][channel] = clamp01(rows[j][channel] + delta * w);
+    }
+  }
+  return rows;
+}
+
+// Push the snapshot `before` on the undo stack (a new change: redo is gone).
+function remember(s, before) {
+  s.undo.push(before);
+  s.redo = [];
+}
+
+/** The named actions: (state, payload) -> a result (most: whether anything changed). */
+export const ACTIONS = {
+  /** A new base (FitPublic): no edits, no history; eta_i kept within its domain. */
+  openBase(s, fit) {
+    Object.assign(s, { base: fit, fit: null, savedId: null, edits: {}, undo: [], redo: [], dragStart: null,
+                       pointerDrag: false, shownEdits: "{}" });
+    const [lo, hi] = fit.eta_i_range;
+    s.eta = Math.min(hi, Math.max(lo, s.eta));
+    return true;
+  },
+  /** The base's curves at the current eta_i ({theta_deg, reference, lazanyi_adjusted, model}) and the fit's. */
+  curves(s, { base, model = null }) {
+    s.baseCurves = base;
+    s.theta = base.theta_deg.map((t) => Math.round(t * 1e6) / 1e6);
+    s.model = model ?? base.model;
+    return true;
+  },
+  setEta(s, eta) {
+    s.eta = eta;
+    return true;
+  },
+  /**
+   * Move a control point ({channel, handle: index into HANDLES, value,
+   * pointer: a pointer drags it, all: the three channels}); false when
+   * nothing moved or the curves of this eta_i are not in yet.
+   */
+  drag(s, { channel, handle, value, pointer = false, all = false }) {
+    const k = key(s.eta);
+    if (!s.baseCurves || key(s.baseCurves.eta_i) !== k) return false;
+    const moved = bump(target(s), s.theta, HANDLES[handle], channel, value, all);
+    if (!moved) return false;
+    if (s.dragStart === null) s.dragStart = snapshot(s);
+    s.pointerDrag = pointer;
+    s.edits[k] = moved;
+    return true;
+  },
+  /** The drag (or key presses) ended: one undo step for it, refits full again. */
+  dragEnd(s) {
+    s.pointerDrag = false;
+    if (s.dragStart !== null && s.dragStart !== snapshot(s)) remember(s, s.dragStart);
+    s.dragStart = null;
+    return true;
+  },
+  undo(s) {
+    if (!s.undo.length) return false;
+    s.redo.push(snapshot(s));
+    s.edits = JSON.parse(s.undo.pop());
+    return true;
+  },
+  redo(s) {
+    if (!s.redo.length) return false;
+    s.undo.push(snapshot(s));
+    s.edits = JSON.parse(s.redo.pop());
+    return true;
+  },
+  /** Back to no edits (undoable). */
+  reset(s) {
+    remember(s, snapshot(s));
+    s.edits = {};
+    return true;
+  },
+  /** Every edit halfway back to `starts[eta]`, the curve it started from (undoable). */
+  gentler(s, starts) {
+    remember(s, snapshot(s));
+    for (const [eta, start] of Object.entries(starts)) {
+      s.edits[eta] = s.edits[eta].map((rgb, j) => rgb.map((v, c) => clamp01(start[j][c] + 0.5 * (v - start[j][c]))));
+    }
+    return true;
+  },
+  /** The fit shown ({fit, edits: the snapshot it fitted, model: its curve at eta_i or null}). */
+  shown(s, { fit, edits = "{}", model = null }) {
+    s.fit = fit;
+    s.shownEdits = edits;
+    if (model) s.model = model;
+    return true;
+  },
+  saved(s, fitId) {
+    s.savedId = fitId;
+    return true;
+  },
+};
+
+/**
+ * The store: `state`, `dispatch(name, payload)` (runs ACTIONS[name], then
+ * every subscriber with (name, state, result)), `subscribe(fn)` (returns
+ * the unsubscribe).
+ */
+export function createStore(state = initialState()) {
+  const listeners = new Set();
+  return {
+    state,
+    dispatch(name, payload) {
+      const action = ACTIONS[name];
+      if (!action) throw new Error(`no editor action ${JSON.stringify(name)}`);
+      const result = action(state, payload);
+      for (const listener of listeners) listener(name, state, result);
+      return result;
+    },
+    subscribe(listener) {
+      listeners.add(listener);
+      return () => listeners.delete(listener);
+    },
+  };
+}

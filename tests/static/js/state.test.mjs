@@ -1,0 +1,155 @@
+// The editor's state and its named actions (static/editor/state.js),
+// the figures it reads from a fit (figures.js) and the model kinds the
+// browser draws (static/kinds.js): node --test, run from pytest by
+// tests/static/test_editor_js.py.
+
+import assert from "node:assert/strict";
+import { test } from "node:test";
+
+import { readFigures, REACH_DE } from "../../../static/editor/figures.js";
+import {
+  HANDLES, SAMPLES, bump, createStore, fitted, key, liveStart, snapshot, target, unsaved,
+} from "../../../static/editor/state.js";
+import { halfBits, modelKind, packedWords, rgbConductorWords } from "../../../static/kinds.js";
+
+const THETA = Array.from({ length: SAMPLES }, (_, i) => 2 * i);
+const flat = (v) => THETA.map(() => [v, v, v]);
+const BASE = { id: "au", kind: "library", model: "coated-conductor", eta_i_range: [1, 2.5] };
+
+function opened() {
+  const store = createStore();
+  store.dispatch("openBase", BASE);
+  store.dispatch("curves", { base: { eta_i: 1.5, theta_deg: THETA, reference: flat(0.5), model: flat(0.45) } });
+  store.dispatch("shown", { fit: BASE });
+  return store;
+}
+
+test("a drag edits the target at the current eta_i with a smooth bump; 90 degrees stays", () => {
+  const store = opened();
+  const s = store.state;
+  assert.deepEqual(target(s), flat(0.5), "a library base starts from its measured reference");
+  assert.equal(store.dispatch("drag", { channel: 1, handle: 3, value: 0.7, pointer: true }), true);
+  const edit = s.edits[key(1.5)];
+  const at = (deg) => edit[THETA.indexOf(deg)];
+  assert.equal(at(50)[1], 0.7);
+  assert.ok(at(44)[1] > 0.5 && at(44)[1] < 0.7, "neighbours move by less");
+  assert.equal(at(50)[0], 0.5, "other channels stay");
+  assert.equal(at(90)[1], 0.5, "grazing stays");
+  assert.equal(liveStart(s), "au", "live while a pointer drags");
+  assert.equal(store.dispatch("drag", { channel: 1, handle: 3, value: 0.7, pointer: true }), false, "no move, no edit");
+  store.dispatch("dragEnd");
+  assert.equal(liveStart(s), null);
+  assert.equal(s.undo.length, 1, "one undo step per drag");
+});
+
+test("'All three' scales the channels: the hue stays at the point", () => {
+  const rows = bump(THETA.map(() => [0.8, 0.4, 0.2]), THETA, 50, 0, 0.4, true);
+  const i = THETA.indexOf(50);
+  assert.deepEqual(rows[i].map((v) => +v.toFixed(12)), [0.4, 0.2, 0.1]);
+  assert.throws(() => bump(flat(0.5), THETA, 51, 0, 0.1), /51/);
+});
+
+test("a drag waits for the curves of the slider's eta_i", () => {
+  const store = opened();
+  store.dispatch("setEta", 2.0);
+  assert.equal(store.dispatch("drag", { channel: 0, handle: 2, value: 0.1 }), false);
+});
+
+test("undo, redo and reset move between snapshots; a new edit clears redo", () => {
+  const store = opened();
+  const s = store.state;
+  store.dispatch("drag", { channel: 0, handle: 2, value: 0.3 });
+  store.dispatch("dragEnd");
+  const one = snapshot(s);
+  store.dispatch("drag", { channel: 0, handle: 4, value: 0.2 });
+  store.dispatch("dragEnd");
+  const two = snapshot(s);
+  assert.equal(store.dispatch("undo"), true);
+  assert.equal(snapshot(s), one);
+  assert.equal(store.dispatch("undo"), true);
+  assert.equal(snapshot(s), "{}");
+  assert.equal(store.dispatch("undo"), false, "nothing left to undo");
+  store.dispatch("redo");
+  store.dispatch("redo");
+  assert.equal(snapshot(s), two);
+  store.dispatch("reset");
+  assert.equal(snapshot(s), "{}");
+  store.dispatch("undo");
+  assert.equal(snapshot(s), two, "reset is undoable");
+  store.dispatch("undo");
+  store.dispatch("drag", { channel: 2, handle: 1, value: 0.9 });
+  store.dispatch("dragEnd");
+  assert.equal(s.redo.length, 0);
+});
+
+test("gentler moves every edit halfway back to where it started (undoable)", () => {
+  const store = opened();
+  const s = store.state;
+  store.dispatch("drag", { channel: 0, handle: 3, value: 0.9 });
+  store.dispatch("dragEnd");
+  store.dispatch("gentler", { [key(1.5)]: flat(0.5) });
+  assert.ok(Math.abs(s.edits[key(1.5)][THETA.indexOf(50)][0] - 0.7) < 1e-12);
+  store.dispatch("undo");
+  assert.equal(s.edits[key(1.5)][THETA.indexOf(50)][0], 0.9);
+});
+
+test("unsaved and fitted follow the fit shown and the save", () => {
+  const store = opened();
+  const s = store.state;
+  assert.equal(unsaved(s), false);
+  store.dispatch("drag", { channel: 0, handle: 3, value: 0.9 });
+  assert.equal(fitted(s), false, "the edit is not fitted yet");
+  store.dispatch("shown", { fit: { id: "draft" }, edits: snapshot(s) });
+  assert.equal(fitted(s), true);
+  assert.equal(unsaved(s), true);
+  store.dispatch("saved", "draft");
+  assert.equal(unsaved(s), false);
+  store.dispatch("openBase", { ...BASE, eta_i_range: [1, 1.2] });
+  assert.equal(s.eta, 1.2, "eta_i kept in the new base's domain");
+  assert.deepEqual([s.edits, s.undo, s.redo], [{}, [], []]);
+});
+
+test("subscribers see every action; unknown actions are refused by name", () => {
+  const store = opened();
+  const seen = [];
+  store.subscribe((name) => seen.push(name));
+  store.dispatch("setEta", 1.7);
+  store.dispatch("undo");
+  assert.deepEqual(seen, ["setEta", "undo"]);
+  assert.throws(() => store.dispatch("nope"), /"nope"/);
+  assert.equal(HANDLES.every((h) => THETA.includes(h)), true);
+});
+
+test("figures: the whole-target figure of an edit, the fit's own of a library fit, the reach", () => {
+  const edit = { kind: "curves", metrics: { model: { delta_E_mean: 0.2 },
+    details: { target: { delta_E_mean: 0.339, delta_E_max: REACH_DE + 1, at_theta_deg: 58, at_eta_i: 1.5 } } } };
+  const f = readFigures(edit);
+  assert.equal(f.mean, 0.339);
+  assert.match(f.label, /edited curves/);
+  assert.deepEqual(f.reach, { max: REACH_DE + 1, thetaDeg: 58, etaI: 1.5 });
+  const library = readFigures({ kind: "library", metrics: { model: { delta_E_mean: 0.14 }, details: {} } });
+  assert.equal(library.mean, 0.14);
+  assert.equal(library.reach, null);
+  assert.match(library.label, /measured reference/);
+  assert.equal(readFigures({ kind: "library", metrics: {} }).mean, null);
+});
+
+test("kinds: the words a renderer uploads, per kind; unknown kinds refused by name", () => {
+  assert.deepEqual([1, 0.5, -2, 65504, 1e-8].map(halfBits), [0x3c00, 0x3800, 0xc000, 0x7bff, 0]);
+  const C = { F0: [[1, 0.5], [0, 0], [0, 0]], a: [[0], [0], [0]], alpha: [[0], [0], [0]] };
+  const words = packedWords(C);
+  assert.equal(words.length, 14);
+  assert.equal(words[0], (0x3c00 | (0x3800 << 16)) >>> 0, "F0 R's first two powers in word 0");
+  const rgb = rgbConductorWords({ n: [1, 0.5, 2], k: [-2, 0, 1] });
+  assert.deepEqual(Array.from(rgb.slice(0, 4)), [
+    (0x3c00 | (0x3800 << 16)) >>> 0, (0x4000 | (0xc000 << 16)) >>> 0, (0 | (0x3c00 << 16)) >>> 0, 0,
+  ]);
+  const fit = { model: "rgb-conductor", eta_i_range: [1, 2.5], coefficients: { n: [0.2, 0.5, 1.3], k: [3, 2.3, 1.9] } };
+  const kind = modelKind(fit);
+  assert.equal(kind.shaderKind, 1);
+  assert.deepEqual(kind.nk(fit.coefficients), [[0.2, 0.5, 1.3], [3, 2.3, 1.9]]);
+  assert.match(kind.describe(fit), /^rgb-conductor/);
+  assert.equal(modelKind({ coefficients: C, degree: 1, eta_i_range: [1, 2] }).name, "coated-conductor");
+  assert.throws(() => modelKind({ model: "schlick", coefficients: {} }), /`model`.*"schlick"/);
+  assert.throws(() => modelKind({ model: "rgb-conductor", coefficients: { n: [1, 1], k: [0, 0, 0] } }), /coefficients\.n/);
+});
