@@ -3,11 +3,12 @@
 // "cannot follow this edit" warning. When the metrics' JSON changes shape,
 // this module is what changes (the views only show what it returns).
 //
-// Today's shape (service/schemas/fits.py FitMetrics): `metrics.model` is
-// the float16 fit against what it was fitted to at its samples;
-// `metrics.details.target` (curve fits) the fit against the whole blended
-// edited target on 46 angles x 31 eta_i, with `delta_E_max`, `at_theta_deg`
-// and `at_eta_i` of the max. The editor shows the latter where there is one.
+// The shape (service/schemas/fits.py FitMetrics, fitting.fits.metrics
+// ErrorMetrics.figure): `metrics.figure` is the fit's one figure, the same
+// the pack JSON and the GLSL / HLSL headers quote: {against (in words),
+// delta_E_mean, delta_E_max, max_at: {eta_i, theta_deg} or null}. For a
+// curve fit with a base it is the fit against the whole blended edited
+// target; for an n, k or library fit, against the measured metal.
 
 // An edit is beyond what the model can follow when the fit misses the
 // blended target by more than this (Delta E 2000) somewhere.
@@ -19,16 +20,14 @@ export const REACH_DE = 3.0;
  * target by more than REACH_DE somewhere).
  */
 export function readFigures(fit) {
-  const metrics = fit.metrics || {};
-  const edited = fit.kind === "curves";
-  const target = (metrics.details && metrics.details.target) || null;
-  const shown = target || metrics.model || {};
-  const mean = Number.isFinite(shown.delta_E_mean) ? shown.delta_E_mean : null;
-  const reach = edited && target && target.delta_E_max > REACH_DE
-    ? { max: target.delta_E_max, thetaDeg: target.at_theta_deg, etaI: target.at_eta_i }
+  const figure = (fit.metrics && fit.metrics.figure) || {};
+  const mean = Number.isFinite(figure.delta_E_mean) ? figure.delta_E_mean : null;
+  const at = figure.max_at || null;
+  const reach = fit.kind === "curves" && at && figure.delta_E_max > REACH_DE
+    ? { max: figure.delta_E_max, thetaDeg: at.theta_deg, etaI: at.eta_i }
     : null;
   return {
-    label: edited ? "Fit vs edited curves, mean ΔE" : "Fit vs measured reference, mean ΔE",
+    label: figure.against ? `Against ${figure.against}, mean ΔE` : "Mean ΔE",
     mean,
     reach,
   };

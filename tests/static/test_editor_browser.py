@@ -16,6 +16,7 @@ from conftest import server_process
 from editor_pages import TIMEOUT_MS, chromium, editor_url, live_server  # noqa: F401 (fixtures; expect's timeout)
 from playwright.sync_api import expect
 
+from fitting.fits.metrics import headline
 from fitting.models.pack import decode_pack
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
@@ -107,7 +108,16 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     edited_red = page.get_attribute("path.target.c0", "d")
     assert edited_red != reference_red
     expect(page.locator("#de-label")).to_contain_text("edited curves")
-    assert float(page.inner_text("#de-mean")) >= 0.0
+    # Issue 19: the editor, the JSON and the shader headers show one figure for one fit.
+    fit_json = page.request.get(f"{editor_url}api/v1/fits/{edited_id}").json()
+    figure = fit_json["metrics"]["figure"]
+    assert page.inner_text("#de-mean") == f"{figure['delta_E_mean']:.3f}"
+    assert page.inner_text("#de-label").startswith(f"Against {figure['against']}, mean ΔE")
+    words = headline({"figure": figure})
+    pack = json.loads(page.request.get(f"{editor_url}api/v1/fits/{edited_id}/pack?format=json").body())
+    assert pack["materials"][0]["metrics"]["figure"] == figure
+    for language in ("glsl", "hlsl"):
+        assert words in page.request.get(f"{editor_url}api/v1/fits/{edited_id}/pack?format={language}").text()
 
     # Undo brings the measured curve (and the material's own fit) back.
     page.click("#undo")

@@ -120,17 +120,20 @@ test("subscribers see every action; unknown actions are refused by name", () => 
   assert.equal(HANDLES.every((h) => THETA.includes(h)), true);
 });
 
-test("figures: the whole-target figure of an edit, the fit's own of a library fit, the reach", () => {
-  const edit = { kind: "curves", metrics: { model: { delta_E_mean: 0.2 },
-    details: { target: { delta_E_mean: 0.339, delta_E_max: REACH_DE + 1, at_theta_deg: 58, at_eta_i: 1.5 } } } };
+test("figures: the fit's one figure (metrics.figure), its target in words, the reach", () => {
+  const against = "your edited curves (the whole edited target, 46 angles x 31 eta_i)";
+  const edit = { kind: "curves", metrics: { model: { delta_E_mean: 0.2 }, figure: {
+    against, delta_E_mean: 0.339, delta_E_max: REACH_DE + 1, max_at: { eta_i: 1.5, theta_deg: 58 } } } };
   const f = readFigures(edit);
   assert.equal(f.mean, 0.339);
-  assert.match(f.label, /edited curves/);
+  assert.equal(f.label, `Against ${against}, mean ΔE`);
   assert.deepEqual(f.reach, { max: REACH_DE + 1, thetaDeg: 58, etaI: 1.5 });
-  const library = readFigures({ kind: "library", metrics: { model: { delta_E_mean: 0.14 }, details: {} } });
+  const library = readFigures({ kind: "library", metrics: { figure: {
+    against: "the measured metal (1 nm spectral reference), 30 x 30 grid", delta_E_mean: 0.14,
+    delta_E_max: REACH_DE + 1, max_at: { eta_i: 1, theta_deg: 85 } } } });
   assert.equal(library.mean, 0.14);
-  assert.equal(library.reach, null);
-  assert.match(library.label, /measured reference/);
+  assert.equal(library.reach, null, "only an edit can be beyond the model's reach");
+  assert.match(library.label, /measured metal/);
   assert.equal(readFigures({ kind: "library", metrics: {} }).mean, null);
 });
 
