@@ -228,9 +228,9 @@ export async function createCoatedConductorMaterial(params, options = {}) {
 /**
  * The GLTFLoader plugin: a material with EXT_materials_coated_conductor
  * becomes a MeshPhysicalMaterial drawing the model (its other properties,
- * KHR_materials_clearcoat included, read by the loader as usual); without
- * the extension nothing changes. Without KHR_materials_clearcoat the coat
- * is the extension's: clearcoat 1, its coatRoughnessFactor.
+ * read by the loader as usual); without the extension nothing changes. The
+ * coat is the extension's (coatFactor, default 1, and coatRoughnessFactor),
+ * not KHR_materials_clearcoat's factor, which is the fallback's.
  */
 export class CoatedConductorExtension {
   constructor(parser, options = {}) {
@@ -252,9 +252,8 @@ export class CoatedConductorExtension {
     const model = this.#extension(materialIndex);
     if (!model) return;
     const resources = await loadResources(this.options);
-    if (materialParams.clearcoat === undefined) {
-      Object.assign(materialParams, { clearcoat: 1, clearcoatRoughness: model.coatRoughnessFactor ?? 0 });
-    }
+    Object.assign(materialParams, { clearcoat: model.coatFactor ?? 1,
+                                    clearcoatRoughness: model.coatRoughnessFactor ?? 0 });
     Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources));
   }
 
