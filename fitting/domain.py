@@ -13,6 +13,8 @@ the package.
     paper's (Vernooij 2024, Section 4.1).
 -   :data:`VISIBLE_RANGE_NM`, :data:`DEFAULT_MIN_COVERAGE`: the integration
     range of the reference and the least fraction of it data must cover.
+-   :data:`COAT_PRESETS`: common clear coats by name, their index at the
+    sodium D line (589 nm) and its source (the editor's coat presets).
 -   :func:`check_eta_i`, :func:`check_eta_i_range`: one index, a domain.
 -   :func:`cos_theta_from_angle`: angle theta in degrees to :math:`\\mu`.
 -   :class:`BoundedCache`: the most recently used values by key, thread-safe,
@@ -50,6 +52,7 @@ __all__ = [
     "DEFAULT_MIN_COVERAGE",
     "STEP_NM_LIMITS",
     "ANGLE_LIMITS_DEG",
+    "COAT_PRESETS",
     "as_float_array",
     "as_finite_array",
     "INDEX_LIMITS",
@@ -86,6 +89,31 @@ STEP_NM_LIMITS: tuple[float, float] = (0.5, 100.0)
 
 ANGLE_LIMITS_DEG: tuple[float, float] = (0.0, 90.0)
 """Angles theta in the coating, degrees: normal to grazing incidence."""
+
+COAT_PRESETS: tuple[tuple[str, str, float, str], ...] = (
+    ("air", "Air (uncoated)", 1.0,
+     "Vacuum is 1; dry air at 15 C and 101.325 kPa is 1.00028 at 589 nm (Ciddor 1996, Appl. Opt. 35, "
+     "1566), which no render tells apart from 1"),
+    ("water", "Water", 1.333,
+     "1.3330 at 589 nm and 20 C (Daimon and Masumura 2007, Appl. Opt. 46, 3811)"),
+    ("acrylic", "Lacquer, acrylic (PMMA)", 1.49,
+     "PMMA 1.4905 at 589 nm (Sultanova, Kasarova and Nikolov 2009, Acta Phys. Pol. A 116, 585); "
+     "clear acrylic and nitrocellulose lacquers lie at 1.49-1.51"),
+    ("glass", "Glass (crown)", 1.5,
+     "Soda-lime and crown glasses 1.50-1.52 at 589 nm (Schott N-BK7: 1.5168 at 587.6 nm)"),
+    ("polyurethane", "Varnish, polyurethane", 1.5,
+     "Polyurethane clear coats about 1.50 at 589 nm (cured two-part automotive clear coats 1.49-1.52)"),
+    ("polycarbonate", "Polycarbonate", 1.585,
+     "1.5855 at 589 nm (Sultanova, Kasarova and Nikolov 2009, Acta Phys. Pol. A 116, 585)"),
+    ("sapphire", "Sapphire", 1.768,
+     "Ordinary ray 1.7681 at 589 nm (Malitson and Dodge 1972, J. Opt. Soc. Am. 62, 1405)"),
+    ("diamond", "Diamond", 2.417,
+     "2.4175 at 589 nm (Phillip and Taft 1964, Phys. Rev. 136, A1445)"),
+)
+"""Coat presets ``(key, display name, eta_i, source)``: common clear coats by their
+index at 589 nm, inside [ETA_I_MIN, ETA_I_MAX]. A coat's index falls by about 0.01-0.02
+from 400 to 700 nm (dispersion); the model takes one real eta_i, so the 589 nm value stands
+for the whole range."""
 
 INDEX_LIMITS: tuple[float, float] = (1.0e-6, 1.0e8)
 """Where the physics kernels clamp a refractive index or extinction

@@ -287,10 +287,10 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return _snippet(format, records, pack_name).encode("utf-8")
 
 
-def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
+def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03) -> bytes:
     """
     The export of one stored fit in ``format`` (one of
-    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i``.
+    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i`` and roughnesses.
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
@@ -307,7 +307,7 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
     if record.kind != "curves":
         nk = measured_nk(record)
         if nk is not None:
-            return export_material(nk, format, eta_i, model=packed)
+            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed)
     lo, hi = packed.eta_i_range
     if not lo <= eta_i <= hi:
         raise ValueError(
@@ -320,7 +320,7 @@ def render_export(record: FitRecord, format: str, eta_i: float) -> bytes:
         "reflectance": lambda mu, eta: model_ACEScg(
             packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
-    return export_material(model, format, eta_i, model=packed)
+    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed)
 
 
 def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:
@@ -376,15 +376,15 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     )
 
 
-def export_response(record: FitRecord, format: str, eta_i: float, stem: str):
-    """An export of one fit (:func:`render_export`) as a download for ``eta_i``."""
+def export_response(record: FitRecord, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03):
+    """An export of one fit (:func:`render_export`) as a download named for ``eta_i`` and the roughnesses."""
     from fastapi import Response
 
-    body = render_export(record, format, eta_i)
+    body = render_export(record, format, eta_i, roughness, coat_roughness)
+    stem = f"{stem}-eta{eta_i:g}-rough{roughness:g}-coat{coat_roughness:g}"
     return Response(
         body, media_type=EXPORT_MEDIA_TYPES[format][0],
-        headers={"Content-Disposition":
-                 f'attachment; filename="{download_name(f"{stem}-eta{eta_i:g}", format)}"'},
+        headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
     )
 
 

@@ -28,7 +28,8 @@ from fastapi.staticfiles import StaticFiles
 from .api.errors import install_error_handlers
 from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
-    curves, environments, fits, health, ibl, materials, packs, preview, reference_texture, scenes,
+    curves, environments, fits, health, ibl, library, materials, packs, preview, reference_texture, scenes,
+    versions,
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
@@ -45,24 +46,41 @@ THREE_DIR = Path(__file__).resolve().parents[1] / "scripts" / "three" / "node_mo
 """three.js as pinned in scripts/three/package-lock.json (``scripts/bootstrap``
 installs it): its ``build/`` and ``examples/jsm/`` served at ``/vendor/three/``
 for the three.js material (static/three/) and its example page."""
+SWAGGER_UI_DIR = Path(__file__).resolve().parents[1] / "scripts" / "swagger-ui" / "node_modules" / "swagger-ui-dist"
+"""Swagger UI as pinned in scripts/swagger-ui/package-lock.json (``scripts/bootstrap``
+installs it), served at ``/vendor/swagger-ui/`` for ``/docs``."""
 
 __all__ = ["create_app"]
 
 
 def _offline_docs(app: FastAPI) -> None:
-    """``/docs``: Swagger UI from the ``swagger_ui_bundle`` package, not a CDN."""
-    import swagger_ui_bundle
+    """
+    ``/docs``: Swagger UI 5 (reads OpenAPI 3.1) from npm ``swagger-ui-dist``
+    as pinned in scripts/swagger-ui/package-lock.json, its assets at
+    ``/vendor/swagger-ui/``: nothing is fetched from another host (no CDN,
+    no validator badge, a local favicon). Without ``scripts/bootstrap``'s
+    install the service still starts and ``/docs`` answers 503 saying so.
+    """
     from fastapi.openapi.docs import get_swagger_ui_html
+    from fastapi.responses import PlainTextResponse
 
-    app.mount("/docs-assets", StaticFiles(directory=swagger_ui_bundle.swagger_ui_path), name="docs-assets")
+    app.mount("/vendor/swagger-ui", StaticFiles(directory=SWAGGER_UI_DIR, check_dir=False),
+              name="swagger-ui")
 
     @app.get("/docs", include_in_schema=False)
     async def docs():
+        if not (SWAGGER_UI_DIR / "swagger-ui-bundle.js").is_file():
+            return PlainTextResponse(
+                f"the API docs need Swagger UI at {SWAGGER_UI_DIR}: run scripts/bootstrap "
+                "(npm ci in scripts/swagger-ui); the API itself is described at /openapi.json",
+                status_code=503)
         return get_swagger_ui_html(
             openapi_url=app.openapi_url, title=f"{app.title} - API docs",
-            swagger_js_url="/docs-assets/swagger-ui-bundle.js",
-            swagger_css_url="/docs-assets/swagger-ui.css",
-            swagger_favicon_url="/docs-assets/favicon-32x32.png",
+            swagger_js_url="/vendor/swagger-ui/swagger-ui-bundle.js",
+            swagger_css_url="/vendor/swagger-ui/swagger-ui.css",
+            swagger_favicon_url="/vendor/swagger-ui/favicon-32x32.png",
+            # validatorUrl None: no badge asking validator.swagger.io about the document.
+            swagger_ui_parameters={"validatorUrl": None, "defaultModelsExpandDepth": 1},
         )
 
 
@@ -119,12 +137,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
                 "and download float16 coefficient packs.",
         lifespan=lifespan,
         docs_url=None,  # served below from local Swagger UI assets (works offline)
+        redoc_url=None,  # ReDoc's page loads its script and fonts from CDNs: /docs covers it
     )
     app.state.settings = settings
     app.state.preview_renderer = None
     install_error_handlers(app)
-    for module in (health, materials, fits, packs, preview, reference_texture, environments, curves, scenes,
-                   ibl):
+    for module in (health, materials, versions, library, fits, packs, preview, reference_texture, environments,
+                   curves, scenes, ibl):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")
@@ -142,7 +161,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     if settings.cors_origins:
         app.add_middleware(
             CORSMiddleware, allow_origins=settings.cors_origins,
-            allow_methods=["GET", "POST"], allow_headers=["Authorization", "Content-Type"],
+            allow_methods=["GET", "POST", "PATCH", "DELETE"], allow_headers=["Authorization", "Content-Type"],
         )
     app.add_middleware(
         RequestLimits, max_body_bytes=settings.max_body_bytes,

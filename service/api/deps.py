@@ -6,6 +6,8 @@ Dependencies
 
 -   :data:`SettingsDep`, :data:`StoreDep`, :data:`RunnerDep`: the app's
     settings, store and fitting pool.
+-   :data:`FitIdPath`, :data:`MaterialIdPath`, :data:`RoughnessQuery`,
+    :data:`CoatRoughnessQuery`, :data:`MinCoverageForm`: shared parameters.
 -   :data:`StoredFit`: the stored fit named by the path's ``fit_id`` (404
     when it is not stored), read in a worker thread.
 -   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
@@ -24,13 +26,13 @@ import hmac
 import threading
 from typing import Annotated
 
-from fastapi import Depends, HTTPException, Path, Request, status
+from fastapi import Depends, Form, HTTPException, Path, Query, Request, status
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
 from ..jobs.common import stored_fit
 from ..pool import FitRunner
-from ..schemas import FIT_ID_PATTERN, ErrorBody
+from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
 from ..store import FitRecord, Store
 
 __all__ = [
@@ -38,6 +40,10 @@ __all__ = [
     "StoreDep",
     "RunnerDep",
     "FitIdPath",
+    "MaterialIdPath",
+    "RoughnessQuery",
+    "CoatRoughnessQuery",
+    "MinCoverageForm",
     "StoredFit",
     "WriteAccess",
     "SingleFormFields",
@@ -65,6 +71,15 @@ SettingsDep = Annotated[Settings, Depends(get_settings)]
 StoreDep = Annotated[Store, Depends(get_store)]
 RunnerDep = Annotated[FitRunner, Depends(get_runner)]
 FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
+MaterialIdPath = Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
+                                     description="A library name or a saved material's id")]
+RoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description=(
+    "The metal's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
+CoatRoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description=(
+    "The coat's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
+MinCoverageForm = Annotated[float | None, Form(ge=0.0, le=1.0, allow_inf_nan=False, description=(
+    "Least covered fraction of 360-830 nm to accept, in [0.9, 1] (default 0.9, the service's own "
+    "rule; a higher value refuses data the service would fit)"))]
 
 
 def get_stored_fit(fit_id: FitIdPath, store: StoreDep) -> FitRecord:

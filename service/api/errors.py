@@ -13,7 +13,7 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``FitTimeout``                         504 with ``Retry-After``
 ``StoreFull``                          507
 ``StoreUnavailable``                   503 with ``Retry-After``
-``StoreConflict``                      409 (another save of the material came first)
+``StoreConflict``                      409 (another save came first; ``NameTaken``: the name is another's)
 ``RecordDamaged``                      500 (only that record)
 anything else                          500, logged with its traceback
 =====================================  ======================================
@@ -132,7 +132,8 @@ async def _timeout(request: Request, error: FitTimeout) -> JSONResponse:
 
 async def _store_error(request: Request, error: StoreError) -> JSONResponse:
     if error.status == status.HTTP_409_CONFLICT:
-        errors = [{"loc": ["body", "expected_version"], "msg": str(error)[:500], "type": "version_conflict"}]
+        errors = [{"loc": ["body", getattr(error, "field", "expected_version")], "msg": str(error)[:500],
+                   "type": getattr(error, "type", "version_conflict")}]
         return error_response(error.status, str(error), errors)
     log.error("store: %s", error)
     headers = {"Retry-After": str(error.retry_after)} if error.status in (503, 507) else None

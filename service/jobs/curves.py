@@ -41,6 +41,7 @@ from ..pool import FitRunner
 from ..store import FitRecord, Store
 from .common import (FIT_FORMAT_VERSION, check_finite, checked_version, checked_writable, content_address,
                      fit_record, measured_nk, nk_holder, stored_fit, with_measured_nk)
+from .materials import resolve_material
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
 
@@ -105,6 +106,7 @@ class CurveFit:
     model: str = DEFAULT_MODEL
     live: bool = False
     start: tuple | None = None  # with live: the coefficients the solve starts from
+    material_id: str = ""  # the material it is saved under (resolve_material)
 
 
 def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
@@ -161,7 +163,7 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
                       blend_width: float = DEFAULTS.blend_width,
                       request: dict[str, Any] | None = None, draft: bool = False,
                       model: str = DEFAULT_MODEL, live: bool = False,
-                      start_fit: str | None = None) -> CurveFit:
+                      start_fit: str | None = None, material_id: str | None = None) -> CurveFit:
     """
     Resolve the base (``LookupError`` for a base fit not stored), check the
     curves and the domain (``ValueError``), and compute the id. A ``live``
@@ -181,6 +183,7 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
     check_curves(curves)
     domain = base.eta_i_range if base is not None else check_eta_i_range(requested or DEFAULT_DOMAIN)
     start = None if start_fit is None else _start_coefficients(store, start_fit, domain, model, base, curves)
+    material_id = resolve_material(store, name, material_id)
     fit_id = content_address(
         FIT_FORMAT_VERSION, CURVES_FORMAT, name, None if base is None else base.key(), curves,
         list(domain), objective, blend_width, repr(DEFAULTS),
@@ -188,10 +191,12 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
         *(() if model == DEFAULT_MODEL else (model,)),
         # Nor does a full refit.
         *(() if not live else ("live", repr(LIVE_SETTINGS), None if start is None else np.ravel(start))),
+        # Nor does the material a name gives (a record names its material once).
+        *(() if material_id == content_address("edited material", name) else ("material", material_id)),
     )
     return CurveFit(name, base, base_record, curves, domain, objective, blend_width,
                     request or {}, fit_id, draft, model, live,
-                    None if start is None else tuple(np.ravel(start).tolist()))
+                    None if start is None else tuple(np.ravel(start).tolist()), material_id)
 
 
 def _start_coefficients(store: Store, start_fit: str, domain, model: str, base, curves) -> np.ndarray | None:
@@ -260,7 +265,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     refused (:class:`service.store.StoreConflict`, 409) unless the material
     is at that version (see :meth:`service.store.Store.put_fit`).
     """
-    material_id = content_address("edited material", fit.name)
+    material_id = fit.material_id
 
     def stored_or_writable() -> FitRecord | None:
         # One trip to a thread for both (a live refit is a round trip per drag step).

@@ -11,7 +11,8 @@ so bad input is refused by the schema and shows in the OpenAPI document.
 -   :mod:`.fits`: n, k fits, packs, plotted curves; :func:`fit_public`.
 -   :mod:`.curves`: curve fits and error maps.
 -   :mod:`.scenes`: scene packs.
--   :mod:`.materials`: the material list and details.
+-   :mod:`.materials`: the material list and details, versions, edits.
+-   :mod:`.library`: the library to browse, coat presets.
 -   :mod:`.health`: health and the domain.
 """
 
@@ -23,6 +24,8 @@ from .fits import *  # noqa: F401,F403
 from .fits import __all__ as _fits
 from .health import *  # noqa: F401,F403
 from .health import __all__ as _health
+from .library import *  # noqa: F401,F403
+from .library import __all__ as _library
 from .materials import *  # noqa: F401,F403
 from .materials import __all__ as _materials
 from .metrics import *  # noqa: F401,F403
@@ -30,4 +33,4 @@ from .metrics import __all__ as _metrics
 from .scenes import *  # noqa: F401,F403
 from .scenes import __all__ as _scenes
 
-__all__ = [*_common, *_metrics, *_fits, *_curves, *_scenes, *_materials, *_health]
+__all__ = [*_common, *_metrics, *_fits, *_curves, *_scenes, *_materials, *_library, *_health]

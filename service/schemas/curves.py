@@ -125,6 +125,11 @@ class CurveFitRequest(RequestModel):
     start_fit: FitId | None = Field(None, description="With `live`: the stored fit (of the same kind and "
                                                       "domain) whose coefficients the solve starts from")
 
+    material_id: Annotated[str, Field(pattern=r"^[0-9a-f]{32}$")] | None = Field(
+        None, description="Save as the next version of this saved edited material (its `id` in "
+                          "`GET /materials`; the editor sends the material it opened, so a renamed "
+                          "material keeps its history). Unset: the material called `name` now, else a "
+                          "new one; 409 when another material is called `name`")
     expected_version: int | None = Field(
         None, ge=0, le=2**62, strict=True,
         description="Save only if the material `name` is at this version now (0: not saved yet; the "

@@ -18,8 +18,12 @@ one on PostgreSQL for any number of service replicas, :class:`PostgresStore`
     both run; :mod:`service.store.move` SQLite to PostgreSQL.
 
 Records are content addressed (the id is a hash of the fit's inputs) and
-written once: ``put_fit`` of an existing id keeps the first record, nothing
-is ever updated or deleted, so a save that was answered is never lost.
+written once: ``put_fit`` of an existing id keeps the first record, no
+record or save is ever updated or deleted, so a save that was answered is
+never lost. What an artist changes is the material's summary row: its name
+(``rename_material``) and whether it is in the bin (``delete_material``, a
+soft delete; ``restore_material``); only drafts, never saved, are removed
+(``expire_drafts``).
 Every ``put_fit`` also appends to an append-only log of saves, so that the
 latest fit of a material is the one saved last, even when it is an earlier
 fit saved again (an artist's undo, then save). Each save is one transaction
@@ -37,6 +41,7 @@ from .records import (
     FitRecord,
     MaterialPage,
     MaterialRow,
+    NameTaken,
     RecordDamaged,
     SchemaMismatch,
     Store,
@@ -45,6 +50,7 @@ from .records import (
     StoreError,
     StoreFull,
     StoreUnavailable,
+    VersionRow,
 )
 from .migrations import SCHEMA_VERSION, migrate
 from .opening import open_store
@@ -63,6 +69,8 @@ __all__ = [
     "StoreDamaged",
     "RecordDamaged",
     "StoreConflict",
+    "NameTaken",
+    "VersionRow",
     "SchemaMismatch",
     "SCHEMA_VERSION",
     "migrate",

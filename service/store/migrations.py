@@ -24,6 +24,9 @@ columns. Versions:
     when another save came first).
 3.  the index ``saves_by_fit``: the drafts' sweep finds the records no
     save refers to (``expire_drafts``).
+4.  ``materials.deleted_at``: a material in the bin (a soft delete; NULL:
+    not deleted), and the index ``materials_by_name`` (a save or a rename
+    finds the material called a name).
 """
 
 from __future__ import annotations
@@ -46,9 +49,10 @@ UPSERT_MATERIAL = (
     "source, coverage, version) VALUES ({p}, {p}, {p}, {p}, {p}, {p}, {p}, {p}, 1) "
     "ON CONFLICT (material_id) DO UPDATE SET latest_fit_id = excluded.latest_fit_id, "
     "kind = excluded.kind, name = excluded.name, source = excluded.source, "
-    "coverage = excluded.coverage, version = materials.version + 1"
+    "coverage = excluded.coverage, version = materials.version + 1, deleted_at = NULL"
 )
-"""A save's summary row (``{p}``: the dialect's placeholder); a new material is version 1."""
+"""A save's summary row (``{p}``: the dialect's placeholder); a new material is version 1,
+a save of a material in the bin takes it out."""
 
 
 def _backfill_materials(connection: Any, dialect: str) -> None:
@@ -116,13 +120,20 @@ _V3: list[Step] = [
     "CREATE INDEX IF NOT EXISTS saves_by_fit ON saves (fit_id)",
 ]
 
+_V4: list[Step] = [
+    "ALTER TABLE materials ADD COLUMN deleted_at DOUBLE PRECISION",
+    "CREATE INDEX IF NOT EXISTS materials_by_name ON materials (kind, name)",
+]
+
 MIGRATIONS: dict[str, list[tuple[int, str, list[Step]]]] = {
     "sqlite": [(1, "fits, save log, material summaries", _SQLITE_V1),
                (2, "material versions", _V2),
-               (3, "saves by fit (the drafts' sweep)", _V3)],
+               (3, "saves by fit (the drafts' sweep)", _V3),
+               (4, "materials in the bin, by name", _V4)],
     "postgresql": [(1, "fits, save log, material summaries", _POSTGRES_V1),
                    (2, "material versions", _V2),
-                   (3, "saves by fit (the drafts' sweep)", _V3)],
+                   (3, "saves by fit (the drafts' sweep)", _V3),
+                   (4, "materials in the bin, by name", _V4)],
 }
 SCHEMA_VERSION = max(version for version, _, _ in MIGRATIONS["sqlite"])
 """The schema version this code reads and writes."""

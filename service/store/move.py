@@ -29,7 +29,7 @@ _TABLES = {
     "fits": ("id", "kind", "material_id", "created_at", "record"),
     "saves": ("seq", "material_id", "fit_id", "saved_at"),
     "materials": ("material_id", "first_seq", "first_saved_at", "latest_fit_id", "kind", "name",
-                  "source", "coverage", "version"),
+                  "source", "coverage", "version", "deleted_at"),
 }
 _ORDER = {"fits": "id", "saves": "seq", "materials": "material_id"}
 _BATCH = 1000

@@ -56,6 +56,7 @@ from .records import (
     StoreError,
     StoreFull,
     StoreUnavailable,
+    VersionRow,
 )
 
 __all__ = ["PostgresStore", "SAVE_LOCK", "redacted"]
@@ -253,8 +254,47 @@ class PostgresStore:
     def material_version(self, material_id: str) -> int:
         return self._read(lambda c: queries.version_of(c, "%s", material_id))
 
-    def material_page(self, after: int | None, limit: int) -> MaterialPage:
-        return queries.page_of(self._read(lambda c: queries.page_rows(c, "%s", after, limit)), limit)
+    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = queries.LISTED_KINDS,
+                      deleted: bool = False, query: str | None = None) -> MaterialPage:
+        return queries.page_of(self._read(
+            lambda c: queries.page_rows(c, "%s", after, limit, kinds, deleted, query)), limit)
+
+    def _write(self, function: Callable[[psycopg.Connection], _T]) -> _T:
+        """``function(connection)`` in one transaction holding the saves' advisory lock."""
+        def write(connection: psycopg.Connection) -> _T:
+            connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))
+            return function(connection)
+
+        return self._read(write)
+
+    def material(self, material_id: str) -> MaterialRow | None:
+        return self._read(lambda c: queries.material_row(c, "%s", material_id))
+
+    def find_material(self, kind: str, name: str) -> str | None:
+        return self._read(lambda c: queries.find_material(c, "%s", kind, name))
+
+    def rename_material(self, material_id: str, name: str) -> MaterialRow:
+        return self._write(lambda c: queries.rename(c, "%s", material_id, name))
+
+    def delete_material(self, material_id: str) -> MaterialRow:
+        return self._write(lambda c: queries.set_deleted(c, "%s", material_id, True))
+
+    def restore_material(self, material_id: str) -> MaterialRow:
+        return self._write(lambda c: queries.set_deleted(c, "%s", material_id, False))
+
+    def material_versions(self, material_id: str, before: int | None, limit: int) -> list[VersionRow]:
+        rows = self._read(lambda c: queries.version_texts(c, "%s", material_id, before, limit))
+        return [VersionRow(v, fit_id, saved_at, self._decoded(fit_id, text)) for v, fit_id, saved_at, text in rows]
+
+    def version_fit(self, material_id: str, version: int) -> FitRecord | None:
+        row = self._read(lambda c: queries.version_text(c, "%s", material_id, version))
+        return None if row is None else self._decode(*row)
+
+    def _decoded(self, fit_id: str, text: Any) -> FitRecord | None:
+        try:
+            return self._decode(fit_id, text)
+        except RecordDamaged:
+            return None
 
     def saved_materials(self) -> list[MaterialRow]:
         rows: list[MaterialRow] = []

@@ -11,7 +11,11 @@ The caller owns the transaction and translates driver errors.
     summary row, the expected-version check).
 -   :func:`expire_drafts`: the drafts' sweep (age, then quota).
 -   :func:`get_text`, :func:`latest_texts`, :func:`latest_ids`,
-    :func:`version_of`, :func:`page_rows`, :func:`page_of`: the reads.
+    :func:`version_of`, :func:`page_rows`, :func:`page_of`,
+    :func:`material_row`, :func:`find_material`, :func:`version_texts`,
+    :func:`version_text`: the reads.
+-   :func:`rename`, :func:`set_deleted`: what an artist changes of a
+    material (its summary row only; records and saves stay as written).
 """
 
 from __future__ import annotations
@@ -21,10 +25,13 @@ import time
 from typing import Any, Callable
 
 from .migrations import UPSERT_MATERIAL
-from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, StoreConflict
+from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict
+
+INT64_MAX = 2**63 - 1
 
 __all__ = ["save", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
-           "expire_drafts"]
+           "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
+           "version_text", "LISTED_KINDS"]
 
 log = logging.getLogger("service.store")
 
@@ -102,28 +109,136 @@ def version_of(connection: Any, p: str, material_id: str) -> int:
     return 0 if row is None else int(row[0])
 
 
-def page_rows(connection: Any, p: str, after: int | None, limit: int) -> list[tuple]:
-    """Summary rows of saved (non-library) materials after cursor ``after``, one more than ``limit``."""
+LISTED_KINDS = ("nk", "curves")
+"""The kinds of saved materials a page lists by default (library fits are listed by the route)."""
+_ROW = ("material_id, name, source, coverage, kind, latest_fit_id, first_saved_at, first_seq, version, "
+        "deleted_at")
+
+
+def _like(text: str) -> str:
+    """``text`` as a LIKE pattern that matches it anywhere, its ``%``, ``_`` and ``\\`` literal."""
+    escaped = text.lower().replace("\\", "\\\\").replace("%", "\\%").replace("_", "\\_")
+    return f"%{escaped}%"
+
+
+def page_rows(connection: Any, p: str, after: int | None, limit: int,
+              kinds: tuple[str, ...] = LISTED_KINDS, deleted: bool = False,
+              query: str | None = None) -> list[tuple]:
+    """
+    Summary rows of saved materials of ``kinds`` after cursor ``after``,
+    one more than ``limit``: those not in the bin (or, ``deleted``, only
+    those in it), with ``query`` only those whose name or source holds it.
+    """
+    # The kinds not asked for are left out, so a row of an unreadable kind is still read
+    # (and reported in ``skipped`` by page_of) whatever was asked for.
+    left_out = ("library", *(k for k in FIT_KINDS if k != "library" and k not in kinds))
+    where = [f"kind NOT IN ({','.join([p] * len(left_out))})", f"first_seq > {p}",
+             "deleted_at IS NOT NULL" if deleted else "deleted_at IS NULL"]
+    params: list[Any] = [*left_out, after or 0]
+    if query:
+        where.append(f"(lower(name) LIKE {p} ESCAPE '\\' OR lower(source) LIKE {p} ESCAPE '\\')")
+        params += [_like(query), _like(query)]
     return connection.execute(
-        "SELECT material_id, name, source, coverage, kind, latest_fit_id, first_saved_at, "
-        f"first_seq, version FROM materials WHERE kind != 'library' AND first_seq > {p} "
-        f"ORDER BY first_seq LIMIT {p}", (after or 0, limit + 1)).fetchall()
+        f"SELECT {_ROW} FROM materials WHERE {' AND '.join(where)} ORDER BY first_seq LIMIT {p}",
+        (*params, limit + 1)).fetchall()
+
+
+def _row(values: tuple) -> MaterialRow | None:
+    """A :class:`MaterialRow` of one summary row, None when it cannot be read (logged)."""
+    material_id, name, source, coverage, kind, latest, first_at, seq, version, deleted_at = values
+    if (kind not in FIT_KINDS or not isinstance(name, str) or not isinstance(source, str)
+            or not (coverage is None or isinstance(coverage, float))):
+        log.error("the summary of material %r cannot be read, skipped", material_id)
+        return None
+    return MaterialRow(material_id=material_id, name=name, source=source, coverage=coverage, kind=kind,
+                       latest_fit_id=latest, created_at=first_at, seq=int(seq), version=int(version),
+                       deleted_at=None if deleted_at is None else float(deleted_at))
 
 
 def page_of(rows: list[tuple], limit: int) -> MaterialPage:
     """A :class:`MaterialPage` of :func:`page_rows`; unreadable summaries are named in ``skipped``."""
     out, skipped = [], []
-    for material_id, name, source, coverage, kind, latest, first_at, seq, version in rows[:limit]:
-        if (kind not in FIT_KINDS or not isinstance(name, str) or not isinstance(source, str)
-                or not (coverage is None or isinstance(coverage, float))):
-            log.error("the summary of material %r cannot be read, skipped", material_id)
-            skipped.append(str(material_id))
-            continue
-        out.append(MaterialRow(material_id=material_id, name=name, source=source,
-                               coverage=coverage, kind=kind, latest_fit_id=latest,
-                               created_at=first_at, seq=int(seq), version=int(version)))
+    for values in rows[:limit]:
+        row = _row(values)
+        if row is None:
+            skipped.append(str(values[0]))
+        else:
+            out.append(row)
     next_cursor = int(rows[limit - 1][7]) if len(rows) > limit else None
     return MaterialPage(out, next_cursor, skipped)
+
+
+def material_row(connection: Any, p: str, material_id: str) -> MaterialRow | None:
+    """The summary row of ``material_id`` (in the bin or not), or None."""
+    values = connection.execute(f"SELECT {_ROW} FROM materials WHERE material_id = {p}",
+                                (material_id,)).fetchone()
+    return None if values is None else _row(values)
+
+
+def find_material(connection: Any, p: str, kind: str, name: str) -> str | None:
+    """The id of the material of ``kind`` called ``name`` (one not in the bin first), or None."""
+    row = connection.execute(
+        f"SELECT material_id FROM materials WHERE kind = {p} AND name = {p} "
+        "ORDER BY (deleted_at IS NOT NULL), first_seq LIMIT 1", (kind, _text(name))).fetchone()
+    return None if row is None else row[0]
+
+
+def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
+    """The row of a saved, non-library material: LookupError or ValueError otherwise."""
+    row = material_row(connection, p, material_id)
+    if row is None:
+        raise LookupError(f"`material_id` {material_id!r} is not a saved material")
+    if row.kind == "library":
+        raise ValueError(f"`material_id` {material_id!r} is a built-in material: it cannot be "
+                         "renamed or deleted")
+    return row
+
+
+def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
+    """Inside a write transaction holding the saves' lock: the summary of ``material_id`` renamed."""
+    row = _saved(connection, p, material_id)
+    if row.kind == "curves":  # an edited material is found by its name: names are unique
+        holder = connection.execute(
+            f"SELECT material_id, deleted_at FROM materials WHERE kind = 'curves' AND name = {p} "
+            f"AND material_id != {p}", (_text(name), material_id)).fetchone()
+        if holder is not None:
+            where = " (in the bin)" if holder[1] is not None else ""
+            raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
+                            "choose another name, or rename that one first", version=row.version,
+                            latest_fit_id=row.latest_fit_id)
+    connection.execute(f"UPDATE materials SET name = {p} WHERE material_id = {p}", (_text(name), material_id))
+    return material_row(connection, p, material_id)
+
+
+def set_deleted(connection: Any, p: str, material_id: str, deleted: bool) -> MaterialRow:
+    """Inside a write transaction: ``material_id`` moved to the bin (``deleted``) or out of it."""
+    row = _saved(connection, p, material_id)
+    if deleted and row.deleted_at is None:
+        connection.execute(f"UPDATE materials SET deleted_at = {p} WHERE material_id = {p}",
+                           (time.time(), material_id))
+    elif not deleted and row.deleted_at is not None:
+        connection.execute(f"UPDATE materials SET deleted_at = NULL WHERE material_id = {p}", (material_id,))
+    return material_row(connection, p, material_id)
+
+
+_VERSIONS = ("(SELECT ROW_NUMBER() OVER (ORDER BY seq) AS v, fit_id, saved_at FROM saves "
+             "WHERE material_id = {p}) t")
+
+
+def version_texts(connection: Any, p: str, material_id: str, before: int | None,
+                  limit: int) -> list[tuple]:
+    """(version, fit id, saved at, JSON text) of a material's saves below ``before``, newest first."""
+    return connection.execute(
+        f"SELECT t.v, t.fit_id, t.saved_at, f.record FROM {_VERSIONS.format(p=p)} "
+        f"JOIN fits f ON f.id = t.fit_id WHERE t.v < {p} ORDER BY t.v DESC LIMIT {p}",
+        (material_id, INT64_MAX if before is None else before, limit)).fetchall()
+
+
+def version_text(connection: Any, p: str, material_id: str, version: int) -> tuple | None:
+    """(fit id, JSON text) of version ``version`` of a material, or None."""
+    return connection.execute(
+        f"SELECT t.fit_id, f.record FROM {_VERSIONS.format(p=p)} JOIN fits f ON f.id = t.fit_id "
+        f"WHERE t.v = {p}", (material_id, version)).fetchone()
 
 
 def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) -> int:

@@ -99,6 +99,20 @@ class MaterialRow:
     created_at: float
     seq: int = 0
     version: int = 0
+    deleted_at: float | None = None
+
+
+@dataclass(frozen=True)
+class VersionRow:
+    """
+    One save of a material: its ``version`` (1 for the first save), the
+    fit saved, when, and the record (None when it cannot be decoded).
+    """
+
+    version: int
+    fit_id: str
+    saved_at: float
+    record: "FitRecord | None"
 
 
 @dataclass(frozen=True)
@@ -156,10 +170,20 @@ class StoreConflict(StoreError):
     """
 
     status = 409
+    field = "expected_version"
+    """The request field the conflict is about (``errors[0].loc``)."""
+    type = "version_conflict"
 
     def __init__(self, message: str, version: int = 0, latest_fit_id: str | None = None) -> None:
         super().__init__(message)
         self.version, self.latest_fit_id = version, latest_fit_id
+
+
+class NameTaken(StoreConflict):
+    """A rename (or a save) to the name of another saved material of the same kind (409)."""
+
+    field = "name"
+    type = "name_taken"
 
 
 class RecordDamaged(StoreError):
@@ -194,8 +218,44 @@ class Store(Protocol):
     def saved_materials(self) -> list[MaterialRow]:
         """Materials with at least one non-library fit, oldest first."""
 
-    def material_page(self, after: int | None, limit: int) -> MaterialPage:
-        """Saved materials after cursor ``after`` (None: from the first), at most ``limit``."""
+    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = ("nk", "curves"),
+                      deleted: bool = False, query: str | None = None) -> MaterialPage:
+        """
+        Saved materials of ``kinds`` after cursor ``after`` (None: from the
+        first), at most ``limit``: those not deleted, or (``deleted``) only
+        those deleted; with ``query``, only those whose name or source
+        holds it (case-insensitive for ASCII letters).
+        """
+
+    def material(self, material_id: str) -> MaterialRow | None:
+        """The summary row of a saved material (deleted or not), or None."""
+
+    def find_material(self, kind: str, name: str) -> str | None:
+        """The id of the material of ``kind`` called ``name`` now (one not deleted first), or None."""
+
+    def rename_material(self, material_id: str, name: str) -> MaterialRow:
+        """
+        Call a saved material ``name`` (not a save: its version is kept);
+        :class:`NameTaken` when another material of kind ``curves`` is
+        called that, ``LookupError`` when not saved, ``ValueError`` for a
+        library material.
+        """
+
+    def delete_material(self, material_id: str) -> MaterialRow:
+        """
+        Move a saved material to the bin (a soft delete: listed only with
+        ``deleted``, its fits and saves kept, :meth:`restore_material`
+        undoes it; a later save of it restores it too). Idempotent.
+        """
+
+    def restore_material(self, material_id: str) -> MaterialRow:
+        """Take a material out of the bin. Idempotent."""
+
+    def material_versions(self, material_id: str, before: int | None, limit: int) -> list[VersionRow]:
+        """A material's saves with version below ``before`` (None: all), newest first, at most ``limit``."""
+
+    def version_fit(self, material_id: str, version: int) -> FitRecord | None:
+        """The fit saved as ``version`` of a material (1: the first save), or None."""
 
     def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
         """The latest fit id of each of ``material_ids`` that has one."""

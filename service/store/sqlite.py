@@ -30,6 +30,7 @@ from .records import (
     StoreError,
     StoreFull,
     StoreUnavailable,
+    VersionRow,
 )
 
 log = logging.getLogger("service.store")
@@ -193,9 +194,50 @@ class SQLiteStore:
     def material_version(self, material_id: str) -> int:
         return self._guard(lambda: queries.version_of(self._connection(), "?", material_id))
 
-    def material_page(self, after: int | None, limit: int) -> MaterialPage:
-        rows = self._guard(lambda: queries.page_rows(self._connection(), "?", after, limit))
+    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = queries.LISTED_KINDS,
+                      deleted: bool = False, query: str | None = None) -> MaterialPage:
+        rows = self._guard(lambda: queries.page_rows(self._connection(), "?", after, limit, kinds, deleted,
+                                                     query))
         return queries.page_of(rows, limit)
+
+    def _write(self, function: Callable[[sqlite3.Connection], _T]) -> _T:
+        """``function(connection)`` in one write transaction holding the write lock (as saves do)."""
+        def write() -> _T:
+            connection = self._connection()
+            with connection:
+                connection.execute("BEGIN IMMEDIATE")
+                return function(connection)
+
+        return self._guard(write)
+
+    def material(self, material_id: str) -> MaterialRow | None:
+        return self._guard(lambda: queries.material_row(self._connection(), "?", material_id))
+
+    def find_material(self, kind: str, name: str) -> str | None:
+        return self._guard(lambda: queries.find_material(self._connection(), "?", kind, name))
+
+    def rename_material(self, material_id: str, name: str) -> MaterialRow:
+        return self._write(lambda c: queries.rename(c, "?", material_id, name))
+
+    def delete_material(self, material_id: str) -> MaterialRow:
+        return self._write(lambda c: queries.set_deleted(c, "?", material_id, True))
+
+    def restore_material(self, material_id: str) -> MaterialRow:
+        return self._write(lambda c: queries.set_deleted(c, "?", material_id, False))
+
+    def material_versions(self, material_id: str, before: int | None, limit: int) -> list[VersionRow]:
+        rows = self._guard(lambda: queries.version_texts(self._connection(), "?", material_id, before, limit))
+        return [VersionRow(v, fit_id, saved_at, self._decoded(fit_id, text)) for v, fit_id, saved_at, text in rows]
+
+    def version_fit(self, material_id: str, version: int) -> FitRecord | None:
+        row = self._guard(lambda: queries.version_text(self._connection(), "?", material_id, version))
+        return None if row is None else self._decode(*row)
+
+    def _decoded(self, fit_id: str, text: Any) -> FitRecord | None:
+        try:
+            return self._decode(fit_id, text)
+        except RecordDamaged:
+            return None
 
     def saved_materials(self) -> list[MaterialRow]:
         rows: list[MaterialRow] = []

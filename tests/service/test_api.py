@@ -173,7 +173,10 @@ class TestFits:
         # The pack keeps the range in float32 (u32 = 6e-8 relative): approx's
         # default rel=1e-6 covers it 17x.
         assert fit["eta_i_range"] == pytest.approx([1.2, 1.8]) and fit["objective"] == "rgb" and fit["has_nk"]
-        saved = [m for m in client.get(f"{API}/materials").json()["materials"] if m["kind"] == "nk"]
+        # Uploads are listed apart from the artist's saved edits (`?kind=nk`).
+        default = client.get(f"{API}/materials").json()["materials"]
+        assert fit["material_id"] not in [m["id"] for m in default]
+        saved = client.get(f"{API}/materials", params={"kind": "nk"}).json()["materials"]
         assert fit["material_id"] in [m["id"] for m in saved]
         detail = client.get(f"{API}/materials/{fit['material_id']}").json()
         assert detail["latest_fit"]["id"] == fit["id"] and detail["name"] == "my gold"

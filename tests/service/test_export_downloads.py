@@ -47,7 +47,7 @@ class TestExportDownloads:
         assert response.status_code == 200, response.text
         assert response.headers["content-type"] == media_type
         assert response.headers["content-disposition"] == (
-            f'attachment; filename="Cu-{fit_id[:8]}-eta1.7{suffix}"')
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.7-rough0.2-coat0.03{suffix}"')
         expected = export_material(library_material("Cu"), format, 1.7, model=stored_model(client, fit_id))
         assert response.content == expected
         assert (b"EXT_materials_coated_conductor" in response.content) == (format == "gltf")
@@ -58,6 +58,22 @@ class TestExportDownloads:
         root = ET.fromstring(pack(client, fit_id, "format=openpbr").content)
         (coat_ior,) = [e for e in root.iter("input") if e.get("name") == "coat_ior"]
         assert coat_ior.get("value") == "1.5"
+
+    @pytest.mark.slow  # starts a process or GL context
+    def test_preview_roughness_and_coat_roughness(self, shared):
+        # The editor's preview values travel into the export and its file name.
+        client, fit_id = shared
+        response = pack(client, fit_id, "format=openpbr&eta_i=1.33&roughness=0.45&coat_roughness=0.1")
+        assert response.status_code == 200, response.text
+        assert response.headers["content-disposition"] == (
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.33-rough0.45-coat0.1.openpbr.mtlx"')
+        expected = export_material(library_material("Cu"), "openpbr", 1.33, 0.45, 0.1,
+                                   model=stored_model(client, fit_id))
+        assert response.content == expected
+        assert response.content != pack(client, fit_id, "format=openpbr&eta_i=1.33").content
+        for query in ("roughness=1.5", "coat_roughness=-0.1", "roughness=nan"):
+            refused = pack(client, fit_id, f"format=gltf&{query}")
+            assert refused.status_code == 422 and query.split("=")[0] in refused.json()["detail"]
 
     @pytest.mark.slow  # starts a process or GL context
     @pytest.mark.parametrize("query, words", [

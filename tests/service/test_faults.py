@@ -112,11 +112,11 @@ def test_materials_paged_by_summary(tmp_path):
                                 source="s", material=material))
     store.close()
     with app_client(tmp_path, materials_page_max=12) as client:
-        first = client.get(f"{API}/materials").json()
+        first = client.get(f"{API}/materials", params={"kind": ["library", "nk"]}).json()
         assert len(first["materials"]) == 22 + 12 and first["next_cursor"] is not None
         names, cursor = [m["name"] for m in first["materials"][22:]], first["next_cursor"]
         for _ in range(10):
-            page = client.get(f"{API}/materials", params={"cursor": cursor, "limit": 12}).json()
+            page = client.get(f"{API}/materials", params={"cursor": cursor, "limit": 12, "kind": "nk"}).json()
             assert all(m["kind"] != "library" for m in page["materials"])
             names += [m["name"] for m in page["materials"]]
             cursor = page["next_cursor"]
@@ -137,7 +137,7 @@ def test_corrupt_record_reported_and_skipped(tmp_path):
             db.execute("UPDATE materials SET kind = 'garbage' WHERE material_id = ?", (b["material_id"],))
         damaged = client.get(f"{API}/fits/{a['id']}")
         assert damaged.status_code == 500 and "damaged" in damaged.json()["detail"]
-        listing = client.get(f"{API}/materials")
+        listing = client.get(f"{API}/materials", params={"kind": "nk"})
         assert listing.status_code == 200
         body = listing.json()
         assert body["skipped"] == [b["material_id"]]
@@ -161,7 +161,8 @@ def test_store_quota_full_507_and_healthz(tmp_path):
         assert health["store_writable"] is False and "quota" in health["store_problem"]
         for i, status in enumerate(statuses[:-1]):  # every acknowledged save is there
             assert client.get(f"{API}/materials").status_code == 200
-        assert len([m for m in client.get(f"{API}/materials").json()["materials"] if m["kind"] == "nk"]) == len(statuses) - 1
+        uploads = client.get(f"{API}/materials", params={"kind": "nk"}).json()["materials"]
+        assert len([m for m in uploads if m["kind"] == "nk"]) == len(statuses) - 1
 
 
 def test_disk_below_free_space_refused_507_before_fitting(tmp_path):

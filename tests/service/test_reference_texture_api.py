@@ -1,7 +1,7 @@
 """
 ``GET /api/v1/fits/{id}/reference-texture`` (the spectral reference of the
 editor's real-time preview), the GLSL the editor loads from ``/glsl/`` and
-the offline ``/docs`` (Swagger UI from the swagger_ui_bundle package).
+the offline ``/docs`` (Swagger UI from npm swagger-ui-dist, scripts/swagger-ui/).
 """
 
 from __future__ import annotations
@@ -75,7 +75,8 @@ def test_docs_use_local_assets(shared):
     page = shared.get("/docs")
     assert page.status_code == 200
     assert "cdn" not in page.text.lower()
-    assert "/docs-assets/swagger-ui-bundle.js" in page.text
-    script = shared.get("/docs-assets/swagger-ui-bundle.js")
+    assert "/vendor/swagger-ui/swagger-ui-bundle.js" in page.text
+    script = shared.get("/vendor/swagger-ui/swagger-ui-bundle.js")
     assert script.status_code == 200 and len(script.content) > 100_000
-    assert shared.get("/docs-assets/swagger-ui.css").status_code == 200
+    assert shared.get("/vendor/swagger-ui/swagger-ui.css").status_code == 200
+    assert shared.get("/redoc").status_code == 404  # dropped: its page loads CDN scripts and fonts

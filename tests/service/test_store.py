@@ -10,7 +10,7 @@ import sqlite3
 
 import pytest
 
-from service.store import SCHEMA_VERSION, FitRecord, SQLiteStore, Store, StoreConflict
+from service.store import SCHEMA_VERSION, FitRecord, NameTaken, SQLiteStore, Store, StoreConflict
 
 POSTGRES = pytest.param("postgresql", marks=[pytest.mark.xdist_group("postgres"), pytest.mark.slow])
 
@@ -133,6 +133,78 @@ class TestStoreContract:
         saved = store.put_fit(record("8" * 32, material_id="n" * 32, name="a\x00b"))
         assert store.get_fit(saved.id).name == "a\x00b"  # the record keeps it exactly
         assert store.saved_materials()[0].name == "a\ufffdb"  # the summary shows it
+
+
+class TestMaterialsManaged:
+    """Rename, the bin, versions and the listing's filters, on both stores."""
+
+    def test_rename_is_not_a_save_and_names_are_unique(self, store):
+        a, b = "a" * 32, "b" * 32
+        store.put_fit(record("1" * 32, material_id=a, kind="curves", name="A"))
+        store.put_fit(record("2" * 32, material_id=b, kind="curves", name="B"))
+        renamed = store.rename_material(a, "A2")
+        assert (renamed.name, renamed.version, renamed.latest_fit_id) == ("A2", 1, "1" * 32)
+        assert store.find_material("curves", "A2") == a and store.find_material("curves", "A") is None
+        with pytest.raises(NameTaken) as taken:
+            store.rename_material(a, "B")
+        assert taken.value.status == 409 and "B" in str(taken.value)
+        assert store.material(a).name == "A2"  # refused: nothing changed
+        with pytest.raises(LookupError):
+            store.rename_material("c" * 32, "C")
+        store.put_fit(record("3" * 32, material_id="Au", kind="library", library_material="Au"))
+        with pytest.raises(ValueError, match="built-in"):
+            store.rename_material("Au", "gold")
+        # The record keeps the name it was saved under; the next save names the material.
+        assert store.get_fit("1" * 32).name == "A"
+        store.put_fit(record("4" * 32, material_id=a, kind="curves", name="A2"))
+        assert (store.material(a).name, store.material(a).version) == ("A2", 2)
+
+    def test_delete_is_a_bin_and_nothing_is_lost(self, store):
+        a, b = "a" * 32, "b" * 32
+        first = store.put_fit(record("1" * 32, material_id=a, kind="curves", name="A"))
+        store.put_fit(record("2" * 32, material_id=a, kind="curves", name="A"))
+        store.put_fit(record("5" * 32, material_id=b, kind="curves", name="B"))
+        gone = store.delete_material(a)
+        assert gone.deleted_at is not None and store.delete_material(a).deleted_at == gone.deleted_at
+        assert [r.material_id for r in store.material_page(None, 10).rows] == [b]
+        assert [r.material_id for r in store.material_page(None, 10, deleted=True).rows] == [a]
+        # Its fits, saves and versions are all still there.
+        assert store.get_fit(first.id) == first and store.latest_fit(a).id == "2" * 32
+        assert [v.version for v in store.material_versions(a, None, 10)] == [2, 1]
+        assert store.restore_material(a).deleted_at is None
+        assert [r.material_id for r in store.material_page(None, 10).rows] == [a, b]
+        # A save of a material in the bin takes it out.
+        store.delete_material(b)
+        store.put_fit(record("6" * 32, material_id=b, kind="curves", name="B"))
+        assert store.material(b).deleted_at is None and store.material(b).version == 2
+        with pytest.raises(LookupError):
+            store.delete_material("c" * 32)
+
+    def test_versions_newest_first_by_page(self, store):
+        m = "a" * 32
+        for i in (1, 2, 3, 1, 4):  # an undo then save of 1: a version of its own
+            store.put_fit(record(f"{i:032x}", material_id=m, kind="curves", name="A"))
+        versions = store.material_versions(m, None, 3)
+        assert [(v.version, v.fit_id[-1]) for v in versions] == [(5, "4"), (4, "1"), (3, "3")]
+        assert versions[0].record == store.get_fit(f"{4:032x}") and versions[0].saved_at > 0
+        older = store.material_versions(m, versions[-1].version, 3)
+        assert [(v.version, v.fit_id[-1]) for v in older] == [(2, "2"), (1, "1")]
+        assert store.version_fit(m, 2).id == f"{2:032x}" and store.version_fit(m, 6) is None
+        assert store.material_versions("b" * 32, None, 3) == []
+
+    def test_listing_by_kind_and_query(self, store):
+        store.put_fit(record("1" * 32, material_id="a" * 32, kind="curves", name="Warm 100%_gold"))
+        store.put_fit(record("2" * 32, material_id="b" * 32, kind="nk", name="upload"))
+        store.put_fit(record("3" * 32, material_id="Au", kind="library", library_material="Au"))
+        names = lambda page: [r.name for r in page.rows]  # noqa: E731
+        assert names(store.material_page(None, 10)) == ["Warm 100%_gold", "upload"]
+        assert names(store.material_page(None, 10, ("curves",))) == ["Warm 100%_gold"]
+        assert names(store.material_page(None, 10, ("nk",))) == ["upload"]
+        assert names(store.material_page(None, 10, ("curves", "nk"), query="WARM")) == ["Warm 100%_gold"]
+        # LIKE's wildcards are literal in a query.
+        assert names(store.material_page(None, 10, query="100%_")) == ["Warm 100%_gold"]
+        assert names(store.material_page(None, 10, query="0_g")) == []
+        assert names(store.material_page(None, 10, query="lab")) == ["Warm 100%_gold", "upload"]  # the source
 
 
 class TestSQLiteStore:

@@ -113,6 +113,7 @@ class TestMove:
             lite.put_fit(record(f"{i:032x}", material_id=f"{i % 7:032x}", name=f"m{i % 7}"))
         lite.put_fit(record(f"{3:032x}"), save=False)
         lite.put_fit(record(f"{100:032x}", material_id="Au", kind="library"))
+        in_bin = lite.delete_material(f"{6:032x}").deleted_at  # the bin moves too
         lite.close()
         url = postgres_server.database()
         result = run_service("migrate", "--from-sqlite", str(tmp_path / "data" / "store.sqlite3"),
@@ -125,7 +126,8 @@ class TestMove:
         assert f"checksum {checksum} (source and target agree)" in result.stdout
         assert url not in result.stdout and redacted(url) in result.stdout
         target = PostgresStore(url)
-        assert [m.name for m in target.saved_materials()] == [f"m{i}" for i in range(7)]
+        assert [m.name for m in target.saved_materials()] == [f"m{i}" for i in range(6)]
+        assert target.material(f"{6:032x}").deleted_at == in_bin
         assert target.material_version(f"{1:032x}") == 5
         target.put_fit(record("f" * 32, material_id="new" * 10))  # seq continues after the moved log
         assert target.saved_materials()[-1].material_id == "new" * 10

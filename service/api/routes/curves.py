@@ -58,6 +58,7 @@ async def create_fit_from_curves(
             blend_width=request.blend_width,
             request=request.model_dump(mode="json", exclude={"base", "draft", "live", "start_fit", "expected_version"}), draft=request.draft,
             model=request.model, live=request.live, start_fit=request.start_fit,
+            material_id=request.material_id,
         ))
     record, created = await fit_from_curves(fit, store, runner, request.expected_version)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK

@@ -24,31 +24,13 @@ from fastapi.concurrency import run_in_threadpool
 from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, export_response, pack_response
 from ...jobs.common import stored_fit
 from ...jobs.nk import NKFit, angle_curves, fit_nk
-from ...schemas import (
-    API_PREFIX,
-    DEFAULT_ETA_I_RANGE,
-    DEFAULT_OBJECTIVE,
-    ETA_I_LIMITS,
-    CurvesPublic,
-    FitPublic,
-    FitRequest,
-    PACK_FORMATS,
-    Objective,
-    fit_public,
-)
+from ...jobs.uploads import check_coverage
+from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, PACK_FORMATS,
+                        CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
 from ...store import FitRecord
-from ..deps import (
-    ERROR_RESPONSES,
-    FIT_ERROR_RESPONSES,
-    NOT_FOUND,
-    FitIdPath,
-    RunnerDep,
-    SettingsDep,
-    SingleFormFields,
-    StoredFit,
-    StoreDep,
-    WriteAccess,
-)
+from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
+                    MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields, StoredFit,
+                    StoreDep, WriteAccess)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -99,16 +81,18 @@ async def upload_fit(
     eta_i_min: EtaForm = DEFAULT_ETA_I_RANGE[0],
     eta_i_max: EtaForm = DEFAULT_ETA_I_RANGE[1],
     objective: Annotated[Objective, Form()] = DEFAULT_OBJECTIVE,
+    min_coverage: MinCoverageForm = None,
 ) -> FitPublic:
     """
     Fit an uploaded n, k file (size limit: COATED_MAX_UPLOAD_BYTES). The
     file is parsed, never stored or executed as given; the fit keeps its
-    n, k as numbers.
+    n, k as numbers. The data must cover 90% of 360-830 nm, or `min_coverage` when it asks more.
     """
     runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
                                   (eta_i_min, eta_i_max), objective, settings.metrics_samples)
+    check_coverage(fit.nk, min_coverage)
     return fit_answer(*await fit_nk(fit, store, runner), response)
 
 
@@ -129,6 +113,7 @@ async def get_pack(
     eta_i: Annotated[float, Query(
         ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
         description="Coating index of an export (mtlx, openpbr, blender, gltf), [1, 3]")] = 1.5,
+    roughness: RoughnessQuery = 0.2, coat_roughness: CoatRoughnessQuery = 0.03,
 ) -> Response:
     """
     The fit as a download: ``binary`` (docs/pack-format.md), ``json``, or a
@@ -136,12 +121,13 @@ async def get_pack(
     evaluation function; or, for one coating index ``eta_i``, an export
     (docs/exports.md): a MaterialX document (``mtlx``: conductor under a
     dielectric coat; ``openpbr``: ``open_pbr_surface``), a Blender script
-    (``blender``) or a glTF asset (``gltf``).
+    (``blender``) or a glTF asset (``gltf``), with ``roughness`` and
+    ``coat_roughness``; named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
     """
     record = stored_fit(store, fit_id)  # after the query is validated: 422 before 404
     stem = f"{record.name}-{record.id[:8]}"
     if format in EXPORT_MEDIA_TYPES:
-        return await run_in_threadpool(export_response, record, format, eta_i, stem)
+        return await run_in_threadpool(export_response, record, format, eta_i, stem, roughness, coat_roughness)
     return pack_response([record], format, stem)
 
 

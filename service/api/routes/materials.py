@@ -2,11 +2,23 @@
 Materials
 =========
 
-``GET /api/v1/materials?limit=&cursor=``: one page of materials: the
-built-in library (first page only), then saved materials (fits of uploaded
-or inline n, k and of edited curves), oldest first, read from the store's
-summary rows, so a page costs what it returns. ``next_cursor`` continues.
-``GET /api/v1/materials/{material_id}``: one material with its latest fit.
+-   ``GET /api/v1/materials?kind=&q=&deleted=&limit=&cursor=``: one page of
+    materials: the built-in library (first page only), then saved
+    materials, oldest first, read from the store's summary rows, so a page
+    costs what it returns. ``kind`` selects: ``library``, ``curves`` (the
+    artist's saved edits) and ``nk`` (fits of uploaded or inline n, k, kept
+    apart: listed only when asked); default ``library`` and ``curves``.
+    ``q`` keeps those whose name, symbol or source holds it; ``deleted``
+    lists the bin instead. ``next_cursor`` continues.
+-   ``GET /api/v1/materials/{material_id}``: one material with its latest fit.
+-   ``PATCH /api/v1/materials/{material_id}``: rename (``{"name"}``).
+-   ``DELETE /api/v1/materials/{material_id}``: to the bin (soft delete).
+-   ``POST /api/v1/materials/{material_id}/restore``: out of the bin.
+
+A material's versions and a fit's edit: :mod:`service.api.routes.versions`.
+
+The writes need what saves need (:data:`service.api.deps.WriteAccess`:
+same site, and the bearer token when the service requires one).
 """
 
 from __future__ import annotations
@@ -14,16 +26,24 @@ from __future__ import annotations
 import functools
 from typing import Annotated
 
-from fastapi import APIRouter, Path, Query
+from fastapi import APIRouter, Query
 
-from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.optics.library import FULL_NAMES, LIBRARY_NAMES, library_material
 from fitting.optics.nk import visible_coverage
 
-from ...schemas import API_PREFIX, INT64_MAX, MATERIAL_ID_PATTERN, MaterialDetail, MaterialList, MaterialSummary, fit_public
 from ...jobs.common import with_measured_nk
-from ..deps import ERROR_RESPONSES, NOT_FOUND, SettingsDep, StoreDep
+from ...jobs.library import matches
+from ...jobs.materials import share_url as _share
+from ...schemas import (API_PREFIX, INT64_MAX, LISTING_KINDS, ErrorBody, MaterialDetail, MaterialList, MaterialRename,
+                        MaterialSummary, fit_public)
+from ...store import MaterialRow
+from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdPath, SettingsDep, StoreDep,
+                    WriteAccess)
 
-router = APIRouter(prefix=f"{API_PREFIX}/materials", tags=["materials"])
+router = APIRouter(prefix=API_PREFIX, tags=["materials"])
+
+WRITE_RESPONSES = {**FIT_ERROR_RESPONSES, **NOT_FOUND,
+                   409: {"model": ErrorBody, "description": "Another saved edited material is called `name`"}}
 
 
 @functools.cache
@@ -32,56 +52,101 @@ def _library_entry(name: str) -> tuple[str, float, tuple[float, float]]:
     return nk.source, visible_coverage(nk.wavelength_range_nm), nk.wavelength_range_nm
 
 
-@router.get("", response_model=MaterialList, responses=ERROR_RESPONSES)
+def _summary(row: MaterialRow) -> MaterialSummary:
+    return MaterialSummary(id=row.material_id, name=row.name, kind=row.kind, source=row.source,
+                           coverage=row.coverage, latest_fit_id=row.latest_fit_id, version=row.version,
+                           deleted_at=row.deleted_at, share_url=_share(row.material_id))
+
+
+@router.get("/materials", response_model=MaterialList, responses=ERROR_RESPONSES)
 def list_materials(
     store: StoreDep, settings: SettingsDep,
     limit: Annotated[int | None, Query(ge=1, le=INT64_MAX, description="Saved materials per page "
                                        "(default and most: COATED_MATERIALS_PAGE_MAX)")] = None,
     cursor: Annotated[int | None, Query(ge=0, le=INT64_MAX,
                                         description="`next_cursor` of the previous page")] = None,
+    kind: Annotated[list[str] | None, Query(
+        description="library | curves (saved edits) | nk (n, k uploads); repeat for several; "
+                    "default library and curves")] = None,
+    q: Annotated[str | None, Query(min_length=1, max_length=200,
+                                   description="Only names, symbols or sources holding it "
+                                               "(case-insensitive)")] = None,
+    deleted: Annotated[bool, Query(description="List the bin (deleted materials) instead")] = False,
 ) -> MaterialList:
-    """The 22 built-in conductors (first page), then the saved materials, oldest first."""
+    """The built-in conductors (first page), then the saved materials of `kind`, oldest first."""
+    kinds = tuple(dict.fromkeys(kind or ("library", "curves")))
+    unknown = [k for k in kinds if k not in LISTING_KINDS]
+    if unknown:
+        raise ValueError(f"`kind` must be one of {', '.join(LISTING_KINDS)}, got {unknown[0][:40]!r}")
     limit = min(limit or settings.materials_page_max, settings.materials_page_max)
     materials = []
-    if cursor is None:
+    if cursor is None and "library" in kinds and not deleted:
         latest = store.latest_fit_ids(list(LIBRARY_NAMES))
         for name in LIBRARY_NAMES:
             source, coverage, _ = _library_entry(name)
+            if q and not matches({"symbol": name, "name": FULL_NAMES[name], "source": source, "page": ""}, q):
+                continue
             materials.append(MaterialSummary(id=name, name=name, kind="library", source=source,
-                                             coverage=coverage, latest_fit_id=latest.get(name)))
-    page = store.material_page(cursor, limit)
-    for row in page.rows:
-        materials.append(MaterialSummary(
-            id=row.material_id, name=row.name, kind=row.kind, source=row.source,
-            coverage=row.coverage, latest_fit_id=row.latest_fit_id, version=row.version,
-        ))
+                                             coverage=coverage, latest_fit_id=latest.get(name),
+                                             share_url=_share(name)))
+    saved_kinds = tuple(k for k in kinds if k != "library")
+    if not saved_kinds:
+        return MaterialList(materials=materials)
+    page = store.material_page(cursor, limit, saved_kinds, deleted, q)
+    materials += [_summary(row) for row in page.rows]
     return MaterialList(materials=materials, next_cursor=page.next_cursor, skipped=page.skipped)
 
 
-@router.get("/{material_id}", response_model=MaterialDetail, responses={**ERROR_RESPONSES, **NOT_FOUND})
-def get_material(
-    material_id: Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
-                                     description="A library name or a saved material's id")],
-    store: StoreDep,
-) -> MaterialDetail:
-    """One material with its latest fit (None for a library material not fitted yet)."""
+@router.get("/materials/{material_id}", response_model=MaterialDetail,
+            responses={**ERROR_RESPONSES, **NOT_FOUND})
+def get_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialDetail:
+    """One material with its latest fit (None for a library material not fitted yet); one in the bin too."""
     latest = with_measured_nk(store, store.latest_fit(material_id))
-    version = store.material_version(material_id)
     if material_id in LIBRARY_NAMES:
         source, coverage, wavelength_range = _library_entry(material_id)
         return MaterialDetail(
             id=material_id, name=material_id, kind="library", source=source,
-            coverage=coverage, latest_fit_id=latest.id if latest else None, version=version,
+            coverage=coverage, latest_fit_id=latest.id if latest else None,
+            version=store.material_version(material_id), share_url=_share(material_id),
             wavelength_range_nm=wavelength_range,
             latest_fit=fit_public(latest) if latest else None,
         )
-    if latest is None:
+    row = store.material(material_id)
+    if latest is None or row is None:
         raise LookupError(f"`material_id` {material_id!r} is neither a built-in material nor a saved one")
     wavelength_range = None
     if latest.nk is not None:
         wavelength_range = (latest.nk["wavelength_nm"][0], latest.nk["wavelength_nm"][-1])
-    return MaterialDetail(
-        id=material_id, name=latest.name, kind=latest.kind, source=latest.source,
-        coverage=latest.coverage, latest_fit_id=latest.id, version=version,
-        wavelength_range_nm=wavelength_range, latest_fit=fit_public(latest),
-    )
+    return MaterialDetail(**dict(_summary(row)), wavelength_range_nm=wavelength_range,
+                          latest_fit=fit_public(latest))
+
+
+@router.patch("/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES,
+              dependencies=[WriteAccess])
+def rename_material(material_id: MaterialIdPath, body: MaterialRename, store: StoreDep) -> MaterialSummary:
+    """
+    Rename a saved material. Not a save: its version, fits and history stay
+    as they are; the next save of it (with its `material_id`) keeps the
+    new name. An edited material's name is unique among edited materials
+    (409 when another, in the bin or not, is called that).
+    """
+    return _summary(store.rename_material(material_id, body.name.strip()))
+
+
+@router.delete("/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES,
+               dependencies=[WriteAccess])
+def delete_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSummary:
+    """
+    Move a saved material to the bin: it leaves the listings (`?deleted=true`
+    lists the bin), nothing is erased (its fits, downloads and versions stay
+    reachable by id), `POST .../restore` brings it back, and so does a save
+    of it. Deleting one in the bin again answers the same.
+    """
+    return _summary(store.delete_material(material_id))
+
+
+@router.post("/materials/{material_id}/restore", response_model=MaterialSummary, responses=WRITE_RESPONSES,
+             dependencies=[WriteAccess])
+def restore_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSummary:
+    """Take a material out of the bin (a material not in it answers as it is)."""
+    return _summary(store.restore_material(material_id))

@@ -1,0 +1,56 @@
+"""
+The library to browse
+=====================
+
+Responses :class:`LibraryList` (:class:`LibraryEntry` with its
+:class:`Swatch`) and :class:`CoatPresets`.
+"""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, Field
+
+__all__ = ["Swatch", "LibraryEntry", "LibraryList", "CoatPreset", "CoatPresets"]
+
+
+class Swatch(BaseModel):
+    """The metal's colour under a coat of index `eta_i`, at `angles_deg` in the coat."""
+
+    eta_i: float
+    angles_deg: list[float]
+    srgb: list[str] = Field(description="`#rrggbb` per angle: linear ACEScg to Rec.709 (CAT02), "
+                                        "clipped, sRGB-encoded, exposure 1, no tone mapping")
+    acescg: list[list[float]] = Field(description="Linear ACEScg reflectance per angle (the 1 nm "
+                                                  "spectral reference the model is fitted to)")
+
+
+class LibraryEntry(BaseModel):
+    id: str = Field(description="The material's id (`GET /materials/{id}`, `POST /fits` `material`)")
+    symbol: str
+    name: str = Field(description="Full name, e.g. Gold")
+    source: str = Field(description="The data's citation as the database gives it")
+    reference: str = Field(description="The citation alone (authors, title, journal)")
+    database: str
+    page: str = Field(description="shelf/book/page of the database")
+    page_url: str
+    wavelength_range_nm: tuple[float, float]
+    coverage: float = Field(description="Covered fraction of 360-830 nm")
+    swatch: Swatch
+
+
+class LibraryList(BaseModel):
+    eta_i: float
+    materials: list[LibraryEntry]
+
+
+class CoatPreset(BaseModel):
+    id: str
+    name: str
+    eta_i: float
+    source: str
+
+
+class CoatPresets(BaseModel):
+    """Common clear coats by their index at 589 nm (fitting.domain.COAT_PRESETS)."""
+
+    presets: list[CoatPreset]

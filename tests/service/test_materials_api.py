@@ -1,0 +1,243 @@
+"""
+Materials an artist manages, against a real server that requires its write
+token (``COATED_API_TOKEN``): every save is a version (listed, each opened
+and downloaded by id), a rename keeps the history and the next save, a
+delete is a bin (only with the token; nothing is lost; restore), uploads
+are kept apart from saved edits, and a fit reopens with its edit
+(``GET /fits/{id}/edit``). Then the library to browse and the coat
+presets, and the upload form's ``min_coverage``. One server for the module.
+"""
+
+from __future__ import annotations
+
+import httpx
+import numpy as np
+import pytest
+from conftest import server_process
+
+from fitting.domain import COAT_PRESETS
+from fitting.fits.curves_base import curve_base_from_nk
+from fitting.optics.library import LIBRARY_NAMES, library_material
+
+pytestmark = [pytest.mark.server, pytest.mark.slow]
+
+API = "/api/v1"
+TOKEN = "studio-test-token"
+AUTH = {"Authorization": f"Bearer {TOKEN}"}
+ANGLE = np.linspace(0.0, 90.0, 19)
+
+
+def gold_curve(red_scale: float, eta_i: float = 1.5) -> dict:
+    mu = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))
+    rgb = curve_base_from_nk(library_material("Au")).rgb(mu, eta_i)
+    rgb[:, 0] *= 1.0 - (1.0 - red_scale) * (1.0 - (ANGLE / 90.0) ** 4)
+    return {"eta_i": eta_i, "angle_deg": ANGLE.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}
+
+
+def nk_csv(shift: float = 0.0, lo: float = 350.0, hi: float = 850.0) -> str:
+    wavelength = np.linspace(lo, hi, 26)
+    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + shift
+    k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
+    return "wavelength_nm,n,k\n" + "".join(f"{w},{a},{b}\n" for w, a, b in zip(wavelength, n, k))
+
+
+@pytest.fixture(scope="module")
+def http(tmp_path_factory):
+    data = tmp_path_factory.mktemp("materials") / "data"
+    with server_process(data, COATED_API_TOKEN=TOKEN, COATED_REQUIRE_TOKEN="true") as server:
+        with httpx.Client(base_url=server.url, timeout=300) as client:
+            yield client
+
+
+def save(http, name: str, red_scale: float, **extra) -> httpx.Response:
+    body = {"name": name, "base": {"material": "Au"}, "curves": [gold_curve(red_scale)], **extra}
+    return http.post(f"{API}/fits/from-curves", json=body, headers=AUTH)
+
+
+def listed(http, **params) -> list[dict]:
+    response = http.get(f"{API}/materials", params=params)
+    assert response.status_code == 200, response.text
+    return [m for m in response.json()["materials"] if m["kind"] != "library"]
+
+
+@pytest.fixture(scope="module")
+def brass(http):
+    """A material saved twice: two versions."""
+    first = save(http, "studio brass", 0.9)
+    assert first.status_code == 201, first.text
+    second = save(http, "studio brass", 0.8, expected_version=1)
+    assert second.status_code == 201, second.text
+    assert first.json()["material_id"] == second.json()["material_id"]
+    return first.json(), second.json()
+
+
+def test_each_save_is_a_version_opened_and_downloaded_by_id(http, brass):
+    first, second = brass
+    material_id = first["material_id"]
+    answer = http.get(f"{API}/materials/{material_id}/versions").json()
+    assert answer["version"] == 2 and answer["next_before"] is None
+    assert [(v["version"], v["fit_id"]) for v in answer["versions"]] == [(2, second["id"]), (1, first["id"])]
+    one = answer["versions"][1]
+    assert one["name"] == "studio brass" and one["kind"] == "curves"
+    assert one["delta_E_mean"] == first["metrics"]["model"]["delta_E_mean"]
+    assert one["share_url"] == f"/?material={material_id}&version=1"
+    opened = http.get(f"{API}/materials/{material_id}/versions/1")
+    assert opened.status_code == 200 and opened.json()["id"] == first["id"]
+    download = http.get(one["pack_url"], params={"format": "json"})
+    assert download.status_code == 200 and download.json()["materials"][0]["name"] == "studio brass"
+    # Paged: one at a time, newest first.
+    page = http.get(f"{API}/materials/{material_id}/versions", params={"limit": 1}).json()
+    assert [v["version"] for v in page["versions"]] == [2] and page["next_before"] == 2
+    older = http.get(f"{API}/materials/{material_id}/versions",
+                     params={"limit": 1, "before": page["next_before"]}).json()
+    assert [v["version"] for v in older["versions"]] == [1] and older["next_before"] is None
+    assert http.get(f"{API}/materials/{material_id}/versions/3").status_code == 404
+    assert http.get(f"{API}/materials/{'0' * 32}/versions").status_code == 404
+    assert http.get(f"{API}/materials/{material_id}/versions/0").status_code == 422
+
+
+def test_a_fit_reopens_with_its_edit(http, brass):
+    _, second = brass
+    edit = http.get(f"{API}/fits/{second['id']}/edit").json()
+    assert edit["kind"] == "curves" and edit["material_id"] == second["material_id"]
+    assert edit["base"] == {"material": "Au"} and edit["version"] == 2
+    request = edit["request"]
+    assert request["base"] == {"material": "Au"} and request["name"] == "studio brass"
+    assert len(request["curves"]) == 1 and request["curves"][0]["eta_i"] == 1.5
+    # The edit posted again is the same fit (served from the store, a new version).
+    again = http.post(f"{API}/fits/from-curves", json={**request, "expected_version": 2}, headers=AUTH)
+    assert again.status_code == 200 and again.json()["id"] == second["id"]
+    # A library fit has no edit: it opens as its base.
+    gold = http.post(f"{API}/fits", json={"material": "Au"}, headers=AUTH).json()
+    library_edit = http.get(f"{API}/fits/{gold['id']}/edit").json()
+    assert library_edit["base"] == {"material": "Au"} and library_edit["request"] is None
+    assert http.get(f"{API}/fits/{'0' * 32}/edit").status_code == 404
+    detail = http.get(f"{API}/materials/{second['material_id']}").json()
+    assert detail["share_url"] == f"/?material={second['material_id']}"
+
+
+def test_rename_keeps_the_history_and_the_next_save(http):
+    a = save(http, "to rename", 0.85).json()
+    material_id = a["material_id"]
+    renamed = http.patch(f"{API}/materials/{material_id}", json={"name": "  renamed gold "}, headers=AUTH)
+    assert renamed.status_code == 200, renamed.text
+    assert (renamed.json()["name"], renamed.json()["version"]) == ("renamed gold", 1)
+    assert [m["name"] for m in listed(http) if m["id"] == material_id] == ["renamed gold"]
+    # The edit carries the new name; saved with its material_id it is the next version.
+    request = http.get(f"{API}/fits/{a['id']}/edit").json()["request"]
+    assert (request["name"], request["material_id"]) == ("renamed gold", material_id)
+    request["curves"] = [gold_curve(0.75)]
+    b = http.post(f"{API}/fits/from-curves", json={**request, "expected_version": 1}, headers=AUTH)
+    assert b.status_code == 201, b.text
+    assert b.json()["material_id"] == material_id and b.json()["name"] == "renamed gold"
+    versions = http.get(f"{API}/materials/{material_id}/versions").json()
+    assert [v["name"] for v in versions["versions"]] == ["renamed gold", "to rename"]
+    # A save under the new name alone finds the material too.
+    c = save(http, "renamed gold", 0.7)
+    assert c.json()["material_id"] == material_id
+    # The old name is free: a new material, which never mixes with the renamed one.
+    fresh = save(http, "to rename", 0.85)
+    assert fresh.status_code == 201 and fresh.json()["material_id"] != material_id
+    assert fresh.json()["id"] != a["id"]
+    assert http.get(f"{API}/materials/{material_id}").json()["version"] == 3
+    # Names of edited materials are unique: a rename or a save onto another's name is 409.
+    taken = http.patch(f"{API}/materials/{material_id}", json={"name": "to rename"}, headers=AUTH)
+    assert taken.status_code == 409 and taken.json()["errors"][0]["loc"] == ["body", "name"]
+    clash = save(http, "to rename", 0.6, material_id=material_id)
+    assert clash.status_code == 409 and "another saved material" in clash.json()["detail"]
+    # Refusals name the rule.
+    assert http.patch(f"{API}/materials/Au", json={"name": "x"}, headers=AUTH).status_code == 422
+    assert http.patch(f"{API}/materials/{'0' * 32}", json={"name": "x"}, headers=AUTH).status_code == 404
+    assert http.patch(f"{API}/materials/{material_id}", json={"name": " "}, headers=AUTH).status_code == 422
+    assert http.patch(f"{API}/materials/{material_id}", json={"name": "x"}).status_code == 401
+    unknown = save(http, "ghost", 0.9, material_id="f" * 32)
+    assert unknown.status_code == 404 and "material_id" in unknown.json()["detail"]
+
+
+def test_delete_needs_the_token_and_loses_nothing(http):
+    fit = save(http, "to delete", 0.95).json()
+    material_id = fit["material_id"]
+    refused = http.delete(f"{API}/materials/{material_id}")
+    assert refused.status_code == 401 and "Bearer" in refused.json()["detail"]
+    wrong = http.delete(f"{API}/materials/{material_id}", headers={"Authorization": "Bearer nope"})
+    assert wrong.status_code == 401
+    cross_site = http.delete(f"{API}/materials/{material_id}", headers={**AUTH, "Origin": "http://evil.example"})
+    assert cross_site.status_code == 403
+    assert material_id in [m["id"] for m in listed(http)]
+    deleted = http.delete(f"{API}/materials/{material_id}", headers=AUTH)
+    assert deleted.status_code == 200 and deleted.json()["deleted_at"] is not None
+    assert material_id not in [m["id"] for m in listed(http)]
+    assert [m["id"] for m in listed(http, deleted="true")] == [material_id]
+    # Nothing is erased: the material, its fit, download and versions answer.
+    assert http.get(f"{API}/materials/{material_id}").json()["deleted_at"] is not None
+    assert http.get(f"{API}/fits/{fit['id']}").status_code == 200
+    assert http.get(f"{API}/fits/{fit['id']}/pack").status_code == 200
+    assert http.get(f"{API}/materials/{material_id}/versions").json()["version"] == 1
+    again = http.delete(f"{API}/materials/{material_id}", headers=AUTH)
+    assert again.status_code == 200 and again.json()["deleted_at"] == deleted.json()["deleted_at"]
+    restored = http.post(f"{API}/materials/{material_id}/restore", headers=AUTH)
+    assert restored.status_code == 200 and restored.json()["deleted_at"] is None
+    assert material_id in [m["id"] for m in listed(http)]
+    assert http.post(f"{API}/materials/{material_id}/restore").status_code == 401
+    assert http.delete(f"{API}/materials/Au", headers=AUTH).status_code == 422
+    assert http.delete(f"{API}/materials/{'0' * 32}", headers=AUTH).status_code == 404
+
+
+def test_uploads_are_kept_apart_from_saved_materials(http, brass):
+    files = {"file": ("lab metal.csv", nk_csv(0.05), "text/csv")}
+    upload = http.post(f"{API}/fits/upload", files=files, headers=AUTH)
+    assert upload.status_code == 201, upload.text
+    material_id = upload.json()["material_id"]
+    default = listed(http)
+    assert material_id not in [m["id"] for m in default] and {m["kind"] for m in default} == {"curves"}
+    uploads = listed(http, kind="nk")
+    assert [m["name"] for m in uploads if m["id"] == material_id] == ["lab metal"]
+    both = http.get(f"{API}/materials", params=[("kind", "nk"), ("kind", "curves")]).json()["materials"]
+    assert material_id in [m["id"] for m in both] and not [m for m in both if m["kind"] == "library"]
+    library = http.get(f"{API}/materials", params={"kind": "library"}).json()
+    assert [m["id"] for m in library["materials"]] == list(LIBRARY_NAMES) and library["next_cursor"] is None
+    assert http.get(f"{API}/materials", params={"kind": "bogus"}).status_code == 422
+    # Search by name or source, the library's entries by symbol, name or source.
+    found = http.get(f"{API}/materials", params={"q": "STUDIO"}).json()["materials"]
+    assert [m["name"] for m in found] == ["studio brass"]
+    gold = http.get(f"{API}/materials", params={"q": "gold", "kind": "library"}).json()["materials"]
+    assert [m["id"] for m in gold] == ["Au"]
+
+
+def test_upload_min_coverage(http):
+    short = {"file": ("short.csv", nk_csv(0.1, 380.0, 830.0), "text/csv")}  # 95.7% of 360-830 nm
+    refused = http.post(f"{API}/fits/upload", files=short, data={"min_coverage": "0.99"}, headers=AUTH)
+    assert refused.status_code == 422 and "min_coverage" in refused.json()["detail"]
+    assert "95.7%" in refused.json()["detail"]
+    low = http.post(f"{API}/fits/upload", files=short, data={"min_coverage": "0.5"}, headers=AUTH)
+    assert low.status_code == 422 and "[0.9, 1]" in low.json()["detail"]
+    accepted = http.post(f"{API}/fits/upload", files=short, data={"min_coverage": "0.95"}, headers=AUTH)
+    assert accepted.status_code == 201, accepted.text
+    assert accepted.json()["coverage"] == pytest.approx(450.0 / 470.0)
+
+
+def test_library_to_browse(http):
+    answer = http.get(f"{API}/library", params={"eta_i": 1.33}).json()
+    assert answer["eta_i"] == 1.33 and [m["id"] for m in answer["materials"]] == list(LIBRARY_NAMES)
+    (gold,) = [m for m in answer["materials"] if m["id"] == "Au"]
+    assert gold["name"] == "Gold" and gold["symbol"] == "Au" and "Johnson" in gold["source"]
+    assert gold["page_url"] == "https://refractiveindex.info/?shelf=main&book=Au&page=Johnson"
+    assert gold["reference"].startswith("P. B. Johnson and R. W. Christy")
+    lo, hi = gold["wavelength_range_nm"]
+    assert lo < 360.0 and hi > 830.0 and gold["coverage"] == 1.0
+    swatch = gold["swatch"]
+    assert swatch["eta_i"] == 1.33 and swatch["angles_deg"][0] == 0.0
+    assert len(swatch["srgb"]) == len(swatch["angles_deg"]) == len(swatch["acescg"])
+    red, green, blue = (int(swatch["srgb"][0][i:i + 2], 16) for i in (1, 3, 5))
+    assert red > green > blue  # gold is yellow at normal incidence
+    air = http.get(f"{API}/library", params={"eta_i": 1.0, "q": "gold"}).json()["materials"]
+    assert [m["id"] for m in air] == ["Au"] and air[0]["swatch"]["srgb"] != swatch["srgb"]
+    johnson = http.get(f"{API}/library", params={"q": "johnson christy"}).json()["materials"]
+    assert {m["id"] for m in johnson} == {"Ag", "Au", "Co", "Cr", "Cu", "Fe", "Mn", "Ni", "Pd"}
+    assert [m["id"] for m in http.get(f"{API}/library", params={"q": "brass"}).json()["materials"]] == ["CuZn"]
+    assert http.get(f"{API}/library", params={"q": "unobtainium"}).json()["materials"] == []
+    assert http.get(f"{API}/library", params={"eta_i": 0.5}).status_code == 422
+    presets = http.get(f"{API}/coat-presets").json()["presets"]
+    assert [(p["id"], p["eta_i"]) for p in presets] == [(key, eta) for key, _, eta, _ in COAT_PRESETS]
+    water = [p for p in presets if p["id"] == "water"][0]
+    assert water["eta_i"] == 1.333 and "589 nm" in water["source"]
