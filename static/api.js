@@ -85,8 +85,15 @@ export async function preview(fitId, etaI, compare) {
   return answer(await fetch(API + path, { headers: headers() }), (r) => r.blob());
 }
 
-export function packURL(fitId, format) {
-  return `${API}/fits/${fitId}/pack?format=${format}`;
+// EXPORTS take the preview's settings (eta_i, roughness, coat roughness); the packs hold every eta_i.
+export const EXPORTS = new Set(["mtlx", "openpbr", "blender", "gltf"]);
+
+/** The download of a fit in `format`; an export at `settings` {etaI, roughness, coatRoughness}. */
+export function packURL(fitId, format, settings = null) {
+  const url = `${API}/fits/${fitId}/pack?format=${format}`;
+  if (!settings || !EXPORTS.has(format)) return url;
+  const { etaI, roughness, coatRoughness } = settings;
+  return `${url}&eta_i=${etaI.toFixed(2)}&roughness=${roughness.toFixed(2)}&coat_roughness=${coatRoughness.toFixed(2)}`;
 }
 
 // The spectral reference of a fit with n, k as a float texture over

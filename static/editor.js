@@ -13,12 +13,13 @@
 import * as api from "./api.js";
 import { modelKind } from "./kinds.js";
 import { bindPageInputs } from "./editor/inputs.js";
-import { fitOf, FIRST, loadMaterials, prefetch, recall, remember } from "./editor/materials.js";
+import { fitOf, FIRST, loadMaterials, prefetch, recall, remember, savedVersion } from "./editor/materials.js";
 import { Messages } from "./editor/messages.js";
 import { PlotView } from "./editor/plot_view.js";
 import { PreviewView } from "./editor/preview_view.js";
 import { Readout } from "./editor/readout.js";
 import { RefitPipeline, refitBody } from "./editor/refit.js";
+import { Continuing, save as saveEdit } from "./editor/save.js";
 import { createStore, fitted, key, liveStart, SAMPLES, snapshot, unsaved } from "./editor/state.js";
 
 const $ = (id) => document.getElementById(id);
@@ -79,6 +80,24 @@ function requestRefit() {
 // Once no refit is pending: true when the fit on screen is the fit of the edits on screen.
 const whenFitted = () => pipeline.whenIdle().then((failed) => !failed && fitted(state));
 
+const continuing = new Continuing();
+
+const save = () => saveEdit({
+  state, name: () => $("name").value, say, report: (...args) => messages.report(...args),
+  busy: (text, work) => messages.busy(text, work),
+  refitFirst: () => { requestRefit(); return whenFitted(); },
+  failed: () => pipeline.failed,
+  async refresh(value) {
+    const materials = await loadMaterials($("material"), value);
+    remember(value);
+    return materials;
+  },
+  onSaved(fit) {
+    store.dispatch("saved", fit.id);
+    readout.showSaved(state);
+  },
+}, continuing);
+
 const plotView = new PlotView({
   onDrag(payload) {
     const moved = store.dispatch("drag", payload);
@@ -104,7 +123,12 @@ const previewView = new PreviewView({
     if (last && last.fit === drawn.fitId && last.frameAt === null) last.frameAt = performance.now();
   },
 });
-const readout = new Readout({ onGentler: guard(gentler), pending: () => pipeline.pending });
+const readout = new Readout({
+  onGentler: guard(gentler), pending: () => pipeline.pending,
+  exportSettings: () => ({ etaI: state.eta, roughness: Number($("roughness").value),
+                           coatRoughness: Number($("coat-roughness").value) }),
+});
+for (const id of ["roughness", "coat-roughness"]) $(id).addEventListener("input", () => readout.showDownload());
 
 // The views follow the state: the plot and the saved line after every change of it.
 const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved"]);
@@ -129,6 +153,7 @@ function present(fit, curves, edits = "{}") {
 async function setBase(fit) {
   modelKind(fit); // a kind this page cannot draw is refused by name, before anything changes
   store.dispatch("openBase", fit);
+  continuing.opened(fit, savedVersion(fit));
   pipeline.drop(); // answers for the previous material are dropped
   plotView.showBase(state);
   previewView.showBase(fit);
@@ -177,6 +202,7 @@ function setEta(eta) {
   store.dispatch("setEta", eta);
   plotView.showEta(state);
   previewView.setEta(eta);
+  readout.showDownload();
   clearTimeout(page.etaTimer);
   page.etaTimer = setTimeout(() => showEta().catch((error) => say(error.message)), 120);
 }
@@ -198,48 +224,6 @@ async function gentler() {
   const bases = await Promise.all(etas.map((eta) => api.curves(state.base.id, Number(eta), SAMPLES)));
   store.dispatch("gentler", Object.fromEntries(etas.map((eta, k) => [eta, bases[k][from] || bases[k].model])));
   requestRefit();
-}
-
-async function save() {
-  const name = $("name").value.trim();
-  if (!name) {
-    say("Give the material a name first.");
-    $("name").focus();
-    return;
-  }
-  if (!Object.keys(state.edits).length) {
-    say("Nothing to save: edit a curve first.");
-    return;
-  }
-  // Saving under the name of another saved material replaces its latest fit: asked first.
-  const { materials } = await api.listMaterials();
-  const clash = materials.find((m) => m.kind === "curves" && m.name === name);
-  const opened = state.base.kind === "curves" && state.base.name === name;
-  if (clash && !opened && !window.confirm(`A saved material is called “${name}”. Replace it with this edit?`)) {
-    say("Not saved: choose another name, or Save again and confirm to replace it.");
-    $("name").focus();
-    return;
-  }
-  requestRefit();
-  // A refused refit (401, 422) is reported by the pipeline: nothing was saved.
-  if (!(await whenFitted())) {
-    if (pipeline.failed) say(`Not saved: ${pipeline.failed.message}`);
-    return;
-  }
-  let fit;
-  try {
-    const body = refitBody({ name, base: state.base, theta: state.theta, edits: state.edits, draft: false });
-    fit = await messages.busy("Saving…", () => api.fitFromCurves(body));
-  } catch (error) {
-    messages.report(error, save, "Not saved: ");
-    return;
-  }
-  store.dispatch("saved", fit.id);
-  const opening = `saved:${fit.material_id}`;
-  await loadMaterials($("material"), opening);
-  remember(opening);
-  readout.showSaved(state);
-  say(`Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
 }
 
 async function upload(file) {

@@ -2,8 +2,16 @@
 // SVG, with draggable, focusable control points on the edited target.
 
 const SVG = "http://www.w3.org/2000/svg";
-const W = 640, H = 400;
 const M = { left: 48, right: 14, top: 12, bottom: 36 };
+// The drawing's size in SVG units follows its width on screen (320 to 640
+// CSS px at one unit a pixel, scaled up beyond): axis text of 11 units stays
+// 11 px or more on a phone, and a handle's hit area is at least 24 px.
+const W_MIN = 320, W_MAX = 640;
+const sizeFor = (px) => {
+  const width = Math.round(Math.min(W_MAX, Math.max(W_MIN, px || W_MAX)));
+  return { width, height: Math.round(Math.max(260, 0.625 * width)) };
+};
+export const HANDLE_HIT_PX = 24; // a handle's diameter on screen at least (touch)
 
 function el(name, attributes = {}, parent = null) {
   const node = document.createElementNS(SVG, name);
@@ -20,8 +28,13 @@ export class ReflectancePlot {
    */
   constructor(container, hooks) {
     this.hooks = hooks;
-    this.svg = el("svg", { viewBox: `0 0 ${W} ${H}`, role: "group", "aria-label": "Reflectance curves" });
+    this.svg = el("svg", { role: "group", "aria-label": "Reflectance curves" });
     container.appendChild(this.svg);
+    this.#resize(container.clientWidth);
+    // A new width redraws at its own size (never during a drag: the point stays under the pointer).
+    new ResizeObserver(() => {
+      if (!this.dragging && this.#resize(container.clientWidth) && this.data) this.draw(this.data);
+    }).observe(container);
     this.yMin = 0;
     this.yMax = 1;
     this.layers = {};
@@ -35,12 +48,32 @@ export class ReflectancePlot {
     this.svg.addEventListener("pointercancel", () => this.#release());
   }
 
-  x(theta) { return M.left + (theta / 90) * (W - M.left - M.right); }
-  y(value) { return H - M.bottom - ((value - this.yMin) / (this.yMax - this.yMin)) * (H - M.top - M.bottom); }
-  value(py) { return this.yMin + ((H - M.bottom - py) / (H - M.top - M.bottom)) * (this.yMax - this.yMin); }
+  // Whether the size changed.
+  #resize(px) {
+    const { width, height } = sizeFor(px);
+    if (width === this.W && height === this.H) return false;
+    this.W = width;
+    this.H = height;
+    this.svg.setAttribute("viewBox", `0 0 ${width} ${height}`);
+    this.signature = null; // handles rebuilt at their new size
+    return true;
+  }
+
+  // A handle's radius in SVG units: 12 px wide on screen for a mouse, HANDLE_HIT_PX
+  // for a finger (a coarse pointer, or a window narrower than 560 px: a phone).
+  #radius() {
+    const scale = this.svg.getBoundingClientRect().width / this.W || 1;
+    const touch = window.matchMedia("(max-width: 560px), (pointer: coarse)").matches;
+    return Math.max(5, (touch ? HANDLE_HIT_PX : 12) / 2 / scale);
+  }
+
+  x(theta) { return M.left + (theta / 90) * (this.W - M.left - M.right); }
+  y(value) { return this.H - M.bottom - ((value - this.yMin) / (this.yMax - this.yMin)) * (this.H - M.top - M.bottom); }
+  value(py) { return this.yMin + ((this.H - M.bottom - py) / (this.H - M.top - M.bottom)) * (this.yMax - this.yMin); }
 
   #axes() {
     const { grid, axis } = this.layers;
+    const { W, H } = this;
     grid.replaceChildren();
     axis.replaceChildren();
     for (let t = 0; t <= 90; t += 15) {
@@ -80,7 +113,7 @@ export class ReflectancePlot {
     if (data.criticalDeg) {
       // The largest angle inside a flat coat seen from air: asin(1 / eta_i).
       const x = this.x(data.criticalDeg);
-      el("line", { x1: x, x2: x, y1: M.top, y2: H - M.bottom }, critical);
+      el("line", { x1: x, x2: x, y1: M.top, y2: this.H - M.bottom }, critical);
       el("text", { x: x + 4, y: M.top + 12 }, critical).textContent = `max from air ${data.criticalDeg.toFixed(1)}°`;
     }
     for (const name of ["lazanyi", "reference", "target", "model"]) {
@@ -114,11 +147,12 @@ export class ReflectancePlot {
 
   #buildHandles(layer, handles, channel) {
     const names = ["red", "green", "blue"];
+    const radius = this.#radius().toFixed(1);
     handles.forEach((angle, h) => {
       for (let c = 0; c < 3; c++) {
         const active = channel === "all" || Number(channel) === c;
         const circle = el("circle", {
-          cx: this.x(angle), r: 6, class: `handle c${c}${active ? "" : " inactive"}`,
+          cx: this.x(angle), r: radius, class: `handle c${c}${active ? "" : " inactive"}`,
           tabindex: active ? 0 : -1, role: "slider",
           "aria-label": `${names[c]} reflectance at ${angle} degrees`,
           "aria-valuemin": 0, "aria-valuemax": 1,

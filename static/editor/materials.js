@@ -35,8 +35,15 @@ export async function fitOf(value) {
   const [kind, id] = value.split(/:(.*)/s);
   if (kind === "library") return api.fitLibrary(id, [1.0, 2.5]);
   const material = await api.getMaterial(id);
+  versions.set(material.latest_fit.id, material.version);
   return material.latest_fit;
 }
+
+// The version of a saved material as its fit was read (fitOf): a save continues from it.
+const versions = new Map();
+
+/** The material's version when `fit` (its latest) was opened; null when not known. */
+export const savedVersion = (fit) => (versions.has(fit.id) ? versions.get(fit.id) : null);
 
 export function remember(value) {
   try {

@@ -44,6 +44,7 @@ export class PreviewView {
     $("roughness-value").textContent = Number($("roughness").value).toFixed(2);
     $("coat-roughness-value").textContent = Number($("coat-roughness").value).toFixed(2);
     $("coat-roughness").disabled = !$("coat").checked;
+    $("coat-why").hidden = $("coat").checked; // with no coat, why eta_i still matters
     if (!this.ball) return;
     this.ball.set({
       environment: ENVIRONMENT[$("environment").value], exposure: Number($("exposure").value),

@@ -13,18 +13,37 @@ import { unsaved } from "./state.js";
 const $ = (id) => document.getElementById(id);
 
 export class Readout {
-  /** hooks: onGentler(), pending() -> whether a refit is under way (the heat map waits for a pause). */
+  /**
+   * hooks: onGentler(), pending() -> whether a refit is under way (the heat
+   * map waits for a pause), exportSettings() -> the preview's {etaI, roughness, coatRoughness}.
+   */
   constructor(hooks) {
     this.hooks = hooks;
     this.mapTimer = null;
     this.fit = null;
     $("reach-gentler").addEventListener("click", () => hooks.onGentler());
-    $("format").addEventListener("change", () => {
-      if (this.fit) $("download").href = api.packURL(this.fit.id, $("format").value);
-    });
+    $("format").addEventListener("change", () => this.showDownload());
+    // The href is set again at the click: an export takes the preview's settings as they are then.
     $("download").addEventListener("click", (event) => {
       if (!this.fit) event.preventDefault();
+      else this.showDownload();
     });
+  }
+
+  /**
+   * The download link of the fit on screen in the chosen format, and what
+   * an export will hold (hooks.exportSettings(): {etaI, roughness, coatRoughness},
+   * the preview's); called again when those change.
+   */
+  showDownload() {
+    if (!this.fit) return;
+    const format = $("format").value;
+    const settings = this.hooks.exportSettings();
+    $("download").href = api.packURL(this.fit.id, format, settings);
+    $("download-settings").textContent = api.EXPORTS.has(format)
+      ? `At the preview's ηᵢ ${settings.etaI.toFixed(2)}, roughness ${settings.roughness.toFixed(2)}, ` +
+        `coat roughness ${settings.coatRoughness.toFixed(2)}; the file name says all three.`
+      : "Every ηᵢ of the fit: the coefficients and how to evaluate them.";
   }
 
   /** Everything that names the fit on screen, set together. */
@@ -36,7 +55,7 @@ export class Readout {
     $("fit-id").textContent = fit.id;
     $("coefficients").textContent = modelKind(fit).describe(fit);
     const download = $("download");
-    download.href = api.packURL(fit.id, $("format").value);
+    this.showDownload();
     download.setAttribute("aria-disabled", "false");
     download.setAttribute("download", "");
     this.#reach(figures.reach);
