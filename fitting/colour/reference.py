@@ -35,7 +35,7 @@ from ..optics.nk import SpectralNK, resample_nk
 from .colorimetry import spectral_to_ACEScg_weights
 
 __all__ = [
-    "spectral_grid", "spectral_weights", "reference_ACEScg", "reference_ACEScg_grid",
+    "spectral_grid", "spectral_weights", "reference_ACEScg", "spectral_integral", "reference_ACEScg_grid",
     "evaluation_grid", "DTYPES",
 ]
 
@@ -94,6 +94,20 @@ def reference_ACEScg(
         Shape ``broadcast(cos_theta, eta_i).shape + (3,)``, linear ACEScg;
         a perfect reflector is (1, 1, 1).
     """
+    return spectral_integral(fresnel_conductor, nk, cos_theta, eta_i, step_nm, min_coverage)
+
+
+def spectral_integral(reflectance, nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
+                      min_coverage: float = DEFAULT_MIN_COVERAGE, chunk_values: int = 2_000_000) -> np.ndarray:
+    """
+    ``reflectance(mu (P, 1), eta_i (P, 1), n (L,), k (L,)) -> (P, L)`` of
+    ``nk`` resampled at the ``step_nm`` nodes, integrated to linear ACEScg
+    at every broadcast (``cos_theta``, ``eta_i``): the spectral integral of
+    :func:`reference_ACEScg` (the exact conductor) and
+    :func:`fitting.colour.seen.seen_ACEScg` (the coated stack seen from
+    air). Chunked at about ``chunk_values`` spectral values, so that memory
+    stays bounded for large images.
+    """
     nodes, W = spectral_weights(step_nm)
     sampled = resample_nk(nk, nodes, min_coverage)
     mu, eta = np.broadcast_arrays(
@@ -104,12 +118,10 @@ def reference_ACEScg(
     shape = mu.shape
     mu, eta = mu.reshape(-1, 1), eta.reshape(-1, 1)
     out = np.empty((mu.shape[0], 3))
-    # Chunked so that memory stays bounded for large images.
-    chunk = max(1, 2_000_000 // nodes.size)
+    chunk = max(1, chunk_values // nodes.size)
     for start in range(0, mu.shape[0], chunk):
         stop = start + chunk
-        R = fresnel_conductor(mu[start:stop], eta[start:stop], sampled.n, sampled.k)
-        out[start:stop] = R @ W.T
+        out[start:stop] = reflectance(mu[start:stop], eta[start:stop], sampled.n, sampled.k) @ W.T
     return out.reshape(shape + (3,))
 
 
