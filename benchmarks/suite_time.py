@@ -30,6 +30,10 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.record import cpu  # noqa: E402
+
 RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
 SUMMARY = re.compile(r"^=*\s*(\d+ passed.*?) in [\d.]+s", re.M)
 
@@ -60,19 +64,9 @@ def main(argv=None) -> int:
     RESULTS.write_text(json.dumps({
         "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
         "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "cpu": _cpu(), "rows": rows,
+        "cpu": cpu(), "rows": rows,
     }, indent=2) + "\n")
     return max(r["returncode"] for r in rows)
-
-
-def _cpu() -> str:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return f"{line.split(':', 1)[1].strip()}, {os.cpu_count()} cores"
-    except OSError:
-        pass
-    return f"{os.cpu_count()} cores"
 
 
 if __name__ == "__main__":
