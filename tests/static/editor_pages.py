@@ -87,6 +87,17 @@ def pages(chromium):
     assert not unexpected, unexpected
 
 
+def settled(page):
+    """Wait until nothing is in flight and the preview draws the fit on screen; that fit's id."""
+    page.wait_for_function(
+        "() => { const id = document.getElementById('fit-id').textContent;"
+        " return !document.body.hasAttribute('aria-busy')"
+        " && document.getElementById('preview-state').hidden"
+        " && document.getElementById('preview').dataset.fit === id; }"
+    )
+    return page.inner_text("#fit-id")
+
+
 def open_editor(page, url):
     page.goto(url)
     page.wait_for_selector("body[data-ready=true]")

@@ -13,20 +13,10 @@ import json
 import re
 
 import pytest
-from editor_pages import editor_url, open_editor, pages, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
+from editor_pages import editor_url, open_editor, pages, chromium, live_server, settled  # noqa: F401 (fixtures: one server and one Chromium a module)
 from playwright.sync_api import expect
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
-
-
-def settled(page):
-    page.wait_for_function(
-        "() => { const id = document.getElementById('fit-id').textContent;"
-        " return !document.body.hasAttribute('aria-busy')"
-        " && document.getElementById('preview-state').hidden"
-        " && document.getElementById('preview').dataset.fit === id; }"
-    )
-    return page.inner_text("#fit-id")
 
 
 def set_range(page, selector, value):
