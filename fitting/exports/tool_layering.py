@@ -165,24 +165,24 @@ def openpbr_metal(cos_theta, eta: float, base_color, specular_color, coat: bool 
     return materialx_layer(mu, eta, metal, coat)
 
 
-def cycles_principled(cos_theta, eta: float, base_color, specular_tint, coat: bool = True) -> np.ndarray:
-    """The ``blender`` export's Principled BSDF (Metallic 1, F82 tint), roughness 0."""
-    mu = _mu(cos_theta)
-    metal = f82_tint(mu, base_color, specular_tint)
+def _cycles_coat(mu, eta: float, metal, coat: bool) -> np.ndarray:
+    """Cycles' coat over ``metal`` at roughness 0 (both Blender outputs): a white mirror mixed in by the coat's exact Fresnel."""
     if not coat:
         return metal
     F = fresnel_dielectric(mu, 1.0, eta)[:, None]
     return F + (1.0 - F) * metal
+
+
+def cycles_principled(cos_theta, eta: float, base_color, specular_tint, coat: bool = True) -> np.ndarray:
+    """The ``blender`` export's Principled BSDF (Metallic 1, F82 tint), roughness 0."""
+    mu = _mu(cos_theta)
+    return _cycles_coat(mu, eta, f82_tint(mu, base_color, specular_tint), coat)
 
 
 def cycles_conductor_mix(cos_theta, eta: float, ior, extinction, coat: bool = True) -> np.ndarray:
     """The ``blender`` export's second output: Mix(Fresnel(eta); Metallic, white Glossy)."""
     mu = _mu(cos_theta)
-    metal = mx_fresnel_conductor(mu, ior, extinction)
-    if not coat:
-        return metal
-    F = fresnel_dielectric(mu, 1.0, eta)[:, None]
-    return F + (1.0 - F) * metal
+    return _cycles_coat(mu, eta, mx_fresnel_conductor(mu, ior, extinction), coat)
 
 
 @functools.cache
