@@ -228,7 +228,7 @@ def fit_curves(
         return outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
 
     def in_range(C16) -> bool:  # issue 21: proven over the whole domain, not the grid only
-        return not outside(C16).any() and proven_in_range(C16, eta_i_range)
+        return not outside(C16).any() and proven_in_range(C16, eta_i_range, max_cells=settings.proof_cells)
 
     def constrained(objective: str, dense=None) -> FitResult:
         weight, check, extra = settings.range_weight, settings.check_samples, None
@@ -239,7 +239,7 @@ def fit_curves(
             if in_range(result.coefficients_float16) or not budget.allows(_MIN_ESCALATION_NFEV):
                 break
             C16 = result.coefficients_float16
-            points = escape_points(C16, eta_i_range, outside(C16), range_M, range_E, check[1])
+            points = escape_points(C16, eta_i_range, outside(C16), range_M, range_E, check[1], settings.proof_cells)
             extra = points if extra is None else (
                 np.concatenate([extra[0], points[0]]), np.concatenate([extra[1], points[1]]))
             if start is None or dense is not None:
@@ -257,7 +257,8 @@ def fit_curves(
     def held(result: FitResult) -> FitResult:
         """``result`` with float16 coefficients in [0, 1] (its fallback when the budget left it outside)."""
         if settings.range_weight > 0 and not in_range(result.coefficients_float16):
-            result.coefficients_float16 = in_range_fallback(result.coefficients_float16, eta_i_range)
+            result.coefficients_float16 = in_range_fallback(result.coefficients_float16, eta_i_range,
+                                                            settings.proof_cells)
             result.best_effort = True
         return result
 
@@ -313,7 +314,7 @@ def fit_curves(
     if result.guard is not None:
         metrics["guard"] = result.guard
     if not solver.bounded:  # issue 21: [0, 1] proven or not over the whole domain
-        metrics["range"] = range_report(C16, eta_i_range)
+        metrics["range"] = range_report(C16, eta_i_range, settings.proof_cells)
     result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(

@@ -23,20 +23,26 @@ from ..colour.colorimetry import ACEScg_to_Lab
 from ..models.coated_conductor import coated_conductor_model
 from .curves_base import edited_target
 from .curves_score import check_grid, score_grid
-from .guarded import _THREADPOOLS, constrained_refits, guard_report
+from .guarded import _THREADPOOLS, GuardWork, constrained_refits, guard_report
+from .paper_method import paper_fit as paper_method_fit
 from .result import FitResult
-from .solver import fit_coefficients
 from .worst_case import MAX_MARGIN, GuardScore, choose, guard_score
 
 CHECK_SAMPLES = (19, 7)
 """Where the constrained refits keep the model in [0, 1]: the refit's default check grid."""
 
-__all__ = ["guard_curve_choice"]
+GUARD_WORK = 3000
+"""The constrained refits' work of one curve refit (SLSQP iterations times
+constraint rows, :class:`fitting.fits.guarded.GuardWork`)."""
+
+_FREE_MAX_NFEV = 200  # the unconstrained paper fit's evaluations per channel
+
+__all__ = ["GUARD_WORK", "guard_curve_choice"]
 
 
 @_THREADPOOLS.wrap(limits=1, user_api="blas")
 def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, FitResult], own: str,
-                       paper: str, samples, in_range) -> tuple[str, dict]:
+                       paper: str, samples, in_range, work: int = GUARD_WORK) -> tuple[str, dict]:
     """
     The name of the candidate to keep, and the guard's report
     (:func:`fitting.fits.guarded.guard_report`). ``candidates`` maps names
@@ -44,8 +50,11 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     ``samples`` = ``(target, mu, eta, weights)`` of the own fit (where the
     mean is minimised); ``in_range(C16)`` says whether float16
     coefficients are proven inside [0, 1]. Constrained candidates join
-    ``candidates``.
+    ``candidates``; their SLSQP solves share ``work`` units
+    (:class:`fitting.fits.guarded.GuardWork`), and the report's
+    ``work_cut`` says whether the budget stopped one.
     """
+    budget = GuardWork(work)
     eta_i_range = base.eta_i_range
     _, _, M, E = score_grid(eta_i_range)
     gM, gE = M.ravel(), E.ravel()
@@ -58,7 +67,9 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     scores = {name: score(c.coefficients_float16) for name, c in candidates.items()}
     # The paper's method as an auditor runs it: rgb on the whole scoring grid, no [0, 1]
     # constraint. Not a candidate when it leaves [0, 1], but its max is the bar.
-    free = fit_coefficients(gT, gM, gE, eta_i_range, candidates[own].degree, "rgb")
+    # Channel by channel from the paper candidate (paper_fit: the same optimum, a fraction of the joint solve).
+    free = paper_method_fit(gT, gM, gE, eta_i_range, candidates[own].degree, _FREE_MAX_NFEV, candidates[paper],
+                            boxed=True)
     bar = min(scores[paper].max, score(free.coefficients_float16).max)
     if in_range(free.coefficients_float16):
         candidates[f"{paper}-free"] = free
@@ -73,7 +84,7 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
             found = False
             for label, C, C16, s in constrained_refits(
                     target, mu, eta, weights, gT, gM, gE, eta_i_range, own_fit.degree, None, starts,
-                    cap, True, score, range_points=(CM.ravel(), CE.ravel())):
+                    cap, True, score, range_points=(CM.ravel(), CE.ravel()), work=budget):
                 if not in_range(C16):
                     continue
                 label += level
@@ -93,4 +104,5 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
         chosen = choose(scores, paper)
     report = guard_report(chosen, scores)
     report["bar_max"] = bar
+    report["work_cut"] = budget.cut
     return chosen, report

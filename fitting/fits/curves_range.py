@@ -17,6 +17,8 @@ budget, and a fit the budget cannot bring into range is made so here.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..models.coated_conductor import coated_conductor_model, model_parameters
@@ -24,7 +26,7 @@ from ..models.range_bound import certify_range
 from ..models.pack import to_float16
 from .curves_score import SCORE_GRID, check_grid
 
-__all__ = ["RANGE_TOLERANCE", "outside_range", "proven_in_range", "range_report", "escape_points", "in_range_fallback", "EvaluationBudget"]
+__all__ = ["RANGE_TOLERANCE", "PROOF_CELLS", "outside_range", "proven_in_range", "range_report", "escape_points", "in_range_fallback", "EvaluationBudget"]
 
 RANGE_TOLERANCE = 1e-4
 """float16 rounding of a fit on the boundary."""
@@ -51,23 +53,39 @@ def _channel_only(C, channel: int) -> np.ndarray:
     return out
 
 
-def proven_in_range(C16, eta_i_range, channel: int | None = None) -> bool:
+PROOF_CELLS = 400_000
+"""Cells a proof of [0, 1] examines at most by default (:func:`fitting.models.range_bound.certify_range`)."""
+
+
+@functools.lru_cache(maxsize=256)
+def _certificate(key: bytes, shape: tuple[int, ...], eta_i_range: tuple[float, float], max_cells: int):
+    """:func:`certify_range` at :data:`RANGE_TOLERANCE`, once per coefficients (a refit asks again and again)."""
+    C = np.frombuffer(key, dtype=np.float64).reshape(shape)
+    return certify_range(C, eta_i_range, RANGE_TOLERANCE, max_cells=max_cells)
+
+
+def _certified(C, eta_i_range, max_cells: int = PROOF_CELLS):
+    C = np.ascontiguousarray(C, dtype=np.float64)
+    return _certificate(C.tobytes(), C.shape, tuple(float(v) for v in eta_i_range), int(max_cells))
+
+
+def proven_in_range(C16, eta_i_range, channel: int | None = None, max_cells: int = PROOF_CELLS) -> bool:
     """
     Whether the model of ``C16`` is proven inside [0, 1] (by
     :data:`RANGE_TOLERANCE`) over the whole domain, every channel or one
-    (:func:`fitting.models.range_bound.certify_range`; unproven counts as
-    outside).
+    (:func:`fitting.models.range_bound.certify_range` examining at most
+    ``max_cells`` cells; unproven counts as outside).
     """
     C = C16 if channel is None else _channel_only(C16, channel)
-    return certify_range(C, eta_i_range, RANGE_TOLERANCE).in_range is True
+    return _certified(C, eta_i_range, max_cells).in_range is True
 
 
-def range_report(C16, eta_i_range) -> dict:
+def range_report(C16, eta_i_range, max_cells: int = PROOF_CELLS) -> dict:
     """The JSON of :func:`fitting.models.range_bound.certify_range` at :data:`RANGE_TOLERANCE`."""
-    return certify_range(C16, eta_i_range, RANGE_TOLERANCE).to_dict()
+    return _certified(C16, eta_i_range, max_cells).to_dict()
 
 
-def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int):
+def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int, max_cells: int = PROOF_CELLS):
     """
     Extra check points of a refit leaving [0, 1]: the scoring-grid points
     of ``mask`` (over ``range_M``, ``range_E``) and, unless proven in
@@ -75,7 +93,7 @@ def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int):
     theta (x 0.5, 1.5, 2) at every check row and its own eta_i.
     """
     pm, pe = range_M[mask], range_E[mask]
-    certificate = certify_range(C16, eta_i_range, RANGE_TOLERANCE)
+    certificate = _certified(C16, eta_i_range, max_cells)
     if certificate.in_range is not True:
         mu_w, eta_w = certificate.worst[0], certificate.worst[1]
         rows = np.unique(np.concatenate([check_grid(eta_i_range, 2, check_rows)[1][:, 0], [eta_w]]))
@@ -85,7 +103,7 @@ def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int):
     return pm, pe
 
 
-def in_range_fallback(C16, eta_i_range) -> np.ndarray:
+def in_range_fallback(C16, eta_i_range, max_cells: int = PROOF_CELLS) -> np.ndarray:
     """
     Float16 coefficients in [0, 1] over the whole domain (on the scoring
     grid and proven by :func:`proven_in_range`), as close to
@@ -102,7 +120,7 @@ def in_range_fallback(C16, eta_i_range) -> np.ndarray:
     C = np.asarray(C16, dtype=np.float64).copy()
     bad = outside_range(to_float16(C), eta_i_range).any(axis=0)
     # Issue 21: the whole domain, not the grid only.
-    bad |= np.array([not proven_in_range(to_float16(C), eta_i_range, c) for c in range(3)])
+    bad |= np.array([not proven_in_range(to_float16(C), eta_i_range, c, max_cells) for c in range(3)])
     if not bad.any():
         return to_float16(C)
     rows = check_grid(eta_i_range, 2, SCORE_GRID[1])[1][:, 0]
@@ -115,7 +133,7 @@ def in_range_fallback(C16, eta_i_range) -> np.ndarray:
         for scale in _SHAPE_SCALES:
             C[1, c, :] = scale * a
             if (not outside_range(to_float16(C), eta_i_range)[:, c].any()
-                    and proven_in_range(to_float16(C), eta_i_range, c)):
+                    and proven_in_range(to_float16(C), eta_i_range, c, max_cells)):
                 break
     return to_float16(C)
 

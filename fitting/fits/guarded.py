@@ -22,19 +22,20 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.optimize import least_squares, minimize
+from scipy.optimize import minimize
 from threadpoolctl import ThreadpoolController
 
 from ..colour.colorimetry import ACEScg_to_Lab
-from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
+from ..models.coated_conductor import coated_conductor_model, model_jacobian
 from ..models.pack import to_float16
 from .objective import Problem, coefficient_bounds
 from .quantise import quantise_coefficients
 from .result import FitResult
+from .paper_method import paper_fit
 from .solver import fit_coefficients
 from .worst_case import MAX_MARGIN, GuardScore, choose, guard_score
 
-__all__ = ["PAPER", "MEAN", "CAP_FACTORS", "constrained_mean", "constrained_refits", "guarded_fit", "guard_report"]
+__all__ = ["PAPER", "MEAN", "CAP_FACTORS", "GuardWork", "constrained_mean", "constrained_refits", "guarded_fit", "guard_report"]
 
 PAPER = "paper"
 """Name of the paper-method candidate."""
@@ -77,8 +78,35 @@ class _Cached:
         return self.value
 
 
+class GuardWork:
+    """
+    The work a guard's constrained refits may do, in SLSQP iterations
+    times the rows of their constraints (the QP of each iteration grows
+    with its rows): a deterministic bound on their CPU time, the same on
+    every machine. ``None`` where a guard has no bound (material fits).
+    """
+
+    def __init__(self, units: int) -> None:
+        self.left = int(units)
+        self.cut = False  # a refit was shortened or not started for the budget
+
+    def iterations(self, rows: int, wanted: int) -> int:
+        """SLSQP iterations of a solve with ``rows`` constraint rows (0: none left; marked cut when short)."""
+        allowed = min(wanted, self.left // max(1, rows))
+        if allowed < wanted:
+            self.cut = True
+        return allowed if allowed >= _MIN_ITERATIONS else 0
+
+    def spend(self, rows: int, iterations: int) -> None:
+        self.left -= rows * max(1, int(iterations))
+
+
+_MIN_ITERATIONS = 5  # a budget-shortened SLSQP solve with fewer iterations is not started
+
+
 def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0, cap: float,
-                     degree: int, max_iterations: int = _SLSQP_ITERATIONS, range_points=None):
+                     degree: int, max_iterations: int = _SLSQP_ITERATIONS, range_points=None,
+                     work: GuardWork | None = None):
     """
     Coefficients minimising the weighted mean of the first-order Delta E
     2000 over the fitting samples subject to Delta E <= ``cap`` at every
@@ -90,7 +118,9 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
     them for another solve (at most :data:`_ACTIVE_ROUNDS`): the max is
     where a few points are, and each constraint costs the QP of every step.
     ``range_points`` = (cos_theta, eta_i): points where the model must also
-    stay in [0, 1] (the same active-set rule: those within 0.05 of an end).
+    stay in [0, 1] (the same active-set rule, per channel and end: a row
+    for each channel within 0.05 of an end). ``work``: the
+    :class:`GuardWork` left; None when it is spent.
     """
     S = mean_problem.mu.size
     w = np.ravel(weights) / np.sum(weights)
@@ -109,7 +139,7 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
             return coated_conductor_model(rM, rE, x.reshape(3, 3, degree + 1), mean_problem.range)
 
         F0 = model_at(x)
-        near = ((F0 > 0.95) | (F0 < 0.05)).any(axis=1)
+        near = np.stack([F0 < 0.05, F0 > 0.95], axis=-1)  # (K, 3, 2): point, channel, lower / upper end
     for _ in range(_ACTIVE_ROUNDS):
         both = _Cached(Problem(
             np.concatenate([mean_problem.target, gT[active]]),
@@ -133,10 +163,17 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
             return -2.0 * np.einsum("so,son->sn", r[S:], J[S:])
 
         constraints = [{"type": "ineq", "fun": constraint, "jac": constraint_jac}]
+        rows = int(active.sum())
         if range_points is not None and near.any():
-            constraints.append(_range_constraint(rM[near], rE[near], mean_problem.range, degree))
+            constraints.append(_range_constraint(rM, rE, near, mean_problem.range, degree))
+            rows += int(near.sum())
+        iterations = max_iterations if work is None else work.iterations(rows, max_iterations)
+        if iterations == 0:
+            return None
         result = minimize(objective, x, jac=True, method="SLSQP", bounds=list(zip(lower, upper)),
-                          constraints=constraints, options={"maxiter": max_iterations, "ftol": 1e-9})
+                          constraints=constraints, options={"maxiter": iterations, "ftol": 1e-9})
+        if work is not None:
+            work.spend(rows, result.nit)
         if not np.all(np.isfinite(result.x)):
             return None
         x = result.x
@@ -145,7 +182,7 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
         active |= over
         if range_points is not None:
             F = model_at(x)
-            leaving = ((F > 1.0) | (F < 0.0)).any(axis=1)
+            leaving = np.stack([F < 0.0, F > 1.0], axis=-1)
             grown = grown or (leaving & ~near).any()
             near |= leaving
         if not grown:
@@ -155,24 +192,28 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
     return x.reshape(3, 3, degree + 1)
 
 
-def _range_constraint(mu, eta, eta_i_range, degree: int, margin: float = 1e-5) -> dict:
-    """SLSQP inequality ``margin <= F <= 1 - margin`` per point and channel, with its Jacobian."""
-    def values(x):
-        F, J = model_jacobian(mu, eta, x.reshape(3, 3, degree + 1), eta_i_range)
-        return F, J
+def _range_constraint(mu, eta, rows, eta_i_range, degree: int, margin: float = 1e-5) -> dict:
+    """
+    SLSQP inequalities ``F >= margin`` and ``F <= 1 - margin`` at the
+    points (``mu``, ``eta``), one row per True of ``rows`` (point,
+    channel, lower / upper end), with their Jacobian.
+    """
+    points = rows.any(axis=(1, 2))
+    mu, eta, rows = np.ravel(mu)[points], np.ravel(eta)[points], rows[points]
+    k, c, end = np.nonzero(rows)
+    sign = np.where(end == 0, 1.0, -1.0)
+    offset = np.where(end == 0, -margin, 1.0 - margin)
+    d1 = degree + 1
 
     def fun(x):
-        F, _ = values(x)
-        return np.concatenate([(F - margin).ravel(), (1.0 - margin - F).ravel()])
+        F, _ = model_jacobian(mu, eta, x.reshape(3, 3, d1), eta_i_range)
+        return sign * F[k, c] + offset
 
     def jac(x):
-        _, Jm = values(x)  # (K, 3, 3, d1): channel c depends on coefficients [:, c, :]
-        K, d1 = Jm.shape[0], degree + 1
-        J = np.zeros((K, 3, 3, 3, d1))
-        idx = np.arange(3)
-        J[:, idx, :, idx, :] = Jm.transpose(1, 0, 2, 3)
-        J = J.reshape(K * 3, -1)
-        return np.concatenate([J, -J])
+        _, Jm = model_jacobian(mu, eta, x.reshape(3, 3, d1), eta_i_range)  # (K, 3, 3, d1): channel c's
+        J = np.zeros((k.size, 3, 3, d1))
+        J[np.arange(k.size), :, c, :] = sign[:, None, None] * Jm[k, c]
+        return J.reshape(k.size, -1)
 
     return {"type": "ineq", "fun": fun, "jac": jac}
 
@@ -214,68 +255,6 @@ def _quantise_capped(mean_problem, guard_problem, weights, C, cap, quantise: boo
     return options[min(range(len(options)), key=lambda i: scored[i][1])]
 
 
-def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int):
-    """
-    Plain rgb least squares, channel by channel (the channels of the model
-    are independent): Levenberg-Marquardt on the 3 (d + 1) unknowns of one
-    channel at a time (Eq. 1 and its derivative written out for one
-    channel), from ``start``; None when a channel does not converge or
-    leaves the box.
-    """
-    C = np.array(start, dtype=np.float64)
-    d1 = C.shape[2]
-    lower, upper = (b.reshape(C.shape) for b in coefficient_bounds(d1 - 1))
-    m = np.clip(np.ravel(mu), 0.0, 1.0)
-    T = np.stack([normalised_eta_i(np.ravel(eta), eta_i_range) ** j for j in range(d1)], axis=-1)
-    x = 1.0 - m
-    x5 = x**5
-    with np.errstate(divide="ignore"):
-        log_x = np.where(x > 0.0, np.log(np.where(x > 0.0, x, 1.0)), 0.0)
-
-    def parts(xc):
-        P = T @ xc.reshape(3, d1).T  # (S, 3): F0, a, alpha
-        alpha = np.maximum(P[:, 2], ALPHA_MIN)
-        mu_xa = m * np.where(x > 0.0, np.exp(alpha * log_x), 0.0)
-        return P, alpha, mu_xa
-
-    for c in range(3):
-        y = target[:, c]
-
-        def residuals(xc, y=y):
-            P, _, mu_xa = parts(xc)
-            return P[:, 0] + (1.0 - P[:, 0]) * x5 - P[:, 1] * mu_xa - y
-
-        def jacobian(xc):
-            P, _, mu_xa = parts(xc)
-            dalpha = np.where(P[:, 2] > ALPHA_MIN, -P[:, 1] * mu_xa * log_x, 0.0)
-            return np.concatenate([(1.0 - x5)[:, None] * T, -mu_xa[:, None] * T, dalpha[:, None] * T], axis=1)
-
-        fit = least_squares(residuals, C[:, c, :].ravel(), jac=jacobian, method="lm",
-                            xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
-        xc = fit.x.reshape(3, d1)
-        if fit.status <= 0 or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
-            return None
-        C[:, c, :] = xc
-    return C
-
-
-def paper_fit(target, mu, eta, eta_i_range, degree, max_nfev, mean_fit: FitResult, range_check=None) -> FitResult:
-    """
-    The paper's method on the guard points: plain rgb least squares,
-    float16 by rounding to nearest (as the paper ships it). Warm-started
-    from the mean fit and solved channel by channel (a fifth of the cost of
-    the joint solve, the same optimum to 1e-5); the joint
-    :func:`fitting.fits.solver.fit_coefficients` when that fails or a
-    range constraint applies.
-    """
-    C = None if range_check is not None else _paper_channels(
-        target, mu, eta, eta_i_range, mean_fit.coefficients, max_nfev)
-    if C is None:
-        return fit_coefficients(target, mu, eta, eta_i_range, degree, "rgb", max_nfev, False,
-                                irls_rounds=0, range_check=range_check, start=mean_fit.coefficients)
-    return _candidate(mean_fit, C, to_float16(C), eta_i_range, degree, "rgb")
-
-
 def guard_report(chosen: str, scores: dict[str, GuardScore]) -> dict:
     """The JSON of a guarded choice: what was kept and every candidate's figures."""
     return {"chosen": chosen, "margin": MAX_MARGIN,
@@ -284,7 +263,7 @@ def guard_report(chosen: str, scores: dict[str, GuardScore]) -> dict:
 
 def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_eta, eta_i_range,
                        degree, range_check, starts, paper_max: float, quantise: bool, score,
-                       range_points=None):
+                       range_points=None, work: GuardWork | None = None):
     """
     Yield ``(label, C, C16, score(C16))`` of the fits of least mean Delta E
     over (``target``, ``mu``, ``eta``, ``weights``) with the first-order
@@ -292,7 +271,8 @@ def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_e
     times ``paper_max`` in order, from each of ``starts`` (``(suffix,
     coefficients)``); the caller stops when one suits it. ``score`` maps
     float16 coefficients to their :class:`GuardScore` (true CIEDE2000);
-    ``range_points``: as :func:`constrained_mean`.
+    ``range_points``, ``work``: as :func:`constrained_mean` (no refit is
+    started once ``work`` is spent).
     """
     base = np.ones(np.ravel(mu).size) if weights is None else np.ravel(weights)
     mean_problem = Problem(target, mu, eta, eta_i_range, degree, "de2000", None, range_check)
@@ -303,11 +283,13 @@ def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_e
             cap = threshold = paper_max * factor
             found = None
             for _ in range(_CAP_ROUNDS):
+                if work is not None and work.left <= 0:
+                    return
                 # The constraint is on the first-order Delta E (the de2000
                 # objective's); the score is the true CIEDE2000, which can
                 # read a little higher: the cap is lowered by their ratio.
                 C = constrained_mean(mean_problem, guard_problem, base, x0, cap, degree,
-                                     range_points=range_points)
+                                     range_points=range_points, work=work)
                 if C is None:
                     break
                 C16 = _quantise_capped(mean_problem, guard_problem, base, C, cap, quantise)
