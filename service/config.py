@@ -70,6 +70,12 @@ class Settings(BaseSettings):
         so browsers refuse cross-origin calls.
     fit_workers
         Worker processes of the fitting pool (default: the CPU count).
+    fit_express_workers
+        Worker processes more, for cheap parts only (a library or upload
+        fit's parts, a live refit step): they start at once while every
+        other worker runs an expensive part (a full curve refit, a scene's
+        material), instead of waiting for one to end (default 1; 0 turns
+        the express lane off).
     fit_queue
         Fits that may wait for a worker; past ``fit_workers + fit_queue``
         fits in flight a new fit is answered 503 with ``Retry-After``.
@@ -131,6 +137,7 @@ class Settings(BaseSettings):
     require_token: bool | None = None
     cors_origins: list[str] = Field(default_factory=list)
     fit_workers: int = Field(default_factory=lambda: os.cpu_count() or 1, ge=1, le=256)
+    fit_express_workers: int = Field(default=1, ge=0, le=16)
     fit_queue: int = Field(default=8, ge=0, le=10_000)
     fit_timeout_s: float = Field(default=120.0, gt=0.0, le=3600.0)
     job_cpu_limit_s: float = Field(default=60.0, gt=0.0, le=3600.0)

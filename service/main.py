@@ -114,7 +114,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         store = await asyncio.to_thread(open_store, settings)
         await asyncio.to_thread(store.check)
         runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
-                           settings.job_cpu_limit_s)
+                           settings.job_cpu_limit_s, express_workers=settings.fit_express_workers)
         app.state.store, app.state.runner = store, runner
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:

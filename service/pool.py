@@ -103,6 +103,10 @@ class Quarantined(WorkerLost):
         self.retry_after = max(1, math.ceil(left_s))
 
 
+EXPRESS_COST_S = 0.1
+"""Parts estimated at most this many seconds (a library fit's parts, a live
+step) may take an express turn (:class:`service.turns.Turns`)."""
+
 _JOB_KEY: contextvars.ContextVar[str | None] = contextvars.ContextVar("job_key", default=None)
 _QUARANTINE_KEYS = 1024  # content ids remembered at most
 
@@ -110,6 +114,10 @@ _QUARANTINE_KEYS = 1024  # content ids remembered at most
 class FitRunner:
     """
     The bounded fitting pool.
+
+    ``workers`` processes run parts of any cost, ``express_workers`` more
+    only cheap ones (:data:`EXPRESS_COST_S`), so a library fit or a live
+    step never waits for an expensive part to end.
 
     ``max_in_flight`` jobs may run or wait at once; the next is refused with
     :class:`Overloaded`. A request waits at most ``timeout_s`` seconds
@@ -121,12 +129,15 @@ class FitRunner:
     """
 
     def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
-                 quarantine_s: float = 600.0) -> None:
+                 quarantine_s: float = 600.0, express_workers: int = 0) -> None:
         if workers < 1 or max_in_flight < workers:
             raise ValueError(
                 f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1"
             )
+        if express_workers < 0:
+            raise ValueError(f"`express_workers` must be >= 0, got {express_workers}")
         self.workers = workers
+        self.express_workers = express_workers
         self.max_in_flight = max_in_flight
         self.timeout_s = timeout_s
         self.cpu_limit_s = cpu_limit_s
@@ -134,7 +145,7 @@ class FitRunner:
         self._quarantine: dict[str, float] = {}  # content id -> monotonic time it is refused until
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
-        self._turns = Turns(workers)
+        self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
         context = multiprocessing.get_context("spawn")
         self._context = context
         self._cancelled = context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
@@ -158,7 +169,7 @@ class FitRunner:
         with self._lock:
             if self._pool is None:
                 self._pool = concurrent.futures.ProcessPoolExecutor(
-                    max_workers=self.workers,
+                    max_workers=self.workers + self.express_workers,
                     mp_context=self._context,
                     initializer=worker_start,
                     initargs=(self._cancelled,),
@@ -187,7 +198,8 @@ class FitRunner:
         loop = asyncio.get_running_loop()
         pool = self._executor()
         try:
-            await asyncio.gather(*(loop.run_in_executor(pool, ping) for _ in range(self.workers)))
+            await asyncio.gather(*(loop.run_in_executor(pool, ping)
+                                   for _ in range(self.workers + self.express_workers)))
         except (BrokenProcessPool, RuntimeError):
             pass  # a pool that broke while warming is replaced by the job that sees it
 

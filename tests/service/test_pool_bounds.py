@@ -133,3 +133,58 @@ def test_turns_let_the_cheapest_waiting_part_go_first():
 
     order, running = asyncio.run(body())
     assert order == ["first", "cheap", "slow", "slow2"] and running == 0
+
+
+def test_express_turns_take_cheap_parts_only_and_keep_expensive_work_at_n():
+    """
+    With every general turn on an expensive part, a cheap part starts at
+    once on an express turn; an expensive part waits (it never takes an
+    express turn); a freed express turn goes to the next cheap part only.
+    """
+    from service.turns import Turns
+
+    async def body():
+        turns, started = Turns(1, express=1, express_cost_s=0.1), []
+        gates = {name: asyncio.Event() for name in ("slow", "cheap", "slow2", "cheap2")}
+
+        async def part(name, cost):
+            async with turns.turn(cost):
+                started.append((name, turns.running, turns.express_running))
+                await gates[name].wait()
+
+        slow = asyncio.ensure_future(part("slow", 1.0))
+        await asyncio.sleep(0)
+        slow2 = asyncio.ensure_future(part("slow2", 1.0))
+        cheap = asyncio.ensure_future(part("cheap", 0.1))
+        await asyncio.sleep(0)
+        assert [s[0] for s in started] == ["slow", "cheap"]  # slow2 waits: no express turn for it
+        cheap2 = asyncio.ensure_future(part("cheap2", 0.05))
+        await asyncio.sleep(0)
+        gates["cheap"].set()
+        await cheap
+        await asyncio.sleep(0)
+        assert [s[0] for s in started] == ["slow", "cheap", "cheap2"]  # the express turn to the cheap part
+        gates["cheap2"].set()
+        await cheap2
+        await asyncio.sleep(0)
+        assert turns.express_running == 0 and turns.running == 1  # slow2 still waits for the general turn
+        gates["slow"].set()
+        await slow
+        await asyncio.sleep(0)
+        gates["slow2"].set()
+        await slow2
+        return started, turns.running, turns.express_running
+
+    started, running, express = asyncio.run(body())
+    assert [s[0] for s in started] == ["slow", "cheap", "cheap2", "slow2"]
+    assert max(s[1] for s in started) == 1 and max(s[2] for s in started) == 1
+    assert running == 0 and express == 0
+
+
+def test_turns_refuse_bad_counts():
+    from service.turns import Turns
+
+    with pytest.raises(ValueError, match="`n` must be >= 1"):
+        Turns(0)
+    with pytest.raises(ValueError, match="`express` >= 0"):
+        Turns(1, express=-1)
