@@ -12,11 +12,13 @@ rough (0.3) under a rough coat (``mode=coated``, coat roughness 0.1) in the
 studio, split with the spectral reference (each at its own eta_i, so none
 shares another's render). Meanwhile a *separate process* (``--probe``: its
 own interpreter, so its timings are the server's and not this process's)
-requests ``/healthz`` back to back, from 1 s before the first round until
-the last preview is answered.
+requests ``/healthz`` back to back, from ``--idle`` (5) seconds before the
+first round until the last preview is answered: the idle seconds are the
+control (on a shared machine, other people's work delays ``/healthz`` too).
 
-Prints one table (``/healthz`` requests, p50 / p95 / p99 / max ms, the
-previews' statuses and seconds) and records it in
+Prints one table (``/healthz`` requests, p50 / p95 / p99 / max ms while
+idle and while the previews render, the previews' statuses and seconds)
+and records it in
 ``benchmarks/results/preview_load.json`` (:mod:`benchmarks.record`). Issue
 20, item 8: ``/healthz`` is always answered fast while previews render.
 
@@ -54,14 +56,14 @@ ROUGH_COATED_REFERENCE = {"roughness": 0.3, "mode": "coated", "coat_roughness": 
 
 def probe(url: str, stop_file: str, limit_s: float) -> int:
     """Separate process: /healthz back to back until ``stop_file`` exists (or ``limit_s``); print JSON."""
-    out: list[float] = []
+    out: list[tuple[float, float]] = []  # (wall-clock time sent, seconds)
     errors = 0
     with httpx.Client(base_url=url, timeout=30) as http:
         deadline = time.monotonic() + limit_s
         while not os.path.exists(stop_file) and time.monotonic() < deadline:
-            start = time.perf_counter()
+            sent, start = time.time(), time.perf_counter()
             response = http.get("/healthz")
-            out.append(time.perf_counter() - start)
+            out.append((sent, time.perf_counter() - start))
             errors += response.status_code != 200
     print(json.dumps({"healthz": out, "errors": errors}))
     return 0
@@ -95,6 +97,7 @@ def main() -> int:
     parser.add_argument("--rounds", type=int, default=1, help="rounds of previews at once (default 1)")
     parser.add_argument("--previews", type=int, default=2, help="previews at once (default 2)")
     parser.add_argument("--size", type=int, default=1024, help="pixels per side (default 1024)")
+    parser.add_argument("--idle", type=float, default=5.0, help="seconds probed before the previews (default 5)")
     parser.add_argument("--name", default="preview_load", help="the record's name (default preview_load)")
     args = parser.parse_args()
 
@@ -110,9 +113,9 @@ def main() -> int:
             stop_file = os.path.join(data, "stop")
             prober = subprocess.Popen([sys.executable, __file__, "--probe", url, stop_file, "900"],
                                       stdout=subprocess.PIPE, text=True)
-            time.sleep(1.0)  # the probe runs before the previews too
+            time.sleep(args.idle)  # the control: the probe alone
             answers = []
-            started = time.perf_counter()
+            started, since = time.perf_counter(), time.time()
             for round_ in range(args.rounds):
                 answers += previews_at_once(url, fit_id, args.previews, args.size, round_)
             wall = time.perf_counter() - started
@@ -121,7 +124,10 @@ def main() -> int:
         finally:
             server.terminate()
             server.wait(timeout=60)
-    p50, p95, p99, worst = percentiles(probed["healthz"])
+    idle = [seconds for sent, seconds in probed["healthz"] if sent < since]
+    during = [seconds for sent, seconds in probed["healthz"] if sent >= since]
+    p50, p95, p99, worst = percentiles(during)
+    i50, i95, i99, iworst = percentiles(idle)
     seconds = [s for _, s in answers]
     statuses: dict[str, int] = {}
     for status, _ in answers:
@@ -131,12 +137,17 @@ def main() -> int:
     print("| quantity | value |\n|---|---|")
     print(f"| previews answered | {', '.join(f'{k}: {v}' for k, v in sorted(statuses.items()))} |")
     print(f"| preview seconds (min / max) | {min(seconds):.1f} / {max(seconds):.1f} |")
-    print(f"| /healthz requests (separate process) | {len(probed['healthz'])} |")
-    print(f"| /healthz p50 / p95 / p99 / max ms | {p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+    print(f"| /healthz idle, no previews: requests | {len(idle)} |")
+    print(f"| /healthz idle: p50 / p95 / p99 / max ms | {i50:.1f} / {i95:.1f} / {i99:.1f} / {iworst:.1f} |")
+    print(f"| /healthz during the previews: requests | {len(during)} |")
+    print(f"| /healthz during the previews: p50 / p95 / p99 / max ms | "
+          f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
     print(f"| /healthz answers other than 200 | {probed['errors']} |")
     figures = {
         "healthz_ms": {"p50": p50, "p95": p95, "p99": p99, "max": worst},
-        "healthz_requests": len(probed["healthz"]), "healthz_errors": probed["errors"],
+        "healthz_requests": len(during), "healthz_errors": probed["errors"],
+        "idle_healthz_ms": {"p50": i50, "p95": i95, "p99": i99, "max": iworst},
+        "idle_healthz_requests": len(idle),
         "preview_statuses": statuses, "preview_s": {"min": min(seconds), "max": max(seconds)},
         "wall_s": wall,
     }
