@@ -35,14 +35,17 @@ Bounds and budgets:
     (``COATED_JOB_CPU_LIMIT_S``; :class:`service.worker.JobCPULimit`, 422).
 -   A job no request waits for any more (each timed out, or its client
     went away: :class:`service.api.middleware.RequestLimits` cancels the
-    request) is cancelled: its worker checks every 0.1 s
-    (:func:`service.worker.run_part`) and is free within a second. A
-    preview's place is held until its worker is free, not only until its
-    request ends, so the bound counts the work really running.
--   A worker that dies breaks the pool: it is replaced (its processes
-    started again on the next job), and the jobs it held answer
-    :class:`RenderWorkerLost`; a render is not tried again (one that killed
-    its worker would kill the next).
+    request) is cancelled: its process checks every 0.1 s
+    (:func:`service.worker.run_part`) and stops at its next check; one
+    that has not stopped :data:`CANCEL_GRACE_S` later (in a long numpy
+    call, or starved of CPU) is stopped (SIGKILL) and another started for
+    the next job. A preview's place is held until its process is free of
+    it, not only until its request ends, so the bound counts the work
+    really running.
+-   Each render process is an executor of its own: a process that dies
+    (or is stopped) fails only its own jobs (:class:`RenderWorkerLost`),
+    and another is started for the next job; a render is not tried again
+    (one that killed its process would kill the next).
 """
 
 from __future__ import annotations
@@ -50,9 +53,12 @@ from __future__ import annotations
 import asyncio
 import collections
 import concurrent.futures
+import contextlib
 import logging
 import math
 import multiprocessing
+import os
+import signal
 import threading
 import time
 from concurrent.futures.process import BrokenProcessPool
@@ -63,12 +69,15 @@ from .render_worker import RendererUnavailable, render_worker_start
 from .worker import CANCEL_SLOTS, run_part
 
 __all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
-           "TEXTURE_QUEUE"]
+           "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
 
 log = logging.getLogger("service.previews")
 
 TEXTURE_QUEUE = 16
 """Texture jobs in flight (running or waiting for a render process) at most; past it 503."""
+CANCEL_GRACE_S = 2.0
+"""A cancelled job still running this long after (its process did not reach a check: a long
+numpy call, or a process starved of CPU) has its process stopped (SIGKILL) and replaced."""
 
 
 class PreviewsBusy(Overloaded):
@@ -90,11 +99,26 @@ class PreviewTimeout(FitTimeout):
 
 
 class RenderWorkerLost(WorkerLost):
-    """The render process of a job died (503); the pool was replaced."""
+    """The render process of a job died (503); another is started for the next job."""
 
     def __init__(self) -> None:
-        Exception.__init__(self, "the render process of this preview died; the render pool was restarted")
+        Exception.__init__(self, "the render process of this preview died; another is started for the next one")
         self.retry_after = 1
+
+
+class _RenderProcess:
+    """
+    One render process: an executor of one worker (so that stopping it
+    touches no other job), its pid once known, its jobs submitted and not
+    ended, and whether it is broken (replaced on the next job).
+    """
+
+    def __init__(self, context, cancelled) -> None:
+        self.executor = concurrent.futures.ProcessPoolExecutor(
+            max_workers=1, mp_context=context, initializer=render_worker_start, initargs=(cancelled,))
+        self.pid: int | None = None
+        self.jobs = 0
+        self.broken = False
 
 
 class PreviewRunner:
@@ -103,24 +127,27 @@ class PreviewRunner:
 
     :meth:`preview` and :meth:`texture` run ``function(*args)`` in a render
     process (``function`` module-level, so that it pickles: the jobs of
-    :mod:`service.jobs.previews` and :mod:`service.jobs.textures`) and return its result; concurrent calls with the same
-    ``key`` share one job. The processes start on the first job.
+    :mod:`service.jobs.previews` and :mod:`service.jobs.textures`) and
+    return its result; concurrent calls with the same ``key`` share one
+    job. The processes start on the first jobs; a job goes to the process
+    with the fewest jobs.
     """
 
     def __init__(self, workers: int, timeout_s: float, cpu_limit_s: float,
-                 texture_queue: int = TEXTURE_QUEUE) -> None:
+                 texture_queue: int = TEXTURE_QUEUE, cancel_grace_s: float = CANCEL_GRACE_S) -> None:
         if workers < 1:
             raise ValueError(f"`workers` must be >= 1, got {workers}")
         self.workers = workers
         self.timeout_s = timeout_s
         self.cpu_limit_s = cpu_limit_s
         self.texture_queue = texture_queue
+        self.cancel_grace_s = cancel_grace_s
         self._context = multiprocessing.get_context("spawn")
         self._cancelled = self._context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
         self._cancel_next = 0
         self._serial = 0
-        self._lock = threading.Lock()  # counts are released from the executor's thread
-        self._pool: concurrent.futures.ProcessPoolExecutor | None = None
+        self._lock = threading.Lock()  # counts are released from the executors' threads
+        self._processes: list[_RenderProcess | None] = [None] * workers
         self._counts = {"preview": 0, "texture": 0}
         self._running: dict[int, concurrent.futures.Future] = {}
         self._pending: dict[tuple, asyncio.Task] = {}
@@ -133,22 +160,31 @@ class PreviewRunner:
         """Previews whose render process is busy with them (or about to be)."""
         return self._counts["preview"]
 
-    def _executor(self) -> concurrent.futures.ProcessPoolExecutor:
+    def _take_process(self) -> _RenderProcess:
+        """The process with the fewest jobs (a missing or broken one made anew), one job more."""
         with self._lock:
-            if self._pool is None:
-                self._pool = concurrent.futures.ProcessPoolExecutor(
-                    max_workers=self.workers, mp_context=self._context,
-                    initializer=render_worker_start, initargs=(self._cancelled,))
-            return self._pool
+            for index, process in enumerate(self._processes):
+                if process is None or process.broken:
+                    self._processes[index] = _RenderProcess(self._context, self._cancelled)
+            process = min(self._processes, key=lambda p: p.jobs)
+            process.jobs += 1
+            return process
 
-    def _replace(self, broken: concurrent.futures.ProcessPoolExecutor) -> None:
+    def _end_job(self, process: _RenderProcess) -> None:
         with self._lock:
-            if self._pool is not broken:
-                return  # another job saw the same break first
-            self._pool = None
+            process.jobs -= 1
+
+    def _break(self, process: _RenderProcess, kill: bool = False) -> None:
+        """Give up ``process`` (``kill``: stop it now, SIGKILL); the next job starts another."""
+        with self._lock:
+            if process.broken:
+                return
+            process.broken = True
             self.restarts += 1
-        broken.shutdown(wait=False, cancel_futures=True)
-        log.warning("a render process died; the render pool was replaced")
+        if kill and process.pid is not None:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(process.pid, signal.SIGKILL)
+        process.executor.shutdown(wait=False, cancel_futures=True)
 
     def _admit(self, what: str) -> None:
         """Take a place of ``what`` ("preview" | "texture") or refuse (:class:`PreviewsBusy`)."""
@@ -173,31 +209,40 @@ class PreviewRunner:
         One job in a render process; its place is left when its process is
         free of it (before it was submitted: when its task ends, :meth:`_once`).
         """
-        pool = self._executor()
+        process = self._take_process()
         with self._lock:
             self._serial += 1
             serial = self._serial
         started = time.perf_counter()
         try:
-            future = pool.submit(run_part, serial, self.cpu_limit_s, function, *args)
-        except (BrokenProcessPool, RuntimeError):
-            self._replace(pool)
-            raise RenderWorkerLost() from None
+            if process.pid is None:  # the process starts (with its GL context) and says who it is
+                process.pid = await asyncio.wrap_future(process.executor.submit(os.getpid))
+            future = process.executor.submit(run_part, serial, self.cpu_limit_s, function, *args)
+        except BaseException as error:
+            self._end_job(process)
+            if isinstance(error, (BrokenProcessPool, RuntimeError)):
+                self._break(process)
+                raise RenderWorkerLost() from None
+            raise
         submitted.append(serial)
         self._running[serial] = future
 
         def done(f: concurrent.futures.Future) -> None:
             self._running.pop(serial, None)
-            self._leave(what, None if f.cancelled() or f.exception() is not None else started)
+            self._end_job(process)
+            failed = f.cancelled() or f.exception() is not None
+            self._leave(what, None if failed else started)
+            if not f.cancelled() and isinstance(f.exception(), BrokenProcessPool):
+                self._break(process)
 
         future.add_done_callback(done)
         try:
             return await asyncio.wrap_future(future)
         except BrokenProcessPool:
-            self._replace(pool)
             raise RenderWorkerLost() from None
         except asyncio.CancelledError:
             self._cancel(serial, future)
+            asyncio.get_running_loop().call_later(self.cancel_grace_s, self._stop_if_running, process, future)
             raise
 
     def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
@@ -207,6 +252,15 @@ class PreviewRunner:
         with self._lock:
             self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
             self._cancel_next += 1
+
+    def _stop_if_running(self, process: _RenderProcess, future: concurrent.futures.Future) -> None:
+        """A cancelled job still running ``cancel_grace_s`` later (in a long numpy call, or
+        starved of CPU): its process is stopped, and the next job starts another."""
+        if future.done():
+            return
+        log.warning("a cancelled render did not stop within %g s; its render process was stopped",
+                    self.cancel_grace_s)
+        self._break(process, kill=True)
 
     async def _once(self, what: str, key: tuple, function: Callable[..., Any], args: tuple) -> Any:
         """``function(*args)`` as one job shared by the calls with ``key``, within the time limit."""
@@ -251,13 +305,13 @@ class PreviewRunner:
         return await self._once("texture", key, function, args)
 
     def close(self) -> None:
-        """Cancel what runs (each process stops at its next check) and stop the processes."""
+        """Cancel what runs (stopped at once: the service is going) and stop the processes."""
         for task in list(self._pending.values()):
             task.cancel()
         with self._lock:
-            pool, self._pool = self._pool, None
-            for serial in list(self._running):
-                self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
-                self._cancel_next += 1
-        if pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
+            processes = [p for p in self._processes if p is not None]
+            self._processes = [None] * self.workers
+        for process in processes:
+            if process.jobs:
+                self._break(process, kill=True)
+            process.executor.shutdown(wait=True, cancel_futures=True)

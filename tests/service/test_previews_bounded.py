@@ -6,11 +6,16 @@ while two 1024 px rough coated reference previews render; previews past
 ``COATED_MAX_PREVIEWS_IN_FLIGHT`` are refused (503 + Retry-After) while
 identical ones share a render; a preview whose client goes away, or that
 runs past ``COATED_PREVIEW_TIMEOUT_S`` (504), is cancelled and its process
-freed; one past ``COATED_JOB_CPU_LIMIT_S`` is stopped (422).
+freed, and one that does not stop at its checks is stopped (its process
+killed and another started); one past ``COATED_JOB_CPU_LIMIT_S`` is
+stopped (422).
 """
 
 from __future__ import annotations
 
+import asyncio
+import hashlib
+import math
 import threading
 import time
 
@@ -118,7 +123,7 @@ def test_bound_shared_renders_and_a_client_that_goes_away(tmp_path):
         wait_for_previews(http, 0, 30)
         freed_s = time.monotonic() - left
         print(f"a 2048 px preview: {full_s:.1f} s; freed {freed_s:.2f} s after its client went away")
-        assert freed_s < min(3.0, full_s / 2), (freed_s, full_s)
+        assert freed_s < min(4.0, full_s / 2), (freed_s, full_s)
         assert http.get(f"{API}/preview.png", params=preview(fit, 64, 1.9)).status_code == 200
 
 
@@ -130,7 +135,7 @@ def test_time_limit_504_and_cpu_limit_422(tmp_path):
         answer = http.get(f"{API}/preview.png", params=preview(fit, 2048, 1.5))
         assert answer.status_code == 504, answer.text
         assert "COATED_PREVIEW_TIMEOUT_S" in answer.json()["detail"] and int(answer.headers["retry-after"]) >= 1
-        assert wait_for_previews(http, 0, 30) < 3.0  # cancelled: the process is free
+        assert wait_for_previews(http, 0, 30) < 4.0  # cancelled: the process is free
     with server_process(tmp_path / "cpu", COATED_JOB_CPU_LIMIT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
             httpx.Client(base_url=server.url, timeout=300) as http:
         fit = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
@@ -138,3 +143,31 @@ def test_time_limit_504_and_cpu_limit_422(tmp_path):
         assert answer.status_code == 422, answer.text
         assert "CPU-time limit of 1 s (COATED_JOB_CPU_LIMIT_S)" in answer.json()["detail"]
         assert http.get(f"{API}/preview.png", params=preview(fit, 64, 1.5)).status_code == 200
+
+
+def test_a_render_that_does_not_stop_at_its_checks_is_killed():
+    from service.previews import PreviewRunner, PreviewTimeout
+
+    async def scenario() -> tuple[float, int]:
+        runner = PreviewRunner(1, timeout_s=120, cpu_limit_s=60, cancel_grace_s=1.0)
+        try:
+            assert await runner.preview(("warm",), math.sqrt, 4.0) == 2.0  # the process started
+            first_pid = runner._processes[0].pid
+            runner.timeout_s = 0.5
+            # One C call of about 30 s that never looks at signals (as a long numpy call):
+            # the process's 0.1 s checks cannot run inside it.
+            with pytest.raises(PreviewTimeout):
+                await runner.preview(("stuck",), hashlib.pbkdf2_hmac, "sha256", b"p", b"s", 50_000_000)
+            left = time.monotonic()
+            while runner.previews_in_flight and time.monotonic() - left < 20:
+                await asyncio.sleep(0.05)
+            freed_s = time.monotonic() - left
+            runner.timeout_s = 120
+            assert await runner.preview(("after",), math.sqrt, 9.0) == 3.0  # another process
+            assert runner._processes[0].pid != first_pid
+            return freed_s, runner.restarts
+        finally:
+            runner.close()
+
+    freed_s, restarts = asyncio.run(scenario())
+    assert restarts == 1 and 0.8 < freed_s < 4.0, (freed_s, restarts)
