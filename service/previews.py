@@ -184,7 +184,8 @@ class PreviewRunner:
         if kill and process.pid is not None:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(process.pid, signal.SIGKILL)
-        process.executor.shutdown(wait=False, cancel_futures=True)
+        # Jobs queued behind it fail with the process (BrokenProcessPool: 503), not as cancelled.
+        process.executor.shutdown(wait=False)
 
     def _admit(self, what: str) -> None:
         """Take a place of ``what`` ("preview" | "texture") or refuse (:class:`PreviewsBusy`)."""
