@@ -93,8 +93,8 @@ class PreviewTimeout(FitTimeout):
 
     def __init__(self, limit_s: float) -> None:
         Exception.__init__(
-            self, f"the preview did not finish within the time limit of {limit_s:g} s "
-                  "(COATED_PREVIEW_TIMEOUT_S); it was cancelled: ask for a smaller `size`")
+            self, f"the render did not finish within the time limit of {limit_s:g} s "
+                  "(COATED_PREVIEW_TIMEOUT_S); it was cancelled (a smaller preview `size` renders faster)")
         self.retry_after = max(1, math.ceil(limit_s / 4))
 
 
