@@ -96,7 +96,13 @@ class Settings(BaseSettings):
         Largest preview side in pixels.
     max_previews_in_flight
         Previews rendered at once (a spectral-reference preview is seconds of
-        CPU); past it a preview request is answered 503 with Retry-After.
+        CPU), and the processes of the render pool that draw them
+        (:class:`service.previews.PreviewRunner`); past it a preview
+        request is answered 503 with Retry-After.
+    preview_timeout_s
+        Time limit of one preview (or GL texture) request, seconds, waiting
+        included; past it the request is answered 504 and its render
+        cancelled. Each render also has ``job_cpu_limit_s``.
     allowed_hosts
         ``Host`` names the service answers (DNS-rebinding guard); default the
         loopback names and addresses. ``.example.com`` allows a domain and
@@ -147,6 +153,7 @@ class Settings(BaseSettings):
     max_upload_bytes: int = Field(default=2_000_000, ge=1_000)
     max_preview_size: int = Field(default=1024, ge=64, le=2048)
     max_previews_in_flight: int = Field(default=2, ge=1, le=64)
+    preview_timeout_s: float = Field(default=60.0, gt=0.0, le=3600.0)
     allowed_hosts: list[str] = Field(default_factory=lambda: ["localhost", "127.0.0.1", "::1"])
     header_timeout_s: float = Field(default=10.0, gt=0.0, le=600.0)
     body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)

@@ -33,6 +33,7 @@ from .api.routes import (
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
+from .previews import PreviewRunner
 from .schemas import API_PREFIX
 from .store import StoreError, open_store
 
@@ -104,8 +105,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     ``settings`` default to :class:`service.config.Settings` from the
     environment (``COATED_*``). The lifespan opens the store
     (:func:`service.store.open_store`: PostgreSQL at ``COATED_STORE_URL``, else
-    SQLite under ``settings.data_dir``; schema migrated) and the fitting pool (warmed at start-up when
-    ``settings.warm_pool``), and closes both at shutdown.
+    SQLite under ``settings.data_dir``; schema migrated), the fitting pool (warmed at start-up when
+    ``settings.warm_pool``) and the render pool (:class:`service.previews.PreviewRunner`, started
+    by the first preview), and closes them at shutdown.
     """
     settings = settings or Settings()
 
@@ -115,7 +117,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         await asyncio.to_thread(store.check)
         runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
                            settings.job_cpu_limit_s, express_workers=settings.fit_express_workers)
-        app.state.store, app.state.runner = store, runner
+        # Its processes start on the first preview: a service that draws none starts none.
+        previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s,
+                                 settings.job_cpu_limit_s)
+        app.state.store, app.state.runner, app.state.previews = store, runner, previews
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:
@@ -124,9 +129,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             yield
         finally:
             sweeper.cancel()
-            if app.state.preview_renderer is not None:
-                app.state.preview_renderer.close()
-                app.state.preview_renderer = None
+            previews.close()
             runner.close()
             store.close()
 
@@ -140,7 +143,6 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         redoc_url=None,  # ReDoc's page loads its script and fonts from CDNs: /docs covers it
     )
     app.state.settings = settings
-    app.state.preview_renderer = None
     install_error_handlers(app)
     for module in (health, materials, versions, library, fits, packs, preview, reference_texture, environments,
                    curves, scenes, ibl):

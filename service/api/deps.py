@@ -14,8 +14,8 @@ Dependencies
     endpoints.
 -   :data:`SingleFormFields`: a form field given twice (two ``file`` parts)
     is refused (422), not resolved silently to the last.
--   :data:`PreviewRendererDep`: the app's GL preview renderer, made on first
-    use (503 when the machine has no GL driver).
+-   :data:`PreviewsDep`: the app's render pool (previews and GL textures,
+    :class:`service.previews.PreviewRunner`).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
     :data:`NOT_FOUND`: the error answers for the OpenAPI document.
 """
@@ -23,7 +23,6 @@ Dependencies
 from __future__ import annotations
 
 import hmac
-import threading
 from typing import Annotated
 
 from fastapi import Depends, Form, HTTPException, Path, Query, Request, status
@@ -32,6 +31,7 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from ..config import Settings
 from ..jobs.common import stored_fit
 from ..pool import FitRunner
+from ..previews import PreviewRunner
 from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
 from ..store import FitRecord, Store
 
@@ -47,7 +47,7 @@ __all__ = [
     "StoredFit",
     "WriteAccess",
     "SingleFormFields",
-    "PreviewRendererDep",
+    "PreviewsDep",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
     "NOT_FOUND",
@@ -67,9 +67,14 @@ def get_runner(request: Request) -> FitRunner:
     return request.app.state.runner
 
 
+def get_previews(request: Request) -> PreviewRunner:
+    return request.app.state.previews
+
+
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 StoreDep = Annotated[Store, Depends(get_store)]
 RunnerDep = Annotated[FitRunner, Depends(get_runner)]
+PreviewsDep = Annotated[PreviewRunner, Depends(get_previews)]
 FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 MaterialIdPath = Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
                                      description="A library name or a saved material's id")]
@@ -144,33 +149,6 @@ async def refuse_repeated_form_fields(request: Request) -> None:
 
 
 SingleFormFields = Depends(refuse_repeated_form_fields)
-
-_renderer_lock = threading.Lock()
-
-
-def get_preview_renderer(request: Request):
-    """
-    The app's preview renderer (:class:`preview_shaders.preview.PreviewRenderer`),
-    made on first use; it owns its GL thread, so concurrent requests are
-    serialised there. A machine without a GL driver answers 503 here; the
-    rest of the service still works.
-    """
-    state = request.app.state
-    with _renderer_lock:
-        if state.preview_renderer is None:
-            try:
-                from preview_shaders.preview import PreviewRenderer
-
-                state.preview_renderer = PreviewRenderer()
-            except Exception as error:
-                raise HTTPException(
-                    status.HTTP_503_SERVICE_UNAVAILABLE, f"the preview renderer is unavailable: {error}"
-                ) from None
-        return state.preview_renderer
-
-
-PreviewRendererDep = Depends(get_preview_renderer)
-
 
 def _error(description: str) -> dict:
     return {"model": ErrorBody, "description": description}

@@ -9,8 +9,9 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``RequestValidationError``             422, naming each field and rule
 ``ValueError`` (the core's refusals)   422 (also ``JobCPULimit``)
 ``LookupError`` (not stored)           404
-``Overloaded`` / ``WorkerLost``        503 with ``Retry-After``
-``FitTimeout``                         504 with ``Retry-After``
+``Overloaded`` / ``WorkerLost``        503 with ``Retry-After`` (also ``PreviewsBusy``, ``RenderWorkerLost``)
+``FitTimeout``                         504 with ``Retry-After`` (also ``PreviewTimeout``)
+``RendererUnavailable``                503 (no GL context on this machine)
 ``StoreFull``                          507
 ``StoreUnavailable``                   503 with ``Retry-After``
 ``StoreConflict``                      409 (another save came first; ``NameTaken``: the name is another's)
@@ -34,6 +35,7 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from ..pool import FitTimeout, Overloaded, WorkerLost
+from ..previews import RendererUnavailable
 from ..store import StoreError
 
 __all__ = ["install_error_handlers", "error_response"]
@@ -130,6 +132,10 @@ async def _timeout(request: Request, error: FitTimeout) -> JSONResponse:
                           headers={"Retry-After": str(error.retry_after)})
 
 
+async def _no_renderer(request: Request, error: RendererUnavailable) -> JSONResponse:
+    return error_response(status.HTTP_503_SERVICE_UNAVAILABLE, str(error))
+
+
 async def _store_error(request: Request, error: StoreError) -> JSONResponse:
     if error.status == status.HTTP_409_CONFLICT:
         errors = [{"loc": ["body", getattr(error, "field", "expected_version")], "msg": str(error)[:500],
@@ -158,5 +164,6 @@ def install_error_handlers(app: FastAPI) -> None:
     app.add_exception_handler(Overloaded, _busy)
     app.add_exception_handler(WorkerLost, _busy)
     app.add_exception_handler(FitTimeout, _timeout)
+    app.add_exception_handler(RendererUnavailable, _no_renderer)
     app.add_exception_handler(StoreError, _store_error)
     app.add_exception_handler(Exception, _internal)

@@ -8,8 +8,10 @@ What every job shares
 -   :func:`measured_nk`: the n, k behind a stored fit, if any.
 -   :func:`nk_view`: a :class:`fitting.optics.nk.SpectralNK` as the record's lists.
 -   :func:`stored_fit`: a stored fit or ``LookupError``, with its n, k.
--   :func:`with_measured_nk`, :func:`nk_holder`: a draft refers to the
-    record holding its n, k (``provenance.nk_of``) instead of a copy.
+-   :func:`with_measured_nk`, :func:`nk_holder`, :func:`nk_record_id`,
+    :func:`draft_nk_reference`: a draft refers to the record holding its
+    n, k (``provenance.nk_of``), or to its n, k stored once as an n, k
+    record (``nk_id``), instead of a copy.
 -   :func:`fit_record`: the record of a finished job.
 -   :func:`checked_writable`: refuse (:class:`service.store.StoreError`)
     before any CPU is spent when the store cannot take the save.
@@ -41,6 +43,8 @@ __all__ = [
     "stored_fit",
     "with_measured_nk",
     "nk_holder",
+    "nk_record_id",
+    "draft_nk_reference",
     "fit_record",
     "checked_writable",
     "checked_version",
@@ -101,19 +105,51 @@ def nk_holder(record: FitRecord) -> str | None:
     return (record.provenance or {}).get("nk_of")
 
 
+def nk_record_id(nk: dict[str, list[float]]) -> str:
+    """The content address of an n, k record (``{"wavelength_nm", "n", "k"}``)."""
+    return content_address("nk record", *(np.asarray(nk[key], dtype=np.float64) for key in ("wavelength_nm", "n", "k")))
+
+
+def draft_nk_reference(draft: bool, base_record: FitRecord | None, measured: dict | None):
+    """
+    How a fit keeps the ``measured`` n, k of its base: ``(nk, nk_of, nk_id,
+    nk_record)``, the record's own ``nk`` and the references. A saved fit
+    keeps its copy; a draft on a stored base refers to the record holding
+    it (``nk_of``); a draft on an inline n, k (or on a base that keeps its
+    own in an n, k record) refers to the n, k record ``nk_id``, stored once
+    (``nk_record``, for :meth:`service.store.Store.put_fit`), content-addressed.
+    """
+    if not draft or measured is None:
+        return measured, None, None, None
+    if base_record is not None and base_record.nk_id is None:
+        return None, nk_holder(base_record), None, None
+    return None, None, nk_record_id(measured), measured
+
+
+_NK_HOPS = 4  # records followed at most to find an n, k (a draft's base is a draft at most once or twice)
+
+
 def with_measured_nk(store: Store, record: FitRecord | None) -> FitRecord | None:
     """
     ``record`` with its n, k: a draft stores the id of the record holding
-    them (``provenance.nk_of``), not a copy; an n, k whose holder is gone
-    (an expired draft) stays absent.
+    them (``provenance.nk_of``), or of the n, k record holding them
+    (``nk_id``, :meth:`service.store.Store.get_nk`), not a copy; an n, k
+    whose holder is gone (an expired draft) stays absent.
     """
     if record is None or record.nk is not None:
         return record
-    holder_id = (record.provenance or {}).get("nk_of")
-    holder = None if holder_id is None else store.get_fit(holder_id)
-    if holder is None or holder.nk is None:
-        return record
-    return dataclasses.replace(record, nk=holder.nk)
+    holder = record
+    for _ in range(_NK_HOPS):
+        if holder.nk is not None:
+            return dataclasses.replace(record, nk=holder.nk)
+        if holder.nk_id is not None:
+            nk = store.get_nk(holder.nk_id)
+            return record if nk is None else dataclasses.replace(record, nk=nk)
+        holder_id = (holder.provenance or {}).get("nk_of")
+        holder = None if holder_id is None else store.get_fit(holder_id)
+        if holder is None:
+            return record
+    return record
 
 
 def checked_writable(store: Store) -> None:

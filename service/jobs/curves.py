@@ -40,7 +40,7 @@ from fitting.optics.nk import SpectralNK
 from ..pool import FitRunner
 from ..store import FitRecord, Store
 from .common import (FIT_FORMAT_VERSION, check_finite, checked_version, checked_writable, content_address,
-                     fit_record, measured_nk, nk_holder, stored_fit, with_measured_nk)
+                     draft_nk_reference, fit_record, measured_nk, stored_fit, with_measured_nk)
 from .materials import resolve_material
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
@@ -276,8 +276,8 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
             checked_version(store, material_id, fit.name, expected_version)
         return stored
 
-    def put(record: FitRecord, save: bool = True, expected: int | None = None) -> FitRecord:
-        return with_measured_nk(store, store.put_fit(record, save, expected))
+    def put(record: FitRecord, save: bool = True, expected: int | None = None, nk=None) -> FitRecord:
+        return with_measured_nk(store, store.put_fit(record, save, expected, nk))
 
     stored = await asyncio.to_thread(stored_or_writable)
     if stored is not None:
@@ -293,10 +293,9 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     }
     if base_record is not None and base_record.kind == "curves":
         measured_library, measured = base_record.library_material, base_record.nk
-    # A draft refers to the stored record holding its n, k, not a copy (~400 KB a step for 20,000 samples).
-    nk_of = nk_holder(base_record) if fit.draft and measured is not None and base_record is not None else None
-    if nk_of is not None:
-        measured = None
+    # A draft refers to its n, k, never holds a copy (~0.5 MB a step for 20,000 samples).
+    measured, nk_of, nk_id, draft_nk = await asyncio.to_thread(draft_nk_reference, fit.draft, base_record,
+                                                                measured)
 
     settings = LIVE_SETTINGS if fit.live else DEFAULTS
     made_here = []  # set when this request's own job ran (and, unless a draft, saved)
@@ -310,7 +309,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         record = fit_record(
             fit.fit_id, "curves", material_id, fit.name,
             job["source"], job, fit.objective,
-            library_material=measured_library, nk=measured,
+            library_material=measured_library, nk=measured, nk_id=nk_id,
             base_fit_id=base_record.id if base_record else None,
             provenance={
                 "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
@@ -321,7 +320,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
                 **({"nk_of": nk_of} if nk_of is not None else {}),
             },
         )
-        return await asyncio.to_thread(put, record, not fit.draft, expected_version)
+        return await asyncio.to_thread(put, record, not fit.draft, expected_version, draft_nk)
 
     record = await runner.once(fit.fit_id, make)
     if not fit.draft and not made_here:

@@ -9,7 +9,9 @@ Reference textures
 -   :func:`prefiltered_environment_texture`: a preview environment
     prefiltered per roughness for the split sum, as float32 equirect slices
     (``GET /api/v1/environments/{name}/prefiltered``,
-    :mod:`service.api.routes.environments`).
+    :mod:`service.api.routes.environments`);
+    :func:`environment_texture`: the same in a render process of the
+    render pool (:class:`service.previews.PreviewRunner`), on its renderer.
 """
 
 from __future__ import annotations
@@ -18,10 +20,11 @@ from fitting.fits.curves_base import curve_base_from_nk
 from fitting.models.baselines import baseline_inputs
 from fitting.models.pack import material_from_json
 
+from ..render_worker import renderer
 from ..store import FitRecord
 from .common import measured_nk
 
-__all__ = ["reference_texture", "prefiltered_environment_texture"]
+__all__ = ["reference_texture", "prefiltered_environment_texture", "environment_texture"]
 
 
 def reference_texture(record: FitRecord) -> tuple[bytes, dict[str, str]]:
@@ -65,3 +68,8 @@ def prefiltered_environment_texture(renderer, environment: str) -> tuple[bytes, 
         "Cache-Control": "max-age=86400",
     }
     return data.astype("<f4").tobytes(), headers
+
+
+def environment_texture(environment: str) -> tuple[bytes, dict[str, str]]:
+    """Render process: :func:`prefiltered_environment_texture` on the process's own renderer."""
+    return prefiltered_environment_texture(renderer(), environment)

@@ -24,6 +24,8 @@ class Health(BaseModel):
     store_writable: bool = Field(description="Whether a save can be written now")
     store_problem: str | None = Field(None, description="Why not, when it cannot")
     pool_restarts: int = Field(0, description="Times a dead worker made the pool restart")
+    previews_in_flight: int = Field(0, description=(
+        "Previews rendering now in the render pool (at most COATED_MAX_PREVIEWS_IN_FLIGHT)"))
     store: dict[str, Any] = Field(default_factory=dict, description=(
         "The store: `kind` (sqlite | postgresql), `schema_version`, its `path` or password-free "
         "`url`, and for PostgreSQL this replica's pool: `connections` open, `connections_max`, "

@@ -27,6 +27,10 @@ columns. Versions:
 4.  ``materials.deleted_at``: a material in the bin (a soft delete; NULL:
     not deleted), and the index ``materials_by_name`` (a save or a rename
     finds the material called a name).
+5.  ``nk_records(id, created_at, record)``: an n, k kept once,
+    content-addressed, for the drafts on an inline n, k (``put_fit(...,
+    nk=)``), and ``fits.nk_id`` with the index ``fits_by_nk``: the fit that
+    refers to one (the drafts' sweep removes those no fit refers to).
 """
 
 from __future__ import annotations
@@ -125,15 +129,24 @@ _V4: list[Step] = [
     "CREATE INDEX IF NOT EXISTS materials_by_name ON materials (kind, name)",
 ]
 
+_V5: list[Step] = [
+    "CREATE TABLE IF NOT EXISTS nk_records (id TEXT PRIMARY KEY, created_at DOUBLE PRECISION NOT NULL, "
+    "record TEXT NOT NULL)",
+    "ALTER TABLE fits ADD COLUMN nk_id TEXT",
+    "CREATE INDEX IF NOT EXISTS fits_by_nk ON fits (nk_id)",
+]
+
 MIGRATIONS: dict[str, list[tuple[int, str, list[Step]]]] = {
     "sqlite": [(1, "fits, save log, material summaries", _SQLITE_V1),
                (2, "material versions", _V2),
                (3, "saves by fit (the drafts' sweep)", _V3),
-               (4, "materials in the bin, by name", _V4)],
+               (4, "materials in the bin, by name", _V4),
+               (5, "n, k records of drafts", _V5)],
     "postgresql": [(1, "fits, save log, material summaries", _POSTGRES_V1),
                    (2, "material versions", _V2),
                    (3, "saves by fit (the drafts' sweep)", _V3),
-                   (4, "materials in the bin, by name", _V4)],
+                   (4, "materials in the bin, by name", _V4),
+                   (5, "n, k records of drafts", _V5)],
 }
 SCHEMA_VERSION = max(version for version, _, _ in MIGRATIONS["sqlite"])
 """The schema version this code reads and writes."""

@@ -3,8 +3,8 @@ SQLite to PostgreSQL
 ====================
 
 :func:`move_sqlite_to_postgres`: copy a SQLite store, every record, the
-whole save log (its order and ``seq`` numbers: page cursors stay valid) and
-the material summaries with their versions, into an empty PostgreSQL store
+whole save log (its order and ``seq`` numbers: page cursors stay valid),
+the material summaries with their versions and the drafts' n, k records, into an empty PostgreSQL store
 in one transaction, and prove it with a count and a checksum computed the
 same way on both sides (:func:`store_checksum`). The command is
 ``python -m service migrate --from-sqlite DATA_DIR/store.sqlite3`` with
@@ -26,12 +26,13 @@ from .sqlite import SQLiteStore
 __all__ = ["MoveReport", "store_checksum", "move_sqlite_to_postgres"]
 
 _TABLES = {
-    "fits": ("id", "kind", "material_id", "created_at", "record"),
+    "fits": ("id", "kind", "material_id", "created_at", "record", "nk_id"),
     "saves": ("seq", "material_id", "fit_id", "saved_at"),
     "materials": ("material_id", "first_seq", "first_saved_at", "latest_fit_id", "kind", "name",
                   "source", "coverage", "version", "deleted_at"),
+    "nk_records": ("id", "created_at", "record"),
 }
-_ORDER = {"fits": "id", "saves": "seq", "materials": "material_id"}
+_ORDER = {"fits": "id", "saves": "seq", "materials": "material_id", "nk_records": "id"}
 _BATCH = 1000
 
 
@@ -58,7 +59,7 @@ def _rows(connection: Any, table: str):
 
 def store_checksum(connection: Any) -> tuple[str, dict[str, int]]:
     """
-    SHA-256 of every row of the three tables in a fixed order (ids, JSON
+    SHA-256 of every row of the four tables in a fixed order (ids, JSON
     texts, numbers as ``repr``), and the row count of each, from an open
     sqlite3 or psycopg connection: equal for two stores holding the same.
     """

@@ -37,15 +37,13 @@ from __future__ import annotations
 import logging
 import os
 import socket
-import time
-from dataclasses import asdict
 from typing import Any, Callable, TypeVar
 
 import psycopg
 from psycopg import errors as pg_errors
 from psycopg_pool import ConnectionPool, PoolTimeout
 
-from . import queries
+from . import queries, records
 from .migrations import SCHEMA_VERSION
 from .migrations import migrate as _migrate
 from .records import (
@@ -216,17 +214,21 @@ class PostgresStore:
     # -- the interface -----------------------------------------------------
 
     def put_fit(self, record: FitRecord, save: bool = True,
-                expected_version: int | None = None) -> FitRecord:
-        if not record.created_at:
-            record = FitRecord(**{**asdict(record), "created_at": time.time()})
-        text = record.to_json()
+                expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
+        record, text, nk_text = records.prepared(record, nk)
 
         def write(connection: psycopg.Connection) -> FitRecord:
-            if save:
+            if save or nk_text is not None:
+                # With an n, k record: the sweep must not find it unreferenced
+                # between this insert and the draft's (it takes the same lock).
                 connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))
-            return queries.save(connection, "%s", record, text, save, expected_version, self._decode)
+            return queries.save(connection, "%s", record, text, save, expected_version, self._decode, nk_text)
 
         return self._read(write)
+
+    def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
+        text = self._read(lambda c: queries.get_nk(c, "%s", nk_id))
+        return None if text is None else records.nk_from_json(nk_id, text)
 
     def expire_drafts(self, older_than: float, max_bytes: int) -> int:
         def sweep(connection: psycopg.Connection) -> int:

@@ -9,7 +9,8 @@ The caller owns the transaction and translates driver errors.
 
 -   :func:`save`: the body of ``put_fit`` (write-once record, save log,
     summary row, the expected-version check).
--   :func:`expire_drafts`: the drafts' sweep (age, then quota).
+-   :func:`expire_drafts`: the drafts' sweep (age, then quota, then the
+    n, k records no fit refers to); :func:`get_nk`: an n, k record.
 -   :func:`get_text`, :func:`latest_texts`, :func:`latest_ids`,
     :func:`version_of`, :func:`page_rows`, :func:`page_of`,
     :func:`material_row`, :func:`find_material`, :func:`version_texts`,
@@ -29,7 +30,7 @@ from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken,
 
 INT64_MAX = 2**63 - 1
 
-__all__ = ["save", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
+__all__ = ["save", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
            "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
            "version_text", "LISTED_KINDS"]
 
@@ -37,16 +38,23 @@ log = logging.getLogger("service.store")
 
 
 def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
-         expected_version: int | None, decode: Callable[[str, Any], FitRecord]) -> FitRecord:
+         expected_version: int | None, decode: Callable[[str, Any], FitRecord],
+         nk_text: str | None = None) -> FitRecord:
     """
     Inside one open write transaction (which the caller serialises with
-    every other save): store ``record`` unless its id exists, then (``save``)
-    check ``expected_version`` and log the save. Returns the stored record.
+    every other save, and with the drafts' sweep when ``nk_text`` is given):
+    store the n, k record ``record.nk_id`` (``nk_text``, its JSON) unless it
+    exists, and ``record`` unless its id exists, then (``save``) check
+    ``expected_version`` and log the save. Returns the stored record.
     """
+    if nk_text is not None:
+        connection.execute(
+            f"INSERT INTO nk_records (id, created_at, record) VALUES ({p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",
+            (record.nk_id, record.created_at, nk_text))
     connection.execute(
-        f"INSERT INTO fits (id, kind, material_id, created_at, record) VALUES ({p}, {p}, {p}, {p}, {p}) "
-        "ON CONFLICT (id) DO NOTHING",
-        (record.id, record.kind, record.material_id, record.created_at, text))
+        f"INSERT INTO fits (id, kind, material_id, created_at, record, nk_id) "
+        f"VALUES ({p}, {p}, {p}, {p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",
+        (record.id, record.kind, record.material_id, record.created_at, text, record.nk_id))
     stored = decode(record.id, get_text(connection, p, record.id))
     if not save:  # a draft: stored, reachable by id, listed under no material
         return stored
@@ -77,6 +85,12 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
 def _text(value: str) -> str:
     """A summary's text column: NUL (which PostgreSQL text refuses) shown as U+FFFD; the record keeps it."""
     return value.replace("\x00", "\ufffd")
+
+
+def get_nk(connection: Any, p: str, nk_id: str) -> Any:
+    """The stored JSON text of the n, k record ``nk_id``, or None."""
+    row = connection.execute(f"SELECT record FROM nk_records WHERE id = {p}", (nk_id,)).fetchone()
+    return None if row is None else row[0]
 
 
 def get_text(connection: Any, p: str, fit_id: str) -> Any:
@@ -245,18 +259,26 @@ def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) ->
     """
     Inside one write transaction that holds the saves' lock: remove the
     drafts (records no save refers to) created before ``older_than``, then
-    the oldest drafts until those left hold at most ``max_bytes``; return
-    how many were removed.
+    the oldest drafts until those left hold at most ``max_bytes`` (a draft's
+    n, k record counted once, with the newest draft that refers to it),
+    then the n, k records no fit refers to; return how many drafts were
+    removed.
     """
     rows = connection.execute(
-        "SELECT id, created_at, length(record) FROM fits WHERE NOT EXISTS "
+        "SELECT id, created_at, length(record), nk_id FROM fits WHERE NOT EXISTS "
         "(SELECT 1 FROM saves WHERE saves.fit_id = fits.id) ORDER BY created_at DESC").fetchall()
-    kept, doomed = 0, []
-    for fit_id, created_at, size in rows:  # newest first: the oldest go past the quota
+    nk_sizes = dict(connection.execute("SELECT id, length(record) FROM nk_records").fetchall())
+    kept, doomed, counted = 0, [], set()
+    for fit_id, created_at, size, nk_id in rows:  # newest first: the oldest go past the quota
+        size += nk_sizes.get(nk_id, 0) if nk_id not in counted else 0
         if created_at < older_than or kept + size > max_bytes:
             doomed.append((fit_id,))
         else:
             kept += size
+            counted.add(nk_id)
     if doomed:
-        connection.executemany(f"DELETE FROM fits WHERE id = {p}", doomed)
+        # A cursor's: psycopg's connection has no executemany (the sweep failed on PostgreSQL).
+        connection.cursor().executemany(f"DELETE FROM fits WHERE id = {p}", doomed)
+    connection.execute("DELETE FROM nk_records WHERE NOT EXISTS "
+                       "(SELECT 1 FROM fits WHERE fits.nk_id = nk_records.id)")
     return len(doomed)

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import json
 import sqlite3
-from dataclasses import asdict, dataclass, field
+import time
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Protocol, runtime_checkable
 
 FIT_KINDS = ("library", "nk", "curves")
@@ -51,6 +52,10 @@ class FitRecord:
         ``{"wavelength_nm", "n", "k"}`` as lists (fits of measured data).
     base_fit_id
         The fit a curve fit started from, if any.
+    nk_id
+        The n, k record holding this fit's n, k (:meth:`Store.put_fit`'s
+        ``nk``, :meth:`Store.get_nk`) instead of ``nk``: a draft on an
+        inline n, k keeps it once, content-addressed, not a copy per draft.
     provenance
         Free-form JSON about how the fit was made.
     created_at
@@ -73,6 +78,7 @@ class FitRecord:
     base_fit_id: str | None = None
     provenance: dict[str, Any] = field(default_factory=dict)
     created_at: float = 0.0
+    nk_id: str | None = None
 
     def __post_init__(self) -> None:
         if self.kind not in FIT_KINDS:
@@ -84,6 +90,31 @@ class FitRecord:
     @classmethod
     def from_json(cls, text: str) -> "FitRecord":
         return cls(**json.loads(text))
+
+
+def prepared(record: FitRecord, nk: dict[str, list[float]] | None) -> tuple[FitRecord, str, str | None]:
+    """
+    What a store's ``put_fit`` writes: the record (its ``created_at`` set
+    when it has none), its JSON, and the JSON of the n, k record ``nk``
+    (None without one; ``nk`` needs the record's ``nk_id``).
+    """
+    if nk is not None and record.nk_id is None:
+        raise TypeError(f"fit {record.id}: an n, k record needs the fit's `nk_id`")
+    if not record.created_at:
+        record = replace(record, created_at=time.time())
+    nk_text = None if nk is None else json.dumps(
+        {key: nk[key] for key in ("wavelength_nm", "n", "k")}, allow_nan=False, separators=(",", ":"))
+    return record, record.to_json(), nk_text
+
+
+def nk_from_json(nk_id: str, text: str) -> dict[str, list[float]]:
+    """An n, k record's ``{"wavelength_nm", "n", "k"}`` (:class:`RecordDamaged` when it cannot be read)."""
+    try:
+        nk = json.loads(text)
+        return {key: list(nk[key]) for key in ("wavelength_nm", "n", "k")}
+    except (TypeError, ValueError, KeyError) as error:
+        raise RecordDamaged(f"the stored n, k record {nk_id} is damaged and cannot be read ({error}); "
+                            "the rest of the store is unaffected") from None
 
 
 @dataclass(frozen=True)
@@ -197,7 +228,7 @@ class Store(Protocol):
     """The store interface of the service (thread-safe implementations)."""
 
     def put_fit(self, record: FitRecord, save: bool = True,
-                expected_version: int | None = None) -> FitRecord:
+                expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
         """
         Save ``record`` unless its id exists, and log the save (the fit
         becomes its material's latest, the material's version one more);
@@ -206,8 +237,15 @@ class Store(Protocol):
         material until saved. With ``expected_version`` (0: a material not
         saved yet) the save is refused with :class:`StoreConflict` unless
         the material is at that version now, or its latest fit already is
-        this record (a retried save: answered, not logged again).
+        this record (a retried save: answered, not logged again). With
+        ``nk`` (``{"wavelength_nm", "n", "k"}``) the n, k record
+        ``record.nk_id`` is stored too, in the same transaction, unless it
+        exists: an n, k record lives as long as a fit refers to it (a saved
+        one: always; drafts: until they expire, :meth:`expire_drafts`).
         """
+
+    def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
+        """The n, k record ``nk_id`` (``{"wavelength_nm", "n", "k"}``), or None (never stored, or expired)."""
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
         """The record of ``fit_id``, or None."""
@@ -267,7 +305,9 @@ class Store(Protocol):
         """
         Remove drafts (fits never saved) created before ``older_than`` (a
         ``time.time()``), then the oldest drafts until all left hold at most
-        ``max_bytes`` of records; return how many were removed.
+        ``max_bytes`` of records (each n, k record counted once, with the
+        newest draft that refers to it), then the n, k records no fit
+        refers to any more; return how many drafts were removed.
         """
 
     def check(self) -> None:

@@ -13,12 +13,10 @@ import os
 import sqlite3
 import contextlib
 import threading
-import time
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Callable, TypeVar
 
-from . import queries
+from . import queries, records
 from .migrations import SCHEMA_VERSION
 from .migrations import migrate as _migrate
 from .records import (
@@ -152,19 +150,22 @@ class SQLiteStore:
     # -- the interface -----------------------------------------------------
 
     def put_fit(self, record: FitRecord, save: bool = True,
-                expected_version: int | None = None) -> FitRecord:
-        if not record.created_at:
-            record = FitRecord(**{**asdict(record), "created_at": time.time()})
-        text = record.to_json()
+                expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
+        record, text, nk_text = records.prepared(record, nk)
 
         def write() -> FitRecord:
             connection = self._connection()
             with connection:
                 # BEGIN IMMEDIATE: the write lock first, so the version read is the one written after.
                 connection.execute("BEGIN IMMEDIATE")
-                return queries.save(connection, "?", record, text, save, expected_version, self._decode)
+                return queries.save(connection, "?", record, text, save, expected_version, self._decode,
+                                    nk_text)
 
         return self._guard(write)
+
+    def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
+        text = self._guard(lambda: queries.get_nk(self._connection(), "?", nk_id))
+        return None if text is None else records.nk_from_json(nk_id, text)
 
     def expire_drafts(self, older_than: float, max_bytes: int) -> int:
         def sweep() -> int:

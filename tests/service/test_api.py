@@ -535,20 +535,3 @@ class TestPackNames:
         response = client.post(f"{API}/packs", json={"fit_ids": [fit["id"], other["id"]]})
         assert response.status_code == 422
         assert "names in a pack must be unique" in response.json()["detail"]
-
-
-class TestPreviewBound:
-    @pytest.mark.slow  # 3.1 s (all cases 3.1 s) in a --durations=0 run
-    def test_previews_past_the_bound_get_503(self, tmp_path, monkeypatch):
-        import threading
-
-        with app_client(tmp_path, max_previews_in_flight=1, metrics_samples=10) as client:
-            fit = client.post(f"{API}/fits", json={"material": "Ag"}).json()
-            # Hold the only slot, as a long spectral-reference preview would.
-            client.app.state.preview_slots = threading.BoundedSemaphore(1)
-            client.app.state.preview_slots.acquire()
-            response = client.get(f"{API}/preview.png", params={"fit": fit["id"], "size": 64})
-            assert response.status_code == 503 and response.headers["retry-after"] == "2"
-            client.app.state.preview_slots.release()
-            response = client.get(f"{API}/preview.png", params={"fit": fit["id"], "size": 64})
-            assert response.status_code == 200 and response.content[:4] == b"\x89PNG"

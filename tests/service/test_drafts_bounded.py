@@ -2,8 +2,11 @@
 Issue 20, item 4: drafts as references, with a life, against a real
 ``python -m service`` on 127.0.0.1. A draft refers to the stored record
 holding its n, k (100 live steps on a 20,000-sample upload add under 2 MB);
-drafts past their time to live, or past the drafts' quota, are removed in
-the background, saved fits never.
+on an inline n, k (issue 20, item 2's rest) to that n, k stored once as a
+content-addressed n, k record (100 live steps on a 20,000-sample inline
+base add under 2 MB too); drafts past their time to live, or past the
+drafts' quota, are removed in the background with the n, k records no fit
+refers to any more, saved fits never.
 """
 
 from __future__ import annotations
@@ -22,26 +25,47 @@ API = "/api/v1"
 ANGLE = np.linspace(0.0, 90.0, 31)
 
 
-def big_csv(samples=20_000) -> bytes:
-    """A 20,000-sample n, k upload (CSV, under the upload limit)."""
+def big_nk(samples=20_000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     wavelength = np.linspace(300.0, 900.0, samples)
     n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2)
     k = 1.8 + 4.0 * (wavelength - 300.0) / 600.0
-    rows = "".join(f"{w:.4f},{a:.6f},{b:.6f}\n" for w, a, b in zip(wavelength, n, k))
+    return wavelength, n, k
+
+
+def big_csv(samples=20_000) -> bytes:
+    """A 20,000-sample n, k upload (CSV, under the upload limit)."""
+    rows = "".join(f"{w:.4f},{a:.6f},{b:.6f}\n" for w, a, b in zip(*big_nk(samples)))
     return ("wavelength_nm,n,k\n" + rows).encode()
 
 
-def step(base_id, start, value, live=True):
+def inline_nk(samples=20_000) -> dict:
+    """The same n, k as an inline base, with the upload's digits (all 17 of each float64 would take
+    the body past COATED_MAX_BODY_BYTES at 20,000 samples)."""
+    wavelength, n, k = big_nk(samples)
+    return {"wavelength_nm": np.round(wavelength, 4).tolist(), "n": np.round(n, 6).tolist(),
+            "k": np.round(k, 6).tolist()}
+
+
+def step(base_id, start, value, live=True, inline=None, name="dragged"):
+    """A live step (a draft) on the stored fit ``base_id``, or on the ``inline`` base; not live and
+    on an inline base: a save."""
     rgb = np.full((ANGLE.size, 3), 0.6)
     rgb[:, 1] = value
-    return {"name": "dragged", "base": {"fit": base_id}, "draft": True, "live": live,
-            **({"start_fit": start} if live else {}),
+    return {"name": name, "base": inline or {"fit": base_id}, "draft": live or inline is None, "live": live,
+            **({"start_fit": start} if live and start else {}),
             "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": rgb.tolist()}]}
 
 
 def stored_bytes(data_dir):
+    """The bytes of every stored record: fits and n, k records."""
     with sqlite3.connect(data_dir / "store.sqlite3") as db:
-        return db.execute("SELECT coalesce(sum(length(record)), 0) FROM fits").fetchone()[0]
+        return db.execute("SELECT (SELECT coalesce(sum(length(record)), 0) FROM fits) + "
+                          "(SELECT coalesce(sum(length(record)), 0) FROM nk_records)").fetchone()[0]
+
+
+def counted(data_dir, sql):
+    with sqlite3.connect(data_dir / "store.sqlite3") as db:
+        return db.execute(sql).fetchone()[0]
 
 
 def test_100_live_steps_on_a_20000_sample_upload_add_under_2_mb(tmp_path):
@@ -62,6 +86,55 @@ def test_100_live_steps_on_a_20000_sample_upload_add_under_2_mb(tmp_path):
         assert fit["has_nk"] is True
         curves = http.get(f"{API}/fits/{start}/curves", params={"eta_i": 1.5})
         assert curves.status_code == 200, curves.text[:300]
+
+
+def test_100_live_steps_on_a_20000_sample_inline_base_add_under_2_mb(tmp_path):
+    data = tmp_path / "data"
+    base = {"nk": inline_nk()}
+    with server_process(data) as server, httpx.Client(base_url=server.url, timeout=120) as http:
+        before = stored_bytes(data)
+        start = None
+        for i in range(100):
+            answer = http.post(f"{API}/fits/from-curves", json=step(None, start, 0.5 + 0.002 * i, inline=base))
+            assert answer.status_code == 201, answer.text[:300]
+            start = answer.json()["id"]
+        grown = stored_bytes(data) - before
+        print(f"100 live steps on a 20,000-sample inline base: {grown} bytes")
+        assert grown < 2_000_000, grown
+        # One n, k record, content-addressed, that the 100 drafts refer to.
+        assert counted(data, "SELECT count(*) FROM nk_records") == 1
+        assert counted(data, "SELECT count(DISTINCT nk_id) FROM fits WHERE nk_id IS NOT NULL") == 1
+        assert counted(data, "SELECT count(*) FROM fits WHERE nk_id IS NOT NULL") == 100
+        # The draft has its n, k (through the record): curves against the measured data.
+        fit = http.get(f"{API}/fits/{start}").json()
+        assert fit["has_nk"] is True
+        assert http.get(f"{API}/fits/{start}/curves", params={"eta_i": 1.5}).status_code == 200
+        # Neither the n, k record nor the drafts are materials, saved or uploaded.
+        listed = http.get(f"{API}/materials", params={"kind": ["nk", "curves"]}).json()["materials"]
+        assert not [m for m in listed if m["name"].startswith("dragged")], listed
+        # A save of the edit keeps its n, k in its own record, as every saved fit.
+        saved = http.post(f"{API}/fits/from-curves", json=step(None, None, 0.7, live=False, inline=base))
+        assert saved.status_code == 201, saved.text[:300]
+        assert counted(data, f"SELECT nk_id IS NULL FROM fits WHERE id = '{saved.json()['id']}'") == 1
+        assert http.get(f"{API}/fits/{saved.json()['id']}").json()["has_nk"] is True
+
+
+def test_an_inline_base_expires_with_its_drafts(tmp_path):
+    data = tmp_path / "data"
+    base = {"nk": inline_nk(2_000)}
+    with server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server, \
+            httpx.Client(base_url=server.url, timeout=120) as http:
+        start = None
+        for i in range(3):
+            answer = http.post(f"{API}/fits/from-curves", json=step(None, start, 0.5 + 0.01 * i, inline=base))
+            assert answer.status_code == 201, answer.text[:300]
+            start = answer.json()["id"]
+        assert counted(data, "SELECT count(*) FROM nk_records") == 1
+        deadline = time.monotonic() + 20
+        while counted(data, "SELECT count(*) FROM nk_records") and time.monotonic() < deadline:
+            time.sleep(0.25)
+        assert counted(data, "SELECT count(*) FROM nk_records") == 0  # gone with its drafts
+        assert http.get(f"{API}/fits/{start}").status_code == 404
 
 
 def test_drafts_expire_and_count_against_their_quota(tmp_path):

@@ -110,6 +110,30 @@ class TestStoreContract:
         assert store.latest_fit("d" * 32) is None and store.material_version("d" * 32) == 0
         assert store.saved_materials() == []
 
+    def test_an_nk_record_is_kept_once_and_expires_with_its_drafts(self, store):
+        # Drafts on an inline n, k refer to it (``nk_id``); it is stored once.
+        nk = {"wavelength_nm": [400.0, 500.0, 600.0], "n": [0.2, 0.3, 0.4], "k": [3.0, 2.5, 2.0]}
+        other = {"wavelength_nm": [400.0, 700.0], "n": [1.0, 1.1], "k": [0.5, 0.6]}
+        drafts = [store.put_fit(record(f"{i:032x}", kind="curves", nk_id="e" * 32, created_at=100.0 + i),
+                                save=False, nk=nk) for i in range(3)]
+        assert store.get_nk("e" * 32) == nk and store.get_nk("f" * 32) is None
+        assert [store.get_fit(d.id) for d in drafts] == drafts and drafts[0].nk is None
+        assert store.saved_materials() == []  # neither listed nor a material
+        saved = store.put_fit(record("a" * 32, kind="curves", nk_id="d" * 32, created_at=50.0), nk=other)
+        # Past their time to live two drafts go; the third still refers to the n, k.
+        assert store.expire_drafts(older_than=101.5, max_bytes=10**9) == 2
+        assert store.get_nk("e" * 32) == nk and store.get_fit(drafts[2].id) == drafts[2]
+        # The quota counts the draft with its n, k record: one byte short, both go.
+        draft_bytes = len(drafts[2].to_json()) + len('{"wavelength_nm":[400.0,500.0,600.0],"n":[0.2,0.3,0.4],'
+                                                     '"k":[3.0,2.5,2.0]}')
+        assert store.expire_drafts(older_than=0.0, max_bytes=draft_bytes) == 0
+        assert store.expire_drafts(older_than=0.0, max_bytes=draft_bytes - 1) == 1
+        assert store.get_fit(drafts[2].id) is None and store.get_nk("e" * 32) is None
+        # A saved fit's n, k record is never removed.
+        assert store.get_fit(saved.id) == saved and store.get_nk("d" * 32) == other
+        with pytest.raises(TypeError, match="needs the fit's `nk_id`"):
+            store.put_fit(record("b" * 32), nk=nk)
+
     def test_pages_follow_the_save_order(self, store):
         for i in range(7):
             store.put_fit(record(f"{i:032x}", material_id=f"{i + 50:032x}", name=f"m{i}"))

@@ -24,10 +24,10 @@ from service.store.postgres import PostgresStore, redacted
 pytestmark = [pytest.mark.xdist_group("postgres"), pytest.mark.slow]
 
 
-def record(fit_id: str, material_id: str = "m" * 32, name: str = "gold", kind: str = "nk") -> FitRecord:
+def record(fit_id: str, material_id: str = "m" * 32, name: str = "gold", kind: str = "nk", **extra) -> FitRecord:
     return FitRecord(id=fit_id, kind=kind, material_id=material_id, name=name, source="lab",
                      material={"name": name, "coefficients": {"F0": [[0.5]] * 3}}, metrics={"x": 1.0},
-                     coverage=0.95)
+                     coverage=0.95, **extra)
 
 
 def run_service(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
@@ -112,6 +112,8 @@ class TestMove:
         for i in range(30):
             lite.put_fit(record(f"{i:032x}", material_id=f"{i % 7:032x}", name=f"m{i % 7}"))
         lite.put_fit(record(f"{3:032x}"), save=False)
+        lite.put_fit(record(f"{101:032x}", kind="curves", nk_id="e" * 32), save=False,
+                     nk={"wavelength_nm": [400.0, 600.0], "n": [0.2, 0.3], "k": [3.0, 2.0]})
         lite.put_fit(record(f"{100:032x}", material_id="Au", kind="library"))
         in_bin = lite.delete_material(f"{6:032x}").deleted_at  # the bin moves too
         lite.close()
@@ -121,18 +123,19 @@ class TestMove:
         assert result.returncode == 0, result.stderr
         with sqlite3.connect(tmp_path / "data" / "store.sqlite3") as connection:
             checksum, counts = store_checksum(connection)
-        assert counts == {"fits": 31, "saves": 31, "materials": 8}
-        assert f"moved 31 fits, 31 saves, 8 materials from {tmp_path}" in result.stdout
+        assert counts == {"fits": 32, "saves": 31, "materials": 8, "nk_records": 1}
+        assert f"moved 32 fits, 31 saves, 8 materials from {tmp_path}" in result.stdout
         assert f"checksum {checksum} (source and target agree)" in result.stdout
         assert url not in result.stdout and redacted(url) in result.stdout
         target = PostgresStore(url)
         assert [m.name for m in target.saved_materials()] == [f"m{i}" for i in range(6)]
         assert target.material(f"{6:032x}").deleted_at == in_bin
         assert target.material_version(f"{1:032x}") == 5
+        assert target.get_nk("e" * 32)["n"] == [0.2, 0.3]  # the drafts' n, k records move too
         target.put_fit(record("f" * 32, material_id="new" * 10))  # seq continues after the moved log
         assert target.saved_materials()[-1].material_id == "new" * 10
         # A second move into the now non-empty store is refused and changes nothing.
-        with pytest.raises(StoreUnavailable, match="already holds 32 fits"):
+        with pytest.raises(StoreUnavailable, match="already holds 33 fits"):
             move_sqlite_to_postgres(tmp_path / "data" / "store.sqlite3", target)
         target.close()
 

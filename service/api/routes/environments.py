@@ -17,9 +17,10 @@ The body is little-endian float32 RGB (linear ACEScg), row-major
 -   ``X-Texture-Width`` columns over the azimuth, u = 0.5 towards -z
     (``cf_equirect_uv`` in ``cf_prefiltered_environment.glsl``).
 
-The environment is drawn on the preview renderer's GL thread (503 without
-a GL driver) and prefiltered once per process (cached on disk: the first
-request of a machine takes seconds, later ones milliseconds).
+The environment is drawn in a process of the render pool
+(:class:`service.previews.PreviewRunner`, on its renderer's GL thread; 503
+without a GL driver) and prefiltered once per process (cached on disk: the
+first request of a machine takes seconds, later ones milliseconds).
 """
 
 from __future__ import annotations
@@ -28,9 +29,9 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, Path, Response, status
 
-from ...jobs.textures import prefiltered_environment_texture
-from ...schemas import API_PREFIX
-from ..deps import ERROR_RESPONSES, PreviewRendererDep
+from ...jobs.textures import environment_texture
+from ...schemas import API_PREFIX, ErrorBody
+from ..deps import ERROR_RESPONSES, PreviewsDep
 
 router = APIRouter(prefix=API_PREFIX, tags=["preview"])
 
@@ -44,12 +45,16 @@ __all__ = ["router"]
         status.HTTP_200_OK: {"content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}},
                              "description": "float32 RGB [slice][row][column][channel]"},
         **ERROR_RESPONSES,
+        status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody, "description": (
+            "No GL on this machine, or too many textures waiting for the render pool (Retry-After)")},
+        status.HTTP_504_GATEWAY_TIMEOUT: {"model": ErrorBody, "description": (
+            "Not ready within COATED_PREVIEW_TIMEOUT_S (Retry-After)")},
     },
 )
-def get_prefiltered_environment(
+async def get_prefiltered_environment(
     environment: Annotated[Literal["white_sky", "studio", "outdoor"], Path(description="A preview environment")],
-    renderer=PreviewRendererDep,
+    previews: PreviewsDep,
 ) -> Response:
     """The environment prefiltered at roughness 0, 1/8, ..., 1 as float32 RGB slices (see the headers)."""
-    body, headers = prefiltered_environment_texture(renderer, environment)
+    body, headers = await previews.texture(("environment", environment), environment_texture, environment)
     return Response(body, media_type="application/octet-stream", headers=headers)

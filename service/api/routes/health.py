@@ -32,7 +32,7 @@ from ...schemas import (
     Health,
 )
 from ...store import Store
-from ..deps import RunnerDep, StoreDep
+from ..deps import PreviewsDep, RunnerDep, StoreDep
 
 router = APIRouter(tags=["health"])
 
@@ -48,13 +48,13 @@ def _probe(store: Store) -> tuple[str | None, dict]:
 
 @router.get("/healthz", response_model=Health,
             responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
-async def healthz(store: StoreDep, runner: RunnerDep) -> Health:
+async def healthz(store: StoreDep, runner: RunnerDep, previews: PreviewsDep) -> Health:
     """Readiness: the store answers and the fitting pool is up; whether a save can be written."""
     problem, described = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
         status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
         max_in_flight=runner.max_in_flight, store_writable=problem is None, store_problem=problem,
-        pool_restarts=runner.restarts, store=described,
+        pool_restarts=runner.restarts, previews_in_flight=previews.previews_in_flight, store=described,
     )
 
 

@@ -6,38 +6,29 @@ Preview
 (``&roughness=0.3&mode=coated&coat_roughness=0.1``): the
 preview sphere of a stored fit (``preview_shaders.preview``), optionally
 split with adjusted Lazanyi or the spectral reference (these need the
-fit's n, k). One renderer per app (:func:`service.api.deps.get_preview_renderer`),
-made on first use; it owns its GL thread, so concurrent requests are
-serialised there. At most
-``max_previews_in_flight`` previews are computed at once (the spectral
-reference of a large preview is seconds of CPU); past it a request is
-answered 503 with Retry-After rather than queued.
+fit's n, k). Rendered and encoded in the render pool
+(:class:`service.previews.PreviewRunner`, :func:`service.jobs.previews.render_preview`),
+never in the server process: at most ``max_previews_in_flight`` previews
+render at once (the spectral reference of a large preview is seconds of
+CPU), past it a request is answered 503 with Retry-After rather than
+queued; identical requests in flight share one render; a request waits at
+most ``preview_timeout_s`` (504), and a preview no request waits for any
+more (its client went away) is cancelled.
 """
 
 from __future__ import annotations
 
-import threading
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, HTTPException, Query, Request, Response, status
+from fastapi import APIRouter, Query, Response, status
+from fastapi.concurrency import run_in_threadpool
 
-from fitting.models.pack import material_from_json
-
-from ...jobs.common import measured_nk, stored_fit
+from ...jobs.common import stored_fit
+from ...jobs.previews import render_preview
 from ...schemas import API_PREFIX, ETA_I_LIMITS, FIT_ID_PATTERN, ErrorBody
-from ..deps import ERROR_RESPONSES, SettingsDep, StoreDep, get_preview_renderer
+from ..deps import ERROR_RESPONSES, PreviewsDep, SettingsDep, StoreDep
 
 router = APIRouter(prefix=API_PREFIX, tags=["preview"])
-_lock = threading.Lock()
-
-
-def _slots(request: Request, settings) -> threading.BoundedSemaphore:
-    """The app's bound on previews in flight, made on first use."""
-    state = request.app.state
-    with _lock:
-        if getattr(state, "preview_slots", None) is None:
-            state.preview_slots = threading.BoundedSemaphore(settings.max_previews_in_flight)
-        return state.preview_slots
 
 
 @router.get(
@@ -46,12 +37,15 @@ def _slots(request: Request, settings) -> threading.BoundedSemaphore:
     responses={
         status.HTTP_200_OK: {"content": {"image/png": {"schema": {"type": "string", "format": "binary"}}}},
         status.HTTP_404_NOT_FOUND: {"model": ErrorBody},
-        status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody},
         **ERROR_RESPONSES,
+        status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody, "description": (
+            "COATED_MAX_PREVIEWS_IN_FLIGHT previews rendering (Retry-After), or no GL on this machine")},
+        status.HTTP_504_GATEWAY_TIMEOUT: {"model": ErrorBody, "description": (
+            "The preview ran past COATED_PREVIEW_TIMEOUT_S and was cancelled (Retry-After)")},
     },
 )
-def preview_png(
-    request: Request, store: StoreDep, settings: SettingsDep,
+async def preview_png(
+    store: StoreDep, settings: SettingsDep, previews: PreviewsDep,
     fit: Annotated[str, Query(pattern=FIT_ID_PATTERN, description="A stored fit's id")],
     eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)] = 1.5,
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
@@ -71,27 +65,8 @@ def preview_png(
         raise ValueError(
             f"`size` must be at most {settings.max_preview_size} (COATED_MAX_PREVIEW_SIZE), got {size}",
         )
-    record = stored_fit(store, fit)
-    nk = measured_nk(record)
-    if compare != "none" and nk is None:
-        raise ValueError(
-            f"`compare`={compare!r} needs measured n, k; fit {fit} was made from curves",
-        )
-    slots = _slots(request, settings)
-    if not slots.acquire(blocking=False):
-        raise HTTPException(
-            status.HTTP_503_SERVICE_UNAVAILABLE,
-            f"{settings.max_previews_in_flight} previews are being rendered "
-            "(COATED_MAX_PREVIEWS_IN_FLIGHT); retry shortly",
-            headers={"Retry-After": "2"},
-        )
-    try:
-        active = get_preview_renderer(request)
-        result = active.render_preview(
-            material_from_json(record.material), nk, eta_i=eta_i, size=size,
-            compare=compare, environment=environment, differences=False,
-            roughness=roughness, mode=mode, coat_roughness=coat_roughness,
-        )
-    finally:
-        slots.release()
-    return Response(result.png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})
+    record = await run_in_threadpool(stored_fit, store, fit)
+    png = await render_preview(previews, record, eta_i=eta_i, size=size, compare=compare,
+                               environment=environment, roughness=roughness, mode=mode,
+                               coat_roughness=coat_roughness)
+    return Response(png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})

@@ -1,0 +1,318 @@
+"""
+Render pool
+===========
+
+The process pool that draws previews and GL textures, apart from the
+fitting pool and off the server process.
+
+-   :class:`PreviewRunner`: ``workers`` render processes (``spawn``), each
+    with its own GL context made on its own render thread
+    (:mod:`service.render_worker`); previews bounded in flight, textures
+    bounded waiting; identical requests in flight share one render; a time
+    limit per request, the CPU-time limit per job, cancellation.
+-   :class:`PreviewsBusy`, :class:`PreviewTimeout`, :class:`RenderWorkerLost`,
+    :class:`RendererUnavailable`: why a render was not answered (503 with
+    ``Retry-After``, 504 with ``Retry-After``, 503 with ``Retry-After``, 503).
+
+Why processes: a preview is seconds of numpy (the spectral reference),
+GL read-back and PNG encoding. In threads of the server process it held
+the GIL for long stretches, and the event loop (``/healthz`` too) stalled
+behind it (issue 20, item 8). Here the server only sends a fit's packed
+material and n, k and receives the PNG bytes; the event loop never waits
+on a render.
+
+Bounds and budgets:
+
+-   At most ``workers`` (``COATED_MAX_PREVIEWS_IN_FLIGHT``) previews render
+    at once; a new preview past that is refused at once (:class:`PreviewsBusy`)
+    rather than queued. A request that joins an identical preview in
+    flight takes no place of its own.
+-   Textures (the prefiltered environments: milliseconds once a process
+    has them, seconds the first time) wait for a worker; at most
+    :data:`TEXTURE_QUEUE` at once, then :class:`PreviewsBusy`.
+-   A request waits at most ``timeout_s`` (``COATED_PREVIEW_TIMEOUT_S``;
+    :class:`PreviewTimeout`); each job may use ``cpu_limit_s`` of CPU
+    (``COATED_JOB_CPU_LIMIT_S``; :class:`service.worker.JobCPULimit`, 422).
+-   A job no request waits for any more (each timed out, or its client
+    went away: :class:`service.api.middleware.RequestLimits` cancels the
+    request) is cancelled: its process checks every 0.1 s
+    (:func:`service.worker.run_part`) and stops at its next check; one
+    that has not stopped :data:`CANCEL_GRACE_S` later (in a long numpy
+    call, or starved of CPU) is stopped (SIGKILL) and another started for
+    the next job. A preview's place is held until its process is free of
+    it, not only until its request ends, so the bound counts the work
+    really running.
+-   Each render process is an executor of its own: a process that dies
+    (or is stopped) fails only its own jobs (:class:`RenderWorkerLost`),
+    and another is started for the next job; a render is not tried again
+    (one that killed its process would kill the next).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import collections
+import concurrent.futures
+import contextlib
+import logging
+import math
+import multiprocessing
+import os
+import signal
+import threading
+import time
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any, Callable
+
+from .pool import FitTimeout, Overloaded, WorkerLost
+from .render_worker import RendererUnavailable, render_worker_start
+from .worker import CANCEL_SLOTS, run_part
+
+__all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
+           "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
+
+log = logging.getLogger("service.previews")
+
+TEXTURE_QUEUE = 16
+"""Texture jobs in flight (running or waiting for a render process) at most; past it 503."""
+CANCEL_GRACE_S = 2.0
+"""A cancelled job still running this long after (its process did not reach a check: a long
+numpy call, or a process starved of CPU) has its process stopped (SIGKILL) and replaced."""
+
+
+class PreviewsBusy(Overloaded):
+    """Previews (or textures) in flight at the bound; ``retry_after`` in seconds (503)."""
+
+    def __init__(self, retry_after: int, what: str) -> None:
+        Exception.__init__(self, f"{what}; retry in about {retry_after} s")
+        self.retry_after = retry_after
+
+
+class PreviewTimeout(FitTimeout):
+    """A render request waited past its time limit (504); its job was cancelled."""
+
+    def __init__(self, limit_s: float) -> None:
+        Exception.__init__(
+            self, f"the render did not finish within the time limit of {limit_s:g} s "
+                  "(COATED_PREVIEW_TIMEOUT_S); it was cancelled (a smaller preview `size` renders faster)")
+        self.retry_after = max(1, math.ceil(limit_s / 4))
+
+
+class RenderWorkerLost(WorkerLost):
+    """The render process of a job died (503); another is started for the next job."""
+
+    def __init__(self) -> None:
+        Exception.__init__(self, "the render process of this preview died; another is started for the next one")
+        self.retry_after = 1
+
+
+class _RenderProcess:
+    """
+    One render process: an executor of one worker (so that stopping it
+    touches no other job), its pid once known, its jobs submitted and not
+    ended, and whether it is broken (replaced on the next job).
+    """
+
+    def __init__(self, context, cancelled) -> None:
+        self.executor = concurrent.futures.ProcessPoolExecutor(
+            max_workers=1, mp_context=context, initializer=render_worker_start, initargs=(cancelled,))
+        self.pid: int | None = None
+        self.jobs = 0
+        self.broken = False
+
+
+class PreviewRunner:
+    """
+    The render pool (see the module docstring).
+
+    :meth:`preview` and :meth:`texture` run ``function(*args)`` in a render
+    process (``function`` module-level, so that it pickles: the jobs of
+    :mod:`service.jobs.previews` and :mod:`service.jobs.textures`) and
+    return its result; concurrent calls with the same ``key`` share one
+    job. The processes start on the first jobs; a job goes to the process
+    with the fewest jobs.
+    """
+
+    def __init__(self, workers: int, timeout_s: float, cpu_limit_s: float,
+                 texture_queue: int = TEXTURE_QUEUE, cancel_grace_s: float = CANCEL_GRACE_S) -> None:
+        if workers < 1:
+            raise ValueError(f"`workers` must be >= 1, got {workers}")
+        self.workers = workers
+        self.timeout_s = timeout_s
+        self.cpu_limit_s = cpu_limit_s
+        self.texture_queue = texture_queue
+        self.cancel_grace_s = cancel_grace_s
+        self._context = multiprocessing.get_context("spawn")
+        self._cancelled = self._context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
+        self._cancel_next = 0
+        self._serial = 0
+        self._lock = threading.Lock()  # counts are released from the executors' threads
+        self._processes: list[_RenderProcess | None] = [None] * workers
+        self._counts = {"preview": 0, "texture": 0}
+        self._running: dict[int, concurrent.futures.Future] = {}
+        self._pending: dict[tuple, asyncio.Task] = {}
+        self._waiters: collections.Counter[tuple] = collections.Counter()
+        self._mean_s = 4.0  # running estimate of one preview's seconds, for Retry-After
+        self.restarts = 0
+
+    @property
+    def previews_in_flight(self) -> int:
+        """Previews whose render process is busy with them (or about to be)."""
+        return self._counts["preview"]
+
+    def _take_process(self) -> _RenderProcess:
+        """The process with the fewest jobs (a missing or broken one made anew), one job more."""
+        with self._lock:
+            for index, process in enumerate(self._processes):
+                if process is None or process.broken:
+                    self._processes[index] = _RenderProcess(self._context, self._cancelled)
+            process = min(self._processes, key=lambda p: p.jobs)
+            process.jobs += 1
+            return process
+
+    def _end_job(self, process: _RenderProcess) -> None:
+        with self._lock:
+            process.jobs -= 1
+
+    def _break(self, process: _RenderProcess, kill: bool = False) -> None:
+        """Give up ``process`` (``kill``: stop it now, SIGKILL); the next job starts another."""
+        with self._lock:
+            if process.broken:
+                return
+            process.broken = True
+            self.restarts += 1
+        if kill and process.pid is not None:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(process.pid, signal.SIGKILL)
+        # Jobs queued behind it fail with the process (BrokenProcessPool: 503), not as cancelled.
+        process.executor.shutdown(wait=False)
+
+    def _admit(self, what: str) -> None:
+        """Take a place of ``what`` ("preview" | "texture") or refuse (:class:`PreviewsBusy`)."""
+        limit = self.workers if what == "preview" else self.texture_queue
+        with self._lock:
+            if self._counts[what] >= limit:
+                waves = math.ceil(max(self._counts["preview"], 1) / self.workers)
+                retry = max(1, math.ceil(waves * self._mean_s))
+                raise PreviewsBusy(retry, (
+                    f"{limit} previews are being rendered (COATED_MAX_PREVIEWS_IN_FLIGHT)" if what == "preview"
+                    else f"{limit} textures are waiting for a render process"))
+            self._counts[what] += 1
+
+    def _leave(self, what: str, started: float | None = None) -> None:
+        with self._lock:
+            self._counts[what] -= 1
+            if started is not None and what == "preview":
+                self._mean_s = 0.8 * self._mean_s + 0.2 * (time.perf_counter() - started)
+
+    async def _job(self, what: str, function: Callable[..., Any], args: tuple, submitted: list) -> Any:
+        """
+        One job in a render process; its place is left when its process is
+        free of it (before it was submitted: when its task ends, :meth:`_once`).
+        """
+        process = self._take_process()
+        with self._lock:
+            self._serial += 1
+            serial = self._serial
+        started = time.perf_counter()
+        try:
+            if process.pid is None:  # the process starts (with its GL context) and says who it is
+                process.pid = await asyncio.wrap_future(process.executor.submit(os.getpid))
+            future = process.executor.submit(run_part, serial, self.cpu_limit_s, function, *args)
+        except BaseException as error:
+            self._end_job(process)
+            if isinstance(error, (BrokenProcessPool, RuntimeError)):
+                self._break(process)
+                raise RenderWorkerLost() from None
+            raise
+        submitted.append(serial)
+        self._running[serial] = future
+
+        def done(f: concurrent.futures.Future) -> None:
+            self._running.pop(serial, None)
+            self._end_job(process)
+            failed = f.cancelled() or f.exception() is not None
+            self._leave(what, None if failed else started)
+            if not f.cancelled() and isinstance(f.exception(), BrokenProcessPool):
+                self._break(process)
+
+        future.add_done_callback(done)
+        try:
+            return await asyncio.wrap_future(future)
+        except BrokenProcessPool:
+            raise RenderWorkerLost() from None
+        except asyncio.CancelledError:
+            self._cancel(serial, future)
+            asyncio.get_running_loop().call_later(self.cancel_grace_s, self._stop_if_running, process, future)
+            raise
+
+    def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
+        """Stop a job: dropped if still queued, else its process stops at its next check."""
+        if future.cancel():
+            return
+        with self._lock:
+            self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
+            self._cancel_next += 1
+
+    def _stop_if_running(self, process: _RenderProcess, future: concurrent.futures.Future) -> None:
+        """A cancelled job still running ``cancel_grace_s`` later (in a long numpy call, or
+        starved of CPU): its process is stopped, and the next job starts another."""
+        if future.done():
+            return
+        log.warning("a cancelled render did not stop within %g s; its render process was stopped",
+                    self.cancel_grace_s)
+        self._break(process, kill=True)
+
+    async def _once(self, what: str, key: tuple, function: Callable[..., Any], args: tuple) -> Any:
+        """``function(*args)`` as one job shared by the calls with ``key``, within the time limit."""
+        key = (what, *key)
+        task = self._pending.get(key)
+        if task is None:
+            self._admit(what)
+            submitted: list[int] = []
+            task = asyncio.ensure_future(self._job(what, function, args, submitted))
+            self._pending[key] = task
+
+            def finished(t: asyncio.Task) -> None:
+                self._pending.pop(key, None)
+                if not submitted:  # cancelled or refused before its process had it
+                    self._leave(what)
+
+            task.add_done_callback(finished)
+        self._waiters[key] += 1
+        try:
+            return await asyncio.wait_for(asyncio.shield(task), self.timeout_s)
+        except asyncio.TimeoutError:
+            raise PreviewTimeout(self.timeout_s) from None
+        finally:
+            self._waiters[key] -= 1
+            if self._waiters[key] <= 0:
+                del self._waiters[key]
+                if not task.done():
+                    task.cancel()
+
+    async def preview(self, key: tuple, function: Callable[..., Any], *args: Any) -> Any:
+        """
+        A preview: refused at once past ``workers`` in flight.
+
+        Raises
+        ------
+        PreviewsBusy, PreviewTimeout, RenderWorkerLost, RendererUnavailable, JobCPULimit, ValueError
+        """
+        return await self._once("preview", key, function, args)
+
+    async def texture(self, key: tuple, function: Callable[..., Any], *args: Any) -> Any:
+        """A texture: waits for a render process (at most :data:`TEXTURE_QUEUE` at once); as :meth:`preview`."""
+        return await self._once("texture", key, function, args)
+
+    def close(self) -> None:
+        """Cancel what runs (stopped at once: the service is going) and stop the processes."""
+        for task in list(self._pending.values()):
+            task.cancel()
+        with self._lock:
+            processes = [p for p in self._processes if p is not None]
+            self._processes = [None] * self.workers
+        for process in processes:
+            if process.jobs:
+                self._break(process, kill=True)
+            process.executor.shutdown(wait=True, cancel_futures=True)
