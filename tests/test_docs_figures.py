@@ -22,13 +22,15 @@ RECORDED_ROWS = (
     "accuracy, 22 conductors",
     "Al / Au / Cu",
     "float16 against float32",
+    "the worst point",
+    "fit time with the max guard",
 )
 """The rows of the README's "What it measures" table whose figures are all
 read from a record (by the start of their first cell): every number of
 their figure column has its marker."""
 
-NUMBER = re.compile(r"(?<![\w.])-?[0-9][0-9,]*(?:\.[0-9]+)?")
-TARGET = re.compile(r"target [^;)]*")
+NUMBER = re.compile(r"(?<![\w.])-?[0-9]+(?:,[0-9]{3})*(?:\.[0-9]+)?")
+TARGET = re.compile(r"target (?:p50 )?[0-9.]+(?: / [0-9.]+)?")
 """A target the figure is held to is the issue's number, not a measured one."""
 
 
