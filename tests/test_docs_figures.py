@@ -23,6 +23,7 @@ RECORDED_ROWS = (
     "Al / Au / Cu",
     "float16 against float32",
     "the worst point",
+    "rgb-conductor kind",
     "fit time with the max guard",
 )
 """The rows of the README's "What it measures" table whose figures are all
