@@ -24,6 +24,7 @@ RECORDED_ROWS = (
     "float16 against float32",
     "the worst point",
     "rgb-conductor kind",
+    "fit time, n, k to float16 pack",
     "fit time with the max guard",
 )
 """The rows of the README's "What it measures" table whose figures are all
