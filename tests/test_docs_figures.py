@@ -26,6 +26,7 @@ RECORDED_ROWS = (
     "rgb-conductor kind",
     "fit time, n, k to float16 pack",
     "fit time with the max guard",
+    "exports at eta_i 1.5",
 )
 """The rows of the README's "What it measures" table whose figures are all
 read from a record (by the start of their first cell): every number of
