@@ -26,6 +26,9 @@ RECORDED_ROWS = (
     "rgb-conductor kind",
     "fit time, n, k to float16 pack",
     "fit time with the max guard",
+    "service: fits/s with metrics",
+    "`/healthz` and pack download p99",
+    "REST fit of unseen data",
     "exports at eta_i 1.5",
 )
 """The rows of the README's "What it measures" table whose figures are all
