@@ -27,6 +27,7 @@ RECORDED_ROWS = (
     "fit time, n, k to float16 pack",
     "fit time with the max guard",
     "service: fits/s with metrics",
+    "service on PostgreSQL",
     "`/healthz` and pack download p99",
     "REST fit of unseen data",
     "exports at eta_i 1.5",
