@@ -31,6 +31,7 @@ RECORDED_ROWS = (
     "`/healthz` and pack download p99",
     "REST fit of unseen data",
     "exports at eta_i 1.5",
+    "mean FLIP vs spectral reference",
 )
 """The rows of the README's "What it measures" table whose figures are all
 read from a record (by the start of their first cell): every number of
