@@ -30,6 +30,7 @@ RECORDED_ROWS = (
     "service on PostgreSQL",
     "`/healthz` and pack download p99",
     "REST fit of unseen data",
+    "preview with the spectral reference",
     "exports at eta_i 1.5",
     "mean FLIP vs spectral reference",
 )
