@@ -34,6 +34,7 @@ RECORDED_ROWS = (
     "exports at eta_i 1.5",
     "shader cost at 2560 x 1440",
     "mean FLIP vs spectral reference",
+    "split sum vs Monte Carlo",
 )
 """The rows of the README's "What it measures" table whose figures are all
 read from a record (by the start of their first cell): every number of
