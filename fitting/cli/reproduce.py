@@ -122,13 +122,17 @@ def _float16_study(results: list[dict]) -> list[str]:
 
 
 def _float16_increases(results: list[dict]) -> dict:
-    """Per eta_i of the breakdown: the largest float32 to float16 increase of a row's mean and its conductor."""
+    """
+    Per eta_i of the breakdown (keyed ``eta_i_1_5``: a dot would split a
+    figure's path): the largest float32 to float16 increase of a row's mean
+    and its conductor.
+    """
     d = DEFAULT_OBJECTIVE
     worst = {}
     for e in BREAKDOWN_ETA_I:
         increases = [r[f"ours_f16_{d}"].row(e).mean - r[f"ours_f32_{d}"].row(e).mean for r in results]
         i = int(np.argmax(increases))  # the first conductor on a tie
-        worst[f"{e:g}"] = {"increase": float(increases[i]), "conductor": results[i]["name"]}
+        worst[f"eta_i_{e:g}".replace(".", "_")] = {"increase": float(increases[i]), "conductor": results[i]["name"]}
     return worst
 
 
