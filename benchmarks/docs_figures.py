@@ -34,7 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "benchmarks" / "results"
 MARKER = re.compile(
     r"<!-- figure: (?P<name>[\w-]+):(?P<path>[^ ]+) (?P<format>[^ ]*) -->(?P<bold>\**)"
-    r"(?P<number>-?[0-9][0-9,]*(?:\.[0-9]+)?)"
+    r"(?P<number>-?[0-9]+(?:,[0-9]{3})*(?:\.[0-9]+)?)"  # "1,024", not the comma after "22, 8"
 )
 
 __all__ = ["MARKER", "pages", "recorded", "figures", "stale", "rewrite"]

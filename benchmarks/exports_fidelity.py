@@ -20,7 +20,11 @@ base Fresnel of each export as its tool evaluates it
 
     .venv/bin/python benchmarks/exports_fidelity.py [--eta-i 1.5,1.33,2.0] [--materials Au,Cu]
 
-Prints one table per eta_i (Markdown) and the mean row.
+Prints one table per eta_i (Markdown) and the mean row; records each eta_i's
+mean and max row and every material's row in
+benchmarks/results/exports_fidelity.json (:mod:`benchmarks.record`), keyed
+by ``eta_i_1_5`` for eta_i = 1.5 (a dot would split a figure's path), the
+columns by ``mtlx``, ``openpbr``, ``gltf``, ``rgb_nk_ACEScg``, ``rgb_nk_as_709``.
 """
 
 from __future__ import annotations
@@ -34,6 +38,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting.exports import export_fidelity, export_values  # noqa: E402
 from fitting.exports.tool_fresnel import mx_fresnel_conductor  # noqa: E402
 from fitting.exports.colour_space import lin_rec709_to_ACEScg  # noqa: E402
@@ -42,6 +47,8 @@ from fitting.fits.rgb_conductor import rgb_nk  # noqa: E402
 from fitting.optics.library import LIBRARY_NAMES, library_material  # noqa: E402
 
 COLUMNS = ("mtlx / Metallic BSDF", "openpbr / Principled", "gltf", "rgb_nk ACEScg", "rgb_nk as 709")
+KEYS = ("mtlx", "openpbr", "gltf", "rgb_nk_ACEScg", "rgb_nk_as_709")
+"""The columns' keys in the record."""
 
 
 def material_row(name: str, eta_i: float, air_nk: tuple) -> list[float]:
@@ -60,7 +67,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--eta-i", default="1.5,1.33,2.0", help="comma-separated coating indices")
     parser.add_argument("--materials", help="comma-separated subset (default: all 22)")
     args = parser.parse_args(argv)
+    load_at_start = load_average()
     etas = [float(v) for v in args.eta_i.split(",")]
+    figures = {}
     names = args.materials.split(",") if args.materials else list(LIBRARY_NAMES)
     air = {name: rgb_nk(library_material(name)) for name in names}
     for eta_i in etas:
@@ -74,6 +83,12 @@ def main(argv: list[str] | None = None) -> int:
         print("| **mean** | " + " | ".join(f"**{v:.3f}**" for v in mean) + " |")
         worst = np.max(list(rows.values()), axis=0)
         print("| max | " + " | ".join(f"{v:.3f}" for v in worst) + " |")
+        figures["eta_i_" + f"{eta_i:g}".replace(".", "_")] = {
+            "mean": dict(zip(KEYS, map(float, mean))),
+            "max": dict(zip(KEYS, map(float, worst))),
+            "material": {name: dict(zip(KEYS, row)) for name, row in rows.items()},
+        }
+    print(f"\nwrote {write_result('exports_fidelity', figures, load_at_start)}")
     return 0
 
 

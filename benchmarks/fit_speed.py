@@ -11,6 +11,10 @@ medians over the conductors, reference generation and fitting apart. Delta E
 2000 is scored for both on the paper's 100 x 100 grid against the 1 nm
 reference, with the float16 coefficients.
 
+Recorded in benchmarks/results/fit_speed.json (:mod:`benchmarks.record`):
+the medians and means of the summary, with the load average (wall-clock
+times: the machine's other work shows in them).
+
 Usage: python benchmarks/fit_speed.py [--materials Au,Cu] [--repeats 3]
 """
 
@@ -26,6 +30,7 @@ from scipy.optimize import least_squares
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting import LIBRARY_NAMES, fit_material, library_material
 from fitting.colour.reference import evaluation_grid, reference_ACEScg
 from fitting.domain import DEFAULT_ETA_I_RANGE
@@ -67,6 +72,7 @@ def main(argv=None) -> int:
     parser.add_argument("--materials", help="comma-separated subset (default: all 22)")
     parser.add_argument("--repeats", type=int, default=3, help="timing repeats of our fit")
     args = parser.parse_args(argv)
+    load_at_start = load_average()
     names = args.materials.split(",") if args.materials else LIBRARY_NAMES
     fit_material(library_material(names[0]))  # warm caches (colour-science, weights)
     M, E = evaluation_grid(100, ETA_I_RANGE)
@@ -102,6 +108,16 @@ def main(argv=None) -> int:
           f"mean Delta E 2000 {a[:, 6].mean():.4f}")
     print(f"  speed-up (median total): {naive_total / med[5]:.1f}x; ours no worse on "
           f"{int(np.sum(a[:, 6] <= a[:, 2] + 1e-12))}/{len(names)} conductors")
+    figures = {
+        "conductors": len(names),
+        "straightforward_ms": {"reference": med[0] * 1e3, "fit": med[1] * 1e3, "total": naive_total * 1e3},
+        "ours_ms": {"reference": med[3] * 1e3, "fit": med[4] * 1e3, "total": med[5] * 1e3},
+        "straightforward_delta_E_mean": float(a[:, 2].mean()),
+        "ours_delta_E_mean": float(a[:, 6].mean()),
+        "speed_up": float(naive_total / med[5]),
+        "ours_no_worse": int(np.sum(a[:, 6] <= a[:, 2] + 1e-12)),
+    }
+    print(f"wrote {write_result('fit_speed', figures, load_at_start, repeats=args.repeats)}")
     return 0
 
 

@@ -5,7 +5,10 @@ spectral reference of the same view (per pixel, fitting.colour.reference): mean
 FLIP and mean Delta E 2000 over the sphere. Writes the split views (model |
 Lazanyi, model | reference) and the FLIP maps to docs/images/.
 
-    .venv/bin/python benchmarks/flip_figure2.py [--size 256]
+Records the rows and the range of each column over the six cases in
+benchmarks/results/flip_figure2.json (:mod:`benchmarks.record`).
+
+    .venv/bin/python benchmarks/flip_figure2.py [--size 256] [--images DIR]
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
+from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting.fits.material import fit_material
 from fitting.optics.library import library_material
 from preview_shaders.display import encode_png, false_colour  # noqa: E402
@@ -37,6 +41,7 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--images", type=Path, default=ROOT / "docs" / "images")
     args = parser.parse_args()
+    load_at_start = load_average()
     args.images.mkdir(parents=True, exist_ok=True)
     rows = []
     with PreviewRenderer() as renderer:
@@ -61,6 +66,16 @@ def main() -> None:
     print("|---|---:|---:|---:|---:|---:|")
     for name, eta_i, flip_m, flip_l, de_m, de_l in rows:
         print(f"| {name} | {eta_i:g} | {flip_m:.4f} | {flip_l:.4f} | {de_m:.3f} | {de_l:.3f} |")
+    keys = ("flip_model", "flip_lazanyi", "delta_E_model", "delta_E_lazanyi")
+    cases = [{"material": name, "eta_i": eta_i, **dict(zip(keys, map(float, values)))}
+             for name, eta_i, *values in rows]
+    figures = {"size": args.size, "cases": cases,
+               "range": {key: {"min": min(c[key] for c in cases), "max": max(c[key] for c in cases)}
+                         for key in keys},
+               # How many times closer to the reference the model is than adjusted Lazanyi, in FLIP.
+               "flip_lazanyi_over_model": {"min": min(c["flip_lazanyi"] / c["flip_model"] for c in cases),
+                                           "max": max(c["flip_lazanyi"] / c["flip_model"] for c in cases)}}
+    print(f"\nwrote {write_result('flip_figure2', figures, load_at_start)}")
 
 
 if __name__ == "__main__":

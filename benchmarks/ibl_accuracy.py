@@ -9,15 +9,25 @@ Grid: NdotV 0.05 .. 1 (12 values), roughness 0.05 .. 1 (8 values), eta_i
 when it is <= 1 % or <= 3 standard errors. Prints the worst error per
 roughness and per eta_i, and the overall worst.
 
+Records the worst and mean relative error, the worst per roughness and per
+eta_i and the points passing in benchmarks/results/ibl_accuracy.json
+(:mod:`benchmarks.record`).
+
     .venv/bin/python benchmarks/ibl_accuracy.py [--samples 65536] [--materials Cr,Ta]
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks.record import load_average, write_result  # noqa: E402
 
 from fitting.fits.material import fit_material
 from fitting.optics.library import LIBRARY_NAMES, library_material
@@ -35,6 +45,7 @@ def main() -> None:
     parser.add_argument("--samples", type=int, default=65536)
     parser.add_argument("--materials", help="comma-separated subset (default: all 22)")
     args = parser.parse_args()
+    load_at_start = load_average()
     names = args.materials.split(",") if args.materials else list(LIBRARY_NAMES)
     t0 = time.perf_counter()
     params = []
@@ -75,6 +86,19 @@ def main() -> None:
     print(f"\nworst relative error {100 * rel.max():.3f} %, mean {100 * rel.mean():.4f} %; "
           f"points passing (<= 1 % or <= 3 stderr): {passes.sum()} / {passes.size}")
     print(f"time: fits {t_fit - t0:.1f} s, LUT {t_lut - t_fit:.1f} s, MC {t_mc - t_lut:.1f} s")
+    figures = {
+        "worst_relative_error_percent": float(100 * rel.max()),
+        "mean_relative_error_percent": float(100 * rel.mean()),
+        "points_passing": int(passes.sum()), "points": int(passes.size),
+        "worst_by_roughness_percent": {f"{r:.2f}".replace(".", "_"): float(100 * rel[j].max())
+                                       for j, r in enumerate(ROUGHNESS)},
+        "worst_by_eta_i_percent": {f"{e:.1f}".replace(".", "_"): float(100 * rel[:, :, i].max())
+                                   for i, e in enumerate(ETA_I)},
+    }
+    path = write_result("ibl_accuracy", figures, load_at_start, samples=args.samples, materials=len(names),
+                        seconds={"fits": round(t_fit - t0, 1), "lut": round(t_lut - t_fit, 1),
+                                 "mc": round(t_mc - t_lut, 1)})
+    print(f"wrote {path}")
 
 
 if __name__ == "__main__":

@@ -11,6 +11,10 @@ of each and their ratio (target: reference at most 3x the model alone).
 ``--per-pixel`` adds the reference image integrated at every pixel, as it
 was; ``--maps`` the reference preview with the Delta E 2000 and FLIP maps.
 
+Records the milliseconds and ratios per size in
+benchmarks/results/preview_speed.json (:mod:`benchmarks.record`, with the
+load average: wall-clock times on a shared machine move with it).
+
     .venv/bin/python benchmarks/preview_speed.py [--repeat 5] [--per-pixel] [--maps]
 """
 
@@ -28,6 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
+from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting.fits.material import fit_material  # noqa: E402
 from fitting.optics.library import library_material  # noqa: E402
 from preview_shaders import preview  # noqa: E402
@@ -56,6 +61,7 @@ def main() -> int:
     parser.add_argument("--per-pixel", action="store_true",
                         help="also time the reference integrated per pixel (slow)")
     args = parser.parse_args()
+    load_at_start = load_average()
     nk = library_material(args.material)
     packed = fit_material(nk).packed
     rows = []
@@ -91,6 +97,13 @@ def main() -> int:
         if per_pixel is not None:
             line += f" {per_pixel * 1e3:.0f} |"
         print(line)
+    figures = {str(size): {"model_ms": model * 1e3, "reference_ms": reference * 1e3, "ratio": reference / model,
+                           **({} if maps is None else {"maps_ms": maps * 1e3}),
+                           **({} if per_pixel is None else {"per_pixel_ms": per_pixel * 1e3})}
+               for size, model, reference, per_pixel, maps in rows}
+    path = write_result("preview_speed", figures, load_at_start, material=args.material, eta_i=args.eta_i,
+                        repeat=args.repeat)
+    print(f"\nwrote {path}")
     return 0
 
 

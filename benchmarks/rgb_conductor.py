@@ -10,6 +10,10 @@ mean and max Delta E 2000 against the 1 nm spectral reference on the paper's
 rgb-conductor's float64 optimum and plain float16 rounding of it, to show
 what the float16-aware rounding buys.
 
+Recorded in benchmarks/results/rgb_conductor.json (:mod:`benchmarks.record`):
+the means over the conductors of each column, how many conductors the
+rgb-conductor is below the coated-conductor on, and each conductor's row.
+
 Usage: python benchmarks/rgb_conductor.py [--materials Au,Cu] [--objective de2000]
 """
 
@@ -24,6 +28,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting import LIBRARY_NAMES, fit_material, library_material  # noqa: E402
 from fitting.fits.settings import OBJECTIVES  # noqa: E402
 from fitting.fits.rgb_conductor import fit_rgb_conductor  # noqa: E402
@@ -40,6 +45,7 @@ def main(argv=None) -> int:
     parser.add_argument("--materials", help="comma-separated subset (default: all 22)")
     parser.add_argument("--objective", choices=OBJECTIVES, default="de2000")
     args = parser.parse_args(argv)
+    load_at_start = load_average()
     names = args.materials.split(",") if args.materials else list(LIBRARY_NAMES)
     M, E = evaluation_grid(100, ETA_I_RANGE)
     rows, times = [], []
@@ -74,8 +80,20 @@ def main(argv=None) -> int:
     mean = lambda i: float(np.mean([r[i][0] for r in rows]))  # noqa: E731
     print(f"| **mean ({len(rows)})** | **{mean(1):.4f}** | {mean(2):.4f} | {mean(3):.4f} | {mean(4):.4f} | "
           f"{sum(r[1][0] < r[4][0] for r in rows)}/{len(rows)} |")
+    run_s = time.perf_counter() - t_all
     print(f"\nrgb-conductor fit time: median {np.median(times) * 1e3:.0f} ms per conductor; "
-          f"run time {time.perf_counter() - t_all:.0f} s")
+          f"run time {run_s:.0f} s")
+    columns = ("rgb_conductor_f16", "rgb_conductor_f64", "rgb_conductor_plain_f16_rounding", "coated_conductor_f16")
+    figures = {
+        "objective": args.objective,
+        "conductors": len(rows),
+        "mean": {column: mean(i + 1) for i, column in enumerate(columns)},
+        "rgb_conductor_below_coated": sum(r[1][0] < r[4][0] for r in rows),
+        "fit_ms_median": float(np.median(times) * 1e3),
+        "conductor": {r[0]: {column: {"mean": r[i + 1][0], "max": r[i + 1][1]} for i, column in enumerate(columns)}
+                      for r in rows},
+    }
+    print(f"wrote {write_result('rgb_conductor', figures, load_at_start, seconds=round(run_s, 1))}")
     return 0
 
 

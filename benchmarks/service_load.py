@@ -163,9 +163,12 @@ def burst(url: str, fit_id: str, count: int) -> tuple[dict, dict, float]:
     def one(i: int) -> None:
         with httpx.Client(base_url=url, timeout=300) as http:
             start_gate.wait()
-            response = http.post(f"{API}/fits", json=nk_body(f"burst {i}"))
+            try:
+                answer = http.post(f"{API}/fits", json=nk_body(f"burst {i}")).status_code
+            except httpx.TransportError as error:  # a connection refused or reset counts, by its kind
+                answer = type(error).__name__
             with lock:
-                counts[response.status_code] = counts.get(response.status_code, 0) + 1
+                counts[answer] = counts.get(answer, 0) + 1
 
     threads = [threading.Thread(target=one, args=(i,)) for i in range(count)]
     start = time.perf_counter()
@@ -308,6 +311,7 @@ def main() -> int:
     twice = sum(len(ids) - len(set(ids)) for ids in listings)
     print(f"| saves answered 201: listed by every replica / listed twice | "
           f"{'all ' + str(len(saved)) if every else 'NOT all'} / {twice} |")
+    figures["saves"] = {"answered": len(saved), "listed_by_every_replica": every, "listed_twice": twice}
     for label, samples in (("idle", idle), ("under load", loaded)):
         p50, p95, p99, worst = percentiles(samples)
         print(f"| pack download {label}: requests | {len(samples)} |")
@@ -316,7 +320,7 @@ def main() -> int:
         figures[f"pack_{label.replace(' ', '_')}_ms"] = {"p50": p50, "p95": p95, "p99": p99, "max": worst}
     if args.burst:
         print(f"| burst: {args.burst} fits at once, answers | "
-              f"{', '.join(f'{k}: {v}' for k, v in sorted(burst_counts.items()))} ({burst_s:.1f} s) |")
+              f"{', '.join(f'{k}: {v}' for k, v in sorted(burst_counts.items(), key=str))} ({burst_s:.1f} s) |")
         for key, label in (("healthz", "/healthz"), ("pack", "pack download")):
             p50, p95, p99, worst = percentiles(probed[key])
             print(f"| burst, separate process: {label} requests | {len(probed[key])} |")
@@ -324,6 +328,7 @@ def main() -> int:
                   f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
         print(f"| burst, separate process: answers other than 200 | {probed['errors']} |")
         figures["burst_p99_ms"] = {key: percentiles(probed[key])[2] for key in ("healthz", "pack")}
+        figures["burst_answers"] = {str(k): v for k, v in burst_counts.items()}
     # One record per store and replica count (the PostgreSQL runs do not overwrite the SQLite one).
     name = "service_load" if args.store == "sqlite" and args.replicas == 1 else (
         f"service_load_{args.store}_{args.replicas}")

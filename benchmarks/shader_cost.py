@@ -27,6 +27,10 @@ Fairness:
 
 Paper (RTX 2080 Ti): model 199 us, adjusted Lazanyi 143 us (1.39x). Targets:
 general model <= 1.15x, scene-specialised <= 1.05x of adjusted Lazanyi.
+
+Recorded in benchmarks/results/shader_cost.json (:mod:`benchmarks.record`):
+the device, and per variant its medians and ratios as printed, with the load
+average (wall times on llvmpipe move with the machine's other work).
 """
 
 from __future__ import annotations
@@ -55,6 +59,7 @@ from preview_shaders.evaluate import (  # noqa: E402
     time_variants,
 )
 from preview_shaders.gl import RenderThread  # noqa: E402
+from benchmarks.record import load_average, write_result  # noqa: E402
 from preview_shaders.shading import SPLIT_SUM_VARIANTS, time_split_sum  # noqa: E402
 
 LABELS = {
@@ -83,6 +88,7 @@ def main() -> None:
     parser.add_argument("--width", type=int, default=2560)
     parser.add_argument("--height", type=int, default=1440)
     args = parser.parse_args()
+    load_at_start = load_average()
 
     nk = library_material(args.material)
     packed = fit_material(nk).packed
@@ -96,7 +102,8 @@ def main() -> None:
     lut = default_lut()
     F0, a, alpha = collapse_to_eta_i(packed.coefficients.astype(np.float64), 1.5, packed.eta_i_range)[..., 0]
     with RenderThread("shader-cost") as thread:
-        print(f"device: {thread.renderer}, {thread.version}")
+        device = f"{thread.renderer}, {thread.version}"
+        print(f"device: {device}")
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
               f"{args.repeats} (one warm-up render before each; variants interleaved); "
               f"scene eta_i {inputs.collapse_eta_i}\n")
@@ -147,6 +154,22 @@ def main() -> None:
         wn = "" if v == fixed else f"{net(sw):.2f}x"
         cn = "" if v == fixed else f"{net(sc):.2f}x"
         print(f"| {SPLIT_LABELS[v]} | {sq[v]:.0f} | {sw[v]:.1f} | {wn} | {sc[v]:.1f} | {cn} |")
+
+    figures = {
+        "device": device,
+        "variant": {v: {"wall_ms": float(wall[v]), "cpu_ms": float(cpu[v]), "wall_ratio": float(ratio(wall, v)),
+                        **({} if v == FIXED else {"wall_net_ratio": float(ratio(wall, v, net=True)),
+                                                  "cpu_net_ratio": float(ratio(cpu, v, net=True))})}
+                    for v in TIMING_VARIANTS},
+        "scene_specialised_against_lazanyi_scene": {
+            "wall_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE)),
+            "wall_net_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE, net=True)),
+            "cpu_net_ratio": float(ratio(cpu, "collapsed", LAZANYI_SCENE, net=True))},
+        "split_sum": {v: {"wall_ms": float(sw[v]), "cpu_ms": float(sc[v])} for v in SPLIT_SUM_VARIANTS},
+    }
+    path = write_result("shader_cost", figures, load_at_start, material=args.material, repeats=args.repeats,
+                        size=[args.width, args.height])
+    print(f"\nwrote {path}")
 
 
 if __name__ == "__main__":

@@ -3,17 +3,65 @@ Figures that cannot drift (issue 19): every figure README.md and docs/*.md
 quote from a benchmark through a ``<!-- figure: record:path format -->``
 marker (:mod:`benchmarks.docs_figures`) is the benchmark's recorded one in
 ``benchmarks/results/``; the README's figures of the editor's drag refit and
-the REST fit, once stale, are marked.
+the REST fit, once stale, are marked; every number of the figure column of
+the README's "What it measures" rows read from a record carries its marker
+(:data:`RECORDED_ROWS`), so a row cannot quietly lose one.
 """
 
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
 from benchmarks import docs_figures
-from benchmarks.docs_figures import figures, pages, recorded, rewrite, stale
+from benchmarks.docs_figures import MARKER, figures, pages, recorded, rewrite, stale
+
+RECORDED_ROWS = (
+    "accuracy, 22 conductors",
+    "Al / Au / Cu",
+    "float16 against float32",
+    "the worst point",
+    "rgb-conductor kind",
+    "fit time, n, k to float16 pack",
+    "fit time with the max guard",
+    "service: fits/s with metrics",
+    "service on PostgreSQL",
+    "`/healthz` and pack download p99",
+    "REST fit of unseen data",
+    "preview with the spectral reference",
+    "exports at eta_i 1.5",
+    "shader cost at 2560 x 1440",
+    "mean FLIP vs spectral reference",
+    "split sum vs Monte Carlo",
+)
+"""The rows of the README's "What it measures" table whose figures are all
+read from a record (by the start of their first cell): every number of
+their figure column has its marker."""
+
+NUMBER = re.compile(r"(?<![\w.])-?[0-9]+(?:,[0-9]{3})*(?:\.[0-9]+)?")
+TARGET = re.compile(r"target (?:p50 )?[0-9.]+(?: / [0-9.]+)?")
+"""A target the figure is held to is the issue's number, not a measured one."""
+
+
+def _measures_table(readme: str) -> dict[str, str]:
+    """The first cell of each row of the README's "What it measures" table and its figure cell."""
+    section = readme.split("## What it measures", 1)[1].split("\n## ", 1)[0]
+    rows = {}
+    for line in section.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split(" | ")]
+        if line.startswith("|") and len(cells) >= 3 and not set(cells[0]) <= {"-"}:
+            rows[cells[0]] = cells[1]
+    return rows
+
+
+def unmarked_numbers(cell: str) -> list[str]:
+    """The numbers of ``cell`` that no figure marker precedes (targets aside)."""
+    bare = MARKER.sub("", cell)
+    bare = TARGET.sub("", bare)
+    bare = re.sub(r"<!--.*?-->", "", bare)
+    return NUMBER.findall(bare)
 
 
 @pytest.mark.parametrize("page", pages(), ids=lambda p: str(p.relative_to(docs_figures.ROOT)))
@@ -48,3 +96,18 @@ def test_a_stale_figure_is_caught_and_rewritten():
     assert rewrite(bad) == good
     assert stale("<!-- figure: editor_speed:no.such.key .0f -->3")[0]["error"].endswith("(at 'no')")
     assert stale("<!-- figure: no_such_benchmark:x .0f -->3")[0]["error"].startswith("no record")
+
+
+@pytest.mark.parametrize("row", RECORDED_ROWS)
+def test_every_figure_of_a_recorded_readme_row_is_marked(row):
+    table = _measures_table((docs_figures.ROOT / "README.md").read_text(encoding="utf-8"))
+    (cell,) = [figure for what, figure in table.items() if what.startswith(row)]
+    assert MARKER.search(cell), f"README row {row!r} quotes no recorded figure"
+    assert not unmarked_numbers(cell), f"README row {row!r} quotes unmarked numbers {unmarked_numbers(cell)}"
+
+
+def test_an_unmarked_number_in_a_row_is_caught():
+    marked = "<!-- figure: editor_speed:drag_to_curve_ms.gentle.median_ms .0f -->**41** ms (target 50 ms)"
+    assert unmarked_numbers(marked) == []
+    assert unmarked_numbers(marked + ", p90 91 ms") == ["91"]
+    assert unmarked_numbers("0.011-0.035") == ["0.011", "0.035"]
