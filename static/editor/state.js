@@ -123,6 +123,11 @@ function remember(s, before) {
   s.redo = [];
 }
 
+// A drag or burst of key presses still under way is one undo step before anything else changes the history.
+function settleDrag(s) {
+  if (s.dragStart !== null) ACTIONS.dragEnd(s);
+}
+
 /** The named actions: (state, payload) -> a result (most: whether anything changed). */
 export const ACTIONS = {
   /** A new base (FitPublic): no edits, no history; eta_i kept within its domain. */
@@ -167,12 +172,14 @@ export const ACTIONS = {
     return true;
   },
   undo(s) {
+    settleDrag(s);
     if (!s.undo.length) return false;
     s.redo.push(snapshot(s));
     s.edits = JSON.parse(s.undo.pop());
     return true;
   },
   redo(s) {
+    settleDrag(s);
     if (!s.redo.length) return false;
     s.undo.push(snapshot(s));
     s.edits = JSON.parse(s.redo.pop());
@@ -180,12 +187,14 @@ export const ACTIONS = {
   },
   /** Back to no edits (undoable). */
   reset(s) {
+    settleDrag(s);
     remember(s, snapshot(s));
     s.edits = {};
     return true;
   },
   /** Every edit halfway back to `starts[eta]`, the curve it started from (undoable). */
   gentler(s, starts) {
+    settleDrag(s);
     remember(s, snapshot(s));
     for (const [eta, start] of Object.entries(starts)) {
       s.edits[eta] = s.edits[eta].map((rgb, j) => rgb.map((v, c) => clamp01(start[j][c] + 0.5 * (v - start[j][c]))));
