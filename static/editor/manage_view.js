@@ -1,5 +1,6 @@
 // The materials an artist manages (state.saved, state.bin, state.versions):
-// the saved edited materials (uploads and drafts apart), each to open,
+// the saved edited materials (uploads and drafts apart), each to open (with
+// its edit: its base and edited curves, as a link reopens it),
 // rename (in place: Enter keeps, Escape drops), delete (to the bin), list
 // its versions or copy its link; the bin with Restore; a material's
 // versions, each to open, download (in the Download menu's format) or

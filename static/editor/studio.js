@@ -61,7 +61,7 @@ export class Studio {
     });
     this.manage = new ManageView({
       rerender: () => this.manage.render(state),
-      onOpen: guard((m) => app.open(`saved:${m.id}`)),
+      onOpen: guard((m) => app.mayDiscard() && this.openFit(m.latest_fit_id)),
       onRename: guard((m, name) => this.rename(m, name)),
       onDelete: guard((m) => this.remove(m)),
       onRestore: guard((m) => this.restore(m)),
