@@ -206,8 +206,8 @@ export class Studio {
     const material = link.version ? null : await api.getMaterial(link.material);
     if (material && material.kind === "library") return this.app.open(`library:${material.id}`, false);
     const fit = link.version ? await api.version(link.material, link.version) : material.latest_fit;
+    await this.openFit(fit.id);
     if (material && material.deleted_at) this.app.say(`“${material.name}” is in the bin: restore it, or save to take it out.`);
-    return this.openFit(fit.id);
   }
 
   /** Reopen the stored fit `fitId` with its edit: its base, its curves as the edits, the material it continues. */
