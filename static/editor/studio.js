@@ -77,7 +77,7 @@ export class Studio {
     });
     $("copy-link").addEventListener("click", () => state.fit && this.copyLink(state.fit.id));
     app.store.subscribe((name) => this.#follow(name));
-    guard(() => this.#load())();
+    this.loading = null; // the studio's lists load once the first fit is on screen (never ahead of it: cold start)
   }
 
   #follow(name) {
@@ -88,8 +88,9 @@ export class Studio {
     if (FOLLOWS.compare.has(name)) this.compareView.render(state);
     if (name === "compareCurves" || name === "compareOff") this.app.plotView.render(state);
     if (name === "shown") $("share-link").value = linkTo(state.fit.id, location.origin);
+    if (name === "shown" && !this.loading) this.loading = this.app.guard(() => this.#load())();
     // The library's swatches and the compared curve follow eta_i (after the slider rests).
-    if (name === "setEta" || name === "openBase") this.#later("library", 400, () => this.#library());
+    if ((name === "setEta" || name === "openBase") && this.loading) this.#later("library", 400, () => this.#library());
     if (name === "setEta" || name === "compareWith") this.#later("compare", 120, () => this.#compareCurves());
   }
 
