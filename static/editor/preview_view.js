@@ -61,13 +61,14 @@ export class PreviewView {
 
   #panels() {
     if (!this.ball) return;
+    // While comparing, each ball shows its model alone (the Split menu waits).
+    $("compare").disabled = !this.hasReference || Boolean(this.comparing);
     this.ball.set({ panels: SPLITS[this.hasReference && !this.comparing ? $("compare").value : "none"] });
   }
 
   /** A new base: whether it has a spectral reference (measured n, k) to compare with. */
   showBase(base) {
     this.hasReference = Boolean(base.has_nk);
-    $("compare").disabled = !base.has_nk;
     this.#panels();
   }
 

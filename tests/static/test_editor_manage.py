@@ -148,6 +148,13 @@ def test_versions_open_download_and_continue(pages, editor_url):
     expect(page.locator("#name")).to_have_value("Versioned gold")
     expect(page.locator("#edited-etas")).to_contain_text("1.50")
     expect(page.locator("#save-state")).to_have_text("Saved")
+    # Two saved versions compared: version 2 beside version 1 on screen.
+    page.locator("#versions-list li[data-version='2']").get_by_role("button", name="Compare version 2").click()
+    expect(page.locator("#preview-compare")).to_have_attribute("data-fit", second)
+    expect(page.locator("#compare-de")).to_have_attribute("data-fit", second)
+    assert float(page.inner_text("#compare-de")) > 0
+    expect(page.locator("#compare-caption")).to_contain_text(f"right: version 2 ({second[:8]})")
+    page.click("#compare-off")
     # Saved again, it is the next version of the same material.
     key_edit(page, channel=2, angle=20, key="Shift+ArrowUp")
     save_as(page, "Versioned gold", "version 3")
