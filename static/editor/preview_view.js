@@ -60,9 +60,9 @@ export class PreviewView {
   }
 
   #panels() {
-    if (!this.ball) return;
     // While comparing, each ball shows its model alone (the Split menu waits).
     $("compare").disabled = !this.hasReference || Boolean(this.comparing);
+    if (!this.ball) return;
     this.ball.set({ panels: SPLITS[this.hasReference && !this.comparing ? $("compare").value : "none"] });
   }
 
