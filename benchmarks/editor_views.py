@@ -73,7 +73,7 @@ def shoot(page, out: Path) -> None:
     page.fill("#library-search", "")
 
     # A coat preset and a typed point.
-    page.select_option("#coat-preset", "water")
+    page.click("#coat-presets button[data-id='water']")
     page.wait_for_function("document.getElementById('plot').dataset.eta === '1.33'")
     settle(page)
     page.locator("input[name=channel][value='1']").check()
@@ -119,7 +119,7 @@ def shoot(page, out: Path) -> None:
     page.fill("#eta-typed", "1.5")
     page.press("#eta-typed", "Enter")
     settle(page)
-    page.select_option("#coat-preset", "glass")
+    page.click("#coat-presets button[data-id='glass']")
     page.click("#compare-base")
     page.wait_for_function("document.getElementById('compare-de').dataset.fit")
     page.wait_for_function("document.getElementById('preview-compare').dataset.fit")

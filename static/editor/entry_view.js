@@ -1,6 +1,6 @@
 // Typed entry: the coating index eta_i as a number (beside the slider), the
-// coat presets (GET /coat-presets: air, water, lacquer, glass, ...; each
-// preset's source as its title) and the selected control point's value.
+// coat presets (GET /coat-presets: air, water, lacquer, glass, ...: a button
+// each, its source as its title, the one at eta_i pressed) and the selected control point's value.
 // Each input is checked before anything changes (a refusal names the rule
 // and the value, and changes nothing); a valid one calls the same hooks as
 // the slider and a drag, so a typed value refits as a drag does.
@@ -29,11 +29,8 @@ export class EntryView {
     this.hooks = hooks;
     this.state = null;
     this.presetsShown = null;
+    this.chosen = null; // the preset last pressed
     $("eta-typed").addEventListener("change", () => this.#eta($("eta-typed").value));
-    $("coat-preset").addEventListener("change", (event) => {
-      const option = event.target.selectedOptions[0];
-      if (option && option.value !== "") this.#eta(option.dataset.eta, option.textContent);
-    });
     $("point-value").addEventListener("change", () => this.#point($("point-value").value));
   }
 
@@ -80,11 +77,13 @@ export class EntryView {
     Object.assign(eta, { min: lo, max: hi });
     if (document.activeElement !== eta) eta.value = key(state.eta);
     if (this.presetsShown !== state.presets || this.presetsDomain !== `${lo}-${hi}`) this.#presets(state.presets, lo, hi);
-    // The preset chosen stays while eta_i is its index (two presets may share one); else the first at eta_i.
+    // The preset chosen stays pressed while eta_i is its index (two presets may share one); else the first at eta_i.
     const at = (p) => key(p.eta_i) === key(state.eta);
-    const chosen = state.presets.find((p) => p.id === $("coat-preset").value);
+    const chosen = state.presets.find((p) => p.id === this.chosen);
     const match = chosen && at(chosen) ? chosen : state.presets.find(at);
-    $("coat-preset").value = match ? match.id : "";
+    for (const button of $("coat-presets").children) {
+      button.setAttribute("aria-pressed", String(Boolean(match) && button.dataset.id === match.id));
+    }
     const point = $("point-value");
     const selected = state.selected;
     const curve = target(state);
@@ -98,15 +97,19 @@ export class EntryView {
   #presets(presets, lo, hi) {
     this.presetsShown = presets;
     this.presetsDomain = `${lo}-${hi}`;
-    const select = $("coat-preset");
-    select.replaceChildren(new Option("Choose a coat…", ""));
-    for (const preset of presets) {
-      const option = new Option(`${preset.name} (${preset.eta_i.toFixed(3).replace(/0+$/, "").replace(/\.$/, ".0")})`, preset.id);
-      option.title = preset.source;
-      option.dataset.eta = preset.eta_i;
+    $("coat-presets").replaceChildren(...presets.map((preset) => {
+      const button = document.createElement("button");
+      button.type = "button";
+      button.dataset.id = preset.id;
+      button.textContent = `${preset.name} ${Number.isInteger(preset.eta_i) ? preset.eta_i.toFixed(1) : preset.eta_i}`;
+      button.title = preset.source;
       // A coat outside the material's fitted domain cannot be previewed with this fit.
-      option.disabled = preset.eta_i < lo - 1e-9 || preset.eta_i > hi + 1e-9;
-      select.appendChild(option);
-    }
+      button.disabled = preset.eta_i < lo - 1e-9 || preset.eta_i > hi + 1e-9;
+      button.addEventListener("click", () => {
+        this.chosen = preset.id;
+        this.#eta(String(preset.eta_i), preset.name);
+      });
+      return button;
+    }));
   }
 }

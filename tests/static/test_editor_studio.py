@@ -69,13 +69,16 @@ def test_presets_and_typed_entry(pages, editor_url):
     open_editor(page, editor_url)
     settled(page)
     presets = api(page, "/coat-presets")["presets"]
-    options = page.eval_on_selector_all("#coat-preset option", "els => els.map(e => [e.value, e.title])")
-    assert options[1:] == [[p["id"], p["source"]] for p in presets]
-    page.select_option("#coat-preset", "water")
+    buttons = page.eval_on_selector_all("#coat-presets button", "els => els.map(e => [e.dataset.id, e.title, e.textContent])")
+    shown = [f"{p['name']} {p['eta_i']:.1f}" if float(p["eta_i"]).is_integer() else f"{p['name']} {p['eta_i']:g}"
+             for p in presets]
+    assert buttons == [[p["id"], p["source"], text] for p, text in zip(presets, shown)]
+    page.click("#coat-presets button[data-id='water']")
     expect(page.locator("#eta-value")).to_have_text("1.33")
     expect(page.locator("#plot")).to_have_attribute("data-eta", "1.33")
     expect(page.locator("#preview")).to_have_attribute("data-eta", "1.33")
     expect(page.locator("#entry-message")).to_contain_text("Coat: Water")
+    expect(page.locator("#coat-presets button[data-id='water']")).to_have_attribute("aria-pressed", "true")
     # eta_i typed: checked against the material's domain, nothing changes when refused.
     page.fill("#eta-typed", "2.7")
     page.press("#eta-typed", "Enter")
@@ -85,8 +88,10 @@ def test_presets_and_typed_entry(pages, editor_url):
     page.fill("#eta-typed", "1.8")
     page.press("#eta-typed", "Enter")
     expect(page.locator("#plot")).to_have_attribute("data-eta", "1.80")
-    expect(page.locator("#coat-preset")).to_have_value("")
-    page.select_option("#coat-preset", "glass")
+    expect(page.locator("#coat-presets button[aria-pressed=true]")).to_have_count(0)
+    # Two presets share 1.5: the one pressed stays pressed.
+    page.click("#coat-presets button[data-id='polyurethane']")
+    expect(page.locator("#coat-presets button[aria-pressed=true]")).to_have_attribute("data-id", "polyurethane")
     expect(page.locator("#plot")).to_have_attribute("data-eta", "1.50")
     settled(page)
     # The selected point's value typed: a refit as for a drag, one undo step.
@@ -203,3 +208,32 @@ def test_compare_a_fit_with_its_edit_and_two_metals(pages, editor_url):
     expect(page.locator("#compare-box")).to_be_hidden()
     expect(page.locator("#plot path.compare")).to_have_count(0)
     expect(page.locator("#compare-readout")).to_be_hidden()
+
+
+# The Split menu: its longest choice within the room for text; every preset button within the panel.
+MENU_FITS = """(id) => {
+    const menu = document.getElementById(id);
+    const style = getComputedStyle(menu);
+    const context = document.createElement('canvas').getContext('2d');
+    context.font = style.font;
+    const widest = Math.max(...[...menu.options].map((o) => context.measureText(o.textContent).width));
+    // The room for text: the box less its padding and the arrow (20 px in Chromium).
+    const room = menu.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight) - 20;
+    const panel = menu.closest('.panel').getBoundingClientRect(), box = menu.getBoundingClientRect();
+    return {widest, room, inside: box.left >= panel.left - 0.5 && box.right <= panel.right + 0.5};
+}"""
+
+
+@pytest.mark.parametrize("width", [1400, 1024, 880, 800, 390])
+def test_split_menu_and_presets_are_never_cut_off(pages, editor_url, width):
+    page = pages.new(width, 900)
+    open_editor(page, editor_url)
+    settled(page)
+    fits = page.evaluate(MENU_FITS, "compare")
+    assert fits["inside"] and fits["widest"] <= fits["room"], (width, fits)
+    page.wait_for_function("document.querySelectorAll('#coat-presets button').length === 8")
+    cut = page.eval_on_selector_all("#coat-presets button", """els => els.filter((e) => {
+        const panel = e.closest('.panel').getBoundingClientRect(), box = e.getBoundingClientRect();
+        return e.scrollWidth > e.clientWidth || box.left < panel.left || box.right > panel.right;
+    }).map((e) => e.textContent)""")
+    assert not cut, (width, cut)
