@@ -57,8 +57,36 @@ export async function postForm(path, form) {
   return answer(await fetch(API + path, { method: "POST", headers: headers(), body: form }));
 }
 
-export const listMaterials = () => getJSON("/materials");
+// kinds: "library", "curves" (saved edits), "nk" (uploads); the service's default is library and curves.
+export function listMaterials({ kinds = null, deleted = false } = {}) {
+  const query = new URLSearchParams();
+  for (const kind of kinds || []) query.append("kind", kind);
+  if (deleted) query.set("deleted", "true");
+  const text = query.toString();
+  return getJSON(`/materials${text ? `?${text}` : ""}`);
+}
 export const getMaterial = (id) => getJSON(`/materials/${encodeURIComponent(id)}`);
+export const getFit = (id) => getJSON(`/fits/${encodeURIComponent(id)}`);
+export const fitEdit = (id) => getJSON(`/fits/${encodeURIComponent(id)}/edit`);
+export const versions = (id) => getJSON(`/materials/${encodeURIComponent(id)}/versions?limit=50`);
+export const version = (id, n) => getJSON(`/materials/${encodeURIComponent(id)}/versions/${Number(n)}`);
+export const library = (etaI) => getJSON(`/library?eta_i=${etaI.toFixed(2)}`);
+export const coatPresets = () => getJSON("/coat-presets");
+export const domain = () => getJSON("/domain");
+
+async function send(method, path, body = null) {
+  const init = { method, headers: headers({ Accept: "application/json" }) };
+  if (body !== null) {
+    init.headers["Content-Type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  return answer(await fetch(API + path, init));
+}
+
+// The writes on a saved material (each with the token when one is set: send() adds it).
+export const renameMaterial = (id, name) => send("PATCH", `/materials/${encodeURIComponent(id)}`, { name });
+export const deleteMaterial = (id) => send("DELETE", `/materials/${encodeURIComponent(id)}`);
+export const restoreMaterial = (id) => send("POST", `/materials/${encodeURIComponent(id)}/restore`);
 export const fitLibrary = (name, etaRange) => postJSON("/fits", { material: name, eta_i_range: etaRange });
 // With `curvesAt` ({ etaI, samples }), the answer also holds the fit's curves
 // there (`curves`, as curves() gives): one round trip per refit.

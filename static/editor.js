@@ -12,7 +12,7 @@
 
 import * as api from "./api.js";
 import { modelKind } from "./kinds.js";
-import { bindPageInputs } from "./editor/inputs.js";
+import { bindPageInputs, mayDiscard } from "./editor/inputs.js";
 import { fitOf, FIRST, loadMaterials, prefetch, recall, remember, savedVersion } from "./editor/materials.js";
 import { Messages } from "./editor/messages.js";
 import { PlotView } from "./editor/plot_view.js";
@@ -20,6 +20,7 @@ import { PreviewView } from "./editor/preview_view.js";
 import { Readout } from "./editor/readout.js";
 import { RefitPipeline, refitBody } from "./editor/refit.js";
 import { Continuing, save as saveEdit } from "./editor/save.js";
+import { linkOf, Studio } from "./editor/studio.js";
 import { createStore, fitted, key, liveStart, SAMPLES, snapshot, unsaved } from "./editor/state.js";
 
 const $ = (id) => document.getElementById(id);
@@ -88,7 +89,7 @@ const save = () => saveEdit({
   refitFirst: () => { requestRefit(); return whenFitted(); },
   failed: () => pipeline.failed,
   async refresh(value) {
-    const materials = await loadMaterials($("material"), value);
+    const [materials] = await Promise.all([loadMaterials($("material"), value), studio.refresh()]);
     remember(value);
     return materials;
   },
@@ -111,6 +112,7 @@ const plotView = new PlotView({
     store.dispatch("dragEnd");
     requestRefit();
   },
+  onSelect: (point) => store.dispatch("select", point),
   onEta: setEta,
   onUndo: guard(() => history("undo")),
   onRedo: guard(() => history("redo")),
@@ -129,6 +131,23 @@ const readout = new Readout({
                            coatRoughness: Number($("coat-roughness").value) }),
 });
 for (const id of ["roughness", "coat-roughness"]) $(id).addEventListener("input", () => readout.showDownload());
+// The library, presets and typed entry, the materials an artist manages, compare mode (studio.js).
+const studio = new Studio({
+  store, say, guard, report: (...args) => messages.report(...args), busy: (text, work) => messages.busy(text, work),
+  setBase, present, setEta, continuing, previewView, plotView, downloadFormat: () => $("format").value,
+  edit(point) { // a typed value: as a drag released, one undo step and a refit
+    if (store.dispatch("drag", point)) store.dispatch("dragEnd");
+    requestRefit();
+  },
+  mayDiscard: () => mayDiscard(unsaved(state)),
+  open: async (value, ask = true) => (!ask || mayDiscard(unsaved(state))) && openValue(value),
+  picked(value) {
+    page.picked = $("material").value = value;
+    remember(value);
+  },
+  reloadPicker: (value = page.picked) => loadMaterials($("material"), value),
+  sayUpload: (text, ok) => messages.sayUpload(text, ok),
+});
 
 // The views follow the state: the plot and the saved line after every change of it.
 const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved"]);
@@ -184,6 +203,12 @@ async function pickMaterial(value, pending = null) {
   await messages.busy("Fitting the material…", async () => setBase(await (pending || fitOf(value))));
 }
 
+// Open a picker value (library:Au, saved:<id>) and remember it.
+async function openValue(value) {
+  await pickMaterial(value);
+  studio.app.picked(value);
+}
+
 // ---------------------------------------------------------------- eta_i
 
 // The curves at the current eta_i: the base's (reference, Lazanyi) and the shown fit's model.
@@ -226,30 +251,16 @@ async function gentler() {
   requestRefit();
 }
 
-async function upload(file) {
-  await messages.busy("Fitting the uploaded n, k…", async () => {
-    const fit = await api.uploadNK(file, $("upload-name").value.trim());
-    await loadMaterials($("material"), `saved:${fit.material_id}`);
-    remember(`saved:${fit.material_id}`);
-    await setBase(fit);
-    messages.sayUpload(`Fitted “${fit.name}” from ${file.name}; saved under that name.`, true);
-  });
-}
-
 // ---------------------------------------------------------------- page inputs
 
 bindPageInputs({
   unsaved: () => unsaved(state),
   picked: () => page.picked,
-  onPick: guard(async (value) => {
-    await pickMaterial(value);
-    page.picked = value;
-    remember(value);
-  }),
+  onPick: guard(openValue),
   onUpload(file) {
     messages.sayUpload("");
-    upload(file).catch((error) => {
-      if (error.status === 401) messages.report(error, () => upload(file));
+    studio.upload(file).catch((error) => {
+      if (error.status === 401) messages.report(error, () => studio.upload(file));
       else messages.sayUpload(`Not uploaded: ${error.message}`);
     });
   },
@@ -260,8 +271,9 @@ bindPageInputs({
 // Cold start: the material list, the first fit and the preview's shaders
 // load at the same time.
 guard(async () => {
+  const link = linkOf(location.search); // a link opens what it names, else the material open last
   const wanted = recall() || FIRST;
-  const first = fitOf(wanted);
+  const first = link ? Promise.reject(new Error("a link")) : fitOf(wanted);
   // Its curves and reference texture are asked for as soon as it is known, while the shaders compile.
   first.then((fit) => page.prefetched.set(fit.id, prefetch(fit, state.eta, SAMPLES)), () => {});
   const picker = $("material");
@@ -271,7 +283,7 @@ guard(async () => {
   if (!found) picker.value = FIRST; // the remembered material is gone
   const ball = await previewView.ready;
   if (ball) ball.set({ eta: state.eta });
-  await pickMaterial(picker.value, found ? first : null);
   page.picked = picker.value;
+  await (link ? studio.openLink(link) : pickMaterial(picker.value, found ? first : null));
   document.body.dataset.ready = "true";
 })();

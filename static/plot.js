@@ -7,6 +7,8 @@ const M = { left: 48, right: 14, top: 12, bottom: 36 };
 // CSS px at one unit a pixel, scaled up beyond): axis text of 11 units stays
 // 11 px or more on a phone, and a handle's hit area is at least 24 px.
 const W_MIN = 320, W_MAX = 640;
+// Arrow-key presses on a point within this long of each other are one edit (one undo step).
+export const KEY_BURST_MS = 700;
 const sizeFor = (px) => {
   const width = Math.round(Math.min(W_MAX, Math.max(W_MIN, px || W_MAX)));
   return { width, height: Math.round(Math.max(260, 0.625 * width)) };
@@ -24,7 +26,8 @@ export class ReflectancePlot {
   /**
    * @param {HTMLElement} container
    * @param {object} hooks  onDrag(channel, handleIndex, value, pointer) -> whether the point moved
-   *   (pointer: true while a pointer drags it, false for a key press), onDragEnd()
+   *   (pointer: true while a pointer drags it, false for a key press), onDragEnd() (the drag, or
+   *   a burst of key presses, ended), onSelect(channel, handleIndex) (a point took the focus)
    */
   constructor(container, hooks) {
     this.hooks = hooks;
@@ -38,11 +41,11 @@ export class ReflectancePlot {
     this.yMin = 0;
     this.yMax = 1;
     this.layers = {};
-    for (const name of ["grid", "axis", "critical", "lazanyi", "reference", "target", "model", "handles"]) {
+    for (const name of ["grid", "axis", "critical", "lazanyi", "reference", "target", "compare", "model", "handles"]) {
       this.layers[name] = el("g", { class: name }, this.svg);
     }
     this.dragging = null;
-    this.keyMoved = false; // a key press moved a point since the last refit
+    this.keyBurst = null; // the timer that ends a burst of key presses (one undo step)
     this.svg.addEventListener("pointermove", (event) => this.#move(event));
     this.svg.addEventListener("pointerup", () => this.#release());
     this.svg.addEventListener("pointercancel", () => this.#release());
@@ -96,13 +99,13 @@ export class ReflectancePlot {
   }
 
   /**
-   * Draw everything. `data`: theta (n), reference, target, model, lazanyi
-   * (each n x 3 or null), handles: angles of the control points, channel:
+   * Draw everything. `data`: theta (n), reference, target, model, lazanyi,
+   * compare (compare mode's other fit; each n x 3 or null), handles: angles of the control points, channel:
    * 0, 1, 2 or "all" (which handles take the pointer).
    */
   draw(data) {
     this.data = data;
-    const all = [data.reference, data.target, data.model, data.lazanyi].filter(Boolean).flat(2);
+    const all = [data.reference, data.target, data.model, data.lazanyi, data.compare].filter(Boolean).flat(2);
     // The grazing end is 1 for every curve; the interesting part is the dip.
     // The scale stays put during a drag so that the point stays under the pointer.
     if (!this.dragging) this.yMin = Math.max(0, Math.floor((Math.min(...all) - 0.05) * 10) / 10);
@@ -116,7 +119,7 @@ export class ReflectancePlot {
       el("line", { x1: x, x2: x, y1: M.top, y2: this.H - M.bottom }, critical);
       el("text", { x: x + 4, y: M.top + 12 }, critical).textContent = `max from air ${data.criticalDeg.toFixed(1)}°`;
     }
-    for (const name of ["lazanyi", "reference", "target", "model"]) {
+    for (const name of ["lazanyi", "reference", "target", "compare", "model"]) {
       this.layers[name].replaceChildren();
       if (data[name]) this.#path(this.layers[name], data.theta, data[name], name);
     }
@@ -167,11 +170,8 @@ export class ReflectancePlot {
           this.dragging = { channel: c, handle: h, moved: false };
         });
         circle.addEventListener("keydown", (event) => this.#key(event, c, h));
-        circle.addEventListener("keyup", (event) => {
-          if (!["ArrowUp", "ArrowDown", "PageUp", "PageDown"].includes(event.key) || !this.keyMoved) return;
-          this.keyMoved = false;
-          this.hooks.onDragEnd();
-        });
+        circle.addEventListener("focus", () => this.hooks.onSelect && this.hooks.onSelect(c, h));
+        circle.addEventListener("blur", () => this.endKeyBurst());
       }
     });
   }
@@ -183,7 +183,18 @@ export class ReflectancePlot {
     if (!(event.key in steps)) return;
     event.preventDefault();
     const step = steps[event.key] * (event.shiftKey ? 5 : 1);
-    if (this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)), false)) this.keyMoved = true;
+    if (!this.hooks.onDrag(c, h, Math.min(1, Math.max(0, current + step)), false)) return;
+    // Presses in quick succession are one edit: it ends KEY_BURST_MS after the last (or when the point loses the focus).
+    clearTimeout(this.keyBurst);
+    this.keyBurst = setTimeout(() => this.endKeyBurst(), KEY_BURST_MS);
+  }
+
+  /** End a burst of key presses now (one undo step for it); nothing when none is under way. */
+  endKeyBurst() {
+    if (this.keyBurst === null) return;
+    clearTimeout(this.keyBurst);
+    this.keyBurst = null;
+    this.hooks.onDragEnd();
   }
 
   #move(event) {

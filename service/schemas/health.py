@@ -48,3 +48,7 @@ class Domain(BaseModel):
                                      description="Samples per edited curve, [min, max]")
     max_curves: int
     max_nk_samples: int
+    visible_range_nm: list[float] = Field(min_length=2, max_length=2,
+                                          description="The range the colour integrates over, nm")
+    min_coverage: float = Field(description="The least fraction of `visible_range_nm` an n, k must cover "
+                                            "(an upload's `min_coverage` may ask for more)")

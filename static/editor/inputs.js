@@ -7,10 +7,13 @@
 
 const $ = (id) => document.getElementById(id);
 
+/** Whether the page may leave the material open: no unsaved edits (`dirty` false), or the artist says so. */
+export const mayDiscard = (dirty) => !dirty || window.confirm("Discard the unsaved edits of this material?");
+
 export function bindPageInputs(hooks) {
   $("material").addEventListener("change", (event) => {
     const value = event.target.value;
-    if (hooks.unsaved() && !window.confirm("Discard the unsaved edits of this material?")) {
+    if (!mayDiscard(hooks.unsaved())) {
       event.target.value = hooks.picked();
       return;
     }

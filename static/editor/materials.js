@@ -7,12 +7,15 @@ import * as api from "../api.js";
 export const LAST_KEY = "coated-editor-material"; // localStorage: the material open last
 export const FIRST = "library:Au";
 
-/** Fill `picker` with the material list (Library, Saved), `select` chosen. */
+// The picker's groups by kind: the library, the artist's saved edits, uploads (n, k fits) apart.
+const GROUPS = { library: "Library", curves: "Saved", nk: "Uploads (n, k)" };
+
+/** Fill `picker` with the material list (Library, Saved, Uploads), `select` chosen. */
 export async function loadMaterials(picker, select = null) {
-  const { materials } = await api.listMaterials();
+  const { materials } = await api.listMaterials({ kinds: Object.keys(GROUPS) });
   picker.replaceChildren();
   const nodes = {};
-  for (const [group, label] of Object.entries({ library: "Library", saved: "Saved" })) {
+  for (const [group, label] of Object.entries(GROUPS)) {
     nodes[group] = document.createElement("optgroup");
     nodes[group].label = label;
     picker.appendChild(nodes[group]);
@@ -23,9 +26,9 @@ export async function loadMaterials(picker, select = null) {
     option.value = saved ? `saved:${m.id}` : `library:${m.id}`;
     option.textContent = saved ? `${m.name} (${m.kind === "curves" ? "edited" : "n, k"})` : m.name;
     option.dataset.source = m.source || "";
-    nodes[saved ? "saved" : "library"].appendChild(option);
+    nodes[m.kind].appendChild(option);
   }
-  if (!nodes.saved.children.length) nodes.saved.remove();
+  for (const node of Object.values(nodes)) if (!node.children.length) node.remove();
   if (select) picker.value = select;
   return materials;
 }

@@ -4,7 +4,8 @@
 // the channel to drag; Undo, Redo, Reset and Save's enabled states.
 // Renders from the state (render(state)); its inputs call `hooks`:
 //   onDrag({channel, handle, value, pointer, all}) -> whether the point moved,
-//   onDragEnd(), onEta(eta), onUndo(), onRedo(), onReset(), onSave().
+//   onDragEnd(), onSelect({channel, handle}), onEta(eta), onUndo(), onRedo(), onReset(), onSave().
+// In compare mode the other fit's curve at eta_i is drawn too (state.compare).
 
 import { ReflectancePlot } from "../plot.js";
 import { HANDLES, key, target } from "./state.js";
@@ -21,6 +22,7 @@ export class PlotView {
       onDrag: (c, handle, value, pointer = false) =>
         hooks.onDrag({ channel: c, handle, value, pointer, all: channel() === "all" }),
       onDragEnd: () => hooks.onDragEnd(),
+      onSelect: (c, handle) => hooks.onSelect({ channel: c, handle }),
     });
     $("eta").addEventListener("input", (event) => hooks.onEta(Number(event.target.value)));
     const again = () => this.state && this.render(this.state);
@@ -61,6 +63,7 @@ export class PlotView {
       target: target(state),
       model: state.model,
       lazanyi: $("show-lazanyi").checked ? state.baseCurves.lazanyi_adjusted : null,
+      compare: state.compare && state.compare.eta === key(state.eta) ? state.compare.model : null,
       handles: HANDLES,
       criticalDeg: state.eta > 1 ? (Math.asin(1 / state.eta) * 180) / Math.PI : null,
       channel: channel(),

@@ -24,7 +24,11 @@ export class PreviewView {
     this.ready = ShaderBall.create($("preview"), $("preview-labels"), $("preview-lighting")).then((ball) => {
       this.ball = ball;
       window.cfPreview = ball; // for the parity tests and benchmarks
-      ball.onFrame = (drawn) => hooks.onFrame && hooks.onFrame(drawn);
+      ball.onFrame = (drawn) => {
+        if (hooks.onFrame) hooks.onFrame(drawn);
+        const other = this.otherBall;
+        if (other && String(other.state.orbit) !== String(drawn.orbit)) this.#follow();
+      };
       this.settings();
       return ball;
     }).catch((error) => {
@@ -52,17 +56,19 @@ export class PreviewView {
       coatRoughness: Number($("coat-roughness").value),
     });
     this.#panels();
+    this.#follow();
   }
 
   #panels() {
+    // While comparing, each ball shows its model alone (the Split menu waits).
+    $("compare").disabled = !this.hasReference || Boolean(this.comparing);
     if (!this.ball) return;
-    this.ball.set({ panels: SPLITS[this.hasReference ? $("compare").value : "none"] });
+    this.ball.set({ panels: SPLITS[this.hasReference && !this.comparing ? $("compare").value : "none"] });
   }
 
   /** A new base: whether it has a spectral reference (measured n, k) to compare with. */
   showBase(base) {
     this.hasReference = Boolean(base.has_nk);
-    $("compare").disabled = !base.has_nk;
     this.#panels();
   }
 
@@ -74,10 +80,42 @@ export class PreviewView {
 
   setEta(eta) {
     if (this.ball) this.ball.set({ eta });
+    this.#follow();
   }
 
   /** The fit on screen, drawn at once. */
   showFit(fit) {
     if (this.ball) this.ball.setFit(fit);
+  }
+
+  /**
+   * Compare mode: `fit` drawn by a second ball beside the first (same
+   * settings, eta_i and orbit; the model alone on both), or null to end it.
+   * The second ball is made on first use.
+   */
+  async compare(fit) {
+    this.comparing = fit;
+    $("compare-box").hidden = !fit;
+    this.#panels();
+    if (!fit || !this.ball) return;
+    if (!this.other) {
+      this.other = ShaderBall.create($("preview-compare"), $("preview-compare-labels"));
+      window.cfPreviewCompare = this.other; // for the tests
+    }
+    const other = await this.other;
+    this.otherBall = other;
+    if (this.comparing !== fit) return;
+    other.setFit(fit);
+    this.#follow();
+  }
+
+  // The second ball takes the first one's settings (the orbit too) when comparing.
+  #follow() {
+    if (!this.comparing || !this.other) return;
+    this.other.then((other) => {
+      const s = this.ball.state;
+      other.set({ eta: s.eta, environment: s.environment, exposure: s.exposure, roughness: s.roughness,
+                  coated: s.coated, coatRoughness: s.coatRoughness, orbit: s.orbit, panels: [PANEL.model] });
+    });
   }
 }

@@ -59,7 +59,17 @@ export class Readout {
     download.setAttribute("aria-disabled", "false");
     download.setAttribute("download", "");
     this.#reach(figures.reach);
+    this.#clearErrorMap(fit);
     this.scheduleErrorMap();
+  }
+
+  // A new fit: the previous fit's map goes at once (it never stands for this one), until this one's is in.
+  #clearErrorMap(fit) {
+    const canvas = $("heatmap");
+    if (canvas.dataset.fit === fit.id) return;
+    canvas.getContext("2d").clearRect(0, 0, canvas.width, canvas.height);
+    canvas.dataset.fit = "";
+    $("heatmap-caption").textContent = "Measuring this fit's differences…";
   }
 
   #reach(reach) {

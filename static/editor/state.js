@@ -29,6 +29,13 @@ export function initialState() {
     theta: [],        // the angles of the curves (degrees)
     baseCurves: null, // the base's curves at `eta` (reference, Lazanyi, model)
     model: null,      // the fit on screen's curve at `eta`
+    selected: null,   // the control point typed entry changes: {channel, handle}
+    compare: null,    // compare mode: {fit, label, model: its curve at `eta` (or null while it loads)}
+    library: { eta: null, materials: [] }, // GET /library at an eta_i: names, sources, swatches
+    saved: [],        // the artist's saved edited materials (kind curves)
+    bin: [],          // the saved materials in the bin
+    versions: null,   // the versions listed: {material: {id, name}, list: newest first}
+    presets: [],      // coat presets ({id, name, eta_i, source})
   };
 }
 
@@ -57,6 +64,28 @@ export function target(s) {
 export const liveStart = (s) => (s.pointerDrag ? (s.fit || s.base).id : null);
 
 const clamp01 = (v) => Math.min(1, Math.max(0, v));
+
+/**
+ * The edits of a stored curve fit's request (GET /fits/{id}/edit:
+ * `request.curves`, each {eta_i, angle_deg | cos_theta, rgb}) at the
+ * editor's angles `theta` (degrees): each curve interpolated linearly in
+ * angle (held flat past its ends), keyed by key(eta_i).
+ */
+export function editsOf(curves, theta) {
+  const edits = {};
+  for (const curve of curves) {
+    const angles = curve.angle_deg || curve.cos_theta.map((mu) => (Math.acos(Math.min(1, Math.max(-1, mu))) * 180) / Math.PI);
+    const order = angles.map((a, i) => [a, curve.rgb[i]]).sort((p, q) => p[0] - q[0]);
+    edits[key(curve.eta_i)] = theta.map((t) => {
+      let j = 0;
+      while (j < order.length - 2 && order[j + 1][0] < t) j++;
+      const [a0, c0] = order[j], [a1, c1] = order[Math.min(j + 1, order.length - 1)];
+      const f = a1 > a0 ? Math.min(1, Math.max(0, (t - a0) / (a1 - a0))) : 0;
+      return [0, 1, 2].map((c) => clamp01(c0[c] + f * (c1[c] - c0[c])));
+    });
+  }
+  return edits;
+}
 
 /**
  * The curve `current` (rows of rgb at angles `theta`) with the point at
@@ -92,6 +121,11 @@ export function bump(current, theta, handleDeg, channel, value, all = false) {
 function remember(s, before) {
   s.undo.push(before);
   s.redo = [];
+}
+
+// A drag or burst of key presses still under way is one undo step before anything else changes the history.
+function settleDrag(s) {
+  if (s.dragStart !== null) ACTIONS.dragEnd(s);
 }
 
 /** The named actions: (state, payload) -> a result (most: whether anything changed). */
@@ -138,12 +172,14 @@ export const ACTIONS = {
     return true;
   },
   undo(s) {
+    settleDrag(s);
     if (!s.undo.length) return false;
     s.redo.push(snapshot(s));
     s.edits = JSON.parse(s.undo.pop());
     return true;
   },
   redo(s) {
+    settleDrag(s);
     if (!s.redo.length) return false;
     s.undo.push(snapshot(s));
     s.edits = JSON.parse(s.redo.pop());
@@ -151,12 +187,14 @@ export const ACTIONS = {
   },
   /** Back to no edits (undoable). */
   reset(s) {
+    settleDrag(s);
     remember(s, snapshot(s));
     s.edits = {};
     return true;
   },
   /** Every edit halfway back to `starts[eta]`, the curve it started from (undoable). */
   gentler(s, starts) {
+    settleDrag(s);
     remember(s, snapshot(s));
     for (const [eta, start] of Object.entries(starts)) {
       s.edits[eta] = s.edits[eta].map((rgb, j) => rgb.map((v, c) => clamp01(start[j][c] + 0.5 * (v - start[j][c]))));
@@ -172,6 +210,50 @@ export const ACTIONS = {
   },
   saved(s, fitId) {
     s.savedId = fitId;
+    return true;
+  },
+  /** A stored edit reopened (after openBase of its base): its edits, no history; `fitId` is saved. */
+  reopened(s, { edits, fitId }) {
+    Object.assign(s, { edits, undo: [], redo: [], dragStart: null, pointerDrag: false, savedId: fitId });
+    return true;
+  },
+  /** The control point typed entry changes ({channel, handle: index into HANDLES}). */
+  select(s, { channel, handle }) {
+    s.selected = { channel, handle };
+    return true;
+  },
+  /** Compare mode: `fit` beside the fit on screen (its curve at eta_i follows with compareCurves). */
+  compareWith(s, { fit, label }) {
+    s.compare = { fit, label, model: null, eta: null };
+    return true;
+  },
+  /** The compared fit's curve at `eta` (dropped if compare mode changed or ended meanwhile). */
+  compareCurves(s, { fitId, eta, model }) {
+    if (!s.compare || s.compare.fit.id !== fitId) return false;
+    Object.assign(s.compare, { model, eta: key(eta) });
+    return true;
+  },
+  compareOff(s) {
+    s.compare = null;
+    return true;
+  },
+  /** The library at an eta_i (GET /library: entries with names, sources, ranges, swatches). */
+  library(s, { eta, materials }) {
+    s.library = { eta: key(eta), materials };
+    return true;
+  },
+  /** The saved edited materials and the bin. */
+  materials(s, { saved, bin }) {
+    Object.assign(s, { saved, bin });
+    return true;
+  },
+  /** A material's versions ({material: {id, name}, list}), or null to close the list. */
+  versions(s, listed) {
+    s.versions = listed;
+    return true;
+  },
+  presets(s, presets) {
+    s.presets = presets;
     return true;
   },
 };

@@ -11,6 +11,7 @@ import pytest
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg
+from fitting.domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM
 from fitting.fits.kinds import evaluate_model, fit_model
 from fitting.fits.material import fit_material
 from fitting.models.coated_conductor import coated_conductor_model
@@ -68,6 +69,11 @@ class TestHealthAndDocs:
         assert nk["k"]["items"]["minimum"] == 0.0
         assert set(request["material"]["anyOf"][0]["enum"]) == set(LIBRARY_NAMES)
         assert client.get("/docs").status_code == 200
+
+    def test_domain_states_the_upload_coverage_rule(self, client):
+        domain = client.get(f"{API}/domain").json()
+        assert domain["visible_range_nm"] == list(VISIBLE_RANGE_NM)
+        assert domain["min_coverage"] == DEFAULT_MIN_COVERAGE
 
 
 class TestMaterials:

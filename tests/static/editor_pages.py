@@ -98,6 +98,16 @@ def settled(page):
     return page.inner_text("#fit-id")
 
 
+def key_edit(page, channel=1, angle=36, key="Shift+ArrowUp"):
+    """Move a control point by one key press; wait for its refit on screen. The refit's id."""
+    before = page.inner_text("#fit-id")
+    page.locator(f"input[name=channel][value='{channel}']").check()
+    page.locator(f"circle.handle.c{channel}[data-angle='{angle}']").focus()
+    page.keyboard.press(key)
+    page.wait_for_function(f"document.getElementById('fit-id').textContent !== '{before}'")
+    return settled(page)
+
+
 def open_editor(page, url):
     page.goto(url)
     page.wait_for_selector("body[data-ready=true]")

@@ -13,7 +13,7 @@ import json
 import re
 
 import pytest
-from editor_pages import editor_url, open_editor, pages, chromium, live_server, settled  # noqa: F401 (fixtures: one server and one Chromium a module)
+from editor_pages import editor_url, key_edit, open_editor, pages, chromium, live_server, settled  # noqa: F401 (fixtures: one server and one Chromium a module)
 from playwright.sync_api import expect
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
@@ -22,15 +22,6 @@ pytestmark = [pytest.mark.server, pytest.mark.browser]
 def set_range(page, selector, value):
     page.eval_on_selector(selector, "(el, v) => { el.value = v; el.dispatchEvent(new Event('input', {bubbles: true})); }",
                           str(value))
-
-
-def key_edit(page, channel=1, angle=36, key="Shift+ArrowUp"):
-    before = page.inner_text("#fit-id")
-    page.locator(f"input[name=channel][value='{channel}']").check()
-    page.locator(f"circle.handle.c{channel}[data-angle='{angle}']").focus()
-    page.keyboard.press(key)
-    page.wait_for_function(f"document.getElementById('fit-id').textContent !== '{before}'")
-    return settled(page)
 
 
 # What each format's file is called and what its content must hold.

@@ -17,6 +17,7 @@ from concurrent.futures import ThreadPoolExecutor
 from fastapi import APIRouter, status
 
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
+from fitting.domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM
 from fitting.fits.settings import OBJECTIVES
 from fitting.optics.library import LIBRARY_NAMES
 
@@ -62,7 +63,7 @@ DOMAIN = Domain(
     eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE), objectives=list(OBJECTIVES),
     default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES), pack_formats=list(PACK_FORMATS),
     curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
-    max_nk_samples=MAX_NK_SAMPLES,
+    max_nk_samples=MAX_NK_SAMPLES, visible_range_nm=list(VISIBLE_RANGE_NM), min_coverage=DEFAULT_MIN_COVERAGE,
 )
 
 

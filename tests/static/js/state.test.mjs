@@ -8,7 +8,7 @@ import { test } from "node:test";
 
 import { readFigures, REACH_DE } from "../../../static/editor/figures.js";
 import {
-  HANDLES, SAMPLES, bump, createStore, fitted, key, liveStart, snapshot, target, unsaved,
+  HANDLES, SAMPLES, bump, createStore, editsOf, fitted, key, liveStart, snapshot, target, unsaved,
 } from "../../../static/editor/state.js";
 import { halfBits, modelKind, packedWords, rgbConductorWords } from "../../../static/kinds.js";
 
@@ -155,4 +155,49 @@ test("kinds: the words a renderer uploads, per kind; unknown kinds refused by na
   assert.equal(modelKind({ coefficients: C, degree: 1, eta_i_range: [1, 2] }).name, "coated-conductor");
   assert.throws(() => modelKind({ model: "schlick", coefficients: {} }), /`model`.*"schlick"/);
   assert.throws(() => modelKind({ model: "rgb-conductor", coefficients: { n: [1, 1], k: [0, 0, 0] } }), /coefficients\.n/);
+});
+
+test("a burst of key presses (drags with no dragEnd yet) is one undo step, even when undo comes first", () => {
+  const store = opened();
+  const s = store.state;
+  for (const value of [0.52, 0.54, 0.56]) store.dispatch("drag", { channel: 0, handle: 3, value });
+  assert.equal(s.undo.length, 0, "the burst is under way");
+  assert.equal(store.dispatch("undo"), true, "undo ends the burst, then takes it back whole");
+  assert.deepEqual(s.edits, {});
+  assert.equal(s.undo.length, 0);
+  assert.equal(s.redo.length, 1);
+  assert.equal(s.dragStart, null);
+});
+
+test("editsOf: a stored request's curves at the editor's angles, by eta_i key", () => {
+  const curve = { eta_i: 1.333, angle_deg: [0, 45, 90], rgb: [[0.2, 0.4, 0.6], [0.4, 0.6, 0.8], [1, 1, 1]] };
+  const edits = editsOf([curve], THETA);
+  assert.deepEqual(Object.keys(edits), ["1.33"]);
+  const at = (deg) => edits["1.33"][THETA.indexOf(deg)];
+  assert.deepEqual(at(0), [0.2, 0.4, 0.6]);
+  assert.deepEqual(at(90), [1, 1, 1]);
+  at(22).forEach((v, c) => assert.ok(Math.abs(v - (curve.rgb[0][c] + (22 / 45) * 0.2)) < 1e-12));
+  // The editor's own angles come back exactly; cos theta is read as an angle.
+  const same = editsOf([{ eta_i: 1.5, angle_deg: THETA, rgb: flat(0.3) }], THETA);
+  assert.deepEqual(same["1.50"], flat(0.3));
+  const byCos = editsOf([{ eta_i: 2, cos_theta: [1, 0], rgb: [[0, 0, 0], [1, 1, 1]] }], THETA);
+  assert.ok(Math.abs(byCos["2.00"][THETA.indexOf(60)][1] - 60 / 90) < 1e-12);
+});
+
+test("reopened: the stored edits with no history, the fit saved; compare curves of another fit are dropped", () => {
+  const store = opened();
+  const s = store.state;
+  store.dispatch("drag", { channel: 1, handle: 2, value: 0.7 });
+  store.dispatch("dragEnd");
+  store.dispatch("reopened", { edits: { "1.50": flat(0.6) }, fitId: "saved-fit" });
+  assert.deepEqual([s.undo, s.redo, s.savedId], [[], [], "saved-fit"]);
+  store.dispatch("shown", { fit: { id: "saved-fit" }, edits: snapshot(s) });
+  assert.equal(unsaved(s), false);
+  store.dispatch("compareWith", { fit: { id: "cu" }, label: "Cu" });
+  assert.equal(store.dispatch("compareCurves", { fitId: "ag", eta: 1.5, model: flat(0.9) }), false);
+  assert.equal(s.compare.model, null);
+  assert.equal(store.dispatch("compareCurves", { fitId: "cu", eta: 1.5, model: flat(0.5) }), true);
+  assert.equal(s.compare.eta, "1.50");
+  store.dispatch("compareOff");
+  assert.equal(s.compare, null);
 });
