@@ -270,13 +270,21 @@ def pytest_runtest_protocol(item, nextitem):
     _started.clear()
     _old_threads.clear()
     _old_threads.update(t.ident for t in threading.enumerate() if t is not threading.main_thread())
-    item.stash[_DURATION] = 0.0
     yield
-    if item.get_closest_marker("slow") is None and item.stash[_DURATION] > SLOW_S:
-        _unmarked_slow.append((item.stash[_DURATION], item.nodeid))
 
 
-_DURATION = pytest.StashKey[float]()
+_durations: dict[str, float] = {}
+
+
+def pytest_runtest_logreport(report):
+    """The tests not marked slow that took over SLOW_S (here, and in the controller under xdist)."""
+    _durations[report.nodeid] = _durations.get(report.nodeid, 0.0) + report.duration
+    if report.when == "teardown":
+        seconds = _durations.pop(report.nodeid, 0.0)
+        if "slow" not in report.keywords and seconds > SLOW_S:
+            _unmarked_slow.append((seconds, report.nodeid))
+
+
 _STARTED = pytest.StashKey[list]()
 
 
@@ -284,7 +292,6 @@ _STARTED = pytest.StashKey[list]()
 def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
-    item.stash[_DURATION] = item.stash.get(_DURATION, 0.0) + report.duration
     if call.when == "call":
         # What the test's set-up and call started; a teardown may end a
         # module's fixtures, whose processes belong to the tests that used them.

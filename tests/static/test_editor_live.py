@@ -51,6 +51,9 @@ def test_continuous_drag_refits_and_ends_on_the_shown_fit(pages, editor_url):
     page.on("response", lambda r: answered.append(r) if refit(r.url) else None)
 
     handle = page.locator("circle.handle.c0[data-angle='50']")
+    # The page had scrolled by 306 px between the radio's check and the drag (scrollY 65 -> 371, seen
+    # since the studio's panels joined the page; its cause not found yet): the handle is brought into view.
+    handle.scroll_into_view_if_needed()
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.mouse.move(x, y)
