@@ -13,22 +13,11 @@ import re
 
 import numpy as np
 import pytest
-from editor_pages import editor_url, open_editor, pages, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
+from editor_pages import editor_url, open_editor, pages, chromium, live_server, settled  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 
 FROM_CURVES = re.compile(r".*/api/v1/fits/from-curves(\?.*)?$")  # with or without its query
-
-
-def settled(page):
-    """No refit pending and the preview drawn for the fit on screen."""
-    page.wait_for_function(
-        "() => { const id = document.getElementById('fit-id').textContent;"
-        " return !document.body.hasAttribute('aria-busy')"
-        " && document.getElementById('preview-state').hidden"
-        " && document.getElementById('preview').dataset.fit === id; }"
-    )
-    return page.inner_text("#fit-id")
 
 
 def test_continuous_drag_refits_and_ends_on_the_shown_fit(pages, editor_url):
