@@ -42,6 +42,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "tests" / "static"))
 
+from benchmarks.record import write_result  # noqa: E402
 from conftest import server_process  # noqa: E402
 from editor_pages import CHROMIUM_ARGS  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
@@ -79,11 +80,43 @@ def _row(material, kind, env, eta_i, r, c, f) -> str:
     return "| " + " | ".join(cells) + " |"
 
 
+def _spread(fs: list[dict]) -> dict[str, float]:
+    """Mean of the settings' means, the worst setting's mean and the worst pixel."""
+    return {"mean": sum(f["mean"] for f in fs) / len(fs), "worst_mean": max(f["mean"] for f in fs),
+            "worst_max": max(f["max"] for f in fs), "settings": len(fs)}
+
+
+def figures(rows: list[tuple], environments: list[str]) -> dict:
+    """The recorded figures: per environment (both kinds and each kind) against the preview, lit in
+    Rec.709 where measured; under the white sky the twin, the physics per kind and the fallback."""
+    out: dict = {"settings": len(rows), "vs_preview": {}, "vs_preview_lit_rec709": {}}
+    for env in environments:
+        for label, kinds in [("all", KINDS), *((kind, (kind,)) for kind in KINDS)]:
+            of = [r[6] for r in rows if r[2] == env and r[1] in kinds]
+            if of:
+                out["vs_preview"].setdefault(env, {})[label] = _spread([f["preview"] for f in of])
+            lit = [f["preview_rec709"] for f in of if "preview_rec709" in f]
+            if lit:
+                out["vs_preview_lit_rec709"].setdefault(env, {})[label] = _spread(lit)
+    white = [r for r in rows if r[2] == "white_sky"]
+    if white:
+        twins = [r[6]["twin"] for r in white if r[6].get("twin")]
+        if twins:
+            out["twin"] = _spread(twins)
+        out["physics"] = {kind: _spread([r[6]["physics"] for r in white if r[1] == kind])
+                          for kind in KINDS if any(r[1] == kind for r in white)}
+        fallback = [r[6]["fallback"]["mean"] for r in white]
+        out["fallback"] = {"mean": sum(fallback) / len(fallback), "min": min(fallback), "max": max(fallback)}
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--materials", default="Au,Cu,Cr,Al", help="comma-separated library materials")
     parser.add_argument("--environments", default=",".join(ENVIRONMENTS), help="comma-separated preview environments")
     parser.add_argument("--record", default=str(RECORD), help="file for the table ('-': none)")
+    parser.add_argument("--result", default="three_parity",
+                        help="name of the figures' record, benchmarks/results/NAME.json ('-': none)")
     args = parser.parse_args()
     environments = args.environments.split(",")
     rows = []
@@ -146,6 +179,10 @@ def main() -> None:
             f"{table}\n"
         )
         print(f"recorded in {path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}", file=sys.stderr)
+    if args.result != "-":
+        path = write_result(args.result, figures(rows, environments), load, materials=args.materials.split(","),
+                            seconds=round(time.perf_counter() - started), three=three_version())
+        print(f"recorded in {path.relative_to(ROOT)}", file=sys.stderr)
 
 
 if __name__ == "__main__":
