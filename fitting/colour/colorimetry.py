@@ -40,6 +40,7 @@ __all__ = [
     "ACEScg_to_XYZ",
     "ACEScg_to_Lab",
     "ACEScg_to_Lab_jacobian",
+    "ACEScg_to_Lab_and_jacobian",
 ]
 
 ACES_WHITE_XY = np.array([0.32168, 0.33767])
@@ -181,6 +182,29 @@ def ACEScg_to_Lab(RGB) -> np.ndarray:
     a = 500.0 * (f[..., 0] - f[..., 1])
     b = 200.0 * (f[..., 1] - f[..., 2])
     return np.stack([L, a, b], axis=-1)
+
+
+def ACEScg_to_Lab_and_jacobian(RGB) -> tuple[np.ndarray, np.ndarray]:
+    """
+    :func:`ACEScg_to_Lab` and :func:`ACEScg_to_Lab_jacobian` of ``RGB`` (S, 3)
+    in one pass (XYZ and its cube root once): for solvers that want both at
+    every point.
+    """
+    with _LOCK:
+        M, XYZ_n = _matrices()
+    Mn = M / XYZ_n[:, None]
+    XYZ = np.asarray(RGB, dtype=np.float64) @ Mn.T
+    above = XYZ > _DELTA3
+    root = np.cbrt(np.maximum(XYZ, _DELTA3))
+    f = np.where(above, root, XYZ / (3.0 * _DELTA * _DELTA) + 4.0 / 29.0)
+    df = np.where(above, 1.0 / (3.0 * root * root), 1.0 / (3.0 * _DELTA * _DELTA))
+    Lab = f @ _LAB_OF_F.T
+    Lab[..., 0] -= 16.0
+    return Lab, (df[..., None, :] * _LAB_OF_F) @ Mn
+
+
+# Lab = K f - (16, 0, 0) with f = f(X / Xn, Y / Yn, Z / Zn)
+_LAB_OF_F = np.array([[0.0, 116.0, 0.0], [500.0, -500.0, 0.0], [0.0, 200.0, -200.0]])
 
 
 def ACEScg_to_Lab_jacobian(RGB) -> np.ndarray:

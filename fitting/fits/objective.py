@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_jacobian
+from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_and_jacobian, ACEScg_to_Lab_jacobian
 from ..colour.delta_e import de2000_weights
-from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian
+from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
 
 __all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds"]
 
@@ -55,6 +55,52 @@ class Problem:
         else:
             self.target_out = ACEScg_to_Lab(self.target)
             self.A = de2000_weights(self.target_out) if objective == "de2000" else None
+
+    def _geometry(self):
+        """What the samples fix of Eq. 1 and its derivative: mu, the powers of t, 1 - mu, (1 - mu)^5, log(1 - mu)."""
+        if getattr(self, "_geo", None) is None:
+            mu = np.clip(self.mu, 0.0, 1.0)
+            t = normalised_eta_i(self.eta, self.range)
+            T = np.stack([t**j for j in range(self.shape[2])], axis=-1)
+            x = (1.0 - mu)[:, None]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                log_x = np.where(x > 0.0, np.log(np.where(x > 0.0, x, 1.0)), 0.0)
+            self._geo = (mu[:, None], T, x, x**5, log_x)
+        return self._geo
+
+    def residuals_jacobian(self, x):
+        """
+        The residuals (S, 3) and the Jacobian (S, 3, n) at ``x`` in one
+        pass: :meth:`residuals` and :meth:`jacobian` of the samples (the
+        model, Lab and its derivative once, the samples' geometry kept), for
+        solvers that ask for both at every point (SLSQP). The range check's
+        rows are not included.
+        """
+        if self.objective == "rgb":
+            S = self.mu.size
+            return self.residuals(x)[: 3 * S].reshape(S, 3), self.jacobian(x)[: 3 * S].reshape(S, 3, -1)
+        mu, T, xx, x5, log_x = self._geometry()
+        S, d1 = T.shape[0], self.shape[2]
+        P = (T @ x.reshape(9, d1).T).reshape(S, 3, 3)  # [s, p, c]
+        alpha_raw = P[:, 2, :]
+        F0, a = P[:, 0, :], P[:, 1, :]
+        mu_x_alpha = mu * xx ** np.maximum(alpha_raw, ALPHA_MIN)
+        F = F0 + (1.0 - F0) * x5 - a * mu_x_alpha
+        dP = np.empty((S, 3, 3))  # [s, p, c]
+        dP[:, 0, :] = 1.0 - x5
+        dP[:, 1, :] = -mu_x_alpha
+        dP[:, 2, :] = np.where(alpha_raw > ALPHA_MIN, -a * mu_x_alpha * log_x, 0.0)
+        Lab, G = ACEScg_to_Lab_and_jacobian(F)
+        d = Lab - self.target_out
+        if self.A is not None:
+            d = np.einsum("sij,sj->si", self.A, d)
+            G = self.A @ G
+        if self.sqrt_w is not None:
+            d = d * self.sqrt_w
+            G = G * self.sqrt_w[:, :, None]
+        # J[s, o, p, c, j] = G[s, o, c] * dP[s, p, c] * T[s, j], as jacobian()
+        J = (G[:, :, None, :] * dP[:, None, :, :])[..., None] * T[:, None, None, None, :]
+        return d, J.reshape(d.shape[0], 3, -1)
 
     def _outputs(self, F):
         if self.objective == "rgb":

@@ -6,6 +6,7 @@ import pytest
 from fitting.colour.colorimetry import (
     ACES_WHITE_XY,
     ACEScg_to_Lab,
+    ACEScg_to_Lab_and_jacobian,
     ACEScg_to_Lab_jacobian,
     ACEScg_to_XYZ,
     spectral_to_ACEScg_weights,
@@ -97,6 +98,18 @@ class TestColorimetry:
             # 1.1e-16 * 100 / 1e-7 = 1.1e-7 absolute; 1e-5 (+ 1e-5 relative)
             # is that with a 90x margin. Measured: 4.2e-7 absolute.
             np.testing.assert_allclose(J[:, :, j], numeric, rtol=1e-5, atol=1e-5)
+
+    def test_lab_and_jacobian_in_one_pass(self):
+        # The one-pass form scales by the white before the product ((M / Xn) RGB,
+        # not (M RGB) / Xn): a few roundings of XYZ apart, so Lab within
+        # LAB_BOUND; its derivative 1 / (3 t^(2/3)) from the same cube root, a
+        # few roundings relative: 1e-12 relative. Includes the linear segment
+        # (dark and negative values) and black.
+        rng = np.random.default_rng(3)
+        rgb = np.concatenate([rng.uniform(-0.02, 1.0, size=(50, 3)), [[0.0, 0.0, 0.0], [1e-4, 2e-4, 0.0]]])
+        Lab, J = ACEScg_to_Lab_and_jacobian(rgb)
+        np.testing.assert_allclose(Lab, ACEScg_to_Lab(rgb), atol=LAB_BOUND)
+        np.testing.assert_allclose(J, ACEScg_to_Lab_jacobian(rgb), rtol=1e-12, atol=1e-12)
 
     def test_delta_E_2000_published_pair(self):
         # Sharma, Wu & Dalal (2005), Table 1, pair 1: 2.0425, printed to 4

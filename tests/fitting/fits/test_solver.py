@@ -5,6 +5,7 @@ import pytest
 
 from fitting.colour.reference import reference_ACEScg
 from fitting.fits.material import fit_material
+from fitting.fits.objective import Problem
 from fitting.fits.settings import FitSettings, fit_grid
 from fitting.fits.solver import fit_coefficients
 from fitting.models.coated_conductor import coated_conductor_model
@@ -19,6 +20,27 @@ KNOWN = np.array(
         [[6.0, -1.0, 0.5], [5.0, 0.5, -0.2], [4.0, 1.0, 0.3]],
     ]
 )
+
+
+class TestProblem:
+    @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
+    @pytest.mark.parametrize("weighted", [False, True])
+    def test_residuals_jacobian_is_both_in_one_pass(self, objective, weighted):
+        # The one pass (SLSQP's evaluation in fitting/fits/guarded.py) computes
+        # Eq. 1, Lab and its derivative in another order than residuals() and
+        # jacobian(): a few roundings of values up to ~100 (Lab) times the
+        # CIEDE2000 weights: 1e-11 absolute (2^-53 * 100 * 16 = 1.8e-13 per
+        # rounding, a 50x margin); the Jacobian, entries up to ~300, 1e-10.
+        mu, eta, _ = fit_grid((1.0, 2.5), 16, 5, "uniform")
+        mu = np.concatenate([mu, [0.0, 1.0]])  # grazing and normal: log(1 - mu) at 0
+        eta = np.concatenate([eta, [2.5, 1.0]])
+        target = coated_conductor_model(mu, eta, KNOWN) * 0.97
+        weights = np.linspace(0.5, 2.0, mu.size) if weighted else None
+        problem = Problem(target, mu, eta, (1.0, 2.5), 2, objective, weights)
+        x = (KNOWN + 0.01).ravel()
+        r, J = problem.residuals_jacobian(x)
+        np.testing.assert_allclose(r.ravel(), problem.residuals(x), rtol=0, atol=1e-11)
+        np.testing.assert_allclose(J.reshape(r.size, -1), problem.jacobian(x), rtol=0, atol=1e-10)
 
 
 class TestFitCoefficients:
