@@ -137,6 +137,10 @@ class Problem:
         return J.reshape(K * 3, -1)
 
     def jacobian(self, x):
+        if self.objective != "rgb":  # the one-pass assembly, without its residuals' cost
+            _, J = self.residuals_jacobian(x)
+            J = J.reshape(J.shape[0] * 3, -1)
+            return J if self.check is None else np.concatenate([J, self._range_jacobian(x)])
         F, Jm = model_jacobian(self.mu, self.eta, x.reshape(self.shape), self.range)
         _, G = self._outputs(F)
         S, d1 = Jm.shape[0], self.shape[2]
