@@ -223,9 +223,15 @@ def fit_curves(
 
     range_M, range_E = check_grid(eta_i_range, *SCORE_GRID)
 
+    seen: dict[bytes, np.ndarray] = {}  # the same candidate is checked again (held, the live fallback)
+
     def outside(C16) -> np.ndarray:
         """Mask of the range grid's points where the float16 fit leaves [0, 1]."""
-        return outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
+        C16 = np.asarray(C16)
+        key = C16.dtype.str.encode() + C16.tobytes()
+        if key not in seen:
+            seen[key] = outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
+        return seen[key]
 
     def in_range(C16) -> bool:  # issue 21: proven over the whole domain, not the grid only
         return not outside(C16).any() and proven_in_range(C16, eta_i_range, max_cells=settings.proof_cells)

@@ -17,7 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..colour.delta_e import delta_E_map
+from ..colour.colorimetry import ACEScg_to_Lab
+from ..colour.delta_e import delta_E_2000
 from ..models.kinds import DEFAULT_MODEL, model_ACEScg
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve
@@ -57,6 +58,25 @@ def check_grid(eta_i_range, angles: int, rows: int) -> tuple[np.ndarray, np.ndar
     return angle_mu(T), E
 
 
+_LAST: list = [None]
+
+
+def _scored_target(base, curves, blend_width, shape):
+    """
+    The scoring grid and the whole blended target's Lab there, kept for the
+    last ``base`` and ``curves`` objects (the same objects, curve by curve):
+    a refit scores several candidates against one target (its result, the
+    fit on screen, a fallback).
+    """
+    objects, values = (base, *curves), (float(blend_width), tuple(shape))
+    last = _LAST[0]
+    if (last is None or len(last[0]) != len(objects) or last[1] != values
+            or not all(a is b for a, b in zip(last[0], objects))):
+        grid = score_grid(base.eta_i_range, shape)
+        last = _LAST[0] = (objects, values, grid, ACEScg_to_Lab(edited_target(base, curves, grid[2], grid[3], blend_width)))
+    return last[2], last[3]
+
+
 def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients, blend_width: float,
                        shape=SCORE_GRID, model: str = DEFAULT_MODEL) -> dict[str, Any]:
     """
@@ -65,10 +85,9 @@ def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients
     mean, max and where the max is (``max_at``; also ``at_theta_deg``,
     ``at_eta_i``), and the model's range there.
     """
-    theta, rows, M, E = score_grid(base.eta_i_range, shape)
-    target = edited_target(base, curves, M, E, blend_width)
+    (theta, rows, M, E), target_Lab = _scored_target(base, curves, blend_width, shape)
     RGB = model_ACEScg(model, M, E, coefficients, base.eta_i_range)
-    dE = delta_E_map(target, RGB)
+    dE = delta_E_2000(target_Lab, ACEScg_to_Lab(RGB))
     j, i = np.unravel_index(int(np.argmax(dE)), dE.shape)
     grid = f"{theta.size} angles x {rows.size} eta_i"
     return {

@@ -81,7 +81,10 @@ class Problem:
             return self.residuals(x)[: 3 * S].reshape(S, 3), self.jacobian(x)[: 3 * S].reshape(S, 3, -1)
         mu, T, xx, x5, log_x = self._geometry()
         S, d1 = T.shape[0], self.shape[2]
-        P = (T @ x.reshape(9, d1).T).reshape(S, 3, 3)  # [s, p, c]
+        C = x.reshape(3, 3, d1)
+        P = T[:, 0, None, None] * C[:, :, 0]  # [s, p, c], elementwise (no BLAS: the same on every CPU)
+        for j in range(1, d1):
+            P = P + T[:, j, None, None] * C[:, :, j]
         alpha_raw = P[:, 2, :]
         F0, a = P[:, 0, :], P[:, 1, :]
         mu_x_alpha = mu * xx ** np.maximum(alpha_raw, ALPHA_MIN)
