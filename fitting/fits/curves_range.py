@@ -119,8 +119,9 @@ def in_range_fallback(C16, eta_i_range, max_cells: int = PROOF_CELLS) -> np.ndar
     """
     C = np.asarray(C16, dtype=np.float64).copy()
     bad = outside_range(to_float16(C), eta_i_range).any(axis=0)
-    # Issue 21: the whole domain, not the grid only.
-    bad |= np.array([not proven_in_range(to_float16(C), eta_i_range, c, max_cells) for c in range(3)])
+    # Issue 21: the whole domain, not the grid only (no proof asked of a channel the grid already refutes).
+    bad |= np.array([not bad[c] and not proven_in_range(to_float16(C), eta_i_range, c, max_cells)
+                     for c in range(3)])
     if not bad.any():
         return to_float16(C)
     rows = check_grid(eta_i_range, 2, SCORE_GRID[1])[1][:, 0]
