@@ -65,7 +65,8 @@ def main() -> None:
         skipped: dict[str, int] = {}
         for r in result.records:
             if r["status"] == "skipped":
-                reason = str(r.get("reason", "")).split(":")[0]
+                reason = str(r.get("reason", ""))
+                reason = "coverage" if reason.startswith("covers") else reason.split(":")[0]
                 skipped[reason] = skipped.get(reason, 0) + 1
     summary = result.summary
     print(f"{len(pages)} pages: {summary['fitted']} fitted, {summary['skipped']} skipped, "
