@@ -40,7 +40,6 @@ Faults:
 from __future__ import annotations
 
 import asyncio
-import collections
 import concurrent.futures
 import contextlib
 import contextvars
@@ -53,7 +52,8 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
 from .turns import Turns
-from .worker import CANCEL_SLOTS, JobCPULimit, ping, run_part, warm_process, worker_start
+from .flights import CancelRing, Flights
+from .worker import JobCPULimit, ping, run_part, warm_process, worker_start
 
 __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "Quarantined", "JobCPULimit", "warm_process"]
 
@@ -148,15 +148,13 @@ class FitRunner:
         self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
         context = multiprocessing.get_context("spawn")
         self._context = context
-        self._cancelled = context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
-        self._cancel_next = 0
+        self._cancels = CancelRing(context)
         self._serial = 0
-        self._waiters: collections.Counter[str] = collections.Counter()
         self._lock = threading.Lock()
         self._in_flight = 0
         self._mean_s = 2.0  # running estimate of one job's duration, for Retry-After
         self._pool: concurrent.futures.ProcessPoolExecutor | None = None
-        self._pending: dict[str, asyncio.Task] = {}
+        self._flights = Flights()
         self._warming: set[asyncio.Task] = set()
         self.completed = 0
         self.restarts = 0
@@ -172,7 +170,7 @@ class FitRunner:
                     max_workers=self.workers + self.express_workers,
                     mp_context=self._context,
                     initializer=worker_start,
-                    initargs=(self._cancelled,),
+                    initargs=(self._cancels.shared,),
                 )
             return self._pool
 
@@ -276,7 +274,7 @@ class FitRunner:
                 if self._alone is None:
                     self._alone = concurrent.futures.ProcessPoolExecutor(
                         max_workers=1, mp_context=self._context, initializer=worker_start,
-                        initargs=(self._cancelled,))
+                        initargs=(self._cancels.shared,))
                 alone = self._alone
             try:
                 return await self._run_in(alone, function, args)
@@ -295,7 +293,7 @@ class FitRunner:
         try:
             return await asyncio.wrap_future(future)
         except asyncio.CancelledError:
-            self._cancel(serial, future)
+            self._cancels.cancel(serial, future)
             raise
 
     def _quarantine_current(self) -> None:
@@ -311,14 +309,6 @@ class FitRunner:
                 self._quarantine.pop(next(iter(self._quarantine)))
             self._quarantine[key] = now + self.quarantine_s
         log.warning("job %s stopped its worker three times; refused for %g s", key[:40], self.quarantine_s)
-
-    def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
-        """Stop a part: dropped if still queued, else its worker stops at its next check."""
-        if future.cancel():
-            return
-        with self._lock:
-            self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
-            self._cancel_next += 1
 
     async def run(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
@@ -344,29 +334,21 @@ class FitRunner:
         left = self._quarantine.get(key, 0.0) - time.monotonic()
         if left > 0:
             raise Quarantined(left)
-        task = self._pending.get(key)
-        if task is None:
+
+        def start() -> asyncio.Task:
             token = _JOB_KEY.set(key)  # the job's task (a copy of this context) knows its content id
             try:
-                task = asyncio.ensure_future(make())
+                return asyncio.ensure_future(make())
             finally:
                 _JOB_KEY.reset(token)
-            self._pending[key] = task
-            task.add_done_callback(lambda t: self._pending.pop(key, None))
-        self._waiters[key] += 1
-        try:
-            return await asyncio.wait_for(asyncio.shield(task), self.timeout_s)
-        except asyncio.TimeoutError:
-            raise FitTimeout(self.timeout_s, self._retry_after()) from None
-        finally:
-            self._waiters[key] -= 1
-            if self._waiters[key] <= 0:
-                del self._waiters[key]
-                if not task.done():
-                    task.cancel()
+
+        task = self._flights.start(key, start)
+        return await self._flights.join(key, task, self.timeout_s,
+                                        lambda: FitTimeout(self.timeout_s, self._retry_after()))
 
     def close(self) -> None:
-        for task in [*self._pending.values(), *self._warming]:
+        self._flights.cancel_all()
+        for task in self._warming:
             task.cancel()
         with self._lock:
             pools, self._pool, self._alone = (self._pool, self._alone), None, None

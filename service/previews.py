@@ -51,7 +51,6 @@ Bounds and budgets:
 from __future__ import annotations
 
 import asyncio
-import collections
 import concurrent.futures
 import contextlib
 import logging
@@ -66,7 +65,8 @@ from typing import Any, Callable
 
 from .pool import FitTimeout, Overloaded, WorkerLost
 from .render_worker import RendererUnavailable, render_worker_start
-from .worker import CANCEL_SLOTS, run_part
+from .flights import CancelRing, Flights
+from .worker import run_part
 
 __all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
            "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
@@ -143,15 +143,13 @@ class PreviewRunner:
         self.texture_queue = texture_queue
         self.cancel_grace_s = cancel_grace_s
         self._context = multiprocessing.get_context("spawn")
-        self._cancelled = self._context.Array("q", [-1] * CANCEL_SLOTS, lock=False)
-        self._cancel_next = 0
+        self._cancels = CancelRing(self._context)
         self._serial = 0
         self._lock = threading.Lock()  # counts are released from the executors' threads
         self._processes: list[_RenderProcess | None] = [None] * workers
         self._counts = {"preview": 0, "texture": 0}
         self._running: dict[int, concurrent.futures.Future] = {}
-        self._pending: dict[tuple, asyncio.Task] = {}
-        self._waiters: collections.Counter[tuple] = collections.Counter()
+        self._flights = Flights()
         self._mean_s = 4.0  # running estimate of one preview's seconds, for Retry-After
         self.restarts = 0
 
@@ -165,7 +163,7 @@ class PreviewRunner:
         with self._lock:
             for index, process in enumerate(self._processes):
                 if process is None or process.broken:
-                    self._processes[index] = _RenderProcess(self._context, self._cancelled)
+                    self._processes[index] = _RenderProcess(self._context, self._cancels.shared)
             process = min(self._processes, key=lambda p: p.jobs)
             process.jobs += 1
             return process
@@ -242,17 +240,9 @@ class PreviewRunner:
         except BrokenProcessPool:
             raise RenderWorkerLost() from None
         except asyncio.CancelledError:
-            self._cancel(serial, future)
+            self._cancels.cancel(serial, future)
             asyncio.get_running_loop().call_later(self.cancel_grace_s, self._stop_if_running, process, future)
             raise
-
-    def _cancel(self, serial: int, future: concurrent.futures.Future) -> None:
-        """Stop a job: dropped if still queued, else its process stops at its next check."""
-        if future.cancel():
-            return
-        with self._lock:
-            self._cancelled[self._cancel_next % CANCEL_SLOTS] = serial
-            self._cancel_next += 1
 
     def _stop_if_running(self, process: _RenderProcess, future: concurrent.futures.Future) -> None:
         """A cancelled job still running ``cancel_grace_s`` later (in a long numpy call, or
@@ -266,30 +256,21 @@ class PreviewRunner:
     async def _once(self, what: str, key: tuple, function: Callable[..., Any], args: tuple) -> Any:
         """``function(*args)`` as one job shared by the calls with ``key``, within the time limit."""
         key = (what, *key)
-        task = self._pending.get(key)
-        if task is None:
+
+        def start() -> asyncio.Task:
             self._admit(what)
             submitted: list[int] = []
             task = asyncio.ensure_future(self._job(what, function, args, submitted))
-            self._pending[key] = task
 
             def finished(t: asyncio.Task) -> None:
-                self._pending.pop(key, None)
                 if not submitted:  # cancelled or refused before its process had it
                     self._leave(what)
 
             task.add_done_callback(finished)
-        self._waiters[key] += 1
-        try:
-            return await asyncio.wait_for(asyncio.shield(task), self.timeout_s)
-        except asyncio.TimeoutError:
-            raise PreviewTimeout(self.timeout_s) from None
-        finally:
-            self._waiters[key] -= 1
-            if self._waiters[key] <= 0:
-                del self._waiters[key]
-                if not task.done():
-                    task.cancel()
+            return task
+
+        task = self._flights.start(key, start)
+        return await self._flights.join(key, task, self.timeout_s, lambda: PreviewTimeout(self.timeout_s))
 
     async def preview(self, key: tuple, function: Callable[..., Any], *args: Any) -> Any:
         """
@@ -307,8 +288,7 @@ class PreviewRunner:
 
     def close(self) -> None:
         """Cancel what runs (stopped at once: the service is going) and stop the processes."""
-        for task in list(self._pending.values()):
-            task.cancel()
+        self._flights.cancel_all()
         with self._lock:
             processes = [p for p in self._processes if p is not None]
             self._processes = [None] * self.workers
