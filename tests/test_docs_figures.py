@@ -35,6 +35,8 @@ RECORDED_ROWS = (
     "shader cost at 2560 x 1440",
     "mean FLIP vs spectral reference",
     "split sum vs Monte Carlo",
+    "three.js through",
+    "refractiveindex.info `main` shelf",
 )
 """The rows of the README's "What it measures" table whose figures are all
 read from a record (by the start of their first cell): every number of
