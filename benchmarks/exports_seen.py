@@ -41,6 +41,15 @@ equal-channel starts (low-n high-k to high-n k-free) and seeded random
 per-channel starts. It records the best mean found per metal and tool, and
 the best per kind of start, under ``conductor_search`` (keyed ``eta_i_1_5``) in the same record
 (the rest of the record is kept).
+
+``--view-dependent`` measures a form both tools offer and the exports do not
+use yet: the conductor's n and k per channel driven by the view angle,
+affine in 1 - cos theta (Blender: Layer Weight's Facing into the Metallic
+BSDF's IOR and Extinction; MaterialX: a node graph of ``normal`` and
+``viewdirection`` into ``conductor_bsdf``'s ior and extinction), twelve
+values, fitted in the mirrors from the shipped fit (:func:`view_dependent_index`),
+recorded under ``view_dependent_index``. Exact in the mirrors at
+roughness 0 only, and not checked in the tools.
 """
 
 from __future__ import annotations
@@ -159,15 +168,47 @@ def conductor_search(tool: str, name: str, eta: float) -> dict:
             "cpu_s": round(time.process_time() - started, 1)}
 
 
-def run_conductor_search(names: list[str], etas: list[float], record: bool, argv) -> int:
-    """``--conductor-search``: print and record :func:`conductor_search` per eta_i, tool and metal."""
+def view_dependent_index(tool: str, name: str, eta: float) -> dict:
+    """
+    The seen Delta E of the conductor of ``tool`` with n_c + n'_c (1 - mu) and
+    k_c + k'_c (1 - mu) per channel (clipped to the fit's bounds), fitted from
+    the shipped values (slopes 0) with the mean Delta E as objective.
+    """
+    mu = np.cos(np.radians(SEEN_ANGLES_DEG))
+    target = seen_ACEScg(library_material(name), mu, eta)
+    facing = (1.0 - mu)[:, None]
+
+    def delta_E(x):
+        n = np.clip(x[0:3] + x[3:6] * facing, *N_BOUNDS)
+        k = np.clip(x[6:9] + x[9:12] * facing, *K_BOUNDS)
+        return seen_delta_E(tool, {"ior": n, "extinction": k, "coat": True}, mu, eta, target)
+
+    shipped = fit_tool_values(tool, mu, eta, target, True)
+    x0 = np.r_[shipped["ior"], [0.0] * 3, shipped["extinction"], [0.0] * 3]
+    fit = least_squares(lambda x: np.sqrt(delta_E(x) + 1e-6), x0, method="trf", x_scale="jac",
+                        diff_step=1e-6, max_nfev=SEARCH_MAX_NFEV)
+    dE, dE0 = delta_E(fit.x), delta_E(x0)
+    return {"shipped": [float(dE0.mean()), float(dE0.max())], "view_dependent": [float(dE.mean()), float(dE.max())],
+            "ior": fit.x[0:3].tolist(), "ior_per_facing": fit.x[3:6].tolist(),
+            "extinction": fit.x[6:9].tolist(), "extinction_per_facing": fit.x[9:12].tolist()}
+
+
+def run_conductor_search(names: list[str], etas: list[float], record: bool, argv, view_dependent: bool) -> int:
+    """
+    ``--conductor-search`` (:func:`conductor_search`) or ``--view-dependent``
+    (:func:`view_dependent_index`): print and record it per eta_i, tool and metal.
+    """
     started = time.time()
     found = {}
     for eta in etas:
         for tool in CONDUCTOR_TOOLS:
             for name in names:
-                row = conductor_search(tool, name, eta)
+                row = (view_dependent_index if view_dependent else conductor_search)(tool, name, eta)
                 found.setdefault(f"eta_i_{eta:g}".replace(".", "_"), {}).setdefault(tool, {})[name] = row
+                if view_dependent:
+                    print(f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, view-dependent "
+                          f"{row['view_dependent'][0]:.3f} / max {row['view_dependent'][1]:.2f}", flush=True)
+                    continue
                 b = row["best"]
                 print(f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, best of {row['starts']} "
                       f"starts {b['mean']:.3f} / max {b['max']:.2f} (from {b['from']}; n {np.round(b['ior'], 3)}, "
@@ -177,13 +218,14 @@ def run_conductor_search(names: list[str], etas: list[float], record: bool, argv
     print(f"{elapsed:.0f} s, load average {load[0]:.1f}")
     if record:
         data = json.loads(RESULT.read_text()) if RESULT.exists() else {}
-        data["conductor_search"] = {
-            "command": "benchmarks/exports_seen.py " + " ".join(argv),
-            "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-            "starts": {"grid_n": SEARCH_GRID_N, "grid_k": SEARCH_GRID_K, "random": SEARCH_RANDOM,
-                       "max_nfev": SEARCH_MAX_NFEV},
-            "found": found, "seconds": round(elapsed, 1), "load_average": round(load[0], 2),
-        }
+        run = {"command": "benchmarks/exports_seen.py " + " ".join(argv),
+               "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+               "starts": {"grid_n": SEARCH_GRID_N, "grid_k": SEARCH_GRID_K, "random": SEARCH_RANDOM,
+                          "max_nfev": SEARCH_MAX_NFEV},
+               "found": found, "seconds": round(elapsed, 1), "load_average": round(load[0], 2)}
+        if view_dependent:
+            run["starts"] = {"shipped": 1, "max_nfev": SEARCH_MAX_NFEV}
+        data["view_dependent_index" if view_dependent else "conductor_search"] = run
         RESULT.write_text(json.dumps(data, indent=1) + "\n")
     return 0
 
@@ -195,13 +237,15 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-record", action="store_true")
     parser.add_argument("--conductor-search", action="store_true",
                         help="the multi-start search of the conductor exports' values")
+    parser.add_argument("--view-dependent", action="store_true",
+                        help="the conductor with n, k affine in 1 - cos theta, in the mirrors")
     args = parser.parse_args(argv)
     argv = sys.argv[1:] if argv is None else argv
-    search = args.conductor_search
+    search = args.conductor_search or args.view_dependent
     etas = [float(e) for e in (args.eta_i or ("1.5" if search else "1.0,1.33,1.5,2.0")).split(",")]
     names = (args.materials or ("W,CuZn" if search else ",".join(LIBRARY_NAMES))).split(",")
     if search:
-        return run_conductor_search(names, etas, not args.no_record, argv)
+        return run_conductor_search(names, etas, not args.no_record, argv, args.view_dependent)
     started = time.time()
     results = {f"{eta:g}": {name: material_rows(name, eta) for name in names} for eta in etas}
     print("| tool | eta_i | seen mean / max | floor mean / max | naive mean / max | worst seen |")
@@ -233,9 +277,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{elapsed:.0f} s, load average {load[0]:.1f}")
     if not args.no_record:
         RESULT.parent.mkdir(parents=True, exist_ok=True)
-        # The conductor search's record is its own run's: kept across this one.
+        # The conductor searches' records are their own runs': kept across this one.
         kept = {k: v for k, v in (json.loads(RESULT.read_text()) if RESULT.exists() else {}).items()
-                if k == "conductor_search"}
+                if k in ("conductor_search", "view_dependent_index")}
         RESULT.write_text(json.dumps({
             "command": "benchmarks/exports_seen.py " + " ".join(argv),
             "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
