@@ -36,6 +36,7 @@ RECORDED_ROWS = (
     "mean FLIP vs spectral reference",
     "split sum vs Monte Carlo",
     "three.js through",
+    "refit from edited curves",
     "refractiveindex.info `main` shelf",
 )
 """The rows of the README's "What it measures" table whose figures are all
