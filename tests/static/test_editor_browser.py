@@ -43,12 +43,18 @@ def wait_idle(page):
 
 
 def wait_fit(page, not_id):
-    """Wait for a refit that replaced ``not_id`` and for its preview."""
+    """
+    Wait for a refit that replaced ``not_id`` and for its preview, and until
+    the fit on screen is the one of the edits on screen (no refit waits: the
+    plot's ``updating`` is off; between two queued refits the busy indicator
+    is briefly down).
+    """
     page.wait_for_function(
         "([old]) => { const id = document.getElementById('fit-id').textContent;"
         " return id.length === 32 && id !== old"
         " && document.getElementById('preview').dataset.fit === id"
-        " && !document.body.hasAttribute('aria-busy'); }",
+        " && !document.body.hasAttribute('aria-busy')"
+        " && !document.getElementById('plot').classList.contains('updating'); }",
         arg=[not_id],
     )
     return page.inner_text("#fit-id")
@@ -147,6 +153,16 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     page.wait_for_function("document.querySelector(\"circle.handle.c1[data-angle='84']\")"
                            ".getAttribute('aria-valuenow') === '1.000'")
     keyboard_id = wait_fit(page, keyboard_id)
+    # End the key burst now (the point loses the focus) rather than KEY_BURST_MS after
+    # the last press: its full refit, then no refit waits (static/plot.js).
+    point.evaluate("e => e.blur()")
+    page.wait_for_function(
+        "() => { const id = document.getElementById('fit-id').textContent;"
+        " return !document.body.hasAttribute('aria-busy')"
+        " && !document.getElementById('plot').classList.contains('updating')"
+        " && document.getElementById('preview').dataset.fit === id; }")
+    keyboard_id = page.inner_text("#fit-id")
+    point.focus()
     requests = from_curves_requests(page)
     page.keyboard.press("ArrowUp")
     page.wait_for_timeout(500)
