@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_and_jacobian, ACEScg_to_Lab_jacobian
+from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_and_jacobian
 from ..colour.delta_e import de2000_weights
 from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
 
@@ -106,14 +106,11 @@ class Problem:
         return d, J.reshape(d.shape[0], 3, -1)
 
     def _outputs(self, F):
+        """The residuals of the model values ``F`` (S, 3), unweighted (the Jacobian: :meth:`residuals_jacobian`)."""
         if self.objective == "rgb":
-            return F - self.target_out, None
+            return F - self.target_out
         d = ACEScg_to_Lab(F) - self.target_out
-        G = ACEScg_to_Lab_jacobian(F)
-        if self.A is not None:
-            d = np.einsum("sij,sj->si", self.A, d)
-            G = self.A @ G
-        return d, G
+        return d if self.A is None else np.einsum("sij,sj->si", self.A, d)
 
     def _range_residuals(self, x):
         mu, eta, weight = self.check
@@ -122,7 +119,7 @@ class Problem:
 
     def residuals(self, x):
         F = coated_conductor_model(self.mu, self.eta, x.reshape(self.shape), self.range)
-        r, _ = self._outputs(F)
+        r = self._outputs(F)
         if self.sqrt_w is not None:
             r = r * self.sqrt_w
         if self.check is not None:
@@ -140,20 +137,16 @@ class Problem:
         return J.reshape(K * 3, -1)
 
     def jacobian(self, x):
-        if self.objective != "rgb":  # the one-pass assembly, without its residuals' cost
+        if self.objective != "rgb":  # Lab and de2000: the one pass (its residuals are a small part of it)
             _, J = self.residuals_jacobian(x)
             J = J.reshape(J.shape[0] * 3, -1)
             return J if self.check is None else np.concatenate([J, self._range_jacobian(x)])
-        F, Jm = model_jacobian(self.mu, self.eta, x.reshape(self.shape), self.range)
-        _, G = self._outputs(F)
+        # rgb: each output is its channel's model value, J[s, c, p, c, j] = Jm[s, c, p, j].
+        _, Jm = model_jacobian(self.mu, self.eta, x.reshape(self.shape), self.range)
         S, d1 = Jm.shape[0], self.shape[2]
-        if G is None:
-            J = np.zeros((S, 3, 3, 3, d1))
-            idx = np.arange(3)
-            J[:, idx, :, idx, :] = Jm.transpose(1, 0, 2, 3)
-        else:
-            # J[s, o, p, c, j] = G[s, o, c] * Jm[s, c, p, j]
-            J = np.einsum("soc,scpj->sopcj", G, Jm)
+        J = np.zeros((S, 3, 3, 3, d1))
+        idx = np.arange(3)
+        J[:, idx, :, idx, :] = Jm.transpose(1, 0, 2, 3)
         if self.sqrt_w is not None:
             J = J * self.sqrt_w[:, :, None, None, None]
         if self.check is not None:
