@@ -45,6 +45,7 @@ from __future__ import annotations
 import httpx
 import numpy as np
 import pytest
+from playwright.sync_api import expect
 from editor_pages import camera_rays, editor_url, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 from fitting import baseline_inputs, coated_conductor_model, curve_base_from_nk, library_material
@@ -357,6 +358,7 @@ def test_controls_change_the_image(pages, editor_url):
     other.fill("#roughness", "0.5")
     other.dispatch_event("#roughness", "input")
     other.wait_for_selector("#preview-lighting:not([hidden])")
-    assert "no GL driver" in other.inner_text("#preview-lighting")
+    # The note shows "Preparing the rough lighting..." until the 503 arrives: wait for its text.
+    expect(other.locator("#preview-lighting")).to_contain_text("no GL driver")
     assert other.get_attribute("#preview", "data-program") == "mirror"
     np.testing.assert_array_equal(read(other, "display"), views["smooth"])
