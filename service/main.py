@@ -33,6 +33,7 @@ from .api.routes import (
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
+from .worker import freeze_heap, thaw_heap
 from .previews import PreviewRunner
 from .schemas import API_PREFIX
 from .store import StoreError, open_store
@@ -126,12 +127,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             if settings.warm_pool:
                 # The workers and this process (curves, reference textures) at once.
                 await asyncio.gather(runner.warm_up(), asyncio.to_thread(warm_process))
+            # What start-up made (imports, caches) out of the collector's full passes.
+            freeze_heap()
             yield
         finally:
             sweeper.cancel()
             previews.close()
             runner.close()
             store.close()
+            thaw_heap()
 
     app = FastAPI(
         title="Coated-metal Fresnel service",
