@@ -17,10 +17,16 @@ client cannot get past:
 -   admission (:meth:`DeadlineH11Protocol.connection_made`): at most
     ``max_connections`` connections, ``max_connections_per_client`` from one
     address; a connection past a bound closes the longest idle one (no
-    request in progress: a flood of idle connections only churns itself),
-    and with none idle it is admitted for ``/healthz`` alone (uvicorn's
-    ``limit_concurrency`` keeps :data:`HEALTH_RESERVE` more for it), every
-    other request on it answered 503; so ``/healthz`` is always answered;
+    request in progress; for the per-address bound also nothing sent or
+    received on it for :data:`IDLE_GRACE_S`: a flood of idle connections
+    only churns itself, while a burst's connections whose requests are
+    still on their way, and a keep-alive connection between two requests,
+    are not cut), and with none idle it is
+    admitted for ``/healthz`` alone (uvicorn's ``limit_concurrency`` keeps
+    :data:`HEALTH_RESERVE` more for it), every other request on it answered
+    503 with ``Retry-After``, its request due within the grace; so
+    ``/healthz`` is always answered and a burst past the bound gets 503s,
+    not connection resets;
 -   the keep-alive timeout (``keep_alive_s``);
 -   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
     closed, the concurrency limit, invalid requests) are logged once, then
@@ -42,13 +48,19 @@ from uvicorn.protocols.http.h11_impl import H11Protocol
 from .config import Settings
 
 __all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
-           "HEALTH_RESERVE"]
+           "HEALTH_RESERVE", "IDLE_GRACE_S"]
 
 log = logging.getLogger("uvicorn.error")
 MAX_HEADER_BYTES = 16 * 1024
 """Largest request line and header fields together (h11's own bound for an incomplete one)."""
 HEALTH_RESERVE = 16
 """Connections past ``max_connections`` kept for ``/healthz``."""
+IDLE_GRACE_S = 1.0
+"""How long after its last byte a connection is not yet counted idle by the
+per-address bound: a new connection's first request, or a keep-alive
+connection's next one, may be on its way (a round trip or two on a slow
+network); a connection admitted for ``/healthz`` alone must send its
+request within it."""
 _HEALTH_REQUESTS = (b"GET /healthz", b"HEAD /healthz")
 _HEADER_END = b"\r\n\r\n"
 _TOO_LARGE = json.dumps({
@@ -66,6 +78,8 @@ def _raw_answer(transport: asyncio.Transport, status: bytes, body: bytes, extra:
                     + str(len(body)).encode() + b"\r\nconnection: close\r\n" + extra + b"\r\n" + body)
     transport.close()
 SLOW_CLIENT = "closed a connection whose request header did not arrive within %g s (COATED_HEADER_TIMEOUT_S)"
+OVER_BOUND = ("closed a connection past the connection bound that sent no request within %g s "
+              "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT)")
 
 
 class OncePerInterval(logging.Filter):
@@ -74,7 +88,7 @@ class OncePerInterval(logging.Filter):
     for ``interval_s``, then let one through with the count of those dropped.
     """
 
-    MESSAGES = ("Exceeded concurrency limit.", "Invalid HTTP request received.", SLOW_CLIENT)
+    MESSAGES = ("Exceeded concurrency limit.", "Invalid HTTP request received.", SLOW_CLIENT, OVER_BOUND)
 
     def __init__(self, interval_s: float = 60.0) -> None:
         super().__init__()
@@ -108,6 +122,7 @@ class DeadlineH11Protocol(H11Protocol):
         self._header_deadline: asyncio.TimerHandle | None = None
         self._header_seen, self._header_tail = 0, b""
         self._health_only = False
+        self._served = False  # a response was sent on it
         super().connection_made(transport)
         self._last_active = self.loop.time()
         self._arm_header_deadline()
@@ -116,16 +131,24 @@ class DeadlineH11Protocol(H11Protocol):
                 and c.client[0] == host]
         if len(mine) >= self.max_connections_per_client and not self._evict(mine):
             self._health_only = True
-        if len(self.connections) > self.max_connections and not self._evict(self.connections):
+        # The service's own bound gives way to any idle connection, however new: it keeps /healthz's slots.
+        if len(self.connections) > self.max_connections and not self._evict(self.connections, grace=False):
             self._health_only = True
+        if self._health_only:
+            # Past a bound with none to give way: its request (503, or /healthz) is due within the grace.
+            self._disarm_header_deadline()
+            self._header_deadline = self.loop.call_later(IDLE_GRACE_S, self._header_timed_out)
 
-    def _idle(self) -> bool:
+    def _idle(self, grace: bool = True) -> bool:
+        """No request in progress, and (with ``grace``) nothing sent or received for the grace."""
         return (self.conn.their_state is h11.IDLE and not self.transport.is_closing()
-                and (self.cycle is None or self.cycle.response_complete))
+                and (self.cycle is None or self.cycle.response_complete)
+                and (not grace or self.loop.time() - self._last_active >= IDLE_GRACE_S))
 
-    def _evict(self, candidates) -> bool:
+    def _evict(self, candidates, grace: bool = True) -> bool:
         """Close the longest idle connection of ``candidates`` (not this one); False when none is idle."""
-        idle = [c for c in candidates if c is not self and isinstance(c, DeadlineH11Protocol) and c._idle()]
+        idle = [c for c in candidates
+                if c is not self and isinstance(c, DeadlineH11Protocol) and c._idle(grace)]
         if not idle:
             return False
         min(idle, key=lambda c: c._last_active).transport.close()
@@ -143,7 +166,10 @@ class DeadlineH11Protocol(H11Protocol):
     def _header_timed_out(self) -> None:
         self._header_deadline = None
         if self.conn.their_state is h11.IDLE and not self.transport.is_closing():
-            log.warning(SLOW_CLIENT, self.header_timeout_s)
+            if self._health_only and not self._served:
+                log.warning(OVER_BOUND, IDLE_GRACE_S)
+            else:
+                log.warning(SLOW_CLIENT, self.header_timeout_s)
             self.transport.close()
 
     def _header_too_large(self, data: bytes) -> bool:
@@ -176,6 +202,7 @@ class DeadlineH11Protocol(H11Protocol):
 
     def on_response_complete(self) -> None:
         super().on_response_complete()
+        self._served = True
         self._last_active = self.loop.time()
         self._header_seen, self._header_tail = 0, b""
         if self.conn.their_state is h11.IDLE and self.conn.trailing_data[0]:
