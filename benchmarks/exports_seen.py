@@ -11,7 +11,10 @@ and the tool's layered result (:mod:`fitting.exports.tool_layering`, numpy
 mirrors of each tool's layering, checked against the tools' own renders by
 ``tests/fitting/exports/test_tool_layering_renders.py``):
 
--   ``seen``: the export as written now (values fitted to the seen target);
+-   ``seen``: the export as written now (values fitted to the seen target;
+    the conductor exports' index affine in 1 - cos theta where it fits better);
+-   ``constant`` (conductor tools only): their constant index, slopes 0
+    (the conductor exports before the view-dependent index);
 -   ``floor``: the tool's layering over a perfect base (the best base
     response in [0, 1] per angle and channel);
 -   ``naive``: the export before issue 22 (base Fresnel fitted to the
@@ -42,14 +45,16 @@ per-channel starts. It records the best mean found per metal and tool, and
 the best per kind of start, under ``conductor_search`` (keyed ``eta_i_1_5``) in the same record
 (the rest of the record is kept).
 
-``--view-dependent`` measures a form both tools offer and the exports do not
-use yet: the conductor's n and k per channel driven by the view angle,
+``--view-dependent`` measures the form the conductor exports now carry
+(:func:`fitting.exports.seen_fit.fit_view_dependent_index`, there with the
+fit's RMS objective, at most 60 evaluations, from the constant fit), with the
+mean objective and a larger budget: the conductor's n and k per channel driven by the view angle,
 affine in 1 - cos theta (Blender: Layer Weight's Facing into the Metallic
 BSDF's IOR and Extinction; MaterialX: a node graph of ``normal`` and
 ``viewdirection`` into ``conductor_bsdf``'s ior and extinction), twelve
 values, fitted in the mirrors from the shipped fit (:func:`view_dependent_index`),
-recorded under ``view_dependent_index``. Exact in the mirrors at
-roughness 0 only, and not checked in the tools.
+recorded under ``view_dependent_index``; ``shipped`` there is the constant
+fit (both search modes start from it). Exact in the mirrors at roughness 0 only.
 """
 
 from __future__ import annotations
@@ -111,6 +116,11 @@ def material_rows(name: str, eta: float) -> dict:
             "floor": [float(floor.mean()), float(floor.max())],
             "naive": [float(naive.mean()), float(naive.max())],
         }
+        if tool in CONDUCTOR_TOOLS:
+            # The constant index (slopes 0): the conductor exports before the view-dependent one.
+            constant = seen_delta_E(tool, fit_tool_values(tool, mu, eta, target, coat, view_dependent=False),
+                                    mu, eta, target)
+            out[tool]["constant"] = [float(constant.mean()), float(constant.max())]
     return out
 
 
@@ -148,7 +158,7 @@ def conductor_search(tool: str, name: str, eta: float) -> dict:
     def delta_E(x):
         return seen_delta_E(tool, {"ior": x[:3], "extinction": x[3:], "coat": True}, mu, eta, target)
 
-    shipped = fit_tool_values(tool, mu, eta, target, True)
+    shipped = fit_tool_values(tool, mu, eta, target, True, view_dependent=False)
     x_shipped = np.r_[shipped["ior"], shipped["extinction"]]
     started = time.process_time()
     best, by_kind = None, {}
@@ -183,7 +193,7 @@ def view_dependent_index(tool: str, name: str, eta: float) -> dict:
         k = np.clip(x[6:9] + x[9:12] * facing, *K_BOUNDS)
         return seen_delta_E(tool, {"ior": n, "extinction": k, "coat": True}, mu, eta, target)
 
-    shipped = fit_tool_values(tool, mu, eta, target, True)
+    shipped = fit_tool_values(tool, mu, eta, target, True, view_dependent=False)
     x0 = np.r_[shipped["ior"], [0.0] * 3, shipped["extinction"], [0.0] * 3]
     fit = least_squares(lambda x: np.sqrt(delta_E(x) + 1e-6), x0, method="trf", x_scale="jac",
                         diff_step=1e-6, max_nfev=SEARCH_MAX_NFEV)
