@@ -30,7 +30,8 @@ Blender export's Metallic BSDF under a Fresnel-mixed Glossy coat),
 
     .venv/bin/python benchmarks/exports_seen.py [--eta-i 1.0,1.33,1.5,2.0] [--materials Au,Cu]
 
-Prints a Markdown table and records benchmarks/results/exports_seen.json.
+Prints a Markdown table and records benchmarks/results/exports_seen.json
+(its ``figures``: the same keyed ``eta_i_1_5``, for the docs' markers).
 
 ``--conductor-search`` measures instead how low the conductor exports can
 go (issue 22's open criterion): for each conductor tool and metal
@@ -214,7 +215,7 @@ def run_conductor_search(names: list[str], etas: list[float], record: bool, argv
         for tool in CONDUCTOR_TOOLS:
             for name in names:
                 row = (view_dependent_index if view_dependent else conductor_search)(tool, name, eta)
-                found.setdefault(f"eta_i_{eta:g}".replace(".", "_"), {}).setdefault(tool, {})[name] = row
+                found.setdefault(eta_key(eta), {}).setdefault(tool, {})[name] = row
                 if view_dependent:
                     print(f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, view-dependent "
                           f"{row['view_dependent'][0]:.3f} / max {row['view_dependent'][1]:.2f}", flush=True)
@@ -238,6 +239,31 @@ def run_conductor_search(names: list[str], etas: list[float], record: bool, argv
         data["view_dependent_index" if view_dependent else "conductor_search"] = run
         RESULT.write_text(json.dumps(data, indent=1) + "\n")
     return 0
+
+
+def eta_key(eta) -> str:
+    """``eta_i_1_5`` for 1.5: a key the docs' dotted figure paths can name (benchmarks.docs_figures)."""
+    return f"eta_i_{float(eta):g}".replace(".", "_")
+
+
+def figures(record: dict) -> dict:
+    """
+    The record's ``summary`` and ``per_material`` keyed by :func:`eta_key`
+    (``summary_by_eta.<tool>.eta_i_1_5.seen.0``, ``material_by_eta.eta_i_1_5.W.mtlx.seen.0``),
+    what docs/exports.md's seen tables quote.
+    """
+    return {
+        "summary_by_eta": {tool: {eta_key(eta): cell for eta, cell in cells.items()}
+                           for tool, cells in record["summary"].items()},
+        "material_by_eta": {eta_key(eta): rows for eta, rows in record["per_material"].items()},
+        # The conductor tools' constant index (slopes 0): mean over the metals, max.
+        "constant_by_eta": {
+            tool: {eta_key(eta): [float(np.mean([r[tool]["constant"][0] for r in rows.values()])),
+                                  float(np.max([r[tool]["constant"][1] for r in rows.values()]))]
+                   for eta, rows in record["per_material"].items()}
+            for tool in CONDUCTOR_TOOLS
+        },
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -290,13 +316,15 @@ def main(argv: list[str] | None = None) -> int:
         # The conductor searches' records are their own runs': kept across this one.
         kept = {k: v for k, v in (json.loads(RESULT.read_text()) if RESULT.exists() else {}).items()
                 if k in ("conductor_search", "view_dependent_index")}
-        RESULT.write_text(json.dumps({
+        record = {
             "command": "benchmarks/exports_seen.py " + " ".join(argv),
             "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
             "angles_deg": [float(SEEN_ANGLES_DEG[0]), float(SEEN_ANGLES_DEG[-1])],
             "summary": summary, "per_material": results,
             "seconds": round(elapsed, 1), "load_average": round(load[0], 2), **kept,
-        }, indent=1) + "\n")
+        }
+        record["figures"] = figures(record)
+        RESULT.write_text(json.dumps(record, indent=1) + "\n")
     return 0
 
 
