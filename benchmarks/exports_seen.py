@@ -34,7 +34,7 @@ Prints a Markdown table and records benchmarks/results/exports_seen.json
 (its ``figures``: the same keyed ``eta_i_1_5``, for the docs' markers).
 
 ``--conductor-search`` measures instead how low the conductor exports can
-go (issue 22's open criterion): for each conductor tool and metal
+go with constant values (issue 22's criterion, before the view-dependent index): for each conductor tool and metal
 (``--materials``, default W and CuZn) at ``--eta-i`` (default 1.5), a
 multi-start search over the six values, n in [0.001, 20] and k in [0, 50]
 per channel (the fit's full bounds), with the mean Delta E itself as the
