@@ -11,7 +11,10 @@ and the tool's layered result (:mod:`fitting.exports.tool_layering`, numpy
 mirrors of each tool's layering, checked against the tools' own renders by
 ``tests/fitting/exports/test_tool_layering_renders.py``):
 
--   ``seen``: the export as written now (values fitted to the seen target);
+-   ``seen``: the export as written now (values fitted to the seen target;
+    the conductor exports' index affine in 1 - cos theta where it fits better);
+-   ``constant`` (conductor tools only): their constant index, slopes 0
+    (the conductor exports before the view-dependent index);
 -   ``floor``: the tool's layering over a perfect base (the best base
     response in [0, 1] per angle and channel);
 -   ``naive``: the export before issue 22 (base Fresnel fitted to the
@@ -27,10 +30,11 @@ Blender export's Metallic BSDF under a Fresnel-mixed Glossy coat),
 
     .venv/bin/python benchmarks/exports_seen.py [--eta-i 1.0,1.33,1.5,2.0] [--materials Au,Cu]
 
-Prints a Markdown table and records benchmarks/results/exports_seen.json.
+Prints a Markdown table and records benchmarks/results/exports_seen.json
+(its ``figures``: the same keyed ``eta_i_1_5``, for the docs' markers).
 
 ``--conductor-search`` measures instead how low the conductor exports can
-go (issue 22's open criterion): for each conductor tool and metal
+go with constant values (issue 22's criterion, before the view-dependent index): for each conductor tool and metal
 (``--materials``, default W and CuZn) at ``--eta-i`` (default 1.5), a
 multi-start search over the six values, n in [0.001, 20] and k in [0, 50]
 per channel (the fit's full bounds), with the mean Delta E itself as the
@@ -42,14 +46,16 @@ per-channel starts. It records the best mean found per metal and tool, and
 the best per kind of start, under ``conductor_search`` (keyed ``eta_i_1_5``) in the same record
 (the rest of the record is kept).
 
-``--view-dependent`` measures a form both tools offer and the exports do not
-use yet: the conductor's n and k per channel driven by the view angle,
+``--view-dependent`` measures the form the conductor exports now carry
+(:func:`fitting.exports.seen_fit.fit_view_dependent_index`, there with the
+fit's RMS objective, at most 60 evaluations, from the constant fit), with the
+mean objective and a larger budget: the conductor's n and k per channel driven by the view angle,
 affine in 1 - cos theta (Blender: Layer Weight's Facing into the Metallic
 BSDF's IOR and Extinction; MaterialX: a node graph of ``normal`` and
 ``viewdirection`` into ``conductor_bsdf``'s ior and extinction), twelve
 values, fitted in the mirrors from the shipped fit (:func:`view_dependent_index`),
-recorded under ``view_dependent_index``. Exact in the mirrors at
-roughness 0 only, and not checked in the tools.
+recorded under ``view_dependent_index``; ``shipped`` there is the constant
+fit (both search modes start from it). Exact in the mirrors at roughness 0 only.
 """
 
 from __future__ import annotations
@@ -111,6 +117,11 @@ def material_rows(name: str, eta: float) -> dict:
             "floor": [float(floor.mean()), float(floor.max())],
             "naive": [float(naive.mean()), float(naive.max())],
         }
+        if tool in CONDUCTOR_TOOLS:
+            # The constant index (slopes 0): the conductor exports before the view-dependent one.
+            constant = seen_delta_E(tool, fit_tool_values(tool, mu, eta, target, coat, view_dependent=False),
+                                    mu, eta, target)
+            out[tool]["constant"] = [float(constant.mean()), float(constant.max())]
     return out
 
 
@@ -148,7 +159,7 @@ def conductor_search(tool: str, name: str, eta: float) -> dict:
     def delta_E(x):
         return seen_delta_E(tool, {"ior": x[:3], "extinction": x[3:], "coat": True}, mu, eta, target)
 
-    shipped = fit_tool_values(tool, mu, eta, target, True)
+    shipped = fit_tool_values(tool, mu, eta, target, True, view_dependent=False)
     x_shipped = np.r_[shipped["ior"], shipped["extinction"]]
     started = time.process_time()
     best, by_kind = None, {}
@@ -183,7 +194,7 @@ def view_dependent_index(tool: str, name: str, eta: float) -> dict:
         k = np.clip(x[6:9] + x[9:12] * facing, *K_BOUNDS)
         return seen_delta_E(tool, {"ior": n, "extinction": k, "coat": True}, mu, eta, target)
 
-    shipped = fit_tool_values(tool, mu, eta, target, True)
+    shipped = fit_tool_values(tool, mu, eta, target, True, view_dependent=False)
     x0 = np.r_[shipped["ior"], [0.0] * 3, shipped["extinction"], [0.0] * 3]
     fit = least_squares(lambda x: np.sqrt(delta_E(x) + 1e-6), x0, method="trf", x_scale="jac",
                         diff_step=1e-6, max_nfev=SEARCH_MAX_NFEV)
@@ -204,7 +215,7 @@ def run_conductor_search(names: list[str], etas: list[float], record: bool, argv
         for tool in CONDUCTOR_TOOLS:
             for name in names:
                 row = (view_dependent_index if view_dependent else conductor_search)(tool, name, eta)
-                found.setdefault(f"eta_i_{eta:g}".replace(".", "_"), {}).setdefault(tool, {})[name] = row
+                found.setdefault(eta_key(eta), {}).setdefault(tool, {})[name] = row
                 if view_dependent:
                     print(f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, view-dependent "
                           f"{row['view_dependent'][0]:.3f} / max {row['view_dependent'][1]:.2f}", flush=True)
@@ -228,6 +239,31 @@ def run_conductor_search(names: list[str], etas: list[float], record: bool, argv
         data["view_dependent_index" if view_dependent else "conductor_search"] = run
         RESULT.write_text(json.dumps(data, indent=1) + "\n")
     return 0
+
+
+def eta_key(eta) -> str:
+    """``eta_i_1_5`` for 1.5: a key the docs' dotted figure paths can name (benchmarks.docs_figures)."""
+    return f"eta_i_{float(eta):g}".replace(".", "_")
+
+
+def figures(record: dict) -> dict:
+    """
+    The record's ``summary`` and ``per_material`` keyed by :func:`eta_key`
+    (``summary_by_eta.<tool>.eta_i_1_5.seen.0``, ``material_by_eta.eta_i_1_5.W.mtlx.seen.0``),
+    what docs/exports.md's seen tables quote.
+    """
+    return {
+        "summary_by_eta": {tool: {eta_key(eta): cell for eta, cell in cells.items()}
+                           for tool, cells in record["summary"].items()},
+        "material_by_eta": {eta_key(eta): rows for eta, rows in record["per_material"].items()},
+        # The conductor tools' constant index (slopes 0): mean over the metals, max.
+        "constant_by_eta": {
+            tool: {eta_key(eta): [float(np.mean([r[tool]["constant"][0] for r in rows.values()])),
+                                  float(np.max([r[tool]["constant"][1] for r in rows.values()]))]
+                   for eta, rows in record["per_material"].items()}
+            for tool in CONDUCTOR_TOOLS
+        },
+    }
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -280,13 +316,15 @@ def main(argv: list[str] | None = None) -> int:
         # The conductor searches' records are their own runs': kept across this one.
         kept = {k: v for k, v in (json.loads(RESULT.read_text()) if RESULT.exists() else {}).items()
                 if k in ("conductor_search", "view_dependent_index")}
-        RESULT.write_text(json.dumps({
+        record = {
             "command": "benchmarks/exports_seen.py " + " ".join(argv),
             "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
             "angles_deg": [float(SEEN_ANGLES_DEG[0]), float(SEEN_ANGLES_DEG[-1])],
             "summary": summary, "per_material": results,
             "seconds": round(elapsed, 1), "load_average": round(load[0], 2), **kept,
-        }, indent=1) + "\n")
+        }
+        record["figures"] = figures(record)
+        RESULT.write_text(json.dumps(record, indent=1) + "\n")
     return 0
 
 

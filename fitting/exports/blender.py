@@ -12,8 +12,11 @@ which makes a material with two outputs:
     EEVEE evaluate a metallic Principled BSDF with the F82-tint model),
     ``Coat Weight`` 1 and ``Coat IOR`` eta_i;
 -   a second ``Material Output (Physical Conductor)``: a Metallic BSDF in
-    Physical Conductor mode with per-channel ``IOR`` and ``Extinction``,
-    under a coat made of a Glossy BSDF mixed in by the Fresnel of eta_i.
+    Physical Conductor mode with per-channel ``IOR`` and ``Extinction``
+    (where the fit found it better, each affine in Layer Weight's Facing,
+    1 - cos theta at blend 0.5: Vector Math ``MULTIPLY_ADD`` then
+    ``MAXIMUM`` at the lower bound), under a coat made of a Glossy BSDF
+    mixed in by the Fresnel of eta_i.
     Make it the active output to use it.
 
 Both sets of values are fitted so that Cycles' own layering (the coat's
@@ -33,14 +36,15 @@ from __future__ import annotations
 
 import json
 
-from .seen_fit import seen_fidelity
+from .seen_fit import K_BOUNDS, N_BOUNDS, seen_fidelity
 from .values import ExportValues
 
 __all__ = ["MODEL_KIND", "blender_script", "NODE_NAMES"]
 
 MODEL_KIND = (
     "f82-tint (Principled BSDF with coat, active output) and exact conductor "
-    "(Metallic BSDF, Physical Conductor, under a Fresnel-mixed Glossy coat, second output), "
+    "(Metallic BSDF, Physical Conductor, IOR / Extinction affine in Layer Weight's Facing where that "
+    "fits better, under a Fresnel-mixed Glossy coat, second output), "
     "both fitted to the coated metal seen from air"
 )
 
@@ -52,6 +56,11 @@ NODE_NAMES = {
     "coat_fresnel": "Coat Fresnel (Physical Conductor)",
     "coat_mix": "Coated Metal (Physical Conductor)",
     "conductor_output": "Material Output (Physical Conductor)",
+    "facing": "Facing (Physical Conductor)",
+    "ior_affine": "IOR per Facing (Physical Conductor)",
+    "ior_bound": "IOR (Physical Conductor)",
+    "extinction_affine": "Extinction per Facing (Physical Conductor)",
+    "extinction_bound": "Extinction (Physical Conductor)",
 }
 """The names of the nodes the script makes (tests read the values back by them)."""
 
@@ -75,9 +84,14 @@ COAT_ROUGHNESS = {coat_roughness!r}
 BASE_COLOR = {F0!r}
 SPECULAR_TINT = {tint!r}
 # Physical Conductor n, k per channel, linear Rec.709, fitted likewise under
-# the Fresnel-mixed coat.
+# the Fresnel-mixed coat: n = max(CONDUCTOR_IOR + CONDUCTOR_IOR_PER_FACING * Facing,
+# IOR_LOWEST) with Facing = 1 - cos theta (Layer Weight, blend 0.5), k likewise.
 CONDUCTOR_IOR = {n_rel!r}
+CONDUCTOR_IOR_PER_FACING = {n_slope!r}
 CONDUCTOR_EXTINCTION = {k_rel!r}
+CONDUCTOR_EXTINCTION_PER_FACING = {k_slope!r}
+IOR_LOWEST = {n_low!r}
+EXTINCTION_LOWEST = {k_low!r}
 NODE_NAMES = {node_names!r}
 
 
@@ -115,6 +129,23 @@ def build_material(name=MATERIAL_NAME):
     metallic.inputs["IOR"].default_value = CONDUCTOR_IOR
     metallic.inputs["Extinction"].default_value = CONDUCTOR_EXTINCTION
     metallic.inputs["Roughness"].default_value = ROUGHNESS
+    if any(CONDUCTOR_IOR_PER_FACING) or any(CONDUCTOR_EXTINCTION_PER_FACING):
+        weight = _node(tree, "ShaderNodeLayerWeight", NODE_NAMES["facing"], (-600, -300))
+        weight.inputs["Blend"].default_value = 0.5  # Facing = 1 - cos theta
+        rows = (("IOR", "ior", CONDUCTOR_IOR, CONDUCTOR_IOR_PER_FACING, IOR_LOWEST, -150),
+                ("Extinction", "extinction", CONDUCTOR_EXTINCTION, CONDUCTOR_EXTINCTION_PER_FACING,
+                 EXTINCTION_LOWEST, -450))
+        for socket, key, const, slope, lowest, y in rows:
+            affine = _node(tree, "ShaderNodeVectorMath", NODE_NAMES[key + "_affine"], (-400, y))
+            affine.operation = "MULTIPLY_ADD"
+            affine.inputs[0].default_value = slope
+            tree.links.new(weight.outputs["Facing"], affine.inputs[1])
+            affine.inputs[2].default_value = const
+            bound = _node(tree, "ShaderNodeVectorMath", NODE_NAMES[key + "_bound"], (-200, y))
+            bound.operation = "MAXIMUM"
+            tree.links.new(affine.outputs["Vector"], bound.inputs[0])
+            bound.inputs[1].default_value = (lowest, lowest, lowest)
+            tree.links.new(bound.outputs["Vector"], metallic.inputs[socket])
     glossy = _node(tree, "ShaderNodeBsdfAnisotropic", NODE_NAMES["coat_glossy"], (0, -650))
     glossy.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     glossy.inputs["Roughness"].default_value = COAT_ROUGHNESS
@@ -188,5 +219,9 @@ def blender_script(values: ExportValues) -> str:
         tint=_floats(principled["specular_tint"]),
         n_rel=_floats(conductor["ior"]),
         k_rel=_floats(conductor["extinction"]),
+        n_slope=_floats(conductor.get("ior_per_facing", (0.0,) * 3)),
+        k_slope=_floats(conductor.get("extinction_per_facing", (0.0,) * 3)),
+        n_low=N_BOUNDS[0],
+        k_low=K_BOUNDS[0],
         node_names=NODE_NAMES,
     )

@@ -35,7 +35,7 @@ def node_values(material) -> dict:
     out = {}
     for node in material.node_tree.nodes:
         entry = {"type": node.bl_idname, "inputs": {}}
-        for attr in ("fresnel_type", "distribution", "is_active_output"):
+        for attr in ("fresnel_type", "distribution", "is_active_output", "operation"):
             if hasattr(node, attr):
                 entry[attr] = getattr(node, attr)
         for socket in node.inputs:

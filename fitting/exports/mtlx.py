@@ -5,7 +5,9 @@ MaterialX export
 A MaterialX document whose ``surfacematerial`` is a coated metal built from
 the standard ``pbrlib`` nodes: a ``dielectric_bsdf`` coat of ``ior`` eta_i
 ``layer``-ed over a ``conductor_bsdf`` whose ``ior`` and ``extinction`` are
-per-channel values fitted so that MaterialX's layering (the coat's
+per-channel values (each channel's n and k affine in the facing 1 - cos theta,
+from a graph of ``normal`` and ``viewdirection``, where the fit found
+that better than constants) fitted so that MaterialX's layering (the coat's
 reflection plus the conductor scaled by the coat's throughput, both at the
 view angle in air) follows the physical coat on the metal seen from air
 (:mod:`fitting.exports.seen_fit`). At eta_i 1 there is no coat: the
@@ -26,16 +28,54 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
+import numpy as np
+
 from ._xml import add_input, document, element_name, number, to_text, triple
-from .seen_fit import seen_fidelity
+from .seen_fit import K_BOUNDS, N_BOUNDS, seen_fidelity
 from .values import ExportValues
 
 __all__ = ["MODEL_KIND", "mtlx_document"]
 
 MODEL_KIND = (
     "conductor_bsdf (exact Fresnel per channel) under MaterialX's layer with a dielectric_bsdf coat, "
-    "ior / extinction fitted to the coated metal seen from air"
+    "ior / extinction (affine in the facing 1 - cos theta where that fits better) fitted to the "
+    "coated metal seen from air"
 )
+
+
+def _index_inputs(graph: ET.Element, metal: ET.Element, fitted: dict) -> None:
+    """
+    The conductor's ``ior`` and ``extinction``: constants, or where a slope
+    is non-zero ``max(value + value_per_facing * facing, lower bound)`` with
+    facing = clamp(1 + N.V) = 1 - cos theta (``viewdirection`` points from
+    the eye to the surface), as :func:`fitting.exports.tool_layering.conductor_index`.
+    """
+    keys = (("ior", N_BOUNDS[0]), ("extinction", K_BOUNDS[0]))
+    if not any(np.any(fitted.get(f"{key}_per_facing", 0.0)) for key, _ in keys):
+        for key, _ in keys:
+            add_input(metal, key, "color3", value=triple(fitted[key]))
+        return
+    for kind, name in (("normal", "view_N"), ("viewdirection", "view_V")):
+        add_input(ET.SubElement(graph, kind, name=name, type="vector3"), "space", "string", value="world")
+    dot = ET.SubElement(graph, "dotproduct", name="view_NdotV", type="float")
+    add_input(dot, "in1", "vector3", nodename="view_N")
+    add_input(dot, "in2", "vector3", nodename="view_V")
+    one_plus = ET.SubElement(graph, "add", name="view_facing_raw", type="float")
+    add_input(one_plus, "in1", "float", nodename="view_NdotV")
+    add_input(one_plus, "in2", "float", value="1")
+    facing = ET.SubElement(graph, "clamp", name="view_facing", type="float")
+    add_input(facing, "in", "float", nodename="view_facing_raw")
+    for key, low in keys:
+        scaled = ET.SubElement(graph, "multiply", name=f"{key}_slope", type="color3")
+        add_input(scaled, "in1", "color3", value=triple(fitted[f"{key}_per_facing"]))
+        add_input(scaled, "in2", "float", nodename="view_facing")
+        affine = ET.SubElement(graph, "add", name=f"{key}_affine", type="color3")
+        add_input(affine, "in1", "color3", nodename=f"{key}_slope")
+        add_input(affine, "in2", "color3", value=triple(fitted[key]))
+        bounded = ET.SubElement(graph, "max", name=f"{key}_at_view", type="color3")
+        add_input(bounded, "in1", "color3", nodename=f"{key}_affine")
+        add_input(bounded, "in2", "float", value=number(low))
+        add_input(metal, key, "color3", nodename=f"{key}_at_view")
 
 
 def mtlx_document(values: ExportValues) -> str:
@@ -71,8 +111,7 @@ def mtlx_document(values: ExportValues) -> str:
     base_alpha = ET.SubElement(graph, "roughness_anisotropy", name="base_alpha", type="vector2")
     add_input(base_alpha, "roughness", "float", interfacename="base_roughness")
     metal = ET.SubElement(graph, "conductor_bsdf", name="metal", type="BSDF")
-    add_input(metal, "ior", "color3", value=triple(fitted["ior"]))
-    add_input(metal, "extinction", "color3", value=triple(fitted["extinction"]))
+    _index_inputs(graph, metal, fitted)
     add_input(metal, "roughness", "vector2", nodename="base_alpha")
     if coat_on:
         coat_alpha = ET.SubElement(graph, "roughness_anisotropy", name="coat_alpha", type="vector2")

@@ -22,6 +22,8 @@ base, :func:`floor_base`).
 -   :func:`floor_base`, :func:`tool_floor`: the best base response per angle
     in [0, 1] and its Delta E (the tool's floor: a perfect base under its layering).
 -   :func:`fit_tool_values`: the fit.
+-   :func:`fit_view_dependent_index`: the conductor exports' n and k made
+    affine in 1 - cos theta (twelve values), from the constant fit.
 -   :func:`seen_delta_E`: Delta E 2000 per angle of an export's values.
 """
 
@@ -34,18 +36,17 @@ from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_conductor, fresnel_dielectric
 from .colour_space import ACEScg_to_lin_rec709, lin_rec709_to_ACEScg
 from .tool_fresnel import f82_tint, schlick
-from .tool_layering import TOOLS, materialx_layer, three_clearcoat, tool_seen
+from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
 __all__ = [
     "N_BOUNDS", "K_BOUNDS",
     "fit_channel_conductor", "fit_channel_f82", "fit_channel_schlick",
-    "gltf_clearcoat_factor", "layer_only", "floor_base", "tool_floor", "fit_tool_values", "seen_delta_E", "seen_fidelity",
+    "gltf_clearcoat_factor", "layer_only", "floor_base", "tool_floor", "fit_tool_values",
+    "fit_view_dependent_index", "seen_delta_E", "seen_fidelity",
 ]
 
-# Per-channel relative index bounds: n > 0 as for any conductor; above every
-# library conductor divided by eta_i >= 1 (n < 5, k < 12 in 360-830 nm).
-N_BOUNDS = (1.0e-3, 20.0)
-K_BOUNDS = (0.0, 50.0)
+VIEW_DEPENDENT_MAX_NFEV = 60  # W at eta_i 1.5: 0.90 / 0.89 (mtlx / Cycles), about 0.3 s CPU per tool
+_SLOPE_ZERO = 1e-6
 MEAN_OBJECTIVE = False  # RMS: measured no better on the mean for W, CuZn, and a larger max
 _TOL = dict(xtol=1e-12, ftol=1e-12, gtol=1e-12)
 
@@ -189,11 +190,59 @@ def _start_and_bounds(tool: str, mu, base: np.ndarray, coat: bool):
     return F0, [0.0] * 3, [1.0] * 3
 
 
-def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True) -> dict:
+def _residuals(tool: str, values: dict, mu, eta: float, target_ACEScg) -> np.ndarray:
+    dE = seen_delta_E(tool, values, mu, eta, target_ACEScg)
+    # sqrt: the sum of squares is then the sum of Delta E, so the fit
+    # minimises the mean Delta E over the angles (what is scored), not
+    # its RMS; the 1e-6 keeps the derivative finite where Delta E is 0.
+    return np.sqrt(dE + 1e-6) if MEAN_OBJECTIVE else dE
+
+
+def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant: dict) -> dict:
+    """
+    The conductor values of ``tool`` (``mtlx``, ``blender-conductor``) with
+    each channel's n and k affine in the facing 1 - cos theta: ``ior``,
+    ``ior_per_facing``, ``extinction``, ``extinction_per_facing`` (3,) each,
+    and ``coat`` (:func:`fitting.exports.tool_layering.conductor_index`).
+    Fitted by the objective of :func:`fit_tool_values` from ``constant``
+    (its constant fit, slopes 0), as the values at facing 0 and 1, each in
+    the bounds (so every angle's n, k is: linear in between), at most
+    :data:`VIEW_DEPENDENT_MAX_NFEV` evaluations. Kept only where it lowers
+    the objective; else ``constant`` with slopes 0.
+    """
+    mu = np.asarray(mu, dtype=np.float64)
+    flat = {**constant, "ior_per_facing": np.zeros(3), "extinction_per_facing": np.zeros(3)}
+    lo = np.r_[[N_BOUNDS[0]] * 6, [K_BOUNDS[0]] * 6]
+    hi = np.r_[[N_BOUNDS[1]] * 6, [K_BOUNDS[1]] * 6]
+
+    def slope(d):
+        return np.where(np.abs(d) < _SLOPE_ZERO, 0.0, d)  # both ends on a bound: 0, not 1e-9
+
+    def pack(x):
+        return {"ior": x[0:3], "ior_per_facing": slope(x[3:6] - x[0:3]), "extinction": x[6:9],
+                "extinction_per_facing": slope(x[9:12] - x[6:9]), "coat": constant["coat"]}
+
+    def residuals(x):
+        return _residuals(tool, pack(x), mu, eta, target_ACEScg)
+
+    n, k = (np.asarray(constant[key], dtype=np.float64) for key in ("ior", "extinction"))
+    x0 = np.clip(np.r_[n, n, k, k], lo + 1e-9, hi - 1e-9)
+    fit = least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", diff_step=1e-6,
+                        xtol=1e-8, ftol=1e-6, gtol=1e-8, max_nfev=VIEW_DEPENDENT_MAX_NFEV)
+    if np.sum(residuals(fit.x) ** 2) < np.sum(_residuals(tool, flat, mu, eta, target_ACEScg) ** 2):
+        return pack(np.asarray(fit.x, dtype=np.float64))
+    return flat
+
+
+def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
+                    view_dependent: bool = True) -> dict:
     """
     The export values of ``tool`` (keys :data:`fitting.exports.tool_layering.TOOLS`,
     and ``coat``) whose layered result is nearest the seen target
-    (``target_ACEScg`` at view cosines ``mu``) in Delta E 2000.
+    (``target_ACEScg`` at view cosines ``mu``) in Delta E 2000. For the
+    conductor tools (``mtlx``, ``blender-conductor``) with ``view_dependent``,
+    the index affine in the facing (:func:`fit_view_dependent_index`) from
+    the constant fit; without it the constant fit alone.
     """
     if tool not in TOOLS:
         raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")
@@ -204,16 +253,15 @@ def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True)
     x0 = np.clip(x0, np.asarray(lo) + 1e-9, np.asarray(hi) - 1e-9)
 
     def residuals(x):
-        dE = seen_delta_E(tool, _pack(tool, x, coat, clearcoat), mu, eta, target_ACEScg)
-        # sqrt: the sum of squares is then the sum of Delta E, so the fit
-        # minimises the mean Delta E over the angles (what is scored), not
-        # its RMS; the 1e-6 keeps the derivative finite where Delta E is 0.
-        return np.sqrt(dE + 1e-6) if MEAN_OBJECTIVE else dE
+        return _residuals(tool, _pack(tool, x, coat, clearcoat), mu, eta, target_ACEScg)
 
     fit = least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac",
                         diff_step=1e-6, xtol=1e-8, ftol=1e-6, gtol=1e-8, max_nfev=100)
     best = fit.x if fit.cost <= 0.5 * np.sum(residuals(x0) ** 2) else x0
-    return _pack(tool, np.asarray(best, dtype=np.float64), coat, clearcoat)
+    values = _pack(tool, np.asarray(best, dtype=np.float64), coat, clearcoat)
+    if view_dependent and tool in ("mtlx", "blender-conductor"):
+        return fit_view_dependent_index(tool, mu, eta, target_ACEScg, values)
+    return values
 
 
 def seen_fidelity(values, tool: str) -> dict:

@@ -33,6 +33,11 @@ Rec.709 (the tools' working space), shape (S, 3).
     ``DFGLUTData.js``, at three's least roughness 0.045, and its
     multiple-scattering term), as glTF's ``KHR_materials_clearcoat`` renders.
 -   :data:`TOOLS`: the tools and what each mirror takes.
+-   :func:`conductor_index`: the conductor exports' n and k at each view
+    angle: per channel ``ior + ior_per_facing (1 - mu)`` (likewise
+    ``extinction``), at least the lower bound of :data:`N_BOUNDS` /
+    :data:`K_BOUNDS`, as the exports' node graphs compute them (constant
+    where the ``*_per_facing`` slopes are absent or 0).
 
 ``coat=False`` (an export at eta_i 1, which has no coat) gives each tool's
 bare base.
@@ -59,6 +64,9 @@ from .tool_fresnel import f82_tint, mx_fresnel_conductor, schlick
 
 __all__ = [
     "TOOLS",
+    "N_BOUNDS",
+    "K_BOUNDS",
+    "conductor_index",
     "THREE_MIN_ROUGHNESS",
     "THREE_CLEARCOAT_F0",
     "mx_ggx_dir_albedo",
@@ -91,6 +99,11 @@ TOOLS = {
     "gltf": ("base_color", "clearcoat"),
 }
 """Tool -> the free values its export fits (linear Rec.709)."""
+
+# Per-channel relative index bounds: n > 0 as for any conductor; above every
+# library conductor divided by eta_i >= 1 (n < 5, k < 12 in 360-830 nm).
+N_BOUNDS = (1.0e-3, 20.0)
+K_BOUNDS = (0.0, 50.0)
 
 
 def _mu(cos_theta) -> np.ndarray:
@@ -238,6 +251,24 @@ def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = 
     return base * (1.0 - cc * Fcc) + cc * coat_specular
 
 
+def conductor_index(values: dict, cos_theta) -> tuple[np.ndarray, np.ndarray]:
+    """
+    The conductor's (n, k) for ``values`` (``ior``, ``extinction`` and,
+    optionally, ``ior_per_facing``, ``extinction_per_facing``, per channel)
+    at view cosines ``cos_theta``: ``max(ior + ior_per_facing (1 - mu), N_BOUNDS[0])``
+    and likewise k, (S, 3) each, as the exports' graphs compute them
+    (MaterialX: 1 + N.V clamped to [0, 1]; Blender: Layer Weight's Facing at
+    blend 0.5); the constants alone, (3,), without slopes.
+    """
+    n, k = (np.asarray(values[key], dtype=np.float64) for key in ("ior", "extinction"))
+    n_slope, k_slope = (np.asarray(values.get(key, 0.0), dtype=np.float64)
+                        for key in ("ior_per_facing", "extinction_per_facing"))
+    if not (np.any(n_slope) or np.any(k_slope)):
+        return n, k
+    facing = (1.0 - _mu(cos_theta))[..., None]
+    return np.maximum(n + n_slope * facing, N_BOUNDS[0]), np.maximum(k + k_slope * facing, K_BOUNDS[0])
+
+
 def tool_seen(tool: str, values: dict, cos_theta, eta: float) -> np.ndarray:
     """
     The mirror of ``tool`` (a key of :data:`TOOLS`) for an export's ``values``
@@ -246,9 +277,9 @@ def tool_seen(tool: str, values: dict, cos_theta, eta: float) -> np.ndarray:
     """
     coat = bool(values.get("coat", eta > 1.0))
     if tool == "mtlx":
-        return mtlx_conductor(cos_theta, eta, values["ior"], values["extinction"], coat)
+        return mtlx_conductor(cos_theta, eta, *conductor_index(values, cos_theta), coat)
     if tool == "blender-conductor":
-        return cycles_conductor_mix(cos_theta, eta, values["ior"], values["extinction"], coat)
+        return cycles_conductor_mix(cos_theta, eta, *conductor_index(values, cos_theta), coat)
     if tool == "openpbr":
         return openpbr_metal(cos_theta, eta, values["base_color"], values["specular_color"], coat,
                              values.get("coat_darkening", 1.0))

@@ -135,7 +135,10 @@ class ExportValues:
     tools
         Per tool (:data:`fitting.exports.tool_layering.TOOLS`) the values its
         export carries, fitted to ``seen_ACEScg`` under the tool's layering,
-        and ``coat`` (False at eta_i 1). ``n_rel`` ... ``F0_schlick`` above
+        and ``coat`` (False at eta_i 1); the conductor tools' also
+        ``ior_per_facing`` and ``extinction_per_facing``, slopes in 1 - cos
+        theta (:func:`fitting.exports.tool_layering.conductor_index`; 0 where
+        the constant index fits as well). ``n_rel`` ... ``F0_schlick`` above
         are the naive fits under the coat (the baseline).
     model
         The fit's own float16 model (:class:`fitting.models.pack.PackedMaterial`),

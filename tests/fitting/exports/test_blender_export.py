@@ -104,12 +104,28 @@ class TestPhysicalConductor:
         metallic = nodes[NODE_NAMES["metallic"]]
         assert metallic["type"] == "ShaderNodeBsdfMetallic"
         assert metallic["fresnel_type"] == "PHYSICAL_CONDUCTOR"
-        assert_rgb(metallic["inputs"]["IOR"], values.tools["blender-conductor"]["ior"])
-        assert_rgb(metallic["inputs"]["Extinction"], values.tools["blender-conductor"]["extinction"])
+        fitted = values.tools["blender-conductor"]
+        links = conductor[0]["links"]
+        for socket, key in (("IOR", "ior"), ("Extinction", "extinction")):
+            if not np.any(fitted[f"{key}_per_facing"]):
+                assert_rgb(metallic["inputs"][socket], fitted[key])
+                continue
+            # max(slope * Facing + constant, lower bound) into the socket, Facing = 1 - cos theta.
+            affine, bound = nodes[NODE_NAMES[f"{key}_affine"]], nodes[NODE_NAMES[f"{key}_bound"]]
+            assert (affine["operation"], bound["operation"]) == ("MULTIPLY_ADD", "MAXIMUM")
+            assert_rgb(affine["inputs"]["Vector"], fitted[f"{key}_per_facing"])
+            assert_rgb(affine["inputs"]["Vector_002"], fitted[key])
+            assert_rgb(bound["inputs"]["Vector"], [{"ior": 1e-3, "extinction": 0.0}[key]] * 3)
+            assert [NODE_NAMES["facing"], "Facing", NODE_NAMES[f"{key}_affine"], "Vector_001"] in links
+            assert [NODE_NAMES[f"{key}_affine"], "Vector", NODE_NAMES[f"{key}_bound"], "Vector"] in links
+            assert [NODE_NAMES[f"{key}_bound"], "Vector", NODE_NAMES["metallic"], socket] in links
+        if np.any(fitted["ior_per_facing"]) or np.any(fitted["extinction_per_facing"]):
+            assert nodes[NODE_NAMES["facing"]]["inputs"]["Blend"] == 0.5
+        else:
+            assert NODE_NAMES["facing"] not in nodes
         assert nodes[NODE_NAMES["coat_fresnel"]]["inputs"]["IOR"] == pytest.approx(1.6, rel=1e-6)  # float32, as assert_rgb
         assert nodes[NODE_NAMES["conductor_output"]]["is_active_output"] is True
         assert nodes[NODE_NAMES["output"]]["is_active_output"] is False
-        links = conductor[0]["links"]
         assert [NODE_NAMES["coat_mix"], "Shader", NODE_NAMES["conductor_output"], "Surface"] in links
         assert [NODE_NAMES["coat_fresnel"], "Factor", NODE_NAMES["coat_mix"], "Fac"] in links
 

@@ -46,6 +46,31 @@ def value_of(node: mx.Node, name: str):
     return node.getInputValue(name)
 
 
+def conductor_input(graph: mx.NodeGraph, metal: mx.Node, key: str):
+    """
+    The conductor's ``key`` (ior, extinction) as written: (constant, slope
+    per facing); a constant input has slope 0, a graph is
+    max(slope * clamp(1 + N.V) + constant, lower bound) (docs/exports.md).
+    """
+    if metal.getConnectedNode(key) is None:
+        return list(value_of(metal, key)), [0.0] * 3
+    bounded = metal.getConnectedNode(key)
+    assert bounded.getCategory() == "max"
+    assert value_of(bounded, "in2") == pytest.approx({"ior": 1e-3, "extinction": 0.0}[key])
+    affine = bounded.getConnectedNode("in1")
+    assert affine.getCategory() == "add"
+    scaled = affine.getConnectedNode("in1")
+    assert scaled.getCategory() == "multiply"
+    facing = scaled.getConnectedNode("in2")
+    assert facing.getCategory() == "clamp"
+    one_plus = facing.getConnectedNode("in")
+    assert one_plus.getCategory() == "add" and value_of(one_plus, "in2") == pytest.approx(1.0)
+    dot = one_plus.getConnectedNode("in1")
+    assert dot.getCategory() == "dotproduct"
+    assert {dot.getConnectedNode(i).getCategory() for i in ("in1", "in2")} == {"normal", "viewdirection"}
+    return list(value_of(affine, "in2")), list(value_of(scaled, "in1"))
+
+
 def glsl_compiles(doc: mx.Document, tmp_path) -> list[str]:
     """Generate GLSL for the document's material; compile both stages; return the sources."""
     generator = mx_gen_glsl.GlslShaderGenerator.create()
@@ -90,8 +115,10 @@ class TestMtlx:
         assert metal.getCategory() == "conductor_bsdf"
         # The values fitted to the coated metal seen from air (issue 22).
         fitted = values.tools["mtlx"]
-        np.testing.assert_allclose(list(value_of(metal, "ior")), fitted["ior"], rtol=1e-5)
-        np.testing.assert_allclose(list(value_of(metal, "extinction")), fitted["extinction"], rtol=1e-5)
+        for key in ("ior", "extinction"):
+            const, slope = conductor_input(graph, metal, key)
+            np.testing.assert_allclose(const, fitted[key], rtol=1e-5, atol=1e-9)
+            np.testing.assert_allclose(slope, fitted[f"{key}_per_facing"], rtol=1e-5, atol=1e-9)
         surface = graph.getNode("shader")
         if not coated:
             # eta_i 1: no coat at all, the conductor straight into the surface.
