@@ -60,8 +60,9 @@ class CurveFitSettings:
         Cells the proof of [0, 1] (:func:`fitting.models.range_bound.certify_range`)
         examines at most per fit checked; a fit it cannot prove within them
         counts as outside (and gets its in-range fallback). Most fits are
-        proven in under 2,000 cells; one that touches 1 along grazing can
-        take 30,000-170,000 (0.1-0.4 s).
+        proven in under 2,000 cells; one that touches 1 inside the domain
+        took 30,000-170,000 (0.1-0.4 s) before the proofs' centred form,
+        a few thousand since.
     """
 
     mu_samples: int = 12
