@@ -17,6 +17,11 @@ benchmarks/results/worst_case_fits.json (:mod:`benchmarks.record`).
 its defaults, importing ``fitting`` from another checkout DIR (before /
 after a change, on the same machine and load).
 
+The whole run uses one BLAS thread (``threadpoolctl``), as the service's
+fitting workers do: the rgb-conductor fits and the auditor's solve would
+otherwise leave OpenBLAS's second thread spinning, and CPU time counts it
+(the fit times of a run with two threads read 1.5-2.7x high).
+
 Usage: python benchmarks/worst_case_fits.py [--materials Au,Cu] [--pages main/Cu/Johnson,...]
        [--repeats 3] [--timing-only --root /work/main]
 """
@@ -62,7 +67,13 @@ def fit_times(fit_material, nk, repeats):
 
 
 def main(argv=None) -> int:
-    args = ARGS.parse_args(argv)
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        return _main(ARGS.parse_args(argv))
+
+
+def _main(args) -> int:
     sys.path.insert(0, args.root)
     from fitting import LIBRARY_NAMES, fit_material, library_material
 
