@@ -19,7 +19,9 @@ from the fit's measured n, k, or for a fit of edited curves from its model:
 -   :data:`PACK_MEDIA_TYPES`: media type and file suffix per format.
 -   :data:`EXPORT_MEDIA_TYPES`: the same for the exports.
 -   :func:`render_pack`: the bytes of a download.
--   :func:`render_export`: the bytes of an export of one fit.
+-   :func:`render_export`: the bytes of an export of one fit (each fits its
+    tool's values, up to about a second of CPU: the routes run it, and
+    :func:`render_export_pack`, in the fitting pool's workers).
 -   :func:`download_name`: a safe file name for Content-Disposition.
 -   :func:`glsl_identifier`: a material name as a GLSL/HLSL identifier.
 """
@@ -184,11 +186,10 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     )
 
 
-def export_response(record: FitRecord, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03):
-    """An export of one fit (:func:`render_export`) as a download named for ``eta_i`` and the roughnesses."""
+def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03):
+    """An export's bytes (:func:`render_export`) as a download named for ``eta_i`` and the roughnesses."""
     from fastapi import Response
 
-    body = render_export(record, format, eta_i, roughness, coat_roughness)
     stem = f"{stem}-eta{eta_i:g}-rough{roughness:g}-coat{coat_roughness:g}"
     return Response(
         body, media_type=EXPORT_MEDIA_TYPES[format][0],

@@ -214,3 +214,20 @@ def test_unique_names_suffix_repeats_ignoring_case():
     from service.downloads import unique_names
 
     assert unique_names(["a.x", "A.x", "a.x", "a-2.x", "b"]) == ["a.x", "A-2.x", "a-3.x", "a-2-2.x", "b"]
+
+
+@pytest.mark.slow  # two in-process services, each with its fitting pool
+def test_exports_are_jobs_of_the_fitting_pool_with_its_cpu_limit(tmp_path):
+    """An export fits its tool's values (up to about a second of CPU): it runs in
+    the fitting pool, under the job CPU-time limit (422 past it, the worker then
+    free), never on the server's own threads; a pack of exports too."""
+    with app_client(tmp_path, metrics_samples=30) as client:
+        fit = client.post(f"{API}/fits", json={"material": "Cu"})
+        assert fit.status_code == 201, fit.text
+        fit_id = fit.json()["id"]
+    with app_client(tmp_path, job_cpu_limit_s=0.05) as client:  # the same store
+        refused = pack(client, fit_id, "format=mtlx&eta_i=1.5")
+        assert refused.status_code == 422 and "CPU-time limit" in refused.json()["detail"], refused.text
+        zipped = client.post(f"{API}/packs", json={"fit_ids": [fit_id], "format": "blender", "eta_i": 1.5})
+        assert zipped.status_code == 422 and "CPU-time limit" in zipped.json()["detail"], zipped.text
+        assert pack(client, fit_id, "format=json").status_code == 200  # a pack is not a job

@@ -21,7 +21,7 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, File, Form, Query, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
-from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, export_response, pack_response
+from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, export_response, pack_response, render_export
 from ...jobs.common import stored_fit
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
@@ -104,10 +104,10 @@ def get_fit(record: StoredFit) -> FitPublic:
 
 @router.get("/{fit_id}/pack", response_class=Response, responses={
     status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The download"},
-    **ERROR_RESPONSES, **NOT_FOUND,
+    **NOT_FOUND, **FIT_ERROR_RESPONSES,
 })
 async def get_pack(
-    fit_id: FitIdPath, store: StoreDep,
+    fit_id: FitIdPath, store: StoreDep, runner: RunnerDep,
     format: Annotated[DownloadFormat, Query(
         description="binary | json | glsl | hlsl | mtlx | openpbr | blender | gltf")] = "binary",
     eta_i: Annotated[float, Query(
@@ -127,7 +127,12 @@ async def get_pack(
     record = stored_fit(store, fit_id)  # after the query is validated: 422 before 404
     stem = f"{record.name}-{record.id[:8]}"
     if format in EXPORT_MEDIA_TYPES:
-        return await run_in_threadpool(export_response, record, format, eta_i, stem, roughness, coat_roughness)
+        # An export fits its tool's values (up to about a second of CPU): a job in the
+        # fitting pool, with its CPU limit and timeout, shared by identical requests.
+        body = await runner.once(
+            f"export {record.id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}",
+            lambda: runner.run(render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0))
+        return export_response(body, format, eta_i, stem, roughness, coat_roughness)
     return pack_response([record], format, stem)
 
 

@@ -9,27 +9,43 @@ nothing.
 """
 
 from fastapi import APIRouter, Response, status
+from fastapi.concurrency import run_in_threadpool
 
 from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, pack_response, render_export_pack
 from ...jobs.common import stored_fit
 from ...schemas import API_PREFIX, PackRequest
-from ..deps import ERROR_RESPONSES, NOT_FOUND, StoreDep
+from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep
 
 router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 
 
 @router.post("", response_class=Response, responses={
     status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
-    **NOT_FOUND, **ERROR_RESPONSES,
+    **NOT_FOUND, **FIT_ERROR_RESPONSES,
 })
-def create_pack(request: PackRequest, store: StoreDep) -> Response:
+async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep) -> Response:
     """
     The fits named by ``fit_ids``, in that order, as one pack. A renderer
     looks materials up by name, so names in a pack are unique: two fits of
     the same name are refused (422) rather than shipped ambiguously.
     """
+    records = await run_in_threadpool(_records, store, request.fit_ids)
+    if request.format in EXPORT_MEDIA_TYPES:
+        # Each export fits its tool's values (up to about a second of CPU): a job in the
+        # fitting pool, with its CPU limit and timeout, shared by identical requests.
+        body = await runner.once(
+            f"export pack {request.format} {request.eta_i!r} {' '.join(r.id for r in records)}",
+            lambda: runner.run(render_export_pack, records, request.format, request.eta_i,
+                               cost_s=float(len(records))))
+        return Response(body, media_type="application/zip", headers={
+            "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
+    return await run_in_threadpool(pack_response, records, request.format, request.name)
+
+
+def _records(store, fit_ids: list[str]) -> list:
+    """The stored fits of ``fit_ids`` (404 naming the index of one not stored); 422 for a repeated name."""
     records, names = [], {}
-    for index, fit_id in enumerate(request.fit_ids):
+    for index, fit_id in enumerate(fit_ids):
         record = stored_fit(store, fit_id, f"fit_ids[{index}]")
         if record.name in names:
             raise ValueError(
@@ -38,8 +54,4 @@ def create_pack(request: PackRequest, store: StoreDep) -> Response:
             )
         names[record.name] = index
         records.append(record)
-    if request.format in EXPORT_MEDIA_TYPES:
-        body = render_export_pack(records, request.format, request.eta_i)
-        return Response(body, media_type="application/zip", headers={
-            "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
-    return pack_response(records, request.format, request.name)
+    return records
