@@ -154,6 +154,7 @@ class TestFidelity:
 
 
 class TestInputs:
+    @pytest.mark.slow  # 1.8-2.5 s in a --durations run since the conductor exports' view-dependent fit
     def test_rgb_conductor_mapping(self):
         values = export_values({"name": "X", "source": "s", "n": [0.3, 0.5, 1.2], "k": [3, 2.5, 2]}, 1.5)
         assert values.name == "X" and values.origin.startswith("rgb-conductor")
