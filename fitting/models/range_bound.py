@@ -77,7 +77,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .coated_conductor import ALPHA_MIN, check_coefficients, coated_conductor_model, model_from_parameters
+from .coated_conductor import ALPHA_MIN, check_coefficients, coated_conductor_model
 
 __all__ = ["RANGE_SLACK", "ROUNDING_SLACK", "RangeCertificate", "quadratic_range", "certify_range"]
 
@@ -189,16 +189,16 @@ def _power_range(x0, x1, b_lo, b_hi):
     return corners.min(axis=0), corners.max(axis=0)
 
 
-def _centred_enclosure(C, x0, x1, t0, t1):
+def _centred_enclosure(C, x0, x1, t0, t1, centre):
     """
     (lower, upper) of each channel's model on each cell in the centred
-    (mean-value) form of the module docstring, shape (cells, 3); cells at
-    x = 0 get (-inf, inf).
+    (mean-value) form of the module docstring, shape (cells, 3), from
+    ``centre``, the model at each cell's centre (cells, 3); cells at x = 0
+    get (-inf, inf).
     """
     inner = x0 > 0.0
     t0, t1 = t0[:, None], t1[:, None]
     x0, x1 = np.where(inner, x0, 0.5)[:, None], x1[:, None]
-    xc, tc = 0.5 * (x0 + x1), 0.5 * (t0 + t1)
     hx, ht = 0.5 * (x1 - x0), 0.5 * (t1 - t0)
     F_lo, F_hi = quadratic_range(C[0][None], t0, t1)
     a_lo, a_hi = quadratic_range(C[1][None], t0, t1)
@@ -220,12 +220,12 @@ def _centred_enclosure(C, x0, x1, t0, t1):
         xa1_lo, xa1_hi = _power_range(x0, x1, al_lo - 1.0, al_hi - 1.0)  # x^(alpha - 1)
         x4_lo, x4_hi = x0**4, x1**4
         # d/dx: 5 x^4 (1 - F0) + a x^alpha - a alpha (1 - x) x^(alpha - 1)
-        t1_lo, t1_hi = _product(5.0 * x4_lo, 5.0 * x4_hi, 1.0 - F_hi, 1.0 - F_lo)
-        t2_lo, t2_hi = _product(a_lo, a_hi, xa_lo, xa_hi)
+        p_lo, p_hi = _product(5.0 * x4_lo, 5.0 * x4_hi, 1.0 - F_hi, 1.0 - F_lo)
+        q_lo, q_hi = _product(a_lo, a_hi, xa_lo, xa_hi)
         aal_lo, aal_hi = _product(a_lo, a_hi, al_lo, al_hi)
         w_lo, w_hi = _product(1.0 - x1, 1.0 - x0, xa1_lo, xa1_hi)
-        t3_lo, t3_hi = _product(aal_lo, aal_hi, w_lo, w_hi)
-        dx_lo, dx_hi = t1_lo + t2_lo - t3_hi, t1_hi + t2_hi - t3_lo
+        r_lo, r_hi = _product(aal_lo, aal_hi, w_lo, w_hi)
+        dx_lo, dx_hi = p_lo + q_lo - r_hi, p_hi + q_hi - r_lo
         # d/dt: F0' (1 - x^5) - (1 - x) x^alpha (a' + a alpha' ln x)
         u_lo, u_hi = _product(dF_lo, dF_hi, 1.0 - x1**5, 1.0 - x0**5)
         g_lo, g_hi = _product(1.0 - x1, 1.0 - x0, xa_lo, xa_hi)
@@ -235,9 +235,6 @@ def _centred_enclosure(C, x0, x1, t0, t1):
         dt_lo, dt_hi = u_lo - s_hi, u_hi - s_lo
         radius = (hx * np.maximum(np.abs(dx_lo), np.abs(dx_hi))
                   + ht * np.maximum(np.abs(dt_lo), np.abs(dt_hi)))
-    T = tc[:, :, None]  # (cells, 1, 1) against C's (parameter, channel)
-    P = C[None, :, :, 0] + T * (C[None, :, :, 1] + T * C[None, :, :, 2])  # (cells, parameter, channel)
-    centre = model_from_parameters(1.0 - xc, P[:, 0], P[:, 1], P[:, 2])
     radius = np.where(np.isfinite(radius) & inner[:, None], radius, np.inf)
     return centre - radius - ROUNDING_SLACK, centre + radius + ROUNDING_SLACK
 
@@ -273,17 +270,18 @@ def certify_range(coefficients, eta_i_range, slack: float = RANGE_SLACK,
     verdict: bool | None = True
     while x0.size:
         examined += x0.size
+        # The model at each cell's corners and centre: counterexamples and the extremes found.
+        samples = [(xp, tp, coated_conductor_model(1.0 - xp, to_eta(tp), C, eta_i_range))
+                   for xp, tp in ((x0, t0), (x1, t1), (x0, t1), (x1, t0), (0.5 * (x0 + x1), 0.5 * (t0 + t1)))]
         lo, hi = _enclosure(C, x0, x1, t0, t1)
         # The centred form where the first cannot decide, once a proof has examined
-        # _CENTRED_AFTER cells (it costs more per cell; most proofs end before).
+        # _CENTRED_AFTER cells (it costs more per cell; most proofs end before), about
+        # the centre's value just computed.
         open_ = ~np.all((lo >= -slack) & (hi <= 1.0 + slack), axis=1)
         if examined > _CENTRED_AFTER and open_.any():
-            c_lo, c_hi = _centred_enclosure(C, x0[open_], x1[open_], t0[open_], t1[open_])
+            c_lo, c_hi = _centred_enclosure(C, x0[open_], x1[open_], t0[open_], t1[open_], samples[-1][2][open_])
             lo[open_], hi[open_] = np.maximum(lo[open_], c_lo), np.minimum(hi[open_], c_hi)
-        # The model at each cell's corners and centre: counterexamples and the extremes found.
-        points = [(x0, t0), (x1, t1), (x0, t1), (x1, t0), (0.5 * (x0 + x1), 0.5 * (t0 + t1))]
-        for xp, tp in points:
-            values = coated_conductor_model(1.0 - xp, to_eta(tp), C, eta_i_range)
+        for xp, tp, values in samples:
             excess = np.maximum(-values, values - 1.0)
             i = np.unravel_index(int(np.argmax(excess)), excess.shape)
             if excess[i] > worst_excess:

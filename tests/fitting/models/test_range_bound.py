@@ -86,7 +86,9 @@ def test_centred_form_encloses_the_model_on_every_cell():
         x1 = np.minimum(1.0, x0 + rng.uniform(1e-3, 0.2, 20))
         t0 = rng.uniform(0.0, 0.9, 20)
         t1 = np.minimum(1.0, t0 + rng.uniform(1e-3, 0.3, 20))
-        lo, hi = _centred_enclosure(C, x0, x1, t0, t1)
+        centre = coated_conductor_model(1.0 - 0.5 * (x0 + x1), DOMAIN[0] + (DOMAIN[1] - DOMAIN[0]) * 0.5 * (t0 + t1),
+                                        C, DOMAIN)
+        lo, hi = _centred_enclosure(C, x0, x1, t0, t1, centre)
         for i in range(20):
             X, T = np.meshgrid(np.linspace(x0[i], x1[i], 31), np.linspace(t0[i], t1[i], 11))
             F = coated_conductor_model(1.0 - X.ravel(), DOMAIN[0] + (DOMAIN[1] - DOMAIN[0]) * T.ravel(), C, DOMAIN)
