@@ -28,10 +28,9 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-import numpy as np
-
 from ._xml import add_input, document, element_name, number, to_text, triple
 from .seen_fit import K_BOUNDS, N_BOUNDS, seen_fidelity
+from .tool_layering import view_dependent
 from .values import ExportValues
 
 __all__ = ["MODEL_KIND", "mtlx_document"]
@@ -51,7 +50,7 @@ def _index_inputs(graph: ET.Element, metal: ET.Element, fitted: dict) -> None:
     the eye to the surface), as :func:`fitting.exports.tool_layering.conductor_index`.
     """
     keys = (("ior", N_BOUNDS[0]), ("extinction", K_BOUNDS[0]))
-    if not any(np.any(fitted.get(f"{key}_per_facing", 0.0)) for key, _ in keys):
+    if not view_dependent(fitted):
         for key, _ in keys:
             add_input(metal, key, "color3", value=triple(fitted[key]))
         return

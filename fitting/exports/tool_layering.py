@@ -33,7 +33,8 @@ Rec.709 (the tools' working space), shape (S, 3).
     ``DFGLUTData.js``, at three's least roughness 0.045, and its
     multiple-scattering term), as glTF's ``KHR_materials_clearcoat`` renders.
 -   :data:`TOOLS`: the tools and what each mirror takes.
--   :func:`conductor_index`: the conductor exports' n and k at each view
+-   :func:`view_dependent`, :func:`conductor_index`: whether a conductor
+    export's index varies with the view angle, and its n and k at each view
     angle: per channel ``ior + ior_per_facing (1 - mu)`` (likewise
     ``extinction``), at least the lower bound of :data:`N_BOUNDS` /
     :data:`K_BOUNDS`, as the exports' node graphs compute them (constant
@@ -66,6 +67,7 @@ __all__ = [
     "TOOLS",
     "N_BOUNDS",
     "K_BOUNDS",
+    "view_dependent",
     "conductor_index",
     "THREE_MIN_ROUGHNESS",
     "THREE_CLEARCOAT_F0",
@@ -251,6 +253,11 @@ def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = 
     return base * (1.0 - cc * Fcc) + cc * coat_specular
 
 
+def view_dependent(values: dict) -> bool:
+    """Whether a conductor export's ``values`` carry a non-zero ``ior_per_facing`` or ``extinction_per_facing``."""
+    return any(np.any(values.get(key, 0.0)) for key in ("ior_per_facing", "extinction_per_facing"))
+
+
 def conductor_index(values: dict, cos_theta) -> tuple[np.ndarray, np.ndarray]:
     """
     The conductor's (n, k) for ``values`` (``ior``, ``extinction`` and,
@@ -261,10 +268,10 @@ def conductor_index(values: dict, cos_theta) -> tuple[np.ndarray, np.ndarray]:
     blend 0.5); the constants alone, (3,), without slopes.
     """
     n, k = (np.asarray(values[key], dtype=np.float64) for key in ("ior", "extinction"))
+    if not view_dependent(values):
+        return n, k
     n_slope, k_slope = (np.asarray(values.get(key, 0.0), dtype=np.float64)
                         for key in ("ior_per_facing", "extinction_per_facing"))
-    if not (np.any(n_slope) or np.any(k_slope)):
-        return n, k
     facing = (1.0 - _mu(cos_theta))[..., None]
     return np.maximum(n + n_slope * facing, N_BOUNDS[0]), np.maximum(k + k_slope * facing, K_BOUNDS[0])
 
