@@ -89,9 +89,13 @@ def paper_fit(base, curves, blend_width):
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--quick", action="store_true", help="every fourth edit")
+    parser.add_argument("--edits", help="comma-separated edit labels (e.g. 'Cu 4 scale'): only those, not recorded")
     args = parser.parse_args()
     settings = CurveFitSettings()
     cases = edits()[:: 4 if args.quick else 1]
+    if args.edits:
+        wanted = set(args.edits.split(","))
+        cases = [case for case in cases if case[0] in wanted]
     load_at_start = load_average()
     print(f"{'edit':<18} {'default dE':>10} {'paper dE':>9} {'default max':>11} {'paper max':>9}"
           f" {'at (deg, eta)':>14} {'range':>15} {'paper range':>15} {'kept':>7} {'ms':>6}")
@@ -132,6 +136,8 @@ def main() -> None:
           f"default worse than the paper's method on the mean on {len(worse_mean)} "
           f"({figures['worse_mean_paper_reflectance']} where the paper's fit is a reflectance), "
           f"on the max on {len(worse_max)} ({figures['worse_max_paper_reflectance']})")
+    if args.edits:
+        return
     print("recorded:", write_result("curve_edits_vs_paper" + ("_quick" if args.quick else ""), figures,
                                     load_at_start, rows=rows))
 
