@@ -4,16 +4,18 @@ Fitting pool
 
 The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
 
--   :class:`FitRunner`: worker processes (``spawn``), a bound on jobs in
+-   :class:`FitRunner`: worker processes (forked by a fork server), a bound on jobs in
     flight, a time limit per request, shared identical jobs, jobs of parts
     run side by side, and recovery from a dead worker.
 -   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`,
     :class:`JobCPULimit`: why a job was not answered (the HTTP edge answers
     503, 504, 503 and 422, the first three with ``Retry-After``).
 
-Fitting is CPU-bound (numpy, scipy): it runs in worker processes started
-with ``spawn`` (forking a process that already runs threads or holds a GL
-context is unsafe), never on the event loop. The number of jobs running or
+Fitting is CPU-bound (numpy, scipy): it runs in worker processes, never on
+the event loop, forked by a fork server (:func:`service.worker.process_context`:
+forking the server itself, which runs threads, is unsafe; the fork server is
+a fresh single-threaded process that imported the core once, so a worker
+starts in a fork instead of seconds of imports). The number of jobs running or
 waiting is bounded; past the bound a job is refused at once with a
 ``Retry-After`` estimate instead of growing a backlog.
 
@@ -45,7 +47,6 @@ import contextlib
 import contextvars
 import logging
 import math
-import multiprocessing
 import threading
 import time
 from concurrent.futures.process import BrokenProcessPool
@@ -53,7 +54,7 @@ from typing import Any, AsyncIterator, Awaitable, Callable
 
 from .turns import Turns
 from .flights import CancelRing, Flights
-from .worker import JobCPULimit, ping, run_part, warm_process, worker_start
+from .worker import JobCPULimit, ping, process_context, run_part, warm_process, worker_start
 
 __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "Quarantined", "JobCPULimit", "warm_process"]
 
@@ -146,7 +147,7 @@ class FitRunner:
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
         self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
-        context = multiprocessing.get_context("spawn")
+        context = process_context()
         self._context = context
         self._cancels = CancelRing(context)
         self._serial = 0

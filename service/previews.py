@@ -5,7 +5,7 @@ Render pool
 The process pool that draws previews and GL textures, apart from the
 fitting pool and off the server process.
 
--   :class:`PreviewRunner`: ``workers`` render processes (``spawn``), each
+-   :class:`PreviewRunner`: ``workers`` render processes (forked by the fork server, :func:`service.worker.process_context`), each
     with its own GL context made on its own render thread
     (:mod:`service.render_worker`); previews bounded in flight, textures
     bounded waiting; identical requests in flight share one render; a time
@@ -55,7 +55,6 @@ import concurrent.futures
 import contextlib
 import logging
 import math
-import multiprocessing
 import os
 import signal
 import threading
@@ -64,9 +63,9 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable
 
 from .pool import FitTimeout, Overloaded, WorkerLost
-from .render_worker import RendererUnavailable, render_worker_start
+from .render_worker import RendererUnavailable, render_worker_start, run_render_part
 from .flights import CancelRing, Flights
-from .worker import run_part
+from .worker import process_context
 
 __all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
            "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
@@ -142,7 +141,7 @@ class PreviewRunner:
         self.cpu_limit_s = cpu_limit_s
         self.texture_queue = texture_queue
         self.cancel_grace_s = cancel_grace_s
-        self._context = multiprocessing.get_context("spawn")
+        self._context = process_context()
         self._cancels = CancelRing(self._context)
         self._serial = 0
         self._lock = threading.Lock()  # counts are released from the executors' threads
@@ -216,7 +215,7 @@ class PreviewRunner:
         try:
             if process.pid is None:  # the process starts (with its GL context) and says who it is
                 process.pid = await asyncio.wrap_future(process.executor.submit(os.getpid))
-            future = process.executor.submit(run_part, serial, self.cpu_limit_s, function, *args)
+            future = process.executor.submit(run_render_part, serial, self.cpu_limit_s, function, *args)
         except BaseException as error:
             self._end_job(process)
             if isinstance(error, (BrokenProcessPool, RuntimeError)):

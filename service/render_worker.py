@@ -12,18 +12,18 @@ What runs in each process of the render pool (:class:`service.previews.PreviewRu
     only there (:class:`preview_shaders.gl.RenderThread`).
 -   :func:`renderer`: that renderer, or :class:`RendererUnavailable` when
     no GL context could be made.
-
-The jobs themselves run under :func:`service.worker.run_part` (the CPU-time
-limit and the server's cancellation, checked every 0.1 s).
+-   :func:`run_render_part`: a job, under :func:`service.worker.run_part`
+    (the CPU-time limit and the server's cancellation, checked every 0.1 s),
+    once the render thread has finished what a stopped job left on it.
 """
 
 from __future__ import annotations
 
 import os
 
-from .worker import worker_start
+from .worker import run_part, worker_start
 
-__all__ = ["RENDER_NICENESS", "RendererUnavailable", "render_worker_start", "renderer"]
+__all__ = ["RENDER_NICENESS", "RendererUnavailable", "render_worker_start", "renderer", "run_render_part"]
 
 RENDER_NICENESS = 10
 """Added to a render process's nice value before any of its threads start (the GL
@@ -67,3 +67,22 @@ def renderer():
     if _renderer is None:
         raise RendererUnavailable(_unavailable or "the render process did not start")
     return _renderer
+
+
+def _idle(state) -> None:
+    """A no-op on the render thread: it runs once every call before it has."""
+
+
+def run_render_part(serial: int, cpu_limit_s: float, function, *args):
+    """
+    ``function(*args)`` under :func:`service.worker.run_part`, after the
+    render thread has finished what it was given before. A job stopped at
+    its CPU-time limit or cancelled stops waiting for the render thread, but
+    the GL call it was in runs to its end there (a GL call cannot be
+    interrupted); without the wait that leftover work ran beside the next
+    job, on that job's CPU-time clock (a 64 px preview after a stopped 2048
+    px one was refused at a limit of 1 s, in a loaded test run).
+    """
+    if _renderer is not None:
+        _renderer.thread.call(_idle)
+    return run_part(serial, cpu_limit_s, function, *args)

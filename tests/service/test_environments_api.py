@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from conftest import app_client
+import httpx
+from conftest import app_client, server_process
 
 # Its module-scoped `client` fits (the fitting pool's processes) or renders (GL).
 pytestmark = pytest.mark.slow
@@ -54,12 +55,13 @@ def test_unknown_environment_422(client):
     assert "environment" in response.text
 
 
-@pytest.mark.slow  # starts a render process
-def test_no_gl_driver_503(tmp_path, monkeypatch):
-    # The render processes inherit this environment: libglvnd then finds no EGL
-    # vendor, as on a machine without a GL driver.
-    monkeypatch.setenv("__EGL_VENDOR_LIBRARY_FILENAMES", str(tmp_path / "no-vendor.json"))
-    with app_client(tmp_path) as other:
+@pytest.mark.server
+def test_no_gl_driver_503(tmp_path):
+    # The server's render processes inherit its environment: libglvnd then finds no EGL
+    # vendor, as on a machine without a GL driver. (A server process of its own: render
+    # processes fork from a fork server that keeps the environment it started with.)
+    with server_process(tmp_path / "data", __EGL_VENDOR_LIBRARY_FILENAMES=str(tmp_path / "no-vendor.json")) as server, \
+            httpx.Client(base_url=server.url, timeout=60) as other:
         response = other.get(f"{API}/environments/studio/prefiltered")
         assert response.status_code == 503
         assert response.json()["detail"].startswith("the preview renderer is unavailable: no GL context")

@@ -16,6 +16,7 @@ import subprocess
 import sys
 import time
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import httpx
 import numpy as np
@@ -208,13 +209,20 @@ def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
 
 # -- 7. worker death -------------------------------------------------------------
 
+def _children(pid: int) -> list[int]:
+    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True, text=True).stdout
+    return [int(p) for p in out.split()]
+
+
 def _worker_pids(server_pid: int) -> list[int]:
-    out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(server_pid)], capture_output=True, text=True).stdout
+    """
+    The server's fitting workers: the children of its fork server
+    (:func:`service.worker.process_context`), itself a child of the server.
+    """
     pids = []
-    for pid in map(int, out.split()):
-        cmd = open(f"/proc/{pid}/cmdline", "rb").read()
-        if b"spawn_main" in cmd:
-            pids.append(pid)
+    for pid in _children(server_pid):
+        if b"forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes():
+            pids += _children(pid)
     return pids
 
 

@@ -1,7 +1,7 @@
 """
 service.pool (issue 20): every part of a job has a CPU-time limit, and a job
 no request waits for any more (timed out, or its client gone) is cancelled,
-its worker free within a second. Real worker processes (spawn).
+its worker free within a second. Real worker processes (forked by the fork server).
 """
 
 from __future__ import annotations
