@@ -196,6 +196,20 @@ def live_server(tmp_path) -> Iterator[str]:
         yield server.url
 
 
+@pytest.fixture(scope="session")
+def browser_server(tmp_path_factory) -> Iterator[ServerProcess]:
+    """
+    One server process with the defaults for the browser modules of a test
+    process (each pytest-xdist worker: its own), started by the first of
+    them and stopped at the end of the session: a start is seconds of CPU
+    (the server, its fork server and workers import the core), and the
+    modules, which already shared one a module, assume nothing of the store
+    but what they make (tests/static/editor_pages.py).
+    """
+    with server_process(tmp_path_factory.mktemp("browser") / "data") as server:
+        yield server
+
+
 # -- the slow marker ---------------------------------------------------------
 
 SLOW_S = 2.0
@@ -203,7 +217,7 @@ SLOW_S = 2.0
 
 _IMPLY_SLOW = ("gl", "server", "browser")
 PROCESS_FIXTURES = frozenset({
-    "shared", "fitted", "live_server", "editor_url", "pages", "page", "curve_fit", "rgb_fit",
+    "shared", "fitted", "live_server", "browser_server", "editor_url", "pages", "page", "curve_fit", "rgb_fit",
     "hostile_run", "chromium", "postgres_server", "postgres_url",
 })
 """

@@ -2,9 +2,11 @@
 Shared fixtures of the editor's browser tests (import them: `from editor_pages import pages, open_editor`): Debian's Chromium through the
 Python playwright package (never a downloaded browser), a real server
 process, and a check that the page logged no error (uncaught exceptions
-and console errors). A module that imports them shares one server
-(``live_server`` here is module-scoped, overriding tests/conftest.py's) and
-one Chromium; each test gets fresh browser contexts (no cookies, storage or
+and console errors). The modules that import them share one server a test
+process (``live_server`` here is tests/conftest.py's session-scoped
+``browser_server``, overriding its function-scoped ``live_server``), so a
+test must assume nothing of the store but what it made; each module has one
+Chromium, and each test fresh browser contexts (no cookies, storage or
 cache from another test). :func:`camera_rays` is
 numpy's twin of the preview's camera (shader_ball.frag), for the WebGL
 parity tests.
@@ -14,7 +16,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import server_process
 from playwright.sync_api import expect, sync_playwright
 
 CHROMIUM_ARGS = [
@@ -29,10 +30,9 @@ expect.set_options(timeout=TIMEOUT_MS)
 
 
 @pytest.fixture(scope="module")
-def live_server(tmp_path_factory):
-    """One server process for the module's tests (a test that saves must not assume an empty list)."""
-    with server_process(tmp_path_factory.mktemp("editor") / "data") as server:
-        yield server.url
+def live_server(browser_server):
+    """The browser modules' one server (a test that saves must not assume an empty list)."""
+    return browser_server.url
 
 
 @pytest.fixture
