@@ -176,3 +176,28 @@ def test_a_render_that_does_not_stop_at_its_checks_is_killed():
 
     freed_s, restarts = asyncio.run(scenario())
     assert restarts == 1 and 0.8 < freed_s < 4.0, (freed_s, restarts)
+
+
+def test_a_job_starts_after_what_a_stopped_one_left_on_the_render_thread(monkeypatch):
+    # A job stopped at its CPU-time limit stops waiting for the render thread, but the GL call
+    # it was in runs on there; the next job's clock must not start beside it.
+    import types
+
+    import service.render_worker as render_worker
+    from preview_shaders.gl import RenderThread
+
+    with RenderThread() as thread:
+        monkeypatch.setattr(render_worker, "_renderer", types.SimpleNamespace(thread=thread))
+        busy = threading.Event()
+
+        def left_over(state):  # what the stopped job's GL call still has to do
+            busy.set()
+            time.sleep(1.0)
+
+        pending = threading.Thread(target=thread.call, args=(left_over,))
+        pending.start()
+        busy.wait(30)
+        asked = time.monotonic()
+        started = render_worker.run_render_part(1, 60.0, time.monotonic)  # when the job itself began
+        pending.join()
+    assert started - asked > 0.9, started - asked
