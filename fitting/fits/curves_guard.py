@@ -115,7 +115,7 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
         chosen = choose(scores, f"{paper}-free" if f"{paper}-free" in scores else paper)
     if chosen in (paper, f"{paper}-free"):
         # The paper method's twin: ahead of the auditor's rounding on both figures, not a tie.
-        C16, polished = polish_float16(candidates[chosen].coefficients_float16, gLab, gM, gE, eta_i_range)
+        C16, polished = polish_float16(candidates[chosen].coefficients_float16, gT, gM, gE, eta_i_range)
         if (polished.mean < scores[chosen].mean or polished.max < scores[chosen].max) and in_range(C16):
             candidates[f"{chosen}-polished"] = candidates[chosen].with_coefficients(C16.astype(np.float64), C16)
             scores[f"{chosen}-polished"] = polished

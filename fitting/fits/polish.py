@@ -14,9 +14,10 @@ so the result is ahead of the rounded optimum on both figures by what
 float16 allows, not by chance.
 
 Each step predicts every move (two per coefficient) to first order: the
-gradient of each point's Delta E in the coefficients, through the model's
-Jacobian, Lab's and the CIEDE2000 metric at the target colour
-(:func:`fitting.colour.delta_e.de2000_weights`); the :data:`SCREEN` most
+gradient of each point's Delta E in the coefficients, from the residuals
+and Jacobian of the ``de2000`` objective
+(:meth:`fitting.fits.objective.Problem.residuals_jacobian`, the CIEDE2000
+metric at the target colour, as the guard's SLSQP objective takes it); the :data:`SCREEN` most
 promising are scored exactly (scoring all 54 exactly costs about 65 ms a
 step, Delta E 2000 on 77,000 points), the best exact one taken. A step
 whose exact scores help neither figure ends the polish, so it never cycles
@@ -28,10 +29,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_and_jacobian
-from ..colour.delta_e import de2000_weights, delta_E_2000
-from ..models.coated_conductor import coated_conductor_model, model_jacobian
-from .worst_case import GuardScore
+from ..colour.colorimetry import ACEScg_to_Lab
+from ..colour.delta_e import delta_E_2000
+from ..models.coated_conductor import coated_conductor_model
+from .objective import Problem
+from .worst_case import score_of
 
 __all__ = ["POLISH_STEPS", "SCREEN", "polish_float16"]
 
@@ -66,38 +68,34 @@ def _figures(target_Lab, cos_theta, eta_i, eta_i_range, stack: np.ndarray):
     return dE.mean(axis=1), dE.max(axis=1), dE
 
 
-def _predicted(C16, moves, dE, target_Lab, metric, mu, eta, eta_i_range):
+def _predicted(problem: Problem, C16, moves, dE):
     """First-order Delta E of each move (K, S): the exact ``dE`` of ``C16`` plus the gradient times the step."""
-    F, J = model_jacobian(mu, eta, C16, eta_i_range)  # (S, 3), J[s, c, p, j] = dF[s, c] / dC[p, c, j]
-    Lab, J_Lab = ACEScg_to_Lab_and_jacobian(F)
-    Ad = np.einsum("sij,sj->si", metric, Lab - target_Lab)
-    size = np.linalg.norm(Ad, axis=1)
-    dE_dLab = np.einsum("sji,sj->si", metric, Ad) / np.maximum(size, 1e-12)[:, None]
-    dE_dRGB = np.einsum("si,sij->sj", dE_dLab, J_Lab)
-    G = (dE_dRGB[:, :, None, None] * J).transpose(0, 2, 1, 3).reshape(mu.size, -1)  # C's (p, c, j) order
+    r, J = problem.residuals_jacobian(C16.ravel().astype(np.float64))
+    G = np.einsum("so,son->sn", r, J) / np.maximum(np.linalg.norm(r, axis=1), 1e-12)[:, None]
     steps = moves.reshape(len(moves), -1).astype(np.float64) - C16.ravel().astype(np.float64)
     return dE[None] + steps @ G.T
 
 
-def polish_float16(C16, target_Lab, cos_theta, eta_i, eta_i_range, steps: int = POLISH_STEPS):
+def polish_float16(C16, target_RGB, cos_theta, eta_i, eta_i_range, steps: int = POLISH_STEPS):
     """
     ``C16`` moved one float16 ulp at a time while a move lowers the mean
-    Delta E 2000 against ``target_Lab`` (S, 3) at (``cos_theta``,
-    ``eta_i``) (S,) without raising the max (else lowers the max without
-    raising the mean), at most ``steps`` moves. Returns ``(C16, score)``
-    (:class:`fitting.fits.worst_case.GuardScore`) of the result, ``C16``
-    itself when no move helped. The caller proves the result's range.
+    Delta E 2000 against ``target_RGB`` (S, 3, linear ACEScg) at
+    (``cos_theta``, ``eta_i``) (S,) without raising the max (else lowers
+    the max without raising the mean), at most ``steps`` moves. Returns
+    ``(C16, score)`` (:class:`fitting.fits.worst_case.GuardScore`) of the
+    result, ``C16`` itself when no move helped. The caller proves the
+    result's range.
     """
     C16 = np.asarray(C16, dtype=np.float16)
-    target_Lab = np.asarray(target_Lab, dtype=np.float64).reshape(-1, 3)
     mu, eta = np.ravel(cos_theta), np.ravel(eta_i)
-    metric = de2000_weights(target_Lab)
+    problem = Problem(target_RGB, mu, eta, eta_i_range, C16.shape[2] - 1, "de2000")
+    target_Lab = problem.target_out
     means, maxes, dE = _figures(target_Lab, mu, eta, eta_i_range, C16[None])
     mean, peak, where = float(means[0]), float(maxes[0]), dE[0]
     by_mean, by_max = SCREEN
     for _ in range(steps):
         moves = _neighbours(C16)
-        predicted = _predicted(C16, moves, where, target_Lab, metric, mu, eta, eta_i_range)
+        predicted = _predicted(problem, C16, moves, where)
         p_mean, p_max = predicted.mean(axis=1), predicted.max(axis=1)
         picks = np.unique(np.concatenate([
             np.argsort(np.where(p_max <= peak, p_mean, np.inf))[:by_mean],
@@ -112,7 +110,4 @@ def polish_float16(C16, target_Lab, cos_theta, eta_i, eta_i_range, steps: int = 
         else:
             break
         C16, mean, peak, where = moves[picks[k]], float(means[k]), float(maxes[k]), dE[k]
-    i = int(np.argmax(where))
-    score = GuardScore(mean=mean, max=peak, eta_i=float(eta[i]),
-                       angle_deg=float(np.degrees(np.arccos(np.clip(mu[i], 0.0, 1.0)))))
-    return C16, score
+    return C16, score_of(where, mu, eta)

@@ -51,6 +51,7 @@ __all__ = [
     "guard_grid",
     "guard_reference",
     "guard_score",
+    "score_of",
     "lp_weights",
     "choose",
 ]
@@ -128,6 +129,11 @@ def guard_reference(nk, eta_i_range, min_coverage: float, shape: tuple[int, int]
 def guard_score(target_Lab, model_RGB, cos_theta, eta_i) -> GuardScore:
     """:class:`GuardScore` of ``model_RGB`` (S, 3) against the target's Lab (S, 3)."""
     dE = delta_E_2000(target_Lab, ACEScg_to_Lab(np.asarray(model_RGB, dtype=np.float64)))
+    return score_of(dE, cos_theta, eta_i)
+
+
+def score_of(dE, cos_theta, eta_i) -> GuardScore:
+    """:class:`GuardScore` of the Delta E 2000 ``dE`` (S,) at (``cos_theta``, ``eta_i``) (S,)."""
     i = int(np.argmax(dE))
     return GuardScore(
         mean=float(dE.mean()), max=float(dE[i]), eta_i=float(np.ravel(eta_i)[i]),
