@@ -148,11 +148,11 @@ def process_context():
     the server) that imports the fitting core and colour-science once; each
     worker is a fork of it. Forking the server itself would copy its
     threads' locks mid-use; spawning imports the core again in every worker.
-    Measured (a pool of two workers, warm): the first pool 1.5 s (the fork
-    server's imports), every pool after it, as after a worker died, 0.3 s,
-    against 1.5-1.9 s each with ``spawn``; a test server's start 5.2 CPU
-    seconds against 6.2. A process forked from it keeps the environment the
-    fork server started with (it starts with the first pool).
+    Measured by hand once (a pool of two workers, warm; not a recorded
+    benchmark): the first pool 1.5 s (the fork server's imports), every pool
+    after it, as after a worker died, 0.3 s, against 1.5-1.9 s each with
+    ``spawn``. A process forked from it keeps the environment the fork
+    server started with (it starts with the first pool).
     """
     import multiprocessing
 
