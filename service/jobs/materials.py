@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 from ..store import FitRecord, NameTaken, Store
+from ..store.queries import summary_text
 from .common import content_address, with_measured_nk
 
 __all__ = ["resolve_material", "fit_edit", "share_url"]
@@ -48,8 +49,12 @@ def resolve_material(store: Store, name: str, material_id: str | None = None) ->
     if holder is not None:
         return holder
     candidate, n = content_address("edited material", name), 0
-    while store.material(candidate) is not None:  # renamed away; one step per such rename
-        n += 1
+    while (row := store.material(candidate)) is not None:
+        if row.kind == "curves" and row.name == summary_text(name):
+            # Saved under this name since the lookup above (a concurrent first
+            # save, here or on another replica): the same material, not a rename.
+            return candidate
+        n += 1  # renamed away; one step per such rename
         candidate = content_address("edited material", name, n)
     return candidate
 

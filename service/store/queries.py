@@ -32,7 +32,7 @@ INT64_MAX = 2**63 - 1
 
 __all__ = ["save", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
            "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
-           "version_text", "LISTED_KINDS"]
+           "version_text", "summary_text", "LISTED_KINDS"]
 
 log = logging.getLogger("service.store")
 
@@ -77,12 +77,12 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
         f"INSERT INTO saves (material_id, fit_id, saved_at) VALUES ({p}, {p}, {p}) RETURNING seq",
         (stored.material_id, stored.id, now)).fetchone()
     connection.execute(UPSERT_MATERIAL.format(p=p), (
-        stored.material_id, seq, now, stored.id, stored.kind, _text(stored.name), _text(stored.source),
-        stored.coverage))
+        stored.material_id, seq, now, stored.id, stored.kind, summary_text(stored.name),
+        summary_text(stored.source), stored.coverage))
     return stored
 
 
-def _text(value: str) -> str:
+def summary_text(value: str) -> str:
     """A summary's text column: NUL (which PostgreSQL text refuses) shown as U+FFFD; the record keeps it."""
     return value.replace("\x00", "\ufffd")
 
@@ -193,7 +193,7 @@ def find_material(connection: Any, p: str, kind: str, name: str) -> str | None:
     """The id of the material of ``kind`` called ``name`` (one not in the bin first), or None."""
     row = connection.execute(
         f"SELECT material_id FROM materials WHERE kind = {p} AND name = {p} "
-        "ORDER BY (deleted_at IS NOT NULL), first_seq LIMIT 1", (kind, _text(name))).fetchone()
+        "ORDER BY (deleted_at IS NOT NULL), first_seq LIMIT 1", (kind, summary_text(name))).fetchone()
     return None if row is None else row[0]
 
 
@@ -214,13 +214,13 @@ def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
     if row.kind == "curves":  # an edited material is found by its name: names are unique
         holder = connection.execute(
             f"SELECT material_id, deleted_at FROM materials WHERE kind = 'curves' AND name = {p} "
-            f"AND material_id != {p}", (_text(name), material_id)).fetchone()
+            f"AND material_id != {p}", (summary_text(name), material_id)).fetchone()
         if holder is not None:
             where = " (in the bin)" if holder[1] is not None else ""
             raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
                             "choose another name, or rename that one first", version=row.version,
                             latest_fit_id=row.latest_fit_id)
-    connection.execute(f"UPDATE materials SET name = {p} WHERE material_id = {p}", (_text(name), material_id))
+    connection.execute(f"UPDATE materials SET name = {p} WHERE material_id = {p}", (summary_text(name), material_id))
     return material_row(connection, p, material_id)
 
 
