@@ -18,7 +18,7 @@ Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
+from scipy.optimize import least_squares, leastsq
 
 from ..models.coated_conductor import ALPHA_MIN, normalised_eta_i
 from ..models.pack import to_float16
@@ -27,6 +27,19 @@ from .result import FitResult
 from .solver import fit_coefficients
 
 __all__ = ["paper_fit"]
+
+
+def _lm(residuals, jacobian, x0, max_nfev):
+    """
+    MINPACK's Levenberg-Marquardt (``lmder``) from ``x0``: (x, MINPACK's
+    info, 1-4 when converged). What ``least_squares(method="lm")`` runs with
+    its default ``x_scale="jac"`` (no ``diag``), called through ``leastsq``,
+    which skips the wrapping of each call: the same iterates to the bit, a
+    fifth less time per paper-method fit (by hand, 7 conductors alternated).
+    """
+    x, _, _, _, ier = leastsq(residuals, x0, Dfun=jacobian, full_output=True, ftol=1e-10, xtol=1e-10,
+                              gtol=1e-10, maxfev=max_nfev, factor=100.0)
+    return np.asarray(x, dtype=np.float64), ier
 
 
 def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: bool = False):
@@ -71,10 +84,9 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
             return np.concatenate([(1.0 - x5)[:, None] * T, -mu_xa[:, None] * T, dalpha[:, None] * T], axis=1)
 
         x0 = C[:, c, :].ravel()
-        fit = least_squares(residuals, x0, jac=jacobian, method="lm",
-                            xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
-        xc = fit.x.reshape(3, d1)
-        if fit.status <= 0 or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
+        xc, ier = _lm(residuals, jacobian, x0, max_nfev)
+        xc = xc.reshape(3, d1)
+        if ier not in (1, 2, 3, 4) or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
             if not boxed:
                 return None
             lo, hi = lower[:, c].ravel(), upper[:, c].ravel()
