@@ -27,9 +27,13 @@ __all__ = ["delta_E_2000", "delta_E_map", "de2000_weights"]
 
 
 def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
-    """CIE Delta E 2000 between two CIE Lab arrays (colour-science)."""
-    colour = _colour()
-    return np.asarray(colour.delta_E(Lab_1, Lab_2, method="CIE 2000"), dtype=np.float64)
+    """
+    CIE Delta E 2000 between two CIE Lab arrays (colour-science's
+    ``delta_E_CIE2000``, called directly: ``colour.delta_E(method="CIE
+    2000")`` gives the same values through a method dispatch that costs a
+    third of the call on the guard's 408 points).
+    """
+    return np.asarray(_colour().difference.delta_E_CIE2000(Lab_1, Lab_2), dtype=np.float64)
 
 
 def delta_E_map(reference_RGB, model_RGB) -> np.ndarray:
