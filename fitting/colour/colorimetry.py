@@ -9,6 +9,8 @@ Spectral reflectance to linear ACEScg, and CIE 1976 L*a*b*.
 -   :func:`reflectance_to_ACEScg`: applies those weights.
 -   :func:`ACEScg_to_XYZ`, :func:`ACEScg_to_Lab`, :func:`ACEScg_to_Lab_jacobian`:
     CIE 1976 L*a*b* with the ACES white as reference white, and its derivative.
+-   :func:`ACEScg_to_Lab_and_jacobian`, :func:`ACEScg_to_Lab_deferred`: both
+    in one pass, or the Jacobian on demand (for solvers).
 -   CIE Delta E 2000 and its linearisation: :mod:`fitting.colour.delta_e`.
 
 Conventions: CIE 1931 2 degree observer; illuminant the CIE D series at the
@@ -27,6 +29,7 @@ formula. Color Research & Application, 30(1), 21-30.
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 import threading
 
 import numpy as np
@@ -41,6 +44,7 @@ __all__ = [
     "ACEScg_to_Lab",
     "ACEScg_to_Lab_jacobian",
     "ACEScg_to_Lab_and_jacobian",
+    "ACEScg_to_Lab_deferred",
 ]
 
 ACES_WHITE_XY = np.array([0.32168, 0.33767])
@@ -190,6 +194,17 @@ def ACEScg_to_Lab_and_jacobian(RGB) -> tuple[np.ndarray, np.ndarray]:
     in one pass (XYZ and its cube root once): for solvers that want both at
     every point.
     """
+    Lab, jacobian = ACEScg_to_Lab_deferred(RGB)
+    return Lab, jacobian()
+
+
+def ACEScg_to_Lab_deferred(RGB) -> tuple[np.ndarray, Callable[[], np.ndarray]]:
+    """
+    The Lab of :func:`ACEScg_to_Lab_and_jacobian` now and a function that
+    returns its Jacobian (the same values, from the cube roots kept): for
+    solvers that need the Jacobian at only some of the points they
+    evaluate (SLSQP's line search asks for values alone).
+    """
     with _LOCK:
         M, XYZ_n = _matrices()
     Mn = M / XYZ_n[:, None]
@@ -197,10 +212,14 @@ def ACEScg_to_Lab_and_jacobian(RGB) -> tuple[np.ndarray, np.ndarray]:
     above = XYZ > _DELTA3
     root = np.cbrt(np.maximum(XYZ, _DELTA3))
     f = np.where(above, root, XYZ / (3.0 * _DELTA * _DELTA) + 4.0 / 29.0)
-    df = np.where(above, 1.0 / (3.0 * root * root), 1.0 / (3.0 * _DELTA * _DELTA))
     Lab = f @ _LAB_OF_F.T
     Lab[..., 0] -= 16.0
-    return Lab, (df[..., None, :] * _LAB_OF_F) @ Mn
+
+    def jacobian() -> np.ndarray:
+        df = np.where(above, 1.0 / (3.0 * root * root), 1.0 / (3.0 * _DELTA * _DELTA))
+        return (df[..., None, :] * _LAB_OF_F) @ Mn
+
+    return Lab, jacobian
 
 
 # Lab = K f - (16, 0, 0) with f = f(X / Xn, Y / Yn, Z / Zn)

@@ -63,16 +63,31 @@ def _candidate(mean_fit: FitResult, C, C16, eta_i_range, degree, objective) -> F
 
 
 class _Cached:
-    """Residuals and Jacobian of a :class:`Problem`, computed once per point (SLSQP asks for both apart)."""
+    """
+    Residuals and Jacobian of a :class:`Problem`, each computed once per
+    point (SLSQP asks for values and derivatives apart) and the Jacobian
+    only where asked for: about two in three of the points SLSQP evaluates
+    are line-search trials whose derivatives it never uses.
+    """
 
     def __init__(self, problem: Problem) -> None:
-        self.problem, self.key, self.value = problem, None, None
+        self.problem, self.key = problem, None
 
-    def __call__(self, x):
+    def _at(self, x) -> None:
         key = x.tobytes()
         if key != self.key:
-            self.key, self.value = key, self.problem.residuals_jacobian(x)
-        return self.value
+            self.key, self.J = key, None
+            self.r, self._jacobian = self.problem.residuals_deferred(x)
+
+    def residuals(self, x):
+        self._at(x)
+        return self.r
+
+    def jacobian(self, x):
+        self._at(x)
+        if self.J is None:
+            self.J = self._jacobian()
+        return self.J
 
 
 class GuardWork:
@@ -146,18 +161,19 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
         ))
 
         def objective(x):
-            r, J = both(x)
+            r = both.residuals(x)
+            return float(w @ np.sqrt(np.sum(r[:S] ** 2, axis=1)))
+
+        def gradient(x):
+            r, J = both.residuals(x), both.jacobian(x)
             dE = np.sqrt(np.sum(r[:S] ** 2, axis=1))
-            grad = np.einsum("so,son->sn", r[:S], J[:S]) / np.maximum(dE, 1e-12)[:, None]
-            return float(w @ dE), w @ grad
+            return w @ (np.einsum("so,son->sn", r[:S], J[:S]) / np.maximum(dE, 1e-12)[:, None])
 
         def constraint(x):
-            r, _ = both(x)
-            return cap * cap - np.sum(r[S:] ** 2, axis=1)
+            return cap * cap - np.sum(both.residuals(x)[S:] ** 2, axis=1)
 
         def constraint_jac(x):
-            r, J = both(x)
-            return -2.0 * np.einsum("so,son->sn", r[S:], J[S:])
+            return -2.0 * np.einsum("so,son->sn", both.residuals(x)[S:], both.jacobian(x)[S:])
 
         constraints = [{"type": "ineq", "fun": constraint, "jac": constraint_jac}]
         rows = int(active.sum())
@@ -167,7 +183,7 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
         iterations = max_iterations if work is None else work.iterations(rows, max_iterations)
         if iterations == 0:
             return None
-        result = minimize(objective, x, jac=True, method="SLSQP", bounds=list(zip(lower, upper)),
+        result = minimize(objective, x, jac=gradient, method="SLSQP", bounds=list(zip(lower, upper)),
                           constraints=constraints, options={"maxiter": iterations, "ftol": 1e-9})
         if work is not None:
             work.spend(rows, result.nit)

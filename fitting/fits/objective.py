@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_and_jacobian
+from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_deferred
 from ..colour.delta_e import de2000_weights
 from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
 
@@ -76,9 +76,19 @@ class Problem:
         solvers that ask for both at every point (SLSQP). The range check's
         rows are not included.
         """
+        d, jacobian = self.residuals_deferred(x)
+        return d, jacobian()
+
+    def residuals_deferred(self, x):
+        """
+        The residuals (S, 3) of :meth:`residuals_jacobian` at ``x`` and a
+        function returning its Jacobian (S, 3, n), the same values: the
+        Jacobian's part of the work is done only when asked for (SLSQP's
+        line search evaluates points whose Jacobian it never uses).
+        """
         if self.objective == "rgb":
             S = self.mu.size
-            return self.residuals(x)[: 3 * S].reshape(S, 3), self.jacobian(x)[: 3 * S].reshape(S, 3, -1)
+            return self.residuals(x)[: 3 * S].reshape(S, 3), lambda: self.jacobian(x)[: 3 * S].reshape(S, 3, -1)
         mu, T, xx, x5, log_x = self._geometry()
         S, d1 = T.shape[0], self.shape[2]
         C = x.reshape(3, 3, d1)
@@ -89,21 +99,28 @@ class Problem:
         F0, a = P[:, 0, :], P[:, 1, :]
         mu_x_alpha = mu * xx ** np.maximum(alpha_raw, ALPHA_MIN)
         F = F0 + (1.0 - F0) * x5 - a * mu_x_alpha
-        dP = np.empty((S, 3, 3))  # [s, p, c]
-        dP[:, 0, :] = 1.0 - x5
-        dP[:, 1, :] = -mu_x_alpha
-        dP[:, 2, :] = np.where(alpha_raw > ALPHA_MIN, -a * mu_x_alpha * log_x, 0.0)
-        Lab, G = ACEScg_to_Lab_and_jacobian(F)
+        Lab, lab_jacobian = ACEScg_to_Lab_deferred(F)
         d = Lab - self.target_out
         if self.A is not None:
             d = np.einsum("sij,sj->si", self.A, d)
-            G = self.A @ G
         if self.sqrt_w is not None:
             d = d * self.sqrt_w
-            G = G * self.sqrt_w[:, :, None]
-        # J[s, o, p, c, j] = G[s, o, c] * dP[s, p, c] * T[s, j], as jacobian()
-        J = (G[:, :, None, :] * dP[:, None, :, :])[..., None] * T[:, None, None, None, :]
-        return d, J.reshape(d.shape[0], 3, -1)
+
+        def jacobian():
+            dP = np.empty((S, 3, 3))  # [s, p, c]
+            dP[:, 0, :] = 1.0 - x5
+            dP[:, 1, :] = -mu_x_alpha
+            dP[:, 2, :] = np.where(alpha_raw > ALPHA_MIN, -a * mu_x_alpha * log_x, 0.0)
+            G = lab_jacobian()
+            if self.A is not None:
+                G = self.A @ G
+            if self.sqrt_w is not None:
+                G = G * self.sqrt_w[:, :, None]
+            # J[s, o, p, c, j] = G[s, o, c] * dP[s, p, c] * T[s, j], as jacobian()
+            J = (G[:, :, None, :] * dP[:, None, :, :])[..., None] * T[:, None, None, None, :]
+            return J.reshape(d.shape[0], 3, -1)
+
+        return d, jacobian
 
     def _outputs(self, F):
         """The residuals of the model values ``F`` (S, 3), unweighted (the Jacobian: :meth:`residuals_jacobian`)."""

@@ -42,6 +42,21 @@ class TestProblem:
         np.testing.assert_allclose(r.ravel(), problem.residuals(x), rtol=0, atol=1e-11)
         np.testing.assert_allclose(J.reshape(r.size, -1), problem.jacobian(x), rtol=0, atol=1e-10)
 
+    @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
+    @pytest.mark.parametrize("weighted", [False, True])
+    def test_deferred_jacobian_is_the_one_pass_to_the_bit(self, objective, weighted):
+        # SLSQP's line-search points take the values alone (fitting/fits/guarded.py):
+        # the same operations on the same values, so exactly the one pass's.
+        mu, eta, _ = fit_grid((1.0, 2.5), 16, 5, "uniform")
+        target = coated_conductor_model(mu, eta, KNOWN) * 0.97
+        weights = np.linspace(0.5, 2.0, mu.size) if weighted else None
+        problem = Problem(target, mu, eta, (1.0, 2.5), 2, objective, weights)
+        x = (KNOWN + 0.01).ravel()
+        r, J = problem.residuals_jacobian(x)
+        d, jacobian = problem.residuals_deferred(x)
+        problem.residuals_deferred(x + 0.5)  # another point between: the first keeps its own
+        assert np.array_equal(d, r) and np.array_equal(jacobian(), J)
+
 
 class TestFitCoefficients:
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
