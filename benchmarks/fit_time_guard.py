@@ -3,17 +3,19 @@ Fit time with the max guard against the pipeline before it
 ===========================================================
 
 Issue 21 asks that guarding the max keeps the fit time within 1.5x of the
-pipeline before it ("today's", 18-25 ms median). This runs the library's
-fit times (``benchmarks/worst_case_fits.py --timing-only``: CPU time of
-``fit_material`` with its defaults, one BLAS thread, median of
-``--repeats`` per conductor, median over the 22) of a checkout of
-``--before`` (by default 51b944e, the commit before the guard, b7362fd)
-and of this checkout, alternately for ``--rounds`` rounds on the same
-machine, so that drifting load and CPU steal land on both. Records each
-round's medians, their ratio, and the ratio of the medians over the
-rounds in benchmarks/results/fit_time_guard.json.
+pipeline before it ("today's", 18-25 ms median). This times the library's
+fits (CPU time of ``fit_material`` with its defaults, one BLAS thread, the
+median of ``--repeats`` per conductor, then the median over the 22) of a
+checkout of ``--before`` (by default 51b944e, the commit before the guard,
+b7362fd) and of this checkout, in two processes that run side by side
+and take turns conductor by conductor (the order swapped every round), so
+that the machine's drifting load and CPU steal land on both alike: whole
+runs in turn, as this benchmark timed before, moved one round's ratio by
+up to 0.25 on this machine. Records each round's medians, their ratio and
+the ratio of the medians over the rounds, and each conductor's own ratio
+(and their median), in benchmarks/results/fit_time_guard.json.
 
-Usage: python benchmarks/fit_time_guard.py [--before REV] [--rounds 3] [--repeats 5]
+Usage: python benchmarks/fit_time_guard.py [--before REV] [--rounds 5] [--repeats 5]
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -37,45 +40,96 @@ BEFORE = "51b944e"
 """The last commit before the max guard (b7362fd): the pipeline issue 21 calls today's."""
 
 
-def timings(root: Path, repeats: int) -> dict:
-    """One ``worst_case_fits.py --timing-only`` run importing ``fitting`` from ``root``."""
-    out = subprocess.run(
-        [sys.executable, str(ROOT / "benchmarks" / "worst_case_fits.py"), "--timing-only", "--root", str(root),
-         "--repeats", str(repeats)],
-        cwd=tempfile.gettempdir(), check=True, capture_output=True, text=True).stdout
-    return json.loads(out)
+def child(root: str, repeats: int) -> int:
+    """One side: ``fitting`` from ``root``; each name read from stdin answered with its median CPU ms."""
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")
+    sys.path.insert(0, root)
+    from fitting import LIBRARY_NAMES, fit_material, library_material
+
+    fit_material(library_material(LIBRARY_NAMES[0]))  # warm caches
+    print(json.dumps(list(LIBRARY_NAMES)), flush=True)
+    for line in sys.stdin:
+        nk = library_material(line.strip())
+        times = []
+        for _ in range(repeats):
+            t = time.process_time()
+            fit_material(nk)
+            times.append(time.process_time() - t)
+        print(json.dumps(1e3 * float(np.median(times))), flush=True)
+    return 0
+
+
+class Side:
+    """A child process timing fits of one checkout."""
+
+    def __init__(self, root: Path, repeats: int) -> None:
+        self.root = str(root)
+        self.process = subprocess.Popen(
+            [sys.executable, __file__, "--child", self.root, "--repeats", str(repeats)],
+            cwd=tempfile.gettempdir(), stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.names = json.loads(self.process.stdout.readline())
+
+    def time(self, name: str) -> float:
+        self.process.stdin.write(name + "\n")
+        self.process.stdin.flush()
+        return json.loads(self.process.stdout.readline())
+
+    def close(self) -> None:
+        self.process.stdin.close()
+        self.process.wait(timeout=60)
 
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
-    parser.add_argument("--rounds", type=int, default=3, help="alternations of before and after")
+    parser.add_argument("--rounds", type=int, default=5, help="rounds over the 22 conductors")
     parser.add_argument("--repeats", type=int, default=5, help="timing repeats of each fit")
+    parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.child:
+        return child(args.child, args.repeats)
     load_start = load_average()
     rounds = []
     with tempfile.TemporaryDirectory() as tmp:
-        before = Path(tmp) / "before"
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(before), args.before],
+        before_root = Path(tmp) / "before"
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(before_root), args.before],
                        check=True, capture_output=True)
+        before = after = None
         try:
+            before, after = Side(before_root, args.repeats), Side(ROOT, args.repeats)
+            if before.names != after.names:
+                raise SystemExit("the two checkouts have different libraries")
             print(f"{'round':>5} {'before ms':>10} {'after ms':>9} {'ratio':>6} {'load':>5}")
             for i in range(args.rounds):
-                a = timings(before, args.repeats)
-                b = timings(ROOT, args.repeats)
-                ratio = b["median_ms"] / a["median_ms"]
-                rounds.append({"before": a, "after": b, "ratio": ratio})
-                print(f"{i + 1:5d} {a['median_ms']:10.1f} {b['median_ms']:9.1f} {ratio:6.2f} "
-                      f"{os.getloadavg()[0]:5.2f}", flush=True)
+                sides = (before, after) if i % 2 == 0 else (after, before)
+                ms = {before.root: {}, after.root: {}}
+                for name in before.names:
+                    for side in sides:
+                        ms[side.root][name] = side.time(name)
+                a, b = (float(np.median(list(ms[s.root].values()))) for s in (before, after))
+                rounds.append({"before": {"median_ms": a, "ms": ms[before.root]},
+                               "after": {"median_ms": b, "ms": ms[after.root]}, "ratio": b / a,
+                               "load": os.getloadavg()[0]})
+                print(f"{i + 1:5d} {a:10.1f} {b:9.1f} {b / a:6.2f} {os.getloadavg()[0]:5.2f}", flush=True)
         finally:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(before)],
+            for side in (before, after):
+                if side is not None:
+                    side.close()
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(before_root)],
                            check=False, capture_output=True)
     before_ms = float(np.median([r["before"]["median_ms"] for r in rounds]))
     after_ms = float(np.median([r["after"]["median_ms"] for r in rounds]))
     ratios = [r["ratio"] for r in rounds]
+    # Each conductor's own ratio (its medians over the rounds): where the
+    # median over the 22 falls moves with which conductors the guard refits.
+    own = {name: float(np.median([r["after"]["ms"][name] for r in rounds])
+                       / np.median([r["before"]["ms"][name] for r in rounds])) for name in rounds[0]["before"]["ms"]}
     figures = {"before_commit": args.before, "before_median_ms": before_ms, "after_median_ms": after_ms,
                "ratio": after_ms / before_ms, "ratio_min": min(ratios), "ratio_max": max(ratios),
-               "rounds": len(rounds)}
+               "rounds": len(rounds), "conductor_ratio_median": float(np.median(list(own.values()))),
+               "conductor_ratio_max": max(own.values()), "conductor_ratios": own}
     print(json.dumps(figures, indent=1))
     print("recorded:", write_result("fit_time_guard", figures, load_start, repeats=args.repeats,
                                     runs=rounds))
