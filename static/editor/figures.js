@@ -15,23 +15,35 @@
 export const REACH_DE = 3.0;
 
 /**
- * The figures of `fit` to show: {label, mean (a number or null), reach:
- * null or {max, thetaDeg, etaI}} (reach only for a curve fit that misses its
- * target by more than REACH_DE somewhere).
+ * The figures of `fit` to show: {label, mean (a number or null), max: null
+ * or {value, thetaDeg, etaI} (thetaDeg and etaI null when the fit does not
+ * say where), reach: null or {max, thetaDeg, etaI}} (reach only for a curve
+ * fit that misses its target by more than REACH_DE somewhere).
  */
 export function readFigures(fit) {
   const figure = (fit.metrics && fit.metrics.figure) || {};
   const mean = Number.isFinite(figure.delta_E_mean) ? figure.delta_E_mean : null;
   const at = figure.max_at || null;
+  const max = Number.isFinite(figure.delta_E_max)
+    ? { value: figure.delta_E_max, thetaDeg: at ? at.theta_deg : null, etaI: at ? at.eta_i : null }
+    : null;
   const reach = fit.kind === "curves" && at && figure.delta_E_max > REACH_DE
     ? { max: figure.delta_E_max, thetaDeg: at.theta_deg, etaI: at.eta_i }
     : null;
   return {
     label: figure.against ? `Against ${figure.against}, mean ΔE` : "Mean ΔE",
     mean,
+    max,
     reach,
   };
 }
 
 /** The figure as the readout writes it. */
 export const formatMean = (mean) => (mean === null ? "–" : mean.toFixed(3));
+
+/** The worst point as the readout writes it: its Delta E and where (the angle inside the coating, eta_i). */
+export const formatMax = (max) => {
+  if (max === null) return "–";
+  const where = max.thetaDeg === null ? "" : ` at ${max.thetaDeg.toFixed(0)}°, ηᵢ ${max.etaI.toFixed(2)}`;
+  return `${max.value.toFixed(3)}${where}`;
+};

@@ -1,4 +1,4 @@
-// The view of the fit on screen (state.fit): its Delta E figure and label
+// The view of the fit on screen (state.fit): its Delta E figures (mean, and max with where it is) and label
 // (figures.js reads them), id, coefficients (as its kind writes them,
 // kinds.js), the pack download, the "cannot follow this edit" warning, the
 // saved/unsaved line and the error heat map. Renders from the state; its
@@ -7,7 +7,7 @@
 import * as api from "../api.js";
 import { drawErrorMap } from "../heatmap.js";
 import { modelKind } from "../kinds.js";
-import { formatMean, readFigures } from "./figures.js";
+import { formatMax, formatMean, readFigures } from "./figures.js";
 import { unsaved } from "./state.js";
 
 const $ = (id) => document.getElementById(id);
@@ -52,6 +52,7 @@ export class Readout {
     const figures = readFigures(fit);
     $("de-label").firstChild.textContent = figures.label;
     $("de-mean").textContent = formatMean(figures.mean);
+    $("de-max").textContent = formatMax(figures.max);
     $("fit-id").textContent = fit.id;
     $("coefficients").textContent = modelKind(fit).describe(fit);
     const download = $("download");

@@ -118,6 +118,9 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     fit_json = page.request.get(f"{editor_url}api/v1/fits/{edited_id}").json()
     figure = fit_json["metrics"]["figure"]
     assert page.inner_text("#de-mean") == f"{figure['delta_E_mean']:.3f}"
+    # Issue 21: the worst point beside the mean, and where it is.
+    at = figure["max_at"]
+    assert page.inner_text("#de-max") == f"{figure['delta_E_max']:.3f} at {at['theta_deg']:.0f}°, ηᵢ {at['eta_i']:.2f}"
     assert page.inner_text("#de-label").startswith(f"Against {figure['against']}, mean ΔE")
     words = headline({"figure": figure})
     pack = json.loads(page.request.get(f"{editor_url}api/v1/fits/{edited_id}/pack?format=json").body())
