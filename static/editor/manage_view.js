@@ -110,7 +110,8 @@ export class ManageView {
       download.href = this.hooks.downloadURL(v.fit_id);
       download.setAttribute("download", "");
       download.setAttribute("aria-label", `Download version ${v.version}`);
-      const figure = v.delta_E_mean === null ? "" : ` · ΔE₀₀ ${v.delta_E_mean.toFixed(2)}`;
+      const figure = v.delta_E_mean === null ? "" : ` · ΔE₀₀ ${v.delta_E_mean.toFixed(2)}` +
+        (v.delta_E_max === null || v.delta_E_max === undefined ? "" : `, max ${v.delta_E_max.toFixed(2)}`);
       const li = line(`v${v.version}${v.version === listed.latest ? " (latest)" : ""}`,
                       `${when(v.saved_at)} · “${v.name}”${figure}`, [
         button("Open", `Open version ${v.version}`, () => this.hooks.onOpenVersion(v)),

@@ -133,6 +133,10 @@ def test_versions_open_download_and_continue(pages, editor_url):
     rows = page.locator("#versions-list li")
     expect(rows).to_have_count(2)
     assert rows.evaluate_all("els => els.map(e => e.dataset.version)") == ["2", "1"]
+    # Each version's figures: the mean and the worst point (issue 21).
+    for row in api(page, f"/materials/{material}/versions")["versions"]:
+        expect(page.locator(f"#versions-list li[data-version='{row['version']}']")).to_contain_text(
+            f"ΔE₀₀ {row['delta_E_mean']:.2f}, max {row['delta_E_max']:.2f}")
     # Any version downloads (in the Download menu's format).
     page.select_option("#format", "json")
     saved_item(page, material).get_by_role("button", name="Versions of Versioned gold").click()
