@@ -72,6 +72,17 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
                 + f", not the expected version {expected_version}: another save came first; "
                 "reload it and save again with `expected_version` "
                 f"{version}", version=version, latest_fit_id=latest)
+    if stored.kind == "curves":
+        # An edited material is found by its name: another one given this name
+        # since the save chose its material (a rename at the same moment) wins.
+        holder = connection.execute(
+            f"SELECT material_id FROM materials WHERE kind = 'curves' AND name = {p} AND material_id != {p}",
+            (summary_text(stored.name), stored.material_id)).fetchone()
+        if holder is not None:
+            row = material_row(connection, p, stored.material_id)
+            raise NameTaken(f"`name` {stored.name!r} was just given to another saved material {holder[0]}: "
+                            "save again (the save then goes to that material), or choose another name",
+                            version=row.version if row else 0, latest_fit_id=row.latest_fit_id if row else None)
     now = time.time()
     (seq,) = connection.execute(
         f"INSERT INTO saves (material_id, fit_id, saved_at) VALUES ({p}, {p}, {p}) RETURNING seq",

@@ -3,7 +3,9 @@ Which material a save of edited curves goes to, when another save of the
 same name lands between the name's lookup and the choice of a new id (two
 first saves at once, on one replica or on two): the same material, never
 a second one of that name (which would split the versions and let two
-``expected_version=0`` saves both win).
+``expected_version=0`` saves both win); and when a rename gives the name to
+another material in that moment, a 409 (names of edited materials are
+unique), never two materials of one name.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import pytest
 
 from service.jobs.common import content_address
 from service.jobs.materials import resolve_material
-from service.store import FitRecord, SQLiteStore
+from service.store import FitRecord, NameTaken, SQLiteStore
 
 POSTGRES = pytest.param("postgresql", marks=[pytest.mark.xdist_group("postgres"), pytest.mark.slow])
 
@@ -65,3 +67,17 @@ def test_renamed_away_takes_the_next_address(store):
     assert resolve_material(store, "gold") == second
     assert resolve_material(StaleLookup(store), "gold") == second
     assert resolve_material(store, "gilt") == first
+
+
+def test_a_rename_to_the_name_in_between_is_a_conflict(store):
+    store.put_fit(curves_record("1" * 32, "m" * 32, "other"))
+    chosen = resolve_material(store, "x")  # nothing is called "x" yet: a new material
+    store.rename_material("m" * 32, "x")  # another user, before this save is written
+    with pytest.raises(NameTaken, match="was just given to another saved material"):
+        store.put_fit(curves_record("2" * 32, chosen, "x"))
+    assert [m.material_id for m in store.saved_materials() if m.name == "x"] == ["m" * 32]
+    assert store.get_fit("2" * 32) is None  # the refused save left nothing behind
+    # Saved again, it goes to the material called "x" now.
+    again = resolve_material(store, "x")
+    assert again == "m" * 32
+    assert store.put_fit(curves_record("3" * 32, again, "x")).material_id == "m" * 32
