@@ -75,9 +75,7 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
     if stored.kind == "curves":
         # An edited material is found by its name: another one given this name
         # since the save chose its material (a rename at the same moment) wins.
-        holder = connection.execute(
-            f"SELECT material_id FROM materials WHERE kind = 'curves' AND name = {p} AND material_id != {p}",
-            (summary_text(stored.name), stored.material_id)).fetchone()
+        holder = _other_holder(connection, p, stored.name, stored.material_id)
         if holder is not None:
             row = material_row(connection, p, stored.material_id)
             raise NameTaken(f"`name` {stored.name!r} was just given to another saved material {holder[0]}: "
@@ -219,13 +217,18 @@ def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
     return row
 
 
+def _other_holder(connection: Any, p: str, name: str, material_id: str):
+    """(id, deleted_at) of an edited material other than ``material_id`` called ``name`` (in the bin or not), or None."""
+    return connection.execute(
+        f"SELECT material_id, deleted_at FROM materials WHERE kind = 'curves' AND name = {p} "
+        f"AND material_id != {p}", (summary_text(name), material_id)).fetchone()
+
+
 def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
     """Inside a write transaction holding the saves' lock: the summary of ``material_id`` renamed."""
     row = _saved(connection, p, material_id)
     if row.kind == "curves":  # an edited material is found by its name: names are unique
-        holder = connection.execute(
-            f"SELECT material_id, deleted_at FROM materials WHERE kind = 'curves' AND name = {p} "
-            f"AND material_id != {p}", (summary_text(name), material_id)).fetchone()
+        holder = _other_holder(connection, p, name, material_id)
         if holder is not None:
             where = " (in the bin)" if holder[1] is not None else ""
             raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
