@@ -29,8 +29,8 @@ formula. Color Research & Application, 30(1), 21-30.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
 import threading
+from collections.abc import Callable
 
 import numpy as np
 

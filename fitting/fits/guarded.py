@@ -28,7 +28,7 @@ from threadpoolctl import ThreadpoolController
 from ..colour.colorimetry import ACEScg_to_Lab
 from ..models.coated_conductor import coated_conductor_model, model_jacobian
 from ..models.pack import to_float16
-from .objective import Problem, coefficient_bounds
+from .objective import Problem, coefficient_bounds, delta_E_gradients
 from .quantise import quantise_coefficients
 from .result import FitResult
 from .paper_method import paper_fit
@@ -165,9 +165,7 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
             return float(w @ np.sqrt(np.sum(r[:S] ** 2, axis=1)))
 
         def gradient(x):
-            r, J = both.residuals(x), both.jacobian(x)
-            dE = np.sqrt(np.sum(r[:S] ** 2, axis=1))
-            return w @ (np.einsum("so,son->sn", r[:S], J[:S]) / np.maximum(dE, 1e-12)[:, None])
+            return w @ delta_E_gradients(both.residuals(x)[:S], both.jacobian(x)[:S])
 
         def constraint(x):
             return cap * cap - np.sum(both.residuals(x)[S:] ** 2, axis=1)

@@ -22,7 +22,7 @@ from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_deferred
 from ..colour.delta_e import de2000_weights
 from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
 
-__all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds"]
+__all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds", "delta_E_gradients"]
 
 
 # Box bounds of the coefficients: F0, a, alpha. Generous for every measured
@@ -31,6 +31,16 @@ __all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds"]
 # from running away, and every coefficient far inside the float16 range.
 # alpha's constant term stays at or above the model's clamp.
 COEFFICIENT_BOUND = np.array([16.0, 64.0, 256.0])
+
+
+def delta_E_gradients(r, J):
+    """
+    The gradient in the coefficients (S, n) of each sample's first-order
+    Delta E, the norm of its ``de2000`` residual: from the residuals (S, 3)
+    and Jacobian (S, 3, n) of :meth:`Problem.residuals_jacobian`.
+    """
+    dE = np.sqrt(np.sum(r**2, axis=1))
+    return np.einsum("so,son->sn", r, J) / np.maximum(dE, 1e-12)[:, None]
 
 
 class Problem:

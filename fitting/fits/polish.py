@@ -32,7 +32,7 @@ import numpy as np
 from ..colour.colorimetry import ACEScg_to_Lab
 from ..colour.delta_e import delta_E_2000
 from ..models.coated_conductor import coated_conductor_model
-from .objective import Problem
+from .objective import Problem, delta_E_gradients
 from .worst_case import score_of
 
 __all__ = ["POLISH_STEPS", "SCREEN", "polish_float16"]
@@ -70,8 +70,7 @@ def _figures(target_Lab, cos_theta, eta_i, eta_i_range, stack: np.ndarray):
 
 def _predicted(problem: Problem, C16, moves, dE):
     """First-order Delta E of each move (K, S): the exact ``dE`` of ``C16`` plus the gradient times the step."""
-    r, J = problem.residuals_jacobian(C16.ravel().astype(np.float64))
-    G = np.einsum("so,son->sn", r, J) / np.maximum(np.linalg.norm(r, axis=1), 1e-12)[:, None]
+    G = delta_E_gradients(*problem.residuals_jacobian(C16.ravel().astype(np.float64)))
     steps = moves.reshape(len(moves), -1).astype(np.float64) - C16.ravel().astype(np.float64)
     return dE[None] + steps @ G.T
 
