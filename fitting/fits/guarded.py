@@ -72,6 +72,7 @@ class _Cached:
 
     def __init__(self, problem: Problem) -> None:
         self.problem, self.key = problem, None
+        self.r = self.J = self._jacobian = None  # at the point of `key`; J once asked for
 
     def _at(self, x) -> None:
         key = x.tobytes()
