@@ -20,7 +20,7 @@ import numpy as np
 
 from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_deferred
 from ..colour.delta_e import de2000_weights
-from ..models.coated_conductor import ALPHA_MIN, coated_conductor_model, model_jacobian, normalised_eta_i
+from ..models.coated_conductor import ALPHA_MIN, ModelAt, model_jacobian, normalised_eta_i
 
 __all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds", "delta_E_gradients"]
 
@@ -65,6 +65,25 @@ class Problem:
         else:
             self.target_out = ACEScg_to_Lab(self.target)
             self.A = de2000_weights(self.target_out) if objective == "de2000" else None
+
+    def reweighted(self, weights) -> "Problem":
+        """
+        This problem with the sample ``weights`` (S,) instead: the target's
+        Lab, its CIEDE2000 metric and the samples' geometry shared, not
+        computed again (the rounds of :func:`fitting.fits.solver.reweighted`).
+        """
+        self._geometry()
+        self._model()
+        again = object.__new__(Problem)
+        again.__dict__.update(self.__dict__)
+        again.sqrt_w = None if weights is None else np.sqrt(np.ravel(weights))[:, None]
+        return again
+
+    def _model(self) -> ModelAt:
+        """The model at the samples (:class:`fitting.models.coated_conductor.ModelAt`), prepared once."""
+        if getattr(self, "_at", None) is None:
+            self._at = ModelAt(self.mu, self.eta, self.range)
+        return self._at
 
     def _geometry(self):
         """What the samples fix of Eq. 1 and its derivative: mu, the powers of t, 1 - mu, (1 - mu)^5, log(1 - mu)."""
@@ -141,12 +160,13 @@ class Problem:
 
     def _range_residuals(self, x):
         mu, eta, weight = self.check
-        F = coated_conductor_model(mu, eta, x.reshape(self.shape), self.range)
+        if getattr(self, "_check_at", None) is None:
+            self._check_at = ModelAt(mu, eta, self.range)
+        F = self._check_at(x.reshape(self.shape))
         return weight * (np.minimum(F, 0.0) + np.maximum(F - 1.0, 0.0))
 
     def residuals(self, x):
-        F = coated_conductor_model(self.mu, self.eta, x.reshape(self.shape), self.range)
-        r = self._outputs(F)
+        r = self._outputs(self._model()(x.reshape(self.shape)))
         if self.sqrt_w is not None:
             r = r * self.sqrt_w
         if self.check is not None:

@@ -48,6 +48,7 @@ __all__ = [
     "model_parameters",
     "collapse_to_eta_i",
     "coated_conductor_model",
+    "ModelAt",
     "model_from_parameters",
     "model_jacobian",
 ]
@@ -114,7 +115,11 @@ def model_parameters(coefficients, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> np
     """
     C = np.asarray(coefficients, dtype=np.float64)
     t = normalised_eta_i(eta_i, eta_i_range)
-    T = _powers(t, C.shape[2] - 1)
+    return _parameters(_powers(t, C.shape[2] - 1), C)
+
+
+def _parameters(T, C) -> np.ndarray:
+    """:func:`model_parameters` from the powers of t ``T`` (..., d + 1) and the coefficients ``C``."""
     with np.errstate(over="ignore", invalid="ignore"):
         P = np.einsum("...j,pcj->...pc", T, C)
     # Clamped, not refused (see PARAMETER_LIMIT); np.clip keeps NaN.
@@ -178,12 +183,38 @@ def coated_conductor_model(
     ValueError
         If ``cos_theta`` or ``eta_i`` is not numbers.
     """
-    C = np.asarray(coefficients, dtype=np.float64)
-    mu, eta_i = np.broadcast_arrays(
-        as_float_array("cos_theta", cos_theta), as_float_array("eta_i", eta_i)
-    )
-    P = model_parameters(C, eta_i, eta_i_range)
-    return model_from_parameters(mu[..., None], P[..., 0, :], P[..., 1, :], P[..., 2, :])
+    return ModelAt(cos_theta, eta_i, eta_i_range)(coefficients)
+
+
+class ModelAt:
+    """
+    :func:`coated_conductor_model` at fixed (``cos_theta``, ``eta_i``) for
+    many coefficient arrays: what the samples fix (the powers of *t*,
+    :math:`1 - \\mu`, :math:`(1 - \\mu)^5`) computed once, for solvers that
+    evaluate one set of samples hundreds of times. Calling it with
+    ``coefficients`` is :func:`coated_conductor_model` (which is defined by
+    it), the same operations on the same values.
+    """
+
+    def __init__(self, cos_theta, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> None:
+        mu, eta_i = np.broadcast_arrays(
+            as_float_array("cos_theta", cos_theta), as_float_array("eta_i", eta_i)
+        )
+        self.t = normalised_eta_i(eta_i, eta_i_range)
+        self.powers: dict[int, np.ndarray] = {}
+        self.mu = np.clip(mu[..., None], 0.0, 1.0)
+        self.x = 1.0 - self.mu
+        self.x5 = self.x**5
+
+    def __call__(self, coefficients) -> np.ndarray:
+        C = np.asarray(coefficients, dtype=np.float64)
+        d1 = C.shape[2]
+        T = self.powers.get(d1)
+        if T is None:
+            T = self.powers[d1] = _powers(self.t, d1 - 1)
+        P = _parameters(T, C)
+        F0, a, alpha = P[..., 0, :], P[..., 1, :], P[..., 2, :]
+        return F0 + (1.0 - F0) * self.x5 - a * self.mu * self.x ** np.maximum(alpha, ALPHA_MIN)
 
 
 def model_jacobian(cos_theta, eta_i, coefficients, eta_i_range=DEFAULT_ETA_I_RANGE):

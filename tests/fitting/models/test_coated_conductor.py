@@ -7,6 +7,7 @@ from fitting.domain import check_eta_i
 from fitting.fits.curves_input import RGBCurve
 from fitting.models.coated_conductor import (
     ALPHA_MIN,
+    ModelAt,
     coated_conductor_model,
     collapse_to_eta_i,
     model_jacobian,
@@ -91,6 +92,22 @@ class TestModel:
         huge[:, :, 1] = -1e300
         F = coated_conductor_model(np.linspace(0.0, 1.0, 11), 1.7, huge)
         assert np.all(np.isfinite(F))
+
+    def test_model_at_fixed_samples_is_the_model(self):
+        # One ModelAt, many coefficient arrays of every degree, in any order:
+        # each is the model of those coefficients, to the bit (the solvers'
+        # residuals rely on it).
+        mu, eta = np.meshgrid(np.linspace(-0.1, 1.1, 13), np.linspace(0.9, 2.7, 5))
+        at = ModelAt(mu, eta, (1.0, 2.5))
+        for C in (KNOWN, KNOWN[:, :, :1], KNOWN * 1.3, KNOWN[:, :, :2], KNOWN - 0.2, KNOWN[:, :, :1] * 0.5):
+            F = at(C)
+            assert F.shape == mu.shape + (3,)
+            assert np.array_equal(F, coated_conductor_model(mu, eta, C, (1.0, 2.5)))
+            P = model_parameters(C, np.clip(eta, 1.0, 2.5), (1.0, 2.5))
+            m = np.clip(mu, 0.0, 1.0)[..., None]
+            expected = P[..., 0, :] + (1.0 - P[..., 0, :]) * (1.0 - m) ** 5 - P[..., 1, :] * m * (1.0 - m) ** P[..., 2, :]
+            np.testing.assert_allclose(F, expected, rtol=0, atol=1e-14)  # a few roundings of terms <= 10
+        assert ModelAt(0.3, 1.2, (1.0, 2.5))(KNOWN).shape == (3,)
 
     def test_nan_in_gives_nan_out_where_it_is(self):
         F = coated_conductor_model([0.2, np.nan], 1.5, KNOWN)
