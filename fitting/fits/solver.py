@@ -236,7 +236,7 @@ def fit_coefficients(
         return dE if weights is None else dE / np.sqrt(np.maximum(weights, 1e-300))
 
     def resolve(sample_weights, x):
-        again = Problem(target, mu, eta, eta_i_range, degree, objective, sample_weights, range_check)
+        again = problem.reweighted(sample_weights)
         return again, solve(again, x, bounds, 1e-8, max_nfev)
 
     # Mean Delta E, not its RMS (de2000 only).

@@ -57,6 +57,21 @@ class TestProblem:
         problem.residuals_deferred(x + 0.5)  # another point between: the first keeps its own
         assert np.array_equal(d, r) and np.array_equal(jacobian(), J)
 
+    @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
+    def test_reweighted_is_the_problem_with_those_weights(self, objective):
+        # The rounds of reweighting share the target's Lab, its metric and the geometry.
+        mu, eta, _ = fit_grid((1.0, 2.5), 16, 5, "uniform")
+        target = coated_conductor_model(mu, eta, KNOWN) * 0.97
+        x = (KNOWN + 0.01).ravel()
+        first = Problem(target, mu, eta, (1.0, 2.5), 2, objective)
+        first.residuals(x), first.jacobian(x)
+        weights = np.linspace(0.5, 2.0, mu.size)
+        again = first.reweighted(weights)
+        fresh = Problem(target, mu, eta, (1.0, 2.5), 2, objective, weights)
+        assert np.array_equal(again.residuals(x), fresh.residuals(x))
+        assert np.array_equal(again.jacobian(x), fresh.jacobian(x))
+        assert np.array_equal(first.residuals(x), Problem(target, mu, eta, (1.0, 2.5), 2, objective).residuals(x))
+
 
 class TestFitCoefficients:
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
