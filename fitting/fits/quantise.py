@@ -54,8 +54,8 @@ def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> n
         if step != 0.0 and free.any():
             # Minimise q over the free coordinates given the fixed ones.
             F = np.flatnonzero(free)
-            rhs = Hs[np.ix_(F, [i])].ravel() * (step * scale[i])
-            delta[F] -= np.linalg.solve(Hs[np.ix_(F, F)], rhs) / scale[F]
+            rhs = Hs[F, i] * (step * scale[i])
+            delta[F] -= np.linalg.solve(Hs[F][:, F], rhs) / scale[F]
     with np.errstate(over="ignore", invalid="ignore"):
         x16 = (x + delta).astype(np.float16)
     if not np.all(np.isfinite(x16)):
@@ -65,25 +65,43 @@ def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> n
     delta = x16.astype(np.float64) - x
     # One-ulp coordinate moves, best first. The change of q for a move s_i of
     # coordinate i alone is s_i (2 (H delta + g)_i + s_i H_ii): all moves are
-    # scored at once, the best taken, the gradient updated, until none helps.
+    # scored at once, the best taken (the first of the lowest, ups before
+    # downs), the gradient and the moved coordinate's steps updated, until
+    # none helps.
     gradient = H @ delta + g
-    for _ in range(passes * n):
-        with np.errstate(over="ignore", invalid="ignore"):
-            up = np.nextafter(x16, np.float16(np.inf)).astype(np.float64) - x16
-            down = np.nextafter(x16, np.float16(-np.inf)).astype(np.float64) - x16
-        steps = np.stack([up, down])
-        change = steps * (2.0 * gradient + steps * np.diag(H))
-        change[~np.isfinite(change)] = np.inf
-        k, i = np.unravel_index(np.argmin(change), change.shape)
-        if not change[k, i] < 0.0:  # q strictly decreases: no cycles
-            break
-        step = steps[k, i]
-        x16[i] = np.float16(x16[i] + step)
-        delta[i] += step
-        gradient += H[:, i] * step
+    curvature = np.diag(H)
+    with np.errstate(over="ignore", invalid="ignore"):
+        up, down = _ulp_steps(x16)
+        for _ in range(passes * n):
+            change_up = _finite_or_inf(up * (2.0 * gradient + up * curvature))
+            change_down = _finite_or_inf(down * (2.0 * gradient + down * curvature))
+            i_up, i_down = int(np.argmin(change_up)), int(np.argmin(change_down))
+            if change_up[i_up] <= change_down[i_down]:
+                i, step, best = i_up, up[i_up], change_up[i_up]
+            else:
+                i, step, best = i_down, down[i_down], change_down[i_down]
+            if not best < 0.0:  # q strictly decreases: no cycles
+                break
+            x16[i] = np.float16(x16[i] + step)
+            delta[i] += step
+            gradient += H[:, i] * step
+            up[i], down[i] = (v[0] for v in _ulp_steps(x16[i:i + 1]))
     x16 = (x + delta).astype(np.float16)
     nearest = to_float16(x)
     cost = np.sum(problem.residuals(x16.astype(np.float64)) ** 2)
     cost_nearest = np.sum(problem.residuals(nearest.astype(np.float64)) ** 2)
     chosen = x16 if cost <= cost_nearest else nearest
     return to_float16(chosen.astype(np.float64)).reshape(C.shape)
+
+
+def _ulp_steps(x16):
+    """The steps (float64) to the next float16 up and down of each of ``x16``."""
+    up = np.nextafter(x16, np.float16(np.inf)).astype(np.float64) - x16
+    down = np.nextafter(x16, np.float16(-np.inf)).astype(np.float64) - x16
+    return up, down
+
+
+def _finite_or_inf(change):
+    """``change`` with every non-finite value made +inf (never taken)."""
+    change[~np.isfinite(change)] = np.inf
+    return change
