@@ -18,6 +18,18 @@ class TestFitGrid:
         assert np.mean(w * f) == pytest.approx(exact, rel=1e-12)  # Gauss
         # nodes and weights to ~10 u64 each, 12 terms in the mean: < 1e3 u64 = 1.1e-13
 
+    def test_grids_are_the_callers_own(self):
+        # The Gauss nodes are computed once per size: a caller writing into
+        # one grid changes no later grid.
+        first = fit_grid((1.0, 2.5), 6, 3)
+        expected = [a.copy() for a in first]
+        for a in first:
+            a *= 2.0
+        for a, b in zip(fit_grid((1.0, 2.5), 6, 3), expected):
+            assert np.array_equal(a, b)
+        x, w = np.polynomial.legendre.leggauss(6)
+        assert np.array_equal(expected[0][:6], 0.5 * (x + 1.0))
+
     def test_uniform_and_single_eta(self):
         mu, eta, w = fit_grid((1.0, 2.5), 5, 3, "uniform")
         np.testing.assert_array_equal(w, 1.0)
