@@ -8,9 +8,10 @@ with its worst point guarded (:mod:`fitting.fits.worst_case`):
 -   :func:`guarded_fit`: the mean-Delta-E fit, the paper method's fit (plain
     linear-RGB least squares on the guard points, rounded to float16 as the
     paper ships it), and, when the mean fit's max is not under the paper
-    method's, soft-maximum refits (:func:`fitting.fits.worst_case.lp_weights`);
-    the one :func:`fitting.fits.worst_case.choose` picks is returned, with
-    the figures of every candidate in ``result.guard``.
+    method's, SLSQP refits of the least mean with the max capped under the
+    paper method's (:func:`constrained_refits`); the one
+    :func:`fitting.fits.worst_case.choose` picks is returned, with the
+    figures of every candidate in ``result.guard``.
 
 References
 ----------
