@@ -76,6 +76,7 @@ class Problem:
         self._model()
         again = object.__new__(Problem)
         again.__dict__.update(self.__dict__)
+        again.__dict__.pop("_last", None)
         again.sqrt_w = None if weights is None else np.sqrt(np.ravel(weights))[:, None]
         return again
 
@@ -166,9 +167,15 @@ class Problem:
         return weight * (np.minimum(F, 0.0) + np.maximum(F - 1.0, 0.0))
 
     def residuals(self, x):
-        r = self._outputs(self._model()(x.reshape(self.shape)))
-        if self.sqrt_w is not None:
-            r = r * self.sqrt_w
+        if self.objective == "rgb":
+            r = self._outputs(self._model()(x.reshape(self.shape)))
+            if self.sqrt_w is not None:
+                r = r * self.sqrt_w
+        else:
+            # Lab and de2000: the one pass, its Jacobian kept for this x
+            # (trf asks for the Jacobian at the point it has just evaluated).
+            r, jacobian = self.residuals_deferred(x)
+            self._last = (np.array(x, dtype=np.float64), jacobian)
         if self.check is not None:
             return np.concatenate([r.ravel(), self._range_residuals(x).ravel()])
         return r.ravel()
@@ -184,8 +191,12 @@ class Problem:
         return J.reshape(K * 3, -1)
 
     def jacobian(self, x):
-        if self.objective != "rgb":  # Lab and de2000: the one pass (its residuals are a small part of it)
-            _, J = self.residuals_jacobian(x)
+        if self.objective != "rgb":  # Lab and de2000: the one pass, kept from residuals() at this x
+            last = getattr(self, "_last", None)
+            if last is not None and np.array_equal(last[0], x):
+                J = last[1]()
+            else:
+                _, J = self.residuals_jacobian(x)
             J = J.reshape(J.shape[0] * 3, -1)
             return J if self.check is None else np.concatenate([J, self._range_jacobian(x)])
         # rgb: each output is its channel's model value, J[s, c, p, c, j] = Jm[s, c, p, j].

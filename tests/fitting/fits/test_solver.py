@@ -57,6 +57,30 @@ class TestProblem:
         problem.residuals_deferred(x + 0.5)  # another point between: the first keeps its own
         assert np.array_equal(d, r) and np.array_equal(jacobian(), J)
 
+    @pytest.mark.parametrize("objective", ["lab", "de2000"])
+    @pytest.mark.parametrize("checked", [False, True])
+    def test_jacobian_after_residuals_is_the_one_pass_to_the_bit(self, objective, checked):
+        # lab and de2000 residuals are the one pass's, and trf asks for the
+        # Jacobian at the point whose residuals it has just evaluated:
+        # residuals() keeps the one pass's Jacobian for that x.
+        mu, eta, _ = fit_grid((1.0, 2.5), 16, 5, "uniform")
+        target = coated_conductor_model(mu, eta, KNOWN) * 0.97
+        check = (np.linspace(0.0, 1.0, 7), np.full(7, 1.7), 3.0) if checked else None
+        weights = np.linspace(0.5, 2.0, mu.size)
+        problem = Problem(target, mu, eta, (1.0, 2.5), 2, objective, weights, check)
+        fresh = Problem(target, mu, eta, (1.0, 2.5), 2, objective, weights, check)
+        x, y = (KNOWN + 0.01).ravel(), (KNOWN * 1.5).ravel()  # at y the range rows are active
+        r, J = fresh.residuals_jacobian(x)
+        assert np.array_equal(problem.residuals(x)[: r.size], r.ravel())
+        assert np.array_equal(problem.jacobian(x)[: r.size], J.reshape(r.size, -1))
+        # At another point the Jacobian is that point's, not the one kept.
+        assert np.array_equal(problem.jacobian(y), fresh.jacobian(y))
+        problem.residuals(x)
+        assert np.array_equal(problem.jacobian(y), fresh.jacobian(y))
+        if checked:
+            assert np.array_equal(problem.residuals(y), fresh.residuals(y))
+            assert np.any(problem.residuals(y)[3 * mu.size:] != 0.0)
+
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
     def test_reweighted_is_the_problem_with_those_weights(self, objective):
         # The rounds of reweighting share the target's Lab, its metric and the geometry.
