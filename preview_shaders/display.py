@@ -39,12 +39,9 @@ __all__ = [
 @functools.cache
 def ACEScg_to_sRGB_matrix() -> np.ndarray:
     """Linear ACEScg to linear sRGB, CAT02 from the ACES white to D65."""
-    import warnings
+    from fitting.colour.colorimetry import colour_science
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        import colour
-
+    colour = colour_science()
     M = colour.matrix_RGB_to_RGB(
         colour.RGB_COLOURSPACES["ACEScg"],
         colour.RGB_COLOURSPACES["sRGB"],

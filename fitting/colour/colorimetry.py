@@ -16,7 +16,8 @@ Spectral reflectance to linear ACEScg, and CIE 1976 L*a*b*.
 Conventions: CIE 1931 2 degree observer; illuminant the CIE D series at the
 ACES white point (D60, xy = 0.32168, 0.33767); CAT02 adaptation to the ACEScg
 white; each row of the weights normalised so that a perfect reflector maps to
-(1, 1, 1). colour-science is imported once, lazily (its import takes ~1 s).
+(1, 1, 1). colour-science is imported once, lazily (:func:`colour_science`;
+its plotting package, and matplotlib with it, only on use).
 
 References
 ----------
@@ -29,6 +30,10 @@ formula. Color Research & Application, 30(1), 21-30.
 from __future__ import annotations
 
 import functools
+import importlib.abc
+import importlib.machinery
+import importlib.util
+import sys
 import threading
 from collections.abc import Callable
 
@@ -37,6 +42,7 @@ import numpy as np
 from ..domain import VISIBLE_RANGE_NM
 
 __all__ = [
+    "colour_science",
     "ACES_WHITE_XY",
     "spectral_to_ACEScg_weights",
     "reflectance_to_ACEScg",
@@ -51,25 +57,51 @@ ACES_WHITE_XY = np.array([0.32168, 0.33767])
 """CIE xy chromaticity of the ACES white point (~D60)."""
 
 _LOCK = threading.Lock()
+_IMPORT_LOCK = threading.Lock()  # apart from _LOCK: callers of colour_science() hold that one
 
 # CIE Lab constants: delta = 6/29 splits the cube root from its linear segment.
 _DELTA = 6.0 / 29.0
 _DELTA3 = _DELTA**3
 
 
-def _colour():
-    """Import colour-science once (slow import), quietly."""
+class _LazyPlotting(importlib.abc.MetaPathFinder):
+    """
+    Finds ``colour.plotting`` with a lazy loader (:class:`importlib.util.LazyLoader`):
+    colour-science's ``__init__`` imports its plotting package, and with it
+    matplotlib, about 0.4 s of every process that imports it (each server
+    and fitting worker, each CLI run); nothing here plots with it. The
+    package runs on its first attribute access, as a plain import would.
+    """
+
+    def find_spec(self, name, path, target=None):
+        if name != "colour.plotting":
+            return None
+        spec = importlib.machinery.PathFinder.find_spec(name, path)
+        if spec is not None and spec.loader is not None:
+            spec.loader = importlib.util.LazyLoader(spec.loader)
+        return spec
+
+
+@functools.cache
+def colour_science():
+    """colour-science, imported once, quietly (its plotting package on first use: :class:`_LazyPlotting`)."""
     import warnings
 
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        import colour
+    with _IMPORT_LOCK:
+        finder = _LazyPlotting()
+        sys.meta_path.insert(0, finder)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                import colour
+        finally:
+            sys.meta_path.remove(finder)
     return colour
 
 
 @functools.cache
 def _weights_1nm() -> np.ndarray:
-    colour = _colour()
+    colour = colour_science()
     shape = colour.SpectralShape(VISIBLE_RANGE_NM[0], VISIBLE_RANGE_NM[1], 1)
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
     illuminant = colour.sd_CIE_illuminant_D_series(ACES_WHITE_XY).copy().align(shape)
@@ -145,7 +177,7 @@ def reflectance_to_ACEScg(reflectance, weights) -> np.ndarray:
 
 @functools.cache
 def _matrices() -> tuple[np.ndarray, np.ndarray]:
-    colour = _colour()
+    colour = colour_science()
     acescg = colour.RGB_COLOURSPACES["ACEScg"]
     M = np.array(acescg.matrix_RGB_to_XYZ, dtype=np.float64)
     XYZ_n = M @ np.ones(3)

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .colorimetry import ACEScg_to_Lab, _colour
+from .colorimetry import ACEScg_to_Lab, colour_science
 
 __all__ = ["delta_E_2000", "delta_E_map", "de2000_weights"]
 
@@ -33,7 +33,7 @@ def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
     2000")`` gives the same values through a method dispatch that costs a
     third of the call on the guard's 408 points).
     """
-    return np.asarray(_colour().difference.delta_E_CIE2000(Lab_1, Lab_2), dtype=np.float64)
+    return np.asarray(colour_science().difference.delta_E_CIE2000(Lab_1, Lab_2), dtype=np.float64)
 
 
 def delta_E_map(reference_RGB, model_RGB) -> np.ndarray:

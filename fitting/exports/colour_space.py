@@ -16,14 +16,14 @@ import functools
 
 import numpy as np
 
-from ..colour.colorimetry import _colour
+from ..colour.colorimetry import colour_science
 
 __all__ = ["ACEScg_to_lin_rec709", "lin_rec709_to_ACEScg"]
 
 
 @functools.cache
 def _ACEScg_to_rec709() -> np.ndarray:
-    colour = _colour()
+    colour = colour_science()
     M = colour.RGB_to_RGB(
         np.eye(3), "ACEScg", "ITU-R BT.709", chromatic_adaptation_transform="CAT02"
     ).T

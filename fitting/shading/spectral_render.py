@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACES_WHITE_XY, _colour
+from ..colour.colorimetry import ACES_WHITE_XY, colour_science
 from ..domain import DEFAULT_MIN_COVERAGE, check_eta_i, check_int
 from ..optics.nk import SpectralNK, resample_nk
 
@@ -54,7 +54,7 @@ def XYZ_to_ACEScg_matrix(XYZ_white) -> np.ndarray:
     white, the ACEScg matrix, rows scaled so that ``XYZ_white`` maps to
     (1, 1, 1) (as :func:`fitting.colour.colorimetry.spectral_to_ACEScg_weights`).
     """
-    colour = _colour()
+    colour = colour_science()
     acescg = colour.RGB_COLOURSPACES["ACEScg"]
     XYZ_w = np.asarray(XYZ_white, dtype=np.float64)
     XYZ_wr = acescg.matrix_RGB_to_XYZ @ np.ones(3)
@@ -95,7 +95,7 @@ def mitsuba_rough_sphere(
     spp = check_int("spp", spp, 1, 1 << 16)
     r = float(np.clip(roughness, 0.0, 1.0))
     sampled = resample_nk(nk, _LAMBDA, min_coverage)
-    colour = _colour()
+    colour = colour_science()
     D60 = colour.sd_CIE_illuminant_D_series(ACES_WHITE_XY).copy().align(
         colour.SpectralShape(360, 830, 5)
     )

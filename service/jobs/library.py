@@ -22,9 +22,9 @@ from __future__ import annotations
 import functools
 from typing import Any
 
-import colour
 import numpy as np
 
+from fitting.colour.colorimetry import colour_science
 from fitting.colour.reference import reference_ACEScg
 from fitting.domain import COAT_PRESETS, check_eta_i, cos_theta_from_angle
 from fitting.exports.colour_space import ACEScg_to_lin_rec709
@@ -40,7 +40,7 @@ SWATCH_ANGLES_DEG: tuple[float, ...] = (0.0, 45.0, 70.0, 85.0)
 def srgb_hex(ACEScg) -> list[str]:
     """``#rrggbb`` of linear ACEScg rows as displayed: Rec.709 (CAT02), clipped, sRGB-encoded."""
     linear = np.clip(ACEScg_to_lin_rec709(np.atleast_2d(ACEScg)), 0.0, 1.0)
-    encoded = np.round(colour.cctf_encoding(linear, function="sRGB") * 255.0).astype(int)
+    encoded = np.round(colour_science().cctf_encoding(linear, function="sRGB") * 255.0).astype(int)
     return ["#" + "".join(f"{v:02x}" for v in row) for row in encoded]
 
 

@@ -118,3 +118,27 @@ class TestColorimetry:
         assert delta_E_2000([50.0, 2.6772, -79.7751], [50.0, 0.0, -82.7485]) == pytest.approx(
             2.0425, abs=1e-4
         )
+
+
+@pytest.mark.slow  # a fresh interpreter
+def test_colour_science_loads_its_plotting_only_on_use():
+    # Every server, worker and CLI process imports colour-science; its
+    # plotting package (matplotlib with it) waits until something uses it,
+    # and then is the real package.
+    import subprocess
+    import sys
+
+    script = (
+        "import sys\n"
+        "from fitting.colour.colorimetry import colour_science\n"
+        "import service.main\n"
+        "colour = colour_science()\n"
+        "assert colour is sys.modules['colour'] and colour_science() is colour\n"
+        "assert 'matplotlib' not in sys.modules, sorted(m for m in sys.modules if 'matplotlib' in m)[:5]\n"
+        "assert callable(colour.plotting.plot_single_colour_swatch)\n"
+        "assert 'matplotlib' in sys.modules\n"
+        "print('ok')\n"
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                          cwd=__file__.rsplit("/tests/", 1)[0])
+    assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]
