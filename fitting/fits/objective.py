@@ -20,7 +20,7 @@ import numpy as np
 
 from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_deferred
 from ..colour.delta_e import de2000_weights
-from ..models.coated_conductor import ALPHA_MIN, ModelAt, model_jacobian, normalised_eta_i
+from ..models.coated_conductor import ALPHA_MIN, ModelAt, model_jacobian
 
 __all__ = ["COEFFICIENT_BOUND", "Problem", "coefficient_bounds", "delta_E_gradients"]
 
@@ -73,7 +73,6 @@ class Problem:
         computed again (the rounds of :func:`fitting.fits.solver.reweighted`).
         """
         self._geometry()
-        self._model()
         again = object.__new__(Problem)
         again.__dict__.update(self.__dict__)
         again.__dict__.pop("_last", None)
@@ -89,13 +88,11 @@ class Problem:
     def _geometry(self):
         """What the samples fix of Eq. 1 and its derivative: mu, the powers of t, 1 - mu, (1 - mu)^5, log(1 - mu)."""
         if getattr(self, "_geo", None) is None:
-            mu = np.clip(self.mu, 0.0, 1.0)
-            t = normalised_eta_i(self.eta, self.range)
-            T = np.stack([t**j for j in range(self.shape[2])], axis=-1)
-            x = (1.0 - mu)[:, None]
+            at = self._model()  # the same values the model is evaluated with
+            x = at.x
             with np.errstate(divide="ignore", invalid="ignore"):
                 log_x = np.where(x > 0.0, np.log(np.where(x > 0.0, x, 1.0)), 0.0)
-            self._geo = (mu[:, None], T, x, x**5, log_x)
+            self._geo = (at.mu, at.powers_of(self.shape[2]), x, at.x5, log_x)
         return self._geo
 
     def residuals_jacobian(self, x):

@@ -206,13 +206,15 @@ class ModelAt:
         self.x = 1.0 - self.mu
         self.x5 = self.x**5
 
+    def powers_of(self, d1: int) -> np.ndarray:
+        """The powers 1, t, ..., t^(d1 - 1) at the samples, shape (..., d1), computed once per ``d1``."""
+        if d1 not in self.powers:
+            self.powers[d1] = _powers(self.t, d1 - 1)
+        return self.powers[d1]
+
     def __call__(self, coefficients) -> np.ndarray:
         C = np.asarray(coefficients, dtype=np.float64)
-        d1 = C.shape[2]
-        T = self.powers.get(d1)
-        if T is None:
-            T = self.powers[d1] = _powers(self.t, d1 - 1)
-        P = _parameters(T, C)
+        P = _parameters(self.powers_of(C.shape[2]), C)
         F0, a, alpha = P[..., 0, :], P[..., 1, :], P[..., 2, :]
         return F0 + (1.0 - F0) * self.x5 - a * self.mu * self.x ** np.maximum(alpha, ALPHA_MIN)
 
