@@ -5,8 +5,11 @@
 // and environment as the editor's preview (static/preview.js: orbit
 // (0.5, 0.25, 4.2), vertical field of view 0.52 rad). The asset's material
 // goes on a finer sphere than the asset's own 24 x 12 one, so that the ball
-// is round to the pixel. `window.cfThree` renders either into a float
-// target for the parity tests.
+// is round to the pixel. One WebGLRenderer (one GL context, off the page)
+// draws both balls, so that an environment is prefiltered (three's PMREM)
+// once and both scenes share it; each ball's canvas shows a copy of its
+// image. `window.cfThree` renders either into a float target for the parity
+// tests.
 
 import * as THREE from "three";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
@@ -106,10 +109,9 @@ async function environment(renderer, name) {
 }
 
 class Ball {
-  constructor(canvas, material) {
+  constructor(renderer, canvas, material) {
     this.canvas = canvas;
-    this.renderer = new THREE.WebGLRenderer({ canvas, antialias: false, preserveDrawingBuffer: true, alpha: true });
-    this.renderer.setClearColor(0x000000, 0);
+    this.renderer = renderer;
     this.scene = new THREE.Scene();
     this.material = material;
     this.mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 512, 256), material);
@@ -120,14 +122,7 @@ class Ball {
     this.camera.lookAt(0, 0, 0);
   }
 
-  /** Light the ball by environment `name` (see environment()). */
-  async setEnvironment(name) {
-    const previous = this.scene.environment;
-    this.scene.environment = await environment(this.renderer, name);
-    if (previous) previous.dispose();
-    this.environmentName = name;
-  }
-
+  /** Draw into the shared renderer at the canvas's size and copy the image to the canvas. */
   draw() {
     const width = this.canvas.clientWidth, height = this.canvas.clientHeight;
     this.renderer.setPixelRatio(1);
@@ -135,6 +130,9 @@ class Ball {
     this.camera.aspect = width / height;
     this.camera.updateProjectionMatrix();
     this.renderer.render(this.scene, this.camera);
+    this.canvas.width = width;
+    this.canvas.height = height;
+    this.canvas.getContext("2d").drawImage(this.renderer.domElement, 0, 0);
   }
 
   /**
@@ -165,22 +163,30 @@ async function main() {
   if (!info) throw new Error("the export carries no EXT_materials_coated_conductor (eta_i outside the fit's range?)");
   document.getElementById("material").textContent =
     `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}.`;
+  const renderer = new THREE.WebGLRenderer({
+    canvas: document.createElement("canvas"), antialias: false, preserveDrawingBuffer: true, alpha: true,
+  });
+  renderer.setClearColor(0x000000, 0);
   const balls = {
-    model: new Ball(document.getElementById("model"), model),
-    fallback: new Ball(document.getElementById("fallback"), fallback),
+    model: new Ball(renderer, document.getElementById("model"), model),
+    fallback: new Ball(renderer, document.getElementById("fallback"), fallback),
   };
-  const light = (name) => Promise.all(Object.values(balls).map((ball) => ball.setEnvironment(name)))
-    .then(() => {
-      for (const ball of Object.values(balls)) ball.draw();
-      if (window.cfThree) window.cfThree.environment = name;
-    });
+  let lighting = null; // the current environment's PMREM texture, both scenes'
+  const light = async (name) => {
+    const texture = await environment(renderer, name);
+    for (const ball of Object.values(balls)) ball.scene.environment = texture;
+    if (lighting) lighting.dispose();
+    lighting = texture;
+    for (const ball of Object.values(balls)) ball.draw();
+    if (window.cfThree) window.cfThree.environment = name;
+  };
   await light(environmentName);
   window.cfThree = {
     balls,
     orbit: ORBIT,
     fov: FOV,
     readFloat: (which, width, height, settings) => balls[which].readFloat(width, height, settings),
-    readTable: () => info.readTable(balls.model.renderer),
+    readTable: () => info.readTable(renderer),
     // Relight both balls (room, white_sky, studio, outdoor) without reloading the asset.
     setEnvironment: light,
     environment: environmentName,
