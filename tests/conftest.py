@@ -91,7 +91,7 @@ class ServerProcess:
                     return
             except httpx.TransportError:
                 pass
-            time.sleep(0.2)
+            time.sleep(0.05)
         raise RuntimeError(f"the server did not answer /healthz in {timeout_s} s:\n{self.log_text()}")
 
     def log_text(self) -> str:
@@ -285,6 +285,15 @@ def pytest_runtest_protocol(item, nextitem):
     _old_threads.clear()
     _old_threads.update(t.ident for t in threading.enumerate() if t is not threading.main_thread())
     yield
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_teardown(item, nextitem):
+    """After a test's fixtures are torn down: the browser modules' Chromium closes unless the next test uses it."""
+    yield
+    editor_pages = sys.modules.get("editor_pages")  # tests/static/editor_pages.py, once a browser module is imported
+    if editor_pages is not None:
+        editor_pages.release_chromium(nextitem)
 
 
 _durations: dict[str, float] = {}

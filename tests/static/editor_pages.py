@@ -1,15 +1,21 @@
 """
-Shared fixtures of the editor's browser tests (import them: `from editor_pages import pages, open_editor`): Debian's Chromium through the
-Python playwright package (never a downloaded browser), a real server
+Shared fixtures and helpers of the editor's browser tests (import them:
+`from editor_pages import pages, open_editor`): Debian's Chromium through
+the Python playwright package (never a downloaded browser), a real server
 process, and a check that the page logged no error (uncaught exceptions
-and console errors). The modules that import them share one server a test
-process (``live_server`` here is tests/conftest.py's session-scoped
-``browser_server``, overriding its function-scoped ``live_server``), so a
-test must assume nothing of the store but what it made; each module has one
-Chromium, and each test fresh browser contexts (no cookies, storage or
-cache from another test). :func:`camera_rays` is
-numpy's twin of the preview's camera (shader_ball.frag), for the WebGL
-parity tests.
+and console errors). The server and Chromium (``live_server``, ``chromium``)
+are one of each a test process: the server is tests/conftest.py's
+session-scoped ``browser_server`` (``live_server`` here overrides its
+function-scoped ``live_server``), so a test must assume nothing of the store
+but what it made; Chromium is launched by the first test that asks for it
+and closed after the last test of a run of such tests (tests/conftest.py's
+``pytest_runtest_teardown`` calls :func:`release_chromium`), so that no
+other test runs beside it: while a browser is open, playwright's sync API
+holds an asyncio loop on the thread, and ``asyncio.run`` in another test
+would refuse to start. Each test has fresh browser contexts (no cookies,
+storage or cache from another test).
+:func:`camera_rays` is numpy's twin of the preview's camera
+(shader_ball.frag), for the WebGL parity tests.
 """
 
 from __future__ import annotations
@@ -29,24 +35,51 @@ TIMEOUT_MS = 120_000  # first fits start worker processes
 expect.set_options(timeout=TIMEOUT_MS)
 
 
+class SharedChromium:
+    """Chromium through Python playwright, launched on first use, until :meth:`close`."""
+
+    def __init__(self) -> None:
+        self.playwright = self.browser = None
+
+    def get(self):
+        if self.browser is None:
+            self.playwright = sync_playwright().start()
+            self.browser = launch(self.playwright)
+        return self.browser
+
+    def close(self) -> None:
+        if self.browser is not None:
+            try:
+                self.browser.close()
+            finally:
+                self.playwright.stop()
+                self.playwright = self.browser = None
+
+
+_CHROMIUM = SharedChromium()
+
+
+def release_chromium(nextitem) -> None:
+    """Close the shared Chromium unless ``nextitem`` (the next test, or None) uses it."""
+    if nextitem is None or "chromium" not in getattr(nextitem, "fixturenames", ()):
+        _CHROMIUM.close()
+
+
 @pytest.fixture(scope="module")
 def live_server(browser_server):
     """The browser modules' one server (a test that saves must not assume an empty list)."""
     return browser_server.url
 
 
+@pytest.fixture(scope="module")
+def chromium(live_server):
+    """The test process's one Chromium (launched unless it is running; see :func:`release_chromium`)."""
+    return _CHROMIUM.get()
+
+
 @pytest.fixture
 def editor_url(live_server):
     return live_server + "/"
-
-
-@pytest.fixture(scope="module")
-def chromium(live_server):
-    """One Chromium for the module; it closes before the server stops."""
-    with sync_playwright() as p:
-        browser = launch(p)
-        yield browser
-        browser.close()
 
 
 def launch(p):

@@ -26,7 +26,7 @@ FROM_CURVES = re.compile(r".*/api/v1/fits/from-curves(\?.*)?$")  # with or witho
 
 @pytest.fixture
 def page(chromium):
-    """A page in a fresh context (no storage or cache from another test) of the module's one Chromium."""
+    """A page in a fresh context (no storage or cache from another test) of the shared Chromium."""
     context = chromium.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
     page = context.new_page()
     page.set_default_timeout(TIMEOUT_MS)

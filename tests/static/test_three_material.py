@@ -7,7 +7,7 @@ mirror and rough lobes), and the physics; without the plugin the same asset
 renders its fallback, a plausible metal, with no error
 (tests/static/three_pages.py says what is compared and how).
 
-Cost: one server, one Chromium and one page for the module; one page load
+Cost: the shared server and Chromium, and one page for the module; one page load
 per fit and coat index, each rendering several settings (the page relights
 with cfThree.setEnvironment and the material takes each roughness in turn).
 
