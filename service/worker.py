@@ -135,9 +135,8 @@ def ping() -> float:
     return time.time()
 
 
-PRELOAD = ("service.worker", "fitting", "fitting.colour.reference", "fitting.fits.settings", "colour",
-           "scipy.optimize")
-"""Modules the fork server imports once, so that each process forked from it starts with them."""
+PRELOAD = ("service.preload",)
+"""What the fork server imports once, so that each process forked from it starts with it (:mod:`service.preload`)."""
 
 
 def process_context():

@@ -29,6 +29,16 @@ def degenerate_refit() -> float:
     return fit_curves(curves, base).metrics["delta_E_mean"]
 
 
+def worker_modules() -> dict:
+    """In a worker: what it started with (from the fork server's service.preload)."""
+    import sys
+
+    from fitting.colour import reference
+
+    return {"colour": "colour" in sys.modules, "scipy.optimize": "scipy.optimize" in sys.modules,
+            "matplotlib": "matplotlib" in sys.modules, "weights_cached": reference._weights.cache_info().currsize}
+
+
 async def _with_runner(body, **kwargs):
     runner = FitRunner(1, 4, **kwargs)
     try:
@@ -36,6 +46,16 @@ async def _with_runner(body, **kwargs):
         return await body(runner)
     finally:
         runner.close()
+
+
+def test_workers_start_with_the_core_warm_and_without_matplotlib():
+    """The fork server imports colour-science as the core does (its plotting, and matplotlib, only on use)."""
+    async def body(runner):
+        return await runner.run(worker_modules)
+
+    seen = asyncio.run(_with_runner(body, timeout_s=60.0))
+    assert seen["colour"] and seen["scipy.optimize"] and seen["weights_cached"] >= 2, seen
+    assert not seen["matplotlib"], seen
 
 
 def test_a_part_past_its_cpu_limit_is_stopped_with_a_clear_error():
