@@ -87,6 +87,13 @@ class Settings(BaseSettings):
         the job stops and is answered 422.
     warm_pool
         Start the worker processes at start-up (so the first fit is fast).
+    freeze_heap
+        After start-up, collect once and freeze what the server process
+        holds out of the garbage collector's full passes
+        (:func:`service.worker.freeze_heap`; thawed at shutdown). Off for an
+        app embedded in a process that is not its own (a test runner's
+        in-process clients), whose heap is the host's: each start would
+        collect all of it.
     metrics_samples
         Side of the scoring grid of the fit metrics (the paper: 100).
     max_body_bytes, max_upload_bytes
@@ -148,6 +155,7 @@ class Settings(BaseSettings):
     fit_timeout_s: float = Field(default=120.0, gt=0.0, le=3600.0)
     job_cpu_limit_s: float = Field(default=60.0, gt=0.0, le=3600.0)
     warm_pool: bool = True
+    freeze_heap: bool = True
     metrics_samples: int = Field(default=100, ge=10, le=400)
     max_body_bytes: int = Field(default=1_000_000, ge=1_000)
     max_upload_bytes: int = Field(default=2_000_000, ge=1_000)

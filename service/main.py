@@ -127,15 +127,17 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             if settings.warm_pool:
                 # The workers and this process (curves, reference textures) at once.
                 await asyncio.gather(runner.warm_up(), asyncio.to_thread(warm_process))
-            # What start-up made (imports, caches) out of the collector's full passes.
-            freeze_heap()
+            if settings.freeze_heap:
+                # What start-up made (imports, caches) out of the collector's full passes.
+                freeze_heap()
             yield
         finally:
             sweeper.cancel()
             previews.close()
             runner.close()
             store.close()
-            thaw_heap()
+            if settings.freeze_heap:
+                thaw_heap()
 
     app = FastAPI(
         title="Coated-metal Fresnel service",

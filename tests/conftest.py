@@ -133,7 +133,8 @@ def server_process(data_dir: Path, **env: str) -> Iterator[ServerProcess]:
 def app_client(tmp_path: Path, **overrides):
     """
     A TestClient over an app with its own data directory under ``tmp_path``,
-    one fit worker, no pool warm-up, and ``overrides`` of
+    one fit worker, no pool warm-up, no heap freeze (the heap is the test
+    process's: each start would collect all of it), and ``overrides`` of
     :class:`service.config.Settings` (use it as a context manager).
     """
     from fastapi.testclient import TestClient
@@ -142,7 +143,7 @@ def app_client(tmp_path: Path, **overrides):
     from service.main import create_app
 
     # TestClient sends `Host: testserver`; it is allowed here as a deployment would name its host.
-    options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False,
+    options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False, "freeze_heap": False,
                "allowed_hosts": ["localhost", "127.0.0.1", "::1", "testserver"], **overrides}
     return TestClient(create_app(Settings(**options)))
 

@@ -38,7 +38,16 @@ def test_each_fitting_worker_freezes_its_start_up_heap():
 
 def test_the_service_freezes_its_heap_while_it_runs_and_thaws_it_at_shutdown(tmp_path):
     gc.unfreeze()  # whatever an earlier test left
-    with app_client(tmp_path) as client:
+    with app_client(tmp_path, freeze_heap=True) as client:
         assert client.get("/healthz").status_code == 200
         assert gc.get_freeze_count() > START_UP_OBJECTS
+    assert gc.get_freeze_count() == 0
+
+
+def test_an_embedded_app_leaves_its_host_s_heap_alone(tmp_path):
+    """COATED_FREEZE_HEAP off (the tests' in-process clients): no collection of the host's heap, no freeze."""
+    gc.unfreeze()
+    with app_client(tmp_path, freeze_heap=False) as client:
+        assert client.get("/healthz").status_code == 200
+        assert gc.get_freeze_count() == 0
     assert gc.get_freeze_count() == 0
