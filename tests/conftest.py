@@ -257,6 +257,21 @@ def _first_rank(item) -> int:
     return 1 if item.get_closest_marker("server") else 2
 
 
+def pytest_configure(config):
+    """
+    One BLAS thread in each test process: pytest-xdist runs a process a core,
+    and OpenBLAS's own threads (as many as cores, spinning between calls)
+    only took CPU from the other worker (the float32 reference's tests used
+    a fifth more CPU time with them). Processes the tests start are not
+    affected (a limit is the process's own).
+    """
+    import numpy  # noqa: F401 (a limit applies to the BLAS libraries loaded: numpy's and scipy's)
+    import scipy.linalg  # noqa: F401
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1, user_api="blas")
+
+
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if any(item.get_closest_marker(name) for name in _IMPLY_SLOW) \
