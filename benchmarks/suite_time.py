@@ -35,7 +35,8 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.record import cpu  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
-SUMMARY = re.compile(r"^=*\s*(\d+ passed.*?) in [\d.]+s", re.M)
+SUMMARY = re.compile(r"^=*\s*((?:\d+ \w+, )*\d+ (?:passed|failed).*?) in [\d.]+s", re.M)
+FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
 
 
 def run(args: list[str]) -> dict:
@@ -47,6 +48,7 @@ def run(args: list[str]) -> dict:
     summaries = SUMMARY.findall(output)
     return {"command": " ".join(["scripts/test", *args]), "seconds": round(seconds, 1),
             "returncode": done.returncode, "summaries": summaries,
+            "failures": FAILURE.findall(output)[:50],  # what failed, when a run did
             "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)]}
 
 
@@ -60,6 +62,9 @@ def main(argv=None) -> int:
     for r in rows:
         print(f"{r['command']:<28} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
               f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f}  {'; '.join(r['summaries'])}")
+    for r in rows:
+        for failure in r["failures"]:
+            print(f"{r['command']}: {failure}")
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     RESULTS.write_text(json.dumps({
         "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
