@@ -233,7 +233,7 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
         # The workers are found before the fits are sent (the server warms its
         # pool before it answers), so that the kill follows the sight of jobs in
         # flight at once: two `ps` runs between them, on a loaded machine, once
-        # outlasted the last fits (about 0.15 s each), and a worker killed idle
+        # outlasted the last fits (a fraction of a second each on warm workers), and a worker killed idle
         # breaks the pool only for the next job. Six fits on two workers leave
         # a few of them queued or running when it lands.
         workers = _worker_pids(server.process.pid)
