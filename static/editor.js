@@ -125,16 +125,14 @@ const previewView = new PreviewView({
     if (last && last.fit === drawn.fitId && last.frameAt === null) last.frameAt = performance.now();
   },
 });
-const readout = new Readout({
-  onGentler: guard(gentler), pending: () => pipeline.pending,
-  exportSettings: () => ({ etaI: state.eta, roughness: Number($("roughness").value),
-                           coatRoughness: Number($("coat-roughness").value) }),
-});
+const exportSettings = () => ({ etaI: state.eta, roughness: Number($("roughness").value),
+                                coatRoughness: Number($("coat-roughness").value) });
+const readout = new Readout({ onGentler: guard(gentler), pending: () => pipeline.pending, exportSettings });
 for (const id of ["roughness", "coat-roughness"]) $(id).addEventListener("input", () => readout.showDownload());
 // The library, presets and typed entry, the materials an artist manages, compare mode (studio.js).
 const studio = new Studio({
   store, say, guard, report: (...args) => messages.report(...args), busy: (text, work) => messages.busy(text, work),
-  setBase, present, setEta, continuing, previewView, plotView, downloadFormat: () => $("format").value,
+  setBase, present, setEta, continuing, previewView, plotView, downloadFormat: () => $("format").value, exportSettings,
   edit(point) { // a typed value: as a drag released, one undo step and a refit
     if (store.dispatch("drag", point)) store.dispatch("dragEnd");
     requestRefit();

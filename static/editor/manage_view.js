@@ -3,8 +3,9 @@
 // its edit: its base and edited curves, as a link reopens it),
 // rename (in place: Enter keeps, Escape drops), delete (to the bin), list
 // its versions or copy its link; the bin with Restore; a material's
-// versions, each to open, download (in the Download menu's format) or
-// compare with the fit on screen. Renders from the state; hooks:
+// versions, each to open, download (in the Download menu's format as it is
+// at the click, as the fit's own Download) or compare with the fit on
+// screen. Renders from the state; hooks:
 //   onOpen(material), onRename(material, name), onDelete(material),
 //   onRestore(material), onVersions(material), onLink(fitId),
 //   onOpenVersion(entry), onCompareVersion(entry), downloadURL(fitId).
@@ -99,6 +100,11 @@ export class ManageView {
     return li;
   }
 
+  /** The versions' download links again, in the Download menu's format (when it changes). */
+  showDownloads() {
+    for (const link of $("versions-list").querySelectorAll("a[data-fit]")) link.href = this.hooks.downloadURL(link.dataset.fit);
+  }
+
   #versions(listed) {
     $("versions").hidden = !listed;
     if (!listed) return;
@@ -107,7 +113,10 @@ export class ManageView {
       const download = document.createElement("a");
       download.className = "button";
       download.textContent = "Download";
+      download.dataset.fit = v.fit_id;
       download.href = this.hooks.downloadURL(v.fit_id);
+      // The href is set again at the click: the Download menu (and an export's settings) as they are then.
+      download.addEventListener("click", () => { download.href = this.hooks.downloadURL(v.fit_id); });
       download.setAttribute("download", "");
       download.setAttribute("aria-label", `Download version ${v.version}`);
       const figure = v.delta_E_mean === null ? "" : ` · ΔE₀₀ ${v.delta_E_mean.toFixed(2)}` +

@@ -17,7 +17,8 @@
 // step, a refit), open(value) (a picker value, asking before discarding
 // unsaved edits), mayDiscard(), picked(value), reloadPicker(value),
 // sayUpload(text, ok), continuing (save.js), previewView, plotView,
-// downloadFormat().
+// downloadFormat(), exportSettings() (the preview's {etaI, roughness,
+// coatRoughness}: an export of a version takes them, as the fit's Download).
 
 import * as api from "../api.js";
 import { CompareView } from "./compare_view.js";
@@ -69,8 +70,9 @@ export class Studio {
       onLink: (fitId) => this.copyLink(fitId),
       onOpenVersion: guard((v) => app.mayDiscard() && this.openFit(v.fit_id)),
       onCompareVersion: guard(async (v) => this.compare(await api.getFit(v.fit_id), `version ${v.version}`)),
-      downloadURL: (fitId) => api.packURL(fitId, app.downloadFormat()),
+      downloadURL: (fitId) => api.packURL(fitId, app.downloadFormat(), app.exportSettings()),
     });
+    $("format").addEventListener("change", () => this.manage.showDownloads());
     this.compareView = new CompareView({
       onCompareBase: guard(() => state.base && this.compare(state.base, "the base (before the edit)")),
       onOff: () => this.compare(null),

@@ -10,6 +10,8 @@ with its edit (`?fit=`) and the service's `?material=&version=` link.
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from conftest import server_process
 from editor_pages import editor_url, key_edit, open_editor, pages, chromium, live_server, settled  # noqa: F401 (fixtures: one server and one Chromium a module)
@@ -137,12 +139,19 @@ def test_versions_open_download_and_continue(pages, editor_url):
     for row in api(page, f"/materials/{material}/versions")["versions"]:
         expect(page.locator(f"#versions-list li[data-version='{row['version']}']")).to_contain_text(
             f"ΔE₀₀ {row['delta_E_mean']:.2f}, max {row['delta_E_max']:.2f}")
-    # Any version downloads (in the Download menu's format).
+    # Any version downloads, in the Download menu's format as it is at the click (the list is not
+    # listed again), an export at the preview's settings, as the fit's own Download.
+    download_v1 = page.locator("#versions-list li[data-version='1']").get_by_role("link", name="Download version 1")
     page.select_option("#format", "json")
-    saved_item(page, material).get_by_role("button", name="Versions of Versioned gold").click()
     with page.expect_download() as info:
-        page.locator("#versions-list li[data-version='1']").get_by_role("link", name="Download version 1").click()
+        download_v1.click()
     assert info.value.suggested_filename.endswith(".json") and first[:8] in info.value.suggested_filename
+    page.eval_on_selector("#roughness", "el => { el.value = '0.35'; el.dispatchEvent(new Event('input', {bubbles: true})); }")
+    page.select_option("#format", "mtlx")
+    with page.expect_download() as info:
+        download_v1.click()
+    assert re.fullmatch(rf".*-{first[:8]}-eta1\.5-rough0\.35-coat[0-9.]+\.mtlx", info.value.suggested_filename), \
+        info.value.suggested_filename
     # An older version opens with its edit: its fit, its edited points, the material it belongs to.
     page.locator("#versions-list li[data-version='1']").get_by_role("button", name="Open version 1").click()
     expect(page.locator("#fit-id")).to_have_text(first)
