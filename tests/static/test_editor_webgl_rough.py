@@ -46,7 +46,7 @@ import httpx
 import numpy as np
 import pytest
 from playwright.sync_api import expect
-from editor_pages import camera_rays, editor_url, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
+from editor_pages import F32_BASE64, camera_rays, editor_url, from_f32, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 from fitting import baseline_inputs, coated_conductor_model, curve_base_from_nk, library_material
 from fitting.models.coated_conductor import collapse_to_eta_i
@@ -269,6 +269,7 @@ def brdf_grid(page, mode, roughness, F0, a, alpha, eta_i=1.0, coat_roughness=0.0
     n x n view x light angles in [0, 1.5] rad: the BRDF, V and L."""
     got = page.evaluate(
         """async ([mode, grid, phi, uniforms, n]) => {
+            """ + F32_BASE64 + """
             const { fullscreenProgram, floatTarget, drawInto, readTarget } = await import('/glpass.js');
             const gl = window.cfPreview.gl;
             const pass = await fullscreenProgram(gl, 'microfacet.frag', { CF_MODE: mode });
@@ -282,7 +283,7 @@ def brdf_grid(page, mode, roughness, F0, a, alpha, eta_i=1.0, coat_roughness=0.0
             }
             const targets = [0, 1, 2].map(() => floatTarget(gl, n, n));
             drawInto(gl, window.cfPreview.vao, targets, n, n);
-            const out = targets.map((t) => Array.from(readTarget(gl, t, n, n)));
+            const out = targets.map((t) => f32(readTarget(gl, t, n, n)));
             targets.forEach((t) => gl.deleteTexture(t));
             return { out, error: gl.getError() };
         }""",
@@ -291,7 +292,7 @@ def brdf_grid(page, mode, roughness, F0, a, alpha, eta_i=1.0, coat_roughness=0.0
           "cf_eta_i": eta_i, "cf_coat_roughness": coat_roughness}, n],
     )
     assert got["error"] == 0
-    f, V, L = (np.asarray(x, dtype=np.float64).reshape(n, n, 4)[..., :3] for x in got["out"])
+    f, V, L = (from_f32(x).reshape(n, n, 4)[..., :3] for x in got["out"])
     return f, V, L
 
 

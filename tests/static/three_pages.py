@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import httpx
 import numpy as np
-from editor_pages import camera_rays
+from editor_pages import F32_BASE64, camera_rays, from_f32
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg_grid
@@ -78,10 +78,10 @@ def open_example(page, server: str, fit_id: str, eta_i: float, env: str = "white
 def three_ACEScg(page, which: str, roughness: float, coat_roughness: float) -> tuple[np.ndarray, np.ndarray]:
     """(H, W, 3) linear ACEScg of ball ``which`` (model or fallback), top row first, and its mask."""
     flat = page.evaluate(
-        "([which, w, h, s]) => window.cfThree.readFloat(which, w, h, s)",
+        f"([which, w, h, s]) => {{ {F32_BASE64} return f32(window.cfThree.readFloat(which, w, h, s)); }}",
         [which, W, H, {"roughness": roughness, "clearcoatRoughness": coat_roughness}],
     )
-    pixels = np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1]
+    pixels = from_f32(flat).reshape(H, W, 4)[::-1]
     rec709 = pixels[..., :3]
     return rec709 @ np.linalg.inv(ACEScg_to_sRGB_matrix()).T, pixels[..., 3] > 0.5
 
@@ -97,6 +97,7 @@ def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughne
     """(H, W, 3) linear ACEScg of the editor's preview (static/preview.js) at the same settings (one ball a page)."""
     flat = page.evaluate(
         """async ([fit, eta, roughness, coatRoughness, env, orbit, fov, w, h]) => {
+            """ + F32_BASE64 + """
             const { ShaderBall, OUTPUT, ENVIRONMENT } = await import('/preview.js');
             if (!window.cfParityBall) {
                 const canvas = document.createElement('canvas');
@@ -108,11 +109,11 @@ def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughne
             ball.setFit(fit);
             ball.set({ eta, roughness, coated: true, coatRoughness, environment: ENVIRONMENT[env], orbit, fov });
             await ball.ready();
-            return Array.from(ball.readFloat(OUTPUT.linear, w, h));
+            return f32(ball.readFloat(OUTPUT.linear, w, h));
         }""",
         [fit, eta_i, roughness, coat_roughness, env, list(ORBIT), FOV, W, H],
     )
-    return np.asarray(flat, dtype=np.float64).reshape(H, W, 4)[::-1][..., :3]
+    return from_f32(flat).reshape(H, W, 4)[::-1][..., :3]
 
 
 def preview_lit_in_rec709(page) -> np.ndarray:
@@ -126,13 +127,14 @@ def preview_lit_in_rec709(page) -> np.ndarray:
     """
     flat = page.evaluate(
         """async ([w, h]) => {
+            """ + F32_BASE64 + """
             const { OUTPUT } = await import('/preview.js');
             const ball = await window.cfParityBall;
-            return ['fresnel', 'baseLight', 'coatLight', 'coat'].map((o) => Array.from(ball.readFloat(OUTPUT[o], w, h)));
+            return ['fresnel', 'baseLight', 'coatLight', 'coat'].map((o) => f32(ball.readFloat(OUTPUT[o], w, h)));
         }""",
         [W, H],
     )
-    F, base, coat_light, coat = (np.asarray(f, dtype=np.float64).reshape(H, W, 4)[::-1] for f in flat)
+    F, base, coat_light, coat = (from_f32(f).reshape(H, W, 4)[::-1] for f in flat)
     M = ACEScg_to_sRGB_matrix()
     E, T = coat[..., :1], coat[..., 1:2]
     rec709 = E * (coat_light[..., :3] @ M.T) + T * (F[..., :3] @ M.T) * (base[..., :3] @ M.T)
