@@ -50,6 +50,7 @@ from pathlib import Path
 from typing import Iterator
 
 import httpx
+import loopback
 import moderngl
 import pytest
 
@@ -87,7 +88,7 @@ class ServerProcess:
             if self.process.poll() is not None:
                 raise RuntimeError(f"the server exited with {self.process.returncode}:\n{self.log_text()}")
             try:
-                if httpx.get(f"{self.url}/healthz", timeout=2.0).status_code == 200:
+                if loopback.get(f"{self.url}/healthz", timeout=2.0).status_code == 200:
                     return
             except httpx.TransportError:
                 pass

@@ -16,6 +16,7 @@ import threading
 import time
 
 import httpx
+import loopback
 import pytest
 
 from conftest import server_process
@@ -56,7 +57,7 @@ def test_healthz_answers_fast_with_600_idle_connections_open(tmp_path):
         seconds = []
         for _ in range(60):
             t0 = time.perf_counter()
-            response = httpx.get(f"{server.url}/healthz", timeout=10)  # a new connection each time
+            response = loopback.get(f"{server.url}/healthz", timeout=10)  # a new connection each time
             seconds.append(time.perf_counter() - t0)
             assert response.status_code == 200, response.text
         p99 = statistics.quantiles(seconds, n=100)[98]
@@ -73,7 +74,7 @@ def test_one_address_cannot_shut_out_another(tmp_path):
             stack.callback(s.close)
         assert still_open(flood, IDLE_GRACE_S + 0.3) <= 20
         transport = httpx.HTTPTransport(local_address="127.0.0.2")
-        with httpx.Client(transport=transport, timeout=10) as other:
+        with loopback.Client(transport=transport, timeout=10) as other:
             assert other.get(f"{server.url}/api/v1/materials").status_code == 200
 
 
@@ -87,8 +88,8 @@ def test_with_every_connection_busy_healthz_is_still_answered(tmp_path):
             s.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
                       b"content-length: 100\r\n\r\n{")
         time.sleep(0.3)
-        assert httpx.get(f"{server.url}/healthz", timeout=10).status_code == 200
-        refused = httpx.get(f"{server.url}/api/v1/materials", timeout=10)
+        assert loopback.get(f"{server.url}/healthz", timeout=10).status_code == 200
+        refused = loopback.get(f"{server.url}/api/v1/materials", timeout=10)
         assert refused.status_code == 503 and "COATED_MAX_CONNECTIONS" in refused.json()["detail"]
         assert still_open(busy) == 8  # busy connections are never evicted
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import sqlite3
 import time
 
-import httpx
+import loopback
 import numpy as np
 import pytest
 
@@ -70,7 +70,7 @@ def counted(data_dir, sql):
 
 def test_100_live_steps_on_a_20000_sample_upload_add_under_2_mb(tmp_path):
     data = tmp_path / "data"
-    with server_process(data) as server, httpx.Client(base_url=server.url, timeout=120) as http:
+    with server_process(data) as server, loopback.Client(base_url=server.url, timeout=120) as http:
         base = http.post(f"{API}/fits/upload", files={"file": ("big.csv", big_csv(), "text/csv")})
         assert base.status_code == 201, base.text[:300]
         base_id = start = base.json()["id"]
@@ -91,7 +91,7 @@ def test_100_live_steps_on_a_20000_sample_upload_add_under_2_mb(tmp_path):
 def test_100_live_steps_on_a_20000_sample_inline_base_add_under_2_mb(tmp_path):
     data = tmp_path / "data"
     base = {"nk": inline_nk()}
-    with server_process(data) as server, httpx.Client(base_url=server.url, timeout=120) as http:
+    with server_process(data) as server, loopback.Client(base_url=server.url, timeout=120) as http:
         before = stored_bytes(data)
         start = None
         for i in range(100):
@@ -123,7 +123,7 @@ def test_an_inline_base_expires_with_its_drafts(tmp_path):
     data = tmp_path / "data"
     base = {"nk": inline_nk(2_000)}
     with server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            httpx.Client(base_url=server.url, timeout=120) as http:
+            loopback.Client(base_url=server.url, timeout=120) as http:
         start = None
         for i in range(3):
             answer = http.post(f"{API}/fits/from-curves", json=step(None, start, 0.5 + 0.01 * i, inline=base))
@@ -140,7 +140,7 @@ def test_an_inline_base_expires_with_its_drafts(tmp_path):
 def test_drafts_expire_and_count_against_their_quota(tmp_path):
     data = tmp_path / "data"
     with server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            httpx.Client(base_url=server.url, timeout=120) as http:
+            loopback.Client(base_url=server.url, timeout=120) as http:
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5, live=False))
         assert draft.status_code == 201, draft.text[:300]
@@ -152,7 +152,7 @@ def test_drafts_expire_and_count_against_their_quota(tmp_path):
         assert http.get(f"{API}/fits/{draft_id}").status_code == 404
         assert http.get(f"{API}/fits/{base}").status_code == 200  # saved fits never expire
     with server_process(tmp_path / "quota", COATED_DRAFT_MAX_BYTES="20000", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            httpx.Client(base_url=server.url, timeout=120) as http:
+            loopback.Client(base_url=server.url, timeout=120) as http:
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         ids = [http.post(f"{API}/fits/from-curves", json=step(base, None, 0.3 + 0.05 * i, live=False)).json()["id"]
                for i in range(6)]

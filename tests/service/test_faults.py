@@ -18,7 +18,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import httpx
+import loopback
 import numpy as np
 import pytest
 
@@ -41,7 +41,7 @@ def gold_like_nk(shift: float = 0.0) -> dict:
 def test_rebinding_host_refused_400_loopback_allowed(tmp_path):
     with server_process(tmp_path / "data") as server:
         evil = {"Host": f"attacker.example:{server.port}", "Origin": f"http://attacker.example:{server.port}"}
-        with httpx.Client(base_url=server.url, timeout=60) as http:
+        with loopback.Client(base_url=server.url, timeout=60) as http:
             write = http.post(f"{API}/fits", json={"material": "Au"}, headers=evil)
             assert write.status_code == 400
             assert write.headers["content-type"] == "application/json"
@@ -79,7 +79,7 @@ def test_slow_clients_are_cut_off_and_healthz_answers(tmp_path):
         body.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
                      b"Content-Length: 100\r\n\r\n{")
         started = time.monotonic()
-        assert httpx.get(f"{server.url}/healthz", timeout=5).status_code == 200
+        assert loopback.get(f"{server.url}/healthz", timeout=5).status_code == 200
         answer = b""
         while chunk := body.recv(4096):  # the server closes the connection after its answer
             answer += chunk
@@ -239,7 +239,7 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
         workers = _worker_pids(server.process.pid)
         assert workers
         fits = 6
-        with httpx.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(fits) as pool:
+        with loopback.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(fits) as pool:
             futures = [pool.submit(http.post, f"{API}/fits", json={"name": f"k{i}", "nk": gold_like_nk(i / 50)})
                        for i in range(fits)]
             deadline = time.monotonic() + 60
@@ -255,7 +255,7 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
             assert after.status_code == 201
             saved = {a.json()["id"] for a in answers if a.status_code == 201} | {after.json()["id"]}
         server.kill()
-    with server_process(tmp_path / "data") as again, httpx.Client(base_url=again.url, timeout=60) as http:
+    with server_process(tmp_path / "data") as again, loopback.Client(base_url=again.url, timeout=60) as http:
         for fit_id in saved:
             assert http.get(f"{API}/fits/{fit_id}").status_code == 200
 
@@ -349,7 +349,7 @@ def test_a_job_whose_client_went_away_is_cancelled_within_a_second(tmp_path):
         {"name": f"m{i}", "nk": gold_like_nk(i / 100), "eta_i": np.linspace(1.0, 2.5, 32).tolist()}
         for i in range(64)]}
     payload = json.dumps(scene).encode()
-    with server_process(tmp_path / "data") as server, httpx.Client(base_url=server.url, timeout=30) as http:
+    with server_process(tmp_path / "data") as server, loopback.Client(base_url=server.url, timeout=30) as http:
         with socket.create_connection(("127.0.0.1", server.port), timeout=10) as raw:
             raw.sendall(b"POST /api/v1/scenes HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
                         + f"content-length: {len(payload)}\r\n\r\n".encode() + payload)

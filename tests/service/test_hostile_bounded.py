@@ -13,7 +13,7 @@ import random
 import threading
 import time
 
-import httpx
+import loopback
 import numpy as np
 import pytest
 
@@ -66,7 +66,7 @@ def test_worst_case_refits_are_bounded_and_do_not_hold_a_library_fit(tmp_path):
     answers: list[tuple[int, float, dict]] = []
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2", COATED_FIT_QUEUE="16") as server:
         def send(body):
-            with httpx.Client(base_url=server.url, timeout=120) as http:
+            with loopback.Client(base_url=server.url, timeout=120) as http:
                 t0 = time.perf_counter()
                 response = http.post(f"{API}/fits/from-curves", json=body)
                 answers.append((response.status_code, time.perf_counter() - t0, response.json()))
@@ -74,7 +74,7 @@ def test_worst_case_refits_are_bounded_and_do_not_hold_a_library_fit(tmp_path):
         threads = [threading.Thread(target=send, args=(body,)) for body in corpus()]
         for thread in threads:
             thread.start()
-        with httpx.Client(base_url=server.url, timeout=120) as http:
+        with loopback.Client(base_url=server.url, timeout=120) as http:
             deadline = time.monotonic() + 30
             while http.get("/healthz").json()["fits_in_flight"] < 6 and time.monotonic() < deadline:
                 time.sleep(0.02)
@@ -105,7 +105,7 @@ def test_a_large_scene_takes_turns_with_a_library_fit(tmp_path):
     finished: list[tuple[str, int]] = []
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="1") as server:
         def post(label: str, path: str, body: dict) -> None:
-            with httpx.Client(base_url=server.url, timeout=300) as http:
+            with loopback.Client(base_url=server.url, timeout=300) as http:
                 response = http.post(f"{API}{path}", json=body)
                 finished.append((label, response.status_code))
                 if label == "scene":
@@ -114,7 +114,7 @@ def test_a_large_scene_takes_turns_with_a_library_fit(tmp_path):
 
         scene_thread = threading.Thread(target=post, args=("scene", "/scenes", scene))
         scene_thread.start()
-        with httpx.Client(base_url=server.url, timeout=60) as http:
+        with loopback.Client(base_url=server.url, timeout=60) as http:
             deadline = time.monotonic() + 60
             while http.get("/healthz").json()["fits_in_flight"] < 1 and time.monotonic() < deadline:
                 time.sleep(0.02)

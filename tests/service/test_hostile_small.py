@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 import random
 
-import httpx
+import loopback
 import pytest
 
 from conftest import app_client, server_process
@@ -24,7 +24,7 @@ GOOD_CSV = b"wavelength_nm,n,k\n400,0.2,3\n500,0.2,3.2\n600,0.2,3.4\n700,0.2,3.6
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
     with server_process(tmp_path_factory.mktemp("small") / "data", COATED_WARM_POOL="false") as running:
-        with httpx.Client(base_url=running.url, timeout=30) as http:
+        with loopback.Client(base_url=running.url, timeout=30) as http:
             yield running, http
 
 
@@ -64,7 +64,7 @@ class TestSmallOnesByClass:
         for size in [16_500, rng.randint(17_000, 60_000), 100_000, 300_000]:
             many = rng.random() < 0.5
             headers = ({f"x-h{i}": "v" * 990 for i in range(size // 1000)} if many else {"x-big": "v" * size})
-            response = httpx.get(f"{running.url}/healthz", headers=headers, timeout=30)
+            response = loopback.get(f"{running.url}/healthz", headers=headers, timeout=30)
             assert response.status_code == 431, (size, many, response.status_code)
             assert "16384 bytes" in response.json()["detail"]
         assert http.get("/healthz", headers={"x-ok": "v" * 12_000}).status_code == 200

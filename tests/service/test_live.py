@@ -14,6 +14,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 import httpx
+import loopback
 import numpy as np
 import pytest
 import schemathesis
@@ -41,7 +42,7 @@ def gold_like_nk(shift: float) -> dict:
 
 
 def test_start_up_and_docs(live_server):
-    with httpx.Client(base_url=live_server, timeout=30) as http:
+    with loopback.Client(base_url=live_server, timeout=30) as http:
         assert http.get("/healthz").json()["status"] == "ok"
         assert http.get("/openapi.json").json()["info"]["title"]
         assert "swagger" in http.get("/docs").text.lower()
@@ -62,7 +63,7 @@ def test_refuses_public_bind_without_token(tmp_path):
 
 def test_concurrent_identical_fits_and_reads(tmp_path):
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server:
-        with httpx.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(8) as pool:
+        with loopback.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(8) as pool:
             fits = [pool.submit(http.post, f"{API}/fits", json={"material": "Cu"}) for _ in range(4)]
             others = [pool.submit(http.post, f"{API}/fits", json={"material": "Ag", "eta_i_range": [1.0, 1.0 + i / 10]})
                       for i in range(1, 4)]
@@ -84,7 +85,7 @@ def test_overload_answers_503_not_a_backlog(tmp_path):
         barrier = threading.Barrier(6)
 
         def fit(i: int) -> httpx.Response:
-            with httpx.Client(base_url=server.url, timeout=120) as http:
+            with loopback.Client(base_url=server.url, timeout=120) as http:
                 barrier.wait()
                 return http.post(f"{API}/fits", json={"material": "Fe", "eta_i_range": [1.0, 1.5 + i / 10]})
 
@@ -106,7 +107,7 @@ def test_saves_survive_sigkill(tmp_path):
         stop = threading.Event()
 
         def save(client: int) -> None:
-            with httpx.Client(base_url=server.url, timeout=60) as http:
+            with loopback.Client(base_url=server.url, timeout=60) as http:
                 for j in range(1000):
                     if stop.is_set():
                         return
@@ -132,7 +133,7 @@ def test_saves_survive_sigkill(tmp_path):
     assert len(answered) >= 8
     with sqlite3.connect(data / "store.sqlite3") as connection:
         assert connection.execute("PRAGMA integrity_check").fetchone()[0] == "ok"
-    with server_process(data) as server, httpx.Client(base_url=server.url, timeout=30) as http:
+    with server_process(data) as server, loopback.Client(base_url=server.url, timeout=30) as http:
         for fit_id, coefficients in answered.items():
             response = http.get(f"{API}/fits/{fit_id}")
             assert response.status_code == 200, fit_id

@@ -11,6 +11,7 @@ presets, and the upload form's ``min_coverage``. One server for the module.
 from __future__ import annotations
 
 import httpx
+import loopback
 import numpy as np
 import pytest
 from conftest import server_process
@@ -45,7 +46,7 @@ def nk_csv(shift: float = 0.0, lo: float = 350.0, hi: float = 850.0) -> str:
 def http(tmp_path_factory):
     data = tmp_path_factory.mktemp("materials") / "data"
     with server_process(data, COATED_API_TOKEN=TOKEN, COATED_REQUIRE_TOKEN="true") as server:
-        with httpx.Client(base_url=server.url, timeout=300) as client:
+        with loopback.Client(base_url=server.url, timeout=300) as client:
             yield client
 
 

@@ -20,6 +20,7 @@ import threading
 import time
 
 import httpx
+import loopback
 import numpy as np
 import pytest
 
@@ -44,7 +45,7 @@ def in_background(url: str, params: dict, out: list, timeout: float = 300,
 
     def get() -> None:
         try:
-            out.append(httpx.get(f"{url}{API}/preview.png", params=params, timeout=timeout))
+            out.append(loopback.get(f"{url}{API}/preview.png", params=params, timeout=timeout))
         except httpx.HTTPError as error:
             out.append(error)
         if ended is not None:
@@ -65,7 +66,7 @@ def wait_for_previews(http: httpx.Client, count: int, limit_s: float) -> float:
 
 
 def test_healthz_within_half_a_second_p99_during_two_1024_px_previews(tmp_path):
-    with server_process(tmp_path / "data") as server, httpx.Client(base_url=server.url, timeout=30) as http:
+    with server_process(tmp_path / "data") as server, loopback.Client(base_url=server.url, timeout=30) as http:
         fit = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         # Both render processes started (their start-up is not what is measured here).
         warm: list = []
@@ -96,7 +97,7 @@ def test_healthz_within_half_a_second_p99_during_two_1024_px_previews(tmp_path):
 
 def test_bound_shared_renders_and_a_client_that_goes_away(tmp_path):
     with server_process(tmp_path / "data", COATED_MAX_PREVIEWS_IN_FLIGHT="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
-            httpx.Client(base_url=server.url, timeout=30) as http:
+            loopback.Client(base_url=server.url, timeout=30) as http:
         fit = http.post(f"{API}/fits", json={"material": "Cu"}).json()["id"]
         assert http.get(f"{API}/preview.png", params={"fit": fit, "size": 64, "eta_i": 1.5}).status_code == 200
         # One large preview renders; the same request again joins it, another is refused.
@@ -134,7 +135,7 @@ def test_bound_shared_renders_and_a_client_that_goes_away(tmp_path):
 
 def test_time_limit_504_and_cpu_limit_422(tmp_path):
     with server_process(tmp_path / "slow", COATED_PREVIEW_TIMEOUT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
-            httpx.Client(base_url=server.url, timeout=60) as http:
+            loopback.Client(base_url=server.url, timeout=60) as http:
         fit = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         http.get(f"{API}/preview.png", params=preview(fit, 64, 1.5))  # the render process started
         answer = http.get(f"{API}/preview.png", params=preview(fit, 2048, 1.5))
@@ -144,7 +145,7 @@ def test_time_limit_504_and_cpu_limit_422(tmp_path):
     # The render process is warmed first (GL start-up and shader compile, which llvmpipe's threads
     # make over 1 s of process CPU time under load), so that the limit of 1 s falls on the render.
     with server_process(tmp_path / "cpu", COATED_JOB_CPU_LIMIT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
-            httpx.Client(base_url=server.url, timeout=300) as http:
+            loopback.Client(base_url=server.url, timeout=300) as http:
         fit = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         warm = http.get(f"{API}/preview.png", params={"fit": fit, "size": 64, "eta_i": 1.5})
         assert warm.status_code == 200, warm.text

@@ -19,6 +19,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 import httpx
+import loopback
 import numpy as np
 import pytest
 
@@ -45,7 +46,7 @@ def curves_body(i: int, name: str, **extra) -> dict:
 def listed(url: str) -> dict[str, dict]:
     """Every saved material (edits and n, k fits) of a replica's listing, by id (all pages)."""
     out, cursor = {}, None
-    with httpx.Client(base_url=url, timeout=60) as http:
+    with loopback.Client(base_url=url, timeout=60) as http:
         for _ in range(100):
             params = [("kind", "curves"), ("kind", "nk"), *([("cursor", cursor)] if cursor is not None else [])]
             page = http.get(f"{API}/materials", params=params).json()
@@ -73,7 +74,7 @@ def replicas(tmp_path_factory, postgres_server):
 
 def test_saves_on_either_replica_are_everyone_s(replicas, postgres_server):
     a, b = replicas
-    health = httpx.get(f"{a.url}/healthz", timeout=10).json()
+    health = loopback.get(f"{a.url}/healthz", timeout=10).json()
     assert health["store"]["kind"] == "postgresql" and health["store"]["connections_max"] == 4
     assert health["store"]["role_connection_limit"] == 40 and health["store"]["server_connection_limit"] == 57
     assert "password" not in str(health) and postgres_server.password not in str(health)
@@ -82,7 +83,7 @@ def test_saves_on_either_replica_are_everyone_s(replicas, postgres_server):
 
     def save(i: int) -> str:
         on, other = pairs[i % 2]
-        with httpx.Client(timeout=120) as http:
+        with loopback.Client(timeout=120) as http:
             answer = http.post(f"{on.url}{API}/fits", json=nk_body(i))
             assert answer.status_code == 201, answer.text
             fit_id = answer.json()["id"]
@@ -97,7 +98,7 @@ def test_saves_on_either_replica_are_everyone_s(replicas, postgres_server):
     for replica in (a, b):
         assert saved <= set(listed(replica.url))
     # The same fit on both replicas is one record (ids are content addresses).
-    again = [httpx.post(f"{r.url}{API}/fits", json=nk_body(7), timeout=60) for r in (a, b)]
+    again = [loopback.post(f"{r.url}{API}/fits", json=nk_body(7), timeout=60) for r in (a, b)]
     assert [r.status_code for r in again] == [200, 200] and again[0].json()["id"] == again[1].json()["id"]
 
 
@@ -107,7 +108,7 @@ def test_same_name_at_once_one_winner(replicas):
 
     def save(i: int, body: dict) -> httpx.Response:
         barrier.wait()
-        return httpx.post(f"{(a, b)[i % 2].url}{API}/fits/from-curves", json=body, timeout=300)
+        return loopback.post(f"{(a, b)[i % 2].url}{API}/fits/from-curves", json=body, timeout=300)
 
     with ThreadPoolExecutor(20) as pool:
         answers = list(pool.map(lambda i: save(i, curves_body(i, "contested", expected_version=0)), range(20)))
@@ -117,7 +118,7 @@ def test_same_name_at_once_one_winner(replicas):
     conflict = next(r.json() for r in answers if r.status_code == 409)
     assert "another save came first" in conflict["detail"] and conflict["errors"][0]["loc"] == ["body", "expected_version"]
     for replica in (a, b):
-        detail = httpx.get(f"{replica.url}{API}/materials/{winner['material_id']}", timeout=30).json()
+        detail = loopback.get(f"{replica.url}{API}/materials/{winner['material_id']}", timeout=30).json()
         assert detail["version"] == 1 and detail["latest_fit_id"] == winner["id"]
     # Without `expected_version`: every save is the next version, one is the latest.
     with ThreadPoolExecutor(20) as pool:
@@ -126,34 +127,34 @@ def test_same_name_at_once_one_winner(replicas):
     assert [r.status_code for r in answers] == [201] * 20
     ids = {r.json()["id"] for r in answers}
     material = answers[0].json()["material_id"]
-    views = [httpx.get(f"{r.url}{API}/materials/{material}", timeout=30).json() for r in (a, b)]
+    views = [loopback.get(f"{r.url}{API}/materials/{material}", timeout=30).json() for r in (a, b)]
     assert views[0] == views[1] and views[0]["version"] == 20 and views[0]["latest_fit_id"] in ids
-    stale = httpx.post(f"{a.url}{API}/fits/from-curves", json=curves_body(50, "shared", expected_version=3),
+    stale = loopback.post(f"{a.url}{API}/fits/from-curves", json=curves_body(50, "shared", expected_version=3),
                        timeout=60)
     assert stale.status_code == 409 and "nothing was fitted" in stale.json()["detail"]
 
 
 def test_postgres_restart_503_then_recovery(replicas, postgres_server):
     a, b = replicas
-    before = httpx.post(f"{a.url}{API}/fits", json=nk_body(1, "p"), timeout=120)
+    before = loopback.post(f"{a.url}{API}/fits", json=nk_body(1, "p"), timeout=120)
     assert before.status_code == 201
     postgres_server.stop()
     try:
         for replica in (a, b):
-            health = httpx.get(f"{replica.url}/healthz", timeout=30)
+            health = loopback.get(f"{replica.url}/healthz", timeout=30)
             assert health.status_code == 503 and 1 <= int(health.headers["retry-after"]) <= 5
-            refused = httpx.post(f"{replica.url}{API}/fits", json=nk_body(2, "p"), timeout=60)
+            refused = loopback.post(f"{replica.url}{API}/fits", json=nk_body(2, "p"), timeout=60)
             assert refused.status_code == 503 and int(refused.headers["retry-after"]) <= 5
             assert "unavailable" in refused.json()["detail"]
-            assert httpx.get(f"{replica.url}{API}/fits/{before.json()['id']}", timeout=30).status_code == 503
+            assert loopback.get(f"{replica.url}{API}/fits/{before.json()['id']}", timeout=30).status_code == 503
     finally:
         postgres_server.start()
     for replica in (a, b):  # recovered by themselves, without a restart
         deadline = time.monotonic() + 30
-        while httpx.get(f"{replica.url}/healthz", timeout=30).status_code != 200:
+        while loopback.get(f"{replica.url}/healthz", timeout=30).status_code != 200:
             assert time.monotonic() < deadline, "the replica did not recover within 30 s"
             time.sleep(0.2)
-    after = httpx.post(f"{b.url}{API}/fits", json=nk_body(2, "p"), timeout=120)
+    after = loopback.post(f"{b.url}{API}/fits", json=nk_body(2, "p"), timeout=120)
     assert after.status_code == 201
     assert {before.json()["material_id"], after.json()["material_id"]} <= set(listed(a.url))
     assert a.process.poll() is None and b.process.poll() is None
@@ -166,7 +167,7 @@ def test_replica_killed_during_saves_loses_nothing_answered(replicas):
     stop = threading.Event()
 
     def client(replica, start: int) -> None:
-        with httpx.Client(base_url=replica.url, timeout=120) as http:
+        with loopback.Client(base_url=replica.url, timeout=120) as http:
             i = start
             while not stop.is_set() and i < start + 200:
                 try:
@@ -190,7 +191,7 @@ def test_replica_killed_during_saves_loses_nothing_answered(replicas):
     for thread in threads:
         thread.join(timeout=180)
     assert len(answered) >= 30
-    with httpx.Client(base_url=b.url, timeout=60) as http:
+    with loopback.Client(base_url=b.url, timeout=60) as http:
         missing = [fit_id for fit_id in answered if http.get(f"{API}/fits/{fit_id}").status_code != 200]
     assert missing == []
     assert len(listed(b.url)) >= len(set(answered))

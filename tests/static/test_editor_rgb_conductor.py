@@ -34,7 +34,7 @@ inputs):
 
 from __future__ import annotations
 
-import httpx
+import loopback
 import numpy as np
 import pytest
 from editor_pages import camera_rays, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
@@ -65,7 +65,7 @@ def rgb_fit(live_server):
     rgb[:, 2] *= 1.1
     body = {"name": "cool copper", "base": {"material": "Cu"}, "model": "rgb-conductor",
             "curves": [{"eta_i": 1.5, "angle_deg": ANGLES.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
-    response = httpx.post(f"{live_server}/api/v1/fits/from-curves", json=body, timeout=300)
+    response = loopback.post(f"{live_server}/api/v1/fits/from-curves", json=body, timeout=300)
     assert response.status_code == 201, response.text
     fit = response.json()
     assert fit["model"] == "rgb-conductor" and set(fit["coefficients"]) == {"n", "k"}

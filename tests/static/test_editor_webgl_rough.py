@@ -42,7 +42,7 @@ Tolerances (float32 shaders against float64 numpy):
 
 from __future__ import annotations
 
-import httpx
+import loopback
 import numpy as np
 import pytest
 from playwright.sync_api import expect
@@ -102,7 +102,7 @@ def interp(table, mu):
 
 
 def slices(url, environment):
-    response = httpx.get(f"{url}/api/v1/environments/{environment}/prefiltered", timeout=120)
+    response = loopback.get(f"{url}/api/v1/environments/{environment}/prefiltered", timeout=120)
     layers, height, width = (int(response.headers[f"x-texture-{k}"]) for k in ("layers", "height", "width"))
     return np.frombuffer(response.content, "<f4").reshape(layers, height, width, 3).astype(np.float64)
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import json
 
-import httpx
+import loopback
 import numpy as np
 import pytest
 from editor_pages import camera_rays, pages, chromium, live_server  # noqa: F401 (fixtures)
@@ -31,7 +31,7 @@ BOUND = 0.2  # the issue's promise for a mirror against its tool
 @pytest.mark.parametrize("material, eta_i", [("Cu", 1.5), ("Au", 1.0)])
 def test_three_fallback_is_the_mirror(pages, live_server, material, eta_i):
     fit = create_fit(live_server, material, "rgb-conductor")
-    response = httpx.get(f"{live_server}/api/v1/fits/{fit['id']}/pack",
+    response = loopback.get(f"{live_server}/api/v1/fits/{fit['id']}/pack",
                          params={"format": "gltf", "eta_i": eta_i}, timeout=300)
     response.raise_for_status()
     gltf_material = json.loads(response.content)["materials"][0]

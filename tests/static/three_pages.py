@@ -42,7 +42,7 @@ split sum at the coat's F0.
 
 from __future__ import annotations
 
-import httpx
+import loopback
 import numpy as np
 from editor_pages import F32_BASE64, camera_rays, from_f32
 
@@ -63,7 +63,7 @@ _NODES = np.linspace(0.0, 1.0, 65) ** 2  # the physics' NdotV nodes, interpolate
 
 def create_fit(server: str, material: str, model: str) -> dict:
     """POST /api/v1/fits for a library material and kind; the FitPublic answer."""
-    response = httpx.post(f"{server}/api/v1/fits", json={"material": material, "model": model}, timeout=300)
+    response = loopback.post(f"{server}/api/v1/fits", json={"material": material, "model": model}, timeout=300)
     response.raise_for_status()
     return response.json()
 
