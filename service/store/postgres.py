@@ -215,14 +215,14 @@ class PostgresStore:
 
     def put_fit(self, record: FitRecord, save: bool = True,
                 expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
-        record, text, nk_text = records.prepared(record, nk)
+        record, text, nk_json = records.prepared(record, nk)
 
         def write(connection: psycopg.Connection) -> FitRecord:
-            if save or nk_text is not None:
+            if save or nk_json is not None:
                 # With an n, k record: the sweep must not find it unreferenced
                 # between this insert and the draft's (it takes the same lock).
                 connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))
-            return queries.save(connection, "%s", record, text, save, expected_version, self._decode, nk_text)
+            return queries.save(connection, "%s", record, text, save, expected_version, self._decode, nk_json)
 
         return self._read(write)
 

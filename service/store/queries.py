@@ -39,18 +39,20 @@ log = logging.getLogger("service.store")
 
 def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
          expected_version: int | None, decode: Callable[[str, Any], FitRecord],
-         nk_text: str | None = None) -> FitRecord:
+         nk_json: Callable[[], str] | None = None) -> FitRecord:
     """
     Inside one open write transaction (which the caller serialises with
-    every other save, and with the drafts' sweep when ``nk_text`` is given):
-    store the n, k record ``record.nk_id`` (``nk_text``, its JSON) unless it
-    exists, and ``record`` unless its id exists, then (``save``) check
-    ``expected_version`` and log the save. Returns the stored record.
+    every other save, and with the drafts' sweep when ``nk_json`` is given):
+    store the n, k record ``record.nk_id`` (``nk_json()``, its JSON, made
+    only then) unless it exists, and ``record`` unless its id exists, then
+    (``save``) check ``expected_version`` and log the save. Returns the
+    stored record.
     """
-    if nk_text is not None:
+    if nk_json is not None and connection.execute(
+            f"SELECT 1 FROM nk_records WHERE id = {p}", (record.nk_id,)).fetchone() is None:
         connection.execute(
             f"INSERT INTO nk_records (id, created_at, record) VALUES ({p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",
-            (record.nk_id, record.created_at, nk_text))
+            (record.nk_id, record.created_at, nk_json()))
     connection.execute(
         f"INSERT INTO fits (id, kind, material_id, created_at, record, nk_id) "
         f"VALUES ({p}, {p}, {p}, {p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",

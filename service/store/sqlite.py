@@ -151,7 +151,7 @@ class SQLiteStore:
 
     def put_fit(self, record: FitRecord, save: bool = True,
                 expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
-        record, text, nk_text = records.prepared(record, nk)
+        record, text, nk_json = records.prepared(record, nk)
 
         def write() -> FitRecord:
             connection = self._connection()
@@ -159,7 +159,7 @@ class SQLiteStore:
                 # BEGIN IMMEDIATE: the write lock first, so the version read is the one written after.
                 connection.execute("BEGIN IMMEDIATE")
                 return queries.save(connection, "?", record, text, save, expected_version, self._decode,
-                                    nk_text)
+                                    nk_json)
 
         return self._guard(write)
 

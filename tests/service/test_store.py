@@ -134,6 +134,22 @@ class TestStoreContract:
         with pytest.raises(TypeError, match="needs the fit's `nk_id`"):
             store.put_fit(record("b" * 32), nk=nk)
 
+    def test_an_nk_record_already_stored_is_not_written_again(self, store):
+        # Content-addressed: a live step on a stored inline n, k makes no JSON of it (0.6 MB at
+        # 20,000 samples), and what was stored first stays.
+        class Read(dict):
+            reads = 0
+
+            def __getitem__(self, key):
+                self.reads += 1
+                return super().__getitem__(key)
+
+        nk = Read({"wavelength_nm": [400.0, 500.0], "n": [0.2, 0.3], "k": [3.0, 2.5]})
+        store.put_fit(record("1" * 32, kind="curves", nk_id="c" * 32), save=False, nk=nk)
+        assert nk.reads == 3 and store.get_nk("c" * 32) == nk
+        again = store.put_fit(record("2" * 32, kind="curves", nk_id="c" * 32), save=False, nk=nk)
+        assert nk.reads == 3 and again.nk_id == "c" * 32 and store.get_nk("c" * 32) == nk
+
     def test_pages_follow_the_save_order(self, store):
         for i in range(7):
             store.put_fit(record(f"{i:032x}", material_id=f"{i + 50:032x}", name=f"m{i}"))
