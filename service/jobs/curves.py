@@ -294,9 +294,8 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     if base_record is not None and base_record.kind == "curves":
         measured_library, measured = base_record.library_material, base_record.nk
     # A draft refers to its n, k, never holds a copy (~0.5 MB a step for 20,000 samples).
-    known_nk = measured  # what the new record holds or refers to: its answer has it without a read back
-    measured, nk_of, nk_id, draft_nk = await asyncio.to_thread(draft_nk_reference, fit.draft, base_record,
-                                                                measured)
+    known_nk = measured  # what the new record holds or refers to
+    measured, nk_of, nk_id, draft_nk = await asyncio.to_thread(draft_nk_reference, fit.draft, base_record, known_nk)
 
     settings = LIVE_SETTINGS if fit.live else DEFAULTS
     made_here = []  # set when this request's own job ran (and, unless a draft, saved)
@@ -322,8 +321,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
             },
         )
         stored = await asyncio.to_thread(store.put_fit, record, not fit.draft, expected_version, draft_nk)
-        # The n, k it refers to is known here (a read back would parse it again: 0.6 MB of JSON at
-        # 20,000 samples, each live step); with_measured_nk finds the same data by reference.
+        # Its n, k is known here (a read back would parse it again: 0.6 MB of JSON at 20,000 samples).
         return stored if stored.nk is not None or known_nk is None else replace(stored, nk=known_nk)
 
     record = await runner.once(fit.fit_id, make)
