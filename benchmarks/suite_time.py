@@ -11,7 +11,10 @@ records each one's wall time, test count and the load average around it in
 -   ``scripts/test --other-cpus`` (the numeric tests under three other
     kernels' settings), unless ``--no-other-cpus``.
 
-    .venv/bin/python benchmarks/suite_time.py [--no-other-cpus]
+    .venv/bin/python benchmarks/suite_time.py [--no-other-cpus] [--log DIR]
+
+``--log DIR`` keeps each mode's whole output (``DIR/quick.log``,
+``full.log``, ``other-cpus.log``), for what a failed run printed.
 
 A run with other work on the machine is slower; the load average says how
 busy it was (1 minute average at the start and the end of each mode).
@@ -39,12 +42,15 @@ SUMMARY = re.compile(r"^=*\s*((?:\d+ \w+, )*\d+ (?:passed|failed).*?) in [\d.]+s
 FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
 
 
-def run(args: list[str]) -> dict:
+def run(args: list[str], log: Path | None = None) -> dict:
     load_start = os.getloadavg()[0]
     start = time.perf_counter()
     done = subprocess.run(["scripts/test", *args], cwd=ROOT, capture_output=True, text=True)
     seconds = time.perf_counter() - start
     output = done.stdout + done.stderr
+    if log is not None:
+        log.mkdir(parents=True, exist_ok=True)
+        (log / f"{args[0].lstrip('-') if args else 'full'}.log").write_text(output)
     summaries = SUMMARY.findall(output)
     return {"command": " ".join(["scripts/test", *args]), "seconds": round(seconds, 1),
             "returncode": done.returncode, "summaries": summaries,
@@ -55,9 +61,10 @@ def run(args: list[str]) -> dict:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--no-other-cpus", action="store_true", help="leave out --other-cpus")
+    parser.add_argument("--log", type=Path, help="keep each mode's whole output in this directory")
     args = parser.parse_args(argv)
     modes = [["--quick"], []] + ([] if args.no_other_cpus else [["--other-cpus"]])
-    rows = [run(mode) for mode in modes]
+    rows = [run(mode, args.log) for mode in modes]
     print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11}  tests")
     for r in rows:
         print(f"{r['command']:<28} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
