@@ -262,8 +262,11 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
 
 @pytest.mark.slow
 def test_timed_out_fit_is_cancelled_and_its_worker_freed(tmp_path):
-    # Issue 20: a job whose request was answered 504 no longer runs on.
-    with app_client(tmp_path, fit_timeout_s=0.2, metrics_samples=10) as client:
+    # Issue 20: a job whose request was answered 504 no longer runs on. The job must outlast the
+    # limit and the workers' 0.1 s checks on any machine: 400 x 400 metrics take 0.9 s of the job here
+    # (a fit with 10 took 0.05 s on a warm worker, and passed only while a fresh worker's start made
+    # up the rest).
+    with app_client(tmp_path, fit_timeout_s=0.2, metrics_samples=400) as client:
         body = {"name": "slow", "nk": gold_like_nk(0.2)}
         first = client.post(f"{API}/fits", json=body)
         assert first.status_code == 504 and int(first.headers["retry-after"]) >= 1
