@@ -130,7 +130,7 @@ def test_same_name_at_once_one_winner(replicas):
     views = [loopback.get(f"{r.url}{API}/materials/{material}", timeout=30).json() for r in (a, b)]
     assert views[0] == views[1] and views[0]["version"] == 20 and views[0]["latest_fit_id"] in ids
     stale = loopback.post(f"{a.url}{API}/fits/from-curves", json=curves_body(50, "shared", expected_version=3),
-                       timeout=60)
+                          timeout=60)
     assert stale.status_code == 409 and "nothing was fitted" in stale.json()["detail"]
 
 

@@ -32,7 +32,7 @@ BOUND = 0.2  # the issue's promise for a mirror against its tool
 def test_three_fallback_is_the_mirror(pages, live_server, material, eta_i):
     fit = create_fit(live_server, material, "rgb-conductor")
     response = loopback.get(f"{live_server}/api/v1/fits/{fit['id']}/pack",
-                         params={"format": "gltf", "eta_i": eta_i}, timeout=300)
+                            params={"format": "gltf", "eta_i": eta_i}, timeout=300)
     response.raise_for_status()
     gltf_material = json.loads(response.content)["materials"][0]
     base = np.asarray(gltf_material["pbrMetallicRoughness"]["baseColorFactor"][:3])
