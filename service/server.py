@@ -26,7 +26,9 @@ client cannot get past:
     :data:`HEALTH_RESERVE` more for it), every other request on it answered
     503 with ``Retry-After``, its request due within the grace; so
     ``/healthz`` is always answered and a burst past the bound gets 503s,
-    not connection resets;
+    not connection resets; the connections are kept in the order of their
+    last activity (:class:`_Admission`), so finding the one to close takes
+    a step or a few, not a pass over every connection;
 -   the keep-alive timeout (``keep_alive_s``);
 -   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
     closed, the concurrency limit, invalid requests) are logged once, then
@@ -111,6 +113,42 @@ class OncePerInterval(logging.Filter):
         return True
 
 
+class _Admission:
+    """
+    A server's connections in the order of their last activity (least
+    recent first), all together and by client address: what
+    :meth:`DeadlineH11Protocol._evict` searches, in a step or a few per new
+    connection where a pass over every connection made a flood of ``n``
+    connections cost ``n**2`` (0.12 s of the event loop for 600).
+    """
+
+    def __init__(self) -> None:
+        self.everyone: dict[DeadlineH11Protocol, None] = {}
+        self.by_host: dict[str | None, dict[DeadlineH11Protocol, None]] = {}
+
+    @classmethod
+    def of(cls, server_state) -> _Admission:
+        """The admission state of the server whose shared state is ``server_state``."""
+        admission = getattr(server_state, "coated_admission", None)
+        if admission is None:
+            admission = server_state.coated_admission = cls()
+        return admission
+
+    def add(self, connection: DeadlineH11Protocol, host: str | None) -> None:
+        """Put ``connection`` last (the most recently active), adding it if new."""
+        for order in (self.everyone, self.by_host.setdefault(host, {})):
+            order.pop(connection, None)
+            order[connection] = None
+
+    def discard(self, connection: DeadlineH11Protocol, host: str | None) -> None:
+        self.everyone.pop(connection, None)
+        mine = self.by_host.get(host)
+        if mine is not None:
+            mine.pop(connection, None)
+            if not mine:
+                del self.by_host[host]
+
+
 class DeadlineH11Protocol(H11Protocol):
     """uvicorn's h11 protocol with a deadline on each request's header."""
 
@@ -124,35 +162,50 @@ class DeadlineH11Protocol(H11Protocol):
         self._health_only = False
         self._served = False  # a response was sent on it
         super().connection_made(transport)
-        self._last_active = self.loop.time()
+        admission = _Admission.of(self.server_state)
+        self._host = self.client[0] if self.client else None
+        self._admission = admission
+        self._touch()
         self._arm_header_deadline()
-        host = self.client[0] if self.client else None
-        mine = [c for c in self.connections if c is not self and getattr(c, "client", None)
-                and c.client[0] == host]
-        if len(mine) >= self.max_connections_per_client and not self._evict(mine):
+        mine = admission.by_host[self._host]  # this one among them
+        if self._host is not None and len(mine) > self.max_connections_per_client and not self._evict(mine):
             self._health_only = True
         # The service's own bound gives way to any idle connection, however new: it keeps /healthz's slots.
-        if len(self.connections) > self.max_connections and not self._evict(self.connections, grace=False):
+        if len(self.connections) > self.max_connections and not self._evict(admission.everyone, grace=False):
             self._health_only = True
         if self._health_only:
             # Past a bound with none to give way: its request (503, or /healthz) is due within the grace.
             self._disarm_header_deadline()
             self._header_deadline = self.loop.call_later(IDLE_GRACE_S, self._header_timed_out)
 
-    def _idle(self, grace: bool = True) -> bool:
-        """No request in progress, and (with ``grace``) nothing sent or received for the grace."""
-        return (self.conn.their_state is h11.IDLE and not self.transport.is_closing()
-                and (self.cycle is None or self.cycle.response_complete)
-                and (not grace or self.loop.time() - self._last_active >= IDLE_GRACE_S))
+    def _touch(self) -> None:
+        """Something was sent or received: this connection becomes the most recently active."""
+        self._last_active = self.loop.time()
+        self._admission.add(self, self._host)
 
-    def _evict(self, candidates, grace: bool = True) -> bool:
-        """Close the longest idle connection of ``candidates`` (not this one); False when none is idle."""
-        idle = [c for c in candidates
-                if c is not self and isinstance(c, DeadlineH11Protocol) and c._idle(grace)]
-        if not idle:
-            return False
-        min(idle, key=lambda c: c._last_active).transport.close()
-        return True
+    def _idle(self) -> bool:
+        """No request in progress on it (and it is not closing)."""
+        return (self.conn.their_state is h11.IDLE and not self.transport.is_closing()
+                and (self.cycle is None or self.cycle.response_complete))
+
+    def _evict(self, candidates: dict, grace: bool = True) -> bool:
+        """
+        Close the longest idle connection of ``candidates`` (not this one;
+        with ``grace`` only one silent for :data:`IDLE_GRACE_S`); False when
+        none is. ``candidates`` are in the order of their last activity, so
+        the search stops at the first idle one, or (with ``grace``) at the
+        first active within the grace: a flood costs each new connection a
+        few steps, not a pass over every connection.
+        """
+        now = self.loop.time()
+        for other in candidates:
+            if grace and now - other._last_active < IDLE_GRACE_S:
+                return False  # the rest were active more recently still
+            if other is not self and other._idle():
+                other._admission.discard(other, other._host)
+                other.transport.close()
+                return True
+        return False
 
     def _arm_header_deadline(self) -> None:
         if self._header_deadline is None:
@@ -187,7 +240,7 @@ class DeadlineH11Protocol(H11Protocol):
         return False
 
     def data_received(self, data: bytes) -> None:
-        self._last_active = self.loop.time()
+        self._touch()
         if self.conn.their_state is h11.IDLE:
             self._arm_header_deadline()
             start = self._header_tail + data if self._header_seen == 0 else b""
@@ -203,13 +256,14 @@ class DeadlineH11Protocol(H11Protocol):
     def on_response_complete(self) -> None:
         super().on_response_complete()
         self._served = True
-        self._last_active = self.loop.time()
+        self._touch()
         self._header_seen, self._header_tail = 0, b""
         if self.conn.their_state is h11.IDLE and self.conn.trailing_data[0]:
             self._arm_header_deadline()  # a pipelined request has begun
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._disarm_header_deadline()
+        self._admission.discard(self, self._host)
         super().connection_lost(exc)
 
 

@@ -128,3 +128,23 @@ def test_a_burst_past_the_bound_is_answered_503_not_cut(tmp_path):
         assert status.count(b"HTTP/1.1 200 OK") >= 20
         refused = [a for a in answers if a.startswith(b"HTTP/1.1 503")]
         assert refused and all(b"retry-after: 2" in a.lower() for a in refused)
+
+
+def test_a_connection_past_the_bound_closes_the_one_idle_longest(tmp_path):
+    """The longest idle is counted from each connection's last activity, not from its opening."""
+    with server_process(tmp_path / "data", COATED_WARM_POOL="false",
+                        COATED_MAX_CONNECTIONS_PER_CLIENT="3") as server, contextlib.ExitStack() as stack:
+        first, second, third = idle_sockets(server.port, 3)
+        for s in (first, second, third):
+            stack.callback(s.close)
+        first.settimeout(10)
+        first.sendall(b"GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")  # kept alive after its answer
+        answer = b""
+        while b"\r\n\r\n" not in answer:
+            answer += first.recv(65536)
+        assert answer.startswith(b"HTTP/1.1 200 OK"), answer
+        time.sleep(IDLE_GRACE_S + 0.3)  # all three idle past the grace; `second` the longest
+        fourth = idle_sockets(server.port, 1)[0]
+        stack.callback(fourth.close)
+        assert still_open([second]) == 0
+        assert still_open([first, third, fourth]) == 3
