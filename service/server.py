@@ -118,8 +118,9 @@ class _Admission:
     A server's connections in the order of their last activity (least
     recent first), all together and by client address: what
     :meth:`DeadlineH11Protocol._evict` searches, in a step or a few per new
-    connection where a pass over every connection made a flood of ``n``
-    connections cost ``n**2`` (0.12 s of the event loop for 600).
+    connection, where a pass over every connection made a flood of ``n``
+    connections cost the event loop ``n**2`` steps, and a request that came
+    just after the flood waited for them.
     """
 
     def __init__(self) -> None:
