@@ -294,8 +294,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     if base_record is not None and base_record.kind == "curves":
         measured_library, measured = base_record.library_material, base_record.nk
     # A draft refers to its n, k, never holds a copy (~0.5 MB a step for 20,000 samples).
-    known_nk = measured  # what the new record holds or refers to
-    measured, nk_of, nk_id, draft_nk = await asyncio.to_thread(draft_nk_reference, fit.draft, base_record, known_nk)
+    own_nk, nk_of, nk_id, draft_nk = await asyncio.to_thread(draft_nk_reference, fit.draft, base_record, measured)
 
     settings = LIVE_SETTINGS if fit.live else DEFAULTS
     made_here = []  # set when this request's own job ran (and, unless a draft, saved)
@@ -309,7 +308,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         record = fit_record(
             fit.fit_id, "curves", material_id, fit.name,
             job["source"], job, fit.objective,
-            library_material=measured_library, nk=measured, nk_id=nk_id,
+            library_material=measured_library, nk=own_nk, nk_id=nk_id,
             base_fit_id=base_record.id if base_record else None,
             provenance={
                 "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
@@ -322,7 +321,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         )
         stored = await asyncio.to_thread(store.put_fit, record, not fit.draft, expected_version, draft_nk)
         # Its n, k is known here (a read back would parse it again: 0.6 MB of JSON at 20,000 samples).
-        return stored if stored.nk is not None or known_nk is None else replace(stored, nk=known_nk)
+        return stored if stored.nk is not None or measured is None else replace(stored, nk=measured)
 
     record = await runner.once(fit.fit_id, make)
     if not fit.draft and not made_here:
