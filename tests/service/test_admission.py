@@ -60,7 +60,10 @@ def test_healthz_answers_fast_with_600_idle_connections_open(tmp_path):
             response = loopback.get(f"{server.url}/healthz", timeout=10)  # a new connection each time
             seconds.append(time.perf_counter() - t0)
             assert response.status_code == 200, response.text
-        p99 = statistics.quantiles(seconds, n=100)[98]
+        # The sample's 99th percentile, between its two largest of 60 (numpy's default, as
+        # test_previews_bounded.py). The default "exclusive" method extrapolates past the largest:
+        # one slow request of 0.44 s among 0.035 s ones made a "p99" of 0.598 s, and a failure.
+        p99 = statistics.quantiles(seconds, n=100, method="inclusive")[98]
         assert p99 < 0.5, (p99, max(seconds))
         # COATED_MAX_CONNECTIONS_PER_CLIENT: those past it close when their first request's grace is over.
         assert still_open(flood, IDLE_GRACE_S + 0.3) <= 128
