@@ -17,7 +17,12 @@ records each one's wall time, test count and the load average around it in
 ``full.log``, ``other-cpus.log``), for what a failed run printed.
 
 A run with other work on the machine is slower; the load average says how
-busy it was (1 minute average at the start and the end of each mode).
+busy it was (1 minute average at the start and the end of each mode). Each
+mode's CPU time, the machine's busy, idle and steal seconds over its run
+(``/proc/stat``), says how far its wall time is from what 2 cores allow
+(busy / 2); ``benchmarks/suite_cpu.py`` says which processes spent it.
+Before each mode, ``calibration_s``: the seconds a fixed pure-Python loop
+takes (:func:`benchmarks.suite_cpu.calibration`), the VM's speed then.
 """
 
 from __future__ import annotations
@@ -36,6 +41,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import cpu  # noqa: E402
+from benchmarks.suite_cpu import TICK, calibration, machine_ticks  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
 SUMMARY = re.compile(r"^=*\s*((?:\d+ \w+, )*\d+ (?:passed|failed).*?) in [\d.]+s", re.M)
@@ -43,10 +49,12 @@ FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
 
 
 def run(args: list[str], log: Path | None = None) -> dict:
-    load_start = os.getloadavg()[0]
+    speed = calibration()
+    load_start, ticks = os.getloadavg()[0], machine_ticks()
     start = time.perf_counter()
     done = subprocess.run(["scripts/test", *args], cwd=ROOT, capture_output=True, text=True)
     seconds = time.perf_counter() - start
+    ticks = {k: round((v - ticks[k]) / TICK, 1) for k, v in machine_ticks().items()}
     output = done.stdout + done.stderr
     if log is not None:
         log.mkdir(parents=True, exist_ok=True)
@@ -55,7 +63,8 @@ def run(args: list[str], log: Path | None = None) -> dict:
     return {"command": " ".join(["scripts/test", *args]), "seconds": round(seconds, 1),
             "returncode": done.returncode, "summaries": summaries,
             "failures": FAILURE.findall(output)[:50],  # what failed, when a run did
-            "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)]}
+            "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)],
+            "machine_seconds": ticks, "calibration_s": speed}
 
 
 def main(argv=None) -> int:
@@ -65,10 +74,12 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     modes = [["--quick"], []] + ([] if args.no_other_cpus else [["--other-cpus"]])
     rows = [run(mode, args.log) for mode in modes]
-    print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11}  tests")
+    print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "
+          f"{'calib s':>7}  tests")
     for r in rows:
         print(f"{r['command']:<28} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
-              f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f}  {'; '.join(r['summaries'])}")
+              f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f} {r['machine_seconds']['busy']:>7.1f} "
+              f"{r['machine_seconds']['idle']:>7.1f} {r['calibration_s']:>7.3f}  {'; '.join(r['summaries'])}")
     for r in rows:
         for failure in r["failures"]:
             print(f"{r['command']}: {failure}")

@@ -1,0 +1,205 @@
+"""
+Where the full suite's CPU time goes
+====================================
+
+Runs the README's full test command (``scripts/test``) once while it
+samples ``/proc`` every ``--interval`` seconds (0.25): each process's own
+CPU time (user and system, all its threads, ``/proc/PID/stat``), kept per
+process under a class read from its command line (the pytest processes,
+the service's server processes, their fork servers and workers, Chromium's
+browser, renderer and GPU processes, playwright's Node.js driver, the CLI
+runs, PostgreSQL, kernel threads, this sampler; :data:`CLASSES`), and the
+machine's busy, idle and steal time from ``/proc/stat``. Records the table
+in ``benchmarks/results/suite_cpu.json`` (``classes.<key>.cpu_seconds``,
+quoted by docs/testing.md):
+
+    .venv/bin/python benchmarks/suite_cpu.py [--interval S] [--log FILE]
+
+``--log FILE`` keeps the suite's whole output. The record also holds
+:func:`calibration`, the seconds a fixed pure-Python loop took just before
+the run: this VM's speed varies from one hour to the next, and the same
+suite takes as many more CPU seconds as that loop does.
+
+The full suite's wall time on 2 cores is bounded below by its busy CPU
+time over 2, so this says what a shorter run has to take CPU time from. A
+process that starts and ends between two samples is not seen; what the
+classes miss of the machine's busy time is the row "not seen". The
+sampler's own CPU time is its row; it makes this run a little slower than
+``benchmarks/suite_time.py``'s, whose wall times are the record of speed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+from collections import Counter
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from benchmarks.record import cpu  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results" / "suite_cpu.json"
+TICK = os.sysconf("SC_CLK_TCK")
+
+CLASSES = (
+    # (key in the record, what it is, substrings of the command line naming it); the first match wins
+    ("chromium_renderer", "Chromium renderer", ("--type=renderer",)),
+    ("chromium_gpu", "Chromium GPU process (SwiftShader)", ("--type=gpu-process",)),
+    ("chromium_other", "Chromium other (zygote, utility)", ("--type=",)),
+    ("chromium_browser", "Chromium browser", ("chromium", "chrome")),
+    ("fork_servers", "fork servers and their workers", ("multiprocessing.forkserver",)),
+    ("servers", "server processes (python -m service)", ("-m service",)),
+    # the second: pytest-xdist's workers
+    ("pytest", "pytest processes", ("pytest", "exec(eval(sys.stdin.readline()))")),
+    ("playwright", "playwright's Node.js driver", ("playwright",)),
+    ("node", "other Node.js (glTF validator, three.js)", ("node",)),
+    ("postgres", "PostgreSQL", ("postgres",)),
+    ("blender", "Blender", ("blender", "bpy")),
+    ("cli", "CLI runs (python -m fitting, benchmarks)", ("-m fitting", "-m benchmarks")),
+)
+OTHERS = {
+    "other_python": "other Python processes",
+    "other": "other programs",
+    "kernel": "kernel threads",
+    "sampler": "this sampler",
+    "not_seen": "not seen (processes that lived between two samples)",
+}
+LABELS = {key: label for key, label, _ in CLASSES} | OTHERS
+
+
+def classify(command: str) -> str:
+    """The key of a process's class by its command line (:data:`CLASSES`)."""
+    if not command:  # kernel threads have none
+        return "kernel"
+    for key, _, needles in CLASSES:
+        if any(n in command for n in needles):
+            return key
+    return "other_python" if "python" in command else "other"
+
+
+def calibration() -> float:
+    """
+    Seconds of CPU time a fixed pure-Python loop takes here (the best of
+    3): the VM's speed at the moment, since the same work takes a different
+    number of CPU seconds from one hour to the next.
+    """
+    best = float("inf")
+    for _ in range(3):
+        start, total = time.process_time(), 0
+        for i in range(2_000_000):
+            total += i * i % 7
+        best = min(best, time.process_time() - start)
+    return round(best, 3)
+
+
+def machine_ticks() -> dict[str, int]:
+    """/proc/stat's first line: busy (user, nice, system, irq, softirq), idle (with iowait) and steal ticks."""
+    v = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+    return {"busy": v[0] + v[1] + v[2] + v[5] + v[6], "idle": v[3] + v[4], "steal": v[7]}
+
+
+class Sampler(threading.Thread):
+    """Every ``interval`` seconds: each live process's CPU ticks so far, kept by (pid, start time)."""
+
+    def __init__(self, interval: float) -> None:
+        super().__init__(daemon=True)
+        self.interval, self.done = interval, threading.Event()
+        # (pid, start) -> [class, ticks counted from, last ticks, samples that read the command line]
+        self.seen: dict[tuple[str, str], list] = {}
+        self.me = str(os.getpid())
+        self.started = False  # after the first sample: a process first seen since then counts from 0
+
+    def sample(self) -> None:
+        for pid in os.listdir("/proc"):
+            if not pid.isdigit():
+                continue
+            try:
+                stat = Path(f"/proc/{pid}/stat").read_text()
+            except OSError:
+                continue
+            fields = stat[stat.rfind(")") + 2:].split()
+            ticks, key = int(fields[11]) + int(fields[12]), (pid, fields[19])
+            entry = self.seen.get(key)
+            if entry is None:
+                self.seen[key] = entry = [None, ticks if not self.started else 0, ticks, 0]
+            if entry[3] < 2:  # read twice: a child seen between its fork and its exec has its parent's
+                try:
+                    command = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+                except OSError:
+                    command = ""
+                if command or entry[0] is None:  # a process gone since (or a zombie) keeps its class
+                    entry[0] = "sampler" if pid == self.me else classify(command)
+                entry[3] += 1
+            entry[2] = max(entry[2], ticks)
+
+    def run(self) -> None:
+        self.sample()  # what the processes running now spent before is not the suite's
+        self.started = True
+        while not self.done.wait(self.interval):
+            self.sample()
+        self.sample()
+
+    def totals(self) -> Counter:
+        out = Counter()
+        for label, first, last, _ in self.seen.values():
+            out[label] += (last - first) / TICK
+        return out
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--interval", type=float, default=0.25, help="seconds between samples (default 0.25)")
+    parser.add_argument("--log", type=Path, help="keep the suite's whole output in this file")
+    args = parser.parse_args(argv)
+    if not 0.01 <= args.interval <= 5:
+        parser.error(f"--interval must lie in [0.01, 5] seconds, got {args.interval}")
+    speed = calibration()
+    sampler = Sampler(args.interval)
+    sampler.start()
+    before, load_start, start = machine_ticks(), os.getloadavg()[0], time.perf_counter()
+    done = subprocess.run(["scripts/test"], cwd=ROOT, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    after = machine_ticks()
+    output = done.stdout + done.stderr
+    if args.log is not None:
+        args.log.parent.mkdir(parents=True, exist_ok=True)
+        args.log.write_text(output)
+    sampler.done.set()
+    sampler.join()
+    machine = {k: round((after[k] - before[k]) / TICK, 1) for k in before}
+    classes = sampler.totals()
+    classes["not_seen"] = machine["busy"] - sum(classes.values())
+    rows = {k: {"class": LABELS[k], "cpu_seconds": round(classes[k], 1),
+                "share": round(classes[k] / machine["busy"], 3)} for k in sorted(LABELS, key=lambda k: -classes[k])}
+    summary = [line for line in output.splitlines() if " passed" in line or " failed" in line]
+    failures = [line for line in output.splitlines() if line.startswith(("FAILED ", "ERROR "))]
+    print(f"scripts/test: {seconds:.0f} s wall, returncode {done.returncode}; machine: busy {machine['busy']} s, "
+          f"idle {machine['idle']} s, steal {machine['steal']} s of CPU time ({os.cpu_count()} cores); "
+          f"calibration loop {speed} s")
+    print(f"{'class':<54} {'CPU s':>8} {'share':>6}")
+    for row in rows.values():
+        print(f"{row['class']:<54} {row['cpu_seconds']:>8.1f} {row['share']:>6.1%}")
+    for failure in failures:
+        print(failure)
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    RESULTS.write_text(json.dumps({
+        "command": "benchmarks/suite_cpu.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+        "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+        "cpu": cpu(), "wall_seconds": round(seconds, 1), "returncode": done.returncode,
+        "summary": summary[-1:], "failures": failures[:50],
+        "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)], "calibration_s": speed,
+        "machine_seconds": machine, "classes": rows,
+    }, indent=2) + "\n")
+    return done.returncode
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,59 @@
+"""
+benchmarks/suite_cpu.py: the class of a process by its command line, and
+the sampler's count of a process's CPU time (a child that spins about a
+second of CPU is seen, in its class, with that time).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from benchmarks.suite_cpu import LABELS, TICK, Sampler, calibration, classify
+
+CHROMIUM = "/usr/lib/chromium/chromium --headless --no-sandbox"
+
+
+@pytest.mark.parametrize("command, key", [
+    (f"{CHROMIUM} --type=renderer --enable-automation", "chromium_renderer"),
+    (f"{CHROMIUM} --type=gpu-process --use-angle=swiftshader", "chromium_gpu"),
+    (f"{CHROMIUM} --type=zygote", "chromium_other"),
+    (f"{CHROMIUM} --remote-debugging-pipe", "chromium_browser"),
+    ("/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.preload'])",
+     "fork_servers"),
+    ("/r/.venv/bin/python -m service --host 127.0.0.1 --port 40123 --data-dir /tmp/x", "servers"),
+    (".venv/bin/python -m pytest -n 2 --dist loadscope", "pytest"),
+    ("/r/.venv/bin/python -u -c import sys;exec(eval(sys.stdin.readline()))", "pytest"),
+    ("/r/.venv/lib/python3.11/site-packages/playwright/driver/node run-driver", "playwright"),
+    ("node node_modules/gltf-validator/cli.js a.gltf", "node"),
+    ("/usr/lib/postgresql/15/bin/postgres -D /tmp/coated-pg-1", "postgres"),
+    ("/r/.venv/bin/python -m fitting fit Au --eta-i 1.5", "cli"),
+    ("/r/.venv/bin/python -c print(1)", "other_python"),
+    ("/usr/bin/glslangValidator shader.frag", "other"),
+    ("", "kernel"),
+])
+def test_a_process_is_classed_by_its_command_line(command, key):
+    assert classify(command) == key
+    assert key in LABELS
+
+
+def test_the_calibration_loop_takes_cpu_time():
+    assert 0.0 < calibration() < 60.0
+
+
+@pytest.mark.slow
+def test_the_sampler_counts_a_child_s_cpu_time_in_its_class():
+    sampler = Sampler(0.05)
+    sampler.start()
+    spin = "import time\nstart = time.process_time()\nwhile time.process_time() - start < 1.0: pass\n"
+    child = subprocess.Popen([sys.executable, "-c", spin])
+    assert child.wait(timeout=60) == 0
+    sampler.done.set()
+    sampler.join()
+    mine = [(label, (last - first) / TICK) for (pid, _), (label, first, last, _) in sampler.seen.items()
+            if pid == str(child.pid)]
+    assert [label for label, _ in mine] == ["other_python"], mine
+    # Its whole CPU time but what it spent after the last sample (under one interval), and its start-up.
+    assert 0.9 <= mine[0][1] <= 1.5, mine
