@@ -13,12 +13,13 @@ machine's busy, idle and steal time from ``/proc/stat``. Records the table
 in ``benchmarks/results/suite_cpu.json`` (``classes.<key>.cpu_seconds``,
 quoted by docs/testing.md):
 
-    .venv/bin/python benchmarks/suite_cpu.py [--interval S] [--log FILE]
+    .venv/bin/python benchmarks/suite_cpu.py [--interval S] [--log DIR]
 
-``--log FILE`` keeps the suite's whole output. The record also holds
-:func:`calibration`, the seconds a fixed pure-Python loop took just before
-the run: this VM's speed varies from one hour to the next, and the same
-suite takes as many more CPU seconds as that loop does.
+``--log DIR`` keeps the suite's whole output (``DIR/full.log``). The record also holds
+:func:`benchmarks.suite_time.calibration`, the seconds a fixed pure-Python
+loop took just before the run (the interpreter's speed on one core then;
+the suite's CPU seconds vary from one hour to the next by more than it
+does). "this sampler" is this process: the sampler and that loop.
 
 The full suite's wall time on 2 cores is bounded below by its busy CPU
 time over 2, so this says what a shorter run has to take CPU time from. A
@@ -33,10 +34,8 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import subprocess
 import sys
 import threading
-import time
 from collections import Counter
 from datetime import datetime, timezone
 from pathlib import Path
@@ -45,9 +44,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import cpu  # noqa: E402
+from benchmarks.suite_time import TICK, run  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "suite_cpu.json"
-TICK = os.sysconf("SC_CLK_TCK")
 
 CLASSES = (
     # (key in the record, what it is, substrings of the command line naming it); the first match wins
@@ -83,27 +82,6 @@ def classify(command: str) -> str:
         if any(n in command for n in needles):
             return key
     return "other_python" if "python" in command else "other"
-
-
-def calibration() -> float:
-    """
-    Seconds of CPU time a fixed pure-Python loop takes here (the best of
-    3): the VM's speed at the moment, since the same work takes a different
-    number of CPU seconds from one hour to the next.
-    """
-    best = float("inf")
-    for _ in range(3):
-        start, total = time.process_time(), 0
-        for i in range(2_000_000):
-            total += i * i % 7
-        best = min(best, time.process_time() - start)
-    return round(best, 3)
-
-
-def machine_ticks() -> dict[str, int]:
-    """/proc/stat's first line: busy (user, nice, system, irq, softirq), idle (with iowait) and steal ticks."""
-    v = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
-    return {"busy": v[0] + v[1] + v[2] + v[5] + v[6], "idle": v[3] + v[4], "steal": v[7]}
 
 
 class Sampler(threading.Thread):
@@ -157,48 +135,38 @@ class Sampler(threading.Thread):
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--interval", type=float, default=0.25, help="seconds between samples (default 0.25)")
-    parser.add_argument("--log", type=Path, help="keep the suite's whole output in this file")
+    parser.add_argument("--log", type=Path, help="keep the suite's whole output in this directory (full.log)")
     args = parser.parse_args(argv)
     if not 0.01 <= args.interval <= 5:
         parser.error(f"--interval must lie in [0.01, 5] seconds, got {args.interval}")
-    speed = calibration()
     sampler = Sampler(args.interval)
     sampler.start()
-    before, load_start, start = machine_ticks(), os.getloadavg()[0], time.perf_counter()
-    done = subprocess.run(["scripts/test"], cwd=ROOT, capture_output=True, text=True)
-    seconds = time.perf_counter() - start
-    after = machine_ticks()
-    output = done.stdout + done.stderr
-    if args.log is not None:
-        args.log.parent.mkdir(parents=True, exist_ok=True)
-        args.log.write_text(output)
+    result = run([], args.log)  # the full suite, as benchmarks/suite_time.py runs it
     sampler.done.set()
     sampler.join()
-    machine = {k: round((after[k] - before[k]) / TICK, 1) for k in before}
+    machine, seconds, speed = result["machine_seconds"], result["seconds"], result["calibration_s"]
     classes = sampler.totals()
     classes["not_seen"] = machine["busy"] - sum(classes.values())
     rows = {k: {"class": LABELS[k], "cpu_seconds": round(classes[k], 1),
                 "share": round(classes[k] / machine["busy"], 3)} for k in sorted(LABELS, key=lambda k: -classes[k])}
-    summary = [line for line in output.splitlines() if " passed" in line or " failed" in line]
-    failures = [line for line in output.splitlines() if line.startswith(("FAILED ", "ERROR "))]
-    print(f"scripts/test: {seconds:.0f} s wall, returncode {done.returncode}; machine: busy {machine['busy']} s, "
+    print(f"scripts/test: {seconds:.0f} s wall, returncode {result['returncode']}; machine: busy {machine['busy']} s, "
           f"idle {machine['idle']} s, steal {machine['steal']} s of CPU time ({os.cpu_count()} cores); "
           f"calibration loop {speed} s")
     print(f"{'class':<54} {'CPU s':>8} {'share':>6}")
     for row in rows.values():
         print(f"{row['class']:<54} {row['cpu_seconds']:>8.1f} {row['share']:>6.1%}")
-    for failure in failures:
+    for failure in result["failures"]:
         print(failure)
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
     RESULTS.write_text(json.dumps({
         "command": "benchmarks/suite_cpu.py " + " ".join(argv if argv is not None else sys.argv[1:]),
         "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "cpu": cpu(), "wall_seconds": round(seconds, 1), "returncode": done.returncode,
-        "summary": summary[-1:], "failures": failures[:50],
-        "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)], "calibration_s": speed,
+        "cpu": cpu(), "wall_seconds": seconds, "returncode": result["returncode"],
+        "summary": result["summaries"][-1:], "failures": result["failures"],
+        "load_average": result["load_average"], "calibration_s": speed,
         "machine_seconds": machine, "classes": rows,
     }, indent=2) + "\n")
-    return done.returncode
+    return result["returncode"]
 
 
 if __name__ == "__main__":

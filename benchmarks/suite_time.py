@@ -22,7 +22,7 @@ mode's CPU time, the machine's busy, idle and steal seconds over its run
 (``/proc/stat``), says how far its wall time is from what 2 cores allow
 (busy / 2); ``benchmarks/suite_cpu.py`` says which processes spent it.
 Before each mode, ``calibration_s``: the seconds a fixed pure-Python loop
-takes (:func:`benchmarks.suite_cpu.calibration`), the VM's speed then.
+takes (:func:`calibration`), the interpreter's speed on one core then.
 """
 
 from __future__ import annotations
@@ -41,11 +41,33 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import cpu  # noqa: E402
-from benchmarks.suite_cpu import TICK, calibration, machine_ticks  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
 SUMMARY = re.compile(r"^=*\s*((?:\d+ \w+, )*\d+ (?:passed|failed).*?) in [\d.]+s", re.M)
 FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
+TICK = os.sysconf("SC_CLK_TCK")
+
+
+def calibration() -> float:
+    """
+    Seconds of CPU time a fixed pure-Python loop takes here (the best of
+    3): the interpreter's speed on one core at the moment. The suite's own
+    CPU seconds have varied by a third between runs where this loop did not
+    (docs/testing.md), so it tells one cause of a slow run apart, not all.
+    """
+    best = float("inf")
+    for _ in range(3):
+        start, total = time.process_time(), 0
+        for i in range(2_000_000):
+            total += i * i % 7
+        best = min(best, time.process_time() - start)
+    return round(best, 3)
+
+
+def machine_ticks() -> dict[str, int]:
+    """/proc/stat's first line: busy (user, nice, system, irq, softirq), idle (with iowait) and steal ticks."""
+    v = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+    return {"busy": v[0] + v[1] + v[2] + v[5] + v[6], "idle": v[3] + v[4], "steal": v[7]}
 
 
 def run(args: list[str], log: Path | None = None) -> dict:

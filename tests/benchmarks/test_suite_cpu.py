@@ -11,7 +11,8 @@ import sys
 
 import pytest
 
-from benchmarks.suite_cpu import LABELS, TICK, Sampler, calibration, classify
+from benchmarks.suite_cpu import LABELS, Sampler, classify
+from benchmarks.suite_time import TICK, calibration
 
 CHROMIUM = "/usr/lib/chromium/chromium --headless --no-sandbox"
 
