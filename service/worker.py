@@ -50,6 +50,16 @@ class _Cancelled(Exception):
     """Raised in a worker whose job was cancelled by the server."""
 
 
+class _OverLimit(BaseException):
+    """
+    Raised in a worker's job at its CPU-time limit, and turned into
+    :class:`JobCPULimit` by :func:`run_part`. Not an ``Exception``: the
+    check lands wherever the job is, and a ``ValueError`` there was caught
+    by the job's own input checks (``except (TypeError, ValueError)`` around
+    ``np.asarray`` in ``fitting.domain``) and answered as bad input.
+    """
+
+
 def warm_process() -> None:
     """
     Process start-up (each worker's initializer, and the server process at
@@ -119,15 +129,18 @@ def run_part(serial: int, cpu_limit_s: float, function: Callable[..., Any], *arg
         if _cancelled is not None and serial in _cancelled[:]:
             raise _Cancelled()
         if time.process_time() - cpu0 > cpu_limit_s:
-            raise JobCPULimit(cpu_limit_s)
+            raise _OverLimit()
 
     previous = signal.signal(signal.SIGALRM, check)
     signal.setitimer(signal.ITIMER_REAL, _CHECK_S, _CHECK_S)
     try:
-        return function(*args)
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, previous)
+        try:
+            return function(*args)
+        finally:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, previous)
+    except _OverLimit:  # in the job, or in an alarm that landed before the timer was off
+        raise JobCPULimit(cpu_limit_s) from None
 
 
 def ping() -> float:

@@ -67,6 +67,27 @@ def test_a_part_past_its_cpu_limit_is_stopped_with_a_clear_error():
     assert asyncio.run(_with_runner(body, timeout_s=60.0, cpu_limit_s=0.05)) > 0
 
 
+def checked_input_for_two_seconds() -> str:
+    """A job that spends its time in the core's input checks (``except ValueError`` around ``np.asarray``)."""
+    from fitting.domain import as_float_array
+
+    values, start = [1.5] * 200_000, time.process_time()
+    while time.process_time() - start < 2.0:
+        as_float_array("eta_t", values)
+    return "not stopped"
+
+
+def test_the_cpu_limit_is_not_taken_for_bad_input_by_the_job_s_own_checks():
+    """The limit lands wherever the job is: inside an input check it is still the limit, not "must be numbers"."""
+    async def body(runner):
+        for _ in range(3):
+            with pytest.raises(JobCPULimit, match=r"CPU-time limit of 0\.05 s"):
+                await runner.run(checked_input_for_two_seconds)
+        return await runner.run(time.time)
+
+    assert asyncio.run(_with_runner(body, timeout_s=60.0, cpu_limit_s=0.05)) > 0
+
+
 def test_a_timed_out_job_is_cancelled_and_its_worker_free_within_a_second():
     async def body(runner):
         with pytest.raises(FitTimeout):
