@@ -33,6 +33,11 @@ client cannot get past:
 -   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
     closed, the concurrency limit, invalid requests) are logged once, then
     counted once a minute, so a flood cannot grow the log.
+
+SIGTERM and SIGINT stop it gracefully (uvicorn's shutdown: connections
+drained, the lifespan's pools and store closed), and the process then exits
+with the signal's conventional status (143, 130) through ``SystemExit``
+(:func:`_exit_after_shutdown`), so that its exit handlers run.
 """
 
 from __future__ import annotations
@@ -40,6 +45,7 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import signal
 import threading
 import time
 
@@ -290,4 +296,19 @@ def serve(app, settings: Settings, host: str, port: int) -> None:
     flood = OncePerInterval()  # after Config, which configures uvicorn's logging
     logging.getLogger("uvicorn.error").addFilter(flood)
     server = uvicorn.Server(config)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _exit_after_shutdown)
     server.run()
+
+
+def _exit_after_shutdown(signum: int, frame) -> None:
+    """
+    The handler of SIGINT and SIGTERM that uvicorn finds, restores after its
+    graceful shutdown and calls by raising the signal again: exit with
+    status 128 + ``signum`` through ``SystemExit``. The default actions
+    skipped the exit handlers: SIGTERM killed the process, so
+    multiprocessing's temporary directory (the fork server's socket,
+    ``/tmp/pymp-*``) was left behind at every stop, and SIGINT raised
+    ``KeyboardInterrupt`` with a traceback.
+    """
+    raise SystemExit(128 + signum)

@@ -207,6 +207,30 @@ def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
     assert "Traceback" not in result.stderr
 
 
+
+@pytest.mark.slow  # starts a process
+@pytest.mark.server
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_stopped_server_exits_with_the_signal_s_status_and_leaves_no_temporary_files(tmp_path, signum):
+    """
+    A stop (SIGTERM from a supervisor, Ctrl-C) shuts down gracefully and then
+    exits through Python's exit handlers, with status 128 + the signal.
+    Before, uvicorn re-raised the signal under its default action: SIGTERM
+    killed the process, leaving multiprocessing's directory of the fork
+    server's socket (``pymp-*``) in the temporary directory at every stop,
+    and SIGINT ended in a ``KeyboardInterrupt`` traceback.
+    """
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    with server_process(tmp_path / "data", TMPDIR=str(temporary)) as server:
+        assert list(temporary.glob("pymp-*")), "the fork server (started with the warm pool) has its directory"
+        server.process.send_signal(signum)
+        assert server.process.wait(timeout=60) == 128 + signum
+        log = server.log_text()
+    assert "Application shutdown complete" in log and "Traceback" not in log
+    assert list(temporary.iterdir()) == []
+
+
 # -- 7. worker death -------------------------------------------------------------
 
 def _children(pid: int) -> list[int]:
