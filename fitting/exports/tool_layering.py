@@ -236,6 +236,7 @@ def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = 
     The glTF export in three.js: ``MeshPhysicalMaterial`` with metalness 1 and
     ``color`` ``base_color``, environment light only, flat geometry (three adds
     the screen-space change of the normal to every roughness; 0 on a plane).
+    ``clearcoat`` is one factor, or one per view angle (S,).
     """
     mu = _mu(cos_theta)
     F0 = np.asarray(base_color, dtype=np.float64)
@@ -246,7 +247,9 @@ def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = 
     base = FssEss + FssEss * Favg / (1.0 - Ems * Favg) * Ems
     if not coat:
         return base
-    cc = float(np.clip(clearcoat, 0.0, 1.0))
+    cc = np.clip(np.asarray(clearcoat, dtype=np.float64), 0.0, 1.0)
+    if cc.ndim:
+        cc = cc[:, None]  # a factor per view angle, (S,): one per row
     Fcc = schlick(mu, THREE_CLEARCOAT_F0)[:, None]
     fcc = three_dfg(mu, max(clearcoat_roughness, THREE_MIN_ROUGHNESS))
     coat_specular = THREE_CLEARCOAT_F0 * fcc[:, :1] + fcc[:, 1:]

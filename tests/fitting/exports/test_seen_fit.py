@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from fitting.colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
-from fitting.exports import export_material, export_values
+from fitting.exports import export_material, export_values, seen_fit
 from fitting.exports.seen_fit import (
-    K_BOUNDS, N_BOUNDS, gltf_clearcoat_factor, layer_only, seen_delta_E, seen_fidelity, tool_floor,
+    K_BOUNDS, N_BOUNDS, PointsAtOnce, fit_tool_values, gltf_clearcoat_factor, layer_only, seen_delta_E,
+    seen_fidelity, tool_floor,
 )
 from fitting.exports.tool_fresnel import f82_tint, mx_fresnel_conductor
 from fitting.exports.tool_layering import (
@@ -84,6 +85,44 @@ def test_no_coat_at_eta_1(cu_bare):
     assert b"COAT = False" in export_material(cu_bare, "blender", 1.0)
     # The seen target is the bare metal, and the conductor fits follow it.
     assert seen_fidelity(cu_bare, "blender-conductor")["delta_E_mean"] < 0.1
+
+
+class CheckedPointsAtOnce(PointsAtOnce):
+    """PointsAtOnce that also evaluates every point one by one, as scipy would, and keeps the largest difference."""
+
+    calls, worst = 0, 0.0
+
+    def __call__(self, fun, points):
+        points = list(points)
+        together = super().__call__(fun, points)
+        one_by_one = [np.asarray(fun(x)) for x in points]
+        assert len(together) == len(one_by_one) == len(points)
+        CheckedPointsAtOnce.calls += 1
+        CheckedPointsAtOnce.worst = max([CheckedPointsAtOnce.worst] + [
+            float(np.max(np.abs(a - b))) for a, b in zip(together, one_by_one)])
+        return together
+
+
+@pytest.mark.parametrize("eta", [1.0, 1.5])
+@pytest.mark.parametrize("tool", list(TOOLS))
+def test_the_jacobian_s_points_at_once_are_the_points_one_by_one(monkeypatch, tool, eta):
+    """
+    The seen fits evaluate the points of scipy's finite-difference Jacobian in
+    one vectorised call (PointsAtOnce): in a real fit (the conductor tools'
+    view-dependent fit too), each point's residuals equal what scipy's own
+    one-call-per-point evaluation gives.
+    """
+    monkeypatch.setattr(seen_fit, "PointsAtOnce", CheckedPointsAtOnce)
+    monkeypatch.setattr(CheckedPointsAtOnce, "calls", 0)
+    monkeypatch.setattr(CheckedPointsAtOnce, "worst", 0.0)
+    fit_tool_values(tool, MU, eta, seen_ACEScg(library_material("Au"), MU, eta), coat=eta > 1.0)
+    assert CheckedPointsAtOnce.calls >= 2
+    # The same element-wise operations on the same numbers; only the 3 x 3
+    # colour-space products may round differently on a longer array (BLAS
+    # blocking): a few ulps (2.2e-16 each) of components <= ~1, carried into
+    # a Delta E 2000 of at most ~100 through Lab's cube root (slope <= ~100
+    # here): 1e-12 bounds it (0 on the developers' machine).
+    assert CheckedPointsAtOnce.worst <= 1e-12, (tool, eta, CheckedPointsAtOnce.worst)
 
 
 def test_mirror_algebra():
