@@ -23,9 +23,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -35,6 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
+from benchmarks.side_by_side import Side, checkout, serve  # noqa: E402
 
 BEFORE = "51b944e"
 """The last commit before the max guard (b7362fd): the pipeline issue 21 calls today's."""
@@ -49,36 +48,17 @@ def child(root: str, repeats: int) -> int:
     from fitting import LIBRARY_NAMES, fit_material, library_material
 
     fit_material(library_material(LIBRARY_NAMES[0]))  # warm caches
-    print(json.dumps(list(LIBRARY_NAMES)), flush=True)
-    for line in sys.stdin:
-        nk = library_material(line.strip())
+
+    def answer(name: str) -> float:
+        nk = library_material(name)
         times = []
         for _ in range(repeats):
             t = time.process_time()
             fit_material(nk)
             times.append(time.process_time() - t)
-        print(json.dumps(1e3 * float(np.median(times))), flush=True)
-    return 0
+        return 1e3 * float(np.median(times))
 
-
-class Side:
-    """A child process timing fits of one checkout."""
-
-    def __init__(self, root: Path, repeats: int) -> None:
-        self.root = str(root)
-        self.process = subprocess.Popen(
-            [sys.executable, __file__, "--child", self.root, "--repeats", str(repeats)],
-            cwd=tempfile.gettempdir(), stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-        self.names = json.loads(self.process.stdout.readline())
-
-    def time(self, name: str) -> float:
-        self.process.stdin.write(name + "\n")
-        self.process.stdin.flush()
-        return json.loads(self.process.stdout.readline())
-
-    def close(self) -> None:
-        self.process.stdin.close()
-        self.process.wait(timeout=60)
+    return serve(LIBRARY_NAMES, answer)
 
 
 def main(argv=None) -> int:
@@ -92,13 +72,11 @@ def main(argv=None) -> int:
         return child(args.child, args.repeats)
     load_start = load_average()
     rounds = []
-    with tempfile.TemporaryDirectory() as tmp:
-        before_root = Path(tmp) / "before"
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(before_root), args.before],
-                       check=True, capture_output=True)
+    with checkout(args.before) as before_root:
         before = after = None
         try:
-            before, after = Side(before_root, args.repeats), Side(ROOT, args.repeats)
+            before = Side(__file__, before_root, "--repeats", str(args.repeats))
+            after = Side(__file__, ROOT, "--repeats", str(args.repeats))
             if before.names != after.names:
                 raise SystemExit("the two checkouts have different libraries")
             print(f"{'round':>5} {'before ms':>10} {'after ms':>9} {'ratio':>6} {'load':>5}")
@@ -107,7 +85,7 @@ def main(argv=None) -> int:
                 ms = {before.root: {}, after.root: {}}
                 for name in before.names:
                     for side in sides:
-                        ms[side.root][name] = side.time(name)
+                        ms[side.root][name] = side.ask(name)
                 a, b = (float(np.median(list(ms[s.root].values()))) for s in (before, after))
                 rounds.append({"before": {"median_ms": a, "ms": ms[before.root]},
                                "after": {"median_ms": b, "ms": ms[after.root]}, "ratio": b / a,
@@ -117,8 +95,6 @@ def main(argv=None) -> int:
             for side in (before, after):
                 if side is not None:
                     side.close()
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(before_root)],
-                           check=False, capture_output=True)
     before_ms = float(np.median([r["before"]["median_ms"] for r in rounds]))
     after_ms = float(np.median([r["after"]["median_ms"] for r in rounds]))
     ratios = [r["ratio"] for r in rounds]
