@@ -296,8 +296,9 @@ def serve(app, settings: Settings, host: str, port: int) -> None:
     flood = OncePerInterval()  # after Config, which configures uvicorn's logging
     logging.getLogger("uvicorn.error").addFilter(flood)
     server = uvicorn.Server(config)
-    for signum in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(signum, _exit_after_shutdown)
+    if threading.current_thread() is threading.main_thread():  # as uvicorn, signals only there
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(signum, _exit_after_shutdown)
     server.run()
 
 

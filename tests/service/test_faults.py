@@ -231,6 +231,51 @@ def test_a_stopped_server_exits_with_the_signal_s_status_and_leaves_no_temporary
     assert list(temporary.iterdir()) == []
 
 
+
+@pytest.mark.parametrize("where", ["main thread", "other thread"])
+def test_serve_sets_its_stop_handlers_in_the_main_thread_only(monkeypatch, tmp_path, where):
+    """
+    serve() installs the exit-after-shutdown handlers where signals can be
+    handled (Python's main thread, as uvicorn does); an application that
+    runs it on another thread keeps its own handlers and gets no error.
+    """
+    import threading
+
+    import uvicorn
+
+    from service import server as server_module
+    from service.config import Settings
+    from service.main import create_app
+
+    monkeypatch.setattr(uvicorn.Server, "run", lambda self, sockets=None: None)
+    settings = Settings(data_dir=tmp_path / "data", warm_pool=False, freeze_heap=False)
+    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    errors = []
+
+    def body():
+        try:
+            server_module.serve(create_app(settings), settings, "127.0.0.1", 0)
+        except BaseException as error:  # reported below, with the thread done
+            errors.append(error)
+
+    try:
+        if where == "main thread":
+            body()
+        else:
+            thread = threading.Thread(target=body)
+            thread.start()
+            thread.join(60)
+        assert errors == []
+        after = {signum: signal.getsignal(signum) for signum in before}
+        if where == "main thread":
+            assert all(handler is server_module._exit_after_shutdown for handler in after.values())
+        else:
+            assert after == before
+    finally:
+        for signum, handler in before.items():
+            signal.signal(signum, handler)
+
+
 # -- 7. worker death -------------------------------------------------------------
 
 def _children(pid: int) -> list[int]:
