@@ -207,7 +207,6 @@ def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
     assert "Traceback" not in result.stderr
 
 
-
 @pytest.mark.slow  # starts a process
 @pytest.mark.server
 @pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
@@ -229,7 +228,6 @@ def test_a_stopped_server_exits_with_the_signal_s_status_and_leaves_no_temporary
         log = server.log_text()
     assert "Application shutdown complete" in log and "Traceback" not in log
     assert list(temporary.iterdir()) == []
-
 
 
 @pytest.mark.parametrize("where", ["main thread", "other thread"])
