@@ -54,6 +54,7 @@ CLASSES = (
     ("chromium_gpu", "Chromium GPU process (SwiftShader)", ("--type=gpu-process",)),
     ("chromium_other", "Chromium other (zygote, utility)", ("--type=",)),
     ("chromium_browser", "Chromium browser", ("chromium", "chrome")),
+    # and a server's forks (its fork server, service.worker.start_fork_server, and their workers): classify()
     ("fork_servers", "fork servers and their workers", ("multiprocessing.forkserver",)),
     ("servers", "server processes (python -m service)", ("-m service",)),
     # the second: pytest-xdist's workers
@@ -74,13 +75,17 @@ OTHERS = {
 LABELS = {key: label for key, label, _ in CLASSES} | OTHERS
 
 
-def classify(command: str) -> str:
-    """The key of a process's class by its command line (:data:`CLASSES`)."""
+def classify(command: str, parent: str | None = None) -> str:
+    """
+    The key of a process's class by its command line (:data:`CLASSES`) and
+    its parent's class: a server's fork (its fork server and the workers,
+    which keep the server's command line) is ``fork_servers``.
+    """
     if not command:  # kernel threads have none
         return "kernel"
     for key, _, needles in CLASSES:
         if any(n in command for n in needles):
-            return key
+            return "fork_servers" if key == "servers" and parent in ("servers", "fork_servers") else key
     return "other_python" if "python" in command else "other"
 
 
@@ -93,6 +98,7 @@ class Sampler(threading.Thread):
         # (pid, start) -> [class, ticks counted from, last ticks, samples that read the command line]
         self.seen: dict[tuple[str, str], list] = {}
         self.me = str(os.getpid())
+        self.classes: dict[str, str] = {}  # pid -> the class of the process last seen with it (a child's parent)
         self.started = False  # after the first sample: a process first seen since then counts from 0
 
     def sample(self) -> None:
@@ -105,6 +111,7 @@ class Sampler(threading.Thread):
                 continue
             fields = stat[stat.rfind(")") + 2:].split()
             ticks, key = int(fields[11]) + int(fields[12]), (pid, fields[19])
+            parent = self.classes.get(fields[1])
             entry = self.seen.get(key)
             if entry is None:
                 self.seen[key] = entry = [None, ticks if not self.started else 0, ticks, 0]
@@ -114,9 +121,10 @@ class Sampler(threading.Thread):
                 except OSError:
                     command = ""
                 if command or entry[0] is None:  # a process gone since (or a zombie) keeps its class
-                    entry[0] = "sampler" if pid == self.me else classify(command)
+                    entry[0] = "sampler" if pid == self.me else classify(command, parent)
                 entry[3] += 1
             entry[2] = max(entry[2], ticks)
+            self.classes[pid] = entry[0]
 
     def run(self) -> None:
         self.sample()  # what the processes running now spent before is not the suite's

@@ -24,6 +24,7 @@ from .config import Settings
 from .main import create_app
 from .server import serve
 from .store import StoreError, open_store
+from .worker import start_fork_server
 
 PROG = "python -m service"
 
@@ -106,6 +107,8 @@ def main(argv: list[str] | None = None) -> int:
     settings = _settings(overrides)
     if settings is None:
         return 2
+    # Before the store is opened and before any thread: the workers' fork server, forked from here.
+    start_fork_server()
     problem = check_store(settings)
     if problem is not None:
         print(f"{PROG}: cannot start: {problem}", file=sys.stderr)

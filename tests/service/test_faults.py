@@ -284,13 +284,11 @@ def _children(pid: int) -> list[int]:
 def _worker_pids(server_pid: int) -> list[int]:
     """
     The server's fitting workers: the children of its fork server
-    (:func:`service.worker.process_context`), itself a child of the server.
+    (:func:`service.worker.process_context`), itself a child of the server
+    (a fork of it, :func:`service.worker.start_fork_server`), as is
+    multiprocessing's resource tracker, which has none.
     """
-    pids = []
-    for pid in _children(server_pid):
-        if b"forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes():
-            pids += _children(pid)
-    return pids
+    return [worker for child in _children(server_pid) for worker in _children(child)]
 
 
 @pytest.mark.slow  # 13.1 s (all cases 13.1 s) in a --durations=0 run
@@ -325,6 +323,60 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
     with server_process(tmp_path / "data") as again, loopback.Client(base_url=again.url, timeout=60) as http:
         for fit_id in saved:
             assert http.get(f"{API}/fits/{fit_id}").status_code == 200
+
+
+def _cmdline(pid: int) -> bytes:
+    return Path(f"/proc/{pid}/cmdline").read_bytes()
+
+
+def _threads(pid: int) -> int:
+    status = Path(f"/proc/{pid}/status").read_text()
+    return int(re.search(r"^Threads:\s+(\d+)", status, re.M).group(1))
+
+
+def test_the_fork_server_is_forked_only_where_multiprocessing_would_start_the_same():
+    from multiprocessing.forkserver import ForkServer
+
+    from service.worker import _cannot_fork_server
+
+    assert _cannot_fork_server(ForkServer(), 1) is None
+    assert "2 Python threads run" in _cannot_fork_server(ForkServer(), 2)
+    running = ForkServer()
+    running._forkserver_pid = os.getpid()
+    assert _cannot_fork_server(running, 1) == "a fork server runs already"
+    newer = ForkServer()  # as Python 3.14's, which authenticates its clients
+    newer._forkserver_authkey = None
+    assert "_forkserver_authkey" in _cannot_fork_server(newer, 1)
+
+
+@pytest.mark.slow
+@pytest.mark.server
+def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_starts_its_own(tmp_path):
+    with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server, \
+            loopback.Client(base_url=server.url, timeout=120) as http:
+        # Started before the first thread (service.worker.start_fork_server): the server's own
+        # command line, one thread, and the workers are its forks.
+        fork_servers = [child for child in _children(server.process.pid) if _children(child)]
+        assert len(fork_servers) == 1
+        fork_server = fork_servers[0]
+        assert _cmdline(fork_server) == _cmdline(server.process.pid)
+        assert _threads(fork_server) == 1
+        workers = _children(fork_server)
+        assert len(workers) == 3  # two workers and the express worker, warmed before the server answered
+        assert all(_cmdline(worker) == _cmdline(server.process.pid) for worker in workers)
+        assert http.post(f"{API}/fits", json={"name": "first", "nk": gold_like_nk(0.1)}).status_code == 201
+        # Killed with its workers: the pool breaks, and the next one's workers come from the fork
+        # server multiprocessing starts (a new interpreter importing service.preload).
+        for pid in (fork_server, *workers):
+            os.kill(pid, signal.SIGKILL)
+        # The job that finds the pool broken runs once more, on the new one (service.pool).
+        after = http.post(f"{API}/fits", json={"name": "after", "nk": gold_like_nk(0.2)})
+        assert after.status_code == 201, after.text
+        assert http.get("/healthz").json()["pool_restarts"] == 1
+        fork_servers = [child for child in _children(server.process.pid) if _children(child)]
+        assert len(fork_servers) == 1 and fork_servers[0] != fork_server
+        assert b"from multiprocessing.forkserver import main" in _cmdline(fork_servers[0])
+        assert b"service.preload" in _cmdline(fork_servers[0])
 
 
 @pytest.mark.slow
