@@ -22,9 +22,9 @@ from pydantic import ValidationError
 
 from .config import Settings
 from .main import create_app
+from .fork_server import start_fork_server
 from .server import serve
 from .store import StoreError, open_store
-from .worker import start_fork_server
 
 PROG = "python -m service"
 

@@ -13,9 +13,8 @@ What runs in each worker process of :class:`service.pool.FitRunner`:
     moved out of the collector's reach, and back.
 -   :func:`run_part`: one part of a job, checked every 0.1 s for its CPU
     time (:class:`JobCPULimit`) and for cancellation by the server.
--   :func:`process_context`: how the workers start (forks of a fork server),
-    and :func:`start_fork_server`: that fork server forked from the
-    server process at its start.
+-   :func:`process_context`: how the workers start (forks of a fork server;
+    :mod:`service.fork_server` forks it from the server process).
 """
 
 from __future__ import annotations
@@ -26,7 +25,7 @@ import time
 from typing import Any, Callable
 
 __all__ = ["CANCEL_SLOTS", "JobCPULimit", "warm_process", "freeze_heap", "thaw_heap", "worker_start", "run_part",
-           "ping", "process_context", "start_fork_server"]
+           "ping", "process_context"]
 
 CANCEL_SLOTS = 256
 """Cancelled job serials remembered (a ring); far more than jobs in flight."""
@@ -164,7 +163,7 @@ def process_context():
     Forking the server itself would copy its threads' locks mid-use;
     spawning imports the core again in every worker. The service's entry
     point (``python -m service``) forks the fork server from itself before
-    any thread starts (:func:`start_fork_server`); elsewhere (an application
+    any thread starts (:func:`service.fork_server.start_fork_server`); elsewhere (an application
     made in another program, the tests' in-process apps) multiprocessing
     starts it with the first pool, as a new interpreter that imports
     :data:`PRELOAD`, and again, that way, if it died. Measured by hand once
@@ -178,92 +177,3 @@ def process_context():
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(list(PRELOAD))
     return context
-
-
-_FORK_SERVER_STATE = frozenset({
-    "_forkserver_address", "_forkserver_alive_fd", "_forkserver_pid", "_inherited_fds", "_lock", "_preload_modules",
-})
-"""The state of multiprocessing's ``ForkServer`` that :func:`start_fork_server` sets, as Python 3.11-3.13 hold it."""
-
-
-def _cannot_fork_server(server, threads: int) -> str | None:
-    """Why :func:`start_fork_server` starts nothing, given multiprocessing's ``ForkServer`` and the Python threads."""
-    if set(vars(server)) != _FORK_SERVER_STATE:
-        return f"multiprocessing's ForkServer holds {sorted(vars(server))}, not {sorted(_FORK_SERVER_STATE)}"
-    if threads > 1:
-        return f"{threads} Python threads run, and a fork would copy their locks mid-use"
-    if server._forkserver_pid is not None:
-        return "a fork server runs already"
-    return None
-
-
-def start_fork_server() -> bool:
-    """
-    Start the fork server of :func:`process_context` as a fork of this
-    process, once it has imported :data:`PRELOAD` (which also warms it up),
-    instead of the new interpreter multiprocessing would start with the
-    first pool, which imports the core and warms up again: a second of CPU
-    time at every server start, and the first pool waits for it. For
-    ``python -m service``, before the store is opened and before any
-    thread: the fork server is then what multiprocessing's would be (one
-    thread, the standard descriptors, the core imported), plus the
-    server's own modules. It takes the place of the one multiprocessing
-    starts: the listening socket in multiprocessing's temporary directory,
-    the "alive" pipe whose end at all of this process's children tells it
-    when to stop, and the loop (``multiprocessing.forkserver.main``).
-
-    Returns ``False``, starting nothing (multiprocessing starts its own with
-    the first pool), when a fork server runs already, when this process has
-    another Python thread (a fork would copy its locks mid-use), or when
-    multiprocessing's ``ForkServer`` holds other state than the one set
-    here (:data:`_FORK_SERVER_STATE`; a Python that added to it, as 3.14
-    adds an authentication key). Should the fork server die, multiprocessing
-    starts its own at the next pool.
-    """
-    import os
-    import socket
-    import sys
-    import threading
-    from multiprocessing import connection, forkserver, resource_tracker, util
-
-    import service.preload  # noqa: F401 (the core, colour-science and the warm-up, for every fork)
-
-    server = forkserver._forkserver
-    if _cannot_fork_server(server, threading.active_count()) is not None:
-        return False
-    with server._lock:
-        if server._forkserver_pid is not None:
-            return False
-        resource_tracker.ensure_running()
-        with socket.socket(socket.AF_UNIX) as listener:
-            address = connection.arbitrary_address("AF_UNIX")
-            listener.bind(address)
-            if not util.is_abstract_socket_namespace(address):
-                os.chmod(address, 0o600)
-            listener.listen()
-            alive_r, alive_w = os.pipe()
-            try:
-                pid = os.fork()
-            except BaseException:
-                os.close(alive_r)
-                os.close(alive_w)
-                raise
-            if pid == 0:  # the fork server: serve forks until every holder of alive_w has exited
-                code = 1
-                try:
-                    os.close(alive_w)
-                    # What start-up made lives as long as the process: out of the collector's reach here and
-                    # in every fork (pages the collector would otherwise write to stay shared).
-                    gc.freeze()
-                    forkserver.main(listener.fileno(), alive_r, [])
-                except SystemExit:  # main's way of stopping at the end of the "alive" pipe
-                    code = 0
-                except BaseException:
-                    sys.excepthook(*sys.exc_info())
-                finally:
-                    os._exit(code)
-            os.close(alive_r)
-        server._forkserver_address = address
-        server._forkserver_alive_fd = alive_w
-        server._forkserver_pid = pid
-    return True

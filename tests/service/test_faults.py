@@ -285,7 +285,7 @@ def _worker_pids(server_pid: int) -> list[int]:
     """
     The server's fitting workers: the children of its fork server
     (:func:`service.worker.process_context`), itself a child of the server
-    (a fork of it, :func:`service.worker.start_fork_server`), as is
+    (a fork of it, :func:`service.fork_server.start_fork_server`), as is
     multiprocessing's resource tracker, which has none.
     """
     return [worker for child in _children(server_pid) for worker in _children(child)]
@@ -337,7 +337,7 @@ def _threads(pid: int) -> int:
 def test_the_fork_server_is_forked_only_where_multiprocessing_would_start_the_same():
     from multiprocessing.forkserver import ForkServer
 
-    from service.worker import _cannot_fork_server
+    from service.fork_server import _cannot_fork_server
 
     assert _cannot_fork_server(ForkServer(), 1) is None
     assert "2 Python threads run" in _cannot_fork_server(ForkServer(), 2)
@@ -354,7 +354,7 @@ def test_the_fork_server_is_forked_only_where_multiprocessing_would_start_the_sa
 def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_starts_its_own(tmp_path):
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server, \
             loopback.Client(base_url=server.url, timeout=120) as http:
-        # Started before the first thread (service.worker.start_fork_server): the server's own
+        # Started before the first thread (service.fork_server.start_fork_server): the server's own
         # command line, one thread, and the workers are its forks.
         fork_servers = [child for child in _children(server.process.pid) if _children(child)]
         assert len(fork_servers) == 1
