@@ -98,7 +98,7 @@ def reference_ACEScg(
 
 
 def spectral_integral(reflectance, nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
-                      min_coverage: float = DEFAULT_MIN_COVERAGE, chunk_values: int = 2_000_000) -> np.ndarray:
+                      min_coverage: float = DEFAULT_MIN_COVERAGE, chunk_values: int = 32_768) -> np.ndarray:
     """
     ``reflectance(mu (P, 1), eta_i (P, 1), n (L,), k (L,)) -> (P, L)`` of
     ``nk`` resampled at the ``step_nm`` nodes, integrated to linear ACEScg
@@ -106,7 +106,11 @@ def spectral_integral(reflectance, nk: SpectralNK, cos_theta, eta_i, step_nm: fl
     :func:`reference_ACEScg` (the exact conductor) and
     :func:`fitting.colour.seen.seen_ACEScg` (the coated stack seen from
     air). Chunked at about ``chunk_values`` spectral values, so that memory
-    stays bounded for large images.
+    stays bounded for large images and a chunk's temporaries (a dozen
+    complex arrays of its size) stay in the CPU's cache: on a 100 x 100 grid
+    at 1 nm, chunks of 2,000,000 values took about three times as long as
+    chunks of 32,768 (measured by hand; the results differ in the last bits
+    only, as the weights' matrix product is blocked otherwise).
     """
     nodes, W = spectral_weights(step_nm)
     sampled = resample_nk(nk, nodes, min_coverage)

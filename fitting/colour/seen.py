@@ -60,5 +60,4 @@ def seen_ACEScg(
     numpy.ndarray
         Shape ``broadcast(cos_theta, eta_i).shape + (3,)``.
     """
-    # The coated stack's temporaries are about twice the bare conductor's: half the chunk.
-    return spectral_integral(coated_stack, nk, cos_theta, eta_i, step_nm, min_coverage, chunk_values=1_000_000)
+    return spectral_integral(coated_stack, nk, cos_theta, eta_i, step_nm, min_coverage)
