@@ -4,7 +4,9 @@ start the HTTP service (:func:`service.server.serve`). Other settings come
 from ``COATED_*`` environment variables (:class:`service.config.Settings`);
 ``COATED_STORE_URL=postgresql://...`` puts the store on PostgreSQL. A store
 that cannot be opened, is damaged, cannot be written or has a schema newer
-than this code stops the start with one line on stderr (exit status 1).
+than this code, or a temporary directory (``TMPDIR``) whose path is too
+long for the fork server's Unix socket, stops the start with one line on
+stderr (exit status 1).
 
 ``python -m service migrate [--data-dir DIR] [--from-sqlite FILE]``: bring
 the configured store's schema to this code's version (what a start does
@@ -108,7 +110,11 @@ def main(argv: list[str] | None = None) -> int:
     if settings is None:
         return 2
     # Before the store is opened and before any thread: the workers' fork server, forked from here.
-    start_fork_server()
+    try:
+        start_fork_server()
+    except ValueError as error:
+        print(f"{PROG}: cannot start: {error}", file=sys.stderr)
+        return 1
     problem = check_store(settings)
     if problem is not None:
         print(f"{PROG}: cannot start: {problem}", file=sys.stderr)

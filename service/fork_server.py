@@ -22,6 +22,9 @@ from multiprocessing import connection, forkserver, resource_tracker, util
 __all__ = ["start_fork_server"]
 
 
+SUN_PATH_MAX = 107
+"""The longest path of a Unix socket on Linux (``sun_path``'s 108 bytes with the final NUL)."""
+
 _FORK_SERVER_STATE = frozenset({
     "_forkserver_address", "_forkserver_alive_fd", "_forkserver_pid", "_inherited_fds", "_lock", "_preload_modules",
 })
@@ -54,7 +57,10 @@ def start_fork_server() -> bool:
     the "alive" pipe whose end at all of this process's children tells it
     when to stop, and the loop (``multiprocessing.forkserver.main``).
 
-    Returns ``False``, starting nothing (multiprocessing starts its own with
+    Raises ``ValueError`` when the socket's path (in the temporary
+    directory, ``TMPDIR``) is too long for a Unix socket, where
+    multiprocessing's own fork server would fail later, with the first
+    pool. Returns ``False``, starting nothing (multiprocessing starts its own with
     the first pool), when a fork server runs already, when this process has
     another Python thread (a fork would copy its locks mid-use), or when
     multiprocessing's ``ForkServer`` holds other state than the one set
@@ -73,6 +79,10 @@ def start_fork_server() -> bool:
         resource_tracker.ensure_running()
         with socket.socket(socket.AF_UNIX) as listener:
             address = connection.arbitrary_address("AF_UNIX")
+            if len(os.fsencode(address)) > SUN_PATH_MAX:
+                raise ValueError(
+                    f"the fork server's socket, {address}, is {len(os.fsencode(address))} bytes long; a Unix "
+                    f"socket's path has at most {SUN_PATH_MAX}: set TMPDIR to a shorter directory")
             listener.bind(address)
             if not util.is_abstract_socket_namespace(address):
                 os.chmod(address, 0o600)

@@ -14,6 +14,7 @@ import socket
 import sqlite3
 import subprocess
 import sys
+import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -219,15 +220,30 @@ def test_a_stopped_server_exits_with_the_signal_s_status_and_leaves_no_temporary
     server's socket (``pymp-*``) in the temporary directory at every stop,
     and SIGINT ended in a ``KeyboardInterrupt`` traceback.
     """
-    temporary = tmp_path / "tmp"
+    # Not under tmp_path: the fork server's socket path must fit a Unix socket's 107 bytes (next test).
+    with tempfile.TemporaryDirectory(prefix="coated-") as temporary:
+        with server_process(tmp_path / "data", TMPDIR=temporary) as server:
+            assert list(Path(temporary).glob("pymp-*")), "the fork server (started at once) has its directory"
+            server.process.send_signal(signum)
+            assert server.process.wait(timeout=60) == 128 + signum
+            log = server.log_text()
+        assert "Application shutdown complete" in log and "Traceback" not in log
+        assert list(Path(temporary).iterdir()) == []
+
+
+@pytest.mark.slow  # starts a process
+@pytest.mark.server
+def test_a_temporary_directory_too_long_for_the_fork_server_s_socket_stops_the_start_with_one_line(tmp_path):
+    temporary = tmp_path / ("t" * 90)  # its fork server's socket: pymp-XXXXXXXX/listener-XXXXXXXX in it
     temporary.mkdir()
-    with server_process(tmp_path / "data", TMPDIR=str(temporary)) as server:
-        assert list(temporary.glob("pymp-*")), "the fork server (started with the warm pool) has its directory"
-        server.process.send_signal(signum)
-        assert server.process.wait(timeout=60) == 128 + signum
-        log = server.log_text()
-    assert "Application shutdown complete" in log and "Traceback" not in log
-    assert list(temporary.iterdir()) == []
+    run = subprocess.run([sys.executable, "-m", "service", "--port", "0", "--data-dir", str(tmp_path / "data")],
+                         cwd=ROOT, env={**os.environ, "TMPDIR": str(temporary)}, capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 1
+    assert run.stderr.startswith("python -m service: cannot start: the fork server's socket, "), run.stderr
+    assert "a Unix socket's path has at most 107: set TMPDIR to a shorter directory" in run.stderr
+    assert "Traceback" not in run.stderr and len(run.stderr.splitlines()) == 1
+    assert list(temporary.iterdir()) == []  # multiprocessing's directory removed at the exit
 
 
 @pytest.mark.parametrize("where", ["main thread", "other thread"])
