@@ -31,15 +31,19 @@ ROOT = Path(__file__).resolve().parents[1]
 INSTALLED = ("scripts/three/node_modules",)
 """What ``scripts/bootstrap`` installs in the tree (git-ignored) that the core reads: linked into a worktree."""
 
+SUITE_INSTALLED = (".venv", ".venv-blender", "scripts/gltf-validator/node_modules", "scripts/swagger-ui/node_modules",
+                   *INSTALLED)
+"""What ``scripts/bootstrap`` installs in the tree (git-ignored) that the test suite reads."""
+
 
 @contextlib.contextmanager
-def checkout(rev: str) -> Iterator[Path]:
-    """A detached git worktree of ``rev`` in a temporary directory (:data:`INSTALLED` linked), removed after."""
+def checkout(rev: str, installed: tuple[str, ...] = INSTALLED) -> Iterator[Path]:
+    """A detached git worktree of ``rev`` in a temporary directory (``installed`` linked), removed after."""
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp) / "before"
         subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(root), rev],
                        check=True, capture_output=True)
-        for path in INSTALLED:
+        for path in installed:
             if (ROOT / path).exists() and not (root / path).exists():
                 (root / path).symlink_to(ROOT / path, target_is_directory=True)
         try:

@@ -12,9 +12,20 @@ records each one's wall time, test count and the load average around it in
     kernels' settings), unless ``--no-other-cpus``.
 
     .venv/bin/python benchmarks/suite_time.py [--no-other-cpus] [--log DIR]
+    .venv/bin/python benchmarks/suite_time.py --before REV [--rounds N] [--log DIR]
 
 ``--log DIR`` keeps each mode's whole output (``DIR/quick.log``,
 ``full.log``, ``other-cpus.log``), for what a failed run printed.
+
+``--before REV``: instead, the full suite of a checkout of ``REV`` (a git
+worktree, what ``scripts/bootstrap`` installed linked in) and of this
+checkout, in turns (``--rounds`` of each, the order swapped every round),
+so that both run in the same hour of a machine whose speed drifts by a
+quarter from one hour to the next; recorded in
+``benchmarks/results/suite_time_side_by_side.json``. Each side runs
+:data:`FULL_SUITE`, ``scripts/test``'s full mode after its set-up
+(``scripts/bootstrap`` would set up the worktree's own environment):
+bytecode caches written, then pytest with this checkout's interpreter.
 
 A run with other work on the machine is slower; the load average says how
 busy it was (1 minute average at the start and the end of each mode). Each
@@ -31,6 +42,7 @@ import argparse
 import json
 import os
 import re
+import statistics
 import subprocess
 import sys
 import time
@@ -43,6 +55,9 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.record import cpu  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
+SIDE_BY_SIDE = ROOT / "benchmarks" / "results" / "suite_time_side_by_side.json"
+FULL_SUITE = ("-m", "pytest", "-n", "2", "--dist", "loadscope", "--durations=25", "-p", "no:cacheprovider")
+"""``scripts/test``'s full mode: the interpreter's arguments after its set-up (tests/benchmarks checks they agree)."""
 SUMMARY = re.compile(r"^=*\s*((?:\d+ \w+, )*\d+ (?:passed|failed).*?) in [\d.]+s", re.M)
 FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
 TICK = os.sysconf("SC_CLK_TCK")
@@ -71,29 +86,87 @@ def machine_ticks() -> dict[str, int]:
 
 
 def run(args: list[str], log: Path | None = None) -> dict:
+    """``scripts/test ARGS`` in this checkout, timed (``--quick``, the full suite, ``--other-cpus``)."""
+    return timed(["scripts/test", *args], ROOT, log, f"{args[0].lstrip('-') if args else 'full'}.log")
+
+
+def full_suite(root: Path, log: Path | None = None, name: str = "full.log") -> dict:
+    """:data:`FULL_SUITE` in the checkout ``root``, timed, after its bytecode caches (as ``scripts/test`` writes them)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    subprocess.run([sys.executable, "-m", "compileall", "-q", "-j", "0", "fitting", "service", "preview_shaders",
+                    "benchmarks"], cwd=root, env=env, capture_output=True, check=True)
+    return timed([sys.executable, *FULL_SUITE], root, log, name, env)
+
+
+def timed(command: list[str], cwd: Path, log: Path | None, name: str, env: dict | None = None) -> dict:
     speed = calibration()
     load_start, ticks = os.getloadavg()[0], machine_ticks()
     start = time.perf_counter()
-    done = subprocess.run(["scripts/test", *args], cwd=ROOT, capture_output=True, text=True)
+    done = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True)
     seconds = time.perf_counter() - start
     ticks = {k: round((v - ticks[k]) / TICK, 1) for k, v in machine_ticks().items()}
     output = done.stdout + done.stderr
     if log is not None:
         log.mkdir(parents=True, exist_ok=True)
-        (log / f"{args[0].lstrip('-') if args else 'full'}.log").write_text(output)
+        (log / name).write_text(output)
     summaries = SUMMARY.findall(output)
-    return {"command": " ".join(["scripts/test", *args]), "seconds": round(seconds, 1),
+    shown = command if command[0] == "scripts/test" else ["python", *command[1:]]
+    return {"command": " ".join(shown), "seconds": round(seconds, 1),
             "returncode": done.returncode, "summaries": summaries,
             "failures": FAILURE.findall(output)[:50],  # what failed, when a run did
             "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)],
             "machine_seconds": ticks, "calibration_s": speed}
 
 
+def side_by_side(before: str, rounds: int, log: Path | None) -> dict:
+    """The full suite of ``before`` and of this checkout in turns, ``rounds`` of each; medians and their ratios."""
+    from benchmarks.side_by_side import SUITE_INSTALLED, checkout
+
+    rows = []
+    with checkout(before, SUITE_INSTALLED) as root:
+        for i in range(rounds):
+            for side in (("before", "now") if i % 2 == 0 else ("now", "before")):
+                row = full_suite(root if side == "before" else ROOT, log, f"full-{side}-{i}.log")
+                rows.append({"checkout": side, **row})
+                print(f"round {i}, {side}: {row['seconds']:.1f} s, busy {row['machine_seconds']['busy']:.1f} s, "
+                      f"{'; '.join(row['summaries'])}", flush=True)
+    figures = {}
+    for side in ("before", "now"):
+        mine = [r for r in rows if r["checkout"] == side]
+        figures[side] = {"seconds": statistics.median(r["seconds"] for r in mine),
+                         "busy_seconds": statistics.median(r["machine_seconds"]["busy"] for r in mine),
+                         "idle_seconds": statistics.median(r["machine_seconds"]["idle"] for r in mine),
+                         "summaries": [r["summaries"][-1:] for r in mine]}
+    figures["ratio_seconds"] = figures["now"]["seconds"] / figures["before"]["seconds"]
+    figures["ratio_busy"] = figures["now"]["busy_seconds"] / figures["before"]["busy_seconds"]
+    return {"before": before, "rounds": rounds, "figures": figures, "rows": rows}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--no-other-cpus", action="store_true", help="leave out --other-cpus")
     parser.add_argument("--log", type=Path, help="keep each mode's whole output in this directory")
+    parser.add_argument("--before", metavar="REV",
+                        help="instead: the full suite of this commit and of this checkout, in turns")
+    parser.add_argument("--rounds", type=int, default=1, help="with --before: full runs of each side (default 1)")
     args = parser.parse_args(argv)
+    if not 1 <= args.rounds <= 5:
+        parser.error(f"--rounds must lie in [1, 5], got {args.rounds}")
+    if args.before is not None:
+        if subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{args.before}^{{commit}}"],
+                          capture_output=True).returncode != 0:
+            parser.error(f"--before must name a commit of this repository, got {args.before!r}")
+        result = side_by_side(args.before, args.rounds, args.log)
+        f = result["figures"]
+        print(f"{'':<8}{'wall s':>9}{'busy s':>9}{'idle s':>9}")
+        for side in ("before", "now"):
+            print(f"{side:<8}{f[side]['seconds']:>9.1f}{f[side]['busy_seconds']:>9.1f}{f[side]['idle_seconds']:>9.1f}")
+        print(f"now / before: wall {f['ratio_seconds']:.3f}, busy {f['ratio_busy']:.3f}")
+        SIDE_BY_SIDE.write_text(json.dumps({
+            "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+            "date": datetime.now(timezone.utc).isoformat(timespec="minutes"), "cpu": cpu(), **result,
+        }, indent=2) + "\n")
+        return max(r["returncode"] for r in result["rows"])
     modes = [["--quick"], []] + ([] if args.no_other_cpus else [["--other-cpus"]])
     rows = [run(mode, args.log) for mode in modes]
     print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "

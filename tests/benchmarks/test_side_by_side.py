@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from benchmarks.side_by_side import INSTALLED, ROOT, Side, checkout
+from benchmarks.side_by_side import INSTALLED, ROOT, SUITE_INSTALLED, Side, checkout
 
 pytestmark = pytest.mark.slow  # starts processes, makes a git worktree
 
@@ -64,3 +64,11 @@ def test_a_checkout_is_the_commit_with_the_installed_dependencies_and_goes_away(
     assert not Path(root).exists()
     listed = subprocess.run(["git", "-C", str(ROOT), "worktree", "list"], capture_output=True, text=True).stdout
     assert str(root) not in listed
+
+
+def test_a_checkout_for_the_suite_links_what_the_suite_reads_and_removing_it_keeps_them(tmp_path):
+    with checkout("HEAD", SUITE_INSTALLED) as root:
+        for path in SUITE_INSTALLED:
+            if (ROOT / path).exists():  # all of them after scripts/bootstrap
+                assert (root / path).is_symlink() and (root / path).resolve() == (ROOT / path).resolve()
+    assert all((ROOT / path).exists() for path in (".venv/bin/python", ".venv-blender/bin/python"))

@@ -1,0 +1,26 @@
+"""
+benchmarks/suite_time.py: the side-by-side mode runs what ``scripts/test``
+runs for the full suite, and its arguments' bounds.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from benchmarks.suite_time import FULL_SUITE, ROOT, main
+
+
+def test_the_side_by_side_runs_scripts_test_s_full_suite():
+    assert f'"$py" {" ".join(FULL_SUITE)}\n' in (ROOT / "scripts" / "test").read_text()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--rounds", "0"], "--rounds must lie in [1, 5], got 0"),
+    pytest.param(["--before", "no-such-commit"], "--before must name a commit of this repository, got 'no-such-commit'",
+                 marks=pytest.mark.slow),  # asks git
+])
+def test_arguments_out_of_bounds_are_refused(argv, message, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(argv)
+    assert exit_.value.code == 2
+    assert message in capsys.readouterr().err
