@@ -73,42 +73,42 @@ def start_fork_server() -> bool:
     server = forkserver._forkserver
     if _cannot_fork_server(server, threading.active_count()) is not None:
         return False
-    with server._lock:
-        if server._forkserver_pid is not None:
-            return False
-        resource_tracker.ensure_running()
-        with socket.socket(socket.AF_UNIX) as listener:
-            address = connection.arbitrary_address("AF_UNIX")
-            if len(os.fsencode(address)) > SUN_PATH_MAX:
-                raise ValueError(
-                    f"the fork server's socket, {address}, is {len(os.fsencode(address))} bytes long; a Unix "
-                    f"socket's path has at most {SUN_PATH_MAX}: set TMPDIR to a shorter directory")
-            listener.bind(address)
-            if not util.is_abstract_socket_namespace(address):
-                os.chmod(address, 0o600)
-            listener.listen()
-            alive_r, alive_w = os.pipe()
-            try:
-                pid = os.fork()
-            except BaseException:
-                os.close(alive_r)
-                os.close(alive_w)
-                raise
-            if pid == 0:  # the fork server: serve forks until every holder of alive_w has exited
-                code = 1
-                try:
-                    os.close(alive_w)
-                    # What start-up made lives as long as the process: out of the collector's reach here and
-                    # in every fork (pages the collector would otherwise write to stay shared).
-                    gc.freeze()
-                    forkserver.main(listener.fileno(), alive_r, [])
-                except SystemExit:  # main's way of stopping at the end of the "alive" pipe
-                    code = 0
-                except BaseException:
-                    sys.excepthook(*sys.exc_info())
-                finally:
-                    os._exit(code)
+    # No lock is held across the fork (there is no other thread to take one): a lock held there would stay
+    # held in the fork server and in every process it forks.
+    resource_tracker.ensure_running()
+    with socket.socket(socket.AF_UNIX) as listener:
+        address = connection.arbitrary_address("AF_UNIX")
+        if len(os.fsencode(address)) > SUN_PATH_MAX:
+            raise ValueError(
+                f"the fork server's socket, {address}, is {len(os.fsencode(address))} bytes long; a Unix "
+                f"socket's path has at most {SUN_PATH_MAX}: set TMPDIR to a shorter directory")
+        listener.bind(address)
+        if not util.is_abstract_socket_namespace(address):
+            os.chmod(address, 0o600)
+        listener.listen()
+        alive_r, alive_w = os.pipe()
+        try:
+            pid = os.fork()
+        except BaseException:
             os.close(alive_r)
+            os.close(alive_w)
+            raise
+        if pid == 0:  # the fork server: serve forks until every holder of alive_w has exited
+            code = 1
+            try:
+                os.close(alive_w)
+                # What start-up made lives as long as the process: out of the collector's reach here and
+                # in every fork (pages the collector would otherwise write to stay shared).
+                gc.freeze()
+                forkserver.main(listener.fileno(), alive_r, [])
+            except SystemExit:  # main's way of stopping at the end of the "alive" pipe
+                code = 0
+            except BaseException:
+                sys.excepthook(*sys.exc_info())
+            finally:
+                os._exit(code)
+        os.close(alive_r)
+    with server._lock:
         server._forkserver_address = address
         server._forkserver_alive_fd = alive_w
         server._forkserver_pid = pid
