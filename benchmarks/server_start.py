@@ -40,19 +40,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
+from benchmarks.service_load import free_port  # noqa: E402
 from benchmarks.side_by_side import checkout  # noqa: E402
+from benchmarks.suite_time import TICK  # noqa: E402
 
 BEFORE = "9e06edd"
 """The last commit whose fork server was a new interpreter (``python -c 'from multiprocessing.forkserver ...'``)."""
 
-TICK = os.sysconf("SC_CLK_TCK")
 READY_TIMEOUT_S = 120.0
-
-
-def _free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 def _answers(port: int) -> bool:
@@ -107,7 +102,7 @@ def by_kind(processes: dict[int, tuple[int, str, float]], server: int) -> Counte
 
 def start(root: Path, workers: int | None) -> dict:
     """One start of ``root``'s service: seconds to the first answer and CPU seconds per kind by then."""
-    port = _free_port()
+    port = free_port()
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     if workers is not None:
         env["COATED_FIT_WORKERS"] = str(workers)

@@ -58,6 +58,8 @@ RESULTS = ROOT / "benchmarks" / "results" / "suite_time.json"
 SIDE_BY_SIDE = ROOT / "benchmarks" / "results" / "suite_time_side_by_side.json"
 FULL_SUITE = ("-m", "pytest", "-n", "2", "--dist", "loadscope", "--durations=25", "-p", "no:cacheprovider")
 """``scripts/test``'s full mode: the interpreter's arguments after its set-up (tests/benchmarks checks they agree)."""
+COMPILED = ("fitting", "service", "preview_shaders", "benchmarks")
+"""The packages whose bytecode caches ``scripts/test`` writes before it runs the suite (checked likewise)."""
 SUMMARY = re.compile(r"^=*\s*((?:\d+ \w+, )*\d+ (?:passed|failed).*?) in [\d.]+s", re.M)
 FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
 TICK = os.sysconf("SC_CLK_TCK")
@@ -93,8 +95,8 @@ def run(args: list[str], log: Path | None = None) -> dict:
 def full_suite(root: Path, log: Path | None = None, name: str = "full.log") -> dict:
     """:data:`FULL_SUITE` in the checkout ``root``, timed, after its bytecode caches (as ``scripts/test`` writes them)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    subprocess.run([sys.executable, "-m", "compileall", "-q", "-j", "0", "fitting", "service", "preview_shaders",
-                    "benchmarks"], cwd=root, env=env, capture_output=True, check=True)
+    subprocess.run([sys.executable, "-m", "compileall", "-q", "-j", "0", *COMPILED], cwd=root, env=env,
+                   capture_output=True, check=True)
     return timed([sys.executable, *FULL_SUITE], root, log, name, env)
 
 

@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import pytest
 
-from benchmarks.suite_time import FULL_SUITE, ROOT, main
+from benchmarks.suite_time import COMPILED, FULL_SUITE, ROOT, main
 
 
 def test_the_side_by_side_runs_scripts_test_s_full_suite():
-    assert f'"$py" {" ".join(FULL_SUITE)}\n' in (ROOT / "scripts" / "test").read_text()
+    script = (ROOT / "scripts" / "test").read_text()
+    assert f'"$py" {" ".join(FULL_SUITE)}\n' in script
+    assert f'"$py" -m compileall -q -j 0 {" ".join(COMPILED)} >/dev/null\n' in script
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -307,6 +307,11 @@ def _worker_pids(server_pid: int) -> list[int]:
     return [worker for child in _children(server_pid) for worker in _children(child)]
 
 
+def _fork_servers(server_pid: int) -> list[int]:
+    """The server's children that have children: its fork server (the resource tracker has none)."""
+    return [child for child in _children(server_pid) if _children(child)]
+
+
 @pytest.mark.slow  # 13.1 s (all cases 13.1 s) in a --durations=0 run
 @pytest.mark.server
 def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path):
@@ -372,7 +377,7 @@ def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_
             loopback.Client(base_url=server.url, timeout=120) as http:
         # Started before the first thread (service.fork_server.start_fork_server): the server's own
         # command line, one thread, and the workers are its forks.
-        fork_servers = [child for child in _children(server.process.pid) if _children(child)]
+        fork_servers = _fork_servers(server.process.pid)
         assert len(fork_servers) == 1
         fork_server = fork_servers[0]
         assert _cmdline(fork_server) == _cmdline(server.process.pid)
@@ -389,7 +394,7 @@ def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_
         after = http.post(f"{API}/fits", json={"name": "after", "nk": gold_like_nk(0.2)})
         assert after.status_code == 201, after.text
         assert http.get("/healthz").json()["pool_restarts"] == 1
-        fork_servers = [child for child in _children(server.process.pid) if _children(child)]
+        fork_servers = _fork_servers(server.process.pid)
         assert len(fork_servers) == 1 and fork_servers[0] != fork_server
         assert b"from multiprocessing.forkserver import main" in _cmdline(fork_servers[0])
         assert b"service.preload" in _cmdline(fork_servers[0])
