@@ -8,18 +8,25 @@ from itself, once it has imported the core and warmed up
 (:mod:`service.preload`), before it opens the store or starts a thread;
 multiprocessing's own fork server is a new interpreter that imports the
 core and warms up again.
+
+:func:`fork_server_exited`: a worker whose start failed with one of
+:data:`START_ERRORS` asked a fork server that died, or is dying: waits
+until its exit can be seen, so that multiprocessing starts another for the
+next worker instead of asking the dying one again.
 """
 
 from __future__ import annotations
 
+import asyncio
 import gc
 import os
 import socket
 import sys
 import threading
+import time
 from multiprocessing import connection, forkserver, resource_tracker, util
 
-__all__ = ["start_fork_server"]
+__all__ = ["START_ERRORS", "fork_server_exited", "start_fork_server"]
 
 
 SUN_PATH_MAX = 107
@@ -112,4 +119,44 @@ def start_fork_server() -> bool:
         server._forkserver_address = address
         server._forkserver_alive_fd = alive_w
         server._forkserver_pid = pid
+    return True
+
+
+START_ERRORS = (EOFError, ConnectionError)
+"""
+What starting a worker raises (``ProcessPoolExecutor.submit``, which starts
+the workers it lacks) when the fork server closed the request unanswered
+(``EOFError``: "unexpected EOF", the pid never written) or cannot be
+reached (a refused or reset connection, a broken pipe): it died, or it is
+dying. A killed process's exit takes time (its memory is freed before its
+descriptors are closed, longer on a loaded machine), and until it has
+exited multiprocessing's check (``waitpid`` with ``WNOHANG``) finds it
+alive and sends it the next start too.
+"""
+
+FORK_SERVER_EXIT_S = 5.0
+"""How long :func:`fork_server_exited` waits for the fork server's exit to be seen."""
+
+
+async def fork_server_exited(timeout_s: float = FORK_SERVER_EXIT_S, poll_s: float = 0.01) -> bool:
+    """
+    Wait (polling, at most ``timeout_s``) until the fork server of
+    :func:`service.worker.process_context` has exited, without reaping it:
+    multiprocessing reaps it at the next start (``ForkServer.ensure_running``)
+    and then starts a new one. For a start that failed with one of
+    :data:`START_ERRORS`. Returns whether it exited (``True`` also when there
+    is none, or it is not this process's child); ``False`` after
+    ``timeout_s``, when it is alive after all, and the next start will tell.
+    """
+    pid = forkserver._forkserver._forkserver_pid
+    deadline = time.monotonic() + timeout_s
+    while pid is not None:
+        try:
+            if os.waitid(os.P_PID, pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None:
+                return True
+        except ChildProcessError:
+            return True
+        if time.monotonic() >= deadline:
+            return False
+        await asyncio.sleep(poll_s)
     return True

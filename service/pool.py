@@ -29,6 +29,13 @@ Faults:
     worker too is answered :class:`WorkerLost`, and its job's content id is
     refused for ``quarantine_s`` (:class:`Quarantined`, before any work). So
     a job that kills its workers fails only itself, however often it does.
+-   A worker that cannot be started (its fork server died, or is dying:
+    :data:`service.fork_server.START_ERRORS`) is not the part's doing: the
+    runner waits until the fork server's exit is seen
+    (:func:`service.fork_server.fork_server_exited`), replaces the pool
+    (multiprocessing starts another fork server with it) and runs the part
+    there; after three such failures in a row it is answered
+    :class:`WorkersNotStarted` (503).
 -   A request that waits past the time limit gets :class:`FitTimeout`, and
     its job is cancelled when no other request waits for it (as when every
     client waiting for it has gone): its worker checks every 0.1 s and is
@@ -54,9 +61,11 @@ from typing import Any, AsyncIterator, Awaitable, Callable
 
 from .turns import Turns
 from .flights import CancelRing, Flights
+from .fork_server import START_ERRORS, fork_server_exited
 from .worker import JobCPULimit, ping, process_context, run_part, warm_process, worker_start
 
-__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "Quarantined", "JobCPULimit", "warm_process"]
+__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
+           "warm_process"]
 
 log = logging.getLogger("service.pool")
 
@@ -92,6 +101,18 @@ class WorkerLost(Exception):
             f"it is refused for {quarantine_s:g} s"
         )
         self.retry_after = max(1, math.ceil(quarantine_s))
+
+
+class WorkersNotStarted(WorkerLost):
+    """No worker process could be started, three times (the fork server kept dying): 503, try again."""
+
+    def __init__(self) -> None:
+        Exception.__init__(self, "no fitting worker process could be started (their fork server died); try again")
+        self.retry_after = 1
+
+
+class _StartFailed(BrokenProcessPool):
+    """A pool could not start a worker (:data:`service.fork_server.START_ERRORS`); its fork server has exited since."""
 
 
 class Quarantined(WorkerLost):
@@ -175,8 +196,9 @@ class FitRunner:
                 )
             return self._pool
 
-    def _restart(self, broken: concurrent.futures.ProcessPoolExecutor) -> None:
-        """Replace a broken pool (once, however many jobs saw it break) and warm the new one."""
+    def _restart(self, broken: concurrent.futures.ProcessPoolExecutor,
+                 why: str = "a fitting worker died; the pool was restarted (interrupted jobs run once more)") -> None:
+        """Replace a broken pool (once, however many jobs saw it break) and warm the new one; log ``why``."""
         with self._lock:
             replaced = self._pool is broken
             if replaced:
@@ -184,7 +206,7 @@ class FitRunner:
                 self.restarts += 1
         broken.shutdown(wait=False, cancel_futures=True)
         if replaced:
-            log.warning("a fitting worker died; the pool was restarted (interrupted jobs run once more)")
+            log.warning(why)
             try:
                 task = asyncio.get_running_loop().create_task(self.warm_up())
             except RuntimeError:
@@ -199,8 +221,8 @@ class FitRunner:
         try:
             await asyncio.gather(*(loop.run_in_executor(pool, ping)
                                    for _ in range(self.workers + self.express_workers)))
-        except (BrokenProcessPool, RuntimeError):
-            pass  # a pool that broke while warming is replaced by the job that sees it
+        except (BrokenProcessPool, RuntimeError, *START_ERRORS):
+            pass  # a pool that broke (or could not start a worker) while warming is replaced by the job that sees it
 
     def _retry_after(self) -> int:
         waves = math.ceil(max(self._in_flight, 1) / self.workers)
@@ -254,21 +276,31 @@ class FitRunner:
         here. Parts take turns in the workers, the cheapest waiting first
         (``cost_s``, its estimated seconds: :class:`service.turns.Turns`). A
         part interrupted by a dead worker runs once more on the replacement
-        pool.
+        pool; one whose worker could not be started runs on a pool whose
+        workers start (:class:`WorkersNotStarted` after three failures).
 
         Raises
         ------
-        WorkerLost
+        WorkerLost, WorkersNotStarted
         """
-        for _ in (1, 2):
+        interrupted = start_failures = 0
+        while interrupted < 2:
             pool = self._executor()
             try:
                 async with self._turns.turn(cost_s):
                     return await self._run_in(pool, function, args)
+            except _StartFailed:
+                # Not the part's doing: it runs on a pool whose workers start, at most twice more.
+                self._restart(pool, "a fitting worker could not be started (its fork server died); the pool was "
+                                    "restarted with a new fork server")
+                start_failures += 1
+                if start_failures > 2:
+                    raise WorkersNotStarted() from None
             except (BrokenProcessPool, RuntimeError) as error:
                 if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                     raise
                 self._restart(pool)
+                interrupted += 1
         # Interrupted twice: run alone in a worker of its own, where a death is its own.
         async with self._alone_lock:
             with self._lock:
@@ -279,10 +311,12 @@ class FitRunner:
                 alone = self._alone
             try:
                 return await self._run_in(alone, function, args)
-            except BrokenProcessPool:
+            except BrokenProcessPool as error:
                 with self._lock:
                     self._alone = None
                 alone.shutdown(wait=False, cancel_futures=True)
+                if isinstance(error, _StartFailed):
+                    raise WorkersNotStarted() from None
                 self._quarantine_current()
                 raise WorkerLost(self.quarantine_s) from None
 
@@ -290,7 +324,13 @@ class FitRunner:
         with self._lock:
             self._serial += 1
             serial = self._serial
-        future = pool.submit(run_part, serial, self.cpu_limit_s, function, *args)
+        try:
+            future = pool.submit(run_part, serial, self.cpu_limit_s, function, *args)  # starts missing workers
+        except START_ERRORS as error:
+            # The fork server died or is dying: wait until multiprocessing can see that it has exited, so
+            # that the pool replacing this one starts another instead of asking it again.
+            await fork_server_exited()
+            raise _StartFailed(f"a fitting worker could not be started: {error!r}") from error
         try:
             return await asyncio.wrap_future(future)
         except asyncio.CancelledError:

@@ -45,7 +45,10 @@ Bounds and budgets:
 -   Each render process is an executor of its own: a process that dies
     (or is stopped) fails only its own jobs (:class:`RenderWorkerLost`),
     and another is started for the next job; a render is not tried again
-    (one that killed its process would kill the next).
+    (one that killed its process would kill the next). So does one that
+    could not be started (its fork server died:
+    :data:`service.fork_server.START_ERRORS`), once the fork server's exit
+    is seen, so that the next starts from another.
 """
 
 from __future__ import annotations
@@ -62,6 +65,7 @@ import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable
 
+from .fork_server import START_ERRORS, fork_server_exited
 from .pool import FitTimeout, Overloaded, WorkerLost
 from .render_worker import RendererUnavailable, render_worker_start, run_render_part
 from .flights import CancelRing, Flights
@@ -100,8 +104,9 @@ class PreviewTimeout(FitTimeout):
 class RenderWorkerLost(WorkerLost):
     """The render process of a job died (503); another is started for the next job."""
 
-    def __init__(self) -> None:
-        Exception.__init__(self, "the render process of this preview died; another is started for the next one")
+    def __init__(self, message: str = "the render process of this preview died; another is started for the next one"
+                 ) -> None:
+        Exception.__init__(self, message)
         self.retry_after = 1
 
 
@@ -218,6 +223,12 @@ class PreviewRunner:
             future = process.executor.submit(run_render_part, serial, self.cpu_limit_s, function, *args)
         except BaseException as error:
             self._end_job(process)
+            if isinstance(error, START_ERRORS):
+                # Its fork server died or is dying: the next job's process starts from another.
+                self._break(process)
+                await fork_server_exited()
+                raise RenderWorkerLost("the render process of this preview could not be started (its fork server "
+                                       "died); another is started for the next one") from None
             if isinstance(error, (BrokenProcessPool, RuntimeError)):
                 self._break(process)
                 raise RenderWorkerLost() from None
