@@ -29,13 +29,12 @@ Faults:
     worker too is answered :class:`WorkerLost`, and its job's content id is
     refused for ``quarantine_s`` (:class:`Quarantined`, before any work). So
     a job that kills its workers fails only itself, however often it does.
--   A worker that cannot be started (its fork server died, or is dying:
-    :data:`service.fork_server.START_ERRORS`) is not the part's doing: the
-    runner waits until the fork server's exit is seen
-    (:func:`service.fork_server.fork_server_exited`), replaces the pool
-    (multiprocessing starts another fork server with it) and runs the part
-    there; after three such failures in a row it is answered
-    :class:`WorkersNotStarted` (503).
+-   A worker that cannot start (its fork server died:
+    :data:`service.fork_server.START_ERRORS`) is not the part's doing: once
+    the fork server's exit is seen, the pool is replaced (with a new fork
+    server) and the part runs there (:class:`WorkersNotStarted` after three).
+-   A pool stuck on a result its killed worker left half-written breaks as
+    for any death (:mod:`service.executors`).
 -   A request that waits past the time limit gets :class:`FitTimeout`, and
     its job is cancelled when no other request waits for it (as when every
     client waiting for it has gone): its worker checks every 0.1 s and is
@@ -59,6 +58,7 @@ import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
+from . import executors
 from .turns import Turns
 from .flights import CancelRing, Flights
 from .fork_server import START_ERRORS, fork_server_exited
@@ -332,7 +332,7 @@ class FitRunner:
             await fork_server_exited()
             raise _StartFailed(f"a fitting worker could not be started: {error!r}") from error
         try:
-            return await asyncio.wrap_future(future)
+            return await executors.result(pool, future)  # a pool stuck on a killed worker's result breaks
         except asyncio.CancelledError:
             self._cancels.cancel(serial, future)
             raise
@@ -395,4 +395,6 @@ class FitRunner:
             pools, self._pool, self._alone = (self._pool, self._alone), None, None
         for pool in pools:
             if pool is not None:
+                if executors.has_dead_worker(pool):  # its manager thread may wait for a result forever
+                    executors.unstick(pool)
                 pool.shutdown(wait=True, cancel_futures=True)

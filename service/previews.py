@@ -65,6 +65,7 @@ import time
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Callable
 
+from . import executors
 from .fork_server import START_ERRORS, fork_server_exited
 from .pool import FitTimeout, Overloaded, WorkerLost
 from .render_worker import RendererUnavailable, render_worker_start, run_render_part
@@ -186,6 +187,9 @@ class PreviewRunner:
         if kill and process.pid is not None:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(process.pid, signal.SIGKILL)
+            # Killed while it sent a result, it would leave the executor waiting for the rest forever, its
+            # jobs' places never left (service.executors): the executor reads end of file instead.
+            executors.unstick(process.executor)
         # Jobs queued behind it fail with the process (BrokenProcessPool: 503), not as cancelled.
         process.executor.shutdown(wait=False)
 
@@ -246,7 +250,7 @@ class PreviewRunner:
 
         future.add_done_callback(done)
         try:
-            return await asyncio.wrap_future(future)
+            return await executors.result(process.executor, future)  # stuck on a killed process's result: broken
         except BrokenProcessPool:
             raise RenderWorkerLost() from None
         except asyncio.CancelledError:

@@ -478,6 +478,87 @@ def test_a_worker_start_that_a_dying_fork_server_refuses_waits_for_its_exit_and_
     assert seen["preview_second"] > 0 and seen["fork_server_is_new"], seen
 
 
+KILLED_WHILE_SENDING = r"""
+import os, signal, threading, time
+
+
+def wchar():
+    with open("/proc/self/io") as io:
+        return next(int(line.split()[1]) for line in io if line.startswith("wchar:"))
+
+
+def result_killed_while_sent_once(marker, size):
+    # SIZE bytes; the first call's worker is SIGKILLed as soon as it has written anything: the header of
+    # its result (a result of over 16 KB is sent in two writes, and wchar counts a write when it returns),
+    # while the payload's write (64 KB at a time as the pool reads it, milliseconds) goes on.
+    payload = b"x" * size
+    if not os.path.exists(marker):
+        open(marker, "w").close()
+        start = wchar()
+
+        def kill_while_sending():
+            while wchar() == start:
+                time.sleep(0.0002)
+            os.kill(os.getpid(), signal.SIGKILL)
+
+        threading.Thread(target=kill_while_sending, daemon=True).start()
+    return payload
+"""
+
+STUCK_POOLS = r"""
+import asyncio, os, sys, time
+
+from killed_while_sending import result_killed_while_sent_once as job
+from service.pool import FitRunner
+from service.previews import PreviewRunner, RenderWorkerLost
+
+SIZE = 64 << 20
+here = sys.argv[1]
+
+
+async def main():
+    runner = FitRunner(1, 4, timeout_s=60.0)
+    started = time.monotonic()
+    sent = await runner.run(job, os.path.join(here, "fit"), SIZE)
+    fit = {"bytes": len(sent), "seconds": time.monotonic() - started, "restarts": runner.restarts}
+    runner.close()
+
+    previews = PreviewRunner(1, timeout_s=60.0, cpu_limit_s=60.0)
+    started = time.monotonic()
+    try:
+        await previews.preview(("a",), job, os.path.join(here, "preview"), SIZE)
+        first = "answered"
+    except RenderWorkerLost as error:
+        first = str(error)
+    first_s = time.monotonic() - started
+    second = await previews.preview(("b",), job, os.path.join(here, "preview"), SIZE)
+    previews.close()
+    return {"fit": fit, "preview_first": first, "preview_first_s": first_s, "preview_second": len(second)}
+
+
+print(repr(asyncio.run(main())))
+"""
+
+
+@pytest.mark.slow
+def test_a_worker_killed_while_it_sends_a_result_does_not_hang_its_pool(tmp_path):
+    # Python's ProcessPoolExecutor waits forever for the rest of a result whose worker was killed while
+    # it wrote it (service.executors); the job then runs again as after any worker's death (fit), or is
+    # answered 503 and the next renders (preview). Without the watch, the script hangs (its timeout).
+    (tmp_path / "killed_while_sending.py").write_text(KILLED_WHILE_SENDING)
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (str(tmp_path), os.environ.get("PYTHONPATH"))))}
+    run = subprocess.run([sys.executable, "-c", STUCK_POOLS, str(tmp_path)], cwd=ROOT, env=env,
+                         capture_output=True, text=True, timeout=150)
+    assert run.returncode == 0, run.stderr[-3000:]
+    seen = eval(run.stdout.strip().splitlines()[-1])
+    assert (tmp_path / "fit").exists() and (tmp_path / "preview").exists(), seen  # each was killed once
+    assert seen["fit"]["bytes"] == 64 << 20 and seen["fit"]["restarts"] == 1, seen
+    assert "the render process of this preview died" in seen["preview_first"], seen
+    assert seen["preview_second"] == 64 << 20, seen
+    # Unstuck after the worker had been dead service.executors.STUCK_S (3 s), well within the 60 s limit.
+    assert seen["fit"]["seconds"] < 30 and seen["preview_first_s"] < 30, seen
+
+
 @pytest.mark.slow
 def test_timed_out_fit_is_cancelled_and_its_worker_freed(tmp_path):
     # Issue 20: a job whose request was answered 504 no longer runs on. The job must outlast the
