@@ -67,8 +67,9 @@ def test_a_checkout_is_the_commit_with_the_installed_dependencies_and_goes_away(
 
 
 def test_a_checkout_for_the_suite_links_what_the_suite_reads_and_removing_it_keeps_them(tmp_path):
+    assert all((ROOT / path).is_dir() for path in SUITE_INSTALLED)  # scripts/test runs scripts/bootstrap first
     with checkout("HEAD", SUITE_INSTALLED) as root:
         for path in SUITE_INSTALLED:
-            if (ROOT / path).exists():  # all of them after scripts/bootstrap
-                assert (root / path).is_symlink() and (root / path).resolve() == (ROOT / path).resolve()
+            assert (root / path).is_symlink() and (root / path).resolve() == (ROOT / path).resolve()
+    assert all((ROOT / path).is_dir() for path in SUITE_INSTALLED)
     assert all((ROOT / path).exists() for path in (".venv/bin/python", ".venv-blender/bin/python"))
