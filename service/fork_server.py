@@ -138,9 +138,9 @@ FORK_SERVER_EXIT_S = 5.0
 """How long :func:`fork_server_exited` waits for the fork server's exit to be seen."""
 
 
-async def fork_server_exited(timeout_s: float = FORK_SERVER_EXIT_S, poll_s: float = 0.01) -> bool:
+async def fork_server_exited(timeout_s: float | None = None, poll_s: float = 0.01) -> bool:
     """
-    Wait (polling, at most ``timeout_s``) until the fork server of
+    Wait (polling, at most ``timeout_s``, by default :data:`FORK_SERVER_EXIT_S`) until the fork server of
     :func:`service.worker.process_context` has exited, without reaping it:
     multiprocessing reaps it at the next start (``ForkServer.ensure_running``)
     and then starts a new one. For a start that failed with one of
@@ -149,7 +149,7 @@ async def fork_server_exited(timeout_s: float = FORK_SERVER_EXIT_S, poll_s: floa
     ``timeout_s``, when it is alive after all, and the next start will tell.
     """
     pid = forkserver._forkserver._forkserver_pid
-    deadline = time.monotonic() + timeout_s
+    deadline = time.monotonic() + (FORK_SERVER_EXIT_S if timeout_s is None else timeout_s)
     while pid is not None:
         try:
             if os.waitid(os.P_PID, pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None:

@@ -407,7 +407,8 @@ DYING_FORK_SERVER = r"""
 import asyncio, os, socket, subprocess, sys, tempfile, threading, time
 from multiprocessing import forkserver
 
-from service.pool import FitRunner
+import service.fork_server
+from service.pool import FitRunner, WorkersNotStarted
 from service.previews import PreviewRunner, RenderWorkerLost
 
 
@@ -452,8 +453,22 @@ async def main():
         first = str(error)
     second = await previews.preview(("b",), os.getpid)
     previews.close()
-    return {"fit": fit, "preview_first": first, "preview_second": second,
-            "fork_server_is_new": forkserver._forkserver._forkserver_pid not in (None, dying.pid)}
+    fork_server_is_new = forkserver._forkserver._forkserver_pid not in (None, dying.pid)
+
+    # One that does not exit (within a bound shortened from 5 s): three failed starts, then a 503.
+    service.fork_server.FORK_SERVER_EXIT_S = 0.2
+    runner = FitRunner(1, 4, timeout_s=60.0)
+    dying = dying_fork_server(60)
+    try:
+        await runner.run(os.getpid)
+        stuck = "answered"
+    except WorkersNotStarted as error:
+        stuck = f"{error} (Retry-After {error.retry_after}), restarts {runner.restarts}"
+    dying.kill()  # reaped by multiprocessing, as a fork server is
+    again = await runner.run(os.getpid)
+    runner.close()
+    return {"fit": fit, "preview_first": first, "preview_second": second, "fork_server_is_new": fork_server_is_new,
+            "stuck": stuck, "again": again}
 
 
 print(repr(asyncio.run(main())))
@@ -476,6 +491,11 @@ def test_a_worker_start_that_a_dying_fork_server_refuses_waits_for_its_exit_and_
     # A preview's start: that preview is answered 503 (RenderWorkerLost), the next renders.
     assert "could not be started (its fork server died)" in seen["preview_first"], seen
     assert seen["preview_second"] > 0 and seen["fork_server_is_new"], seen
+    # A fork server that stays unreachable: 503 (WorkersNotStarted) after three failed starts, not quarantined;
+    # once it has exited, the next fit runs.
+    assert seen["stuck"] == ("no fitting worker process could be started (their fork server died); try again "
+                             "(Retry-After 1), restarts 3"), seen
+    assert seen["again"] > 0, seen
 
 
 KILLED_WHILE_SENDING = r"""
