@@ -15,9 +15,8 @@ thread waiting in ``recv()`` for the rest of a message that never comes:
 the other workers, and this process itself, hold the pipe's write end, so
 no end of file comes either. The thread then never looks at the workers
 again, so the pool never breaks: every job in it, and every later one,
-waits forever, and its shutdown hangs. Measured by hand
-(``ProcessPoolExecutor`` with two forkserver workers, a 300 MB result, the
-worker SIGKILLed at a random time in its first 0.6 s): 5 of 12 pools hung.
+waits forever, and its shutdown hangs (``benchmarks/stuck_pools.py``
+measures how often, with and without :func:`result`).
 
 :func:`result` awaits a job's future and watches its executor's workers:
 a worker dead for :data:`STUCK_S` in a pool that has not broken is that
