@@ -7,6 +7,7 @@ on 127.0.0.1; every loop is bounded.
 
 from __future__ import annotations
 
+import ast
 import os
 import re
 import signal
@@ -403,6 +404,14 @@ def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_
         assert b"service.preload" in _cmdline(fork_servers[0])
 
 
+def _run_script(script: str, *args: str, env: dict | None = None, timeout_s: float) -> dict:
+    """Run ``script`` (``python -c``, in the repository) in a process of its own; the dict its last line prints."""
+    run = subprocess.run([sys.executable, "-c", script, *args], cwd=ROOT, env=env, capture_output=True, text=True,
+                         timeout=timeout_s)
+    assert run.returncode == 0, run.stderr[-3000:]
+    return ast.literal_eval(run.stdout.strip().splitlines()[-1])
+
+
 DYING_FORK_SERVER = r"""
 import asyncio, os, socket, subprocess, sys, tempfile, threading, time
 from multiprocessing import forkserver
@@ -480,10 +489,7 @@ def test_a_worker_start_that_a_dying_fork_server_refuses_waits_for_its_exit_and_
     # A fork server killed (with its workers, or by the OOM killer) is seen alive by multiprocessing
     # until its exit ends, and closes the next start's request unanswered (EOFError): that start once
     # ended in a 500 ("internal error (EOFError)") in the fork server test above.
-    run = subprocess.run([sys.executable, "-c", DYING_FORK_SERVER], cwd=ROOT, capture_output=True, text=True,
-                         timeout=120)
-    assert run.returncode == 0, run.stderr[-3000:]
-    seen = eval(run.stdout.strip().splitlines()[-1])
+    seen = _run_script(DYING_FORK_SERVER, timeout_s=120)
     fit = seen["fit"]
     assert fit["worker"] != os.getpid() and fit["worker"] > 0, seen
     # Waited for the exit (0.5 s), then one restart onto multiprocessing's new fork server.
@@ -567,10 +573,7 @@ def test_a_worker_killed_while_it_sends_a_result_does_not_hang_its_pool(tmp_path
     # answered 503 and the next renders (preview). Without the watch, the script hangs (its timeout).
     (tmp_path / "killed_while_sending.py").write_text(KILLED_WHILE_SENDING)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (str(tmp_path), os.environ.get("PYTHONPATH"))))}
-    run = subprocess.run([sys.executable, "-c", STUCK_POOLS, str(tmp_path)], cwd=ROOT, env=env,
-                         capture_output=True, text=True, timeout=150)
-    assert run.returncode == 0, run.stderr[-3000:]
-    seen = eval(run.stdout.strip().splitlines()[-1])
+    seen = _run_script(STUCK_POOLS, str(tmp_path), env=env, timeout_s=150)
     assert (tmp_path / "fit").exists() and (tmp_path / "preview").exists(), seen  # each was killed once
     assert seen["fit"]["bytes"] == 64 << 20 and seen["fit"]["restarts"] == 1, seen
     assert "the render process of this preview died" in seen["preview_first"], seen
