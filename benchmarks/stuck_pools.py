@@ -92,9 +92,9 @@ async def trial(side: str, size: int, kill_after_s: float | None, limit_s: float
         pool.shutdown(wait=True, cancel_futures=True)
 
 
-def _bounded(name: str, low: float, high: float):
-    def parse(text: str) -> float:
-        value = float(text)
+def _bounded(name: str, low: float, high: float, kind: type = float):
+    def parse(text: str):
+        value = kind(text)
         if not low <= value <= high:
             raise argparse.ArgumentTypeError(f"--{name} must lie in [{low:g}, {high:g}], got {text}")
         return value
@@ -103,15 +103,15 @@ def _bounded(name: str, low: float, high: float):
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--trials", type=_bounded("trials", 1, 200), default=12)
-    parser.add_argument("--mb", type=_bounded("mb", 1, 1000), default=300)
+    parser.add_argument("--trials", type=_bounded("trials", 1, 200, int), default=12)
+    parser.add_argument("--mb", type=_bounded("mb", 1, 1000, int), default=300)
     parser.add_argument("--window", type=_bounded("window", 0.01, 10), default=0.6)
     parser.add_argument("--limit", type=_bounded("limit", 1, 120), default=15.0)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args(argv)
     load_at_start = load_average()
-    kills = [random.Random(args.seed + i).uniform(0.05, args.window) for i in range(int(args.trials))]
-    size = int(args.mb) << 20
+    kills = [random.Random(args.seed + i).uniform(0.05, args.window) for i in range(args.trials)]
+    size = args.mb << 20
     runs: dict[str, list[tuple[str, float | None]]] = {side: [] for side in SIDES}
     for i, kill in enumerate(kills):
         for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
@@ -132,7 +132,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"| {side} | {f['trials']} | {f['answered']} | {f['broken']} | {f['hung']} | "
               f"{f['seconds_median']} / {f['seconds_max']} |")
     path = write_result("stuck_pools", figures, load_at_start, kills_s=[round(k, 3) for k in kills],
-                        settings={"mb": int(args.mb), "limit_s": args.limit, "stuck_s": executors.STUCK_S,
+                        settings={"mb": args.mb, "limit_s": args.limit, "stuck_s": executors.STUCK_S,
                                   "watch_s": executors.WATCH_S},
                         runs={side: [[o, None if s is None else round(s, 3)] for o, s in runs[side]] for side in SIDES})
     print(f"\nrecorded {path.relative_to(ROOT)}")
