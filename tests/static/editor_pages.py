@@ -1,7 +1,8 @@
 """
 Shared fixtures and helpers of the editor's browser tests (import them:
 `from editor_pages import pages, open_editor`): Debian's Chromium through
-the Python playwright package (never a downloaded browser), a real server
+the Python playwright package (never a downloaded browser; launched
+without the address bar's popup, :data:`UNUSED_FEATURES`), a real server
 process, and a check that the page logged no error (uncaught exceptions
 and console errors). The server and Chromium (``live_server``, ``chromium``)
 are one of each a test process: the server is tests/conftest.py's
@@ -84,8 +85,45 @@ def editor_url(live_server):
     return live_server + "/"
 
 
+UNUSED_FEATURES = ("WebUIOmniboxPopup", "WebUIOmniboxAimPopup", "WebUIOmniboxFullPopup", "PreloadTopChromeWebUI")
+"""
+Chromium features that cost the tests CPU and do nothing for a page:
+headless Chromium gives every window (one a browser context) an address
+bar whose popup is a WebUI page, loaded at once in a renderer process of
+its own (chrome://omnibox-popup.top-chrome). Disabled, a fresh context's
+editor load takes about half the renderer CPU time
+(``benchmarks/browser_page_cost.py``).
+"""
+
+_disable_features: str | None = None  # the launch switch, once read (see disable_features)
+
+
+def disable_features(p) -> str:
+    """
+    ``--disable-features=`` with playwright's own list and
+    :data:`UNUSED_FEATURES`. Chromium keeps only the last of several such
+    switches, and playwright passes its list (features that break
+    automation) before the caller's arguments, so a switch of ours alone
+    would enable those again. Its list is read from chrome://version's
+    command line, once a process (one more launch).
+    """
+    global _disable_features
+    if _disable_features is None:
+        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page()
+            page.goto("chrome://version")
+            switches = page.inner_text("#command_line").split()
+        finally:
+            browser.close()
+        own = [s.split("=", 1)[1] for s in switches if s.startswith("--disable-features=")]
+        features = [f for f in ",".join(own).split(",") if f]
+        _disable_features = "--disable-features=" + ",".join(dict.fromkeys([*features, *UNUSED_FEATURES]))
+    return _disable_features
+
+
 def launch(p):
-    return p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+    return p.chromium.launch(executable_path="/usr/bin/chromium", args=[*CHROMIUM_ARGS, disable_features(p)])
 
 
 class Pages:
