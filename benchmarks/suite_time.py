@@ -12,7 +12,7 @@ records each one's wall time, test count and the load average around it in
     kernels' settings), unless ``--no-other-cpus``.
 
     .venv/bin/python benchmarks/suite_time.py [--no-other-cpus] [--log DIR]
-    .venv/bin/python benchmarks/suite_time.py --before REV [--rounds N] [--log DIR]
+    .venv/bin/python benchmarks/suite_time.py --before REV [--rounds N] [--name NAME] [--log DIR]
 
 ``--log DIR`` keeps each mode's whole output (``DIR/quick.log``,
 ``full.log``, ``other-cpus.log``), for what a failed run printed.
@@ -22,7 +22,8 @@ worktree, what ``scripts/bootstrap`` installed linked in) and of this
 checkout, in turns (``--rounds`` of each, the order swapped every round),
 so that both run in the same hour of a machine whose speed drifts by a
 quarter from one hour to the next; recorded in
-``benchmarks/results/suite_time_side_by_side.json``. Each side runs
+``benchmarks/results/suite_time_side_by_side.json`` (or ``--name``'s
+record). Each side runs
 :data:`FULL_SUITE`, ``scripts/test``'s full mode after its set-up
 (``scripts/bootstrap`` would set up the worktree's own environment):
 bytecode caches written, then pytest with this checkout's interpreter.
@@ -151,9 +152,13 @@ def main(argv=None) -> int:
     parser.add_argument("--before", metavar="REV",
                         help="instead: the full suite of this commit and of this checkout, in turns")
     parser.add_argument("--rounds", type=int, default=1, help="with --before: full runs of each side (default 1)")
+    parser.add_argument("--name", default=SIDE_BY_SIDE.stem,
+                        help=f"with --before: the record, benchmarks/results/NAME.json (default {SIDE_BY_SIDE.stem})")
     args = parser.parse_args(argv)
     if not 1 <= args.rounds <= 5:
         parser.error(f"--rounds must lie in [1, 5], got {args.rounds}")
+    if not re.fullmatch(r"suite_time_[a-z0-9_]+", args.name):
+        parser.error(f"--name must be suite_time_ and lower-case letters, digits or _, got {args.name!r}")
     if args.before is not None:
         if subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{args.before}^{{commit}}"],
                           capture_output=True).returncode != 0:
@@ -164,7 +169,7 @@ def main(argv=None) -> int:
         for side in ("before", "now"):
             print(f"{side:<8}{f[side]['seconds']:>9.1f}{f[side]['busy_seconds']:>9.1f}{f[side]['idle_seconds']:>9.1f}")
         print(f"now / before: wall {f['ratio_seconds']:.3f}, busy {f['ratio_busy']:.3f}")
-        SIDE_BY_SIDE.write_text(json.dumps({
+        (SIDE_BY_SIDE.parent / f"{args.name}.json").write_text(json.dumps({
             "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
             "date": datetime.now(timezone.utc).isoformat(timespec="minutes"), "cpu": cpu(), **result,
         }, indent=2) + "\n")

@@ -18,6 +18,7 @@ def test_the_side_by_side_runs_scripts_test_s_full_suite():
 
 @pytest.mark.parametrize("argv, message", [
     (["--rounds", "0"], "--rounds must lie in [1, 5], got 0"),
+    (["--name", "../suite_time"], "--name must be suite_time_ and lower-case letters, digits or _, got '../suite_time'"),
     pytest.param(["--before", "no-such-commit"], "--before must name a commit of this repository, got 'no-such-commit'",
                  marks=pytest.mark.slow),  # asks git
 ])
