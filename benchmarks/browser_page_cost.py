@@ -28,7 +28,6 @@ and workers. Prints a table and records benchmarks/results/browser_page_cost.jso
 from __future__ import annotations
 
 import argparse
-import os
 import statistics
 import sys
 import tempfile
@@ -42,6 +41,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 sys.path.insert(0, str(ROOT / "tests" / "static"))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
+from benchmarks.server_start import processes  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from conftest import server_process  # noqa: E402
 from editor_pages import CHROMIUM_ARGS, launch, open_editor, settled  # noqa: E402
@@ -69,19 +69,10 @@ def _kind(pid: int, command: str, servers: set[int]) -> str | None:
 def cpu_by_process(servers: set[int]) -> dict[int, tuple[str, float]]:
     """Each process of a kind in KINDS: (kind, its CPU seconds so far); a server's forks by their session."""
     seen: dict[int, tuple[str, float]] = {}
-    for name in os.listdir("/proc"):
-        if not name.isdigit():
-            continue
-        try:
-            stat = Path(f"/proc/{name}/stat").read_text()
-            command = Path(f"/proc/{name}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
-        except OSError:
-            continue
-        fields = stat[stat.rindex(")") + 2:].split()
-        session = int(fields[3])
-        kind = _kind(session, command, servers)
+    for pid, fields, command in processes():
+        kind = _kind(int(fields[3]), command, servers)
         if kind is not None:
-            seen[int(name)] = (kind, (int(fields[11]) + int(fields[12])) / TICK)
+            seen[pid] = (kind, (int(fields[11]) + int(fields[12])) / TICK)
     return seen
 
 

@@ -35,6 +35,7 @@ import tempfile
 import time
 from collections import Counter
 from pathlib import Path
+from typing import Iterator
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -69,9 +70,12 @@ def kind_of(command: str) -> str:
     return "server"
 
 
-def session_cpu(session: int) -> dict[int, tuple[int, str, float]]:
-    """Every live process of ``session``: pid -> (parent pid, command line, CPU seconds with its reaped children)."""
-    out = {}
+def processes() -> Iterator[tuple[int, list[str], str]]:
+    """
+    Every live process: its pid, the fields of ``/proc/PID/stat`` after the
+    command name (``[1]`` parent, ``[3]`` session, ``[11:13]`` user and
+    system ticks, ``[13:15]`` its reaped children's) and its command line.
+    """
     for pid in os.listdir("/proc"):
         if not pid.isdigit():
             continue
@@ -80,10 +84,13 @@ def session_cpu(session: int) -> dict[int, tuple[int, str, float]]:
             command = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
         except OSError:
             continue
-        fields = stat[stat.rfind(")") + 2:].split()
-        if int(fields[3]) == session:
-            out[int(pid)] = (int(fields[1]), command, sum(int(f) for f in fields[11:15]) / TICK)
-    return out
+        yield int(pid), stat[stat.rfind(")") + 2:].split(), command
+
+
+def session_cpu(session: int) -> dict[int, tuple[int, str, float]]:
+    """Every live process of ``session``: pid -> (parent pid, command line, CPU seconds with its reaped children)."""
+    return {pid: (int(fields[1]), command, sum(int(f) for f in fields[11:15]) / TICK)
+            for pid, fields, command in processes() if int(fields[3]) == session}
 
 
 def by_kind(processes: dict[int, tuple[int, str, float]], server: int) -> Counter:
