@@ -91,7 +91,7 @@ Chromium features that cost the tests CPU and do nothing for a page:
 headless Chromium gives every window (one a browser context) an address
 bar whose popup is a WebUI page, loaded at once in a renderer process of
 its own (chrome://omnibox-popup.top-chrome). Disabled, a fresh context's
-editor load takes about half the renderer CPU time
+editor load takes less than half the renderer CPU time it took
 (``benchmarks/browser_page_cost.py``).
 """
 
