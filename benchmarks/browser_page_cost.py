@@ -15,10 +15,11 @@ launched side by side, in turns (the order swapped every round):
 
 A load is a new context and page, the editor opened and settled (its first
 fit drawn), as ``open_editor`` and ``settled`` do. Its CPU seconds are read
-from ``/proc`` before the context closes, by kind of process: Chromium's
-renderers, browser process, GPU process (SwiftShader) and the rest of
-Chromium, playwright's Node.js driver, and the server with its fork server
-and workers. Prints a table and records benchmarks/results/browser_page_cost.json
+from ``/proc`` before the context closes, by kind of process
+(:data:`KINDS`, benchmarks/suite_cpu.py's classes; both Chromiums' processes
+are read): Chromium's renderers, browser process, GPU process (SwiftShader)
+and the rest of Chromium, playwright's Node.js driver, and the server with
+its fork server and workers. Prints a table and records benchmarks/results/browser_page_cost.json
 (``figures.<side>.cpu_s`` and ``.renderer_cpu_s``: median and max a load;
 ``saved_cpu_s_median``: plain's median less the tests')::
 
@@ -42,36 +43,27 @@ sys.path.insert(0, str(ROOT / "tests" / "static"))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.server_start import processes  # noqa: E402
+from benchmarks.suite_cpu import classify  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from conftest import server_process  # noqa: E402
 from editor_pages import CHROMIUM_ARGS, launch, open_editor, settled  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
 SIDES = ("plain", "tests")
-KINDS = (
-    # (kind, substrings of the command line naming it); the first match wins
-    ("renderer", ("--type=renderer",)),
-    ("gpu", ("--type=gpu-process",)),
-    ("chromium_other", ("--type=",)),
-    ("chromium_browser", ("chromium",)),
-    ("driver", ("playwright",)),
-    ("server", ("-m service", "multiprocessing.forkserver")),
-)
-
-
-def _kind(pid: int, command: str, servers: set[int]) -> str | None:
-    for kind, marks in KINDS:
-        if any(mark in command for mark in marks):
-            return kind
-    return "server" if pid in servers else None
+KINDS = ("chromium_renderer", "chromium_gpu", "chromium_other", "chromium_browser", "playwright", "server")
+"""The kinds of process a load is read by: benchmarks/suite_cpu.py's classes, and the server's session."""
 
 
 def cpu_by_process(servers: set[int]) -> dict[int, tuple[str, float]]:
-    """Each process of a kind in KINDS: (kind, its CPU seconds so far); a server's forks by their session."""
+    """
+    Each process of a kind in :data:`KINDS`: (kind, its CPU seconds so far);
+    the server with its fork server and workers by their session, the rest
+    by :func:`benchmarks.suite_cpu.classify`.
+    """
     seen: dict[int, tuple[str, float]] = {}
     for pid, fields, command in processes():
-        kind = _kind(int(fields[3]), command, servers)
-        if kind is not None:
+        kind = "server" if int(fields[3]) in servers else classify(command)
+        if kind in KINDS:
             seen[pid] = (kind, (int(fields[11]) + int(fields[12])) / TICK)
     return seen
 
@@ -130,17 +122,17 @@ def main(argv: list[str] | None = None) -> None:
     print(f"{'side':<6} {'CPU s a load, median (max)':>28} {'renderer':>9} {'browser':>8} {'GPU':>6} {'wall s':>7}")
     for side in SIDES:
         rows = runs[side]
-        kind_median = {kind: round(statistics.median(r["kinds"].get(kind, 0.0) for r in rows), 3)
-                       for kind, _ in KINDS}
+        kind_median = {kind: round(statistics.median(r["kinds"].get(kind, 0.0) for r in rows), 3) for kind in KINDS}
         figures[side] = {
             "cpu_s": _summary([r["cpu_s"] for r in rows]),
-            "renderer_cpu_s": _summary([r["kinds"].get("renderer", 0.0) for r in rows]),
+            "renderer_cpu_s": _summary([r["kinds"].get("chromium_renderer", 0.0) for r in rows]),
             "wall_s": _summary([r["wall_s"] for r in rows]),
             "cpu_s_median_by_kind": kind_median,
         }
         f = figures[side]
-        print(f"{side:<6} {f['cpu_s']['median']:>19.2f} ({f['cpu_s']['max']:.2f}) {kind_median['renderer']:>9.2f} "
-              f"{kind_median['chromium_browser']:>8.2f} {kind_median['gpu']:>6.2f} {f['wall_s']['median']:>7.2f}")
+        print(f"{side:<6} {f['cpu_s']['median']:>19.2f} ({f['cpu_s']['max']:.2f}) "
+              f"{kind_median['chromium_renderer']:>9.2f} {kind_median['chromium_browser']:>8.2f} "
+              f"{kind_median['chromium_gpu']:>6.2f} {f['wall_s']['median']:>7.2f}")
     figures["saved_cpu_s_median"] = round(figures["plain"]["cpu_s"]["median"] - figures["tests"]["cpu_s"]["median"], 3)
     print(f"saved a load (median): {figures['saved_cpu_s_median']:.2f} CPU s")
     path = write_result("browser_page_cost", figures, load, rounds=args.rounds, runs=runs)
