@@ -46,7 +46,7 @@ from benchmarks.server_start import processes  # noqa: E402
 from benchmarks.suite_cpu import classify  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from conftest import server_process  # noqa: E402
-from editor_pages import CHROMIUM_ARGS, launch, open_editor, settled  # noqa: E402
+from editor_pages import launch, open_editor, settled  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
 SIDES = ("plain", "tests")
@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> None:
     with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data") as server, \
             sync_playwright() as p:
         browsers = {
-            "plain": p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS),
+            "plain": launch(p, plain=True),
             "tests": launch(p),
         }
         servers = {server.process.pid}

@@ -98,32 +98,41 @@ editor load takes less than half the renderer CPU time it took
 _disable_features: str | None = None  # the launch switch, once read (see disable_features)
 
 
+def disabled_features(browser) -> list[list[str]]:
+    """Each ``--disable-features=`` switch of ``browser``'s command line (chrome://version): its features, in order."""
+    page = browser.new_page()
+    try:
+        page.goto("chrome://version")
+        switches = page.inner_text("#command_line").split()
+    finally:
+        page.close()
+    return [s.split("=", 1)[1].split(",") for s in switches if s.startswith("--disable-features=")]
+
+
 def disable_features(p) -> str:
     """
     ``--disable-features=`` with playwright's own list and
     :data:`UNUSED_FEATURES`. Chromium keeps only the last of several such
     switches, and playwright passes its list (features that break
     automation) before the caller's arguments, so a switch of ours alone
-    would enable those again. Its list is read from chrome://version's
-    command line, once a process (one more launch).
+    would enable those again. Its list is read from a plain launch's
+    command line (:func:`disabled_features`), once a process.
     """
     global _disable_features
     if _disable_features is None:
-        browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+        browser = launch(p, plain=True)
         try:
-            page = browser.new_page()
-            page.goto("chrome://version")
-            switches = page.inner_text("#command_line").split()
+            playwrights = [feature for switch in disabled_features(browser) for feature in switch if feature]
         finally:
             browser.close()
-        own = [s.split("=", 1)[1] for s in switches if s.startswith("--disable-features=")]
-        features = [f for f in ",".join(own).split(",") if f]
-        _disable_features = "--disable-features=" + ",".join(dict.fromkeys([*features, *UNUSED_FEATURES]))
+        _disable_features = "--disable-features=" + ",".join(dict.fromkeys([*playwrights, *UNUSED_FEATURES]))
     return _disable_features
 
 
-def launch(p):
-    return p.chromium.launch(executable_path="/usr/bin/chromium", args=[*CHROMIUM_ARGS, disable_features(p)])
+def launch(p, plain: bool = False):
+    """Chromium with :data:`CHROMIUM_ARGS` and, unless ``plain``, :data:`UNUSED_FEATURES` disabled."""
+    return p.chromium.launch(executable_path="/usr/bin/chromium",
+                             args=CHROMIUM_ARGS if plain else [*CHROMIUM_ARGS, disable_features(p)])
 
 
 class Pages:

@@ -10,20 +10,9 @@ from __future__ import annotations
 
 import editor_pages
 import pytest
-from editor_pages import CHROMIUM_ARGS, UNUSED_FEATURES, chromium, live_server  # noqa: F401 (shared fixtures)
+from editor_pages import UNUSED_FEATURES, chromium, disabled_features, launch, live_server  # noqa: F401 (fixtures)
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
-
-
-def _disabled_features(browser) -> list[set[str]]:
-    """Each ``--disable-features=`` switch of the browser's command line (chrome://version), in order."""
-    page = browser.new_page()
-    try:
-        page.goto("chrome://version")
-        switches = page.inner_text("#command_line").split()
-    finally:
-        page.close()
-    return [set(s.split("=", 1)[1].split(",")) for s in switches if s.startswith("--disable-features=")]
 
 
 def _browser_ui(browser) -> list[str]:
@@ -42,9 +31,9 @@ def _browser_ui(browser) -> list[str]:
 
 
 def test_playwrights_disabled_features_are_kept_and_no_context_loads_an_omnibox_popup(chromium):
-    plain = editor_pages._CHROMIUM.playwright.chromium.launch(executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS)
+    plain = launch(editor_pages._CHROMIUM.playwright, plain=True)
     try:
-        (playwrights,) = _disabled_features(plain)
+        (playwrights,) = [set(switch) for switch in disabled_features(plain)]
         popups = _browser_ui(plain)
     finally:
         plain.close()
@@ -52,9 +41,9 @@ def test_playwrights_disabled_features_are_kept_and_no_context_loads_an_omnibox_
     # What is disabled is there by default: the popup's WebUI, loaded with the context's window.
     assert any(url.startswith("chrome://omnibox-popup") for url in popups), popups
 
-    switches = _disabled_features(chromium)
+    switches = disabled_features(chromium)
     # Chromium keeps the last switch only: it must hold playwright's list and ours.
-    assert switches[-1] == playwrights | set(UNUSED_FEATURES)
+    assert set(switches[-1]) == playwrights | set(UNUSED_FEATURES)
     assert _browser_ui(chromium) == []
 
 
