@@ -56,7 +56,7 @@ CLASSES = (
     ("chromium_browser", "Chromium browser", ("chromium", "chrome")),
     # and a server's forks (its fork server, service.fork_server.start_fork_server, and their workers): classify()
     ("fork_servers", "fork servers and their workers", ("multiprocessing.forkserver",)),
-    ("servers", "server processes (python -m service)", ("-m service",)),
+    ("servers", "server processes (python -m service)", ("-m service", "tests/server_forks.py")),
     # the second: pytest-xdist's workers
     ("pytest", "pytest processes", ("pytest", "exec(eval(sys.stdin.readline()))")),
     ("playwright", "playwright's Node.js driver", ("playwright",)),
@@ -75,17 +75,21 @@ OTHERS = {
 LABELS = {key: label for key, label, _ in CLASSES} | OTHERS
 
 
-def classify(command: str, parent: str | None = None) -> str:
+def classify(command: str, parent: str | None = None, leader: bool = False) -> str:
     """
-    The key of a process's class by its command line (:data:`CLASSES`) and
-    its parent's class: a server's fork (its fork server and the workers,
-    which keep the server's command line) is ``fork_servers``.
+    The key of a process's class by its command line (:data:`CLASSES`), its
+    parent's class and whether it leads its session: a server's fork (its
+    fork server and the workers, which keep the server's command line) is
+    ``fork_servers``; a server forked by tests/server_forks.py (which has
+    that program's command line) leads a session of its own, as a
+    ``python -m service`` the tests start does, and is ``servers``.
     """
     if not command:  # kernel threads have none
         return "kernel"
     for key, _, needles in CLASSES:
         if any(n in command for n in needles):
-            return "fork_servers" if key == "servers" and parent in ("servers", "fork_servers") else key
+            forked = key == "servers" and parent in ("servers", "fork_servers") and not leader
+            return "fork_servers" if forked else key
     return "other_python" if "python" in command else "other"
 
 
@@ -121,7 +125,7 @@ class Sampler(threading.Thread):
                 except OSError:
                     command = ""
                 if command or entry[0] is None:  # a process gone since (or a zombie) keeps its class
-                    entry[0] = "sampler" if pid == self.me else classify(command, parent)
+                    entry[0] = "sampler" if pid == self.me else classify(command, parent, fields[3] == pid)
                 entry[3] += 1
             entry[2] = max(entry[2], ticks)
             self.classes[pid] = entry[0]

@@ -48,6 +48,14 @@ def test_a_server_s_forks_are_fork_servers():
     assert classify(".venv/bin/python -m pytest", "servers") == "pytest"
 
 
+def test_a_server_forked_by_the_tests_program_is_a_server():
+    program = "/r/.venv/bin/python -c import runpy; runpy.run_path('tests/server_forks.py', run_name='__main__')"
+    assert classify(program, "pytest") == "servers"  # the program: its imports are the servers' start
+    assert classify(program, "servers", leader=True) == "servers"  # a server it forked (its own session)
+    assert classify(program, "servers") == "fork_servers"  # that server's fork server
+    assert classify(program, "fork_servers") == "fork_servers"  # and its workers
+
+
 def test_the_calibration_loop_takes_cpu_time():
     assert 0.0 < calibration() < 60.0
 
