@@ -10,6 +10,10 @@ Shared fixtures of the test suite.
     on 127.0.0.1 with a fresh data directory; waits for ``/healthz`` and
     yields the base URL (``"http://127.0.0.1:<port>"``); terminates the
     process afterwards. Mark tests that use it ``@pytest.mark.server``.
+    Servers are forked from one interpreter that has imported the service
+    (tests/server_forks.py: the imports are most of a start's CPU time)
+    where their environment differs only in ``COATED_*`` and ``TMPDIR``;
+    ``server_process(..., spawn=True)`` starts the command itself.
 -   :func:`app_client`: the TestClient factory behind ``client``, with
     settings overrides (``with app_client(tmp_path, fit_queue=0) as c: ...``).
 -   :func:`server_process`: the context manager behind ``live_server``, for
@@ -53,6 +57,7 @@ import httpx
 import loopback
 import moderngl
 import pytest
+from server_forks import ServerForks
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -66,21 +71,33 @@ def free_port() -> int:
         return sock.getsockname()[1]
 
 
-class ServerProcess:
-    """A running ``python -m service``: its URL, process and data directory."""
+SERVER_FORKS = ServerForks()
+"""This test process's program that forks servers (tests/server_forks.py), started on first use."""
 
-    def __init__(self, data_dir: Path, env: dict[str, str], log: Path) -> None:
+
+class ServerProcess:
+    """
+    A running ``python -m service``: its URL, process and data directory.
+    Forked from :data:`SERVER_FORKS` where the environment allows
+    (``ServerForks.can_fork``) unless ``spawn``; else started as the
+    command itself. Either way in a session of its own, its output in ``log``.
+    """
+
+    def __init__(self, data_dir: Path, env: dict[str, str], log: Path, spawn: bool = False) -> None:
         self.data_dir = data_dir
         self.port = free_port()
         self.url = f"http://127.0.0.1:{self.port}"
         self.log = log
         self._log_file = open(log, "ab")
-        self.process = subprocess.Popen(
-            [sys.executable, "-m", "service", "--host", "127.0.0.1", "--port", str(self.port),
-             "--data-dir", str(data_dir)],
-            cwd=ROOT, env={**os.environ, **env}, stdout=self._log_file, stderr=subprocess.STDOUT,
-            start_new_session=True,
-        )
+        argv = ["--host", "127.0.0.1", "--port", str(self.port), "--data-dir", str(data_dir)]
+        env = {**os.environ, **env}
+        if not spawn and SERVER_FORKS.can_fork(env):
+            self.process = SERVER_FORKS.start(argv, env, log)
+        else:
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "service", *argv], cwd=ROOT, env=env, stdout=self._log_file,
+                stderr=subprocess.STDOUT, start_new_session=True,
+            )
 
     def wait_ready(self, timeout_s: float = SERVER_START_TIMEOUT_S) -> None:
         deadline = time.monotonic() + timeout_s
@@ -120,10 +137,13 @@ class ServerProcess:
 
 
 @contextlib.contextmanager
-def server_process(data_dir: Path, **env: str) -> Iterator[ServerProcess]:
-    """Start ``python -m service`` on a free loopback port; stop it on exit."""
+def server_process(data_dir: Path, spawn: bool = False, **env: str) -> Iterator[ServerProcess]:
+    """
+    Start ``python -m service`` on a free loopback port (forked, or with
+    ``spawn`` the command itself: :class:`ServerProcess`); stop it on exit.
+    """
     env = {"COATED_FIT_WORKERS": "1", "COATED_METRICS_SAMPLES": "30", **env}
-    server = ServerProcess(Path(data_dir), env, Path(data_dir).with_suffix(".log"))
+    server = ServerProcess(Path(data_dir), env, Path(data_dir).with_suffix(".log"), spawn)
     try:
         server.wait_ready()
         yield server
@@ -249,6 +269,7 @@ subprocess.Popen.__init__ = _watch("a process (subprocess)", subprocess.Popen.__
 multiprocessing.process.BaseProcess.start = _watch(
     "a process (multiprocessing)", multiprocessing.process.BaseProcess.start)
 moderngl.create_context = _watch("a GL context", moderngl.create_context)
+ServerForks.start = _watch("a process (a server forked by tests/server_forks.py)", ServerForks.start)
 
 
 def _first_rank(item) -> int:
@@ -271,6 +292,10 @@ def pytest_configure(config):
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(limits=1, user_api="blas")
+
+
+def pytest_unconfigure(config):
+    SERVER_FORKS.close()
 
 
 def pytest_collection_modifyitems(config, items):

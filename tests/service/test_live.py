@@ -41,8 +41,11 @@ def gold_like_nk(shift: float) -> dict:
     return {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}
 
 
-def test_start_up_and_docs(live_server):
-    with loopback.Client(base_url=live_server, timeout=30) as http:
+def test_start_up_and_docs(tmp_path):
+    """The command itself (``python -m service``, as README starts it; other tests' servers are forks)."""
+    with server_process(tmp_path / "data", spawn=True) as server, \
+            loopback.Client(base_url=server.url, timeout=30) as http:
+        assert server.process.args[:3] == [sys.executable, "-m", "service"]
         assert http.get("/healthz").json()["status"] == "ok"
         assert http.get("/openapi.json").json()["info"]["title"]
         assert "swagger" in http.get("/docs").text.lower()
