@@ -1,0 +1,126 @@
+"""
+A test server's start: the command against a fork
+=================================================
+
+What one server start of the tests costs (tests/conftest.py's
+``server_process``: one fit worker, metrics on a 30 x 30 grid, a new data
+directory, the pool warmed before the first answer), started as the
+command, ``python -m service``, and forked from tests/server_forks.py's
+program, which has imported the service once: the wall time from the
+start to the first ``/healthz`` answer, and the CPU seconds of the start's
+session by then (the server, its fork server, the workers,
+multiprocessing's resource tracker; ``benchmarks/server_start.py``'s
+reading), in turns (the order swapped every round), after one start of
+each not counted. The program's own start (its imports, once a test
+process) is recorded beside them.
+
+Prints a table and records benchmarks/results/forked_servers.json
+(``figures``: per side, the median and max of the wall seconds to ready
+and of the CPU seconds in all, and the median CPU seconds per kind of
+process; ``program_cpu_s``; ``saved_cpu_s_median``, the command's median
+less the fork's).
+
+Usage: python benchmarks/forked_servers.py [--rounds N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from benchmarks.record import load_average, write_result  # noqa: E402
+from benchmarks.server_start import READY_TIMEOUT_S, _answers, by_kind, session_cpu, summary  # noqa: E402
+from benchmarks.service_load import free_port  # noqa: E402
+from benchmarks.suite_time import TICK  # noqa: E402
+from server_forks import ServerForks  # noqa: E402
+
+SIDES = ("command", "fork")
+ENV = {"COATED_FIT_WORKERS": "1", "COATED_METRICS_SAMPLES": "30"}
+"""tests/conftest.py's ``server_process`` defaults."""
+
+
+def start(side: str, forks: ServerForks) -> dict:
+    """One start: seconds to the first answer and CPU seconds per kind of the start's session by then."""
+    port = free_port()
+    env = {**os.environ, **ENV}
+    with tempfile.TemporaryDirectory() as data:
+        argv = ["--host", "127.0.0.1", "--port", str(port), "--data-dir", f"{data}/data"]
+        t0 = time.monotonic()
+        if side == "fork":
+            process = forks.start(argv, env, Path(data) / "log")
+        else:
+            process = subprocess.Popen([sys.executable, "-m", "service", *argv], cwd=ROOT, env=env,
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+        try:
+            while not _answers(port):
+                if process.poll() is not None:
+                    raise RuntimeError(f"the {side}'s server exited ({process.returncode})")
+                if time.monotonic() - t0 > READY_TIMEOUT_S:
+                    raise RuntimeError(f"the {side}'s server did not answer in {READY_TIMEOUT_S} s")
+                time.sleep(0.02)
+            ready = time.monotonic() - t0
+            kinds = by_kind(session_cpu(process.pid), process.pid)
+        finally:
+            process.terminate()
+            try:
+                process.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                os.killpg(process.pid, 9)
+                process.wait()
+    return {"ready_s": ready, "cpu_s": sum(kinds.values()), "kinds": dict(kinds)}
+
+
+def program_cpu(forks: ServerForks) -> float:
+    """CPU seconds the forks' program has spent (its imports; its requests cost next to nothing)."""
+    stat = Path(f"/proc/{forks.program.pid}/stat").read_text()
+    fields = stat[stat.rfind(")") + 2:].split()
+    return (int(fields[11]) + int(fields[12])) / TICK
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--rounds", type=int, default=10, help="counted starts of each side (default 10)")
+    args = parser.parse_args(argv)
+    if not 1 <= args.rounds <= 100:
+        parser.error(f"--rounds must lie in [1, 100], got {args.rounds}")
+    load = load_average()
+    forks = ServerForks()
+    try:
+        for side in SIDES:
+            start(side, forks)  # the program's start and the bytecode caches, not counted
+        program = program_cpu(forks)
+        runs = {side: [] for side in SIDES}
+        for i in range(args.rounds):
+            for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
+                runs[side].append(start(side, forks))
+    finally:
+        forks.close()
+    figures = {side: summary(runs[side]) for side in SIDES}
+    figures["program_cpu_s"] = program
+    figures["saved_cpu_s_median"] = figures["command"]["cpu_s"]["median"] - figures["fork"]["cpu_s"]["median"]
+    kinds = sorted({k for side in SIDES for k in figures[side]["cpu_s_median_by_kind"]})
+    print(f"a test server's start, {args.rounds} of each side ({', '.join(f'{k}={v}' for k, v in ENV.items())})")
+    print(f"{'':<36}{'command':>10}{'fork':>10}")
+    for label, key in (("ready s, median", ("ready_s", "median")), ("ready s, max", ("ready_s", "max")),
+                       ("CPU s, median", ("cpu_s", "median")), ("CPU s, max", ("cpu_s", "max"))):
+        print(f"{label:<36}" + "".join(f"{figures[s][key[0]][key[1]]:>10.2f}" for s in SIDES))
+    for kind in kinds:
+        print(f"{'  CPU s, ' + kind + ', median':<36}"
+              + "".join(f"{figures[s]['cpu_s_median_by_kind'].get(kind, 0.0):>10.2f}" for s in SIDES))
+    print(f"saved a start (medians): {figures['saved_cpu_s_median']:.2f} CPU s; "
+          f"the program's own start, once a test process: {program:.2f} CPU s")
+    write_result("forked_servers", figures, load, rounds=args.rounds, runs=runs)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

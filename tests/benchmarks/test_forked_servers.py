@@ -1,0 +1,34 @@
+"""
+benchmarks/forked_servers.py: one start of each side read from its
+session (the server and its warmed pool's worker), and its arguments'
+bounds.
+"""
+
+from __future__ import annotations
+
+import pytest
+from server_forks import ServerForks
+
+from benchmarks.forked_servers import SIDES, main, start
+
+pytestmark = [pytest.mark.server, pytest.mark.slow]
+
+
+def test_a_start_of_each_side_is_read_from_its_session():
+    forks = ServerForks()
+    try:
+        for side in SIDES:
+            run = start(side, forks)
+            assert run["ready_s"] > 0, (side, run)
+            assert run["kinds"]["server"] > 0 and run["kinds"]["workers"] > 0, (side, run)  # the pool is warmed
+            assert run["cpu_s"] == pytest.approx(sum(run["kinds"].values())), (side, run)
+    finally:
+        forks.close()
+    assert forks.program is None
+
+
+@pytest.mark.parametrize("rounds", ["0", "101"])
+def test_the_forked_servers_benchmark_refuses_rounds_out_of_bounds(rounds, capsys):
+    with pytest.raises(SystemExit):
+        main(["--rounds", rounds])
+    assert f"--rounds must lie in [1, 100], got {rounds}" in capsys.readouterr().err
