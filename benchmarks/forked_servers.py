@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.server_start import READY_TIMEOUT_S, _answers, by_kind, session_cpu, summary  # noqa: E402
+from benchmarks.server_start import measured, summary  # noqa: E402
 from benchmarks.service_load import free_port  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from server_forks import ServerForks  # noqa: E402
@@ -60,23 +60,7 @@ def start(side: str, forks: ServerForks) -> dict:
         else:
             process = subprocess.Popen([sys.executable, "-m", "service", *argv], cwd=ROOT, env=env,
                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
-        try:
-            while not _answers(port):
-                if process.poll() is not None:
-                    raise RuntimeError(f"the {side}'s server exited ({process.returncode})")
-                if time.monotonic() - t0 > READY_TIMEOUT_S:
-                    raise RuntimeError(f"the {side}'s server did not answer in {READY_TIMEOUT_S} s")
-                time.sleep(0.02)
-            ready = time.monotonic() - t0
-            kinds = by_kind(session_cpu(process.pid), process.pid)
-        finally:
-            process.terminate()
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                os.killpg(process.pid, 9)
-                process.wait()
-    return {"ready_s": ready, "cpu_s": sum(kinds.values()), "kinds": dict(kinds)}
+        return measured(process, port, t0, f"the {side}'s server")
 
 
 def program_cpu(forks: ServerForks) -> float:

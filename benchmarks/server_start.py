@@ -118,23 +118,33 @@ def start(root: Path, workers: int | None) -> dict:
         process = subprocess.Popen(
             [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data], cwd=root, env=env,
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+        return measured(process, port, t0, f"the server of {root}",
+                        lambda: process.stderr.read().decode(errors="replace")[-2000:])
+
+
+def measured(process, port: int, t0: float, what: str, output=lambda: "") -> dict:
+    """
+    Wait for ``process``'s first ``/healthz`` answer on ``port``; the seconds
+    since ``t0`` and the CPU seconds per kind of its session by then; stop
+    it. ``process`` is a ``subprocess.Popen`` or tests/server_forks.py's
+    ``ForkedProcess``; ``output()``, what it wrote, names an early exit.
+    """
+    try:
+        while not _answers(port):
+            if process.poll() is not None:
+                raise RuntimeError(f"{what} exited ({process.returncode}): {output()}")
+            if time.monotonic() - t0 > READY_TIMEOUT_S:
+                raise RuntimeError(f"{what} did not answer in {READY_TIMEOUT_S} s")
+            time.sleep(0.02)
+        ready = time.monotonic() - t0
+        kinds = by_kind(session_cpu(process.pid), process.pid)
+    finally:
+        process.terminate()
         try:
-            while not _answers(port):
-                if process.poll() is not None:
-                    raise RuntimeError(f"the server of {root} exited ({process.returncode}): "
-                                       f"{process.stderr.read().decode(errors='replace')[-2000:]}")
-                if time.monotonic() - t0 > READY_TIMEOUT_S:
-                    raise RuntimeError(f"the server of {root} did not answer in {READY_TIMEOUT_S} s")
-                time.sleep(0.02)
-            ready = time.monotonic() - t0
-            kinds = by_kind(session_cpu(process.pid), process.pid)
-        finally:
-            process.terminate()
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                os.killpg(process.pid, 9)
-                process.wait()
+            process.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            os.killpg(process.pid, 9)
+            process.wait()
     return {"ready_s": ready, "cpu_s": sum(kinds.values()), "kinds": dict(kinds)}
 
 
