@@ -12,8 +12,10 @@ Shared fixtures of the test suite.
     process afterwards. Mark tests that use it ``@pytest.mark.server``.
     Servers are forked from one interpreter that has imported the service
     (tests/server_forks.py: the imports are most of a start's CPU time)
-    where their environment differs only in ``COATED_*`` and ``TMPDIR``;
-    ``server_process(..., spawn=True)`` starts the command itself.
+    where their environment differs from its own only in the service's
+    ``COATED_*``, ``TMPDIR`` and ``PYTEST_CURRENT_TEST``
+    (``server_forks.FORK_MAY_SET``); else, and with
+    ``server_process(..., spawn=True)``, the command itself starts.
 -   :func:`app_client`: the TestClient factory behind ``client``, with
     settings overrides (``with app_client(tmp_path, fit_queue=0) as c: ...``).
 -   :func:`server_process`: the context manager behind ``live_server``, for
