@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.server_start import measured, summary  # noqa: E402
+from benchmarks.server_start import measured, stat_fields, summary  # noqa: E402
 from benchmarks.service_load import free_port  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from server_forks import ServerForks  # noqa: E402
@@ -65,8 +65,7 @@ def start(side: str, forks: ServerForks) -> dict:
 
 def program_cpu(forks: ServerForks) -> float:
     """CPU seconds the forks' program has spent (its imports; its requests cost next to nothing)."""
-    stat = Path(f"/proc/{forks.program.pid}/stat").read_text()
-    fields = stat[stat.rfind(")") + 2:].split()
+    fields = stat_fields(forks.program.pid)
     return (int(fields[11]) + int(fields[12])) / TICK
 
 

@@ -70,21 +70,27 @@ def kind_of(command: str) -> str:
     return "server"
 
 
+def stat_fields(pid: int | str) -> list[str]:
+    """
+    The fields of ``/proc/PID/stat`` after the command name (``[1]`` parent,
+    ``[3]`` session, ``[11:13]`` user and system ticks, ``[13:15]`` its
+    reaped children's, ``[19]`` start time); ``OSError`` once it is gone.
+    """
+    stat = Path(f"/proc/{pid}/stat").read_text()
+    return stat[stat.rfind(")") + 2:].split()
+
+
 def processes() -> Iterator[tuple[int, list[str], str]]:
-    """
-    Every live process: its pid, the fields of ``/proc/PID/stat`` after the
-    command name (``[1]`` parent, ``[3]`` session, ``[11:13]`` user and
-    system ticks, ``[13:15]`` its reaped children's) and its command line.
-    """
+    """Every live process: its pid, its :func:`stat_fields` and its command line."""
     for pid in os.listdir("/proc"):
         if not pid.isdigit():
             continue
         try:
-            stat = Path(f"/proc/{pid}/stat").read_text()
+            fields = stat_fields(pid)
             command = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
         except OSError:
             continue
-        yield int(pid), stat[stat.rfind(")") + 2:].split(), command
+        yield int(pid), fields, command
 
 
 def session_cpu(session: int) -> dict[int, tuple[int, str, float]]:

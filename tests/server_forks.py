@@ -54,9 +54,6 @@ starting so): the service's settings, the temporary directory (read when
 first used) and pytest's name of the running test.
 """
 
-START_TIMEOUT_S = 120.0
-
-
 def forkable(base: dict[str, str], env: dict[str, str]) -> bool:
     """Whether a server with environment ``env`` can be forked from a program started with ``base``."""
     changed = {key for key in base.keys() | env.keys() if base.get(key) != env.get(key)}
@@ -117,6 +114,8 @@ class ServerForks:
         from this process's), in its own session, its output appended to
         ``log``.
         """
+        if not self.can_fork(env):
+            raise ValueError(f"env differs from the program's environment in more than {FORK_MAY_SET}")
         if not self.running():
             self.environment = dict(os.environ)
             self.program = subprocess.Popen(
@@ -124,8 +123,6 @@ class ServerForks:
                 cwd=ROOT, env=self.environment, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
             )
             self.request(op="ready")
-        if not forkable(self.environment, env):
-            raise ValueError(f"env differs from the program's environment in more than {FORK_MAY_SET}")
         answer = self.request(op="start", argv=argv, env=env, log=str(log), cwd=str(ROOT))
         return ForkedProcess(self, answer["pid"])
 

@@ -12,12 +12,13 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
-from pathlib import Path
 
 import loopback
 import pytest
 from conftest import server_process
 from server_forks import ForkedProcess, forkable
+
+from benchmarks.server_start import stat_fields
 
 pytestmark = [pytest.mark.server, pytest.mark.slow]
 
@@ -38,11 +39,6 @@ def test_a_fork_takes_only_the_service_s_variables(env, expected):
     assert forkable(BASE, env) is expected
 
 
-def _stat(pid: int) -> list[str]:
-    text = Path(f"/proc/{pid}/stat").read_text()
-    return text[text.rfind(")") + 2:].split()
-
-
 def test_a_forked_server_reads_its_settings_leads_its_session_and_exits_as_the_command(tmp_path):
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="3") as server, \
             loopback.Client(base_url=server.url, timeout=30) as http:
@@ -50,7 +46,7 @@ def test_a_forked_server_reads_its_settings_leads_its_session_and_exits_as_the_c
         assert isinstance(process, ForkedProcess)
         health = http.get("/healthz").json()
         assert health["fit_workers"] == 3 and health["store"]["path"].startswith(str(tmp_path / "data"))
-        fields = _stat(process.pid)
+        fields = stat_fields(process.pid)
         assert int(fields[3]) == process.pid  # its own session (what start_new_session gives the command)
         assert int(fields[1]) != os.getpid()  # the program's child, not this process's
         assert process.poll() is None
