@@ -29,7 +29,11 @@ schema and every query are those of the SQLite store
     a failed reconnection is given up after ``2 * pool_timeout_s`` and
     tried afresh on the next call, so its back-off never grows long).
     While the server is down, calls fail at once (one plain connection
-    attempt each, beside the pool: at most ``pool_max + 1`` connections).
+    attempt each, beside the pool: at most ``pool_max + 1`` connections),
+    the first one after it went away too: a call that gets no pooled
+    connection within :data:`QUICK_WAIT_S` tries one plain connection (one
+    call at a time), whose refusal answers it, and otherwise waits the rest
+    of ``pool_timeout_s`` (the pool is busy, or reconnecting).
 """
 
 from __future__ import annotations
@@ -37,6 +41,8 @@ from __future__ import annotations
 import logging
 import os
 import socket
+import threading
+import time
 from typing import Any, Callable, TypeVar
 
 import psycopg
@@ -65,6 +71,14 @@ _T = TypeVar("_T")
 SAVE_LOCK = 0x636F617465645F73  # the advisory lock every save takes (pg_advisory_xact_lock)
 RETRY_AFTER_S = 2
 """Retry-After of a 503 for a connection fault: the pool reconnects within a few seconds."""
+QUICK_WAIT_S = 0.25
+"""
+How long a call waits for a pooled connection before it asks the server
+itself (:meth:`PostgresStore._run`): a pool with a connection free answers
+at once, and a server that went away refuses at once, so the first call
+after it did is a 503 in well under a second instead of a wait of the pool
+timeout, which a load balancer's health check would read as a hang.
+"""
 
 
 def redacted(url: str) -> str:
@@ -123,6 +137,8 @@ class PostgresStore:
                  max_bytes: int | None = None, migrate: bool = True) -> None:
         self.where = redacted(url)
         self._url, self._down = url, False
+        self._pool_timeout_s = float(pool_timeout_s)
+        self._probing = threading.Lock()  # one early probe at a time: at most pool_max + 1 connections
         self._connect_timeout = max(1, int(connect_timeout_s))
         self.max_bytes = max_bytes
         self.pool_max = pool_max
@@ -173,19 +189,47 @@ class PostgresStore:
         ``function`` on a pooled connection, one transaction (rolled back on
         error). After a connection fault, each call first tries one plain
         connection (refused at once while the server is down, so a 503 is
-        quick instead of a wait of ``pool_timeout_s``) until one succeeds.
+        quick instead of a wait of ``pool_timeout_s``) until one succeeds;
+        so does a call that waited :data:`QUICK_WAIT_S` for a pooled one.
         """
         if self._down:
             self._probe()
         try:
-            with self._pool.connection() as connection:
-                return function(connection)
+            connection = self._connection()
         except PoolTimeout:
             self._probe()  # the server's own refusal when it is down; else the pool is busy
             raise
         except psycopg.OperationalError:
             self._down = True
             raise
+        try:
+            with connection:  # commit, or roll back on an error (the pool keeps the connection open)
+                return function(connection)
+        except psycopg.OperationalError:
+            self._down = True
+            raise
+        finally:
+            self._pool.putconn(connection)
+
+    def _connection(self) -> psycopg.Connection:
+        """
+        A pooled connection within ``pool_timeout_s``: past
+        :data:`QUICK_WAIT_S`, one plain connection first (unless another call
+        is making one), whose refusal raises at once.
+        """
+        start = time.monotonic()
+        try:
+            return self._pool.getconn(timeout=min(QUICK_WAIT_S, self._pool_timeout_s))
+        except PoolTimeout:
+            left = self._pool_timeout_s - (time.monotonic() - start)
+            if left <= 0:
+                raise
+        if self._probing.acquire(blocking=False):
+            try:
+                self._probe()
+            finally:
+                self._probing.release()
+        return self._pool.getconn(timeout=max(0.0, self._pool_timeout_s - (time.monotonic() - start)))
 
     def _probe(self) -> None:
         """One plain connection: raises (and marks the server down) when the server refuses it."""

@@ -19,7 +19,7 @@ import pytest
 from conftest import ROOT
 from service.store import SCHEMA_VERSION, FitRecord, SchemaMismatch, SQLiteStore, StoreConflict, StoreUnavailable
 from service.store.move import move_sqlite_to_postgres, store_checksum
-from service.store.postgres import PostgresStore, redacted
+from service.store.postgres import QUICK_WAIT_S, PostgresStore, redacted
 
 pytestmark = [pytest.mark.xdist_group("postgres"), pytest.mark.slow]
 
@@ -220,6 +220,46 @@ class TestFaults:
                 assert time.monotonic() < deadline, "the store did not recover within 10 s"
                 time.sleep(0.2)
         assert [m.material_id for m in store.saved_materials()] == ["m" * 32, "b" * 32]
+        store.close()
+
+    def test_the_first_call_after_the_server_went_away_is_refused_at_once(self, postgres_server, postgres_url):
+        """
+        Not a wait of the pool timeout (5 s here) for a connection the pool
+        cannot make: past QUICK_WAIT_S the call asks the server itself, whose
+        refusal answers it. Bound: half the pool timeout (the probe is a
+        refused connection on loopback, milliseconds; without it the call
+        took the whole 5 s).
+        """
+        store = PostgresStore(postgres_url, pool_timeout_s=5)
+        store.put_fit(record("1" * 32))
+        postgres_server.stop()
+        try:
+            start = time.monotonic()
+            with pytest.raises(StoreUnavailable, match="unavailable") as down:
+                store.get_fit("1" * 32)
+            assert time.monotonic() - start < 2.5
+            assert "COATED_STORE_POOL_TIMEOUT_S" not in str(down.value)  # the server's refusal, not a timeout
+        finally:
+            postgres_server.start()
+        store.close()
+
+    def test_a_busy_pool_still_waits_for_its_connection(self, postgres_url):
+        """A call that waits past QUICK_WAIT_S on a busy pool (the server up) gets the freed connection, no 503."""
+        store = PostgresStore(postgres_url, pool_min=1, pool_max=1, pool_timeout_s=5)
+        store.put_fit(record("1" * 32))
+        held = threading.Event()
+
+        def hold(connection):
+            held.set()
+            time.sleep(4 * QUICK_WAIT_S)
+
+        worker = threading.Thread(target=store.transaction, args=(hold,))
+        worker.start()
+        held.wait(10)
+        start = time.monotonic()
+        assert store.get_fit("1" * 32).id == "1" * 32
+        assert time.monotonic() - start >= 2 * QUICK_WAIT_S  # it did wait for the held connection
+        worker.join()
         store.close()
 
     def test_two_instances_one_winner(self, postgres_url):
