@@ -35,6 +35,7 @@ the servers to their stops, as a ``Popen``'s would be.
 
 from __future__ import annotations
 
+import gc
 import json
 import os
 import signal
@@ -218,6 +219,10 @@ if __name__ == "__main__":
     import service.__main__
     import service.preload  # noqa: F401 (the fork server's imports and warm-up, as start_fork_server has them)
 
+    # What the imports made lives as long as every fork: out of the collector's reach now, as each server's
+    # start would put it (service.worker.freeze_heap), which then collects only what that server made.
+    gc.collect()
+    gc.freeze()
     argv = _serve_requests()
     if argv is None:
         sys.exit(0)
