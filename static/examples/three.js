@@ -9,7 +9,10 @@
 // draws both balls, so that an environment is prefiltered (three's PMREM)
 // once and both scenes share it; each ball's canvas shows a copy of its
 // image. `window.cfThree` renders either into a float target for the parity
-// tests.
+// tests; `setEnvironment(name)` relights both balls and `setFit(id, etaI)`
+// puts another fit's export on them, neither with a reload, and each
+// environment is prefiltered once a page (three's PMREM, the page's slowest
+// step in SwiftShader).
 
 import * as THREE from "three";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
@@ -122,6 +125,15 @@ class Ball {
     this.camera.lookAt(0, 0, 0);
   }
 
+  /** Draw `material` from now on; the one before it is disposed (and the plugin's table with it). */
+  setMaterial(material) {
+    const before = this.material;
+    this.material = material;
+    this.mesh.material = material;
+    before.userData.coatedConductor?.dispose?.();
+    before.dispose();
+  }
+
   /** Draw into the shared renderer at the canvas's size and copy the image to the canvas. */
   draw() {
     const width = this.canvas.clientWidth, height = this.canvas.clientHeight;
@@ -155,14 +167,20 @@ class Ball {
   }
 }
 
-async function main() {
-  if (!fitId) throw new Error("no fit: open /examples/three.html?fit=ID");
-  const url = `/api/v1/fits/${encodeURIComponent(fitId)}/pack?format=gltf&eta_i=${etaI}`;
+// The fit `id`'s glTF export at `eta`, loaded with the plugin (model) and without (fallback).
+async function loadFit(id, eta) {
+  const url = `/api/v1/fits/${encodeURIComponent(id)}/pack?format=gltf&eta_i=${eta}`;
   const [model, fallback] = await Promise.all([loadMaterial(url, true), loadMaterial(url, false)]);
   const info = model.userData.coatedConductor;
   if (!info) throw new Error("the export carries no EXT_materials_coated_conductor (eta_i outside the fit's range?)");
   document.getElementById("material").textContent =
     `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}.`;
+  return { model, fallback, info };
+}
+
+async function main() {
+  if (!fitId) throw new Error("no fit: open /examples/three.html?fit=ID");
+  let { model, fallback, info } = await loadFit(fitId, etaI);
   const renderer = new THREE.WebGLRenderer({
     canvas: document.createElement("canvas"), antialias: false, preserveDrawingBuffer: true, alpha: true,
   });
@@ -171,12 +189,11 @@ async function main() {
     model: new Ball(renderer, document.getElementById("model"), model),
     fallback: new Ball(renderer, document.getElementById("fallback"), fallback),
   };
-  let lighting = null; // the current environment's PMREM texture, both scenes'
+  const environments = new Map(); // name -> Promise of its PMREM texture, both scenes', kept for the page's life
   const light = async (name) => {
-    const texture = await environment(renderer, name);
+    if (!environments.has(name)) environments.set(name, environment(renderer, name));
+    const texture = await environments.get(name);
     for (const ball of Object.values(balls)) ball.scene.environment = texture;
-    if (lighting) lighting.dispose();
-    lighting = texture;
     for (const ball of Object.values(balls)) ball.draw();
     if (window.cfThree) window.cfThree.environment = name;
   };
@@ -190,6 +207,15 @@ async function main() {
     // Relight both balls (room, white_sky, studio, outdoor) without reloading the asset.
     setEnvironment: light,
     environment: environmentName,
+    // Another fit's export (its id, at coat index etaI) on both balls, without reloading the page.
+    setFit: async (id, eta) => {
+      ({ model, fallback, info } = await loadFit(id, eta));
+      balls.model.setMaterial(model);
+      balls.fallback.setMaterial(fallback);
+      for (const ball of Object.values(balls)) ball.draw();
+      window.cfThree.fit = { id, etaI: eta };
+    },
+    fit: { id: fitId, etaI },
   };
   document.body.dataset.ready = "true";
 }

@@ -201,8 +201,11 @@ export function coatedConductorHooks(model, resources) {
       return `${EXTENSION_NAME}:${model.kind}`;
     },
     // userData is copied through JSON by Material.clone: the model is plain
-    // JSON, and the table is reached through a function (JSON skips it).
-    userData: { coatedConductor: { model, readTable: (renderer) => table.read(renderer) } },
+    // JSON, and the table is reached through functions (JSON skips them):
+    // dispose() frees its render target, which Material.dispose leaves.
+    userData: {
+      coatedConductor: { model, readTable: (renderer) => table.read(renderer), dispose: () => table.dispose() },
+    },
   };
 }
 

@@ -7,9 +7,12 @@ mirror and rough lobes), and the physics; without the plugin the same asset
 renders its fallback, a plausible metal, with no error
 (tests/static/three_pages.py says what is compared and how).
 
-Cost: the shared server and Chromium, and one page for the module; one page load
-per fit and coat index, each rendering several settings (the page relights
-with cfThree.setEnvironment and the material takes each roughness in turn).
+Cost: the shared server and Chromium, and one page for the module, loaded
+with the first fit and coat index; each other is put on it with
+cfThree.setFit, so that each environment is prefiltered (three's PMREM, the
+page's slowest step in SwiftShader) once a module; each renders several
+settings (the page relights with cfThree.setEnvironment and the material
+takes each roughness in turn).
 
 Tolerances, Delta E 2000 over the ball's pixels with NdotV >= 0.1 (128 x 128,
 about 10 800 pixels), each with headroom over what it measured here
@@ -47,7 +50,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from editor_pages import TIMEOUT_MS, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
-from three_pages import create_fit, measure_three, open_example
+from three_pages import create_fit, measure_three, open_example, show_fit
 
 from fitting.optics.library import library_material
 
@@ -78,10 +81,16 @@ class Session:
         return self.fits[material, kind]
 
     def example(self, fit: dict, eta_i: float):
-        """The example page open on ``fit`` at ``eta_i`` (loaded only when another is open)."""
-        if self.open != (fit["id"], eta_i):
+        """
+        The example page showing ``fit`` at ``eta_i``: loaded with the
+        module's first fit, then each other put on it (``cfThree.setFit``),
+        so that each environment is prefiltered once a module.
+        """
+        if self.open is None:
             open_example(self.page, self.server, fit["id"], eta_i)
-            self.open = (fit["id"], eta_i)
+        elif self.open != (fit["id"], eta_i):
+            show_fit(self.page, fit["id"], eta_i)
+        self.open = (fit["id"], eta_i)
         return self.page
 
 

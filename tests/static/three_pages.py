@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import loopback
 import numpy as np
+import pytest
 from editor_pages import F32_BASE64, camera_rays, from_f32
 
 from fitting.colour.delta_e import delta_E_map
@@ -73,6 +74,18 @@ def open_example(page, server: str, fit_id: str, eta_i: float, env: str = "white
     page.wait_for_function("document.body.dataset.ready")
     state = page.evaluate("document.body.dataset.ready")
     assert state == "true", page.evaluate("document.getElementById('status').textContent")
+
+
+def show_fit(page, fit_id: str, eta_i: float) -> None:
+    """
+    Put another fit's export on the open example page's balls
+    (``cfThree.setFit``, no reload: its environments stay prefiltered, the
+    page's slowest step in SwiftShader) and check that they show it.
+    """
+    page.evaluate("([id, eta]) => window.cfThree.setFit(id, eta)", [fit_id, eta_i])
+    assert page.evaluate("window.cfThree.fit") == {"id": fit_id, "etaI": eta_i}
+    shown = page.evaluate("window.cfThree.balls.model.material.userData.coatedConductor.model.coatIor")
+    assert shown == pytest.approx(eta_i), (shown, eta_i)
 
 
 def three_ACEScg(page, which: str, roughness: float, coat_roughness: float) -> tuple[np.ndarray, np.ndarray]:
