@@ -15,8 +15,8 @@ import json
 import loopback
 import numpy as np
 import pytest
-from editor_pages import Pages, camera_rays, chromium, live_server  # noqa: F401 (fixtures)
-from three_pages import FOV, H, ORBIT, W, create_fit, open_example, show_fit, three_ACEScg
+from editor_pages import camera_rays, chromium, live_server  # noqa: F401 (fixtures)
+from three_pages import FOV, H, ORBIT, W, create_fit, example_page, three_ACEScg
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.exports.colour_space import lin_rec709_to_ACEScg
@@ -30,35 +30,16 @@ BOUND = 0.2  # the issue's promise for a mirror against its tool
 
 @pytest.fixture(scope="module")
 def example(chromium, live_server):
-    """
-    One example page for the module: loaded with the first fit, then each
-    other put on it (``cfThree.setFit``), so that the white sky is
-    prefiltered once (three's PMREM, the page's slowest step in
-    SwiftShader); no page may log an error.
-    """
-    pages = Pages(chromium)
-    state = {"page": pages.new(900, 700), "open": False}
-
-    def show(fit_id: str, eta_i: float):
-        if state["open"]:
-            show_fit(state["page"], fit_id, eta_i)
-        else:
-            open_example(state["page"], live_server, fit_id, eta_i)
-            state["open"] = True
-        return state["page"]
-
-    show.errors = pages.errors
-    yield show
-    for context in pages.contexts:
-        context.close()  # before the server stops
+    """One example page for the module (three_pages.ExamplePage): the white sky is prefiltered once."""
+    with example_page(chromium, live_server) as page:
+        yield page
 
 
 @pytest.fixture(autouse=True)
 def no_page_errors(example):
     """No test may make the page log an error."""
-    before = len(example.errors)
-    yield
-    assert example.errors[before:] == []
+    with example.no_new_errors():
+        yield
 
 
 @pytest.mark.parametrize("material, eta_i", [("Cu", 1.5), ("Au", 1.0)])
@@ -71,7 +52,7 @@ def test_three_fallback_is_the_mirror(example, live_server, material, eta_i):
     base = np.asarray(gltf_material["pbrMetallicRoughness"]["baseColorFactor"][:3])
     coat = gltf_material.get("extensions", {}).get("KHR_materials_clearcoat")
     assert (coat is None) == (eta_i == 1.0)  # no coat at all at eta_i 1
-    page = example(fit["id"], eta_i)
+    page = example.show(fit["id"], eta_i)
     rendered, mask = three_ACEScg(page, "fallback", 0.0, 0.0)
     NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
     theta = np.degrees(np.arccos(np.clip(NdotV, 0.0, 1.0)))

@@ -49,8 +49,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from editor_pages import TIMEOUT_MS, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
-from three_pages import create_fit, measure_three, open_example, show_fit
+from editor_pages import chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
+from three_pages import ExamplePage, create_fit, example_page, measure_three
 
 from fitting.optics.library import library_material
 
@@ -64,16 +64,12 @@ ENVIRONMENT_BOUNDS = {"studio": 1.5, "outdoor": 4.0}
 LIT_MEAN = 1.5
 
 
-class Session:
-    """The module's one page, the fits it made and the errors it logged."""
+class Session(ExamplePage):
+    """The module's one example page and the fits it made."""
 
     def __init__(self, page, server):
-        self.page, self.server = page, server
-        self.errors: list[str] = []
+        super().__init__(page, server)
         self.fits: dict = {}
-        self.open = None
-        page.on("pageerror", lambda error: self.errors.append(f"uncaught: {error}"))
-        page.on("console", lambda m: self.errors.append(f"console: {m.text}") if m.type == "error" else None)
 
     def fit(self, material: str, kind: str) -> dict:
         if (material, kind) not in self.fits:
@@ -81,34 +77,21 @@ class Session:
         return self.fits[material, kind]
 
     def example(self, fit: dict, eta_i: float):
-        """
-        The example page showing ``fit`` at ``eta_i``: loaded with the
-        module's first fit, then each other put on it (``cfThree.setFit``),
-        so that each environment is prefiltered once a module.
-        """
-        if self.open is None:
-            open_example(self.page, self.server, fit["id"], eta_i)
-        elif self.open != (fit["id"], eta_i):
-            show_fit(self.page, fit["id"], eta_i)
-        self.open = (fit["id"], eta_i)
-        return self.page
+        """The page showing ``fit`` at ``eta_i`` (loaded with the module's first, then ``cfThree.setFit``)."""
+        return self.show(fit["id"], eta_i)
 
 
 @pytest.fixture(scope="module")
 def session(chromium, live_server):
-    context = chromium.new_context(viewport={"width": 900, "height": 700})
-    page = context.new_page()
-    page.set_default_timeout(TIMEOUT_MS)
-    yield Session(page, live_server)
-    context.close()  # before the server stops
+    with example_page(chromium, live_server, Session) as made:
+        yield made
 
 
 @pytest.fixture(autouse=True)
 def no_page_errors(session):
     """No test may make the page log an error."""
-    before = len(session.errors)
-    yield
-    assert session.errors[before:] == []
+    with session.no_new_errors():
+        yield
 
 
 def check_white_sky(figures, kind):

@@ -42,10 +42,12 @@ split sum at the coat's F0.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 import loopback
 import numpy as np
 import pytest
-from editor_pages import F32_BASE64, camera_rays, from_f32
+from editor_pages import F32_BASE64, TIMEOUT_MS, camera_rays, from_f32
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg_grid
@@ -74,6 +76,50 @@ def open_example(page, server: str, fit_id: str, eta_i: float, env: str = "white
     page.wait_for_function("document.body.dataset.ready")
     state = page.evaluate("document.body.dataset.ready")
     assert state == "true", page.evaluate("document.getElementById('status').textContent")
+
+
+class ExamplePage:
+    """
+    One example page for a test module: loaded with the first fit shown
+    (:func:`open_example`), then each other put on it (:func:`show_fit`),
+    so that each environment is prefiltered once a module; ``errors``: what
+    the page logged (uncaught errors, console errors).
+    """
+
+    def __init__(self, page, server: str) -> None:
+        self.page, self.server = page, server
+        self.errors: list[str] = []
+        self.open: tuple[str, float] | None = None
+        page.on("pageerror", lambda error: self.errors.append(f"uncaught: {error}"))
+        page.on("console", lambda m: self.errors.append(f"console: {m.text}") if m.type == "error" else None)
+
+    def show(self, fit_id: str, eta_i: float):
+        """The page showing fit ``fit_id`` at ``eta_i``."""
+        if self.open is None:
+            open_example(self.page, self.server, fit_id, eta_i)
+        elif self.open != (fit_id, eta_i):
+            show_fit(self.page, fit_id, eta_i)
+        self.open = (fit_id, eta_i)
+        return self.page
+
+    @contextmanager
+    def no_new_errors(self):
+        """Fails if the page logs an error inside the block."""
+        before = len(self.errors)
+        yield
+        assert self.errors[before:] == []
+
+
+@contextmanager
+def example_page(chromium, server: str, cls=ExamplePage):
+    """A :class:`ExamplePage` (or ``cls``) in a context of its own, closed at the end (before the server stops)."""
+    context = chromium.new_context(viewport={"width": 900, "height": 700})
+    page = context.new_page()
+    page.set_default_timeout(TIMEOUT_MS)
+    try:
+        yield cls(page, server)
+    finally:
+        context.close()
 
 
 def show_fit(page, fit_id: str, eta_i: float) -> None:
