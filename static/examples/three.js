@@ -191,7 +191,11 @@ async function main() {
   };
   const environments = new Map(); // name -> Promise of its PMREM texture, both scenes', kept for the page's life
   const light = async (name) => {
-    if (!environments.has(name)) environments.set(name, environment(renderer, name));
+    if (!environments.has(name)) {
+      const made = environment(renderer, name);
+      environments.set(name, made);
+      made.catch(() => environments.delete(name)); // a failed one is tried again next time
+    }
     const texture = await environments.get(name);
     for (const ball of Object.values(balls)) ball.scene.environment = texture;
     for (const ball of Object.values(balls)) ball.draw();
