@@ -67,8 +67,8 @@ LIT_MEAN = 1.5
 class Session(ExamplePage):
     """The module's one example page and the fits it made."""
 
-    def __init__(self, page, server):
-        super().__init__(page, server)
+    def __init__(self, page, server, errors):
+        super().__init__(page, server, errors)
         self.fits: dict = {}
 
     def fit(self, material: str, kind: str) -> dict:

@@ -47,7 +47,7 @@ from contextlib import contextmanager
 import loopback
 import numpy as np
 import pytest
-from editor_pages import F32_BASE64, TIMEOUT_MS, camera_rays, from_f32
+from editor_pages import F32_BASE64, Pages, camera_rays, from_f32
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg_grid
@@ -83,15 +83,12 @@ class ExamplePage:
     One example page for a test module: loaded with the first fit shown
     (:func:`open_example`), then each other put on it (:func:`show_fit`),
     so that each environment is prefiltered once a module; ``errors``: what
-    the page logged (uncaught errors, console errors).
+    the page logged (uncaught errors, console errors: ``editor_pages.Pages``'s list).
     """
 
-    def __init__(self, page, server: str) -> None:
-        self.page, self.server = page, server
-        self.errors: list[str] = []
+    def __init__(self, page, server: str, errors: list[str]) -> None:
+        self.page, self.server, self.errors = page, server, errors
         self.open: tuple[str, float] | None = None
-        page.on("pageerror", lambda error: self.errors.append(f"uncaught: {error}"))
-        page.on("console", lambda m: self.errors.append(f"console: {m.text}") if m.type == "error" else None)
 
     def show(self, fit_id: str, eta_i: float):
         """The page showing fit ``fit_id`` at ``eta_i``."""
@@ -112,14 +109,17 @@ class ExamplePage:
 
 @contextmanager
 def example_page(chromium, server: str, cls=ExamplePage):
-    """A :class:`ExamplePage` (or ``cls``) in a context of its own, closed at the end (before the server stops)."""
-    context = chromium.new_context(viewport={"width": 900, "height": 700})
-    page = context.new_page()
-    page.set_default_timeout(TIMEOUT_MS)
+    """
+    A :class:`ExamplePage` (or ``cls``) on a page of ``editor_pages.Pages``
+    (a context of its own, its errors recorded), closed at the end (before
+    the server stops).
+    """
+    pages = Pages(chromium)
     try:
-        yield cls(page, server)
+        yield cls(pages.new(900, 700), server, pages.errors)
     finally:
-        context.close()
+        for context in pages.contexts:
+            context.close()
 
 
 def show_fit(page, fit_id: str, eta_i: float) -> None:
