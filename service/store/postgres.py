@@ -217,19 +217,18 @@ class PostgresStore:
         :data:`QUICK_WAIT_S`, one plain connection first (unless another call
         is making one), whose refusal raises at once.
         """
-        start = time.monotonic()
+        deadline = time.monotonic() + self._pool_timeout_s
         try:
             return self._pool.getconn(timeout=min(QUICK_WAIT_S, self._pool_timeout_s))
         except PoolTimeout:
-            left = self._pool_timeout_s - (time.monotonic() - start)
-            if left <= 0:
+            if time.monotonic() >= deadline:
                 raise
         if self._probing.acquire(blocking=False):
             try:
                 self._probe()
             finally:
                 self._probing.release()
-        return self._pool.getconn(timeout=max(0.0, self._pool_timeout_s - (time.monotonic() - start)))
+        return self._pool.getconn(timeout=max(0.0, deadline - time.monotonic()))
 
     def _probe(self) -> None:
         """One plain connection: raises (and marks the server down) when the server refuses it."""
