@@ -13,6 +13,11 @@ the configured store's schema to this code's version (what a start does
 unless ``COATED_STORE_MIGRATE=false``); with ``--from-sqlite``, copy that
 SQLite store into the (empty) PostgreSQL store of ``COATED_STORE_URL`` and
 print the count and checksum of what moved.
+
+The application, the server and the fork server (FastAPI, the fitting core,
+scipy, colour-science: about a second of CPU time) are imported only once
+the arguments and settings are valid, so a start refused for them, and the
+``migrate`` command, answer without that cost.
 """
 
 from __future__ import annotations
@@ -23,9 +28,6 @@ import sys
 from pydantic import ValidationError
 
 from .config import Settings
-from .main import create_app
-from .fork_server import start_fork_server
-from .server import serve
 from .store import StoreError, open_store
 
 PROG = "python -m service"
@@ -109,6 +111,10 @@ def main(argv: list[str] | None = None) -> int:
     settings = _settings(overrides)
     if settings is None:
         return 2
+    from .fork_server import start_fork_server
+    from .main import create_app
+    from .server import serve
+
     # Before the store is opened and before any thread: the workers' fork server, forked from here.
     try:
         start_fork_server()
