@@ -16,6 +16,9 @@ Shared fixtures of the test suite.
     ``COATED_*``, ``TMPDIR`` and ``PYTEST_CURRENT_TEST``
     (``server_forks.FORK_MAY_SET``); else, and with
     ``server_process(..., spawn=True)``, the command itself starts.
+-   :func:`run_command`: ``python -m fitting ...`` (or ``service``) as
+    ``subprocess.run(..., capture_output=True, text=True)`` runs it, forked
+    from the same program where the environment allows.
 -   :func:`app_client`: the TestClient factory behind ``client``, with
     settings overrides (``with app_client(tmp_path, fit_queue=0) as c: ...``).
 -   :func:`server_process`: the context manager behind ``live_server``, for
@@ -153,6 +156,21 @@ def server_process(data_dir: Path, spawn: bool = False, **env: str) -> Iterator[
         server.stop()
 
 
+def run_command(module: str, *args: str, cwd: Path = ROOT, timeout: float | None = 300,
+                env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    """
+    ``python -m MODULE ARGS`` (``fitting`` or ``service``) as ``subprocess.run``
+    with ``capture_output=True, text=True`` runs it: forked from
+    :data:`SERVER_FORKS` where ``env`` (default this process's) allows
+    (``ServerForks.can_fork``), else the command itself.
+    """
+    env = dict(os.environ) if env is None else env
+    if SERVER_FORKS.can_fork(env):
+        return SERVER_FORKS.run(module, list(args), env, cwd, timeout)
+    return subprocess.run([sys.executable, "-m", module, *args], cwd=cwd, env=env, capture_output=True, text=True,
+                          timeout=timeout)
+
+
 def app_client(tmp_path: Path, **overrides):
     """
     A TestClient over an app with its own data directory under ``tmp_path``,
@@ -272,6 +290,7 @@ multiprocessing.process.BaseProcess.start = _watch(
     "a process (multiprocessing)", multiprocessing.process.BaseProcess.start)
 moderngl.create_context = _watch("a GL context", moderngl.create_context)
 ServerForks.start = _watch("a process (a server forked by tests/server_forks.py)", ServerForks.start)
+ServerForks.run = _watch("a process (a command forked by tests/server_forks.py)", ServerForks.run)
 
 
 def _first_rank(item) -> int:

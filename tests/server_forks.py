@@ -1,29 +1,32 @@
 """
-Servers forked from one interpreter that has imported the service
-=================================================================
+Servers and commands forked from one interpreter that has imported them
+=======================================================================
 
 A ``python -m service`` start spends most of its CPU time importing
 (FastAPI and the route models, scipy.optimize, colour-science,
 pydantic-settings: about 1.9 of its 2.4 CPU seconds, see
-``benchmarks/server_start.py``), and the suite starts about forty servers.
+``benchmarks/server_start.py``), and the suite starts about forty servers;
+a ``python -m fitting`` command spends about 0.65 of its 0.9 CPU seconds
+importing the core, and the suite runs about thirty.
 :class:`ServerForks` starts, once a test process, one interpreter (this file
-run as a program) that imports what ``python -m service`` imports and the
-fork server's preload (:mod:`service.preload`, whose warm-up depends on no
-setting), then forks a server for each :meth:`ServerForks.start`: the fork
-sets the server's environment, working directory, session and output, and
-returns to the top of this program, which runs
-``sys.exit(service.__main__.main(argv))`` as ``python -m service`` does,
-interpreter exit included. The server's code, sockets, store, fork server
-and workers are those of ``python -m service``; only the imports are
-shared.
+run as a program) that imports what ``python -m service`` and
+``python -m fitting`` import and the fork server's preload
+(:mod:`service.preload`, whose warm-up depends on no setting), then forks
+a server for each :meth:`ServerForks.start` and a command for each
+:meth:`ServerForks.run`: the fork sets the process's environment, working
+directory, output (and a server's session), and returns to the top of this
+program, which runs the package's ``__main__`` module as ``python -m``
+does (:func:`runpy.run_module`, ``sys.argv`` and interpreter exit
+included). The server's code, sockets, store, fork server and workers, and
+the command's, are those of ``python -m``; only the imports are shared.
 
 The environment that an interpreter reads at its start (``PYTHON*``,
 numpy's and OpenBLAS's kernels and threads) cannot change in a fork, so a
 fork takes only a difference in the service's own variables (``COATED_*``),
 ``TMPDIR`` and pytest's ``PYTEST_CURRENT_TEST`` from the environment the
-program started with (:func:`forkable`, :data:`FORK_MAY_SET`); tests/conftest.py's ``server_process`` starts
-``python -m service`` itself for anything else, and where the command line
-is what a test checks.
+program started with (:func:`forkable`, :data:`FORK_MAY_SET`); tests/conftest.py's ``server_process``
+and ``run_command`` start the command itself for anything else, and where
+the command line is what a test checks.
 
 The program reaps its forks and keeps their exit statuses:
 :class:`ForkedProcess` is ``subprocess.Popen``'s interface to one (``pid``,
@@ -38,6 +41,7 @@ from __future__ import annotations
 import gc
 import json
 import os
+import runpy
 import signal
 import subprocess
 import sys
@@ -47,6 +51,9 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+
+PROGRAMS = ("service", "fitting")
+"""The packages whose ``python -m`` the program forks (it imports what each imports)."""
 
 FORK_MAY_SET = ("COATED_", "TMPDIR", "PYTEST_CURRENT_TEST")
 """
@@ -115,7 +122,37 @@ class ServerForks:
         from this process's), in its own session, its output appended to
         ``log``.
         """
-        if not self.can_fork(env):
+        return self._fork(module="service", argv=argv, env=env, cwd=str(ROOT), stdout=str(log), stderr=str(log),
+                          append=True, session=True)
+
+    def run(self, module: str, argv: list[str], env: dict[str, str], cwd: Path, timeout: float | None = None,
+            ) -> subprocess.CompletedProcess:
+        """
+        ``subprocess.run([sys.executable, "-m", module, *argv], cwd=cwd,
+        env=env, capture_output=True, text=True, timeout=timeout)`` for
+        ``module`` ``fitting`` or ``service``, forked (``env`` ``forkable``
+        from this process's): standard input ``/dev/null``, the output
+        captured in files and returned as text; on ``timeout`` the process is
+        killed and ``subprocess.TimeoutExpired`` raised, as ``subprocess.run``
+        does.
+        """
+        with tempfile.TemporaryDirectory(prefix="server-forks-run-") as directory:
+            out, err = Path(directory) / "stdout", Path(directory) / "stderr"
+            process = self._fork(module=module, argv=list(argv), env=env, cwd=str(cwd), stdout=str(out),
+                                 stderr=str(err), append=False, session=False)
+            try:
+                returncode = process.wait(timeout)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+                raise
+            return subprocess.CompletedProcess([sys.executable, "-m", module, *argv], returncode,
+                                               out.read_text(), err.read_text())
+
+    def _fork(self, **request) -> ForkedProcess:
+        if request["module"] not in PROGRAMS:
+            raise ValueError(f"module must be one of {', '.join(PROGRAMS)}, got {request['module']!r}")
+        if not self.can_fork(request["env"]):
             raise ValueError(f"env differs from the program's environment in more than {FORK_MAY_SET}")
         if not self.running():
             self.environment = dict(os.environ)
@@ -124,7 +161,7 @@ class ServerForks:
                 cwd=ROOT, env=self.environment, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
             )
             self.request(op="ready")
-        answer = self.request(op="start", argv=argv, env=env, log=str(log), cwd=str(ROOT))
+        answer = self.request(op="start", **request)
         return ForkedProcess(self, answer["pid"])
 
     def request(self, **message) -> dict:
@@ -150,11 +187,11 @@ def _returncode(status: int) -> int:
     return -os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status)
 
 
-def _serve_requests() -> list[str] | None:
+def _serve_requests() -> tuple[str, list[str]] | None:
     """
     Answer requests until standard input closes (``None``); in a fork, the
-    server's ``argv``, its process set up as ``subprocess.Popen`` with
-    ``start_new_session`` would have set it up.
+    ``(module, argv)`` it is to run, its process set up as ``subprocess.Popen``
+    would have set it up (a server's with ``start_new_session``).
     """
     exited: dict[int, int] = {}
 
@@ -187,27 +224,30 @@ def _serve_requests() -> list[str] | None:
             pid = os.fork()
             if pid == 0:
                 try:
-                    _become_server(request)
+                    _become(request)
                 except BaseException:  # not on to the program's loop in a fork
                     sys.excepthook(*sys.exc_info())
                     os._exit(1)
-                return request["argv"]
+                return request["module"], request["argv"]
             answer({"pid": pid})
         else:
             raise ValueError(f"unknown request {request['op']!r}")
     return None
 
 
-def _become_server(request: dict) -> None:
-    os.setsid()
-    log = os.open(request["log"], os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+def _become(request: dict) -> None:
+    if request["session"]:
+        os.setsid()
+    flags = os.O_WRONLY | os.O_CREAT | (os.O_APPEND if request["append"] else os.O_TRUNC)
     null = os.open(os.devnull, os.O_RDONLY)
     os.dup2(null, 0)
-    os.dup2(log, 1)
-    os.dup2(log, 2)
     os.close(null)
-    os.close(log)
+    for fd, path in ((1, request["stdout"]), (2, request["stderr"])):
+        target = os.open(path, flags, 0o644)
+        os.dup2(target, fd)
+        os.close(target)
     os.chdir(request["cwd"])
+    sys.path[0] = os.getcwd()  # python -m's first entry: its working directory
     os.environ.clear()
     os.environ.update(request["env"])
     tempfile.tempdir = None  # read again from TMPDIR
@@ -216,15 +256,21 @@ def _become_server(request: dict) -> None:
 
 if __name__ == "__main__":
     sys.path[0] = os.getcwd()  # as ``python -m``'s (``-c`` puts '' there)
-    import service.__main__
+    import fitting.cli.main  # noqa: F401 (what python -m fitting imports)
+    # What python -m service imports, at its start and then in main (not service.__main__ itself, which
+    # run_module executes as __main__, as -m does).
+    import service.fork_server  # noqa: F401
+    import service.main  # noqa: F401
     import service.preload  # noqa: F401 (the fork server's imports and warm-up, as start_fork_server has them)
+    import service.server  # noqa: F401
 
     # What the imports made lives as long as every fork: out of the collector's reach now, as each server's
     # start would put it (service.worker.freeze_heap), which then collects only what that server made.
     gc.collect()
     gc.freeze()
-    argv = _serve_requests()
-    if argv is None:
+    started = _serve_requests()
+    if started is None:
         sys.exit(0)
-    sys.argv = [service.__main__.__file__, *argv]
-    sys.exit(service.__main__.main(argv))
+    module, sys.argv = started[0], ["-m", *started[1]]  # run_module puts the __main__ file's path first
+    runpy.run_module(module, run_name="__main__", alter_sys=True)
+    sys.exit(0)  # a __main__ that returned (python -m exits 0)

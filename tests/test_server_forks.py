@@ -4,18 +4,23 @@ that has imported the service are ``python -m service`` in all but the
 imports: their settings come from their environment, each leads a session
 of its own with its output in its log, and their exit statuses are
 ``subprocess.Popen``'s; an environment a fork cannot take starts the
-command itself.
+command itself. The commands it forks (``run_command``) are ``python -m
+fitting``'s runs: exit statuses, standard output and error, working
+directory and timeout.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
+import sys
+import time
 
 import loopback
 import pytest
-from conftest import server_process
+from conftest import ROOT, SERVER_FORKS, run_command, server_process
 from server_forks import ForkedProcess, forkable
 
 from benchmarks.server_start import stat_fields
@@ -71,3 +76,39 @@ def test_an_environment_a_fork_cannot_take_starts_the_command(tmp_path):
         assert isinstance(server.process, subprocess.Popen)
         assert server.process.args[1:3] == ["-m", "service"]
         assert http.get("/healthz").json()["status"] == "ok"
+
+
+def test_a_forked_command_is_the_command_s_run(tmp_path):
+    """run_command forks python -m fitting: the same exit statuses, output streams and working directory."""
+    argv = ["fit", "Au", "--eta-range", "1:2", "--no-metrics", "--json"]
+    forked, spawned = run_command("fitting", *argv), subprocess.run(
+        [sys.executable, "-m", "fitting", *argv], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert forked.args == spawned.args and forked.returncode == spawned.returncode == 0
+    views = [json.loads(result.stdout) for result in (forked, spawned)]
+    for view in views:
+        del view["fit"]["timings"]  # the seconds each step took: the only field two runs differ in
+    assert views[0] == views[1] and forked.stderr == spawned.stderr
+    refused = run_command("fitting", "fit", "Unobtainium")
+    assert refused.returncode == 2 and refused.stdout == ""
+    assert refused.stderr.startswith("error: `material` must be one of")
+    usage = run_command("fitting", "--no-such-option")
+    assert usage.returncode == 2 and usage.stderr.startswith("usage: python -m fitting")
+    (tmp_path / "metal.csv").write_text("wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n"
+                                        "650,0.6,3.0\n750,0.7,3.8\n850,0.8,4.5\n")
+    relative = run_command("fitting", "fit", "--nk", "metal.csv", "--no-metrics", "-o", "metal.cfpk", cwd=tmp_path)
+    assert relative.returncode == 0, relative.stderr
+    assert (tmp_path / "metal.cfpk").stat().st_size > 0  # the paths are the working directory's
+
+
+def test_a_forked_command_past_its_timeout_is_killed(tmp_path):
+    started = time.monotonic()
+    with pytest.raises(subprocess.TimeoutExpired):
+        run_command("fitting", "reproduce", "-o", str(tmp_path / "results.md"), timeout=0.5)
+    assert time.monotonic() - started < 30 and not (tmp_path / "results.md").exists()
+
+
+def test_an_environment_a_fork_cannot_take_runs_the_command():
+    result = run_command("fitting", "library", env={**os.environ, "PYTHONHASHSEED": "7"})
+    assert result.returncode == 0 and len(result.stdout.strip().splitlines()) == 22
+    with pytest.raises(ValueError, match="module must be one of service, fitting"):
+        SERVER_FORKS.run("preview_shaders", ["--help"], dict(os.environ), ROOT)

@@ -4,24 +4,16 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 
 import pytest
-from pathlib import Path
-
-import pytest
+from conftest import run_command
 
 from fitting.exports import export_material
 from fitting.optics.library import library_material
 
-ROOT = Path(__file__).resolve().parents[3]
-
 
 def cli(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "fitting", *args], capture_output=True, text=True, cwd=ROOT,
-        timeout=300,
-    )
+    return run_command("fitting", *args)
 
 
 class TestExportOption:

@@ -2,15 +2,9 @@
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import numpy as np
-
 import pytest
-
-ROOT = Path(__file__).resolve().parents[3]
+from conftest import run_command
 
 
 def glass_csv(tmp_path):
@@ -22,8 +16,7 @@ def glass_csv(tmp_path):
 
 
 def fit(*args):
-    return subprocess.run([sys.executable, "-m", "fitting", "fit", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=600)
+    return run_command("fitting", "fit", *args, timeout=600)
 
 
 @pytest.mark.slow  # 5.9 s (all cases 5.9 s) in a --durations=0 run

@@ -3,20 +3,17 @@
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 
 import pytest
+from conftest import run_command
 
 from fitting.shading.ibl import decode_lut
 
 
 def _run(*args, timeout=600):
-    return subprocess.run(
-        [sys.executable, "-m", "fitting", *args], capture_output=True, text=True, timeout=timeout
-    )
+    return run_command("fitting", *args, timeout=timeout)
 
 
 @pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run

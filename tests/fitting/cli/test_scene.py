@@ -2,16 +2,13 @@
 
 import argparse
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
+from conftest import run_command
 
 from fitting.cli.scene import add_scene_parser
 from fitting.models.pack import decode_pack, pack_from_json
 
-ROOT = Path(__file__).resolve().parents[3]
 SCENE = {"name": "desk", "materials": [
     {"material": "Cu", "eta_i": 1.5},
     {"material": "Au", "name": "uncoated gold", "eta_i": 1},
@@ -83,10 +80,7 @@ class TestSceneCommand:
 @pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
 def test_python_m_fitting_scene(scene_file, tmp_path):
     out = tmp_path / "desk.cfpk"
-    done = subprocess.run(
-        [sys.executable, "-m", "fitting", "scene", str(scene_file), "-o", str(out), "--json"],
-        cwd=ROOT, capture_output=True, text=True, timeout=120,
-    )
+    done = run_command("fitting", "scene", str(scene_file), "-o", str(out), "--json", timeout=120)
     assert done.returncode == 0, done.stderr
     report = json.loads(done.stdout)
     assert len(decode_pack(out.read_bytes())) == len(report["materials"]) == 2

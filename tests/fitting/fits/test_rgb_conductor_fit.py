@@ -8,12 +8,10 @@ rounding matters), refusals, and the command line.
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import run_command
 
 from fitting.colour.reference import reference_ACEScg
 from fitting.fits.kinds import evaluate_model, fit_model
@@ -25,8 +23,6 @@ from fitting.models.rgb_conductor import rgb_conductor_model
 from fitting.optics.library import library_material
 
 pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
-
-ROOT = Path(__file__).resolve().parents[3]
 
 
 @pytest.fixture(scope="module")
@@ -117,8 +113,7 @@ class TestFloat16Rounding:
 
 
 def run(*args):
-    return subprocess.run([sys.executable, "-m", "fitting", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=300)
+    return run_command("fitting", *args)
 
 
 class TestCommandLine:
