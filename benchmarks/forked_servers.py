@@ -14,11 +14,19 @@ reading), in turns (the order swapped every round), after one start of
 each not counted. The program's own start (its imports, once a test
 process) is recorded beside them.
 
+And what one command run of the tests costs (tests/conftest.py's
+``run_command``): :data:`COMMAND`, a fit written to a file, run as the
+command, ``python -m fitting``, and forked from the same program, in turns:
+its wall seconds and CPU seconds (the command's, read from
+``getrusage``'s children; the fork's, from the program's reaped children,
+``/proc`` fields ``cutime`` and ``cstime``).
+
 Prints a table and records benchmarks/results/forked_servers.json
 (``figures``: per side, the median and max of the wall seconds to ready
 and of the CPU seconds in all, and the median CPU seconds per kind of
 process; ``program_cpu_s``; ``saved_cpu_s_median``, the command's median
-less the fork's).
+less the fork's; ``commands``: per side the median and max of ``wall_s``
+and ``cpu_s``, and ``saved_cpu_s_median``).
 
 Usage: python benchmarks/forked_servers.py [--rounds N]
 """
@@ -27,6 +35,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -47,6 +57,9 @@ SIDES = ("command", "fork")
 ENV = {"COATED_FIT_WORKERS": "1", "COATED_METRICS_SAMPLES": "30"}
 """tests/conftest.py's ``server_process`` defaults."""
 
+COMMAND = ("fit", "Au", "--eta-range", "1:2", "--no-metrics", "-o")
+"""The command run (``python -m fitting``, then the output file): a fit of the CLI's tests."""
+
 
 def start(side: str, forks: ServerForks) -> dict:
     """One start: seconds to the first answer and CPU seconds per kind of the start's session by then."""
@@ -61,6 +74,35 @@ def start(side: str, forks: ServerForks) -> dict:
             process = subprocess.Popen([sys.executable, "-m", "service", *argv], cwd=ROOT, env=env,
                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
         return measured(process, port, t0, f"the {side}'s server")
+
+
+def run_command(side: str, forks: ServerForks) -> dict:
+    """One ``python -m fitting`` run of :data:`COMMAND`: its wall and CPU seconds."""
+    with tempfile.TemporaryDirectory() as directory:
+        argv = [*COMMAND, f"{directory}/au.cfpk"]
+        if side == "fork":
+            before = program_children_cpu(forks) if forks.running() else 0.0  # it starts with the first fork
+            t0 = time.monotonic()
+            result = forks.run("fitting", argv, dict(os.environ), ROOT, timeout=300)
+            wall = time.monotonic() - t0
+            cpu = program_children_cpu(forks) - before
+        else:
+            usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.monotonic()
+            result = subprocess.run([sys.executable, "-m", "fitting", *argv], cwd=ROOT, capture_output=True,
+                                    text=True, timeout=300)
+            wall = time.monotonic() - t0
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = after.ru_utime + after.ru_stime - usage.ru_utime - usage.ru_stime
+        if result.returncode != 0:
+            raise RuntimeError(f"the {side}'s python -m fitting exited with {result.returncode}: {result.stderr}")
+    return {"wall_s": wall, "cpu_s": cpu}
+
+
+def program_children_cpu(forks: ServerForks) -> float:
+    """CPU seconds of the forks' program's reaped children (``cutime``, ``cstime``)."""
+    fields = stat_fields(forks.program.pid)
+    return (int(fields[13]) + int(fields[14])) / TICK
 
 
 def program_cpu(forks: ServerForks) -> float:
@@ -85,11 +127,22 @@ def main(argv=None) -> int:
         for i in range(args.rounds):
             for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
                 runs[side].append(start(side, forks))
+        for side in SIDES:
+            run_command(side, forks)  # not counted
+        commands = {side: [] for side in SIDES}
+        for i in range(args.rounds):
+            for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
+                commands[side].append(run_command(side, forks))
     finally:
         forks.close()
     figures = {side: summary(runs[side]) for side in SIDES}
     figures["program_cpu_s"] = program
     figures["saved_cpu_s_median"] = figures["command"]["cpu_s"]["median"] - figures["fork"]["cpu_s"]["median"]
+    figures["commands"] = {side: {key: {"median": statistics.median(r[key] for r in commands[side]),
+                                         "max": max(r[key] for r in commands[side])}
+                                   for key in ("wall_s", "cpu_s")} for side in SIDES}
+    figures["commands"]["saved_cpu_s_median"] = (figures["commands"]["command"]["cpu_s"]["median"]
+                                                 - figures["commands"]["fork"]["cpu_s"]["median"])
     kinds = sorted({k for side in SIDES for k in figures[side]["cpu_s_median_by_kind"]})
     print(f"a test server's start, {args.rounds} of each side ({', '.join(f'{k}={v}' for k, v in ENV.items())})")
     print(f"{'':<36}{'command':>10}{'fork':>10}")
@@ -101,7 +154,13 @@ def main(argv=None) -> int:
               + "".join(f"{figures[s]['cpu_s_median_by_kind'].get(kind, 0.0):>10.2f}" for s in SIDES))
     print(f"saved a start (medians): {figures['saved_cpu_s_median']:.2f} CPU s; "
           f"the program's own start, once a test process: {program:.2f} CPU s")
-    write_result("forked_servers", figures, load, rounds=args.rounds, runs=runs)
+    print(f"\na command run of the tests, python -m fitting {' '.join(COMMAND)} FILE, {args.rounds} of each side")
+    print(f"{'':<36}{'command':>10}{'fork':>10}")
+    for label, key in (("wall s, median", ("wall_s", "median")), ("wall s, max", ("wall_s", "max")),
+                       ("CPU s, median", ("cpu_s", "median")), ("CPU s, max", ("cpu_s", "max"))):
+        print(f"{label:<36}" + "".join(f"{figures['commands'][s][key[0]][key[1]]:>10.2f}" for s in SIDES))
+    print(f"saved a run (medians): {figures['commands']['saved_cpu_s_median']:.2f} CPU s")
+    write_result("forked_servers", figures, load, rounds=args.rounds, runs=runs, commands=commands)
     return 0
 
 

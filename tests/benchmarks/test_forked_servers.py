@@ -1,7 +1,7 @@
 """
 benchmarks/forked_servers.py: one start of each side read from its
-session (the server and its warmed pool's worker), and its arguments'
-bounds.
+session (the server and its warmed pool's worker), one command run of each
+side read from its CPU time, and its arguments' bounds.
 """
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from __future__ import annotations
 import pytest
 from server_forks import ServerForks
 
-from benchmarks.forked_servers import SIDES, main, start
+from benchmarks.forked_servers import SIDES, main, run_command, start
 
 pytestmark = [pytest.mark.server, pytest.mark.slow]
 
@@ -25,6 +25,18 @@ def test_a_start_of_each_side_is_read_from_its_session():
     finally:
         forks.close()
     assert forks.program is None
+
+
+def test_a_command_run_of_each_side_is_read_from_its_cpu_time():
+    forks = ServerForks()
+    try:
+        runs = {side: run_command(side, forks) for side in SIDES}
+    finally:
+        forks.close()
+    for side, run in runs.items():
+        assert 0 < run["cpu_s"] < 60 and 0 < run["wall_s"] < 300, (side, run)
+    # The command imports the core (over half a CPU second here); the fork inherits it.
+    assert runs["fork"]["cpu_s"] < runs["command"]["cpu_s"], runs
 
 
 @pytest.mark.parametrize("rounds", ["0", "101"])
