@@ -20,6 +20,8 @@ silently reads zeros), so every GL call of the package runs on a
 
 from __future__ import annotations
 
+import ctypes.util
+import functools
 import queue
 import re
 import threading
@@ -162,9 +164,21 @@ class GLState:
         return self._programs[key]
 
 
+@functools.cache
+def _gl_libraries() -> dict[str, str]:
+    """
+    libGL and libEGL for glcontext's EGL backend, looked up once a process:
+    left to it, it looks both up at every context with
+    ``ctypes.util.find_library``, which starts ``ldconfig -p`` (a fork of
+    this process) each time. One not found is left to glcontext, as before.
+    """
+    found = {"libgl": ctypes.util.find_library("GL"), "libegl": ctypes.util.find_library("EGL")}
+    return {key: name for key, name in found.items() if name}
+
+
 def _create_context() -> moderngl.Context:
     """The one place a GL context is created (headless, EGL)."""
-    return moderngl.create_context(standalone=True, backend="egl", require=GL_VERSION)
+    return moderngl.create_context(standalone=True, backend="egl", require=GL_VERSION, **_gl_libraries())
 
 
 class RenderThread:
