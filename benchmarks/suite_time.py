@@ -34,7 +34,11 @@ mode's CPU time, the machine's busy, idle and steal seconds over its run
 (``/proc/stat``), says how far its wall time is from what 2 cores allow
 (busy / 2); ``benchmarks/suite_cpu.py`` says which processes spent it.
 Before each mode, ``calibration_s``: the seconds a fixed pure-Python loop
-takes (:func:`calibration`), the interpreter's speed on one core then.
+takes (:func:`calibration`), the interpreter's speed on one core then; and
+``calibration_memory_s``: the seconds 8 copies of a 128 MiB array take
+(:func:`memory_calibration`), the memory bandwidth one core gets then,
+which neighbours on the host share and the loop (in the core's caches)
+does not see.
 """
 
 from __future__ import annotations
@@ -82,6 +86,25 @@ def calibration() -> float:
     return round(best, 3)
 
 
+def memory_calibration() -> float:
+    """
+    CPU seconds 8 copies of a 128 MiB float64 array into another take here
+    (the best of 3): 2 GiB read and written, far past the caches, so the
+    memory bandwidth one core gets at the moment.
+    """
+    import numpy as np
+
+    source = np.ones(16 * 2**20)
+    target = np.empty_like(source)
+    best = float("inf")
+    for _ in range(3):
+        start = time.process_time()
+        for _ in range(8):
+            np.copyto(target, source)
+        best = min(best, time.process_time() - start)
+    return round(best, 3)
+
+
 def machine_ticks() -> dict[str, int]:
     """/proc/stat's first line: busy (user, nice, system, irq, softirq), idle (with iowait) and steal ticks."""
     v = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
@@ -102,7 +125,7 @@ def full_suite(root: Path, log: Path | None = None, name: str = "full.log") -> d
 
 
 def timed(command: list[str], cwd: Path, log: Path | None, name: str, env: dict | None = None) -> dict:
-    speed = calibration()
+    speed, memory = calibration(), memory_calibration()
     load_start, ticks = os.getloadavg()[0], machine_ticks()
     start = time.perf_counter()
     done = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True)
@@ -118,7 +141,7 @@ def timed(command: list[str], cwd: Path, log: Path | None, name: str, env: dict 
             "returncode": done.returncode, "summaries": summaries,
             "failures": FAILURE.findall(output)[:50],  # what failed, when a run did
             "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)],
-            "machine_seconds": ticks, "calibration_s": speed}
+            "machine_seconds": ticks, "calibration_s": speed, "calibration_memory_s": memory}
 
 
 def side_by_side(before: str, rounds: int, log: Path | None) -> dict:
@@ -132,6 +155,7 @@ def side_by_side(before: str, rounds: int, log: Path | None) -> dict:
                 row = full_suite(root if side == "before" else ROOT, log, f"full-{side}-{i}.log")
                 rows.append({"checkout": side, **row})
                 print(f"round {i}, {side}: {row['seconds']:.1f} s, busy {row['machine_seconds']['busy']:.1f} s, "
+                      f"calibration {row['calibration_s']:.3f} s, memory {row['calibration_memory_s']:.3f} s, "
                       f"{'; '.join(row['summaries'])}", flush=True)
     figures = {}
     for side in ("before", "now"):
@@ -177,11 +201,12 @@ def main(argv=None) -> int:
     modes = [["--quick"], []] + ([] if args.no_other_cpus else [["--other-cpus"]])
     rows = [run(mode, args.log) for mode in modes]
     print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "
-          f"{'calib s':>7}  tests")
+          f"{'calib s':>7} {'mem s':>6}  tests")
     for r in rows:
         print(f"{r['command']:<28} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
               f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f} {r['machine_seconds']['busy']:>7.1f} "
-              f"{r['machine_seconds']['idle']:>7.1f} {r['calibration_s']:>7.3f}  {'; '.join(r['summaries'])}")
+              f"{r['machine_seconds']['idle']:>7.1f} {r['calibration_s']:>7.3f} {r['calibration_memory_s']:>6.3f}  "
+              f"{'; '.join(r['summaries'])}")
     for r in rows:
         for failure in r["failures"]:
             print(f"{r['command']}: {failure}")

@@ -1,13 +1,14 @@
 """
 benchmarks/suite_time.py: the side-by-side mode runs what ``scripts/test``
-runs for the full suite, and its arguments' bounds.
+runs for the full suite, its memory calibration takes time, and its
+arguments' bounds.
 """
 
 from __future__ import annotations
 
 import pytest
 
-from benchmarks.suite_time import COMPILED, FULL_SUITE, ROOT, main
+from benchmarks.suite_time import COMPILED, FULL_SUITE, ROOT, main, memory_calibration
 
 
 def test_the_side_by_side_runs_scripts_test_s_full_suite():
@@ -27,3 +28,7 @@ def test_arguments_out_of_bounds_are_refused(argv, message, capsys):
         main(argv)
     assert exit_.value.code == 2
     assert message in capsys.readouterr().err
+
+
+def test_the_memory_calibration_takes_cpu_time():
+    assert 0.0 < memory_calibration() < 60.0
