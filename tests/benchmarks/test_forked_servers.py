@@ -7,6 +7,7 @@ side read from its CPU time, and its arguments' bounds.
 from __future__ import annotations
 
 import pytest
+from conftest import SERVER_FORKS
 from server_forks import ServerForks
 
 from benchmarks.forked_servers import SIDES, main, run_command, start
@@ -28,11 +29,8 @@ def test_a_start_of_each_side_is_read_from_its_session():
 
 
 def test_a_command_run_of_each_side_is_read_from_its_cpu_time():
-    forks = ServerForks()
-    try:
-        runs = {side: run_command(side, forks) for side in SIDES}
-    finally:
-        forks.close()
+    # The test process's own program (started here if no test before started it), as the command tests use.
+    runs = {side: run_command(side, SERVER_FORKS) for side in SIDES}
     for side, run in runs.items():
         assert 0 < run["cpu_s"] < 60 and 0 < run["wall_s"] < 300, (side, run)
     # The command imports the core (over half a CPU second here); the fork inherits it.
