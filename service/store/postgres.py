@@ -29,11 +29,12 @@ schema and every query are those of the SQLite store
     a failed reconnection is given up after ``2 * pool_timeout_s`` and
     tried afresh on the next call, so its back-off never grows long).
     While the server is down, calls fail at once (one plain connection
-    attempt each, beside the pool: at most ``pool_max + 1`` connections),
+    attempt beside the pool at a time, which calls that come during it
+    share: at most ``pool_max + 1`` connections, however many calls),
     the first one after it went away too: a call that gets no pooled
-    connection within :data:`QUICK_WAIT_S` tries one plain connection (one
-    call at a time), whose refusal answers it, and otherwise waits the rest
-    of ``pool_timeout_s`` (the pool is busy, or reconnecting).
+    connection within :data:`QUICK_WAIT_S` tries one plain connection (or
+    shares the one in flight), whose refusal answers it, and otherwise
+    waits the rest of ``pool_timeout_s`` (the pool is busy, or reconnecting).
 """
 
 from __future__ import annotations
@@ -116,6 +117,23 @@ def _translate(error: Exception, where: str) -> StoreError:
                             retry_after=RETRY_AFTER_S)
 
 
+def _copy(error: psycopg.OperationalError) -> psycopg.OperationalError:
+    """An error of the same class and message, for another thread to raise (each call raises its own)."""
+    try:
+        return type(error)(*error.args)
+    except TypeError:
+        return psycopg.OperationalError(str(error))
+
+
+class _Probe:
+    """One plain connection attempt, shared by the calls that come while it is in flight."""
+
+    def __init__(self) -> None:
+        self.done = threading.Event()
+        self.error: psycopg.OperationalError | None = psycopg.OperationalError(
+            "the connection attempt of another call did not finish")
+
+
 class PostgresStore:
     """
     :class:`Store` on PostgreSQL at ``url`` (``postgresql://user:password@host:port/db``).
@@ -138,7 +156,8 @@ class PostgresStore:
         self.where = redacted(url)
         self._url, self._down = url, False
         self._pool_timeout_s = float(pool_timeout_s)
-        self._probing = threading.Lock()  # one early probe at a time: at most pool_max + 1 connections
+        self._probe_lock = threading.Lock()  # guards _probe_in_flight: at most pool_max + 1 connections
+        self._probe_in_flight: _Probe | None = None
         self._connect_timeout = max(1, int(connect_timeout_s))
         self.max_bytes = max_bytes
         self.pool_max = pool_max
@@ -214,8 +233,8 @@ class PostgresStore:
     def _connection(self) -> psycopg.Connection:
         """
         A pooled connection within ``pool_timeout_s``: past
-        :data:`QUICK_WAIT_S`, one plain connection first (unless another call
-        is making one), whose refusal raises at once.
+        :data:`QUICK_WAIT_S`, one plain connection first (or the one another
+        call is making, :meth:`_probe`), whose refusal raises at once.
         """
         deadline = time.monotonic() + self._pool_timeout_s
         try:
@@ -223,21 +242,42 @@ class PostgresStore:
         except PoolTimeout:
             if time.monotonic() >= deadline:
                 raise
-        if self._probing.acquire(blocking=False):
-            try:
-                self._probe()
-            finally:
-                self._probing.release()
+        self._probe()
         return self._pool.getconn(timeout=max(0.0, deadline - time.monotonic()))
 
     def _probe(self) -> None:
-        """One plain connection: raises (and marks the server down) when the server refuses it."""
+        """
+        One plain connection: raises ``psycopg.OperationalError`` (and marks
+        the server down) when the server refuses it. One attempt at a time:
+        a call that finds one in flight waits for it (at most the connect
+        timeout and a second) and takes its outcome, so that a burst of
+        calls while the server is down, or as it comes back, opens one
+        connection beside the pool, not one each.
+        """
+        with self._probe_lock:
+            probe, leader = self._probe_in_flight, False
+            if probe is None:
+                probe, leader = _Probe(), True
+                self._probe_in_flight = probe
+        if not leader:
+            if not probe.done.wait(self._connect_timeout + 1.0):
+                raise psycopg.OperationalError(
+                    f"no answer to another call's connection attempt within {self._connect_timeout + 1} s")
+            if probe.error is not None:
+                raise _copy(probe.error)
+            return
         try:
             psycopg.connect(self._url, connect_timeout=self._connect_timeout).close()
-        except psycopg.OperationalError:
+            probe.error = None
+            self._down = False
+        except psycopg.OperationalError as error:
+            probe.error = error
             self._down = True
             raise
-        self._down = False
+        finally:
+            with self._probe_lock:
+                self._probe_in_flight = None
+            probe.done.set()
 
     def _read(self, function: Callable[[psycopg.Connection], _T]) -> _T:
         return self._guard(lambda: self._run(function))

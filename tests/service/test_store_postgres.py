@@ -12,8 +12,10 @@ import subprocess
 import sys
 import threading
 import time
+import types
 from concurrent.futures import ThreadPoolExecutor
 
+import psycopg
 import pytest
 
 from conftest import ROOT
@@ -241,6 +243,83 @@ class TestFaults:
             assert "COATED_STORE_POOL_TIMEOUT_S" not in str(down.value)  # the server's refusal, not a timeout
         finally:
             postgres_server.start()
+        store.close()
+
+    @staticmethod
+    def counted_probes(monkeypatch) -> dict:
+        """
+        The store's plain connections (its probes, ``psycopg.connect`` in
+        service.store.postgres; the pool connects otherwise), each held 0.2 s
+        so that a burst overlaps it: how many, and the most at once.
+        """
+        import service.store.postgres as postgres
+
+        seen = {"attempts": 0, "now": 0, "most": 0}
+        lock = threading.Lock()
+
+        def connect(*args, **kwargs):
+            with lock:
+                seen["attempts"] += 1
+                seen["now"] += 1
+                seen["most"] = max(seen["most"], seen["now"])
+            try:
+                time.sleep(0.2)
+                return psycopg.connect(*args, **kwargs)
+            finally:
+                with lock:
+                    seen["now"] -= 1
+
+        monkeypatch.setattr(postgres, "psycopg", types.SimpleNamespace(**{**vars(psycopg), "connect": connect}))
+        return seen
+
+    @staticmethod
+    def burst(call, n: int = 16) -> list:
+        """``call()`` from ``n`` threads at once: each one's result or exception."""
+        barrier = threading.Barrier(n)
+
+        def one(_):
+            barrier.wait()
+            try:
+                return call()
+            except Exception as error:  # noqa: BLE001 (what each call raised is what the test checks)
+                return error
+
+        with ThreadPoolExecutor(n) as pool:
+            return list(pool.map(one, range(n)))
+
+    def test_a_burst_after_a_fault_shares_one_connection_check(self, postgres_url, monkeypatch):
+        """
+        Calls that come while the store checks whether the server is back
+        (after a connection fault, as ``_down`` marks it) share that check:
+        one plain connection beside the pool at a time (at most pool_max + 1
+        in all, docs/deploy.md), not one each.
+        """
+        store = PostgresStore(postgres_url, pool_max=4, pool_timeout_s=5)
+        store.put_fit(record("1" * 32))
+        seen = self.counted_probes(monkeypatch)
+        store._down = True  # as a connection fault leaves it
+        answers = self.burst(lambda: store.get_fit("1" * 32))
+        assert all(isinstance(a, FitRecord) and a.id == "1" * 32 for a in answers), answers
+        assert seen["most"] == 1 and seen["attempts"] < 16, seen
+        store.close()
+
+    def test_a_burst_while_the_server_is_down_shares_each_refusal(self, postgres_server, postgres_url, monkeypatch):
+        """Every call is refused at once (503), with one plain connection attempt at a time."""
+        store = PostgresStore(postgres_url, pool_max=4, pool_timeout_s=5)
+        store.put_fit(record("1" * 32))
+        postgres_server.stop()
+        try:
+            seen = self.counted_probes(monkeypatch)
+            start = time.monotonic()
+            answers = self.burst(lambda: store.get_fit("1" * 32))
+            elapsed = time.monotonic() - start
+        finally:
+            postgres_server.start()
+        assert all(isinstance(a, StoreUnavailable) and "unavailable" in str(a) for a in answers), answers
+        assert seen["most"] == 1 and seen["attempts"] >= 1, seen
+        # Bound: the first call's quick wait and 16 refusals of 0.2 s one after another, at worst, under the
+        # 16 pool timeouts (80 s) that waiting calls would take.
+        assert elapsed < QUICK_WAIT_S + 16 * 0.2 + 5, elapsed
         store.close()
 
     def test_a_busy_pool_still_waits_for_its_connection(self, postgres_url):
