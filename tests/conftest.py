@@ -16,7 +16,7 @@ Shared fixtures of the test suite.
     ``COATED_*``, ``TMPDIR`` and ``PYTEST_CURRENT_TEST``
     (``server_forks.FORK_MAY_SET``); else, and with
     ``server_process(..., spawn=True)``, the command itself starts.
--   :func:`run_command`: ``python -m fitting ...`` (or ``service``) as
+-   :func:`run_command`: ``python -m fitting ...`` (or another package) as
     ``subprocess.run(..., capture_output=True, text=True)`` runs it, forked
     from the same program where the environment allows.
 -   :func:`app_client`: the TestClient factory behind ``client``, with
@@ -159,7 +159,7 @@ def server_process(data_dir: Path, spawn: bool = False, **env: str) -> Iterator[
 def run_command(module: str, *args: str, cwd: Path = ROOT, timeout: float | None = 300,
                 env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
     """
-    ``python -m MODULE ARGS`` (``fitting`` or ``service``) as ``subprocess.run``
+    ``python -m MODULE ARGS`` (``fitting``, ``service`` or ``preview_shaders``) as ``subprocess.run``
     with ``capture_output=True, text=True`` runs it: forked from
     :data:`SERVER_FORKS` where ``env`` (default this process's) allows
     (``ServerForks.can_fork``), else the command itself.

@@ -7,10 +7,12 @@ A ``python -m service`` start spends most of its CPU time importing
 pydantic-settings: about 1.9 of its 2.4 CPU seconds, see
 ``benchmarks/server_start.py``), and the suite starts about forty servers;
 a ``python -m fitting`` command spends about 0.65 of its 0.9 CPU seconds
-importing the core, and the suite runs about thirty.
+importing the core, and the suite runs about thirty (and four of
+``python -m preview_shaders``).
 :class:`ServerForks` starts, once a test process, one interpreter (this file
-run as a program) that imports what ``python -m service`` and
-``python -m fitting`` import and the fork server's preload
+run as a program) that imports what ``python -m service``,
+``python -m fitting`` and ``python -m preview_shaders`` import (no GL
+context: each command makes its own) and the fork server's preload
 (:mod:`service.preload`, whose warm-up depends on no setting), then forks
 a server for each :meth:`ServerForks.start` and a command for each
 :meth:`ServerForks.run`: the fork sets the process's environment, working
@@ -52,7 +54,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 
-PROGRAMS = ("service", "fitting")
+PROGRAMS = ("service", "fitting", "preview_shaders")
 """The packages whose ``python -m`` the program forks (it imports what each imports)."""
 
 FORK_MAY_SET = ("COATED_", "TMPDIR", "PYTEST_CURRENT_TEST")
@@ -257,6 +259,8 @@ def _become(request: dict) -> None:
 if __name__ == "__main__":
     sys.path[0] = os.getcwd()  # as ``python -m``'s (``-c`` puts '' there)
     import fitting.cli.main  # noqa: F401 (what python -m fitting imports)
+    import preview_shaders.display  # noqa: F401 (what python -m preview_shaders imports; no GL context here)
+    import preview_shaders.preview  # noqa: F401
     # What python -m service imports, at its start and then in main (not service.__main__ itself, which
     # run_module executes as __main__, as -m does).
     import service.fork_server  # noqa: F401

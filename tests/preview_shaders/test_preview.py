@@ -7,12 +7,12 @@ the command line.
 from __future__ import annotations
 
 import io
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import run_command
 from PIL import Image
 
 from fitting.colour.reference import reference_ACEScg
@@ -183,10 +183,7 @@ class TestInputChecks:
 
 class TestCommandLine:
     def _run(self, *args):
-        return subprocess.run(
-            [sys.executable, "-m", "preview_shaders", "render", *args],
-            cwd=ROOT, capture_output=True, text=True, timeout=120,
-        )
+        return run_command("preview_shaders", "render", *args, timeout=120)
 
     def test_fit_file_renders_the_golden(self, tmp_path):
         pack = tmp_path / "gold.cfpk"

@@ -158,13 +158,9 @@ class TestChecks:
 
 class TestCommandLine:
     def _run(self, *args):
-        import subprocess
-        import sys
+        from conftest import run_command
 
-        return subprocess.run(
-            [sys.executable, "-m", "preview_shaders", "render", *args],
-            cwd=GOLDEN.parents[1], capture_output=True, text=True, timeout=300,
-        )
+        return run_command("preview_shaders", "render", *args, cwd=GOLDEN.parents[1])
 
     def test_rough_coated_render_matches_the_library(self, renderer, gold, tmp_path):
         from PIL import Image
