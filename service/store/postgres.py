@@ -42,7 +42,6 @@ from __future__ import annotations
 import logging
 import os
 import socket
-import threading
 import time
 from typing import Any, Callable, TypeVar
 
@@ -63,6 +62,7 @@ from .records import (
     StoreUnavailable,
     VersionRow,
 )
+from .shared_check import SharedCheck
 
 __all__ = ["PostgresStore", "SAVE_LOCK", "redacted"]
 
@@ -117,23 +117,6 @@ def _translate(error: Exception, where: str) -> StoreError:
                             retry_after=RETRY_AFTER_S)
 
 
-def _copy(error: psycopg.OperationalError) -> psycopg.OperationalError:
-    """An error of the same class and message, for another thread to raise (each call raises its own)."""
-    try:
-        return type(error)(*error.args)
-    except TypeError:
-        return psycopg.OperationalError(str(error))
-
-
-class _Probe:
-    """One plain connection attempt, shared by the calls that come while it is in flight."""
-
-    def __init__(self) -> None:
-        self.done = threading.Event()
-        self.error: psycopg.OperationalError | None = psycopg.OperationalError(
-            "the connection attempt of another call did not finish")
-
-
 class PostgresStore:
     """
     :class:`Store` on PostgreSQL at ``url`` (``postgresql://user:password@host:port/db``).
@@ -156,9 +139,9 @@ class PostgresStore:
         self.where = redacted(url)
         self._url, self._down = url, False
         self._pool_timeout_s = float(pool_timeout_s)
-        self._probe_lock = threading.Lock()  # guards _probe_in_flight: at most pool_max + 1 connections
-        self._probe_in_flight: _Probe | None = None
         self._connect_timeout = max(1, int(connect_timeout_s))
+        # One plain connection at a time beside the pool (at most pool_max + 1), shared by concurrent calls.
+        self._probe = SharedCheck(self._connect_once, psycopg.OperationalError, self._connect_timeout + 1.0)
         self.max_bytes = max_bytes
         self.pool_max = pool_max
         name = f"coated-service {socket.gethostname()}:{os.getpid()}"[:63]
@@ -234,7 +217,7 @@ class PostgresStore:
         """
         A pooled connection within ``pool_timeout_s``: past
         :data:`QUICK_WAIT_S`, one plain connection first (or the one another
-        call is making, :meth:`_probe`), whose refusal raises at once.
+        call is making, :attr:`_probe`), whose refusal raises at once.
         """
         deadline = time.monotonic() + self._pool_timeout_s
         try:
@@ -245,39 +228,19 @@ class PostgresStore:
         self._probe()
         return self._pool.getconn(timeout=max(0.0, deadline - time.monotonic()))
 
-    def _probe(self) -> None:
+    def _connect_once(self) -> None:
         """
-        One plain connection: raises ``psycopg.OperationalError`` (and marks
-        the server down) when the server refuses it. One attempt at a time:
-        a call that finds one in flight waits for it (at most the connect
-        timeout and a second) and takes its outcome, so that a burst of
-        calls while the server is down, or as it comes back, opens one
-        connection beside the pool, not one each.
+        One plain connection (through :attr:`_probe`, one at a time, which
+        the calls that come during it share): raises
+        ``psycopg.OperationalError`` (and marks the server down) when the
+        server refuses it.
         """
-        with self._probe_lock:
-            probe, leader = self._probe_in_flight, False
-            if probe is None:
-                probe, leader = _Probe(), True
-                self._probe_in_flight = probe
-        if not leader:
-            if not probe.done.wait(self._connect_timeout + 1.0):
-                raise psycopg.OperationalError(
-                    f"no answer to another call's connection attempt within {self._connect_timeout + 1} s")
-            if probe.error is not None:
-                raise _copy(probe.error)
-            return
         try:
             psycopg.connect(self._url, connect_timeout=self._connect_timeout).close()
-            probe.error = None
-            self._down = False
-        except psycopg.OperationalError as error:
-            probe.error = error
+        except psycopg.OperationalError:
             self._down = True
             raise
-        finally:
-            with self._probe_lock:
-                self._probe_in_flight = None
-            probe.done.set()
+        self._down = False
 
     def _read(self, function: Callable[[psycopg.Connection], _T]) -> _T:
         return self._guard(lambda: self._run(function))
