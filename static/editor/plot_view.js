@@ -6,6 +6,8 @@
 //   onDrag({channel, handle, value, pointer, all}) -> whether the point moved,
 //   onDragEnd(), onSelect({channel, handle}), onEta(eta), onUndo(), onRedo(), onReset(), onSave().
 // In compare mode the other fit's curve at eta_i is drawn too (state.compare).
+// The plot's data-eta is the slider's eta_i; data-curves-eta the eta_i of the
+// curves drawn, which follow it once they are in (a moved slider asks for them).
 
 import { ReflectancePlot } from "../plot.js";
 import { HANDLES, key, target } from "./state.js";
@@ -56,6 +58,7 @@ export class PlotView {
     this.state = state;
     if (!state.baseCurves) return;
     $("plot").dataset.eta = key(state.eta);
+    $("plot").dataset.curvesEta = key(state.baseCurves.eta_i);
     $("eta-value").textContent = key(state.eta);
     this.plot.draw({
       theta: state.theta,

@@ -96,7 +96,9 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     for _ in range(10):
         page.keyboard.press("ArrowRight")
     expect(page.locator("#eta-value")).to_have_text("1.60")
-    page.wait_for_selector("#plot[data-eta='1.60']")
+    # The curves of 1.60 drawn, not only the slider there (they follow it after a fetch; under load the
+    # curves of an eta_i the key presses passed on the way could still be on screen).
+    page.wait_for_selector("#plot[data-eta='1.60'][data-curves-eta='1.60']")
     wait_idle(page)
     reference_red = page.get_attribute("path.reference.c0", "d")
     assert page.get_attribute("path.target.c0", "d") == reference_red
