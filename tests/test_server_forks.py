@@ -4,9 +4,9 @@ that has imported the service are ``python -m service`` in all but the
 imports: their settings come from their environment, each leads a session
 of its own with its output in its log, and their exit statuses are
 ``subprocess.Popen``'s; an environment a fork cannot take starts the
-command itself. The commands it forks (``run_command``) are ``python -m
-fitting``'s runs: exit statuses, standard output and error, working
-directory and timeout.
+command itself. The commands it forks (``run_command``: ``python -m
+fitting``, ``python -m preview_shaders``) are the commands' runs: exit
+statuses, standard output and error, working directory and timeout.
 """
 
 from __future__ import annotations
