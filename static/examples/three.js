@@ -175,12 +175,12 @@ async function loadFit(id, eta) {
   if (!info) throw new Error("the export carries no EXT_materials_coated_conductor (eta_i outside the fit's range?)");
   document.getElementById("material").textContent =
     `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}.`;
-  return { model, fallback, info };
+  return { model, fallback };
 }
 
 async function main() {
   if (!fitId) throw new Error("no fit: open /examples/three.html?fit=ID");
-  let { model, fallback, info } = await loadFit(fitId, etaI);
+  const { model, fallback } = await loadFit(fitId, etaI);
   const renderer = new THREE.WebGLRenderer({
     canvas: document.createElement("canvas"), antialias: false, preserveDrawingBuffer: true, alpha: true,
   });
@@ -207,15 +207,15 @@ async function main() {
     orbit: ORBIT,
     fov: FOV,
     readFloat: (which, width, height, settings) => balls[which].readFloat(width, height, settings),
-    readTable: () => info.readTable(renderer),
+    readTable: () => balls.model.material.userData.coatedConductor.readTable(renderer), // the fit on screen
     // Relight both balls (room, white_sky, studio, outdoor) without reloading the asset.
     setEnvironment: light,
     environment: environmentName,
     // Another fit's export (its id, at coat index etaI) on both balls, without reloading the page.
     setFit: async (id, eta) => {
-      ({ model, fallback, info } = await loadFit(id, eta));
-      balls.model.setMaterial(model);
-      balls.fallback.setMaterial(fallback);
+      const next = await loadFit(id, eta);
+      balls.model.setMaterial(next.model);
+      balls.fallback.setMaterial(next.fallback);
       for (const ball of Object.values(balls)) ball.draw();
       window.cfThree.fit = { id, etaI: eta };
     },
