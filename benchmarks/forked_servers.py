@@ -81,11 +81,11 @@ def run_command(side: str, forks: ServerForks) -> dict:
     with tempfile.TemporaryDirectory() as directory:
         argv = [*COMMAND, f"{directory}/au.cfpk"]
         if side == "fork":
-            before = program_children_cpu(forks) if forks.running() else 0.0  # it starts with the first fork
+            before = program_cpu(forks, reaped=True) if forks.running() else 0.0  # it starts with the first fork
             t0 = time.monotonic()
             result = forks.run("fitting", argv, dict(os.environ), ROOT, timeout=300)
             wall = time.monotonic() - t0
-            cpu = program_children_cpu(forks) - before
+            cpu = program_cpu(forks, reaped=True) - before
         else:
             usage = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.monotonic()
@@ -99,16 +99,15 @@ def run_command(side: str, forks: ServerForks) -> dict:
     return {"wall_s": wall, "cpu_s": cpu}
 
 
-def program_children_cpu(forks: ServerForks) -> float:
-    """CPU seconds of the forks' program's reaped children (``cutime``, ``cstime``)."""
+def program_cpu(forks: ServerForks, reaped: bool = False) -> float:
+    """
+    CPU seconds the forks' program has spent (its imports; its requests cost
+    next to nothing), or with ``reaped`` those of its reaped children, its
+    forks (``/proc`` fields ``cutime`` and ``cstime``).
+    """
     fields = stat_fields(forks.program.pid)
-    return (int(fields[13]) + int(fields[14])) / TICK
-
-
-def program_cpu(forks: ServerForks) -> float:
-    """CPU seconds the forks' program has spent (its imports; its requests cost next to nothing)."""
-    fields = stat_fields(forks.program.pid)
-    return (int(fields[11]) + int(fields[12])) / TICK
+    first = 13 if reaped else 11
+    return (int(fields[first]) + int(fields[first + 1])) / TICK
 
 
 def main(argv=None) -> int:
