@@ -29,7 +29,9 @@ Shared fixtures of the test suite.
     (:class:`postgres_server.PostgresServer`: temporary directory, free
     loopback port, run as the ``postgres`` user when the tests run as
     root); ``postgres_url``: a fresh empty database on it per test. Tests
-    that use them belong to ``@pytest.mark.xdist_group("postgres")``.
+    that use them belong to ``@pytest.mark.xdist_group("postgres")`` (one
+    worker under ``--dist loadgroup``; under ``scripts/test``'s ``--dist
+    loadscope`` each pytest-xdist worker that runs one starts its own server).
 
 The ``slow`` marker (``scripts/test --quick`` leaves those tests out) is on
 every test that starts a process, a GL context or a browser, or that took
