@@ -22,7 +22,7 @@ Mean Delta E 2000 over the ball's pixels with NdotV >= 0.1, its 99th
 percentile, its max, the mean at the centre (NdotV >= 0.97) and on the ring near
 grazing (NdotV in [0.1, 0.25]). Prints a Markdown table and records it::
 
-    .venv/bin/python benchmarks/three_parity.py            # about 20 min here
+    .venv/bin/python benchmarks/three_parity.py            # about 4 min here
     .venv/bin/python benchmarks/three_parity.py --materials Au --environments studio --record -
 """
 

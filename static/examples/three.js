@@ -117,7 +117,9 @@ class Ball {
     this.renderer = renderer;
     this.scene = new THREE.Scene();
     this.material = material;
-    this.mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 512, 256), material);
+    // 256 x 128 segments: the polygon strays from the sphere by at most 8e-5 of its radius (1 - cos(pi / 256)),
+    // 0.01 px on this page's 384 px canvas; 512 x 256 drew 4 times the triangles for nothing a pixel shows.
+    this.mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 256, 128), material);
     this.scene.add(this.mesh);
     const { eye } = orbitCamera(ORBIT, FOV);
     this.camera = new THREE.PerspectiveCamera(THREE.MathUtils.radToDeg(FOV), 1, 0.1, 100);

@@ -23,7 +23,7 @@ three in linear Rec.709 (its working space), converted back to ACEScg with
 the inverse of the very matrix the shader used (CF_ACESCG_TO_SRGB).
 
 Pixels compared: on the ball in both, with NdotV >= :data:`NDOTV_MIN` (the
-outermost pixels differ by geometry alone: three rasterises a 512 x 256
+outermost pixels differ by geometry alone: three rasterises a 256 x 128
 sphere mesh, the preview intersects the exact sphere). The centre is
 NdotV >= :data:`CENTRE`, the ring near grazing NdotV in :data:`RING`.
 
