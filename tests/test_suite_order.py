@@ -7,7 +7,7 @@ number of tests (pyproject.toml's ``--no-loadscope-reorder``). Sorted by
 size, the browser modules (2 to 10 tests each) went last and apart: the
 longest modules ran at the end of the run, and the shared Chromium, which
 closes after the last of a run of browser tests, was launched again for
-nearly every browser module.
+most browser modules.
 """
 
 from __future__ import annotations
