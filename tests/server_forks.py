@@ -132,7 +132,7 @@ class ServerForks:
         """
         ``subprocess.run([sys.executable, "-m", module, *argv], cwd=cwd,
         env=env, capture_output=True, text=True, timeout=timeout)`` for
-        ``module`` ``fitting`` or ``service``, forked (``env`` ``forkable``
+        ``module`` one of :data:`PROGRAMS`, forked (``env`` ``forkable``
         from this process's): standard input ``/dev/null``, the output
         captured in files and returned as text; on ``timeout`` the process is
         killed and ``subprocess.TimeoutExpired`` raised, as ``subprocess.run``

@@ -9,29 +9,15 @@ from __future__ import annotations
 
 import threading
 import time
-from concurrent.futures import ThreadPoolExecutor
 
 import pytest
+from at_once import at_once
 
 from service.store.shared_check import SharedCheck
 
 
 class Refused(Exception):
     pass
-
-
-def at_once(call, n=8):
-    barrier = threading.Barrier(n)
-
-    def one(_):
-        barrier.wait()
-        try:
-            return call()
-        except Exception as error:  # noqa: BLE001 (each caller's outcome is what the tests check)
-            return error
-
-    with ThreadPoolExecutor(n) as pool:
-        return list(pool.map(one, range(n)))
 
 
 def slow(runs, outcome=None, seconds=0.5):

@@ -17,6 +17,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import psycopg
 import pytest
+from at_once import at_once
 
 from conftest import ROOT
 from service.store import SCHEMA_VERSION, FitRecord, SchemaMismatch, SQLiteStore, StoreConflict, StoreUnavailable
@@ -272,21 +273,6 @@ class TestFaults:
         monkeypatch.setattr(postgres, "psycopg", types.SimpleNamespace(**{**vars(psycopg), "connect": connect}))
         return seen
 
-    @staticmethod
-    def burst(call, n: int = 16) -> list:
-        """``call()`` from ``n`` threads at once: each one's result or exception."""
-        barrier = threading.Barrier(n)
-
-        def one(_):
-            barrier.wait()
-            try:
-                return call()
-            except Exception as error:  # noqa: BLE001 (what each call raised is what the test checks)
-                return error
-
-        with ThreadPoolExecutor(n) as pool:
-            return list(pool.map(one, range(n)))
-
     def test_a_burst_after_a_fault_shares_one_connection_check(self, postgres_url, monkeypatch):
         """
         Calls that come while the store checks whether the server is back
@@ -298,7 +284,7 @@ class TestFaults:
         store.put_fit(record("1" * 32))
         seen = self.counted_probes(monkeypatch)
         store._down = True  # as a connection fault leaves it
-        answers = self.burst(lambda: store.get_fit("1" * 32))
+        answers = at_once(lambda: store.get_fit("1" * 32), n=16)
         assert all(isinstance(a, FitRecord) and a.id == "1" * 32 for a in answers), answers
         assert seen["most"] == 1 and seen["attempts"] < 16, seen
         store.close()
@@ -311,7 +297,7 @@ class TestFaults:
         try:
             seen = self.counted_probes(monkeypatch)
             start = time.monotonic()
-            answers = self.burst(lambda: store.get_fit("1" * 32))
+            answers = at_once(lambda: store.get_fit("1" * 32), n=16)
             elapsed = time.monotonic() - start
         finally:
             postgres_server.start()
