@@ -11,11 +11,18 @@ records each one's wall time, test count and the load average around it in
 -   ``scripts/test --other-cpus`` (the numeric tests under three other
     kernels' settings), unless ``--no-other-cpus``.
 
-    .venv/bin/python benchmarks/suite_time.py [--no-other-cpus] [--log DIR]
+    .venv/bin/python benchmarks/suite_time.py [--rounds N] [--no-other-cpus] [--log DIR]
     .venv/bin/python benchmarks/suite_time.py --before REV [--rounds N] [--name NAME] [--log DIR]
 
-``--log DIR`` keeps each mode's whole output (``DIR/quick.log``,
-``full.log``, ``other-cpus.log``), for what a failed run printed.
+``--rounds N`` runs the quick loop and the full suite N times each, in
+turns (quick, full, quick, full, ...), then ``--other-cpus`` once: every
+run is a row, and ``figures`` holds each mode's median and worst (the
+largest wall time), so a record says how far the slowest of its runs is
+from the target beside the typical one.
+
+``--log DIR`` keeps each run's whole output (``DIR/quick.log``,
+``full.log``, ``other-cpus.log``; ``quick-1.log``, ``full-1.log`` and so
+on for the later rounds), for what a failed run printed.
 
 ``--before REV``: instead, the full suite of a checkout of ``REV`` (a git
 worktree, what ``scripts/bootstrap`` installed linked in) and of this
@@ -111,9 +118,30 @@ def machine_ticks() -> dict[str, int]:
     return {"busy": v[0] + v[1] + v[2] + v[5] + v[6], "idle": v[3] + v[4], "steal": v[7]}
 
 
-def run(args: list[str], log: Path | None = None) -> dict:
+def mode_name(args: list[str]) -> str:
+    """``quick``, ``full`` or ``other-cpus``: the mode ``scripts/test ARGS`` runs."""
+    return args[0].lstrip("-") if args else "full"
+
+
+def run(args: list[str], log: Path | None = None, round_: int = 0) -> dict:
     """``scripts/test ARGS`` in this checkout, timed (``--quick``, the full suite, ``--other-cpus``)."""
-    return timed(["scripts/test", *args], ROOT, log, f"{args[0].lstrip('-') if args else 'full'}.log")
+    name = mode_name(args) + (f"-{round_}" if round_ else "")
+    return {"mode": mode_name(args), "round": round_,
+            **timed(["scripts/test", *args], ROOT, log, f"{name}.log")}
+
+
+def mode_figures(rows: list[dict]) -> dict:
+    """
+    Each mode's runs: ``runs``, ``median_s`` and ``worst_s`` (the largest
+    wall time), and ``all_passed`` (every run's return code 0).
+    """
+    figures = {}
+    for mode in dict.fromkeys(r["mode"] for r in rows):
+        seconds = [r["seconds"] for r in rows if r["mode"] == mode]
+        figures[mode] = {"runs": len(seconds), "median_s": round(statistics.median(seconds), 1),
+                         "worst_s": max(seconds),
+                         "all_passed": all(r["returncode"] == 0 for r in rows if r["mode"] == mode)}
+    return figures
 
 
 def full_suite(root: Path, log: Path | None = None, name: str = "full.log") -> dict:
@@ -175,7 +203,9 @@ def main(argv=None) -> int:
     parser.add_argument("--log", type=Path, help="keep each mode's whole output in this directory")
     parser.add_argument("--before", metavar="REV",
                         help="instead: the full suite of this commit and of this checkout, in turns")
-    parser.add_argument("--rounds", type=int, default=1, help="with --before: full runs of each side (default 1)")
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="runs of the quick loop and of the full suite each (with --before: full runs of each "
+                             "side); default 1")
     parser.add_argument("--name", default=SIDE_BY_SIDE.stem,
                         help=f"with --before: the record, benchmarks/results/NAME.json (default {SIDE_BY_SIDE.stem})")
     args = parser.parse_args(argv)
@@ -198,15 +228,19 @@ def main(argv=None) -> int:
             "date": datetime.now(timezone.utc).isoformat(timespec="minutes"), "cpu": cpu(), **result,
         }, indent=2) + "\n")
         return max(r["returncode"] for r in result["rows"])
-    modes = [["--quick"], []] + ([] if args.no_other_cpus else [["--other-cpus"]])
-    rows = [run(mode, args.log) for mode in modes]
-    print(f"{'command':<28} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "
+    rows = [run(mode, args.log, i) for i in range(args.rounds) for mode in (["--quick"], [])]
+    rows += [] if args.no_other_cpus else [run(["--other-cpus"], args.log)]
+    figures = mode_figures(rows)
+    print(f"{'command':<28} {'round':>5} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "
           f"{'calib s':>7} {'mem s':>6}  tests")
     for r in rows:
-        print(f"{r['command']:<28} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
+        print(f"{r['command']:<28} {r['round']:>5} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
               f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f} {r['machine_seconds']['busy']:>7.1f} "
               f"{r['machine_seconds']['idle']:>7.1f} {r['calibration_s']:>7.3f} {r['calibration_memory_s']:>6.3f}  "
               f"{'; '.join(r['summaries'])}")
+    print(f"\n{'mode':<12} {'runs':>4} {'median s':>9} {'worst s':>8}  all passed")
+    for mode, f in figures.items():
+        print(f"{mode:<12} {f['runs']:>4} {f['median_s']:>9.1f} {f['worst_s']:>8.1f}  {f['all_passed']}")
     for r in rows:
         for failure in r["failures"]:
             print(f"{r['command']}: {failure}")
@@ -214,7 +248,7 @@ def main(argv=None) -> int:
     RESULTS.write_text(json.dumps({
         "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
         "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "cpu": cpu(), "rows": rows,
+        "cpu": cpu(), "rounds": args.rounds, "figures": figures, "rows": rows,
     }, indent=2) + "\n")
     return max(r["returncode"] for r in rows)
 
