@@ -125,9 +125,9 @@ def mode_name(args: list[str]) -> str:
 
 def run(args: list[str], log: Path | None = None, round_: int = 0) -> dict:
     """``scripts/test ARGS`` in this checkout, timed (``--quick``, the full suite, ``--other-cpus``)."""
-    name = mode_name(args) + (f"-{round_}" if round_ else "")
-    return {"mode": mode_name(args), "round": round_,
-            **timed(["scripts/test", *args], ROOT, log, f"{name}.log")}
+    mode = mode_name(args)
+    name = mode + (f"-{round_}" if round_ else "")
+    return {"mode": mode, "round": round_, **timed(["scripts/test", *args], ROOT, log, f"{name}.log")}
 
 
 def mode_figures(rows: list[dict]) -> dict:
@@ -137,10 +137,10 @@ def mode_figures(rows: list[dict]) -> dict:
     """
     figures = {}
     for mode in dict.fromkeys(r["mode"] for r in rows):
-        seconds = [r["seconds"] for r in rows if r["mode"] == mode]
-        figures[mode] = {"runs": len(seconds), "median_s": round(statistics.median(seconds), 1),
-                         "worst_s": max(seconds),
-                         "all_passed": all(r["returncode"] == 0 for r in rows if r["mode"] == mode)}
+        mine = [r for r in rows if r["mode"] == mode]
+        seconds = [r["seconds"] for r in mine]
+        figures[mode] = {"runs": len(mine), "median_s": round(statistics.median(seconds), 1),
+                         "worst_s": max(seconds), "all_passed": all(r["returncode"] == 0 for r in mine)}
     return figures
 
 
