@@ -1,6 +1,6 @@
 """
 ``python -m service [--host 127.0.0.1] [--port 8000] [--data-dir DIR]``:
-start the HTTP service (:func:`service.server.serve`). Other settings come
+start the HTTP service (:func:`service.runtime.server.serve`). Other settings come
 from ``COATED_*`` environment variables (:class:`service.config.Settings`);
 ``COATED_STORE_URL=postgresql://...`` puts the store on PostgreSQL. A store
 that cannot be opened, is damaged, cannot be written or has a schema newer
@@ -111,9 +111,9 @@ def main(argv: list[str] | None = None) -> int:
     settings = _settings(overrides)
     if settings is None:
         return 2
-    from .fork_server import start_fork_server
+    from .runtime.fork_server import start_fork_server
     from .main import create_app
-    from .server import serve
+    from .runtime.server import serve
 
     # Before the store is opened and before any thread: the workers' fork server, forked from here.
     try:

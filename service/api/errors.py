@@ -34,8 +34,8 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from ..pool import FitTimeout, Overloaded, WorkerLost
-from ..previews import RendererUnavailable
+from ..runtime.pool import FitTimeout, Overloaded, WorkerLost
+from ..runtime.previews import RendererUnavailable
 from ..store import StoreError
 
 __all__ = ["install_error_handlers", "error_response"]

@@ -21,7 +21,7 @@ import pytest
 
 from conftest import server_process
 
-from service.server import IDLE_GRACE_S
+from service.runtime.server import IDLE_GRACE_S
 
 pytestmark = [pytest.mark.slow, pytest.mark.server]
 

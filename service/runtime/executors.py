@@ -3,7 +3,7 @@ Process executors' results
 ==========================
 
 What Python's ``ProcessPoolExecutor`` (3.11-3.13) does not do for the
-fitting and render pools (:mod:`service.pool`, :mod:`service.previews`):
+fitting and render pools (:mod:`service.runtime.pool`, :mod:`service.runtime.previews`):
 see a worker that was killed while it wrote a result.
 
 A worker sends a result of over 16 KB in two writes to the pipe all the
@@ -38,7 +38,7 @@ from typing import Any
 
 __all__ = ["STUCK_S", "WATCH_S", "has_dead_worker", "unstick", "result"]
 
-log = logging.getLogger("service.executors")
+log = logging.getLogger("service.runtime.executors")
 
 STUCK_S = 3.0
 """How long a worker may be dead in a pool that has not broken before :func:`unstick` (the manager

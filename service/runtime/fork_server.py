@@ -3,9 +3,9 @@ The fork server, forked from the server
 =======================================
 
 :func:`start_fork_server`: ``python -m service`` forks the fork server of
-its fitting and render processes (:func:`service.worker.process_context`)
+its fitting and render processes (:func:`service.runtime.worker.process_context`)
 from itself, once it has imported the core and warmed up
-(:mod:`service.preload`), before it opens the store or starts a thread;
+(:mod:`service.runtime.preload`), before it opens the store or starts a thread;
 multiprocessing's own fork server is a new interpreter that imports the
 core and warms up again.
 
@@ -51,8 +51,8 @@ def _cannot_fork_server(server, threads: int) -> str | None:
 
 def start_fork_server() -> bool:
     """
-    Start the fork server of :func:`service.worker.process_context` as a fork of this
-    process, once it has imported :data:`service.worker.PRELOAD` (:mod:`service.preload`) (which also warms it up),
+    Start the fork server of :func:`service.runtime.worker.process_context` as a fork of this
+    process, once it has imported :data:`service.runtime.worker.PRELOAD` (:mod:`service.runtime.preload`) (which also warms it up),
     instead of the new interpreter multiprocessing would start with the
     first pool, which imports the core and warms up again: a second of CPU
     time at every server start, and the first pool waits for it. For
@@ -75,7 +75,7 @@ def start_fork_server() -> bool:
     adds an authentication key). Should the fork server die, multiprocessing
     starts its own at the next pool.
     """
-    import service.preload  # noqa: F401 (the core, colour-science and the warm-up, for every fork)
+    import service.runtime.preload  # noqa: F401 (the core, colour-science and the warm-up, for every fork)
 
     server = forkserver._forkserver
     if _cannot_fork_server(server, threading.active_count()) is not None:
@@ -141,7 +141,7 @@ FORK_SERVER_EXIT_S = 5.0
 async def fork_server_exited(timeout_s: float | None = None, poll_s: float = 0.01) -> bool:
     """
     Wait (polling, at most ``timeout_s``, by default :data:`FORK_SERVER_EXIT_S`) until the fork server of
-    :func:`service.worker.process_context` has exited, without reaping it:
+    :func:`service.runtime.worker.process_context` has exited, without reaping it:
     multiprocessing reaps it at the next start (``ForkServer.ensure_running``)
     and then starts a new one. For a start that failed with one of
     :data:`START_ERRORS`. Returns whether it exited (``True`` also when there

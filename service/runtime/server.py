@@ -53,7 +53,7 @@ import h11
 import uvicorn
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
-from .config import Settings
+from ..config import Settings
 
 __all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
            "HEALTH_RESERVE", "IDLE_GRACE_S"]
