@@ -111,9 +111,9 @@ def main(argv: list[str] | None = None) -> int:
     settings = _settings(overrides)
     if settings is None:
         return 2
-    from .runtime.fork_server import start_fork_server
+    from .runtime import start_fork_server
     from .main import create_app
-    from .runtime.server import serve
+    from .runtime import serve
 
     # Before the store is opened and before any thread: the workers' fork server, forked from here.
     try:

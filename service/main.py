@@ -32,9 +32,7 @@ from .api.routes import (
     versions,
 )
 from .config import Settings
-from .runtime.pool import FitRunner, warm_process
-from .runtime.worker import freeze_heap, thaw_heap
-from .runtime.previews import PreviewRunner
+from .runtime import FitRunner, PreviewRunner, freeze_heap, thaw_heap, warm_process
 from .schemas import API_PREFIX
 from .store import StoreError, open_store
 

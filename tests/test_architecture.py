@@ -201,3 +201,11 @@ def test_service_no_route_imports_another_route():
     """Routes share code through service modules, never through another route."""
     wrong = [f"{n} imports {sorted(GRAPH[n] & set(ROUTES))}" for n in ROUTES if GRAPH[n] & set(ROUTES)]
     assert ROUTES and not wrong, wrong
+
+
+def test_the_runtime_is_used_through_its_public_surface():
+    """Outside service/runtime/, the service imports the runtime's package (its __init__'s names), never its modules."""
+    wrong = [f"{n} imports {t}" for n, ts in GRAPH.items() if n.startswith("service") and not n.startswith("service.runtime")
+             for t in ts if t.startswith("service.runtime.")]
+    assert "service.runtime" in GRAPH["service.main"]
+    assert not wrong, "\n".join(wrong)

@@ -30,8 +30,7 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
 from ..jobs.common import stored_fit
-from ..runtime.pool import FitRunner
-from ..runtime.previews import PreviewRunner
+from ..runtime import FitRunner, PreviewRunner
 from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
 from ..store import FitRecord, Store
 

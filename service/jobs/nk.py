@@ -36,7 +36,7 @@ from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK, resample_nk
 from fitting.optics.readers import FORMATS, read_nk
 
-from ..runtime.pool import FitRunner
+from ..runtime import FitRunner
 from ..store import FitRecord, Store
 from .curves import target_at
 from .common import (

@@ -17,8 +17,7 @@ import asyncio
 from fitting.models.pack import PackedMaterial, material_from_json
 from fitting.optics.nk import SpectralNK
 
-from ..runtime.previews import PreviewRunner
-from ..runtime.render_worker import renderer
+from ..runtime import PreviewRunner, renderer
 from ..store import FitRecord
 from .common import measured_nk
 

@@ -20,7 +20,7 @@ from fitting.fits.curves_base import curve_base_from_nk
 from fitting.models.baselines import baseline_inputs
 from fitting.models.pack import material_from_json
 
-from ..runtime.render_worker import renderer
+from ..runtime import renderer
 from ..store import FitRecord
 from .common import measured_nk
 
