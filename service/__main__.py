@@ -111,10 +111,18 @@ def main(argv: list[str] | None = None) -> int:
     settings = _settings(overrides)
     if settings is None:
         return 2
+    from fitting.cli.plugins import load_plugins
+
     from .runtime import start_fork_server
     from .main import create_app
     from .runtime import serve
 
+    # Before the fork server: its forks, the workers, have the plugins' formats and kinds too.
+    try:
+        load_plugins(settings.plugins)
+    except ValueError as error:
+        print(f"{PROG}: cannot start: {error}", file=sys.stderr)
+        return 1
     # Before the store is opened and before any thread: the workers' fork server, forked from here.
     try:
         start_fork_server()

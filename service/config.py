@@ -140,6 +140,9 @@ class Settings(BaseSettings):
         How often drafts are swept (past their time to live, then the quota).
     materials_page_max
         Most saved materials in one page of ``GET /api/v1/materials``.
+    plugins
+        Modules to import at the start, separated by commas: each registers
+        an export format or a model kind (:mod:`fitting.cli.plugins`).
     """
 
     model_config = SettingsConfigDict(env_prefix="COATED_", extra="ignore")
@@ -180,6 +183,7 @@ class Settings(BaseSettings):
     store_pool_timeout_s: float = Field(default=5.0, gt=0.0, le=600.0)
     store_statement_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
     store_migrate: bool = True
+    plugins: str = ""
 
     @model_validator(mode="after")
     def _check_token(self) -> "Settings":

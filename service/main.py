@@ -25,6 +25,8 @@ from fastapi import FastAPI
 from fastapi.middleware.cors import CORSMiddleware
 from fastapi.staticfiles import StaticFiles
 
+from fitting.cli.plugins import load_plugins
+
 from .api.errors import install_error_handlers
 from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
@@ -109,6 +111,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     by the first preview), and closes them at shutdown.
     """
     settings = settings or Settings()
+    load_plugins(settings.plugins)  # as python -m service does before its fork server; imported once
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):

@@ -103,13 +103,15 @@ def _write_export(nk, args) -> int:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)
     else:
-        sys.stdout.write(body.decode("utf-8"))
+        sys.stdout.flush()
+        sys.stdout.buffer.write(body)
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from .batch import add_batch_parser
+    from ..exports.formats import EXPORT_FORMATS
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
@@ -137,7 +139,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
-    p.add_argument("--export", choices=("mtlx", "openpbr", "blender", "gltf"),
+    p.add_argument("--export", choices=EXPORT_FORMATS,
                    help="write this export (docs/exports.md) to -o or stdout instead of a pack")
     p.add_argument("--eta-i", type=float, default=1.5,
                    help="coating index of --export, [1, 3] (default 1.5)")
@@ -164,6 +166,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from .plugins import load_plugins
+
+    try:
+        load_plugins()  # before the parser: a plugin's formats and kinds are among its choices
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

@@ -104,6 +104,9 @@ export class Studio {
   async #load() {
     const [presets, domain] = await Promise.all([api.coatPresets(), api.domain(), this.#library(), this.refresh()]);
     this.app.store.dispatch("presets", presets.presets);
+    api.setExportFormats(domain.export_formats);
+    $("export-formats").replaceChildren(...domain.export_formats.map(
+      ({ name, label }) => Object.assign(document.createElement("option"), { value: name, textContent: label })));
     const [lo, hi] = domain.visible_range_nm;
     $("upload-rule").textContent = `Measured n, k must cover at least ${Math.round(100 * domain.min_coverage)}% of ` +
       `${lo}–${hi} nm (the colour is integrated over that range; the data are held flat past their ends, ` +
