@@ -6,7 +6,7 @@ Stored fits as the files a renderer loads:
 
 -   ``binary``: the documented binary pack (:func:`fitting.models.pack.encode_pack`).
 -   ``json``: its JSON view (:func:`fitting.models.pack.pack_to_json`).
--   ``glsl``, ``hlsl``: ready-to-paste snippets (:mod:`service.snippets`):
+-   ``glsl``, ``hlsl``: ready-to-paste snippets (:mod:`fitting.exports.snippets`):
     the project's function of each model kind in the pack and per material
     its float16 coefficients and a ``cf_material_<name>(NdotV, eta_i)``.
 
@@ -35,12 +35,13 @@ import zipfile
 
 from fitting.domain import cached_once
 from fitting.exports import EXPORT_FORMATS, export_format, export_material
+from fitting.exports.snippets import TEMPLATE_DIR, SnippetMaterial, glsl_identifier, snippet
+from fitting.fits.metrics import headline
 from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json
 from fitting.models.pack import pack_to_json
 
 from .jobs.common import FIT_FORMAT_VERSION, measured_nk
-from .snippets import TEMPLATE_DIR, glsl_identifier, snippet
 from .store import FitRecord
 
 __all__ = [
@@ -99,7 +100,9 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
                 }},
             ))
         return pack_to_json(materials).encode("utf-8")
-    return snippet(format, records, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
+    materials = [SnippetMaterial(r.name, r.source, r.id, headline(r.metrics), material_from_json(r.material))
+                 for r in records]
+    return snippet(format, materials, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
 
 
 def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03) -> bytes:

@@ -209,3 +209,12 @@ def test_the_runtime_is_used_through_its_public_surface():
              for t in ts if t.startswith("service.runtime.")]
     assert "service.runtime" in GRAPH["service.main"]
     assert not wrong, "\n".join(wrong)
+
+
+SERVICE_TOP_LEVEL_MAX = 12
+
+
+def test_service_top_level_is_small():
+    """service/ holds at most 12 entries (the runtime, the API, the jobs, the store...: each one room)."""
+    entries = sorted(p.name for p in (ROOT / "service").iterdir() if p.name != "__pycache__")
+    assert len(entries) <= SERVICE_TOP_LEVEL_MAX, entries

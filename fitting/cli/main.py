@@ -7,7 +7,8 @@ Command line
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
     print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
-    (``coated-conductor``, the default, or ``rgb-conductor``).
+    (``coated-conductor``, the default, or ``rgb-conductor``); ``--snippet glsl`` / ``hlsl`` writes the
+    fit as a ready-to-paste shader snippet, ``--export FORMAT`` an export for one coating index.
 -   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
     conductors and the Section 4.3 float16 study.
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
@@ -82,6 +83,8 @@ def _cmd_fit(args) -> int:
             print(f"error: {what}; nothing written (--strict)", file=sys.stderr)
             return 3
         print(f"warning: {what}", file=sys.stderr)
+    if args.snippet is not None:
+        return _write_snippet(nk, result, args)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -105,6 +108,20 @@ def _write_export(nk, args) -> int:
     else:
         sys.stdout.flush()
         sys.stdout.buffer.write(body)
+    return 0
+
+
+def _write_snippet(nk, result, args) -> int:
+    from ..exports.snippets import SnippetMaterial, snippet
+    from ..fits.metrics import headline
+
+    material = SnippetMaterial(nk.name, nk.source, "python -m fitting fit", headline(result.metrics), result.packed)
+    text = snippet(args.snippet, [material], nk.name, "python -m fitting fit")
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
     return 0
 
 
@@ -141,6 +158,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
     p.add_argument("--export", choices=EXPORT_FORMATS,
                    help="write this export (docs/exports.md) to -o or stdout instead of a pack")
+    p.add_argument("--snippet", choices=("glsl", "hlsl"),
+                   help="write a ready-to-paste GLSL or HLSL snippet of the fit to -o or stdout instead of a pack")
     p.add_argument("--eta-i", type=float, default=1.5,
                    help="coating index of --export, [1, 3] (default 1.5)")
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
