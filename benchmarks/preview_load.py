@@ -47,7 +47,7 @@ sys.path.insert(0, str(ROOT))
 API = "/api/v1"
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_load import free_port, percentiles, start_replicas  # noqa: E402
+from benchmarks.service_load import percentiles, start_replicas  # noqa: E402
 
 ROUGH_COATED_REFERENCE = {"roughness": 0.3, "mode": "coated", "coat_roughness": 0.1,
                           "environment": "studio", "compare": "reference"}

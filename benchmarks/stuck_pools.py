@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
             runs[side].append(asyncio.run(trial(side, size, kill, args.limit)))
             print(f"trial {i} {side}: kill after {kill:.2f} s -> {runs[side][-1][0]}", flush=True)
     figures = {}
-    print(f"\n| side | trials | answered | broken | hung | kill to outcome, median / max s |")
+    print("\n| side | trials | answered | broken | hung | kill to outcome, median / max s |")
     print("|---|---:|---:|---:|---:|---:|")
     for side in SIDES:
         outcomes = [outcome for outcome, _ in runs[side]]

@@ -9,8 +9,9 @@ Command line
     print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
     (``coated-conductor``, the default, or ``rgb-conductor``); ``--snippet glsl`` / ``hlsl`` writes the
     fit as a ready-to-paste shader snippet, ``--export FORMAT`` an export for one coating index.
--   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
-    conductors and the Section 4.3 float16 study.
+-   ``reproduce``: the paper's Table 1 for all 22 conductors and the Section
+    4.3 float16 study, printed and written to ``-o FILE`` (default a temporary
+    file; ``--write-docs``: ``docs/results.md``).
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
 -   ``batch --shelf main``: a selection of the refractiveindex.info database
     into one pack and report (:mod:`fitting.cli.batch`).
@@ -173,8 +174,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "larger fits sparse data with a warning in the result and the pack)")
     p.set_defaults(func=_cmd_fit)
 
-    p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
-    p.add_argument("-o", "--output", default="docs/results.md", metavar="FILE")
+    p = sub.add_parser("reproduce", help="print Table 1 and write the results page (Table 1, Section 4.3, the worst point)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("-o", "--output", metavar="FILE", help="write the page here (default: a new temporary file)")
+    where.add_argument("--write-docs", action="store_true", help="update docs/results.md")
     p.add_argument("--materials", help="comma-separated subset (default: all 22)")
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 

@@ -65,6 +65,8 @@ def _import_file(path: Path) -> None:
     if not path.is_file():
         raise ImportError(f"no file {str(path)!r}")
     spec = importlib.util.spec_from_file_location(path.stem, path)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"{str(path)!r} is not a Python module")
     module = importlib.util.module_from_spec(spec)
     sys.modules[path.stem] = module
     try:

@@ -87,8 +87,8 @@ def model_source(language: str, kinds: tuple[str, ...]) -> str:
         seen.add(file_name)
         return _INCLUDE.sub(lambda m: expand(m.group(1)), (GLSL_DIR / file_name).read_text())
 
-    files = [model_kind(k).glsl_file for k in kinds] + [f"{f}.glsl" for f in _split_sum(kinds)]
-    source = "\n".join(expand(f).strip() for f in files)
+    names = [model_kind(k).glsl_file for k in kinds] + [f"{f}.glsl" for f in _split_sum(kinds)]
+    source = "\n".join(expand(name).strip() for name in names)
     return _only_reachable(source, kinds).strip()
 
 

@@ -262,7 +262,7 @@ def export_values(
         origin = str(fit_or_nk.get("origin", "the fit's model curve under the coat"))
         seen = coated_stack_from_metal(view, eta, lambda mc: fit_or_nk["reflectance"](mc, eta))
         if seen.shape != (view.size, 3) or not np.all(np.isfinite(seen)):
-            raise ValueError(f"`fit_or_nk['reflectance']` must give finite (S, 3) RGB for S cos theta")
+            raise ValueError("`fit_or_nk['reflectance']` must give finite (S, 3) RGB for S cos theta")
     elif isinstance(fit_or_nk, dict) and {"n", "k"} <= set(fit_or_nk):
         name = str(fit_or_nk.get("name", "material"))
         source = str(fit_or_nk.get("source", ""))

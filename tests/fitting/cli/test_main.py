@@ -107,7 +107,11 @@ def test_errors_are_clear():
 @pytest.mark.slow  # 4.3 s (all cases 4.3 s) in a --durations=0 run
 def test_reproduce_subset(tmp_path):
     out = tmp_path / "results.md"
+    out.write_text("old\n<!-- end of the part written by python -m fitting reproduce: what follows is kept by "
+                   "--write-docs -->\n\n## Kept\n")
     result = run("reproduce", "--materials", "Au,Ta", "-o", str(out))
-    assert "2/2" in result.stderr  # progress bar
+    assert "2/2" in result.stderr and f"wrote {out}" in result.stderr  # progress bar, where it went
+    assert "| Au |" in result.stdout and "| Ta |" in result.stdout  # the table, printed
     text = out.read_text()
     assert "| Au |" in text and "| Ta |" in text and "beats every baseline on every conductor: **yes**" in text
+    assert "old" not in text and text.endswith("-->\n\n## Kept\n")  # the page written again, the rest kept
