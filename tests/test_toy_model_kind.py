@@ -1,5 +1,5 @@
 """
-The promise of issue 19: a third model kind is one registration per layer.
+A third model kind is one registration per layer.
 
 A toy kind, Schlick's approximation with a constant F0 per channel (3
 float16), registered here and nowhere else (its numpy model, its fit, its

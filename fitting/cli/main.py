@@ -72,7 +72,7 @@ def _cmd_fit(args) -> int:
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
                        evaluate=not args.no_metrics, **extra)
     for warning in result.quality.get("warnings", []):
-        # Issue 21: sparse data or a model outside [0, 1] are said, and refused with --strict.
+        # Sparse data or a model outside [0, 1] are said, and refused with --strict.
         if args.strict and not in_range_verdict(result.quality):
             print(f"error: the fit of {nk.name!r}: {warning}; nothing written (--strict)", file=sys.stderr)
             return 3

@@ -14,7 +14,7 @@ degrees, against the tool's own layering of its coat over its base
 (:mod:`fitting.exports.tool_layering`), in Delta E 2000; they are
 :attr:`ExportValues.tools`. The rest of this docstring is the earlier,
 naive fit, kept as the baseline the seen fit is measured against (today's
-values before issue 22): the base's Fresnel fitted to the metal under the
+values before the seen fit): the base's Fresnel fitted to the metal under the
 coat at the same angle inside the coat.
 
 The naive target curve :math:`T(\\mu)` is the spectral reference under the coat

@@ -17,7 +17,7 @@ fitting pool and off the server process.
 Why processes: a preview is seconds of numpy (the spectral reference),
 GL read-back and PNG encoding. In threads of the server process it held
 the GIL for long stretches, and the event loop (``/healthz`` too) stalled
-behind it (issue 20, item 8). Here the server only sends a fit's packed
+behind it (item 8). Here the server only sends a fit's packed
 material and n, k and receives the PNG bytes; the event loop never waits
 on a render.
 

@@ -1,4 +1,4 @@
-// The editor an artist keeps open all day (issue 24): the library to
+// The editor an artist keeps open all day: the library to
 // browse (library_view.js), coat presets and typed entry (entry_view.js),
 // the materials an artist manages (manage_view.js: rename, delete and the
 // bin, versions, links) and compare mode (compare_view.js, with the

@@ -1,5 +1,5 @@
 """
-Issue 10 (items 3-9) against the service: host allow-list, slow clients,
+Faults against the service: host allow-list, slow clients,
 paged listing, storage faults, worker death, generated code and ids, edits
 in scenes and float32 bounds. Server tests run a real ``python -m service``
 on 127.0.0.1; every loop is bounded.
@@ -584,7 +584,7 @@ def test_a_worker_killed_while_it_sends_a_result_does_not_hang_its_pool(tmp_path
 
 @pytest.mark.slow
 def test_timed_out_fit_is_cancelled_and_its_worker_freed(tmp_path):
-    # Issue 20: a job whose request was answered 504 no longer runs on. The job must outlast the
+    # A job whose request was answered 504 no longer runs on. The job must outlast the
     # limit and the workers' 0.1 s checks on any machine: 400 x 400 metrics take 0.9 s of the job here
     # (a fit with 10 took 0.05 s on a warm worker, and passed only while a fresh worker's start made
     # up the rest).
@@ -663,7 +663,7 @@ def test_edit_at_the_float32_rounded_upper_end(tmp_path):
         assert response.status_code == 201, response.text
 
 
-# -- issue 20: a client that goes away cancels its job ------------------------------
+# -- a client that goes away cancels its job ------------------------------
 
 @pytest.mark.slow
 @pytest.mark.server

@@ -1,5 +1,5 @@
 """
-The garbage collector's full passes kept off the request path (issue 20):
+The garbage collector's full passes kept off the request path:
 the server and every fitting worker freeze what start-up made
 (service.runtime.worker.freeze_heap), so a full collection traverses only what
 requests made since; the service thaws it at shutdown. Before, a full

@@ -1,5 +1,5 @@
 """
-service.runtime.pool (issue 20): every part of a job has a CPU-time limit, and a job
+service.runtime.pool: every part of a job has a CPU-time limit, and a job
 no request waits for any more (timed out, or its client gone) is cancelled,
 its worker free within a second. Real worker processes (forked by the fork server).
 """

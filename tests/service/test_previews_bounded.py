@@ -1,5 +1,5 @@
 """
-Issue 20, item 8: previews off the event loop, against a real
+Previews off the event loop, against a real
 ``python -m service`` on 127.0.0.1. Previews render in the render pool's
 processes (service/runtime/previews.py), so ``/healthz`` answers within 0.5 s p99
 while two 1024 px rough coated reference previews render; previews past

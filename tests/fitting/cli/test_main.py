@@ -63,7 +63,7 @@ def test_fit_user_file(tmp_path):
 
 @pytest.mark.slow  # starts processes
 def test_sparse_file_refused_or_fitted_with_a_warning(tmp_path):
-    # Issue 21: three samples leave gaps of 250 nm inside 360-830 nm.
+    # Three samples leave gaps of 250 nm inside 360-830 nm.
     path = tmp_path / "sparse.csv"
     path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n600,0.6,3.0\n850,0.8,4.5\n")
     refused = run("fit", "--nk", str(path), "--no-metrics", check=False)
