@@ -13,7 +13,7 @@ two pools of 2 ``spawn`` workers, both cores busy:
 -   ``before``: the workers as started before (``warm_process`` only: BLAS
     threads = cores);
 -   ``after``: the workers as the service starts them now
-    (``service.worker.worker_start``: one BLAS thread each).
+    (``service.runtime.worker.worker_start``: one BLAS thread each).
 
 It prints a table of per-job wall time (median, p90, max) and the total, and
 records it in ``benchmarks/results/blas_threads.json`` with the command, the
@@ -44,7 +44,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from service.worker import warm_process, worker_start  # noqa: E402
+from service.runtime.worker import warm_process, worker_start  # noqa: E402
 
 RESULTS = ROOT / "benchmarks" / "results" / "blas_threads.json"
 

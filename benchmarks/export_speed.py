@@ -108,7 +108,7 @@ def main(argv=None) -> int:
                 side.close()
     figures = {"before_commit": args.before}
     groups = {"all": items, **{key(eta): [i for i in items if i.endswith(f"@{eta:g}")] for eta in etas}}
-    print(f"\n| coating | before median / max ms | after median / max ms | after / before (medians) |")
+    print("\n| coating | before median / max ms | after median / max ms | after / before (medians) |")
     print("|---|---|---|---|")
     for name, group in groups.items():
         figures[name] = summary({i: answers["before"][i]["ms"] for i in group},

@@ -17,7 +17,7 @@ mirrors of each tool's layering, checked against the tools' own renders by
     (the conductor exports before the view-dependent index);
 -   ``floor``: the tool's layering over a perfect base (the best base
     response in [0, 1] per angle and channel);
--   ``naive``: the export before issue 22 (base Fresnel fitted to the
+-   ``naive``: the export before the seen fit (base Fresnel fitted to the
     metal under the coat at the same angle inside the coat; at eta_i 1 the
     ``mtlx`` / ``openpbr`` coat of index 1 and glTF's clear coat factor 1
     kept; OpenPBR with ``coat_darkening`` 0).
@@ -34,7 +34,7 @@ Prints a Markdown table and records benchmarks/results/exports_seen.json
 (its ``figures``: the same keyed ``eta_i_1_5``, for the docs' markers).
 
 ``--conductor-search`` measures instead how low the conductor exports can
-go with constant values (issue 22's criterion, before the view-dependent index): for each conductor tool and metal
+go with constant values (the criterion, before the view-dependent index): for each conductor tool and metal
 (``--materials``, default W and CuZn) at ``--eta-i`` (default 1.5), a
 multi-start search over the six values, n in [0.001, 20] and k in [0, 50]
 per channel (the fit's full bounds), with the mean Delta E itself as the
@@ -86,7 +86,7 @@ CONDUCTOR_TOOLS = ("mtlx", "blender-conductor")
 
 
 def naive_values(values, tool: str) -> dict:
-    """Today's (before issue 22) export values of ``tool``, and its coat."""
+    """The earlier (naive) export values of ``tool``, and its coat."""
     if tool in CONDUCTOR_TOOLS:
         v = {"ior": values.n_rel, "extinction": values.k_rel}
     elif tool == "openpbr":

@@ -2,7 +2,7 @@
 Fit time with the max guard against the pipeline before it
 ===========================================================
 
-Issue 21 asks that guarding the max keeps the fit time within 1.5x of the
+Guarding the max must keep the fit time within 1.5x of the
 pipeline before it ("today's", 18-25 ms median). This times the library's
 fits (CPU time of ``fit_material`` with its defaults, one BLAS thread, the
 median of ``--repeats`` per conductor, then the median over the 22) of a
@@ -36,7 +36,7 @@ from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.side_by_side import Side, checkout, serve  # noqa: E402
 
 BEFORE = "51b944e"
-"""The last commit before the max guard (b7362fd): the pipeline issue 21 calls today's."""
+"""The last commit before the max guard (b7362fd): the pipeline before the guard."""
 
 
 def child(root: str, repeats: int) -> int:

@@ -82,7 +82,7 @@ HARD_CASES = {
     "Au 5 samples": (lambda: sparse(library_material("Au"), [360, 480, 600, 720, 830]), 0.9,
                      "sparse: 5 samples"),
     "Au 2 samples": (lambda: sparse(library_material("Au"), [360, 830]), 0.9,
-                     "sparse: 2 samples: refused, a 470 nm gap (issue 21)"),
+                     "sparse: 2 samples: refused, a 470 nm gap"),
     "Au 380-900 nm": (lambda: cut(library_material("Au"), 380, 900), 0.9,
                       "95% visible coverage (381.5-892 nm): accepted, held flat below"),
     "Au 400-900 nm": (lambda: cut(library_material("Au"), 400, 900), 0.9,

@@ -19,7 +19,7 @@ is left out). Per step:
 With ``--gc-trace`` the server and its workers log every garbage
 collection over 5 ms (a ``sitecustomize`` on their ``PYTHONPATH``), and the
 record counts those that happened during the measured drags. Before the
-heap was frozen after start-up (:func:`service.worker.freeze_heap`), full
+heap was frozen after start-up (:func:`service.runtime.worker.freeze_heap`), full
 collections of 60-86 ms in the server and 15-46 ms in a worker landed on
 about one step in 160.
 

@@ -5,7 +5,7 @@
 Starts a real ``python -m service`` on a free loopback port with a fresh
 data directory, fits gold, renders ``--previews`` small warm-up previews at
 once (each render process is started, with its GL context, its LUT and the
-prefiltered studio; before issue 20, item 8: the server's one GL thread),
+prefiltered studio; before the render pool: the server's one GL thread),
 then, for each
 of ``--rounds`` rounds, sends ``--previews`` (2) previews at once: 1024 px,
 rough (0.3) under a rough coat (``mode=coated``, coat roughness 0.1) in the
@@ -47,7 +47,7 @@ sys.path.insert(0, str(ROOT))
 API = "/api/v1"
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_load import free_port, percentiles, start_replicas  # noqa: E402
+from benchmarks.service_load import percentiles, start_replicas  # noqa: E402
 
 ROUGH_COATED_REFERENCE = {"roughness": 0.3, "mode": "coated", "coat_roughness": 0.1,
                           "environment": "studio", "compare": "reference"}

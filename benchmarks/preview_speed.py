@@ -30,12 +30,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import numpy as np  # noqa: E402
 
 from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting.fits.material import fit_material  # noqa: E402
 from fitting.optics.library import library_material  # noqa: E402
-from preview_shaders import preview  # noqa: E402
 from preview_shaders.preview import PreviewRenderer, reference_image  # noqa: E402
 
 SIZES = (256, 512, 1024)

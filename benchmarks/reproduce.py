@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from fitting.cli.reproduce import reproduce  # noqa: E402
+from fitting.cli.reproduce import reproduce, write_page  # noqa: E402
 from fitting.cli.reproduce_worst import SHELF_SAMPLE  # noqa: E402
 from fitting.optics.library import LIBRARY_NAMES  # noqa: E402
 
@@ -42,8 +42,7 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     subset = tuple(args.materials.split(",")) if args.materials else None
     text, figures = reproduce(subset or LIBRARY_NAMES, () if subset else SHELF_SAMPLE)
-    args.output.parent.mkdir(parents=True, exist_ok=True)
-    args.output.write_text(text)
+    write_page(text, args.output)
     print(f"wrote {args.output}")
     if subset is None or args.record:
         print(f"wrote {write_result('reproduce', figures, load0, seconds=round(time.perf_counter() - t0, 1))}")

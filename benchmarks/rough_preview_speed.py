@@ -2,7 +2,7 @@
 Rough preview start-up and speed
 ================================
 
-What issue 11's preview costs: the split-sum LUT generated (``generate_lut``)
+What the rough preview costs: the split-sum LUT generated (``generate_lut``)
 against read from the on-disk cache (``cached_lut``), the environment
 prefilter (``prefilter_equirect`` of the 128 x 64 studio, nine slices), and
 ``PreviewRenderer.render_preview`` of gold at eta_i = 1.5 in the studio:

@@ -2,21 +2,21 @@
 Pools whose worker is killed while it sends a result
 ====================================================
 
-What :mod:`service.executors` is for, measured. Each trial is a new pool
+What :mod:`service.runtime.executors` is for, measured. Each trial is a new pool
 of two workers (Python's ``ProcessPoolExecutor``, forks of the service's
-fork server: :func:`service.worker.process_context`) given one job
+fork server: :func:`service.runtime.worker.process_context`) given one job
 whose result is ``--mb`` MB; one worker is SIGKILLed from outside (as the
 OOM killer would: the one with the most resident memory, the job's) at a random time in the first
 ``--window`` seconds after the submit: before, while or after its result is
 sent. The same kill times (``--seed``) run twice, in turns:
 
 -   ``plain``: the job awaited as ``asyncio.wrap_future`` (the service
-    before :mod:`service.executors`);
--   ``watched``: awaited with :func:`service.executors.result`.
+    before :mod:`service.runtime.executors`);
+-   ``watched``: awaited with :func:`service.runtime.executors.result`.
 
 Each trial ends ``answered`` (the result came), ``broken`` (the pool saw
 the death: ``BrokenProcessPool``) or ``hung`` (neither within ``--limit``
-seconds; the pool is then unstuck with :func:`service.executors.unstick`
+seconds; the pool is then unstuck with :func:`service.runtime.executors.unstick`
 so that the next trial starts clean). Prints a table and records
 benchmarks/results/stuck_pools.json (``figures``: per side the counts and
 the median and max seconds from the kill to the outcome, hung trials
@@ -42,8 +42,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from service import executors  # noqa: E402
-from service.worker import process_context  # noqa: E402
+from service.runtime import executors  # noqa: E402
+from service.runtime.worker import process_context  # noqa: E402
 
 SIDES = ("plain", "watched")
 
@@ -118,7 +118,7 @@ def main(argv: list[str] | None = None) -> int:
             runs[side].append(asyncio.run(trial(side, size, kill, args.limit)))
             print(f"trial {i} {side}: kill after {kill:.2f} s -> {runs[side][-1][0]}", flush=True)
     figures = {}
-    print(f"\n| side | trials | answered | broken | hung | kill to outcome, median / max s |")
+    print("\n| side | trials | answered | broken | hung | kill to outcome, median / max s |")
     print("|---|---:|---:|---:|---:|---:|")
     for side in SIDES:
         outcomes = [outcome for outcome, _ in runs[side]]

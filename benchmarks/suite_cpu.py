@@ -54,7 +54,7 @@ CLASSES = (
     ("chromium_gpu", "Chromium GPU process (SwiftShader)", ("--type=gpu-process",)),
     ("chromium_other", "Chromium other (zygote, utility)", ("--type=",)),
     ("chromium_browser", "Chromium browser", ("chromium", "chrome")),
-    # and a server's forks (its fork server, service.fork_server.start_fork_server, and their workers): classify()
+    # and a server's forks (its fork server, service.runtime.fork_server.start_fork_server, and their workers): classify()
     ("fork_servers", "fork servers and their workers", ("multiprocessing.forkserver",)),
     ("servers", "server processes (python -m service)", ("-m service", "tests/server_forks.py")),
     # the second: pytest-xdist's workers

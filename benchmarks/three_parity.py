@@ -48,7 +48,7 @@ from editor_pages import CHROMIUM_ARGS  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 from three_pages import create_fit, measure_three, open_example  # noqa: E402
 
-from fitting.models.kinds import MODEL_KINDS, model_kind  # noqa: E402
+from fitting.models.kinds import MODEL_KINDS  # noqa: E402
 from fitting.optics.library import library_material  # noqa: E402
 
 # (eta_i, [(metal roughness, coat roughness), ...]): the settings of one page load.

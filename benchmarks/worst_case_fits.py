@@ -2,7 +2,7 @@
 Mean and max against the paper's method, on the library and database pages.
 
 For each material: the shipped float16 fit (``fit_material``, the max
-guarded, issue 21), the same fit without the guard (``guard_max=False``,
+guarded), the same fit without the guard (``guard_max=False``,
 the pipeline before), and the paper's method as an outside auditor runs it
 (plain linear-RGB least squares on the 100 x 100 scoring grid against the
 1 nm reference, coefficients rounded to float16), all scored on that grid:

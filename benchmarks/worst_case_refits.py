@@ -3,7 +3,7 @@ Worst-case curve refits
 =======================
 
 Wall time of :func:`fitting.fits.curves.fit_curves` in this process for the
-edits of issue 20 against a gentle one (each the median of ``--repeats``),
+worst-case edits against a gentle one (each the median of ``--repeats``),
 and of the live steps of a drag (``LIVE_SETTINGS``, warm-started from the
 fit before, 20 steps) for each, p50 and p99:
 

@@ -45,7 +45,7 @@ radius.
     (:mod:`preview_shaders.reference`, re-exported).
 -   How each model kind is drawn: :mod:`preview_shaders.kinds` (the kind's
     ``preview_call`` in ``cf_preview_model``, one program per kind).
-Rough spheres and the coated mode (issue 11) are drawn by
+Rough spheres and the coated mode are drawn by
 ``glsl/preview_rough.frag`` through the split sum with a prefiltered
 environment (:mod:`preview_shaders.rough`).
 

@@ -2,7 +2,7 @@
 Rough preview spheres
 =====================
 
-The preview sphere with a GGX lobe (issue 11): image-based lighting by the
+The preview sphere with a GGX lobe: image-based lighting by the
 split sum (Karis 2013). The shader ``glsl/preview_rough.frag`` multiplies
 the directional albedo from the pre-integrated LUT
 (:func:`fitting.shading.ibl.default_lut`, cached on disk) with the

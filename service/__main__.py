@@ -1,6 +1,6 @@
 """
 ``python -m service [--host 127.0.0.1] [--port 8000] [--data-dir DIR]``:
-start the HTTP service (:func:`service.server.serve`). Other settings come
+start the HTTP service (:func:`service.runtime.server.serve`). Other settings come
 from ``COATED_*`` environment variables (:class:`service.config.Settings`);
 ``COATED_STORE_URL=postgresql://...`` puts the store on PostgreSQL. A store
 that cannot be opened, is damaged, cannot be written or has a schema newer
@@ -111,10 +111,18 @@ def main(argv: list[str] | None = None) -> int:
     settings = _settings(overrides)
     if settings is None:
         return 2
-    from .fork_server import start_fork_server
-    from .main import create_app
-    from .server import serve
+    from fitting.cli.plugins import load_plugins
 
+    from .runtime import start_fork_server
+    from .main import create_app
+    from .runtime import serve
+
+    # Before the fork server: its forks, the workers, have the plugins' formats and kinds too.
+    try:
+        load_plugins(settings.plugins)
+    except ValueError as error:
+        print(f"{PROG}: cannot start: {error}", file=sys.stderr)
+        return 1
     # Before the store is opened and before any thread: the workers' fork server, forked from here.
     try:
         start_fork_server()

@@ -90,7 +90,7 @@ class Settings(BaseSettings):
     freeze_heap
         After start-up, collect once and freeze what the server process
         holds out of the garbage collector's full passes
-        (:func:`service.worker.freeze_heap`; thawed at shutdown). Off for an
+        (:func:`service.runtime.worker.freeze_heap`; thawed at shutdown). Off for an
         app embedded in a process that is not its own (a test runner's
         in-process clients), whose heap is the host's: each start would
         collect all of it.
@@ -104,7 +104,7 @@ class Settings(BaseSettings):
     max_previews_in_flight
         Previews rendered at once (a spectral-reference preview is seconds of
         CPU), and the processes of the render pool that draw them
-        (:class:`service.previews.PreviewRunner`); past it a preview
+        (:class:`service.runtime.previews.PreviewRunner`); past it a preview
         request is answered 503 with Retry-After.
     preview_timeout_s
         Time limit of one preview (or GL texture) request, seconds, waiting
@@ -140,6 +140,9 @@ class Settings(BaseSettings):
         How often drafts are swept (past their time to live, then the quota).
     materials_page_max
         Most saved materials in one page of ``GET /api/v1/materials``.
+    plugins
+        Modules to import at the start, separated by commas: each registers
+        an export format or a model kind (:mod:`fitting.cli.plugins`).
     """
 
     model_config = SettingsConfigDict(env_prefix="COATED_", extra="ignore")
@@ -180,6 +183,7 @@ class Settings(BaseSettings):
     store_pool_timeout_s: float = Field(default=5.0, gt=0.0, le=600.0)
     store_statement_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
     store_migrate: bool = True
+    plugins: str = ""
 
     @model_validator(mode="after")
     def _check_token(self) -> "Settings":

@@ -6,7 +6,7 @@ Stored fits as the files a renderer loads:
 
 -   ``binary``: the documented binary pack (:func:`fitting.models.pack.encode_pack`).
 -   ``json``: its JSON view (:func:`fitting.models.pack.pack_to_json`).
--   ``glsl``, ``hlsl``: ready-to-paste snippets (:mod:`service.snippets`):
+-   ``glsl``, ``hlsl``: ready-to-paste snippets (:mod:`fitting.exports.snippets`):
     the project's function of each model kind in the pack and per material
     its float16 coefficients and a ``cf_material_<name>(NdotV, eta_i)``.
 
@@ -17,7 +17,8 @@ from the fit's measured n, k, or for a fit of edited curves from its model:
     Python script; ``gltf``: a glTF 2.0 asset.
 
 -   :data:`PACK_MEDIA_TYPES`: media type and file suffix per format.
--   :data:`EXPORT_MEDIA_TYPES`: the same for the exports.
+-   :func:`is_export`: whether a format is an export (of the registry,
+    :data:`fitting.exports.EXPORT_FORMATS`, which has their media types and suffixes).
 -   :func:`render_pack`: the bytes of a download.
 -   :func:`render_export`: the bytes of an export of one fit (each fits its
     tool's values, up to about a second of CPU: the routes run it, and
@@ -33,17 +34,18 @@ import re
 import zipfile
 
 from fitting.domain import cached_once
-from fitting.exports import EXPORT_FORMATS, export_material
+from fitting.exports import EXPORT_FORMATS, export_format, export_material
+from fitting.exports.snippets import TEMPLATE_DIR, SnippetMaterial, glsl_identifier, snippet
+from fitting.fits.metrics import headline
 from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json
 from fitting.models.pack import pack_to_json
 
 from .jobs.common import FIT_FORMAT_VERSION, measured_nk
-from .snippets import TEMPLATE_DIR, glsl_identifier, snippet
 from .store import FitRecord
 
 __all__ = [
-    "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
+    "PACK_MEDIA_TYPES", "is_export", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
     "render_export", "render_export_pack", "pack_response", "export_response", "download_name", "unique_names",
     "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
@@ -55,7 +57,11 @@ PACK_MEDIA_TYPES = {
     "glsl": ("text/plain; charset=utf-8", "glsl"),
     "hlsl": ("text/plain; charset=utf-8", "hlsl"),
 }
-EXPORT_MEDIA_TYPES = dict(EXPORT_FORMATS)
+
+
+def is_export(format: str) -> bool:
+    """Whether ``format`` is a registered export format (one coating index) rather than a pack format."""
+    return format in EXPORT_FORMATS
 
 
 @cached_once
@@ -94,13 +100,15 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
                 }},
             ))
         return pack_to_json(materials).encode("utf-8")
-    return snippet(format, records, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
+    materials = [SnippetMaterial(r.name, r.source, r.id, headline(r.metrics), material_from_json(r.material))
+                 for r in records]
+    return snippet(format, materials, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
 
 
 def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03) -> bytes:
     """
     The export of one stored fit in ``format`` (one of
-    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i`` and roughnesses.
+    :data:`fitting.exports.EXPORT_FORMATS`) for the coating index ``eta_i`` and roughnesses.
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
@@ -170,7 +178,7 @@ def unique_names(names: list[str]) -> list[str]:
 def download_name(stem: str, format: str) -> str:
     """``<stem>.<suffix>`` with only [A-Za-z0-9._-] in the stem (a safe header value)."""
     safe = re.sub(r"[^A-Za-z0-9._-]", "_", stem).strip("._") or "material"
-    suffix = {**PACK_MEDIA_TYPES, **EXPORT_MEDIA_TYPES}[format][1]
+    suffix = PACK_MEDIA_TYPES[format][1] if format in PACK_MEDIA_TYPES else export_format(format).extension
     return f"{safe[:80]}.{suffix}"
 
 
@@ -192,7 +200,7 @@ def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness
 
     stem = f"{stem}-eta{eta_i:g}-rough{roughness:g}-coat{coat_roughness:g}"
     return Response(
-        body, media_type=EXPORT_MEDIA_TYPES[format][0],
+        body, media_type=export_format(format).media_type,
         headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
     )
 

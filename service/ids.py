@@ -4,7 +4,7 @@ Content addresses
 
 -   :func:`content_address`: the id of a fit (or a scene) from its inputs in
     canonical JSON, so that the same request finds the same stored fit and
-    two different requests never share an id (issue 10, item 8).
+    two different requests never share an id (item 8).
 -   :func:`content_id`: the earlier NUL-separated digest, kept for readers
     of ids made before ``fit/v2``; new ids never use it (a NUL inside a
     part moves content between parts).

@@ -10,7 +10,7 @@ the edge: the ``Host`` allow-list, the body size and time limits, CORS
 "errors": [...]}`` naming the field and the broken rule).
 
 The server around it (header deadline, connection bound, flood logging)
-is :mod:`service.server`.
+is :mod:`service.runtime.server`.
 """
 
 from __future__ import annotations
@@ -25,6 +25,8 @@ from fastapi import FastAPI
 from fastapi.middleware.cors import CORSMiddleware
 from fastapi.staticfiles import StaticFiles
 
+from fitting.cli.plugins import load_plugins
+
 from .api.errors import install_error_handlers
 from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
@@ -32,9 +34,7 @@ from .api.routes import (
     versions,
 )
 from .config import Settings
-from .pool import FitRunner, warm_process
-from .worker import freeze_heap, thaw_heap
-from .previews import PreviewRunner
+from .runtime import FitRunner, PreviewRunner, freeze_heap, thaw_heap, warm_process
 from .schemas import API_PREFIX
 from .store import StoreError, open_store
 
@@ -107,10 +107,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     environment (``COATED_*``). The lifespan opens the store
     (:func:`service.store.open_store`: PostgreSQL at ``COATED_STORE_URL``, else
     SQLite under ``settings.data_dir``; schema migrated), the fitting pool (warmed at start-up when
-    ``settings.warm_pool``) and the render pool (:class:`service.previews.PreviewRunner`, started
+    ``settings.warm_pool``) and the render pool (:class:`service.runtime.previews.PreviewRunner`, started
     by the first preview), and closes them at shutdown.
     """
     settings = settings or Settings()
+    load_plugins(settings.plugins)  # as python -m service does before its fork server; imported once
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):

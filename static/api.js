@@ -114,7 +114,14 @@ export async function preview(fitId, etaI, compare) {
 }
 
 // EXPORTS take the preview's settings (eta_i, roughness, coat roughness); the packs hold every eta_i.
-export const EXPORTS = new Set(["mtlx", "openpbr", "blender", "gltf"]);
+// The names are the service's registry (GET /domain's export_formats), filled by setExportFormats.
+export const EXPORTS = new Set();
+
+/** Take the export formats of GET /domain ([{name, label, ...}]) as the ones packURL knows. */
+export function setExportFormats(formats) {
+  EXPORTS.clear();
+  for (const format of formats) EXPORTS.add(format.name);
+}
 
 /** The download of a fit in `format`; an export at `settings` {etaI, roughness, coatRoughness}. */
 export function packURL(fitId, format, settings = null) {

@@ -1,5 +1,5 @@
 """
-Named precision bounds the tests share (issue 18: every numeric tolerance is
+Named precision bounds the tests share (every numeric tolerance is
 derived or is a documented promise). Import as ``from precision import ...``
 (``tests/`` is on ``sys.path``: the root conftest lives there).
 

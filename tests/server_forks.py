@@ -13,7 +13,7 @@ importing the core, and the suite runs about thirty (and four of
 run as a program) that imports what ``python -m service``,
 ``python -m fitting`` and ``python -m preview_shaders`` import (no GL
 context: each command makes its own) and the fork server's preload
-(:mod:`service.preload`, whose warm-up depends on no setting), then forks
+(:mod:`service.runtime.preload`, whose warm-up depends on no setting), then forks
 a server for each :meth:`ServerForks.start` and a command for each
 :meth:`ServerForks.run`: the fork sets the process's environment, working
 directory, output (and a server's session), and returns to the top of this
@@ -263,13 +263,13 @@ if __name__ == "__main__":
     import preview_shaders.preview  # noqa: F401
     # What python -m service imports, at its start and then in main (not service.__main__ itself, which
     # run_module executes as __main__, as -m does).
-    import service.fork_server  # noqa: F401
+    import service.runtime.fork_server  # noqa: F401
     import service.main  # noqa: F401
-    import service.preload  # noqa: F401 (the fork server's imports and warm-up, as start_fork_server has them)
-    import service.server  # noqa: F401
+    import service.runtime.preload  # noqa: F401 (the fork server's imports and warm-up, as start_fork_server has them)
+    import service.runtime.server  # noqa: F401
 
     # What the imports made lives as long as every fork: out of the collector's reach now, as each server's
-    # start would put it (service.worker.freeze_heap), which then collects only what that server made.
+    # start would put it (service.runtime.worker.freeze_heap), which then collects only what that server made.
     gc.collect()
     gc.freeze()
     started = _serve_requests()

@@ -1,11 +1,13 @@
 """
-Figures that cannot drift (issue 19): every figure README.md and docs/*.md
-quote from a benchmark through a ``<!-- figure: record:path format -->``
-marker (:mod:`benchmarks.docs_figures`) is the benchmark's recorded one in
+Figures that cannot drift: every figure README.md and docs/*.md quote from
+a benchmark through a ``<!-- figure: record:path format -->`` marker
+(:mod:`benchmarks.docs_figures`) is the benchmark's recorded one in
 ``benchmarks/results/``; the README's figures of the editor's drag refit and
-the REST fit, once stale, are marked; every number of the figure column of
-the README's "What it measures" rows read from a record carries its marker
-(:data:`RECORDED_ROWS`), so a row cannot quietly lose one.
+the REST fit are marked; every number of the figure column of the rows of
+docs/results.md's "Headline figures, in full" read from a record carries its
+marker (:data:`RECORDED_ROWS`), so a row cannot quietly lose one, and so
+does every number of the README's "Headline figures", a short table (at
+most 10 rows, no cell over 200 characters) whose rows link to docs/results.md.
 """
 
 from __future__ import annotations
@@ -39,24 +41,33 @@ RECORDED_ROWS = (
     "refit from edited curves",
     "refractiveindex.info `main` shelf",
 )
-"""The rows of the README's "What it measures" table whose figures are all
-read from a record (by the start of their first cell): every number of
-their figure column has its marker."""
+"""The rows of docs/results.md's "Headline figures, in full" whose figures
+are all read from a record (by the start of their first cell): every number
+of their figure column has its marker."""
+
+README_ROWS_MAX = 10
+README_CELL_MAX = 200
+README_LINES_MAX = 250
 
 NUMBER = re.compile(r"(?<![\w.])-?[0-9]+(?:,[0-9]{3})*(?:\.[0-9]+)?")
 TARGET = re.compile(r"target (?:p50 )?[0-9.]+(?: / [0-9.]+)?")
-"""A target the figure is held to is the issue's number, not a measured one."""
+"""A target the figure is held to is a requirement, not a measured number."""
 
 
-def _measures_table(readme: str) -> dict[str, str]:
-    """The first cell of each row of the README's "What it measures" table and its figure cell."""
-    section = readme.split("## What it measures", 1)[1].split("\n## ", 1)[0]
-    rows = {}
+def _rows(page: str, heading: str) -> list[list[str]]:
+    """The cells of each row (not the header or rule) of the first table under ``heading`` of ``page``."""
+    section = page.split(f"## {heading}\n", 1)[1].split("\n## ", 1)[0]
+    rows = []
     for line in section.splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split(" | ")]
         if line.startswith("|") and len(cells) >= 3 and not set(cells[0]) <= {"-"}:
-            rows[cells[0]] = cells[1]
-    return rows
+            rows.append(cells)
+    return rows[1:]
+
+
+def _measures_table(page: str) -> dict[str, str]:
+    """The first cell of each row of docs/results.md's "Headline figures, in full" and its figure cell."""
+    return {cells[0]: cells[1] for cells in _rows(page, "Headline figures, in full")}
 
 
 def unmarked_numbers(cell: str) -> list[str]:
@@ -102,11 +113,24 @@ def test_a_stale_figure_is_caught_and_rewritten():
 
 
 @pytest.mark.parametrize("row", RECORDED_ROWS)
-def test_every_figure_of_a_recorded_readme_row_is_marked(row):
-    table = _measures_table((docs_figures.ROOT / "README.md").read_text(encoding="utf-8"))
+def test_every_figure_of_a_recorded_row_is_marked(row):
+    table = _measures_table((docs_figures.ROOT / "docs" / "results.md").read_text(encoding="utf-8"))
     (cell,) = [figure for what, figure in table.items() if what.startswith(row)]
-    assert MARKER.search(cell), f"README row {row!r} quotes no recorded figure"
-    assert not unmarked_numbers(cell), f"README row {row!r} quotes unmarked numbers {unmarked_numbers(cell)}"
+    assert MARKER.search(cell), f"results.md row {row!r} quotes no recorded figure"
+    assert not unmarked_numbers(cell), f"results.md row {row!r} quotes unmarked numbers {unmarked_numbers(cell)}"
+
+
+def test_the_readme_headline_figures_are_short_marked_and_linked():
+    readme = (docs_figures.ROOT / "README.md").read_text(encoding="utf-8")
+    rows = _rows(readme, "Headline figures")
+    assert 1 <= len(rows) <= README_ROWS_MAX, len(rows)
+    for what, figure, record in rows:
+        assert MARKER.search(figure) and not unmarked_numbers(figure), (what, unmarked_numbers(figure))
+        assert "](docs/results.md#" in record, what
+    assert len(readme.splitlines()) < README_LINES_MAX
+    long = [cell[:60] for line in readme.splitlines() if line.startswith("|")
+            for cell in line.strip().strip("|").split(" | ") if len(cell.strip()) > README_CELL_MAX]
+    assert not long, long
 
 
 def test_an_unmarked_number_in_a_row_is_caught():

@@ -1,6 +1,6 @@
 """
-No module outside the two registries treats a model kind by its name
-(issue 19): the kinds live in ``fitting/models/kinds.py`` (:class:`ModelKind`)
+No module outside the two registries treats a model kind by its name:
+the kinds live in ``fitting/models/kinds.py`` (:class:`ModelKind`)
 and ``fitting/fits/kinds.py`` (:class:`FitKind`), and every other module asks
 them. Read from the source with ``ast``: a comparison with a kind's name
 (``model == "rgb-conductor"``, ``kind in ("coated-conductor", ...)``) or a

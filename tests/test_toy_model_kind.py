@@ -1,5 +1,5 @@
 """
-The promise of issue 19: a third model kind is one registration per layer.
+A third model kind is one registration per layer.
 
 A toy kind, Schlick's approximation with a constant F0 per channel (3
 float16), registered here and nowhere else (its numpy model, its fit, its
@@ -26,8 +26,8 @@ from fitting.models.pack import (decode_pack, encode_pack, material_to_json, pac
                                  to_float16)
 from fitting.optics.library import library_material
 from preview_shaders.preview import PreviewRenderer
-from service.snippets import snippet
-from service.store import FitRecord
+from fitting.exports.snippets import SnippetMaterial, snippet
+from fitting.fits.metrics import headline
 
 TOY = "toy-schlick"
 
@@ -135,9 +135,9 @@ def test_the_packs_carry_the_toy(fitted, toy):
         "F0": [float(v) for v in fitted.packed.coefficients[0]]}
 
 
-def toy_record(fitted) -> FitRecord:
-    return FitRecord(id="d" * 32, kind="nk", material_id="Au", name="toy gold", source="test",
-                     material=material_to_json(fitted.packed), metrics=fitted.metrics)
+def toy_record(fitted) -> SnippetMaterial:
+    return SnippetMaterial(name="toy gold", source="test", fit_id="d" * 32, quality=headline(fitted.metrics),
+                           packed=fitted.packed)
 
 
 def test_the_glsl_snippet_has_the_toy(fitted):

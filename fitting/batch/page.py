@@ -90,7 +90,7 @@ def fit_page(
             )
             record["seconds"] = time.perf_counter() - t0
             return record
-        try:  # issue 21: a gap inside the visible range is data the fit refuses, not a failed fit
+        try:  # A gap inside the visible range is data the fit refuses, not a failed fit
             check_gaps(nk)
         except ValueError as error:
             record["reason"] = f"gap: {_reason(error)}"

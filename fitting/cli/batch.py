@@ -17,7 +17,6 @@ outputs without fitting anything).
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 

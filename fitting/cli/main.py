@@ -7,9 +7,11 @@ Command line
 -   ``library``: the built-in materials with their sources.
 -   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
     print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
-    (``coated-conductor``, the default, or ``rgb-conductor``).
--   ``reproduce``: writes ``docs/results.md``, the paper's Table 1 for all 22
-    conductors and the Section 4.3 float16 study.
+    (``coated-conductor``, the default, or ``rgb-conductor``); ``--snippet glsl`` / ``hlsl`` writes the
+    fit as a ready-to-paste shader snippet, ``--export FORMAT`` an export for one coating index.
+-   ``reproduce``: the paper's Table 1 for all 22 conductors and the Section
+    4.3 float16 study, printed and written to ``-o FILE`` (default a temporary
+    file; ``--write-docs``: ``docs/results.md``).
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
 -   ``batch --shelf main``: a selection of the refractiveindex.info database
     into one pack and report (:mod:`fitting.cli.batch`).
@@ -70,7 +72,7 @@ def _cmd_fit(args) -> int:
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
                        evaluate=not args.no_metrics, **extra)
     for warning in result.quality.get("warnings", []):
-        # Issue 21: sparse data or a model outside [0, 1] are said, and refused with --strict.
+        # Sparse data or a model outside [0, 1] are said, and refused with --strict.
         if args.strict and not in_range_verdict(result.quality):
             print(f"error: the fit of {nk.name!r}: {warning}; nothing written (--strict)", file=sys.stderr)
             return 3
@@ -82,6 +84,8 @@ def _cmd_fit(args) -> int:
             print(f"error: {what}; nothing written (--strict)", file=sys.stderr)
             return 3
         print(f"warning: {what}", file=sys.stderr)
+    if args.snippet is not None:
+        return _write_snippet(nk, result, args)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
     if args.output:
@@ -103,13 +107,29 @@ def _write_export(nk, args) -> int:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)
     else:
-        sys.stdout.write(body.decode("utf-8"))
+        sys.stdout.flush()
+        sys.stdout.buffer.write(body)
+    return 0
+
+
+def _write_snippet(nk, result, args) -> int:
+    from ..exports.snippets import SnippetMaterial, snippet
+    from ..fits.metrics import headline
+
+    material = SnippetMaterial(nk.name, nk.source, "python -m fitting fit", headline(result.metrics), result.packed)
+    text = snippet(args.snippet, [material], nk.name, "python -m fitting fit")
+    if args.output:
+        Path(args.output).write_text(text, encoding="utf-8")
+        print(f"wrote {args.output}", file=sys.stderr)
+    else:
+        sys.stdout.write(text)
     return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from .batch import add_batch_parser
+    from ..exports.formats import EXPORT_FORMATS
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
     from .scene import add_scene_parser
@@ -137,8 +157,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
-    p.add_argument("--export", choices=("mtlx", "openpbr", "blender", "gltf"),
+    p.add_argument("--export", choices=EXPORT_FORMATS,
                    help="write this export (docs/exports.md) to -o or stdout instead of a pack")
+    p.add_argument("--snippet", choices=("glsl", "hlsl"),
+                   help="write a ready-to-paste GLSL or HLSL snippet of the fit to -o or stdout instead of a pack")
     p.add_argument("--eta-i", type=float, default=1.5,
                    help="coating index of --export, [1, 3] (default 1.5)")
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
@@ -152,8 +174,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "larger fits sparse data with a warning in the result and the pack)")
     p.set_defaults(func=_cmd_fit)
 
-    p = sub.add_parser("reproduce", help="write docs/results.md (Table 1 and Section 4.3)")
-    p.add_argument("-o", "--output", default="docs/results.md", metavar="FILE")
+    p = sub.add_parser("reproduce", help="print Table 1 and write the results page (Table 1, Section 4.3, the worst point)")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("-o", "--output", metavar="FILE", help="write the page here (default: a new temporary file)")
+    where.add_argument("--write-docs", action="store_true", help="update docs/results.md")
     p.add_argument("--materials", help="comma-separated subset (default: all 22)")
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
@@ -164,6 +188,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from .plugins import load_plugins
+
+    try:
+        load_plugins()  # before the parser: a plugin's formats and kinds are among its choices
+    except ValueError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

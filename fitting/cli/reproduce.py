@@ -2,7 +2,9 @@
 Reproduction of the paper's results
 ===================================
 
-``python -m fitting reproduce`` writes ``docs/results.md``:
+``python -m fitting reproduce`` prints Table 1 and writes the results page
+(to ``-o FILE``, by default a new temporary file; ``--write-docs`` updates
+``docs/results.md``, keeping what follows :data:`END_MARKER` there):
 
 -   Table 1 for all 22 conductors: mean and max Delta E 2000 of ours (float16
     and float32, default objective), ours with the paper's linear-RGB
@@ -15,12 +17,15 @@ Reproduction of the paper's results
     against the paper's method, on the 22 and a sample of the shelf.
 
 :func:`reproduce` returns the page and its figures (``benchmarks/reproduce.py``
-records them for the figures the README quotes); :func:`run` writes the page.
+records them for the figures the README quotes); :func:`write_page` writes
+it; :func:`run` is the command.
 """
 
 from __future__ import annotations
 
+import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -35,7 +40,12 @@ from ..models.coated_conductor import coated_conductor_model
 from ..optics.library import LIBRARY, LIBRARY_NAMES, library_material
 from .reproduce_worst import SHELF_SAMPLE, worst_point_section
 
-__all__ = ["PAPER_TABLE_1", "reproduce_material", "reproduce", "run"]
+__all__ = ["PAPER_TABLE_1", "END_MARKER", "DOCS_PAGE", "reproduce_material", "reproduce", "write_page", "run"]
+
+END_MARKER = ("<!-- end of the part written by python -m fitting reproduce: "
+              "what follows is kept by --write-docs -->")
+"""The line after which the results page is kept as it is when the page is written again."""
+DOCS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "results.md"
 
 PAPER_TABLE_1 = {"Al": 0.09, "Au": 0.14, "Cu": 0.10, "Ta": 0.47, "Cr": 0.31}
 """Mean Delta E 2000 of the paper's model (Vernooij 2024, Table 1)."""
@@ -173,7 +183,7 @@ def reproduce(names=LIBRARY_NAMES, shelf=SHELF_SAMPLE) -> tuple[str, dict]:
     lines = [
         "# Results: the paper's Table 1 and Section 4.3, reproduced",
         "",
-        "Written by `python -m fitting reproduce` (do not edit by hand). "
+        "Written, down to the headline figures, by `python -m fitting reproduce --write-docs` (do not edit it by hand). "
         f"Conductors: {len(results)}; grid: 100 x 100 over cos theta in [0, 1] and eta_i in [1, 2.5] "
         "(the paper's 10,000 samples), reference at 1 nm, CIE 1931 2 degree observer, D60 (ACES white), "
         "linear ACEScg, Delta E 2000 with the ACES white as Lab reference white.",
@@ -203,19 +213,40 @@ def reproduce(names=LIBRARY_NAMES, shelf=SHELF_SAMPLE) -> tuple[str, dict]:
         "",
         *_float16_study(results),
         "",
-        # Issue 21: the max beside the mean, against the paper's method, on the library and the shelf.
+        # The max beside the mean, against the paper's method, on the library and the shelf.
         *worst_point_section({name: library_material(name) for name in names}, shelf),
         f"Run time: {time.perf_counter() - t0:.0f} s.",
         "",
+        END_MARKER,
     ]
     return "\n".join(lines), figures
 
 
+def write_page(text: str, path: Path) -> None:
+    """Write the page ``text`` to ``path``, followed by what followed :data:`END_MARKER` in the file there."""
+    kept = ""
+    if path.is_file():
+        old = path.read_text(encoding="utf-8")
+        if END_MARKER in old:
+            kept = old.split(END_MARKER, 1)[1]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text + kept, encoding="utf-8")
+
+
 def run(args) -> int:
     subset = getattr(args, "materials", None)
-    text, _ = reproduce(tuple(subset.split(",")) if subset else LIBRARY_NAMES, () if subset else SHELF_SAMPLE)
-    output = Path(getattr(args, "output", "docs/results.md"))
-    output.parent.mkdir(parents=True, exist_ok=True)
-    output.write_text(text)
-    print(f"wrote {output}")
+    names = tuple(subset.split(",")) if subset else LIBRARY_NAMES
+    text, _ = reproduce(names, () if subset else SHELF_SAMPLE)
+    if getattr(args, "write_docs", False):
+        output = DOCS_PAGE
+    elif getattr(args, "output", None):
+        output = Path(args.output)
+    else:
+        handle, name = tempfile.mkstemp(prefix="results-", suffix=".md")
+        os.close(handle)
+        output = Path(name)
+    write_page(text, output)
+    section = text.split("## Table 1, all 22 conductors", 1)[1].split("\n## ", 1)[0]
+    print(section.strip())
+    print(f"wrote {output}", file=sys.stderr)
     return 0

@@ -2,7 +2,7 @@
 The worst point, reproduced
 ===========================
 
-The ``docs/results.md`` section of issue 21: for the 22 conductors and a
+The ``docs/results.md`` section of the worst point: for the 22 conductors and a
 sample of the database shelf (:data:`SHELF_SAMPLE`), the mean and the max
 Delta E 2000 of the shipped float16 fit beside the paper's method as an
 outside auditor runs it (plain linear-RGB least squares on the same 100 x
@@ -35,7 +35,7 @@ SHELF_SAMPLE = (
     "main/Zn/Werner", "main/V/Werner", "main/Au/McPeak", "main/Al/Rakic", "main/W/Werner",
 )
 """Database pages of the shelf sample: the five where the max lost before
-the guard (issue 21) and nine more metals of the main shelf."""
+the guard and nine more metals of the main shelf."""
 
 _KINDS = ("coated-conductor", "rgb-conductor")
 

@@ -23,16 +23,14 @@ metal seen from air (:mod:`fitting.exports.seen_fit`,
 :mod:`fitting.exports.tool_fresnel` has the tools' base Fresnel terms and
 the earlier (naive) fidelity under the coat.
 
--   :data:`EXPORT_FORMATS`: media type and file suffix per format.
+-   :data:`EXPORT_FORMATS`: the registry of formats (:mod:`fitting.exports.formats`).
 -   :func:`export_material`: the document of a material in a format.
 """
 
 from __future__ import annotations
 
-from .blender import blender_script
-from .gltf import gltf_document
-from .mtlx import mtlx_document
-from .openpbr import openpbr_document
+from .formats import (EXPORT_FORMATS, ExportFormat, export_format, register_export_format,
+                      unregister_export_format)
 from .seen_fit import seen_fidelity
 from .tool_fresnel import TOOL_MODELS, export_fidelity, tool_curve
 from ..domain import check_eta_i
@@ -40,7 +38,10 @@ from .values import ETA_I_LIMITS, ExportValues, export_values
 
 __all__ = [
     "EXPORT_FORMATS",
-    "FORMAT_TOOLS",
+    "ExportFormat",
+    "register_export_format",
+    "unregister_export_format",
+    "export_format",
     "ETA_I_LIMITS",
     "ExportValues",
     "TOOL_MODELS",
@@ -52,35 +53,9 @@ __all__ = [
     "tool_curve",
 ]
 
-EXPORT_FORMATS = {
-    "mtlx": ("application/xml", "mtlx"),
-    "openpbr": ("application/xml", "openpbr.mtlx"),
-    "blender": ("text/x-python; charset=utf-8", "py"),
-    "gltf": ("model/gltf+json", "gltf"),
-}
-"""Format -> (media type, file suffix)."""
-
-FORMAT_TOOLS = {
-    "mtlx": ("mtlx",),
-    "openpbr": ("openpbr",),
-    "blender": ("blender", "blender-conductor"),
-    "gltf": ("gltf",),
-}
-"""Format -> the tools whose fitted values it carries (:mod:`fitting.exports.tool_layering`)."""
-
-_WRITERS = {
-    "mtlx": mtlx_document,
-    "openpbr": openpbr_document,
-    "blender": blender_script,
-    "gltf": gltf_document,
-}
-
-
 def check_format(format: str) -> str:
     """``format`` if it is one of :data:`EXPORT_FORMATS`, else ``ValueError``."""
-    if format not in EXPORT_FORMATS:
-        raise ValueError(f"`format` must be one of {', '.join(EXPORT_FORMATS)}, got {format!r}")
-    return format
+    return export_format(format).name
 
 
 def export_material(
@@ -116,7 +91,7 @@ def export_material(
         For an unknown format, eta_i outside [1, 3], a roughness outside
         [0, 1], or unusable n, k; the message names the argument.
     """
-    check_format(format)
+    writer = export_format(format)
     eta = check_eta_i(eta_i)
     if isinstance(fit_or_nk, ExportValues):
         if abs(fit_or_nk.eta_i - eta) > 1e-12:
@@ -124,12 +99,12 @@ def export_material(
                 f"`eta_i` must be the values' own {fit_or_nk.eta_i:g} for ExportValues, got {eta_i}"
             )
         values = fit_or_nk
-        missing = [tool for tool in FORMAT_TOOLS[format] if tool not in values.tools]
+        missing = [tool for tool in writer.tools if tool not in values.tools]
         if missing:
             raise ValueError(
                 f"`fit_or_nk` must carry the fitted values of {', '.join(missing)} for a "
                 f"{format} export (export_values(..., tools=None) fits them all)"
             )
     else:
-        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, FORMAT_TOOLS[format])
-    return _WRITERS[format](values).encode("utf-8")
+        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, writer.tools)
+    return writer.document(values)

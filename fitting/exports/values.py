@@ -14,7 +14,7 @@ degrees, against the tool's own layering of its coat over its base
 (:mod:`fitting.exports.tool_layering`), in Delta E 2000; they are
 :attr:`ExportValues.tools`. The rest of this docstring is the earlier,
 naive fit, kept as the baseline the seen fit is measured against (today's
-values before issue 22): the base's Fresnel fitted to the metal under the
+values before the seen fit): the base's Fresnel fitted to the metal under the
 coat at the same angle inside the coat.
 
 The naive target curve :math:`T(\\mu)` is the spectral reference under the coat
@@ -262,7 +262,7 @@ def export_values(
         origin = str(fit_or_nk.get("origin", "the fit's model curve under the coat"))
         seen = coated_stack_from_metal(view, eta, lambda mc: fit_or_nk["reflectance"](mc, eta))
         if seen.shape != (view.size, 3) or not np.all(np.isfinite(seen)):
-            raise ValueError(f"`fit_or_nk['reflectance']` must give finite (S, 3) RGB for S cos theta")
+            raise ValueError("`fit_or_nk['reflectance']` must give finite (S, 3) RGB for S cos theta")
     elif isinstance(fit_or_nk, dict) and {"n", "k"} <= set(fit_or_nk):
         name = str(fit_or_nk.get("name", "material"))
         source = str(fit_or_nk.get("source", ""))

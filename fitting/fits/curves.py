@@ -233,7 +233,7 @@ def fit_curves(
             seen[key] = outside_range(C16, eta_i_range).any(axis=-1).reshape(range_M.shape)
         return seen[key]
 
-    def in_range(C16) -> bool:  # issue 21: proven over the whole domain, not the grid only
+    def in_range(C16) -> bool:  # Proven over the whole domain, not the grid only
         return not outside(C16).any() and proven_in_range(C16, eta_i_range, max_cells=settings.proof_cells)
 
     def constrained(objective: str, dense=None) -> FitResult:
@@ -298,7 +298,7 @@ def fit_curves(
         dense_target = edited_target(base, curves, rgb_M, rgb_E, settings.blend_width)
         dense = (dense_target.reshape(-1, 3), rgb_M.ravel(), rgb_E.ravel())
         candidates = {settings.objective: result, "rgb": held(constrained("rgb", dense))}
-        # Issue 21 hook: kept by mean and max against the paper method (fitting.fits.curves_guard).
+        # Kept by mean and max against the paper method (fitting.fits.curves_guard).
         chosen, guard = guard_curve_choice(base, curves, settings.blend_width, candidates, settings.objective,
                                            "rgb", (target, mu, eta, weights), in_range)
         result = candidates[chosen]
@@ -319,7 +319,7 @@ def fit_curves(
         metrics["figure"] = {key: target[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at")}
     if result.guard is not None:
         metrics["guard"] = result.guard
-    if not solver.bounded:  # issue 21: [0, 1] proven or not over the whole domain
+    if not solver.bounded:  # [0, 1] proven or not over the whole domain
         metrics["range"] = range_report(C16, eta_i_range, settings.proof_cells)
     result.error = error
     result.metrics = metrics

@@ -5,7 +5,7 @@ The max of curve refits, guarded
 A curve refit (:func:`fitting.fits.curves.fit_curves`) with a base has two
 candidates: its own objective's fit and the paper's method (plain rgb least
 squares on the whole blended target). Kept by the mean alone, the refit
-could end with the worse max (issue 21: 5 of 8 edits, one by 3 Delta E).
+could end with the worse max (5 of 8 edits, one by 3 Delta E).
 
 -   :func:`guard_curve_choice`: the candidates scored on the whole blended
     target on :data:`fitting.fits.curves_score.SCORE_GRID`; when the own

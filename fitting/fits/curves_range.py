@@ -119,7 +119,7 @@ def in_range_fallback(C16, eta_i_range, max_cells: int = PROOF_CELLS) -> np.ndar
     """
     C = np.asarray(C16, dtype=np.float64).copy()
     bad = outside_range(to_float16(C), eta_i_range).any(axis=0)
-    # Issue 21: the whole domain, not the grid only (no proof asked of a channel the grid already refutes).
+    # The whole domain, not the grid only (no proof asked of a channel the grid already refutes).
     bad |= np.array([not bad[c] and not proven_in_range(to_float16(C), eta_i_range, c, max_cells)
                      for c in range(3)])
     if not bad.any():

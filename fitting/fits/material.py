@@ -33,7 +33,7 @@ from .worst_case import guard_reference
 __all__ = ["COATED_CONDUCTOR_FIT", "fit_material"]
 
 def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitResult) -> FitResult:
-    """Issue 21: the max guarded against the paper's method on a subsample of the scoring grid."""
+    """The max guarded against the paper's method on a subsample of the scoring grid."""
     guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
     return guarded_fit(
         target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
@@ -43,7 +43,7 @@ def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitRes
 
 
 def _quality(result: FitResult, eta_i_range, warnings) -> dict:
-    """Issue 21: the proof of [0, 1] over the whole domain and the data's warnings."""
+    """The proof of [0, 1] over the whole domain and the data's warnings."""
     return fit_quality(result.coefficients_float16, eta_i_range, warnings)
 
 

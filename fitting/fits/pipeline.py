@@ -60,7 +60,7 @@ class FitKind:
     guard
         ``guard(nk, target, cos_theta, eta_i, weights, eta_i_range, settings,
         mean_fit) -> FitResult``: the fit with its max guarded against the
-        paper's method (issue 21; :mod:`fitting.fits.guarded`), or None for
+        paper's method (:mod:`fitting.fits.guarded`), or None for
         a kind without one. Run when ``settings.guard_max`` and the objective
         is not the paper's own ``rgb``.
     quality
@@ -136,7 +136,7 @@ def fit_spectral(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    warnings = check_gaps(nk, settings.max_gap_nm)  # gaps inside the visible range (issue 21)
+    warnings = check_gaps(nk, settings.max_gap_nm)  # gaps inside the visible range
     if samples is None:
         samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
     mu, eta, weights = samples

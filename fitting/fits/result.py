@@ -126,8 +126,8 @@ class FitResult:
             timings=dict(timings),
             model=model,
         )
-    guard: dict[str, Any] | None = None  # issue 21: the worst-case guard's candidates (fitting.fits.guarded)
-    quality: dict[str, Any] = field(default_factory=dict)  # issue 21: range proof and data warnings (fitting.fits.fit_quality)
+    guard: dict[str, Any] | None = None  # The worst-case guard's candidates (fitting.fits.guarded)
+    quality: dict[str, Any] = field(default_factory=dict)  # Range proof and data warnings (fitting.fits.fit_quality)
 
     def with_coefficients(self, coefficients, coefficients_float16) -> "FitResult":
         """

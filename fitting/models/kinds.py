@@ -86,7 +86,7 @@ class ModelKind:
         linear ACEScg (a physics kernel: never raises on numbers).
     glsl_file, hlsl_file
         The kind's shader source: a file name in ``preview_shaders/glsl/``
-        (HLSL: ``service/templates/``) or an absolute path.
+        (HLSL: ``fitting/exports/templates/``) or an absolute path.
     glsl_function
         The function the snippet's material blocks call (its
         reachable helpers are kept, the rest dropped).
@@ -97,7 +97,7 @@ class ModelKind:
         gives them, zero-padded).
     material_template
         Template stem (``<stem>.glsl`` / ``<stem>.hlsl`` in
-        ``service/templates/``, or an absolute path without suffix) of a
+        ``fitting/exports/templates/``, or an absolute path without suffix) of a
         download's material block; it is given each parameter's values
         (padded to ``max_degree``) as ``${<parameter>}``.
     split_sum

@@ -6,7 +6,7 @@ Coverage (:func:`fitting.optics.nk.visible_coverage`) looks at the ends of
 the data only. Linear interpolation across a gap inside 360-830 nm invents
 the metal's colour there: an Au file without samples between 471 and 659 nm
 fits its own interpolation to about 0.1 Delta E while it is about 6 away
-from the real metal (issue 21).
+from the real metal.
 
 -   :data:`DEFAULT_MAX_GAP_NM`: the largest spacing of samples inside the
     visible range accepted by default.

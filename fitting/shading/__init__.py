@@ -2,7 +2,7 @@
 Shading
 =======
 
-The coated-conductor model as a renderer uses it (issue 11): the GGX
+The coated-conductor model as a renderer uses it: the GGX
 microfacet BRDF in the immersed and coated set-ups
 (:mod:`fitting.shading.microfacet`), the split-sum pre-integration for
 image-based lighting (:mod:`fitting.shading.ibl`) and the Monte Carlo ground

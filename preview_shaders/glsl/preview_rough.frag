@@ -1,5 +1,5 @@
 #version 430
-// The rough preview sphere (issue 11): the sphere of preview.frag with a
+// The rough preview sphere: the sphere of preview.frag with a
 // GGX lobe of perceptual roughness u_roughness, lit by image-based lighting
 // through the split sum (Karis 2013): the directional albedo from the
 // pre-integrated LUT (cf_ibl.glsl) times the environment prefiltered at the

@@ -15,7 +15,7 @@ Dependencies
 -   :data:`SingleFormFields`: a form field given twice (two ``file`` parts)
     is refused (422), not resolved silently to the last.
 -   :data:`PreviewsDep`: the app's render pool (previews and GL textures,
-    :class:`service.previews.PreviewRunner`).
+    :class:`service.runtime.previews.PreviewRunner`).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
     :data:`NOT_FOUND`: the error answers for the OpenAPI document.
 """
@@ -30,8 +30,7 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
 from ..jobs.common import stored_fit
-from ..pool import FitRunner
-from ..previews import PreviewRunner
+from ..runtime import FitRunner, PreviewRunner
 from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
 from ..store import FitRecord, Store
 

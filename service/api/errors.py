@@ -34,8 +34,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from ..pool import FitTimeout, Overloaded, WorkerLost
-from ..previews import RendererUnavailable
+from ..runtime import FitTimeout, Overloaded, RendererUnavailable, WorkerLost
 from ..store import StoreError
 
 __all__ = ["install_error_handlers", "error_response"]

@@ -176,7 +176,7 @@ async def _cancel_on_disconnect(app: ASGIApp, scope: Scope, body: bytes, receive
     """
     Run ``app`` on the read ``body`` while watching the connection: a client
     that goes away before its answer is complete cancels the request's task
-    (and with it the job it waits for, :meth:`service.pool.FitRunner.once`).
+    (and with it the job it waits for, :meth:`service.runtime.pool.FitRunner.once`).
     """
     disconnected = asyncio.Event()
     answered = False

@@ -4,7 +4,7 @@ Jobs
 
 One module per kind of fit; each validates its input once, gives it an id
 (:func:`service.jobs.common.content_address`), runs the CPU work in the
-fitting pool (:mod:`service.pool`) and saves what it made:
+fitting pool (:mod:`service.runtime.pool`) and saves what it made:
 
 -   :mod:`service.jobs.nk`: fits of measured n, k (a built-in material,
     inline data, an upload), and the curves of a stored fit for plotting.

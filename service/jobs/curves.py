@@ -37,7 +37,7 @@ from fitting.models.pack import material_from_json, material_to_json
 from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK
 
-from ..pool import FitRunner
+from ..runtime import FitRunner
 from ..store import FitRecord, Store
 from .common import (FIT_FORMAT_VERSION, check_finite, checked_version, checked_writable, content_address,
                      draft_nk_reference, fit_record, measured_nk, stored_fit, with_measured_nk)

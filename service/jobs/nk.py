@@ -36,7 +36,7 @@ from fitting.optics.library import library_material
 from fitting.optics.nk import SpectralNK, resample_nk
 from fitting.optics.readers import FORMATS, read_nk
 
-from ..pool import FitRunner
+from ..runtime import FitRunner
 from ..store import FitRecord, Store
 from .curves import target_at
 from .common import (
@@ -63,7 +63,7 @@ twice as fast as the float64 definition, its Delta E within 0.001 of it
 """
 
 PART_COST_S = 0.1
-"""Estimated seconds of each part of an n, k fit: its turn in the pool (:class:`service.turns.Turns`)."""
+"""Estimated seconds of each part of an n, k fit: its turn in the pool (:class:`service.runtime.turns.Turns`)."""
 
 
 @dataclass(frozen=True)
@@ -223,7 +223,7 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord
     StoreError
         When the store cannot take the save (checked before any fitting).
     Overloaded, FitTimeout, WorkerLost
-        From :class:`service.pool.FitRunner`.
+        From :class:`service.runtime.pool.FitRunner`.
     """
     stored = await asyncio.to_thread(store.get_fit, fit.fit_id)
     if stored is not None:

@@ -3,7 +3,7 @@ Previews
 ========
 
 -   :func:`render_preview`: the preview sphere of a stored fit as PNG bytes,
-    drawn in the render pool (:class:`service.previews.PreviewRunner`): one
+    drawn in the render pool (:class:`service.runtime.previews.PreviewRunner`): one
     job per distinct request in flight, never on the server's event loop.
 -   :func:`preview_png`: what a render process runs for it
     (:meth:`preview_shaders.preview.PreviewRenderer.render_preview` on the
@@ -17,8 +17,7 @@ import asyncio
 from fitting.models.pack import PackedMaterial, material_from_json
 from fitting.optics.nk import SpectralNK
 
-from ..previews import PreviewRunner
-from ..render_worker import renderer
+from ..runtime import PreviewRunner, renderer
 from ..store import FitRecord
 from .common import measured_nk
 
@@ -49,7 +48,7 @@ async def render_preview(runner: PreviewRunner, record: FitRecord, *, eta_i: flo
     ValueError
         A comparison of a fit made from curves alone (no n, k), or a view
         its model kind cannot draw.
-    service.previews.PreviewsBusy, PreviewTimeout, RenderWorkerLost, RendererUnavailable
+    service.runtime.previews.PreviewsBusy, PreviewTimeout, RenderWorkerLost, RendererUnavailable
     """
     packed, nk = await asyncio.to_thread(_inputs, record)
     if compare != "none" and nk is None:

@@ -41,7 +41,7 @@ from fitting.models.pack import (
 )
 from fitting.optics.library import LIBRARY_NAMES, library_material
 
-from ..pool import FitRunner
+from ..runtime import FitRunner
 from ..store import Store
 from .common import content_address, measured_nk, with_measured_nk
 

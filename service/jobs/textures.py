@@ -11,7 +11,7 @@ Reference textures
     (``GET /api/v1/environments/{name}/prefiltered``,
     :mod:`service.api.routes.environments`);
     :func:`environment_texture`: the same in a render process of the
-    render pool (:class:`service.previews.PreviewRunner`), on its renderer.
+    render pool (:class:`service.runtime.previews.PreviewRunner`), on its renderer.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from fitting.fits.curves_base import curve_base_from_nk
 from fitting.models.baselines import baseline_inputs
 from fitting.models.pack import material_from_json
 
-from ..render_worker import renderer
+from ..runtime import renderer
 from ..store import FitRecord
 from .common import measured_nk
 

@@ -13,9 +13,10 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
 
 from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
+from fitting.exports import EXPORT_FORMATS
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.bounded import excerpt
@@ -25,7 +26,7 @@ from ..jobs.nk import MAX_NK_SAMPLES
 
 __all__ = [
     "API_PREFIX", "INT64_MAX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
-    "EXPORT_FORMAT_NAMES", "MAX_EXPORT_PACK",
+    "DownloadFormat", "download_formats", "MAX_EXPORT_PACK",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
     "PackFormat", "Text", "RequestModel",
@@ -38,8 +39,6 @@ INT64_MAX = 2**63 - 1
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
-EXPORT_FORMAT_NAMES = ("mtlx", "openpbr", "blender", "gltf")
-"""Exports for one coating index (docs/exports.md); a pack of them is a zip archive."""
 MAX_EXPORT_PACK = 16
 """Most fits in one pack of exports (each export fits its tool's values, about 1 s)."""
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
@@ -52,6 +51,22 @@ LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
 ModelKind = Literal[tuple(MODEL_KINDS)]  # type: ignore[valid-type]
 PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
+
+
+def download_formats() -> tuple[str, ...]:
+    """Every download format: the pack formats, then the registered exports (:data:`fitting.exports.EXPORT_FORMATS`)."""
+    return (*PACK_FORMATS, *EXPORT_FORMATS)
+
+
+def _check_download_format(format: str) -> str:
+    if format not in PACK_FORMATS and format not in EXPORT_FORMATS:
+        raise ValueError(f"`format` must be one of {', '.join(map(repr, download_formats()))}, got {format!r}")
+    return format
+
+
+DownloadFormat = Annotated[str, AfterValidator(_check_download_format)]
+"""A pack format or a registered export (checked against the registry when the request is read, so a
+plugin's format counts; ``GET /api/v1/domain`` lists them)."""
 Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 

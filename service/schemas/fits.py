@@ -22,7 +22,7 @@ from .common import (
     DEFAULT_ETA_I_RANGE,
     DEFAULT_MODEL,
     DEFAULT_OBJECTIVE,
-    EXPORT_FORMAT_NAMES,
+    DownloadFormat,
     MAX_EXPORT_PACK,
     MAX_NK_SAMPLES,
     PACK_FORMATS,
@@ -31,7 +31,6 @@ from .common import (
     LibraryName,
     ModelKind,
     Objective,
-    PackFormat,
     RequestModel,
     Text,
 )
@@ -133,15 +132,15 @@ class PackRequest(RequestModel):
     model_config = ConfigDict(extra="forbid")
 
     fit_ids: list[FitId] = Field(min_length=1, max_length=256)
-    format: Literal[(*PACK_FORMATS, *EXPORT_FORMAT_NAMES)] = Field(  # type: ignore[valid-type]
-        "binary", description="binary | json | glsl | hlsl, or an export (mtlx | openpbr | blender "
-        f"| gltf: a zip archive of one file per fit, at most {MAX_EXPORT_PACK} fits)")
+    format: DownloadFormat = Field(
+        "binary", description="binary | json | glsl | hlsl, or an export format of `GET /api/v1/domain`'s "
+        f"`export_formats` (a zip archive of one file per fit, at most {MAX_EXPORT_PACK} fits)")
     eta_i: EtaI = Field(1.5, description="Coating index of an export, [1, 3]")
     name: Annotated[str, Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9._-]+$")] = "materials"
 
     @model_validator(mode="after")
     def _check_export_size(self) -> "PackRequest":
-        if self.format in EXPORT_FORMAT_NAMES and len(self.fit_ids) > MAX_EXPORT_PACK:
+        if self.format not in PACK_FORMATS and len(self.fit_ids) > MAX_EXPORT_PACK:
             raise ValueError(
                 f"`fit_ids` must hold at most {MAX_EXPORT_PACK} fits for an export pack "
                 f"({self.format}), got {len(self.fit_ids)}"

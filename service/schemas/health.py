@@ -13,7 +13,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field
 
-__all__ = ["Health", "Domain"]
+__all__ = ["Health", "Domain", "ExportFormatPublic"]
 
 
 class Health(BaseModel):
@@ -33,6 +33,16 @@ class Health(BaseModel):
         "the server's `server_connection_limit` (max_connections less the superusers' reserve)"))
 
 
+class ExportFormatPublic(BaseModel):
+    """One registered export format (:class:`fitting.exports.formats.ExportFormat`)."""
+
+    name: str = Field(description="The `format` of a download")
+    label: str = Field(description="What a menu shows, with the file extension")
+    media_type: str
+    extension: str = Field(description="The file name's suffix, without the leading dot")
+    options: list[str] = Field(description="The query parameters it takes (eta_i, roughness, coat_roughness)")
+
+
 class Domain(BaseModel):
     """The rules a client checks before sending (the service checks them again)."""
 
@@ -44,6 +54,7 @@ class Domain(BaseModel):
     default_objective: str
     library: list[str] = Field(description="The built-in conductors")
     pack_formats: list[str]
+    export_formats: list[ExportFormatPublic] = Field(description="Every export format, in menu order")
     curve_samples: list[int] = Field(min_length=2, max_length=2,
                                      description="Samples per edited curve, [min, max]")
     max_curves: int

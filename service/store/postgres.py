@@ -50,17 +50,14 @@ from psycopg import errors as pg_errors
 from psycopg_pool import ConnectionPool, PoolTimeout
 
 from . import queries, records
+from .sql import SQLStore
 from .migrations import SCHEMA_VERSION
 from .migrations import migrate as _migrate
 from .records import (
     FitRecord,
-    MaterialPage,
-    MaterialRow,
-    RecordDamaged,
     StoreError,
     StoreFull,
     StoreUnavailable,
-    VersionRow,
 )
 from .shared_check import SharedCheck
 
@@ -117,7 +114,7 @@ def _translate(error: Exception, where: str) -> StoreError:
                             retry_after=RETRY_AFTER_S)
 
 
-class PostgresStore:
+class PostgresStore(SQLStore):
     """
     :class:`Store` on PostgreSQL at ``url`` (``postgresql://user:password@host:port/db``).
 
@@ -132,6 +129,7 @@ class PostgresStore:
     """
 
     kind = "postgresql"
+    placeholder = "%s"
 
     def __init__(self, url: str, pool_min: int = 1, pool_max: int = 4, pool_timeout_s: float = 5.0,
                  statement_timeout_s: float = 30.0, connect_timeout_s: float = 5.0,
@@ -249,14 +247,6 @@ class PostgresStore:
         """``function(connection)`` in one transaction on a pooled connection; errors as :class:`StoreError`."""
         return self._read(function)
 
-    def _decode(self, fit_id: str, text: Any) -> FitRecord:
-        try:
-            return FitRecord.from_json(text)
-        except (TypeError, ValueError) as error:
-            log.error("stored fit %s cannot be decoded: %s", fit_id, error)
-            raise RecordDamaged(f"the stored record of fit {fit_id} is damaged and cannot be "
-                                "read; the rest of the store is unaffected") from None
-
     # -- the interface -----------------------------------------------------
 
     def put_fit(self, record: FitRecord, save: bool = True,
@@ -272,41 +262,6 @@ class PostgresStore:
 
         return self._read(write)
 
-    def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
-        text = self._read(lambda c: queries.get_nk(c, "%s", nk_id))
-        return None if text is None else records.nk_from_json(nk_id, text)
-
-    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
-        def sweep(connection: psycopg.Connection) -> int:
-            connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))  # no save half done
-            return queries.expire_drafts(connection, "%s", older_than, max_bytes)
-
-        return self._read(sweep)
-
-    def get_fit(self, fit_id: str) -> FitRecord | None:
-        text = self._read(lambda c: queries.get_text(c, "%s", fit_id))
-        return None if text is None else self._decode(fit_id, text)
-
-    def latest_fit(self, material_id: str) -> FitRecord | None:
-        """The latest decodable fit of a material (a damaged one is logged and passed over)."""
-        for fit_id, text in self._read(lambda c: queries.latest_texts(c, "%s", material_id)):
-            try:
-                return self._decode(fit_id, text)
-            except RecordDamaged:
-                continue
-        return None
-
-    def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
-        return self._read(lambda c: queries.latest_ids(c, "%s", material_ids))
-
-    def material_version(self, material_id: str) -> int:
-        return self._read(lambda c: queries.version_of(c, "%s", material_id))
-
-    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = queries.LISTED_KINDS,
-                      deleted: bool = False, query: str | None = None) -> MaterialPage:
-        return queries.page_of(self._read(
-            lambda c: queries.page_rows(c, "%s", after, limit, kinds, deleted, query)), limit)
-
     def _write(self, function: Callable[[psycopg.Connection], _T]) -> _T:
         """``function(connection)`` in one transaction holding the saves' advisory lock."""
         def write(connection: psycopg.Connection) -> _T:
@@ -314,45 +269,6 @@ class PostgresStore:
             return function(connection)
 
         return self._read(write)
-
-    def material(self, material_id: str) -> MaterialRow | None:
-        return self._read(lambda c: queries.material_row(c, "%s", material_id))
-
-    def find_material(self, kind: str, name: str) -> str | None:
-        return self._read(lambda c: queries.find_material(c, "%s", kind, name))
-
-    def rename_material(self, material_id: str, name: str) -> MaterialRow:
-        return self._write(lambda c: queries.rename(c, "%s", material_id, name))
-
-    def delete_material(self, material_id: str) -> MaterialRow:
-        return self._write(lambda c: queries.set_deleted(c, "%s", material_id, True))
-
-    def restore_material(self, material_id: str) -> MaterialRow:
-        return self._write(lambda c: queries.set_deleted(c, "%s", material_id, False))
-
-    def material_versions(self, material_id: str, before: int | None, limit: int) -> list[VersionRow]:
-        rows = self._read(lambda c: queries.version_texts(c, "%s", material_id, before, limit))
-        return [VersionRow(v, fit_id, saved_at, self._decoded(fit_id, text)) for v, fit_id, saved_at, text in rows]
-
-    def version_fit(self, material_id: str, version: int) -> FitRecord | None:
-        row = self._read(lambda c: queries.version_text(c, "%s", material_id, version))
-        return None if row is None else self._decode(*row)
-
-    def _decoded(self, fit_id: str, text: Any) -> FitRecord | None:
-        try:
-            return self._decode(fit_id, text)
-        except RecordDamaged:
-            return None
-
-    def saved_materials(self) -> list[MaterialRow]:
-        rows: list[MaterialRow] = []
-        cursor = None
-        while True:
-            page = self.material_page(cursor, 1000)
-            rows.extend(page.rows)
-            if page.next_cursor is None:
-                return rows
-            cursor = page.next_cursor
 
     def check(self) -> None:
         """The server answers and the schema is this code's (PostgreSQL checks its own pages)."""

@@ -17,18 +17,15 @@ from pathlib import Path
 from typing import Any, Callable, TypeVar
 
 from . import queries, records
+from .sql import SQLStore
 from .migrations import SCHEMA_VERSION
 from .migrations import migrate as _migrate
 from .records import (
     FitRecord,
-    MaterialPage,
-    MaterialRow,
-    RecordDamaged,
     StoreDamaged,
     StoreError,
     StoreFull,
     StoreUnavailable,
-    VersionRow,
 )
 
 log = logging.getLogger("service.store")
@@ -51,7 +48,7 @@ _WRITE_FLOOR_BYTES = 1_000_000
 """Free disk below which the store is not writable even with COATED_STORE_MIN_FREE_BYTES=0
 (a save writes its record, the journal and the index pages)."""
 
-class SQLiteStore:
+class SQLiteStore(SQLStore):
     """
     :class:`Store` on one SQLite file in WAL mode: one connection per
     thread (WAL lets readers run while a writer commits), ``synchronous=FULL``
@@ -66,6 +63,7 @@ class SQLiteStore:
     """
 
     kind = "sqlite"
+    placeholder = "?"
 
     def __init__(self, path: str | Path, max_bytes: int | None = None,
                  min_free_bytes: int = 0, migrate: bool = True) -> None:
@@ -139,14 +137,6 @@ class SQLiteStore:
                 self._connections.append(connection)
         return connection
 
-    def _decode(self, fit_id: str, text: Any) -> FitRecord:
-        try:
-            return FitRecord.from_json(text)
-        except (TypeError, ValueError) as error:
-            log.error("stored fit %s cannot be decoded: %s", fit_id, error)
-            raise RecordDamaged(f"the stored record of fit {fit_id} is damaged and cannot be "
-                                "read; the rest of the store is unaffected") from None
-
     # -- the interface -----------------------------------------------------
 
     def put_fit(self, record: FitRecord, save: bool = True,
@@ -163,43 +153,8 @@ class SQLiteStore:
 
         return self._guard(write)
 
-    def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
-        text = self._guard(lambda: queries.get_nk(self._connection(), "?", nk_id))
-        return None if text is None else records.nk_from_json(nk_id, text)
-
-    def expire_drafts(self, older_than: float, max_bytes: int) -> int:
-        def sweep() -> int:
-            connection = self._connection()
-            with connection:
-                connection.execute("BEGIN IMMEDIATE")  # the saves' write lock: none is half done
-                return queries.expire_drafts(connection, "?", older_than, max_bytes)
-
-        return self._guard(sweep)
-
-    def get_fit(self, fit_id: str) -> FitRecord | None:
-        text = self._guard(lambda: queries.get_text(self._connection(), "?", fit_id))
-        return None if text is None else self._decode(fit_id, text)
-
-    def latest_fit(self, material_id: str) -> FitRecord | None:
-        """The latest decodable fit of a material (a damaged one is logged and passed over)."""
-        for fit_id, text in self._guard(lambda: queries.latest_texts(self._connection(), "?", material_id)):
-            try:
-                return self._decode(fit_id, text)
-            except RecordDamaged:
-                continue
-        return None
-
-    def latest_fit_ids(self, material_ids: list[str]) -> dict[str, str]:
-        return self._guard(lambda: queries.latest_ids(self._connection(), "?", material_ids))
-
-    def material_version(self, material_id: str) -> int:
-        return self._guard(lambda: queries.version_of(self._connection(), "?", material_id))
-
-    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = queries.LISTED_KINDS,
-                      deleted: bool = False, query: str | None = None) -> MaterialPage:
-        rows = self._guard(lambda: queries.page_rows(self._connection(), "?", after, limit, kinds, deleted,
-                                                     query))
-        return queries.page_of(rows, limit)
+    def _read(self, function: Callable[[sqlite3.Connection], _T]) -> _T:
+        return self._guard(lambda: function(self._connection()))
 
     def _write(self, function: Callable[[sqlite3.Connection], _T]) -> _T:
         """``function(connection)`` in one write transaction holding the write lock (as saves do)."""
@@ -210,45 +165,6 @@ class SQLiteStore:
                 return function(connection)
 
         return self._guard(write)
-
-    def material(self, material_id: str) -> MaterialRow | None:
-        return self._guard(lambda: queries.material_row(self._connection(), "?", material_id))
-
-    def find_material(self, kind: str, name: str) -> str | None:
-        return self._guard(lambda: queries.find_material(self._connection(), "?", kind, name))
-
-    def rename_material(self, material_id: str, name: str) -> MaterialRow:
-        return self._write(lambda c: queries.rename(c, "?", material_id, name))
-
-    def delete_material(self, material_id: str) -> MaterialRow:
-        return self._write(lambda c: queries.set_deleted(c, "?", material_id, True))
-
-    def restore_material(self, material_id: str) -> MaterialRow:
-        return self._write(lambda c: queries.set_deleted(c, "?", material_id, False))
-
-    def material_versions(self, material_id: str, before: int | None, limit: int) -> list[VersionRow]:
-        rows = self._guard(lambda: queries.version_texts(self._connection(), "?", material_id, before, limit))
-        return [VersionRow(v, fit_id, saved_at, self._decoded(fit_id, text)) for v, fit_id, saved_at, text in rows]
-
-    def version_fit(self, material_id: str, version: int) -> FitRecord | None:
-        row = self._guard(lambda: queries.version_text(self._connection(), "?", material_id, version))
-        return None if row is None else self._decode(*row)
-
-    def _decoded(self, fit_id: str, text: Any) -> FitRecord | None:
-        try:
-            return self._decode(fit_id, text)
-        except RecordDamaged:
-            return None
-
-    def saved_materials(self) -> list[MaterialRow]:
-        rows: list[MaterialRow] = []
-        cursor = None
-        while True:
-            page = self.material_page(cursor, 1000)
-            rows.extend(page.rows)
-            if page.next_cursor is None:
-                return rows
-            cursor = page.next_cursor
 
     def check(self) -> None:
         try:

@@ -1,4 +1,4 @@
-// The editor an artist keeps open all day (issue 24): the library to
+// The editor an artist keeps open all day: the library to
 // browse (library_view.js), coat presets and typed entry (entry_view.js),
 // the materials an artist manages (manage_view.js: rename, delete and the
 // bin, versions, links) and compare mode (compare_view.js, with the
@@ -104,6 +104,9 @@ export class Studio {
   async #load() {
     const [presets, domain] = await Promise.all([api.coatPresets(), api.domain(), this.#library(), this.refresh()]);
     this.app.store.dispatch("presets", presets.presets);
+    api.setExportFormats(domain.export_formats);
+    $("export-formats").replaceChildren(...domain.export_formats.map(
+      ({ name, label }) => Object.assign(document.createElement("option"), { value: name, textContent: label })));
     const [lo, hi] = domain.visible_range_nm;
     $("upload-rule").textContent = `Measured n, k must cover at least ${Math.round(100 * domain.min_coverage)}% of ` +
       `${lo}–${hi} nm (the colour is integrated over that range; the data are held flat past their ends, ` +

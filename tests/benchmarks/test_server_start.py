@@ -13,7 +13,7 @@ from benchmarks.server_start import ROOT, by_kind, kind_of, main, start
 
 SERVER = "/r/.venv/bin/python -m service --port 40123 --data-dir /tmp/x"
 TRACKER = "/r/.venv/bin/python -B -c from multiprocessing.resource_tracker import main;main(15)"
-FORK_SERVER = "/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.preload'])"
+FORK_SERVER = "/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.runtime.preload'])"
 
 
 def test_kinds_by_command_line():

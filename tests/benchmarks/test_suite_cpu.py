@@ -22,7 +22,7 @@ CHROMIUM = "/usr/lib/chromium/chromium --headless --no-sandbox"
     (f"{CHROMIUM} --type=gpu-process --use-angle=swiftshader", "chromium_gpu"),
     (f"{CHROMIUM} --type=zygote", "chromium_other"),
     (f"{CHROMIUM} --remote-debugging-pipe", "chromium_browser"),
-    ("/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.preload'])",
+    ("/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.runtime.preload'])",
      "fork_servers"),
     ("/r/.venv/bin/python -m service --host 127.0.0.1 --port 40123 --data-dir /tmp/x", "servers"),
     (".venv/bin/python -m pytest -n 2 --dist loadscope", "pytest"),
@@ -43,7 +43,7 @@ def test_a_process_is_classed_by_its_command_line(command, key):
 def test_a_server_s_forks_are_fork_servers():
     server = "/r/.venv/bin/python -m service --host 127.0.0.1 --port 40123 --data-dir /tmp/x"
     assert classify(server, "pytest") == "servers"
-    assert classify(server, "servers") == "fork_servers"  # its fork server (service.fork_server.start_fork_server)
+    assert classify(server, "servers") == "fork_servers"  # its fork server (service.runtime.fork_server.start_fork_server)
     assert classify(server, "fork_servers") == "fork_servers"  # that fork server's workers
     assert classify(".venv/bin/python -m pytest", "servers") == "pytest"
 

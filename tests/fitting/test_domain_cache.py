@@ -33,7 +33,7 @@ def test_size_must_be_a_positive_integer(size):
 
 
 class TestOneFlightPerKey:
-    """Issue 20, item 7: concurrent cold gets share one build (the LUT, curve bases, measured curves)."""
+    """Concurrent cold gets share one build (the LUT, curve bases, measured curves)."""
 
     def _race(self, get, threads=8):
         import threading

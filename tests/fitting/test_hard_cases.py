@@ -31,14 +31,14 @@ UNIT_REFLECTANCE_BOUND = 1e-12
 GLSL_MODEL_REL = GLSL_F32_BOUND
 
 REFUSED = {"TiO2", "Au 400-900 nm"}
-GAP_REFUSED = {"Au 2 samples"}  # issue 21: a 470 nm gap inside 360-830 nm (fitting/optics/quality.py)
-# A dielectric fitted with the max guarded (issue 21): TiO2's mean rises from 0.971 to about 1.05
+GAP_REFUSED = {"Au 2 samples"}  # A 470 nm gap inside 360-830 nm (fitting/optics/quality.py)
+# A dielectric fitted with the max guarded: TiO2's mean rises from 0.971 to about 1.05
 # while its max falls from 12.6 to about 3.6 and the model comes inside [0, 1]. Which guard
 # candidate wins on this dielectric turns on the last bits of the solvers' BLAS and SIMD
 # arithmetic (the paper fit and SLSQP run LAPACK): measured on 40 x 40, the mean is 1.040 with
 # numpy's baseline kernels, 1.045 with OpenBLAS Prescott, 1.043 on the EPYC of 2026-12-01 and 1.060 on an
 # AVX-512 one (its own kernels, and OpenBLAS Haswell), the max 3.52-3.67. The bound 1.05 was
-# set from one of them and failed on another (issue 18); 1.10 is the documented figure
+# set from one of them and failed on another; 1.10 is the documented figure
 # (docs/hard-cases.md), above that spread with room for the CPUs not measured.
 MEAN_BOUND = {"TiO2 min_coverage 0.8": 1.10}
 TIR = {"SiO2", "water", "diamond"}

@@ -1,5 +1,5 @@
 """
-Issue 20, item 2: connection admission against a real ``python -m service``
+Connection admission against a real ``python -m service``
 on 127.0.0.1. A flood of idle connections only churns itself (a new
 connection closes the longest idle one), one address cannot hold more than
 its share, ``/healthz`` is answered even when every connection is busy, and
@@ -21,7 +21,7 @@ import pytest
 
 from conftest import server_process
 
-from service.server import IDLE_GRACE_S
+from service.runtime.server import IDLE_GRACE_S
 
 pytestmark = [pytest.mark.slow, pytest.mark.server]
 

@@ -1,8 +1,8 @@
 """
-Issue 20, item 4: drafts as references, with a life, against a real
+Drafts as references, with a life, against a real
 ``python -m service`` on 127.0.0.1. A draft refers to the stored record
 holding its n, k (100 live steps on a 20,000-sample upload add under 2 MB);
-on an inline n, k (issue 20, item 2's rest) to that n, k stored once as a
+on an inline n, k (item 2's rest) to that n, k stored once as a
 content-addressed n, k record (100 live steps on a 20,000-sample inline
 base add under 2 MB too); drafts past their time to live, or past the
 drafts' quota, are removed in the background with the n, k records no fit

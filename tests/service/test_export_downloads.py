@@ -185,7 +185,7 @@ class TestExportPacks:
 
 @pytest.mark.slow
 class TestExportPackNames:
-    """Issue 20, item 6: names that make one file name, and long names with one prefix."""
+    """Names that make one file name, and long names with one prefix."""
 
     NAMES = ["gold alloy", "gold_alloy", "gold/alloy", "Gold Alloy", "p" * 90 + "one", "p" * 90 + "two"]
 
@@ -194,7 +194,7 @@ class TestExportPackNames:
         import zipfile
 
         client, _ = shared
-        wavelength = [350.0, 450.0, 550.0, 650.0, 750.0, 850.0]  # no gap over the 120 nm limit (issue 21)
+        wavelength = [350.0, 450.0, 550.0, 650.0, 750.0, 850.0]  # no gap over the 120 nm limit
         ids = []
         for i, name in enumerate(self.NAMES):
             nk = {"wavelength_nm": wavelength, "n": [0.2 + 0.01 * i] * 6, "k": [3.0, 3.1, 3.2, 3.3, 3.4, 3.6]}

@@ -1,5 +1,5 @@
 """
-Issue 10 (items 3-9) against the service: host allow-list, slow clients,
+Faults against the service: host allow-list, slow clients,
 paged listing, storage faults, worker death, generated code and ids, edits
 in scenes and float32 bounds. Server tests run a real ``python -m service``
 on 127.0.0.1; every loop is bounded.
@@ -258,7 +258,7 @@ def test_serve_sets_its_stop_handlers_in_the_main_thread_only(monkeypatch, tmp_p
 
     import uvicorn
 
-    from service import server as server_module
+    from service.runtime import server as server_module
     from service.config import Settings
     from service.main import create_app
 
@@ -301,8 +301,8 @@ def _children(pid: int) -> list[int]:
 def _worker_pids(server_pid: int) -> list[int]:
     """
     The server's fitting workers: the children of its fork server
-    (:func:`service.worker.process_context`), itself a child of the server
-    (a fork of it, :func:`service.fork_server.start_fork_server`), as is
+    (:func:`service.runtime.worker.process_context`), itself a child of the server
+    (a fork of it, :func:`service.runtime.fork_server.start_fork_server`), as is
     multiprocessing's resource tracker, which has none.
     """
     return [worker for child in _children(server_pid) for worker in _children(child)]
@@ -359,7 +359,7 @@ def _threads(pid: int) -> int:
 def test_the_fork_server_is_forked_only_where_multiprocessing_would_start_the_same():
     from multiprocessing.forkserver import ForkServer
 
-    from service.fork_server import _cannot_fork_server
+    from service.runtime.fork_server import _cannot_fork_server
 
     assert _cannot_fork_server(ForkServer(), 1) is None
     assert "2 Python threads run" in _cannot_fork_server(ForkServer(), 2)
@@ -376,7 +376,7 @@ def test_the_fork_server_is_forked_only_where_multiprocessing_would_start_the_sa
 def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_starts_its_own(tmp_path):
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server, \
             loopback.Client(base_url=server.url, timeout=120) as http:
-        # Started before the first thread (service.fork_server.start_fork_server): the server's own
+        # Started before the first thread (service.runtime.fork_server.start_fork_server): the server's own
         # command line, one thread, and the workers are its forks.
         fork_servers = _fork_servers(server.process.pid)
         assert len(fork_servers) == 1
@@ -388,10 +388,10 @@ def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_
         assert all(_cmdline(worker) == _cmdline(server.process.pid) for worker in workers)
         assert http.post(f"{API}/fits", json={"name": "first", "nk": gold_like_nk(0.1)}).status_code == 201
         # Killed with its workers: the pool breaks, and the next one's workers come from the fork
-        # server multiprocessing starts (a new interpreter importing service.preload).
+        # server multiprocessing starts (a new interpreter importing service.runtime.preload).
         for pid in (fork_server, *workers):
             os.kill(pid, signal.SIGKILL)
-        # The job that finds the pool broken runs once more, on the new one (service.pool).
+        # The job that finds the pool broken runs once more, on the new one (service.runtime.pool).
         after = http.post(f"{API}/fits", json={"name": "after", "nk": gold_like_nk(0.2)})
         assert after.status_code == 201, after.text
         # Once for the workers' death; once more when the killed fork server had not yet exited as the
@@ -401,7 +401,7 @@ def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_
         fork_servers = _fork_servers(server.process.pid)
         assert len(fork_servers) == 1 and fork_servers[0] != fork_server
         assert b"from multiprocessing.forkserver import main" in _cmdline(fork_servers[0])
-        assert b"service.preload" in _cmdline(fork_servers[0])
+        assert b"service.runtime.preload" in _cmdline(fork_servers[0])
 
 
 def _run_script(script: str, *args: str, env: dict | None = None, timeout_s: float) -> dict:
@@ -416,9 +416,9 @@ DYING_FORK_SERVER = r"""
 import asyncio, os, socket, subprocess, sys, tempfile, threading, time
 from multiprocessing import forkserver
 
-import service.fork_server
-from service.pool import FitRunner, WorkersNotStarted
-from service.previews import PreviewRunner, RenderWorkerLost
+import service.runtime.fork_server
+from service.runtime.pool import FitRunner, WorkersNotStarted
+from service.runtime.previews import PreviewRunner, RenderWorkerLost
 
 
 def dying_fork_server(exit_after_s):
@@ -465,7 +465,7 @@ async def main():
     fork_server_is_new = forkserver._forkserver._forkserver_pid not in (None, dying.pid)
 
     # One that does not exit (within a bound shortened from 5 s): three failed starts, then a 503.
-    service.fork_server.FORK_SERVER_EXIT_S = 0.2
+    service.runtime.fork_server.FORK_SERVER_EXIT_S = 0.2
     runner = FitRunner(1, 4, timeout_s=60.0)
     dying = dying_fork_server(60)
     try:
@@ -535,8 +535,8 @@ STUCK_POOLS = r"""
 import asyncio, os, sys, time
 
 from killed_while_sending import result_killed_while_sent_once as job
-from service.pool import FitRunner
-from service.previews import PreviewRunner, RenderWorkerLost
+from service.runtime.pool import FitRunner
+from service.runtime.previews import PreviewRunner, RenderWorkerLost
 
 SIZE = 64 << 20
 here = sys.argv[1]
@@ -569,7 +569,7 @@ print(repr(asyncio.run(main())))
 @pytest.mark.slow
 def test_a_worker_killed_while_it_sends_a_result_does_not_hang_its_pool(tmp_path):
     # Python's ProcessPoolExecutor waits forever for the rest of a result whose worker was killed while
-    # it wrote it (service.executors); the job then runs again as after any worker's death (fit), or is
+    # it wrote it (service.runtime.executors); the job then runs again as after any worker's death (fit), or is
     # answered 503 and the next renders (preview). Without the watch, the script hangs (its timeout).
     (tmp_path / "killed_while_sending.py").write_text(KILLED_WHILE_SENDING)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, (str(tmp_path), os.environ.get("PYTHONPATH"))))}
@@ -578,13 +578,13 @@ def test_a_worker_killed_while_it_sends_a_result_does_not_hang_its_pool(tmp_path
     assert seen["fit"]["bytes"] == 64 << 20 and seen["fit"]["restarts"] == 1, seen
     assert "the render process of this preview died" in seen["preview_first"], seen
     assert seen["preview_second"] == 64 << 20, seen
-    # Unstuck after the worker had been dead service.executors.STUCK_S (3 s), well within the 60 s limit.
+    # Unstuck after the worker had been dead service.runtime.executors.STUCK_S (3 s), well within the 60 s limit.
     assert seen["fit"]["seconds"] < 30 and seen["preview_first_s"] < 30, seen
 
 
 @pytest.mark.slow
 def test_timed_out_fit_is_cancelled_and_its_worker_freed(tmp_path):
-    # Issue 20: a job whose request was answered 504 no longer runs on. The job must outlast the
+    # A job whose request was answered 504 no longer runs on. The job must outlast the
     # limit and the workers' 0.1 s checks on any machine: 400 x 400 metrics take 0.9 s of the job here
     # (a fit with 10 took 0.05 s on a warm worker, and passed only while a fresh worker's start made
     # up the rest).
@@ -663,7 +663,7 @@ def test_edit_at_the_float32_rounded_upper_end(tmp_path):
         assert response.status_code == 201, response.text
 
 
-# -- issue 20: a client that goes away cancels its job ------------------------------
+# -- a client that goes away cancels its job ------------------------------
 
 @pytest.mark.slow
 @pytest.mark.server

@@ -1,5 +1,5 @@
 """
-One figure end to end (issue 19): for the same saved fit, the API's
+One figure end to end: for the same saved fit, the API's
 ``metrics.figure``, the pack JSON's ``metrics.figure`` and the GLSL and HLSL
 headers quote the same numbers, with the same words for what they are
 measured against (the measured metal for an n, k fit, your edited curves

@@ -1,7 +1,7 @@
 """
-The garbage collector's full passes kept off the request path (issue 20):
+The garbage collector's full passes kept off the request path:
 the server and every fitting worker freeze what start-up made
-(service.worker.freeze_heap), so a full collection traverses only what
+(service.runtime.worker.freeze_heap), so a full collection traverses only what
 requests made since; the service thaws it at shutdown. Before, a full
 collection of 60-86 ms in the server landed on a live refit step
 (benchmarks/live_overhead.py --gc-trace).
@@ -15,7 +15,7 @@ import gc
 import pytest
 from conftest import app_client
 
-from service.pool import FitRunner
+from service.runtime.pool import FitRunner
 
 pytestmark = pytest.mark.slow  # worker processes, an in-process service
 

@@ -1,10 +1,10 @@
 """
-Issue 20, item 1, as a fresh corpus against a real ``python -m service`` on
+Hostile input as a fresh corpus against a real ``python -m service`` on
 127.0.0.1: worst-case curve refits (degenerate bases, edits the model cannot
 follow), generated with a fixed seed, ten at once on two workers. Every one
 is answered 2xx within its budget, in [0, 1] (a best effort when flagged),
 and a library fit sent meanwhile is answered within 2 s: parts take turns
-in the workers cheapest first (service/turns.py).
+in the workers cheapest first (service/runtime/turns.py).
 """
 
 from __future__ import annotations

@@ -455,7 +455,7 @@ def gen_non_finite(rng: random.Random) -> list[Case]:
         literal = rng.choice(["nan", "inf", "-inf", "NaN", "1e999", "Infinity"])
         text = f"wavelength_nm,n,k\n400,1,1\n500,{literal},1\n600,1,1\n"
         cases.append(upload("non_finite", f"csv-{literal}-{i}", text, "nan.csv", r"finite"))
-    eta = [f'{{"material": "Au", "eta_i_range": [NaN, 2]}}', '{"material": "Au", "eta_i_range": [1, Infinity]}',
+    eta = ['{"material": "Au", "eta_i_range": [NaN, 2]}', '{"material": "Au", "eta_i_range": [1, Infinity]}',
            '{"name": "s", "materials": [{"material": "Au", "eta_i": NaN}]}']
     for i, text in enumerate(eta):
         path = f"{API}/scenes" if "materials" in text else f"{API}/fits"

@@ -1,5 +1,5 @@
 """
-Issue 20, items 9 and 10, as classes against a real ``python -m service``
+Small hostile inputs, as classes against a real ``python -m service``
 on 127.0.0.1 (a fresh corpus, seeded): integers past 64 bits in queries,
 ``Host`` values with junk after the name, request headers past 16 KiB,
 repeated form parts, malformed multipart (422, as the docs say), and

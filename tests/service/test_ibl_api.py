@@ -1,5 +1,5 @@
 """
-Issue 11 in the service: the rough / coated preview query, the LUT download
+The service's rough / coated preview query, the LUT download
 and the split-sum functions in the GLSL and HLSL pack downloads.
 """
 

@@ -1,5 +1,5 @@
 """
-service.pool (issue 20): every part of a job has a CPU-time limit, and a job
+service.runtime.pool: every part of a job has a CPU-time limit, and a job
 no request waits for any more (timed out, or its client gone) is cancelled,
 its worker free within a second. Real worker processes (forked by the fork server).
 """
@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from service.pool import FitRunner, FitTimeout, JobCPULimit, Quarantined, WorkerLost
+from service.runtime.pool import FitRunner, FitTimeout, JobCPULimit, Quarantined, WorkerLost
 
 pytestmark = pytest.mark.slow
 
@@ -30,7 +30,7 @@ def degenerate_refit() -> float:
 
 
 def worker_modules() -> dict:
-    """In a worker: what it started with (from the fork server's service.preload)."""
+    """In a worker: what it started with (from the fork server's service.runtime.preload)."""
     import sys
 
     from fitting.colour import reference
@@ -153,7 +153,7 @@ def test_a_job_that_kills_its_workers_fails_only_itself_and_is_quarantined():
 
 
 def test_turns_let_the_cheapest_waiting_part_go_first():
-    from service.turns import Turns
+    from service.runtime.turns import Turns
 
     async def body():
         turns, order = Turns(1), []
@@ -182,7 +182,7 @@ def test_express_turns_take_cheap_parts_only_and_keep_expensive_work_at_n():
     once on an express turn; an expensive part waits (it never takes an
     express turn); a freed express turn goes to the next cheap part only.
     """
-    from service.turns import Turns
+    from service.runtime.turns import Turns
 
     async def body():
         turns, started = Turns(1, express=1, express_cost_s=0.1), []
@@ -223,7 +223,7 @@ def test_express_turns_take_cheap_parts_only_and_keep_expensive_work_at_n():
 
 
 def test_turns_refuse_bad_counts():
-    from service.turns import Turns
+    from service.runtime.turns import Turns
 
     with pytest.raises(ValueError, match="`n` must be >= 1"):
         Turns(0)

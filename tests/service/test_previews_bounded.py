@@ -1,7 +1,7 @@
 """
-Issue 20, item 8: previews off the event loop, against a real
+Previews off the event loop, against a real
 ``python -m service`` on 127.0.0.1. Previews render in the render pool's
-processes (service/previews.py), so ``/healthz`` answers within 0.5 s p99
+processes (service/runtime/previews.py), so ``/healthz`` answers within 0.5 s p99
 while two 1024 px rough coated reference previews render; previews past
 ``COATED_MAX_PREVIEWS_IN_FLIGHT`` are refused (503 + Retry-After) while
 identical ones share a render; a preview whose client goes away, or that
@@ -157,7 +157,7 @@ def test_time_limit_504_and_cpu_limit_422(tmp_path):
 
 
 def test_a_render_that_does_not_stop_at_its_checks_is_killed():
-    from service.previews import PreviewRunner, PreviewTimeout
+    from service.runtime.previews import PreviewRunner, PreviewTimeout
 
     async def scenario() -> tuple[float, int]:
         runner = PreviewRunner(1, timeout_s=120, cpu_limit_s=60, cancel_grace_s=1.0)
@@ -189,7 +189,7 @@ def test_a_job_starts_after_what_a_stopped_one_left_on_the_render_thread(monkeyp
     # it was in runs on there; the next job's clock must not start beside it.
     import types
 
-    import service.render_worker as render_worker
+    import service.runtime.render_worker as render_worker
     from preview_shaders.gl import RenderThread
 
     with RenderThread() as thread:

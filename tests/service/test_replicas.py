@@ -1,5 +1,5 @@
 """
-Issue 25: two service replicas on one PostgreSQL store, as real processes
+Two service replicas on one PostgreSQL store, as real processes
 on loopback ports (``server_process`` with ``COATED_STORE_URL``) against a
 real PostgreSQL server the tests start (``postgres_server``):
 

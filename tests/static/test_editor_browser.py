@@ -116,11 +116,11 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     edited_red = page.get_attribute("path.target.c0", "d")
     assert edited_red != reference_red
     expect(page.locator("#de-label")).to_contain_text("edited curves")
-    # Issue 19: the editor, the JSON and the shader headers show one figure for one fit.
+    # The editor, the JSON and the shader headers show one figure for one fit.
     fit_json = page.request.get(f"{editor_url}api/v1/fits/{edited_id}").json()
     figure = fit_json["metrics"]["figure"]
     assert page.inner_text("#de-mean") == f"{figure['delta_E_mean']:.3f}"
-    # Issue 21: the worst point beside the mean, and where it is.
+    # The worst point beside the mean, and where it is.
     at = figure["max_at"]
     assert page.inner_text("#de-max") == f"{figure['delta_E_max']:.3f} at {at['theta_deg']:.0f}°, ηᵢ {at['eta_i']:.2f}"
     assert page.inner_text("#de-label").startswith(f"Against {figure['against']}, mean ΔE")

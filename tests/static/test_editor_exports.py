@@ -1,6 +1,6 @@
 """
-Every download from the editor, in a real Chromium against a real server
-(issue 24): binary, JSON, GLSL and HLSL packs and the MaterialX, OpenPBR,
+Every download from the editor, in a real Chromium against a real server:
+binary, JSON, GLSL and HLSL packs and the MaterialX, OpenPBR,
 Blender and glTF exports, each at the preview's eta_i, roughness and coat
 roughness, each arriving under a name that says what it is; and saving
 again the material one saved (or opened) continues it: the next version,

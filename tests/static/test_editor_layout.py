@@ -1,5 +1,5 @@
 """
-The editor's layout in a real Chromium against a real server (issue 24,
+The editor's layout in a real Chromium against a real server (
 "a layout for every window"): at 1280, 880, 800 and 390 px wide a dragged
 point stays under the pointer from the first move of the first edit on
 (nothing above the plot changes height: "No edits yet." becoming the row

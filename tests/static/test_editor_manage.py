@@ -1,6 +1,6 @@
 """
-The materials an artist manages, in a real Chromium against a real server
-(issue 24): the saved list holds saved edits only (an upload is under
+The materials an artist manages, in a real Chromium against a real server:
+the saved list holds saved edits only (an upload is under
 Uploads in the picker, drafts nowhere); rename; delete to the bin and
 restore (Undo, or from the bin), with the API token when the service wants
 one; the versions of a material (an older one opened with its edit,
@@ -135,7 +135,7 @@ def test_versions_open_download_and_continue(pages, editor_url):
     rows = page.locator("#versions-list li")
     expect(rows).to_have_count(2)
     assert rows.evaluate_all("els => els.map(e => e.dataset.version)") == ["2", "1"]
-    # Each version's figures: the mean and the worst point (issue 21).
+    # Each version's figures: the mean and the worst point.
     for row in api(page, f"/materials/{material}/versions")["versions"]:
         expect(page.locator(f"#versions-list li[data-version='{row['version']}']")).to_contain_text(
             f"ΔE₀₀ {row['delta_E_mean']:.2f}, max {row['delta_E_max']:.2f}")

@@ -1,5 +1,5 @@
 """
-The preview says why eta_i matters with the clear coat off (issue 24, item
+The preview says why eta_i matters with the clear coat off (item
 7): the metal's n, k count relative to the medium it is in, so eta_i
 changes its colour with no coat on top; with the coat on the line goes.
 """

@@ -1,5 +1,5 @@
 """
-An rgb-conductor fit opens in the editor (issue 19): a curve fit of the
+An rgb-conductor fit opens in the editor: a curve fit of the
 rgb-conductor kind (POST /api/v1/fits/from-curves with ``"model":
 "rgb-conductor"``), saved and picked in the material list, opens in a real
 Chromium (SwiftShader WebGL2) against a real server with no console error;

@@ -1,5 +1,5 @@
 """
-The editor an artist keeps open all day (issue 24), in a real Chromium
+The editor an artist keeps open all day, in a real Chromium
 against a real server: the library to browse (search by name, symbol or
 source; swatches at the current eta_i; open a metal from it), the coat
 presets and typed entry (eta_i and the selected point's value, checked,

@@ -18,7 +18,7 @@ The body is little-endian float32 RGB (linear ACEScg), row-major
     (``cf_equirect_uv`` in ``cf_prefiltered_environment.glsl``).
 
 The environment is drawn in a process of the render pool
-(:class:`service.previews.PreviewRunner`, on its renderer's GL thread; 503
+(:class:`service.runtime.previews.PreviewRunner`, on its renderer's GL thread; 503
 without a GL driver) and prefiltered once per process (cached on disk: the
 first request of a machine takes seconds, later ones milliseconds).
 """

@@ -16,16 +16,16 @@ from the store (200) without refitting; a new fit answers 201.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated
 
 from fastapi import APIRouter, File, Form, Query, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
-from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, export_response, pack_response, render_export
+from ...downloads import PACK_CONTENT, export_response, is_export, pack_response, render_export
 from ...jobs.common import stored_fit
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
-from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, PACK_FORMATS,
+from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, DownloadFormat,
                         CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
@@ -38,7 +38,6 @@ CREATED = {
     status.HTTP_200_OK: {"model": FitPublic, "description": "Served from the store"},
     status.HTTP_201_CREATED: {"model": FitPublic, "description": "Fitted and saved"},
 }
-DownloadFormat = Literal[(*PACK_FORMATS, *EXPORT_MEDIA_TYPES)]  # type: ignore[valid-type]
 EtaForm = Annotated[float, Form(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)]
 
 
@@ -109,10 +108,10 @@ def get_fit(record: StoredFit) -> FitPublic:
 async def get_pack(
     fit_id: FitIdPath, store: StoreDep, runner: RunnerDep,
     format: Annotated[DownloadFormat, Query(
-        description="binary | json | glsl | hlsl | mtlx | openpbr | blender | gltf")] = "binary",
+        description="binary | json | glsl | hlsl, or an export format (`GET /api/v1/domain`: `export_formats`)")] = "binary",
     eta_i: Annotated[float, Query(
         ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-        description="Coating index of an export (mtlx, openpbr, blender, gltf), [1, 3]")] = 1.5,
+        description="Coating index of an export, [1, 3]")] = 1.5,
     roughness: RoughnessQuery = 0.2, coat_roughness: CoatRoughnessQuery = 0.03,
 ) -> Response:
     """
@@ -126,7 +125,7 @@ async def get_pack(
     """
     record = stored_fit(store, fit_id)  # after the query is validated: 422 before 404
     stem = f"{record.name}-{record.id[:8]}"
-    if format in EXPORT_MEDIA_TYPES:
+    if is_export(format):
         # An export fits its tool's values (up to about a second of CPU): a job in the
         # fitting pool, with its CPU limit and timeout, shared by identical requests.
         body = await runner.once(

@@ -18,6 +18,7 @@ from fastapi import APIRouter, status
 
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 from fitting.domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM
+from fitting.exports.formats import describe_export_formats
 from fitting.fits.settings import OBJECTIVES
 from fitting.optics.library import LIBRARY_NAMES
 
@@ -59,15 +60,18 @@ async def healthz(store: StoreDep, runner: RunnerDep, previews: PreviewsDep) -> 
     )
 
 
-DOMAIN = Domain(
-    eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE), objectives=list(OBJECTIVES),
-    default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES), pack_formats=list(PACK_FORMATS),
-    curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
-    max_nk_samples=MAX_NK_SAMPLES, visible_range_nm=list(VISIBLE_RANGE_NM), min_coverage=DEFAULT_MIN_COVERAGE,
-)
+def current_domain() -> Domain:
+    """The rules and defaults, with the export formats registered now (a plugin's among them)."""
+    return Domain(
+        eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE),
+        objectives=list(OBJECTIVES), default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES),
+        pack_formats=list(PACK_FORMATS), export_formats=describe_export_formats(),
+        curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
+        max_nk_samples=MAX_NK_SAMPLES, visible_range_nm=list(VISIBLE_RANGE_NM), min_coverage=DEFAULT_MIN_COVERAGE,
+    )
 
 
 @router.get(f"{API_PREFIX}/domain", response_model=Domain)
 async def domain() -> Domain:
     """The rules and defaults of the API's inputs (the editor reads them instead of repeating them)."""
-    return DOMAIN
+    return current_domain()

@@ -4,14 +4,14 @@ Packs
 
 ``POST /api/v1/packs``: several stored fits in one download (a scene's
 materials together), in any pack format, or their exports for one coating
-index as a zip archive (mtlx, openpbr, blender, gltf). Reads only; saves
+index as a zip archive (any registered export format). Reads only; saves
 nothing.
 """
 
 from fastapi import APIRouter, Response, status
 from fastapi.concurrency import run_in_threadpool
 
-from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, pack_response, render_export_pack
+from ...downloads import PACK_CONTENT, is_export, pack_response, render_export_pack
 from ...jobs.common import stored_fit
 from ...schemas import API_PREFIX, PackRequest
 from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep
@@ -30,7 +30,7 @@ async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep) 
     the same name are refused (422) rather than shipped ambiguously.
     """
     records = await run_in_threadpool(_records, store, request.fit_ids)
-    if request.format in EXPORT_MEDIA_TYPES:
+    if is_export(request.format):
         # Each export fits its tool's values (up to about a second of CPU): a job in the
         # fitting pool, with its CPU limit and timeout, shared by identical requests.
         body = await runner.once(

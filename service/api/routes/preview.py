@@ -7,7 +7,7 @@ Preview
 preview sphere of a stored fit (``preview_shaders.preview``), optionally
 split with adjusted Lazanyi or the spectral reference (these need the
 fit's n, k). Rendered and encoded in the render pool
-(:class:`service.previews.PreviewRunner`, :func:`service.jobs.previews.render_preview`),
+(:class:`service.runtime.previews.PreviewRunner`, :func:`service.jobs.previews.render_preview`),
 never in the server process: at most ``max_previews_in_flight`` previews
 render at once (the spectral reference of a large preview is seconds of
 CPU), past it a request is answered 503 with Retry-After rather than

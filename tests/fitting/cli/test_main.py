@@ -63,7 +63,7 @@ def test_fit_user_file(tmp_path):
 
 @pytest.mark.slow  # starts processes
 def test_sparse_file_refused_or_fitted_with_a_warning(tmp_path):
-    # Issue 21: three samples leave gaps of 250 nm inside 360-830 nm.
+    # Three samples leave gaps of 250 nm inside 360-830 nm.
     path = tmp_path / "sparse.csv"
     path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n600,0.6,3.0\n850,0.8,4.5\n")
     refused = run("fit", "--nk", str(path), "--no-metrics", check=False)
@@ -107,7 +107,11 @@ def test_errors_are_clear():
 @pytest.mark.slow  # 4.3 s (all cases 4.3 s) in a --durations=0 run
 def test_reproduce_subset(tmp_path):
     out = tmp_path / "results.md"
+    out.write_text("old\n<!-- end of the part written by python -m fitting reproduce: what follows is kept by "
+                   "--write-docs -->\n\n## Kept\n")
     result = run("reproduce", "--materials", "Au,Ta", "-o", str(out))
-    assert "2/2" in result.stderr  # progress bar
+    assert "2/2" in result.stderr and f"wrote {out}" in result.stderr  # progress bar, where it went
+    assert "| Au |" in result.stdout and "| Ta |" in result.stdout  # the table, printed
     text = out.read_text()
     assert "| Au |" in text and "| Ta |" in text and "beats every baseline on every conductor: **yes**" in text
+    assert "old" not in text and text.endswith("-->\n\n## Kept\n")  # the page written again, the rest kept

@@ -71,7 +71,7 @@ class TestPrincipled:
         node = nodes[NODE_NAMES["principled"]]
         assert node["type"] == "ShaderNodeBsdfPrincipled"
         inputs = node["inputs"]
-        # The values fitted to the coated metal seen from air (issue 22).
+        # The values fitted to the coated metal seen from air.
         assert_rgb(inputs["Base Color"], values.tools["blender"]["base_color"])
         assert_rgb(inputs["Specular Tint"], values.tools["blender"]["specular_tint"])
         assert inputs["Metallic"] == 1.0 and inputs["Coat Weight"] == 1.0

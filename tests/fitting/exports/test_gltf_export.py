@@ -124,7 +124,7 @@ class TestBlenderImport:
         inputs = principled["inputs"]
         np.testing.assert_allclose(inputs["Base Color"][:3], values.tools["gltf"]["base_color"], atol=1e-6)  # float32, as above
         assert inputs["Metallic"] == 1.0
-        # The fitted clearcoatFactor (issue 22), float32 as above.
+        # The fitted clearcoatFactor, float32 as above.
         assert inputs["Coat Weight"] == pytest.approx(values.tools["gltf"]["clearcoat"], abs=1e-6)
         # glTF's clear coat has index 1.5 whatever the export was fitted for.
         assert inputs["Coat IOR"] == pytest.approx(1.5)

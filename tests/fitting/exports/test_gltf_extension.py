@@ -122,7 +122,7 @@ class TestExport:
         assert "extensionsRequired" not in asset
         material = asset["materials"][0]
         assert material["pbrMetallicRoughness"]["metallicFactor"] == 1.0
-        # Fitted with the base colour to the coated metal seen from air (issue 22).
+        # Fitted with the base colour to the coated metal seen from air.
         assert 0.0 <= material["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] <= 1.0
         coat = material["extensions"]["KHR_materials_clearcoat"]["clearcoatRoughnessFactor"]
         assert material["extensions"][EXTENSION_NAME]["coatRoughnessFactor"] == coat

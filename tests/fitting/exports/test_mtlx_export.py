@@ -113,7 +113,7 @@ class TestMtlx:
         graph = nodedef.getImplementation()
         metal = graph.getNode("metal")
         assert metal.getCategory() == "conductor_bsdf"
-        # The values fitted to the coated metal seen from air (issue 22).
+        # The values fitted to the coated metal seen from air.
         fitted = values.tools["mtlx"]
         for key in ("ior", "extinction"):
             const, slope = conductor_input(graph, metal, key)

@@ -1,5 +1,5 @@
 """
-The conductor exports' index driven by the view angle (issue 22): the fit
+The conductor exports' index driven by the view angle: the fit
 (fitting.exports.seen_fit.fit_view_dependent_index) lowers W below 1.0 in
 both conductor tools, falls back to the constant fit (slopes 0) where it
 does not help, keeps n and k inside the fit's bounds at every angle, and the

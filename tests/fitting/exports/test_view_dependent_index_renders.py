@@ -1,6 +1,6 @@
 """
 The conductor exports' index driven by the view angle, rendered by the tools
-(issue 22, docs/exports.md "A better form each tool offers"): for W and CuZn
+(docs/exports.md "A better form each tool offers"): for W and CuZn
 at eta_i 1.5 the shipped `mtlx` document and Blender script carry each
 channel's n and k affine in 1 - cos theta (a `normal` / `viewdirection`
 graph into `conductor_bsdf`; Layer Weight's Facing into the Metallic BSDF),

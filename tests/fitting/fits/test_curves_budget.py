@@ -73,7 +73,7 @@ class TestWorstEdits:
         assert sum(counted) <= settings.max_evaluations
         assert in_range(result)
         # Still follows the rest of the curves: the refit's mean and max on the whole target
-        # are no worse than the paper method's candidate (issue 21's rule: the guard may
+        # are no worse than the paper method's candidate (the rule: the guard may
         # trade mean for max, never lose on both).
         guard = result.metrics["guard"]["candidates"]
         target = result.metrics["target"]

@@ -1,5 +1,5 @@
 """
-Fit numbers unchanged by issue 19 (one model-kind registry, one pipeline):
+Fit numbers held fixed across refactors (one model-kind registry, one pipeline):
 ``python -m fitting fit Au --json`` and ``... --model rgb-conductor --json``
 give the float16 coefficients they gave before it, bit for bit
 (``tests/golden/fit_Au_coefficients.json``, recorded on main 51b944e).

@@ -5,7 +5,6 @@ import pytest
 
 from fitting.fits.evaluate import evaluate_material
 from fitting.fits.material import fit_material
-from fitting.models.baselines import lazanyi_adjusted
 from fitting.optics.library import LIBRARY_NAMES, library_material
 from fitting.optics.nk import SpectralNK
 

@@ -1,6 +1,6 @@
 """
-The float16 polish of a kept paper-method twin (fitting/fits/polish.py,
-issue 21): ahead of the rounded least-squares optimum on both figures, by
+The float16 polish of a kept paper-method twin (fitting/fits/polish.py):
+ahead of the rounded least-squares optimum on both figures, by
 one-ulp moves only, and what a curve refit that keeps the twin ships.
 """
 

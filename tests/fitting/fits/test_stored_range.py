@@ -1,4 +1,4 @@
-"""Every stored fit's model lies in [0, 1]: proven, and on a 10^4-point dense evaluation (issue 21)."""
+"""Every stored fit's model lies in [0, 1]: proven, and on a 10^4-point dense evaluation."""
 
 from __future__ import annotations
 
@@ -61,7 +61,7 @@ def test_au_green_pulled_to_002_at_80_degrees():
     # (rgb least squares on the scoring grid, as benchmarks/curve_edits_vs_paper.py) when
     # that fit is a reflectance; here it leaves [0, 1] (max Delta E 16.8, a model above 1),
     # so the bar is the paper's method held in [0, 1], the guard's `rgb` candidate. Known
-    # gap (issue 21): no in-range refit reaches the out-of-range fit's max on this edit.
+    # gap: no in-range refit reaches the out-of-range fit's max on this edit.
     _, _, M, E = score_grid(base.eta_i_range)
     target = edited_target(base, [curve], M, E, 0.5)
     paper = fit_coefficients(target.reshape(-1, 3), M.ravel(), E.ravel(), base.eta_i_range, 2, "rgb")

@@ -1,4 +1,4 @@
-"""The max guarded against the paper's method (fitting/fits/worst_case.py, guarded.py; issue 21)."""
+"""The max guarded against the paper's method (fitting/fits/worst_case.py, guarded.py)."""
 
 from __future__ import annotations
 

@@ -16,7 +16,7 @@ from fitting.models.baselines import (
     schlick,
 )
 from fitting.optics.library import library_material
-from precision import F64_FEW_OPS, F64_RGB_BOUND, U64
+from precision import F64_FEW_OPS, F64_RGB_BOUND
 
 pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
 

@@ -1,4 +1,4 @@
-"""The proven range of the coated-conductor model (fitting/models/range_bound.py, issue 21)."""
+"""The proven range of the coated-conductor model (fitting/models/range_bound.py)."""
 
 from __future__ import annotations
 
@@ -97,7 +97,7 @@ def test_centred_form_encloses_the_model_on_every_cell():
 
 
 def test_a_fit_touching_one_inside_the_domain_is_proven_in_few_cells():
-    # The green channel of the degenerate base's refit (issue 20), which
+    # The green channel of the degenerate base's refit, which
     # touches 1 inside the domain: the first-order form alone took 93,304
     # cells (0.2 s); with the centred form 1,456.
     C = np.array([[[0.5, 0.0, 0.0], [0.0003001689910888672, 1.865234375, -1.712890625], [0.5, 0.0, 0.0]],

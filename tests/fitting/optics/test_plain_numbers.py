@@ -1,5 +1,5 @@
 """
-fitting.optics.bounded.parse_number and the readers (issue 20, item 10):
+fitting.optics.bounded.parse_number and the readers (item 10):
 numbers are ASCII decimal (Python's float also reads full-width and Arabic
 digits and ``6_00``); a CSV of exactly the row limit is read.
 """

@@ -1,4 +1,4 @@
-"""Data quality: gaps inside the visible range, and models that leave [0, 1] (issue 21)."""
+"""Data quality: gaps inside the visible range, and models that leave [0, 1]."""
 
 from __future__ import annotations
 

@@ -10,7 +10,6 @@ from scipy.integrate import quad
 from fitting.models.baselines import lazanyi_adjusted, external_medium_F0, lazanyi_a
 from fitting.models.coated_conductor import model_from_parameters
 from fitting.shading.ibl import (
-    SplitSumLUT,
     _hammersley,
     _node_terms,
     average_fresnel,

@@ -6,17 +6,19 @@ The ``glsl`` and ``hlsl`` downloads of stored fits: a ready-to-paste snippet
 with the project's function of each model kind in the pack (its
 :class:`fitting.models.kinds.ModelKind` names the file: GLSL from
 ``preview_shaders/glsl/`` with its includes inlined, HLSL from
-``service/templates/``), and per material the float16 coefficients as
+``fitting/exports/templates/``), and per material the float16 coefficients as
 constants and a ``cf_material_<name>(NdotV, eta_i)`` function (the kind's
 material template). With a kind that has the split-sum lookup
 (``ModelKind.split_sum``: the coated-conductor), the snippet also carries
 ``cf_split_sum_model`` (and the baselines), which reads the LUT of ``GET
 /api/v1/ibl-lut`` (``cf_ibl.glsl``, ``templates/cf_ibl.hlsl``).
 
-Each material's header quotes its figures from the one metrics schema
-(:func:`fitting.fits.metrics.headline`), with what they were measured against
-in words, the same numbers as the JSON download.
+Each material's header quotes its figures (:attr:`SnippetMaterial.quality`:
+the service and the CLI give :func:`fitting.fits.metrics.headline` of the
+fit's metrics), with what they were measured against in words, the same
+numbers as the JSON download.
 
+-   :class:`SnippetMaterial`: one material of a snippet.
 -   :func:`snippet`: the text of a download.
 -   :func:`model_source`: the functions of a set of kinds.
 -   :func:`glsl_identifier`: a material name as a GLSL/HLSL identifier.
@@ -27,20 +29,20 @@ from __future__ import annotations
 import functools
 import re
 import string
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from fitting.fits.metrics import headline
-from fitting.models.kinds import MODEL_KINDS, model_kind
-from fitting.models.pack import PackedMaterial, material_from_json
-from preview_shaders.gl import GLSL_DIR
+from ..models.kinds import MODEL_KINDS, model_kind
+from ..models.pack import PackedMaterial
 
-from .store import FitRecord
-
-__all__ = ["TEMPLATE_DIR", "SPLIT_SUM_FUNCTIONS", "snippet", "model_source", "glsl_identifier", "quality"]
+__all__ = ["GLSL_DIR", "TEMPLATE_DIR", "SPLIT_SUM_FUNCTIONS", "SnippetMaterial", "snippet", "model_source",
+           "glsl_identifier"]
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
+GLSL_DIR = Path(__file__).resolve().parents[2] / "preview_shaders" / "glsl"
+"""The project's GLSL files (read as files: ``fitting`` never imports ``preview_shaders``)."""
 SPLIT_SUM_FUNCTIONS = (
     "cf_split_sum_model", "cf_split_sum_schlick", "cf_split_sum_lazanyi", "cf_average_fresnel",
 )
@@ -85,8 +87,8 @@ def model_source(language: str, kinds: tuple[str, ...]) -> str:
         seen.add(file_name)
         return _INCLUDE.sub(lambda m: expand(m.group(1)), (GLSL_DIR / file_name).read_text())
 
-    files = [model_kind(k).glsl_file for k in kinds] + [f"{f}.glsl" for f in _split_sum(kinds)]
-    source = "\n".join(expand(f).strip() for f in files)
+    names = [model_kind(k).glsl_file for k in kinds] + [f"{f}.glsl" for f in _split_sum(kinds)]
+    source = "\n".join(expand(name).strip() for name in names)
     return _only_reachable(source, kinds).strip()
 
 
@@ -160,12 +162,23 @@ def _literal(value: float) -> str:
     return text if ("." in text or "e" in text) else text + ".0"
 
 
-def quality(record: FitRecord) -> str:
-    """The fit's headline figures in words (:func:`fitting.fits.metrics.headline`), one comment line."""
-    return headline(record.metrics)
+@dataclass(frozen=True)
+class SnippetMaterial:
+    """
+    One material of a snippet: its ``name`` and ``source`` (quoted in its
+    header), the ``fit_id`` it came from, ``quality`` (its headline figures
+    in words, one line) and its float16 model ``packed``.
+    """
+
+    name: str
+    source: str
+    fit_id: str
+    quality: str
+    packed: PackedMaterial
 
 
-def _material_block(language: str, record: FitRecord, packed: PackedMaterial, ident: str) -> str:
+def _material_block(language: str, material: SnippetMaterial, ident: str) -> str:
+    packed = material.packed
     kind = model_kind(packed.model)
     C = packed.coefficients.astype(np.float64)
     if kind.polynomial:
@@ -176,8 +189,8 @@ def _material_block(language: str, record: FitRecord, packed: PackedMaterial, id
     values = {p: ", ".join(_literal(v) for v in C[i].ravel()) for i, p in enumerate(kind.parameters)}
     lo, hi = packed.eta_i_range
     return _template(_material_template(kind.material_template, language)).substitute(
-        name=_comment(record.name, 80), source=_comment(record.source), fit_id=record.id,
-        model=kind.name, quality=_comment(quality(record), 400), prefix=f"cf_{ident}", ident=ident,
+        name=_comment(material.name, 80), source=_comment(material.source), fit_id=material.fit_id,
+        model=kind.name, quality=_comment(material.quality, 400), prefix=f"cf_{ident}", ident=ident,
         eta_lo=_literal(lo), eta_hi=_literal(hi), **values,
     )
 
@@ -189,24 +202,23 @@ def _symbols(language: str, ident: str, packed: PackedMaterial) -> set[str]:
     return {f"cf_{ident}{s}" for s in suffixes} | {f"cf_material_{ident}"}
 
 
-def snippet(language: str, records: list[FitRecord], pack_name: str, fit_format: str) -> str:
-    """The ``glsl`` or ``hlsl`` download of ``records`` (see the module docstring)."""
-    materials = [(record, material_from_json(record.material)) for record in records]
-    used_kinds = {packed.model for _, packed in materials}
+def snippet(language: str, materials: list[SnippetMaterial], pack_name: str, fit_format: str) -> str:
+    """The ``glsl`` or ``hlsl`` snippet of ``materials`` (see the module docstring)."""
+    used_kinds = {material.packed.model for material in materials}
     model = model_source(language, tuple(k for k in MODEL_KINDS if k in used_kinds))
     # Symbols are unique within the pack: a material whose symbols would meet
     # another's (``material x`` and ``x F0`` both define cf_material_x_F0) or
     # the model's gets the next free suffix.
     used = set(re.findall(r"\b[A-Za-z_]\w*", model))
     blocks = []
-    for record, packed in materials:
-        ident = base = glsl_identifier(record.name)
+    for material in materials:
+        ident = base = glsl_identifier(material.name)
         suffix = 2
-        while _symbols(language, ident, packed) & used:
+        while _symbols(language, ident, material.packed) & used:
             ident, suffix = f"{base}_{suffix}", suffix + 1
-        used |= _symbols(language, ident, packed)
-        blocks.append(_material_block(language, record, packed, ident))
+        used |= _symbols(language, ident, material.packed)
+        blocks.append(_material_block(language, material, ident))
     return _template(TEMPLATE_DIR / f"pack.{language}").substitute(
-        pack_name=_comment(pack_name, 80), count=len(records), fit_format=fit_format,
+        pack_name=_comment(pack_name, 80), count=len(materials), fit_format=fit_format,
         model=model, materials="".join(blocks),
     )

@@ -5,7 +5,7 @@ Turns in the fitting pool
 -   :class:`Turns`: at most ``n`` parts of jobs in the workers at once; of
     the parts waiting, the cheapest (its estimated seconds, then its
     arrival) goes next, so that a 0.1 s library fit does not wait behind ten
-    worst-case refits (:class:`service.pool.FitRunner`). Parts only wait
+    worst-case refits (:class:`service.runtime.pool.FitRunner`). Parts only wait
     here while they hold their job's slot, and the slots are bounded, so an
     expensive part waits at most behind that many cheaper ones.
 

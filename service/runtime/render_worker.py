@@ -2,17 +2,17 @@
 Render workers
 ==============
 
-What runs in each process of the render pool (:class:`service.previews.PreviewRunner`):
+What runs in each process of the render pool (:class:`service.runtime.previews.PreviewRunner`):
 
 -   :func:`render_worker_start`: a render process's initializer: a lower
     CPU priority (:data:`RENDER_NICENESS`), the fitting workers' start-up
-    (:func:`service.worker.worker_start`: the shared ring of cancelled job
+    (:func:`service.runtime.worker.worker_start`: the shared ring of cancelled job
     serials, the warm-up, one BLAS thread), then the process's one preview
     renderer, whose GL context is made on its own render thread and used
     only there (:class:`preview_shaders.gl.RenderThread`).
 -   :func:`renderer`: that renderer, or :class:`RendererUnavailable` when
     no GL context could be made.
--   :func:`run_render_part`: a job, under :func:`service.worker.run_part`
+-   :func:`run_render_part`: a job, under :func:`service.runtime.worker.run_part`
     (the CPU-time limit and the server's cancellation, checked every 0.1 s),
     once the render thread has finished what a stopped job left on it.
 """
@@ -75,7 +75,7 @@ def _idle(state) -> None:
 
 def run_render_part(serial: int, cpu_limit_s: float, function, *args):
     """
-    ``function(*args)`` under :func:`service.worker.run_part`, after the
+    ``function(*args)`` under :func:`service.runtime.worker.run_part`, after the
     render thread has finished what it was given before. A job stopped at
     its CPU-time limit or cancelled stops waiting for the render thread, but
     the GL call it was in runs to its end there (a GL call cannot be

@@ -3,9 +3,9 @@ The fork server, forked from the server
 =======================================
 
 :func:`start_fork_server`: ``python -m service`` forks the fork server of
-its fitting and render processes (:func:`service.worker.process_context`)
+its fitting and render processes (:func:`service.runtime.worker.process_context`)
 from itself, once it has imported the core and warmed up
-(:mod:`service.preload`), before it opens the store or starts a thread;
+(:mod:`service.runtime.preload`), before it opens the store or starts a thread;
 multiprocessing's own fork server is a new interpreter that imports the
 core and warms up again.
 
@@ -26,33 +26,31 @@ import threading
 import time
 from multiprocessing import connection, forkserver, resource_tracker, util
 
+from .mp_private import FORK_SERVER_STATE, adopt_fork_server, fork_server, fork_server_pid
+
 __all__ = ["START_ERRORS", "fork_server_exited", "start_fork_server"]
 
 
 SUN_PATH_MAX = 107
 """The longest path of a Unix socket on Linux (``sun_path``'s 108 bytes with the final NUL)."""
 
-_FORK_SERVER_STATE = frozenset({
-    "_forkserver_address", "_forkserver_alive_fd", "_forkserver_pid", "_inherited_fds", "_lock", "_preload_modules",
-})
-"""The state of multiprocessing's ``ForkServer`` that :func:`start_fork_server` sets, as Python 3.11-3.13 hold it."""
 
 
 def _cannot_fork_server(server, threads: int) -> str | None:
     """Why :func:`start_fork_server` starts nothing, given multiprocessing's ``ForkServer`` and the Python threads."""
-    if set(vars(server)) != _FORK_SERVER_STATE:
-        return f"multiprocessing's ForkServer holds {sorted(vars(server))}, not {sorted(_FORK_SERVER_STATE)}"
+    if set(vars(server)) != FORK_SERVER_STATE:
+        return f"multiprocessing's ForkServer holds {sorted(vars(server))}, not {sorted(FORK_SERVER_STATE)}"
     if threads > 1:
         return f"{threads} Python threads run, and a fork would copy their locks mid-use"
-    if server._forkserver_pid is not None:
+    if fork_server_pid(server) is not None:
         return "a fork server runs already"
     return None
 
 
 def start_fork_server() -> bool:
     """
-    Start the fork server of :func:`service.worker.process_context` as a fork of this
-    process, once it has imported :data:`service.worker.PRELOAD` (:mod:`service.preload`) (which also warms it up),
+    Start the fork server of :func:`service.runtime.worker.process_context` as a fork of this
+    process, once it has imported :data:`service.runtime.worker.PRELOAD` (:mod:`service.runtime.preload`) (which also warms it up),
     instead of the new interpreter multiprocessing would start with the
     first pool, which imports the core and warms up again: a second of CPU
     time at every server start, and the first pool waits for it. For
@@ -71,13 +69,13 @@ def start_fork_server() -> bool:
     the first pool), when a fork server runs already, when this process has
     another Python thread (a fork would copy its locks mid-use), or when
     multiprocessing's ``ForkServer`` holds other state than the one set
-    here (:data:`_FORK_SERVER_STATE`; a Python that added to it, as 3.14
+    here (:data:`~service.runtime.mp_private.FORK_SERVER_STATE`; a Python that added to it, as 3.14
     adds an authentication key). Should the fork server die, multiprocessing
     starts its own at the next pool.
     """
-    import service.preload  # noqa: F401 (the core, colour-science and the warm-up, for every fork)
+    import service.runtime.preload  # noqa: F401 (the core, colour-science and the warm-up, for every fork)
 
-    server = forkserver._forkserver
+    server = fork_server()
     if _cannot_fork_server(server, threading.active_count()) is not None:
         return False
     # No lock is held across the fork (there is no other thread to take one): a lock held there would stay
@@ -115,10 +113,7 @@ def start_fork_server() -> bool:
             finally:
                 os._exit(code)
         os.close(alive_r)
-    with server._lock:
-        server._forkserver_address = address
-        server._forkserver_alive_fd = alive_w
-        server._forkserver_pid = pid
+    adopt_fork_server(address, alive_w, pid)
     return True
 
 
@@ -141,14 +136,14 @@ FORK_SERVER_EXIT_S = 5.0
 async def fork_server_exited(timeout_s: float | None = None, poll_s: float = 0.01) -> bool:
     """
     Wait (polling, at most ``timeout_s``, by default :data:`FORK_SERVER_EXIT_S`) until the fork server of
-    :func:`service.worker.process_context` has exited, without reaping it:
+    :func:`service.runtime.worker.process_context` has exited, without reaping it:
     multiprocessing reaps it at the next start (``ForkServer.ensure_running``)
     and then starts a new one. For a start that failed with one of
     :data:`START_ERRORS`. Returns whether it exited (``True`` also when there
     is none, or it is not this process's child); ``False`` after
     ``timeout_s``, when it is alive after all, and the next start will tell.
     """
-    pid = forkserver._forkserver._forkserver_pid
+    pid = fork_server_pid()
     deadline = time.monotonic() + (FORK_SERVER_EXIT_S if timeout_s is None else timeout_s)
     while pid is not None:
         try:

@@ -3,7 +3,7 @@ Process executors' results
 ==========================
 
 What Python's ``ProcessPoolExecutor`` (3.11-3.13) does not do for the
-fitting and render pools (:mod:`service.pool`, :mod:`service.previews`):
+fitting and render pools (:mod:`service.runtime.pool`, :mod:`service.runtime.previews`):
 see a worker that was killed while it wrote a result.
 
 A worker sends a result of over 16 KB in two writes to the pipe all the
@@ -36,9 +36,11 @@ import time
 from multiprocessing import connection
 from typing import Any
 
+from .mp_private import close_result_pipe, executor_processes
+
 __all__ = ["STUCK_S", "WATCH_S", "has_dead_worker", "unstick", "result"]
 
-log = logging.getLogger("service.executors")
+log = logging.getLogger("service.runtime.executors")
 
 STUCK_S = 3.0
 """How long a worker may be dead in a pool that has not broken before :func:`unstick` (the manager
@@ -54,7 +56,7 @@ def has_dead_worker(executor: concurrent.futures.ProcessPoolExecutor) -> bool:
     ready; read, not consumed). ``False`` for an executor shut down, with
     no workers yet, or of a Python that keeps them elsewhere.
     """
-    processes = getattr(executor, "_processes", None)
+    processes = executor_processes(executor)
     if not processes:
         return False
     try:
@@ -75,13 +77,11 @@ def unstick(executor: concurrent.futures.ProcessPoolExecutor) -> None:
     fail with ``BrokenProcessPool``). Harmless to a pool whose manager
     thread is not stuck: it breaks the pool for the dead workers.
     """
-    processes = getattr(executor, "_processes", None) or {}
+    processes = executor_processes(executor)
     for process in list(processes.values()):
         with contextlib.suppress(OSError, ValueError, AttributeError):
             process.kill()
-    queue = getattr(executor, "_result_queue", None)
-    if queue is not None:
-        queue._writer.close()
+    close_result_pipe(executor)
 
 
 async def result(executor: concurrent.futures.ProcessPoolExecutor, future: concurrent.futures.Future,

@@ -34,6 +34,11 @@ client cannot get past:
     closed, the concurrency limit, invalid requests) are logged once, then
     counted once a minute, so a flood cannot grow the log.
 
+This module is the one adapter to uvicorn's internals (its h11 protocol's
+hooks and state, :data:`UVICORN_PRIVATE`); :func:`uvicorn_mismatches` says
+what of them a uvicorn release no longer holds, and
+``tests/service/test_runtime_private.py`` fails on any.
+
 SIGTERM and SIGINT stop it gracefully (uvicorn's shutdown: connections
 drained, the lifespan's pools and store closed), and the process then exits
 with the signal's conventional status (143, 130) through ``SystemExit``
@@ -42,7 +47,9 @@ with the signal's conventional status (143, 130) through ``SystemExit``
 
 from __future__ import annotations
 
+import ast
 import asyncio
+import inspect
 import json
 import logging
 import signal
@@ -51,12 +58,31 @@ import time
 
 import h11
 import uvicorn
-from uvicorn.protocols.http.h11_impl import H11Protocol
+from uvicorn.protocols.http.h11_impl import H11Protocol, RequestResponseCycle
 
-from .config import Settings
+from ..config import Settings
 
 __all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
-           "HEALTH_RESERVE", "IDLE_GRACE_S"]
+           "HEALTH_RESERVE", "IDLE_GRACE_S", "UVICORN_PRIVATE", "uvicorn_mismatches"]
+
+UVICORN_PRIVATE = {
+    H11Protocol: ("connection_made", "data_received", "on_response_complete", "connection_lost",
+                  "conn", "cycle", "server_state", "connections", "transport", "client", "loop"),
+    RequestResponseCycle: ("response_complete",),
+}
+"""What :class:`DeadlineH11Protocol` uses of uvicorn's h11 protocol: methods it overrides, attributes it reads."""
+
+
+def uvicorn_mismatches() -> list[str]:
+    """What of :data:`UVICORN_PRIVATE` this uvicorn's classes neither define nor assign (empty when all is there)."""
+    found = []
+    for cls, names in UVICORN_PRIVATE.items():
+        tree = ast.parse(inspect.getsource(cls))
+        assigned = {node.attr for node in ast.walk(tree) if isinstance(node, ast.Attribute)
+                    and isinstance(node.ctx, ast.Store) and isinstance(node.value, ast.Name) and node.value.id == "self"}
+        found += [f"uvicorn's {cls.__name__} has no {name} (uvicorn {uvicorn.__version__})"
+                  for name in names if not callable(getattr(cls, name, None)) and name not in assigned]
+    return found
 
 log = logging.getLogger("uvicorn.error")
 MAX_HEADER_BYTES = 16 * 1024

@@ -2,15 +2,15 @@
 Shared flights and cancellation
 ===============================
 
-What the fitting pool (:class:`service.pool.FitRunner`) and the render pool
-(:class:`service.previews.PreviewRunner`) both need of a job:
+What the fitting pool (:class:`service.runtime.pool.FitRunner`) and the render pool
+(:class:`service.runtime.previews.PreviewRunner`) both need of a job:
 
 -   :class:`Flights`: one flight per key. Concurrent requests for the same
     content share one task; each waits at most its time limit; a task no
     request waits for any more (each timed out, or its client went away) is
     cancelled.
 -   :class:`CancelRing`: the serials of cancelled jobs, in a ring of
-    :data:`service.worker.CANCEL_SLOTS` shared with the worker processes,
+    :data:`service.runtime.worker.CANCEL_SLOTS` shared with the worker processes,
     which stop a cancelled job at its next check.
 """
 

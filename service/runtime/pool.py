@@ -12,7 +12,7 @@ The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
     503, 504, 503 and 422, the first three with ``Retry-After``).
 
 Fitting is CPU-bound (numpy, scipy): it runs in worker processes, never on
-the event loop, forked by a fork server (:func:`service.worker.process_context`:
+the event loop, forked by a fork server (:func:`service.runtime.worker.process_context`:
 forking the server itself, which runs threads, is unsafe; the fork server is
 a fresh single-threaded process that imported the core once, so a worker
 starts in a fork instead of seconds of imports). The number of jobs running or
@@ -30,11 +30,11 @@ Faults:
     refused for ``quarantine_s`` (:class:`Quarantined`, before any work). So
     a job that kills its workers fails only itself, however often it does.
 -   A worker that cannot start (its fork server died:
-    :data:`service.fork_server.START_ERRORS`) is not the part's doing: once
+    :data:`service.runtime.fork_server.START_ERRORS`) is not the part's doing: once
     the fork server's exit is seen, the pool is replaced (with a new fork
     server) and the part runs there (:class:`WorkersNotStarted` after three).
 -   A pool stuck on a result its killed worker left half-written breaks as
-    for any death (:mod:`service.executors`).
+    for any death (:mod:`service.runtime.executors`).
 -   A request that waits past the time limit gets :class:`FitTimeout`, and
     its job is cancelled when no other request waits for it (as when every
     client waiting for it has gone): its worker checks every 0.1 s and is
@@ -67,7 +67,7 @@ from .worker import JobCPULimit, ping, process_context, run_part, warm_process, 
 __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
            "warm_process"]
 
-log = logging.getLogger("service.pool")
+log = logging.getLogger("service.runtime.pool")
 
 
 class Overloaded(Exception):
@@ -112,7 +112,7 @@ class WorkersNotStarted(WorkerLost):
 
 
 class _StartFailed(BrokenProcessPool):
-    """A pool could not start a worker (:data:`service.fork_server.START_ERRORS`); its fork server has exited since."""
+    """A pool could not start a worker (:data:`service.runtime.fork_server.START_ERRORS`); its fork server has exited since."""
 
 
 class Quarantined(WorkerLost):
@@ -127,7 +127,7 @@ class Quarantined(WorkerLost):
 
 EXPRESS_COST_S = 0.1
 """Parts estimated at most this many seconds (a library fit's parts, a live
-step) may take an express turn (:class:`service.turns.Turns`)."""
+step) may take an express turn (:class:`service.runtime.turns.Turns`)."""
 
 _JOB_KEY: contextvars.ContextVar[str | None] = contextvars.ContextVar("job_key", default=None)
 _QUARANTINE_KEYS = 1024  # content ids remembered at most
@@ -274,7 +274,7 @@ class FitRunner:
         Run ``function(*args)`` in a worker as one part of a job that holds
         a :meth:`slot`; its exceptions (ValueError for bad input) are raised
         here. Parts take turns in the workers, the cheapest waiting first
-        (``cost_s``, its estimated seconds: :class:`service.turns.Turns`). A
+        (``cost_s``, its estimated seconds: :class:`service.runtime.turns.Turns`). A
         part interrupted by a dead worker runs once more on the replacement
         pool; one whose worker could not be started runs on a pool whose
         workers start (:class:`WorkersNotStarted` after three failures).

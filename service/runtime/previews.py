@@ -5,9 +5,9 @@ Render pool
 The process pool that draws previews and GL textures, apart from the
 fitting pool and off the server process.
 
--   :class:`PreviewRunner`: ``workers`` render processes (forked by the fork server, :func:`service.worker.process_context`), each
+-   :class:`PreviewRunner`: ``workers`` render processes (forked by the fork server, :func:`service.runtime.worker.process_context`), each
     with its own GL context made on its own render thread
-    (:mod:`service.render_worker`); previews bounded in flight, textures
+    (:mod:`service.runtime.render_worker`); previews bounded in flight, textures
     bounded waiting; identical requests in flight share one render; a time
     limit per request, the CPU-time limit per job, cancellation.
 -   :class:`PreviewsBusy`, :class:`PreviewTimeout`, :class:`RenderWorkerLost`,
@@ -17,7 +17,7 @@ fitting pool and off the server process.
 Why processes: a preview is seconds of numpy (the spectral reference),
 GL read-back and PNG encoding. In threads of the server process it held
 the GIL for long stretches, and the event loop (``/healthz`` too) stalled
-behind it (issue 20, item 8). Here the server only sends a fit's packed
+behind it (item 8). Here the server only sends a fit's packed
 material and n, k and receives the PNG bytes; the event loop never waits
 on a render.
 
@@ -32,11 +32,11 @@ Bounds and budgets:
     :data:`TEXTURE_QUEUE` at once, then :class:`PreviewsBusy`.
 -   A request waits at most ``timeout_s`` (``COATED_PREVIEW_TIMEOUT_S``;
     :class:`PreviewTimeout`); each job may use ``cpu_limit_s`` of CPU
-    (``COATED_JOB_CPU_LIMIT_S``; :class:`service.worker.JobCPULimit`, 422).
+    (``COATED_JOB_CPU_LIMIT_S``; :class:`service.runtime.worker.JobCPULimit`, 422).
 -   A job no request waits for any more (each timed out, or its client
     went away: :class:`service.api.middleware.RequestLimits` cancels the
     request) is cancelled: its process checks every 0.1 s
-    (:func:`service.worker.run_part`) and stops at its next check; one
+    (:func:`service.runtime.worker.run_part`) and stops at its next check; one
     that has not stopped :data:`CANCEL_GRACE_S` later (in a long numpy
     call, or starved of CPU) is stopped (SIGKILL) and another started for
     the next job. A preview's place is held until its process is free of
@@ -47,7 +47,7 @@ Bounds and budgets:
     and another is started for the next job; a render is not tried again
     (one that killed its process would kill the next). So does one that
     could not be started (its fork server died:
-    :data:`service.fork_server.START_ERRORS`), once the fork server's exit
+    :data:`service.runtime.fork_server.START_ERRORS`), once the fork server's exit
     is seen, so that the next starts from another.
 """
 
@@ -75,7 +75,7 @@ from .worker import process_context
 __all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
            "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
 
-log = logging.getLogger("service.previews")
+log = logging.getLogger("service.runtime.previews")
 
 TEXTURE_QUEUE = 16
 """Texture jobs in flight (running or waiting for a render process) at most; past it 503."""
@@ -188,7 +188,7 @@ class PreviewRunner:
             with contextlib.suppress(ProcessLookupError):
                 os.kill(process.pid, signal.SIGKILL)
             # Killed while it sent a result, it would leave the executor waiting for the rest forever, its
-            # jobs' places never left (service.executors): the executor reads end of file instead.
+            # jobs' places never left (service.runtime.executors): the executor reads end of file instead.
             executors.unstick(process.executor)
         # Jobs queued behind it fail with the process (BrokenProcessPool: 503), not as cancelled.
         process.executor.shutdown(wait=False)

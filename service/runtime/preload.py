@@ -1,11 +1,11 @@
 """
-What the fork server (:func:`service.worker.process_context`) imports once,
+What the fork server (:func:`service.runtime.worker.process_context`) imports once,
 before it forks the fitting and render processes, so that each of them
 starts with it: the fitting core, colour-science through
 :func:`fitting.colour.colorimetry.colour_science` (its plotting package, and
 matplotlib with it, load only on use; a plain ``import colour`` here loaded
 both in every fork server), scipy's least squares, and the warm-up
-(:func:`service.worker.warm_process`: the spectral weights of the fit and of
+(:func:`service.runtime.worker.warm_process`: the spectral weights of the fit and of
 the metrics), whose caches every forked process inherits.
 """
 
@@ -15,7 +15,7 @@ import scipy.optimize  # noqa: F401 (imported for the processes forked from here
 
 import fitting  # noqa: F401
 from fitting.colour.colorimetry import colour_science
-from service.worker import warm_process
+from service.runtime.worker import warm_process
 
 colour_science()
 warm_process()

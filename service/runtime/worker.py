@@ -2,7 +2,7 @@
 Fitting workers
 ===============
 
-What runs in each worker process of :class:`service.pool.FitRunner`:
+What runs in each worker process of :class:`service.runtime.pool.FitRunner`:
 
 -   :func:`warm_process`: the start-up every worker (and the server process)
     does once, so that no request pays for imports and spectral weights.
@@ -14,7 +14,7 @@ What runs in each worker process of :class:`service.pool.FitRunner`:
 -   :func:`run_part`: one part of a job, checked every 0.1 s for its CPU
     time (:class:`JobCPULimit`) and for cancellation by the server.
 -   :func:`process_context`: how the workers start (forks of a fork server;
-    :mod:`service.fork_server` forks it from the server process).
+    :mod:`service.runtime.fork_server` forks it from the server process).
 """
 
 from __future__ import annotations
@@ -150,8 +150,8 @@ def ping() -> float:
     return time.time()
 
 
-PRELOAD = ("service.preload",)
-"""What the fork server imports once, so that each process forked from it starts with it (:mod:`service.preload`)."""
+PRELOAD = ("service.runtime.preload",)
+"""What the fork server imports once, so that each process forked from it starts with it (:mod:`service.runtime.preload`)."""
 
 
 def process_context():
@@ -163,7 +163,7 @@ def process_context():
     Forking the server itself would copy its threads' locks mid-use;
     spawning imports the core again in every worker. The service's entry
     point (``python -m service``) forks the fork server from itself before
-    any thread starts (:func:`service.fork_server.start_fork_server`); elsewhere (an application
+    any thread starts (:func:`service.runtime.fork_server.start_fork_server`); elsewhere (an application
     made in another program, the tests' in-process apps) multiprocessing
     starts it with the first pool, as a new interpreter that imports
     :data:`PRELOAD`, and again, that way, if it died. Measured by hand once
