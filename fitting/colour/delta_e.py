@@ -50,20 +50,20 @@ def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
     delta_C_p = C_p_2 - C_p_1
     h_p_2_s_1 = h_p_2 - h_p_1
     C_p_1_m_2 = C_p_1 * C_p_2
-    delta_h_p = np.select(
-        [C_p_1_m_2 == 0, np.fabs(h_p_2_s_1) <= 180, h_p_2_s_1 > 180, h_p_2_s_1 < -180],
-        [0, h_p_2_s_1, h_p_2_s_1 - 360, h_p_2_s_1 + 360],
-    )
+    # colour-science's np.select (the first condition that holds, else 0) as
+    # nested selections: the same values, a fraction of the time.
+    delta_h_p = np.where(C_p_1_m_2 == 0, 0, np.where(
+        np.fabs(h_p_2_s_1) <= 180, h_p_2_s_1, np.where(
+            h_p_2_s_1 > 180, h_p_2_s_1 - 360, np.where(h_p_2_s_1 < -180, h_p_2_s_1 + 360, 0))))
     delta_H_p = 2 * np.sqrt(C_p_1_m_2) * np.sin(np.deg2rad(delta_h_p / 2))
     L_bar_p = (L_1 + L_2) / 2
     C_bar_p = (C_p_1 + C_p_2) / 2
     a_h_p_1_s_2 = np.fabs(h_p_1 - h_p_2)
     h_p_1_a_2 = h_p_1 + h_p_2
-    h_bar_p = np.select(
-        [C_p_1_m_2 == 0, a_h_p_1_s_2 <= 180, (a_h_p_1_s_2 > 180) & (h_p_1_a_2 < 360),
-         (a_h_p_1_s_2 > 180) & (h_p_1_a_2 >= 360)],
-        [h_p_1_a_2, h_p_1_a_2 / 2, (h_p_1_a_2 + 360) / 2, (h_p_1_a_2 - 360) / 2],
-    )
+    h_bar_p = np.where(C_p_1_m_2 == 0, h_p_1_a_2, np.where(
+        a_h_p_1_s_2 <= 180, h_p_1_a_2 / 2, np.where(
+            (a_h_p_1_s_2 > 180) & (h_p_1_a_2 < 360), (h_p_1_a_2 + 360) / 2, np.where(
+                (a_h_p_1_s_2 > 180) & (h_p_1_a_2 >= 360), (h_p_1_a_2 - 360) / 2, 0))))
     T = (
         1
         - 0.17 * np.cos(np.deg2rad(h_bar_p - 30))
