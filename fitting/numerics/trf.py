@@ -211,7 +211,7 @@ def trf_least_squares(
     alpha = 0.0
     status = None
     while True:
-        if not (np.all(np.isfinite(A)) and np.all(np.isfinite(g))):
+        if not math.isfinite(A.sum() + g.sum()):  # one sum: a NaN or inf anywhere shows in it
             status = -1  # no step can be taken from a Jacobian that is not finite
             break
         if np.abs(g).max() < gtol:
@@ -229,10 +229,10 @@ def trf_least_squares(
             f_new = np.asarray(fun(x_new), dtype=np.float64)
             nfev += 1
             step_h_norm = _norm(step_h)
-            if not np.all(np.isfinite(f_new)):
+            cost_new = 0.5 * np.dot(f_new, f_new)
+            if not math.isfinite(cost_new):  # f not finite there (or beyond 1e154): a smaller region
                 Delta = 0.25 * step_h_norm
                 continue
-            cost_new = 0.5 * np.dot(f_new, f_new)
             actual_reduction = cost - cost_new
             if predicted_reduction > 0:
                 ratio = actual_reduction / predicted_reduction
