@@ -19,7 +19,7 @@ import numpy as np
 from ..models.pack import FLOAT16_MAX, to_float16
 from .objective import Problem
 
-__all__ = ["quantise_coefficients"]
+__all__ = ["quantise_coefficients", "compensations"]
 
 
 def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> np.ndarray:
@@ -51,10 +51,7 @@ def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> n
     # U is the inverse of V, V V^T = Hs with V upper: the Cholesky factor of
     # Hs with its order reversed (no explicit inverse of Hs).
     order = np.argsort(-np.diag(H))
-    reversed_order = order[::-1]
-    V = np.linalg.cholesky(Hs[np.ix_(reversed_order, reversed_order)])[::-1, ::-1]
-    U = np.linalg.inv(V)
-    moves = U / np.diag(U)[:, None]
+    moves = compensations(Hs, order)
     u = np.zeros(n)  # the scaled change delta * scale, in the rounding order
     xs = x[order]
     for k, i in enumerate(order):
@@ -101,6 +98,22 @@ def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> n
     cost_nearest = np.sum(problem.residuals(nearest.astype(np.float64)) ** 2)
     chosen = x16 if cost <= cost_nearest else nearest
     return to_float16(chosen.astype(np.float64)).reshape(C.shape)
+
+
+def compensations(Hs: np.ndarray, order: np.ndarray) -> np.ndarray:
+    """
+    Row k (in ``order``) is the move of coordinates ``order[k:]`` that
+    minimises the quadratic form of the symmetric positive definite ``Hs``
+    when coordinate ``order[k]`` moves by one and ``order[:k]`` are held:
+    1 at k, :math:`-H_{FF}^{-1} H_{F i}` on the free F = ``order[k+1:]``.
+    All rows from one factorisation: U = V^-1 with V V^T = Hs (in order, V
+    upper: the Cholesky factor with the order reversed), each row of U
+    divided by its diagonal (Frantar et al. 2023).
+    """
+    reversed_order = order[::-1]
+    V = np.linalg.cholesky(Hs[np.ix_(reversed_order, reversed_order)])[::-1, ::-1]
+    U = np.linalg.inv(V)
+    return U / np.diag(U)[:, None]
 
 
 def _ulp_steps(x16):
