@@ -15,7 +15,11 @@ up to 0.25 on this machine. Records each round's medians, their ratio and
 the ratio of the medians over the rounds, and each conductor's own ratio
 (and their median), in benchmarks/results/fit_time_guard.json.
 
-Usage: python benchmarks/fit_time_guard.py [--before REV] [--rounds 5] [--repeats 5]
+``--output NAME`` records benchmarks/results/NAME.json instead: the same
+comparison against another commit (``fit_solver_speed``: the lean
+trust-region solver against the commit before it, 09bbd13).
+
+Usage: python benchmarks/fit_time_guard.py [--before REV] [--rounds 5] [--repeats 5] [--output NAME]
 """
 
 from __future__ import annotations
@@ -66,6 +70,8 @@ def main(argv=None) -> int:
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
     parser.add_argument("--rounds", type=int, default=5, help="rounds over the 22 conductors")
     parser.add_argument("--repeats", type=int, default=5, help="timing repeats of each fit")
+    parser.add_argument("--output", default="fit_time_guard",
+                        help="record to write, benchmarks/results/NAME.json (default fit_time_guard)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
@@ -107,7 +113,7 @@ def main(argv=None) -> int:
                "rounds": len(rounds), "conductor_ratio_median": float(np.median(list(own.values()))),
                "conductor_ratio_max": max(own.values()), "conductor_ratios": own}
     print(json.dumps(figures, indent=1))
-    print("recorded:", write_result("fit_time_guard", figures, load_start, repeats=args.repeats,
+    print("recorded:", write_result(args.output, figures, load_start, repeats=args.repeats,
                                     runs=rounds))
     return 0
 

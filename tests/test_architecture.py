@@ -20,6 +20,7 @@ MAX_ROUTE_LINES = 160
 # layers below, never a higher one.
 LAYERS = {
     "fitting.domain": 0,
+    "fitting.numerics": 0,
     "fitting.optics": 1,
     "fitting.colour": 2,
     "fitting.models": 3,

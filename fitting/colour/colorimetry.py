@@ -16,8 +16,11 @@ Spectral reflectance to linear ACEScg, and CIE 1976 L*a*b*.
 Conventions: CIE 1931 2 degree observer; illuminant the CIE D series at the
 ACES white point (D60, xy = 0.32168, 0.33767); CAT02 adaptation to the ACEScg
 white; each row of the weights normalised so that a perfect reflector maps to
-(1, 1, 1). colour-science is imported once, lazily (:func:`colour_science`;
-its plotting package, and matplotlib with it, only on use).
+(1, 1, 1). The 1 nm weights and ACEScg's matrix are colour-science's,
+stored with the package (:data:`STORED_CONSTANTS`); colour-science itself
+is imported once, lazily, where a caller needs more of it
+(:func:`colour_science`; its plotting package, and matplotlib with it,
+only on use).
 
 References
 ----------
@@ -36,6 +39,7 @@ import importlib.util
 import sys
 import threading
 from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 
@@ -99,8 +103,22 @@ def colour_science():
     return colour
 
 
-@functools.cache
-def _weights_1nm() -> np.ndarray:
+STORED_CONSTANTS = Path(__file__).with_name("ACEScg_1nm.npz")
+"""The 1 nm weights and the ACEScg to XYZ matrix of :func:`colour_science_constants`,
+stored (``weights`` (3, 471), ``RGB_to_XYZ`` (3, 3)): a fit reads them
+without importing colour-science (with scipy, most of a command's start);
+``tests/fitting/colour/test_colorimetry.py`` holds them equal to the bit to
+colour-science's (:func:`write_stored_constants` writes them again)."""
+
+
+def colour_science_constants() -> tuple[np.ndarray, np.ndarray]:
+    """
+    The definition of the stored constants, by colour-science: the weights
+    (3, 471) from spectral reflectance at 360-830 nm, 1 nm, to linear ACEScg
+    (CIE 1931 2 degree observer, the D series illuminant at the ACES white,
+    CAT02 to the ACEScg white, each row normalised so that a perfect
+    reflector maps to (1, 1, 1)), and ACEScg's RGB to XYZ matrix.
+    """
     colour = colour_science()
     shape = colour.SpectralShape(VISIBLE_RANGE_NM[0], VISIBLE_RANGE_NM[1], 1)
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
@@ -117,8 +135,29 @@ def _weights_1nm() -> np.ndarray:
     W = acescg.matrix_XYZ_to_RGB @ cat @ W_XYZ
     # A perfect reflector maps to (1, 1, 1) exactly.
     W /= W.sum(axis=1, keepdims=True)
-    W.setflags(write=False)
-    return W
+    return W, np.array(acescg.matrix_RGB_to_XYZ, dtype=np.float64)
+
+
+def write_stored_constants(path: Path = STORED_CONSTANTS) -> Path:
+    """Write :func:`colour_science_constants` to ``path`` (after a colour-science update changes them)."""
+    weights, RGB_to_XYZ = colour_science_constants()
+    np.savez(path, weights=weights, RGB_to_XYZ=RGB_to_XYZ)
+    return path
+
+
+@functools.cache
+def _stored() -> tuple[np.ndarray, np.ndarray]:
+    with np.load(STORED_CONSTANTS) as data:
+        weights, RGB_to_XYZ = data["weights"], data["RGB_to_XYZ"]
+    if weights.shape != (3, int(VISIBLE_RANGE_NM[1] - VISIBLE_RANGE_NM[0]) + 1) or RGB_to_XYZ.shape != (3, 3):
+        raise ValueError(f"{STORED_CONSTANTS} holds arrays of the wrong shape: write it again")
+    weights.setflags(write=False)
+    RGB_to_XYZ.setflags(write=False)
+    return weights, RGB_to_XYZ
+
+
+def _weights_1nm() -> np.ndarray:
+    return _stored()[0]
 
 
 def _hat_matrix(fine: np.ndarray, nodes: np.ndarray) -> np.ndarray:
@@ -177,9 +216,7 @@ def reflectance_to_ACEScg(reflectance, weights) -> np.ndarray:
 
 @functools.cache
 def _matrices() -> tuple[np.ndarray, np.ndarray]:
-    colour = colour_science()
-    acescg = colour.RGB_COLOURSPACES["ACEScg"]
-    M = np.array(acescg.matrix_RGB_to_XYZ, dtype=np.float64)
+    M = _stored()[1]
     XYZ_n = M @ np.ones(3)
     return M, XYZ_n
 

@@ -23,12 +23,12 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.optimize import minimize
 from threadpoolctl import ThreadpoolController
 
 from ..colour.colorimetry import ACEScg_to_Lab
 from ..models.coated_conductor import coated_conductor_model, model_jacobian
 from ..models.pack import to_float16
+from ..numerics import scipy_optimize
 from .objective import Problem, coefficient_bounds, delta_E_gradients
 from .quantise import quantise_coefficients
 from .result import FitResult
@@ -183,8 +183,10 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
         iterations = max_iterations if work is None else work.iterations(rows, max_iterations)
         if iterations == 0:
             return None
-        result = minimize(objective, x, jac=gradient, method="SLSQP", bounds=list(zip(lower, upper)),
-                          constraints=constraints, options={"maxiter": iterations, "ftol": 1e-9})
+        optimize, threadpools = scipy_optimize()  # the constrained refits alone import scipy.optimize
+        with threadpools.limit(limits=1, user_api="blas"):
+            result = optimize.minimize(objective, x, jac=gradient, method="SLSQP", bounds=list(zip(lower, upper)),
+                              constraints=constraints, options={"maxiter": iterations, "ftol": 1e-9})
         if work is not None:
             work.spend(rows, result.nit)
         if not np.all(np.isfinite(result.x)):

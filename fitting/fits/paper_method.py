@@ -18,10 +18,10 @@ Vernooij, H. B. (2024). A Fresnel Model for Coated Materials. Eurographics.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares, leastsq
 
 from ..models.coated_conductor import ALPHA_MIN, normalised_eta_i
 from ..models.pack import to_float16
+from ..numerics import scipy_optimize, trf_least_squares
 from .objective import coefficient_bounds
 from .result import FitResult
 from .solver import fit_coefficients
@@ -29,24 +29,12 @@ from .solver import fit_coefficients
 __all__ = ["paper_fit"]
 
 
-def _lm(residuals, jacobian, x0, max_nfev):
-    """
-    MINPACK's Levenberg-Marquardt (``lmder``) from ``x0``: (x, MINPACK's
-    info, 1-4 when converged). What ``least_squares(method="lm")`` runs with
-    its default ``x_scale="jac"`` (no ``diag``), called through ``leastsq``,
-    which skips the wrapping of each call: the same iterates to the bit, a
-    fifth less time per paper-method fit (by hand, 7 conductors alternated).
-    """
-    x, _, _, _, ier = leastsq(residuals, x0, Dfun=jacobian, full_output=True, ftol=1e-10, xtol=1e-10,
-                              gtol=1e-10, maxfev=max_nfev, factor=100.0)
-    return np.asarray(x, dtype=np.float64), ier
-
-
 def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: bool = False):
     """
     Plain rgb least squares, channel by channel (the channels of the model
-    are independent): Levenberg-Marquardt on the 3 (d + 1) unknowns of one
-    channel at a time (Eq. 1 and its derivative written out for one
+    are independent): the trust-region solve of the fits
+    (:func:`fitting.numerics.trf_least_squares`) on the 3 (d + 1) unknowns
+    of one channel at a time (Eq. 1 and its derivative written out for one
     channel), from ``start``; None when a channel does not converge or
     leaves the box. With ``boxed``, such a channel is solved again inside
     the box (``trf`` with bounds, from ``start`` clipped into it) instead.
@@ -61,7 +49,8 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
     with np.errstate(divide="ignore"):
         log_x = np.where(x > 0.0, np.log(np.where(x > 0.0, x, 1.0)), 0.0)
 
-    last = [None, None]  # MINPACK asks for the Jacobian at the point it just evaluated
+    dF0 = (1.0 - x5)[:, None] * T
+    last = [None, None]  # the solver asks for the Jacobian at the point it just evaluated
 
     def parts(xc):
         key = xc.tobytes()
@@ -81,17 +70,24 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
         def jacobian(xc):
             P, _, mu_xa = parts(xc)
             dalpha = np.where(P[:, 2] > ALPHA_MIN, -P[:, 1] * mu_xa * log_x, 0.0)
-            return np.concatenate([(1.0 - x5)[:, None] * T, -mu_xa[:, None] * T, dalpha[:, None] * T], axis=1)
+            J = np.empty((m.size, 3 * d1))
+            J[:, :d1] = dF0  # the F0 columns do not depend on the coefficients
+            np.multiply(-mu_xa[:, None], T, out=J[:, d1:2 * d1])
+            np.multiply(dalpha[:, None], T, out=J[:, 2 * d1:])
+            return J
 
         x0 = C[:, c, :].ravel()
-        xc, ier = _lm(residuals, jacobian, x0, max_nfev)
-        xc = xc.reshape(3, d1)
-        if ier not in (1, 2, 3, 4) or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
+        fit = trf_least_squares(residuals, jacobian, x0, 1e-10, 1e-10, 1e-10, max_nfev)
+        xc = fit.x.reshape(3, d1)
+        if not fit.success or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
             if not boxed:
                 return None
+            optimize, threadpools = scipy_optimize()  # a channel out of its box only
             lo, hi = lower[:, c].ravel(), upper[:, c].ravel()
-            fit = least_squares(residuals, np.clip(x0, lo, hi), jac=jacobian, method="trf", bounds=(lo, hi),
-                                xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+            with threadpools.limit(limits=1, user_api="blas"):
+                fit = optimize.least_squares(
+                    residuals, np.clip(x0, lo, hi), jac=jacobian, method="trf", bounds=(lo, hi),
+                    xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
             xc = fit.x.reshape(3, d1)
             if fit.status < 0 or not np.all(np.isfinite(xc)):
                 return None

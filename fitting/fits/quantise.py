@@ -19,7 +19,7 @@ import numpy as np
 from ..models.pack import FLOAT16_MAX, to_float16
 from .objective import Problem
 
-__all__ = ["quantise_coefficients"]
+__all__ = ["quantise_coefficients", "compensations"]
 
 
 def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> np.ndarray:
@@ -44,18 +44,24 @@ def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> n
     scale = np.sqrt(np.maximum(np.diag(H), 1e-300))
     Hs = H / np.outer(scale, scale) + 1e-12 * np.eye(n)
 
-    delta = np.zeros(n)
-    free = np.ones(n, dtype=bool)
-    for i in np.argsort(-np.diag(H)):
-        target = float(np.float16(np.clip(x[i] + delta[i], -FLOAT16_MAX, FLOAT16_MAX)))
-        step = target - x[i] - delta[i]
-        delta[i] = target - x[i]
-        free[i] = False
-        if step != 0.0 and free.any():
-            # Minimise q over the free coordinates given the fixed ones.
-            F = np.flatnonzero(free)
-            rhs = Hs[F, i] * (step * scale[i])
-            delta[F] -= np.linalg.solve(Hs[F][:, F], rhs) / scale[F]
+    # The compensations of every rounding at once (Frantar et al. 2023):
+    # in the rounding order, row k of the upper Cholesky factor U of the
+    # inverse (U^T U = Hs^-1) is, divided by U[k, k], the move of the
+    # still-free coordinates that minimises q when coordinate k moves by one.
+    # U is the inverse of V, V V^T = Hs with V upper: the Cholesky factor of
+    # Hs with its order reversed (no explicit inverse of Hs).
+    order = np.argsort(-np.diag(H))
+    moves = compensations(Hs, order)
+    u = np.zeros(n)  # the scaled change delta * scale, in the rounding order
+    xs = x[order]
+    for k, i in enumerate(order):
+        target = float(np.float16(np.clip(xs[k] + u[k] / scale[i], -FLOAT16_MAX, FLOAT16_MAX)))
+        step = (target - xs[k]) * scale[i] - u[k]
+        if step != 0.0:
+            u[k:] += step * moves[k, k:]
+        u[k] = (target - xs[k]) * scale[i]
+    delta = np.empty(n)
+    delta[order] = u / scale[order]
     with np.errstate(over="ignore", invalid="ignore"):
         x16 = (x + delta).astype(np.float16)
     if not np.all(np.isfinite(x16)):
@@ -92,6 +98,22 @@ def quantise_coefficients(problem: Problem, C: np.ndarray, passes: int = 3) -> n
     cost_nearest = np.sum(problem.residuals(nearest.astype(np.float64)) ** 2)
     chosen = x16 if cost <= cost_nearest else nearest
     return to_float16(chosen.astype(np.float64)).reshape(C.shape)
+
+
+def compensations(Hs: np.ndarray, order: np.ndarray) -> np.ndarray:
+    """
+    Row k (in ``order``) is the move of coordinates ``order[k:]`` that
+    minimises the quadratic form of the symmetric positive definite ``Hs``
+    when coordinate ``order[k]`` moves by one and ``order[:k]`` are held:
+    1 at k, :math:`-H_{FF}^{-1} H_{F i}` on the free F = ``order[k+1:]``.
+    All rows from one factorisation: U = V^-1 with V V^T = Hs (in order, V
+    upper: the Cholesky factor with the order reversed), each row of U
+    divided by its diagonal (Frantar et al. 2023).
+    """
+    reversed_order = order[::-1]
+    V = np.linalg.cholesky(Hs[np.ix_(reversed_order, reversed_order)])[::-1, ::-1]
+    U = np.linalg.inv(V)
+    return U / np.diag(U)[:, None]
 
 
 def _ulp_steps(x16):

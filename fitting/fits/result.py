@@ -37,7 +37,8 @@ class FitResult:
     eta_i_range, degree, objective
         The fitted domain, polynomial degree and objective.
     success, status, message, nfev, njev
-        Convergence report of :func:`scipy.optimize.least_squares`
+        Convergence report of the last solve (:func:`fitting.numerics.trf_least_squares`,
+        or scipy's ``least_squares`` for a bounded one)
         (``status`` > 0 is convergence, 0 is the evaluation budget).
     cost
         Half the sum of squared (weighted) residuals of the last solve at the
@@ -106,7 +107,8 @@ class FitResult:
     ) -> "FitResult":
         """
         The result of a least-squares fit of any kind: ``solution`` is the
-        last :func:`scipy.optimize.least_squares` result (its success,
+        last solve's result (:func:`fitting.numerics.trf_least_squares` or
+        :func:`scipy.optimize.least_squares`: its success,
         status, message and cost), ``nfev`` / ``njev`` the totals over every
         solve (reweighting rounds included).
         """

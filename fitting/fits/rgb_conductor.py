@@ -33,7 +33,6 @@ import time
 from typing import Any
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, check_eta_i_range
@@ -46,6 +45,7 @@ from .result import FitResult
 from .rgb_conductor_quantise import N_BOUNDS, K_BOUNDS, RGBConductorObjective, nk_bounds, quantise_rgb_conductor
 from .settings import OBJECTIVES, FitSettings
 from .pipeline import FitKind, fit_spectral
+from ..numerics import scipy_optimize
 from .solver import check_samples, reweighted
 
 __all__ = [
@@ -72,6 +72,8 @@ def _initial_guess(target, mu, eta, weights) -> np.ndarray:
     starts of n (k from the normal-incidence reflectance); the best start
     wins, so the result is deterministic.
     """
+    least_squares = scipy_optimize()[0].least_squares  # imported on first use (a coated-conductor fit never does)
+
     lower, upper = nk_bounds()
     sqrt_w = np.sqrt(weights)
     x0 = np.empty((2, 3))
@@ -149,6 +151,8 @@ def fit_rgb_conductor_coefficients(
         per channel), ``model`` ``"rgb-conductor"``, ``degree`` 0; never
         raises for non-convergence (see ``success``, ``status``, ``message``).
     """
+    least_squares = scipy_optimize()[0].least_squares  # imported on first use (a coated-conductor fit never does)
+
     t_start = time.perf_counter()
     eta_i_range = check_eta_i_range(eta_i_range)
     if objective not in OBJECTIVES:
@@ -283,6 +287,8 @@ def rgb_nk(
     ValueError
         For data covering too little of the visible range.
     """
+    least_squares = scipy_optimize()[0].least_squares  # imported on first use (a coated-conductor fit never does)
+
     mu = np.linspace(0.0, 1.0, RGB_NK_SAMPLES)
     target = reference_ACEScg(nk, mu, 1.0, step_nm, min_coverage)
     n_out, k_out = np.empty(3), np.empty(3)

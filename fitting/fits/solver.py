@@ -26,11 +26,11 @@ import functools
 import time
 
 import numpy as np
-from scipy.optimize import least_squares
 from threadpoolctl import ThreadpoolController
 
 from ..domain import DEFAULT_ETA_I_RANGE, check_choice, check_eta_i_range
 from ..models.pack import to_float16
+from ..numerics import scipy_optimize, trf_least_squares
 from .objective import Problem, coefficient_bounds
 from .quantise import quantise_coefficients
 from .result import FitResult
@@ -74,17 +74,20 @@ def reweighted(problem, result, rounds: int, delta_E, base, resolve):
 
 def solve(problem: Problem, x0: np.ndarray, bounds, tol: float, max_nfev: int):
     """
-    TRF from ``x0``, unbounded first (cheaper per iteration); the bounded
-    solve is run only when the unbounded optimum leaves the box, i.e. when
-    the data leave some coefficient unidentified.
+    TRF from ``x0``, unbounded first (:func:`fitting.numerics.trf_least_squares`:
+    scipy's iteration without its SVD, the analytic Jacobian); scipy's
+    bounded solve is run only when the unbounded optimum leaves the box,
+    i.e. when the data leave some coefficient unidentified.
     """
     lower, upper = bounds
-    options = dict(jac=problem.jacobian, method="trf", x_scale="jac",
-                   ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev)
-    result = least_squares(problem.residuals, x0, **options)
+    result = trf_least_squares(problem.residuals, problem.jacobian, x0, tol, tol, tol, max_nfev)
     if np.all(np.isfinite(result.x)) and np.all((result.x >= lower) & (result.x <= upper)):
         return result
-    bounded = least_squares(problem.residuals, x0, bounds=(lower, upper), **options)
+    optimize, threadpools = scipy_optimize()  # the rare bounded solve only
+    with threadpools.limit(limits=1, user_api="blas"):
+        bounded = optimize.least_squares(
+            problem.residuals, x0, bounds=(lower, upper), jac=problem.jacobian, method="trf",
+            x_scale="jac", ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev)
     bounded.nfev += result.nfev
     bounded.njev = (bounded.njev or 0) + (result.njev or 0)
     return bounded

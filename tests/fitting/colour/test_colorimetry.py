@@ -31,6 +31,15 @@ LAB_BOUND = 1e-11
 
 
 class TestColorimetry:
+    def test_stored_constants_are_colour_sciences(self):
+        """The weights and matrix a fit reads from the package are colour-science's to the bit."""
+        from fitting.colour.colorimetry import _stored, colour_science_constants
+
+        weights, RGB_to_XYZ = colour_science_constants()
+        stored_weights, stored_matrix = _stored()
+        np.testing.assert_array_equal(stored_weights, weights)
+        np.testing.assert_array_equal(stored_matrix, RGB_to_XYZ)
+
     def test_white_maps_to_one(self):
         nodes, W = spectral_weights(1.0)
         np.testing.assert_allclose(W @ np.ones(nodes.size), 1.0, atol=WEIGHT_SUM_BOUND)

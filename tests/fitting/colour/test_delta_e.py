@@ -82,6 +82,19 @@ class TestDeltaE2000:
         assert np.isnan(dE[0]) and np.isnan(dE[1]) and dE[2] == 0.0
 
 
+    def test_colour_science_to_the_bit(self):
+        """The same operations as colour-science's delta_E_CIE2000: the same numbers, achromatic and hue wraps included."""
+        from fitting.colour.colorimetry import colour_science
+
+        rng = np.random.default_rng(11)
+        Lab_1 = np.concatenate([rng.uniform([0, -120, -120], [100, 120, 120], (500, 3)), SHARMA_LAB_1,
+                                [[50.0, 0.0, 0.0], [20.0, -3.0, 0.0]]])
+        Lab_2 = np.concatenate([Lab_1[:500] + rng.normal(0.0, 5.0, (500, 3)), SHARMA_LAB_2,
+                                [[60.0, 0.0, 0.0], [20.0, 3.0, 0.0]]])
+        theirs = colour_science().difference.delta_E_CIE2000(Lab_1, Lab_2)
+        np.testing.assert_array_equal(delta_E_2000(Lab_1, Lab_2), theirs)
+
+
 class TestDeltaEMap:
     def test_is_delta_E_2000_of_the_Lab(self):
         rng = np.random.default_rng(4)

@@ -6,7 +6,7 @@ import pytest
 from fitting.colour.reference import reference_ACEScg
 from fitting.domain import DEFAULT_ETA_I_RANGE
 from fitting.fits.objective import Problem
-from fitting.fits.quantise import quantise_coefficients
+from fitting.fits.quantise import compensations, quantise_coefficients
 from fitting.fits.settings import fit_grid
 from fitting.fits.solver import fit_coefficients
 from fitting.models.pack import PackedMaterial, decode_pack, encode_pack
@@ -58,3 +58,23 @@ class TestQuantisation:
         assert np.all(np.abs(C16.astype(np.float64) - result.coefficients) <= 64 * step)
         packed = decode_pack(encode_pack([PackedMaterial("q", C16, DEFAULT_ETA_I_RANGE)]))[0]
         assert packed.coefficients.tobytes() == C16.tobytes()
+
+
+class TestCompensations:
+    def test_each_row_re_solves_the_free_coordinates(self):
+        """One factorisation gives, row by row, what a solve over the still-free coordinates gives."""
+        rng = np.random.default_rng(7)
+        J = rng.standard_normal((60, 12)) * np.logspace(-2, 2, 12)
+        H = J.T @ J
+        scale = np.sqrt(np.diag(H))
+        Hs = H / np.outer(scale, scale) + 1e-12 * np.eye(12)
+        order = np.argsort(-np.diag(H))
+        moves = compensations(Hs, order)
+        for k, i in enumerate(order):
+            free = order[k + 1:]
+            assert moves[k, k] == pytest.approx(1.0, abs=1e-12)
+            if free.size:
+                expected = -np.linalg.solve(Hs[np.ix_(free, free)], Hs[free, i])
+                # Two factorisations of Hs (condition up to ~1e4 here, its columns
+                # spanning 1e-2..1e2 before scaling): 1e4 * u64 << 1e-9.
+                np.testing.assert_allclose(moves[k, k + 1:], expected, rtol=1e-9, atol=1e-11)

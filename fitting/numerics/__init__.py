@@ -1,0 +1,18 @@
+"""
+Numerics
+========
+
+Small dense solvers sized for the fits of this package (tens of unknowns,
+hundreds of residuals), below every layer that fits something:
+
+-   :func:`trf_least_squares`: the trust-region reflective method of
+    :func:`scipy.optimize.least_squares` for small problems, without its
+    per-iteration SVD (:mod:`fitting.numerics.trf`).
+-   :func:`scipy_optimize`: scipy.optimize on first use, with a thread-pool
+    controller that covers its BLAS (:mod:`fitting.numerics.optimize`).
+"""
+
+from .optimize import scipy_optimize
+from .trf import TRFResult, trf_least_squares
+
+__all__ = ["TRFResult", "scipy_optimize", "trf_least_squares"]
