@@ -32,6 +32,8 @@ from .api.routes import (
     versions,
 )
 from .config import Settings
+from .derived import DerivedCache
+from .jobs.evaluation import Evaluations
 from .pool import FitRunner, warm_process
 from .worker import freeze_heap, thaw_heap
 from .previews import PreviewRunner
@@ -122,6 +124,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s,
                                  settings.job_cpu_limit_s)
         app.state.store, app.state.runner, app.state.previews = store, runner, previews
+        # New fits' metrics, evaluated when the pool is idle (or when asked for).
+        app.state.evaluations = Evaluations(store, runner, settings.metrics_idle_s or None)
+        app.state.exports = DerivedCache(settings.export_cache_bytes)
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:
@@ -133,6 +138,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             yield
         finally:
             sweeper.cancel()
+            app.state.evaluations.close()
             previews.close()
             runner.close()
             store.close()

@@ -163,6 +163,9 @@ class SQLiteStore:
 
         return self._guard(write)
 
+    def set_metrics(self, fit_id: str, metrics: dict[str, Any]) -> FitRecord | None:
+        return self._write(lambda c: queries.set_metrics(c, "?", fit_id, metrics, self._decode))
+
     def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
         text = self._guard(lambda: queries.get_nk(self._connection(), "?", nk_id))
         return None if text is None else records.nk_from_json(nk_id, text)
