@@ -20,14 +20,17 @@ from __future__ import annotations
 import collections
 import threading
 from collections.abc import Awaitable, Callable, Hashable
+from typing import Any
 
 __all__ = ["DerivedCache"]
 
 
 class DerivedCache:
     """
-    Bytes by key, at most ``max_bytes`` in all (0: nothing kept); a value
-    larger than a quarter of the bound is returned but not kept.
+    Values by key, at most ``max_bytes`` in all (0: nothing kept): bytes, or
+    a tuple whose last item is the bytes (what else it holds, such as a
+    file name, is counted as nothing); a value larger than a quarter of the
+    bound is returned but not kept.
     """
 
     def __init__(self, max_bytes: int) -> None:
@@ -36,13 +39,13 @@ class DerivedCache:
         self.max_bytes = max_bytes
         self.bytes = 0
         self.hits = self.misses = 0
-        self._values: collections.OrderedDict[Hashable, bytes] = collections.OrderedDict()
+        self._values: collections.OrderedDict[Hashable, Any] = collections.OrderedDict()
         self._lock = threading.Lock()
 
     def __len__(self) -> int:
         return len(self._values)
 
-    def get(self, key: Hashable) -> bytes | None:
+    def get(self, key: Hashable) -> Any:
         """The value kept for ``key`` (now the most recently used), or None."""
         with self._lock:
             value = self._values.get(key)
@@ -53,22 +56,26 @@ class DerivedCache:
             self.hits += 1
             return value
 
-    def put(self, key: Hashable, value: bytes) -> None:
+    @staticmethod
+    def _size(value: Any) -> int:
+        return len(value[-1] if isinstance(value, tuple) else value)
+
+    def put(self, key: Hashable, value: Any) -> None:
         """Keep ``value`` for ``key``, dropping the least recently used past the bound."""
-        size = len(value)
+        size = self._size(value)
         if size * 4 > self.max_bytes:
             return
         with self._lock:
             old = self._values.pop(key, None)
             if old is not None:
-                self.bytes -= len(old)
+                self.bytes -= self._size(old)
             self._values[key] = value
             self.bytes += size
             while self.bytes > self.max_bytes:
                 _, dropped = self._values.popitem(last=False)
-                self.bytes -= len(dropped)
+                self.bytes -= self._size(dropped)
 
-    async def get_or_make(self, key: Hashable, make: Callable[[], Awaitable[bytes]]) -> bytes:
+    async def get_or_make(self, key: Hashable, make: Callable[[], Awaitable[Any]]) -> Any:
         """The value of ``key``: kept, else ``await make()`` (kept for the next request)."""
         value = self.get(key)
         if value is None:

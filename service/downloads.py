@@ -22,9 +22,9 @@ from the fit's measured n, k, or for a fit of edited curves from its model:
 -   :func:`render_export`: the bytes of an export of one fit (each fits its
     tool's values, up to about a second of CPU: the routes run it, and
     :func:`render_export_pack`, in the fitting pool's workers).
--   :func:`kept_export`: :func:`render_export` as a job of the fitting
-    pool, kept in the service's :class:`service.derived.DerivedCache` (a fit
-    never changes: a repeated download costs a lookup).
+-   :func:`kept_export`, :func:`export_key`: :func:`render_export` as a job
+    of the fitting pool, kept in the service's :class:`service.derived.DerivedCache`
+    (a fit never changes: a repeated download costs a lookup).
 -   :func:`download_name`: a safe file name for Content-Disposition.
 -   :func:`glsl_identifier`: a material name as a GLSL/HLSL identifier.
 """
@@ -47,7 +47,7 @@ from .store import FitRecord
 
 __all__ = [
     "PACK_MEDIA_TYPES", "EXPORT_MEDIA_TYPES", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
-    "render_export", "kept_export", "render_export_pack", "pack_response", "export_response", "download_name", "unique_names",
+    "render_export", "export_key", "kept_export", "render_export_pack", "pack_response", "export_response", "download_name", "unique_names",
     "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
 
@@ -136,17 +136,27 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
     return export_material(model, format, eta_i, roughness, coat_roughness, model=packed)
 
 
+def export_key(fit_id: str, format: str, eta_i: float, roughness: float, coat_roughness: float) -> str:
+    """The key of one export of a fit (:func:`kept_export`)."""
+    return f"export {fit_id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}"
+
+
 async def kept_export(cache, runner, record: FitRecord, format: str, eta_i: float, roughness: float,
-                      coat_roughness: float) -> bytes:
+                      coat_roughness: float) -> tuple[str, bytes]:
     """
-    :func:`render_export` of ``record`` in ``runner``'s pool (its CPU limit
-    and time limit; identical requests share one job), kept in ``cache``
-    (:class:`service.derived.DerivedCache`) by fit, format, eta_i and
-    roughnesses.
+    ``(record.name, render_export(...))`` of ``record``, made in
+    ``runner``'s pool (its CPU limit and time limit; identical requests
+    share one job) and kept in ``cache`` (:class:`service.derived.DerivedCache`)
+    by :func:`export_key`: a later download is answered from it without
+    reading the store.
     """
-    key = f"export {record.id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}"
-    return await cache.get_or_make(key, lambda: runner.once(key, lambda: runner.run(
-        render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0)))
+    key = export_key(record.id, format, eta_i, roughness, coat_roughness)
+
+    async def make() -> tuple[str, bytes]:
+        body = await runner.run(render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0)
+        return record.name, body
+
+    return await cache.get_or_make(key, lambda: runner.once(key, make))
 
 
 def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:

@@ -21,7 +21,8 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
-from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, export_response, kept_export, pack_response
+from ...downloads import (EXPORT_MEDIA_TYPES, PACK_CONTENT, export_key, export_response, kept_export,
+                           pack_response)
 from ...jobs.common import stored_fit
 from ...jobs.evaluation import ensure_metrics
 from ...jobs.nk import NKFit, angle_curves, fit_nk
@@ -130,17 +131,18 @@ async def get_pack(
     (``blender``) or a glTF asset (``gltf``), with ``roughness`` and
     ``coat_roughness``; named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
     """
-    record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query is validated: 422 before 404
-    stem = f"{record.name}-{record.id[:8]}"
     if format in EXPORT_MEDIA_TYPES:
-        # An export fits its tool's values (up to about a second of CPU): a job in the
-        # fitting pool, with its CPU limit and timeout, shared by identical requests, and
-        # kept (the fit never changes), so that a repeated download costs a lookup.
-        body = await kept_export(http.app.state.exports, runner, record, format, eta_i, roughness, coat_roughness)
-        return export_response(body, format, eta_i, stem, roughness, coat_roughness)
+        # A job of the fitting pool (up to about a second of CPU), kept: a fit never changes.
+        kept = http.app.state.exports.get(export_key(fit_id, format, eta_i, roughness, coat_roughness))
+        if kept is None:
+            record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query: 422 before 404
+            kept = await kept_export(http.app.state.exports, runner, record, format, eta_i, roughness,
+                                     coat_roughness)
+        return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness)
+    record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query is validated: 422 before 404
     if format != "binary":  # the JSON and the snippets quote the figures
         record = await ensure_metrics(record, store, runner)
-    return await run_in_threadpool(pack_response, [record], format, stem)
+    return await run_in_threadpool(pack_response, [record], format, f"{record.name}-{record.id[:8]}")
 
 
 @router.get("/{fit_id}/curves", response_model=CurvesPublic, responses={**ERROR_RESPONSES, **NOT_FOUND})
