@@ -181,12 +181,18 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner, evaluations: Evalu
     Overloaded, FitTimeout, WorkerLost
         From :class:`service.pool.FitRunner`.
     """
-    stored = await asyncio.to_thread(store.get_fit, fit.fit_id)
-    if stored is not None:
-        # Asked for again: logged as the material's latest save.
-        record = await asyncio.to_thread(store.put_fit, stored)
+    def stored_or_writable() -> FitRecord | None:
+        """The stored fit, asked for again (logged as the material's latest save), else None once the
+        store can take a save (one trip to a thread for both)."""
+        stored = store.get_fit(fit.fit_id)
+        if stored is not None:
+            return store.put_fit(stored)
+        checked_writable(store)
+        return None
+
+    record = await asyncio.to_thread(stored_or_writable)
+    if record is not None:
         return (await ensure_metrics(record, store, runner) if metrics else record), False
-    await asyncio.to_thread(checked_writable, store)
 
     async def make() -> FitRecord:
         job = await runner.run(_fit_part, fit, cost_s=PART_COST_S)
