@@ -9,7 +9,11 @@ What the service benchmarks (``service_load.py``, ``service_stores.py``,
 -   :func:`bare_fit_cpu`: the CPU of the core's own fit of a request's data.
 -   :func:`fit_latencies`: REST fits one after the other, each with its wall
     time, the server's CPU on it and, right after, its bare fit's CPU.
+-   :func:`evaluation_cpu`: the server's CPU on evaluating a fit's metrics when asked for.
 -   :func:`cpu_figures`: those as the records' ``rest_fit_cpu``.
+
+The servers run with ``COATED_METRICS_IDLE_S=0`` (no background evaluation), so that
+each figure is the CPU of what it names: a REST fit, or an evaluation.
 """
 
 from __future__ import annotations
@@ -75,7 +79,7 @@ def fit_latencies(url: str, bodies: list[dict], pid: int | None = None, query: s
     bare fit of the same body in this process, measured right after it (the
     two take turns, so the machine's drifting load lands on both alike).
     """
-    out: dict[str, list[float]] = {"wall": [], "cpu": [], "bare": []}
+    out: dict[str, list] = {"wall": [], "cpu": [], "bare": [], "ids": []}
     if pid is not None and not _BARE_WARM:
         from threadpoolctl import threadpool_limits
 
@@ -93,14 +97,37 @@ def fit_latencies(url: str, bodies: list[dict], pid: int | None = None, query: s
                 out["bare"].append(bare_fit_cpu(body))
             if response.status_code != 201:
                 raise SystemExit(f"unseen fit answered {response.status_code}: {response.text[:200]}")
+            out["ids"].append(response.json()["id"])
     return out
 
 
-def cpu_figures(measured: dict[str, list[float]]) -> dict:
-    """The service's CPU per REST fit against its bare fit's (ms; the ratio per fit, p50 and p90)."""
+def evaluation_cpu(url: str, pid: int, fit_ids: list[str]) -> list[float]:
+    """CPU seconds of the server's tree on ``GET /fits/{id}`` of fits whose metrics are not evaluated yet."""
+    out = []
+    with httpx.Client(base_url=url, timeout=300) as http:
+        for fit_id in fit_ids:
+            cpu = tree_cpu(pid)
+            response = http.get(f"{API}/fits/{fit_id}")
+            out.append(tree_cpu(pid) - cpu)
+            if response.status_code != 200 or not response.json()["metrics"]["evaluated"]:
+                raise SystemExit(f"GET /fits/{fit_id} answered {response.status_code}: {response.text[:200]}")
+    return out
+
+
+def cpu_figures(measured: dict[str, list], evaluations: list[float] = ()) -> dict:
+    """
+    The service's CPU per REST fit against its bare fit's (ms; the ratio per
+    fit, p50 and p90), and, with ``evaluations`` (:func:`evaluation_cpu`),
+    the CPU of a fit's evaluation when it is asked for (``evaluation_ms_p50``).
+    """
     cpu, bare = np.asarray(measured["cpu"]) * 1e3, np.asarray(measured["bare"]) * 1e3
     ratio = cpu / bare
-    return {"service_ms_p50": float(np.median(cpu)), "service_ms_p90": float(np.percentile(cpu, 90)),
+    extra = {}
+    if len(evaluations):
+        ms = np.asarray(evaluations) * 1e3
+        extra = {"evaluation_ms_p50": float(np.median(ms)), "evaluation_ms_max": float(ms.max()),
+                 "evaluations": int(ms.size)}
+    return {**extra, "service_ms_p50": float(np.median(cpu)), "service_ms_p90": float(np.percentile(cpu, 90)),
             "bare_ms_p50": float(np.median(bare)), "bare_ms_p90": float(np.percentile(bare, 90)),
             "ratio_p50": float(np.median(ratio)), "ratio_p90": float(np.percentile(ratio, 90)),
             "ratio_of_medians": float(np.median(cpu) / np.median(bare)), "n": int(cpu.size)}

@@ -12,6 +12,8 @@ lands on both alike:
     in turn, fit by fit: the wall time and the CPU the server's process
     tree spent on each against the CPU of the bare fit of the same data
     (:func:`benchmarks.service_load.fit_latencies`);
+-   ``--evaluations`` of those fits' metrics asked for (``GET /fits/{id}``):
+    the CPU of an evaluation, which the REST fit no longer carries;
 -   ``--rounds`` rounds of ``--duration`` seconds of ``--fit-clients``
     closed-loop clients POSTing new n, k fits (as ``service_load.py``), on
     each store in turn (the order swapped every round): fits answered 201
@@ -44,7 +46,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_cpu import cpu_figures, fit_latencies  # noqa: E402
+from benchmarks.service_cpu import cpu_figures, evaluation_cpu, fit_latencies  # noqa: E402
 from benchmarks.service_load import post_fits, start_replicas, unseen_fit_bodies  # noqa: E402
 
 STORES = ("sqlite", "postgresql")
@@ -75,6 +77,8 @@ def main() -> int:
     parser.add_argument("--rounds", type=int, default=2, help="load rounds per store (default 2)")
     parser.add_argument("--latency-fits", type=int, default=30, help="REST fits of unseen data per store")
     parser.add_argument("--workers", type=int, default=None, help="fit workers per service (default: every CPU)")
+    parser.add_argument("--evaluations", type=int, default=10,
+                        help="fits per store whose metrics are then asked for (their evaluation's CPU)")
     args = parser.parse_args()
     workers = args.workers or os.cpu_count() or 1
 
@@ -85,20 +89,25 @@ def main() -> int:
     servers = {}
     try:
         with tempfile.TemporaryDirectory() as data:
-            env = {**os.environ, "COATED_FIT_WORKERS": str(workers)}
+            # No background evaluation: the CPU measured of a REST fit is the fit's (the evaluation's
+            # own is measured apart, asked for).
+            env = {**os.environ, "COATED_FIT_WORKERS": str(workers), "COATED_METRICS_IDLE_S": "0"}
             (servers["sqlite"],) = start_replicas(1, env, f"{data}/sqlite")
             (servers["postgresql"],) = start_replicas(
                 1, {**env, "COATED_STORE_URL": postgres.database("bench")}, f"{data}/postgresql")
             try:
                 # Latency and CPU: fit by fit, each store in turn, each its own unseen data.
                 bodies = unseen_fit_bodies(2 * args.latency_fits)
-                measured = {store: {"wall": [], "cpu": [], "bare": []} for store in STORES}
+                measured = {store: {"wall": [], "cpu": [], "bare": [], "ids": []} for store in STORES}
                 for j in range(args.latency_fits):
                     for k, store in enumerate(STORES if j % 2 == 0 else STORES[::-1]):
                         process, url = servers[store]
                         one = fit_latencies(url, [bodies[2 * j + STORES.index(store)]], process.pid)
                         for key, values in one.items():
                             measured[store][key] += values
+                evaluated = {store: evaluation_cpu(servers[store][1], servers[store][0].pid,
+                                                   measured[store]["ids"][:args.evaluations])
+                             for store in STORES}
                 # Throughput: rounds in turn, the order swapped every round.
                 rounds: dict[str, list] = {store: [] for store in STORES}
                 for r in range(args.rounds):
@@ -128,7 +137,7 @@ def main() -> int:
             "other": sum(v for c, _ in rounds[store] for k, v in c.items() if k not in (201, 503)),
             "rest_fit_unseen_ms": {"p50": float(np.median(wall)), "p90": float(np.percentile(wall, 90)),
                                    "max": float(wall.max()), "n": int(wall.size)},
-            "rest_fit_cpu": cpu_figures(measured[store]),
+            "rest_fit_cpu": cpu_figures(measured[store], evaluated[store]),
         }
     figures["postgresql_over_sqlite"] = figures["postgresql"]["fits_per_s"] / figures["sqlite"]["fits_per_s"]
     figures["slower_store_over_faster"] = min(figures["postgresql_over_sqlite"],
@@ -136,14 +145,15 @@ def main() -> int:
     print(f"\nservice on each store: {workers} fit workers each, {args.fit_clients} fit clients, "
           f"{args.rounds} x {args.duration:g} s per store in turns, machine {os.cpu_count()} CPUs")
     print("\n| store | fits/s (rounds) | refused 503 | REST fit p50 / p90 ms | service CPU / bare fit CPU ms "
-          "(p50) | ratio p50 / p90 |")
-    print("|---|---|---|---|---|---|")
+          "(p50) | ratio p50 / p90 | evaluation CPU ms (p50) |")
+    print("|---|---|---|---|---|---|---|")
     for store in STORES:
         f = figures[store]
         c = f["rest_fit_cpu"]
         print(f"| {store} | {f['fits_per_s']:.2f} ({', '.join(f'{x:.1f}' for x in f['rounds'])}) | "
               f"{f['refused']} | {f['rest_fit_unseen_ms']['p50']:.0f} / {f['rest_fit_unseen_ms']['p90']:.0f} | "
-              f"{c['service_ms_p50']:.1f} / {c['bare_ms_p50']:.1f} | {c['ratio_p50']:.2f} / {c['ratio_p90']:.2f} |")
+              f"{c['service_ms_p50']:.1f} / {c['bare_ms_p50']:.1f} | {c['ratio_p50']:.2f} / {c['ratio_p90']:.2f} | "
+              f"{c['evaluation_ms_p50']:.1f} |")
     print(f"\nPostgreSQL / SQLite fits per second: {figures['postgresql_over_sqlite']:.3f}")
     print("recorded:", write_result("service_stores", figures, load_at_start, workers=workers,
                                     fit_clients=args.fit_clients, rounds=args.rounds, duration_s=args.duration))
