@@ -126,7 +126,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.state.store, app.state.runner, app.state.previews = store, runner, previews
         # New fits' metrics, evaluated when the pool is idle (or when asked for).
         app.state.evaluations = Evaluations(store, runner, settings.metrics_idle_s or None)
-        app.state.exports = DerivedCache(settings.export_cache_bytes)
+        app.state.derived = DerivedCache(settings.derived_cache_bytes)
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:

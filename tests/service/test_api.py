@@ -439,6 +439,16 @@ class TestPreview:
         image = Image.open(io.BytesIO(response.content))
         assert image.size == (64, 64)
 
+    def test_a_repeated_preview_is_answered_from_memory(self, shared):
+        client, fit = shared
+        params = {"fit": fit["id"], "size": 64, "eta_i": 1.3}
+        first = client.get(f"{API}/preview.png", params=params)
+        assert first.status_code == 200, first.text
+        derived = client.app.state.derived
+        hits = derived.hits
+        again = client.get(f"{API}/preview.png", params=params)
+        assert again.content == first.content and derived.hits == hits + 1
+
     @pytest.mark.parametrize(
         ("params", "status"),
         [({"size": 4096}, 422), ({"size": 32}, 422), ({"compare": "x"}, 422), ({"eta_i": 5}, 422)],

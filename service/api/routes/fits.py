@@ -133,10 +133,10 @@ async def get_pack(
     """
     if format in EXPORT_MEDIA_TYPES:
         # A job of the fitting pool (up to about a second of CPU), kept: a fit never changes.
-        kept = http.app.state.exports.get(export_key(fit_id, format, eta_i, roughness, coat_roughness))
+        kept = http.app.state.derived.get(export_key(fit_id, format, eta_i, roughness, coat_roughness))
         if kept is None:
             record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query: 422 before 404
-            kept = await kept_export(http.app.state.exports, runner, record, format, eta_i, roughness,
+            kept = await kept_export(http.app.state.derived, runner, record, format, eta_i, roughness,
                                      coat_roughness)
         return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness)
     record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query is validated: 422 before 404

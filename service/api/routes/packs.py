@@ -36,7 +36,7 @@ async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep, 
         # fitting pool, with its CPU limit and timeout, shared by identical requests, and
         # kept (the fits never change).
         key = f"export pack {request.format} {request.eta_i!r} {' '.join(r.id for r in records)}"
-        body = await http.app.state.exports.get_or_make(key, lambda: runner.once(key, lambda: runner.run(
+        body = await http.app.state.derived.get_or_make(key, lambda: runner.once(key, lambda: runner.run(
             render_export_pack, records, request.format, request.eta_i, cost_s=float(len(records)))))
         return Response(body, media_type="application/zip", headers={
             "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
