@@ -13,7 +13,12 @@ data directory, then runs a bounded load generator against it:
 
 First, one client alone POSTs ``--latency-fits`` fits of data the service has
 not seen, one after the other: half a library metal over a new eta_i range,
-half an upload of perturbed n, k (metrics on the paper's grid included).
+half an upload of perturbed n, k (answered once saved; the evaluation of
+the metrics on the paper's grid runs later, when asked for or when the pool
+is idle). For each it measures the CPU the server's process tree spent
+(``psutil``, the server and its workers) and, right after, the CPU of the
+bare fit of the same data in the benchmark's own process (one BLAS thread,
+as a worker): ``rest_fit_cpu`` records both and their ratio.
 
 Prints one table: the REST fit latency of unseen data (first, p50, p90),
 fits per second (answered 201), 503 refusals, and the latency percentiles of
@@ -59,6 +64,7 @@ sys.path.insert(0, str(ROOT))
 API = "/api/v1"
 
 from benchmarks.record import load_average, write_result  # noqa: E402
+from benchmarks.service_cpu import cpu_figures, fit_latencies  # noqa: E402
 
 
 def free_port() -> int:
@@ -95,18 +101,6 @@ def unseen_fit_bodies(count: int) -> list[dict]:
             body["nk"]["n"] = (np.asarray(body["nk"]["n"]) * (1.0 + 0.02 * rng.random(26))).tolist()
             bodies.append(body)
     return bodies
-
-
-def fit_latencies(url: str, bodies: list[dict]) -> list[float]:
-    out = []
-    with httpx.Client(base_url=url, timeout=300) as http:
-        for body in bodies:
-            start = time.perf_counter()
-            response = http.post(f"{API}/fits", json=body)
-            out.append(time.perf_counter() - start)
-            if response.status_code != 201:
-                raise SystemExit(f"unseen fit answered {response.status_code}: {response.text[:200]}")
-    return out
 
 
 def read_packs(url: str, fit_id: str, stop: threading.Event, out: list[float]) -> None:
@@ -241,8 +235,9 @@ def main() -> int:
     args.workers = args.workers or max(1, (os.cpu_count() or 1) // args.replicas)
     postgres = None
     with tempfile.TemporaryDirectory() as data:
+        # No background evaluation of the metrics: each figure is the CPU of what it names.
         env = {**os.environ, "COATED_FIT_WORKERS": str(args.workers),
-               "COATED_METRICS_SAMPLES": str(args.metrics_samples)}
+               "COATED_METRICS_SAMPLES": str(args.metrics_samples), "COATED_METRICS_IDLE_S": "0"}
         if args.store == "postgresql":
             sys.path.insert(0, str(ROOT / "tests"))
             from postgres_server import PostgresServer
@@ -253,7 +248,8 @@ def main() -> int:
         urls = [url for _, url in servers]
         url = urls[0]
         try:
-            latency = fit_latencies(url, unseen_fit_bodies(args.latency_fits))
+            measured = fit_latencies(url, unseen_fit_bodies(args.latency_fits), servers[0][0].pid)
+            latency = measured["wall"]
             fit_id = httpx.post(f"{url}{API}/fits", json={"material": "Au"}, timeout=120).json()["id"]
             saved: list[str] = []
 
@@ -303,6 +299,10 @@ def main() -> int:
         print(f"| REST fit of unseen data, one client: fits | {ms.size} |")
         print(f"| REST fit of unseen data: first / p50 / p90 ms | {ms[0]:.0f} / "
               f"{np.percentile(ms, 50):.0f} / {np.percentile(ms, 90):.0f} |")
+        figures["rest_fit_cpu"] = cpu_figures(measured)
+        print(f"| REST fit of unseen data: service CPU / bare fit CPU ms (p50), ratio p50 / p90 | "
+              f"{figures['rest_fit_cpu']['service_ms_p50']:.1f} / {figures['rest_fit_cpu']['bare_ms_p50']:.1f}, "
+              f"{figures['rest_fit_cpu']['ratio_p50']:.2f} / {figures['rest_fit_cpu']['ratio_p90']:.2f} |")
     print(f"| fits answered 201 | {fits} |")
     print(f"| fits per second | {fits / elapsed:.2f} |")
     print(f"| fits refused 503 (Retry-After) | {counts.get(503, 0)} |")

@@ -96,6 +96,14 @@ class Settings(BaseSettings):
         collect all of it.
     metrics_samples
         Side of the scoring grid of the fit metrics (the paper: 100).
+    metrics_idle_s
+        A new fit's metrics are evaluated in the background once the pool
+        has had no job for this many seconds (:mod:`service.jobs.evaluation`);
+        0 evaluates them only when asked for.
+    derived_cache_bytes
+        Bytes of what is derived from stored fits kept in memory (exports per
+        fit, format, eta_i and roughnesses; previews per fit and view), each
+        made once; the least recently used dropped past it.
     max_body_bytes, max_upload_bytes
         Largest JSON body and largest upload (multipart body), bytes; larger
         requests get 413.
@@ -160,6 +168,8 @@ class Settings(BaseSettings):
     warm_pool: bool = True
     freeze_heap: bool = True
     metrics_samples: int = Field(default=100, ge=10, le=400)
+    metrics_idle_s: float = Field(default=1.0, ge=0.0, le=3600.0)
+    derived_cache_bytes: int = Field(default=64_000_000, ge=0, le=8_000_000_000)
     max_body_bytes: int = Field(default=1_000_000, ge=1_000)
     max_upload_bytes: int = Field(default=2_000_000, ge=1_000)
     max_preview_size: int = Field(default=1024, ge=64, le=2048)

@@ -23,6 +23,9 @@ from the fit's measured n, k, or for a fit of edited curves from its model:
 -   :func:`render_export`: the bytes of an export of one fit (each fits its
     tool's values, up to about a second of CPU: the routes run it, and
     :func:`render_export_pack`, in the fitting pool's workers).
+-   :func:`kept_export`, :func:`export_key`: :func:`render_export` as a job
+    of the fitting pool, kept in the service's :class:`service.derived.DerivedCache`
+    (a fit never changes: a repeated download costs a lookup).
 -   :func:`download_name`: a safe file name for Content-Disposition.
 -   :func:`glsl_identifier`: a material name as a GLSL/HLSL identifier.
 """
@@ -46,7 +49,8 @@ from .store import FitRecord
 
 __all__ = [
     "PACK_MEDIA_TYPES", "is_export", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
-    "render_export", "render_export_pack", "pack_response", "export_response", "download_name", "unique_names",
+    "render_export", "export_key", "kept_export", "render_export_pack", "pack_response", "export_response",
+    "download_name", "unique_names",
     "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
 
@@ -139,6 +143,29 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
             packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
     return export_material(model, format, eta_i, roughness, coat_roughness, model=packed)
+
+
+def export_key(fit_id: str, format: str, eta_i: float, roughness: float, coat_roughness: float) -> str:
+    """The key of one export of a fit (:func:`kept_export`)."""
+    return f"export {fit_id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}"
+
+
+async def kept_export(cache, runner, record: FitRecord, format: str, eta_i: float, roughness: float,
+                      coat_roughness: float) -> tuple[str, bytes]:
+    """
+    ``(record.name, render_export(...))`` of ``record``, made in
+    ``runner``'s pool (its CPU limit and time limit; identical requests
+    share one job) and kept in ``cache`` (:class:`service.derived.DerivedCache`)
+    by :func:`export_key`: a later download is answered from it without
+    reading the store.
+    """
+    key = export_key(record.id, format, eta_i, roughness, coat_roughness)
+
+    async def make() -> tuple[str, bytes]:
+        body = await runner.run(render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0)
+        return record.name, body
+
+    return await cache.get_or_make(key, lambda: runner.once(key, make))
 
 
 def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:

@@ -35,6 +35,8 @@ from .api.routes import (
 )
 from .config import Settings
 from .runtime import FitRunner, PreviewRunner, freeze_heap, thaw_heap, warm_process
+from .derived import DerivedCache
+from .jobs.evaluation import Evaluations
 from .schemas import API_PREFIX
 from .store import StoreError, open_store
 
@@ -123,6 +125,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s,
                                  settings.job_cpu_limit_s)
         app.state.store, app.state.runner, app.state.previews = store, runner, previews
+        # New fits' metrics, evaluated when the pool is idle (or when asked for).
+        app.state.evaluations = Evaluations(store, runner, settings.metrics_idle_s or None)
+        app.state.derived = DerivedCache(settings.derived_cache_bytes)
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:
@@ -134,6 +139,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             yield
         finally:
             sweeper.cancel()
+            app.state.evaluations.close()
             previews.close()
             runner.close()
             store.close()

@@ -87,7 +87,10 @@ async function send(method, path, body = null) {
 export const renameMaterial = (id, name) => send("PATCH", `/materials/${encodeURIComponent(id)}`, { name });
 export const deleteMaterial = (id) => send("DELETE", `/materials/${encodeURIComponent(id)}`);
 export const restoreMaterial = (id) => send("POST", `/materials/${encodeURIComponent(id)}/restore`);
-export const fitLibrary = (name, etaRange) => postJSON("/fits", { material: name, eta_i_range: etaRange });
+// `?metrics=full`: the editor shows the fit's figure, so its answer waits for the evaluation on the
+// metrics grid (without it an n, k fit answers as soon as it is saved, `metrics.evaluated` false).
+export const fitLibrary = (name, etaRange) =>
+  postJSON("/fits?metrics=full", { material: name, eta_i_range: etaRange });
 // With `curvesAt` ({ etaI, samples }), the answer also holds the fit's curves
 // there (`curves`, as curves() gives): one round trip per refit.
 export function fitFromCurves(body, curvesAt = null) {
@@ -100,7 +103,7 @@ export function uploadNK(file, name = "") {
   const form = new FormData();
   form.append("file", file, file.name);
   if (name) form.append("name", name);
-  return postForm("/fits/upload", form);
+  return postForm("/fits/upload?metrics=full", form);
 }
 
 export function curves(fitId, etaI, samples) {

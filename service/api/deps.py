@@ -7,7 +7,7 @@ Dependencies
 -   :data:`SettingsDep`, :data:`StoreDep`, :data:`RunnerDep`: the app's
     settings, store and fitting pool.
 -   :data:`FitIdPath`, :data:`MaterialIdPath`, :data:`RoughnessQuery`,
-    :data:`CoatRoughnessQuery`, :data:`MinCoverageForm`: shared parameters.
+    :data:`CoatRoughnessQuery`, :data:`MinCoverageForm`, :data:`MetricsQuery`: shared parameters.
 -   :data:`StoredFit`: the stored fit named by the path's ``fit_id`` (404
     when it is not stored), read in a worker thread.
 -   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
@@ -23,7 +23,7 @@ Dependencies
 from __future__ import annotations
 
 import hmac
-from typing import Annotated
+from typing import Annotated, Literal
 
 from fastapi import Depends, Form, HTTPException, Path, Query, Request, status
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
@@ -43,6 +43,7 @@ __all__ = [
     "RoughnessQuery",
     "CoatRoughnessQuery",
     "MinCoverageForm",
+    "MetricsQuery",
     "StoredFit",
     "WriteAccess",
     "SingleFormFields",
@@ -81,6 +82,10 @@ RoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, des
     "The metal's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
 CoatRoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description=(
     "The coat's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
+MetricsQuery = Annotated[Literal["solve", "full"], Query(description=(
+    "`solve` (default): answer as soon as the fit is saved, with what its solve measured "
+    "(`metrics.evaluated` false until its evaluation on the metrics grid has run, after the answer); "
+    "`full`: wait for that evaluation (the figure, Delta E of the model and the baselines)"))]
 MinCoverageForm = Annotated[float | None, Form(ge=0.0, le=1.0, allow_inf_nan=False, description=(
     "Least covered fraction of 360-830 nm to accept, in [0.9, 1] (default 0.9, the service's own "
     "rule; a higher value refuses data the service would fit)"))]

@@ -6,7 +6,8 @@ n, k fits
     data given by the user): the :class:`fitting.optics.nk.SpectralNK` built and
     checked once, and the ids computed once.
 -   :func:`fit_nk`: the stored fit of an :class:`NKFit`, else fitted in the
-    pool and saved; ``(record, created)``.
+    pool and saved (its metrics evaluated later, :mod:`service.jobs.evaluation`);
+    ``(record, created)``.
 -   :func:`angle_curves`: the float16 model, the spectral reference and
     adjusted Lazanyi of a stored fit against the angle (for plotting).
 """
@@ -14,20 +15,16 @@ n, k fits
 from __future__ import annotations
 
 import asyncio
-import time
 from pathlib import PurePath
 from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
-from fitting.colour.reference import evaluation_grid, reference_ACEScg, reference_ACEScg_grid, spectral_grid
+from fitting.colour.reference import reference_ACEScg, spectral_grid
 from fitting.domain import DEFAULT_MIN_COVERAGE, BoundedCache, check_eta_i_range, cos_theta_from_angle
-from fitting.fits.evaluate import grid_models, metrics_json, score_on_grid
 from fitting.fits.kinds import fit_kind, fit_model
-from fitting.fits.metrics import ErrorMetrics
 from fitting.fits.pipeline import with_metrics
-from fitting.fits.result import FitResult
 from fitting.fits.settings import DEFAULT_OBJECTIVE, FitSettings
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
@@ -39,6 +36,7 @@ from fitting.optics.readers import FORMATS, read_nk
 from ..runtime import FitRunner
 from ..store import FitRecord, Store
 from .curves import target_at
+from .evaluation import Evaluations, ensure_metrics, evaluation_provenance, solve_metrics
 from .common import (
     FIT_FORMAT_VERSION,
     check_finite,
@@ -54,16 +52,8 @@ __all__ = ["NKFit", "fit_nk", "angle_curves", "MAX_NK_SAMPLES"]
 MAX_NK_SAMPLES = 20_000
 """Most wavelength samples accepted in one n, k table."""
 
-METRICS_DTYPE = "float32"
-"""
-Arithmetic of the spectral reference of a fit's metrics: float32, nearly
-twice as fast as the float64 definition, its Delta E within 0.001 of it
-(measured 7e-6, the same on every CPU; see
-:func:`fitting.colour.reference.reference_ACEScg_grid`; docs/service.md).
-"""
-
 PART_COST_S = 0.1
-"""Estimated seconds of each part of an n, k fit: its turn in the pool (:class:`service.runtime.turns.Turns`)."""
+"""Estimated seconds of an n, k fit: its turn in the pool (:class:`service.runtime.turns.Turns`)."""
 
 
 @dataclass(frozen=True)
@@ -152,71 +142,37 @@ class NKFit:
                            metrics_samples)
 
 
-def _fit_part(fit: NKFit) -> FitResult:
-    """Worker process: fit and quantise one material."""
-    return fit_model(fit.nk, fit.eta_i_range, fit.model, objective=fit.objective)
-
-
-def _reference_part(fit: NKFit) -> tuple[np.ndarray, dict[str, ErrorMetrics], float]:
+def _fit_part(fit: NKFit) -> dict[str, Any]:
     """
-    Worker process, beside :func:`_fit_part` (none of it needs the fit):
-    the 1 nm reference on the scoring grid, the baselines' metrics against
-    it, and the seconds they took.
+    Worker process: fit and quantise one material; the job's answer, its
+    metrics those of the solve (:func:`service.jobs.evaluation.solve_metrics`:
+    the evaluation on the metrics grid comes later, once).
     """
-    t0 = time.perf_counter()
-    M, E = evaluation_grid(fit.metrics_samples, fit.eta_i_range)
-    reference = reference_ACEScg_grid(fit.nk, M[0], E[:, 0], 1.0, DEFAULT_MIN_COVERAGE, METRICS_DTYPE)
-    baselines = score_on_grid(fit.nk, M, E, {}, reference=reference)
-    return reference, baselines, time.perf_counter() - t0
-
-
-def _metrics_part(fit: NKFit, result: FitResult, reference: np.ndarray,
-                  baselines: dict[str, ErrorMetrics], seconds: float) -> dict[str, Any]:
-    """Worker process: score the fit against the reference; the job's answer."""
-    t0 = time.perf_counter()
-    # The fit's domain is the request's (checked once, in NKFit), so is the grid.
-    M, E = evaluation_grid(fit.metrics_samples, fit.eta_i_range)
-    errors = score_on_grid(fit.nk, M, E, grid_models(result, M, E), baselines=False, reference=reference)
-    # The pipeline's own steps (fitting.fits.pipeline): the metrics JSON and the record carrying it.
-    with_metrics(result, metrics_json({**errors, **baselines}, result, fit.metrics_samples), name=fit.name)
-    evaluate = seconds + time.perf_counter() - t0
-    # As fit_spectral's: "total" is the whole fit, its evaluation included.
-    timings = {**result.timings, "evaluate": evaluate, "total": result.timings["total"] + evaluate}
+    result = fit_model(fit.nk, fit.eta_i_range, fit.model, objective=fit.objective)
+    with_metrics(result, solve_metrics(result, result.coverage), name=fit.name)
     summary = result.summary()
     summary.pop("timings")
-    check_finite("metrics", result.metrics)
+    check_finite("coefficients", result.coefficients.tolist())
     return {
         "material": material_to_json(result.packed),
         "metrics": result.metrics,
-        "timings": timings,
+        "timings": result.timings,
         "convergence": summary,
         "coverage": result.coverage,
         "settings": asdict(result.settings),
+        "evaluation": evaluation_provenance(result, fit.metrics_samples),
     }
 
 
-async def _nk_job(fit: NKFit, runner: FitRunner) -> dict[str, Any]:
-    """
-    One fit in the pool under one slot: the fit and the reference of its
-    metrics side by side (two workers when both are idle), then the score.
-    """
-    async with runner.slot():
-        parts = await asyncio.gather(
-            runner.submit(_fit_part, fit, cost_s=PART_COST_S), runner.submit(_reference_part, fit, cost_s=PART_COST_S),
-            return_exceptions=True,
-        )
-        for part in parts:
-            if isinstance(part, BaseException):
-                raise part
-        result, (reference, baselines, seconds) = parts
-        return await runner.submit(_metrics_part, fit, result, reference, baselines, seconds, cost_s=PART_COST_S)
-
-
-async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord, bool]:
+async def fit_nk(fit: NKFit, store: Store, runner: FitRunner, evaluations: Evaluations | None = None,
+                 metrics: bool = False) -> tuple[FitRecord, bool]:
     """
     The stored fit of ``fit``: served from ``store`` when its id is there,
-    otherwise fitted in ``runner``'s pool and saved. Returns
-    ``(record, created)``.
+    otherwise fitted in ``runner``'s pool (one part, one worker) and saved
+    with the metrics of its solve, its evaluation on the metrics grid left
+    to ``evaluations`` (in the background) or to whoever asks for it; with
+    ``metrics`` true, evaluated before the answer
+    (:func:`service.jobs.evaluation.ensure_metrics`). Returns ``(record, created)``.
 
     Raises
     ------
@@ -225,24 +181,37 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner) -> tuple[FitRecord
     Overloaded, FitTimeout, WorkerLost
         From :class:`service.runtime.pool.FitRunner`.
     """
-    stored = await asyncio.to_thread(store.get_fit, fit.fit_id)
-    if stored is not None:
-        # Asked for again: logged as the material's latest save.
-        return await asyncio.to_thread(store.put_fit, stored), False
-    await asyncio.to_thread(checked_writable, store)
+    def stored_or_writable() -> FitRecord | None:
+        """The stored fit, asked for again (logged as the material's latest save), else None once the
+        store can take a save (one trip to a thread for both)."""
+        stored = store.get_fit(fit.fit_id)
+        if stored is not None:
+            return store.put_fit(stored)
+        checked_writable(store)
+        return None
+
+    record = await asyncio.to_thread(stored_or_writable)
+    if record is not None:
+        return (await ensure_metrics(record, store, runner) if metrics else record), False
 
     async def make() -> FitRecord:
-        job = await _nk_job(fit, runner)
+        job = await runner.run(_fit_part, fit, cost_s=PART_COST_S)
         record = fit_record(
             fit.fit_id, fit.kind, fit.material_id, fit.name, fit.nk.source, job, fit.objective,
             library_material=fit.library_material,
             nk=None if fit.library_material else nk_view(fit.nk),
-            # The settings that ran (the kind's, with the request's objective).
-            provenance={"fit_format": FIT_FORMAT_VERSION, "settings": job["settings"]},
+            # The settings that ran (the kind's, with the request's objective), and what the
+            # evaluation of its metrics needs.
+            provenance={"fit_format": FIT_FORMAT_VERSION, "settings": job["settings"], **job["evaluation"]},
         )
         return await asyncio.to_thread(store.put_fit, record)
 
-    return await runner.once(fit.fit_id, make), True
+    record = await runner.once(fit.fit_id, make)
+    if metrics:
+        record = await ensure_metrics(record, store, runner)
+    elif evaluations is not None:
+        evaluations.schedule(record.id)
+    return record, True
 
 
 _MEASURED_CURVES = BoundedCache(64)

@@ -242,6 +242,7 @@ def fit_public(record: FitRecord) -> FitPublic:
         coefficients=(Coefficients if model_kind(view.get("model", DEFAULT_MODEL)).polynomial
                       else RGBConductorCoefficients)(**view["coefficients"]),
         metrics=FitMetrics(
+            evaluated=metrics.get("evaluated", True) is not False,
             figure=metrics.get("figure"),
             grid=metrics.get("grid"),
             model=metrics.get("model_float16"),

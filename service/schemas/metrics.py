@@ -10,6 +10,8 @@ The JSON keys are the core's.
 
 from __future__ import annotations
 
+from typing import Any
+
 from pydantic import BaseModel, Field
 
 from .common import Mirror, absent
@@ -79,11 +81,22 @@ class FitDetails(Mirror):
     samples: int | None = absent("Samples a curve fit fitted")
     best_effort: bool | None = absent("True when the refit's evaluation budget ran out and the fit was made to stay in [0, 1]")
     target: DeltaE | None = absent()
+    guard: dict[str, Any] | None = absent("What the fit's solve measured itself: the worst-case guard's "
+                                          "candidates (Delta E 2000 on its points) and which it kept")
 
 
 class FitMetrics(BaseModel):
-    """The one figure, Delta E 2000 of the float16 model and of adjusted Lazanyi, and every detail."""
+    """
+    The one figure, Delta E 2000 of the float16 model and of adjusted
+    Lazanyi, and every detail. An n, k fit's evaluation on the metrics grid
+    runs once, after the fit: until it has, ``evaluated`` is false and
+    ``figure``, ``grid``, ``model`` and ``lazanyi_adjusted`` are null
+    (``details.guard`` holds what the solve measured itself).
+    """
 
+    evaluated: bool = Field(True, description="False while an n, k fit's evaluation on the metrics grid "
+                            "has not run yet: `figure`, `grid`, `model` and `lazanyi_adjusted` are then null; "
+                            "`GET /fits/{id}` (or `?metrics=full` on the fit) waits for it")
     figure: Figure | None = Field(None, description="The fit's figure: what it is measured against, "
                                   "mean, max and where the max is; the pack JSON and shader headers quote it")
     grid: str | None = None

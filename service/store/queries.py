@@ -9,6 +9,7 @@ The caller owns the transaction and translates driver errors.
 
 -   :func:`save`: the body of ``put_fit`` (write-once record, save log,
     summary row, the expected-version check).
+-   :func:`set_metrics`: a stored fit's metrics, evaluated after it was saved.
 -   :func:`expire_drafts`: the drafts' sweep (age, then quota, then the
     n, k records no fit refers to); :func:`get_nk`: an n, k record.
 -   :func:`get_text`, :func:`latest_texts`, :func:`latest_ids`,
@@ -21,6 +22,7 @@ The caller owns the transaction and translates driver errors.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import time
 from typing import Any, Callable
@@ -30,7 +32,7 @@ from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken,
 
 INT64_MAX = 2**63 - 1
 
-__all__ = ["save", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
+__all__ = ["save", "set_metrics", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
            "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
            "version_text", "summary_text", "LISTED_KINDS"]
 
@@ -102,6 +104,21 @@ def get_nk(connection: Any, p: str, nk_id: str) -> Any:
     """The stored JSON text of the n, k record ``nk_id``, or None."""
     row = connection.execute(f"SELECT record FROM nk_records WHERE id = {p}", (nk_id,)).fetchone()
     return None if row is None else row[0]
+
+
+def set_metrics(connection: Any, p: str, fit_id: str, metrics: dict[str, Any],
+                decode: Callable[[str, Any], FitRecord]) -> FitRecord | None:
+    """
+    Replace the metrics of the stored fit ``fit_id`` (the rest of its record
+    stays as written); the record as stored now, or None when it is not
+    stored (an expired draft).
+    """
+    text = get_text(connection, p, fit_id)
+    if text is None:
+        return None
+    record = dataclasses.replace(decode(fit_id, text), metrics=metrics)
+    connection.execute(f"UPDATE fits SET record = {p} WHERE id = {p}", (record.to_json(), fit_id))
+    return record
 
 
 def get_text(connection: Any, p: str, fit_id: str) -> Any:

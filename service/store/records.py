@@ -248,6 +248,14 @@ class Store(Protocol):
         one: always; drafts: until they expire, :meth:`expire_drafts`).
         """
 
+    def set_metrics(self, fit_id: str, metrics: dict[str, Any]) -> FitRecord | None:
+        """
+        Give the stored fit ``fit_id`` its ``metrics`` (a fit's metrics are
+        evaluated after it is saved, :mod:`service.jobs.evaluation`; the rest
+        of the record never changes); the record as stored now, or None when
+        it is not stored.
+        """
+
     def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
         """The n, k record ``nk_id`` (``{"wavelength_nm", "n", "k"}``), or None (never stored, or expired)."""
 

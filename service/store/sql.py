@@ -57,6 +57,9 @@ class SQLStore:
 
     # -- the interface -----------------------------------------------------
 
+    def set_metrics(self, fit_id: str, metrics: dict[str, Any]) -> FitRecord | None:
+        return self._write(lambda c: queries.set_metrics(c, self.placeholder, fit_id, metrics, self._decode))
+
     def get_nk(self, nk_id: str) -> dict[str, list[float]] | None:
         text = self._read(lambda c: queries.get_nk(c, self.placeholder, nk_id))
         return None if text is None else records.nk_from_json(nk_id, text)

@@ -18,7 +18,7 @@ from fitting.models.coated_conductor import coated_conductor_model
 from fitting.models.pack import decode_pack, pack_from_json
 from fitting.optics.library import LIBRARY_NAMES, library_material
 from service.config import Settings
-from service.jobs.nk import METRICS_DTYPE
+from service.jobs.evaluation import METRICS_DTYPE
 from conftest import app_client
 
 API = "/api/v1"
@@ -124,23 +124,33 @@ class TestFits:
         expected = fit_material(library_material("Au"), (1.0, 2.5)).coefficients_float16
         got = np.array([fit["coefficients"][p] for p in ("F0", "a", "alpha")])
         np.testing.assert_array_equal(got, expected.astype(np.float64))
-        metrics = fit["metrics"]
-        assert metrics["grid"] == "30x30"
+        # The answer carries what the solve measured; the evaluation on the metrics grid comes after it.
+        lazy = fit["metrics"]
+        assert lazy["evaluated"] is False and lazy["figure"] is None and lazy["model"] is None
+        assert lazy["details"]["guard"]["chosen"] in lazy["details"]["guard"]["candidates"]
+        assert {"reference", "fit", "quantise", "total"} <= set(fit["timings"])
+        assert fit["convergence"]["success"] is True
+        # Asked for, the fit has them (evaluated now or in the background meanwhile).
+        metrics = client.get(f"{API}/fits/{fit['id']}").json()["metrics"]
+        assert metrics["evaluated"] is True and metrics["grid"] == "30x30"
         assert 0 < metrics["model"]["delta_E_mean"] < metrics["lazanyi_adjusted"]["delta_E_mean"]
         assert metrics["model"]["delta_E_mean"] <= metrics["model"]["delta_E_max"]
-        assert {"reference", "fit", "quantise", "total", "evaluate"} <= set(fit["timings"])
-        assert fit["convergence"]["success"] is True
+        assert metrics["details"]["guard"] == lazy["details"]["guard"]
 
     @pytest.mark.slow  # starts a process or GL context
     def test_metrics_are_the_core_evaluation(self, shared):
-        # The pool's three parts (the fit, the reference beside it, the score)
-        # give the numbers of the core's evaluation on the service's reference.
+        # The fit in one part, its evaluation in another (asked for by the GET), stored:
+        # the numbers of the core's evaluation on the service's reference, and the
+        # core's quality report and guard.
         client, fit = shared
+        assert client.get(f"{API}/fits/{fit['id']}").status_code == 200
         record = client.app.state.store.get_fit(fit["id"])
         nk = library_material("Au")
-        expected = evaluate_model(nk, fit_model(nk, (1.0, 2.5)), samples=30, dtype=METRICS_DTYPE)
-        assert record.metrics == expected
-        assert record.timings["evaluate"] > 0.0
+        result = fit_model(nk, (1.0, 2.5))
+        expected = evaluate_model(nk, result, samples=30, dtype=METRICS_DTYPE)
+        assert {k: v for k, v in record.metrics.items() if k not in ("quality", "guard")} == expected
+        assert json.loads(json.dumps([result.quality, result.guard])) == [record.metrics["quality"],
+                                                                         record.metrics["guard"]]
 
     @pytest.mark.slow  # starts a process or GL context
     def test_same_input_same_id_no_refit(self, shared):
@@ -428,6 +438,16 @@ class TestPreview:
 
         image = Image.open(io.BytesIO(response.content))
         assert image.size == (64, 64)
+
+    def test_a_repeated_preview_is_answered_from_memory(self, shared):
+        client, fit = shared
+        params = {"fit": fit["id"], "size": 64, "eta_i": 1.3}
+        first = client.get(f"{API}/preview.png", params=params)
+        assert first.status_code == 200, first.text
+        derived = client.app.state.derived
+        hits = derived.hits
+        again = client.get(f"{API}/preview.png", params=params)
+        assert again.content == first.content and derived.hits == hits + 1
 
     @pytest.mark.parametrize(
         ("params", "status"),

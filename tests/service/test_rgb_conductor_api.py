@@ -23,9 +23,9 @@ API = "/api/v1"
 def fitted(tmp_path_factory):
     """One app with Au fitted as an rgb-conductor and as the default kind."""
     with app_client(tmp_path_factory.mktemp("rgbkind"), metrics_samples=30) as client:
-        rgb = client.post(f"{API}/fits", json={"material": "Au", "model": "rgb-conductor"})
+        rgb = client.post(f"{API}/fits?metrics=full", json={"material": "Au", "model": "rgb-conductor"})
         assert rgb.status_code == 201, rgb.text
-        coated = client.post(f"{API}/fits", json={"material": "Au"})
+        coated = client.post(f"{API}/fits?metrics=full", json={"material": "Au"})
         assert coated.status_code == 201, coated.text
         yield client, rgb.json(), coated.json()
 

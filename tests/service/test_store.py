@@ -56,6 +56,17 @@ class TestStoreContract:
         assert again == first and again.name == "first"
         assert store.latest_fit(first.material_id) == first
 
+    def test_metrics_set_after_the_save_and_nothing_else(self, store):
+        import dataclasses
+
+        saved = store.put_fit(dataclasses.replace(record("1" * 32), metrics={"evaluated": False}))
+        stored = store.set_metrics("1" * 32, {"figure": {"delta_E_mean": 0.5}})
+        assert stored == store.get_fit("1" * 32)
+        assert stored.metrics == {"figure": {"delta_E_mean": 0.5}}
+        assert {**stored.__dict__, "metrics": None} == {**saved.__dict__, "metrics": None}
+        assert store.material_version(saved.material_id) == 1  # not a save
+        assert store.set_metrics("2" * 32, {}) is None
+
     def test_saving_an_earlier_fit_again_makes_it_latest(self, store):
         # An artist's undo then save: the earlier state is the material's latest.
         a = store.put_fit(record("1" * 32, material_id="m" * 32, kind="curves", name="A"))

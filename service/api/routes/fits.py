@@ -18,18 +18,20 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, File, Form, Query, Response, UploadFile, status
+from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
-from ...downloads import PACK_CONTENT, export_response, is_export, pack_response, render_export
+from ...downloads import (is_export, PACK_CONTENT, export_key, export_response, kept_export,
+                           pack_response)
 from ...jobs.common import stored_fit
+from ...jobs.evaluation import ensure_metrics
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
 from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, DownloadFormat,
                         CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
-                    MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields, StoredFit,
+                    MetricsQuery, MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields,
                     StoreDep, WriteAccess)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
@@ -51,12 +53,14 @@ def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPubli
 @router.post("", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
              responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess])
 async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, settings: SettingsDep,
-                     response: Response) -> FitPublic:
+                     response: Response, http: Request, metrics: MetricsQuery = "solve") -> FitPublic:
     """
     Fit a built-in material (``{"material": "Au"}``) or inline n, k
     (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) over
-    ``eta_i_range``; the answer carries the float16 coefficients, Delta E
-    2000 of the model and of adjusted Lazanyi, and timings.
+    ``eta_i_range``; the answer carries the float16 coefficients, what the
+    solve measured, and timings; Delta E 2000 of the model and of adjusted
+    Lazanyi on the metrics grid with ``?metrics=full`` (else later:
+    ``GET /fits/{id}``).
     """
     runner.check_capacity()
     if request.material is not None:
@@ -66,14 +70,14 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
         fit = await run_in_threadpool(
             NKFit.data, (request.name or "uploaded").strip(), request.source, *request.nk.arrays(),
             request.eta_i_range, request.objective, settings.metrics_samples, request.model)
-    return fit_answer(*await fit_nk(fit, store, runner), response)
+    return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
 
 @router.post("/upload", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
              responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess, SingleFormFields])
 async def upload_fit(
     file: Annotated[UploadFile, File(description="n, k as CSV, JSON or refractiveindex.info YAML")],
-    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response,
+    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response, http: Request,
     format: Annotated[str | None, Form(pattern=r"^(csv|json|yaml|yml)$",
                                        description="Default: from the file name")] = None,
     name: Annotated[str | None, Form(min_length=1, max_length=200, pattern=r"\S")] = None,
@@ -81,6 +85,7 @@ async def upload_fit(
     eta_i_max: EtaForm = DEFAULT_ETA_I_RANGE[1],
     objective: Annotated[Objective, Form()] = DEFAULT_OBJECTIVE,
     min_coverage: MinCoverageForm = None,
+    metrics: MetricsQuery = "solve",
 ) -> FitPublic:
     """
     Fit an uploaded n, k file (size limit: COATED_MAX_UPLOAD_BYTES). The
@@ -92,13 +97,15 @@ async def upload_fit(
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
                                   (eta_i_min, eta_i_max), objective, settings.metrics_samples)
     check_coverage(fit.nk, min_coverage)
-    return fit_answer(*await fit_nk(fit, store, runner), response)
+    return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
 
-@router.get("/{fit_id}", response_model=FitPublic, responses={**ERROR_RESPONSES, **NOT_FOUND})
-def get_fit(record: StoredFit) -> FitPublic:
-    """A stored fit."""
-    return fit_public(record)
+@router.get("/{fit_id}", response_model=FitPublic, responses={**ERROR_RESPONSES, **NOT_FOUND,
+                                                             **FIT_ERROR_RESPONSES})
+async def get_fit(fit_id: FitIdPath, store: StoreDep, runner: RunnerDep) -> FitPublic:
+    """A stored fit, with its metrics (evaluated now, once, if they were not yet)."""
+    record = await run_in_threadpool(stored_fit, store, fit_id)
+    return fit_public(await ensure_metrics(record, store, runner))
 
 
 @router.get("/{fit_id}/pack", response_class=Response, responses={
@@ -106,7 +113,7 @@ def get_fit(record: StoredFit) -> FitPublic:
     **NOT_FOUND, **FIT_ERROR_RESPONSES,
 })
 async def get_pack(
-    fit_id: FitIdPath, store: StoreDep, runner: RunnerDep,
+    fit_id: FitIdPath, store: StoreDep, runner: RunnerDep, http: Request,
     format: Annotated[DownloadFormat, Query(
         description="binary | json | glsl | hlsl, or an export format (`GET /api/v1/domain`: `export_formats`)")] = "binary",
     eta_i: Annotated[float, Query(
@@ -123,16 +130,18 @@ async def get_pack(
     (``blender``) or a glTF asset (``gltf``), with ``roughness`` and
     ``coat_roughness``; named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
     """
-    record = stored_fit(store, fit_id)  # after the query is validated: 422 before 404
-    stem = f"{record.name}-{record.id[:8]}"
     if is_export(format):
-        # An export fits its tool's values (up to about a second of CPU): a job in the
-        # fitting pool, with its CPU limit and timeout, shared by identical requests.
-        body = await runner.once(
-            f"export {record.id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}",
-            lambda: runner.run(render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0))
-        return export_response(body, format, eta_i, stem, roughness, coat_roughness)
-    return pack_response([record], format, stem)
+        # A job of the fitting pool (up to about a second of CPU), kept: a fit never changes.
+        kept = http.app.state.derived.get(export_key(fit_id, format, eta_i, roughness, coat_roughness))
+        if kept is None:
+            record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query: 422 before 404
+            kept = await kept_export(http.app.state.derived, runner, record, format, eta_i, roughness,
+                                     coat_roughness)
+        return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness)
+    record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query is validated: 422 before 404
+    if format != "binary":  # the JSON and the snippets quote the figures
+        record = await ensure_metrics(record, store, runner)
+    return await run_in_threadpool(pack_response, [record], format, f"{record.name}-{record.id[:8]}")
 
 
 @router.get("/{fit_id}/curves", response_model=CurvesPublic, responses={**ERROR_RESPONSES, **NOT_FOUND})

@@ -8,11 +8,12 @@ index as a zip archive (any registered export format). Reads only; saves
 nothing.
 """
 
-from fastapi import APIRouter, Response, status
+from fastapi import APIRouter, Request, Response, status
 from fastapi.concurrency import run_in_threadpool
 
 from ...downloads import PACK_CONTENT, is_export, pack_response, render_export_pack
 from ...jobs.common import stored_fit
+from ...jobs.evaluation import ensure_metrics
 from ...schemas import API_PREFIX, PackRequest
 from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep
 
@@ -23,7 +24,7 @@ router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
     status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
     **NOT_FOUND, **FIT_ERROR_RESPONSES,
 })
-async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep) -> Response:
+async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep, http: Request) -> Response:
     """
     The fits named by ``fit_ids``, in that order, as one pack. A renderer
     looks materials up by name, so names in a pack are unique: two fits of
@@ -32,13 +33,15 @@ async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep) 
     records = await run_in_threadpool(_records, store, request.fit_ids)
     if is_export(request.format):
         # Each export fits its tool's values (up to about a second of CPU): a job in the
-        # fitting pool, with its CPU limit and timeout, shared by identical requests.
-        body = await runner.once(
-            f"export pack {request.format} {request.eta_i!r} {' '.join(r.id for r in records)}",
-            lambda: runner.run(render_export_pack, records, request.format, request.eta_i,
-                               cost_s=float(len(records))))
+        # fitting pool, with its CPU limit and timeout, shared by identical requests, and
+        # kept (the fits never change).
+        key = f"export pack {request.format} {request.eta_i!r} {' '.join(r.id for r in records)}"
+        body = await http.app.state.derived.get_or_make(key, lambda: runner.once(key, lambda: runner.run(
+            render_export_pack, records, request.format, request.eta_i, cost_s=float(len(records)))))
         return Response(body, media_type="application/zip", headers={
             "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
+    if request.format != "binary":  # the JSON and the snippets quote the figures
+        records = [await ensure_metrics(record, store, runner) for record in records]
     return await run_in_threadpool(pack_response, records, request.format, request.name)
 
 

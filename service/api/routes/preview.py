@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Query, Response, status
+from fastapi import APIRouter, Query, Request, Response, status
 from fastapi.concurrency import run_in_threadpool
 
 from ...jobs.common import stored_fit
@@ -45,7 +45,7 @@ router = APIRouter(prefix=API_PREFIX, tags=["preview"])
     },
 )
 async def preview_png(
-    store: StoreDep, settings: SettingsDep, previews: PreviewsDep,
+    store: StoreDep, settings: SettingsDep, previews: PreviewsDep, http: Request,
     fit: Annotated[str, Query(pattern=FIT_ID_PATTERN, description="A stored fit's id")],
     eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)] = 1.5,
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
@@ -65,8 +65,12 @@ async def preview_png(
         raise ValueError(
             f"`size` must be at most {settings.max_preview_size} (COATED_MAX_PREVIEW_SIZE), got {size}",
         )
-    record = await run_in_threadpool(stored_fit, store, fit)
-    png = await render_preview(previews, record, eta_i=eta_i, size=size, compare=compare,
-                               environment=environment, roughness=roughness, mode=mode,
-                               coat_roughness=coat_roughness)
+    # A fit never changes, nor does its preview: kept (service.derived), a repeat is a lookup.
+    key = ("preview", fit, eta_i, size, compare, environment, roughness, mode, coat_roughness)
+    png = http.app.state.derived.get(key)
+    if png is None:
+        record = await run_in_threadpool(stored_fit, store, fit)
+        png = await http.app.state.derived.get_or_make(key, lambda: render_preview(
+            previews, record, eta_i=eta_i, size=size, compare=compare, environment=environment,
+            roughness=roughness, mode=mode, coat_roughness=coat_roughness))
     return Response(png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})

@@ -14,11 +14,13 @@ from __future__ import annotations
 from typing import Annotated
 
 from fastapi import APIRouter, Path, Query
+from fastapi.concurrency import run_in_threadpool
 
 from ...jobs.common import stored_fit, with_measured_nk
+from ...jobs.evaluation import ensure_metrics
 from ...jobs.materials import fit_edit, share_url
 from ...schemas import API_PREFIX, INT64_MAX, FitEdit, FitPublic, VersionList, VersionSummary, fit_public
-from ..deps import ERROR_RESPONSES, NOT_FOUND, FitIdPath, MaterialIdPath, StoreDep
+from ..deps import ERROR_RESPONSES, NOT_FOUND, FitIdPath, MaterialIdPath, RunnerDep, StoreDep
 
 router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
@@ -54,16 +56,21 @@ def list_versions(
 
 @router.get("/materials/{material_id}/versions/{version}", response_model=FitPublic,
             responses={**ERROR_RESPONSES, **NOT_FOUND})
-def get_version(
-    material_id: MaterialIdPath, store: StoreDep,
+async def get_version(
+    material_id: MaterialIdPath, store: StoreDep, runner: RunnerDep,
     version: Annotated[int, Path(ge=1, le=INT64_MAX, description="1 for the first save")],
 ) -> FitPublic:
-    """The fit saved as one version of a material (download it from its `links`)."""
+    """The fit saved as one version of a material (download it from its `links`), with its metrics."""
+    record = await run_in_threadpool(_version_fit, store, material_id, version)
+    return fit_public(await ensure_metrics(record, store, runner))
+
+
+def _version_fit(store, material_id: str, version: int):
     record = store.version_fit(material_id, version)
     if record is None:
         raise LookupError(f"material {material_id!r} has no version {version} "
                           f"(it has {store.material_version(material_id)})")
-    return fit_public(with_measured_nk(store, record))
+    return with_measured_nk(store, record)
 
 
 @router.get("/fits/{fit_id}/edit", response_model=FitEdit, responses={**ERROR_RESPONSES, **NOT_FOUND},
