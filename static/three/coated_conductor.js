@@ -268,7 +268,7 @@ export function checkModel(model) {
  * albedo table at the material's roughness and clear-coat roughness) and
  * customProgramCacheKey. Set them through the material's parameters.
  */
-export function coatedConductorHooks(model, resources) {
+export function coatedConductorHooks(model, resources, fallback = null) {
   checkModel(model);
   const rgb = model.kind === "rgb-conductor";
   const words = rgb ? new Uint32Array(14) : packedWords(model.coefficients);
@@ -310,7 +310,7 @@ export function coatedConductorHooks(model, resources) {
     // dispose() frees its render target, which Material.dispose leaves.
     userData: {
       coatedConductor: {
-        model, readTable: (renderer) => table.read(renderer), readEscape: (renderer) => escape.read(renderer),
+        model, fallback, readTable: (renderer) => table.read(renderer), readEscape: (renderer) => escape.read(renderer),
         dispose: () => { table.dispose(); escape.dispose(); },
       },
     },
@@ -395,7 +395,13 @@ export class CoatedConductorExtension {
     if (!resources) return;
     Object.assign(materialParams, { clearcoat: model.coatFactor ?? 1,
                                     clearcoatRoughness: model.coatRoughnessFactor ?? 0 });
-    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources));
+    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources, this.fallback(materialIndex)));
+  }
+
+  /** The fallback's KHR_materials_clearcoat values (the exporter plugin writes them back), or null. */
+  fallback(materialIndex) {
+    const clearcoat = this.parser.json.materials?.[materialIndex]?.extensions?.KHR_materials_clearcoat;
+    return clearcoat && typeof clearcoat === "object" ? { KHR_materials_clearcoat: clearcoat } : null;
   }
 
   /**
@@ -413,11 +419,43 @@ export class CoatedConductorExtension {
           const index = this.parser.associations.get(material)?.materials;
           const model = index === undefined ? null : this.model(index);
           if (!model || material.userData.coatedConductor?.readTable) continue;
-          const { userData, ...hooks } = coatedConductorHooks(model, resources);
+          const { userData, ...hooks } = coatedConductorHooks(model, resources, this.fallback(index));
           Object.assign(material, hooks);
           Object.assign(material.userData, userData);
         }
       });
+    }
+  }
+}
+
+/**
+ * The GLTFExporter plugin: a material drawing the model (made by the
+ * loader plugin or createCoatedConductorMaterial) is written with its
+ * EXT_materials_coated_conductor object, and with the fallback's
+ * KHR_materials_clearcoat values it was loaded with (three's own exporter
+ * writes the coat the plugin draws, `clearcoat` 1, which is not the
+ * fallback's fitted factor); the model is not repeated in `extras`.
+ *
+ *   exporter.register((writer) => new CoatedConductorExporterExtension(writer));
+ */
+export class CoatedConductorExporterExtension {
+  constructor(writer) {
+    this.writer = writer;
+    this.name = EXTENSION_NAME;
+  }
+
+  async writeMaterialAsync(material, materialDef) {
+    const data = material.userData?.coatedConductor;
+    if (!data?.model) return;
+    materialDef.extensions = materialDef.extensions || {};
+    materialDef.extensions[this.name] = JSON.parse(JSON.stringify(data.model));
+    this.writer.extensionsUsed[this.name] = true;
+    for (const [name, values] of Object.entries(data.fallback ?? {})) {
+      if (materialDef.extensions[name]) materialDef.extensions[name] = JSON.parse(JSON.stringify(values));
+    }
+    if (materialDef.extras) {
+      delete materialDef.extras.coatedConductor;
+      if (Object.keys(materialDef.extras).length === 0) delete materialDef.extras;
     }
   }
 }

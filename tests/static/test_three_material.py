@@ -231,6 +231,43 @@ def test_malformed_extensions_draw_the_fallback(session):
         assert field in warning and "draws its fallback" in warning, (what, warning)
 
 
+def test_export_round_trip_keeps_the_extension(session):
+    """
+    A fit's export loaded with the plugin, written by GLTFExporter with the
+    exporter plugin and loaded again: the extension objects and the
+    fallback's clear coat are the file's, and the model is drawn again.
+    """
+    fit = session.fit("Cu", "coated-conductor")
+    page = session.example(fit, 1.8)
+    result = page.evaluate("""async (url) => {
+        const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+        const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
+        const { CoatedConductorExtension, CoatedConductorExporterExtension } =
+            await import('/static/three/coated_conductor.js');
+        const original = await (await fetch(url)).json();
+        const load = async (source) => {
+            const loader = new GLTFLoader();
+            loader.register((parser) => new CoatedConductorExtension(parser));
+            return loader.parseAsync(JSON.stringify(source), '');
+        };
+        const first = await load(original);
+        const exporter = new GLTFExporter();
+        exporter.register((writer) => new CoatedConductorExporterExtension(writer));
+        const written = await exporter.parseAsync(first.scene, { binary: false });
+        const second = await load(written);
+        let drawn = null;
+        second.scene.traverse((o) => { if (o.isMesh) drawn = Boolean(o.material.userData.coatedConductor?.readTable); });
+        const ext = (doc) => doc.materials[0].extensions;
+        return { original: ext(original), written: ext(written), used: written.extensionsUsed,
+                 required: written.extensionsRequired ?? [], extras: written.materials[0].extras ?? {}, drawn };
+    }""", f"{session.server}/api/v1/fits/{fit['id']}/pack?format=gltf&eta_i=1.8")
+    for name in ("EXT_materials_coated_conductor", "KHR_materials_clearcoat"):
+        assert result["written"][name] == result["original"][name], name
+    assert "EXT_materials_coated_conductor" in result["used"] and result["required"] == []
+    assert "coatedConductor" not in result["extras"]
+    assert result["drawn"] is True
+
+
 def test_material_refuses_malformed_extensions(session):
     """createCoatedConductorMaterial checks the extension object and names the field."""
     # Any example page will do: the one the test before left open (Cu at 1.8), no reload.
