@@ -1,10 +1,13 @@
 """
 The three.js material and GLTFLoader plugin (static/three/coated_conductor.js)
 in a real Chromium (SwiftShader WebGL2) against a real server: a stored fit's
-glTF export loaded with the plugin renders what the editor's WebGL preview
-renders at the same settings (both kinds, white sky, studio and outdoor,
-mirror and rough lobes), and the physics; without the plugin the same asset
-renders its fallback, a plausible metal, with no error
+glTF export loaded with the plugin renders the same fit composed with the
+full air-coat-metal stack in numpy (both kinds, mirror and rough lobes under
+the white sky), the editor's preview's own parts composed with that stack
+(white sky, studio and outdoor), and the physics; without the plugin the
+same asset renders its fallback, a plausible metal further from the physics,
+with no error; malformed extension objects draw the fallback with a
+warning; the exporter plugin writes the extension back
 (tests/static/three_pages.py says what is compared and how).
 
 Cost: the shared server and Chromium, and one page for the module, loaded
@@ -15,34 +18,24 @@ settings (the page relights with cfThree.setEnvironment and the material
 takes each roughness in turn).
 
 Tolerances, Delta E 2000 over the ball's pixels with NdotV >= 0.1 (128 x 128,
-about 10 800 pixels), each with headroom over what it measured here
-(benchmarks/three_parity.py records the full table,
-benchmarks/records/three_parity.md):
+about 10 800 pixels), each with headroom over what
+benchmarks/three_parity.py records (benchmarks/records/three_parity.md):
 
--   white sky, against the preview (both kinds) and numpy's twin
-    (rgb-conductor): mean < ``PARITY_MEAN`` 0.05 (the issue's target 0.5;
-    measured 0.002-0.008, 0.006-0.012 against the twin), 99th percentile <
-    0.25 (measured 0.01-0.11: the outermost pixels, where three's mesh and
-    the exact sphere differ), centre < 0.02 (measured 0.0004-0.004; 0.008 for
-    the rgb-conductor's rough table against the twin, a 2048-point quadrature
-    on SwiftShader's coarse sin and cos), ring near grazing < 0.15
-    (0.01-0.07);
--   studio and outdoor, against the preview: there both draw the same
-    cf_environment.glsl but filter it each its own way (three's PMREM of a
-    1024 x 512 equirect with its roughness floor of 0.0525; the preview's
-    exact mirror or the project's prefiltered slices), and three multiplies
-    albedo by radiance per channel in linear Rec.709 where the preview does
-    in ACEScg, so the figures hold those differences as well as the
-    material's. Mean < ``ENVIRONMENT_BOUNDS`` (studio 1.5, outdoor 4.0;
-    measured worst means 1.21 and 3.14 over 4 materials, both kinds, 3
-    settings); against the preview lit as three lights it (its products in
-    Rec.709, ``preview_rec709``), mean < ``LIT_MEAN`` 1.5 (measured 0.33-1.14;
-    the rest is the filters and the highlights' edges);
--   against the physics (the spectral reference under the coat): mean <
-    0.25, centre and ring < 0.3 (measured 0.11 / 0.19 / 0.09 for Au mirrors,
-    the model's own float16 error, the paper's 0.14 for Au);
--   the fallback against the physics: centre < 4 (measured 2.5-3.1: Schlick
-    base colour, three's coat at 1.5), its colour ordered as the metal's.
+-   white sky, against the fit through the full stack (``composed``) and
+    the preview's parts through it (``preview``): mean < ``PARITY_MEAN``
+    0.05 (measured a few thousandths smooth, about 0.03 rough), 99th
+    percentile < 0.25 (the outermost pixels, where three's mesh and the
+    exact sphere differ), centre < 0.02, ring near grazing < 0.15;
+-   studio and outdoor, against the preview as it draws (no bounces, and
+    its own environment filter and colour space of the lighting product):
+    mean < ``ENVIRONMENT_BOUNDS`` (studio 3, outdoor 6); against the
+    preview's parts lit as three lights them with the stack
+    (``preview_rec709``), mean < ``LIT_MEAN`` 1.5 (the rest is the filters
+    and the highlights' edges);
+-   against the physics (the spectral reference through the same stack):
+    mean < 0.25, centre and ring < 0.3 (the model's own float16 error);
+-   the fallback against the physics: centre < 4, its colour ordered as the
+    metal's, and further from the physics than the plugin.
 """
 
 from __future__ import annotations
@@ -60,7 +53,7 @@ PARITY_MEAN, PARITY_P99, PARITY_CENTRE, PARITY_RING = 0.05, 0.25, 0.02, 0.15
 PHYSICS_MEAN, PHYSICS_CENTRE, PHYSICS_RING = 0.25, 0.3, 0.3
 FALLBACK_CENTRE = 4.0
 # environment -> bound on the mean Delta E against the preview (see the docstring).
-ENVIRONMENT_BOUNDS = {"studio": 1.5, "outdoor": 4.0}
+ENVIRONMENT_BOUNDS = {"studio": 3.0, "outdoor": 6.0}
 LIT_MEAN = 1.5
 
 
