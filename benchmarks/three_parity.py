@@ -64,7 +64,7 @@ SKY_SETTINGS = [(1.5, (0.3, 0.1), "studio"), (1.5, (0.3, 0.1), "outdoor")]
 # The fit's own error below which the plugin must be within PHYSICS_BOUND of the physics.
 FIT_ERROR_BELOW, PHYSICS_BOUND = 0.2, 0.3
 KINDS = tuple(MODEL_KINDS)
-RECORD = ROOT / "benchmarks" / "records" / "three_parity.md"
+RECORD = ROOT / "benchmarks" / "records" / "three_stack.md"
 
 
 def three_version() -> str:
@@ -140,7 +140,7 @@ def main() -> None:
     parser.add_argument("--rough-materials", default="Au,Cu,Cr,Al",
                         help="comma-separated materials also measured rough and under the coloured skies")
     parser.add_argument("--record", default=str(RECORD), help="file for the table ('-': none)")
-    parser.add_argument("--result", default="three_parity",
+    parser.add_argument("--result", default="three_stack",
                         help="name of the figures' record, benchmarks/results/NAME.json ('-': none)")
     args = parser.parse_args()
     materials = args.materials.split(",")
