@@ -8,23 +8,34 @@
 //   const material = await createCoatedConductorMaterial({ model: extension, roughness: 0.2 });
 //
 // What is patched in three's MeshPhysicalMaterial shader (onBeforeCompile,
-// the project's GLSL from /glsl/ pasted in):
-//   - direct lights: BRDF_GGX's Schlick F is the model at v.h (the
-//     cosine inside the coat when there is a clear coat, Snell);
+// the project's GLSL from /glsl/ pasted in), so that it draws the whole
+// air / coat / metal stack (docs/gltf/EXT_materials_coated_conductor/,
+// "Combining with the coat"; fitting/shading/coated_layer.py is the numpy twin):
+//   - direct lights: BRDF_GGX's Schlick F is the model at v.h (the cosine
+//     inside the coat when there is a clear coat, Snell), through the coat
+//     with the mirror's series of bounces at NdotV, per polarisation;
 //   - image-based light: the metal's single and multiple scattering are
 //     replaced by the model's directional albedo from its split-sum table
-//     (albedo_table.js), the coat's EnvironmentBRDF by the table's coat row;
-//   - the clear coat: its F0 from the coat index coatIor (not 0.04), and
-//     the base seen through it weighted by (1 - F_c(NdotV))^2, the exact
-//     dielectric in and out, as the project's coated split sum
-//     (cf_ibl_coated.glsl) instead of three's (1 - Schlick).
-// The model's reflectance is linear ACEScg; it is converted to three's
-// working space (linear Rec.709) with CF_ACESCG_TO_SRGB (cf_display.glsl).
+//     (albedo_table.js) through the coat: the mirror's series, and for a
+//     rough metal the share of its lobe that leaves at once and the rest
+//     returned over the hemisphere (escape_table.js); the coat's
+//     EnvironmentBRDF by the table's coat row (the exact dielectric for a
+//     smooth coat);
+//   - the clear coat: its F0 from the coat index coatIor (not 0.04); the
+//     base is no longer weighted by three's 1 - clearcoat * Fcc (its
+//     transmission is in the terms above).
+// A material whose extension object fails the schema's or the range's
+// rules draws its fallback (console.warn), as does every material when the
+// GLSL or the LUT cannot be fetched.
+// The model's reflectance is linear ACEScg; the stack is composed in ACEScg
+// and converted to three's working space (linear Rec.709) with
+// CF_ACESCG_TO_SRGB (cf_display.glsl).
 
 import * as THREE from "three";
 import { loadIncludes } from "../glsl.js";
 import { packedWords } from "../kinds.js";
 import { AlbedoTable, lutTexture, tableSources } from "./albedo_table.js";
+import { EscapeTable, ROUGH_BLEND, internalReflectance } from "./escape_table.js";
 
 export const EXTENSION_NAME = "EXT_materials_coated_conductor";
 export const KINDS = ["coated-conductor", "rgb-conductor"];
@@ -38,6 +49,9 @@ const INCLUDES = [
 // The model's terms, pasted before three's (patched) pars chunk that calls them.
 const HEAD = `
 uniform sampler2D cf_albedo;
+uniform sampler2D cf_escape;
+uniform float cf_r_bar;
+uniform float cf_rough_blend;
 uniform float cf_coat_ior;
 uniform uint cf_words[14];
 uniform vec2 cf_eta_i_range;
@@ -55,22 +69,78 @@ float cf_metal_cos(float c)
 #endif
 }
 
-// The metal's Fresnel at cosine c (direct lights), linear Rec.709.
-vec3 cf_metal_fresnel(float c)
+// (R_s, R_p): the coat's reflectance from air at cosine NdotV, both
+// polarisations (cf_fresnel_dielectric is their mean).
+vec2 cf_coat_sp(float NdotV, float eta)
+{
+    float mu = cf_saturate(NdotV);
+    float cos_t = sqrt(max(1.0 - (1.0 - mu * mu) / (eta * eta), 0.0));
+    float rs = (mu - eta * cos_t) / max(mu + eta * cos_t, CF_FLT_MIN);
+    float rp = (eta * mu - cos_t) / max(eta * mu + cos_t, CF_FLT_MIN);
+    return eta <= 1.0 ? vec2(0.0) : vec2(rs * rs, rp * rp);
+}
+
+// The mirror's series: the metal's reflectance F under the coat (ACEScg, at
+// the cosine in the coat) as seen from air at NdotV, per polarisation x the
+// coat's transmission in and out and the series of bounces between the
+// metal and the underside of the coat, (1 - R_x)^2 F / (1 - R_x F),
+// averaged over s and p (fitting.optics.coated_stack, less the coat's own
+// R, which the coat's lobe draws).
+vec3 cf_mirror_through_coat(vec3 F, float NdotV)
+{
+    vec2 R = cf_coat_sp(NdotV, max(cf_coat_ior, 1.0));
+    vec2 T = (1.0 - R) * (1.0 - R);
+    return 0.5 * (T.x * F / max(1.0 - R.x * F, CF_FLT_MIN) + T.y * F / max(1.0 - R.y * F, CF_FLT_MIN));
+}
+
+// The metal's Fresnel under the coat at cosine c in air, ACEScg.
+vec3 cf_metal_model(float c)
 {
     float mu = cf_metal_cos(c);
 #if CF_RGB_CONDUCTOR
-    vec3 F = cf_rgb_conductor(mu, cf_coat_ior, cf_n, cf_k);
+    return cf_rgb_conductor(mu, cf_coat_ior, cf_n, cf_k);
 #else
-    vec3 F = cf_coated_conductor_packed(mu, cf_coat_ior, cf_eta_i_range, cf_words);
+    return cf_coated_conductor_packed(mu, cf_coat_ior, cf_eta_i_range, cf_words);
 #endif
-    return CF_ACESCG_TO_SRGB * F;
 }
 
-// The metal's directional albedo (image-based light), linear Rec.709.
-vec3 cf_metal_albedo(float NdotV)
+// The coat's weight (three's material.clearcoat), 0 without a coat.
+#ifdef USE_CLEARCOAT
+#define CF_COAT_WEIGHT(material) (material).clearcoat
+#else
+#define CF_COAT_WEIGHT(material) 0.0
+#endif
+
+// The metal's lobe under direct light, linear Rec.709: the model at the
+// microfacet's cosine v.h carried into the coat, through the coat at NdotV.
+vec3 cf_metal_fresnel(float VdotH, float NdotV, float weight)
 {
-    return CF_ACESCG_TO_SRGB * cf_albedo_table_lookup(cf_albedo, 0, cf_metal_cos(NdotV));
+    vec3 F = cf_metal_model(VdotH);
+    return CF_ACESCG_TO_SRGB * mix(F, cf_mirror_through_coat(F, NdotV), weight);
+}
+
+// The metal's directional albedo (image-based light) through the coat,
+// linear Rec.709 (fitting/shading/coated_layer.py): the mirror's series M,
+// and for a rough metal (blend w = cf_rough_blend) the share q of its lobe
+// that leaves at once and the rest returned over the hemisphere,
+//   D = (1 - F_d) E [q + (1 - q) mix(X_m, X_d, w)],  S = mix(M, D, w).
+vec3 cf_metal_albedo(float NdotV, float weight)
+{
+    float mu_t = cf_metal_cos(NdotV);
+    vec3 E = cf_albedo_table_lookup(cf_albedo, 0, mu_t);
+    vec3 seen = cf_mirror_through_coat(E, NdotV);
+    float w = cf_rough_blend;
+    if (w > 0.0)
+    {
+        vec3 q = cf_albedo_table_lookup(cf_escape, 0, mu_t);
+        vec3 E_bar = texelFetch(cf_escape, ivec2(0, 1), 0).rgb;
+        float Fd = cf_fresnel_dielectric(NdotV, max(cf_coat_ior, 1.0));
+        vec3 X_mirror = (1.0 - Fd) * E / max(1.0 - Fd * E, CF_FLT_MIN);
+        vec3 X_diffuse = E_bar * (1.0 - cf_r_bar) / max(1.0 - E_bar * cf_r_bar, CF_FLT_MIN);
+        vec3 D = (1.0 - Fd) * E * (q + (1.0 - q) * mix(X_mirror, X_diffuse, w));
+        seen = mix(seen, D, w);
+    }
+    return CF_ACESCG_TO_SRGB * mix(E, seen, weight);
 }
 
 // The coat's own directional albedo, grey.
@@ -84,11 +154,11 @@ float cf_coat_albedo(float NdotV)
 // release differs from the one this was written for (scripts/three).
 const PATCHES = [
   ["pars", /(vec3 BRDF_GGX\( const in vec3 lightDir[\s\S]*?)vec3 F = F_Schlick\( f0, f90, dotVH \);/,
-    "$1vec3 F = cf_metal_fresnel( dotVH );"],
+    "$1vec3 F = cf_metal_fresnel( dotVH, dotNV, CF_COAT_WEIGHT( material ) );"],
   ["pars", /clearcoatSpecularIndirect \+= clearcoatRadiance \* EnvironmentBRDF\([^;]*\);/,
     "clearcoatSpecularIndirect += clearcoatRadiance * cf_coat_albedo( saturate( dot( geometryClearcoatNormal, geometryViewDir ) ) );"],
   ["pars", /vec3 indirectSpecular = radiance \* singleScattering;\s*indirectSpecular \+= multiScattering \* cosineWeightedIrradiance;/,
-    "vec3 indirectSpecular = radiance * cf_metal_albedo( saturate( dot( geometryNormal, geometryViewDir ) ) );"],
+    "vec3 indirectSpecular = radiance * cf_metal_albedo( saturate( dot( geometryNormal, geometryViewDir ) ), CF_COAT_WEIGHT( material ) );"],
   ["main", /#include <lights_physical_fragment>/,
     `#include <lights_physical_fragment>
     // The model has no multiple-scattering term; the coat's F0 is its index's.
@@ -96,8 +166,9 @@ const PATCHES = [
     #ifdef USE_CLEARCOAT
     material.clearcoatF0 = vec3( pow2( ( cf_coat_ior - 1.0 ) / ( cf_coat_ior + 1.0 ) ) );
     #endif`],
+  // The base's transmission through the coat is in cf_metal_fresnel and cf_metal_albedo.
   ["main", /outgoingLight = outgoingLight \* \( 1\.0 - material\.clearcoat \* Fcc \)/,
-    "outgoingLight = outgoingLight * mix( 1.0, cf_coat_transmission( dotNVcc, cf_coat_ior ), material.clearcoat )"],
+    "outgoingLight = outgoingLight"],
 ];
 
 function patch(text, pattern, replacement) {
@@ -133,30 +204,58 @@ export function loadResources(options = {}) {
   return resourcesFor.get(key);
 }
 
+const PROPERTIES = new Set([
+  "kind", "colorSpace", "etaIRange", "degree", "coefficients", "coatIor", "coatFactor",
+  "coatRoughnessFactor", "extensions", "extras",
+]);
+const FLOAT16_MAX = 65504;
+// A coat index this far outside a coated-conductor's fitted range (float32
+// rounding of the stored range) counts as inside (fitting/exports/gltf_coated.py).
+const RANGE_SLACK = 1e-6;
+
 /**
  * The extension object `model` if it is one this module draws; else an
- * Error naming the field and the rule (the schema's rules that matter to
- * the shader).
+ * Error naming the field and the rule: the schema's rules
+ * (docs/gltf/EXT_materials_coated_conductor/schema/) and the two it cannot
+ * state (lo <= hi; a coated-conductor's coatIor inside etaIRange).
  */
 export function checkModel(model) {
   const fail = (what) => { throw new Error(`${EXTENSION_NAME}: ${what}`); };
-  if (!model || typeof model !== "object") fail("the extension must be an object");
+  if (!model || typeof model !== "object" || Array.isArray(model)) fail("the extension must be an object");
+  for (const key of Object.keys(model)) {
+    if (!PROPERTIES.has(key)) fail(`\`${key}\` is not a property of the extension`);
+  }
   if (!KINDS.includes(model.kind)) fail(`\`kind\` must be one of ${KINDS.join(", ")}, got ${JSON.stringify(model.kind)}`);
   if (model.colorSpace !== "ACEScg") fail(`\`colorSpace\` must be "ACEScg", got ${JSON.stringify(model.colorSpace)}`);
+  const inUnit = (x) => typeof x === "number" && x >= 0 && x <= 1;
+  const index = (x) => typeof x === "number" && x >= 1 && x <= 3;
+  const range = model.etaIRange;
+  if (!Array.isArray(range) || range.length !== 2 || !range.every(index) || !(range[0] <= range[1])) {
+    fail(`\`etaIRange\` must be [lo, hi] with 1 <= lo <= hi <= 3, got ${JSON.stringify(range)}`);
+  }
   const eta = model.coatIor;
-  if (!(eta >= 1 && eta <= 3)) fail(`\`coatIor\` must lie in [1, 3], got ${eta}`);
-  const C = model.coefficients || {};
-  const numbers = (row, n) => Array.isArray(row) && row.length === n && row.every(Number.isFinite);
+  if (!index(eta)) fail(`\`coatIor\` must lie in [1, 3], got ${JSON.stringify(eta)}`);
+  for (const p of ["coatFactor", "coatRoughnessFactor"]) {
+    if (p in model && !inUnit(model[p])) fail(`\`${p}\` must lie in [0, 1], got ${JSON.stringify(model[p])}`);
+  }
+  const C = model.coefficients;
+  if (!C || typeof C !== "object" || Array.isArray(C)) fail("`coefficients` must be an object");
+  const half = (x) => Number.isFinite(x) && Math.abs(x) <= FLOAT16_MAX;
+  const numbers = (row, n) => Array.isArray(row) && row.length === n && row.every(half);
   if (model.kind === "rgb-conductor") {
-    if (!numbers(C.n, 3) || !numbers(C.k, 3)) fail("`coefficients` of an rgb-conductor must be n and k, three numbers each");
+    if (!numbers(C.n, 3) || !numbers(C.k, 3) || !C.n.every((x) => x > 0) || !C.k.every((x) => x >= 0)) {
+      fail("`coefficients` of an rgb-conductor must be n > 0 and k >= 0, three float16 numbers each");
+    }
   } else {
-    const [lo, hi] = model.etaIRange || [];
-    if (!(lo <= hi)) fail(`\`etaIRange\` must be [lo, hi] with lo <= hi, got ${JSON.stringify(model.etaIRange)}`);
+    const [lo, hi] = range;
+    if (!(eta >= lo - RANGE_SLACK && eta <= hi + RANGE_SLACK)) {
+      fail(`\`coatIor\` ${eta} lies outside the coated-conductor's etaIRange [${lo}, ${hi}]`);
+    }
     const d = model.degree;
-    if (![0, 1, 2].includes(d)) fail(`\`degree\` must be 0, 1 or 2, got ${d}`);
+    if (![0, 1, 2].includes(d)) fail(`\`degree\` must be 0, 1 or 2, got ${JSON.stringify(d)}`);
     for (const p of ["F0", "a", "alpha"]) {
       if (!Array.isArray(C[p]) || C[p].length !== 3 || !C[p].every((row) => numbers(row, d + 1))) {
-        fail(`\`coefficients.${p}\` must be three rows of ${d + 1} numbers`);
+        fail(`\`coefficients.${p}\` must be three rows of ${d + 1} float16 numbers`);
       }
     }
   }
@@ -169,13 +268,17 @@ export function checkModel(model) {
  * albedo table at the material's roughness and clear-coat roughness) and
  * customProgramCacheKey. Set them through the material's parameters.
  */
-export function coatedConductorHooks(model, resources) {
+export function coatedConductorHooks(model, resources, fallback = null) {
   checkModel(model);
   const rgb = model.kind === "rgb-conductor";
   const words = rgb ? new Uint32Array(14) : packedWords(model.coefficients);
   const table = new AlbedoTable(resources, model, words);
+  const escape = new EscapeTable(resources.glsl, model, words, table.nodes);
   const uniforms = {
     cf_albedo: { value: table.texture },
+    cf_escape: { value: escape.texture },
+    cf_r_bar: { value: internalReflectance(model.coatIor) },
+    cf_rough_blend: { value: 0 },
     cf_coat_ior: { value: model.coatIor },
     cf_words: { value: words },
     cf_eta_i_range: { value: new THREE.Vector2(...(model.etaIRange || [1, 1])) },
@@ -196,6 +299,8 @@ export function coatedConductorHooks(model, resources) {
     },
     onBeforeRender(renderer) {
       table.draw(renderer, { roughness: this.roughness, coatRoughness: this.clearcoat > 0 ? this.clearcoatRoughness : 0 });
+      uniforms.cf_rough_blend.value = Math.min(Math.max(this.roughness, 0) / ROUGH_BLEND, 1);
+      if (uniforms.cf_rough_blend.value > 0) escape.draw(renderer, this.roughness);
     },
     customProgramCacheKey() {
       return `${EXTENSION_NAME}:${model.kind}`;
@@ -204,7 +309,10 @@ export function coatedConductorHooks(model, resources) {
     // JSON, and the table is reached through functions (JSON skips them):
     // dispose() frees its render target, which Material.dispose leaves.
     userData: {
-      coatedConductor: { model, readTable: (renderer) => table.read(renderer), dispose: () => table.dispose() },
+      coatedConductor: {
+        model, fallback, readTable: (renderer) => table.read(renderer), readEscape: (renderer) => escape.read(renderer),
+        dispose: () => { table.dispose(); escape.dispose(); },
+      },
     },
   };
 }
@@ -240,24 +348,60 @@ export class CoatedConductorExtension {
     this.parser = parser;
     this.name = EXTENSION_NAME;
     this.options = options;
+    this.checked = new Map(); // material index -> the checked model, or null
   }
 
-  #extension(materialIndex) {
-    const def = this.parser.json.materials?.[materialIndex];
-    return def?.extensions?.[this.name] ?? null;
+  /**
+   * Material `materialIndex`'s extension object if it is one this plugin
+   * draws; null without one, and null with a console warning (once per
+   * material) for one that fails the schema or the range rules: the
+   * specification's consumers draw the fallback then.
+   */
+  model(materialIndex) {
+    if (!this.checked.has(materialIndex)) {
+      const def = this.parser.json.materials?.[materialIndex];
+      const object = def?.extensions?.[this.name];
+      let model = null;
+      if (object !== undefined) {
+        try {
+          model = checkModel(object);
+        } catch (error) {
+          console.warn(`${error.message}; material ${materialIndex} (${def.name ?? "unnamed"}) draws its fallback`);
+        }
+      }
+      this.checked.set(materialIndex, model);
+    }
+    return this.checked.get(materialIndex);
+  }
+
+  /** The GLSL and the table, or null with a console warning when they cannot be had. */
+  async #resources() {
+    try {
+      return await loadResources(this.options);
+    } catch (error) {
+      console.warn(`${EXTENSION_NAME}: ${error.message}; the materials draw their fallback`);
+      return null;
+    }
   }
 
   getMaterialType(materialIndex) {
-    return this.#extension(materialIndex) ? THREE.MeshPhysicalMaterial : null;
+    return this.model(materialIndex) ? THREE.MeshPhysicalMaterial : null;
   }
 
   async extendMaterialParams(materialIndex, materialParams) {
-    const model = this.#extension(materialIndex);
+    const model = this.model(materialIndex);
     if (!model) return;
-    const resources = await loadResources(this.options);
+    const resources = await this.#resources();
+    if (!resources) return;
     Object.assign(materialParams, { clearcoat: model.coatFactor ?? 1,
                                     clearcoatRoughness: model.coatRoughnessFactor ?? 0 });
-    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources));
+    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources, this.fallback(materialIndex)));
+  }
+
+  /** The fallback's KHR_materials_clearcoat values (the exporter plugin writes them back), or null. */
+  fallback(materialIndex) {
+    const clearcoat = this.parser.json.materials?.[materialIndex]?.extensions?.KHR_materials_clearcoat;
+    return clearcoat && typeof clearcoat === "object" ? { KHR_materials_clearcoat: clearcoat } : null;
   }
 
   /**
@@ -266,18 +410,52 @@ export class CoatedConductorExtension {
    * neither the hooks nor the table: each gets its own here.
    */
   async afterRoot(result) {
-    const resources = await loadResources(this.options);
+    const drawn = (this.parser.json.materials ?? []).some((_, i) => this.model(i));
+    const resources = drawn ? await this.#resources() : null;
+    if (!resources) return;
     for (const scene of result.scenes ?? [result.scene]) {
       scene.traverse((object) => {
         for (const material of [object.material ?? []].flat()) {
           const index = this.parser.associations.get(material)?.materials;
-          const model = index === undefined ? null : this.#extension(index);
+          const model = index === undefined ? null : this.model(index);
           if (!model || material.userData.coatedConductor?.readTable) continue;
-          const { userData, ...hooks } = coatedConductorHooks(model, resources);
+          const { userData, ...hooks } = coatedConductorHooks(model, resources, this.fallback(index));
           Object.assign(material, hooks);
           Object.assign(material.userData, userData);
         }
       });
+    }
+  }
+}
+
+/**
+ * The GLTFExporter plugin: a material drawing the model (made by the
+ * loader plugin or createCoatedConductorMaterial) is written with its
+ * EXT_materials_coated_conductor object, and with the fallback's
+ * KHR_materials_clearcoat values it was loaded with (three's own exporter
+ * writes the coat the plugin draws, `clearcoat` 1, which is not the
+ * fallback's fitted factor); the model is not repeated in `extras`.
+ *
+ *   exporter.register((writer) => new CoatedConductorExporterExtension(writer));
+ */
+export class CoatedConductorExporterExtension {
+  constructor(writer) {
+    this.writer = writer;
+    this.name = EXTENSION_NAME;
+  }
+
+  async writeMaterialAsync(material, materialDef) {
+    const data = material.userData?.coatedConductor;
+    if (!data?.model) return;
+    materialDef.extensions = materialDef.extensions || {};
+    materialDef.extensions[this.name] = JSON.parse(JSON.stringify(data.model));
+    this.writer.extensionsUsed[this.name] = true;
+    for (const [name, values] of Object.entries(data.fallback ?? {})) {
+      if (materialDef.extensions[name]) materialDef.extensions[name] = JSON.parse(JSON.stringify(values));
+    }
+    if (materialDef.extras) {
+      delete materialDef.extras.coatedConductor;
+      if (Object.keys(materialDef.extras).length === 0) delete materialDef.extras;
     }
   }
 }

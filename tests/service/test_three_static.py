@@ -17,7 +17,8 @@ LOCK = json.loads((ROOT / "scripts" / "three" / "package-lock.json").read_text()
 
 
 @pytest.mark.parametrize("path", [
-    "/static/three/coated_conductor.js", "/static/three/albedo_table.js", "/static/glsl.js",
+    "/static/three/coated_conductor.js", "/static/three/albedo_table.js", "/static/three/escape_table.js",
+    "/static/glsl.js",
     "/vendor/three/build/three.module.js", "/vendor/three/build/three.core.js",
     "/vendor/three/examples/jsm/loaders/GLTFLoader.js",
     "/vendor/three/examples/jsm/environments/RoomEnvironment.js", "/examples/three.js",

@@ -1,10 +1,13 @@
 """
 The three.js material and GLTFLoader plugin (static/three/coated_conductor.js)
 in a real Chromium (SwiftShader WebGL2) against a real server: a stored fit's
-glTF export loaded with the plugin renders what the editor's WebGL preview
-renders at the same settings (both kinds, white sky, studio and outdoor,
-mirror and rough lobes), and the physics; without the plugin the same asset
-renders its fallback, a plausible metal, with no error
+glTF export loaded with the plugin renders the same fit composed with the
+full air-coat-metal stack in numpy (both kinds, mirror and rough lobes under
+the white sky), the editor's preview's own parts composed with that stack
+(white sky, studio and outdoor), and the physics; without the plugin the
+same asset renders its fallback, a plausible metal further from the physics,
+with no error; malformed extension objects draw the fallback with a
+warning; the exporter plugin writes the extension back
 (tests/static/three_pages.py says what is compared and how).
 
 Cost: the shared server and Chromium, and one page for the module, loaded
@@ -15,34 +18,24 @@ settings (the page relights with cfThree.setEnvironment and the material
 takes each roughness in turn).
 
 Tolerances, Delta E 2000 over the ball's pixels with NdotV >= 0.1 (128 x 128,
-about 10 800 pixels), each with headroom over what it measured here
-(benchmarks/three_parity.py records the full table,
-benchmarks/records/three_parity.md):
+about 10 800 pixels), each with headroom over what
+benchmarks/three_parity.py records (benchmarks/records/three_parity.md):
 
--   white sky, against the preview (both kinds) and numpy's twin
-    (rgb-conductor): mean < ``PARITY_MEAN`` 0.05 (the issue's target 0.5;
-    measured 0.002-0.008, 0.006-0.012 against the twin), 99th percentile <
-    0.25 (measured 0.01-0.11: the outermost pixels, where three's mesh and
-    the exact sphere differ), centre < 0.02 (measured 0.0004-0.004; 0.008 for
-    the rgb-conductor's rough table against the twin, a 2048-point quadrature
-    on SwiftShader's coarse sin and cos), ring near grazing < 0.15
-    (0.01-0.07);
--   studio and outdoor, against the preview: there both draw the same
-    cf_environment.glsl but filter it each its own way (three's PMREM of a
-    1024 x 512 equirect with its roughness floor of 0.0525; the preview's
-    exact mirror or the project's prefiltered slices), and three multiplies
-    albedo by radiance per channel in linear Rec.709 where the preview does
-    in ACEScg, so the figures hold those differences as well as the
-    material's. Mean < ``ENVIRONMENT_BOUNDS`` (studio 1.5, outdoor 4.0;
-    measured worst means 1.21 and 3.14 over 4 materials, both kinds, 3
-    settings); against the preview lit as three lights it (its products in
-    Rec.709, ``preview_rec709``), mean < ``LIT_MEAN`` 1.5 (measured 0.33-1.14;
-    the rest is the filters and the highlights' edges);
--   against the physics (the spectral reference under the coat): mean <
-    0.25, centre and ring < 0.3 (measured 0.11 / 0.19 / 0.09 for Au mirrors,
-    the model's own float16 error, the paper's 0.14 for Au);
--   the fallback against the physics: centre < 4 (measured 2.5-3.1: Schlick
-    base colour, three's coat at 1.5), its colour ordered as the metal's.
+-   white sky, against the fit through the full stack (``composed``) and
+    the preview's parts through it (``preview``): mean < ``PARITY_MEAN``
+    0.05 (measured a few thousandths smooth, about 0.03 rough), 99th
+    percentile < 0.25 (the outermost pixels, where three's mesh and the
+    exact sphere differ), centre < 0.02, ring near grazing < 0.15;
+-   studio and outdoor, against the preview as it draws (no bounces, and
+    its own environment filter and colour space of the lighting product):
+    mean < ``ENVIRONMENT_BOUNDS`` (studio 3, outdoor 6); against the
+    preview's parts lit as three lights them with the stack
+    (``preview_rec709``), mean < ``LIT_MEAN`` 1.5 (the rest is the filters
+    and the highlights' edges);
+-   against the physics (the spectral reference through the same stack):
+    mean < 0.25, centre and ring < 0.3 (the model's own float16 error);
+-   the fallback against the physics: centre < 4, its colour ordered as the
+    metal's, and further from the physics than the plugin.
 """
 
 from __future__ import annotations
@@ -60,7 +53,7 @@ PARITY_MEAN, PARITY_P99, PARITY_CENTRE, PARITY_RING = 0.05, 0.25, 0.02, 0.15
 PHYSICS_MEAN, PHYSICS_CENTRE, PHYSICS_RING = 0.25, 0.3, 0.3
 FALLBACK_CENTRE = 4.0
 # environment -> bound on the mean Delta E against the preview (see the docstring).
-ENVIRONMENT_BOUNDS = {"studio": 1.5, "outdoor": 4.0}
+ENVIRONMENT_BOUNDS = {"studio": 3.0, "outdoor": 6.0}
 LIT_MEAN = 1.5
 
 
@@ -96,18 +89,18 @@ def no_page_errors(session):
 
 def check_white_sky(figures, kind):
     assert figures["pixels"] > 10_000
-    for name in ("preview", "twin") if kind == "rgb-conductor" else ("preview",):
+    for name in ("preview", "composed"):
         parity = figures[name]
         assert parity["mean"] < PARITY_MEAN and parity["p99"] < PARITY_P99, (name, parity)
         assert parity["centre"] < PARITY_CENTRE and parity["ring"] < PARITY_RING, (name, parity)
     physics = figures["physics"]
     assert physics["mean"] < PHYSICS_MEAN, physics
     assert physics["centre"] < PHYSICS_CENTRE and physics["ring"] < PHYSICS_RING, physics
-    # The fallback: a plausible metal of the same colour family, not the model.
+    # The fallback: a plausible metal of the same colour family, never closer to the physics.
     assert figures["fallback"]["centre"] < FALLBACK_CENTRE, figures["fallback"]
     r, g, b = figures["fallback_centre_rgb"]
     assert r > g > b > 0.1, figures["fallback_centre_rgb"]
-    assert figures["fallback"]["mean"] > 5 * physics["mean"]
+    assert figures["fallback"]["mean"] > physics["mean"], (figures["fallback"], physics)
 
 
 @pytest.mark.parametrize("kind, material, eta_i, env, lobe", [
@@ -143,6 +136,7 @@ def test_roughness_and_coat_change_the_render(session):
     rough = measure_three(page, session.server, library_material("Cu"), fit, 1.8, 0.6, 0.3)
     check_white_sky(smooth, "coated-conductor")
     assert rough["preview"]["mean"] < PARITY_MEAN, rough["preview"]
+    assert rough["composed"]["mean"] < PARITY_MEAN, rough["composed"]
     assert not np.allclose(smooth["centre_rgb"], rough["centre_rgb"], atol=1e-3)
     # Each canvas shows its ball (a copy of the shared renderer's image).
     shown = page.evaluate("""() => ['model', 'fallback'].map((id) => {
@@ -165,6 +159,108 @@ def test_roughness_and_coat_change_the_render(session):
     assert lit[1] > lit[0] + 0.05, lit
 
 
+# Malformed or out-of-range extension objects, each with what its warning names.
+GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5], "coatIor": 1.5,
+            "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]}}
+GOOD_COATED = {"kind": "coated-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2], "degree": 0,
+               "coatIor": 1.5, "coefficients": {"F0": [[0.9], [0.7], [0.4]], "a": [[0.1], [0.2], [0.1]],
+                                                "alpha": [[5.0], [4.0], [3.0]]}}
+MALFORMED = [
+    ("not an object", [1, 2, 3], "must be an object"),
+    ("null", None, "must be an object"),
+    ("unknown kind", {**GOOD_RGB, "kind": "schlick"}, "`kind`"),
+    ("colour space", {**GOOD_RGB, "colorSpace": "sRGB"}, "`colorSpace`"),
+    ("coat index below 1", {**GOOD_RGB, "coatIor": 0.5}, "`coatIor`"),
+    ("coat index a string", {**GOOD_RGB, "coatIor": "1.5"}, "`coatIor`"),
+    ("coat index outside the fit", {**GOOD_COATED, "coatIor": 2.4}, "outside"),
+    ("range reversed", {**GOOD_COATED, "etaIRange": [2, 1]}, "`etaIRange`"),
+    ("range missing", {k: v for k, v in GOOD_RGB.items() if k != "etaIRange"}, "`etaIRange`"),
+    ("n of two", {**GOOD_RGB, "coefficients": {"n": [1, 1], "k": [0, 0, 0]}}, "n > 0"),
+    ("negative k", {**GOOD_RGB, "coefficients": {"n": [1, 1, 1], "k": [0, -1, 0]}}, "n > 0"),
+    ("no coefficients", {k: v for k, v in GOOD_RGB.items() if k != "coefficients"}, "`coefficients`"),
+    ("rows too short", {**GOOD_COATED, "degree": 2}, "`coefficients.F0`"),
+    ("degree 5", {**GOOD_COATED, "degree": 5}, "`degree`"),
+    ("beyond float16", {**GOOD_COATED, "coefficients": {**GOOD_COATED["coefficients"],
+                                                        "alpha": [[1e6], [4.0], [3.0]]}}, "`coefficients.alpha`"),
+    ("coat factor 2", {**GOOD_RGB, "coatFactor": 2}, "`coatFactor`"),
+    ("unknown property", {**GOOD_RGB, "tint": [1, 0, 0]}, "`tint`"),
+]
+
+
+def test_malformed_extensions_draw_the_fallback(session):
+    """
+    A glTF document whose materials carry each malformed or out-of-range
+    extension object loads through GLTFLoader with the plugin without an
+    exception: each such material is the fallback (the loader's own
+    material, no model), with one console warning naming the field; the
+    well-formed ones beside them draw the model.
+    """
+    page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
+    objects = [GOOD_RGB, GOOD_COATED] + [o for _, o, _ in MALFORMED]
+    result = page.evaluate("""async (objects) => {
+        const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+        const { CoatedConductorExtension } = await import('/static/three/coated_conductor.js');
+        const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor'],
+                       materials: objects.map((o, i) => ({ name: `m${i}`, pbrMetallicRoughness: {
+                           baseColorFactor: [0.9, 0.6, 0.3, 1], metallicFactor: 1 },
+                           extensions: { EXT_materials_coated_conductor: o } })) };
+        const warnings = [];
+        const warn = console.warn;
+        console.warn = (...args) => warnings.push(args.join(' '));
+        try {
+            const loader = new GLTFLoader();
+            loader.register((parser) => new CoatedConductorExtension(parser));
+            const gltf = await loader.parseAsync(JSON.stringify(json), '');
+            const materials = await Promise.all(objects.map((_, i) => gltf.parser.getDependency('material', i)));
+            return { warnings, drawn: materials.map((m) => Boolean(m.userData.coatedConductor)),
+                     types: materials.map((m) => m.type) };
+        } finally {
+            console.warn = warn;
+        }
+    }""", objects)
+    assert result["drawn"] == [True, True] + [False] * len(MALFORMED), result
+    assert len(result["warnings"]) == len(MALFORMED), result["warnings"]
+    for (what, _, field), warning in zip(MALFORMED, result["warnings"]):
+        assert field in warning and "draws its fallback" in warning, (what, warning)
+
+
+def test_export_round_trip_keeps_the_extension(session):
+    """
+    A fit's export loaded with the plugin, written by GLTFExporter with the
+    exporter plugin and loaded again: the extension objects and the
+    fallback's clear coat are the file's, and the model is drawn again.
+    """
+    fit = session.fit("Cu", "coated-conductor")
+    page = session.example(fit, 1.8)
+    result = page.evaluate("""async (url) => {
+        const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+        const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
+        const { CoatedConductorExtension, CoatedConductorExporterExtension } =
+            await import('/static/three/coated_conductor.js');
+        const original = await (await fetch(url)).json();
+        const load = async (source) => {
+            const loader = new GLTFLoader();
+            loader.register((parser) => new CoatedConductorExtension(parser));
+            return loader.parseAsync(JSON.stringify(source), '');
+        };
+        const first = await load(original);
+        const exporter = new GLTFExporter();
+        exporter.register((writer) => new CoatedConductorExporterExtension(writer));
+        const written = await exporter.parseAsync(first.scene, { binary: false });
+        const second = await load(written);
+        let drawn = null;
+        second.scene.traverse((o) => { if (o.isMesh) drawn = Boolean(o.material.userData.coatedConductor?.readTable); });
+        const ext = (doc) => doc.materials[0].extensions;
+        return { original: ext(original), written: ext(written), used: written.extensionsUsed,
+                 required: written.extensionsRequired ?? [], extras: written.materials[0].extras ?? {}, drawn };
+    }""", f"{session.server}/api/v1/fits/{fit['id']}/pack?format=gltf&eta_i=1.8")
+    for name in ("EXT_materials_coated_conductor", "KHR_materials_clearcoat"):
+        assert result["written"][name] == result["original"][name], name
+    assert "EXT_materials_coated_conductor" in result["used"] and result["required"] == []
+    assert "coatedConductor" not in result["extras"]
+    assert result["drawn"] is True
+
+
 def test_material_refuses_malformed_extensions(session):
     """createCoatedConductorMaterial checks the extension object and names the field."""
     # Any example page will do: the one the test before left open (Cu at 1.8), no reload.
@@ -183,6 +279,6 @@ def test_material_refuses_malformed_extensions(session):
         return bad.map((m) => { try { checkModel(m); return null; } catch (e) { return e.message; } });
     }""")
     assert all(messages), messages
-    for message, field in zip(messages, ["`kind`", "`colorSpace`", "`coatIor`", "n and k",
+    for message, field in zip(messages, ["`kind`", "`colorSpace`", "`coatIor`", "n > 0",
                                          "`coefficients.F0`", "`degree`"]):
         assert field in message, message

@@ -31,13 +31,22 @@ Several settings are measured on one page load (the example page relights
 its balls with ``cfThree.setEnvironment``, sets the material's roughness
 per read-back, and the preview's ball is made once per page).
 
-The physics: under the white sky the ball's radiance is the directional
-albedo of the coated metal, E_c(mu) + [1 - F_c(mu)]^2 E_m(mu_t) (the
-project's coated split sum, fitting.shading.ibl.split_sum_coated), with the
-metal's lobe E_m the 1 nm spectral reference under the coat (at roughness 0
-its Fresnel; else its GGX albedo by fitting.shading.ibl.directional_albedo)
-and the coat's lobe E_c the exact dielectric (mirror coat) or Schlick's
-split sum at the coat's F0.
+The full air-coat-metal stack: under the white sky the ball's radiance is
+the directional albedo of the coated metal seen from air (:func:`coated_albedo`),
+
+    E_c(mu) + 1/2 sum_{x = s, p} [1 - R_x(mu)]^2 E_m(mu_t) / [1 - R_x(mu) E_m(mu_t)],
+
+the coat's own lobe E_c (the exact dielectric for a mirror coat, Schlick's
+split sum at the coat's F0 for a rough one), the coat's reflectance R_x of
+each polarisation at the view angle, and the metal's lobe E_m at the cosine
+inside the coat mu_t: at roughness 0 its Fresnel, where the sum is exactly
+fitting.optics.coated_stack.coated_stack_from_metal; for a rough metal
+its GGX lobe's parts (fitting.shading.coated_layer: what leaves at once,
+what returns over the hemisphere), the plugin's approximation
+(docs/gltf/EXT_materials_coated_conductor/).
+``composed`` is the fit's own model (numpy, fitting.models.kinds) through
+that stack, what the plugin must draw; ``physics`` the 1 nm spectral
+reference under the coat through it.
 """
 
 from __future__ import annotations
@@ -51,9 +60,13 @@ from editor_pages import F32_BASE64, Pages, camera_rays, from_f32
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg_grid
-from fitting.models.rgb_conductor import rgb_fresnel_conductor
+from fitting.models.kinds import model_kind
+from fitting.optics.coated_stack import refracted_cos
 from fitting.optics.fresnel import fresnel_dielectric
-from fitting.shading.ibl import directional_albedo, split_sum_schlick
+from fitting.shading.coated_layer import (
+    escape_fraction, hemispherical_albedo, internal_reflectance, seen_base, through_coat,
+)
+from fitting.shading.ibl import split_sum_schlick
 from preview_shaders.display import ACEScg_to_sRGB_matrix
 
 W, H = 128, 128
@@ -175,14 +188,35 @@ def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughne
     return from_f32(flat).reshape(H, W, 4)[::-1][..., :3]
 
 
-def preview_lit_in_rec709(page) -> np.ndarray:
+def base_through_coat(E: np.ndarray, NdotV: np.ndarray, fit: dict, eta_i: float, roughness: float) -> np.ndarray:
+    """
+    The metal's albedo ``E`` (H, W, 3) at each pixel's in-coat cosine seen
+    from air at ``NdotV`` (H, W) through the coat with the bounces
+    (fitting.shading.coated_layer.through_coat): for a rough metal with the
+    fit's own lobe parts (its escape fraction, per pixel by the physics'
+    nodes, and its hemispherical albedo), as the plugin's escape table.
+    """
+    mu = np.clip(np.nan_to_num(NdotV), 0.0, 1.0)
+    flat = E.reshape(-1, 3)
+    if roughness > 0:
+        fresnel = fit_fresnel(fit, eta_i)
+        q = per_pixel(escape_fraction(refracted_cos(_NODES, eta_i), roughness, fresnel, eta_i), mu).reshape(-1, 3)
+        E_bar, r_bar = hemispherical_albedo(roughness, fresnel), internal_reflectance(eta_i)
+    else:
+        q, E_bar, r_bar = np.ones_like(flat), np.zeros(3), 0.0
+    return through_coat(flat, q, E_bar, r_bar, mu.reshape(-1), eta_i, roughness).reshape(E.shape)
+
+
+def preview_lit_in_rec709(page, NdotV: np.ndarray, fit: dict, eta_i: float, roughness: float) -> np.ndarray:
     """
     (H, W, 3) linear ACEScg: the preview ball's last settings lit as three
     lights them, the products of albedo and radiance taken per channel in
     linear Rec.709 (three's working space) rather than in ACEScg (the
-    preview's): M^-1 [E_c M L_c + T (M F) (M L_m)] from the preview's own
-    parts (albedo F, lightings L_m and L_c, coat albedo E_c and transmission
-    T), M = CF_ACESCG_TO_SRGB. Under the white sky it is the preview itself.
+    preview's), and the base composed with the full stack (the bounces
+    between coat and metal, which the preview leaves out):
+    M^-1 [E_c M L_c + M S(F) M L_m] from the preview's own parts (the
+    metal's albedo F, lightings L_m and L_c, coat albedo E_c), S
+    :func:`base_through_coat` at each pixel's ``NdotV``, M = CF_ACESCG_TO_SRGB.
     """
     flat = page.evaluate(
         """async ([w, h]) => {
@@ -195,24 +229,32 @@ def preview_lit_in_rec709(page) -> np.ndarray:
     )
     F, base, coat_light, coat = (from_f32(f).reshape(H, W, 4)[::-1] for f in flat)
     M = ACEScg_to_sRGB_matrix()
-    E, T = coat[..., :1], coat[..., 1:2]
-    rec709 = E * (coat_light[..., :3] @ M.T) + T * (F[..., :3] @ M.T) * (base[..., :3] @ M.T)
+    E = coat[..., :1]
+    seen = base_through_coat(F[..., :3], NdotV, fit, eta_i, roughness)
+    rec709 = E * (coat_light[..., :3] @ M.T) + (seen @ M.T) * (base[..., :3] @ M.T)
     return rec709 @ np.linalg.inv(M).T
 
 
 def coated_albedo(metal_fresnel, eta_i: float, roughness: float, coat_roughness: float) -> np.ndarray:
     """
-    E_c(mu) + [1 - F_c(mu)]^2 E_m(mu_t) at the physics' NdotV nodes, (n, 3)
-    linear ACEScg; ``metal_fresnel(cos) -> (..., 3)`` the metal under the coat.
+    The coated metal's directional albedo seen from air at the physics'
+    NdotV nodes, (n, 3) linear ACEScg: the coat's lobe E_c and the metal's
+    lobe (``metal_fresnel(cos) -> (..., 3)`` the metal under the coat)
+    through the coat with the bounces (fitting.shading.coated_layer.seen_base);
+    for mirrors the full stack exactly.
     """
     mu = _NODES
     F0c = ((eta_i - 1.0) / (eta_i + 1.0)) ** 2
     coat = (fresnel_dielectric(mu, 1.0, eta_i)[:, None] if coat_roughness == 0
             else split_sum_schlick(mu, coat_roughness, np.full(3, F0c)))
-    T = (1.0 - fresnel_dielectric(mu, 1.0, eta_i))[:, None] ** 2
-    mu_t = np.sqrt(1.0 - (1.0 - mu * mu) / eta_i**2)
-    metal = (metal_fresnel(mu_t) if roughness == 0 else directional_albedo(mu_t, roughness, metal_fresnel))
-    return coat + T * metal
+    return coat + seen_base(mu, eta_i, roughness, metal_fresnel)
+
+
+def fit_fresnel(fit: dict, eta_i: float):
+    """The fit's own model (numpy, its kind's evaluation) under a coat of ``eta_i``: cos -> (..., 3) ACEScg."""
+    kind = model_kind(fit["model"])
+    C = np.asarray([fit["coefficients"][p] for p in kind.parameters], dtype=np.float64)
+    return lambda c: kind.evaluate(np.asarray(c), eta_i, C, tuple(fit["eta_i_range"]))
 
 
 def per_pixel(nodes_rgb: np.ndarray, NdotV: np.ndarray) -> np.ndarray:
@@ -233,12 +275,15 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
                   coat_roughness: float, env: str = "white_sky") -> dict:
     """
     Delta E 2000 figures ({mean, p99, max, centre, ring} each) of the
-    three.js ball through the plugin against the editor's WebGL preview at
-    the same settings (``preview``, both kinds) under ``env``; under the
-    white sky also against numpy's twin of an rgb-conductor material
-    (``twin``), the physics (``physics``), and the fallback ball against the
-    physics (``fallback``). The example page must be open on ``fit`` at
-    ``eta_i``.
+    three.js ball through the plugin under ``env`` against the editor's
+    WebGL preview at the same settings as it draws (``preview``; under the
+    white sky ``preview_bare``) and its parts composed as three lights them
+    with the full stack (``preview_rec709``; under the white sky
+    ``preview``); under the white sky also against the fit's own model
+    through the full stack in numpy (``composed``), the physics
+    (``physics``), the fit's own error there (``fit_vs_physics``: composed
+    against physics) and the fallback ball against the physics
+    (``fallback``). The example page must be open on ``fit`` at ``eta_i``.
     """
     set_environment(page, env)
     NdotV, hit, _, _ = camera_rays(*ORBIT, FOV, W, H, bands=1)
@@ -246,7 +291,7 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
     preview = preview_ACEScg(page, fit, eta_i, roughness, coat_roughness, env)
     if env != "white_sky":  # the preview alone, as it draws and lit in three's working space
         region = hit & three_mask & (NdotV >= NDOTV_MIN)
-        in_rec709 = preview_lit_in_rec709(page)
+        in_rec709 = preview_lit_in_rec709(page, NdotV, fit, eta_i, roughness)
         return {"pixels": int(region.sum()), "preview": _stats(delta_E_map(preview, three), NdotV, region),
                 "preview_rec709": _stats(delta_E_map(in_rec709, three), NdotV, region),
                 "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist()}
@@ -254,7 +299,8 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
     region = hit & three_mask & fallback_mask & (NdotV >= NDOTV_MIN)
     figures = {
         "pixels": int(region.sum()),
-        "preview": _stats(delta_E_map(preview, three), NdotV, region),
+        "preview_bare": _stats(delta_E_map(preview, three), NdotV, region),
+        "preview": _stats(delta_E_map(preview_lit_in_rec709(page, NdotV, fit, eta_i, roughness), three), NdotV, region),
         "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
         "fallback_centre_rgb": fallback[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
     }
@@ -266,9 +312,7 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
         eta_i, roughness, coat_roughness), NdotV)
     figures["physics"] = _stats(delta_E_map(physics, three), NdotV, region)
     figures["fallback"] = _stats(delta_E_map(physics, fallback), NdotV, region)
-    if fit["model"] == "rgb-conductor":
-        n, k = (np.asarray(fit["coefficients"][p], dtype=np.float64) for p in ("n", "k"))
-        twin = per_pixel(coated_albedo(lambda c: rgb_fresnel_conductor(c, eta_i, n, k),
-                                       eta_i, roughness, coat_roughness), NdotV)
-        figures["twin"] = _stats(delta_E_map(twin, three), NdotV, region)
+    composed = per_pixel(coated_albedo(fit_fresnel(fit, eta_i), eta_i, roughness, coat_roughness), NdotV)
+    figures["composed"] = _stats(delta_E_map(composed, three), NdotV, region)
+    figures["fit_vs_physics"] = _stats(delta_E_map(physics, composed), NdotV, region)
     return figures
