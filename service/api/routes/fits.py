@@ -25,8 +25,8 @@ from ...downloads import PACK_CONTENT, export_response, is_export, pack_response
 from ...jobs.common import stored_fit
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
-from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, DownloadFormat,
-                        CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
+from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_MODEL, DEFAULT_OBJECTIVE, ETA_I_LIMITS,
+                        CurvesPublic, DownloadFormat, FitPublic, FitRequest, ModelKind, Objective, fit_public)
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
                     MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields, StoredFit,
@@ -80,6 +80,7 @@ async def upload_fit(
     eta_i_min: EtaForm = DEFAULT_ETA_I_RANGE[0],
     eta_i_max: EtaForm = DEFAULT_ETA_I_RANGE[1],
     objective: Annotated[Objective, Form()] = DEFAULT_OBJECTIVE,
+    model: Annotated[ModelKind, Form(description="The model kind to fit")] = DEFAULT_MODEL,
     min_coverage: MinCoverageForm = None,
 ) -> FitPublic:
     """
@@ -90,7 +91,7 @@ async def upload_fit(
     runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
-                                  (eta_i_min, eta_i_max), objective, settings.metrics_samples)
+                                  (eta_i_min, eta_i_max), objective, settings.metrics_samples, model)
     check_coverage(fit.nk, min_coverage)
     return fit_answer(*await fit_nk(fit, store, runner), response)
 
