@@ -115,16 +115,18 @@ class NKFit:
 
     @classmethod
     def from_nk(cls, nk: SpectralNK, eta_i_range, objective: str = DEFAULT_OBJECTIVE,
-                metrics_samples: int = 100) -> "NKFit":
-        """A fit of an n, k already read (an upload)."""
-        return cls._make("nk", nk.name, nk, eta_i_range, objective, metrics_samples, None)
+                metrics_samples: int = 100, model: str = DEFAULT_MODEL) -> "NKFit":
+        """A fit of an n, k already read (an upload), of the model kind ``model``."""
+        return cls._make("nk", nk.name, nk, eta_i_range, objective, metrics_samples, None, model)
 
     @classmethod
     def upload(cls, data: bytes, file_name: str, format: str | None, name: str | None,
-               eta_i_range, objective: str = DEFAULT_OBJECTIVE, metrics_samples: int = 100) -> "NKFit":
+               eta_i_range, objective: str = DEFAULT_OBJECTIVE, metrics_samples: int = 100,
+               model: str = DEFAULT_MODEL) -> "NKFit":
         """
         A fit of an uploaded file: ``format`` (csv, json, yaml) or the file
-        name's suffix; the display name ``name`` or the file's stem.
+        name's suffix; the display name ``name`` or the file's stem; the
+        model kind ``model``.
         """
         lo, hi = eta_i_range
         if lo > hi:
@@ -139,7 +141,7 @@ class NKFit:
         display = (name or PurePath(file_name).stem or "uploaded").strip()[:200]
         # The row limit is checked on the line count, before any number is parsed.
         return cls.from_nk(read_nk(data, fmt, display, MAX_NK_SAMPLES), eta_i_range, objective,
-                           metrics_samples)
+                           metrics_samples, model)
 
 
 def _fit_part(fit: NKFit) -> dict[str, Any]:

@@ -27,8 +27,8 @@ from ...jobs.common import stored_fit
 from ...jobs.evaluation import ensure_metrics
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
-from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, DownloadFormat,
-                        CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
+from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_MODEL, DEFAULT_OBJECTIVE, ETA_I_LIMITS,
+                        CurvesPublic, DownloadFormat, FitPublic, FitRequest, ModelKind, Objective, fit_public)
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
                     MetricsQuery, MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields,
@@ -84,6 +84,7 @@ async def upload_fit(
     eta_i_min: EtaForm = DEFAULT_ETA_I_RANGE[0],
     eta_i_max: EtaForm = DEFAULT_ETA_I_RANGE[1],
     objective: Annotated[Objective, Form()] = DEFAULT_OBJECTIVE,
+    model: Annotated[ModelKind, Form(description="The model kind to fit")] = DEFAULT_MODEL,
     min_coverage: MinCoverageForm = None,
     metrics: MetricsQuery = "solve",
 ) -> FitPublic:
@@ -95,7 +96,7 @@ async def upload_fit(
     runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
-                                  (eta_i_min, eta_i_max), objective, settings.metrics_samples)
+                                  (eta_i_min, eta_i_max), objective, settings.metrics_samples, model)
     check_coverage(fit.nk, min_coverage)
     return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
