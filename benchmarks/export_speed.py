@@ -19,7 +19,11 @@ benchmarks/results/export_speed.json (``figures``: ``all`` and
 and the ratio of the medians; ``delta_E``: per tool, this checkout's mean
 of the means and max of the maxima; ``delta_E_change_max``).
 
-Usage: python benchmarks/export_speed.py [--before REV] [--eta-i 1.0,1.5] [--materials Au,Cu]
+``--output NAME`` records benchmarks/results/NAME.json instead
+(``export_speed_numpy_de2000``: the exports against 09bbd13, before the
+CIEDE2000 of their residuals was written out in numpy).
+
+Usage: python benchmarks/export_speed.py [--before REV] [--eta-i 1.0,1.5] [--materials Au,Cu] [--output NAME]
 """
 
 from __future__ import annotations
@@ -81,6 +85,8 @@ def main(argv=None) -> int:
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
     parser.add_argument("--eta-i", default="1.0,1.5", help="coating indices (default 1.0,1.5)")
     parser.add_argument("--materials", default=None, help="library conductors (default all)")
+    parser.add_argument("--output", default="export_speed",
+                        help="record to write, benchmarks/results/NAME.json (default export_speed)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--items", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -129,7 +135,7 @@ def main(argv=None) -> int:
     for tool, d in figures["delta_E"].items():
         print(f"| {tool} | {d['mean']:.3f} | {d['max']:.2f} |")
     print(f"\nlargest change of a Delta E between the two checkouts: {figures['delta_E_change_max']:.2e}")
-    print("recorded:", write_result("export_speed", figures, load_start, materials=materials, eta_i=etas,
+    print("recorded:", write_result(args.output, figures, load_start, materials=materials, eta_i=etas,
                                     runs=answers))
     return 0
 
