@@ -96,7 +96,7 @@ def internal_reflectance(eta) -> float:
     reflectance of a coat of index ``eta`` >= 1 seen from inside (1 beyond
     the critical angle), by the midpoint rule in :math:`c^2`.
     """
-    eta = float(max(as_finite_array("eta", eta), 1.0))
+    eta = max(float(as_finite_array("eta", eta)), 1.0)
     c = _hemisphere_nodes()
     return float(np.mean(fresnel_dielectric(c, eta, 1.0)))
 
