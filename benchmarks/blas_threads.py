@@ -5,9 +5,9 @@ BLAS threads in the fitting pool's workers
 The service's pool runs ``workers`` processes (one per core). Each imports
 numpy, whose OpenBLAS starts as many threads as the machine has cores, so a
 2-core machine runs 2 workers x 2 BLAS threads. This benchmark runs the same
-jobs (the three parts of a REST fit of every library conductor, of both
-model kinds: ``service.jobs.nk``'s fit, reference and metrics parts, in that
-order; the rgb-conductor kind's fit calls scipy's least_squares directly) through
+jobs (a REST fit of every library conductor, of both model kinds, and its
+evaluation: ``service.jobs.nk``'s fit part, then ``service.jobs.evaluation``'s
+evaluation part; the rgb-conductor kind's fit calls scipy's least_squares directly) through
 two pools of 2 ``spawn`` workers, both cores busy:
 
 -   ``before``: the workers as started before (``warm_process`` only: BLAS

@@ -20,7 +20,7 @@ from ...jobs.common import stored_fit, with_measured_nk
 from ...jobs.evaluation import ensure_metrics
 from ...jobs.materials import fit_edit, share_url
 from ...schemas import API_PREFIX, INT64_MAX, FitEdit, FitPublic, VersionList, VersionSummary, fit_public
-from ..deps import ERROR_RESPONSES, NOT_FOUND, FitIdPath, MaterialIdPath, RunnerDep, StoreDep
+from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, MaterialIdPath, RunnerDep, StoreDep
 
 router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
@@ -55,7 +55,7 @@ def list_versions(
 
 
 @router.get("/materials/{material_id}/versions/{version}", response_model=FitPublic,
-            responses={**ERROR_RESPONSES, **NOT_FOUND})
+            responses={**ERROR_RESPONSES, **NOT_FOUND, **FIT_ERROR_RESPONSES})
 async def get_version(
     material_id: MaterialIdPath, store: StoreDep, runner: RunnerDep,
     version: Annotated[int, Path(ge=1, le=INT64_MAX, description="1 for the first save")],
