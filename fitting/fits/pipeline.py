@@ -22,6 +22,8 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
+import numpy as np
+
 from ..colour.reference import reference_ACEScg, spectral_weights
 from ..domain import check_eta_i_range
 from ..models.kinds import model_kind
@@ -59,10 +61,12 @@ class FitKind:
         construction (no range constraint in curve fits).
     guard
         ``guard(nk, target, cos_theta, eta_i, weights, eta_i_range, settings,
-        mean_fit) -> FitResult``: the fit with its max guarded against the
-        paper's method (issue 21; :mod:`fitting.fits.guarded`), or None for
-        a kind without one. Run when ``settings.guard_max`` and the objective
-        is not the paper's own ``rgb``.
+        mean_fit, rows=None) -> FitResult``: the fit with its max guarded
+        against the paper's method (:mod:`fitting.fits.guarded`), or None
+        for a kind without one; ``rows``: the eta_i rows to guard at when
+        ``samples`` replaced the grid (a scene's set), else None (the
+        domain). Run when ``settings.guard_max`` and the objective is not
+        the paper's own ``rgb``.
     quality
         ``quality(result, eta_i_range, warnings) -> dict``: what the fit can be
         trusted for (:mod:`fitting.fits.fit_quality`: the proof of [0, 1] and
@@ -137,6 +141,7 @@ def fit_spectral(
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
     warnings = check_gaps(nk, settings.max_gap_nm)  # gaps inside the visible range (issue 21)
+    rows = None if samples is None else np.unique(np.ravel(samples[1]))
     if samples is None:
         samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
     mu, eta, weights = samples
@@ -147,7 +152,7 @@ def fit_spectral(
         settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
     )
     if kind.guard is not None and settings.guard_max and settings.objective != "rgb":
-        result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result)
+        result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result, rows=rows)
     result.coverage = coverage
     result.settings = settings
     result.timings["reference"] = t_ref - t0
