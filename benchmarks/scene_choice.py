@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections import Counter
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
@@ -113,8 +114,7 @@ def main() -> int:
         "runs": len(rows),
         "no_worse_than_general": sum(r["no_worse_than_general"] for r in rows),
         "default_no_worse_than_dearer": sum(bool(r["no_worse_than_dearer"]) for r in default),
-        "default_rgb_conductor": sum(r["chosen"] == "rgb-conductor" for r in default),
-        "default_general_fit": sum(r["chosen"] == "general fit" for r in default),
+        "default_chosen": dict(Counter(r["chosen"] for r in default)),
         "default_mean_ratio_to_general_median": sorted(
             r["shipped"]["mean"] / r["general"]["mean"] for r in default)[len(default) // 2],
         "default_mean_ratio_to_general_worst": max(r["shipped"]["mean"] / r["general"]["mean"] for r in default),

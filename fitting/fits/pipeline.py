@@ -29,9 +29,9 @@ from ..domain import check_eta_i_range
 from ..models.kinds import model_kind
 from ..models.pack import PackedMaterial
 from ..optics.nk import SpectralNK, resample_nk
-from ..optics.quality import check_gaps
+from ..optics.quality import check_gaps, outlier_warnings
 from .evaluate import evaluate_material
-from .fit_quality import provenance
+from .fit_quality import data_uncertainty, provenance, uncertainty_warning
 from .result import FitResult
 from .settings import FitSettings, fit_grid
 
@@ -140,7 +140,10 @@ def fit_spectral(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    warnings = check_gaps(nk, settings.max_gap_nm)  # gaps inside the visible range (issue 21)
+    # Gaps inside the visible range, isolated outliers, and how far gaps and
+    # sparse sampling leave the figure uncertain (fitting.fits.fit_quality).
+    warnings = check_gaps(nk, settings.max_gap_nm) + outlier_warnings(nk)
+    uncertainty = data_uncertainty(nk, eta_i_range, settings.min_coverage)
     rows = None if samples is None else np.unique(np.ravel(samples[1]))
     if samples is None:
         samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
@@ -158,6 +161,12 @@ def fit_spectral(
     result.timings["reference"] = t_ref - t0
     result.quality = (kind.quality(result, eta_i_range, warnings) if kind.quality is not None
                       else {"warnings": list(warnings)})
+    if uncertainty is not None:
+        own, warning = uncertainty_warning(uncertainty, nk, eta_i_range, model.name,
+                                           result.coefficients_float16)
+        result.quality["uncertainty"] = {**uncertainty, "fit_delta_E_mean": own}
+        if warning is not None:
+            result.quality["warnings"] = [*result.quality["warnings"], warning]
     result.packed = PackedMaterial(
         name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
         source=provenance(nk.source, result.quality), model=result.model,
