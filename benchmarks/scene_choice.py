@@ -114,7 +114,8 @@ def main() -> int:
         "runs": len(rows),
         "no_worse_than_general": sum(r["no_worse_than_general"] for r in rows),
         "default_no_worse_than_dearer": sum(bool(r["no_worse_than_dearer"]) for r in default),
-        "default_chosen": dict(Counter(r["chosen"] for r in default)),
+        "default_chosen": {label.replace(" ", "_"): count
+                           for label, count in Counter(r["chosen"] for r in default).items()},
         "default_mean_ratio_to_general_median": sorted(
             r["shipped"]["mean"] / r["general"]["mean"] for r in default)[len(default) // 2],
         "default_mean_ratio_to_general_worst": max(r["shipped"]["mean"] / r["general"]["mean"] for r in default),
