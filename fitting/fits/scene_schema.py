@@ -53,7 +53,7 @@ same evaluation grid: :data:`EVALUATION_MU_SAMPLES` values of cos theta times
 the scene's eta_i (a range: :data:`EVALUATION_ETA_ROWS` values over it).
 
 -   :func:`parse_scene`: a validated :class:`Scene` from JSON text or a dict.
--   The fits and the degree rule: :mod:`fitting.fits.scene_fit`; the
+-   The fits and the rule: :mod:`fitting.fits.scene_fit`; the
     results and their report: :mod:`fitting.fits.scene_report`; the command
     ``python -m fitting scene``: :mod:`fitting.cli.scene`.
 
