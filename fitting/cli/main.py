@@ -58,7 +58,6 @@ def _cmd_library(args) -> int:
 
 
 def _cmd_fit(args) -> int:
-    from ..fits.fit_quality import in_range_verdict
     from ..fits.kinds import fit_model
     from ..models.pack import encode_pack, material_to_json
     from .materials import material_nk
@@ -72,8 +71,8 @@ def _cmd_fit(args) -> int:
     result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
                        evaluate=not args.no_metrics, **extra)
     for warning in result.quality.get("warnings", []):
-        # Sparse data or a model outside [0, 1] are said, and refused with --strict.
-        if args.strict and not in_range_verdict(result.quality):
+        # Sparse data, outliers or a model outside [0, 1] are said, and refused with --strict.
+        if args.strict:
             print(f"error: the fit of {nk.name!r}: {warning}; nothing written (--strict)", file=sys.stderr)
             return 3
         print(f"warning: {warning}", file=sys.stderr)
@@ -88,11 +87,17 @@ def _cmd_fit(args) -> int:
         return _write_snippet(nk, result, args)
     view = material_to_json(result.packed)
     view["fit"] = result.summary()
+    try:
+        text = json.dumps(view, indent=2, allow_nan=False)
+    except ValueError:
+        print(f"error: the fit of {nk.name!r} gave non-finite figures: the data cannot be fitted; "
+              "nothing written", file=sys.stderr)
+        return 3
     if args.output:
         Path(args.output).write_bytes(encode_pack([result.packed]))
         print(f"wrote {args.output}", file=sys.stderr)
     if args.json or not args.output:
-        print(json.dumps(view, indent=2))
+        print(text)
     return 0
 
 
@@ -167,8 +172,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--coat-roughness", type=float, default=0.03,
                    help="coat roughness of --export, [0, 1]")
     p.add_argument("--strict", action="store_true",
-                   help="exit with status 3 (writing nothing) when the fit does not converge "
-                        "or its model is not proven inside [0, 1]")
+                   help="exit with status 3 (writing nothing) on any warning: the fit does not "
+                        "converge, its model is not proven inside [0, 1], or the data are sparse, "
+                        "gapped or hold an outlier")
     p.add_argument("--max-gap-nm", type=float, default=None, metavar="NM",
                    help="largest gap between samples inside 360-830 nm accepted (default 120; "
                         "larger fits sparse data with a warning in the result and the pack)")

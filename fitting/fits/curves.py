@@ -55,7 +55,7 @@ from ..domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
 from ..models.kinds import DEFAULT_MODEL, model_ACEScg, model_kind
 from ..models.pack import PackedMaterial, to_float16
 from .curves_base import CurveBase, edited_target
-from .curves_guard import guard_curve_choice
+from .curves_guard import edit_warnings, guard_curve_choice
 from .curves_input import RGBCurve, check_curves
 from .curves_range import EvaluationBudget, escape_points, in_range_fallback, outside_range, proven_in_range
 from .curves_range import range_report
@@ -313,6 +313,9 @@ def fit_curves(
         "best_effort": bool(result.best_effort or budget.cut),
     }
     metrics["figure"] = error.figure()
+    unfollowed = edit_warnings(metrics.get("by_curve", ()))
+    if unfollowed:  # an edit the model family cannot bend to: where and by how much
+        metrics["warnings"] = unfollowed
     if base is not None:
         target = metrics["target"] = whole_target_error(base, curves, C16, settings.blend_width, model=model)
         # With a base the figure is the whole edited target's (what the editor's error map shows).

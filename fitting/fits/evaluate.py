@@ -118,4 +118,6 @@ def metrics_json(errors: dict[str, ErrorMetrics], result: FitResult, samples: in
     out["model_float64"] = errors.pop("model_float64").to_dict()
     out["coverage"] = result.coverage
     out.update({name: metrics.to_dict() for name, metrics in errors.items()})
+    if result.quality:  # the data's warnings and, for gaps or sparse data, the uncertainty beside the error
+        out["quality"] = result.quality
     return out

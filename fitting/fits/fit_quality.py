@@ -11,15 +11,40 @@ What a fit can be trusted for
     and ``--strict`` errors.
 -   :func:`provenance`: the source citation with the warnings appended (the
     pack's provenance).
+-   :func:`data_uncertainty`: how far a fit's figure can be off for the
+    data's gaps or sparse sampling: the spread of the reference under other
+    plausible interpolations of the data (splines instead of straight
+    lines, each sample left out, a window as wide as the widest gap left out
+    elsewhere); :func:`uncertainty_warning`: the warning when it exceeds
+    the fit's own error.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from ..models.range_bound import certify_range
+import numpy as np
+from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
 
-__all__ = ["fit_quality", "out_of_range_message", "provenance", "in_range_verdict"]
+from ..colour.delta_e import delta_E_map
+from ..colour.reference import reference_ACEScg_grid
+from ..domain import VISIBLE_RANGE_NM
+from ..models.kinds import model_ACEScg
+from ..models.range_bound import certify_range
+from ..optics.nk import SpectralNK
+from ..optics.quality import UNCERTAIN_GAP_NM, visible_gaps
+
+__all__ = ["fit_quality", "out_of_range_message", "provenance", "in_range_verdict",
+           "SPARSE_SAMPLES", "data_uncertainty", "uncertainty_warning"]
+
+SPARSE_SAMPLES = 12
+"""Data with fewer samples than this inside 360-830 nm (a spacing near 40 nm
+or more) are sparse: their fits report an uncertainty whatever the widest gap."""
+
+_MU = np.linspace(0.0, 1.0, 12)  # the uncertainty's grid: 12 angles x 3 eta_i over the fit's domain
+_MOST_LEFT_OUT = 40  # samples left out one at a time, evenly chosen, at most
+_WINDOW_STEP_NM = 20.0  # centres of the windows left out
+_LOG_FLOOR = 1e-3  # splines run through log(n), log(k + floor): positive, as n and k must be
 
 
 def out_of_range_message(range_report: dict[str, Any]) -> str:
@@ -54,3 +79,114 @@ def provenance(source: str, quality: dict[str, Any]) -> str:
         return source
     text = (source + "; " if source else "") + "; ".join(f"warning: {w}" for w in warnings)
     return text[:4000]
+
+
+def _spline_nk(nk: SpectralNK, spline) -> SpectralNK:
+    """``nk`` densified to 1 nm inside the visible range by ``spline`` through log n, log(k + floor)."""
+    w = nk.wavelength_nm
+    lo, hi = VISIBLE_RANGE_NM
+    first = max(int(np.searchsorted(w, lo, side="right")) - 3, 0)
+    last = min(int(np.searchsorted(w, hi, side="left")) + 3, w.size)
+    ws = w[first:last]
+    dense = np.arange(np.ceil(max(ws[0], lo)), np.floor(min(ws[-1], hi)) + 1.0)
+    grid = np.union1d(w, dense)
+    inside = (grid >= ws[0]) & (grid <= ws[-1])
+    n, k = np.interp(grid, w, nk.n), np.interp(grid, w, nk.k)
+    with np.errstate(all="ignore"):
+        n_s = np.exp(spline(ws, np.log(nk.n[first:last]))(grid[inside]))
+        k_s = np.exp(spline(ws, np.log(nk.k[first:last] + _LOG_FLOOR))(grid[inside])) - _LOG_FLOOR
+    n[inside] = np.where(np.isfinite(n_s), np.clip(n_s, 1e-6, None), n[inside])
+    k[inside] = np.where(np.isfinite(k_s), np.clip(k_s, 0.0, None), k[inside])
+    return SpectralNK(grid, n, k, name=nk.name)
+
+
+def data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[str, Any] | None:
+    """
+    How far a figure measured against ``nk`` (linearly interpolated, as the
+    reference does) can be off for the data's gaps and sparse sampling;
+    None for data sampled densely (widest gap inside 360-830 nm under
+    :data:`fitting.optics.quality.UNCERTAIN_GAP_NM` and at least
+    :data:`SPARSE_SAMPLES` samples there).
+
+    The uncertainty is the largest mean Delta E 2000 (12 angles x 3 eta_i
+    over ``eta_i_range``) between the reference of the data as given and of
+    other plausible readings of them: monotone cubic (PCHIP), Akima and
+    natural cubic splines through log n and log k; each sample left out
+    (at most 40, evenly chosen; a quarter of the largest move, as leaving
+    one out doubles the spacing and linear interpolation's error grows
+    with its square); and the median over positions of a window
+    as wide as the widest gap left out where the data have samples (what a
+    gap that wide hides in this metal elsewhere).
+    """
+    w = nk.wavelength_nm
+    gaps = visible_gaps(w)
+    widest = gaps[0] if gaps else (VISIBLE_RANGE_NM[0], VISIBLE_RANGE_NM[0])
+    width = widest[1] - widest[0]
+    lo, hi = VISIBLE_RANGE_NM
+    inner = np.flatnonzero((w > lo) & (w < hi))
+    if width < UNCERTAIN_GAP_NM and inner.size >= SPARSE_SAMPLES:
+        return None
+    eta = np.linspace(eta_i_range[0], eta_i_range[1], 3)
+
+    def reference(data: SpectralNK):
+        return reference_ACEScg_grid(data, _MU, eta, 1.0, 0.0)
+
+    def spread(data: SpectralNK) -> float:
+        return float(delta_E_map(base, reference(data)).mean())
+
+    base = reference(nk)
+    parts: dict[str, float] = {}
+    parts["splines"] = max(spread(_spline_nk(nk, spline))
+                           for spline in (PchipInterpolator, Akima1DInterpolator, CubicSpline))
+    left_out = []
+    for i in np.unique(np.round(np.linspace(0, inner.size - 1, min(inner.size, _MOST_LEFT_OUT))).astype(int)):
+        keep = np.ones(w.size, dtype=bool)
+        keep[inner[i]] = False
+        left_out.append(spread(SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name)))
+    # Leaving a sample out doubles the spacing there; linear interpolation's
+    # error grows with the spacing squared, so a quarter of that move is the
+    # data's own at their spacing.
+    parts["leave_one_out"] = max(left_out, default=0.0) / 4.0
+    windows = []
+    for centre in np.arange(lo + width / 2, hi - width / 2 + 1e-9, _WINDOW_STEP_NM):
+        keep = (w < centre - width / 2) | (w > centre + width / 2)
+        if keep.all() or keep.sum() < 2 or (widest[0] < centre < widest[1]):
+            continue
+        thin = SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name)
+        try:
+            windows.append(spread(thin))
+        except ValueError:  # the window took an end of the data past the coverage
+            continue
+    parts["window_left_out"] = float(np.median(windows)) if windows else 0.0
+    value = max(parts.values())
+    return {
+        "delta_E_mean": value,
+        "widest_gap_nm": [float(widest[0]), float(widest[1])],
+        "samples_inside_visible": int(inner.size),
+        "parts": parts,
+        "grid": f"{_MU.size} x {eta.size} (cos theta x eta_i over the fit's domain), 1 nm",
+    }
+
+
+def uncertainty_warning(uncertainty: dict[str, Any] | None, nk: SpectralNK, eta_i_range,
+                        kind: str, coefficients_float16) -> tuple[float | None, str | None]:
+    """
+    The fit's own mean Delta E 2000 on the uncertainty's grid, and the
+    warning to carry when ``uncertainty`` exceeds it (else None).
+    """
+    if uncertainty is None:
+        return None, None
+    eta = np.linspace(eta_i_range[0], eta_i_range[1], 3)
+    E, M = np.meshgrid(eta, _MU, indexing="ij")
+    base = reference_ACEScg_grid(nk, _MU, eta, 1.0, 0.0)
+    own = float(delta_E_map(base, model_ACEScg(kind, M, E, coefficients_float16, eta_i_range)).mean())
+    u = uncertainty["delta_E_mean"]
+    if u <= own:
+        return own, None
+    a, b = uncertainty["widest_gap_nm"]
+    return own, (
+        f"data uncertainty: other plausible interpolations of the data (widest gap {a:g}-{b:g} nm, "
+        f"{uncertainty['samples_inside_visible']} samples inside 360-830 nm) move the reference by "
+        f"{u:.3f} mean Delta E 2000, more than the fit's own error {own:.3f}: the figure can be off "
+        f"by that much against the real metal"
+    )

@@ -32,9 +32,11 @@ from .worst_case import guard_reference
 
 __all__ = ["COATED_CONDUCTOR_FIT", "fit_material"]
 
-def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitResult) -> FitResult:
-    """The max guarded against the paper's method on a subsample of the scoring grid."""
-    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage)
+def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitResult,
+           rows=None) -> FitResult:
+    """The max guarded against the paper's method on a subsample of the scoring grid (at ``rows``: a scene's set)."""
+    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage,
+                                                        rows=rows)
     return guarded_fit(
         target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
         settings.quantise, weights, settings.irls_rounds, guard_target, guard_mu, guard_eta,

@@ -22,14 +22,16 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
+import numpy as np
+
 from ..colour.reference import reference_ACEScg, spectral_weights
 from ..domain import check_eta_i_range
 from ..models.kinds import model_kind
 from ..models.pack import PackedMaterial
 from ..optics.nk import SpectralNK, resample_nk
-from ..optics.quality import check_gaps
+from ..optics.quality import check_gaps, outlier_warnings
 from .evaluate import evaluate_material
-from .fit_quality import provenance
+from .fit_quality import data_uncertainty, provenance, uncertainty_warning
 from .result import FitResult
 from .settings import FitSettings, fit_grid
 
@@ -59,10 +61,12 @@ class FitKind:
         construction (no range constraint in curve fits).
     guard
         ``guard(nk, target, cos_theta, eta_i, weights, eta_i_range, settings,
-        mean_fit) -> FitResult``: the fit with its max guarded against the
-        paper's method (:mod:`fitting.fits.guarded`), or None for
-        a kind without one. Run when ``settings.guard_max`` and the objective
-        is not the paper's own ``rgb``.
+        mean_fit, rows=None) -> FitResult``: the fit with its max guarded
+        against the paper's method (:mod:`fitting.fits.guarded`), or None
+        for a kind without one; ``rows``: the eta_i rows to guard at when
+        ``samples`` replaced the grid (a scene's set), else None (the
+        domain). Run when ``settings.guard_max`` and the objective is not
+        the paper's own ``rgb``.
     quality
         ``quality(result, eta_i_range, warnings) -> dict``: what the fit can be
         trusted for (:mod:`fitting.fits.fit_quality`: the proof of [0, 1] and
@@ -136,7 +140,11 @@ def fit_spectral(
     eta_i_range = check_eta_i_range(eta_i_range)
     nodes, _ = spectral_weights(settings.step_nm)
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    warnings = check_gaps(nk, settings.max_gap_nm)  # gaps inside the visible range
+    # Gaps inside the visible range, isolated outliers, and how far gaps and
+    # sparse sampling leave the figure uncertain (fitting.fits.fit_quality).
+    warnings = check_gaps(nk, settings.max_gap_nm) + outlier_warnings(nk)
+    uncertainty = data_uncertainty(nk, eta_i_range, settings.min_coverage)
+    rows = None if samples is None else np.unique(np.ravel(samples[1]))
     if samples is None:
         samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
     mu, eta, weights = samples
@@ -147,12 +155,18 @@ def fit_spectral(
         settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
     )
     if kind.guard is not None and settings.guard_max and settings.objective != "rgb":
-        result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result)
+        result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result, rows=rows)
     result.coverage = coverage
     result.settings = settings
     result.timings["reference"] = t_ref - t0
     result.quality = (kind.quality(result, eta_i_range, warnings) if kind.quality is not None
                       else {"warnings": list(warnings)})
+    if uncertainty is not None:
+        own, warning = uncertainty_warning(uncertainty, nk, eta_i_range, model.name,
+                                           result.coefficients_float16)
+        result.quality["uncertainty"] = {**uncertainty, "fit_delta_E_mean": own}
+        if warning is not None:
+            result.quality["warnings"] = [*result.quality["warnings"], warning]
     result.packed = PackedMaterial(
         name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
         source=provenance(nk.source, result.quality), model=result.model,

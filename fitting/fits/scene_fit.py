@@ -3,16 +3,16 @@ Scene packs: the fits and the degree rule
 =========================================
 
 Each material of a scene (:mod:`fitting.fits.scene_schema`) is fitted over
-the eta_i the scene uses, with the lowest polynomial degree that serves them
-(:func:`choose_degree`), and compared with the general fit on the same
-evaluation grid; see the module docstring of :mod:`fitting.fits.scene_schema`
-for the rule in words.
+the eta_i the scene uses with every candidate kind and degree, each scored
+where the scene looks (its set of eta_i, or its range) beside the general
+fit, and the rule of :func:`choose_candidate` picks one; see the module
+docstring of :mod:`fitting.fits.scene_schema` for the rule in words.
 
 -   :func:`fit_scene_material`: one material, a :class:`~fitting.fits.scene_report.SceneMaterialResult`.
 -   :func:`fit_scene`: every material, a :class:`~fitting.fits.scene_report.SceneResult`.
--   :func:`choose_degree`, :func:`general_domain`: the rules.
--   :data:`CANDIDATES`, :func:`choose_candidate`: the model kind and degree
-    for a scene's ``max_delta_e`` or ``prefer``.
+-   :data:`CANDIDATES`, :data:`GENERAL`, :func:`choose_candidate`: the
+    model kind and degree, by default or for a scene's ``max_delta_e`` or
+    ``prefer``; :func:`general_domain`: the general fit's domain.
 
 References
 ----------
@@ -39,24 +39,13 @@ from .scene_schema import EVALUATION_MU_SAMPLES, EtaSpec, Scene, SceneMaterial
 from .settings import FitSettings, fit_grid
 
 __all__ = [
-    "DEGREE_TOLERANCE_MEAN",
-    "DEGREE_TOLERANCE_MAX",
     "CANDIDATES",
-    "choose_degree",
+    "GENERAL",
     "choose_candidate",
     "general_domain",
     "fit_scene_material",
     "fit_scene",
 ]
-
-DEGREE_TOLERANCE_MEAN = 0.05
-"""A lower degree is kept if its mean Delta E 2000 is at most this much above
-the highest degree's (a twentieth of a just-noticeable difference)."""
-
-
-DEGREE_TOLERANCE_MAX = 0.5
-"""... and its max Delta E 2000 at most this much above (half a JND)."""
-
 
 CANDIDATES = (
     ("coated-conductor", 0),
@@ -71,40 +60,71 @@ rgb-conductor a complex square root per channel (6 halves, 1.60x); degrees 1
 and 2 the general model's polynomial in t (18 and 27 halves, 2.9x), degree 1
 first for its fewer bytes."""
 
+GENERAL = ("general fit", 2)
+"""The general fit (degree 2 over the default domain) as the dearest
+candidate: as dear to shade as degree 2, and what a scene saves against."""
+
 
 def _label(kind: str, degree: int) -> str:
+    if (kind, degree) == GENERAL:
+        return kind
     return f"{kind} degree {degree}" if model_kind(kind).polynomial else kind
+
+
+def _no_worse(a: ErrorMetrics, b: ErrorMetrics) -> bool:
+    return a.mean <= b.mean and a.max <= b.max
 
 
 def choose_candidate(
     errors: dict[tuple[str, int], ErrorMetrics], max_delta_e: float | None, prefer: str | None
 ) -> tuple[tuple[str, int], str]:
     """
-    The (kind, degree) a scene material gets, and why: with ``max_delta_e``
-    the first of :data:`CANDIDATES` (among ``errors``) whose mean Delta E
-    2000 is at most it, else the most accurate; with ``prefer="accuracy"``
-    the most accurate (lowest mean, the cheaper on a tie).
+    The (kind, degree) a scene material gets, and why, among ``errors``
+    (the candidates of :data:`CANDIDATES` fitted, and :data:`GENERAL` when
+    present), all scored on the scene's own evaluation grid. Only candidates
+    no worse than the general fit on both mean and max compete (the general
+    fit itself always does):
+
+    -   default: the cheapest candidate no worse on mean and on max than
+        every dearer candidate (the dearest always qualifies), so no
+        candidate is passed over for its cost while it beats the one
+        shipped on either figure;
+    -   ``max_delta_e``: the cheapest whose mean Delta E 2000 is at most it,
+        else as the default;
+    -   ``prefer="accuracy"``: the lowest mean (the cheaper on a tie).
     """
-    ordered = [c for c in CANDIDATES if c in errors]
-    best = min(ordered, key=lambda c: errors[c].mean)
+    ordered = [c for c in (*CANDIDATES, GENERAL) if c in errors]
+    if GENERAL in errors:
+        ordered = [c for c in ordered if _no_worse(errors[c], errors[GENERAL])]
+    worse = [c for c in errors if c not in ordered]
+    note = "" if not worse else "; worse than the general fit on mean or max: " + ", ".join(
+        _label(*c) for c in worse)
     if prefer == "accuracy":
+        best = min(ordered, key=lambda c: errors[c].mean)
         return best, (
             f"prefer accuracy: {_label(*best)} has the lowest mean Delta E 2000 "
-            f"({errors[best].mean:.4f}) of {len(ordered)} candidates"
+            f"({errors[best].mean:.4f}) of {len(ordered)} candidates{note}"
         )
-    for candidate in ordered:
-        if errors[candidate].mean <= max_delta_e:
-            cheaper = ordered[: ordered.index(candidate)]
-            why = "" if not cheaper else "; cheaper candidates miss it: " + ", ".join(
-                f"{_label(*c)} {errors[c].mean:.4f}" for c in cheaper
-            )
-            return candidate, (
-                f"max_delta_e {max_delta_e:g}: {_label(*candidate)} is the cheapest candidate within it "
-                f"(mean Delta E 2000 {errors[candidate].mean:.4f}){why}"
-            )
-    return best, (
-        f"max_delta_e {max_delta_e:g}: no candidate is within it; {_label(*best)} is the most "
-        f"accurate (mean Delta E 2000 {errors[best].mean:.4f})"
+    if max_delta_e is not None:
+        for candidate in ordered:
+            if errors[candidate].mean <= max_delta_e:
+                cheaper = ordered[: ordered.index(candidate)]
+                why = "" if not cheaper else "; cheaper candidates miss it: " + ", ".join(
+                    f"{_label(*c)} {errors[c].mean:.4f}" for c in cheaper
+                )
+                return candidate, (
+                    f"max_delta_e {max_delta_e:g}: {_label(*candidate)} is the cheapest candidate "
+                    f"within it (mean Delta E 2000 {errors[candidate].mean:.4f}){why}{note}"
+                )
+    for i, candidate in enumerate(ordered):
+        if all(_no_worse(errors[candidate], errors[d]) for d in ordered[i + 1:]):
+            break
+    head = (f"max_delta_e {max_delta_e:g}: no candidate is within it; " if max_delta_e is not None
+            else "")
+    return candidate, (
+        f"{head}{_label(*candidate)} is the cheapest candidate no worse on mean and max than every "
+        f"dearer one (mean Delta E 2000 {errors[candidate].mean:.4f}, max "
+        f"{errors[candidate].max:.4f}){note}"
     )
 
 
@@ -130,25 +150,6 @@ def _fit_candidate(entry: SceneMaterial, kind: str, degree: int, settings: FitSe
     return fit_model(entry.nk, spec.domain, kind, settings, samples=samples, **extra)
 
 
-def choose_degree(
-    by_degree: dict[int, ErrorMetrics], general_error: ErrorMetrics
-) -> int:
-    """
-    The degree rule: the lowest degree whose mean Delta E is at most
-    :data:`DEGREE_TOLERANCE_MEAN` above the highest degree's and no worse
-    than the general fit's, and whose max is at most
-    :data:`DEGREE_TOLERANCE_MAX` above the highest degree's; if none
-    qualifies, the degree with the lowest mean.
-    """
-    top = by_degree[max(by_degree)]
-    bound_mean = min(top.mean + DEGREE_TOLERANCE_MEAN, general_error.mean)
-    for degree in sorted(by_degree):
-        error = by_degree[degree]
-        if error.mean <= bound_mean and error.max <= top.max + DEGREE_TOLERANCE_MAX:
-            return degree
-    return min(by_degree, key=lambda d: (by_degree[d].mean, d))
-
-
 def general_domain(spec: EtaSpec) -> tuple[float, float]:
     """The default domain [1, 2.5] widened to hold the scene's eta_i."""
     lo, hi = spec.domain
@@ -160,9 +161,12 @@ def fit_scene_material(
     max_delta_e: float | None = None, prefer: str | None = None,
 ) -> SceneMaterialResult:
     """
-    Fit one scene material with the degree rule of the module docstring, or
-    with ``max_delta_e`` / ``prefer`` the kind and degree of
-    :func:`choose_candidate`, and score it against the general fit.
+    Fit one scene material: every candidate of :data:`CANDIDATES` (the
+    coated-conductor of each degree the scene's eta_i allow, the
+    rgb-conductor) over the scene's eta_i, each scored as shipped on the
+    scene's evaluation grid beside the general fit (:data:`GENERAL`), and
+    the one :func:`choose_candidate` picks for ``max_delta_e`` / ``prefer``
+    shipped (the general fit itself when it is chosen).
 
     Raises
     ------
@@ -186,57 +190,40 @@ def fit_scene_material(
     )
     general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
     general_error = _error(ref, general_model, against)
-    fits, by_degree = {}, {}
-    for degree in range(spec.max_degree + 1):
-        fit = _fit_candidate(entry, DEFAULT_MODEL, degree, settings)
-        fits[degree] = fit
+    fits, by_degree, errors = {}, {}, {GENERAL: general_error}
+    for candidate in CANDIDATES:
+        kind, degree = candidate
+        if model_kind(kind).polynomial and degree > spec.max_degree:
+            continue
+        fit = fits[candidate] = _fit_candidate(entry, kind, degree, settings)
         # Scored as shipped: float16 coefficients, the pack's float32 domain.
-        by_degree[degree] = _error(
-            ref, coated_conductor_model(M, E, fit.packed.coefficients, fit.packed.eta_i_range), against
-        )
-    choice, others = None, {}
-    if max_delta_e is not None or prefer is not None:
-        errors = {(DEFAULT_MODEL, d): e for d, e in by_degree.items()}
-        for candidate in CANDIDATES:
-            if candidate[0] != DEFAULT_MODEL:
-                other = others[candidate] = _fit_candidate(entry, *candidate, settings)
-                errors[candidate] = _error(ref, model_ACEScg(
-                    candidate[0], M, E, other.packed.coefficients, other.packed.eta_i_range), against)
-        (kind, chosen), reason = choose_candidate(errors, max_delta_e, prefer)
-        choice = {
-            "rule": "prefer accuracy" if prefer == "accuracy" else f"max_delta_e {max_delta_e:g}",
-            "model": kind, "degree": chosen, "reason": reason,
-            "candidates": {_label(*c): errors[c].to_dict() for c in CANDIDATES if c in errors},
-        }
-    else:
-        chosen = choose_degree(by_degree, general_error)
-    scene_error = by_degree[chosen]
-    if choice is not None and (kind, chosen) in others:
-        fits[chosen] = others[(kind, chosen)]
-        scene_error = errors[(kind, chosen)]
-        packed = PackedMaterial(
-            entry.name, fits[chosen].packed.coefficients, spec.domain, source=entry.nk.source,
-            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
-                     "from_general_fit": False},
-            model=kind,
-        )
-    elif choice is None and scene_error.mean > general_error.mean:
-        # No scene fit beats the general fit on the scene's eta_i (a narrow
-        # range the general fit already follows as well as its own fit can):
-        # the general fit itself serves it, never a worse one.
+        errors[candidate] = _error(
+            ref, model_ACEScg(kind, M, E, fit.packed.coefficients, fit.packed.eta_i_range), against)
+        if kind == DEFAULT_MODEL:
+            by_degree[degree] = errors[candidate]
+    fits[GENERAL] = general_fit
+    candidate, reason = choose_candidate(errors, max_delta_e, prefer)
+    rule = ("prefer accuracy" if prefer == "accuracy" else
+            f"max_delta_e {max_delta_e:g}" if max_delta_e is not None else "no dearer one better")
+    choice = {
+        "rule": rule, "model": DEFAULT_MODEL if candidate == GENERAL else candidate[0],
+        "degree": candidate[1], "from_general_fit": candidate == GENERAL, "reason": reason,
+        "candidates": {_label(*c): errors[c].to_dict() for c in (*CANDIDATES, GENERAL) if c in errors},
+    }
+    scene_error, fit = errors[candidate], fits[candidate]
+    if candidate == GENERAL:
         packed = PackedMaterial(
             entry.name, general.coefficients, general.eta_i_range, source=entry.nk.source,
             metrics={"delta_E_2000": general_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": True},
         )
-        scene_error = general_error
     else:
         packed = PackedMaterial(
-            entry.name, fits[chosen].packed.coefficients, spec.domain, source=entry.nk.source,
+            entry.name, fit.packed.coefficients, spec.domain, source=entry.nk.source,
             metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
                      "from_general_fit": False},
+            model=candidate[0],
         )
-    fit = fits[chosen]
     scene_model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
     return SceneMaterialResult(
         material=entry,

@@ -26,29 +26,25 @@ Scene description (JSON)::
 or whatever a caller's resolver knows (the service's stored materials);
 ``nk`` gives the data inline. Names in a pack are unique.
 
-Degree rule (:data:`DEGREE_TOLERANCE_MEAN`, :data:`DEGREE_TOLERANCE_MAX`):
-one eta_i is fitted with degree 0 (9 coefficients, the scene-specialised
-shader). A set of *m* values or a range is fitted with every degree up to
-min(2, m - 1) (a range counts as many values); the lowest degree whose float16
-fit has a mean Delta E 2000 at most :data:`DEGREE_TOLERANCE_MEAN` above the
-highest degree's and no worse than the general fit's, and a max at most
-:data:`DEGREE_TOLERANCE_MAX` above the highest degree's, is kept
-(:func:`choose_degree`). Where no scene fit beats the general fit on the
-scene's eta_i (a narrow range the general fit already follows as closely),
-the general fit itself is shipped for that material
-(``metrics["from_general_fit"]``), so a scene material is never worse than
-the general fit.
+Candidates (:data:`fitting.fits.scene_fit.CANDIDATES`, cheapest to shade
+first): the coated-conductor of each degree up to min(2, m - 1) for a set
+of *m* values (a range counts as many values; one eta_i: degree 0 only, the
+scene-specialised shader) and the rgb-conductor, each fitted over the
+scene's eta_i (a set: at its values only, the max guard included), and the
+general fit as the dearest. Each is scored as shipped (float16) where the
+scene looks: at the set's values, or over the range. A candidate worse than
+the general fit on the mean or the max never ships; of the others:
 
-Model kinds (:data:`fitting.models.kinds.MODEL_KINDS`): without
-``max_delta_e`` or ``prefer`` every material is a coated-conductor chosen by
-the degree rule above. With ``max_delta_e`` (a mean Delta E 2000 on the
-scene's eta_i, > 0), each material gets the cheapest candidate to shade whose
-error is at most that, candidates being the coated-conductor of each degree
-and the rgb-conductor, all fitted over the scene's eta_i
-(:data:`fitting.fits.scene_fit.CANDIDATES` gives the order); where none is
-within it, the most accurate. With ``"prefer": "accuracy"`` each material
-gets the most accurate candidate. The report says per material what was
-chosen and why (``choice``).
+-   by default, the cheapest no worse on mean and on max than every dearer
+    candidate: nothing is passed over for its cost while it beats the one
+    shipped on either figure;
+-   with ``max_delta_e`` (a mean Delta E 2000 on the scene's eta_i, > 0),
+    the cheapest within it, else as by default;
+-   with ``"prefer": "accuracy"``, the lowest mean.
+
+Where the general fit itself is chosen it ships
+(``metrics["from_general_fit"]``). The report says per material what was
+chosen and why, with every candidate's figures (``choice``).
 
 Each material is compared with the general fit (degree 2, 27 coefficients,
 over the default domain [1, 2.5], widened to hold the scene's eta_i): bytes in
@@ -57,7 +53,7 @@ same evaluation grid: :data:`EVALUATION_MU_SAMPLES` values of cos theta times
 the scene's eta_i (a range: :data:`EVALUATION_ETA_ROWS` values over it).
 
 -   :func:`parse_scene`: a validated :class:`Scene` from JSON text or a dict.
--   The fits and the degree rule: :mod:`fitting.fits.scene_fit`; the
+-   The fits and the rule: :mod:`fitting.fits.scene_fit`; the
     results and their report: :mod:`fitting.fits.scene_report`; the command
     ``python -m fitting scene``: :mod:`fitting.cli.scene`.
 

@@ -84,30 +84,39 @@ class GuardScore:
                 "max_eta_i": self.eta_i, "max_angle_deg": self.angle_deg}
 
 
-def guard_grid(eta_i_range, shape: tuple[int, int] = GUARD_GRID, samples: int = 100):
+def guard_grid(eta_i_range, shape: tuple[int, int] = GUARD_GRID, samples: int = 100, rows=None):
     """
     (cos_theta, eta_i) of the guard, flattened: ``shape`` = (angles, rows)
     points of the ``samples`` x ``samples`` scoring grid, evenly by index,
-    both ends included; one row for a single eta_i.
+    both ends included; one row for a single eta_i. ``rows``: the eta_i
+    rows themselves instead (a scene's set of coat indices: the guard
+    judges a fit where it is used, not between the set's values).
     """
     lo, hi = eta_i_range
     mu_all = np.linspace(0.0, 1.0, samples)
     eta_all = np.linspace(lo, hi, samples)
     mu = mu_all[np.unique(np.round(np.linspace(0, samples - 1, shape[0])).astype(int))]
-    eta = eta_all[np.unique(np.round(np.linspace(0, samples - 1, shape[1])).astype(int))] if hi > lo else np.array([lo])
+    if rows is not None:
+        eta = np.unique(np.asarray(rows, dtype=np.float64))
+    elif hi > lo:
+        eta = eta_all[np.unique(np.round(np.linspace(0, samples - 1, shape[1])).astype(int))]
+    else:
+        eta = np.array([lo])
     E, M = np.meshgrid(eta, mu, indexing="ij")
     return M.ravel(), E.ravel()
 
 
-def guard_reference(nk, eta_i_range, min_coverage: float, shape: tuple[int, int] = GUARD_GRID):
+def guard_reference(nk, eta_i_range, min_coverage: float, shape: tuple[int, int] = GUARD_GRID,
+                    rows=None):
     """
-    The guard points of ``nk`` over ``eta_i_range``: (cos_theta, eta_i,
+    The guard points of ``nk`` over ``eta_i_range`` (or at its eta_i
+    ``rows``, :func:`guard_grid`): (cos_theta, eta_i,
     the 1 nm spectral reference (S, 3)), flattened [eta_i, cos_theta], the
     reference as the scoring grid's (:func:`fitting.colour.reference.reference_ACEScg_grid`),
     in float64: its float32 arithmetic (7e-6 Delta E away) turned the guard's
     choice on a hard case (TiO2 at 80 % coverage, mean 0.97 to 1.07).
     """
-    M, E = guard_grid(eta_i_range, shape)
+    M, E = guard_grid(eta_i_range, shape, rows=rows)
     mu, eta = np.unique(M), np.unique(E)
     reference = reference_ACEScg_grid(nk, mu, eta, 1.0, min_coverage)
     return M, E, reference.reshape(-1, 3)

@@ -9,6 +9,8 @@ The validated type for the measured complex index of refraction
 -   :func:`resample_nk`: *n*, *k* on a target wavelength grid, held flat past
     the ends of the data, with the covered fraction of the visible range.
 -   :data:`VISIBLE_RANGE_NM` (from :mod:`fitting.domain`): the integration range of the reference, 360-830 nm.
+-   :data:`MAX_NK`, :func:`check_nk_range`: the physical range of *n* and
+    *k* the fit accepts where it uses them.
 
 References
 ----------
@@ -32,7 +34,18 @@ __all__ = [
     "ResampledNK",
     "resample_nk",
     "visible_coverage",
+    "MAX_NK",
+    "check_nk_range",
 ]
+
+MAX_NK = 1000.0
+"""Largest *n* and *k* accepted at the samples a fit uses (those inside
+360-830 nm and the nearest beyond each end): metals' visible *n* and *k*
+stay under a few tens (the library's 22 under 10), so a value above this is
+a unit or typing error, and every arithmetic of the reference, float32
+included, stays finite up to it (the Fresnel terms square |n + ik|^2; 1e20
+overflows float32). The CLI, the service and the scenes refuse the same
+values through :func:`resample_nk`."""
 
 def _format_value(value: float) -> str:
     return f"{value:.6g}"
@@ -179,8 +192,9 @@ def resample_nk(
     Raises
     ------
     ValueError
-        If ``min_coverage`` is outside [0, 1] or the data cover less of the
-        visible range than ``min_coverage``.
+        If ``min_coverage`` is outside [0, 1], the data cover less of the
+        visible range than ``min_coverage`` or hold a value outside
+        :func:`check_nk_range`.
     """
     check_min_coverage(min_coverage)
     coverage = visible_coverage(nk.wavelength_range_nm)
@@ -191,7 +205,30 @@ def resample_nk(
             f"{VISIBLE_RANGE_NM[0]:.0f}-{VISIBLE_RANGE_NM[1]:.0f} nm, the data "
             f"({_format_value(lo)}-{_format_value(hi)} nm) cover {coverage:.1%}"
         )
+    check_nk_range(nk)
     wavelength_nm = np.asarray(wavelength_nm, dtype=np.float64)
     n = np.interp(wavelength_nm, nk.wavelength_nm, nk.n)
     k = np.interp(wavelength_nm, nk.wavelength_nm, nk.k)
     return ResampledNK(wavelength_nm, n, k, coverage)
+
+
+def check_nk_range(nk: SpectralNK, limit: float = MAX_NK) -> None:
+    """
+    Refuse (``ValueError`` naming the field, the wavelength and the rule)
+    an *n* or *k* above ``limit`` at a sample the reference uses: inside
+    :data:`VISIBLE_RANGE_NM` or the nearest beyond each end.
+    """
+    w = nk.wavelength_nm
+    lo, hi = VISIBLE_RANGE_NM
+    first = max(int(np.searchsorted(w, lo, side="right")) - 1, 0)
+    last = min(int(np.searchsorted(w, hi, side="left")), w.size - 1)
+    for label, values in (("n", nk.n), ("k", nk.k)):
+        used = values[first:last + 1]
+        over = np.flatnonzero(used > limit)
+        if over.size:
+            i = first + int(over[0])
+            raise ValueError(
+                f"`{label}` must be at most {limit:g} inside {lo:.0f}-{hi:.0f} nm (the physical range "
+                f"the fit scores in any precision), got {_format_value(values[i])} at "
+                f"{_format_value(w[i])} nm"
+            )

@@ -1,6 +1,6 @@
 """
-Data quality: gaps inside the visible range
-===========================================
+Data quality: gaps and outliers inside the visible range
+========================================================
 
 Coverage (:func:`fitting.optics.nk.visible_coverage`) looks at the ends of
 the data only. Linear interpolation across a gap inside 360-830 nm invents
@@ -14,6 +14,12 @@ from the real metal.
     range, widest first.
 -   :func:`check_gaps`: refuse data with a gap wider than the limit, naming
     it; or, with the limit relaxed past the default, the warning to carry.
+-   :data:`OUTLIER_DECADES`, :func:`find_outliers`, :func:`outlier_warnings`:
+    isolated samples whose *n* or *k* is off the line through their
+    neighbours by more than a factor of ten (a typing or unit error: metals'
+    *n* and *k* change smoothly between samples), named with their wavelength.
+-   :data:`UNCERTAIN_GAP_NM`: the gap from which a fit reports how far its
+    figure can be off (:func:`fitting.fits.fit_quality.data_uncertainty`).
 
 Why 120 nm: it is the widest spacing in the curated library (118 nm, Mo, Pb
 and Ta), so every curated data set passes, and no wider: a gap hides what
@@ -37,10 +43,24 @@ import numpy as np
 
 from ..domain import VISIBLE_RANGE_NM
 
-__all__ = ["DEFAULT_MAX_GAP_NM", "visible_gaps", "check_max_gap", "check_gaps"]
+__all__ = ["DEFAULT_MAX_GAP_NM", "UNCERTAIN_GAP_NM", "OUTLIER_DECADES", "visible_gaps", "check_max_gap",
+           "check_gaps", "find_outliers", "outlier_warnings"]
 
 DEFAULT_MAX_GAP_NM: float = 120.0
 """Largest spacing of samples inside 360-830 nm accepted by default (see the module docstring)."""
+
+
+UNCERTAIN_GAP_NM: float = 60.0
+"""From this widest gap inside 360-830 nm a fit reports the uncertainty of
+its figure: a 60 nm window moves some library conductors' reference by
+more than 2 Delta E 2000 (``benchmarks/results/data_gaps.json``)."""
+
+OUTLIER_DECADES: float = 1.0
+"""A sample is an outlier when its *n* or *k* lies more than this many
+decades (a factor of ten) off the line, in log10, through its two
+neighbours, and further off than the neighbours are from each other."""
+
+_FLOOR = {"n": 1e-3, "k": 1e-2}  # below these, n and k do not move the colour: no decades counted
 
 
 def check_max_gap(max_gap_nm) -> float:
@@ -95,3 +115,41 @@ def check_gaps(nk, max_gap_nm: float = DEFAULT_MAX_GAP_NM) -> list[str]:
         return [f"sparse data: no samples between {a:g} and {b:g} nm ({b - a:g} nm, more than "
                 f"the default largest gap {DEFAULT_MAX_GAP_NM:g} nm); the colour there is interpolated"]
     return []
+
+
+def find_outliers(nk, decades: float = OUTLIER_DECADES) -> list[dict]:
+    """
+    The isolated outliers of ``nk`` among the samples a fit uses (inside
+    360-830 nm and the nearest beyond each end): ``{"field", "wavelength_nm",
+    "value", "expected", "decades"}`` each, in wavelength order. Each value
+    is compared in log10 (floored where *n* or *k* no longer moves the
+    colour) with the line through its two neighbours (at an end: the line
+    through the next two).
+    """
+    w = np.asarray(nk.wavelength_nm, dtype=np.float64)
+    lo, hi = VISIBLE_RANGE_NM
+    first = max(int(np.searchsorted(w, lo, side="right")) - 1, 0)
+    last = min(int(np.searchsorted(w, hi, side="left")), w.size - 1)
+    found = []
+    if w.size < 3:
+        return found
+    for label in ("n", "k"):
+        values = np.asarray(getattr(nk, label), dtype=np.float64)
+        logs = np.log10(np.maximum(values, _FLOOR[label]))
+        for i in range(first, last + 1):
+            a, b = (i - 1, i + 1) if 0 < i < w.size - 1 else ((i + 1, i + 2) if i == 0 else (i - 2, i - 1))
+            expected = logs[a] + (logs[b] - logs[a]) * (w[i] - w[a]) / (w[b] - w[a])
+            off = logs[i] - expected
+            if abs(off) > decades and abs(off) > abs(logs[b] - logs[a]):
+                found.append({"field": label, "wavelength_nm": float(w[i]), "value": float(values[i]),
+                              "expected": float(10.0 ** expected), "decades": float(abs(off))})
+    return sorted(found, key=lambda o: (o["wavelength_nm"], o["field"]))
+
+
+def outlier_warnings(nk, decades: float = OUTLIER_DECADES) -> list[str]:
+    """The warning a fit carries for each outlier of :func:`find_outliers`."""
+    return [
+        f"outlier: {o['field']} = {o['value']:.4g} at {o['wavelength_nm']:g} nm is "
+        f"{o['decades']:.1f} decades off its neighbours' {o['expected']:.4g}; check the data there"
+        for o in find_outliers(nk, decades)
+    ]

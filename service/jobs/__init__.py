@@ -11,7 +11,7 @@ fitting pool (:mod:`service.runtime.pool`) and saves what it made:
 -   :mod:`service.jobs.curves`: fits of edited RGB curves, and the error map
     of any stored fit against what it was fitted to.
 -   :mod:`service.jobs.scenes`: scene packs (each material over the eta_i it
-    uses, with the lowest degree that serves it).
+    uses, with the kind and degree its rule picks).
 
 They raise ``ValueError`` for bad input and ``LookupError`` for something
 not stored; the HTTP edge (:mod:`service.api.errors`) maps them to 422 and

@@ -12,7 +12,7 @@ Scene packs
     the pack.
 
 A material measured as n, k is fitted over the eta_i the scene uses with the
-lowest degree that serves it (:func:`fitting.fits.scene_fit.fit_scene_material`). An
+kind and degree its rule picks (:func:`fitting.fits.scene_fit.fit_scene_material`). An
 edited material is shipped as stored (its degree, coefficients and domain),
 and the scene's eta_i must lie in its domain; its report says so
 (``from_stored_model``) and its Delta E against itself is 0.

@@ -16,7 +16,8 @@ from pydantic import BaseModel, Field
 
 from .common import Mirror, absent
 
-__all__ = ["RowError", "MaxAt", "Figure", "DeltaE", "CurveError", "FitDetails", "FitMetrics"]
+__all__ = ["RowError", "MaxAt", "Figure", "DeltaE", "CurveError", "DataUncertainty", "DataQuality", "FitDetails",
+           "FitMetrics"]
 
 
 class RowError(Mirror):
@@ -65,6 +66,25 @@ class CurveError(Mirror):
     delta_E_max: float
 
 
+class DataUncertainty(Mirror):
+    """How far the figure can be off for gaps or sparse data (``fitting.fits.fit_quality.data_uncertainty``)."""
+
+    delta_E_mean: float = Field(description="Largest mean Delta E 2000 between the reference of the data "
+                                            "as given and of other plausible interpolations of them")
+    fit_delta_E_mean: float | None = Field(None, description="The fit's own mean on the same grid")
+    widest_gap_nm: list[float]
+    samples_inside_visible: int
+    parts: dict[str, float] = Field(description="splines, leave_one_out, window_left_out")
+
+
+class DataQuality(Mirror):
+    """What the fit can be trusted for: the data's warnings, the range proof, the uncertainty."""
+
+    warnings: list[str] = Field(default_factory=list, description="Sparse or gapped data, outliers "
+                                "(named with their wavelength), a model not proven in [0, 1]")
+    uncertainty: DataUncertainty | None = absent("Present for gapped (60 nm or more) or sparse data")
+
+
 class FitDetails(Mirror):
     """Every metric of a fit, as the core gave it."""
 
@@ -83,6 +103,7 @@ class FitDetails(Mirror):
     target: DeltaE | None = absent()
     guard: dict[str, Any] | None = absent("What the fit's solve measured itself: the worst-case guard's "
                                           "candidates (Delta E 2000 on its points) and which it kept")
+    quality: DataQuality | None = absent("The data's warnings and uncertainty (n, k fits)")
 
 
 class FitMetrics(BaseModel):

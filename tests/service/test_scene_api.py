@@ -33,7 +33,10 @@ class TestScenePack:
         assert [m["name"] for m in body["materials"]] == ["Cu", "lamp"]
         assert body["materials"][1]["material"] == "Al"
         cu = body["materials"][0]
-        assert cu["degree"] == 0 and cu["coefficients"] == 9 and cu["shader_variant"] == "collapsed"
+        # One eta_i: the rgb-conductor (6 halves) beats degree 0 and the general fit on both figures.
+        assert cu["model"] == "rgb-conductor" and cu["coefficients"] == 6
+        assert cu["shader_variant"] == "rgb_conductor" and cu["choice"]["model"] == cu["model"]
+        assert cu["delta_E_2000"]["max"] <= cu["general"]["delta_E_2000"]["max"]
         assert cu["general"]["coefficients"] == 27
         assert cu["delta_E_2000"]["mean"] < cu["general"]["delta_E_2000"]["mean"]
         totals = body["totals"]

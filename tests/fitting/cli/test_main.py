@@ -58,7 +58,10 @@ def test_fit_user_file(tmp_path):
     path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n650,0.6,3.0\n"
                     "750,0.7,3.8\n850,0.8,4.5\n")
     view = json.loads(run("fit", "--nk", str(path), "--no-metrics").stdout)
-    assert view["name"] == "metal" and view["source"] == "user CSV"
+    assert view["name"] == "metal" and view["source"].startswith("user CSV")
+    # Six samples 100 nm apart: the fit says how far its figure can be off.
+    uncertainty = view["fit"]["quality"]["uncertainty"]
+    assert uncertainty["samples_inside_visible"] == 4 and uncertainty["delta_E_mean"] > 0
 
 
 @pytest.mark.slow  # starts processes

@@ -51,7 +51,9 @@ class TestFitMaterial:
     def test_evaluate_material_without_baselines(self):
         nk = library_material("Ag")
         m = evaluate_material(nk, fit_material(nk), samples=20, baselines=False)
-        assert set(m) == {"grid", "figure", "model_float16", "model_float64", "coverage"}
+        assert set(m) == {"grid", "figure", "model_float16", "model_float64", "coverage", "quality"}
+        # Johnson's silver has a 65 nm gap (756-821 nm): the fit says how far its figure can be off.
+        assert m["quality"]["uncertainty"]["widest_gap_nm"][1] - m["quality"]["uncertainty"]["widest_gap_nm"][0] > 60
         # The one figure is the float16 model's, against the measured metal, with where its max is.
         assert m["figure"]["delta_E_mean"] == m["model_float16"]["delta_E_mean"]
         assert m["figure"]["against"].startswith("the measured metal (1 nm spectral reference)")

@@ -68,12 +68,15 @@ def test_a_refit_that_keeps_the_twin_is_ahead_of_the_papers_method():
     curves = [pulled(base, eta, 1, 36, None, 0.75) for eta in (1.5, 1.2, 2.0, 2.4)]
     result = fit_curves(curves, base)
     assert result.guard["chosen"].endswith("-polished"), result.guard["chosen"]
-    ours = result.metrics["target"]
     from fitting.fits.curves_base import edited_target
+    from fitting.fits.curves_guard import AUDIT_SAMPLES
 
-    _, _, M, E = score_grid(DOMAIN)
+    # Judged where the guard judges: the whole target on the dense 100 x 100 grid.
+    dense = (AUDIT_SAMPLES, AUDIT_SAMPLES)
+    ours = whole_target_error(base, curves, result.coefficients_float16, 0.5, shape=dense)
+    _, _, M, E = score_grid(DOMAIN, dense)
     target = edited_target(base, curves, M, E, 0.5)
     paper = fit_coefficients(target.reshape(-1, 3), M.ravel(), E.ravel(), DOMAIN, 2, "rgb").coefficients_float16
-    theirs = whole_target_error(base, curves, paper, 0.5)
+    theirs = whole_target_error(base, curves, paper, 0.5, shape=dense)
     assert ours["delta_E_mean"] < theirs["delta_E_mean"] - 1e-5
     assert ours["delta_E_max"] <= theirs["delta_E_max"]

