@@ -104,11 +104,11 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     # (paper_fit), then polished and quantised jointly from that optimum. Not a
     # candidate when it leaves [0, 1], but its figures are the bar.
     degree = candidates[own].degree
-    starts = {"paper": candidates[paper].coefficients, "own": candidates[own].coefficients,
+    audit_starts = {"paper": candidates[paper].coefficients, "own": candidates[own].coefficients,
               "guess": initial_guess(gT, gM, gE, eta_i_range, degree)}
     audits = {}
     for label in AUDIT_STARTS:
-        start = candidates[paper].with_coefficients(starts[label], to_float16(starts[label]))
+        start = candidates[paper].with_coefficients(audit_starts[label], to_float16(audit_starts[label]))
         channels = paper_method_fit(gT, gM, gE, eta_i_range, degree, _FREE_MAX_NFEV, start, boxed=True)
         audits[label] = fit_coefficients(gT, gM, gE, eta_i_range, degree, "rgb", _POLISH_MAX_NFEV,
                                          start=channels.coefficients)

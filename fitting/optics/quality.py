@@ -39,6 +39,8 @@ the pack's provenance.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from ..domain import VISIBLE_RANGE_NM
@@ -130,7 +132,7 @@ def find_outliers(nk, decades: float = OUTLIER_DECADES) -> list[dict]:
     lo, hi = VISIBLE_RANGE_NM
     first = max(int(np.searchsorted(w, lo, side="right")) - 1, 0)
     last = min(int(np.searchsorted(w, hi, side="left")), w.size - 1)
-    found = []
+    found: list[dict[str, Any]] = []
     if w.size < 3:
         return found
     for label in ("n", "k"):

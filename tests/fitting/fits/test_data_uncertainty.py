@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fitting import LIBRARY_NAMES, library_material
+from fitting import library_material
 from fitting.fits.evaluate import evaluate_material
 from fitting.fits.fit_quality import data_uncertainty
 from fitting.fits.kinds import fit_model
