@@ -23,6 +23,10 @@ metal seen from air (:mod:`fitting.exports.seen_fit`,
 :mod:`fitting.exports.tool_fresnel` has the tools' base Fresnel terms and
 the earlier (naive) fidelity under the coat.
 
+Every export is named and carries its identity through
+:mod:`fitting.exports.naming` (unique per fit and coat index), and is fitted
+and written in one working space (:data:`WORKING_SPACES`).
+
 -   :data:`EXPORT_FORMATS`: media type and file suffix per format.
 -   :func:`export_material`: the document of a material in a format.
 """
@@ -30,6 +34,7 @@ the earlier (naive) fidelity under the coat.
 from __future__ import annotations
 
 from .blender import blender_script
+from .colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES, check_working_space
 from .gltf import gltf_document
 from .mtlx import mtlx_document
 from .openpbr import openpbr_document
@@ -43,6 +48,9 @@ __all__ = [
     "FORMAT_TOOLS",
     "ETA_I_LIMITS",
     "ExportValues",
+    "WORKING_SPACES",
+    "DEFAULT_WORKING_SPACE",
+    "check_working_space",
     "TOOL_MODELS",
     "check_format",
     "export_fidelity",
@@ -85,7 +93,7 @@ def check_format(format: str) -> str:
 
 def export_material(
     fit_or_nk, format: str, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
-    model=None,
+    model=None, fit_id: str | None = None, working_space: str | None = None,
 ) -> bytes:
     """
     The export of a material for one coating index, as UTF-8 bytes.
@@ -109,12 +117,20 @@ def export_material(
         The fit's float16 model (:class:`fitting.models.pack.PackedMaterial`),
         or ``None``: the glTF export then also carries it in
         ``EXT_materials_coated_conductor`` (:mod:`fitting.exports.gltf_coated`).
+    fit_id
+        The stored fit's id (32 lower-case hex digits) the export carries
+        and is named by; ``None``: a content address of the material.
+    working_space
+        ``lin_rec709`` or ``acescg`` (:data:`WORKING_SPACES`): the space the
+        values are fitted and written in; ``None``: ``lin_rec709``, or for
+        :class:`ExportValues` their own.
 
     Raises
     ------
     ValueError
         For an unknown format, eta_i outside [1, 3], a roughness outside
-        [0, 1], or unusable n, k; the message names the argument.
+        [0, 1], an unknown working space, a fit id that is not 32 hex
+        digits, or unusable n, k; the message names the argument.
     """
     check_format(format)
     eta = check_eta_i(eta_i)
@@ -124,6 +140,11 @@ def export_material(
                 f"`eta_i` must be the values' own {fit_or_nk.eta_i:g} for ExportValues, got {eta_i}"
             )
         values = fit_or_nk
+        if working_space is not None and check_working_space(working_space) != values.working_space:
+            raise ValueError(
+                f"`working_space` must be the values' own {values.working_space!r} for "
+                f"ExportValues, got {working_space!r}"
+            )
         missing = [tool for tool in FORMAT_TOOLS[format] if tool not in values.tools]
         if missing:
             raise ValueError(
@@ -131,5 +152,6 @@ def export_material(
                 f"{format} export (export_values(..., tools=None) fits them all)"
             )
     else:
-        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, FORMAT_TOOLS[format])
+        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, FORMAT_TOOLS[format],
+                               fit_id=fit_id, working_space=working_space or DEFAULT_WORKING_SPACE)
     return _WRITERS[format](values).encode("utf-8")

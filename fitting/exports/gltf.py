@@ -11,8 +11,14 @@ the metal's roughness, with a ``KHR_materials_clearcoat`` coat; its
 index 1.5, layered at the view angle in air) follows the physical coat of
 index eta_i on the metal seen from air (:mod:`fitting.exports.seen_fit`): for
 a coat weaker than glTF's 1.5 the fit lowers ``clearcoatFactor``. At eta_i 1
-there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance is in the
-material's and the asset's ``extras``.
+there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance, with the
+full fit id, the service version, the coat index and the working space
+(:func:`fitting.exports.naming.identity`), is in the material's and the
+asset's ``extras``; the material's name is ``<name>_<id>_<eta>``
+(:func:`fitting.exports.naming.element_stem`), unique per fit and coat index.
+Its colours are in the export's working space (glTF's own is linear Rec.709:
+an ``acescg`` export is for a pipeline that reads the asset's
+``extras.coated_fresnel.working_space``).
 
 When the values carry the fit's own model (:attr:`ExportValues.model`), the
 material also has ``EXT_materials_coated_conductor``
@@ -36,6 +42,7 @@ import json
 import numpy as np
 
 from .gltf_coated import EXTENSION_NAME, coated_conductor_extension
+from .naming import element_stem
 from .seen_fit import seen_fidelity
 from .values import ExportValues
 
@@ -110,7 +117,7 @@ def gltf_document(values: ExportValues) -> str:
         {"bufferView": 2, "componentType": _UNSIGNED_SHORT, "count": len(indices), "type": "SCALAR"},
     ]
     material = {
-        "name": f"{values.name} coated (eta_i {values.eta_i:g})",
+        "name": element_stem(values),
         "pbrMetallicRoughness": {
             "baseColorFactor": [round(float(v), 6) for v in fitted["base_color"]] + [1.0],
             "metallicFactor": 1.0,
