@@ -97,10 +97,13 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return snippet(format, records, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
 
 
-def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03) -> bytes:
+def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03,
+                  working_space: str = "lin_rec709") -> bytes:
     """
     The export of one stored fit in ``format`` (one of
-    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i`` and roughnesses.
+    :data:`EXPORT_MEDIA_TYPES`) for the coating index ``eta_i`` and
+    roughnesses, fitted and written in ``working_space``, named by and
+    carrying the fit's id (:mod:`fitting.exports.naming`).
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
@@ -117,7 +120,8 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
     if record.kind != "curves":
         nk = measured_nk(record)
         if nk is not None:
-            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed)
+            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed,
+                                   fit_id=record.id, working_space=working_space)
     lo, hi = packed.eta_i_range
     if not lo <= eta_i <= hi:
         raise ValueError(
@@ -130,12 +134,15 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
         "reflectance": lambda mu, eta: model_ACEScg(
             packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
-    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed)
+    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed,
+                           fit_id=record.id, working_space=working_space)
 
 
-def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:
+def render_export_pack(records: list[FitRecord], format: str, eta_i: float, roughness=0.2,
+                       coat_roughness=0.03, working_space: str = "lin_rec709") -> bytes:
     """
-    The exports of several fits for one ``eta_i``: a zip archive with one
+    The exports of several fits for one ``eta_i``, roughnesses and working
+    space (:func:`render_export`): a zip archive with one
     ``<name>-eta<eta_i>.<suffix>`` per fit, in order, byte-for-byte
     deterministic (fixed time stamps), so the same request gives the same
     archive. Entry names are unique (:func:`unique_names`), so that no
@@ -147,7 +154,7 @@ def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> b
         for record, name in zip(records, names):
             info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
             info.compress_type = zipfile.ZIP_DEFLATED
-            archive.writestr(info, render_export(record, format, eta_i))
+            archive.writestr(info, render_export(record, format, eta_i, roughness, coat_roughness, working_space))
     return buffer.getvalue()
 
 
@@ -186,11 +193,17 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     )
 
 
-def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03):
-    """An export's bytes (:func:`render_export`) as a download named for ``eta_i`` and the roughnesses."""
+def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03,
+                    working_space: str = "lin_rec709"):
+    """
+    An export's bytes (:func:`render_export`) as a download named for
+    ``eta_i``, the roughnesses and (when not ``lin_rec709``) the working space.
+    """
     from fastapi import Response
 
     stem = f"{stem}-eta{eta_i:g}-rough{roughness:g}-coat{coat_roughness:g}"
+    if working_space != "lin_rec709":
+        stem += f"-{working_space}"
     return Response(
         body, media_type=EXPORT_MEDIA_TYPES[format][0],
         headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},

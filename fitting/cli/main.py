@@ -98,7 +98,8 @@ def _write_export(nk, args) -> int:
 
     # The fit's own float16 model travels in the glTF export's extension.
     model = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=False).packed
-    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model)
+    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model,
+                           working_space=args.working_space)
     if args.output:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)
@@ -108,6 +109,7 @@ def _write_export(nk, args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from ..exports.colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from .batch import add_batch_parser
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
@@ -144,6 +146,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
     p.add_argument("--coat-roughness", type=float, default=0.03,
                    help="coat roughness of --export, [0, 1]")
+    p.add_argument("--working-space", choices=WORKING_SPACES, default=DEFAULT_WORKING_SPACE,
+                   help="working space --export is fitted and written in (default %(default)s)")
     p.add_argument("--strict", action="store_true",
                    help="exit with status 3 (writing nothing) when the fit does not converge "
                         "or its model is not proven inside [0, 1]")

@@ -7,7 +7,7 @@ Dependencies
 -   :data:`SettingsDep`, :data:`StoreDep`, :data:`RunnerDep`: the app's
     settings, store and fitting pool.
 -   :data:`FitIdPath`, :data:`MaterialIdPath`, :data:`RoughnessQuery`,
-    :data:`CoatRoughnessQuery`, :data:`MinCoverageForm`: shared parameters.
+    :data:`CoatRoughnessQuery`, :data:`WorkingSpaceQuery`, :data:`MinCoverageForm`: shared parameters.
 -   :data:`StoredFit`: the stored fit named by the path's ``fit_id`` (404
     when it is not stored), read in a worker thread.
 -   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
@@ -32,7 +32,7 @@ from ..config import Settings
 from ..jobs.common import stored_fit
 from ..pool import FitRunner
 from ..previews import PreviewRunner
-from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
+from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody, WorkingSpace
 from ..store import FitRecord, Store
 
 __all__ = [
@@ -43,6 +43,7 @@ __all__ = [
     "MaterialIdPath",
     "RoughnessQuery",
     "CoatRoughnessQuery",
+    "WorkingSpaceQuery",
     "MinCoverageForm",
     "StoredFit",
     "WriteAccess",
@@ -82,6 +83,8 @@ RoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, des
     "The metal's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
 CoatRoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description=(
     "The coat's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
+WorkingSpaceQuery = Annotated[WorkingSpace, Query(description=(
+    "lin_rec709 | acescg: the working space an export is fitted and written in (docs/exports.md)"))]
 MinCoverageForm = Annotated[float | None, Form(ge=0.0, le=1.0, allow_inf_nan=False, description=(
     "Least covered fraction of 360-830 nm to accept, in [0.9, 1] (default 0.9, the service's own "
     "rule; a higher value refuses data the service would fit)"))]

@@ -16,6 +16,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
+from fitting.exports.colour_space import WORKING_SPACES as WORKING_SPACE_NAMES
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.bounded import excerpt
@@ -28,7 +29,7 @@ __all__ = [
     "EXPORT_FORMAT_NAMES", "MAX_EXPORT_PACK",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
-    "PackFormat", "Text", "RequestModel",
+    "PackFormat", "Text", "RequestModel", "WORKING_SPACES", "WorkingSpace",
     "Mirror", "absent", "ErrorItem", "ErrorBody",
 ]
 
@@ -40,6 +41,9 @@ MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
 EXPORT_FORMAT_NAMES = ("mtlx", "openpbr", "blender", "gltf")
 """Exports for one coating index (docs/exports.md); a pack of them is a zip archive."""
+WORKING_SPACES = WORKING_SPACE_NAMES
+"""The working spaces an export is fitted and written in (docs/exports.md)."""
+WorkingSpace = Literal[WORKING_SPACE_NAMES]  # type: ignore[valid-type]
 MAX_EXPORT_PACK = 16
 """Most fits in one pack of exports (each export fits its tool's values, about 1 s)."""
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)

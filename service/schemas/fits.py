@@ -29,6 +29,7 @@ from .common import (
     EtaI,
     FitId,
     LibraryName,
+    WorkingSpace,
     ModelKind,
     Objective,
     PackFormat,
@@ -137,6 +138,12 @@ class PackRequest(RequestModel):
         "binary", description="binary | json | glsl | hlsl, or an export (mtlx | openpbr | blender "
         f"| gltf: a zip archive of one file per fit, at most {MAX_EXPORT_PACK} fits)")
     eta_i: EtaI = Field(1.5, description="Coating index of an export, [1, 3]")
+    roughness: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = Field(
+        0.2, description="The metal's perceptual roughness of an export, [0, 1]")
+    coat_roughness: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = Field(
+        0.03, description="The coat's perceptual roughness of an export, [0, 1]")
+    working_space: WorkingSpace = Field(
+        "lin_rec709", description="lin_rec709 | acescg: the space an export is fitted and written in")
     name: Annotated[str, Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9._-]+$")] = "materials"
 
     @model_validator(mode="after")

@@ -29,7 +29,7 @@ from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_
                         CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
-                    MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields, StoredFit,
+                    MinCoverageForm, RoughnessQuery, WorkingSpaceQuery, RunnerDep, SettingsDep, SingleFormFields, StoredFit,
                     StoreDep, WriteAccess)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
@@ -114,6 +114,7 @@ async def get_pack(
         ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
         description="Coating index of an export (mtlx, openpbr, blender, gltf), [1, 3]")] = 1.5,
     roughness: RoughnessQuery = 0.2, coat_roughness: CoatRoughnessQuery = 0.03,
+    working_space: WorkingSpaceQuery = "lin_rec709",
 ) -> Response:
     """
     The fit as a download: ``binary`` (docs/pack-format.md), ``json``, or a
@@ -122,7 +123,10 @@ async def get_pack(
     (docs/exports.md): a MaterialX document (``mtlx``: conductor under a
     dielectric coat; ``openpbr``: ``open_pbr_surface``), a Blender script
     (``blender``) or a glTF asset (``gltf``), with ``roughness`` and
-    ``coat_roughness``; named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
+    ``coat_roughness``, fitted and written in ``working_space``
+    (``lin_rec709`` or ``acescg``); named
+    ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>`` (``-acescg`` before the
+    suffix for an ACEScg export).
     """
     record = stored_fit(store, fit_id)  # after the query is validated: 422 before 404
     stem = f"{record.name}-{record.id[:8]}"
@@ -130,9 +134,10 @@ async def get_pack(
         # An export fits its tool's values (up to about a second of CPU): a job in the
         # fitting pool, with its CPU limit and timeout, shared by identical requests.
         body = await runner.once(
-            f"export {record.id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}",
-            lambda: runner.run(render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0))
-        return export_response(body, format, eta_i, stem, roughness, coat_roughness)
+            f"export {record.id} {format} {eta_i!r} {roughness!r} {coat_roughness!r} {working_space}",
+            lambda: runner.run(render_export, record, format, eta_i, roughness, coat_roughness, working_space,
+                               cost_s=1.0))
+        return export_response(body, format, eta_i, stem, roughness, coat_roughness, working_space)
     return pack_response([record], format, stem)
 
 
