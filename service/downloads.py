@@ -217,6 +217,7 @@ PACK_CONTENT = {
     "application/xml": {"schema": {"type": "string"}},
     "text/x-python": {"schema": {"type": "string"}},
     "model/gltf+json": {"schema": {"type": "object"}},
+    "model/gltf-binary": {"schema": {"type": "string", "format": "binary"}},
     "application/zip": {"schema": {"type": "string", "format": "binary"}},
 }
 """The OpenAPI content of a download."""

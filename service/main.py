@@ -28,8 +28,8 @@ from fastapi.staticfiles import StaticFiles
 from .api.errors import install_error_handlers
 from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
-    curves, environments, fits, health, ibl, library, materials, packs, preview, reference_texture, scenes,
-    versions,
+    curves, environments, fits, health, ibl, imports, library, materials, packs, preview, reference_texture,
+    scenes, versions,
 )
 from .config import Settings
 from .pool import FitRunner, warm_process
@@ -150,8 +150,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     install_error_handlers(app)
-    for module in (health, materials, versions, library, fits, packs, preview, reference_texture, environments,
-                   curves, scenes, ibl):
+    for module in (health, materials, versions, library, imports, fits, packs, preview, reference_texture,
+                   environments, curves, scenes, ibl):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")

@@ -104,7 +104,8 @@ def _write_export(nk, args) -> int:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)
     else:
-        sys.stdout.write(body.decode("utf-8"))
+        sys.stdout.buffer.write(body)
+        sys.stdout.flush()
     return 0
 
 
@@ -114,6 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
     from .batch import add_batch_parser
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
+    from .import_fit import add_import_parser
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -139,7 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
-    p.add_argument("--export", choices=("mtlx", "openpbr", "blender", "gltf"),
+    p.add_argument("--export", choices=("mtlx", "openpbr", "blender", "gltf", "glb"),
                    help="write this export (docs/exports.md) to -o or stdout instead of a pack")
     p.add_argument("--eta-i", type=float, default=1.5,
                    help="coating index of --export, [1, 3] (default 1.5)")
@@ -164,6 +166,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_scene_parser(sub)
     add_batch_parser(sub, parse_eta_range)
     add_ibl_parsers(sub)
+    add_import_parser(sub)
     return parser
 
 

@@ -13,7 +13,10 @@ one coating index eta_i, each saying what it was made from:
     Metallic BSDF in Physical Conductor mode (:mod:`fitting.exports.blender`);
 -   ``gltf``: glTF 2.0 with ``KHR_materials_clearcoat`` and a sphere
     (:mod:`fitting.exports.gltf`), and the model itself in
-    ``EXT_materials_coated_conductor`` (:mod:`fitting.exports.gltf_coated`).
+    ``EXT_materials_coated_conductor`` (:mod:`fitting.exports.gltf_coated`);
+    ``glb``: the same asset as binary glTF.
+
+Each carries the fit's float16 model, read back by :mod:`fitting.exports.readback`.
 
 The values come from :mod:`fitting.exports.values`: each fitted so that the
 tool's own layering of its coat over its base
@@ -35,7 +38,7 @@ from __future__ import annotations
 
 from .blender import blender_script
 from .colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES, check_working_space
-from .gltf import gltf_document
+from .gltf import glb_document, gltf_document
 from .mtlx import mtlx_document
 from .openpbr import openpbr_document
 from .seen_fit import seen_fidelity
@@ -65,6 +68,7 @@ EXPORT_FORMATS = {
     "openpbr": ("application/xml", "openpbr.mtlx"),
     "blender": ("text/x-python; charset=utf-8", "py"),
     "gltf": ("model/gltf+json", "gltf"),
+    "glb": ("model/gltf-binary", "glb"),
 }
 """Format -> (media type, file suffix)."""
 
@@ -73,6 +77,7 @@ FORMAT_TOOLS = {
     "openpbr": ("openpbr",),
     "blender": ("blender", "blender-conductor"),
     "gltf": ("gltf",),
+    "glb": ("gltf",),
 }
 """Format -> the tools whose fitted values it carries (:mod:`fitting.exports.tool_layering`)."""
 
@@ -81,6 +86,7 @@ _WRITERS = {
     "openpbr": openpbr_document,
     "blender": blender_script,
     "gltf": gltf_document,
+    "glb": glb_document,
 }
 
 
@@ -96,7 +102,7 @@ def export_material(
     model=None, fit_id: str | None = None, working_space: str | None = None,
 ) -> bytes:
     """
-    The export of a material for one coating index, as UTF-8 bytes.
+    The export of a material for one coating index, as bytes (UTF-8 text but for ``glb``).
 
     Parameters
     ----------
@@ -154,4 +160,5 @@ def export_material(
     else:
         values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, FORMAT_TOOLS[format],
                                fit_id=fit_id, working_space=working_space or DEFAULT_WORKING_SPACE)
-    return _WRITERS[format](values).encode("utf-8")
+    document = _WRITERS[format](values)
+    return document if isinstance(document, bytes) else document.encode("utf-8")

@@ -36,14 +36,15 @@ IDENTITY_ATTRIBUTES = {
     "service_version": "coatedfresnel_version",
     "eta_i": "coatedfresnel_eta_i",
     "working_space": "coatedfresnel_working_space",
+    "pack": "coatedfresnel_pack",
 }
 """Identity field (:func:`fitting.exports.naming.identity`) -> the MaterialX attribute that carries it
 on the document and on the material (which keeps it when documents are merged)."""
 
 
 def identity_attributes(identity: dict) -> dict:
-    """``identity`` as MaterialX attributes (:data:`IDENTITY_ATTRIBUTES`), all text."""
-    return {IDENTITY_ATTRIBUTES[key]: str(value) for key, value in identity.items()}
+    """``identity`` as MaterialX attributes (:data:`IDENTITY_ATTRIBUTES`), all text; ``None`` left out."""
+    return {IDENTITY_ATTRIBUTES[key]: str(value) for key, value in identity.items() if value is not None}
 
 
 def document(provenance: dict, identity: dict) -> ET.Element:

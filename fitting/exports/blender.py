@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import json
 
-from .naming import element_stem, identity
+from .naming import carried_pack, element_stem, identity
 from .seen_fit import K_BOUNDS, N_BOUNDS, seen_fidelity
 from .values import ExportValues
 
@@ -92,6 +92,8 @@ ETA_I = {eta_i!r}
 COAT = {coat!r}
 ROUGHNESS = {roughness!r}
 IDENTITY = {identity!r}
+# The fit's float16 model: a binary pack of one material, base64 (read back by coated-fresnel).
+PACK = {pack!r}
 # The working space every colour and n, k below is in, and Blender's name for it.
 WORKING_SPACE = {working_space!r}
 WORKING_SPACE_INTEROP_IDS = {{"lin_rec709": "lin_rec709_scene", "acescg": "lin_ap1_scene"}}
@@ -150,6 +152,8 @@ def build_material(name=MATERIAL_NAME):
     material["coated_fresnel"] = PROVENANCE
     for key in ("fit_id", "service_version", "eta_i", "working_space"):
         material["coated_fresnel_" + ("version" if key == "service_version" else key)] = IDENTITY[key]
+    if PACK is not None:
+        material["coated_fresnel_pack"] = PACK
 
     principled = _node(tree, "ShaderNodeBsdfPrincipled", NODE_NAMES["principled"], (0, 300))
     principled.inputs["Base Color"].default_value = (*BASE_COLOR, 1.0)
@@ -255,6 +259,7 @@ def blender_script(values: ExportValues) -> str:
         header=header,
         material_name=element_stem(values),
         identity=identity(values),
+        pack=carried_pack(values),
         working_space=values.working_space,
         provenance_json=json.dumps(provenance, sort_keys=True),
         eta_i=round(values.eta_i, 6),

@@ -100,7 +100,7 @@ def mtlx_document(values: ExportValues) -> str:
     node = f"coated_metal_{ident}"
     nodedef_name = f"ND_{node}"
     provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "mtlx"))
-    root = document(provenance, identity(values))
+    root = document(provenance, identity(values, with_pack=True))
     fitted = values.tools["mtlx"]
     coat_on = fitted["coat"]
 
@@ -146,7 +146,7 @@ def mtlx_document(values: ExportValues) -> str:
     material = ET.SubElement(
         root, "surfacematerial", name=ident, type="material",
         doc="; ".join(f"{k}: {v}" for k, v in provenance.items()),
-        **identity_attributes(identity(values)),
+        **identity_attributes(identity(values, with_pack=True)),
     )
     add_input(material, "surfaceshader", "surfaceshader", nodename=f"{ident}_shader")
     return to_text(root)

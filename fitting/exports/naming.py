@@ -14,20 +14,25 @@ different node definitions and materials).
     MaterialX element name (``Au_1a2b3c4d_eta1p33``).
 -   :func:`identity`: the fields every export carries (fit id, service
     version, coat index, working space).
+-   :func:`carried_pack`: the fit's float16 model as the binary pack of one
+    material (its CRC inside), base64: what an export carries to be read
+    back to the same coefficients (:mod:`fitting.exports.readback`).
 """
 
 from __future__ import annotations
 
+import base64
 import hashlib
 import json
 import re
 
 import numpy as np
 
+from ..models.pack import encode_pack
 from ._xml import element_name
 
 __all__ = ["FIT_ID_LENGTH", "SHORT_ID_LENGTH", "export_id", "eta_tag", "element_stem", "identity",
-           "check_fit_id"]
+           "check_fit_id", "carried_pack"]
 
 FIT_ID_LENGTH = 32
 """Hex digits of a fit id (SHA-256, as the service's content addresses)."""
@@ -77,12 +82,12 @@ def element_stem(values) -> str:
     return element_name(f"{values.name}_{export_id(values)[:SHORT_ID_LENGTH]}_{eta_tag(values.eta_i)}")
 
 
-def identity(values) -> dict:
+def identity(values, with_pack: bool = False) -> dict:
     """
     What every export carries to be traced and read back: ``fit_id`` (in
     full), ``fit_id_kind`` (``stored`` for a service fit, ``content`` for a
     content address), ``service_version``, ``eta_i`` (the coat index) and
-    ``working_space``.
+    ``working_space``; with ``with_pack`` also ``pack`` (:func:`carried_pack`).
     """
     return {
         "fit_id": export_id(values),
@@ -90,4 +95,15 @@ def identity(values) -> dict:
         "service_version": values.version,
         "eta_i": values.eta_i,
         "working_space": values.working_space,
+        **({"pack": carried_pack(values)} if with_pack else {}),
     }
+
+
+def carried_pack(values) -> str | None:
+    """
+    ``values.model`` as a binary pack of one material (:func:`fitting.models.pack.encode_pack`,
+    CRC-32 checked when read) in base64 ASCII; ``None`` when the export has no model.
+    """
+    if values.model is None:
+        return None
+    return base64.b64encode(encode_pack([values.model])).decode("ascii")

@@ -43,7 +43,7 @@ def openpbr_document(values: ExportValues) -> str:
     """The OpenPBR (MaterialX) document of ``values``, UTF-8 text."""
     ident = f"{element_stem(values)}_openpbr"
     provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "openpbr"))
-    root = document(provenance, identity(values))
+    root = document(provenance, identity(values, with_pack=True))
     fitted = values.tools["openpbr"]
     coat_on = fitted["coat"]
     shader = ET.SubElement(root, "open_pbr_surface", name=f"{ident}_shader", type="surfaceshader")
@@ -66,7 +66,7 @@ def openpbr_document(values: ExportValues) -> str:
     material = ET.SubElement(
         root, "surfacematerial", name=ident, type="material",
         doc="; ".join(f"{k}: {v}" for k, v in provenance.items()),
-        **identity_attributes(identity(values)),
+        **identity_attributes(identity(values, with_pack=True)),
     )
     add_input(material, "surfaceshader", "surfaceshader", nodename=f"{ident}_shader")
     return to_text(root)

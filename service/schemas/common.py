@@ -39,7 +39,7 @@ INT64_MAX = 2**63 - 1
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
-EXPORT_FORMAT_NAMES = ("mtlx", "openpbr", "blender", "gltf")
+EXPORT_FORMAT_NAMES = ("mtlx", "openpbr", "blender", "gltf", "glb")
 """Exports for one coating index (docs/exports.md); a pack of them is a zip archive."""
 WORKING_SPACES = WORKING_SPACE_NAMES
 """The working spaces an export is fitted and written in (docs/exports.md)."""

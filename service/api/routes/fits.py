@@ -6,7 +6,7 @@ Fits
 -   ``POST /api/v1/fits/upload``: fit an uploaded n, k file (CSV, JSON, YAML), multipart.
 -   ``GET /api/v1/fits/{fit_id}``: a stored fit.
 -   ``GET /api/v1/fits/{fit_id}/pack``: its download (binary, json, glsl,
-    hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf).
+    hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf, glb).
 -   ``GET /api/v1/fits/{fit_id}/curves``: reference, model and baseline RGB
     against the angle, for plotting.
 
@@ -109,10 +109,10 @@ def get_fit(record: StoredFit) -> FitPublic:
 async def get_pack(
     fit_id: FitIdPath, store: StoreDep, runner: RunnerDep,
     format: Annotated[DownloadFormat, Query(
-        description="binary | json | glsl | hlsl | mtlx | openpbr | blender | gltf")] = "binary",
+        description="binary | json | glsl | hlsl | mtlx | openpbr | blender | gltf | glb")] = "binary",
     eta_i: Annotated[float, Query(
         ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-        description="Coating index of an export (mtlx, openpbr, blender, gltf), [1, 3]")] = 1.5,
+        description="Coating index of an export (mtlx, openpbr, blender, gltf, glb), [1, 3]")] = 1.5,
     roughness: RoughnessQuery = 0.2, coat_roughness: CoatRoughnessQuery = 0.03,
     working_space: WorkingSpaceQuery = "lin_rec709",
 ) -> Response:

@@ -4,7 +4,7 @@ Packs
 
 ``POST /api/v1/packs``: several stored fits in one download (a scene's
 materials together), in any pack format, or their exports for one coating
-index as a zip archive (mtlx, openpbr, blender, gltf). Reads only; saves
+index as a zip archive (mtlx, openpbr, blender, gltf, glb). Reads only; saves
 nothing.
 """
 
