@@ -157,7 +157,6 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
             "roughnessFactor": round(values.roughness, 6),
         },
         "extensions": {},
-        "extras": {"coated_fresnel": {**provenance, **identity(values, with_pack=True)}},
     }
     used = []
     if coat_on:
@@ -175,6 +174,7 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
             used.append(EXTENSION_NAME)
     if not material["extensions"]:
         del material["extensions"]
+    material["extras"] = {"coated_fresnel": {**provenance, **identity(values, with_pack=True)}}
     asset = {
         "asset": {
             "version": "2.0",
