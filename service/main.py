@@ -173,7 +173,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         )
     app.add_middleware(
         RequestLimits, max_body_bytes=settings.max_body_bytes,
-        max_upload_bytes=settings.max_upload_bytes, upload_paths=(f"{API_PREFIX}/fits/upload",),
+        max_upload_bytes=settings.max_upload_bytes,
+        upload_paths=(f"{API_PREFIX}/fits/upload", f"{API_PREFIX}/fits/import"),
         body_timeout_s=settings.body_timeout_s,
     )
     # Outermost: a request for another host name is refused before anything else,

@@ -120,3 +120,19 @@ class TestImport:
         response = post(client, json.dumps(asset).encode())
         assert response.status_code == 422, response.text
         assert "coefficients are not that fit's" in response.json()["detail"]
+
+
+class TestImportGuards:
+    def test_token_required_401(self, tmp_path):
+        with app_client(tmp_path, require_token=True, api_token="s3cret") as client:
+            response = post(client, b"CFPK")
+            assert response.status_code == 401 and response.headers["www-authenticate"] == "Bearer"
+            # Past the token check: refused for what the file is.
+            allowed = client.post(f"{API}/fits/import", files={"file": ("a", b"CFPK")},
+                                  headers={"Authorization": "Bearer s3cret"})
+            assert allowed.status_code == 422 and "truncated" in allowed.json()["detail"]
+
+    def test_too_large_413(self, tmp_path):
+        with app_client(tmp_path, max_upload_bytes=4096) as client:
+            response = post(client, b"x" * 10_000)
+            assert response.status_code == 413, response.text
