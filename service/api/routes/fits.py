@@ -23,6 +23,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, export_response, pack_response, render_export
 from ...jobs.common import stored_fit
+from ...jobs.edge_tint import fit_from_colours
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
 from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, PACK_FORMATS,
@@ -54,11 +55,14 @@ def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPubli
 async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, settings: SettingsDep,
                      response: Response) -> FitPublic:
     """
-    Fit a built-in material (``{"material": "Au"}``) or inline n, k
-    (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) over
+    Fit a built-in material (``{"material": "Au"}``), inline n, k
+    (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) or F0 and F82 tint
+    (``{"name", "f0", "f82", "space"}``: an ``rgb-conductor``) over
     ``eta_i_range``; the answer carries the float16 coefficients, Delta E
     2000 of the model and of adjusted Lazanyi, and timings.
     """
+    if request.f0 is not None:  # F0 and F82 colours: n, k from them, no fit to run
+        return fit_answer(*await fit_from_colours(store, request), response)
     runner.check_capacity()
     if request.material is not None:
         fit = await run_in_threadpool(NKFit.library, request.material, request.eta_i_range,
