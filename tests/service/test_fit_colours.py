@@ -22,6 +22,7 @@ def client(tmp_path_factory):
         yield client
 
 
+@pytest.mark.slow  # the module's app starts its store and pools (about 9 s on a busy machine)
 class TestFitFromColours:
     def test_fits_and_is_stored(self, client):
         response = client.post(f"{API}/fits", json={**GOLD, "space": "acescg"})
@@ -45,7 +46,6 @@ class TestFitFromColours:
         F0, _ = F0_F82_from_nk(*model.coefficients.astype(np.float64))
         np.testing.assert_allclose(F0, np.clip(lin_rec709_to_ACEScg(GOLD["f0"]), 0, 1), atol=2e-3)
 
-    @pytest.mark.slow  # an export fitted in the pool
     def test_exports_like_any_fit(self, client):
         fit = client.post(f"{API}/fits", json={**GOLD, "name": "artist gold 709"}).json()
         response = client.get(f"{API}/fits/{fit['id']}/pack?format=openpbr&eta_i=1.5")
