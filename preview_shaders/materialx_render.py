@@ -14,7 +14,9 @@ its Fresnel F(cos theta): the paper's validation setting).
 
 -   :func:`materialx_glsl`: vertex and pixel shader of a document's material.
 -   :func:`render_materialx`: the rendered sphere, linear, in the document's
-    colour space.
+    colour space, or in a target colour space through MaterialX's own colour
+    management (its ``DefaultColorManagementSystem`` and the generator's
+    ``targetColorSpaceOverride``, as a host working in that space sets them).
 """
 
 from __future__ import annotations
@@ -48,10 +50,13 @@ def _libraries():
     return lib
 
 
-def materialx_glsl(document_text: str) -> tuple[str, str]:
+def materialx_glsl(document_text: str, target_colorspace: str | None = None) -> tuple[str, str]:
     """
     The GLSL vertex and pixel shader MaterialX generates for the (only)
-    material of a document, after checking the document is valid.
+    material of a document, after checking the document is valid. With
+    ``target_colorspace`` (a MaterialX colour space name, ``acescg``), the
+    generator has MaterialX's default colour management system and that
+    target: each colour input of another colour space is converted to it.
 
     Raises
     ------
@@ -78,6 +83,11 @@ def materialx_glsl(document_text: str) -> tuple[str, str]:
     generator = mx_gen_glsl.GlslShaderGenerator.create()
     context = mx_gen_shader.GenContext(generator)
     context.registerSourceCodeSearchPath(mx.getDefaultDataSearchPath())
+    if target_colorspace is not None:
+        cms = mx_gen_shader.DefaultColorManagementSystem.create(generator.getTarget())
+        cms.loadLibrary(_libraries())
+        generator.setColorManagementSystem(cms)
+        context.getOptions().targetColorSpaceOverride = target_colorspace
     shader = generator.generate(materials[0].getName(), materials[0], context)
     return (shader.getSourceCode(mx_gen_shader.VERTEX_STAGE),
             shader.getSourceCode(mx_gen_shader.PIXEL_STAGE))
@@ -134,7 +144,8 @@ def _render(state: GLState, vertex: str, pixel: str, size: int) -> np.ndarray:
     return image.reshape(size, size, 4)[::-1].copy()
 
 
-def render_materialx(document_text: str, size: int = 128, thread: RenderThread | None = None):
+def render_materialx(document_text: str, size: int = 128, thread: RenderThread | None = None,
+                     target_colorspace: str | None = None):
     """
     The sphere of a MaterialX document's material under a uniform white
     environment (see the module docstring).
@@ -147,17 +158,20 @@ def render_materialx(document_text: str, size: int = 128, thread: RenderThread |
         Pixels per side, 16..1024.
     thread
         A render thread to use; a new one (made and closed here) when None.
+    target_colorspace
+        ``None``: the document's own colour space; else the space the
+        shader is generated for (:func:`materialx_glsl`).
 
     Returns
     -------
     tuple
         ``(image, coverage)``: (size, size, 3) float32, linear in the
-        document's colour space, top row first; (size, size) bool, where the
+        document's colour space (or ``target_colorspace``), top row first; (size, size) bool, where the
         sphere was drawn.
     """
     if not (isinstance(size, int) and 16 <= size <= 1024):
         raise ValueError(f"`size` must be an integer in [16, 1024], got {size!r}")
-    vertex, pixel = materialx_glsl(document_text)
+    vertex, pixel = materialx_glsl(document_text, target_colorspace)
     if thread is None:
         with RenderThread("materialx-render") as own:
             rgba = own.call(_render, vertex, pixel, size)

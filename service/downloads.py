@@ -44,12 +44,12 @@ from fitting.models.kinds import model_ACEScg
 from fitting.models.pack import PackedMaterial, encode_pack, material_from_json
 from fitting.models.pack import pack_to_json
 
-from .jobs.common import FIT_FORMAT_VERSION, measured_nk
+from .jobs.common import FIT_FORMAT_VERSION, measured_nk, stored_fit
 from .store import FitRecord
 
 __all__ = [
     "PACK_MEDIA_TYPES", "is_export", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
-    "render_export", "export_key", "kept_export", "render_export_pack", "pack_response", "export_response",
+    "render_export", "export_key", "kept_export", "export_download", "render_export_pack", "pack_response", "export_response",
     "download_name", "unique_names",
     "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
 ]
@@ -109,10 +109,13 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
     return snippet(format, materials, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
 
 
-def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03) -> bytes:
+def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03,
+                  working_space: str = "lin_rec709") -> bytes:
     """
     The export of one stored fit in ``format`` (one of
-    :data:`fitting.exports.EXPORT_FORMATS`) for the coating index ``eta_i`` and roughnesses.
+    :data:`fitting.exports.EXPORT_FORMATS`) for the coating index ``eta_i`` and
+    roughnesses, fitted and written in ``working_space``, named by and
+    carrying the fit's id (:mod:`fitting.exports.naming`).
 
     A fit of measured n, k is exported from them (the spectral reference
     under the coat); a fit made from edited curves from its own float16
@@ -129,7 +132,8 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
     if record.kind != "curves":
         nk = measured_nk(record)
         if nk is not None:
-            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed)
+            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed,
+                                   fit_id=record.id, working_space=working_space)
     lo, hi = packed.eta_i_range
     if not lo <= eta_i <= hi:
         raise ValueError(
@@ -142,16 +146,18 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
         "reflectance": lambda mu, eta: model_ACEScg(
             packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
-    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed)
+    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed,
+                           fit_id=record.id, working_space=working_space)
 
 
-def export_key(fit_id: str, format: str, eta_i: float, roughness: float, coat_roughness: float) -> str:
+def export_key(fit_id: str, format: str, eta_i: float, roughness: float, coat_roughness: float,
+               working_space: str = "lin_rec709") -> str:
     """The key of one export of a fit (:func:`kept_export`)."""
-    return f"export {fit_id} {format} {eta_i!r} {roughness!r} {coat_roughness!r}"
+    return f"export {fit_id} {format} {eta_i!r} {roughness!r} {coat_roughness!r} {working_space}"
 
 
 async def kept_export(cache, runner, record: FitRecord, format: str, eta_i: float, roughness: float,
-                      coat_roughness: float) -> tuple[str, bytes]:
+                      coat_roughness: float, working_space: str = "lin_rec709") -> tuple[str, bytes]:
     """
     ``(record.name, render_export(...))`` of ``record``, made in
     ``runner``'s pool (its CPU limit and time limit; identical requests
@@ -159,18 +165,40 @@ async def kept_export(cache, runner, record: FitRecord, format: str, eta_i: floa
     by :func:`export_key`: a later download is answered from it without
     reading the store.
     """
-    key = export_key(record.id, format, eta_i, roughness, coat_roughness)
+    key = export_key(record.id, format, eta_i, roughness, coat_roughness, working_space)
 
     async def make() -> tuple[str, bytes]:
-        body = await runner.run(render_export, record, format, eta_i, roughness, coat_roughness, cost_s=1.0)
+        body = await runner.run(render_export, record, format, eta_i, roughness, coat_roughness, working_space,
+                                cost_s=1.0)
         return record.name, body
 
     return await cache.get_or_make(key, lambda: runner.once(key, make))
 
 
-def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> bytes:
+async def export_download(cache, store, runner, fit_id: str, format: str, eta_i: float, roughness: float,
+                          coat_roughness: float, working_space: str = "lin_rec709"):
     """
-    The exports of several fits for one ``eta_i``: a zip archive with one
+    The download of one export of the stored fit ``fit_id``: from ``cache``
+    when it was made before (without reading the store), else made by
+    :func:`kept_export` (a job of the fitting pool, up to about a second of
+    CPU) and kept: a fit never changes. ``LookupError`` (404) when no such
+    fit is stored.
+    """
+    from fastapi.concurrency import run_in_threadpool
+
+    kept = cache.get(export_key(fit_id, format, eta_i, roughness, coat_roughness, working_space))
+    if kept is None:
+        record = await run_in_threadpool(stored_fit, store, fit_id)
+        kept = await kept_export(cache, runner, record, format, eta_i, roughness, coat_roughness, working_space)
+    return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness,
+                           working_space)
+
+
+def render_export_pack(records: list[FitRecord], format: str, eta_i: float, roughness=0.2,
+                       coat_roughness=0.03, working_space: str = "lin_rec709") -> bytes:
+    """
+    The exports of several fits for one ``eta_i``, roughnesses and working
+    space (:func:`render_export`): a zip archive with one
     ``<name>-eta<eta_i>.<suffix>`` per fit, in order, byte-for-byte
     deterministic (fixed time stamps), so the same request gives the same
     archive. Entry names are unique (:func:`unique_names`), so that no
@@ -182,7 +210,7 @@ def render_export_pack(records: list[FitRecord], format: str, eta_i: float) -> b
         for record, name in zip(records, names):
             info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
             info.compress_type = zipfile.ZIP_DEFLATED
-            archive.writestr(info, render_export(record, format, eta_i))
+            archive.writestr(info, render_export(record, format, eta_i, roughness, coat_roughness, working_space))
     return buffer.getvalue()
 
 
@@ -221,11 +249,17 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     )
 
 
-def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03):
-    """An export's bytes (:func:`render_export`) as a download named for ``eta_i`` and the roughnesses."""
+def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03,
+                    working_space: str = "lin_rec709"):
+    """
+    An export's bytes (:func:`render_export`) as a download named for
+    ``eta_i``, the roughnesses and (when not ``lin_rec709``) the working space.
+    """
     from fastapi import Response
 
     stem = f"{stem}-eta{eta_i:g}-rough{roughness:g}-coat{coat_roughness:g}"
+    if working_space != "lin_rec709":
+        stem += f"-{working_space}"
     return Response(
         body, media_type=export_format(format).media_type,
         headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
@@ -239,6 +273,7 @@ PACK_CONTENT = {
     "application/xml": {"schema": {"type": "string"}},
     "text/x-python": {"schema": {"type": "string"}},
     "model/gltf+json": {"schema": {"type": "object"}},
+    "model/gltf-binary": {"schema": {"type": "string", "format": "binary"}},
     "application/zip": {"schema": {"type": "string", "format": "binary"}},
 }
 """The OpenAPI content of a download."""

@@ -30,8 +30,8 @@ from fitting.cli.plugins import load_plugins
 from .api.errors import install_error_handlers
 from .api.middleware import FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
-    curves, environments, fits, health, ibl, library, materials, packs, preview, reference_texture, scenes,
-    versions,
+    curves, environments, fits, health, ibl, imports, library, materials, packs, preview, reference_texture,
+    scenes, versions,
 )
 from .config import Settings
 from .runtime import FitRunner, PreviewRunner, freeze_heap, thaw_heap, warm_process
@@ -157,8 +157,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     install_error_handlers(app)
-    for module in (health, materials, versions, library, fits, packs, preview, reference_texture, environments,
-                   curves, scenes, ibl):
+    for module in (health, materials, versions, library, imports, fits, packs, preview, reference_texture,
+                   environments, curves, scenes, ibl):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")
@@ -180,7 +180,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         )
     app.add_middleware(
         RequestLimits, max_body_bytes=settings.max_body_bytes,
-        max_upload_bytes=settings.max_upload_bytes, upload_paths=(f"{API_PREFIX}/fits/upload",),
+        max_upload_bytes=settings.max_upload_bytes,
+        upload_paths=(f"{API_PREFIX}/fits/upload", f"{API_PREFIX}/fits/import"),
         body_timeout_s=settings.body_timeout_s,
     )
     # Outermost: a request for another host name is refused before anything else,

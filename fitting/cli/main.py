@@ -107,13 +107,15 @@ def _write_export(nk, args) -> int:
 
     # The fit's own float16 model travels in the glTF export's extension.
     model = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=False).packed
-    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model)
+    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model,
+                           working_space=args.working_space)
     if args.output:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)
     else:
         sys.stdout.flush()
         sys.stdout.buffer.write(body)
+        sys.stdout.flush()
     return 0
 
 
@@ -132,11 +134,13 @@ def _write_snippet(nk, result, args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from ..exports.colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
     from .batch import add_batch_parser
     from ..exports.formats import EXPORT_FORMATS
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
+    from .import_fit import add_import_parser
     from .scene import add_scene_parser
 
     parser = argparse.ArgumentParser(
@@ -171,6 +175,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
     p.add_argument("--coat-roughness", type=float, default=0.03,
                    help="coat roughness of --export, [0, 1]")
+    p.add_argument("--working-space", choices=WORKING_SPACES, default=DEFAULT_WORKING_SPACE,
+                   help="working space --export is fitted and written in (default %(default)s)")
     p.add_argument("--strict", action="store_true",
                    help="exit with status 3 (writing nothing) on any warning: the fit does not "
                         "converge, its model is not proven inside [0, 1], or the data are sparse, "
@@ -190,6 +196,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_scene_parser(sub)
     add_batch_parser(sub, parse_eta_range)
     add_ibl_parsers(sub)
+    add_import_parser(sub)
     return parser
 
 

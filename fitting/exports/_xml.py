@@ -30,8 +30,30 @@ def comment_text(provenance: dict) -> str:
     return (" " + "\n     ".join(lines) + " ").replace("--", "- -")
 
 
-def document(provenance: dict) -> ET.Element:
-    root = ET.Element("materialx", version=MATERIALX_VERSION, colorspace="lin_rec709")
+IDENTITY_ATTRIBUTES = {
+    "fit_id": "coatedfresnel_fit_id",
+    "fit_id_kind": "coatedfresnel_fit_id_kind",
+    "service_version": "coatedfresnel_version",
+    "eta_i": "coatedfresnel_eta_i",
+    "working_space": "coatedfresnel_working_space",
+    "pack": "coatedfresnel_pack",
+}
+"""Identity field (:func:`fitting.exports.naming.identity`) -> the MaterialX attribute that carries it
+on the document and on the material (which keeps it when documents are merged)."""
+
+
+def identity_attributes(identity: dict) -> dict:
+    """``identity`` as MaterialX attributes (:data:`IDENTITY_ATTRIBUTES`), all text; ``None`` left out."""
+    return {IDENTITY_ATTRIBUTES[key]: str(value) for key, value in identity.items() if value is not None}
+
+
+def document(provenance: dict, identity: dict) -> ET.Element:
+    """
+    The ``materialx`` element: its ``colorspace`` the export's working space
+    (every colour in it is in that space) and the identity attributes.
+    """
+    root = ET.Element("materialx", version=MATERIALX_VERSION, colorspace=identity["working_space"],
+                      **identity_attributes(identity))
     root.append(ET.Comment(comment_text(provenance)))
     return root
 

@@ -5,7 +5,8 @@ Blender export
 A Python script that builds the material's node tree in Blender (4.3 or
 later; checked with the ``bpy`` 5.0 module). Run it in Blender's Text Editor
 or ``blender --python FILE``; it calls :func:`build_material` in the script,
-which makes a material with two outputs:
+which makes a new material named ``<name>_<id>_<eta>``
+(:func:`fitting.exports.naming.element_stem`) with two outputs:
 
 -   the active ``Material Output``: a Principled BSDF, ``Metallic`` 1, with
     ``Base Color`` and ``Specular Tint`` the F0 and F82 tint (Cycles and
@@ -25,9 +26,20 @@ angle in air) follows the physical coat on the metal seen from air
 (:mod:`fitting.exports.seen_fit`). At eta_i 1 there is no coat (``Coat
 Weight`` 0; the Metallic BSDF straight into its output).
 
+The values are those of one working space (``lin_rec709`` or ``acescg``,
+:data:`fitting.exports.colour_space.WORKING_SPACES`). Before it makes
+anything the script reads the file's working space (Blender 5's
+``bpy.data.colorspace``; before 5.0 always linear Rec.709) and refuses, with
+a ``RuntimeError`` that says which export to take, when it is not the one
+the values were fitted in. Run as a script it assigns the material to the
+active slot of the active mesh object (a new slot when it has none) and
+changes nothing else.
+
 The script uses only ``bpy`` and the standard library; its values are
 literals, and its provenance is in the header comment and in the material's
-custom property ``coated_fresnel`` (JSON).
+custom properties: ``coated_fresnel`` (JSON), and ``coated_fresnel_fit_id``,
+``coated_fresnel_version``, ``coated_fresnel_eta_i``,
+``coated_fresnel_working_space``.
 
 -   :func:`blender_script`: the script as text.
 """
@@ -36,6 +48,7 @@ from __future__ import annotations
 
 import json
 
+from .naming import carried_pack, element_stem, identity
 from .seen_fit import K_BOUNDS, N_BOUNDS, seen_fidelity
 from .values import ExportValues
 
@@ -78,12 +91,18 @@ PROVENANCE = {provenance_json!r}
 ETA_I = {eta_i!r}
 COAT = {coat!r}
 ROUGHNESS = {roughness!r}
+IDENTITY = {identity!r}
+# The fit's float16 model: a binary pack of one material, base64 (read back by coated-fresnel).
+PACK = {pack!r}
+# The working space every colour and n, k below is in, and Blender's name for it.
+WORKING_SPACE = {working_space!r}
+WORKING_SPACE_INTEROP_IDS = {{"lin_rec709": "lin_rec709_scene", "acescg": "lin_ap1_scene"}}
 COAT_ROUGHNESS = {coat_roughness!r}
-# F82-tint model, linear Rec.709 (Blender's scene linear), fitted to the coated
-# metal seen from air under the Principled BSDF's coat.
+# F82-tint model in WORKING_SPACE, fitted to the coated metal seen from air
+# under the Principled BSDF's coat.
 BASE_COLOR = {F0!r}
 SPECULAR_TINT = {tint!r}
-# Physical Conductor n, k per channel, linear Rec.709, fitted likewise under
+# Physical Conductor n, k per channel in WORKING_SPACE, fitted likewise under
 # the Fresnel-mixed coat: n = max(CONDUCTOR_IOR + CONDUCTOR_IOR_PER_FACING * Facing,
 # IOR_LOWEST) with Facing = 1 - cos theta (Layer Weight, blend 0.5), k likewise.
 CONDUCTOR_IOR = {n_rel!r}
@@ -102,14 +121,39 @@ def _node(tree, kind, name, location):
     return node
 
 
+def file_working_space():
+    """The interop id of this file's working space (Blender 5); before 5.0 always linear Rec.709."""
+    colorspace = getattr(bpy.data, "colorspace", None)
+    if colorspace is None:
+        return WORKING_SPACE_INTEROP_IDS["lin_rec709"]
+    return colorspace.working_space_interop_id
+
+
+def check_working_space():
+    """Refuse a file whose working space is not the one the values were fitted in."""
+    found = file_working_space()
+    if found != WORKING_SPACE_INTEROP_IDS[WORKING_SPACE]:
+        known = {{v: k for k, v in WORKING_SPACE_INTEROP_IDS.items()}}
+        raise RuntimeError(
+            f"coated-fresnel: this file's working space is {{found!r}}, but this material's "
+            f"colours and n, k were fitted in {{WORKING_SPACE!r}}; export it again with "
+            f"working_space={{known.get(found, 'lin_rec709 or acescg, after changing the file to one of them')}}"
+        )
+
+
 def build_material(name=MATERIAL_NAME):
-    """Make the material and return it (a new one each call)."""
+    """Make the material and return it (a new one each call); refuses a file of another working space."""
+    check_working_space()
     material = bpy.data.materials.new(name)
     if material.node_tree is None:  # Blender 4.x; from 5.0 every material has nodes
         material.use_nodes = True
     tree = material.node_tree
     tree.nodes.clear()
     material["coated_fresnel"] = PROVENANCE
+    for key in ("fit_id", "service_version", "eta_i", "working_space"):
+        material["coated_fresnel_" + ("version" if key == "service_version" else key)] = IDENTITY[key]
+    if PACK is not None:
+        material["coated_fresnel_pack"] = PACK
 
     principled = _node(tree, "ShaderNodeBsdfPrincipled", NODE_NAMES["principled"], (0, 300))
     principled.inputs["Base Color"].default_value = (*BASE_COLOR, 1.0)
@@ -184,8 +228,12 @@ if __name__ == "__main__":
     made = build_material()
     target = bpy.context.active_object if hasattr(bpy.context, "active_object") else None
     if target is not None and getattr(target, "type", None) == "MESH":
-        target.data.materials.clear()
-        target.data.materials.append(made)
+        # Only the active slot changes (a new slot when there is none): other
+        # slots, their materials and the faces' assignments stay as they were.
+        if len(target.material_slots) == 0:
+            target.data.materials.append(made)
+        else:
+            target.material_slots[target.active_material_index].material = made
     print(f"coated-fresnel: made material {{made.name!r}}: {{json.loads(PROVENANCE)['material']}}")
 '''
 
@@ -209,7 +257,10 @@ def blender_script(values: ExportValues) -> str:
     )
     return _SCRIPT.format(
         header=header,
-        material_name=f"{values.name} coated (eta_i {values.eta_i:g})",
+        material_name=element_stem(values),
+        identity=identity(values),
+        pack=carried_pack(values),
+        working_space=values.working_space,
         provenance_json=json.dumps(provenance, sort_keys=True),
         eta_i=round(values.eta_i, 6),
         coat=bool(principled["coat"]),

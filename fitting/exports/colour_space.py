@@ -7,7 +7,14 @@ Linear Rec.709 primaries with the D65 white: MaterialX's default
 reference is linear ACEScg (ACES white); the two are related by the CAT02
 adapted matrix, so that a perfect reflector is (1, 1, 1) in both.
 
+An export is fitted and written in one *working space*
+(:data:`WORKING_SPACES`): ``lin_rec709`` (the default of glTF and Blender)
+or ``acescg`` (linear ACEScg, AP1 primaries: Blender's "ACEScg" working
+space, MaterialX's ``acescg``). The names are MaterialX's colour space names.
+
+-   :data:`WORKING_SPACES`, :data:`DEFAULT_WORKING_SPACE`, :func:`check_working_space`.
 -   :func:`ACEScg_to_lin_rec709`, :func:`lin_rec709_to_ACEScg`.
+-   :func:`ACEScg_to_working`, :func:`working_to_ACEScg`: the same for any working space.
 """
 
 from __future__ import annotations
@@ -18,7 +25,23 @@ import numpy as np
 
 from ..colour.colorimetry import colour_science
 
-__all__ = ["ACEScg_to_lin_rec709", "lin_rec709_to_ACEScg"]
+__all__ = [
+    "WORKING_SPACES", "DEFAULT_WORKING_SPACE", "check_working_space",
+    "ACEScg_to_lin_rec709", "lin_rec709_to_ACEScg", "ACEScg_to_working", "working_to_ACEScg",
+]
+
+WORKING_SPACES = ("lin_rec709", "acescg")
+"""The working spaces an export can be fitted and written in (MaterialX's names)."""
+DEFAULT_WORKING_SPACE = "lin_rec709"
+
+
+def check_working_space(working_space) -> str:
+    """``working_space`` if one of :data:`WORKING_SPACES`, else ``ValueError`` naming the rule."""
+    if working_space not in WORKING_SPACES:
+        raise ValueError(
+            f"`working_space` must be one of {', '.join(WORKING_SPACES)}, got {working_space!r}"
+        )
+    return working_space
 
 
 @functools.cache
@@ -39,3 +62,17 @@ def ACEScg_to_lin_rec709(RGB) -> np.ndarray:
 def lin_rec709_to_ACEScg(RGB) -> np.ndarray:
     """Inverse of :func:`ACEScg_to_lin_rec709`."""
     return np.asarray(RGB, dtype=np.float64) @ np.linalg.inv(_ACEScg_to_rec709()).T
+
+
+def ACEScg_to_working(RGB, working_space: str) -> np.ndarray:
+    """Linear ACEScg to ``working_space`` (:data:`WORKING_SPACES`); ACEScg itself is returned as is."""
+    if check_working_space(working_space) == "acescg":
+        return np.asarray(RGB, dtype=np.float64)
+    return ACEScg_to_lin_rec709(RGB)
+
+
+def working_to_ACEScg(RGB, working_space: str) -> np.ndarray:
+    """Inverse of :func:`ACEScg_to_working`."""
+    if check_working_space(working_space) == "acescg":
+        return np.asarray(RGB, dtype=np.float64)
+    return lin_rec709_to_ACEScg(RGB)

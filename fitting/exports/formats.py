@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from .blender import blender_script
-from .gltf import gltf_document
+from .gltf import glb_document, gltf_document
 from .mtlx import mtlx_document
 from .openpbr import openpbr_document
 from .values import ExportValues
@@ -37,8 +37,9 @@ from .values import ExportValues
 __all__ = ["ExportFormat", "EXPORT_FORMATS", "EXPORT_OPTIONS", "register_export_format",
            "unregister_export_format", "export_format", "describe_export_formats"]
 
-EXPORT_OPTIONS = ("eta_i", "roughness", "coat_roughness")
-"""The options every export takes: the coating index and the two perceptual roughnesses."""
+EXPORT_OPTIONS = ("eta_i", "roughness", "coat_roughness", "working_space")
+"""The options every export takes: the coating index, the two perceptual roughnesses and the
+working space it is fitted and written in (:mod:`fitting.exports.colour_space`)."""
 
 
 @dataclass(frozen=True)
@@ -125,3 +126,6 @@ register_export_format(ExportFormat(
 register_export_format(ExportFormat(
     name="gltf", label="glTF asset (.gltf)", media_type="model/gltf+json",
     extension="gltf", tools=("gltf",), write=gltf_document))
+register_export_format(ExportFormat(
+    name="glb", label="glTF binary asset (.glb)", media_type="model/gltf-binary",
+    extension="glb", tools=("gltf",), write=glb_document))

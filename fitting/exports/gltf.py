@@ -11,8 +11,14 @@ the metal's roughness, with a ``KHR_materials_clearcoat`` coat; its
 index 1.5, layered at the view angle in air) follows the physical coat of
 index eta_i on the metal seen from air (:mod:`fitting.exports.seen_fit`): for
 a coat weaker than glTF's 1.5 the fit lowers ``clearcoatFactor``. At eta_i 1
-there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance is in the
-material's and the asset's ``extras``.
+there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance, with the
+full fit id, the service version, the coat index and the working space
+(:func:`fitting.exports.naming.identity`), is in the material's and the
+asset's ``extras``; the material's name is ``<name>_<id>_<eta>``
+(:func:`fitting.exports.naming.element_stem`), unique per fit and coat index.
+Its colours are in the export's working space (glTF's own is linear Rec.709:
+an ``acescg`` export is for a pipeline that reads the asset's
+``extras.coated_fresnel.working_space``).
 
 When the values carry the fit's own model (:attr:`ExportValues.model`), the
 material also has ``EXT_materials_coated_conductor``
@@ -20,7 +26,9 @@ material also has ``EXT_materials_coated_conductor``
 viewer that implements it, listed in ``extensionsUsed`` only: the values
 above are its fallback.
 
--   :func:`gltf_document`: the asset as JSON text.
+-   :func:`gltf_document`: the asset as JSON text (the buffer a base64 data URI).
+-   :func:`glb_document`: the same asset as binary glTF (``.glb``: a JSON
+    chunk and a BIN chunk holding the buffer).
 -   :func:`uv_sphere`: the sphere's positions, normals and indices.
 
 References
@@ -32,14 +40,16 @@ from __future__ import annotations
 
 import base64
 import json
+import struct
 
 import numpy as np
 
 from .gltf_coated import EXTENSION_NAME, coated_conductor_extension
+from .naming import element_stem, identity
 from .seen_fit import seen_fidelity
 from .values import ExportValues
 
-__all__ = ["MODEL_KIND", "GLTF_COAT_IOR", "gltf_document", "uv_sphere"]
+__all__ = ["MODEL_KIND", "GLTF_COAT_IOR", "gltf_document", "glb_document", "uv_sphere"]
 
 MODEL_KIND = (
     "metallic base colour and clear coat factor, fitted under three.js's clear coat to the "
@@ -50,6 +60,7 @@ GLTF_COAT_IOR = 1.5
 
 _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
 _FLOAT, _UNSIGNED_SHORT = 5126, 5123
+_CHUNK_JSON, _CHUNK_BIN = 0x4E4F534A, 0x004E4942
 
 
 def uv_sphere(segments: int = 24, rings: int = 12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -83,6 +94,35 @@ def _padded(data: bytes) -> bytes:
 
 def gltf_document(values: ExportValues) -> str:
     """The glTF 2.0 asset of ``values`` as JSON text."""
+    asset, buffer = _asset(values)
+    asset["buffers"] = [{
+        "byteLength": len(buffer),
+        "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii"),
+    }]
+    return json.dumps(asset, indent=1) + "\n"
+
+
+def glb_document(values: ExportValues) -> bytes:
+    """
+    The glTF 2.0 asset of ``values`` as a GLB (glTF 2.0, 4.4 Binary glTF
+    Layout): the 12-byte header, the JSON chunk (padded with spaces) and
+    the BIN chunk (padded with zeros), the buffer without a URI.
+    """
+    asset, buffer = _asset(values)
+    asset["buffers"] = [{"byteLength": len(buffer)}]
+    text = json.dumps(asset, separators=(",", ":")).encode("utf-8")
+    text += b" " * (-len(text) % 4)
+    binary = _padded(buffer)
+    total = 12 + 8 + len(text) + 8 + len(binary)
+    return b"".join([
+        struct.pack("<4sII", b"glTF", 2, total),
+        struct.pack("<II", len(text), _CHUNK_JSON), text,
+        struct.pack("<II", len(binary), _CHUNK_BIN), binary,
+    ])
+
+
+def _asset(values: ExportValues) -> tuple[dict, bytes]:
+    """The asset without ``buffers``, and the buffer's bytes."""
     fidelity = seen_fidelity(values, "gltf")
     provenance = values.provenance(MODEL_KIND, fidelity)
     fitted = values.tools["gltf"]
@@ -110,14 +150,13 @@ def gltf_document(values: ExportValues) -> str:
         {"bufferView": 2, "componentType": _UNSIGNED_SHORT, "count": len(indices), "type": "SCALAR"},
     ]
     material = {
-        "name": f"{values.name} coated (eta_i {values.eta_i:g})",
+        "name": element_stem(values),
         "pbrMetallicRoughness": {
             "baseColorFactor": [round(float(v), 6) for v in fitted["base_color"]] + [1.0],
             "metallicFactor": 1.0,
             "roughnessFactor": round(values.roughness, 6),
         },
         "extensions": {},
-        "extras": {"coated_fresnel": provenance},
     }
     used = []
     if coat_on:
@@ -135,6 +174,7 @@ def gltf_document(values: ExportValues) -> str:
             used.append(EXTENSION_NAME)
     if not material["extensions"]:
         del material["extensions"]
+    material["extras"] = {"coated_fresnel": {**provenance, **identity(values, with_pack=True)}}
     asset = {
         "asset": {
             "version": "2.0",
@@ -152,9 +192,5 @@ def gltf_document(values: ExportValues) -> str:
         "materials": [material],
         "accessors": accessors,
         "bufferViews": views,
-        "buffers": [{
-            "byteLength": len(buffer),
-            "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii"),
-        }],
     }
-    return json.dumps(asset, indent=1) + "\n"
+    return asset, buffer

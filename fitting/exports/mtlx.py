@@ -11,10 +11,20 @@ that better than constants) fitted so that MaterialX's layering (the coat's
 reflection plus the conductor scaled by the coat's throughput, both at the
 view angle in air) follows the physical coat on the metal seen from air
 (:mod:`fitting.exports.seen_fit`). At eta_i 1 there is no coat: the
-conductor alone, with the metal's own values in air. The node graph is the implementation of a node definition of its
-own, ``ND_coated_metal_<name>``, whose inputs expose the roughness of the
+conductor alone, with the metal's own values in air. The node graph is the
+implementation of a node definition of its own,
+``ND_coated_metal_<name>_<id>_<eta>`` (:func:`fitting.exports.naming.element_stem`,
+for example ``ND_coated_metal_Au_1a2b3c4d_eta1p33``: every fit and coat index
+its own, so exports merge), whose inputs expose the roughness of the
 metal and of the coat (perceptual, squared by ``roughness_anisotropy``) and
 the coat index; the material instantiates it with the export's values.
+
+The document's ``colorspace`` is the export's working space, and the
+conductor's ``ior`` and ``extinction`` (and the values of their graph)
+declare it too: a host whose target is that space converts nothing, and
+the per-channel n, k are the ones fitted in it. The document and the
+material carry the full fit id, the service version, the coat index and the
+working space as attributes (:data:`fitting.exports._xml.IDENTITY_ATTRIBUTES`).
 
 -   :func:`mtlx_document`: the document as text.
 
@@ -28,7 +38,8 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from ._xml import add_input, document, element_name, number, to_text, triple
+from ._xml import add_input, document, identity_attributes, number, to_text, triple
+from .naming import element_stem, identity
 from .seen_fit import K_BOUNDS, N_BOUNDS, seen_fidelity
 from .tool_layering import view_dependent
 from .values import ExportValues
@@ -42,17 +53,18 @@ MODEL_KIND = (
 )
 
 
-def _index_inputs(graph: ET.Element, metal: ET.Element, fitted: dict) -> None:
+def _index_inputs(graph: ET.Element, metal: ET.Element, fitted: dict, space: str) -> None:
     """
     The conductor's ``ior`` and ``extinction``: constants, or where a slope
     is non-zero ``max(value + value_per_facing * facing, lower bound)`` with
     facing = clamp(1 + N.V) = 1 - cos theta (``viewdirection`` points from
     the eye to the surface), as :func:`fitting.exports.tool_layering.conductor_index`.
+    Every colour value declares ``space``, the space the n, k were fitted in.
     """
     keys = (("ior", N_BOUNDS[0]), ("extinction", K_BOUNDS[0]))
     if not view_dependent(fitted):
         for key, _ in keys:
-            add_input(metal, key, "color3", value=triple(fitted[key]))
+            add_input(metal, key, "color3", value=triple(fitted[key]), colorspace=space)
         return
     for kind, name in (("normal", "view_N"), ("viewdirection", "view_V")):
         add_input(ET.SubElement(graph, kind, name=name, type="vector3"), "space", "string", value="world")
@@ -66,11 +78,11 @@ def _index_inputs(graph: ET.Element, metal: ET.Element, fitted: dict) -> None:
     add_input(facing, "in", "float", nodename="view_facing_raw")
     for key, low in keys:
         scaled = ET.SubElement(graph, "multiply", name=f"{key}_slope", type="color3")
-        add_input(scaled, "in1", "color3", value=triple(fitted[f"{key}_per_facing"]))
+        add_input(scaled, "in1", "color3", value=triple(fitted[f"{key}_per_facing"]), colorspace=space)
         add_input(scaled, "in2", "float", nodename="view_facing")
         affine = ET.SubElement(graph, "add", name=f"{key}_affine", type="color3")
         add_input(affine, "in1", "color3", nodename=f"{key}_slope")
-        add_input(affine, "in2", "color3", value=triple(fitted[key]))
+        add_input(affine, "in2", "color3", value=triple(fitted[key]), colorspace=space)
         bounded = ET.SubElement(graph, "max", name=f"{key}_at_view", type="color3")
         add_input(bounded, "in1", "color3", nodename=f"{key}_affine")
         add_input(bounded, "in2", "float", value=number(low))
@@ -81,14 +93,14 @@ def mtlx_document(values: ExportValues) -> str:
     """
     The MaterialX document of ``values`` (one eta_i), UTF-8 text.
 
-    The provenance (material, source, eta_i, model kind, generator) is an XML
-    comment at the top and the ``doc`` string of the material.
+    The provenance (material, fit id, source, eta_i, model kind, generator)
+    is an XML comment at the top and the ``doc`` string of the material.
     """
-    ident = element_name(values.name)
+    ident = element_stem(values)
     node = f"coated_metal_{ident}"
     nodedef_name = f"ND_{node}"
     provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "mtlx"))
-    root = document(provenance)
+    root = document(provenance, identity(values, with_pack=True))
     fitted = values.tools["mtlx"]
     coat_on = fitted["coat"]
 
@@ -110,7 +122,7 @@ def mtlx_document(values: ExportValues) -> str:
     base_alpha = ET.SubElement(graph, "roughness_anisotropy", name="base_alpha", type="vector2")
     add_input(base_alpha, "roughness", "float", interfacename="base_roughness")
     metal = ET.SubElement(graph, "conductor_bsdf", name="metal", type="BSDF")
-    _index_inputs(graph, metal, fitted)
+    _index_inputs(graph, metal, fitted, values.working_space)
     add_input(metal, "roughness", "vector2", nodename="base_alpha")
     if coat_on:
         coat_alpha = ET.SubElement(graph, "roughness_anisotropy", name="coat_alpha", type="vector2")
@@ -134,6 +146,7 @@ def mtlx_document(values: ExportValues) -> str:
     material = ET.SubElement(
         root, "surfacematerial", name=ident, type="material",
         doc="; ".join(f"{k}: {v}" for k, v in provenance.items()),
+        **identity_attributes(identity(values, with_pack=True)),
     )
     add_input(material, "surfaceshader", "surfaceshader", nodename=f"{ident}_shader")
     return to_text(root)

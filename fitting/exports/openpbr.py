@@ -10,7 +10,13 @@ the specification's default: the base darkened by the coat's internal
 reflections) over that metal, as MaterialX builds it, follows the physical
 coat on the metal seen from air (:mod:`fitting.exports.seen_fit`). At eta_i 1
 there is no coat (``coat_weight`` 0). ``specular_roughness`` and
-``coat_roughness`` are the surface's own inputs.
+``coat_roughness`` are the surface's own inputs. The shader is
+``<name>_<id>_<eta>_openpbr_shader`` and the material
+``<name>_<id>_<eta>_openpbr`` (:func:`fitting.exports.naming.element_stem`):
+unique per fit and coat index, and apart from the MaterialX export's, so
+both merge into one document. The document's ``colorspace`` is the
+export's working space; the document and the material carry the fit's
+identity as the MaterialX export does.
 
 -   :func:`openpbr_document`: the document as text.
 
@@ -23,7 +29,8 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from ._xml import add_input, document, element_name, number, to_text, triple
+from ._xml import add_input, document, identity_attributes, number, to_text, triple
+from .naming import element_stem, identity
 from .seen_fit import seen_fidelity
 from .values import ExportValues
 
@@ -34,12 +41,12 @@ MODEL_KIND = "f82-tint metal under OpenPBR's coat: F0 and F82 tint fitted to the
 
 def openpbr_document(values: ExportValues) -> str:
     """The OpenPBR (MaterialX) document of ``values``, UTF-8 text."""
-    ident = element_name(values.name)
+    ident = f"{element_stem(values)}_openpbr"
     provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "openpbr"))
-    root = document(provenance)
+    root = document(provenance, identity(values, with_pack=True))
     fitted = values.tools["openpbr"]
     coat_on = fitted["coat"]
-    shader = ET.SubElement(root, "open_pbr_surface", name=f"{ident}_openpbr", type="surfaceshader")
+    shader = ET.SubElement(root, "open_pbr_surface", name=f"{ident}_shader", type="surfaceshader")
     for name, type_, value in (
         ("base_weight", "float", number(1.0)),
         ("base_color", "color3", triple(fitted["base_color"])),
@@ -59,6 +66,7 @@ def openpbr_document(values: ExportValues) -> str:
     material = ET.SubElement(
         root, "surfacematerial", name=ident, type="material",
         doc="; ".join(f"{k}: {v}" for k, v in provenance.items()),
+        **identity_attributes(identity(values, with_pack=True)),
     )
-    add_input(material, "surfaceshader", "surfaceshader", nodename=f"{ident}_openpbr")
+    add_input(material, "surfaceshader", "surfaceshader", nodename=f"{ident}_shader")
     return to_text(root)

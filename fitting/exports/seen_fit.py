@@ -6,8 +6,8 @@ Each export's free values fitted so that the tool's layered result
 (:mod:`fitting.exports.tool_layering`) follows the physical coated metal seen
 from air (:func:`fitting.colour.seen.seen_ACEScg`) over the view angles
 :data:`fitting.colour.seen.SEEN_ANGLES_DEG` (0 to 83 degrees), perceptually:
-the residuals are the Delta E 2000 at each angle (tool result in linear
-Rec.709, back to linear ACEScg, against the target), minimised by scipy's
+the residuals are the Delta E 2000 at each angle (tool result in the
+export's working space, back to linear ACEScg, against the target), minimised by scipy's
 ``least_squares`` (``trf``) inside the tool's limits (every colour in
 [0, 1], a conductor's n in [0.001, 20] and k in [0, 50]).
 
@@ -41,7 +41,7 @@ from scipy.optimize import least_squares
 
 from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_conductor, fresnel_dielectric
-from .colour_space import ACEScg_to_lin_rec709, lin_rec709_to_ACEScg
+from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, working_to_ACEScg
 from .tool_fresnel import f82_tint, schlick
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
@@ -126,13 +126,13 @@ def layer_only(tool: str, mu, eta: float, base, coat: bool = True, clearcoat: fl
 
 
 def floor_base(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
-               clearcoat: float = 1.0) -> np.ndarray:
+               clearcoat: float = 1.0, space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
     """
-    The base response in [0, 1] per angle and channel whose layered result
-    is nearest the target (each channel's layering is increasing in its
-    base: bisection, 50 halvings, to 1e-15).
+    The base response in [0, 1] per angle and channel of the working space
+    ``space`` whose layered result is nearest the target (each channel's
+    layering is increasing in its base: bisection, 50 halvings, to 1e-15).
     """
-    target = ACEScg_to_lin_rec709(target_ACEScg)
+    target = ACEScg_to_working(target_ACEScg, space)
     lo, hi = np.zeros_like(target), np.ones_like(target)
     for _ in range(50):
         mid = 0.5 * (lo + hi)
@@ -141,19 +141,24 @@ def floor_base(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     return 0.5 * (lo + hi)
 
 
-def tool_floor(tool: str, mu, eta: float, target_ACEScg, coat: bool = True) -> np.ndarray:
+def tool_floor(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
+               space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
     """
     Delta E 2000 per angle of :func:`floor_base` under the tool's layering
     (glTF's at the clear coat factor the export uses).
     """
     clearcoat = gltf_clearcoat_factor(mu, eta) if tool == "gltf" and coat else 1.0
-    base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat)
-    return delta_E_map(target_ACEScg, lin_rec709_to_ACEScg(layer_only(tool, mu, eta, base, coat, clearcoat)))
+    base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat, space)
+    return delta_E_map(target_ACEScg, working_to_ACEScg(layer_only(tool, mu, eta, base, coat, clearcoat), space))
 
 
-def seen_delta_E(tool: str, values: dict, mu, eta: float, target_ACEScg) -> np.ndarray:
-    """Delta E 2000 per angle of the tool's result for ``values`` against the target."""
-    return delta_E_map(target_ACEScg, lin_rec709_to_ACEScg(tool_seen(tool, values, mu, eta)))
+def seen_delta_E(tool: str, values: dict, mu, eta: float, target_ACEScg,
+                 space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+    """
+    Delta E 2000 per angle of the tool's result for ``values`` (colours and
+    n, k per channel of the working space ``space``) against the target.
+    """
+    return delta_E_map(target_ACEScg, working_to_ACEScg(tool_seen(tool, values, mu, eta), space))
 
 
 def gltf_clearcoat_factor(mu, eta: float) -> float:
@@ -231,23 +236,26 @@ def _stacked(values: list[dict], samples: int) -> dict:
     return stacked
 
 
-def _residual_rows(tool: str, pack, X: np.ndarray, mu, eta: float, target_ACEScg) -> np.ndarray:
+def _residual_rows(tool: str, pack, X: np.ndarray, mu, eta: float, target_ACEScg,
+                   space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
     """:func:`_residuals` of ``pack(x)`` for each row x of ``X`` (P, n), in one call: (P, S)."""
     P, S = X.shape[0], mu.size
     values = _stacked([pack(x) for x in X], S)
-    rows = _residuals(tool, values, np.tile(mu, P), eta, np.tile(target_ACEScg, (P, 1)))
+    rows = _residuals(tool, values, np.tile(mu, P), eta, np.tile(target_ACEScg, (P, 1)), space)
     return rows.reshape(P, S)
 
 
-def _residuals(tool: str, values: dict, mu, eta: float, target_ACEScg) -> np.ndarray:
-    dE = seen_delta_E(tool, values, mu, eta, target_ACEScg)
+def _residuals(tool: str, values: dict, mu, eta: float, target_ACEScg,
+               space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+    dE = seen_delta_E(tool, values, mu, eta, target_ACEScg, space)
     # sqrt: the sum of squares is then the sum of Delta E, so the fit
     # minimises the mean Delta E over the angles (what is scored), not
     # its RMS; the 1e-6 keeps the derivative finite where Delta E is 0.
     return np.sqrt(dE + 1e-6) if MEAN_OBJECTIVE else dE
 
 
-def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant: dict) -> dict:
+def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant: dict,
+                             space: str = DEFAULT_WORKING_SPACE) -> dict:
     """
     The conductor values of ``tool`` (``mtlx``, ``blender-conductor``) with
     each channel's n and k affine in the facing 1 - cos theta: ``ior``,
@@ -272,33 +280,35 @@ def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant:
                 "extinction_per_facing": slope(x[9:12] - x[6:9]), "coat": constant["coat"]}
 
     def residuals(x):
-        return _residuals(tool, pack(x), mu, eta, target_ACEScg)
+        return _residuals(tool, pack(x), mu, eta, target_ACEScg, space)
 
     n, k = (np.asarray(constant[key], dtype=np.float64) for key in ("ior", "extinction"))
     x0 = np.clip(np.r_[n, n, k, k], lo + 1e-9, hi - 1e-9)
     fit = least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac", diff_step=1e-6,
                         xtol=1e-8, ftol=1e-6, gtol=1e-8, max_nfev=VIEW_DEPENDENT_MAX_NFEV,
-                        workers=PointsAtOnce(lambda X: _residual_rows(tool, pack, X, mu, eta, target_ACEScg)))
-    if np.sum(residuals(fit.x) ** 2) < np.sum(_residuals(tool, flat, mu, eta, target_ACEScg) ** 2):
+                        workers=PointsAtOnce(lambda X: _residual_rows(tool, pack, X, mu, eta, target_ACEScg, space)))
+    if np.sum(residuals(fit.x) ** 2) < np.sum(_residuals(tool, flat, mu, eta, target_ACEScg, space) ** 2):
         return pack(np.asarray(fit.x, dtype=np.float64))
     return flat
 
 
 def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
-                    view_dependent: bool = True) -> dict:
+                    view_dependent: bool = True, space: str = DEFAULT_WORKING_SPACE) -> dict:
     """
     The export values of ``tool`` (keys :data:`fitting.exports.tool_layering.TOOLS`,
     and ``coat``) whose layered result is nearest the seen target
     (``target_ACEScg`` at view cosines ``mu``) in Delta E 2000. For the
     conductor tools (``mtlx``, ``blender-conductor``) with ``view_dependent``,
     the index affine in the facing (:func:`fit_view_dependent_index`) from
-    the constant fit; without it the constant fit alone.
+    the constant fit; without it the constant fit alone. Colours and n, k
+    per channel are those of the working space ``space``
+    (:data:`fitting.exports.colour_space.WORKING_SPACES`).
     """
     if tool not in TOOLS:
         raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")
     mu = np.asarray(mu, dtype=np.float64)
     clearcoat = gltf_clearcoat_factor(mu, eta) if tool == "gltf" and coat else 1.0
-    base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat)
+    base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat, space)
     x0, lo, hi = _start_and_bounds(tool, mu, base, coat)
     x0 = np.clip(x0, np.asarray(lo) + 1e-9, np.asarray(hi) - 1e-9)
 
@@ -306,15 +316,15 @@ def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
         return _pack(tool, x, coat, clearcoat)
 
     def residuals(x):
-        return _residuals(tool, pack(x), mu, eta, target_ACEScg)
+        return _residuals(tool, pack(x), mu, eta, target_ACEScg, space)
 
     fit = least_squares(residuals, x0, bounds=(lo, hi), method="trf", x_scale="jac",
                         diff_step=1e-6, xtol=1e-8, ftol=1e-6, gtol=1e-8, max_nfev=100,
-                        workers=PointsAtOnce(lambda X: _residual_rows(tool, pack, X, mu, eta, target_ACEScg)))
+                        workers=PointsAtOnce(lambda X: _residual_rows(tool, pack, X, mu, eta, target_ACEScg, space)))
     best = fit.x if fit.cost <= 0.5 * np.sum(residuals(x0) ** 2) else x0
     values = _pack(tool, np.asarray(best, dtype=np.float64), coat, clearcoat)
     if view_dependent and tool in ("mtlx", "blender-conductor"):
-        return fit_view_dependent_index(tool, mu, eta, target_ACEScg, values)
+        return fit_view_dependent_index(tool, mu, eta, target_ACEScg, values, space)
     return values
 
 
@@ -326,5 +336,6 @@ def seen_fidelity(values, tool: str) -> dict:
     """
     if tool not in values.tools:
         raise ValueError(f"`tool` must be one of the fitted {', '.join(values.tools)}, got {tool!r}")
-    dE = seen_delta_E(tool, values.tools[tool], values.view_cos, values.eta_i, values.seen_ACEScg)
+    dE = seen_delta_E(tool, values.tools[tool], values.view_cos, values.eta_i, values.seen_ACEScg,
+                      values.working_space)
     return {"delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max())}

@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..colour.delta_e import delta_E_map
-from .colour_space import lin_rec709_to_ACEScg
+from .colour_space import working_to_ACEScg
 
 __all__ = [
     "F82_COS_THETA",
@@ -169,8 +169,8 @@ def export_fidelity(values, target: str) -> dict:
     """
     Delta E 2000 of an export against the spectral reference under the coat.
 
-    The tool's base Fresnel (:func:`tool_curve`, linear Rec.709, back to
-    linear ACEScg) against ``values.target_ACEScg`` at the same
+    The tool's base Fresnel (:func:`tool_curve`, in the values' working
+    space, back to linear ACEScg) against ``values.target_ACEScg`` at the same
     ``values.cos_theta`` in the coating, eta_i = ``values.eta_i``.
 
     Returns
@@ -178,5 +178,5 @@ def export_fidelity(values, target: str) -> dict:
     dict
         ``{"delta_E_mean", "delta_E_max"}``.
     """
-    dE = delta_E_map(values.target_ACEScg, lin_rec709_to_ACEScg(tool_curve(values, target)))
+    dE = delta_E_map(values.target_ACEScg, working_to_ACEScg(tool_curve(values, target), values.working_space))
     return {"delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max())}

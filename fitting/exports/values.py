@@ -3,9 +3,10 @@ Export values
 =============
 
 The numbers an export carries, for one coating index eta_i, fitted in the
-working space of the target tools (linear Rec.709 primaries, D65 white: the
-default ``lin_rec709`` of MaterialX, Blender's scene linear, glTF's linear
-sRGB) to the reflectance of the metal under the coat.
+export's working space (:data:`fitting.exports.colour_space.WORKING_SPACES`:
+by default linear Rec.709 primaries, D65 white, the default ``lin_rec709`` of
+MaterialX, Blender's scene linear, glTF's linear sRGB; or linear ACEScg) to
+the reflectance of the metal under the coat.
 
 Each export carries the values fitted to what the user sees
 (:mod:`fitting.exports.seen_fit`): the physical coat on the metal seen from
@@ -19,8 +20,8 @@ coat at the same angle inside the coat.
 
 The naive target curve :math:`T(\\mu)` is the spectral reference under the coat
 (:func:`fitting.colour.reference.reference_ACEScg` at eta_i, 1 nm, linear ACEScg)
-converted to linear Rec.709 with CAT02 adaptation (a perfect reflector stays
-(1, 1, 1)), at :data:`EXPORT_SAMPLES` values of :math:`\\mu = \\cos\\theta`
+converted to the working space (linear Rec.709 with CAT02 adaptation: a
+perfect reflector stays (1, 1, 1)), at :data:`EXPORT_SAMPLES` values of :math:`\\mu = \\cos\\theta`
 in the coating, evenly over [0, 1]. For a material given only as per-channel
 n, k (an ``rgb-conductor`` fit, linear ACEScg) the target is that model's
 curve at eta_i, and for a fit made from edited curves the fit's own model
@@ -64,7 +65,8 @@ from ..models.pack import PackedMaterial
 from ..models.rgb_conductor import rgb_fresnel_conductor
 from ..optics.coated_stack import coated_stack, coated_stack_from_metal
 from ..optics.nk import SpectralNK
-from .colour_space import ACEScg_to_lin_rec709
+from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, check_working_space
+from .naming import check_fit_id, identity
 from .seen_fit import fit_channel_conductor, fit_channel_f82, fit_channel_schlick, fit_tool_values
 from .tool_layering import TOOLS
 
@@ -105,7 +107,8 @@ def check_roughness(name: str, value) -> float:
 @dataclass(frozen=True)
 class ExportValues:
     """
-    What an export is made of, all colours linear Rec.709.
+    What an export is made of, all colours (and per-channel n, k) in the
+    working space ``working_space``.
 
     Attributes
     ----------
@@ -118,7 +121,7 @@ class ExportValues:
     cos_theta
         The :data:`EXPORT_SAMPLES` values of mu in the coating.
     target
-        T(mu), shape (EXPORT_SAMPLES, 3), linear Rec.709.
+        T(mu), shape (EXPORT_SAMPLES, 3), in the working space.
     target_ACEScg
         The same in linear ACEScg (what the fidelity is scored against).
     n_rel, k_rel
@@ -144,6 +147,13 @@ class ExportValues:
         The fit's own float16 model (:class:`fitting.models.pack.PackedMaterial`),
         when the export carries it as well as the tool's values (glTF's
         ``EXT_materials_coated_conductor``); ``None`` otherwise.
+    fit_id
+        The stored fit's id (32 hex digits) when the export is of one;
+        ``None`` otherwise (the export then carries a content address,
+        :func:`fitting.exports.naming.export_id`).
+    working_space
+        ``lin_rec709`` or ``acescg``: the space every colour and per-channel
+        n, k here is fitted and written in.
     """
 
     name: str
@@ -165,16 +175,21 @@ class ExportValues:
     view_cos: np.ndarray | None = None
     seen_ACEScg: np.ndarray | None = None
     tools: dict = field(default_factory=dict)
+    fit_id: str | None = None
+    working_space: str = DEFAULT_WORKING_SPACE
 
     def provenance(self, model_kind: str, fidelity: dict | None = None) -> dict:
         """
         What the export was made from, for a comment or ``extras``: material,
-        source (one line), eta_i, model kind, what was fitted, colour space,
-        generator and version, and the export's Delta E 2000 under the coat
-        (``fidelity``, from :func:`fitting.exports.tool_fresnel.export_fidelity`).
+        the full fit id, its kind, the service version, eta_i, the working
+        space (:func:`fitting.exports.naming.identity`), source (one line),
+        model kind, what was fitted, colour space, generator and version,
+        and the export's Delta E 2000 (``fidelity``, from
+        :func:`fitting.exports.seen_fit.seen_fidelity`).
         """
         info = {
             "material": self.name,
+            **identity(self),
             "source": " ".join(self.source.split()),
             "eta_i": self.eta_i,
             "model_kind": model_kind,
@@ -184,7 +199,7 @@ class ExportValues:
                 "from air (both polarisations, metal at the refracted angle, bounces between "
                 "the interfaces), Delta E 2000 least squares"
             ),
-            "colour_space": "lin_rec709",
+            "colour_space": self.working_space,
             "generator": f"coated-fresnel {self.version}",
         }
         if fidelity is not None:
@@ -202,7 +217,8 @@ def has_coat(eta_i: float) -> bool:
 
 def export_values(
     fit_or_nk, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
-    model: PackedMaterial | None = None, tools=None,
+    model: PackedMaterial | None = None, tools=None, fit_id: str | None = None,
+    working_space: str = DEFAULT_WORKING_SPACE,
 ) -> ExportValues:
     """
     The values of every export of a material at one coating index.
@@ -226,6 +242,11 @@ def export_values(
     tools
         The tools whose values to fit (keys of
         :data:`fitting.exports.tool_layering.TOOLS`); all when ``None``.
+    fit_id
+        The stored fit's id (32 lower-case hex digits), or ``None``.
+    working_space
+        ``lin_rec709`` (default) or ``acescg``: the space the values are
+        fitted and written in.
 
     Raises
     ------
@@ -237,6 +258,8 @@ def export_values(
     eta = check_eta_i(eta_i)
     roughness = check_roughness("roughness", roughness)
     coat_roughness = check_roughness("coat_roughness", coat_roughness)
+    fit_id = check_fit_id(fit_id)
+    working_space = check_working_space(working_space)
     if model is not None and not isinstance(model, PackedMaterial):
         raise ValueError(f"`model` must be a PackedMaterial or None, got {type(model).__name__}")
     tools = tuple(TOOLS) if tools is None else tuple(tools)
@@ -277,15 +300,15 @@ def export_values(
             "or a `reflectance` function, "
             f"got {type(fit_or_nk).__name__}"
         )
-    target = ACEScg_to_lin_rec709(target_ACEScg)
+    target = ACEScg_to_working(target_ACEScg, working_space)
     n_rel, k_rel = fit_channel_conductor(mu, target)
     F0, tint = fit_channel_f82(mu, target)
     coat = has_coat(eta)
-    fitted = {tool: fit_tool_values(tool, view, eta, seen, coat) for tool in tools}
+    fitted = {tool: fit_tool_values(tool, view, eta, seen, coat, space=working_space) for tool in tools}
     return ExportValues(
         name=name, source=source, eta_i=eta, origin=origin, cos_theta=mu, target=target,
         target_ACEScg=target_ACEScg, n_rel=n_rel, k_rel=k_rel, F0=F0, F82_tint=tint,
         F0_schlick=fit_channel_schlick(mu, target), roughness=roughness,
         coat_roughness=coat_roughness, model=model, view_cos=view, seen_ACEScg=seen,
-        tools=fitted,
+        tools=fitted, fit_id=fit_id, working_space=working_space,
     )

@@ -11,6 +11,8 @@ Layer 1, optics: measured optical constants and the exact Fresnel equations.
 -   :mod:`.bounded`: the bounded parsers under the readers (size, depth,
     YAML aliases, rows and samples checked before the work is done).
 -   :mod:`.library`: the 22 built-in conductors.
+-   :mod:`.edge_tint`: a metal given by F0 and F82 tint to per-channel n, k,
+    and the F0 and F82 tint an F82-tint renderer must use under a coat.
 
 Imports only :mod:`fitting.domain`.
 """

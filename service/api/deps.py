@@ -7,7 +7,8 @@ Dependencies
 -   :data:`SettingsDep`, :data:`StoreDep`, :data:`RunnerDep`: the app's
     settings, store and fitting pool.
 -   :data:`FitIdPath`, :data:`MaterialIdPath`, :data:`RoughnessQuery`,
-    :data:`CoatRoughnessQuery`, :data:`MinCoverageForm`, :data:`MetricsQuery`: shared parameters.
+    :data:`CoatRoughnessQuery`, :data:`WorkingSpaceQuery`, :data:`MinCoverageForm`, :data:`MetricsQuery`: shared
+    parameters.
 -   :data:`StoredFit`: the stored fit named by the path's ``fit_id`` (404
     when it is not stored), read in a worker thread.
 -   :data:`WriteAccess`: the cross-site and bearer-token checks of the write
@@ -31,7 +32,7 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from ..config import Settings
 from ..jobs.common import stored_fit
 from ..runtime import FitRunner, PreviewRunner
-from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
+from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody, WorkingSpace
 from ..store import FitRecord, Store
 
 __all__ = [
@@ -42,6 +43,7 @@ __all__ = [
     "MaterialIdPath",
     "RoughnessQuery",
     "CoatRoughnessQuery",
+    "WorkingSpaceQuery",
     "MinCoverageForm",
     "MetricsQuery",
     "StoredFit",
@@ -86,6 +88,8 @@ MetricsQuery = Annotated[Literal["solve", "full"], Query(description=(
     "`solve` (default): answer as soon as the fit is saved, with what its solve measured "
     "(`metrics.evaluated` false until its evaluation on the metrics grid has run, after the answer); "
     "`full`: wait for that evaluation (the figure, Delta E of the model and the baselines)"))]
+WorkingSpaceQuery = Annotated[WorkingSpace, Query(description=(
+    "lin_rec709 | acescg: the working space an export is fitted and written in (docs/exports.md)"))]
 MinCoverageForm = Annotated[float | None, Form(ge=0.0, le=1.0, allow_inf_nan=False, description=(
     "Least covered fraction of 360-830 nm to accept, in [0.9, 1] (default 0.9, the service's own "
     "rule; a higher value refuses data the service would fit)"))]

@@ -17,6 +17,7 @@ from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validat
 
 from fitting.domain import DEFAULT_ETA_I_RANGE, ETA_I_MAX, ETA_I_MIN
 from fitting.exports import EXPORT_FORMATS
+from fitting.exports.colour_space import WORKING_SPACES as WORKING_SPACE_NAMES
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.bounded import excerpt
@@ -29,7 +30,7 @@ __all__ = [
     "DownloadFormat", "download_formats", "MAX_EXPORT_PACK",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
-    "PackFormat", "Text", "RequestModel",
+    "PackFormat", "Text", "RequestModel", "WORKING_SPACES", "WorkingSpace",
     "Mirror", "absent", "ErrorItem", "ErrorBody",
 ]
 
@@ -39,6 +40,9 @@ INT64_MAX = 2**63 - 1
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
 MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
+WORKING_SPACES = WORKING_SPACE_NAMES
+"""The working spaces an export is fitted and written in (docs/exports.md)."""
+WorkingSpace = Literal[WORKING_SPACE_NAMES]  # type: ignore[valid-type]
 MAX_EXPORT_PACK = 16
 """Most fits in one pack of exports (each export fits its tool's values, about 1 s)."""
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)

@@ -29,6 +29,7 @@ from .common import (
     EtaI,
     FitId,
     LibraryName,
+    WorkingSpace,
     ModelKind,
     Objective,
     RequestModel,
@@ -76,10 +77,16 @@ class NKData(RequestModel):
         return tuple(self.wavelength_nm), tuple(self.n), tuple(self.k)
 
 
+Unit = Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False, strict=False)]
+RGBColour = Annotated[list[Unit], Field(min_length=3, max_length=3)]
+
+
 class FitRequest(RequestModel):
     """
-    A fit: either ``material`` (a built-in conductor) or ``nk`` (measured
-    data, with a ``name``), over the coating-index domain ``eta_i_range``.
+    A fit: ``material`` (a built-in conductor), ``nk`` (measured data, with
+    a ``name``), or ``f0`` and ``f82`` (a metal given by its F0 and F82 tint
+    in air, linear colours of ``space``, with a ``name``), over the
+    coating-index domain ``eta_i_range``.
     """
 
     model_config = ConfigDict(
@@ -94,6 +101,8 @@ class FitRequest(RequestModel):
                     "nk": {"wavelength_nm": [350, 600, 850], "n": [1.6, 0.25, 0.2],
                            "k": [1.9, 3.0, 5.4]},
                 },
+                {"name": "artist gold", "f0": [0.944, 0.776, 0.373], "f82": [0.93, 0.96, 0.99],
+                 "space": "lin_rec709"},
             ]
         },
     )
@@ -102,6 +111,9 @@ class FitRequest(RequestModel):
     name: Text | None = Field(None, description="Display name of inline data")
     source: str = Field("", max_length=2000, description="Citation of inline data")
     nk: NKData | None = None
+    f0: RGBColour | None = Field(None, description="F0 in air, linear, [0, 1] per channel of `space`")
+    f82: RGBColour | None = Field(None, description="F82 tint in air (OpenPBR specular_color), [0, 1]")
+    space: WorkingSpace = Field("lin_rec709", description="lin_rec709 | acescg: the space of `f0`, `f82`")
     eta_i_range: tuple[EtaI, EtaI] = Field(
         DEFAULT_ETA_I_RANGE, description="Coating index domain [lo, hi], 1 <= lo <= hi <= 3"
     )
@@ -114,9 +126,12 @@ class FitRequest(RequestModel):
 
     @model_validator(mode="after")
     def _check_choice(self) -> "FitRequest":
-        if (self.material is None) == (self.nk is None):
+        if (self.f0 is None) != (self.f82 is None):
+            raise ValueError("give `f0` and `f82` together (a metal given by its F0 and F82 tint)")
+        if sum(x is not None for x in (self.material, self.nk, self.f0)) != 1:
             raise ValueError(
-                "give exactly one of `material` (a built-in conductor) or `nk` (inline data)"
+                "give exactly one of `material` (a built-in conductor), `nk` (inline data) or "
+                "`f0` with `f82` (colours)"
             )
         if self.material is not None and self.name is not None:
             raise ValueError("`name` is only for inline `nk` data (a built-in material has its own)")
@@ -136,6 +151,12 @@ class PackRequest(RequestModel):
         "binary", description="binary | json | glsl | hlsl, or an export format of `GET /api/v1/domain`'s "
         f"`export_formats` (a zip archive of one file per fit, at most {MAX_EXPORT_PACK} fits)")
     eta_i: EtaI = Field(1.5, description="Coating index of an export, [1, 3]")
+    roughness: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = Field(
+        0.2, description="The metal's perceptual roughness of an export, [0, 1]")
+    coat_roughness: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = Field(
+        0.03, description="The coat's perceptual roughness of an export, [0, 1]")
+    working_space: WorkingSpace = Field(
+        "lin_rec709", description="lin_rec709 | acescg: the space an export is fitted and written in")
     name: Annotated[str, Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9._-]+$")] = "materials"
 
     @model_validator(mode="after")

@@ -48,9 +48,21 @@ class TestExportDownloads:
         assert response.headers["content-type"] == media_type
         assert response.headers["content-disposition"] == (
             f'attachment; filename="Cu-{fit_id[:8]}-eta1.7-rough0.2-coat0.03{suffix}"')
-        expected = export_material(library_material("Cu"), format, 1.7, model=stored_model(client, fit_id))
+        expected = export_material(library_material("Cu"), format, 1.7, model=stored_model(client, fit_id),
+                                   fit_id=fit_id)
         assert response.content == expected
         assert (b"EXT_materials_coated_conductor" in response.content) == (format == "gltf")
+
+    @pytest.mark.slow  # starts a process or GL context
+    def test_working_space_and_identity(self, shared):
+        client, fit_id = shared
+        response = pack(client, fit_id, "format=mtlx&eta_i=1.5&working_space=acescg")
+        assert response.status_code == 200, response.text
+        assert response.headers["content-disposition"] == (
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.5-rough0.2-coat0.03-acescg.mtlx"')
+        root = ET.fromstring(response.content)
+        assert root.get("colorspace") == "acescg" and root.get("coatedfresnel_fit_id") == fit_id
+        assert root.find("nodedef").get("name") == f"ND_coated_metal_Cu_{fit_id[:8]}_eta1p5"
 
     @pytest.mark.slow  # starts a process or GL context
     def test_default_eta_i_is_1_5(self, shared):
@@ -68,10 +80,10 @@ class TestExportDownloads:
         assert response.headers["content-disposition"] == (
             f'attachment; filename="Cu-{fit_id[:8]}-eta1.33-rough0.45-coat0.1.openpbr.mtlx"')
         expected = export_material(library_material("Cu"), "openpbr", 1.33, 0.45, 0.1,
-                                   model=stored_model(client, fit_id))
+                                   model=stored_model(client, fit_id), fit_id=fit_id)
         assert response.content == expected
         assert response.content != pack(client, fit_id, "format=openpbr&eta_i=1.33").content
-        for query in ("roughness=1.5", "coat_roughness=-0.1", "roughness=nan"):
+        for query in ("roughness=1.5", "coat_roughness=-0.1", "roughness=nan", "working_space=srgb"):
             refused = pack(client, fit_id, f"format=gltf&{query}")
             assert refused.status_code == 422 and query.split("=")[0] in refused.json()["detail"]
 
@@ -159,12 +171,29 @@ class TestExportPacks:
         assert archive.namelist() == [f"Cu-eta1.3{suffix}", f"Au-eta1.3{suffix}"]
         for name, material, fit_id in zip(archive.namelist(), ("Cu", "Au"), ids):
             model = stored_model(client, fit_id)
-            assert archive.read(name) == export_material(library_material(material), format, 1.3, model=model)
+            assert archive.read(name) == export_material(library_material(material), format, 1.3, model=model,
+                                                         fit_id=fit_id)
         # Deterministic: the same request, the same bytes.
         assert client.post(f"{API}/packs", json=body).content == response.content
 
+    def test_zip_takes_the_roughness_and_working_space(self, two_fits):
+        import io
+        import zipfile
+
+        client, ids = two_fits
+        body = {"fit_ids": ids[:1], "format": "openpbr", "eta_i": 1.3, "roughness": 0.45,
+                "coat_roughness": 0.1, "working_space": "acescg"}
+        response = client.post(f"{API}/packs", json=body)
+        assert response.status_code == 200, response.text
+        (entry,) = zipfile.ZipFile(io.BytesIO(response.content)).namelist()
+        assert zipfile.ZipFile(io.BytesIO(response.content)).read(entry) == export_material(
+            library_material("Cu"), "openpbr", 1.3, 0.45, 0.1, model=stored_model(client, ids[0]),
+            fit_id=ids[0], working_space="acescg")
+
     @pytest.mark.parametrize("body, words", [
         ({"format": "mtlx", "eta_i": 0.5}, ["eta_i", "greater than or equal to 1"]),
+        ({"format": "mtlx", "working_space": "srgb"}, ["working_space", "'acescg'"]),
+        ({"format": "mtlx", "roughness": 2}, ["roughness", "less than or equal to 1"]),
         ({"format": "usdz"}, ["format", "'mtlx'"]),
         ({"format": "gltf", "eta_i": True}, ["eta_i"]),
     ])

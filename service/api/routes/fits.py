@@ -6,7 +6,7 @@ Fits
 -   ``POST /api/v1/fits/upload``: fit an uploaded n, k file (CSV, JSON, YAML), multipart.
 -   ``GET /api/v1/fits/{fit_id}``: a stored fit.
 -   ``GET /api/v1/fits/{fit_id}/pack``: its download (binary, json, glsl,
-    hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf).
+    hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf, glb).
 -   ``GET /api/v1/fits/{fit_id}/curves``: reference, model and baseline RGB
     against the angle, for plotting.
 
@@ -21,18 +21,18 @@ from typing import Annotated
 from fastapi import APIRouter, File, Form, Query, Request, Response, UploadFile, status
 from fastapi.concurrency import run_in_threadpool
 
-from ...downloads import (is_export, PACK_CONTENT, export_key, export_response, kept_export,
-                           pack_response)
+from ...downloads import PACK_CONTENT, export_download, is_export, pack_response
 from ...jobs.common import stored_fit
 from ...jobs.evaluation import ensure_metrics
+from ...jobs.edge_tint import fit_from_colours
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
 from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_MODEL, DEFAULT_OBJECTIVE, ETA_I_LIMITS,
                         CurvesPublic, DownloadFormat, FitPublic, FitRequest, ModelKind, Objective, fit_public)
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
-                    MetricsQuery, MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields,
-                    StoreDep, WriteAccess)
+                    MetricsQuery, MinCoverageForm, RoughnessQuery, WorkingSpaceQuery, RunnerDep, SettingsDep,
+                    SingleFormFields, StoreDep, WriteAccess)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -55,13 +55,16 @@ def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPubli
 async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, settings: SettingsDep,
                      response: Response, http: Request, metrics: MetricsQuery = "solve") -> FitPublic:
     """
-    Fit a built-in material (``{"material": "Au"}``) or inline n, k
-    (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) over
+    Fit a built-in material (``{"material": "Au"}``), inline n, k
+    (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) or F0 and F82 tint
+    (``{"name", "f0", "f82", "space"}``: an ``rgb-conductor``) over
     ``eta_i_range``; the answer carries the float16 coefficients, what the
     solve measured, and timings; Delta E 2000 of the model and of adjusted
     Lazanyi on the metrics grid with ``?metrics=full`` (else later:
     ``GET /fits/{id}``).
     """
+    if request.f0 is not None:  # F0 and F82 colours: n, k from them, no fit to run
+        return fit_answer(*await fit_from_colours(store, request), response)
     runner.check_capacity()
     if request.material is not None:
         fit = await run_in_threadpool(NKFit.library, request.material, request.eta_i_range,
@@ -121,6 +124,7 @@ async def get_pack(
         ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
         description="Coating index of an export, [1, 3]")] = 1.5,
     roughness: RoughnessQuery = 0.2, coat_roughness: CoatRoughnessQuery = 0.03,
+    working_space: WorkingSpaceQuery = "lin_rec709",
 ) -> Response:
     """
     The fit as a download: ``binary`` (docs/pack-format.md), ``json``, or a
@@ -128,17 +132,13 @@ async def get_pack(
     evaluation function; or, for one coating index ``eta_i``, an export
     (docs/exports.md): a MaterialX document (``mtlx``: conductor under a
     dielectric coat; ``openpbr``: ``open_pbr_surface``), a Blender script
-    (``blender``) or a glTF asset (``gltf``), with ``roughness`` and
-    ``coat_roughness``; named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
+    (``blender``) or a glTF asset (``gltf``, ``glb``), with ``roughness`` and ``coat_roughness``,
+    fitted and written in ``working_space`` (``lin_rec709`` or ``acescg``; ``-acescg`` before the
+    suffix), named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
     """
     if is_export(format):
-        # A job of the fitting pool (up to about a second of CPU), kept: a fit never changes.
-        kept = http.app.state.derived.get(export_key(fit_id, format, eta_i, roughness, coat_roughness))
-        if kept is None:
-            record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query: 422 before 404
-            kept = await kept_export(http.app.state.derived, runner, record, format, eta_i, roughness,
-                                     coat_roughness)
-        return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness)
+        return await export_download(http.app.state.derived, store, runner, fit_id, format, eta_i, roughness,
+                                     coat_roughness, working_space)
     record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query is validated: 422 before 404
     if format != "binary":  # the JSON and the snippets quote the figures
         record = await ensure_metrics(record, store, runner)

@@ -35,9 +35,11 @@ async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep, 
         # Each export fits its tool's values (up to about a second of CPU): a job in the
         # fitting pool, with its CPU limit and timeout, shared by identical requests, and
         # kept (the fits never change).
-        key = f"export pack {request.format} {request.eta_i!r} {' '.join(r.id for r in records)}"
+        key = (f"export pack {request.format} {request.eta_i!r} {request.roughness!r} "
+               f"{request.coat_roughness!r} {request.working_space} {' '.join(r.id for r in records)}")
         body = await http.app.state.derived.get_or_make(key, lambda: runner.once(key, lambda: runner.run(
-            render_export_pack, records, request.format, request.eta_i, cost_s=float(len(records)))))
+            render_export_pack, records, request.format, request.eta_i, request.roughness,
+            request.coat_roughness, request.working_space, cost_s=float(len(records)))))
         return Response(body, media_type="application/zip", headers={
             "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
     if request.format != "binary":  # the JSON and the snippets quote the figures

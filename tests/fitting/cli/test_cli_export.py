@@ -8,7 +8,9 @@ import subprocess
 import pytest
 from conftest import run_command
 
+from fitting.domain import DEFAULT_ETA_I_RANGE
 from fitting.exports import export_material
+from fitting.fits.kinds import fit_model
 from fitting.optics.library import library_material
 
 
@@ -22,7 +24,9 @@ class TestExportOption:
         out = tmp_path / "au.mtlx"
         result = cli("fit", "Au", "--export", "mtlx", "--eta-i", "1.5", "-o", str(out))
         assert result.returncode == 0, result.stderr
-        assert out.read_bytes() == export_material(library_material("Au"), "mtlx", 1.5)
+        # The CLI's export carries its fit's float16 model (read back by `import`).
+        model = fit_model(library_material("Au"), DEFAULT_ETA_I_RANGE, evaluate=False).packed
+        assert out.read_bytes() == export_material(library_material("Au"), "mtlx", 1.5, model=model)
 
     @pytest.mark.slow  # 2.7 s (all cases 2.7 s) in a --durations=0 run
     def test_stdout_and_roughness(self):

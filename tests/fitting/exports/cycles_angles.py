@@ -5,7 +5,11 @@ uniform white world of strength 1, and print the mean linear RGB per angle
 as JSON. Used by test_tool_layering_renders.py to check the numpy mirrors
 of Cycles' layering.
 
-    python cycles_angles.py EXPORT.py --output principled|conductor --angles 0,30,60 --samples 256
+    python cycles_angles.py EXPORT.py --output principled|conductor --angles 0,30,60 --samples 256 \
+        [--working-space lin_rec709|acescg]
+
+``--working-space acescg`` makes the file's working space ACEScg first
+(Blender 5; the pixels are then linear ACEScg).
 """
 
 from __future__ import annotations
@@ -29,8 +33,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--output", choices=("principled", "conductor"), default="principled")
     parser.add_argument("--angles", default="0,30,60")
     parser.add_argument("--samples", type=int, default=256)
+    parser.add_argument("--working-space", choices=("lin_rec709", "acescg"), default="lin_rec709")
     args = parser.parse_args(argv)
     bpy.ops.wm.read_factory_settings(use_empty=True)
+    if args.working_space == "acescg":
+        bpy.ops.wm.set_working_color_space(working_space="ACEScg", convert_colors=False)
     namespace = runpy.run_path(args.script, run_name="coated_fresnel_export")
     material = namespace["build_material"]()
     namespace["use_output"](material, args.output)

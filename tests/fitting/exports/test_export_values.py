@@ -173,7 +173,7 @@ class TestInputs:
         assert str(info.value).startswith(rule)
 
     def test_bad_format_roughness_and_input(self, cu_values):
-        with pytest.raises(ValueError, match="`format` must be one of mtlx, openpbr, blender, gltf, got 'usd'"):
+        with pytest.raises(ValueError, match="`format` must be one of mtlx, openpbr, blender, gltf, glb, got 'usd'"):
             export_material(cu_values, "usd", 1.5)
         with pytest.raises(ValueError, match=r"`roughness` must be a number in \[0, 1\], got 1.5"):
             export_values(library_material("Cu"), 1.5, roughness=1.5)

@@ -130,3 +130,25 @@ class TestBlenderImport:
         assert inputs["Coat IOR"] == pytest.approx(1.5)
         assert material["custom"]["coated_fresnel"]["eta_i"] == values.eta_i
         assert png.stat().st_size > 0
+
+
+class TestGLB:
+    """The same asset as binary glTF (``.glb``), beside the ``.gltf``."""
+
+    @pytest.mark.slow  # starts a process
+    def test_validates_and_is_the_gltf(self, exported, tmp_path):
+        values, path = exported
+        glb = tmp_path / "au.glb"
+        glb.write_bytes(export_material(values, "glb", values.eta_i))
+        code, report = khronos_report(glb)
+        assert code == 0, report["issues"]
+        assert report["issues"]["numErrors"] == 0 and report["issues"]["numWarnings"] == 0, report
+        assert report["info"]["materialCount"] == 1 and report["info"]["drawCallCount"] == 1
+        binary, text = pygltflib.GLTF2().load(str(glb)), json.loads(path.read_text())
+        material, expected = binary.materials[0], text["materials"][0]
+        assert material.name == expected["name"] and material.extras == expected["extras"]
+        assert material.extensions == expected["extensions"]
+        assert material.pbrMetallicRoughness.baseColorFactor == expected["pbrMetallicRoughness"]["baseColorFactor"]
+        # The same buffer: the .gltf's data URI, the .glb's BIN chunk.
+        uri = text["buffers"][0]["uri"].split(",", 1)[1]
+        assert binary.binary_blob()[: text["buffers"][0]["byteLength"]] == base64.b64decode(uri)
