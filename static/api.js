@@ -70,7 +70,9 @@ export const getFit = (id) => getJSON(`/fits/${encodeURIComponent(id)}`);
 export const fitEdit = (id) => getJSON(`/fits/${encodeURIComponent(id)}/edit`);
 export const versions = (id) => getJSON(`/materials/${encodeURIComponent(id)}/versions?limit=50`);
 export const version = (id, n) => getJSON(`/materials/${encodeURIComponent(id)}/versions/${Number(n)}`);
-export const library = (etaI) => getJSON(`/library?eta_i=${etaI.toFixed(2)}`);
+// The library's conductors at a coat index; with `q` those matching it, best first (the service ranks them).
+export const library = (etaI, q = null) =>
+  getJSON(`/library?eta_i=${etaI.toFixed(2)}${q ? `&q=${encodeURIComponent(q)}` : ""}`);
 export const coatPresets = () => getJSON("/coat-presets");
 export const domain = () => getJSON("/domain");
 

@@ -44,7 +44,7 @@ export const linkTo = (fitId, origin) => `${origin}/?fit=${encodeURIComponent(fi
 const FOLLOWS = {
   entry: new Set(["openBase", "curves", "setEta", "select", "drag", "dragEnd", "undo", "redo", "reset", "gentler",
                   "presets", "reopened"]),
-  library: new Set(["library", "openBase"]),
+  library: new Set(["library", "librarySearch", "openBase"]),
   manage: new Set(["materials", "versions", "openBase"]),
   compare: new Set(["compareWith", "compareCurves", "compareOff", "shown", "curves", "setEta"]),
 };
@@ -59,6 +59,7 @@ export class Studio {
     this.library = new LibraryView({
       onOpen: guard((id) => app.open(`library:${id}`)),
       onCompare: guard(async (id) => this.compare(await api.fitLibrary(id, [1.0, 2.5]), `${id} (library)`)),
+      onSearch: (query) => this.#later("search", 120, () => this.#search(query)),
     });
     this.manage = new ManageView({
       rerender: () => this.manage.render(state),
@@ -115,6 +116,12 @@ export class Studio {
     if (this.state.library.eta === key(eta)) return;
     const { materials } = await api.library(eta);
     if (key(eta) === key(this.state.eta)) this.app.store.dispatch("library", { eta, materials });
+  }
+
+  /** The library's search, asked of the service (names and symbols first; never inside a citation). */
+  async #search(query) {
+    const ids = query.trim() ? (await api.library(this.state.eta, query)).materials.map((m) => m.id) : null;
+    if ($("library-search").value === query) this.app.store.dispatch("librarySearch", { query, ids });
   }
 
   /** The saved edited materials and the bin, again. */
