@@ -44,8 +44,9 @@ export async function save(ctx, continuing) {
   const going = continuing.continues(name);
   if (!going) {
     // Saving under the name of another saved material replaces its latest fit: asked first.
-    const { materials } = await api.listMaterials();
-    const clash = materials.find((m) => m.kind === "curves" && m.name === name);
+    // The service is asked (every page of the saved materials holding the name), not the list on screen.
+    const materials = await api.listAllMaterials({ kinds: ["curves"], q: name });
+    const clash = materials.find((m) => m.name === name);
     if (clash && !window.confirm(`A saved material is called “${name}”. Replace it with this edit?`)) {
       ctx.say("Not saved: choose another name, or Save again and confirm to replace it.");
       return false;

@@ -45,7 +45,7 @@ const FOLLOWS = {
   entry: new Set(["openBase", "curves", "setEta", "select", "drag", "dragEnd", "undo", "redo", "reset", "gentler",
                   "presets", "reopened"]),
   library: new Set(["library", "librarySearch", "openBase"]),
-  manage: new Set(["materials", "versions", "openBase"]),
+  manage: new Set(["materials", "savedSearch", "versions", "openBase"]),
   compare: new Set(["compareWith", "compareCurves", "compareOff", "shown", "curves", "setEta"]),
 };
 
@@ -72,6 +72,7 @@ export class Studio {
       onOpenVersion: guard((v) => app.mayDiscard() && this.openFit(v.fit_id)),
       onCompareVersion: guard(async (v) => this.compare(await api.getFit(v.fit_id), `version ${v.version}`)),
       downloadURL: (fitId) => api.packURL(fitId, app.downloadFormat(), app.exportSettings()),
+      onSearch: (query) => this.#later("savedSearch", 120, () => this.#searchSaved(query)),
     });
     $("format").addEventListener("change", () => this.manage.showDownloads());
     this.compareView = new CompareView({
@@ -124,13 +125,20 @@ export class Studio {
     if ($("library-search").value === query) this.app.store.dispatch("librarySearch", { query, ids });
   }
 
+  /** The search of the saved materials, asked of the service (GET /materials?kind=curves&q=, every page). */
+  async #searchSaved(query) {
+    const ids = query.trim() ? (await api.listAllMaterials({ kinds: ["curves"], q: query.trim() })).map((m) => m.id) : null;
+    if ($("saved-search").value === query) this.app.store.dispatch("savedSearch", { query, ids });
+  }
+
   /** The saved edited materials and the bin, again. */
   async refresh() {
-    const [saved, bin] = await Promise.all([api.listMaterials({ kinds: ["curves"] }),
-                                            api.listMaterials({ kinds: ["curves"], deleted: true })]);
-    this.app.store.dispatch("materials", { saved: saved.materials, bin: bin.materials });
+    const [saved, bin] = await Promise.all([api.listAllMaterials({ kinds: ["curves"] }),
+                                            api.listAllMaterials({ kinds: ["curves"], deleted: true })]);
+    this.app.store.dispatch("materials", { saved, bin });
     const listed = this.state.versions;
-    if (listed && !saved.materials.some((m) => m.id === listed.material.id)) this.app.store.dispatch("versions", null);
+    if (listed && !saved.some((m) => m.id === listed.material.id)) this.app.store.dispatch("versions", null);
+    if ($("saved-search").value.trim()) this.#searchSaved($("saved-search").value);
   }
 
   #said(text, undo = null) {
