@@ -25,7 +25,7 @@ import { CompareView } from "./compare_view.js";
 import { EntryView } from "./entry_view.js";
 import { LibraryView } from "./library_view.js";
 import { ManageView } from "./manage_view.js";
-import { SAMPLES, editsOf, key, snapshot } from "./state.js";
+import { SAMPLES, editsOf, key, snapshot, unsaved } from "./state.js";
 
 const $ = (id) => document.getElementById(id);
 
@@ -35,6 +35,18 @@ export function linkOf(search) {
   if (query.get("fit")) return { fit: query.get("fit") };
   if (query.get("material")) return { material: query.get("material"), version: Number(query.get("version")) || null };
   return null;
+}
+
+/**
+ * What a link to an unsaved edit must say: it opens a draft, which the
+ * service keeps `ttlSeconds` from its refit (then it is gone), and when.
+ */
+export function draftExpiry(fit, ttlSeconds) {
+  if (!ttlSeconds || !fit || !fit.created_at) return " It opens an unsaved edit: save it to keep the link working.";
+  const until = new Date((fit.created_at + ttlSeconds) * 1000);
+  const when = until.toLocaleString("en-GB", { dateStyle: "medium", timeStyle: "short" });
+  const hours = Math.round(ttlSeconds / 3600);
+  return ` It opens an unsaved edit, kept ${hours} h: it expires ${when}. Save to keep it.`;
 }
 
 /** The link that reopens the stored fit `fitId` with its edit. */
@@ -68,7 +80,7 @@ export class Studio {
       onDelete: guard((m) => this.remove(m)),
       onRestore: guard((m) => this.restore(m)),
       onVersions: guard((m) => this.versions(m)),
-      onLink: (fitId) => this.copyLink(fitId),
+      onLink: guard((fitId) => this.copyLink(fitId)),
       onOpenVersion: guard((v) => app.mayDiscard() && this.openFit(v.fit_id)),
       onCompareVersion: guard(async (v) => this.compare(await api.getFit(v.fit_id), `version ${v.version}`)),
       downloadURL: (fitId) => api.packURL(fitId, app.downloadFormat(), app.exportSettings()),
@@ -79,7 +91,7 @@ export class Studio {
       onCompareBase: guard(() => state.base && this.compare(state.base, "the base (before the edit)")),
       onOff: () => this.compare(null),
     });
-    $("copy-link").addEventListener("click", () => state.fit && this.copyLink(state.fit.id));
+    $("copy-link").addEventListener("click", guard(() => state.fit && this.copyLink(state.fit.id)));
     app.store.subscribe((name) => this.#follow(name));
     this.loading = null; // the studio's lists load once the first fit is on screen (never ahead of it: cold start)
   }
@@ -106,6 +118,7 @@ export class Studio {
   async #load() {
     const [presets, domain] = await Promise.all([api.coatPresets(), api.domain(), this.#library(), this.refresh()]);
     this.app.store.dispatch("presets", presets.presets);
+    this.draftTtl = domain.draft_ttl_s;
     const [lo, hi] = domain.visible_range_nm;
     $("upload-rule").textContent = `Measured n, k must cover at least ${Math.round(100 * domain.min_coverage)}% of ` +
       `${lo}–${hi} nm (the colour is integrated over that range; the data are held flat past their ends, ` +
@@ -197,13 +210,17 @@ export class Studio {
     this.app.store.dispatch("versions", { material: m, list: listed.versions, latest: listed.version });
   }
 
-  copyLink(fitId) {
+  async copyLink(fitId) {
     const link = linkTo(fitId, location.origin);
     $("share-link").value = link;
     $("share-link").select();
     const copied = navigator.clipboard ? navigator.clipboard.writeText(link).then(() => true, () => false)
       : Promise.resolve(false);
-    copied.then((ok) => this.#said(ok ? `Link copied: ${link}` : `Link (select and copy it): ${link}`));
+    const state = this.state;
+    const isDraft = state.fit && state.fit.id === fitId && unsaved(state);
+    if (isDraft && this.draftTtl === undefined) this.draftTtl = (await api.domain()).draft_ttl_s;
+    const draft = isDraft ? draftExpiry(state.fit, this.draftTtl) : "";
+    copied.then((ok) => this.#said((ok ? `Link copied: ${link}` : `Link (select and copy it): ${link}`) + draft));
   }
 
   /** Fit an uploaded n, k file (saved under the upload's name; listed under Uploads) and open it. */

@@ -75,6 +75,7 @@ class TestHealthAndDocs:
         domain = client.get(f"{API}/domain").json()
         assert domain["visible_range_nm"] == list(VISIBLE_RANGE_NM)
         assert domain["min_coverage"] == DEFAULT_MIN_COVERAGE
+        assert domain["draft_ttl_s"] == 86_400.0  # how long a link to an unsaved edit lasts
 
 
 class TestMaterials:

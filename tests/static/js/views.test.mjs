@@ -9,7 +9,7 @@ import { test } from "node:test";
 import { compareFigures } from "../../../static/editor/compare_view.js";
 import { parseTyped } from "../../../static/editor/entry_view.js";
 import { shownLibrary } from "../../../static/editor/library_view.js";
-import { linkOf, linkTo } from "../../../static/editor/studio.js";
+import { draftExpiry, linkOf, linkTo } from "../../../static/editor/studio.js";
 
 test("parseTyped: a finite number within [lo, hi], else why (naming the rule and the value)", () => {
   assert.deepEqual(parseTyped(" 1.33 ", 1, 2.5, "ηᵢ"), { value: 1.33 });
@@ -45,4 +45,12 @@ test("compareFigures: none until the other curve is in at this eta_i; then mean 
   assert.equal(compareFigures(state), null, "a curve of another eta_i");
   state.compare.eta = "1.50";
   assert.deepEqual(compareFigures(state), { mean: 0, max: 0, atDeg: 0 });
+});
+
+test("draftExpiry: a link to an unsaved edit says it expires and when", () => {
+  const fit = { created_at: Date.UTC(2026, 0, 2, 10, 0) / 1000 };
+  const text = draftExpiry(fit, 86400);
+  assert.match(text, /unsaved edit, kept 24 h: it expires 3 Jan 2026/);
+  assert.match(text, /Save to keep it/);
+  assert.match(draftExpiry(fit, null), /save it to keep the link working/);
 });
