@@ -274,7 +274,7 @@ export class Studio {
     const store = this.app.store;
     if (!fit) store.dispatch("compareOff");
     else store.dispatch("compareWith", { fit, label });
-    return this.app.previewView.compare(fit);
+    return this.app.previewView.compare(fit, label);
   }
 
   async #compareCurves() {

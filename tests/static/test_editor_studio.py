@@ -186,6 +186,9 @@ def test_compare_a_fit_with_its_edit_and_two_metals(pages, editor_url):
     assert page.locator("#plot path.compare").count() == 3
     expect(page.locator("#compare-state")).to_contain_text("against the base (before the edit) at ηᵢ 1.50")
     expect(page.locator("#compare-caption")).to_contain_text(f"the fit on screen ({edited[:8]})")
+    # Each ball says which fit it is.
+    expect(page.locator("#preview-labels")).to_have_text("The fit on screen: Model")
+    expect(page.locator("#preview-compare-labels")).to_have_text("Compared: the base (before the edit): Model")
     # The second ball follows the first one's settings.
     page.check("#coat")
     page.wait_for_function("window.cfPreviewCompare && window.cfPreviewCompare.then(b => b.state.coated)")
@@ -194,6 +197,7 @@ def test_compare_a_fit_with_its_edit_and_two_metals(pages, editor_url):
     copper = page.evaluate("fetch('/api/v1/fits', {method: 'POST', headers: {'Content-Type': 'application/json'},"
                            " body: JSON.stringify({material: 'Cu', eta_i_range: [1, 2.5]})}).then(r => r.json())")["id"]
     expect(page.locator("#preview-compare")).to_have_attribute("data-fit", copper)
+    expect(page.locator("#preview-compare-labels")).to_have_text("Compared: Cu (library): Model")
     expect(page.locator("#compare-de")).to_have_attribute("data-fit", copper)
     figure = compare_figure(page, edited, copper)
     assert figure > 5 and float(page.inner_text("#compare-de")) == pytest.approx(figure, abs=6e-4)
