@@ -6,7 +6,8 @@ Debian's headless Chromium against a real server (a fresh data directory),
 driven as an artist would: the library searched, a coat preset and a typed
 point, two saved materials (one renamed, one in the bin, versions listed,
 a link copied), and compare mode (a fit and its edit). Writes
-``docs/images/editor_{library,entry,materials,compare}.png``.
+``docs/images/editor_{library,entry,materials,compare}.png``, and the README's
+``docs/images/editor.png``: the whole editor at 1920 x 1080 with an edit on screen.
 
 Command: ``.venv/bin/python benchmarks/editor_views.py [--out docs/images]``.
 """
@@ -67,7 +68,8 @@ def shoot(page, out: Path) -> None:
     page.wait_for_function(READY, timeout=120_000)
     settle(page)
     # The library, searched.
-    page.fill("#library-search", "johnson")
+    page.fill("#library-search", "gold")
+    expect(page.locator("#library-state")).to_contain_text("match “gold”", timeout=120_000)
     page.locator("#library-list li[data-id='Au']").hover()
     page.locator("section[aria-labelledby=library-heading]").screenshot(path=out / "editor_library.png")
     page.fill("#library-search", "")
@@ -128,6 +130,15 @@ def shoot(page, out: Path) -> None:
     page.screenshot(path=out / "editor_compare.png", clip=clip(page, "#plot-heading", "#compare-readout", "#compare-caption"))
 
 
+def shoot_window(page, out: Path) -> None:
+    """The README's picture: the editor as it opens, at 1920 x 1080, with one edit refitted."""
+    page.wait_for_function(READY, timeout=120_000)
+    settle(page)
+    key_edit(page, channel=0, angle=60, key="Shift+ArrowDown", presses=2)
+    page.evaluate("window.scrollTo(0, 0)")
+    page.screenshot(path=out / "editor.png")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path, default=ROOT / "docs" / "images")
@@ -141,10 +152,15 @@ def main() -> None:
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
             page.goto(server.url + "/")
             shoot(page, args.out)
+            window = browser.new_page(viewport={"width": 1920, "height": 1080})
+            window.on("pageerror", lambda error: errors.append(str(error)))
+            window.goto(server.url + "/?material=Cu")
+            shoot_window(window, args.out)
             browser.close()
             if errors:
                 raise SystemExit(f"the page logged errors: {errors}")
-    print("wrote", *(args.out / f"editor_{v}.png" for v in ("library", "entry", "materials", "compare")))
+    print("wrote", *(args.out / f"editor_{v}.png" for v in ("library", "entry", "materials", "compare")),
+          args.out / "editor.png")
 
 
 if __name__ == "__main__":

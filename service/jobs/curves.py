@@ -34,7 +34,7 @@ from fitting.fits.curves_base import CurveBase, curve_base_from_coefficients, cu
 from fitting.fits.curves_input import check_curves
 from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
 from fitting.models.pack import material_from_json, material_to_json
-from fitting.optics.library import library_material
+from fitting.optics.catalogue import catalogue_material
 from fitting.optics.nk import SpectralNK
 
 from ..runtime import FitRunner
@@ -73,7 +73,7 @@ class BaseSpec:
 
     def spectral_nk(self) -> SpectralNK:
         if self.library_material is not None:
-            return library_material(self.library_material)
+            return catalogue_material(self.library_material)
         wavelength, n, k = (np.asarray(a, dtype=np.float64) for a in self.nk)
         return SpectralNK(wavelength, n, k, name=self.name, source=self.source)
 
@@ -129,7 +129,7 @@ def _snap_to_domain(curves: list[dict], domain: tuple[float, float]) -> list[dic
 def _base_spec(store: Store, name: str, material: str | None, fit: str | None,
                nk: tuple | None, requested) -> tuple[BaseSpec | None, FitRecord | None]:
     if material is not None:
-        return BaseSpec("nk", material, library_material(material).source,
+        return BaseSpec("nk", material, catalogue_material(material).source,
                         requested or DEFAULT_DOMAIN, library_material=material), None
     if nk is not None:
         return BaseSpec("nk", f"{name} base", "user n, k", requested or DEFAULT_DOMAIN, nk=nk), None

@@ -2,11 +2,13 @@
 The library to browse
 =====================
 
-:func:`library_entries`: per built-in material its symbol, full name, data
-source (citation, refractiveindex.info page), wavelength range, visible
-coverage and a swatch: the colour of the metal under a coat of index
-``eta_i`` at a few angles, for the editor's library list and its search
-(:func:`matches`: by symbol, name or source).
+:func:`library_entries`: per conductor of the catalogue
+(:mod:`fitting.optics.catalogue`: every opaque page a batch fits) its
+common name, symbol, category, data source (citation, refractiveindex.info
+page), wavelength range, visible coverage and a swatch: the colour of the
+metal under a coat of index ``eta_i`` at a few angles, for the editor's
+library list and its search (name and symbol matches first, never inside
+the citation: :func:`fitting.optics.catalogue.search_catalogue`).
 
 The swatch is the exact spectral reference the model is fitted to
 (:func:`fitting.colour.reference.reference_ACEScg`, 1 nm), which the
@@ -28,10 +30,9 @@ from fitting.colour.colorimetry import colour_science
 from fitting.colour.reference import reference_ACEScg
 from fitting.domain import COAT_PRESETS, check_eta_i, cos_theta_from_angle
 from fitting.exports.colour_space import ACEScg_to_lin_rec709
-from fitting.optics.library import FULL_NAMES, LIBRARY, LIBRARY_NAMES, library_material, page_url
-from fitting.optics.nk import visible_coverage
+from fitting.optics.catalogue import catalogue, catalogue_material, search_catalogue
 
-__all__ = ["SWATCH_ANGLES_DEG", "library_entries", "matches", "srgb_hex", "coat_presets"]
+__all__ = ["SWATCH_ANGLES_DEG", "library_entries", "library_about", "srgb_hex", "coat_presets"]
 
 SWATCH_ANGLES_DEG: tuple[float, ...] = (0.0, 45.0, 70.0, 85.0)
 """The angles in the coating of a swatch: normal incidence, then towards grazing."""
@@ -44,44 +45,44 @@ def srgb_hex(ACEScg) -> list[str]:
     return ["#" + "".join(f"{v:02x}" for v in row) for row in encoded]
 
 
-@functools.lru_cache(maxsize=64)
-def _swatch(name: str, eta_i: float) -> tuple[tuple[tuple[float, ...], ...], tuple[str, ...]]:
+@functools.lru_cache(maxsize=2048)
+def _swatch(material_id: str, eta_i: float) -> tuple[tuple[tuple[float, ...], ...], tuple[str, ...]]:
     mu = cos_theta_from_angle(np.asarray(SWATCH_ANGLES_DEG))
-    rgb = reference_ACEScg(library_material(name), mu, eta_i)
+    rgb = reference_ACEScg(catalogue_material(material_id), mu, eta_i)
     return tuple(tuple(float(v) for v in row) for row in rgb), tuple(srgb_hex(rgb))
 
 
-@functools.cache
-def _about(name: str) -> dict[str, Any]:
-    nk = library_material(name)
-    shelf, book, page = LIBRARY[name]
-    citation = nk.source.split(": ", 1)[1] if ": " in nk.source else nk.source
+def _page_url(page: str) -> str:
+    shelf, book, name = page.split("/", 2)
+    return f"https://refractiveindex.info/?shelf={shelf}&book={book}&page={name}"
+
+
+def library_about(material_id: str) -> dict[str, Any]:
+    """
+    A catalogue conductor as the API shows it: id, common name, symbol,
+    category, page, label, citation, range, coverage (KeyError for an unknown id).
+    """
+    entry = catalogue()[material_id]
+    source = f"refractiveindex.info {entry['page']}" + (f": {entry['reference']}" if entry["reference"] else "")
     return {
-        "id": name, "symbol": name, "name": FULL_NAMES[name],
-        "source": nk.source, "reference": " ".join(citation.split()),
-        "database": "refractiveindex.info", "page": f"{shelf}/{book}/{page}", "page_url": page_url(name),
-        "wavelength_range_nm": tuple(float(v) for v in nk.wavelength_range_nm),
-        "coverage": float(visible_coverage(nk.wavelength_range_nm)),
+        "id": entry["id"], "symbol": entry["symbol"], "name": entry["name"],
+        "category": entry["category"], "label": entry["label"], "preferred": entry["preferred"],
+        "source": source, "reference": entry["reference"], "database": "refractiveindex.info",
+        "page": entry["page"], "page_url": _page_url(entry["page"]),
+        "wavelength_range_nm": tuple(entry["wavelength_range_nm"]), "coverage": entry["coverage"],
     }
 
 
-def matches(entry: dict[str, Any], query: str) -> bool:
-    """Whether ``query`` (case-insensitive, every word) is in the symbol, name, source or page."""
-    text = " ".join((entry["symbol"], entry["name"], entry["source"], entry["page"])).casefold()
-    return all(word in text for word in query.casefold().split())
-
-
-def library_entries(eta_i: float, query: str | None = None) -> list[dict[str, Any]]:
-    """The library materials (those matching ``query`` when given), each with its swatch at ``eta_i``."""
+def library_entries(eta_i: float, query: str | None = None, limit: int | None = None) -> list[dict[str, Any]]:
+    """The catalogue's conductors (those matching ``query``, best first, when given; at most
+    ``limit``), each with its swatch at ``eta_i``."""
     eta_i = check_eta_i(eta_i)
     out = []
-    for name in LIBRARY_NAMES:
-        entry = _about(name)
-        if query and not matches(entry, query):
-            continue
-        acescg, hexes = _swatch(name, eta_i)
-        out.append({**entry, "swatch": {"eta_i": eta_i, "angles_deg": list(SWATCH_ANGLES_DEG),
-                                        "srgb": list(hexes), "acescg": [list(row) for row in acescg]}})
+    for entry in search_catalogue(query)[:limit]:
+        acescg, hexes = _swatch(entry["id"], eta_i)
+        out.append({**library_about(entry["id"]),
+                    "swatch": {"eta_i": eta_i, "angles_deg": list(SWATCH_ANGLES_DEG),
+                               "srgb": list(hexes), "acescg": [list(row) for row in acescg]}})
     return out
 
 

@@ -29,7 +29,7 @@ from fitting.fits.settings import DEFAULT_OBJECTIVE, FitSettings
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted
 from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
 from fitting.models.pack import material_from_json, material_to_json
-from fitting.optics.library import library_material
+from fitting.optics.catalogue import catalogue_material, resolve_material
 from fitting.optics.nk import SpectralNK, resample_nk
 from fitting.optics.readers import FORMATS, read_nk
 
@@ -100,8 +100,9 @@ class NKFit:
     @classmethod
     def library(cls, material: str, eta_i_range, objective: str = DEFAULT_OBJECTIVE,
                 metrics_samples: int = 100, model: str = DEFAULT_MODEL) -> "NKFit":
-        """A fit of a built-in conductor (ValueError for an unknown name)."""
-        return cls._make("library", material, library_material(material), eta_i_range,
+        """A fit of a library conductor by name, symbol or id (ValueError for an unknown one)."""
+        material = resolve_material(material)
+        return cls._make("library", material, catalogue_material(material), eta_i_range,
                          objective, metrics_samples, material, model)
 
     @classmethod

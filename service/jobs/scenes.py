@@ -39,7 +39,7 @@ from fitting.models.pack import (
     material_record_bytes,
     pack_to_json,
 )
-from fitting.optics.library import LIBRARY_NAMES, library_material
+from fitting.optics.catalogue import catalogue_material, resolve_material
 
 from ..runtime import FitRunner
 from ..store import Store
@@ -74,6 +74,15 @@ class PreparedScene:
     prefer: str | None = None
 
 
+
+def _catalogued(material: str) -> bool:
+    """Whether ``material`` names a library conductor (else it may be a saved material's id)."""
+    try:
+        resolve_material(material)
+    except ValueError:
+        return False
+    return True
+
 def _renumber(error: ValueError, index: int) -> ValueError:
     return ValueError(str(error).replace("materials[0]", f"materials[{index}]"))
 
@@ -97,14 +106,14 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
     used_fits: list[str] = []
 
     def resolve(material: str):
-        if material in LIBRARY_NAMES:
-            return library_material(material)
+        if _catalogued(material):
+            return catalogue_material(material)
         record = with_measured_nk(store, store.latest_fit(material))
         nk = None if record is None else measured_nk(record)
         if nk is None:
             raise ValueError(
-                f"`material` must be a built-in conductor ({', '.join(LIBRARY_NAMES)}) "
-                f"or the id of a saved material, got {material!r}"
+                "`material` must be a library conductor (a name such as gold, a symbol such as Au, "
+                f"or an id) or the id of a saved material, got {material[:80]!r}"
             )
         used_fits.append(record.id)
         return nk
@@ -117,7 +126,7 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
         seen.add(entry_name)
         material = entry.get("material")
         record = None
-        if material is not None and material not in LIBRARY_NAMES:
+        if material is not None and not _catalogued(material):
             record = with_measured_nk(store, store.latest_fit(material))
         if record is not None and record.kind == "curves":
             eta = parse_eta_i(entry["eta_i"], f"{where}.eta_i")

@@ -21,7 +21,7 @@ from fitting.exports.colour_space import WORKING_SPACES as WORKING_SPACE_NAMES
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.bounded import excerpt
-from fitting.optics.library import LIBRARY_NAMES
+from fitting.optics.catalogue import resolve_material
 
 from ..jobs.nk import MAX_NK_SAMPLES
 
@@ -38,7 +38,8 @@ API_PREFIX = "/api/v1"
 INT64_MAX = 2**63 - 1
 """Largest integer a query may give where it reaches the store (SQLite integers are 64-bit)."""
 FIT_ID_PATTERN = r"^[0-9a-f]{32}$"
-MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32})$"
+MATERIAL_ID_PATTERN = r"^([A-Za-z]{1,8}|[0-9a-f]{32}|[A-Za-z0-9+-]{1,40}\.[A-Za-z0-9+-]{1,80})$"
+"""A library symbol (``Au``), a saved material's id, or a catalogue page (``Ti.Johnson``)."""
 PACK_FORMATS = ("binary", "json", "glsl", "hlsl")
 WORKING_SPACES = WORKING_SPACE_NAMES
 """The working spaces an export is fitted and written in (docs/exports.md)."""
@@ -51,7 +52,10 @@ ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False, strict=True)]
 EtaI = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False, strict=True)]
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
-LibraryName = Literal[LIBRARY_NAMES]  # type: ignore[valid-type]
+LibraryName = Annotated[str, Field(min_length=1, max_length=200, description=(
+    "A conductor of the library by name, symbol or id, any case: gold, Au, aluminum, TiN, Ti.Johnson "
+    "(GET /library)")), AfterValidator(resolve_material)]
+"""A catalogue conductor, checked and turned into its id (``gold`` -> ``Au``)."""
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
 ModelKind = Literal[tuple(MODEL_KINDS)]  # type: ignore[valid-type]
 PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]

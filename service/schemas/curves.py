@@ -70,7 +70,7 @@ class CurveBaseIn(RequestModel):
 
     model_config = ConfigDict(extra="forbid")
 
-    material: LibraryName | None = Field(None, description="A built-in conductor")
+    material: LibraryName | None = None
     fit: Annotated[str, Field(pattern=FIT_ID_PATTERN)] | None = Field(None, description="A stored fit's id")
     nk: NKData | None = Field(None, description="Measured n, k")
 

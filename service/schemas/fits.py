@@ -107,7 +107,7 @@ class FitRequest(RequestModel):
         },
     )
 
-    material: LibraryName | None = Field(None, description="A built-in conductor")
+    material: LibraryName | None = None
     name: Text | None = Field(None, description="Display name of inline data")
     source: str = Field("", max_length=2000, description="Citation of inline data")
     nk: NKData | None = None

@@ -63,3 +63,5 @@ class Domain(BaseModel):
                                           description="The range the colour integrates over, nm")
     min_coverage: float = Field(description="The least fraction of `visible_range_nm` an n, k must cover "
                                             "(an upload's `min_coverage` may ask for more)")
+    draft_ttl_s: float | None = Field(None, description="How long an unsaved edit's refit (a draft) and a "
+                                                        "link to it are kept, seconds (COATED_DRAFT_TTL_S)")

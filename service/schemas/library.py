@@ -25,9 +25,13 @@ class Swatch(BaseModel):
 
 
 class LibraryEntry(BaseModel):
-    id: str = Field(description="The material's id (`GET /materials/{id}`, `POST /fits` `material`)")
-    symbol: str
-    name: str = Field(description="Full name, e.g. Gold")
+    id: str = Field(description="The material's id (`GET /materials/{id}`, `POST /fits` `material`): "
+                                "a library symbol (`Au`) or BOOK.PAGE (`Ti.Johnson`)")
+    symbol: str = Field(description="Symbol or formula, e.g. Au, TiN, Cu-Zn")
+    name: str = Field(description="Common name, e.g. gold, brass 70/30")
+    category: str = Field(description="metal, alloy, nitride, carbide, semiconductor, ...")
+    label: str = Field(description="The page's label in the database (authors, year, what was measured)")
+    preferred: bool = Field(description="The page a bare name or symbol fits (`\"material\": \"gold\"`)")
     source: str = Field(description="The data's citation as the database gives it")
     reference: str = Field(description="The citation alone (authors, title, journal)")
     database: str
@@ -40,6 +44,7 @@ class LibraryEntry(BaseModel):
 
 class LibraryList(BaseModel):
     eta_i: float
+    total: int = Field(description="Conductors matching (before `limit`)")
     materials: list[LibraryEntry]
 
 

@@ -14,7 +14,6 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fitting.fits.scene_schema import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS
-from fitting.optics.library import LIBRARY_NAMES
 
 from .common import ETA_I_LIMITS, Mirror, RequestModel
 from .fits import NKData
@@ -43,7 +42,7 @@ class SceneMaterialRequest(RequestModel):
 
     name: Name | None = Field(default=None, description="Name in the pack (default: `material`)")
     material: Name | None = Field(
-        default=None, description=f"A built-in conductor ({', '.join(LIBRARY_NAMES)}) or a saved material id"
+        default=None, description="A library conductor (name, symbol or id, e.g. gold, Au) or a saved material id"
     )
     nk: NKData | None = None
     source: str = Field(default="scene description", max_length=2000,

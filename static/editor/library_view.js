@@ -1,25 +1,21 @@
-// The library to browse: the built-in conductors (GET /library at the
-// preview's eta_i, state.library) with a search box, each with its full
-// name and symbol, a swatch (the spectral reference under the coat at 0,
-// 45, 70 and 85 degrees as a gradient: the service's swatch.srgb), the
-// data's source and its wavelength range. Open makes it the base; Compare
-// puts it beside the fit on screen. Renders from the state; hooks:
-//   onOpen(symbol), onCompare(symbol).
+// The library to browse: every conductor of the catalogue (GET /library at
+// the preview's eta_i, state.library), each with its common name, symbol and
+// category, a swatch (the spectral reference under the coat at 0, 45, 70 and
+// 85 degrees as a gradient: the service's swatch.srgb), the page's label and
+// its wavelength range. The search box asks the service (GET /library?q=:
+// names and symbols first, never inside a citation) and shows its order.
+// Open makes one the base; Compare puts it beside the fit on screen. Renders
+// from the state; hooks: onOpen(id), onCompare(id), onSearch(query).
 
 import { key } from "./state.js";
 
 const $ = (id) => document.getElementById(id);
 
-/**
- * The entries holding every word of `query` (case-insensitive) in their
- * symbol, full name or source: the service's rule for `GET /library?q=`.
- */
-export function searchLibrary(materials, query) {
-  const words = query.toLowerCase().split(/\s+/).filter(Boolean);
-  return materials.filter((m) => {
-    const text = `${m.symbol}\n${m.name}\n${m.source}`.toLowerCase();
-    return words.every((word) => text.includes(word));
-  });
+/** The entries to list: the service's matches for the search, best first, or all of them. */
+export function shownLibrary({ materials, found }) {
+  if (!found) return materials;
+  const byId = new Map(materials.map((m) => [m.id, m]));
+  return found.map((id) => byId.get(id)).filter(Boolean);
 }
 
 const nm = (v) => Math.round(v).toLocaleString("en");
@@ -28,7 +24,7 @@ export class LibraryView {
   constructor(hooks) {
     this.hooks = hooks;
     this.state = null;
-    $("library-search").addEventListener("input", () => this.state && this.render(this.state));
+    $("library-search").addEventListener("input", (event) => this.hooks.onSearch(event.target.value));
   }
 
   render(state) {
@@ -39,11 +35,12 @@ export class LibraryView {
       $("library-state").textContent = "Loading the library…";
       return;
     }
-    const query = $("library-search").value;
-    const found = searchLibrary(materials, query);
+    const query = state.library.found ? state.library.query : "";
+    const found = shownLibrary(state.library);
     const signature = `${eta}|${query}|${state.base ? state.base.id : ""}|${found.map((m) => m.id).join()}`;
     $("library-state").textContent = query.trim()
-      ? `${found.length} of ${materials.length} match “${query.trim()}”; swatches under a coat of ηᵢ ${eta}.`
+      ? `${found.length} of ${materials.length} match “${query.trim()}”, names and symbols first; ` +
+        `swatches under a coat of ηᵢ ${eta}.`
       : `${materials.length} conductors; swatches under a coat of ηᵢ ${eta} (0°, 45°, 70°, 85°).`;
     list.dataset.eta = eta;
     if (signature === this.signature) return;
@@ -64,6 +61,7 @@ export class LibraryView {
     const title = document.createElement("span");
     title.className = "title";
     title.textContent = `${m.name} (${m.symbol})`;
+    title.title = m.category;
     const actions = document.createElement("span");
     actions.className = "actions";
     actions.append(this.#button("Open", `Open ${m.name} as the base`, () => this.hooks.onOpen(m.id)),
@@ -71,7 +69,7 @@ export class LibraryView {
     const meta = document.createElement("span");
     meta.className = "meta";
     const [lo, hi] = m.wavelength_range_nm;
-    meta.textContent = `${m.source.split("\n")[0]} · ${nm(lo)}–${nm(hi)} nm`;
+    meta.textContent = `${m.category} · ${m.label} · ${nm(lo)}–${nm(hi)} nm`;
     meta.title = m.reference;
     li.append(swatch, title, actions, meta);
     return li;

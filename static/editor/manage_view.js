@@ -5,8 +5,10 @@
 // its versions or copy its link; the bin with Restore; a material's
 // versions, each to open, download (in the Download menu's format as it is
 // at the click, as the fit's own Download) or compare with the fit on
-// screen. Renders from the state; hooks:
-//   onOpen(material), onRename(material, name), onDelete(material),
+// screen. Every saved material is listed (each page of GET /materials); the
+// search box asks the service (?q=) and lists what it found. Renders from
+// the state; hooks:
+//   onSearch(query), onOpen(material), onRename(material, name), onDelete(material),
 //   onRestore(material), onVersions(material), onLink(fitId),
 //   onOpenVersion(entry), onCompareVersion(entry), downloadURL(fitId).
 
@@ -39,15 +41,28 @@ function line(title, meta, actions, current = false) {
   return li;
 }
 
+/** The saved materials to list: those the service found (in the list's order), or all. */
+export function shownSaved(saved, found) {
+  if (!found) return saved;
+  const ids = new Set(found);
+  return saved.filter((m) => ids.has(m.id));
+}
+
 export class ManageView {
   constructor(hooks) {
     this.hooks = hooks;
     this.renaming = null; // the id of the material being renamed
+    $("saved-search").addEventListener("input", (event) => this.hooks.onSearch(event.target.value));
   }
 
   render(state) {
     const open = state.base && state.base.kind === "curves" ? state.base.material_id : null;
-    $("saved-list").replaceChildren(...state.saved.map((m) => this.#saved(m, m.id === open)));
+    const shown = shownSaved(state.saved, state.savedSearch.found);
+    const { query } = state.savedSearch;
+    $("saved-state").textContent = state.savedSearch.found
+      ? `${shown.length} of ${state.saved.length} match “${query.trim()}”.`
+      : `${state.saved.length} saved material${state.saved.length === 1 ? "" : "s"}.`;
+    $("saved-list").replaceChildren(...shown.map((m) => this.#saved(m, m.id === open)));
     if (!state.saved.length) $("saved-list").append(line("Nothing saved yet", "Edit a curve and press Save.", []));
     $("bin-count").textContent = String(state.bin.length);
     $("bin-list").replaceChildren(...state.bin.map((m) => {

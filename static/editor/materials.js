@@ -1,5 +1,5 @@
-// The material picker: the library and saved materials (GET /materials) in
-// one <select>, the fit behind a picker value, and the material open last
+// The material picker: the library and every saved material (GET /materials,
+// each page followed to the last) in one <select>, the fit behind a picker value, and the material open last
 // (localStorage). No state of the editor: what it fetches it returns.
 
 import * as api from "../api.js";
@@ -12,7 +12,7 @@ const GROUPS = { library: "Library", curves: "Saved", nk: "Uploads (n, k)" };
 
 /** Fill `picker` with the material list (Library, Saved, Uploads), `select` chosen. */
 export async function loadMaterials(picker, select = null) {
-  const { materials } = await api.listMaterials({ kinds: Object.keys(GROUPS) });
+  const materials = await api.listAllMaterials({ kinds: Object.keys(GROUPS) });
   picker.replaceChildren();
   const nodes = {};
   for (const [group, label] of Object.entries(GROUPS)) {

@@ -63,7 +63,8 @@ export class PreviewView {
     // While comparing, each ball shows its model alone (the Split menu waits).
     $("compare").disabled = !this.hasReference || Boolean(this.comparing);
     if (!this.ball) return;
-    this.ball.set({ panels: SPLITS[this.hasReference && !this.comparing ? $("compare").value : "none"] });
+    this.ball.set({ panels: SPLITS[this.hasReference && !this.comparing ? $("compare").value : "none"],
+                    caption: this.comparing ? "The fit on screen" : "" });
   }
 
   /** A new base: whether it has a spectral reference (measured n, k) to compare with. */
@@ -93,8 +94,9 @@ export class PreviewView {
    * settings, eta_i and orbit; the model alone on both), or null to end it.
    * The second ball is made on first use.
    */
-  async compare(fit) {
+  async compare(fit, label = "") {
     this.comparing = fit;
+    this.comparedLabel = label;
     $("compare-box").hidden = !fit;
     this.#panels();
     if (!fit || !this.ball) return;
@@ -115,7 +117,8 @@ export class PreviewView {
     this.other.then((other) => {
       const s = this.ball.state;
       other.set({ eta: s.eta, environment: s.environment, exposure: s.exposure, roughness: s.roughness,
-                  coated: s.coated, coatRoughness: s.coatRoughness, orbit: s.orbit, panels: [PANEL.model] });
+                  coated: s.coated, coatRoughness: s.coatRoughness, orbit: s.orbit, panels: [PANEL.model],
+                  caption: `Compared: ${this.comparedLabel || "another fit"}` });
     });
   }
 }

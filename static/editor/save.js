@@ -3,7 +3,8 @@
 // opened from the list, or the one this page saved it as) gets the next
 // version under its id (material_id, expected_version: a save from
 // elsewhere since is a 409, nothing lost), with no "Replace it?" question;
-// a name that belongs to another saved material asks first.
+// a name that belongs to another saved material asks first; a save of the
+// material as it was saved answers "nothing to save" (no new version).
 //
 // `ctx`: state, name() -> the name field, say(text, ok), report(error,
 // retry, prefix), busy(text, work), refitFirst() -> Promise<bool> (the fit
@@ -12,6 +13,7 @@
 
 import * as api from "../api.js";
 import { refitBody } from "./refit.js";
+import { fitted, unsaved } from "./state.js";
 
 /** The saved material an edit continues: {id, name, version} (version: saves so far when last read). */
 export class Continuing {
@@ -42,10 +44,17 @@ export async function save(ctx, continuing) {
     return false;
   }
   const going = continuing.continues(name);
+  if (going && !unsaved(state) && fitted(state)) {
+    // The material's latest version is what is on screen: another save would only repeat it.
+    const version = continuing.material.version;
+    ctx.say(`Nothing to save: “${name}”${version ? ` version ${version}` : ""} is what is on screen.`, true);
+    return false;
+  }
   if (!going) {
     // Saving under the name of another saved material replaces its latest fit: asked first.
-    const { materials } = await api.listMaterials();
-    const clash = materials.find((m) => m.kind === "curves" && m.name === name);
+    // The service is asked (every page of the saved materials holding the name), not the list on screen.
+    const materials = await api.listAllMaterials({ kinds: ["curves"], q: name });
+    const clash = materials.find((m) => m.name === name);
     if (clash && !window.confirm(`A saved material is called “${name}”. Replace it with this edit?`)) {
       ctx.say("Not saved: choose another name, or Save again and confirm to replace it.");
       return false;

@@ -31,8 +31,9 @@ export function initialState() {
     model: null,      // the fit on screen's curve at `eta`
     selected: null,   // the control point typed entry changes: {channel, handle}
     compare: null,    // compare mode: {fit, label, model: its curve at `eta` (or null while it loads)}
-    library: { eta: null, materials: [] }, // GET /library at an eta_i: names, sources, swatches
-    saved: [],        // the artist's saved edited materials (kind curves)
+    library: { eta: null, materials: [], query: "", found: null }, // GET /library at an eta_i; found: ?q= ids, best first
+    saved: [],        // the artist's saved edited materials (kind curves), every page
+    savedSearch: { query: "", found: null }, // GET /materials?kind=curves&q=: the ids found (null: no search)
     bin: [],          // the saved materials in the bin
     versions: null,   // the versions listed: {material: {id, name}, list: newest first}
     presets: [],      // coat presets ({id, name, eta_i, source})
@@ -239,12 +240,22 @@ export const ACTIONS = {
   },
   /** The library at an eta_i (GET /library: entries with names, sources, ranges, swatches). */
   library(s, { eta, materials }) {
-    s.library = { eta: key(eta), materials };
+    s.library = { ...s.library, eta: key(eta), materials };
+    return true;
+  },
+  /** The library's search: the ids GET /library?q= answered for `query`, best first (null: no search). */
+  librarySearch(s, { query, ids }) {
+    s.library = { ...s.library, query, found: query.trim() ? ids : null };
     return true;
   },
   /** The saved edited materials and the bin. */
   materials(s, { saved, bin }) {
     Object.assign(s, { saved, bin });
+    return true;
+  },
+  /** The search of the saved materials: the ids the service found for `query` (null: no search). */
+  savedSearch(s, { query, ids }) {
+    s.savedSearch = { query, found: query.trim() ? ids : null };
     return true;
   },
   /** A material's versions ({material: {id, name}, list}), or null to close the list. */

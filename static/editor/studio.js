@@ -25,7 +25,7 @@ import { CompareView } from "./compare_view.js";
 import { EntryView } from "./entry_view.js";
 import { LibraryView } from "./library_view.js";
 import { ManageView } from "./manage_view.js";
-import { SAMPLES, editsOf, key, snapshot } from "./state.js";
+import { SAMPLES, editsOf, key, snapshot, unsaved } from "./state.js";
 
 const $ = (id) => document.getElementById(id);
 
@@ -37,6 +37,18 @@ export function linkOf(search) {
   return null;
 }
 
+/**
+ * What a link to an unsaved edit must say: it opens a draft, which the
+ * service keeps `ttlSeconds` from its refit (then it is gone), and when.
+ */
+export function draftExpiry(fit, ttlSeconds) {
+  if (!ttlSeconds || !fit || !fit.created_at) return " It opens an unsaved edit: save it to keep the link working.";
+  const until = new Date((fit.created_at + ttlSeconds) * 1000);
+  const when = until.toLocaleString("en-GB", { dateStyle: "medium", timeStyle: "short" });
+  const hours = Math.round(ttlSeconds / 3600);
+  return ` It opens an unsaved edit, kept ${hours} h: it expires ${when}. Save to keep it.`;
+}
+
 /** The link that reopens the stored fit `fitId` with its edit. */
 export const linkTo = (fitId, origin) => `${origin}/?fit=${encodeURIComponent(fitId)}`;
 
@@ -44,8 +56,8 @@ export const linkTo = (fitId, origin) => `${origin}/?fit=${encodeURIComponent(fi
 const FOLLOWS = {
   entry: new Set(["openBase", "curves", "setEta", "select", "drag", "dragEnd", "undo", "redo", "reset", "gentler",
                   "presets", "reopened"]),
-  library: new Set(["library", "openBase"]),
-  manage: new Set(["materials", "versions", "openBase"]),
+  library: new Set(["library", "librarySearch", "openBase"]),
+  manage: new Set(["materials", "savedSearch", "versions", "openBase"]),
   compare: new Set(["compareWith", "compareCurves", "compareOff", "shown", "curves", "setEta"]),
 };
 
@@ -59,6 +71,7 @@ export class Studio {
     this.library = new LibraryView({
       onOpen: guard((id) => app.open(`library:${id}`)),
       onCompare: guard(async (id) => this.compare(await api.fitLibrary(id, [1.0, 2.5]), `${id} (library)`)),
+      onSearch: (query) => this.#later("search", 120, () => this.#search(query)),
     });
     this.manage = new ManageView({
       rerender: () => this.manage.render(state),
@@ -67,17 +80,18 @@ export class Studio {
       onDelete: guard((m) => this.remove(m)),
       onRestore: guard((m) => this.restore(m)),
       onVersions: guard((m) => this.versions(m)),
-      onLink: (fitId) => this.copyLink(fitId),
+      onLink: guard((fitId) => this.copyLink(fitId)),
       onOpenVersion: guard((v) => app.mayDiscard() && this.openFit(v.fit_id)),
       onCompareVersion: guard(async (v) => this.compare(await api.getFit(v.fit_id), `version ${v.version}`)),
       downloadURL: (fitId) => api.packURL(fitId, app.downloadFormat(), app.exportSettings()),
+      onSearch: (query) => this.#later("savedSearch", 120, () => this.#searchSaved(query)),
     });
     $("format").addEventListener("change", () => this.manage.showDownloads());
     this.compareView = new CompareView({
       onCompareBase: guard(() => state.base && this.compare(state.base, "the base (before the edit)")),
       onOff: () => this.compare(null),
     });
-    $("copy-link").addEventListener("click", () => state.fit && this.copyLink(state.fit.id));
+    $("copy-link").addEventListener("click", guard(() => state.fit && this.copyLink(state.fit.id)));
     app.store.subscribe((name) => this.#follow(name));
     this.loading = null; // the studio's lists load once the first fit is on screen (never ahead of it: cold start)
   }
@@ -107,6 +121,7 @@ export class Studio {
     api.setExportFormats(domain.export_formats);
     $("export-formats").replaceChildren(...domain.export_formats.map(
       ({ name, label }) => Object.assign(document.createElement("option"), { value: name, textContent: label })));
+    this.draftTtl = domain.draft_ttl_s;
     const [lo, hi] = domain.visible_range_nm;
     $("upload-rule").textContent = `Measured n, k must cover at least ${Math.round(100 * domain.min_coverage)}% of ` +
       `${lo}–${hi} nm (the colour is integrated over that range; the data are held flat past their ends, ` +
@@ -120,13 +135,26 @@ export class Studio {
     if (key(eta) === key(this.state.eta)) this.app.store.dispatch("library", { eta, materials });
   }
 
+  /** The library's search, asked of the service (names and symbols first; never inside a citation). */
+  async #search(query) {
+    const ids = query.trim() ? (await api.library(this.state.eta, query)).materials.map((m) => m.id) : null;
+    if ($("library-search").value === query) this.app.store.dispatch("librarySearch", { query, ids });
+  }
+
+  /** The search of the saved materials, asked of the service (GET /materials?kind=curves&q=, every page). */
+  async #searchSaved(query) {
+    const ids = query.trim() ? (await api.listAllMaterials({ kinds: ["curves"], q: query.trim() })).map((m) => m.id) : null;
+    if ($("saved-search").value === query) this.app.store.dispatch("savedSearch", { query, ids });
+  }
+
   /** The saved edited materials and the bin, again. */
   async refresh() {
-    const [saved, bin] = await Promise.all([api.listMaterials({ kinds: ["curves"] }),
-                                            api.listMaterials({ kinds: ["curves"], deleted: true })]);
-    this.app.store.dispatch("materials", { saved: saved.materials, bin: bin.materials });
+    const [saved, bin] = await Promise.all([api.listAllMaterials({ kinds: ["curves"] }),
+                                            api.listAllMaterials({ kinds: ["curves"], deleted: true })]);
+    this.app.store.dispatch("materials", { saved, bin });
     const listed = this.state.versions;
-    if (listed && !saved.materials.some((m) => m.id === listed.material.id)) this.app.store.dispatch("versions", null);
+    if (listed && !saved.some((m) => m.id === listed.material.id)) this.app.store.dispatch("versions", null);
+    if ($("saved-search").value.trim()) this.#searchSaved($("saved-search").value);
   }
 
   #said(text, undo = null) {
@@ -185,13 +213,17 @@ export class Studio {
     this.app.store.dispatch("versions", { material: m, list: listed.versions, latest: listed.version });
   }
 
-  copyLink(fitId) {
+  async copyLink(fitId) {
     const link = linkTo(fitId, location.origin);
     $("share-link").value = link;
     $("share-link").select();
     const copied = navigator.clipboard ? navigator.clipboard.writeText(link).then(() => true, () => false)
       : Promise.resolve(false);
-    copied.then((ok) => this.#said(ok ? `Link copied: ${link}` : `Link (select and copy it): ${link}`));
+    const state = this.state;
+    const isDraft = state.fit && state.fit.id === fitId && unsaved(state);
+    if (isDraft && this.draftTtl === undefined) this.draftTtl = (await api.domain()).draft_ttl_s;
+    const draft = isDraft ? draftExpiry(state.fit, this.draftTtl) : "";
+    copied.then((ok) => this.#said((ok ? `Link copied: ${link}` : `Link (select and copy it): ${link}`) + draft));
   }
 
   /** Fit an uploaded n, k file (saved under the upload's name; listed under Uploads) and open it. */
@@ -245,7 +277,7 @@ export class Studio {
     const store = this.app.store;
     if (!fit) store.dispatch("compareOff");
     else store.dispatch("compareWith", { fit, label });
-    return this.app.previewView.compare(fit);
+    return this.app.previewView.compare(fit, label);
   }
 
   async #compareCurves() {

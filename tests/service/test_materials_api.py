@@ -10,6 +10,8 @@ presets, and the upload form's ``min_coverage``. One server for the module.
 
 from __future__ import annotations
 
+import re
+
 import httpx
 import loopback
 import numpy as np
@@ -18,7 +20,9 @@ from conftest import server_process
 
 from fitting.domain import COAT_PRESETS
 from fitting.fits.curves_base import curve_base_from_nk
+from fitting.optics.catalogue import catalogue, search_catalogue
 from fitting.optics.library import LIBRARY_NAMES, library_material
+from service.schemas import MATERIAL_ID_PATTERN
 
 pytestmark = [pytest.mark.server, pytest.mark.slow]
 
@@ -117,6 +121,16 @@ def test_a_fit_reopens_with_its_edit(http, brass):
     assert detail["share_url"] == f"/?material={second['material_id']}"
 
 
+def test_a_fit_by_name_or_symbol_any_case(http):
+    gold = http.post(f"{API}/fits", json={"material": "Au"}, headers=AUTH).json()
+    for named in ("gold", "GOLD", "au", " Gold "):
+        fit = http.post(f"{API}/fits", json={"material": named}, headers=AUTH)
+        assert fit.status_code in (200, 201) and fit.json()["id"] == gold["id"], named
+    refused = http.post(f"{API}/fits", json={"material": "unobtainium"}, headers=AUTH)
+    assert refused.status_code == 422 and "`material`" in refused.json()["detail"]
+    assert http.get(f"{API}/materials/Ti.Johnson").json()["name"] == "titanium (Ti)"
+
+
 def test_rename_keeps_the_history_and_the_next_save(http):
     a = save(http, "to rename", 0.85).json()
     material_id = a["material_id"]
@@ -196,13 +210,16 @@ def test_uploads_are_kept_apart_from_saved_materials(http, brass):
     both = http.get(f"{API}/materials", params=[("kind", "nk"), ("kind", "curves")]).json()["materials"]
     assert material_id in [m["id"] for m in both] and not [m for m in both if m["kind"] == "library"]
     library = http.get(f"{API}/materials", params={"kind": "library"}).json()
-    assert [m["id"] for m in library["materials"]] == list(LIBRARY_NAMES) and library["next_cursor"] is None
+    ids = [m["id"] for m in library["materials"]]
+    assert set(LIBRARY_NAMES) <= set(ids) and "Ti.Palm" in ids and library["next_cursor"] is None
+    assert len(ids) == len({e["book"] for e in catalogue().values()})  # one preferred page per conductor
     assert http.get(f"{API}/materials", params={"kind": "bogus"}).status_code == 422
     # Search by name or source, the library's entries by symbol, name or source.
     found = http.get(f"{API}/materials", params={"q": "STUDIO"}).json()["materials"]
     assert [m["name"] for m in found] == ["studio brass"]
     gold = http.get(f"{API}/materials", params={"q": "gold", "kind": "library"}).json()["materials"]
-    assert [m["id"] for m in gold] == ["Au"]
+    assert gold[0]["id"] == "Au" and gold[0]["name"] == "gold (Au)"
+    assert {m["id"] for m in gold} == {e["id"] for e in search_catalogue("gold")}
 
 
 def test_upload_min_coverage(http):
@@ -219,9 +236,12 @@ def test_upload_min_coverage(http):
 
 def test_library_to_browse(http):
     answer = http.get(f"{API}/library", params={"eta_i": 1.33}).json()
-    assert answer["eta_i"] == 1.33 and [m["id"] for m in answer["materials"]] == list(LIBRARY_NAMES)
+    assert answer["eta_i"] == 1.33 and [m["id"] for m in answer["materials"]] == list(catalogue())
+    assert answer["total"] == len(answer["materials"]) >= 300 and set(LIBRARY_NAMES) <= set(catalogue())
+    assert all(re.fullmatch(MATERIAL_ID_PATTERN, m["id"]) for m in answer["materials"])
     (gold,) = [m for m in answer["materials"] if m["id"] == "Au"]
-    assert gold["name"] == "Gold" and gold["symbol"] == "Au" and "Johnson" in gold["source"]
+    assert gold["name"] == "gold" and gold["symbol"] == "Au" and "Johnson" in gold["source"]
+    assert gold["category"] == "metal" and gold["preferred"] and gold["label"].startswith("Johnson and Christy")
     assert gold["page_url"] == "https://refractiveindex.info/?shelf=main&book=Au&page=Johnson"
     assert gold["reference"].startswith("P. B. Johnson and R. W. Christy")
     lo, hi = gold["wavelength_range_nm"]
@@ -231,11 +251,15 @@ def test_library_to_browse(http):
     assert len(swatch["srgb"]) == len(swatch["angles_deg"]) == len(swatch["acescg"])
     red, green, blue = (int(swatch["srgb"][0][i:i + 2], 16) for i in (1, 3, 5))
     assert red > green > blue  # gold is yellow at normal incidence
-    air = http.get(f"{API}/library", params={"eta_i": 1.0, "q": "gold"}).json()["materials"]
-    assert [m["id"] for m in air] == ["Au"] and air[0]["swatch"]["srgb"] != swatch["srgb"]
-    johnson = http.get(f"{API}/library", params={"q": "johnson christy"}).json()["materials"]
-    assert {m["id"] for m in johnson} == {"Ag", "Au", "Co", "Cr", "Cu", "Fe", "Mn", "Ni", "Pd"}
-    assert [m["id"] for m in http.get(f"{API}/library", params={"q": "brass"}).json()["materials"]] == ["CuZn"]
+    air = http.get(f"{API}/library", params={"eta_i": 1.0, "q": "gold", "limit": 1}).json()
+    assert [m["id"] for m in air["materials"]] == ["Au"] and air["total"] > 30
+    assert air["materials"][0]["swatch"]["srgb"] != swatch["srgb"]
+    # Names and symbols rank first; the citation is never searched.
+    assert http.get(f"{API}/library", params={"q": "johnson christy"}).json()["materials"] == []
+    first = {q: http.get(f"{API}/library", params={"q": q, "limit": 1}).json()["materials"][0]["id"]
+             for q in ("brass", "TiN", "aluminum")}
+    assert first == {"brass": "CuZn", "TiN": catalogue()[first["TiN"]]["id"], "aluminum": "Al"}
+    assert catalogue()[first["TiN"]]["book"] == "TiN"
     assert http.get(f"{API}/library", params={"q": "unobtainium"}).json()["materials"] == []
     assert http.get(f"{API}/library", params={"eta_i": 0.5}).status_code == 422
     presets = http.get(f"{API}/coat-presets").json()["presets"]

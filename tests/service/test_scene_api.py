@@ -83,7 +83,7 @@ class TestRefusals:
             ({"materials": [{"material": "Au"}]}, "eta_i"),
             ({"materials": [{"material": "Au", "nk": {"wavelength_nm": [400, 700], "n": [1, 1],
                                                      "k": [0, 0]}, "eta_i": 1}]}, "exactly one of"),
-            ({"materials": [{"material": "Ti", "eta_i": 1}]}, "built-in conductor"),
+            ({"materials": [{"material": "Unobtainium", "eta_i": 1}]}, "library conductor"),
             ({"materials": [{"material": "Au", "eta_i": 1}, {"material": "Au", "eta_i": 2}]}, "used twice"),
             ({"materials": [{"name": "x", "eta_i": 1.5, "nk": {
                 "wavelength_nm": [500, 600], "n": [1, 1], "k": [1, 1]}}]}, "must cover at least 90%"),

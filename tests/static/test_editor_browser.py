@@ -280,9 +280,17 @@ def test_token_is_asked_for_kept_and_sent(page, tmp_path):
         wait_fit(page, base_id)
         assert writes[-1].url.split("?")[0].endswith("/fits/from-curves")
         assert writes[-1].headers.get("authorization") == f"Bearer {token}"
+        # A link to the unsaved edit says that it expires, and when (the service keeps drafts 24 h).
+        page.click("#copy-link")
+        expect(page.locator("#manage-message")).to_contain_text("It opens an unsaved edit, kept 24 h: it expires")
         page.fill("#name", "Token browser test")
         page.click("#save")
         expect(message).to_contain_text("Saved “Token browser test”")
+        # Saved again with no change: nothing is sent, no identical version is added.
+        saves = len(writes)
+        page.click("#save")
+        expect(message).to_contain_text("Nothing to save: “Token browser test” version 1 is what is on screen.")
+        assert len(writes) == saves
 
         # The token is kept for the tab (sessionStorage): a reload works at once.
         assert page.evaluate("sessionStorage.getItem('coated-api-token')") == token

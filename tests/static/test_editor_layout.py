@@ -82,3 +82,22 @@ def test_phone_handles_are_touch_sized_and_axis_text_readable(pages, editor_url)
     assert sizes and min(sizes) >= 11, sizes
     # Nothing wider than the phone (no sideways scrolling).
     assert page.evaluate("document.documentElement.scrollWidth") <= 390
+
+
+@pytest.mark.parametrize("width, height", [(1920, 1080), (1280, 800)])
+def test_the_preview_takes_45_percent_and_save_stays_in_view(pages, editor_url, width, height):
+    page = pages.new(width, height)
+    open_editor(page, editor_url)
+    preview = page.locator("#preview").bounding_box()
+    assert preview["width"] >= 0.45 * width, preview
+    assert preview["y"] + preview["height"] <= height, preview  # the whole ball on the first screen
+    assert page.evaluate("document.documentElement.scrollWidth") <= width  # nothing cut off at the side
+    for selector in ("#plot svg", ".controls", ".side"):
+        box = page.locator(selector).bounding_box()
+        assert box["x"] >= 0 and box["x"] + box["width"] <= width, (selector, box)
+    # Save is on the first screen, not covered by anything.
+    save = page.locator("#save").bounding_box()
+    assert 0 <= save["y"] and save["y"] + save["height"] <= height, save
+    hit = page.evaluate("([x, y]) => document.elementFromPoint(x, y).id",
+                        [save["x"] + save["width"] / 2, save["y"] + save["height"] / 2])
+    assert hit == "save"

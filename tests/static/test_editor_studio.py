@@ -18,6 +18,7 @@ from editor_pages import editor_url, key_edit, open_editor, pages, chromium, liv
 from playwright.sync_api import expect
 
 from fitting.colour.delta_e import delta_E_map
+from fitting.optics.catalogue import catalogue
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 
@@ -31,23 +32,23 @@ def test_library_search_swatches_and_open(pages, editor_url):
     open_editor(page, editor_url)
     settled(page)
     items = page.locator("#library-list li")
-    expect(items).to_have_count(22)
+    expect(items).to_have_count(len(catalogue()))
     gold = page.locator("#library-list li[data-id='Au']")
-    expect(gold.locator(".title")).to_have_text("Gold (Au)")
-    expect(gold.locator(".meta")).to_contain_text("Johnson and R. W. Christy")
+    expect(gold.locator(".title")).to_have_text("gold (Au)")
+    expect(gold.locator(".meta")).to_contain_text("metal · Johnson and Christy 1972")
     expect(gold.locator(".meta")).to_contain_text("nm")
     library = api(page, "/library?eta_i=1.50")
     au = next(m for m in library["materials"] if m["id"] == "Au")
     expect(gold.locator(".chip-swatch")).to_have_attribute("data-srgb", au["swatch"]["srgb"][0])
-    # Search by full name, by symbol, by words of the source: what the service's ?q= keeps.
-    for query in ["gold", "Cu", "johnson christy", "rakic"]:
+    # Search by name, symbol or another name: the service's ?q= answer, in its order.
+    for query in ["gold", "Cu", "titanium", "aluminum", "stainless"]:
         page.fill("#library-search", query)
+        expect(page.locator("#library-state")).to_contain_text(f"match “{query}”")
         ids = page.eval_on_selector_all("#library-list li", "els => els.map(e => e.dataset.id)")
         served = [m["id"] for m in api(page, f"/library?eta_i=1.5&q={query.replace(' ', '+')}")["materials"]]
         assert ids == served and ids, (query, ids, served)
-        if query == "gold":
-            assert ids == ["Au"]
-    expect(page.locator("#library-state")).to_contain_text("match “rakic”")
+        assert ids[0] == {"gold": "Au", "Cu": "Cu", "aluminum": "Al"}.get(query, ids[0])
+    assert catalogue()[ids[0]]["book"] == "stainless_steel"
     page.fill("#library-search", "")
     # The swatches follow eta_i.
     page.fill("#eta-typed", "1.00")
@@ -185,6 +186,9 @@ def test_compare_a_fit_with_its_edit_and_two_metals(pages, editor_url):
     assert page.locator("#plot path.compare").count() == 3
     expect(page.locator("#compare-state")).to_contain_text("against the base (before the edit) at ηᵢ 1.50")
     expect(page.locator("#compare-caption")).to_contain_text(f"the fit on screen ({edited[:8]})")
+    # Each ball says which fit it is.
+    expect(page.locator("#preview-labels")).to_have_text("The fit on screen: Model")
+    expect(page.locator("#preview-compare-labels")).to_have_text("Compared: the base (before the edit): Model")
     # The second ball follows the first one's settings.
     page.check("#coat")
     page.wait_for_function("window.cfPreviewCompare && window.cfPreviewCompare.then(b => b.state.coated)")
@@ -193,6 +197,7 @@ def test_compare_a_fit_with_its_edit_and_two_metals(pages, editor_url):
     copper = page.evaluate("fetch('/api/v1/fits', {method: 'POST', headers: {'Content-Type': 'application/json'},"
                            " body: JSON.stringify({material: 'Cu', eta_i_range: [1, 2.5]})}).then(r => r.json())")["id"]
     expect(page.locator("#preview-compare")).to_have_attribute("data-fit", copper)
+    expect(page.locator("#preview-compare-labels")).to_have_text("Compared: Cu (library): Model")
     expect(page.locator("#compare-de")).to_have_attribute("data-fit", copper)
     figure = compare_figure(page, edited, copper)
     assert figure > 5 and float(page.inner_text("#compare-de")) == pytest.approx(figure, abs=6e-4)

@@ -34,7 +34,7 @@ from ...schemas import (
     Health,
 )
 from ...store import Store
-from ..deps import PreviewsDep, RunnerDep, StoreDep
+from ..deps import PreviewsDep, RunnerDep, SettingsDep, StoreDep
 
 router = APIRouter(tags=["health"])
 
@@ -72,6 +72,6 @@ def current_domain() -> Domain:
 
 
 @router.get(f"{API_PREFIX}/domain", response_model=Domain)
-async def domain() -> Domain:
+async def domain(settings: SettingsDep) -> Domain:
     """The rules and defaults of the API's inputs (the editor reads them instead of repeating them)."""
-    return current_domain()
+    return current_domain().model_copy(update={"draft_ttl_s": settings.draft_ttl_s})

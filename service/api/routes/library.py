@@ -2,9 +2,11 @@
 The library to browse
 =====================
 
--   ``GET /api/v1/library?q=&eta_i=``: the built-in materials with full
-    names, sources, ranges and swatches at ``eta_i`` (:mod:`service.jobs.library`);
-    ``q`` keeps those whose symbol, name or source holds every word of it.
+-   ``GET /api/v1/library?q=&eta_i=&limit=``: the catalogue's conductors with
+    common names, symbols, categories, sources, ranges and swatches at
+    ``eta_i`` (:mod:`service.jobs.library`); ``q`` keeps those whose name,
+    symbol, category or page description holds every word of it, name and
+    symbol matches first (never the citation).
 -   ``GET /api/v1/coat-presets``: common clear coats and their eta_i, with sources.
 """
 
@@ -14,6 +16,8 @@ from typing import Annotated
 
 from fastapi import APIRouter, Query
 from fastapi.concurrency import run_in_threadpool
+
+from fitting.optics.catalogue import search_catalogue
 
 from ...jobs.library import coat_presets, library_entries
 from ...schemas import API_PREFIX, ETA_I_LIMITS, CoatPresets, LibraryList
@@ -27,11 +31,13 @@ async def get_library(
     eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
                                   description="Coating index of the swatches")] = 1.5,
     q: Annotated[str | None, Query(min_length=1, max_length=200,
-                                   description="Words each in the symbol, name or source "
-                                               "(case-insensitive)")] = None,
+                                   description="Words each in the name, symbol, category or page "
+                                               "description (case-insensitive); best matches first")] = None,
+    limit: Annotated[int | None, Query(ge=1, le=1000, description="At most this many (default all)")] = None,
 ) -> LibraryList:
-    """The built-in conductors to browse: names, sources, ranges, swatches under the coat at `eta_i`."""
-    return LibraryList(eta_i=eta_i, materials=await run_in_threadpool(library_entries, eta_i, q))
+    """The library's conductors: names, symbols, sources, ranges, swatches under the coat at `eta_i`."""
+    found = await run_in_threadpool(library_entries, eta_i, q, limit)
+    return LibraryList(eta_i=eta_i, total=len(search_catalogue(q)), materials=found)
 
 
 @router.get("/coat-presets", response_model=CoatPresets, responses=ERROR_RESPONSES)

@@ -3,7 +3,8 @@ Materials
 =========
 
 -   ``GET /api/v1/materials?kind=&q=&deleted=&limit=&cursor=``: one page of
-    materials: the built-in library (first page only), then saved
+    materials: the library (first page only: each conductor's preferred
+    page, or with ``q`` every catalogue page matching it), then saved
     materials, oldest first, read from the store's summary rows, so a page
     costs what it returns. ``kind`` selects: ``library``, ``curves`` (the
     artist's saved edits) and ``nk`` (fits of uploaded or inline n, k, kept
@@ -23,16 +24,14 @@ same site, and the bearer token when the service requires one).
 
 from __future__ import annotations
 
-import functools
 from typing import Annotated
 
 from fastapi import APIRouter, Query
 
-from fitting.optics.library import FULL_NAMES, LIBRARY_NAMES, library_material
-from fitting.optics.nk import visible_coverage
+from fitting.optics.catalogue import catalogue, search_catalogue
 
 from ...jobs.common import with_measured_nk
-from ...jobs.library import matches
+from ...jobs.library import library_about
 from ...jobs.materials import share_url as _share
 from ...schemas import (API_PREFIX, INT64_MAX, LISTING_KINDS, ErrorBody, MaterialDetail, MaterialList, MaterialRename,
                         MaterialSummary, fit_public)
@@ -44,12 +43,6 @@ router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
 WRITE_RESPONSES = {**FIT_ERROR_RESPONSES, **NOT_FOUND,
                    409: {"model": ErrorBody, "description": "Another saved edited material is called `name`"}}
-
-
-@functools.cache
-def _library_entry(name: str) -> tuple[str, float, tuple[float, float]]:
-    nk = library_material(name)
-    return nk.source, visible_coverage(nk.wavelength_range_nm), nk.wavelength_range_nm
 
 
 def _summary(row: MaterialRow) -> MaterialSummary:
@@ -73,7 +66,7 @@ def list_materials(
                                                "(case-insensitive)")] = None,
     deleted: Annotated[bool, Query(description="List the bin (deleted materials) instead")] = False,
 ) -> MaterialList:
-    """The built-in conductors (first page), then the saved materials of `kind`, oldest first."""
+    """The library's conductors (first page), then the saved materials of `kind`, oldest first."""
     kinds = tuple(dict.fromkeys(kind or ("library", "curves")))
     unknown = [k for k in kinds if k not in LISTING_KINDS]
     if unknown:
@@ -81,14 +74,14 @@ def list_materials(
     limit = min(limit or settings.materials_page_max, settings.materials_page_max)
     materials = []
     if cursor is None and "library" in kinds and not deleted:
-        latest = store.latest_fit_ids(list(LIBRARY_NAMES))
-        for name in LIBRARY_NAMES:
-            source, coverage, _ = _library_entry(name)
-            if q and not matches({"symbol": name, "name": FULL_NAMES[name], "source": source, "page": ""}, q):
-                continue
-            materials.append(MaterialSummary(id=name, name=name, kind="library", source=source,
-                                             coverage=coverage, latest_fit_id=latest.get(name),
-                                             share_url=_share(name)))
+        listed = [e["id"] for e in search_catalogue(q) if q or e["preferred"]]
+        latest = store.latest_fit_ids(listed)
+        for material_id in listed:
+            about = library_about(material_id)
+            materials.append(MaterialSummary(id=material_id, name=f"{about['name']} ({about['symbol']})",
+                                             kind="library", source=about["source"],
+                                             coverage=about["coverage"], latest_fit_id=latest.get(material_id),
+                                             share_url=_share(material_id)))
     saved_kinds = tuple(k for k in kinds if k != "library")
     if not saved_kinds:
         return MaterialList(materials=materials)
@@ -102,13 +95,13 @@ def list_materials(
 def get_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialDetail:
     """One material with its latest fit (None for a library material not fitted yet); one in the bin too."""
     latest = with_measured_nk(store, store.latest_fit(material_id))
-    if material_id in LIBRARY_NAMES:
-        source, coverage, wavelength_range = _library_entry(material_id)
+    if material_id in catalogue():
+        about = library_about(material_id)
         return MaterialDetail(
-            id=material_id, name=material_id, kind="library", source=source,
-            coverage=coverage, latest_fit_id=latest.id if latest else None,
+            id=material_id, name=f"{about['name']} ({about['symbol']})", kind="library", source=about["source"],
+            coverage=about["coverage"], latest_fit_id=latest.id if latest else None,
             version=store.material_version(material_id), share_url=_share(material_id),
-            wavelength_range_nm=wavelength_range,
+            wavelength_range_nm=about["wavelength_range_nm"],
             latest_fit=fit_public(latest) if latest else None,
         )
     row = store.material(material_id)

@@ -26,19 +26,21 @@ def run(*args, check=True):
 
 
 @pytest.mark.slow  # starts a process or GL context
-def test_library_lists_22():
+def test_library_lists_the_catalogue():
     # The command itself, as a user types it (the other tests fork it).
     result = subprocess.run([sys.executable, "-m", "fitting", "library"], cwd=ROOT, capture_output=True,
                             text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     lines = result.stdout.strip().splitlines()
-    assert len(lines) == 22 and lines[2].startswith("Au") and "Johnson" in lines[2]
+    assert len(lines) >= 300
+    (gold,) = [line for line in lines if line.startswith("Au ")]
+    assert " gold " in gold and "Johnson" in gold
 
 
 @pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
 def test_fit_writes_binary_pack(tmp_path):
     out = tmp_path / "au.cfpk"
-    run("fit", "Au", "--eta-range", "1:2", "--no-metrics", "-o", str(out))
+    run("fit", "gold", "--eta-range", "1:2", "--no-metrics", "-o", str(out))
     (material,) = decode_pack(out.read_bytes())
     assert material.name == "Au" and material.eta_i_range == (1.0, 2.0)
 
@@ -100,7 +102,7 @@ def test_errors_are_clear():
     result = run("fit", "--page", "main/Ni", check=False)
     assert result.returncode == 2 and "SHELF/BOOK/PAGE" in result.stderr
     result = run("fit", "Unobtainium", check=False)
-    assert result.returncode == 2 and "`material` must be one of" in result.stderr
+    assert result.returncode == 2 and "`material` must name a conductor of the library" in result.stderr
     result = run("fit", "Au", "--eta-range", "2:1", check=False)
     assert result.returncode == 2 and "`eta_i_range` must satisfy" in result.stderr
     result = run("fit", "Au", "--eta-range", "x", check=False)

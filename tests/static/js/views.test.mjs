@@ -1,6 +1,6 @@
 // The pure parts of the studio's views: typed entry's check
 // (entry_view.js parseTyped), the library's search (library_view.js
-// searchLibrary, the service's ?q= rule), links (studio.js linkOf, linkTo)
+// shownLibrary: the service's ?q= answer in its order), links (studio.js linkOf, linkTo)
 // and compare mode's figures (compare_view.js compareFigures).
 
 import assert from "node:assert/strict";
@@ -8,8 +8,8 @@ import { test } from "node:test";
 
 import { compareFigures } from "../../../static/editor/compare_view.js";
 import { parseTyped } from "../../../static/editor/entry_view.js";
-import { searchLibrary } from "../../../static/editor/library_view.js";
-import { linkOf, linkTo } from "../../../static/editor/studio.js";
+import { shownLibrary } from "../../../static/editor/library_view.js";
+import { draftExpiry, linkOf, linkTo } from "../../../static/editor/studio.js";
 
 test("parseTyped: a finite number within [lo, hi], else why (naming the rule and the value)", () => {
   assert.deepEqual(parseTyped(" 1.33 ", 1, 2.5, "ηᵢ"), { value: 1.33 });
@@ -19,18 +19,13 @@ test("parseTyped: a finite number within [lo, hi], else why (naming the rule and
   assert.deepEqual(parseTyped("0", 0, 1, "x"), { value: 0 });
 });
 
-test("searchLibrary: every word in the symbol, name or source, case-insensitive", () => {
-  const library = [
-    { id: "Au", symbol: "Au", name: "Gold", source: "Johnson and Christy" },
-    { id: "Cu", symbol: "Cu", name: "Copper", source: "Johnson and Christy" },
-    { id: "Al", symbol: "Al", name: "Aluminium", source: "Rakic" },
-  ];
-  const ids = (q) => searchLibrary(library, q).map((m) => m.id);
-  assert.deepEqual(ids("gold"), ["Au"]);
-  assert.deepEqual(ids("JOHNSON copper"), ["Cu"]);
-  assert.deepEqual(ids("rakic al"), ["Al"]);
-  assert.deepEqual(ids("  "), ["Au", "Cu", "Al"]);
-  assert.deepEqual(ids("silver"), []);
+test("shownLibrary: the service's matches in its order, or every entry", () => {
+  const materials = [{ id: "Au" }, { id: "Cu" }, { id: "Al" }];
+  const ids = (found) => shownLibrary({ materials, found }).map((m) => m.id);
+  assert.deepEqual(ids(null), ["Au", "Cu", "Al"]);
+  assert.deepEqual(ids(["Cu", "Au"]), ["Cu", "Au"], "the service's rank, not the list's order");
+  assert.deepEqual(ids(["Zz", "Al"]), ["Al"], "an id listed at another eta_i is left out");
+  assert.deepEqual(ids([]), []);
 });
 
 test("links: ?fit= and the service's ?material=&version=", () => {
@@ -50,4 +45,12 @@ test("compareFigures: none until the other curve is in at this eta_i; then mean 
   assert.equal(compareFigures(state), null, "a curve of another eta_i");
   state.compare.eta = "1.50";
   assert.deepEqual(compareFigures(state), { mean: 0, max: 0, atDeg: 0 });
+});
+
+test("draftExpiry: a link to an unsaved edit says it expires and when", () => {
+  const fit = { created_at: Date.UTC(2026, 0, 2, 10, 0) / 1000 };
+  const text = draftExpiry(fit, 86400);
+  assert.match(text, /unsaved edit, kept 24 h: it expires 3 Jan 2026/);
+  assert.match(text, /Save to keep it/);
+  assert.match(draftExpiry(fit, null), /save it to keep the link working/);
 });
