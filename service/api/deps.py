@@ -160,8 +160,9 @@ ERROR_RESPONSES = {
     status.HTTP_503_SERVICE_UNAVAILABLE: _error("The store is unavailable, or the service is busy; see Retry-After"),
 }
 NOT_FOUND = {status.HTTP_404_NOT_FOUND: _error("Not stored")}
-CONFLICT = {status.HTTP_409_CONFLICT: _error("`expected_version` is not the material's version: "
-                                             "another save came first; nothing was saved")}
+CONFLICT = {status.HTTP_409_CONFLICT: _error("`expected_version` is not the material's version, or the "
+                                             "material was renamed or moved to the bin since: the "
+                                             "message names what changed; nothing was saved")}
 FIT_ERROR_RESPONSES = {
     **ERROR_RESPONSES,
     status.HTTP_401_UNAUTHORIZED: _error("Missing or wrong bearer token (when required)"),

@@ -60,13 +60,13 @@ async def create_fit_from_curves(
             model=request.model, live=request.live, start_fit=request.start_fit,
             material_id=request.material_id,
         ))
-    record, created = await fit_from_curves(fit, store, runner, request.expected_version)
+    record, created, restored = await fit_from_curves(fit, store, runner, request.expected_version)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
     curves = None
     if curves_eta_i is not None:
         curves = CurvesPublic(**await run_in_threadpool(angle_curves, record, curves_eta_i, curves_samples))
-    return CurveFitPublic(**dict(fit_public(record)), curves=curves)
+    return CurveFitPublic(**dict(fit_public(record)), curves=curves, restored_from_bin=restored)
 
 
 @router.get("/fits/{fit_id}/error-map", response_model=ErrorMap, responses={**ERROR_RESPONSES, **NOT_FOUND})

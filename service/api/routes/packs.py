@@ -4,8 +4,10 @@ Packs
 
 ``POST /api/v1/packs``: several stored fits in one download (a scene's
 materials together), in any pack format, or their exports for one coating
-index as a zip archive (mtlx, openpbr, blender, gltf). Reads only; saves
-nothing.
+index as a zip archive (mtlx, openpbr, blender, gltf). Saves nothing, but
+may cost seconds of fitting per request, so it needs what writes need
+(:data:`service.api.deps.WriteAccess`: same site, and the bearer token when
+the service requires one).
 """
 
 from fastapi import APIRouter, Response, status
@@ -14,7 +16,7 @@ from fastapi.concurrency import run_in_threadpool
 from ...downloads import EXPORT_MEDIA_TYPES, PACK_CONTENT, pack_response, render_export_pack
 from ...jobs.common import stored_fit
 from ...schemas import API_PREFIX, PackRequest
-from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep
+from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep, WriteAccess
 
 router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 
@@ -22,7 +24,7 @@ router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 @router.post("", response_class=Response, responses={
     status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
     **NOT_FOUND, **FIT_ERROR_RESPONSES,
-})
+}, dependencies=[WriteAccess])
 async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep) -> Response:
     """
     The fits named by ``fit_ids``, in that order, as one pack. A renderer
