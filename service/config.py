@@ -120,6 +120,12 @@ class Settings(BaseSettings):
         ``body_timeout_s`` (else 408).
     keep_alive_s
         An idle keep-alive connection is closed after this many seconds.
+    client_bulk_jobs
+        Reads computed on demand (exports), packs and scenes of one client
+        (its address, or the token's holder) in the fitting pool at once;
+        past it 503 with ``Retry-After``. Unset: ``fit_workers``. Together
+        these bulk jobs hold at most ``fit_queue`` of the pool's slots (at
+        least one): ``fit_workers`` are kept for saves.
     drain_timeout_s
         After SIGTERM (or SIGINT), requests in flight may finish for this
         long; then they are cancelled (their jobs too) and the process
@@ -172,6 +178,7 @@ class Settings(BaseSettings):
     body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
     keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
     drain_timeout_s: float = Field(default=25.0, ge=0.0, le=3600.0)
+    client_bulk_jobs: int | None = Field(default=None, ge=1, le=10_000)
     max_connections: int = Field(default=512, ge=8, le=100_000)
     max_connections_per_client: int = Field(default=128, ge=1, le=100_000)
     store_max_bytes: int | None = Field(default=None, ge=100_000)

@@ -9,7 +9,8 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``RequestValidationError``             422, naming each field and rule
 ``ValueError`` (the core's refusals)   422 (also ``JobCPULimit``)
 ``LookupError`` (not stored)           404
-``Overloaded`` / ``WorkerLost``        503 with ``Retry-After`` (also ``PreviewsBusy``, ``RenderWorkerLost``)
+``Overloaded`` / ``WorkerLost``        503 with ``Retry-After`` (also ``PreviewsBusy``, ``RenderWorkerLost``,
+                                      ``ShareExceeded``: a client past its share of the fitting pool)
 ``FitTimeout``                         504 with ``Retry-After`` (also ``PreviewTimeout``)
 ``RendererUnavailable``                503 (no GL context on this machine)
 ``StoreFull``                          507
@@ -35,6 +36,7 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from ..pool import FitTimeout, Overloaded, WorkerLost
+from ..shares import ShareExceeded
 from ..previews import RendererUnavailable
 from ..store import StoreError
 
@@ -122,7 +124,7 @@ async def _lookup_error(request: Request, error: LookupError) -> JSONResponse:
     return error_response(status.HTTP_404_NOT_FOUND, str(error.args[0] if error.args else error)[:2000])
 
 
-async def _busy(request: Request, error: Overloaded | WorkerLost) -> JSONResponse:
+async def _busy(request: Request, error: Overloaded | WorkerLost | ShareExceeded) -> JSONResponse:
     return error_response(status.HTTP_503_SERVICE_UNAVAILABLE, str(error),
                           headers={"Retry-After": str(error.retry_after)})
 
@@ -162,6 +164,7 @@ def install_error_handlers(app: FastAPI) -> None:
     app.add_exception_handler(ValueError, _value_error)
     app.add_exception_handler(LookupError, _lookup_error)
     app.add_exception_handler(Overloaded, _busy)
+    app.add_exception_handler(ShareExceeded, _busy)
     app.add_exception_handler(WorkerLost, _busy)
     app.add_exception_handler(FitTimeout, _timeout)
     app.add_exception_handler(RendererUnavailable, _no_renderer)
