@@ -11,7 +11,9 @@ scenes; a request with the token is the token's holder's):
 -   3 maximal scenes (64 materials x 32 eta_i: 2,048 parts each) from three
     other addresses: the same;
 -   a scene past what one request may use is refused up front (422 naming
-    the limit).
+    the limit);
+-   ``/healthz`` answers at once while another process holds the store's
+    write lock.
 
 Before, one bound (workers + queue) fed cheapest-first let the loops hold
 every slot (14 of 17 writes 503) and the scenes every worker (a save took
@@ -21,6 +23,7 @@ every slot (14 of 17 writes 503) and the scenes every worker (a save took
 from __future__ import annotations
 
 import random
+import sqlite3
 import statistics
 import threading
 import time
@@ -127,6 +130,20 @@ def test_maximal_scenes_leave_the_writers_their_share(server):
     writes, saves = _under(server, fit_id, idle, [scene_from(f"127.0.0.{i}") for i in (2, 3, 4)])
     assert writes.count(201) >= 0.95 * len(writes), writes
     assert statistics.median(saves) <= 3 * idle, (saves, idle)
+
+
+def test_healthz_never_waits_for_the_store_s_write_lock(server):
+    server, _, _ = server
+    holder = sqlite3.connect(server.data_dir / "store.sqlite3", isolation_level=None)
+    holder.execute("BEGIN IMMEDIATE")  # another process holds the write lock (it took /healthz 30.2 s)
+    try:
+        started = time.perf_counter()
+        health = loopback.get(f"{server.url}/healthz", timeout=60)
+        assert health.status_code == 200 and health.json()["store_writable"] is True
+        assert time.perf_counter() - started < 2.0
+    finally:
+        holder.execute("ROLLBACK")
+        holder.close()
 
 
 def test_a_scene_past_what_one_request_may_use_is_refused_up_front(tmp_path):

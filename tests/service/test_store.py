@@ -282,6 +282,22 @@ class TestSQLiteStore:
             assert connection.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
         store.close()
 
+    def test_the_writable_probe_never_waits_for_another_writer_s_lock(self, tmp_path):
+        import time
+
+        store = SQLiteStore(tmp_path / "store.sqlite3")
+        holder = sqlite3.connect(store.path, isolation_level=None)
+        holder.execute("BEGIN IMMEDIATE")  # another process's long write transaction
+        try:
+            started = time.perf_counter()
+            store.ping()
+            assert store.writable() is None and time.perf_counter() - started < 1.0  # it waited 30 s
+        finally:
+            holder.execute("ROLLBACK")
+            holder.close()
+        store.put_fit(record("1" * 32))  # the probe left the saves' own wait for the lock as it was
+        store.close()
+
     def test_store_from_before_the_save_log_is_read(self, tmp_path):
         import sqlite3
 
