@@ -214,6 +214,19 @@ def test_identical_saves_are_one_version(http):
     assert http.get(f"{API}/materials/Ag").json()["version"] == 1
 
 
+def test_names_are_one_spelling_visible_and_not_a_built_in_material_s(http):
+    nfd = save(http, "Cafe\u0301 brass", 0.9)
+    nfc = save(http, "Caf\u00e9 brass", 0.85)
+    assert nfd.status_code == 201 and nfc.json()["material_id"] == nfd.json()["material_id"]
+    assert nfc.json()["name"] == "Caf\u00e9 brass"
+    material_id = nfd.json()["material_id"]
+    for name, rule in (("Au", "reserved"), ("gold", "reserved"), ("\u200b\u200b", "visible character"),
+                       ("brass\u202eevil", "bidirectional control")):
+        renamed = http.patch(f"{API}/materials/{material_id}", json={"name": name}, headers=AUTH)
+        assert renamed.status_code == 422 and rule in renamed.json()["detail"], renamed.text
+        assert save(http, name, 0.8).status_code == 422
+
+
 def test_packs_need_the_token(http, brass):
     body = {"fit_ids": [brass[0]["id"]], "format": "json"}
     refused = http.post(f"{API}/packs", json=body)
