@@ -14,6 +14,7 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``FitTimeout``                         504 with ``Retry-After`` (also ``PreviewTimeout``)
 ``RendererUnavailable``                503 (no GL context on this machine)
 ``StoreFull``                          507
+OSError ENOSPC/EDQUOT under a body     507 with ``Retry-After`` (the temporary directory is full)
 ``StoreUnavailable``                   503 with ``Retry-After``
 ``StoreConflict``                      409 (another save came first; ``NameTaken``: the name is another's)
 ``RecordDamaged``                      500 (only that record)
@@ -26,6 +27,7 @@ the service's own code is a bug, not bad input: 500, never 404 or 422.
 
 from __future__ import annotations
 
+import errno
 import logging
 from typing import Any
 
@@ -95,7 +97,17 @@ async def _validation_error(request: Request, error: RequestValidationError) -> 
 _UNPARSABLE_BODY = "There was an error parsing the body"
 
 
+_NO_SPACE = (errno.ENOSPC, errno.EDQUOT)
+
+
 async def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
+    cause = error.__cause__
+    if isinstance(cause, OSError) and cause.errno in _NO_SPACE:
+        # The body was spooled to a full temporary directory: the server's fault, not the file's.
+        log.error("a request body could not be spooled: %s", cause)
+        return error_response(status.HTTP_507_INSUFFICIENT_STORAGE, (
+            "the server's temporary directory is full: the upload could not be received; nothing was "
+            "fitted; retry later"), headers={"Retry-After": "60"})
     if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail != _UNPARSABLE_BODY:
         # Starlette's multipart parser (a missing boundary, too many fields
         # or files): the body is invalid, as every other unparsable body.
