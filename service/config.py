@@ -126,6 +126,11 @@ class Settings(BaseSettings):
         past it 503 with ``Retry-After``. Unset: ``fit_workers``. Together
         these bulk jobs hold at most ``fit_queue`` of the pool's slots (at
         least one): ``fit_workers`` are kept for saves.
+    saves_per_client_per_minute
+        Saves (``POST /fits``, ``/fits/upload``, a non-draft
+        ``/fits/from-curves``) of one client (address, or the token's
+        holder) in any minute, per replica; past it 429 with
+        ``Retry-After``.
     drain_timeout_s
         After SIGTERM (or SIGINT), requests in flight may finish for this
         long; then they are cancelled (their jobs too) and the process
@@ -179,6 +184,7 @@ class Settings(BaseSettings):
     keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
     drain_timeout_s: float = Field(default=25.0, ge=0.0, le=3600.0)
     client_bulk_jobs: int | None = Field(default=None, ge=1, le=10_000)
+    saves_per_client_per_minute: int = Field(default=600, ge=1, le=1_000_000)
     max_connections: int = Field(default=512, ge=8, le=100_000)
     max_connections_per_client: int = Field(default=128, ge=1, le=100_000)
     store_max_bytes: int | None = Field(default=None, ge=100_000)

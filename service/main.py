@@ -36,6 +36,7 @@ from .pool import FitRunner, warm_process
 from .worker import freeze_heap, thaw_heap
 from .previews import PreviewRunner
 from .schemas import API_PREFIX
+from .shares import SaveRate
 from .store import StoreError, open_store
 
 log = logging.getLogger("service.store")
@@ -123,6 +124,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s,
                                  settings.job_cpu_limit_s)
         app.state.store, app.state.runner, app.state.previews = store, runner, previews
+        app.state.save_rate = SaveRate(settings.saves_per_client_per_minute)
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:

@@ -23,6 +23,9 @@ and every worker while the writers waited or got 503. The pool
     (``charge``); it decays with a half-life of :data:`HALF_LIFE_S`, and a
     bulk client's waiting parts are ordered by it (:meth:`Shares.rank`),
     so the client that used least goes first.
+-   :class:`SaveRate`: saves (new versions) per client per minute, at
+    most ``per_minute``; past it :class:`TooManySaves` (429 with
+    ``Retry-After``).
 
 The turns in the workers (:class:`service.turns.Turns`) put every waiting
 interactive part before every bulk one, and keep one general worker of
@@ -31,13 +34,15 @@ two or more for interactive parts.
 
 from __future__ import annotations
 
+import collections
 import contextvars
 import math
 import threading
 import time
 from dataclasses import dataclass
 
-__all__ = ["Claim", "CLAIM", "KINDS", "INTERACTIVE", "Shares", "ShareExceeded", "HALF_LIFE_S"]
+__all__ = ["Claim", "CLAIM", "KINDS", "INTERACTIVE", "Shares", "ShareExceeded", "HALF_LIFE_S", "SaveRate",
+           "TooManySaves"]
 
 KINDS = ("save", "scene", "pack", "read")
 """The kinds of work, as the pool accounts them."""
@@ -150,3 +155,42 @@ class Shares:
     def bulk_in_flight(self) -> int:
         with self._lock:
             return self._bulk
+
+
+class TooManySaves(Exception):
+    """A client past its saves per minute (429, ``retry_after`` s)."""
+
+    def __init__(self, retry_after: int, message: str) -> None:
+        super().__init__(message)
+        self.retry_after = retry_after
+
+
+class SaveRate:
+    """
+    At most ``per_minute`` saves of one client (:class:`Claim` ``client``)
+    in any 60 s, counted in this process (a replica's own). Thread-safe.
+    """
+
+    def __init__(self, per_minute: int) -> None:
+        if per_minute < 1:
+            raise ValueError(f"`per_minute` must be >= 1, got {per_minute}")
+        self.per_minute = per_minute
+        self._lock = threading.Lock()
+        self._times: dict[str, collections.deque] = {}
+
+    def note(self, claim: Claim) -> None:
+        """Count one save of ``claim``'s client now, or raise :class:`TooManySaves` past the rate."""
+        now = time.monotonic()
+        with self._lock:
+            times = self._times.setdefault(claim.client, collections.deque())
+            while times and times[0] <= now - 60.0:
+                times.popleft()
+            if len(times) >= self.per_minute:
+                wait = max(1, math.ceil(times[0] + 60.0 - now))
+                raise TooManySaves(wait, (
+                    f"this client saved {len(times)} times in the last minute, the most it may "
+                    f"(COATED_SAVES_PER_CLIENT_PER_MINUTE); retry in about {wait} s"))
+            times.append(now)
+            if len(self._times) > _CLIENTS_KEPT:  # forget the clients whose window has ended
+                for client in [c for c, t in self._times.items() if not t or t[-1] <= now - 60.0]:
+                    del self._times[client]

@@ -14,6 +14,9 @@ Dependencies
     endpoints.
 -   :data:`SingleFormFields`: a form field given twice (two ``file`` parts)
     is refused (422), not resolved silently to the last.
+-   :data:`SaveRateDep`: the app's saves per client per minute
+    (:class:`service.shares.SaveRate`); a save route counts itself there
+    once its input is valid.
 -   :data:`PreviewsDep`: the app's render pool (previews and GL textures,
     :class:`service.previews.PreviewRunner`).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
@@ -33,6 +36,7 @@ from ..jobs.common import stored_fit
 from ..pool import FitRunner
 from ..previews import PreviewRunner
 from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody
+from ..shares import SaveRate
 from ..store import FitRecord, Store
 
 __all__ = [
@@ -48,6 +52,7 @@ __all__ = [
     "WriteAccess",
     "SingleFormFields",
     "PreviewsDep",
+    "SaveRateDep",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
     "NOT_FOUND",
@@ -71,10 +76,15 @@ def get_previews(request: Request) -> PreviewRunner:
     return request.app.state.previews
 
 
+def get_save_rate(request: Request) -> SaveRate:
+    return request.app.state.save_rate
+
+
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 StoreDep = Annotated[Store, Depends(get_store)]
 RunnerDep = Annotated[FitRunner, Depends(get_runner)]
 PreviewsDep = Annotated[PreviewRunner, Depends(get_previews)]
+SaveRateDep = Annotated[SaveRate, Depends(get_save_rate)]
 FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 MaterialIdPath = Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
                                      description="A library name or a saved material's id")]
@@ -169,6 +179,7 @@ FIT_ERROR_RESPONSES = {
     status.HTTP_403_FORBIDDEN: _error("A cross-site write from a browser (Origin of another site)"),
     status.HTTP_408_REQUEST_TIMEOUT: _error("The body arrived slower than COATED_BODY_TIMEOUT_S"),
     status.HTTP_413_CONTENT_TOO_LARGE: _error("The body is larger than the limit"),
+    status.HTTP_429_TOO_MANY_REQUESTS: _error("A save past COATED_SAVES_PER_CLIENT_PER_MINUTE; see Retry-After"),
     status.HTTP_503_SERVICE_UNAVAILABLE: _error("Too many fits in flight, a worker died twice, "
                                                 "or the store is unavailable; see Retry-After"),
     status.HTTP_504_GATEWAY_TIMEOUT: _error("The fit ran past its time limit; it goes on, retry "

@@ -14,6 +14,7 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``FitTimeout``                         504 with ``Retry-After`` (also ``PreviewTimeout``)
 ``RendererUnavailable``                503 (no GL context on this machine)
 ``StoreFull``                          507
+``TooManySaves``                       429 with ``Retry-After`` (saves per client per minute)
 OSError ENOSPC/EDQUOT under a body     507 with ``Retry-After`` (the temporary directory is full)
 ``StoreUnavailable``                   503 with ``Retry-After``
 ``StoreConflict``                      409 (another save came first; ``NameTaken``: the name is another's)
@@ -38,7 +39,7 @@ from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from ..pool import FitTimeout, Overloaded, WorkerLost
-from ..shares import ShareExceeded
+from ..shares import ShareExceeded, TooManySaves
 from ..previews import RendererUnavailable
 from ..store import StoreError
 
@@ -141,6 +142,11 @@ async def _busy(request: Request, error: Overloaded | WorkerLost | ShareExceeded
                           headers={"Retry-After": str(error.retry_after)})
 
 
+async def _too_many(request: Request, error: TooManySaves) -> JSONResponse:
+    return error_response(status.HTTP_429_TOO_MANY_REQUESTS, str(error),
+                          headers={"Retry-After": str(error.retry_after)})
+
+
 async def _timeout(request: Request, error: FitTimeout) -> JSONResponse:
     return error_response(status.HTTP_504_GATEWAY_TIMEOUT, str(error),
                           headers={"Retry-After": str(error.retry_after)})
@@ -177,6 +183,7 @@ def install_error_handlers(app: FastAPI) -> None:
     app.add_exception_handler(LookupError, _lookup_error)
     app.add_exception_handler(Overloaded, _busy)
     app.add_exception_handler(ShareExceeded, _busy)
+    app.add_exception_handler(TooManySaves, _too_many)
     app.add_exception_handler(WorkerLost, _busy)
     app.add_exception_handler(FitTimeout, _timeout)
     app.add_exception_handler(RendererUnavailable, _no_renderer)

@@ -26,9 +26,11 @@ import time
 from typing import Any, Callable
 
 from .migrations import UPSERT_MATERIAL
-from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict
+from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict, StoreFull
 
 INT64_MAX = 2**63 - 1
+MAX_VERSIONS_PER_MATERIAL = 10_000
+"""The most versions one material keeps; a save past them is refused (507): its history is bounded."""
 
 __all__ = ["save", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
            "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
@@ -65,6 +67,9 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
             and row.name == summary_text(stored.name):
         return stored  # nothing changed (a repeat, or this very save retried): no new version
     check_expected(row, stored.material_id, stored.name, expected_version)
+    if row is not None and row.version >= MAX_VERSIONS_PER_MATERIAL:
+        raise StoreFull(f"material {stored.name!r} ({stored.material_id}) has {row.version} versions, the most "
+                        f"one material keeps ({MAX_VERSIONS_PER_MATERIAL}); save it under another name")
     if stored.kind == "curves":
         # An edited material is found by its name: another one given this name
         # since the save chose its material (a rename at the same moment) wins.

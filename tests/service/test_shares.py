@@ -116,3 +116,36 @@ def test_one_worker_is_shared_and_bulk_parts_never_take_express_turns():
         return started
 
     assert asyncio.run(body()) == ["read", "live step", "cheap read"]
+
+
+def test_save_rate_per_client_per_minute(monkeypatch):
+    import service.shares as module
+    from service.shares import SaveRate, TooManySaves
+
+    now = [500.0]
+    monkeypatch.setattr(module.time, "monotonic", lambda: now[0])
+    rate, a, b = SaveRate(2), Claim("10.0.0.1", "save"), Claim("token", "save")
+    rate.note(a)
+    now[0] += 20.0
+    rate.note(a)
+    with pytest.raises(TooManySaves, match="saved 2 times in the last minute") as refused:
+        rate.note(a)
+    assert refused.value.retry_after == 40
+    rate.note(b)  # another client keeps its own
+    now[0] += 40.0
+    rate.note(a)  # the first save has left the window
+
+
+@pytest.mark.slow  # starts the fitting pool's processes
+def test_saves_past_the_rate_are_429_with_retry_after(tmp_path):
+    from conftest import app_client
+
+    with app_client(tmp_path, saves_per_client_per_minute=2, metrics_samples=10) as client:
+        answers = [client.post("/api/v1/fits", json={"material": "Au"}) for _ in range(3)]
+        draft = client.post("/api/v1/fits/from-curves", json={"draft": True, "base": {"material": "Au"}, "curves": [
+            {"eta_i": 1.5, "angle_deg": [0, 30, 60, 75, 90],
+             "rgb": [[0.9, 0.7, 0.35], [0.9, 0.7, 0.35], [0.88, 0.69, 0.36], [0.85, 0.7, 0.45], [1, 1, 1]]}]})
+    assert [a.status_code for a in answers] == [201, 200, 429], answers[2].text
+    assert "COATED_SAVES_PER_CLIENT_PER_MINUTE" in answers[2].json()["detail"]
+    assert int(answers[2].headers["retry-after"]) >= 1
+    assert draft.status_code == 201, draft.text  # a draft is not a save: never counted

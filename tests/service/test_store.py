@@ -114,6 +114,18 @@ class TestStoreContract:
         store.put_fit(first)  # an earlier state saved again: a change, so a version
         assert store.material_version(m) == 3
 
+    def test_versions_per_material_are_bounded(self, store, monkeypatch):
+        from service.store import StoreFull, queries
+
+        monkeypatch.setattr(queries, "MAX_VERSIONS_PER_MATERIAL", 3)
+        m = "b" * 32
+        for i in range(3):
+            store.put_fit(record(f"{i + 1:032x}", material_id=m, kind="curves", name="A"))
+        with pytest.raises(StoreFull, match="has 3 versions, the most one material keeps"):
+            store.put_fit(record(f"{9:032x}", material_id=m, kind="curves", name="A"))
+        assert store.material_version(m) == 3 and store.get_fit(f"{9:032x}") is None
+        assert store.put_fit(record(f"{3:032x}", material_id=m, kind="curves", name="A")).id == f"{3:032x}"
+
     def test_a_stale_save_does_not_undo_a_rename_or_a_delete(self, store):
         m = "s" * 32
         first = store.put_fit(record("1" * 32, material_id=m, kind="curves", name="A"))

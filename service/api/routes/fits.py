@@ -27,10 +27,11 @@ from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
 from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_OBJECTIVE, ETA_I_LIMITS, PACK_FORMATS,
                         CurvesPublic, FitPublic, FitRequest, Objective, fit_public)
+from ...shares import CLAIM
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
                     MinCoverageForm, RoughnessQuery, RunnerDep, SettingsDep, SingleFormFields, StoredFit,
-                    StoreDep, WriteAccess)
+                    SaveRateDep, StoreDep, WriteAccess)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -52,13 +53,14 @@ def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPubli
 @router.post("", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
              responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess])
 async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, settings: SettingsDep,
-                     response: Response) -> FitPublic:
+                     response: Response, rate: SaveRateDep) -> FitPublic:
     """
     Fit a built-in material (``{"material": "Au"}``) or inline n, k
     (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) over
     ``eta_i_range``; the answer carries the float16 coefficients, Delta E
     2000 of the model and of adjusted Lazanyi, and timings.
     """
+    rate.note(CLAIM.get())  # a save: counted against its client's saves per minute (429 past them)
     runner.check_capacity()
     if request.material is not None:
         fit = await run_in_threadpool(NKFit.library, request.material, request.eta_i_range,
@@ -71,10 +73,11 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
 
 
 @router.post("/upload", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
-             responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess, SingleFormFields])
+             responses={**CREATED, **FIT_ERROR_RESPONSES},
+             dependencies=[WriteAccess, SingleFormFields])
 async def upload_fit(
     file: Annotated[UploadFile, File(description="n, k as CSV, JSON or refractiveindex.info YAML")],
-    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response,
+    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response, rate: SaveRateDep,
     format: Annotated[str | None, Form(pattern=r"^(csv|json|yaml|yml)$",
                                        description="Default: from the file name")] = None,
     name: Annotated[str | None, Form(min_length=1, max_length=200, pattern=r"\S")] = None,
@@ -88,6 +91,7 @@ async def upload_fit(
     file is parsed, never stored or executed as given; the fit keeps its
     n, k as numbers. The data must cover 90% of 360-830 nm, or `min_coverage` when it asks more.
     """
+    rate.note(CLAIM.get())
     runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
