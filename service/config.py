@@ -128,6 +128,22 @@ class Settings(BaseSettings):
         ``body_timeout_s`` (else 408).
     keep_alive_s
         An idle keep-alive connection is closed after this many seconds.
+    client_bulk_jobs
+        Reads computed on demand (exports), packs and scenes of one client
+        (its address, or the token's holder) in the fitting pool at once;
+        past it 503 with ``Retry-After``. Unset: ``fit_workers``. Together
+        these bulk jobs hold at most ``fit_queue`` of the pool's slots (at
+        least one): ``fit_workers`` are kept for saves.
+    saves_per_client_per_minute
+        Saves (``POST /fits``, ``/fits/upload``, a non-draft
+        ``/fits/from-curves``) of one client (address, or the token's
+        holder) in any minute, per replica; past it 429 with
+        ``Retry-After``.
+    drain_timeout_s
+        After SIGTERM (or SIGINT), requests in flight may finish for this
+        long; then they are cancelled (their jobs too) and the process
+        exits. Shorter than common supervisors' grace (Kubernetes' and
+        systemd's 30 s, Docker's 10 s: set it below that one).
     max_connections
         Connections at once. A new connection past it closes the longest
         idle one (no request in progress); with none idle it is admitted
@@ -179,6 +195,9 @@ class Settings(BaseSettings):
     header_timeout_s: float = Field(default=10.0, gt=0.0, le=600.0)
     body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
     keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
+    drain_timeout_s: float = Field(default=25.0, ge=0.0, le=3600.0)
+    client_bulk_jobs: int | None = Field(default=None, ge=1, le=10_000)
+    saves_per_client_per_minute: int = Field(default=600, ge=1, le=1_000_000)
     max_connections: int = Field(default=512, ge=8, le=100_000)
     max_connections_per_client: int = Field(default=128, ge=1, le=100_000)
     store_max_bytes: int | None = Field(default=None, ge=100_000)

@@ -28,13 +28,13 @@ from fastapi.staticfiles import StaticFiles
 from fitting.cli.plugins import load_plugins
 
 from .api.errors import install_error_handlers
-from .api.middleware import FrameDenial, HostAllowList, RequestLimits
+from .api.middleware import ClaimWork, FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
     curves, environments, fits, health, ibl, imports, library, materials, packs, preview, reference_texture,
     scenes, versions,
 )
 from .config import Settings
-from .runtime import FitRunner, PreviewRunner, freeze_heap, thaw_heap, warm_process
+from .runtime import FitRunner, PreviewRunner, SaveRate, freeze_heap, thaw_heap, warm_process
 from .derived import DerivedCache
 from .jobs.evaluation import Evaluations
 from .schemas import API_PREFIX
@@ -120,7 +120,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         store = await asyncio.to_thread(open_store, settings)
         await asyncio.to_thread(store.check)
         runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
-                           settings.job_cpu_limit_s, express_workers=settings.fit_express_workers)
+                           settings.job_cpu_limit_s, express_workers=settings.fit_express_workers,
+                           client_bulk_jobs=settings.client_bulk_jobs)
         # Its processes start on the first preview: a service that draws none starts none.
         previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s,
                                  settings.job_cpu_limit_s)
@@ -128,6 +129,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         # New fits' metrics, evaluated when the pool is idle (or when asked for).
         app.state.evaluations = Evaluations(store, runner, settings.metrics_idle_s or None)
         app.state.derived = DerivedCache(settings.derived_cache_bytes)
+        app.state.save_rate = SaveRate(settings.saves_per_client_per_minute)
         sweeper = asyncio.create_task(_sweep_drafts(store, settings))
         try:
             if settings.warm_pool:
@@ -178,6 +180,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
             CORSMiddleware, allow_origins=settings.cors_origins,
             allow_methods=["GET", "POST", "PATCH", "DELETE"], allow_headers=["Authorization", "Content-Type"],
         )
+    token = settings.api_token.get_secret_value() if settings.api_token else None
+    app.add_middleware(ClaimWork, token=token, scene_path=f"{API_PREFIX}/scenes", pack_path=f"{API_PREFIX}/packs",
+                       save_paths=tuple(f"{API_PREFIX}/fits{p}" for p in ("", "/upload", "/from-curves")))
     app.add_middleware(
         RequestLimits, max_body_bytes=settings.max_body_bytes,
         max_upload_bytes=settings.max_upload_bytes,

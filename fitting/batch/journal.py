@@ -17,8 +17,11 @@ record before and after it is kept.
 The journal holds an exclusive lock on the directory (``flock`` on
 ``.lock``) while it is open: a second batch on the same directory is
 refused at once instead of fitting every page again beside the first. The
-journal and the lock file are opened with ``O_NOFOLLOW``: a link planted
-under their names is refused, never written through.
+journal and the lock file are opened with ``O_NOFOLLOW`` and
+``O_NONBLOCK``, and must be regular files: a link planted under their names
+is refused, never written through, and a FIFO or a device is refused
+instead of hanging the batch. A journal larger than
+:data:`MAX_JOURNAL_BYTES` is refused before a byte of it is read.
 """
 
 from __future__ import annotations
@@ -27,14 +30,18 @@ import errno
 import fcntl
 import json
 import os
+import stat
 from pathlib import Path
 from typing import Any
 
-__all__ = ["JOURNAL_NAME", "LOCK_NAME", "Journal"]
+__all__ = ["JOURNAL_NAME", "LOCK_NAME", "MAX_JOURNAL_BYTES", "Journal"]
 
 JOURNAL_NAME = "journal.jsonl"
 LOCK_NAME = ".lock"
 _FORMAT = "fitting-batch-journal/1"
+
+MAX_JOURNAL_BYTES = 256 * 2**20
+"""The largest journal a batch reads (256 MiB; a page's record is about 1-3 kB, so some 100,000 pages)."""
 
 
 class Journal:
@@ -69,6 +76,10 @@ class Journal:
             raise
 
     def _load(self, fd: int, header: dict[str, Any]) -> None:
+        size = os.fstat(fd).st_size
+        if size > MAX_JOURNAL_BYTES:
+            raise ValueError(f"`output` {self.path} holds {size} bytes, more than a batch journal may "
+                             f"({MAX_JOURNAL_BYTES}); choose another output directory")
         with os.fdopen(os.dup(fd), "rb") as f:
             data = f.read()
         lines = data.split(b"\n")
@@ -115,13 +126,28 @@ class Journal:
 
 
 def _open_nofollow(path: Path, flags: int) -> int:
-    """``os.open`` that refuses a link at ``path`` (``ValueError`` naming it)."""
+    """
+    ``os.open`` of a regular file that refuses a link at ``path``, and a
+    FIFO, socket or device (opened without blocking, then checked):
+    ``ValueError`` naming it.
+    """
     try:
-        return os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+        fd = os.open(path, flags | os.O_NOFOLLOW | os.O_CLOEXEC | os.O_NONBLOCK, 0o644)
     except OSError as error:
         if error.errno == errno.ELOOP:
             raise ValueError(f"`output` {path} is a symbolic link; a batch writes only its own files") from None
+        if error.errno == errno.ENXIO:  # a FIFO without a reader, opened for writing
+            raise ValueError(f"`output` {path} is not a regular file (a FIFO); a batch opens only its own "
+                             "files") from None
         raise
+    mode = os.fstat(fd).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(fd)
+        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else (
+            "a directory" if stat.S_ISDIR(mode) else "a socket or other special file")
+        raise ValueError(f"`output` {path} is not a regular file ({kind}); a batch opens only its own files")
+    os.set_blocking(fd, True)
+    return fd
 
 
 def _lock_directory(directory: Path) -> int:

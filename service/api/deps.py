@@ -15,6 +15,9 @@ Dependencies
     endpoints.
 -   :data:`SingleFormFields`: a form field given twice (two ``file`` parts)
     is refused (422), not resolved silently to the last.
+-   :data:`SaveRateDep`: the app's saves per client per minute
+    (:class:`service.runtime.shares.SaveRate`); a save route counts itself there
+    once its input is valid.
 -   :data:`PreviewsDep`: the app's render pool (previews and GL textures,
     :class:`service.runtime.previews.PreviewRunner`).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
@@ -31,7 +34,7 @@ from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
 from ..jobs.common import stored_fit
-from ..runtime import FitRunner, PreviewRunner
+from ..runtime import FitRunner, PreviewRunner, SaveRate
 from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody, WorkingSpace
 from ..store import FitRecord, Store
 
@@ -50,6 +53,7 @@ __all__ = [
     "WriteAccess",
     "SingleFormFields",
     "PreviewsDep",
+    "SaveRateDep",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
     "NOT_FOUND",
@@ -73,10 +77,15 @@ def get_previews(request: Request) -> PreviewRunner:
     return request.app.state.previews
 
 
+def get_save_rate(request: Request) -> SaveRate:
+    return request.app.state.save_rate
+
+
 SettingsDep = Annotated[Settings, Depends(get_settings)]
 StoreDep = Annotated[Store, Depends(get_store)]
 RunnerDep = Annotated[FitRunner, Depends(get_runner)]
 PreviewsDep = Annotated[PreviewRunner, Depends(get_previews)]
+SaveRateDep = Annotated[SaveRate, Depends(get_save_rate)]
 FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 MaterialIdPath = Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
                                      description="A library name or a saved material's id")]
@@ -168,14 +177,16 @@ ERROR_RESPONSES = {
     status.HTTP_503_SERVICE_UNAVAILABLE: _error("The store is unavailable, or the service is busy; see Retry-After"),
 }
 NOT_FOUND = {status.HTTP_404_NOT_FOUND: _error("Not stored")}
-CONFLICT = {status.HTTP_409_CONFLICT: _error("`expected_version` is not the material's version: "
-                                             "another save came first; nothing was saved")}
+CONFLICT = {status.HTTP_409_CONFLICT: _error("`expected_version` is not the material's version, or the "
+                                             "material was renamed or moved to the bin since: the "
+                                             "message names what changed; nothing was saved")}
 FIT_ERROR_RESPONSES = {
     **ERROR_RESPONSES,
     status.HTTP_401_UNAUTHORIZED: _error("Missing or wrong bearer token (when required)"),
     status.HTTP_403_FORBIDDEN: _error("A cross-site write from a browser (Origin of another site)"),
     status.HTTP_408_REQUEST_TIMEOUT: _error("The body arrived slower than COATED_BODY_TIMEOUT_S"),
     status.HTTP_413_CONTENT_TOO_LARGE: _error("The body is larger than the limit"),
+    status.HTTP_429_TOO_MANY_REQUESTS: _error("A save past COATED_SAVES_PER_CLIENT_PER_MINUTE; see Retry-After"),
     status.HTTP_503_SERVICE_UNAVAILABLE: _error("Too many fits in flight, a worker died twice, "
                                                 "or the store is unavailable; see Retry-After"),
     status.HTTP_504_GATEWAY_TIMEOUT: _error("The fit ran past its time limit; it goes on, retry "

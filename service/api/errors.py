@@ -9,10 +9,13 @@ The one place where exceptions become HTTP answers; every 4xx and 5xx is
 ``RequestValidationError``             422, naming each field and rule
 ``ValueError`` (the core's refusals)   422 (also ``JobCPULimit``)
 ``LookupError`` (not stored)           404
-``Overloaded`` / ``WorkerLost``        503 with ``Retry-After`` (also ``PreviewsBusy``, ``RenderWorkerLost``)
+``Overloaded`` / ``WorkerLost``        503 with ``Retry-After`` (also ``PreviewsBusy``, ``RenderWorkerLost``,
+                                      ``ShareExceeded``: a client past its share of the fitting pool)
 ``FitTimeout``                         504 with ``Retry-After`` (also ``PreviewTimeout``)
 ``RendererUnavailable``                503 (no GL context on this machine)
 ``StoreFull``                          507
+``TooManySaves``                       429 with ``Retry-After`` (saves per client per minute)
+OSError ENOSPC/EDQUOT under a body     507 with ``Retry-After`` (the temporary directory is full)
 ``StoreUnavailable``                   503 with ``Retry-After``
 ``StoreConflict``                      409 (another save came first; ``NameTaken``: the name is another's)
 ``RecordDamaged``                      500 (only that record)
@@ -25,6 +28,7 @@ the service's own code is a bug, not bad input: 500, never 404 or 422.
 
 from __future__ import annotations
 
+import errno
 import logging
 from typing import Any
 
@@ -34,7 +38,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from ..runtime import FitTimeout, Overloaded, RendererUnavailable, WorkerLost
+from ..runtime import FitTimeout, Overloaded, RendererUnavailable, ShareExceeded, TooManySaves, WorkerLost
 from ..store import StoreError
 
 __all__ = ["install_error_handlers", "error_response"]
@@ -92,7 +96,17 @@ async def _validation_error(request: Request, error: RequestValidationError) -> 
 _UNPARSABLE_BODY = "There was an error parsing the body"
 
 
+_NO_SPACE = (errno.ENOSPC, errno.EDQUOT)
+
+
 async def _http_error(request: Request, error: StarletteHTTPException) -> JSONResponse:
+    cause = error.__cause__
+    if isinstance(cause, OSError) and cause.errno in _NO_SPACE:
+        # The body was spooled to a full temporary directory: the server's fault, not the file's.
+        log.error("a request body could not be spooled: %s", cause)
+        return error_response(status.HTTP_507_INSUFFICIENT_STORAGE, (
+            "the server's temporary directory is full: the upload could not be received; nothing was "
+            "fitted; retry later"), headers={"Retry-After": "60"})
     if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail != _UNPARSABLE_BODY:
         # Starlette's multipart parser (a missing boundary, too many fields
         # or files): the body is invalid, as every other unparsable body.
@@ -121,8 +135,13 @@ async def _lookup_error(request: Request, error: LookupError) -> JSONResponse:
     return error_response(status.HTTP_404_NOT_FOUND, str(error.args[0] if error.args else error)[:2000])
 
 
-async def _busy(request: Request, error: Overloaded | WorkerLost) -> JSONResponse:
+async def _busy(request: Request, error: Overloaded | WorkerLost | ShareExceeded) -> JSONResponse:
     return error_response(status.HTTP_503_SERVICE_UNAVAILABLE, str(error),
+                          headers={"Retry-After": str(error.retry_after)})
+
+
+async def _too_many(request: Request, error: TooManySaves) -> JSONResponse:
+    return error_response(status.HTTP_429_TOO_MANY_REQUESTS, str(error),
                           headers={"Retry-After": str(error.retry_after)})
 
 
@@ -161,6 +180,8 @@ def install_error_handlers(app: FastAPI) -> None:
     app.add_exception_handler(ValueError, _value_error)
     app.add_exception_handler(LookupError, _lookup_error)
     app.add_exception_handler(Overloaded, _busy)
+    app.add_exception_handler(ShareExceeded, _busy)
+    app.add_exception_handler(TooManySaves, _too_many)
     app.add_exception_handler(WorkerLost, _busy)
     app.add_exception_handler(FitTimeout, _timeout)
     app.add_exception_handler(RendererUnavailable, _no_renderer)

@@ -10,6 +10,8 @@ Pure ASGI middleware that answers before the application sees a request:
 -   :class:`RequestLimits`: a body larger than the limit is answered 413,
     and one that arrives slower than the body deadline 408; a client that
     goes away before its answer cancels its request (and the job it waits for).
+-   :class:`ClaimWork`: whose work a request is and its kind
+    (:data:`service.runtime.shares.CLAIM`), for the fitting pool's fair shares.
 -   :class:`FrameDenial`: every answer forbids framing (``X-Frame-Options:
     DENY``, CSP ``frame-ancestors 'none'``): a page framed by another site
     would be same-origin for the editor, and clicks tricked through it
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import hmac
 import ipaddress
 import json
 import re
@@ -27,7 +30,9 @@ import re
 from fastapi import status
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
-__all__ = ["HostAllowList", "RequestLimits", "FrameDenial", "host_allowed", "LOOPBACK_HOSTS"]
+from ..runtime import CLAIM, Claim
+
+__all__ = ["HostAllowList", "RequestLimits", "ClaimWork", "FrameDenial", "host_allowed", "LOOPBACK_HOSTS"]
 
 LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "::1")
 """The default allow-list: names and addresses that only reach this machine."""
@@ -216,6 +221,42 @@ async def _cancel_on_disconnect(app: ASGIApp, scope: Scope, body: bytes, receive
         raise
     finally:
         watcher.cancel()
+
+
+class ClaimWork:
+    """
+    ASGI middleware: set :data:`service.runtime.shares.CLAIM` for the request. The
+    client is ``"token"`` when the request carries the service's bearer
+    token (``token``; compared in constant time), else its address; the
+    kind is ``save`` for ``POST`` to one of ``save_paths``, ``scene`` and
+    ``pack`` for ``POST`` to ``scene_path`` and ``pack_path``, and ``read``
+    for anything else.
+    """
+
+    def __init__(self, app: ASGIApp, token: str | None, save_paths: tuple[str, ...], scene_path: str,
+                 pack_path: str) -> None:
+        self.app = app
+        self.token = f"Bearer {token}".encode() if token else None
+        self.kinds = {**dict.fromkeys(save_paths, "save"), scene_path: "scene", pack_path: "pack"}
+
+    def claim(self, scope: Scope) -> Claim:
+        kind = self.kinds.get(scope["path"], "read") if scope["method"] == "POST" else "read"
+        if self.token is not None:
+            given = next((v for k, v in scope["headers"] if k == b"authorization"), b"")
+            if hmac.compare_digest(given, self.token):
+                return Claim("token", kind)
+        client = scope.get("client")
+        return Claim(client[0] if client else "unknown", kind)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        token = CLAIM.set(self.claim(scope))
+        try:
+            await self.app(scope, receive, send)
+        finally:
+            CLAIM.reset(token)
 
 
 class FrameDenial:

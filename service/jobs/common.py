@@ -16,7 +16,8 @@ What every job shares
 -   :func:`checked_writable`: refuse (:class:`service.store.StoreError`)
     before any CPU is spent when the store cannot take the save.
 -   :func:`checked_version`: refuse (:class:`service.store.StoreConflict`)
-    before any CPU is spent a save that expects another version.
+    before any CPU is spent a save that expects another version, name or
+    a material not in the bin.
 """
 
 from __future__ import annotations
@@ -32,7 +33,8 @@ from fitting.optics.catalogue import catalogue_material
 from fitting.optics.nk import SpectralNK
 
 from ..ids import content_address
-from ..store import FitRecord, Store, StoreConflict, StoreFull, StoreUnavailable
+from ..store import FitRecord, Store, StoreFull, StoreUnavailable
+from ..store.queries import check_expected
 
 __all__ = [
     "FIT_FORMAT_VERSION",
@@ -162,20 +164,18 @@ def checked_writable(store: Store) -> None:
     raise StoreUnavailable(f"{reason}; nothing was fitted")
 
 
-def checked_version(store: Store, material_id: str, name: str, expected_version: int | None) -> None:
+def checked_version(store: Store, material_id: str, name: str, expected_version: int | None) -> bool:
     """
-    Raise StoreConflict (409) when ``expected_version`` is given and the
-    material is at another version now: nothing is fitted for a save that
-    would be refused (the save itself checks again, in its transaction).
+    Raise StoreConflict (409) when a save naming ``expected_version`` would
+    undo a save, a rename or a delete made since
+    (:func:`service.store.queries.check_expected`): nothing is fitted for a
+    save that would be refused (the save itself checks again, in its
+    transaction). Returns whether the material is in the bin now (a save
+    without ``expected_version`` takes it out).
     """
-    if expected_version is None:
-        return
-    version = store.material_version(material_id)
-    if version != expected_version:
-        raise StoreConflict(
-            f"material {name!r} ({material_id}) is at version {version}, not the expected version "
-            f"{expected_version}: another save came first; nothing was fitted; reload it and save "
-            f"again with `expected_version` {version}", version=version)
+    row = store.material(material_id)
+    check_expected(row, material_id, name, expected_version, "nothing was fitted")
+    return row is not None and row.deleted_at is not None
 
 
 def fit_record(fit_id: str, kind: str, material_id: str, name: str, source: str,

@@ -257,33 +257,34 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
 
 
 async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
-                          expected_version: int | None = None) -> tuple[FitRecord, bool]:
+                          expected_version: int | None = None) -> tuple[FitRecord, bool, bool]:
     """
     The stored fit of ``fit`` (an earlier state saved again becomes the
     latest), else fitted and saved; a draft (the editor's refits while
     editing) is stored but not saved under its material until the same
     request comes without ``draft``. ``expected_version``: the save is
     refused (:class:`service.store.StoreConflict`, 409) unless the material
-    is at that version (see :meth:`service.store.Store.put_fit`).
+    is at that version, under the save's name and not in the bin. Returns
+    (record, fitted now, the save took the material out of the bin).
     """
     material_id = fit.material_id
 
-    def stored_or_writable() -> FitRecord | None:
+    def stored_or_writable() -> tuple[FitRecord | None, bool]:
         # One trip to a thread for both (a live refit is a round trip per drag step).
         stored = with_measured_nk(store, store.get_fit(fit.fit_id))
         if stored is None:
             checked_writable(store)
-            checked_version(store, material_id, fit.name, expected_version)
-        return stored
+        in_bin = False if fit.draft else checked_version(store, material_id, fit.name, expected_version)
+        return stored, in_bin
 
     def put(record: FitRecord, save: bool = True, expected: int | None = None, nk=None) -> FitRecord:
         return with_measured_nk(store, store.put_fit(record, save, expected, nk))
 
-    stored = await asyncio.to_thread(stored_or_writable)
+    stored, in_bin = await asyncio.to_thread(stored_or_writable)
     if stored is not None:
         if fit.draft:
-            return stored, False
-        return await asyncio.to_thread(put, stored, True, expected_version), False
+            return stored, False, False
+        return await asyncio.to_thread(put, stored, True, expected_version), False, in_bin
     base, base_record = fit.base, fit.base_record
     # The measured data behind the edit (for the reference curves and
     # previews): the base's, or, for an edited base, the data it had.
@@ -328,7 +329,7 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         # Another request's flight made it (a draft's, or the same save's): saved now,
         # once. (Asking whether it is the latest would race with other saves.)
         record = await asyncio.to_thread(put, record, True, expected_version)
-    return record, True
+    return record, True, in_bin
 
 
 def _measured_nk_or_refuse(record: FitRecord) -> SpectralNK:

@@ -208,8 +208,24 @@ def _scene_report(scene: PreparedScene, parts: list[tuple[dict[str, Any], Any, A
     }
 
 
-MATERIAL_COST_S = 0.2
-"""A scene material's estimated seconds in a worker (a fit and its candidates): its turn in the pool."""
+ETA_COST_S = 0.03
+"""Estimated worker seconds of one part of a scene, a material at one of its eta_i (64 x 32 took 55 s)."""
+
+
+def scene_parts(scene: PreparedScene) -> int:
+    """The parts of ``scene``: each fitted material times the eta_i rows it is fitted and scored at."""
+    return sum(len(entry.eta_i.evaluation_eta_i()) for entry in scene.materials
+               if not isinstance(entry, StoredModel))
+
+
+def check_scene_cost(scene: PreparedScene, runner: FitRunner) -> None:
+    """ValueError (422) naming the limit for a scene whose estimated fitting cannot end within its time limit."""
+    parts = scene_parts(scene)
+    budget_s = runner.timeout_s * runner.workers
+    if parts * ETA_COST_S > budget_s:
+        raise ValueError(
+            f"the scene has {parts} parts (materials x eta_i), about {parts * ETA_COST_S:.0f} s of fitting, more "
+            f"than one request may use: {budget_s:g} s (COATED_FIT_TIMEOUT_S x COATED_FIT_WORKERS); split it")
 
 
 async def _scene_parts(scene: PreparedScene, runner: FitRunner) -> list[tuple[dict[str, Any], Any, Any]]:
@@ -227,8 +243,9 @@ async def _scene_parts(scene: PreparedScene, runner: FitRunner) -> list[tuple[di
             parts.append((_stored_model_report(entry), entry.packed, entry.packed))
         else:
             parts.append(None)
+            cost_s = ETA_COST_S * len(entry.eta_i.evaluation_eta_i())
             tasks[index] = asyncio.ensure_future(runner.submit(
-                _material_part, entry, scene.max_delta_e, scene.prefer, cost_s=MATERIAL_COST_S))
+                _material_part, entry, scene.max_delta_e, scene.prefer, cost_s=cost_s))
     try:
         done = await asyncio.gather(*tasks.values())
     except BaseException:
@@ -242,7 +259,8 @@ async def _scene_parts(scene: PreparedScene, runner: FitRunner) -> list[tuple[di
 
 
 async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
-    """The report and pack of ``scene`` (cancelled when no request waits for it any more)."""
+    """The report and pack of ``scene`` (cancelled when no request waits for it any more); 422 past its cost."""
+    check_scene_cost(scene, runner)
 
     async def make() -> dict[str, Any]:
         async with runner.slot():

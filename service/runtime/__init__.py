@@ -15,6 +15,10 @@ Where the service's work runs, off the event loop, in processes of its own:
     and :class:`PreviewTimeout` (504), :class:`WorkerLost`,
     :class:`WorkersNotStarted`, :class:`Quarantined`, :class:`RenderWorkerLost`
     and :class:`RendererUnavailable` (503), :class:`JobCPULimit` (422);
+-   the fair shares of the fitting pool (:class:`Shares`): each job's
+    :class:`Claim` (its client and kind, set per request in :data:`CLAIM`),
+    :class:`ShareExceeded` (503) past a client's share, and the saves per
+    client per minute (:class:`SaveRate`, :class:`TooManySaves`: 429);
 -   the process's own set-up: :func:`warm_process`, :func:`freeze_heap`,
     :func:`thaw_heap`; and for ``python -m service``, :func:`start_fork_server`
     (before any thread) and :func:`serve` (uvicorn with the connection
@@ -26,7 +30,8 @@ content key, the ring of cancelled jobs), ``executors`` (a pool stuck on a
 half-written result unstuck), ``worker`` and ``render_worker`` (what runs in
 each process), ``fork_server`` and ``preload`` (the processes are forks of a
 fork server forked from the server), ``server`` (uvicorn's adapter) and
-``mp_private`` (multiprocessing's private state); docs/architecture.md draws them.
+``mp_private`` (multiprocessing's private state), ``shares`` (the fair
+shares); docs/architecture.md draws them.
 """
 
 from __future__ import annotations
@@ -36,12 +41,14 @@ from typing import Any
 from .pool import FitRunner, FitTimeout, Overloaded, Quarantined, WorkerLost, WorkersNotStarted
 from .previews import PreviewRunner, PreviewsBusy, PreviewTimeout, RenderWorkerLost
 from .render_worker import RendererUnavailable, renderer
+from .shares import CLAIM, Claim, SaveRate, ShareExceeded, Shares, TooManySaves
 from .worker import JobCPULimit, freeze_heap, thaw_heap, warm_process
 
 __all__ = [
     "FitRunner", "PreviewRunner",
     "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
     "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
+    "Shares", "Claim", "CLAIM", "ShareExceeded", "SaveRate", "TooManySaves",
     "renderer", "warm_process", "freeze_heap", "thaw_heap", "start_fork_server", "serve",
 ]
 

@@ -27,6 +27,7 @@ import time
 from multiprocessing import connection, forkserver, resource_tracker, util
 
 from .mp_private import FORK_SERVER_STATE, adopt_fork_server, fork_server, fork_server_pid
+from .worker import end_with_parent
 
 __all__ = ["START_ERRORS", "fork_server_exited", "start_fork_server"]
 
@@ -60,7 +61,9 @@ def start_fork_server() -> bool:
     server's own modules. It takes the place of the one multiprocessing
     starts: the listening socket in multiprocessing's temporary directory,
     the "alive" pipe whose end at all of this process's children tells it
-    when to stop, and the loop (``multiprocessing.forkserver.main``).
+    when to stop, and the loop (``multiprocessing.forkserver.main``). It
+    is killed when this process dies, however it dies
+    (:func:`service.worker.end_with_parent`), and so are its forks.
 
     Raises ``ValueError`` when the socket's path (in the temporary
     directory, ``TMPDIR``) is too long for a Unix socket, where
@@ -92,6 +95,7 @@ def start_fork_server() -> bool:
             os.chmod(address, 0o600)
         listener.listen()
         alive_r, alive_w = os.pipe()
+        server_pid = os.getpid()
         try:
             pid = os.fork()
         except BaseException:
@@ -102,6 +106,9 @@ def start_fork_server() -> bool:
             code = 1
             try:
                 os.close(alive_w)
+                # Its workers hold the "alive" pipe too, so the pipe alone never ends it when
+                # the server is killed: it dies with the server, and its forks with it.
+                end_with_parent(server_pid)
                 # What start-up made lives as long as the process: out of the collector's reach here and
                 # in every fork (pages the collector would otherwise write to stay shared).
                 gc.freeze()

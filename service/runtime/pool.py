@@ -12,33 +12,27 @@ The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
     503, 504, 503 and 422, the first three with ``Retry-After``).
 
 Fitting is CPU-bound (numpy, scipy): it runs in worker processes, never on
-the event loop, forked by a fork server (:func:`service.runtime.worker.process_context`:
-forking the server itself, which runs threads, is unsafe; the fork server is
-a fresh single-threaded process that imported the core once, so a worker
-starts in a fork instead of seconds of imports). The number of jobs running or
-waiting is bounded; past the bound a job is refused at once with a
-``Retry-After`` estimate instead of growing a backlog.
+the event loop, forked by a fork server (:func:`service.runtime.worker.process_context`).
+The jobs running or waiting are bounded, past the bound refused at once with
+a ``Retry-After`` estimate; bulk jobs (reads, packs, scenes) also within
+their client's share, and saves first (:mod:`service.runtime.shares`).
 
 Faults:
 
 -   A worker that dies breaks the whole ``ProcessPoolExecutor`` (every job in
     it fails with ``BrokenProcessPool``). The runner replaces the pool, warms
-    the new workers at once, and runs each interrupted job (or part of one)
-    once more there. A part interrupted twice runs a third time alone, in a
-    worker of its own (one such part at a time): only a part that kills that
-    worker too is answered :class:`WorkerLost`, and its job's content id is
-    refused for ``quarantine_s`` (:class:`Quarantined`, before any work). So
-    a job that kills its workers fails only itself, however often it does.
+    the new workers at once, and runs each interrupted part once more there;
+    one interrupted twice runs alone, in a worker of its own (one at a time):
+    only a part that kills that worker too is answered :class:`WorkerLost`,
+    its job's content id refused for ``quarantine_s`` (:class:`Quarantined`).
 -   A worker that cannot start (its fork server died:
     :data:`service.runtime.fork_server.START_ERRORS`) is not the part's doing: once
     the fork server's exit is seen, the pool is replaced (with a new fork
     server) and the part runs there (:class:`WorkersNotStarted` after three).
--   A pool stuck on a result its killed worker left half-written breaks as
-    for any death (:mod:`service.runtime.executors`).
--   A request that waits past the time limit gets :class:`FitTimeout`, and
-    its job is cancelled when no other request waits for it (as when every
-    client waiting for it has gone): its worker checks every 0.1 s and is
-    free within a second.
+-   A pool stuck on a result its killed worker left half-written breaks
+    (:mod:`service.runtime.executors`).
+-   A request that waits past the time limit gets :class:`FitTimeout`; a job
+    no request waits for is cancelled, its worker free within a second.
 -   Each part of a job has a CPU-time limit (``cpu_limit_s``), checked by
     its worker every 0.1 s: past it the part stops with
     :class:`JobCPULimit`. BLAS runs one thread per worker (the fits'
@@ -59,6 +53,7 @@ from concurrent.futures.process import BrokenProcessPool
 from typing import Any, AsyncIterator, Awaitable, Callable
 
 from . import executors
+from .shares import CLAIM, Claim, Shares
 from .turns import Turns
 from .flights import CancelRing, Flights
 from .fork_server import START_ERRORS, fork_server_exited
@@ -151,11 +146,9 @@ class FitRunner:
     """
 
     def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
-                 quarantine_s: float = 600.0, express_workers: int = 0) -> None:
+                 quarantine_s: float = 600.0, express_workers: int = 0, client_bulk_jobs: int | None = None) -> None:
         if workers < 1 or max_in_flight < workers:
-            raise ValueError(
-                f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1"
-            )
+            raise ValueError(f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1")
         if express_workers < 0:
             raise ValueError(f"`express_workers` must be >= 0, got {express_workers}")
         self.workers = workers
@@ -168,9 +161,9 @@ class FitRunner:
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
         self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
-        context = process_context()
-        self._context = context
-        self._cancels = CancelRing(context)
+        self.shares = Shares(max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers)
+        self._context = process_context()
+        self._cancels = CancelRing(self._context)
         self._serial = 0
         self._lock = threading.Lock()
         self._in_flight = 0
@@ -229,21 +222,20 @@ class FitRunner:
         return max(1, math.ceil(waves * self._mean_s))
 
     def check_capacity(self) -> None:
-        """
-        Refuse (:class:`Overloaded`) at once when the pool is full, before a
-        request spends CPU on validating its input; :meth:`run` checks again.
-        """
+        """Refuse (:class:`Overloaded`) a full pool before a request's input is read; :meth:`run` checks again."""
         if self._in_flight >= self.max_in_flight:
             raise Overloaded(self._retry_after(), self.max_in_flight)
 
-    def _acquire(self) -> None:
+    def _acquire(self, claim: Claim) -> None:
         with self._lock:
             if self._in_flight >= self.max_in_flight:
                 raise Overloaded(self._retry_after(), self.max_in_flight)
+            self.shares.admit(claim, self._retry_after())  # a bulk job within its client's share
             self._in_flight += 1
 
-    def _release(self, started: float | None) -> None:
+    def _release(self, started: float | None, claim: Claim) -> None:
         with self._lock:
+            self.shares.leave(claim)
             self._in_flight -= 1
             if started is not None:
                 self.completed += 1
@@ -258,23 +250,26 @@ class FitRunner:
 
         Raises
         ------
-        Overloaded
+        Overloaded, service.runtime.shares.ShareExceeded
         """
-        self._acquire()
+        claim = CLAIM.get()
+        self._acquire(claim)
         started = time.perf_counter()
         done = None
         try:
             yield
             done = started
         finally:
-            self._release(done)
+            self._release(done, claim)
 
     async def submit(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
         Run ``function(*args)`` in a worker as one part of a job that holds
         a :meth:`slot`; its exceptions (ValueError for bad input) are raised
-        here. Parts take turns in the workers, the cheapest waiting first
-        (``cost_s``, its estimated seconds: :class:`service.runtime.turns.Turns`). A
+        here. Parts take turns in the workers, saves first, then the
+        cheapest waiting (``cost_s``, its estimated seconds:
+        :class:`service.runtime.turns.Turns`); its worker time is charged to its
+        claim (:data:`service.runtime.shares.CLAIM`). A
         part interrupted by a dead worker runs once more on the replacement
         pool; one whose worker could not be started runs on a pool whose
         workers start (:class:`WorkersNotStarted` after three failures).
@@ -284,10 +279,11 @@ class FitRunner:
         WorkerLost, WorkersNotStarted
         """
         interrupted = start_failures = 0
+        claim = CLAIM.get()
         while interrupted < 2:
             pool = self._executor()
             try:
-                async with self._turns.turn(cost_s):
+                async with self._turns.turn(cost_s, self.shares.rank(claim)):
                     return await self._run_in(pool, function, args)
             except _StartFailed:
                 # Not the part's doing: it runs on a pool whose workers start, at most twice more.
@@ -331,11 +327,14 @@ class FitRunner:
             # that the pool replacing this one starts another instead of asking it again.
             await fork_server_exited()
             raise _StartFailed(f"a fitting worker could not be started: {error!r}") from error
+        began = time.perf_counter()
         try:
             return await executors.result(pool, future)  # a pool stuck on a killed worker's result breaks
         except asyncio.CancelledError:
             self._cancels.cancel(serial, future)
             raise
+        finally:
+            self.shares.charge(CLAIM.get(), time.perf_counter() - began)
 
     def _quarantine_current(self) -> None:
         """Refuse the content id of the job in this context for ``quarantine_s``."""

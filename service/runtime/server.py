@@ -40,7 +40,9 @@ what of them a uvicorn release no longer holds, and
 ``tests/service/test_runtime_private.py`` fails on any.
 
 SIGTERM and SIGINT stop it gracefully (uvicorn's shutdown: connections
-drained, the lifespan's pools and store closed), and the process then exits
+drained for at most ``drain_timeout_s``, then the requests still in flight
+cancelled, the lifespan's pools, whose jobs are cancelled, and store
+closed), and the process then exits
 with the signal's conventional status (143, 130) through ``SystemExit``
 (:func:`_exit_after_shutdown`), so that its exit handlers run.
 """
@@ -317,6 +319,7 @@ def serve(app, settings: Settings, host: str, port: int) -> None:
                                     settings.max_connections_per_client),
         limit_concurrency=settings.max_connections + HEALTH_RESERVE,
         timeout_keep_alive=settings.keep_alive_s,
+        timeout_graceful_shutdown=settings.drain_timeout_s,
         ws="none", lifespan="on",
     )
     flood = OncePerInterval()  # after Config, which configures uvicorn's logging

@@ -6,9 +6,12 @@ What runs in each worker process of :class:`service.runtime.pool.FitRunner`:
 
 -   :func:`warm_process`: the start-up every worker (and the server process)
     does once, so that no request pays for imports and spectral weights.
--   :func:`worker_start`: a worker's initializer: one BLAS thread, the
-    server's shared ring of cancelled job serials, the warm-up, then what
-    the warm-up made frozen out of the garbage collector (:func:`freeze_heap`).
+-   :func:`worker_start`: a worker's initializer: it ends with the server
+    (:func:`end_with_parent`), one BLAS thread, the server's shared ring of
+    cancelled job serials, the warm-up, then what the warm-up made frozen
+    out of the garbage collector (:func:`freeze_heap`).
+-   :func:`end_with_parent`: the process is killed when its parent dies,
+    however it dies (Linux's parent-death signal).
 -   :func:`freeze_heap`, :func:`thaw_heap`: the process's objects so far
     moved out of the collector's reach, and back.
 -   :func:`run_part`: one part of a job, checked every 0.1 s for its CPU
@@ -19,13 +22,20 @@ What runs in each worker process of :class:`service.runtime.pool.FitRunner`:
 
 from __future__ import annotations
 
+import ctypes
 import gc
+import multiprocessing
+import os
 import signal
+import threading
 import time
+from multiprocessing.connection import wait
 from typing import Any, Callable
 
 __all__ = ["CANCEL_SLOTS", "JobCPULimit", "warm_process", "freeze_heap", "thaw_heap", "worker_start", "run_part",
-           "ping", "process_context"]
+           "ping", "process_context", "end_with_parent"]
+
+_PR_SET_PDEATHSIG = 1  # prctl(2) option, <linux/prctl.h>
 
 CANCEL_SLOTS = 256
 """Cancelled job serials remembered (a ring); far more than jobs in flight."""
@@ -104,15 +114,52 @@ def thaw_heap() -> None:
     gc.unfreeze()
 
 
+def end_with_parent(parent_pid: int | None = None) -> None:
+    """
+    End this process when its parent dies, however it dies (a SIGKILL of
+    the server runs none of its exit code):
+
+    -   the kernel SIGKILLs it when the thread that forked it ends
+        (``prctl(PR_SET_PDEATHSIG)``), and it exits at once if that parent,
+        ``parent_pid``, is gone already (it was reparented);
+    -   in a process that multiprocessing started (a worker, forked by a
+        fork server, whose own parent is that fork server), a thread waits
+        on the pipe whose other end the process that started it (the
+        server) holds, and kills the process when the pipe ends.
+
+    The fork server calls it, and so does each process forked from it.
+    ``prctl`` is skipped where it is missing (not Linux).
+    """
+    try:
+        prctl = ctypes.CDLL(None, use_errno=True).prctl
+    except (OSError, AttributeError):
+        prctl = None
+    if prctl is not None and prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) != 0:
+        raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG) failed")
+    if parent_pid is not None and os.getppid() != parent_pid:
+        os._exit(1)
+    starter = multiprocessing.parent_process()
+    if starter is not None and starter.sentinel is not None:
+        threading.Thread(target=_kill_at_end_of, args=(starter.sentinel,), name="end-with-server",
+                         daemon=True).start()
+
+
+def _kill_at_end_of(sentinel: int) -> None:
+    wait([sentinel])
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
 def worker_start(cancelled) -> None:
     """
-    Each worker's initializer: the shared cancellation ring, the warm-up,
+    Each worker's initializer: it ends with the server
+    (:func:`end_with_parent`), the shared cancellation ring, the warm-up,
     then one BLAS thread for the process's life (after the warm-up: a limit
     applies only to the BLAS libraries already loaded).
     """
     global _cancelled
     from threadpoolctl import threadpool_limits
 
+    end_with_parent()
     _cancelled = cancelled
     warm_process()
     threadpool_limits(limits=1, user_api="blas")

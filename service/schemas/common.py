@@ -11,6 +11,7 @@ result did not have left out, so the JSON is the core's, key for key.
 
 from __future__ import annotations
 
+import unicodedata
 from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, model_validator
@@ -22,6 +23,7 @@ from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.bounded import excerpt
 from fitting.optics.catalogue import resolve_material
+from fitting.optics.library import FULL_NAMES, LIBRARY_NAMES
 
 from ..jobs.nk import MAX_NK_SAMPLES
 
@@ -30,7 +32,7 @@ __all__ = [
     "DownloadFormat", "download_formats", "MAX_EXPORT_PACK",
     "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
     "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
-    "PackFormat", "Text", "RequestModel", "WORKING_SPACES", "WorkingSpace",
+    "PackFormat", "Text", "MaterialName", "material_name", "RequestModel", "WORKING_SPACES", "WorkingSpace",
     "Mirror", "absent", "ErrorItem", "ErrorBody",
 ]
 
@@ -76,6 +78,35 @@ DownloadFormat = Annotated[str, AfterValidator(_check_download_format)]
 """A pack format or a registered export (checked against the registry when the request is read, so a
 plugin's format counts; ``GET /api/v1/domain`` lists them)."""
 Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
+
+_BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
+_INVISIBLE = frozenset({"Zs", "Zl", "Zp", "Cc", "Cf", "Cn", "Co", "Cs", "Mn", "Me"})
+"""Unicode general categories that show nothing on their own (spaces, controls, format, marks)."""
+_RESERVED = {name.casefold(): name for name in (*LIBRARY_NAMES, *FULL_NAMES.values())}
+
+
+def material_name(value: str) -> str:
+    """
+    A saved material's name as stored: NFC-normalised (an NFD spelling is
+    the same name) and stripped; ``ValueError`` when it holds a
+    bidirectional control (it would show its letters out of order), has no
+    visible character (only spaces, zero-width or format characters), or
+    is a built-in material's symbol or name (``Au``, ``Gold``: reserved).
+    """
+    value = unicodedata.normalize("NFC", value).strip()
+    control = next((c for c in value if c in _BIDI_CONTROLS), None)
+    if control is not None:
+        raise ValueError(f"`name` must hold no bidirectional control, got U+{ord(control):04X}")
+    if all(unicodedata.category(c) in _INVISIBLE for c in value):
+        raise ValueError("`name` needs a visible character (spaces, zero-width and format characters show nothing)")
+    reserved = _RESERVED.get(value.casefold())
+    if reserved is not None:
+        raise ValueError(f"`name` {value!r} is reserved: {reserved!r} names a built-in material")
+    return value
+
+
+MaterialName = Annotated[str, Field(min_length=1, max_length=200), AfterValidator(material_name)]
+"""A saved material's name (:func:`material_name`)."""
 
 
 _MAX_UNKNOWN_LISTED = 5

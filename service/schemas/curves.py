@@ -15,7 +15,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from fitting.fits.curves import CurveFitSettings
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 
-from .common import DEFAULT_MODEL, FIT_ID_PATTERN, EtaI, FitId, LibraryName, ModelKind, Objective, RequestModel
+from .common import (DEFAULT_MODEL, FIT_ID_PATTERN, EtaI, FitId, LibraryName, MaterialName, ModelKind, Objective,
+                     RequestModel)
 from .fits import NKData
 
 __all__ = ["CurveIn", "CurveBaseIn", "CurveFitRequest", "ErrorMap"]
@@ -105,8 +106,9 @@ class CurveFitRequest(RequestModel):
         },
     )
 
-    name: str = Field("edited", min_length=1, max_length=200, pattern=r"\S",
-                      description="The material's name; refits under one name are one material")
+    name: MaterialName = Field("edited", description="The material's name (NFC; a visible character, no "
+                               "bidirectional control, not a built-in material's); refits under one name "
+                               "are one material")
     base: CurveBaseIn | None = None
     eta_i_range: tuple[EtaI, EtaI] | None = Field(
         None, description="Domain [lo, hi]: default the base fit's, else [1, 2.5]"

@@ -240,6 +240,9 @@ class CurveFitPublic(FitPublic):
     curves: CurvesPublic | None = Field(
         None, description="`GET /fits/{id}/curves` of this fit at `curves_eta_i`, in the same answer "
                           "(the editor's live refits: one round trip per drag step)")
+    restored_from_bin: bool = Field(
+        False, description="The material was in the bin: this save (made without `expected_version`) "
+                           "took it out")
 
 
 def fit_public(record: FitRecord) -> FitPublic:

@@ -15,7 +15,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from ..store import FIT_KINDS
-from .common import RequestModel, Text
+from .common import MaterialName, RequestModel
 from .fits import FitPublic
 
 __all__ = ["MaterialSummary", "MaterialList", "MaterialDetail", "MaterialRename", "VersionSummary",
@@ -59,7 +59,7 @@ class MaterialRename(RequestModel):
 
     model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"name": "warm brass"}]})
 
-    name: Text
+    name: MaterialName
 
 
 class VersionSummary(BaseModel):

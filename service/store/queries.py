@@ -28,13 +28,15 @@ import time
 from typing import Any, Callable
 
 from .migrations import UPSERT_MATERIAL
-from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict
+from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict, StoreFull
 
 INT64_MAX = 2**63 - 1
+MAX_VERSIONS_PER_MATERIAL = 10_000
+"""The most versions one material keeps; a save past them is refused (507): its history is bounded."""
 
 __all__ = ["save", "set_metrics", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
            "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
-           "version_text", "summary_text", "LISTED_KINDS"]
+           "version_text", "summary_text", "check_expected", "LISTED_KINDS"]
 
 log = logging.getLogger("service.store")
 
@@ -62,20 +64,14 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
     stored = decode(record.id, get_text(connection, p, record.id))
     if not save:  # a draft: stored, reachable by id, listed under no material
         return stored
-    if expected_version is not None:
-        row = connection.execute(
-            f"SELECT version, latest_fit_id FROM materials WHERE material_id = {p}",
-            (stored.material_id,)).fetchone()
-        version, latest = (int(row[0]), row[1]) if row else (0, None)
-        if version != expected_version:
-            if latest == stored.id and version == expected_version + 1:
-                return stored  # this very save, retried: answered, not logged twice
-            raise StoreConflict(
-                f"material {stored.name!r} ({stored.material_id}) is at version {version}"
-                + (f" (latest fit {latest})" if latest else "")
-                + f", not the expected version {expected_version}: another save came first; "
-                "reload it and save again with `expected_version` "
-                f"{version}", version=version, latest_fit_id=latest)
+    row = material_row(connection, p, stored.material_id)
+    if row is not None and row.latest_fit_id == stored.id and row.deleted_at is None \
+            and row.name == summary_text(stored.name):
+        return stored  # nothing changed (a repeat, or this very save retried): no new version
+    check_expected(row, stored.material_id, stored.name, expected_version)
+    if row is not None and row.version >= MAX_VERSIONS_PER_MATERIAL:
+        raise StoreFull(f"material {stored.name!r} ({stored.material_id}) has {row.version} versions, the most "
+                        f"one material keeps ({MAX_VERSIONS_PER_MATERIAL}); save it under another name")
     if stored.kind == "curves":
         # An edited material is found by its name: another one given this name
         # since the save chose its material (a rename at the same moment) wins.
@@ -93,6 +89,37 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
         stored.material_id, seq, now, stored.id, stored.kind, summary_text(stored.name),
         summary_text(stored.source), stored.coverage))
     return stored
+
+
+def check_expected(row: MaterialRow | None, material_id: str, name: str, expected_version: int | None,
+                   done: str = "nothing was saved") -> None:
+    """
+    Raise :class:`StoreConflict` (409) when a save that names
+    ``expected_version`` would undo what changed since that version: another
+    save (the version moved on), a rename (the save still carries the old
+    ``name``) or a delete (the material is in the bin; a save expecting a
+    version does not take it out). ``row``: the material's summary now.
+    """
+    if expected_version is None:
+        return
+    version, latest = (row.version, row.latest_fit_id) if row else (0, None)
+    now = f"material {name!r} ({material_id})"
+    if version != expected_version:
+        raise StoreConflict(
+            f"{now} is at version {version}" + (f" (latest fit {latest})" if latest else "")
+            + f", not the expected version {expected_version}: another save came first; {done}; "
+            f"reload it and save again with `expected_version` {version}", version=version, latest_fit_id=latest)
+    if row is None:
+        return
+    if row.kind == "curves" and row.name != summary_text(name):
+        raise StoreConflict(
+            f"{now} was renamed {row.name!r} since version {version} was read: {done}; reopen it, "
+            f"or save it with `name` {row.name!r}", version=version, latest_fit_id=latest)
+    if row.deleted_at is not None:
+        raise StoreConflict(
+            f"{now} was moved to the bin at {time.strftime('%Y-%m-%d %H:%M:%S UTC', time.gmtime(row.deleted_at))}"
+            f": {done}; restore it first (`POST /api/v1/materials/{material_id}/restore`), or save "
+            "without `expected_version` to restore it with the save", version=version, latest_fit_id=latest)
 
 
 def summary_text(value: str) -> str:

@@ -215,11 +215,18 @@ class SQLiteStore(SQLStore):
                 return (f"the store holds {pages * page_size} bytes, at its quota "
                         f"COATED_STORE_MAX_BYTES ({self.max_bytes})")
         # A write statement that changes nothing: refused by a read-only
-        # store; rolled back at once so that it holds no lock.
+        # store; rolled back at once so that it holds no lock. It never waits
+        # for another writer's lock (a probe must answer at once): a store
+        # whose lock another connection holds is writable, its saves wait.
+        connection.execute("PRAGMA busy_timeout=0")
         try:
             connection.execute("DELETE FROM saves WHERE 0")
+        except sqlite3.OperationalError as error:
+            if "locked" not in str(error):
+                raise
         finally:
             connection.rollback()
+            connection.execute("PRAGMA busy_timeout=30000")
         return None
 
     def close(self) -> None:

@@ -87,6 +87,7 @@ export async function save(ctx, continuing) {
   ctx.onSaved(fit);
   ctx.say(going
     ? `Saved “${fit.name}”, version ${entry ? entry.version : "?"}: it continues the material (its history is kept).`
-    : `Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`, true);
+    : `Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`)
+    + (fit.restored_from_bin ? " It was in the bin: this save took it out." : ""), true);
   return true;
 }

@@ -3,7 +3,8 @@ Small hostile inputs, as classes against a real ``python -m service``
 on 127.0.0.1 (a fresh corpus, seeded): integers past 64 bits in queries,
 ``Host`` values with junk after the name, request headers past 16 KiB,
 repeated form parts, malformed multipart (422, as the docs say), and
-framing headers on every page; plus the store's free-space floor.
+framing headers on every page; plus the store's free-space floor and a
+full temporary directory (507).
 """
 
 from __future__ import annotations
@@ -117,3 +118,25 @@ def test_a_full_disk_is_not_writable_even_with_no_reserve(tmp_path, monkeypatch)
         assert health["store_writable"] is False and "bytes free" in health["store_problem"]
         response = client.post(f"{API}/fits", json={"material": "Au"})
         assert response.status_code == 507
+
+
+@pytest.mark.slow  # 4.0 s in a --durations=0 run (an app's start and a 1.3 MB body)
+def test_a_full_temporary_directory_is_507_not_the_file_s_fault(tmp_path, monkeypatch):
+    """
+    An upload past Starlette's 1 MiB spool goes to a temporary file; on a
+    full disk its write fails with ENOSPC, which FastAPI reported as an
+    unparsable body (422 blaming the file). The disk is made full here by
+    the temporary file's creation failing as the kernel's would.
+    """
+    import errno
+    import tempfile
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    body = GOOD_CSV + b"".join(b"800,0.2,3.8\n" for _ in range(110_000))  # 1.3 MB: spooled to disk
+    with app_client(tmp_path) as client:
+        monkeypatch.setattr(tempfile, "TemporaryFile", full)
+        answer = client.post(f"{API}/fits/upload", files={"file": ("big.csv", body, "text/csv")})
+    assert answer.status_code == 507 and "temporary directory is full" in answer.json()["detail"], answer.text
+    assert answer.headers["retry-after"] == "60"

@@ -4,8 +4,11 @@ token (``COATED_API_TOKEN``): every save is a version (listed, each opened
 and downloaded by id), a rename keeps the history and the next save, a
 delete is a bin (only with the token; nothing is lost; restore), uploads
 are kept apart from saved edits, and a fit reopens with its edit
-(``GET /fits/{id}/edit``). Then the library to browse and the coat
-presets, and the upload form's ``min_coverage``. One server for the module.
+(``GET /fits/{id}/edit``); a stale save (``expected_version`` read before a
+rename or a delete) is 409 naming what changed, a save that restores from
+the bin says so, identical saves are one version, and ``POST /packs``
+needs the token. Then the library to browse and the coat presets, and the
+upload form's ``min_coverage``. One server for the module.
 """
 
 from __future__ import annotations
@@ -109,9 +112,10 @@ def test_a_fit_reopens_with_its_edit(http, brass):
     request = edit["request"]
     assert request["base"] == {"material": "Au"} and request["name"] == "studio brass"
     assert len(request["curves"]) == 1 and request["curves"][0]["eta_i"] == 1.5
-    # The edit posted again is the same fit (served from the store, a new version).
+    # The edit posted again is the same fit (served from the store), and nothing changed: no new version.
     again = http.post(f"{API}/fits/from-curves", json={**request, "expected_version": 2}, headers=AUTH)
     assert again.status_code == 200 and again.json()["id"] == second["id"]
+    assert http.get(f"{API}/materials/{second['material_id']}").json()["version"] == 2
     # A library fit has no edit: it opens as its base.
     gold = http.post(f"{API}/fits", json={"material": "Au"}, headers=AUTH).json()
     library_edit = http.get(f"{API}/fits/{gold['id']}/edit").json()
@@ -196,6 +200,53 @@ def test_delete_needs_the_token_and_loses_nothing(http):
     assert http.post(f"{API}/materials/{material_id}/restore").status_code == 401
     assert http.delete(f"{API}/materials/Au", headers=AUTH).status_code == 422
     assert http.delete(f"{API}/materials/{'0' * 32}", headers=AUTH).status_code == 404
+
+
+def test_a_stale_save_does_not_undo_a_rename_or_a_delete(http):
+    first = save(http, "stale gold", 0.9).json()
+    material_id = first["material_id"]
+    opened = http.get(f"{API}/fits/{first['id']}/edit").json()["request"]  # an editor, at version 1
+    assert http.patch(f"{API}/materials/{material_id}", json={"name": "fresh gold"}, headers=AUTH).status_code == 200
+    stale = http.post(f"{API}/fits/from-curves", headers=AUTH, json={
+        **opened, "curves": [gold_curve(0.8)], "expected_version": 1})
+    assert stale.status_code == 409 and "renamed 'fresh gold'" in stale.json()["detail"], stale.text
+    assert http.get(f"{API}/materials/{material_id}").json()["name"] == "fresh gold"
+    assert http.delete(f"{API}/materials/{material_id}", headers=AUTH).status_code == 200
+    again = http.post(f"{API}/fits/from-curves", headers=AUTH, json={
+        **opened, "name": "fresh gold", "curves": [gold_curve(0.8)], "expected_version": 1})
+    assert again.status_code == 409 and "moved to the bin" in again.json()["detail"], again.text
+    # Without `expected_version` the save takes it out of the bin, and says so.
+    restoring = save(http, "fresh gold", 0.8, material_id=material_id)
+    assert restoring.status_code == 201 and restoring.json()["restored_from_bin"] is True
+    assert http.get(f"{API}/materials/{material_id}").json()["deleted_at"] is None
+    assert save(http, "fresh gold", 0.75).json()["restored_from_bin"] is False
+
+
+def test_identical_saves_are_one_version(http):
+    answers = [http.post(f"{API}/fits", json={"material": "Ag"}, headers=AUTH) for _ in range(50)]
+    assert {r.status_code for r in answers[1:]} == {200} and len({r.json()["id"] for r in answers}) == 1
+    assert http.get(f"{API}/materials/Ag").json()["version"] == 1
+
+
+def test_names_are_one_spelling_visible_and_not_a_built_in_material_s(http):
+    nfd = save(http, "Cafe\u0301 brass", 0.9)
+    nfc = save(http, "Caf\u00e9 brass", 0.85)
+    assert nfd.status_code == 201 and nfc.json()["material_id"] == nfd.json()["material_id"]
+    assert nfc.json()["name"] == "Caf\u00e9 brass"
+    material_id = nfd.json()["material_id"]
+    for name, rule in (("Au", "reserved"), ("gold", "reserved"), ("\u200b\u200b", "visible character"),
+                       ("brass\u202eevil", "bidirectional control")):
+        renamed = http.patch(f"{API}/materials/{material_id}", json={"name": name}, headers=AUTH)
+        assert renamed.status_code == 422 and rule in renamed.json()["detail"], renamed.text
+        assert save(http, name, 0.8).status_code == 422
+
+
+def test_packs_need_the_token(http, brass):
+    body = {"fit_ids": [brass[0]["id"]], "format": "json"}
+    refused = http.post(f"{API}/packs", json=body)
+    assert refused.status_code == 401 and "Bearer" in refused.json()["detail"]
+    assert http.post(f"{API}/packs", json=body, headers={**AUTH, "Origin": "http://evil.example"}).status_code == 403
+    assert http.post(f"{API}/packs", json=body, headers=AUTH).status_code == 200
 
 
 def test_uploads_are_kept_apart_from_saved_materials(http, brass):

@@ -7,6 +7,8 @@ real PostgreSQL server the tests start (``postgres_server``):
     downloadable from the other replica the moment it is answered;
 -   20 concurrent saves of one name with ``expected_version`` 0: exactly
     one 201, 19 answers 409; without it: 20 versions, one latest;
+-   a save on one replica expecting the version read before a rename or a
+    delete on the other: 409 naming what changed;
 -   one replica SIGKILLed during a burst of saves: no answered save lost;
 -   PostgreSQL restarted under the replicas: 503 with Retry-After while it
     is down (the first answer at once), then both answer again without
@@ -133,6 +135,22 @@ def test_same_name_at_once_one_winner(replicas):
     stale = loopback.post(f"{a.url}{API}/fits/from-curves", json=curves_body(50, "shared", expected_version=3),
                           timeout=60)
     assert stale.status_code == 409 and "nothing was fitted" in stale.json()["detail"]
+
+
+def test_a_stale_save_on_one_replica_does_not_undo_a_rename_or_delete_on_the_other(replicas):
+    a, b = replicas
+    with loopback.Client(timeout=300) as http:
+        first = http.post(f"{a.url}{API}/fits/from-curves", json=curves_body(60, "renamed away")).json()
+        material_id = first["material_id"]
+        assert http.patch(f"{b.url}{API}/materials/{material_id}", json={"name": "renamed here"}).status_code == 200
+        stale = http.post(f"{a.url}{API}/fits/from-curves", json=curves_body(
+            61, "renamed away", material_id=material_id, expected_version=1))
+        assert stale.status_code == 409 and "renamed 'renamed here'" in stale.json()["detail"], stale.text
+        assert http.delete(f"{a.url}{API}/materials/{material_id}").status_code == 200
+        binned = http.post(f"{b.url}{API}/fits/from-curves", json=curves_body(
+            61, "renamed here", material_id=material_id, expected_version=1))
+        assert binned.status_code == 409 and "moved to the bin" in binned.json()["detail"], binned.text
+        assert http.get(f"{a.url}{API}/materials/{material_id}").json()["version"] == 1
 
 
 def test_postgres_restart_503_then_recovery(replicas, postgres_server):

@@ -115,6 +115,46 @@ class TestStoreContract:
         (row,) = store.saved_materials()
         assert (row.version, row.latest_fit_id) == (3, first.id)
 
+    def test_a_repeat_is_not_a_version(self, store):
+        m = "r" * 32
+        first = store.put_fit(record("1" * 32, material_id=m, kind="curves", name="A"))
+        for _ in range(1000):
+            assert store.put_fit(record("1" * 32, material_id=m, kind="curves", name="A")) == first
+        assert store.material_version(m) == 1 and len(store.material_versions(m, None, 10)) == 1
+        store.put_fit(record("2" * 32, material_id=m, kind="curves", name="A"))
+        store.put_fit(first)  # an earlier state saved again: a change, so a version
+        assert store.material_version(m) == 3
+
+    def test_versions_per_material_are_bounded(self, store, monkeypatch):
+        from service.store import StoreFull, queries
+
+        monkeypatch.setattr(queries, "MAX_VERSIONS_PER_MATERIAL", 3)
+        m = "b" * 32
+        for i in range(3):
+            store.put_fit(record(f"{i + 1:032x}", material_id=m, kind="curves", name="A"))
+        with pytest.raises(StoreFull, match="has 3 versions, the most one material keeps"):
+            store.put_fit(record(f"{9:032x}", material_id=m, kind="curves", name="A"))
+        assert store.material_version(m) == 3 and store.get_fit(f"{9:032x}") is None
+        assert store.put_fit(record(f"{3:032x}", material_id=m, kind="curves", name="A")).id == f"{3:032x}"
+
+    def test_a_stale_save_does_not_undo_a_rename_or_a_delete(self, store):
+        m = "s" * 32
+        first = store.put_fit(record("1" * 32, material_id=m, kind="curves", name="A"))
+        store.rename_material(m, "B")
+        # An editor opened at version 1 (as "A") saves: it would rename the material back.
+        with pytest.raises(StoreConflict, match="renamed 'B' since version 1") as renamed:
+            store.put_fit(record("2" * 32, material_id=m, kind="curves", name="A"), expected_version=1)
+        assert renamed.value.version == 1 and store.get_fit("2" * 32) is None
+        store.put_fit(record("2" * 32, material_id=m, kind="curves", name="B"), expected_version=1)
+        store.delete_material(m)
+        with pytest.raises(StoreConflict, match="moved to the bin") as binned:
+            store.put_fit(record("3" * 32, material_id=m, kind="curves", name="B"), expected_version=2)
+        assert binned.value.latest_fit_id == "2" * 32 and store.material(m).deleted_at is not None
+        # Without an expectation the save restores it (the service's answer says so).
+        store.put_fit(record("3" * 32, material_id=m, kind="curves", name="B"))
+        assert store.material(m).deleted_at is None and store.material_version(m) == 3
+        assert store.latest_fit(m).id == "3" * 32 and first.id != "3" * 32
+
     def test_drafts_are_not_saves(self, store):
         draft = store.put_fit(record("3" * 32, material_id="d" * 32, kind="curves"), save=False)
         assert store.get_fit(draft.id) == draft
@@ -263,6 +303,22 @@ class TestSQLiteStore:
         store = SQLiteStore(tmp_path / "store.sqlite3")
         with sqlite3.connect(store.path) as connection:
             assert connection.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+        store.close()
+
+    def test_the_writable_probe_never_waits_for_another_writer_s_lock(self, tmp_path):
+        import time
+
+        store = SQLiteStore(tmp_path / "store.sqlite3")
+        holder = sqlite3.connect(store.path, isolation_level=None)
+        holder.execute("BEGIN IMMEDIATE")  # another process's long write transaction
+        try:
+            started = time.perf_counter()
+            store.ping()
+            assert store.writable() is None and time.perf_counter() - started < 1.0  # it waited 30 s
+        finally:
+            holder.execute("ROLLBACK")
+            holder.close()
+        store.put_fit(record("1" * 32))  # the probe left the saves' own wait for the lock as it was
         store.close()
 
     def test_store_from_before_the_save_log_is_read(self, tmp_path):

@@ -22,7 +22,9 @@ from ...jobs.common import stored_fit
 from ...jobs.curves import error_map, fit_from_curves, prepare_curve_fit
 from ...jobs.nk import angle_curves
 from ...schemas import API_PREFIX, ETA_I_LIMITS, CurveFitPublic, CurveFitRequest, CurvesPublic, ErrorMap, fit_public
-from ..deps import CONFLICT, ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, StoreDep, WriteAccess
+from ...runtime import CLAIM
+from ..deps import (CONFLICT, ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, SaveRateDep,
+                    StoreDep, WriteAccess)
 
 router = APIRouter(prefix=API_PREFIX, tags=["curves"])
 
@@ -34,7 +36,7 @@ router = APIRouter(prefix=API_PREFIX, tags=["curves"])
                  **NOT_FOUND, **FIT_ERROR_RESPONSES, **CONFLICT,
              }, dependencies=[WriteAccess])
 async def create_fit_from_curves(
-    request: CurveFitRequest, store: StoreDep, runner: RunnerDep, response: Response,
+    request: CurveFitRequest, store: StoreDep, runner: RunnerDep, response: Response, rate: SaveRateDep,
     curves_eta_i: Annotated[float | None, Query(
         ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
         description="Also answer `GET /fits/{id}/curves` of the fit at this coating index")] = None,
@@ -48,6 +50,8 @@ async def create_fit_from_curves(
     target, with a base); with ``curves_eta_i``, ``curves`` holds the fit's
     curves there (one round trip for the editor).
     """
+    if not request.draft:
+        rate.note(CLAIM.get())  # a save: counted against its client's saves per minute (429 past them)
     base = request.base
     fit = await run_in_threadpool(
         lambda: prepare_curve_fit(
@@ -60,13 +64,13 @@ async def create_fit_from_curves(
             model=request.model, live=request.live, start_fit=request.start_fit,
             material_id=request.material_id,
         ))
-    record, created = await fit_from_curves(fit, store, runner, request.expected_version)
+    record, created, restored = await fit_from_curves(fit, store, runner, request.expected_version)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
     curves = None
     if curves_eta_i is not None:
         curves = CurvesPublic(**await run_in_threadpool(angle_curves, record, curves_eta_i, curves_samples))
-    return CurveFitPublic(**dict(fit_public(record)), curves=curves)
+    return CurveFitPublic(**dict(fit_public(record)), curves=curves, restored_from_bin=restored)
 
 
 @router.get("/fits/{fit_id}/error-map", response_model=ErrorMap, responses={**ERROR_RESPONSES, **NOT_FOUND})

@@ -5,8 +5,7 @@ Fits
 -   ``POST /api/v1/fits``: fit a built-in material or inline n, k (JSON).
 -   ``POST /api/v1/fits/upload``: fit an uploaded n, k file (CSV, JSON, YAML), multipart.
 -   ``GET /api/v1/fits/{fit_id}``: a stored fit.
--   ``GET /api/v1/fits/{fit_id}/pack``: its download (binary, json, glsl,
-    hlsl) or an export for one coating index (mtlx, openpbr, blender, gltf, glb).
+-   ``GET /api/v1/fits/{fit_id}/pack``: its download (a pack format) or an export for one coating index.
 -   ``GET /api/v1/fits/{fit_id}/curves``: reference, model and baseline RGB
     against the angle, for plotting.
 
@@ -29,10 +28,11 @@ from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
 from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_MODEL, DEFAULT_OBJECTIVE, ETA_I_LIMITS,
                         CurvesPublic, DownloadFormat, FitPublic, FitRequest, ModelKind, Objective, fit_public)
+from ...runtime import CLAIM
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
                     MetricsQuery, MinCoverageForm, RoughnessQuery, WorkingSpaceQuery, RunnerDep, SettingsDep,
-                    SingleFormFields, StoreDep, WriteAccess)
+                    SingleFormFields, SaveRateDep, StoreDep, WriteAccess)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -53,16 +53,16 @@ def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPubli
 @router.post("", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
              responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess])
 async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, settings: SettingsDep,
-                     response: Response, http: Request, metrics: MetricsQuery = "solve") -> FitPublic:
+                     response: Response, http: Request, rate: SaveRateDep, metrics: MetricsQuery = "solve",
+                     ) -> FitPublic:
     """
-    Fit a built-in material (``{"material": "Au"}``), inline n, k
-    (``{"name": ..., "nk": {"wavelength_nm", "n", "k"}}``) or F0 and F82 tint
-    (``{"name", "f0", "f82", "space"}``: an ``rgb-conductor``) over
-    ``eta_i_range``; the answer carries the float16 coefficients, what the
-    solve measured, and timings; Delta E 2000 of the model and of adjusted
-    Lazanyi on the metrics grid with ``?metrics=full`` (else later:
-    ``GET /fits/{id}``).
+    Fit a built-in material (``{"material": "Au"}``), inline n, k (``{"name": ..., "nk": {"wavelength_nm",
+    "n", "k"}}``) or F0 and F82 tint (``{"name", "f0", "f82", "space"}``: an ``rgb-conductor``) over
+    ``eta_i_range``; the answer carries the float16 coefficients, what the solve measured, and timings;
+    Delta E 2000 of the model and of adjusted Lazanyi on the metrics grid with ``?metrics=full`` (else
+    later: ``GET /fits/{id}``).
     """
+    rate.note(CLAIM.get())  # a save: counted against its client's saves per minute (429 past them)
     if request.f0 is not None:  # F0 and F82 colours: n, k from them, no fit to run
         return fit_answer(*await fit_from_colours(store, request), response)
     runner.check_capacity()
@@ -80,7 +80,7 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
              responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess, SingleFormFields])
 async def upload_fit(
     file: Annotated[UploadFile, File(description="n, k as CSV, JSON or refractiveindex.info YAML")],
-    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response, http: Request,
+    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response, http: Request, rate: SaveRateDep,
     format: Annotated[str | None, Form(pattern=r"^(csv|json|yaml|yml)$",
                                        description="Default: from the file name")] = None,
     name: Annotated[str | None, Form(min_length=1, max_length=200, pattern=r"\S")] = None,
@@ -96,6 +96,7 @@ async def upload_fit(
     file is parsed, never stored or executed as given; the fit keeps its
     n, k as numbers. The data must cover 90% of 360-830 nm, or `min_coverage` when it asks more.
     """
+    rate.note(CLAIM.get())
     runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
@@ -104,8 +105,7 @@ async def upload_fit(
     return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
 
-@router.get("/{fit_id}", response_model=FitPublic, responses={**ERROR_RESPONSES, **NOT_FOUND,
-                                                             **FIT_ERROR_RESPONSES})
+@router.get("/{fit_id}", response_model=FitPublic, responses={**ERROR_RESPONSES, **NOT_FOUND, **FIT_ERROR_RESPONSES})
 async def get_fit(fit_id: FitIdPath, store: StoreDep, runner: RunnerDep) -> FitPublic:
     """A stored fit, with its metrics (evaluated now, once, if they were not yet)."""
     record = await run_in_threadpool(stored_fit, store, fit_id)

@@ -120,8 +120,10 @@ def rename_material(material_id: MaterialIdPath, body: MaterialRename, store: St
     """
     Rename a saved material. Not a save: its version, fits and history stay
     as they are; the next save of it (with its `material_id`) keeps the
-    new name. An edited material's name is unique among edited materials
-    (409 when another, in the bin or not, is called that).
+    new name, and a save expecting a version read before the rename (still
+    carrying the old name) is refused (409 naming the new one). An edited
+    material's name is unique among edited materials (409 when another, in
+    the bin or not, is called that).
     """
     return _summary(store.rename_material(material_id, body.name.strip()))
 
@@ -133,7 +135,9 @@ def delete_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSum
     Move a saved material to the bin: it leaves the listings (`?deleted=true`
     lists the bin), nothing is erased (its fits, downloads and versions stay
     reachable by id), `POST .../restore` brings it back, and so does a save
-    of it. Deleting one in the bin again answers the same.
+    of it without `expected_version` (its answer says `restored_from_bin`);
+    a save with `expected_version` is refused (409: it would undo the
+    delete unseen). Deleting one in the bin again answers the same.
     """
     return _summary(store.delete_material(material_id))
 

@@ -4,8 +4,10 @@ Packs
 
 ``POST /api/v1/packs``: several stored fits in one download (a scene's
 materials together), in any pack format, or their exports for one coating
-index as a zip archive (any registered export format). Reads only; saves
-nothing.
+index as a zip archive (any registered export format). Saves nothing, but
+may cost seconds of fitting per request, so it needs what writes need
+(:data:`service.api.deps.WriteAccess`: same site, and the bearer token when
+the service requires one).
 """
 
 from fastapi import APIRouter, Request, Response, status
@@ -15,7 +17,7 @@ from ...downloads import PACK_CONTENT, is_export, pack_response, render_export_p
 from ...jobs.common import stored_fit
 from ...jobs.evaluation import ensure_metrics
 from ...schemas import API_PREFIX, PackRequest
-from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep
+from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep, WriteAccess
 
 router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 
@@ -23,7 +25,7 @@ router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 @router.post("", response_class=Response, responses={
     status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
     **NOT_FOUND, **FIT_ERROR_RESPONSES,
-})
+}, dependencies=[WriteAccess])
 async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep, http: Request) -> Response:
     """
     The fits named by ``fit_ids``, in that order, as one pack. A renderer

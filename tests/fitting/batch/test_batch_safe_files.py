@@ -1,8 +1,9 @@
 """
 A batch writes only its own files in its output directory
 (links planted under its temporary or output names are never written
-through), holds the directory against a second run, and keeps every valid
-journal record around a damaged line.
+through), refuses a FIFO planted at its journal or lock and a journal past
+its size (before reading it), holds the directory against a second run,
+and keeps every valid journal record around a damaged line.
 """
 
 from __future__ import annotations
@@ -49,6 +50,20 @@ def test_a_journal_link_is_refused(tmp_path):
     with pytest.raises(ValueError, match="is a symbolic link"):
         run_batch([PAGE], out, workers=1, samples=SAMPLES, progress=False)
     assert victim.read_text() == "precious\n"
+
+
+@pytest.mark.parametrize("name", [JOURNAL_NAME, ".lock"])
+def test_a_fifo_planted_at_the_journal_or_lock_is_refused_not_waited_on(tmp_path, name):
+    os.mkfifo(tmp_path / name)
+    with pytest.raises(ValueError, match=r"is not a regular file \(a FIFO\)"):
+        Journal(tmp_path, {"pages": [PAGE]})
+
+
+def test_a_journal_past_its_size_is_refused_before_it_is_read(tmp_path):
+    with open(tmp_path / JOURNAL_NAME, "wb") as f:
+        f.truncate(2**30)  # 1 GB, sparse: read whole, it took 1.39 GB of memory
+    with pytest.raises(ValueError, match=f"holds {2**30} bytes, more than a batch journal may"):
+        Journal(tmp_path, {"pages": [PAGE]})
 
 
 def test_a_second_run_on_one_directory_is_refused(tmp_path):
