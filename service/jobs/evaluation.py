@@ -125,8 +125,9 @@ def _evaluate_part(nk: SpectralNK, library: str | None, material: dict[str, Any]
                                    ("model_float64", coefficients_float64))
     }
     errors = score_on_grid(nk, M, E, models, baselines=False, reference=reference)
-    # metrics_json reads the fit's coverage and sets its ``error``: a stand-in of the fit carries both.
-    fit = types.SimpleNamespace(coverage=coverage, error=None)
+    # metrics_json reads the fit's coverage and quality and sets its ``error``: a stand-in of the fit
+    # carries them (the quality report stays the solve's: ensure_metrics keeps it beside the evaluation).
+    fit = types.SimpleNamespace(coverage=coverage, quality=None, error=None)
     metrics = metrics_json({**errors, **baselines}, fit, samples)
     check_finite("metrics", metrics)
     return metrics
