@@ -49,7 +49,10 @@ GLSL_DIR = Path(__file__).resolve().parents[1] / "preview_shaders" / "glsl"
 THREE_DIR = Path(__file__).resolve().parents[1] / "scripts" / "three" / "node_modules" / "three"
 """three.js as pinned in scripts/three/package-lock.json (``scripts/bootstrap``
 installs it): its ``build/`` and ``examples/jsm/`` served at ``/vendor/three/``
-for the three.js material (static/three/) and its example page."""
+for the three.js material and its example page."""
+THREE_PACKAGE_DIR = Path(__file__).resolve().parents[1] / "web" / "three" / "src"
+"""The three.js material's package (web/three/, npm ``coated-conductor-three``),
+its modules served at ``/static/three/`` for the example page."""
 SWAGGER_UI_DIR = Path(__file__).resolve().parents[1] / "scripts" / "swagger-ui" / "node_modules" / "swagger-ui-dist"
 """Swagger UI as pinned in scripts/swagger-ui/package-lock.json (``scripts/bootstrap``
 installs it), served at ``/vendor/swagger-ui/`` for ``/docs``."""
@@ -169,8 +172,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for part in ("build", "examples/jsm"):
         app.mount(f"/vendor/three/{part}", StaticFiles(directory=THREE_DIR / part, check_dir=False),
                   name=f"three-{part}")
-    # /static/...: the page's modules at a path of their own for other pages
-    # (the three.js material at /static/three/coated_conductor.js).
+    # The three.js material's package (web/three/src/) at /static/three/,
+    # before /static, whose directory has no three/.
+    app.mount("/static/three", StaticFiles(directory=THREE_PACKAGE_DIR), name="three-package")
+    # /static/...: the page's modules at a path of their own for other pages.
     app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
     # The browser editor (static/), after the API so that /api, /docs and
     # /openapi.json keep their routes; html=True serves index.html at /.

@@ -49,8 +49,9 @@ export async function loadShader(name, base = "/glsl") {
 /**
  * The include files `names` (no #version line), each with its includes
  * resolved, concatenated in order, every file once: GLSL to paste into
- * another program's source (static/three/coated_conductor.js patches
- * three.js's shader chunks with it).
+ * another program's source (the three.js example page draws its
+ * environments with it; the three.js package, web/three/, carries its own
+ * copy, written by `python -m preview_shaders.three_package`).
  */
 export async function loadIncludes(names, base = "/glsl") {
   const seen = new Set();

@@ -17,7 +17,7 @@
 import * as THREE from "three";
 import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
 import { RoomEnvironment } from "three/addons/environments/RoomEnvironment.js";
-import { CoatedConductorExtension } from "/static/three/coated_conductor.js";
+import { CoatedConductorExtension } from "/static/three/index.js";
 import { loadIncludes } from "/static/glsl.js";
 import { orbitCamera } from "/static/preview.js";
 

@@ -1,6 +1,6 @@
 """
-The three.js material's files as the service serves them: the module at
-/static/three/, three itself (scripts/three, as the lock pins it) at
+The three.js material's files as the service serves them: the package's
+modules (web/three/src/) at /static/three/, three itself (scripts/three, as the lock pins it) at
 /vendor/three/, the example page at /examples/three.html; nothing else of
 node_modules is reachable.
 """
@@ -17,7 +17,9 @@ LOCK = json.loads((ROOT / "scripts" / "three" / "package-lock.json").read_text()
 
 
 @pytest.mark.parametrize("path", [
-    "/static/three/coated_conductor.js", "/static/three/albedo_table.js", "/static/three/escape_table.js",
+    "/static/three/index.js", "/static/three/coated_conductor.js", "/static/three/albedo_table.js",
+    "/static/three/escape_table.js", "/static/three/gltf_loader.js", "/static/three/gltf_exporter.js",
+    "/static/three/packing.js", "/static/three/generated/glsl.js", "/static/three/generated/lut.js",
     "/static/glsl.js",
     "/vendor/three/build/three.module.js", "/vendor/three/build/three.core.js",
     "/vendor/three/examples/jsm/loaders/GLTFLoader.js",

@@ -1,5 +1,5 @@
 """
-The three.js material and GLTFLoader plugin (static/three/coated_conductor.js)
+The three.js material and GLTFLoader plugin (web/three/, served at /static/three/)
 in a real Chromium (SwiftShader WebGL2) against a real server: a stored fit's
 glTF export loaded with the plugin renders the same fit composed with the
 full air-coat-metal stack in numpy (both kinds, mirror and rough lobes under
@@ -199,7 +199,7 @@ def test_malformed_extensions_draw_the_fallback(session):
     objects = [GOOD_RGB, GOOD_COATED] + [o for _, o, _ in MALFORMED]
     result = page.evaluate("""async (objects) => {
         const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
-        const { CoatedConductorExtension } = await import('/static/three/coated_conductor.js');
+        const { CoatedConductorExtension } = await import('/static/three/index.js');
         const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor'],
                        materials: objects.map((o, i) => ({ name: `m${i}`, pbrMetallicRoughness: {
                            baseColorFactor: [0.9, 0.6, 0.3, 1], metallicFactor: 1 },
@@ -236,7 +236,7 @@ def test_export_round_trip_keeps_the_extension(session):
         const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
         const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
         const { CoatedConductorExtension, CoatedConductorExporterExtension } =
-            await import('/static/three/coated_conductor.js');
+            await import('/static/three/index.js');
         const original = await (await fetch(url)).json();
         const load = async (source) => {
             const loader = new GLTFLoader();
@@ -266,7 +266,7 @@ def test_material_refuses_malformed_extensions(session):
     # Any example page will do: the one the test before left open (Cu at 1.8), no reload.
     page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
     messages = page.evaluate("""async () => {
-        const { checkModel } = await import('/static/three/coated_conductor.js');
+        const { checkModel } = await import('/static/three/index.js');
         const good = { kind: 'rgb-conductor', colorSpace: 'ACEScg', etaIRange: [1, 2.5], coatIor: 1.5,
                        coefficients: { n: [0.2, 0.5, 1.3], k: [3, 2.3, 1.9] } };
         const bad = [

@@ -5,11 +5,12 @@
 // drawn by three into an n x 3 float target: row 0 the metal's lobe, row 2
 // the coat's, at NdotV = (i / (n - 1))^2 (cf_albedo_table_lookup reads it).
 // The same tables, from the same GLSL and LUT, as the editor's preview
-// (static/splitsum.js), so the two agree to float rounding.
+// (static/splitsum.js), so the two agree to float rounding. Both come with
+// the package (generated/, written by tools/generate.py): nothing is fetched.
 
 import * as THREE from "three";
-import { decodeLut } from "../api.js";
-import { loadShader } from "../glsl.js";
+import { lutTexels } from "./lut.js";
+import { TABLE_SOURCES } from "./generated/glsl.js";
 
 // Quadrature points per node of the rgb-conductor's table: the editor's
 // REFERENCE_SAMPLES (static/splitsum.js), the preview's reference albedo.
@@ -18,15 +19,9 @@ export const RGB_SAMPLES = 2048;
 const VERTEX = `in vec3 position;
 void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }`;
 
-// three's RawShaderMaterial puts its own #define lines first and the
-// #version line before them (glslVersion), so the file's own goes.
-function withoutVersion(source) {
-  return source.slice(source.indexOf("\n") + 1);
-}
-
-/** The LUT file (GET /api/v1/ibl-lut, docs/shading.md) as an RGBA float 3D texture. */
-export function lutTexture(buffer) {
-  const lut = decodeLut(buffer);
+/** The LUT as an RGBA float 3D texture ({texture, width, alphaRange}). */
+export async function lutTexture() {
+  const lut = await lutTexels();
   const texels = lut.width * lut.height * lut.depth;
   const rgba = new Float32Array(4 * texels);
   for (let i = 0; i < texels; i++) {
@@ -41,12 +36,12 @@ export function lutTexture(buffer) {
   return { texture, width: lut.width, alphaRange: lut.alphaRange };
 }
 
-/** The two table programs' sources (GLSL ES 3.00 without the #version line). */
-export async function tableSources(glslBase) {
-  const [model, rgb] = await Promise.all([
-    loadShader("albedo_table.frag", glslBase), loadShader("rgb_albedo_table.frag", glslBase),
-  ]);
-  return { "coated-conductor": withoutVersion(model), "rgb-conductor": withoutVersion(rgb) };
+/** The table program of each kind (GLSL ES 3.00 without the #version line, which three writes). */
+export function tableSources() {
+  return {
+    "coated-conductor": TABLE_SOURCES["albedo_table.frag"],
+    "rgb-conductor": TABLE_SOURCES["rgb_albedo_table.frag"],
+  };
 }
 
 /**

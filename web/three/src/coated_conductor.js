@@ -1,14 +1,15 @@
 // EXT_materials_coated_conductor in three.js (docs/gltf/EXT_materials_coated_conductor/):
 // a MeshPhysicalMaterial whose metal Fresnel is this project's model, and
-// the GLTFLoader plugin that makes one from a glTF material with the
-// extension. ES module, no build step; `three` comes from the page's
-// import map.
+// the GLTFLoader and GLTFExporter plugins that read and write the
+// extension. ES module, no build step, nothing fetched: the GLSL and the
+// split-sum LUT are in generated/ (tools/generate.py); `three` is the
+// package's peer dependency (an import map or a bundler resolves it).
 //
 //   loader.register((parser) => new CoatedConductorExtension(parser));
 //   const material = await createCoatedConductorMaterial({ model: extension, roughness: 0.2 });
 //
 // What is patched in three's MeshPhysicalMaterial shader (onBeforeCompile,
-// the project's GLSL from /glsl/ pasted in), so that it draws the whole
+// the project's GLSL, generated/glsl.js, pasted in), so that it draws the whole
 // air / coat / metal stack (docs/gltf/EXT_materials_coated_conductor/,
 // "Combining with the coat"; fitting/shading/coated_layer.py is the numpy twin):
 //   - direct lights: BRDF_GGX's Schlick F is the model at v.h (the cosine
@@ -26,25 +27,19 @@
 //     transmission is in the terms above).
 // A material whose extension object fails the schema's or the range's
 // rules draws its fallback (console.warn), as does every material when the
-// GLSL or the LUT cannot be fetched.
+// LUT cannot be decoded.
 // The model's reflectance is linear ACEScg; the stack is composed in ACEScg
 // and converted to three's working space (linear Rec.709) with
 // CF_ACESCG_TO_SRGB (cf_display.glsl).
 
 import * as THREE from "three";
-import { loadIncludes } from "../glsl.js";
-import { packedWords } from "../kinds.js";
+import { GLSL } from "./generated/glsl.js";
+import { packedWords } from "./packing.js";
 import { AlbedoTable, lutTexture, tableSources } from "./albedo_table.js";
 import { EscapeTable, ROUGH_BLEND, internalReflectance } from "./escape_table.js";
 
 export const EXTENSION_NAME = "EXT_materials_coated_conductor";
 export const KINDS = ["coated-conductor", "rgb-conductor"];
-export const DEFAULT_OPTIONS = { glslBase: "/glsl", lutUrl: "/api/v1/ibl-lut" };
-
-const INCLUDES = [
-  "cf_coated_conductor.glsl", "cf_rgb_conductor.glsl", "cf_ibl_coated.glsl",
-  "cf_reference_albedo.glsl", "cf_display.glsl",
-];
 
 // The model's terms, pasted before three's (patched) pars chunk that calls them.
 const HEAD = `
@@ -178,30 +173,24 @@ function patch(text, pattern, replacement) {
   return text.replace(pattern, replacement);
 }
 
-const resourcesFor = new Map(); // JSON of options -> Promise
+let resources = null; // Promise, made once
 
-/** The GLSL and the LUT every material needs, fetched once per set of options. */
-export function loadResources(options = {}) {
-  const { glslBase, lutUrl } = { ...DEFAULT_OPTIONS, ...options };
-  const key = JSON.stringify([glslBase, lutUrl]);
-  if (!resourcesFor.has(key)) {
-    resourcesFor.set(key, (async () => {
-      const [glsl, tables, lut] = await Promise.all([
-        loadIncludes(INCLUDES, glslBase),
-        tableSources(glslBase),
-        fetch(lutUrl).then((r) => {
-          if (!r.ok) throw new Error(`${EXTENSION_NAME}: the LUT ${lutUrl}: ${r.status} ${r.statusText}`);
-          return r.arrayBuffer();
-        }),
-      ]);
+/**
+ * The GLSL, the patched chunk, the table programs and the LUT every
+ * material needs, made once (the LUT inflated at the first call).
+ */
+export function loadResources() {
+  if (!resources) {
+    resources = (async () => {
       let pars = THREE.ShaderChunk.lights_physical_pars_fragment;
       for (const [where, pattern, replacement] of PATCHES) {
         if (where === "pars") pars = patch(pars, pattern, replacement);
       }
-      return { glsl, pars, tables, lut: lutTexture(lut) };
-    })());
+      return { glsl: GLSL, pars, tables: tableSources(), lut: await lutTexture() };
+    })();
+    resources.catch(() => { resources = null; }); // a failure is tried again next time
   }
-  return resourcesFor.get(key);
+  return resources;
 }
 
 const PROPERTIES = new Set([
@@ -321,141 +310,16 @@ export function coatedConductorHooks(model, resources, fallback = null) {
  * A MeshPhysicalMaterial drawing the coated metal `params.model` (an
  * EXT_materials_coated_conductor object); the other params are
  * MeshPhysicalMaterial's (roughness: the metal's; clearcoat default 1,
- * clearcoatRoughness default model.coatRoughnessFactor). `options`:
- * {glslBase, lutUrl}, where the project's GLSL and split-sum LUT are
- * served. Resolves once the GLSL and the LUT are in.
+ * clearcoatRoughness default model.coatRoughnessFactor). Resolves once the
+ * LUT is decoded (the first call only).
  */
-export async function createCoatedConductorMaterial(params, options = {}) {
+export async function createCoatedConductorMaterial(params) {
   const { model, ...physical } = params;
-  const resources = await loadResources(options);
+  const resources = await loadResources();
   const hooks = coatedConductorHooks(model, resources);
   const material = new THREE.MeshPhysicalMaterial({
     metalness: 1, color: 0xffffff, clearcoat: 1, clearcoatRoughness: model.coatRoughnessFactor ?? 0,
     ...physical,
   });
   return Object.assign(material, hooks);
-}
-
-/**
- * The GLTFLoader plugin: a material with EXT_materials_coated_conductor
- * becomes a MeshPhysicalMaterial drawing the model (its other properties,
- * read by the loader as usual); without the extension nothing changes. The
- * coat is the extension's (coatFactor, default 1, and coatRoughnessFactor),
- * not KHR_materials_clearcoat's factor, which is the fallback's.
- */
-export class CoatedConductorExtension {
-  constructor(parser, options = {}) {
-    this.parser = parser;
-    this.name = EXTENSION_NAME;
-    this.options = options;
-    this.checked = new Map(); // material index -> the checked model, or null
-  }
-
-  /**
-   * Material `materialIndex`'s extension object if it is one this plugin
-   * draws; null without one, and null with a console warning (once per
-   * material) for one that fails the schema or the range rules: the
-   * specification's consumers draw the fallback then.
-   */
-  model(materialIndex) {
-    if (!this.checked.has(materialIndex)) {
-      const def = this.parser.json.materials?.[materialIndex];
-      const object = def?.extensions?.[this.name];
-      let model = null;
-      if (object !== undefined) {
-        try {
-          model = checkModel(object);
-        } catch (error) {
-          console.warn(`${error.message}; material ${materialIndex} (${def.name ?? "unnamed"}) draws its fallback`);
-        }
-      }
-      this.checked.set(materialIndex, model);
-    }
-    return this.checked.get(materialIndex);
-  }
-
-  /** The GLSL and the table, or null with a console warning when they cannot be had. */
-  async #resources() {
-    try {
-      return await loadResources(this.options);
-    } catch (error) {
-      console.warn(`${EXTENSION_NAME}: ${error.message}; the materials draw their fallback`);
-      return null;
-    }
-  }
-
-  getMaterialType(materialIndex) {
-    return this.model(materialIndex) ? THREE.MeshPhysicalMaterial : null;
-  }
-
-  async extendMaterialParams(materialIndex, materialParams) {
-    const model = this.model(materialIndex);
-    if (!model) return;
-    const resources = await this.#resources();
-    if (!resources) return;
-    Object.assign(materialParams, { clearcoat: model.coatFactor ?? 1,
-                                    clearcoatRoughness: model.coatRoughnessFactor ?? 0 });
-    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources, this.fallback(materialIndex)));
-  }
-
-  /** The fallback's KHR_materials_clearcoat values (the exporter plugin writes them back), or null. */
-  fallback(materialIndex) {
-    const clearcoat = this.parser.json.materials?.[materialIndex]?.extensions?.KHR_materials_clearcoat;
-    return clearcoat && typeof clearcoat === "object" ? { KHR_materials_clearcoat: clearcoat } : null;
-  }
-
-  /**
-   * The loader puts clones of a material on meshes (assignFinalMaterial:
-   * derivative tangents, vertex colours, flat shading), and a clone keeps
-   * neither the hooks nor the table: each gets its own here.
-   */
-  async afterRoot(result) {
-    const drawn = (this.parser.json.materials ?? []).some((_, i) => this.model(i));
-    const resources = drawn ? await this.#resources() : null;
-    if (!resources) return;
-    for (const scene of result.scenes ?? [result.scene]) {
-      scene.traverse((object) => {
-        for (const material of [object.material ?? []].flat()) {
-          const index = this.parser.associations.get(material)?.materials;
-          const model = index === undefined ? null : this.model(index);
-          if (!model || material.userData.coatedConductor?.readTable) continue;
-          const { userData, ...hooks } = coatedConductorHooks(model, resources, this.fallback(index));
-          Object.assign(material, hooks);
-          Object.assign(material.userData, userData);
-        }
-      });
-    }
-  }
-}
-
-/**
- * The GLTFExporter plugin: a material drawing the model (made by the
- * loader plugin or createCoatedConductorMaterial) is written with its
- * EXT_materials_coated_conductor object, and with the fallback's
- * KHR_materials_clearcoat values it was loaded with (three's own exporter
- * writes the coat the plugin draws, `clearcoat` 1, which is not the
- * fallback's fitted factor); the model is not repeated in `extras`.
- *
- *   exporter.register((writer) => new CoatedConductorExporterExtension(writer));
- */
-export class CoatedConductorExporterExtension {
-  constructor(writer) {
-    this.writer = writer;
-    this.name = EXTENSION_NAME;
-  }
-
-  async writeMaterialAsync(material, materialDef) {
-    const data = material.userData?.coatedConductor;
-    if (!data?.model) return;
-    materialDef.extensions = materialDef.extensions || {};
-    materialDef.extensions[this.name] = JSON.parse(JSON.stringify(data.model));
-    this.writer.extensionsUsed[this.name] = true;
-    for (const [name, values] of Object.entries(data.fallback ?? {})) {
-      if (materialDef.extensions[name]) materialDef.extensions[name] = JSON.parse(JSON.stringify(values));
-    }
-    if (materialDef.extras) {
-      delete materialDef.extras.coatedConductor;
-      if (Object.keys(materialDef.extras).length === 0) delete materialDef.extras;
-    }
-  }
 }
