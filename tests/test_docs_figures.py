@@ -40,6 +40,16 @@ RECORDED_ROWS = (
     "three.js through",
     "refit from edited curves",
     "refractiveindex.info `main` shelf",
+    "exports seen from air in the tool",
+    "exports in an ACEScg host",
+    "a metal from F0 and F82",
+    "repeated export download",
+    "hard curve edits",
+    "scene packs: the shipped material",
+    "extreme but finite n, k",
+    "gapped data (100 nm gaps)",
+    "`python -m fitting fit Au`",
+    "the three.js package",
 )
 """The rows of docs/results.md's "Headline figures, in full" whose figures
 are all read from a record (by the start of their first cell): every number
