@@ -85,7 +85,7 @@ export async function save(ctx, continuing) {
   const entry = materials.find((m) => m.id === fit.material_id);
   continuing.material = { id: fit.material_id, name: fit.name, version: entry ? entry.version : null };
   ctx.onSaved(fit);
-  ctx.say(going
+  ctx.say((going
     ? `Saved “${fit.name}”, version ${entry ? entry.version : "?"}: it continues the material (its history is kept).`
     : `Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`)
     + (fit.restored_from_bin ? " It was in the bin: this save took it out." : ""), true);
