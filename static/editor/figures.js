@@ -17,8 +17,10 @@ export const REACH_DE = 3.0;
 /**
  * The figures of `fit` to show: {label, mean (a number or null), max: null
  * or {value, thetaDeg, etaI} (thetaDeg and etaI null when the fit does not
- * say where), reach: null or {max, thetaDeg, etaI}} (reach only for a curve
- * fit that misses its target by more than REACH_DE somewhere).
+ * say where), reach: null or {max, thetaDeg, etaI} (reach only for a curve
+ * fit that misses its target by more than REACH_DE somewhere), unfollowed:
+ * the server's words for each edited curve the fit cannot follow
+ * (`metrics.details.warnings` of a curve fit: where and by how much), else []}.
  */
 export function readFigures(fit) {
   const figure = (fit.metrics && fit.metrics.figure) || {};
@@ -30,11 +32,16 @@ export function readFigures(fit) {
   const reach = fit.kind === "curves" && at && figure.delta_E_max > REACH_DE
     ? { max: figure.delta_E_max, thetaDeg: at.theta_deg, etaI: at.eta_i }
     : null;
+  const details = (fit.metrics && fit.metrics.details) || {};
+  const unfollowed = fit.kind === "curves" && Array.isArray(details.warnings)
+    ? details.warnings.filter((w) => typeof w === "string")
+    : [];
   return {
     label: figure.against ? `Against ${figure.against}, mean ΔE` : "Mean ΔE",
     mean,
     max,
     reach,
+    unfollowed,
   };
 }
 

@@ -59,7 +59,7 @@ export class Readout {
     this.showDownload();
     download.setAttribute("aria-disabled", "false");
     download.setAttribute("download", "");
-    this.#reach(figures.reach);
+    this.#reach(figures.reach, figures.unfollowed);
     this.#clearErrorMap(fit);
     this.scheduleErrorMap();
   }
@@ -73,17 +73,21 @@ export class Readout {
     $("heatmap-caption").textContent = "Measuring this fit's differences…";
   }
 
-  #reach(reach) {
+  // The worst miss (reach) and, in the server's words, each edited curve the fit cannot follow.
+  #reach(reach, unfollowed) {
     const box = $("reach");
-    if (!reach) {
+    $("reach-warnings").replaceChildren(
+      ...unfollowed.map((text) => Object.assign(document.createElement("li"), { textContent: text })));
+    if (!reach && unfollowed.length === 0) {
       box.hidden = true;
       return;
     }
-    $("reach-text").textContent =
-      `The model cannot follow this edit everywhere: it misses the edited curves by up to ` +
-      `ΔE ${reach.max.toFixed(1)} at ${reach.thetaDeg.toFixed(0)}° and ` +
-      `ηᵢ ${reach.etaI.toFixed(2)} (1 is a just-visible difference). The fit stays a valid ` +
-      `reflectance (0 to 1); the curve shows what you will get.`;
+    $("reach-text").textContent = reach
+      ? `The model cannot follow this edit everywhere: it misses the edited curves by up to ` +
+        `ΔE ${reach.max.toFixed(1)} at ${reach.thetaDeg.toFixed(0)}° and ` +
+        `ηᵢ ${reach.etaI.toFixed(2)} (1 is a just-visible difference). The fit stays a valid ` +
+        `reflectance (0 to 1); the curve shows what you will get.`
+      : "The model cannot follow every edited curve; the curve shows what you will get.";
     box.hidden = false;
   }
 

@@ -44,6 +44,10 @@ def test_extreme_edit_warns_stays_in_range_and_can_be_gentler(pages, editor_url)
     expect(page.locator("#reach")).to_be_visible()
     text = page.inner_text("#reach-text")
     assert "cannot follow" in text and "ΔE" in text and "°" in text and "ηᵢ" in text
+    # Each edited curve the fit cannot follow, in the server's words (where and by how much).
+    said = page.evaluate(f"fetch('/api/v1/fits/{extreme_id}').then(r => r.json())")["metrics"]["details"]["warnings"]
+    assert said and all("edit not followed" in w for w in said)
+    assert page.locator("#reach-warnings li").all_inner_texts() == said
     low, high = model_range(page, extreme_id)
     assert low >= -2e-4 and high <= 1.0 + 2e-4, (low, high)
 

@@ -135,6 +135,19 @@ test("figures: the fit's one figure (metrics.figure), its target in words, the r
   assert.equal(library.reach, null, "only an edit can be beyond the model's reach");
   assert.match(library.label, /measured metal/);
   assert.equal(readFigures({ kind: "library", metrics: {} }).mean, null);
+  assert.deepEqual(f.unfollowed, [], "no warning when the server gives none");
+});
+
+test("figures: the server's warnings for edited curves the fit cannot follow", () => {
+  const said = "edit not followed: the fit stays 2.10 mean Delta E 2000 from the edited curve at eta_i 1.5 " +
+    "(max 6.00 at 60 degrees); the model cannot bend that way";
+  const edit = { kind: "curves", metrics: { figure: { delta_E_mean: 0.5, delta_E_max: 1.0, max_at: null },
+    details: { warnings: [said, 7] } } };
+  const f = readFigures(edit);
+  assert.deepEqual(f.unfollowed, [said], "every warning in words, nothing else");
+  assert.equal(f.reach, null, "a warning shows without a miss past REACH_DE");
+  const library = readFigures({ kind: "library", metrics: { figure: {}, details: { warnings: [said] } } });
+  assert.deepEqual(library.unfollowed, [], "a measured metal's data warnings are not edits");
 });
 
 test("kinds: the words a renderer uploads, per kind; unknown kinds refused by name", () => {
