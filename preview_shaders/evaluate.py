@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fitting.models.baselines import external_medium_F0, lazanyi_a
-from fitting.models.coated_conductor import collapse_to_eta_i
+from fitting.models.baselines import equivalent_index, external_medium_F0, lazanyi_a
+from fitting.models.coated_conductor import collapse_to_eta_i, lean_constants
 from fitting.models.kinds import MODEL_KINDS, model_kind
 from fitting.models.pack import PackedMaterial, halves_to_uint32
 
@@ -41,16 +41,22 @@ __all__ = [
     "time_variants",
 ]
 
-VARIANTS = ("packed", "floats", "collapsed", "lazanyi", "schlick", "exact", "rgb_conductor")
+VARIANTS = (
+    "packed", "floats", "collapsed", "lazanyi", "schlick", "exact", "rgb_conductor",
+    "lean", "collapsed_lean", "lazanyi_lean",
+)
 """Model from float16 halves in uint32, model from float coefficients,
 scene-specialised model (Eq. 1 only), adjusted Lazanyi, Schlick, exact RGB
-conductor Fresnel from float n, k, and the rgb-conductor model kind from its
-6 float16 halves in 3 uint32."""
+conductor Fresnel from float n, k, the rgb-conductor model kind from its
+6 float16 halves in 3 uint32, and the lean forms (per-material constants
+from the CPU): the general model (``cf_coated_conductor_lean``), the
+scene-specialised model (``cf_coated_conductor_eq1_lean``) and adjusted
+Lazanyi (``cf_lazanyi_adjusted_lean``)."""
 
 LAZANYI_SCENE = "lazanyi_scene"
 FIXED = "fixed"
 TIMING_VARIANTS = VARIANTS + (LAZANYI_SCENE, FIXED)
-"""The variants and, for timing only (``CF_VARIANT`` 6 and 7 of
+"""The variants and, for timing only (``CF_VARIANT`` 10 and 11 of
 evaluate.frag): adjusted Lazanyi at the scene's constant eta_i with F0 and a
 from the CPU (the like-for-like counterpart of the scene-specialised model),
 and a pass with no Fresnel term (the fixed cost every variant pays)."""
@@ -148,12 +154,21 @@ def _set_uniforms(program, variant: str, inputs: ShaderInputs) -> None:
     for name, m in zip(("cf_C_F0", "cf_C_a", "cf_C_alpha"), inputs.coefficients.reshape(3, 9)):
         _set(program, name, tuple(float(c) for c in m))
     _set(program, "cf_eta_i_range", tuple(float(v) for v in inputs.eta_i_range))
-    if variant == "collapsed":
+    if variant == "lean":
+        P, t_map = lean_constants(inputs.coefficients.reshape(3, 3, 3), inputs.eta_i_range)
+        # Column j of each mat3 is power j across the channels: P[p] row-major.
+        for name, m in zip(("cf_P_F0", "cf_P_a", "cf_P_alpha"), P):
+            _set(program, name, tuple(float(c) for c in m.ravel()))
+        _set(program, "cf_t_map", t_map)
+    if variant == "lazanyi_lean":
+        _set(program, "cf_n_equivalent", tuple(float(v) for v in equivalent_index(inputs.F0_air)))
+        _set(program, "cf_a", tuple(float(v) for v in lazanyi_a(inputs.F0_air, inputs.F82_air)))
+    if variant in ("collapsed", "collapsed_lean"):
         F0, a, alpha = (tuple(float(v) for v in row) for row in inputs.collapsed)
         _set(program, "cf_F0", F0)
         _set(program, "cf_a", a)
         _set(program, "cf_alpha", alpha)
-    else:
+    elif variant != "lazanyi_lean":
         _set(program, "cf_F0", tuple(float(v) for v in inputs.F0_air))
     _set(program, "cf_F0_air", tuple(float(v) for v in inputs.F0_air))
     _set(program, "cf_F82_air", tuple(float(v) for v in inputs.F82_air))

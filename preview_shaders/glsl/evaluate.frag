@@ -4,9 +4,12 @@
 // eta_i = grid.z + j grid.w. CF_VARIANT is set by the host:
 // 0 model from packed halves, 1 model from floats, 2 scene-specialised model,
 // 3 adjusted Lazanyi, 4 Schlick, 5 exact RGB conductor Fresnel from floats,
-// 6 the rgb-conductor kind from packed halves; for the cost benchmark only:
-// 7 Lazanyi at a scene-constant eta_i (F0 and a from the CPU), 8 no Fresnel
-// term (the pass's fixed cost: rasterisation, the grid inputs, the store).
+// 6 the rgb-conductor kind from packed halves, 7 the lean general model
+// (per-power coefficients and the t map from the CPU), 8 the lean
+// scene-specialised model, 9 adjusted Lazanyi with n and a from the CPU;
+// for the cost benchmark only: 10 Lazanyi at a scene-constant eta_i (F0 and
+// a from the CPU), 11 no Fresnel term (the pass's fixed cost:
+// rasterisation, the grid inputs, the store).
 #include "cf_coated_conductor.glsl"
 #include "cf_rgb_conductor.glsl"
 #include "cf_fresnel_baselines.glsl"
@@ -37,6 +40,19 @@ uniform vec3 cf_k;
 #elif CF_VARIANT == 6
 uniform uint cf_rgb_words[3];
 #elif CF_VARIANT == 7
+// Column j: power j of t for the three channels.
+uniform mat3 cf_P_F0;
+uniform mat3 cf_P_a;
+uniform mat3 cf_P_alpha;
+uniform vec2 cf_t_map;
+#elif CF_VARIANT == 8
+uniform vec3 cf_F0;
+uniform vec3 cf_a;
+uniform vec3 cf_alpha;
+#elif CF_VARIANT == 9
+uniform vec3 cf_n_equivalent;
+uniform vec3 cf_a;
+#elif CF_VARIANT == 10
 uniform vec3 cf_F0;
 uniform vec3 cf_a;
 #endif
@@ -66,8 +82,14 @@ void main()
 #elif CF_VARIANT == 6
     vec3 F = cf_rgb_conductor_packed(NdotV, eta_i, cf_rgb_words);
 #elif CF_VARIANT == 7
-    vec3 F = cf_lazanyi(NdotV, cf_F0, cf_a);
+    vec3 F = cf_coated_conductor_lean(NdotV, eta_i, cf_t_map, cf_P_F0, cf_P_a, cf_P_alpha);
 #elif CF_VARIANT == 8
+    vec3 F = cf_coated_conductor_eq1_lean(NdotV, cf_F0, cf_a, cf_alpha);
+#elif CF_VARIANT == 9
+    vec3 F = cf_lazanyi_adjusted_lean(NdotV, eta_i, cf_n_equivalent, cf_a);
+#elif CF_VARIANT == 10
+    vec3 F = cf_lazanyi(NdotV, cf_F0, cf_a);
+#elif CF_VARIANT == 11
     // Depends on both inputs, so neither is optimised away.
     vec3 F = vec3(NdotV, eta_i, 0.0);
 #endif

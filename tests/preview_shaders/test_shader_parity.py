@@ -96,7 +96,7 @@ class TestHalvesDecoding:
 
 
 class TestCoatedConductorModel:
-    @pytest.mark.parametrize("variant", ["packed", "floats"])
+    @pytest.mark.parametrize("variant", ["packed", "floats", "lean"])
     @pytest.mark.parametrize("name", sorted(MATERIALS))
     def test_matches_numpy_model(self, thread, variant, name):
         material = MATERIALS[name]
@@ -112,11 +112,13 @@ class TestCoatedConductorModel:
         assert np.all(np.isfinite(F))
         assert np.abs(F - expected).max() <= TOLERANCE
 
+    @pytest.mark.parametrize("variant", ["collapsed", "collapsed_lean"])
     @pytest.mark.parametrize("eta_i", [1.0, 1.5, 2.2, 2.5])
-    def test_scene_specialised_matches_collapse(self, thread, eta_i):
+    def test_scene_specialised_matches_collapse(self, thread, eta_i, variant):
         material = MATERIALS["random-0"]
         inputs = shader_inputs(material, collapse_eta_i=eta_i)
-        F, mu, _ = evaluate_grid(thread, "collapsed", inputs, MU_AXIS, (eta_i, 0.0, 4))
+        F, mu, _ = evaluate_grid(thread, variant, inputs, MU_AXIS, (eta_i, 0.0, 4))
+        assert np.all(np.isfinite(F))
         P = collapse_to_eta_i(material.coefficients.astype(np.float64), eta_i, material.eta_i_range)
         expected = model_from_parameters(mu.astype(np.float64)[..., None], P[0, :, 0], P[1, :, 0], P[2, :, 0])
         assert np.abs(F - expected).max() <= TOLERANCE
@@ -146,9 +148,10 @@ class TestBaselines:
     F0_air = np.array([0.95, 0.64, 0.29])
     F82_air = np.array([0.91, 0.70, 0.45])
 
-    def test_lazanyi_adjusted_matches_numpy(self, thread):
+    @pytest.mark.parametrize("variant", ["lazanyi", "lazanyi_lean"])
+    def test_lazanyi_adjusted_matches_numpy(self, thread, variant):
         inputs = shader_inputs(MATERIALS["random-0"], F0_air=self.F0_air, F82_air=self.F82_air)
-        F, mu, eta = evaluate_grid(thread, "lazanyi", inputs, MU_AXIS, ETA_AXIS)
+        F, mu, eta = evaluate_grid(thread, variant, inputs, MU_AXIS, ETA_AXIS)
         expected = lazanyi_adjusted(*_numpy_inputs(mu, eta), self.F0_air, self.F82_air)
         assert np.abs(F - expected).max() <= TOLERANCE
 
