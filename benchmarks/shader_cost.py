@@ -190,7 +190,7 @@ def main() -> None:
           f"CPU net {ratio(cpu, 'collapsed', LAZANYI_SCENE, net=True):.2f}x")
 
     rng = np.random.default_rng(0)
-    pairs = {name: {"variant": v, "against": base,
+    pairs: dict[str, dict] = {name: {"variant": v, "against": base,
                     "cpu": paired_ratio(samples[v][:, 2], samples[base][:, 2], rng),
                     "wall": paired_ratio(samples[v][:, 1], samples[base][:, 1], rng)}
              for name, (v, base) in PAIRS.items()}
