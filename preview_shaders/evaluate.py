@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fitting.models.baselines import external_medium_F0, lazanyi_a
-from fitting.models.coated_conductor import collapse_to_eta_i
+from fitting.models.baselines import equivalent_index, external_medium_F0, lazanyi_a
+from fitting.models.coated_conductor import collapse_to_eta_i, lean_constants
 from fitting.models.kinds import MODEL_KINDS, model_kind
 from fitting.models.pack import PackedMaterial, halves_to_uint32
 
@@ -39,18 +39,26 @@ __all__ = [
     "TIMING_VARIANTS",
     "MODEL_VARIANTS",
     "time_variants",
+    "constants_source",
+    "CONSTANTS_SUFFIX",
 ]
 
-VARIANTS = ("packed", "floats", "collapsed", "lazanyi", "schlick", "exact", "rgb_conductor")
+VARIANTS = (
+    "packed", "floats", "collapsed", "lazanyi", "schlick", "exact", "rgb_conductor",
+    "lean", "collapsed_lean", "lazanyi_lean",
+)
 """Model from float16 halves in uint32, model from float coefficients,
 scene-specialised model (Eq. 1 only), adjusted Lazanyi, Schlick, exact RGB
-conductor Fresnel from float n, k, and the rgb-conductor model kind from its
-6 float16 halves in 3 uint32."""
+conductor Fresnel from float n, k, the rgb-conductor model kind from its
+6 float16 halves in 3 uint32, and the lean forms (per-material constants
+from the CPU): the general model (``cf_coated_conductor_lean``), the
+scene-specialised model (``cf_coated_conductor_eq1_lean``) and adjusted
+Lazanyi (``cf_lazanyi_adjusted_lean``)."""
 
 LAZANYI_SCENE = "lazanyi_scene"
 FIXED = "fixed"
 TIMING_VARIANTS = VARIANTS + (LAZANYI_SCENE, FIXED)
-"""The variants and, for timing only (``CF_VARIANT`` 6 and 7 of
+"""The variants and, for timing only (``CF_VARIANT`` 10 and 11 of
 evaluate.frag): adjusted Lazanyi at the scene's constant eta_i with F0 and a
 from the CPU (the like-for-like counterpart of the scene-specialised model),
 and a pass with no Fresnel term (the fixed cost every variant pays)."""
@@ -136,30 +144,79 @@ def shader_inputs(
     )
 
 
-def _set(program, name: str, value) -> None:
-    """Set a uniform the compiler kept (a variant's unused ones are gone)."""
-    if name in program:
-        program[name].value = value
+def _uniform_values(variant: str, inputs: ShaderInputs) -> dict:
+    """The values of the uniforms ``variant`` reads (some others too), by name."""
+    values: dict = {"cf_words": [int(w) for w in inputs.words]}
+    # mat3 fills column by column: the layout order is already column-major.
+    for name, m in zip(("cf_C_F0", "cf_C_a", "cf_C_alpha"), inputs.coefficients.reshape(3, 9)):
+        values[name] = tuple(float(c) for c in m)
+    values["cf_eta_i_range"] = tuple(float(v) for v in inputs.eta_i_range)
+    if variant == "lean":
+        P, t_map = lean_constants(inputs.coefficients.reshape(3, 3, 3), inputs.eta_i_range)
+        # Column j of each mat3 is power j across the channels: P[p] row-major.
+        for name, m in zip(("cf_P_F0", "cf_P_a", "cf_P_alpha"), P):
+            values[name] = tuple(float(c) for c in m.ravel())
+        values["cf_t_map"] = tuple(float(v) for v in t_map)
+    if variant == "lazanyi_lean":
+        values["cf_n_equivalent"] = tuple(float(v) for v in equivalent_index(inputs.F0_air))
+        values["cf_a"] = tuple(float(v) for v in lazanyi_a(inputs.F0_air, inputs.F82_air))
+    if variant in ("collapsed", "collapsed_lean"):
+        for name, row in zip(("cf_F0", "cf_a", "cf_alpha"), inputs.collapsed):
+            values[name] = tuple(float(v) for v in row)
+    elif variant == LAZANYI_SCENE:
+        # What a renderer precomputes when eta_i is constant for the scene.
+        values["cf_F0"] = tuple(float(v) for v in external_medium_F0(inputs.F0_air, inputs.collapse_eta_i))
+        values["cf_a"] = tuple(float(v) for v in lazanyi_a(inputs.F0_air, inputs.F82_air))
+    elif variant != "lazanyi_lean":
+        values["cf_F0"] = tuple(float(v) for v in inputs.F0_air)
+    values["cf_F0_air"] = tuple(float(v) for v in inputs.F0_air)
+    values["cf_F82_air"] = tuple(float(v) for v in inputs.F82_air)
+    values["cf_n"] = tuple(float(v) for v in inputs.n)
+    values["cf_k"] = tuple(float(v) for v in inputs.k)
+    values["cf_rgb_words"] = [int(w) for w in inputs.rgb_words]
+    return values
 
 
 def _set_uniforms(program, variant: str, inputs: ShaderInputs) -> None:
-    _set(program, "cf_words", [int(w) for w in inputs.words])
-    # mat3 fills column by column: the layout order is already column-major.
-    for name, m in zip(("cf_C_F0", "cf_C_a", "cf_C_alpha"), inputs.coefficients.reshape(3, 9)):
-        _set(program, name, tuple(float(c) for c in m))
-    _set(program, "cf_eta_i_range", tuple(float(v) for v in inputs.eta_i_range))
-    if variant == "collapsed":
-        F0, a, alpha = (tuple(float(v) for v in row) for row in inputs.collapsed)
-        _set(program, "cf_F0", F0)
-        _set(program, "cf_a", a)
-        _set(program, "cf_alpha", alpha)
-    else:
-        _set(program, "cf_F0", tuple(float(v) for v in inputs.F0_air))
-    _set(program, "cf_F0_air", tuple(float(v) for v in inputs.F0_air))
-    _set(program, "cf_F82_air", tuple(float(v) for v in inputs.F82_air))
-    _set(program, "cf_n", tuple(float(v) for v in inputs.n))
-    _set(program, "cf_k", tuple(float(v) for v in inputs.k))
-    _set(program, "cf_rgb_words", [int(w) for w in inputs.rgb_words])
+    for name, value in _uniform_values(variant, inputs).items():
+        if name in program:  # a variant's unused uniforms are compiled out
+            program[name].value = value
+
+
+_GLSL_TYPES = {2: "vec2", 3: "vec3", 9: "mat3"}
+
+
+def constants_source(variant: str, inputs: ShaderInputs) -> str:
+    """
+    ``cf_constants.glsl`` for ``CF_CONSTANTS`` 1 of evaluate.frag: the
+    values :func:`_set_uniforms` uploads, as GLSL constants instead (what an
+    exported material snippet ships; a compiler folds work on them).
+    Floats are written with Python's shortest repr, which the GLSL compiler
+    rounds to the same float32 as an uploaded uniform.
+    """
+    lines = []
+    for name, value in _uniform_values(variant, inputs).items():
+        if isinstance(value, list):  # uint words
+            items = ", ".join(f"{w}u" for w in value)
+            lines.append(f"const uint {name}[{len(value)}] = uint[{len(value)}]({items});")
+        else:
+            items = ", ".join(repr(float(v)) for v in value)
+            lines.append(f"const {_GLSL_TYPES[len(value)]} {name} = {_GLSL_TYPES[len(value)]}({items});")
+    return "\n".join(lines) + "\n"
+
+
+def _program(state: GLState, variant: str, inputs: ShaderInputs, constants: bool, write_inputs: int):
+    """evaluate.frag for one (timing) variant, its inputs uniforms or constants."""
+    source = constants_source(variant, inputs) if constants else ""
+    program, vao = state.program(
+        "evaluate.frag",
+        {"CF_VARIANT": TIMING_VARIANTS.index(variant), "CF_WRITE_INPUTS": write_inputs,
+         "CF_CONSTANTS": int(constants)},
+        {"cf_constants.glsl": source},
+    )
+    if not constants:
+        _set_uniforms(program, variant, inputs)
+    return program, vao
 
 
 def _check_variant(variant: str) -> int:
@@ -168,12 +225,10 @@ def _check_variant(variant: str) -> int:
     return VARIANTS.index(variant)
 
 
-def _evaluate_grid(state: GLState, variant, inputs, grid, width, height):
+def _evaluate_grid(state: GLState, variant, inputs, grid, width, height, constants):
     ctx = state.ctx
-    program, vao = state.program(
-        "evaluate.frag", {"CF_VARIANT": _check_variant(variant), "CF_WRITE_INPUTS": 1}
-    )
-    _set_uniforms(program, variant, inputs)
+    _check_variant(variant)
+    program, vao = _program(state, variant, inputs, constants, 1)
     program["u_grid"].value = tuple(float(g) for g in grid)
     fbo, targets = state.float_targets((width, height), 2)
     try:
@@ -192,9 +247,12 @@ def evaluate_grid(
     inputs: ShaderInputs,
     cos_theta_axis: tuple[float, float, int],
     eta_i_axis: tuple[float, float, int],
+    constants: bool = False,
 ):
     """
     Evaluate one variant over a grid into a float32 target and read it back.
+    With ``constants``, the material's values are compiled into the shader
+    (:func:`constants_source`) instead of uploaded as uniforms.
 
     Parameters
     ----------
@@ -211,7 +269,7 @@ def evaluate_grid(
     mu0, mu_step, width = cos_theta_axis
     eta0, eta_step, height = eta_i_axis
     grid = (mu0, mu_step, eta0, eta_step)
-    return thread.call(_evaluate_grid, variant, inputs, grid, int(width), int(height))
+    return thread.call(_evaluate_grid, variant, inputs, grid, int(width), int(height), bool(constants))
 
 
 def _decode_halves(state: GLState, words):
@@ -237,19 +295,14 @@ def decode_halves_in_shader(thread: RenderThread, words) -> np.ndarray:
     return thread.call(_decode_halves, words)
 
 
-def _timing_program(state: GLState, variant: str, inputs: ShaderInputs):
-    """The full-screen program of one timing variant, uniforms set."""
-    program, vao = state.program(
-        "evaluate.frag", {"CF_VARIANT": TIMING_VARIANTS.index(variant), "CF_WRITE_INPUTS": 0}
-    )
-    _set_uniforms(program, variant if variant in VARIANTS else "lazanyi", inputs)
-    if variant == LAZANYI_SCENE:
-        # What a renderer precomputes when eta_i is constant for the scene.
-        F0 = external_medium_F0(inputs.F0_air, inputs.collapse_eta_i)
-        a = lazanyi_a(inputs.F0_air, inputs.F82_air)
-        program["cf_F0"].value = tuple(float(v) for v in F0)
-        program["cf_a"].value = tuple(float(v) for v in a)
-    return program, vao
+CONSTANTS_SUFFIX = "@const"
+"""A timing variant name with this suffix has its inputs compiled in as constants."""
+
+
+def _timing_program(state: GLState, name: str, inputs: ShaderInputs):
+    """The full-screen program of one timing variant, inputs set."""
+    variant = name.removesuffix(CONSTANTS_SUFFIX)
+    return _program(state, variant, inputs, name.endswith(CONSTANTS_SUFFIX), 0)
 
 
 def _time_variants(state: GLState, inputs, variants, width, height, rounds):
@@ -276,7 +329,8 @@ def time_variants(
 ) -> dict[str, np.ndarray]:
     """
     Time full-screen renders of ``variants`` (names of
-    :data:`TIMING_VARIANTS`) into an RGBA32F target, interleaved round by
+    :data:`TIMING_VARIANTS`, each optionally with :data:`CONSTANTS_SUFFIX`:
+    the material's values compiled in rather than uniforms) into an RGBA32F target, interleaved round by
     round so drifting machine load hits every variant alike, one warm-up
     render before each timed one.
 
@@ -287,7 +341,7 @@ def time_variants(
         and process CPU time (s) of each timed render.
     """
     for variant in variants:
-        if variant not in TIMING_VARIANTS:
+        if variant.removesuffix(CONSTANTS_SUFFIX) not in TIMING_VARIANTS:
             raise ValueError(
                 f"`variants` must name {', '.join(TIMING_VARIANTS)}, got {variant!r}"
             )

@@ -37,6 +37,7 @@ __all__ = [
     "schlick",
     "external_medium_F0",
     "lazanyi_a",
+    "equivalent_index",
     "lazanyi_adjusted",
     "baseline_inputs",
     "baseline_ACEScg",
@@ -66,6 +67,17 @@ def schlick(cos_theta, F0) -> np.ndarray:
     return F0 + (1.0 - F0) * (1.0 - mu) ** 5
 
 
+def equivalent_index(F0_air) -> np.ndarray:
+    """
+    Hoffman (2020): the real index :math:`n = (1 + \\sqrt{F_0})/(1 - \\sqrt{F_0})`
+    whose normal reflectance in air is ``F0_air`` (F0 clipped to
+    [0, 1 - 1e-6] so n stays finite): a per-material constant a renderer
+    computes once for :func:`external_medium_F0` at any eta_i.
+    """
+    s = np.sqrt(np.clip(np.asarray(F0_air, dtype=np.float64), 0.0, _F0_MAX))
+    return (1.0 + s) / (1.0 - s)
+
+
 def external_medium_F0(F0_air, eta_i) -> np.ndarray:
     """
     Hoffman (2020): the F0 of a metal in air mapped to a coating of index
@@ -73,8 +85,7 @@ def external_medium_F0(F0_air, eta_i) -> np.ndarray:
     :math:`n = (1 + \\sqrt{F_0})/(1 - \\sqrt{F_0})`, giving
     :math:`((n - \\eta_i)/(n + \\eta_i))^2`.
     """
-    s = np.sqrt(np.clip(np.asarray(F0_air, dtype=np.float64), 0.0, _F0_MAX))
-    n = (1.0 + s) / (1.0 - s)
+    n = equivalent_index(F0_air)
     eta_i = np.asarray(eta_i, dtype=np.float64)[..., None]
     return ((n - eta_i) / (n + eta_i)) ** 2
 

@@ -43,6 +43,7 @@ __all__ = [
     "PARAMETERS",
     "CHANNELS",
     "ALPHA_MIN",
+    "lean_constants",
     "normalised_eta_i",
     "check_coefficients",
     "model_parameters",
@@ -136,6 +137,23 @@ def collapse_to_eta_i(coefficients, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> n
     C = check_coefficients(coefficients)
     P = model_parameters(C, float(eta_i), eta_i_range)
     return P[..., None]
+
+
+def lean_constants(coefficients, eta_i_range=DEFAULT_ETA_I_RANGE) -> tuple[np.ndarray, tuple[float, float]]:
+    """
+    The per-material constants of the lean general shader
+    (``cf_coated_conductor_lean``): a (3, 3, 3) array P[p, j, c], parameter p,
+    power j of t, channel c (the coefficients with channel and power
+    swapped, degree padded to 2), and ``t_map`` (s, o) with
+    t = clamp(eta_i s + o, 0, 1) equal to :func:`normalised_eta_i`
+    ((0, 0) for a single-index fit).
+    """
+    C = check_coefficients(coefficients)
+    P = np.zeros((3, 3, 3))
+    P[:, : C.shape[2], :] = np.swapaxes(C, 1, 2)
+    lo, hi = (float(v) for v in eta_i_range)
+    t_map = (1.0 / (hi - lo), -lo / (hi - lo)) if hi > lo else (0.0, 0.0)
+    return P, t_map
 
 
 def model_from_parameters(cos_theta, F0, a, alpha) -> np.ndarray:

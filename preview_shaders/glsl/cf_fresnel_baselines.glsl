@@ -60,4 +60,15 @@ vec3 cf_lazanyi_adjusted(float NdotV, float eta_i, vec3 F0_air, vec3 F82_air)
     return cf_lazanyi(NdotV, cf_f0_in_medium(F0_air, eta_i), cf_lazanyi_a(F0_air, F82_air));
 }
 
+// Adjusted Lazanyi with its per-material constants from the CPU, as a
+// renderer with eta_i varying per pixel computes it: the equivalent real
+// index n of the air F0 (fitting.models.baselines.equivalent_index) and a
+// (cf_lazanyi_a) are uniforms, and only the external-medium F0
+// ((n - eta_i) / (n + eta_i))^2 is evaluated per pixel.
+vec3 cf_lazanyi_adjusted_lean(float NdotV, float eta_i, vec3 n, vec3 a)
+{
+    vec3 r = (n - eta_i) / (n + eta_i);
+    return cf_lazanyi(NdotV, r * r, a);
+}
+
 #endif

@@ -18,6 +18,7 @@ from fitting.models.coated_conductor import (
 from fitting.models.pack import PackedMaterial, halves_to_uint32, to_float16
 from fitting.optics.fresnel import fresnel_conductor
 from preview_shaders.evaluate import (
+    CONSTANTS_SUFFIX,
     TIMING_VARIANTS,
     time_variants,
     decode_halves_in_shader,
@@ -96,7 +97,7 @@ class TestHalvesDecoding:
 
 
 class TestCoatedConductorModel:
-    @pytest.mark.parametrize("variant", ["packed", "floats"])
+    @pytest.mark.parametrize("variant", ["packed", "floats", "lean"])
     @pytest.mark.parametrize("name", sorted(MATERIALS))
     def test_matches_numpy_model(self, thread, variant, name):
         material = MATERIALS[name]
@@ -112,11 +113,13 @@ class TestCoatedConductorModel:
         assert np.all(np.isfinite(F))
         assert np.abs(F - expected).max() <= TOLERANCE
 
+    @pytest.mark.parametrize("variant", ["collapsed", "collapsed_lean"])
     @pytest.mark.parametrize("eta_i", [1.0, 1.5, 2.2, 2.5])
-    def test_scene_specialised_matches_collapse(self, thread, eta_i):
+    def test_scene_specialised_matches_collapse(self, thread, eta_i, variant):
         material = MATERIALS["random-0"]
         inputs = shader_inputs(material, collapse_eta_i=eta_i)
-        F, mu, _ = evaluate_grid(thread, "collapsed", inputs, MU_AXIS, (eta_i, 0.0, 4))
+        F, mu, _ = evaluate_grid(thread, variant, inputs, MU_AXIS, (eta_i, 0.0, 4))
+        assert np.all(np.isfinite(F))
         P = collapse_to_eta_i(material.coefficients.astype(np.float64), eta_i, material.eta_i_range)
         expected = model_from_parameters(mu.astype(np.float64)[..., None], P[0, :, 0], P[1, :, 0], P[2, :, 0])
         assert np.abs(F - expected).max() <= TOLERANCE
@@ -124,6 +127,17 @@ class TestCoatedConductorModel:
             mu.astype(np.float64), eta_i, material.coefficients.astype(np.float64), material.eta_i_range
         )
         assert np.abs(F - general).max() <= TOLERANCE
+
+    @pytest.mark.parametrize("variant", ["packed", "floats", "lean"])
+    @pytest.mark.parametrize("name", ["random-1", "single-index"])
+    def test_compiled_in_constants_match_numpy_model(self, thread, variant, name):
+        # The material's values as GLSL constants (what an exported snippet ships).
+        material = MATERIALS[name]
+        F, mu, eta = evaluate_grid(thread, variant, shader_inputs(material), MU_AXIS, ETA_AXIS, constants=True)
+        expected = coated_conductor_model(
+            *_numpy_inputs(mu, eta), material.coefficients.astype(np.float64), material.eta_i_range
+        )
+        assert np.all(np.isfinite(F)) and np.abs(F - expected).max() <= TOLERANCE
 
     def test_detects_a_one_ulp_change_of_a_coefficient(self, thread):
         material = MATERIALS["random-0"]
@@ -146,9 +160,11 @@ class TestBaselines:
     F0_air = np.array([0.95, 0.64, 0.29])
     F82_air = np.array([0.91, 0.70, 0.45])
 
-    def test_lazanyi_adjusted_matches_numpy(self, thread):
+    @pytest.mark.parametrize("constants", [False, True])
+    @pytest.mark.parametrize("variant", ["lazanyi", "lazanyi_lean"])
+    def test_lazanyi_adjusted_matches_numpy(self, thread, variant, constants):
         inputs = shader_inputs(MATERIALS["random-0"], F0_air=self.F0_air, F82_air=self.F82_air)
-        F, mu, eta = evaluate_grid(thread, "lazanyi", inputs, MU_AXIS, ETA_AXIS)
+        F, mu, eta = evaluate_grid(thread, variant, inputs, MU_AXIS, ETA_AXIS, constants=constants)
         expected = lazanyi_adjusted(*_numpy_inputs(mu, eta), self.F0_air, self.F82_air)
         assert np.abs(F - expected).max() <= TOLERANCE
 
@@ -212,8 +228,9 @@ class TestTimingHarness:
     """The harness behind benchmarks/shader_cost.py renders every variant cleanly."""
 
     def test_every_timing_variant_renders(self, thread):
-        samples = time_variants(thread, shader_inputs(MATERIALS["random-0"]), TIMING_VARIANTS, 64, 32, 2)
-        assert set(samples) == set(TIMING_VARIANTS)
+        names = TIMING_VARIANTS + tuple(v + CONSTANTS_SUFFIX for v in TIMING_VARIANTS)
+        samples = time_variants(thread, shader_inputs(MATERIALS["random-0"]), names, 64, 32, 2)
+        assert set(samples) == set(names)
         for values in samples.values():
             assert values.shape == (2, 3) and np.all(np.isfinite(values)) and np.all(values[:, 1] > 0)
 

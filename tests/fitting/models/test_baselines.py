@@ -5,6 +5,7 @@ import pytest
 
 from fitting.colour.reference import reference_ACEScg
 from fitting.models.baselines import (
+    equivalent_index,
     BASELINES,
     MU_BAR,
     baseline_ACEScg,
@@ -44,6 +45,12 @@ class TestBaselines:
         # A dielectric with n = 1.5 has F0 = 0.04; under eta_i = 1.5 it vanishes.
         # n comes back within ~4 ulps of 1.5, so ((n - 1.5) / (n + 1.5))^2 <= 1e-31.
         assert external_medium_F0([0.04], 1.5)[0] == pytest.approx(0.0, abs=1e-12)
+
+    def test_equivalent_index_gives_F0_in_air(self):
+        F0 = np.array([0.0, 0.04, 0.5, 0.95, 1.0])
+        n = equivalent_index(F0)
+        assert np.all(np.isfinite(n))
+        np.testing.assert_allclose(((n - 1.0) / (n + 1.0)) ** 2, np.minimum(F0, 1.0 - 1.0e-6), atol=1e-12)
 
     def test_lazanyi_passes_through_F82_in_air(self):
         F0, F82 = np.array([0.9, 0.75, 0.4]), np.array([0.8, 0.7, 0.5])

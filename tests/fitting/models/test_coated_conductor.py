@@ -10,6 +10,7 @@ from fitting.models.coated_conductor import (
     ModelAt,
     coated_conductor_model,
     collapse_to_eta_i,
+    lean_constants,
     model_jacobian,
     model_parameters,
     normalised_eta_i,
@@ -132,3 +133,28 @@ class TestModel:
             collapse_to_eta_i(np.zeros((3, 3, 4)), 1.5)
         with pytest.raises(ValueError, match="finite"):
             collapse_to_eta_i(np.full((3, 3, 3), np.nan), 1.5)
+
+
+class TestLeanConstants:
+    """The lean shader's per-material constants (cf_coated_conductor_lean) are the same model."""
+
+    def test_same_parameters_as_model_parameters(self):
+        rng = np.random.default_rng(7)
+        C = rng.uniform(-2.0, 5.0, (3, 3, 3))
+        eta = np.linspace(0.8, 3.2, 41)  # outside the range too: t clamps
+        P, (s, o) = lean_constants(C, (1.2, 2.4))
+        t = np.clip(eta * s + o, 0.0, 1.0)[:, None]
+        lean = P[:, 0][None] + t[..., None] * (P[:, 1][None] + t[..., None] * P[:, 2][None])
+        lean[:, 2] = np.maximum(lean[:, 2], ALPHA_MIN)
+        np.testing.assert_allclose(lean, model_parameters(C, eta, (1.2, 2.4)), rtol=0, atol=1e-12)
+
+    def test_single_index_and_lower_degree(self):
+        C = np.arange(18.0).reshape(3, 3, 2)
+        P, t_map = lean_constants(C, (1.5, 1.5))
+        assert t_map == (0.0, 0.0)
+        np.testing.assert_array_equal(P[:, :2], np.swapaxes(C, 1, 2))
+        assert np.all(P[:, 2] == 0.0)
+
+    def test_rejects_bad_coefficients(self):
+        with pytest.raises(ValueError, match="`coefficients` must have shape"):
+            lean_constants(np.zeros((3, 3)))
