@@ -45,7 +45,7 @@ from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_conductor, fresnel_dielectric
 from .colour_space import ACEScg_to_lin_rec709, lin_rec709_to_ACEScg
 from .seen_jacobian import DeltaEComponents, delta_E_jacobian
-from .tool_fresnel import f82_tint, schlick
+from .tool_fresnel import F82_COS_THETA, f82_tint, schlick
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
 __all__ = [
@@ -61,6 +61,30 @@ MEAN_OBJECTIVE = False  # RMS: measured no better on the mean for W, CuZn, and a
 _TOL = dict(xtol=1e-12, ftol=1e-12, gtol=1e-12)
 
 
+def _conductor_jacobian(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """
+    (S, 2) derivative of the conductor's Fresnel in n and k at ``x``:
+    central differences (step 1e-6 max(1, |x|), one-sided at a bound) of
+    the closed form, the four points in one call.
+    """
+    lo, hi = np.array([N_BOUNDS[0], K_BOUNDS[0]]), np.array([N_BOUNDS[1], K_BOUNDS[1]])
+    h = 1e-6 * np.maximum(1.0, np.abs(x))
+    up, down = np.minimum(x + h, hi), np.maximum(x - h, lo)
+    n = np.array([up[0], down[0], x[0], x[0]])
+    k = np.array([x[1], x[1], up[1], down[1]])
+    R = fresnel_conductor(mu[:, None], 1.0, n, k)
+    return np.stack([(R[:, 0] - R[:, 1]) / (up[0] - down[0]), (R[:, 2] - R[:, 3]) / (up[1] - down[1])], axis=1)
+
+
+def _f82_jacobian(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """(S, 2) derivative of :func:`f82_tint` in F0 and the tint (bilinear in them), exact."""
+    m = F82_COS_THETA
+    w = (1.0 - mu) ** 5
+    u = mu * (1.0 - mu) ** 6 / (m * (1.0 - m) ** 6)
+    Sm = x[0] + (1.0 - x[0]) * (1.0 - m) ** 5
+    return np.stack([1.0 - w - u * (1.0 - (1.0 - m) ** 5) * (1.0 - x[1]), u * Sm], axis=1)
+
+
 def fit_channel_conductor(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per channel, n + i k of an exact conductor in air whose Fresnel is nearest ``T`` (S, 3)."""
     n_out, k_out = np.empty(3), np.empty(3)
@@ -71,8 +95,8 @@ def fit_channel_conductor(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np
         F0 = float(np.clip(R[np.argmax(mu)], 0.0, 0.999))
         x0 = np.clip([1.0, np.sqrt(4.0 * F0 / (1.0 - F0))], lo, hi)
         fit = least_squares(
-            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R, x0, bounds=(lo, hi),
-            method="trf", **_TOL,
+            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R, x0, jac=lambda x: _conductor_jacobian(mu, x),
+            bounds=(lo, hi), method="trf", **_TOL,
         )
         n_out[c], k_out[c] = fit.x
     return n_out, k_out
@@ -85,8 +109,8 @@ def fit_channel_f82(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarr
         R = T[:, c]
         x0 = np.clip([R[np.argmax(mu)], 1.0], 0.0, 1.0)
         fit = least_squares(
-            lambda x: f82_tint(mu, x[0], x[1]) - R, x0, bounds=([0.0, 0.0], [1.0, 1.0]),
-            method="trf", **_TOL,
+            lambda x: f82_tint(mu, x[0], x[1]) - R, x0, jac=lambda x: _f82_jacobian(mu, x),
+            bounds=([0.0, 0.0], [1.0, 1.0]), method="trf", **_TOL,
         )
         F0[c], tint[c] = fit.x
     return F0, tint

@@ -174,3 +174,18 @@ def test_export_values_refuses_unknown_tools():
     values = export_values(library_material("Cu"), 1.5, tools=("mtlx",))
     with pytest.raises(ValueError, match="fitted values of openpbr"):
         export_material(values, "openpbr", 1.5)
+
+
+def test_the_channel_fits_jacobians():
+    """The naive per-channel fits' Jacobians (F82 tint exact, the conductor's Fresnel differenced) against central differences."""
+    from fitting.optics.fresnel import fresnel_conductor
+
+    mu = np.linspace(0.0, 1.0, 100)
+    h = 1e-7
+    for x in (np.array([0.3, 0.7]), np.array([0.95, 0.1])):
+        fd = np.stack([(f82_tint(mu, *(x + h * e)) - f82_tint(mu, *(x - h * e))) / (2 * h) for e in np.eye(2)], 1)
+        assert np.abs(seen_fit._f82_jacobian(mu, x) - fd).max() < 1e-7
+    for x in (np.array([0.3, 3.0]), np.array([1.5, 0.2])):
+        fd = np.stack([(fresnel_conductor(mu, 1.0, *(x + h * e)) - fresnel_conductor(mu, 1.0, *(x - h * e))) / (2 * h)
+                       for e in np.eye(2)], 1)
+        assert np.abs(seen_fit._conductor_jacobian(mu, x) - fd).max() < 1e-6
