@@ -120,10 +120,17 @@ class DeltaEComponents:
 
     def fun(self, x) -> np.ndarray:
         Lab = ACEScg_to_Lab(tool_seen(self.tool, self.pack(x), self.mu, self.eta) @ self.M.T)
-        return delta_E_2000_components(self.target_Lab, Lab)[0].ravel()
+        v, dv = delta_E_2000_components(self.target_Lab, Lab)
+        self._last = (np.array(x, dtype=np.float64), dv)  # scipy asks for J where it just asked for f
+        return v.ravel()
 
     def jac(self, x) -> np.ndarray:
         rgb, D = tool_derivative(self.tool, self.pack, x, self.lo, self.hi, self.mu, self.eta)
         Lab, dLab = ACEScg_to_Lab_and_jacobian(rgb @ self.M.T)
-        dv = delta_E_2000_components(self.target_Lab, Lab)[1] @ dLab @ self.M  # (S, 3, 3 rgb)
+        last = getattr(self, "_last", None)
+        if last is not None and np.array_equal(last[0], x):
+            dv = last[1]
+        else:
+            dv = delta_E_2000_components(self.target_Lab, Lab)[1]
+        dv = dv @ dLab @ self.M  # (S, 3, 3 rgb)
         return np.einsum("sic,scj->sij", dv, D).reshape(-1, np.size(x))
