@@ -55,7 +55,7 @@ __all__ = [
     "fit_view_dependent_index", "seen_delta_E", "seen_fidelity",
 ]
 
-VIEW_DEPENDENT_MAX_NFEV = 60  # W at eta_i 1.5: 0.90 / 0.89 (mtlx / Cycles), about 0.3 s CPU per tool
+VIEW_DEPENDENT_MAX_NFEV = 60  # a cap: the solves stop by their tolerances in about 25-40
 _SLOPE_ZERO = 1e-6
 MEAN_OBJECTIVE = False  # RMS: measured no better on the mean for W, CuZn, and a larger max
 _TOL = dict(xtol=1e-12, ftol=1e-12, gtol=1e-12)
@@ -190,7 +190,7 @@ def gltf_clearcoat_factor(mu, eta: float) -> float:
     squares over ``mu``, in [0, 1] (1 for eta_i 1.33 to 2): the start of the
     glTF fit, where the factor is then free with the base colour. The fit
     lowers it where three's metallic base (F90 1) carries the coat's rise
-    towards grazing better than three's coat over it (Cu at 1.5: 0.07).
+    towards grazing better than three's coat over it (Cu and Au at 1.5: 0).
     """
     mu = np.asarray(mu, dtype=np.float64)
     coat = three_clearcoat(mu, np.zeros(3), 1.0)[:, 0] - three_clearcoat(mu, np.zeros(3), coat=False)[:, 0]
