@@ -11,7 +11,8 @@ their Jacobian's points at once) and in this checkout, side by side
 (:mod:`benchmarks.side_by_side`: two processes taking turns item by item,
 the order swapped every item). Beside the time, the accuracy the user gets:
 each tool's Delta E 2000 (mean and max over the view angles) of both
-sides, and the largest change between them.
+sides, the largest change between them, and the largest rise of a mean
+and of a max (``delta_E_rise_mean``, ``delta_E_rise_max``: value and where).
 
 Prints a table per coating index and records
 benchmarks/results/export_speed.json (``figures``: ``all`` and
@@ -21,7 +22,9 @@ of the means and max of the maxima; ``delta_E_change_max``).
 
 ``--output NAME`` records benchmarks/results/NAME.json instead
 (``export_speed_numpy_de2000``: the exports against 09bbd13, before the
-CIEDE2000 of their residuals was written out in numpy).
+CIEDE2000 of their residuals was written out in numpy;
+``export_speed_jacobians``: against e780278, before the seen fits had exact
+Jacobians and least squares on the Delta E's components, at eta_i 1, 1.5, 2).
 
 Usage: python benchmarks/export_speed.py [--before REV] [--eta-i 1.0,1.5] [--materials Au,Cu] [--output NAME]
 """
@@ -127,6 +130,14 @@ def main(argv=None) -> int:
         "mean": float(np.mean([answers["after"][i]["delta_E"][tool]["delta_E_mean"] for i in items])),
         "max": float(np.max([answers["after"][i]["delta_E"][tool]["delta_E_max"] for i in items])),
     } for tool in tools}
+    figures["delta_E_before"] = {tool: {
+        "mean": float(np.mean([answers["before"][i]["delta_E"][tool]["delta_E_mean"] for i in items])),
+        "max": float(np.max([answers["before"][i]["delta_E"][tool]["delta_E_max"] for i in items])),
+    } for tool in tools}
+    for stat in ("delta_E_mean", "delta_E_max"):  # the largest rise of one tool's figure on one item, and where
+        rise, where = max((answers["after"][i]["delta_E"][tool][stat] - answers["before"][i]["delta_E"][tool][stat],
+                           f"{tool} {i}") for i in items for tool in tools)
+        figures[f"delta_E_rise_{stat[8:]}"] = {"value": float(rise), "at": where}
     figures["delta_E_change_max"] = float(max(
         abs(answers["after"][i]["delta_E"][tool][stat] - answers["before"][i]["delta_E"][tool][stat])
         for i in items for tool in tools for stat in ("delta_E_mean", "delta_E_max")))

@@ -103,3 +103,33 @@ class TestDeltaEMap:
         np.testing.assert_array_equal(
             delta_E_map(reference, model), delta_E_2000(ACEScg_to_Lab(reference), ACEScg_to_Lab(model))
         )
+
+
+def test_components_and_gradient_against_differences():
+    """
+    delta_E_2000_components: a vector whose length is the Delta E 2000, and
+    its Jacobian in the second colour, equal to central differences; the
+    gradient of delta_E_2000_gradient likewise (colours near each other,
+    far apart, and near the achromatic axis, where the hue is steep).
+    """
+    from fitting.colour.delta_e import delta_E_2000_components, delta_E_2000_gradient
+
+    rng = np.random.default_rng(7)
+    n = 400
+    Lab_1 = np.c_[rng.uniform(5, 95, n), rng.normal(0, 30, n), rng.normal(0, 30, n)]
+    Lab_2 = Lab_1 + rng.normal(0, 1, (n, 3)) * rng.choice([0.01, 1.0, 20.0], (n, 1))
+    Lab_1[:20, 1:] *= 1e-3  # near grey
+    v, dv = delta_E_2000_components(Lab_1, Lab_2)
+    dE, grad = delta_E_2000_gradient(Lab_1, Lab_2)
+    np.testing.assert_allclose(np.linalg.norm(v, axis=-1), delta_E_2000(Lab_1, Lab_2), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(dE, delta_E_2000(Lab_1, Lab_2), rtol=1e-12, atol=1e-12)
+    h = 1e-6
+    for j in range(3):
+        e = np.zeros(3)
+        e[j] = h
+        fd_v = (delta_E_2000_components(Lab_1, Lab_2 + e)[0] - delta_E_2000_components(Lab_1, Lab_2 - e)[0]) / (2 * h)
+        fd_E = (delta_E_2000(Lab_1, Lab_2 + e) - delta_E_2000(Lab_1, Lab_2 - e)) / (2 * h)
+        np.testing.assert_allclose(dv[:, :, j], fd_v, atol=2e-5 * (1 + np.abs(fd_v).max()))
+        np.testing.assert_allclose(grad[:, j], fd_E, atol=2e-5 * (1 + np.abs(fd_E).max()))
+    # Where the difference is 0 the gradient is 0, never NaN.
+    assert np.all(delta_E_2000_gradient(Lab_1, Lab_1)[1] == 0)

@@ -40,7 +40,7 @@ def test_fit_takes_w_below_one(tool, w_target):
     shipped = fit_tool_values(tool, MU, 1.5, w_target)
     before = seen_delta_E(tool, constant, MU, 1.5, w_target).mean()
     after = seen_delta_E(tool, shipped, MU, 1.5, w_target).mean()
-    # Measured: mtlx 1.161 -> 0.899, Physical Conductor 1.055 -> 0.892.
+    # Measured: mtlx 1.158 -> 0.929, Physical Conductor 1.051 -> 0.919.
     assert before > 1.0 and after < 1.0, (before, after)
     assert np.any(shipped["ior_per_facing"]) or np.any(shipped["extinction_per_facing"])
     # n, k inside the fit's bounds at every angle (the values at facing 0 and 1 are).
