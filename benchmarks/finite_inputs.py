@@ -118,7 +118,7 @@ def run_cli(name: str, table, directory: Path) -> dict:
 def run_service(url: str, name: str, table) -> dict:
     w, n, k = table
     body = {"name": "case", "nk": {"wavelength_nm": w.tolist(), "n": n.tolist(), "k": k.tolist()}}
-    response = httpx.post(f"{url}/api/v1/fits", json=body, timeout=600)
+    response = httpx.post(f"{url}/api/v1/fits?metrics=full", json=body, timeout=600)
     answer = _strict_json(response.text)
     if response.status_code >= 400:
         detail = answer.get("detail")

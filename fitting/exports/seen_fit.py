@@ -39,7 +39,6 @@ Delta E stopped at their cap of 100 (60) short of it.
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_conductor, fresnel_dielectric
@@ -59,6 +58,15 @@ VIEW_DEPENDENT_MAX_NFEV = 60  # a cap: the solves stop by their tolerances in ab
 _SLOPE_ZERO = 1e-6
 MEAN_OBJECTIVE = False  # RMS: measured no better on the mean for W, CuZn, and a larger max
 _TOL = dict(xtol=1e-12, ftol=1e-12, gtol=1e-12)
+
+
+def least_squares(*args, **kwargs):
+    """scipy's ``least_squares``, imported on first use: the export writers are imported by every
+    ``python -m fitting`` command (the CLI's choices come from the format registry), most of which fit
+    nothing here."""
+    from scipy.optimize import least_squares as solve
+
+    return solve(*args, **kwargs)
 
 
 def _conductor_jacobian(mu: np.ndarray, x: np.ndarray) -> np.ndarray:

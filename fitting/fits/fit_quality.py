@@ -24,7 +24,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
 
 from ..colour.delta_e import delta_E_map
 from ..colour.reference import reference_ACEScg_grid
@@ -133,6 +132,10 @@ def data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[s
 
     def spread(data: SpectralNK) -> float:
         return float(delta_E_map(base, reference(data)).mean())
+
+    # scipy.interpolate (and with it scipy.optimize) is imported only for data that needs it: a
+    # fit of dense data (no gap of UNCERTAIN_GAP_NM, enough samples) never pays for the import.
+    from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
 
     base = reference(nk)
     parts: dict[str, float] = {}

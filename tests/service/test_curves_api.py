@@ -208,7 +208,7 @@ class TestErrorMap:
         assert body["against"] == "curves" and body["eta_i"] == [1.2, 2.2]
 
     def test_library_fit_against_reference(self, shared):
-        fit = shared.post("/api/v1/fits", json={"material": "Cu"}).json()
+        fit = shared.post("/api/v1/fits", params={"metrics": "full"}, json={"material": "Cu"}).json()
         body = shared.get(f"/api/v1/fits/{fit['id']}/error-map?rows=5").json()
         assert body["against"] == "reference"
         # The service's own metrics (1 nm, 30 x 30) and the map (5 nm) agree closely.

@@ -71,7 +71,7 @@ def test_the_domain_lists_the_toy(toy_server):
     names = [f["name"] for f in formats]
     assert names[:4] == ["mtlx", "openpbr", "blender", "gltf"] and names[-1] == "usda"
     assert formats[-1] == {"name": "usda", "label": "USD preview surface (.usda)", "media_type": "model/vnd.usda",
-                           "extension": "usda", "options": ["eta_i", "roughness", "coat_roughness"]}
+                           "extension": "usda", "options": ["eta_i", "roughness", "coat_roughness", "working_space"]}
 
 
 def test_rest_and_packs_serve_the_toy(toy_server, gold):
@@ -89,7 +89,7 @@ def test_rest_and_packs_serve_the_toy(toy_server, gold):
         for bad in (http.get(f"{API}/fits/{gold}/pack", params={"format": "usdz"}),
                     http.post(f"{API}/packs", json={"fit_ids": [gold], "format": "usdz"})):
             assert bad.status_code == 422
-            assert "`format` must be one of 'binary', 'json', 'glsl', 'hlsl', 'mtlx', 'openpbr', 'blender', 'gltf', 'usda', got 'usdz'" \
+            assert "`format` must be one of 'binary', 'json', 'glsl', 'hlsl', 'mtlx', 'openpbr', 'blender', 'gltf', 'glb', 'usda', got 'usdz'" \
                 in bad.text
 
 

@@ -34,7 +34,15 @@ def _loaded_after(*args: str) -> dict:
 
 @pytest.mark.slow  # starts a process
 def test_fit_imports_neither_scipy_optimize_nor_colour_science():
-    after = _loaded_after("fit", "Au", "--json")
+    """
+    A fit of dense data (W, Weaver: no gap wide enough for the data-uncertainty
+    splines, a guard that needs no SLSQP refit) imports neither, though the
+    CLI's parser imports every export writer. Data with a wide gap (Au,
+    Johnson: 65 nm) load scipy.interpolate, and with it scipy.optimize, for
+    the uncertainty; the conductors whose guard refits under a capped max
+    (Al, K, Mo) load scipy.optimize for SLSQP.
+    """
+    after = _loaded_after("fit", "W", "--json")
     assert after == {"status": 0, "loaded": []}
 
 
