@@ -34,6 +34,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.export_speed import summary  # noqa: E402
 from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.side_by_side import Side, checkout, serve  # noqa: E402
 
@@ -72,13 +73,6 @@ def child(root: str, names: list[str], lo: float, hi: float) -> int:
                 "mean": result.scene.mean, "max": result.scene.max}
 
     return serve(names, answer)
-
-
-def summary(before: list[float], after: list[float]) -> dict:
-    a, b = np.array(before), np.array(after)
-    return {"before_median_ms": float(np.median(a)), "after_median_ms": float(np.median(b)),
-            "ratio": float(np.median(b) / np.median(a)), "before_max_ms": float(a.max()),
-            "after_max_ms": float(b.max()), "items": int(a.size)}
 
 
 def main(argv=None) -> int:
