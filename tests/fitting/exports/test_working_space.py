@@ -119,3 +119,21 @@ def test_blender_refuses_another_working_space_and_touches_one_slot(au_values, t
     assert ("REFUSED coated-fresnel: this file's working space is 'lin_ap1_scene', but this material's "
             "colours and n, k were fitted in 'lin_rec709'; export it again with working_space=acescg"
             ) in result.stdout
+
+
+@pytest.mark.slow  # 16 export fits, about 15 s
+def test_acescg_is_as_faithful_as_rec709_metal_by_metal():
+    # What an ACEScg host sees of an ACEScg export is within 0.1 Delta E (mean
+    # over the view angles) of what a Rec.709 host sees of a Rec.709 one, for
+    # each of 8 metals and each tool; the numpy mirrors stand for the tools'
+    # renders (test_tool_layering_renders.py, benchmarks/exports_working_space.py).
+    from fitting.exports import seen_fidelity
+
+    tools = ("mtlx", "openpbr", "blender", "blender-conductor")
+    for metal in ("Au", "Cu", "Ag", "Al", "CuZn", "Cr", "Ni", "W"):
+        rec709, aces = (export_values(library_material(metal), 1.5, roughness=0.0, coat_roughness=0.0,
+                                      tools=tools, working_space=space)
+                        for space in ("lin_rec709", "acescg"))
+        for tool in tools:
+            worse = seen_fidelity(aces, tool)["delta_E_mean"] - seen_fidelity(rec709, tool)["delta_E_mean"]
+            assert worse <= 0.1, (metal, tool, worse)
