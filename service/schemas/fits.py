@@ -208,7 +208,9 @@ class FitPublic(BaseModel):
     model: ModelKind = DEFAULT_MODEL
     degree: int
     colour_space: Literal["ACEScg"] = "ACEScg"
-    coefficients: Coefficients | RGBConductorCoefficients
+    coefficients: dict[str, list[list[float]] | list[float]] = Field(description=(
+        "Float16 coefficients by the kind's parameters (GET /api/v1/domain: model_kinds): per parameter three "
+        "rows (R, G, B) of powers (1, t, t^2) for a kind with a power axis, else one value per channel"))
     metrics: FitMetrics
     timings: dict[str, float]
     convergence: dict[str, Any]
@@ -263,8 +265,7 @@ def fit_public(record: FitRecord) -> FitPublic:
         model=view.get("model", DEFAULT_MODEL),
         degree=view.get("degree", 0),
         # Rows of powers for a kind with a power axis, one value per channel otherwise.
-        coefficients=(Coefficients if model_kind(view.get("model", DEFAULT_MODEL)).polynomial
-                      else RGBConductorCoefficients)(**view["coefficients"]),
+        coefficients={p: view["coefficients"][p] for p in model_kind(view.get("model", DEFAULT_MODEL)).parameters},
         metrics=FitMetrics(
             evaluated=metrics.get("evaluated", True) is not False,
             figure=metrics.get("figure"),
