@@ -3,8 +3,8 @@ n, k fits, packs and plotted curves
 ===================================
 
 Requests :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`;
-responses :class:`FitPublic` (with :class:`Coefficients`,
-:class:`service.schemas.metrics.FitMetrics`, :class:`FitLinks`) and
+responses :class:`FitPublic` (its coefficients keyed by the kind's
+parameters, :class:`service.schemas.metrics.FitMetrics`, :class:`FitLinks`) and
 :class:`CurvesPublic`; :func:`fit_public` is a stored record's view.
 """
 
@@ -37,7 +37,7 @@ from .common import (
 )
 from .metrics import FitDetails, FitMetrics
 
-__all__ = ["NKData", "FitRequest", "PackRequest", "Coefficients", "RGBConductorCoefficients", "FitLinks", "FitPublic",
+__all__ = ["NKData", "FitRequest", "PackRequest", "FitLinks", "FitPublic",
            "CurvesPublic", "CurveFitPublic", "fit_public"]
 
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
@@ -167,21 +167,6 @@ class PackRequest(RequestModel):
                 f"({self.format}), got {len(self.fit_ids)}"
             )
         return self
-
-
-class Coefficients(BaseModel):
-    """Float16 coefficients, three rows (R, G, B) of powers (1, t, t^2) each."""
-
-    F0: list[list[float]]
-    a: list[list[float]]
-    alpha: list[list[float]]
-
-
-class RGBConductorCoefficients(BaseModel):
-    """Float16 n and k of an rgb-conductor, one value per channel (R, G, B)."""
-
-    n: list[float]
-    k: list[float]
 
 
 class FitLinks(BaseModel):
