@@ -89,7 +89,12 @@ export const version = (id, n) => getJSON(`/materials/${encodeURIComponent(id)}/
 export const library = (etaI, q = null) =>
   getJSON(`/library?eta_i=${etaI.toFixed(2)}${q ? `&q=${encodeURIComponent(q)}` : ""}`);
 export const coatPresets = () => getJSON("/coat-presets");
-export const domain = () => getJSON("/domain");
+let domainAnswer = null;
+/** GET /domain, asked once a page (its rules and registries do not change while a server runs; a failure is asked again). */
+export function domain() {
+  if (!domainAnswer) domainAnswer = getJSON("/domain").catch((error) => { domainAnswer = null; throw error; });
+  return domainAnswer;
+}
 
 async function send(method, path, body = null) {
   const init = { method, headers: headers({ Accept: "application/json" }) };

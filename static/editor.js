@@ -11,7 +11,7 @@
 // same fit: present() sets them from one answer.
 
 import * as api from "./api.js";
-import { modelKind } from "./kinds.js";
+import { modelKind, modelKindsKnown, setModelKinds } from "./kinds.js";
 import { bindPageInputs, mayDiscard } from "./editor/inputs.js";
 import { fitOf, FIRST, loadMaterials, prefetch, recall, remember, savedVersion } from "./editor/materials.js";
 import { Messages } from "./editor/messages.js";
@@ -167,7 +167,11 @@ function present(fit, curves, edits = "{}") {
   previewView.showFit(fit);
 }
 
+// The model kinds this page draws: the server's registry (GET /domain).
+const kindsKnown = api.domain().then((domain) => { if (!modelKindsKnown()) setModelKinds(domain); });
+
 async function setBase(fit) {
+  await kindsKnown;
   modelKind(fit); // a kind this page cannot draw is refused by name, before anything changes
   store.dispatch("openBase", fit);
   continuing.opened(fit, savedVersion(fit));

@@ -18,10 +18,11 @@ function compile(gl, type, source, name) {
 /**
  * The program of `fullscreen.vert` and the fragment shader `name` (a
  * preview_shaders/glsl file; `defines` become `#define` lines after the
- * version line), with its uniforms' locations by name.
+ * version line; `sources`: generated includes by name, kinds.js's
+ * previewSources), with its uniforms' locations by name.
  */
-export async function fullscreenProgram(gl, name, defines = {}) {
-  const [vertex, fragment] = await Promise.all([loadShader("fullscreen.vert"), loadShader(name)]);
+export async function fullscreenProgram(gl, name, defines = {}, sources = {}) {
+  const [vertex, fragment] = await Promise.all([loadShader("fullscreen.vert"), loadShader(name, "/glsl", sources)]);
   const lines = Object.entries(defines).map(([key, value]) => `#define ${key} ${value}`);
   const newline = fragment.indexOf("\n");
   const source = lines.length ? `${fragment.slice(0, newline)}\n${lines.join("\n")}${fragment.slice(newline)}` : fragment;

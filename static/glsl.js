@@ -3,7 +3,10 @@
 // (moderngl, GLSL 4.30), never copied. A main shader's `#version` line is
 // replaced by `#version 300 es` and precision statements; `#include "f"`
 // lines are replaced by the file, each file once (its include guard covers
-// repeats), as preview_shaders.gl.load_shader_source does.
+// repeats), as preview_shaders.gl.load_shader_source does. `sources` gives
+// the text of generated includes by name: the preview's
+// cf_preview_model.glsl of a model kind, served by GET /api/v1/domain
+// (kinds.js).
 
 const INCLUDE = /^\s*#include\s+"([^"]+)"\s*$/gm;
 const ES_HEADER = [
@@ -27,19 +30,19 @@ function fetchFile(base, name) {
 }
 
 // Every file `name` includes, fetched in parallel level by level.
-async function expand(base, name, seen) {
+async function expand(base, name, seen, sources = {}) {
   if (seen.has(name)) return "";
   seen.add(name);
-  const text = await fetchFile(base, name);
+  const text = Object.hasOwn(sources, name) ? sources[name] : await fetchFile(base, name);
   const names = [...text.matchAll(INCLUDE)].map((m) => m[1]);
   const bodies = new Map();
-  for (const included of names) bodies.set(included, await expand(base, included, seen));
+  for (const included of names) bodies.set(included, await expand(base, included, seen, sources));
   return text.replace(INCLUDE, (_, included) => bodies.get(included) ?? "");
 }
 
-/** The GLSL ES 3.00 source of `name` with its includes resolved. */
-export async function loadShader(name, base = "/glsl") {
-  const source = await expand(base, name, new Set());
+/** The GLSL ES 3.00 source of `name` with its includes resolved (`sources`: generated includes by name). */
+export async function loadShader(name, base = "/glsl", sources = {}) {
+  const source = await expand(base, name, new Set(), sources);
   const newline = source.indexOf("\n");
   const head = source.slice(0, newline);
   if (!head.startsWith("#version")) throw new Error(`${name} must start with a #version line`);

@@ -1,12 +1,15 @@
-// The model kinds the browser draws: for each kind the API serves
-// (FitPublic.model), how its coefficients become the words a renderer
-// uploads, how the preview's shaders are told the kind, and how the editor
-// writes its coefficients out. The browser's twin of the registry in
-// fitting/models/kinds.py; a fit of a kind not listed here is refused by
+// The model kinds the browser draws, as GET /api/v1/domain serves them
+// (model_kinds, default_model: the registry of fitting/models/kinds.py,
+// a plugin's kinds among them; setModelKinds takes that answer): for each
+// kind how its coefficients become the words a renderer uploads (its
+// parameters, channel R, G, B, then power, two float16 halves a word), the
+// GLSL the preview includes to draw it (cf_preview_model.glsl, generated
+// from the registry) and how the editor writes its coefficients out. No
+// kind is named here; a fit of a kind the server did not list is refused by
 // name (modelKind), never drawn as another kind.
 //
 // No DOM, no WebGL: imported by the preview (preview.js, splitsum.js), the
-// editor's views and the three.js material, and by the node unit tests.
+// editor's views, and by the node unit tests.
 
 // ------------------------------------------------------------ float16 halves
 
@@ -48,82 +51,90 @@ export function wordsOf(halves, count = 14) {
 }
 
 /**
- * The 14 uint32 words of a coated-conductor fit (fitting.pack.halves_to_uint32):
- * coefficients[p][c][j] for p in (F0, a, alpha), two halves a word, the
- * earlier in the low 16 bits; powers beyond the fit's degree are 0.
+ * The 14 uint32 words of coefficients of a kind with `parameters` and
+ * `maxDegree` (a ModelKindPublic's): for each parameter, channel R, G, B,
+ * its value (maxDegree 0) or its maxDegree + 1 powers, those beyond the
+ * fit's degree 0 (preview_shaders.kinds.preview_words).
  */
-export function packedWords(coefficients) {
+export function wordsFor({ parameters, maxDegree }, coefficients) {
   const halves = [];
-  for (const p of ["F0", "a", "alpha"]) {
+  for (const p of parameters) {
     for (let c = 0; c < 3; c++) {
-      for (let j = 0; j < 3; j++) halves.push(halfBits(coefficients[p][c][j] ?? 0));
+      if (maxDegree === 0) halves.push(halfBits(coefficients[p][c]));
+      else for (let j = 0; j <= maxDegree; j++) halves.push(halfBits(coefficients[p][c][j] ?? 0));
     }
   }
   return wordsOf(halves);
-}
-
-/**
- * The words of an rgb-conductor fit: its 6 halves n_R, n_G, n_B, k_R, k_G,
- * k_B in 3 words (cf_unpack_rgb_conductor), the rest of the preview's 14 zero.
- */
-export function rgbConductorWords(coefficients) {
-  return wordsOf([...coefficients.n, ...coefficients.k].map(halfBits));
 }
 
 const row = (values) => values.map((v) => v.toFixed(5)).join(", ");
 
 // ------------------------------------------------------------ the registry
 
-/**
- * name -> {
- *   parameters: the coefficients' keys,
- *   shaderKind: CF_RGB_CONDUCTOR's value in shader_ball.frag (0 or 1),
- *   words(coefficients): Uint32Array(14), what the preview uploads as cf_words,
- *   nk(coefficients): [n, k] per channel for the kinds the exact Fresnel draws, else null,
- *   check(coefficients): throws an Error naming the field when malformed,
- *   describe(fit): the editor's text of its coefficients,
- * }
- */
-export const MODEL_KINDS = {
-  "coated-conductor": {
-    parameters: ["F0", "a", "alpha"],
-    shaderKind: 0,
-    words: packedWords,
-    nk: () => null,
+/** The name of the include each kind's `glsl` is (shader_ball.frag, model_albedo_table.frag). */
+export const PREVIEW_MODEL_FILE = "cf_preview_model.glsl";
+
+const KINDS = new Map(); // name -> kind (see kindOf)
+let defaultName = null;
+
+// A ModelKindPublic of GET /domain as the browser uses it.
+function kindOf(k) {
+  const parameters = [...k.parameters], maxDegree = k.max_degree;
+  const rowOk = (r) => (maxDegree === 0
+    ? Number.isFinite(r)
+    : Array.isArray(r) && r.length >= 1 && r.length <= maxDegree + 1 && r.every(Number.isFinite));
+  return Object.freeze({
+    name: k.name,
+    description: k.description,
+    parameters,
+    maxDegree,
+    splitSum: k.split_sum,
+    /** Generated includes by name, for glpass.fullscreenProgram. */
+    sources: Object.freeze({ [PREVIEW_MODEL_FILE]: k.glsl }),
+    /** Uint32Array(14): what the preview uploads as cf_words. */
+    words: (coefficients) => wordsFor({ parameters, maxDegree }, coefficients),
+    /** Throws an Error naming the field when `coefficients` are malformed. */
     check(C) {
-      for (const p of ["F0", "a", "alpha"]) {
-        const ok = Array.isArray(C[p]) && C[p].length === 3 &&
-          C[p].every((r) => Array.isArray(r) && r.length >= 1 && r.length <= 3 && r.every(Number.isFinite));
-        if (!ok) throw new Error(`\`coefficients.${p}\` of a coated-conductor fit must be three rows of 1 to 3 numbers`);
-      }
-    },
-    describe(fit) {
-      const rows = ["F0", "a", "alpha"].map((p) =>
-        `${p.padEnd(5)} ` + fit.coefficients[p].map((r, c) => `${"RGB"[c]} [${row(r)}]`).join("  "));
-      return `coated-conductor, degree ${fit.degree}, eta_i in [${fit.eta_i_range.join(", ")}]\n${rows.join("\n")}`;
-    },
-  },
-  "rgb-conductor": {
-    parameters: ["n", "k"],
-    shaderKind: 1,
-    words: rgbConductorWords,
-    nk: (C) => [C.n.slice(), C.k.slice()],
-    check(C) {
-      for (const p of ["n", "k"]) {
-        if (!Array.isArray(C[p]) || C[p].length !== 3 || !C[p].every(Number.isFinite)) {
-          throw new Error(`\`coefficients.${p}\` of an rgb-conductor fit must be three numbers (R, G, B)`);
+      const rows = maxDegree === 0 ? "three numbers (R, G, B)" : `three rows of 1 to ${maxDegree + 1} numbers`;
+      for (const p of parameters) {
+        if (!Array.isArray(C[p]) || C[p].length !== 3 || !C[p].every(rowOk)) {
+          throw new Error(`\`coefficients.${p}\` of a ${k.name} fit must be ${rows}`);
         }
       }
     },
+    /** The editor's text of a fit's coefficients. */
     describe(fit) {
-      const rows = ["n", "k"].map((p) => `${p.padEnd(5)} R ${row([fit.coefficients[p][0]])}  ` +
-        `G ${row([fit.coefficients[p][1]])}  B ${row([fit.coefficients[p][2]])}`);
-      return `rgb-conductor (n + i k per channel), eta_i in [${fit.eta_i_range.join(", ")}]\n${rows.join("\n")}`;
+      const head = maxDegree === 0 ? k.name : `${k.name}, degree ${fit.degree}`;
+      const rows = parameters.map((p) => `${p.padEnd(5)} ` + fit.coefficients[p].map((r, c) =>
+        `${"RGB"[c]} ${maxDegree === 0 ? row([r]) : `[${row(r)}]`}`).join("  "));
+      return `${head} (${k.description}), eta_i in [${fit.eta_i_range.join(", ")}]\n${rows.join("\n")}`;
     },
-  },
-};
+  });
+}
 
-export const DEFAULT_KIND = "coated-conductor";
+/** Take the kinds of a GET /domain answer ({model_kinds, default_model}) as the ones this page draws. */
+export function setModelKinds(domain) {
+  if (!Array.isArray(domain?.model_kinds) || !domain.model_kinds.length || typeof domain.default_model !== "string") {
+    throw new Error("the domain must list `model_kinds` and name `default_model`");
+  }
+  KINDS.clear();
+  for (const k of domain.model_kinds) KINDS.set(k.name, kindOf(k));
+  defaultName = domain.default_model;
+}
+
+/** Whether setModelKinds has been given the server's kinds. */
+export const modelKindsKnown = () => defaultName !== null;
+
+/** The kind of a fit that names none (the server's default_model). */
+export const defaultModelKind = () => defaultName;
+
+/** The kinds' names, in the registry's order. */
+export const modelKindNames = () => [...KINDS.keys()];
+
+/** The kind called `name` (no coefficients checked); an Error naming `model` for one the server did not list. */
+export function modelKindNamed(name) {
+  return modelKind({ model: name, coefficients: null });
+}
 
 /**
  * The kind of `fit` (a FitPublic answer; no `model` means the default
@@ -131,11 +142,12 @@ export const DEFAULT_KIND = "coated-conductor";
  * page cannot draw.
  */
 export function modelKind(fit) {
-  const name = fit.model ?? DEFAULT_KIND;
-  const kind = MODEL_KINDS[name];
+  if (!modelKindsKnown()) throw new Error("the model kinds are not known yet (setModelKinds with GET /domain)");
+  const name = fit.model ?? defaultName;
+  const kind = KINDS.get(name);
   if (!kind) {
-    throw new Error(`\`model\` must be one of ${Object.keys(MODEL_KINDS).join(", ")} to be drawn here, got ${JSON.stringify(name)}`);
+    throw new Error(`\`model\` must be one of ${modelKindNames().join(", ")} to be drawn here, got ${JSON.stringify(name)}`);
   }
-  kind.check(fit.coefficients || {});
-  return { name, ...kind };
+  if (fit.coefficients !== null) kind.check(fit.coefficients || {});
+  return kind;
 }

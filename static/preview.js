@@ -11,13 +11,14 @@
 // first use, albedo tables integrated when the settings change). Frames
 // wait for those textures (the last frame stays, and `status` says so).
 //
-// Model kinds (kinds.js): the model band draws the kind of the fit shown,
-// each kind its own variant of the programs (CF_RGB_CONDUCTOR 0: the
-// coated-conductor model from its 14 packed words; 1: the rgb-conductor's
-// exact Fresnel from its 3), compiled when a fit of that kind first shows.
+// Model kinds (kinds.js, from GET /api/v1/domain): the model band draws the
+// kind of the fit shown, each kind its own programs (shader_ball.frag with
+// the kind's cf_preview_model.glsl, its float16 coefficients in 14 words),
+// compiled when a fit of that kind first shows.
 
+import * as api from "./api.js";
 import { drawInto, floatTarget, fullscreenProgram, readTarget } from "./glpass.js";
-import { modelKind } from "./kinds.js";
+import { defaultModelKind, modelKind, modelKindNamed, modelKindsKnown, setModelKinds } from "./kinds.js";
 import { ENVIRONMENT_NAMES, SplitSum, UNIT, setMaterial } from "./splitsum.js";
 
 export const PANEL = { model: 0, lazanyi: 1, reference: 2 };
@@ -27,7 +28,7 @@ const LABELS = ["Model", "Adjusted Lazanyi", "Spectral reference"];
 
 // The float16 halves and the kinds' words live in kinds.js (re-exported:
 // the three.js material and older callers import them from here).
-export { halfBits, packedWords } from "./kinds.js";
+export { halfBits, wordsFor } from "./kinds.js";
 
 // ------------------------------------------------------------ renderer
 
@@ -60,10 +61,11 @@ export class ShaderBall {
     this.labels = labels;
     this.status = status;
     this.gl = gl;
-    // shader_ball.frag, every lobe a mirror, by shader kind (kinds.js):
+    // shader_ball.frag, every lobe a mirror, by model kind (kinds.js):
     // the program, or a promise while it compiles.
-    this.mirrors = new Map([[0, mirror]]);
-    this.mirror = mirror; // the coated-conductor's, for older callers
+    const kind = modelKindNamed(defaultModelKind());
+    this.mirrors = new Map([[kind.name, mirror]]);
+    this.mirror = mirror; // the default kind's
     this.vao = gl.createVertexArray();
     this.splitSum = new SplitSum(gl, this.vao);
     this.lightingError = null;
@@ -71,7 +73,7 @@ export class ShaderBall {
       orbit: [0.5, 0.25, 4.2], fov: 0.52, panels: [PANEL.model], caption: "", environment: ENVIRONMENT.studio,
       exposure: 0, eta: 1.5, words: new Uint32Array(14), etaRange: [1, 2.5],
       F0: [0, 0, 0], F82: [0, 0, 0], fitId: null, referenceFor: null, referenceRange: [1, 2.5],
-      model: "coated-conductor", shaderKind: 0, nk: null,
+      model: kind.name, kind,
       roughness: 0, coated: false, coatRoughness: 0,
     };
     this.reference = this.#texture(new Float32Array(6), 2, 1);
@@ -85,7 +87,9 @@ export class ShaderBall {
   static async create(canvas, labels, status = null) {
     const gl = canvas.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true });
     if (!gl) throw new Error("this browser has no WebGL2");
-    return new ShaderBall(canvas, labels, status, gl, await fullscreenProgram(gl, "shader_ball.frag"));
+    if (!modelKindsKnown()) setModelKinds(await api.domain());
+    const kind = modelKindNamed(defaultModelKind());
+    return new ShaderBall(canvas, labels, status, gl, await fullscreenProgram(gl, "shader_ball.frag", {}, kind.sources));
   }
 
   #texture(data, width, height) {
@@ -107,28 +111,27 @@ export class ShaderBall {
   setFit(fit) {
     const kind = modelKind(fit);
     Object.assign(this.state, {
-      words: kind.words(fit.coefficients), etaRange: fit.eta_i_range, fitId: fit.id,
-      model: kind.name, shaderKind: kind.shaderKind, nk: kind.nk(fit.coefficients),
+      words: kind.words(fit.coefficients), etaRange: fit.eta_i_range, fitId: fit.id, model: kind.name, kind,
     });
     this.drawNow();
   }
 
-  /** A promise of the mirror program of shader kind `shaderKind` (compiled once). */
-  #mirrorFor(shaderKind) {
-    const made = this.mirrors.get(shaderKind);
+  /** A promise of the mirror program of model kind `kind` (kinds.js; compiled once). */
+  #mirrorFor(kind) {
+    const made = this.mirrors.get(kind.name);
     if (made && !(made instanceof Promise)) return Promise.resolve(made);
     if (!made) {
-      const compiling = fullscreenProgram(this.gl, "shader_ball.frag", { CF_RGB_CONDUCTOR: shaderKind }).then((program) => {
-        this.mirrors.set(shaderKind, program);
+      const compiling = fullscreenProgram(this.gl, "shader_ball.frag", {}, kind.sources).then((program) => {
+        this.mirrors.set(kind.name, program);
         return program;
       }, (error) => {
-        this.mirrors.delete(shaderKind);
+        this.mirrors.delete(kind.name);
         this.#say(`The preview cannot draw this kind: ${error.message}`);
         throw error;
       });
-      this.mirrors.set(shaderKind, compiling);
+      this.mirrors.set(kind.name, compiling);
     }
-    return this.mirrors.get(shaderKind);
+    return this.mirrors.get(kind.name);
   }
 
   /**
@@ -136,7 +139,7 @@ export class ShaderBall {
    * kind's programs, and for a rough lobe the split sum's textures.
    */
   ready() {
-    return this.#mirrorFor(this.state.shaderKind).then(() => this.lightingReady()).then(() => this.draw());
+    return this.#mirrorFor(this.state.kind).then(() => this.lightingReady()).then(() => this.draw());
   }
 
   /** The spectral reference texture and Lazanyi inputs (see api.referenceTexture). */
@@ -174,8 +177,8 @@ export class ShaderBall {
    * then draws every lobe as a mirror.
    */
   lightingReady() {
-    if (!this.#rough()) return this.#mirrorFor(this.state.shaderKind).then(() => this.draw());
-    return this.splitSum.load(this.state.environment, this.state.shaderKind).then(() => this.draw(), (error) => {
+    if (!this.#rough()) return this.#mirrorFor(this.state.kind).then(() => this.draw());
+    return this.splitSum.load(this.state.environment, this.state.kind).then(() => this.draw(), (error) => {
       this.lightingError = error;
       this.#say(`Rough lighting unavailable, every surface is drawn smooth: ${error.message}`);
       this.draw();
@@ -193,22 +196,22 @@ export class ShaderBall {
   #program() {
     const s = this.state;
     if (!this.#rough()) {
-      const mirror = this.mirrors.get(s.shaderKind);
+      const mirror = this.mirrors.get(s.kind.name);
       if (!mirror || mirror instanceof Promise) {
-        this.#mirrorFor(s.shaderKind).then(() => this.draw(), () => {});
+        this.#mirrorFor(s.kind).then(() => this.draw(), () => {});
         return null;
       }
       if (!this.lightingError) this.#say("");
       return mirror;
     }
-    if (!this.splitSum.loaded(s.environment, s.shaderKind)) {
+    if (!this.splitSum.loaded(s.environment, s.kind)) {
       this.#say("Preparing the rough lighting…");
       this.lightingReady();
       return null;
     }
     this.#say("");
     this.splitSum.integrate(s, this.reference, s.panels.includes(PANEL.reference));
-    return this.splitSum.programFor(s.shaderKind);
+    return this.splitSum.programFor(s.kind);
   }
 
   /** The split sum's albedo tables as last integrated, for the parity tests. */
@@ -232,7 +235,7 @@ export class ShaderBall {
     gl.activeTexture(gl.TEXTURE0 + UNIT.reference);
     gl.bindTexture(gl.TEXTURE_2D, this.reference);
     gl.uniform1i(u.u_reference, UNIT.reference);
-    if (ball === this.splitSum.programFor(s.shaderKind)) this.splitSum.bind(u, s.environment);
+    if (ball === this.splitSum.programFor(s.kind)) this.splitSum.bind(u, s.environment);
   }
 
   /** Ask for a frame (drawn on the next animation frame, once). */
@@ -265,7 +268,7 @@ export class ShaderBall {
     this.frames += 1;
     canvas.dataset.fit = this.state.fitId || "";
     canvas.dataset.eta = this.state.eta.toFixed(2);
-    canvas.dataset.program = ball === this.splitSum.programFor(this.state.shaderKind) ? "split-sum" : "mirror";
+    canvas.dataset.program = ball === this.splitSum.programFor(this.state.kind) ? "split-sum" : "mirror";
     canvas.dataset.model = this.state.model;
     this.#label();
     if (this.onFrame) this.onFrame(this.state);

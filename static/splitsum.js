@@ -4,10 +4,11 @@
 // use; the split-sum variant of shader_ball.frag; and its albedo tables
 // over NdotV, which albedo_table.frag (model, Lazanyi, coat, from the LUT)
 // and reference_albedo.frag (the reference, from its texture) integrate
-// when the fit, eta_i or a roughness change, never per frame. For the
-// rgb-conductor kind (kinds.js) the model's row is the GGX lobe of its
-// exact Fresnel by quadrature (rgb_albedo_table.frag, the three.js
-// material's table), drawn over albedo_table.frag's row 0.
+// when the fit, eta_i or a roughness change, never per frame. For a kind
+// without the split-sum lookup (kinds.js: splitSum false) the model's row
+// is the GGX lobe of the kind's own Fresnel by quadrature
+// (model_albedo_table.frag with the kind's cf_preview_model.glsl), drawn
+// over albedo_table.frag's row 0.
 
 import * as api from "./api.js";
 import { drawInto, floatTarget, fullscreenProgram, readTarget } from "./glpass.js";
@@ -35,10 +36,6 @@ export function setMaterial(gl, u, s) {
   gl.uniform1f(u.u_roughness, s.roughness);
   gl.uniform1i(u.u_coated, s.coated ? 1 : 0);
   gl.uniform1f(u.u_coat_roughness, s.coatRoughness);
-  if (s.nk) {
-    gl.uniform3f(u.cf_n, ...s.nk[0]);
-    gl.uniform3f(u.cf_k, ...s.nk[1]);
-  }
 }
 
 function texture3D(gl, target, format, data, width, height, depth, filter) {
@@ -58,9 +55,9 @@ export class SplitSum {
     this.gl = gl;
     this.vao = vao;
     this.loads = new Map(); // what -> Promise
-    this.programs = new Map(); // shader kind -> shader_ball.frag with CF_SPLIT_SUM 1
+    this.programs = new Map(); // model kind's name -> shader_ball.frag with CF_SPLIT_SUM 1
     this.tablePass = null;
-    this.rgbTablePass = null; // rgb_albedo_table.frag, once an rgb-conductor is rough
+    this.modelTablePasses = new Map(); // model kind's name -> model_albedo_table.frag (kinds without the lookup)
     this.referencePass = null;
     this.lut = null;
     this.alphaRange = null;
@@ -79,21 +76,16 @@ export class SplitSum {
     return this.loads.get(what);
   }
 
-  /** The split-sum program of shader kind `shaderKind` (undefined until loaded). */
-  programFor(shaderKind) {
-    return this.programs.get(shaderKind);
-  }
-
-  /** The coated-conductor's split-sum program, for older callers. */
-  get program() {
-    return this.programs.get(0) ?? null;
+  /** The split-sum program of model kind `kind` (kinds.js; undefined until loaded). */
+  programFor(kind) {
+    return this.programs.get(kind.name);
   }
 
   /**
-   * A promise of the programs of shader kind `shaderKind` (kinds.js), the
-   * LUT and the slices of `environment` (an index).
+   * A promise of the programs of model kind `kind` (kinds.js), the LUT and
+   * the slices of `environment` (an index).
    */
-  load(environment, shaderKind = 0) {
+  load(environment, kind) {
     const gl = this.gl;
     const programs = this.#once("programs", async () => {
       const [tablePass, referencePass] = await Promise.all([
@@ -102,13 +94,13 @@ export class SplitSum {
       ]);
       Object.assign(this, { tablePass, referencePass });
     });
-    const program = this.#once(`program ${shaderKind}`, async () => {
-      const [made, rgbTablePass] = await Promise.all([
-        fullscreenProgram(gl, "shader_ball.frag", { CF_SPLIT_SUM: 1, CF_RGB_CONDUCTOR: shaderKind }),
-        shaderKind === 1 ? fullscreenProgram(gl, "rgb_albedo_table.frag") : null,
+    const program = this.#once(`program ${kind.name}`, async () => {
+      const [made, modelTablePass] = await Promise.all([
+        fullscreenProgram(gl, "shader_ball.frag", { CF_SPLIT_SUM: 1 }, kind.sources),
+        kind.splitSum ? null : fullscreenProgram(gl, "model_albedo_table.frag", {}, kind.sources),
       ]);
-      if (rgbTablePass) this.rgbTablePass = rgbTablePass;
-      this.programs.set(shaderKind, made);
+      if (modelTablePass) this.modelTablePasses.set(kind.name, modelTablePass);
+      this.programs.set(kind.name, made);
     });
     const lut = this.#once("lut", async () => {
       const table = await api.iblLut();
@@ -131,9 +123,9 @@ export class SplitSum {
     return Promise.all([programs, program, lut, slices]).then(() => undefined);
   }
 
-  /** Whether load(environment, shaderKind) has completed. */
-  loaded(environment, shaderKind = 0) {
-    return this.tablePass !== null && this.programs.has(shaderKind) && this.lut !== null && this.prefiltered.has(environment);
+  /** Whether load(environment, kind) has completed. */
+  loaded(environment, kind) {
+    return this.tablePass !== null && this.programs.has(kind.name) && this.lut !== null && this.prefiltered.has(environment);
   }
 
   /**
@@ -143,7 +135,7 @@ export class SplitSum {
    */
   integrate(s, reference, withReference) {
     const gl = this.gl;
-    const key = JSON.stringify([s.shaderKind, Array.from(s.words), s.nk, s.etaRange, s.F0, s.F82, s.eta, s.roughness, s.coatRoughness]);
+    const key = JSON.stringify([s.kind.name, Array.from(s.words), s.etaRange, s.F0, s.F82, s.eta, s.roughness, s.coatRoughness]);
     if (key !== this.albedoFor) {
       const u = this.tablePass.uniforms;
       gl.useProgram(this.tablePass.program);
@@ -154,7 +146,7 @@ export class SplitSum {
       gl.bindTexture(gl.TEXTURE_3D, this.lut);
       gl.uniform1i(u.cf_lut, UNIT.lut);
       drawInto(gl, this.vao, [this.albedo], this.nodes, 3);
-      if (s.shaderKind === 1) this.#rgbModelRow(s);
+      if (!s.kind.splitSum) this.#modelRow(s);
       this.albedoFor = key;
     }
     const referenceKey = JSON.stringify([s.referenceFor, s.referenceRange, s.eta, s.roughness]);
@@ -172,19 +164,16 @@ export class SplitSum {
     }
   }
 
-  // The rgb-conductor's model row (row 0) from rgb_albedo_table.frag, over
-  // albedo_table.frag's (rows 1 and 2, Lazanyi and the coat, are kept: the
-  // scissor lets the pass write row 0 only).
-  #rgbModelRow(s) {
-    const gl = this.gl, u = this.rgbTablePass.uniforms;
-    gl.useProgram(this.rgbTablePass.program);
+  // The model row (row 0) of a kind without the split-sum lookup, from
+  // model_albedo_table.frag, over albedo_table.frag's (rows 1 and 2,
+  // Lazanyi and the coat, are kept: the scissor lets the pass write row 0 only).
+  #modelRow(s) {
+    const pass = this.modelTablePasses.get(s.kind.name);
+    const gl = this.gl, u = pass.uniforms;
+    gl.useProgram(pass.program);
     gl.uniform2f(u.u_resolution, this.nodes, 3);
     setMaterial(gl, u, s);
     gl.uniform1i(u.u_samples, REFERENCE_SAMPLES);
-    gl.uniform2f(u.cf_alpha_range, ...this.alphaRange);
-    gl.activeTexture(gl.TEXTURE0 + UNIT.lut);
-    gl.bindTexture(gl.TEXTURE_3D, this.lut);
-    gl.uniform1i(u.cf_lut, UNIT.lut);
     gl.enable(gl.SCISSOR_TEST);
     gl.scissor(0, 0, this.nodes, 1);
     drawInto(gl, this.vao, [this.albedo], this.nodes, 3);

@@ -6,11 +6,22 @@ them. Read from the source with ``ast``: a comparison with a kind's name
 (``model == "rgb-conductor"``, ``kind in ("coated-conductor", ...)``) or a
 table keyed by kind names (``{"coated-conductor": ...}``) anywhere else in
 the Python packages fails.
+
+The browser and the GLSL are read too: a kind's name as a string literal
+in ``static/**/*.js`` / ``*.html`` or in a package under ``web/*/src`` (the
+browser's kinds come from ``GET /api/v1/domain``, static/kinds.js), and a
+preprocessor switch on a kind (``#if CF_RGB_CONDUCTOR``: a macro named after
+a kind, include guards aside) in the GLSL of ``preview_shaders/glsl/``,
+``static/`` and the JavaScript that carries GLSL. The three.js package
+(web/three/) still names the two built-in kinds its glTF extension's schema
+lists: :data:`THREE_PACKAGE_USES` counts them, and the test fails when a
+file gains one.
 """
 
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 from fitting.models.kinds import MODEL_KINDS
@@ -19,6 +30,16 @@ ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("fitting", "service", "preview_shaders", "benchmarks", "scripts")
 REGISTRIES = {Path("fitting/models/kinds.py"), Path("fitting/fits/kinds.py")}
 NAMES = frozenset(MODEL_KINDS)
+BUILT_IN = ("coated-conductor", "rgb-conductor")
+"""The kinds registered by fitting/models/kinds.py (a toy plugin's kind is not loaded here)."""
+THREE_PACKAGE_USES = {
+    "web/three/src/coated_conductor.js": 5,
+    "web/three/src/escape_table.js": 2,
+    "web/three/src/albedo_table.js": 3,
+    "web/three/src/index.d.ts": 4,
+}
+"""The three.js package's remaining kind names and switches (its kinds are not yet generated from the
+registry by ``python -m preview_shaders.three_package``): a file may lose uses, never gain one."""
 
 
 def _names_in(node: ast.AST) -> list[str]:
@@ -66,4 +87,48 @@ def test_no_module_outside_the_registries_compares_kind_names():
             if relative in REGISTRIES or "node_modules" in relative.parts:
                 continue
             wrong += [f"{relative}:{use}" for use in kind_name_uses(path.read_text(encoding="utf-8"), str(path))]
+    assert not wrong, "\n".join(wrong)
+
+
+def _macro(name: str) -> str:
+    return "CF_" + re.sub(r"\W", "_", name).upper()
+
+
+def js_kind_uses(source: str) -> list[str]:
+    """Each string literal that is a kind's name, and each preprocessor switch on a kind, as ``line: text``."""
+    names = "|".join(map(re.escape, sorted(NAMES)))
+    macros = "|".join(_macro(name) for name in sorted(NAMES))
+    patterns = [re.compile(r"""["'`](%s)["'`]""" % names),
+                re.compile(r"^[ \t]*#[ \t]*(?:if|ifdef|ifndef|elif|define)\b.*\b(%s)\b" % macros, re.M)]
+    found = [(m.start(), m.group(0).strip()) for pattern in patterns for m in pattern.finditer(source)]
+    return [f"{source.count(chr(10), 0, at) + 1}: {text}" for at, text in sorted(found)]
+
+
+def test_the_browser_check_sees_what_it_must_refuse():
+    assert set(BUILT_IN) <= NAMES
+    for text in ('if (model.kind === "rgb-conductor") x();', "const KINDS = ['coated-conductor'];",
+                 "#if CF_RGB_CONDUCTOR\n", "  #define CF_COATED_CONDUCTOR 1", "#ifdef CF_RGB_CONDUCTOR"):
+        assert js_kind_uses(text), text
+    for text in ("#ifndef CF_RGB_CONDUCTOR_GLSL", "// the coated-conductor model", "kind.name === defaultModelKind()"):
+        assert not js_kind_uses(text), text
+
+
+def _browser_files():
+    yield from (p for p in sorted((ROOT / "static").rglob("*")) if p.suffix in (".js", ".html", ".frag", ".glsl"))
+    yield from (p for p in sorted((ROOT / "preview_shaders" / "glsl").iterdir()) if p.suffix in (".frag", ".vert", ".glsl"))
+    for package in sorted((ROOT / "web").iterdir()):
+        if (package / "src").is_dir():
+            yield from (p for p in sorted((package / "src").rglob("*")) if p.suffix in (".js", ".mjs", ".ts"))
+
+
+def test_no_browser_or_glsl_file_names_a_kind():
+    wrong = []
+    for path in _browser_files():
+        relative = path.relative_to(ROOT)
+        if "node_modules" in relative.parts:
+            continue
+        uses = js_kind_uses(path.read_text(encoding="utf-8"))
+        allowed = THREE_PACKAGE_USES.get(relative.as_posix(), 0)
+        if len(uses) > allowed:
+            wrong += [f"{relative}:{use}" for use in uses] + ([f"{relative}: {allowed} allowed"] if allowed else [])
     assert not wrong, "\n".join(wrong)

@@ -24,19 +24,16 @@
 // (cf_prefiltered_environment.glsl). The mirror program runs no split-sum
 // code: a software rasteriser (SwiftShader) pays for every branch.
 //
-// The model band's kind (static/kinds.js) is a compile-time choice too:
-// CF_RGB_CONDUCTOR 0 (the default) is the coated-conductor model from its
-// 14 packed words; 1 the rgb-conductor kind, the exact Fresnel of n + i k
-// per channel from the first 3 words (cf_rgb_conductor.glsl). Its split-sum
-// table row comes from rgb_albedo_table.frag (static/splitsum.js).
+// The model band draws whichever model kind cf_preview_model.glsl is: the
+// include generated from the kind's registry entry (fitting.models.kinds,
+// preview_shaders.kinds), which GET /api/v1/domain serves with each kind
+// (static/kinds.js gives it to the loader, one program per kind). A kind
+// without the split-sum lookup takes its table row from
+// model_albedo_table.frag (static/splitsum.js).
 #ifndef CF_SPLIT_SUM
 #define CF_SPLIT_SUM 0
 #endif
-#ifndef CF_RGB_CONDUCTOR
-#define CF_RGB_CONDUCTOR 0
-#endif
-#include "cf_coated_conductor.glsl"
-#include "cf_rgb_conductor.glsl"
+#include "cf_preview_model.glsl"
 #include "cf_fresnel_baselines.glsl"
 #include "cf_environment.glsl"
 #include "cf_microfacet.glsl"
@@ -74,7 +71,7 @@ uniform float u_roughness;    // the metal's GGX perceptual roughness, [0, 1]
 uniform int u_coated;         // 0 immersed, 1 a clear coat seen from air
 uniform float u_coat_roughness; // the coat's, [0, 1]
 
-uniform uint cf_words[14];      // the model's packed halves (CF_RGB_CONDUCTOR 1: the first 3)
+uniform uint cf_words[14];      // the model's float16 coefficients, two per word, zero-padded
 uniform vec2 cf_eta_i_range;
 uniform vec3 cf_F0_air;
 uniform vec3 cf_F82_air;
@@ -94,12 +91,7 @@ vec3 cf_panel_fresnel(int kind, float NdotV)
         return cf_lazanyi_adjusted(NdotV, u_eta_i, cf_F0_air, cf_F82_air);
     if (kind == CF_PANEL_REFERENCE)
         return cf_reference_lookup(u_reference, NdotV, u_eta_i, u_reference_eta_i_range);
-#if CF_RGB_CONDUCTOR
-    uint words[3] = uint[3](cf_words[0], cf_words[1], cf_words[2]);
-    return cf_rgb_conductor_packed(NdotV, u_eta_i, words);
-#else
-    return cf_coated_conductor_packed(NdotV, u_eta_i, cf_eta_i_range, cf_words);
-#endif
+    return cf_preview_model(NdotV, u_eta_i, cf_eta_i_range, cf_words);
 }
 
 #if CF_SPLIT_SUM

@@ -59,7 +59,17 @@ LibraryName = Annotated[str, Field(min_length=1, max_length=200, description=(
     "(GET /library)")), AfterValidator(resolve_material)]
 """A catalogue conductor, checked and turned into its id (``gold`` -> ``Au``)."""
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
-ModelKind = Literal[tuple(MODEL_KINDS)]  # type: ignore[valid-type]
+
+
+def _check_model_kind(model: str) -> str:
+    if model not in MODEL_KINDS:
+        raise ValueError(f"`model` must be one of {', '.join(map(repr, MODEL_KINDS))}, got {model[:60]!r}")
+    return model
+
+
+ModelKind = Annotated[str, Field(description="A registered model kind (GET /api/v1/domain: model_kinds)"),
+                      AfterValidator(_check_model_kind)]
+"""A model kind's name (checked against the registry when the request is read, so a plugin's kind counts)."""
 PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
 
 

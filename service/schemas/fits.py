@@ -3,8 +3,8 @@ n, k fits, packs and plotted curves
 ===================================
 
 Requests :class:`NKData`, :class:`FitRequest`, :class:`PackRequest`;
-responses :class:`FitPublic` (with :class:`Coefficients`,
-:class:`service.schemas.metrics.FitMetrics`, :class:`FitLinks`) and
+responses :class:`FitPublic` (its coefficients keyed by the kind's
+parameters, :class:`service.schemas.metrics.FitMetrics`, :class:`FitLinks`) and
 :class:`CurvesPublic`; :func:`fit_public` is a stored record's view.
 """
 
@@ -37,7 +37,7 @@ from .common import (
 )
 from .metrics import FitDetails, FitMetrics
 
-__all__ = ["NKData", "FitRequest", "PackRequest", "Coefficients", "RGBConductorCoefficients", "FitLinks", "FitPublic",
+__all__ = ["NKData", "FitRequest", "PackRequest", "FitLinks", "FitPublic",
            "CurvesPublic", "CurveFitPublic", "fit_public"]
 
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
@@ -169,21 +169,6 @@ class PackRequest(RequestModel):
         return self
 
 
-class Coefficients(BaseModel):
-    """Float16 coefficients, three rows (R, G, B) of powers (1, t, t^2) each."""
-
-    F0: list[list[float]]
-    a: list[list[float]]
-    alpha: list[list[float]]
-
-
-class RGBConductorCoefficients(BaseModel):
-    """Float16 n and k of an rgb-conductor, one value per channel (R, G, B)."""
-
-    n: list[float]
-    k: list[float]
-
-
 class FitLinks(BaseModel):
     self: str
     pack_binary: str
@@ -208,7 +193,9 @@ class FitPublic(BaseModel):
     model: ModelKind = DEFAULT_MODEL
     degree: int
     colour_space: Literal["ACEScg"] = "ACEScg"
-    coefficients: Coefficients | RGBConductorCoefficients
+    coefficients: dict[str, list[list[float]] | list[float]] = Field(description=(
+        "Float16 coefficients by the kind's parameters (GET /api/v1/domain: model_kinds): per parameter three "
+        "rows (R, G, B) of powers (1, t, t^2) for a kind with a power axis, else one value per channel"))
     metrics: FitMetrics
     timings: dict[str, float]
     convergence: dict[str, Any]
@@ -263,8 +250,7 @@ def fit_public(record: FitRecord) -> FitPublic:
         model=view.get("model", DEFAULT_MODEL),
         degree=view.get("degree", 0),
         # Rows of powers for a kind with a power axis, one value per channel otherwise.
-        coefficients=(Coefficients if model_kind(view.get("model", DEFAULT_MODEL)).polynomial
-                      else RGBConductorCoefficients)(**view["coefficients"]),
+        coefficients={p: view["coefficients"][p] for p in model_kind(view.get("model", DEFAULT_MODEL)).parameters},
         metrics=FitMetrics(
             evaluated=metrics.get("evaluated", True) is not False,
             figure=metrics.get("figure"),

@@ -13,7 +13,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field
 
-__all__ = ["Health", "Domain", "ExportFormatPublic"]
+__all__ = ["Health", "Domain", "ExportFormatPublic", "ModelKindPublic"]
 
 
 class Health(BaseModel):
@@ -43,6 +43,22 @@ class ExportFormatPublic(BaseModel):
     options: list[str] = Field(description="The query parameters it takes (eta_i, roughness, coat_roughness)")
 
 
+class ModelKindPublic(BaseModel):
+    """One registered model kind (:class:`fitting.models.kinds.ModelKind`), as a browser draws it."""
+
+    name: str = Field(description="The `model` of a fit")
+    description: str
+    parameters: list[str] = Field(description="The keys of a fit's `coefficients`, each one row per channel R, G, B")
+    max_degree: int = Field(description="0: each row is one number; above: each row is a polynomial in t of "
+                                        "1 to max_degree + 1 numbers")
+    split_sum: bool = Field(description="Whether the kind's rough lobe has the split-sum lookup (`cf_ibl`); "
+                                        "otherwise its albedo is integrated from `glsl`'s Fresnel")
+    glsl: str = Field(description="GLSL of `cf_preview_model.glsl`: `vec3 cf_preview_model(float NdotV, "
+                                  "float eta_i, vec2 eta_i_range, uint words[14])`, the kind's reflectance from "
+                                  "its float16 coefficients two per word (parameter by parameter, channel R, G, "
+                                  "B, then power); its `#include` lines name files served under /glsl/")
+
+
 class Domain(BaseModel):
     """The rules a client checks before sending (the service checks them again)."""
 
@@ -55,6 +71,8 @@ class Domain(BaseModel):
     library: list[str] = Field(description="The built-in conductors")
     pack_formats: list[str]
     export_formats: list[ExportFormatPublic] = Field(description="Every export format, in menu order")
+    model_kinds: list[ModelKindPublic] = Field(description="Every model kind, in registry order")
+    default_model: str = Field(description="The kind of a fit that names none")
     curve_samples: list[int] = Field(min_length=2, max_length=2,
                                      description="Samples per edited curve, [min, max]")
     max_curves: int

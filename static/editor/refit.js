@@ -16,8 +16,9 @@
 //     edit unless a newer one is waiting; after RETRY_MS.length refusals it
 //     is reported, as any other refusal.
 
+import { defaultModelKind } from "../kinds.js";
+
 export const RETRY_MS = [250, 500, 1000, 2000, 4000];
-export const DEFAULT_MODEL = "coated-conductor";
 
 /** A fresh pipeline: nothing wanted, nothing in flight. */
 export function initialPipeline() {
@@ -103,7 +104,7 @@ export function refitBody({ name, base, theta, edits, draft = true, startFit = n
     curves: etas.map((eta) => ({ eta_i: Number(eta), angle_deg: theta, rgb: edits[eta] })),
     draft,
   };
-  if (base.model && base.model !== DEFAULT_MODEL) body.model = base.model;
+  if (base.model && base.model !== defaultModelKind()) body.model = base.model;
   if (startFit) Object.assign(body, { live: true, start_fit: startFit });
   return body;
 }

@@ -6,7 +6,7 @@ Chromium (SwiftShader WebGL2) against a real server with no console error;
 the plot draws its curves, the readout its n and k, and the preview draws
 it: every pixel of a 96 x 64 float read-back of its model band agrees with
 numpy (fitting.models.rgb_conductor) at the GL's own cosine, smooth and
-rough (the split sum's table from rgb_albedo_table.frag); an edit refits it
+rough (the split sum's table from model_albedo_table.frag, the kind's own Fresnel); an edit refits it
 as an rgb-conductor (a live refit, then the full one).
 
 Tolerances (float32 GLSL ES 3.00 against float64 numpy at the same float32

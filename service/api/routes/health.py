@@ -8,7 +8,9 @@ Health and domain
     with Retry-After if the store cannot be read (the database restarting). Cheap (no integrity scan, no write), and its
     store probe runs in a worker thread, so it answers while fits run.
 -   ``GET /api/v1/domain``: the eta_i limits, the default domain and the
-    other constants a client checks before sending, from the core.
+    other constants a client checks before sending, from the core, and
+    every registered export format and model kind (a kind with its
+    parameters and the GLSL the browser's preview includes to draw it).
 """
 
 import asyncio
@@ -20,7 +22,9 @@ from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_
 from fitting.domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM
 from fitting.exports.formats import describe_export_formats
 from fitting.fits.settings import OBJECTIVES
+from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.library import LIBRARY_NAMES
+from preview_shaders.kinds import preview_model_source
 
 from ...schemas import (
     API_PREFIX,
@@ -32,6 +36,7 @@ from ...schemas import (
     Domain,
     ErrorBody,
     Health,
+    ModelKindPublic,
 )
 from ...store import Store
 from ..deps import PreviewsDep, RunnerDep, SettingsDep, StoreDep
@@ -60,12 +65,21 @@ async def healthz(store: StoreDep, runner: RunnerDep, previews: PreviewsDep) -> 
     )
 
 
+def describe_model_kinds() -> list[ModelKindPublic]:
+    """Every registered model kind as the browser draws it (its preview's GLSL generated from the registry)."""
+    return [ModelKindPublic(name=kind.name, description=kind.description, parameters=list(kind.parameters),
+                            max_degree=kind.max_degree, split_sum=kind.split_sum,
+                            glsl=preview_model_source(kind, inline=True))
+            for kind in MODEL_KINDS.values()]
+
+
 def current_domain() -> Domain:
-    """The rules and defaults, with the export formats registered now (a plugin's among them)."""
+    """The rules and defaults, with the export formats and model kinds registered now (a plugin's among them)."""
     return Domain(
         eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE),
         objectives=list(OBJECTIVES), default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES),
         pack_formats=list(PACK_FORMATS), export_formats=describe_export_formats(),
+        model_kinds=describe_model_kinds(), default_model=DEFAULT_MODEL,
         curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
         max_nk_samples=MAX_NK_SAMPLES, visible_range_nm=list(VISIBLE_RANGE_NM), min_coverage=DEFAULT_MIN_COVERAGE,
     )

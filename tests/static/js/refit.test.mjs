@@ -5,6 +5,8 @@
 import assert from "node:assert/strict";
 import { test } from "node:test";
 
+import "./domain.mjs";
+
 import {
   RETRY_MS, RefitPipeline, answered, dropAnswers, idle, initialPipeline, refitBody, refused, retryDelay,
   settle, take, want,

@@ -10,7 +10,8 @@ import { readFigures, REACH_DE } from "../../../static/editor/figures.js";
 import {
   HANDLES, SAMPLES, bump, createStore, editsOf, fitted, key, liveStart, snapshot, target, unsaved,
 } from "../../../static/editor/state.js";
-import { halfBits, modelKind, packedWords, rgbConductorWords } from "../../../static/kinds.js";
+import { DOMAIN } from "./domain.mjs";
+import { halfBits, modelKind, modelKindNamed, modelKindNames } from "../../../static/kinds.js";
 
 const THETA = Array.from({ length: SAMPLES }, (_, i) => 2 * i);
 const flat = (v) => THETA.map(() => [v, v, v]);
@@ -150,22 +151,25 @@ test("figures: the server's warnings for edited curves the fit cannot follow", (
   assert.deepEqual(library.unfollowed, [], "a measured metal's data warnings are not edits");
 });
 
-test("kinds: the words a renderer uploads, per kind; unknown kinds refused by name", () => {
+test("kinds: the server's registry, the words a renderer uploads, per kind; unknown kinds refused by name", () => {
   assert.deepEqual([1, 0.5, -2, 65504, 1e-8].map(halfBits), [0x3c00, 0x3800, 0xc000, 0x7bff, 0]);
+  assert.deepEqual(modelKindNames(), DOMAIN.model_kinds.map((k) => k.name));
+  const coated = modelKindNamed("coated-conductor");
+  assert.equal(coated.splitSum, true);
+  assert.match(coated.sources["cf_preview_model.glsl"], /vec3 cf_preview_model\(float NdotV/);
   const C = { F0: [[1, 0.5], [0, 0], [0, 0]], a: [[0], [0], [0]], alpha: [[0], [0], [0]] };
-  const words = packedWords(C);
+  const words = coated.words(C);
   assert.equal(words.length, 14);
   assert.equal(words[0], (0x3c00 | (0x3800 << 16)) >>> 0, "F0 R's first two powers in word 0");
-  const rgb = rgbConductorWords({ n: [1, 0.5, 2], k: [-2, 0, 1] });
+  const rgb = modelKindNamed("rgb-conductor").words({ n: [1, 0.5, 2], k: [-2, 0, 1] });
   assert.deepEqual(Array.from(rgb.slice(0, 4)), [
     (0x3c00 | (0x3800 << 16)) >>> 0, (0x4000 | (0xc000 << 16)) >>> 0, (0 | (0x3c00 << 16)) >>> 0, 0,
   ]);
   const fit = { model: "rgb-conductor", eta_i_range: [1, 2.5], coefficients: { n: [0.2, 0.5, 1.3], k: [3, 2.3, 1.9] } };
   const kind = modelKind(fit);
-  assert.equal(kind.shaderKind, 1);
-  assert.deepEqual(kind.nk(fit.coefficients), [[0.2, 0.5, 1.3], [3, 2.3, 1.9]]);
+  assert.equal(kind.splitSum, false);
   assert.match(kind.describe(fit), /^rgb-conductor/);
-  assert.equal(modelKind({ coefficients: C, degree: 1, eta_i_range: [1, 2] }).name, "coated-conductor");
+  assert.equal(modelKind({ coefficients: C, degree: 1, eta_i_range: [1, 2] }).name, DOMAIN.default_model);
   assert.throws(() => modelKind({ model: "schlick", coefficients: {} }), /`model`.*"schlick"/);
   assert.throws(() => modelKind({ model: "rgb-conductor", coefficients: { n: [1, 1], k: [0, 0, 0] } }), /coefficients\.n/);
 });

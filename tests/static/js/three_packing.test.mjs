@@ -6,6 +6,7 @@
 import assert from "node:assert/strict";
 import { test } from "node:test";
 
+import { DOMAIN } from "./domain.mjs";
 import * as editor from "../../../static/kinds.js";
 import * as pkg from "../../../web/three/src/packing.js";
 
@@ -25,7 +26,9 @@ test("the package's words are the editor's", () => {
     a: [[0.1, 0.2, 0.3], [0.05, 0.01, 0], [0.2, -0.1, 0.01]],
     alpha: [[5.5, -0.25, 0.125], [4, 0.5, 0], [3.25, 0, 0]],
   };
-  assert.deepEqual(Array.from(pkg.packedWords(coefficients)), Array.from(editor.packedWords(coefficients)));
+  const kind = editor.modelKindNamed(DOMAIN.default_model);
+  assert.deepEqual(kind.parameters, ["F0", "a", "alpha"]);
+  assert.deepEqual(Array.from(pkg.packedWords(coefficients)), Array.from(kind.words(coefficients)));
   const halves = [1, 2, 3, 4, 5].map(editor.halfBits);
   assert.deepEqual(Array.from(pkg.wordsOf(halves)), Array.from(editor.wordsOf(halves)));
 });
