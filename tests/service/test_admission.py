@@ -21,7 +21,7 @@ import pytest
 
 from conftest import server_process
 
-from service.runtime.server import IDLE_GRACE_S
+from service.runtime.server import BODY_GRACE_S, IDLE_GRACE_S
 
 pytestmark = [pytest.mark.slow, pytest.mark.server]
 
@@ -81,20 +81,45 @@ def test_one_address_cannot_shut_out_another(tmp_path):
             assert other.get(f"{server.url}/api/v1/materials").status_code == 200
 
 
-def test_with_every_connection_busy_healthz_is_still_answered(tmp_path):
+def test_with_every_connection_busy_healthz_answers_503_and_slow_bodies_are_answered_408(tmp_path):
+    """Eight bodies trickling at 5 B/s against a minimum rate of 2 B/s hold every connection: /healthz is
+    answered, 503 naming why, and a library request 503; once they stop trickling each is answered 408
+    within the rate's allowance and /healthz is 200 again."""
     with server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS="8",
-                        COATED_BODY_TIMEOUT_S="20") as server, contextlib.ExitStack() as stack:
+                        COATED_MIN_BODY_RATE="2") as server, contextlib.ExitStack() as stack:
         busy = idle_sockets(server.port, 8)
         for s in busy:
             stack.callback(s.close)
-            # A request in progress: its header sent, its body still to come.
             s.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                      b"content-length: 100\r\n\r\n{")
-        time.sleep(0.3)
-        assert loopback.get(f"{server.url}/healthz", timeout=10).status_code == 200
+                      b"content-length: 1000\r\n\r\n")
+        trickling = threading.Event()
+        trickling.set()
+
+        def trickle() -> None:
+            while trickling.is_set():
+                for s in busy:
+                    s.sendall(b" ")
+                time.sleep(0.2)
+
+        thread = threading.Thread(target=trickle)
+        thread.start()
+        stack.callback(thread.join)
+        stack.callback(trickling.clear)
+        time.sleep(BODY_GRACE_S + 0.5)  # past the grace, at the rate: still busy
+        health = loopback.get(f"{server.url}/healthz", timeout=10)
+        assert health.status_code == 503 and "COATED_MAX_CONNECTIONS" in health.json()["detail"], health.text
+        assert health.headers["retry-after"] == "2"
         refused = loopback.get(f"{server.url}/api/v1/materials", timeout=10)
         assert refused.status_code == 503 and "COATED_MAX_CONNECTIONS" in refused.json()["detail"]
         assert still_open(busy) == 8  # busy connections are never evicted
+        trickling.clear()
+        thread.join()
+        answers = []
+        for s in busy:  # behind the rate from now: 408 within the allowance earned (about 3 s) and the grace
+            s.settimeout(15)
+            answers.append(s.recv(65536))
+        assert all(a.startswith(b"HTTP/1.1 408 ") and b"COATED_MIN_BODY_RATE" in a for a in answers), answers
+        assert loopback.get(f"{server.url}/healthz", timeout=10).status_code == 200
 
 
 def test_a_burst_past_the_bound_is_answered_503_not_cut(tmp_path):
