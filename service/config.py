@@ -126,6 +126,12 @@ class Settings(BaseSettings):
         A request's header must arrive within ``header_timeout_s`` of its
         first byte (else the connection is closed), its body within
         ``body_timeout_s`` (else 408).
+    min_body_rate
+        Bytes per second a request body must arrive at, from 2 s after its
+        header (it must have sent ``min_body_rate x (elapsed - 2 s)``
+        bytes at any time): a body behind it is answered 408 and its
+        connection closed, and meanwhile counts as idle (a new connection
+        past a bound may close it).
     keep_alive_s
         An idle keep-alive connection is closed after this many seconds.
     client_bulk_jobs
@@ -194,6 +200,7 @@ class Settings(BaseSettings):
     allowed_hosts: list[str] = Field(default_factory=lambda: ["localhost", "127.0.0.1", "::1"])
     header_timeout_s: float = Field(default=10.0, gt=0.0, le=600.0)
     body_timeout_s: float = Field(default=30.0, gt=0.0, le=3600.0)
+    min_body_rate: float = Field(default=1024.0, gt=0.0, le=1e9)
     keep_alive_s: float = Field(default=5.0, gt=0.0, le=600.0)
     drain_timeout_s: float = Field(default=25.0, ge=0.0, le=3600.0)
     client_bulk_jobs: int | None = Field(default=None, ge=1, le=10_000)

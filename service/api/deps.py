@@ -5,7 +5,10 @@ Dependencies
 ``Annotated`` dependencies shared by the routers:
 
 -   :data:`SettingsDep`, :data:`StoreDep`, :data:`RunnerDep`: the app's
-    settings, store and fitting pool.
+    settings, store and fitting pool. These lookups, and :data:`WriteAccess`,
+    are ``async``: FastAPI runs a plain ``def`` dependency in a worker
+    thread, two thread hops a request that took most of a kept export's
+    download (:data:`StoredFit` reads the store and stays a plain ``def``).
 -   :data:`FitIdPath`, :data:`MaterialIdPath`, :data:`RoughnessQuery`,
     :data:`CoatRoughnessQuery`, :data:`WorkingSpaceQuery`, :data:`MinCoverageForm`, :data:`MetricsQuery`: shared
     parameters.
@@ -61,23 +64,23 @@ __all__ = [
 ]
 
 
-def get_settings(request: Request) -> Settings:
+async def get_settings(request: Request) -> Settings:
     return request.app.state.settings
 
 
-def get_store(request: Request) -> Store:
+async def get_store(request: Request) -> Store:
     return request.app.state.store
 
 
-def get_runner(request: Request) -> FitRunner:
+async def get_runner(request: Request) -> FitRunner:
     return request.app.state.runner
 
 
-def get_previews(request: Request) -> PreviewRunner:
+async def get_previews(request: Request) -> PreviewRunner:
     return request.app.state.previews
 
 
-def get_save_rate(request: Request) -> SaveRate:
+async def get_save_rate(request: Request) -> SaveRate:
     return request.app.state.save_rate
 
 
@@ -114,7 +117,7 @@ StoredFit = Annotated[FitRecord, Depends(get_stored_fit)]
 _bearer = HTTPBearer(auto_error=False, description="COATED_API_TOKEN, when the service requires one")
 
 
-def require_write_access(
+async def require_write_access(
     request: Request,
     settings: SettingsDep,
     credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)],

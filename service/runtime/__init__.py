@@ -30,7 +30,7 @@ content key, the ring of cancelled jobs), ``executors`` (a pool stuck on a
 half-written result unstuck), ``worker`` and ``render_worker`` (what runs in
 each process), ``fork_server`` and ``preload`` (the processes are forks of a
 fork server forked from the server), ``server`` (uvicorn's adapter) and
-``mp_private`` (multiprocessing's private state), ``shares`` (the fair
+``mp_private`` (multiprocessing's private state), ``admission`` (the server's connection bounds), ``shares`` (the fair
 shares); docs/architecture.md draws them.
 """
 

@@ -11,24 +11,31 @@ client cannot get past:
     closed; uvicorn has no such timeout of its own;
 -   the body deadline and size limits of
     :class:`service.api.middleware.RequestLimits` (408, 413);
+-   a minimum body rate (``min_body_rate`` bytes per second after the
+    header, past :data:`service.runtime.admission.BODY_GRACE_S`): a body
+    behind it is answered 408 and its connection closed, and, from its
+    first moment, one behind the rate counts as idle for admission
+    (:meth:`DeadlineH11Protocol.idle`), so a trickle holds no connection a
+    new one needs, however often it reconnects;
 -   a header size bound (:data:`MAX_HEADER_BYTES`, 16 KiB; past it 431
     and the connection closed): h11 bounds only a header still incomplete,
     so one that arrives whole in one read is counted here;
--   admission (:meth:`DeadlineH11Protocol.connection_made`): at most
+-   admission (:class:`service.runtime.admission.Admission`): at most
     ``max_connections`` connections, ``max_connections_per_client`` from one
     address; a connection past a bound closes the longest idle one (no
-    request in progress; for the per-address bound also nothing sent or
-    received on it for :data:`IDLE_GRACE_S`: a flood of idle connections
-    only churns itself, while a burst's connections whose requests are
-    still on their way, and a keep-alive connection between two requests,
-    are not cut), and with none idle it is
-    admitted for ``/healthz`` alone (uvicorn's ``limit_concurrency`` keeps
-    :data:`HEALTH_RESERVE` more for it), every other request on it answered
-    503 with ``Retry-After``, its request due within the grace; so
-    ``/healthz`` is always answered and a burst past the bound gets 503s,
-    not connection resets; the connections are kept in the order of their
-    last activity (:class:`_Admission`), so finding the one to close takes
-    a step or a few, not a pass over every connection;
+    request in progress, or a body behind the rate; for the per-address
+    bound also nothing sent or received on it for :data:`IDLE_GRACE_S`: a
+    flood of idle connections only churns itself, while a burst's
+    connections whose requests are still on their way, and a keep-alive
+    connection between two requests, are not cut), and with none idle it is
+    admitted for ``/healthz`` alone, in a reserve of its own
+    (:data:`HEALTH_RESERVE`, never closed for an ordinary connection; past
+    it the address holding most of it loses a silent one), every other request on it answered 503 with
+    ``Retry-After``, its request due within the grace, the connection
+    closed after its answer; so ``/healthz`` is always answered and a burst
+    past the bound gets 503s, not connection resets. uvicorn's own
+    ``limit_concurrency`` is off: past it uvicorn answered 503 to
+    ``/healthz`` too;
 -   the keep-alive timeout (``keep_alive_s``);
 -   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
     closed, the concurrency limit, invalid requests) are logged once, then
@@ -60,17 +67,21 @@ import time
 
 import h11
 import uvicorn
+from uvicorn.protocols.http.flow_control import FlowControl
 from uvicorn.protocols.http.h11_impl import H11Protocol, RequestResponseCycle
 
 from ..config import Settings
+from .admission import BODY_GRACE_S, HEALTH_RESERVE, IDLE_GRACE_S, Admission
 
 __all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
-           "HEALTH_RESERVE", "IDLE_GRACE_S", "UVICORN_PRIVATE", "uvicorn_mismatches"]
+           "HEALTH_RESERVE", "IDLE_GRACE_S", "BODY_GRACE_S", "UVICORN_PRIVATE", "uvicorn_mismatches"]
 
 UVICORN_PRIVATE = {
     H11Protocol: ("connection_made", "data_received", "on_response_complete", "connection_lost",
-                  "conn", "cycle", "server_state", "connections", "transport", "client", "loop"),
-    RequestResponseCycle: ("response_complete",),
+                  "conn", "cycle", "server_state", "transport", "client", "loop", "flow"),
+    RequestResponseCycle: ("response_complete", "response_started", "body"),
+    FlowControl: ("read_paused",),
+    uvicorn.Server: ("server_state",),
 }
 """What :class:`DeadlineH11Protocol` uses of uvicorn's h11 protocol: methods it overrides, attributes it reads."""
 
@@ -89,14 +100,6 @@ def uvicorn_mismatches() -> list[str]:
 log = logging.getLogger("uvicorn.error")
 MAX_HEADER_BYTES = 16 * 1024
 """Largest request line and header fields together (h11's own bound for an incomplete one)."""
-HEALTH_RESERVE = 16
-"""Connections past ``max_connections`` kept for ``/healthz``."""
-IDLE_GRACE_S = 1.0
-"""How long after its last byte a connection is not yet counted idle by the
-per-address bound: a new connection's first request, or a keep-alive
-connection's next one, may be on its way (a round trip or two on a slow
-network); a connection admitted for ``/healthz`` alone must send its
-request within it."""
 _HEALTH_REQUESTS = (b"GET /healthz", b"HEAD /healthz")
 _HEADER_END = b"\r\n\r\n"
 _TOO_LARGE = json.dumps({
@@ -106,6 +109,9 @@ _FULL = json.dumps({
     "detail": "the service has as many connections as it accepts, all busy "
               "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT); retry shortly", "errors": [],
 }).encode()
+def _slow_body_answer(rate: float) -> bytes:
+    return json.dumps({"detail": f"the request body arrived slower than {rate:g} bytes per second after its first "
+                                 f"{BODY_GRACE_S:g} s (COATED_MIN_BODY_RATE)", "errors": []}).encode()
 
 
 def _raw_answer(transport: asyncio.Transport, status: bytes, body: bytes, extra: bytes = b"") -> None:
@@ -116,6 +122,7 @@ def _raw_answer(transport: asyncio.Transport, status: bytes, body: bytes, extra:
 SLOW_CLIENT = "closed a connection whose request header did not arrive within %g s (COATED_HEADER_TIMEOUT_S)"
 OVER_BOUND = ("closed a connection past the connection bound that sent no request within %g s "
               "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT)")
+SLOW_BODY = "answered 408 to a request whose body arrived slower than %g bytes per second (COATED_MIN_BODY_RATE)"
 
 
 class OncePerInterval(logging.Filter):
@@ -124,7 +131,7 @@ class OncePerInterval(logging.Filter):
     for ``interval_s``, then let one through with the count of those dropped.
     """
 
-    MESSAGES = ("Exceeded concurrency limit.", "Invalid HTTP request received.", SLOW_CLIENT, OVER_BOUND)
+    MESSAGES = ("Exceeded concurrency limit.", "Invalid HTTP request received.", SLOW_CLIENT, OVER_BOUND, SLOW_BODY)
 
     def __init__(self, interval_s: float = 60.0) -> None:
         super().__init__()
@@ -147,100 +154,53 @@ class OncePerInterval(logging.Filter):
         return True
 
 
-class _Admission:
-    """
-    A server's connections in the order of their last activity (least
-    recent first), all together and by client address: what
-    :meth:`DeadlineH11Protocol._evict` searches, in a step or a few per new
-    connection, where a pass over every connection made a flood of ``n``
-    connections cost the event loop ``n**2`` steps, and a request that came
-    just after the flood waited for them.
-    """
-
-    def __init__(self) -> None:
-        self.everyone: dict[DeadlineH11Protocol, None] = {}
-        self.by_host: dict[str | None, dict[DeadlineH11Protocol, None]] = {}
-
-    @classmethod
-    def of(cls, server_state) -> _Admission:
-        """The admission state of the server whose shared state is ``server_state``."""
-        admission = getattr(server_state, "coated_admission", None)
-        if admission is None:
-            admission = server_state.coated_admission = cls()
-        return admission
-
-    def add(self, connection: DeadlineH11Protocol, host: str | None) -> None:
-        """Put ``connection`` last (the most recently active), adding it if new."""
-        for order in (self.everyone, self.by_host.setdefault(host, {})):
-            order.pop(connection, None)
-            order[connection] = None
-
-    def discard(self, connection: DeadlineH11Protocol, host: str | None) -> None:
-        self.everyone.pop(connection, None)
-        mine = self.by_host.get(host)
-        if mine is not None:
-            mine.pop(connection, None)
-            if not mine:
-                del self.by_host[host]
-
-
 class DeadlineH11Protocol(H11Protocol):
-    """uvicorn's h11 protocol with a deadline on each request's header."""
+    """uvicorn's h11 protocol with a deadline on each request's header, a minimum body rate and admission."""
 
     header_timeout_s = 10.0
+    min_body_rate = 1024.0
     max_connections = 512
     max_connections_per_client = 128
 
     def connection_made(self, transport: asyncio.Transport) -> None:  # type: ignore[override]
         self._header_deadline: asyncio.TimerHandle | None = None
+        self._body_timer: asyncio.TimerHandle | None = None
+        self._body_start, self._body_bytes = 0.0, 0
         self._header_seen, self._header_tail = 0, b""
         self._health_only = False
-        self._served = False  # a response was sent on it
+        self.served = False  # a response was sent on it
         super().connection_made(transport)
-        admission = _Admission.of(self.server_state)
-        self._host = self.client[0] if self.client else None
+        admission = self.server_state.coated_admission
+        self.host = self.client[0] if self.client else None
         self._admission = admission
         self._touch()
         self._arm_header_deadline()
-        mine = admission.by_host[self._host]  # this one among them
-        if self._host is not None and len(mine) > self.max_connections_per_client and not self._evict(mine):
-            self._health_only = True
-        # The service's own bound gives way to any idle connection, however new: it keeps /healthz's slots.
-        if len(self.connections) > self.max_connections and not self._evict(admission.everyone, grace=False):
-            self._health_only = True
-        if self._health_only:
+        if not admission.admit(self, self.loop.time()):
             # Past a bound with none to give way: its request (503, or /healthz) is due within the grace.
+            self._health_only = True
             self._disarm_header_deadline()
             self._header_deadline = self.loop.call_later(IDLE_GRACE_S, self._header_timed_out)
 
     def _touch(self) -> None:
         """Something was sent or received: this connection becomes the most recently active."""
-        self._last_active = self.loop.time()
-        self._admission.add(self, self._host)
+        self.last_active = self.loop.time()
+        self._admission.touch(self, self._health_only)
 
-    def _idle(self) -> bool:
-        """No request in progress on it (and it is not closing)."""
-        return (self.conn.their_state is h11.IDLE and not self.transport.is_closing()
-                and (self.cycle is None or self.cycle.response_complete))
+    def close(self) -> None:
+        self.transport.close()
 
-    def _evict(self, candidates: dict, grace: bool = True) -> bool:
-        """
-        Close the longest idle connection of ``candidates`` (not this one;
-        with ``grace`` only one silent for :data:`IDLE_GRACE_S`); False when
-        none is. ``candidates`` are in the order of their last activity, so
-        the search stops at the first idle one, or (with ``grace``) at the
-        first active within the grace: a flood costs each new connection a
-        few steps, not a pass over every connection.
-        """
-        now = self.loop.time()
-        for other in candidates:
-            if grace and now - other._last_active < IDLE_GRACE_S:
-                return False  # the rest were active more recently still
-            if other is not self and other._idle():
-                other._admission.discard(other, other._host)
-                other.transport.close()
-                return True
-        return False
+    def waiting(self) -> bool:
+        """Nothing received on it yet."""
+        return self.cycle is None and self.conn.their_state is h11.IDLE and not self.transport.is_closing()
+
+    def idle(self) -> bool:
+        """No request in progress on it (and it is not closing), or one whose body is slower than the rate."""
+        if self.transport.is_closing():
+            return False
+        if self.conn.their_state is h11.SEND_BODY and self._body_timer is not None:
+            # Behind the rate (no grace here): a trickle reconnected at once is no busier than an idle one.
+            return self._body_bytes < self.min_body_rate * (self.loop.time() - self._body_start)
+        return self.conn.their_state is h11.IDLE and (self.cycle is None or self.cycle.response_complete)
 
     def _arm_header_deadline(self) -> None:
         if self._header_deadline is None:
@@ -254,10 +214,38 @@ class DeadlineH11Protocol(H11Protocol):
     def _header_timed_out(self) -> None:
         self._header_deadline = None
         if self.conn.their_state is h11.IDLE and not self.transport.is_closing():
-            if self._health_only and not self._served:
+            if self._health_only and not self.served:
                 log.warning(OVER_BOUND, IDLE_GRACE_S)
             else:
                 log.warning(SLOW_CLIENT, self.header_timeout_s)
+            self.transport.close()
+
+    def _body_clock(self, received: int) -> None:
+        """Count a body's bytes; start its clock after the header, stop it once the body is whole."""
+        if self.conn.their_state is not h11.SEND_BODY:
+            if self._body_timer is not None:
+                self._body_timer.cancel()
+                self._body_timer = None
+        elif self._body_timer is None:  # the header is in: count what came with it of the body
+            self._body_start, self._body_bytes = self.loop.time(), len(self.cycle.body)
+            self._body_timer = self.loop.call_at(self._body_start + BODY_GRACE_S, self._body_check)
+        else:
+            self._body_bytes += received
+
+    def _body_check(self) -> None:
+        """The body's rate: behind it, 408 and the connection closed; else look again when it would be."""
+        now = self.loop.time()
+        if self.flow.read_paused:  # the service is not reading (the app has not taken what came): not the client's
+            self._body_start, self._body_bytes = now, 0
+        due = self._body_start + BODY_GRACE_S + self._body_bytes / self.min_body_rate
+        if now < due:
+            self._body_timer = self.loop.call_at(due, self._body_check)
+            return
+        self._body_timer = None
+        log.warning(SLOW_BODY, self.min_body_rate)
+        if self.cycle is not None and not self.cycle.response_started:
+            _raw_answer(self.transport, b"408 Request Timeout", _slow_body_answer(self.min_body_rate))
+        else:
             self.transport.close()
 
     def _header_too_large(self, data: bytes) -> bool:
@@ -287,10 +275,14 @@ class DeadlineH11Protocol(H11Protocol):
         super().data_received(data)
         if self.conn.their_state is not h11.IDLE:
             self._disarm_header_deadline()
+        self._body_clock(len(data))
 
     def on_response_complete(self) -> None:
         super().on_response_complete()
-        self._served = True
+        self.served = True
+        if self._health_only:  # its place in the reserve is for the next probe
+            self.transport.close()
+            return
         self._touch()
         self._header_seen, self._header_tail = 0, b""
         if self.conn.their_state is h11.IDLE and self.conn.trailing_data[0]:
@@ -298,33 +290,47 @@ class DeadlineH11Protocol(H11Protocol):
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._disarm_header_deadline()
-        self._admission.discard(self, self._host)
+        if self._body_timer is not None:
+            self._body_timer.cancel()
+            self._body_timer = None
+        self._admission.discard(self)
         super().connection_lost(exc)
 
 
 def protocol_with_deadline(header_timeout_s: float, max_connections: int = 512,
-                           max_connections_per_client: int = 128) -> type[DeadlineH11Protocol]:
-    """A :class:`DeadlineH11Protocol` subclass with its deadline and connection bounds set."""
+                           max_connections_per_client: int = 128,
+                           min_body_rate: float = 1024.0) -> type[DeadlineH11Protocol]:
+    """A :class:`DeadlineH11Protocol` subclass with its deadline, body rate and connection bounds set."""
     return type("DeadlineH11Protocol", (DeadlineH11Protocol,), {
         "header_timeout_s": header_timeout_s, "max_connections": max_connections,
-        "max_connections_per_client": max_connections_per_client,
+        "max_connections_per_client": max_connections_per_client, "min_body_rate": min_body_rate,
     })
+
+
+class _Server(uvicorn.Server):
+    """uvicorn's server with this module's admission state shared by its connections (and ``/healthz``)."""
+
+    def __init__(self, config: uvicorn.Config, admission: Admission) -> None:
+        super().__init__(config)
+        self.server_state.coated_admission = admission
 
 
 def serve(app, settings: Settings, host: str, port: int) -> None:
     """Run ``app`` on ``host``:``port`` until stopped (SIGINT/SIGTERM)."""
+    admission = Admission(settings.max_connections, settings.max_connections_per_client)
+    app.state.connections = admission  # /healthz: 503 while every connection is held
     config = uvicorn.Config(
         app, host=host, port=port, log_level="info",
         http=protocol_with_deadline(settings.header_timeout_s, settings.max_connections,
-                                    settings.max_connections_per_client),
-        limit_concurrency=settings.max_connections + HEALTH_RESERVE,
+                                    settings.max_connections_per_client, settings.min_body_rate),
+        # No limit_concurrency: past it uvicorn answers 503 to /healthz too; the admission bounds the connections.
         timeout_keep_alive=settings.keep_alive_s,
         timeout_graceful_shutdown=settings.drain_timeout_s,
         ws="none", lifespan="on",
     )
     flood = OncePerInterval()  # after Config, which configures uvicorn's logging
     logging.getLogger("uvicorn.error").addFilter(flood)
-    server = uvicorn.Server(config)
+    server = _Server(config, admission)
     if threading.current_thread() is threading.main_thread():  # as uvicorn, signals only there
         for signum in (signal.SIGINT, signal.SIGTERM):
             signal.signal(signum, _exit_after_shutdown)

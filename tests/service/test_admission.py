@@ -21,7 +21,7 @@ import pytest
 
 from conftest import server_process
 
-from service.runtime.server import IDLE_GRACE_S
+from service.runtime.server import BODY_GRACE_S, IDLE_GRACE_S
 
 pytestmark = [pytest.mark.slow, pytest.mark.server]
 
@@ -81,20 +81,66 @@ def test_one_address_cannot_shut_out_another(tmp_path):
             assert other.get(f"{server.url}/api/v1/materials").status_code == 200
 
 
-def test_with_every_connection_busy_healthz_is_still_answered(tmp_path):
+@contextlib.contextmanager
+def bodies_at_the_rate(busy: list[socket.socket]):
+    """``busy`` connections whose bodies trickle 5 B/s (a rate of 2 B/s is asked) while the block runs."""
+    for s in busy:
+        s.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+                  b"content-length: 1000\r\n\r\n")
+    trickling = threading.Event()
+    trickling.set()
+
+    def trickle() -> None:
+        while trickling.is_set():
+            for s in busy:
+                s.sendall(b" ")
+            time.sleep(0.2)
+
+    thread = threading.Thread(target=trickle)
+    thread.start()
+    try:
+        time.sleep(BODY_GRACE_S + 0.5)  # past the grace, at the rate: busy
+        yield busy
+    finally:
+        trickling.clear()
+        thread.join()
+
+
+def test_with_every_connection_busy_healthz_answers_503_and_slow_bodies_are_answered_408(tmp_path):
+    """Eight bodies at the rate hold every connection: /healthz is answered, 503 naming why, and a library
+    request 503; once they stop each is answered 408 within the rate's allowance and /healthz is 200 again."""
     with server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS="8",
-                        COATED_BODY_TIMEOUT_S="20") as server, contextlib.ExitStack() as stack:
+                        COATED_MIN_BODY_RATE="2") as server, contextlib.ExitStack() as stack:
         busy = idle_sockets(server.port, 8)
-        for s in busy:
-            stack.callback(s.close)
-            # A request in progress: its header sent, its body still to come.
-            s.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                      b"content-length: 100\r\n\r\n{")
-        time.sleep(0.3)
+        stack.callback(lambda: [s.close() for s in busy])
+        with bodies_at_the_rate(busy):
+            health = loopback.get(f"{server.url}/healthz", timeout=10)
+            assert health.status_code == 503 and "COATED_MAX_CONNECTIONS" in health.json()["detail"], health.text
+            assert health.headers["retry-after"] == "2"
+            refused = loopback.get(f"{server.url}/api/v1/materials", timeout=10)
+            assert refused.status_code == 503 and "COATED_MAX_CONNECTIONS" in refused.json()["detail"]
+            assert still_open(busy) == 8  # busy connections are never evicted
+        answers = []
+        for s in busy:  # behind the rate from now: 408 within the allowance earned (a few seconds) and the grace
+            s.settimeout(15)
+            answers.append(s.recv(65536))
+        assert all(a.startswith(b"HTTP/1.1 408 ") and b"COATED_MIN_BODY_RATE" in a for a in answers), answers
         assert loopback.get(f"{server.url}/healthz", timeout=10).status_code == 200
-        refused = loopback.get(f"{server.url}/api/v1/materials", timeout=10)
-        assert refused.status_code == 503 and "COATED_MAX_CONNECTIONS" in refused.json()["detail"]
-        assert still_open(busy) == 8  # busy connections are never evicted
+
+
+def test_with_an_address_s_every_connection_busy_its_healthz_is_answered(tmp_path):
+    with server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS_PER_CLIENT="4",
+                        COATED_MIN_BODY_RATE="2") as server, contextlib.ExitStack() as stack:
+        busy = idle_sockets(server.port, 4, "127.0.0.2")
+        stack.callback(lambda: [s.close() for s in busy])
+        with bodies_at_the_rate(busy):
+            transport = httpx.HTTPTransport(local_address="127.0.0.2", verify=loopback.TLS)
+            with httpx.Client(transport=transport, timeout=10) as same:
+                assert same.get(f"{server.url}/healthz").status_code == 200  # the replica serves others
+            with httpx.Client(transport=httpx.HTTPTransport(local_address="127.0.0.2", verify=loopback.TLS),
+                              timeout=10) as same:
+                assert same.get(f"{server.url}/api/v1/materials").status_code == 503
+            assert loopback.get(f"{server.url}/api/v1/materials", timeout=10).status_code == 200
 
 
 def test_a_burst_past_the_bound_is_answered_503_not_cut(tmp_path):

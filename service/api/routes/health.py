@@ -5,8 +5,12 @@ Health and domain
 -   ``GET /healthz``: answers once the service is ready (store open, fitting
     pool started), says whether the store can take a save now and which
     store it is (kind, schema version, this replica's connections); 503
-    with Retry-After if the store cannot be read (the database restarting). Cheap (no integrity scan, no write), and its
-    store probe runs in a worker thread, so it answers while fits run.
+    with Retry-After and the reason when this replica cannot serve another
+    client: the store cannot be read (the database restarting), or every
+    connection it accepts has a request in progress. Cheap (no integrity
+    scan, no write), its store probe runs in a thread of its own, so it
+    answers while fits run, and its connection has a reserve of its own
+    (:mod:`service.runtime.server`), so it answers past every bound.
 -   ``GET /api/v1/domain``: the eta_i limits, the default domain and the
     other constants a client checks before sending, from the core, and
     every registered export format and model kind (a kind with its
@@ -16,7 +20,7 @@ Health and domain
 import asyncio
 from concurrent.futures import ThreadPoolExecutor
 
-from fastapi import APIRouter, status
+from fastapi import APIRouter, HTTPException, Request, status
 
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 from fitting.domain import DEFAULT_MIN_COVERAGE, VISIBLE_RANGE_NM
@@ -55,8 +59,12 @@ def _probe(store: Store) -> tuple[str | None, dict]:
 
 @router.get("/healthz", response_model=Health,
             responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
-async def healthz(store: StoreDep, runner: RunnerDep, previews: PreviewsDep) -> Health:
-    """Readiness: the store answers and the fitting pool is up; whether a save can be written."""
+async def healthz(request: Request, store: StoreDep, runner: RunnerDep, previews: PreviewsDep) -> Health:
+    """Readiness: the store answers, a new client's connection would be served; whether a save can be written."""
+    connections = getattr(request.app.state, "connections", None)  # set by the server (none in-process)
+    held = connections.held() if connections is not None else None
+    if held:
+        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, f"not ready: {held}", headers={"Retry-After": "2"})
     problem, described = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
         status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
