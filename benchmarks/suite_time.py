@@ -6,7 +6,7 @@ Runs the README's test command in its modes, one after another, and
 records each one's wall time, test count and the load average around it in
 ``benchmarks/results/suite_time.json`` (quoted by docs/testing.md):
 
--   ``scripts/test --quick`` (target: under 2 minutes on 2 cores);
+-   ``scripts/test --quick`` (target: under 1 minute on 2 cores);
 -   ``scripts/test`` (the full suite on both cores; target: under 6 minutes);
 -   ``scripts/test --other-cpus`` (the numeric tests under three other
     kernels' settings), unless ``--no-other-cpus``.
