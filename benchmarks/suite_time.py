@@ -147,7 +147,7 @@ def mode_figures(rows: list[dict]) -> dict:
 def full_suite(root: Path, log: Path | None = None, name: str = "full.log") -> dict:
     """:data:`FULL_SUITE` in the checkout ``root``, timed, after its bytecode caches (as ``scripts/test`` writes them)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    subprocess.run([sys.executable, "-m", "compileall", "-q", "-j", "0", *COMPILED], cwd=root, env=env,
+    subprocess.run([sys.executable, "-m", "compileall", "-q", *COMPILED], cwd=root, env=env,
                    capture_output=True, check=True)
     return timed([sys.executable, *FULL_SUITE], root, log, name, env)
 
