@@ -362,11 +362,21 @@ def pytest_runtest_teardown(item, nextitem):
 
 
 _durations: dict[str, float] = {}
+_module_s: dict[str, float] = {}   # test module -> seconds of its tests (setup, call, teardown)
+_worker_s: dict[str, float] = {}   # pytest-xdist worker -> seconds of the tests it ran
 
 
 def pytest_runtest_logreport(report):
-    """The tests not marked slow that took over SLOW_S (here, and in the controller under xdist)."""
+    """
+    The tests not marked slow that took over SLOW_S (here, and in the
+    controller under xdist); each module's and each worker's seconds.
+    """
     _durations[report.nodeid] = _durations.get(report.nodeid, 0.0) + report.duration
+    module = report.nodeid.split("::", 1)[0]
+    _module_s[module] = _module_s.get(module, 0.0) + report.duration
+    worker = getattr(getattr(report, "node", None), "gateway", None)
+    if worker is not None:
+        _worker_s[worker.id] = _worker_s.get(worker.id, 0.0) + report.duration
     if report.when == "teardown":
         seconds = _durations.pop(report.nodeid, 0.0)
         if "slow" not in report.keywords and seconds > SLOW_S:
@@ -397,7 +407,15 @@ def pytest_runtest_makereport(item, call):
         )
 
 
-def pytest_terminal_summary(terminalreporter):
+def pytest_terminal_summary(terminalreporter, config):
+    """With ``--durations``: the slowest modules (their tests' seconds summed) and each worker's seconds."""
+    if config.option.durations is not None and _module_s:
+        count = config.option.durations or len(_module_s)
+        terminalreporter.write_sep("=", f"slowest {min(count, len(_module_s))} modules (seconds of their tests)")
+        for module, seconds in sorted(_module_s.items(), key=lambda item: -item[1])[:count]:
+            terminalreporter.write_line(f"{seconds:7.1f}s {module}")
+        for worker, seconds in sorted(_worker_s.items()):
+            terminalreporter.write_line(f"{seconds:7.1f}s of tests on {worker}")
     if _unmarked_slow:
         terminalreporter.write_sep("-", f"not marked slow, over {SLOW_S:g} s")
         for seconds, nodeid in sorted(_unmarked_slow, reverse=True):

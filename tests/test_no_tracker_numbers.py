@@ -9,6 +9,7 @@ reference a reader can follow.
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -27,9 +28,11 @@ def tracker_numbers(text: str) -> list[str]:
 def _files():
     yield ROOT / "README.md"
     for folder in FOLDERS:
-        for path in sorted((ROOT / folder).rglob("*")):
-            if path.suffix in SUFFIXES and "node_modules" not in path.parts and path.is_file():
-                yield path
+        paths = []
+        for parent, dirs, files in os.walk(ROOT / folder):
+            dirs[:] = [d for d in dirs if d != "node_modules"]  # not walked: npm's, most of scripts/ on a fresh clone
+            paths += [Path(parent, name) for name in files]
+        yield from (path for path in sorted(paths) if path.suffix in SUFFIXES and path.is_file())
     for path in sorted((ROOT / "scripts").iterdir()):
         if path.is_file() and not path.suffix:
             yield path
