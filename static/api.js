@@ -114,6 +114,8 @@ export function fitFromCurves(body, curvesAt = null) {
   const query = curvesAt ? `?curves_eta_i=${curvesAt.etaI.toFixed(3)}&curves_samples=${curvesAt.samples}` : "";
   return postJSON(`/fits/from-curves${query}`, body);
 }
+// The curves (linear ACEScg) of the metal of a base colour and an edge tint (nothing stored).
+export const colourCurves = (body) => postJSON("/colour-curves", body);
 export const errorMap = (fitId) => getJSON(`/fits/${fitId}/error-map?angles=46&rows=31`);
 
 export function uploadNK(file, name = "") {
