@@ -125,6 +125,13 @@ export function uploadNK(file, name = "") {
   return postForm("/fits/upload?metrics=full", form);
 }
 
+// A pack or an export of this service read back to its fit (the stored fit it names, or a new one of its model).
+export function importFile(file) {
+  const form = new FormData();
+  form.append("file", file, file.name);
+  return postForm("/fits/import", form);
+}
+
 export function curves(fitId, etaI, samples) {
   return getJSON(`/fits/${fitId}/curves?eta_i=${etaI.toFixed(3)}&samples=${samples}`);
 }

@@ -290,6 +290,13 @@ bindPageInputs({
       else messages.sayUpload(`Not uploaded: ${error.message}`);
     });
   },
+  onOpenFile(file) {
+    $("open-message").textContent = "";
+    studio.importFile(file).catch((error) => {
+      if (error.status === 401) messages.report(error, () => studio.importFile(file));
+      else $("open-message").textContent = `Not opened: ${error.message}`;
+    });
+  },
   onUndo: guard(() => history("undo")),
   onRedo: guard(() => history("redo")),
 });
