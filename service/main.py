@@ -30,7 +30,7 @@ from fitting.cli.plugins import load_plugins
 from .api.errors import install_error_handlers
 from .api.middleware import ClaimWork, FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
-    curves, environments, fits, health, ibl, imports, library, materials, packs, preview, reference_texture,
+    colours, curves, environments, fits, health, ibl, imports, library, materials, packs, preview, reference_texture,
     scenes, versions,
 )
 from .config import Settings
@@ -163,7 +163,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     install_error_handlers(app)
     for module in (health, materials, versions, library, imports, fits, packs, preview, reference_texture,
-                   environments, curves, scenes, ibl):
+                   environments, curves, colours, scenes, ibl):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")

@@ -119,6 +119,8 @@ export function fitFromCurves(body, curvesAt = null) {
   const query = curvesAt ? `?curves_eta_i=${curvesAt.etaI.toFixed(3)}&curves_samples=${curvesAt.samples}` : "";
   return postJSON(`/fits/from-curves${query}`, body);
 }
+// The curves (linear ACEScg) of the metal of a base colour and an edge tint (nothing stored).
+export const colourCurves = (body) => postJSON("/colour-curves", body);
 export const errorMap = (fitId) => getJSON(`/fits/${fitId}/error-map?angles=46&rows=31`);
 
 export function uploadNK(file, name = "") {
@@ -126,6 +128,13 @@ export function uploadNK(file, name = "") {
   form.append("file", file, file.name);
   if (name) form.append("name", name);
   return postForm("/fits/upload?metrics=full", form);
+}
+
+// A pack or an export of this service read back to its fit (the stored fit it names, or a new one of its model).
+export function importFile(file) {
+  const form = new FormData();
+  form.append("file", file, file.name);
+  return postForm("/fits/import", form);
 }
 
 export function curves(fitId, etaI, samples) {

@@ -12,6 +12,8 @@
 
 import * as api from "./api.js";
 import { modelKind, modelKindsKnown, setModelKinds } from "./kinds.js";
+import { colourRows, coloursOf } from "./editor/colour.js";
+import { ColourView } from "./editor/colour_view.js";
 import { bindPageInputs, mayDiscard } from "./editor/inputs.js";
 import { fitOf, FIRST, loadMaterials, prefetch, recall, remember, savedVersion } from "./editor/materials.js";
 import { Messages } from "./editor/messages.js";
@@ -147,8 +149,32 @@ const studio = new Studio({
   sayUpload: (text, ok) => messages.sayUpload(text, ok),
 });
 
+// The colour controls (colour_view.js): a base colour and an edge tint set the curves, one undoable edit.
+const colourView = new ColourView({
+  async onColours({ f0, f82, seenAt }) {
+    const base = state.base;
+    if (!base) return null;
+    const body = { f0, f82, space: "lin_rec709", seen_at: seenAt, eta_i: colourRows(base.eta_i_range, state.eta, seenAt),
+                   samples: SAMPLES };
+    const answer = await messages.busy("Setting the colours…", () => api.colourCurves(body));
+    if (state.base !== base) return null; // another material opened meanwhile
+    store.dispatch("colour", Object.fromEntries(answer.curves.map((curve) => [key(curve.eta_i), curve.rgb])));
+    telemetry.lastEditAt = performance.now();
+    requestRefit();
+    return answer;
+  },
+  onFalloff: (name) => store.dispatch("falloff", name),
+  async showColours(seenAt) {
+    const fit = state.fit || state.base;
+    if (!fit) return null;
+    if (key(seenAt) === key(state.eta) && state.model) return coloursOf(state.model, state.theta);
+    const curves = await api.curves(fit.id, seenAt, SAMPLES);
+    return coloursOf(curves.model, curves.theta_deg);
+  },
+});
+
 // The views follow the state: the plot and the saved line after every change of it.
-const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved"]);
+const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved", "colour"]);
 store.subscribe((name) => {
   if (!RENDERED.has(name)) return;
   plotView.render(state);
@@ -187,6 +213,7 @@ async function setBase(fit) {
   const [curves] = await Promise.all([curves$, loadReference(fit, early && early.texture)]);
   store.dispatch("curves", { base: curves });
   present(fit, curves);
+  colourView.refresh().catch((error) => say(error.message));
 }
 
 // The spectral reference texture of the base (its measured n, k) for the
@@ -229,6 +256,7 @@ function setEta(eta) {
   store.dispatch("setEta", eta);
   plotView.showEta(state);
   previewView.setEta(eta);
+  colourView.setEta(eta);
   readout.showDownload();
   clearTimeout(page.etaTimer);
   page.etaTimer = setTimeout(() => showEta().catch((error) => say(error.message)), 120);
@@ -264,6 +292,13 @@ bindPageInputs({
     studio.upload(file).catch((error) => {
       if (error.status === 401) messages.report(error, () => studio.upload(file));
       else messages.sayUpload(`Not uploaded: ${error.message}`);
+    });
+  },
+  onOpenFile(file) {
+    $("open-message").textContent = "";
+    studio.importFile(file).catch((error) => {
+      if (error.status === 401) messages.report(error, () => studio.importFile(file));
+      else $("open-message").textContent = `Not opened: ${error.message}`;
     });
   },
   onUndo: guard(() => history("undo")),

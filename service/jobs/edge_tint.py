@@ -17,6 +17,9 @@ the colours, the space and, per channel, how far the F82 tint was out of
 reach of any conductor (0 where it was reached).
 
 -   :func:`fit_from_colours`: the record and whether it is new.
+-   :func:`colour_curves`: the same metal's curves at given coating
+    indices, the colours seen in air or from under a coat (the editor's
+    colour controls; nothing stored).
 """
 
 from __future__ import annotations
@@ -25,15 +28,17 @@ import asyncio
 
 import numpy as np
 
+from fitting.domain import cos_theta_from_angle
 from fitting.exports.colour_space import working_to_ACEScg
 from fitting.models.pack import PackedMaterial, material_to_json, to_float16
 from fitting.models.rgb_conductor import MODEL_KIND as RGB_CONDUCTOR
+from fitting.models.rgb_conductor import rgb_fresnel_conductor
 from fitting.optics.edge_tint import F82_COS_THETA, nk_from_F0_F82
 
 from ..store import FitRecord, Store
 from .common import FIT_FORMAT_VERSION, checked_writable, content_address, fit_record
 
-__all__ = ["fit_from_colours"]
+__all__ = ["fit_from_colours", "colour_curves"]
 
 
 def _schlick82(F0):
@@ -75,3 +80,25 @@ async def fit_from_colours(store: Store, request) -> tuple[FitRecord, bool]:
     """
     return await asyncio.to_thread(_make, store, (request.name or "metal").strip(), request.source,
                                    request.f0, request.f82, request.space, request.eta_i_range)
+
+
+def colour_curves(F0, tint, space: str, seen_at: float, eta_i, samples: int) -> dict:
+    """
+    The reflectance curves (linear ACEScg, ``samples`` angles evenly from 0
+    to 90 degrees) at each coating index of ``eta_i`` of the metal whose F0
+    and F82 tint (linear colours of ``space``) are seen from a medium of
+    index ``seen_at``: per ACEScg channel the index of
+    :func:`fitting.optics.edge_tint.nk_from_F0_F82` is the relative index
+    (n + i k) / seen_at, so the metal's own index is that times ``seen_at``
+    (1: the colours are the metal in air). The curve at ``seen_at`` then
+    starts at F0; the others are the same metal under other coats.
+    """
+    F0_a, tint_a = _to_ACEScg(F0, tint, space)
+    index = nk_from_F0_F82(F0_a, tint_a)
+    n, k = index.n * float(seen_at), index.k * float(seen_at)
+    theta = np.linspace(0.0, 90.0, int(samples))
+    mu = cos_theta_from_angle(theta)
+    curves = [{"eta_i": float(eta), "rgb": np.clip(rgb_fresnel_conductor(mu, float(eta), n, k), 0.0, 1.0).tolist()}
+              for eta in eta_i]
+    return {"theta_deg": theta.tolist(), "curves": curves, "n": n.tolist(), "k": k.tolist(),
+            "reachable": index.reachable.tolist(), "F82_error": index.F82_error.tolist()}

@@ -10,6 +10,7 @@ so bad input is refused by the schema and shows in the OpenAPI document.
 -   :mod:`.metrics`: the mirror of the core's error metrics.
 -   :mod:`.fits`: n, k fits, packs, plotted curves; :func:`fit_public`.
 -   :mod:`.curves`: curve fits and error maps.
+-   :mod:`.colours`: the curves of a metal given by a base colour and an edge tint.
 -   :mod:`.scenes`: scene packs.
 -   :mod:`.materials`: the material list and details, versions, edits.
 -   :mod:`.library`: the library to browse, coat presets.
@@ -18,6 +19,8 @@ so bad input is refused by the schema and shows in the OpenAPI document.
 
 from .common import *  # noqa: F401,F403
 from .common import __all__ as _common
+from .colours import *  # noqa: F401,F403
+from .colours import __all__ as _colours
 from .curves import *  # noqa: F401,F403
 from .curves import __all__ as _curves
 from .fits import *  # noqa: F401,F403
@@ -33,4 +36,4 @@ from .metrics import __all__ as _metrics
 from .scenes import *  # noqa: F401,F403
 from .scenes import __all__ as _scenes
 
-__all__ = [*_common, *_metrics, *_fits, *_curves, *_scenes, *_materials, *_library, *_health]
+__all__ = [*_common, *_colours, *_metrics, *_fits, *_curves, *_scenes, *_materials, *_library, *_health]

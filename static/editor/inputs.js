@@ -3,7 +3,7 @@
 // edits (beforeunload), and Ctrl+Z / Ctrl+Shift+Z (Ctrl+Y). Each calls a
 // hook; none changes the state itself:
 //   unsaved() -> bool, picked() -> the picker value open,
-//   onPick(value) -> Promise, onUpload(file), onUndo(), onRedo().
+//   onPick(value) -> Promise, onUpload(file), onOpenFile(file) (a pack or an export), onUndo(), onRedo().
 
 const $ = (id) => document.getElementById(id);
 
@@ -22,6 +22,11 @@ export function bindPageInputs(hooks) {
   $("upload").addEventListener("change", (event) => {
     const file = event.target.files[0];
     if (file) hooks.onUpload(file);
+  });
+  $("open-file").addEventListener("change", (event) => {
+    const file = event.target.files[0];
+    event.target.value = ""; // the same file can be opened again
+    if (file && mayDiscard(hooks.unsaved())) hooks.onOpenFile(file);
   });
   window.addEventListener("beforeunload", (event) => {
     if (!hooks.unsaved()) return;

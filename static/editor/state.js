@@ -7,9 +7,10 @@
 // (JSON strings), so every change of the edits is undoable and a snapshot
 // names exactly what a refit fitted.
 
+import { DEFAULT_FALLOFF, falloffWeight } from "./falloff.js";
+
 export const SAMPLES = 46; // 0, 2, ..., 90 degrees
 export const HANDLES = [0, 20, 36, 50, 60, 70, 78, 84]; // the control points' angles
-export const FALLOFF_DEG = 9; // width of the bump a dragged point makes
 
 /** The key of a coating index in `edits` (two decimals). */
 export const key = (eta) => Number(eta).toFixed(2);
@@ -22,6 +23,7 @@ export function initialState() {
     savedId: null,    // the fit last saved from this base
     eta: 1.5,
     edits: {},
+    falloff: DEFAULT_FALLOFF, // how far a dragged point reaches (falloff.js: none, narrow, wide)
     undo: [],
     redo: [],
     dragStart: null,  // the snapshot before the drag under way
@@ -90,24 +92,23 @@ export function editsOf(curves, theta) {
 
 /**
  * The curve `current` (rows of rgb at angles `theta`) with the point at
- * `handleDeg` of `channel` moved to `value`: a smooth bump (Gaussian,
- * FALLOFF_DEG wide, 0 at 90 degrees, where the model is 1 whatever its
- * coefficients). One channel moves by the offset; `all` scales the three
+ * `handleDeg` of `channel` moved to `value`, its neighbours as `falloff`
+ * says (falloff.js: "none" the point alone, its neighbouring handles
+ * kept; "narrow", "wide" a Gaussian; 0 at 90 degrees, where the model is 1
+ * whatever its coefficients). One channel moves by the offset; `all` scales the three
  * channels (brightness changes, hue stays). A new array; null when the
  * point is already there.
  */
-export function bump(current, theta, handleDeg, channel, value, all = false) {
+export function bump(current, theta, handleDeg, channel, value, all = false, falloff = DEFAULT_FALLOFF) {
   const rows = current.map((rgb) => rgb.map(clamp01));
   const i = theta.indexOf(handleDeg);
   if (i < 0) throw new Error(`handle ${handleDeg} is not one of the curve's angles`);
   const before = rows[i][channel];
   if (value === before) return null;
-  const at = (t) => Math.exp(-0.5 * ((t - handleDeg) / FALLOFF_DEG) ** 2) * (1 - (t / 90) ** 6);
-  const peak = at(handleDeg);
   const delta = value - before;
   const ratio = before > 1e-6 ? value / before : null;
   for (let j = 0; j < theta.length; j++) {
-    const w = at(theta[j]) / peak;
+    const w = falloffWeight(theta[j], handleDeg, falloff, HANDLES);
     if (all) {
       const scale = ratio === null ? null : 1 + (ratio - 1) * w;
       for (let c = 0; c < 3; c++) rows[j][c] = clamp01(scale === null ? rows[j][c] + delta * w : rows[j][c] * scale);
@@ -158,7 +159,7 @@ export const ACTIONS = {
   drag(s, { channel, handle, value, pointer = false, all = false }) {
     const k = key(s.eta);
     if (!s.baseCurves || key(s.baseCurves.eta_i) !== k) return false;
-    const moved = bump(target(s), s.theta, HANDLES[handle], channel, value, all);
+    const moved = bump(target(s), s.theta, HANDLES[handle], channel, value, all, s.falloff);
     if (!moved) return false;
     if (s.dragStart === null) s.dragStart = snapshot(s);
     s.pointerDrag = pointer;
@@ -184,6 +185,19 @@ export const ACTIONS = {
     if (!s.redo.length) return false;
     s.undo.push(snapshot(s));
     s.edits = JSON.parse(s.redo.pop());
+    return true;
+  },
+  /** How far the next drags reach ("none", "narrow", "wide"; falloff.js). */
+  falloff(s, falloff) {
+    falloffWeight(0, HANDLES[0], falloff, HANDLES); // refuses an unknown name
+    s.falloff = falloff;
+    return true;
+  },
+  /** A colour edit (colour.js): the edits replaced by the metal's curves ({eta key: rgb rows}; undoable). */
+  colour(s, edits) {
+    settleDrag(s);
+    remember(s, snapshot(s));
+    s.edits = edits;
     return true;
   },
   /** Back to no edits (undoable). */

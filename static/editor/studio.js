@@ -238,6 +238,14 @@ export class Studio {
     });
   }
 
+  /** Open a pack or an export (POST /fits/import): the fit it names with its edit, or a new fit of its model. */
+  async importFile(file) {
+    const fit = await this.app.busy("Reading the file…", () => api.importFile(file));
+    await this.openFit(fit.id);
+    await this.app.reloadPicker();
+    $("open-message").textContent = `Opened “${fit.name}” from ${file.name}.`;
+  }
+
   /** Open a link ({fit} or {material, version}, linkOf). */
   async openLink(link) {
     if (link.fit) return this.openFit(link.fit);

@@ -64,3 +64,47 @@ class TestFitFromColours:
         detail = json.dumps(response.json())
         for word in words:
             assert word in detail, detail
+
+
+@pytest.mark.slow  # the module's app (see above)
+class TestColourCurves:
+    """``POST /api/v1/colour-curves``: the curves the editor's colour controls set."""
+
+    BODY = {"f0": GOLD["f0"], "f82": GOLD["f82"], "eta_i": [1.0, 1.5, 2.5], "samples": 46}
+
+    def test_in_air_the_curve_at_1_starts_at_the_colour(self, client):
+        listed = client.get(f"{API}/materials").json()["materials"]
+        response = client.post(f"{API}/colour-curves", json=self.BODY)
+        assert response.status_code == 200, response.text
+        answer = response.json()
+        assert answer["theta_deg"] == list(np.linspace(0.0, 90.0, 46))
+        assert [c["eta_i"] for c in answer["curves"]] == [1.0, 1.5, 2.5]
+        F0 = lin_rec709_to_ACEScg(GOLD["f0"])
+        rgb = [np.asarray(c["rgb"]) for c in answer["curves"]]
+        np.testing.assert_allclose(rgb[0][0], F0, atol=1e-9)  # both anchors hold to rounding (edge_tint.py)
+        np.testing.assert_allclose(rgb[0][-1], 1.0, atol=1e-12)  # grazing
+        assert np.all(rgb[1][0] < rgb[0][0]), "the same metal under a coat reflects less at normal incidence"
+        assert answer["reachable"] == [True, True, True] and len(answer["n"]) == len(answer["k"]) == 3
+        # Nothing stored: the list of materials does not grow.
+        assert client.get(f"{API}/materials").json()["materials"] == listed
+
+    def test_under_the_coat_the_curve_at_its_index_starts_at_the_colour(self, client):
+        answer = client.post(f"{API}/colour-curves", json={**self.BODY, "seen_at": 1.5}).json()
+        np.testing.assert_allclose(answer["curves"][1]["rgb"][0], lin_rec709_to_ACEScg(GOLD["f0"]), atol=1e-9)
+        air = client.post(f"{API}/colour-curves", json=self.BODY).json()
+        np.testing.assert_allclose(np.asarray(answer["n"]), 1.5 * np.asarray(air["n"]), rtol=1e-12)
+
+    @pytest.mark.parametrize("change, words", [
+        ({"eta_i": []}, ["eta_i", "at least 1"]),
+        ({"eta_i": [1.5] * 17}, ["eta_i", "at most 16"]),
+        ({"seen_at": 3.5}, ["seen_at", "less than or equal to 3"]),
+        ({"samples": 1}, ["samples", "greater than or equal to 2"]),
+        ({"f82": [0.5, -0.1, 0.5]}, ["f82", "greater than or equal to 0"]),
+        ({"f0": None}, ["f0"]),
+    ])
+    def test_bad_requests_422(self, client, change, words):
+        response = client.post(f"{API}/colour-curves", json={**self.BODY, **change})
+        assert response.status_code == 422, response.text
+        detail = json.dumps(response.json())
+        for word in words:
+            assert word in detail, detail
