@@ -100,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
             figures[variant][f"roughness_{r}"] = {
                 "delta_E_mean": float(every.mean()), "delta_E_max": float(every.max()),
                 "worst_point_mean": max(per_point),
-                "by_eta": {f"{eta:g}": {"delta_E_mean": float(np.concatenate(dE[variant][r][eta]).mean()),
+                "by_eta": {"eta_i_" + f"{eta:g}".replace(".", "_"): {"delta_E_mean": float(np.concatenate(dE[variant][r][eta]).mean()),
                                         "delta_E_max": float(np.concatenate(dE[variant][r][eta]).max())}
                            for eta in ETAS},
             }
