@@ -10,7 +10,11 @@ the metal's roughness, with a ``KHR_materials_clearcoat`` coat; its
 ``MeshPhysicalMaterial`` (its metallic base and its clear coat of fixed
 index 1.5, layered at the view angle in air) follows the physical coat of
 index eta_i on the metal seen from air (:mod:`fitting.exports.seen_fit`): for
-a coat weaker than glTF's 1.5 the fit lowers ``clearcoatFactor``. At eta_i 1
+a coat weaker than glTF's 1.5 the fit lowers ``clearcoatFactor``, never below
+0.5 where the coat's own reflectance at normal incidence is 2 % or more
+(eta_i >= 1.33: a coated metal reads as coated); for a rough metal the values
+follow what three draws at the metal's roughness under a smooth coat
+(:mod:`fitting.exports.gltf_fallback`). At eta_i 1
 there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance, with the
 full fit id, the service version, the coat index and the working space
 (:func:`fitting.exports.naming.identity`), is in the material's and the
@@ -45,6 +49,7 @@ import struct
 import numpy as np
 
 from .gltf_coated import EXTENSION_NAME, coated_conductor_extension
+from .gltf_fallback import gltf_seen_delta_E
 from .naming import element_stem, identity
 from .seen_fit import seen_fidelity
 from .values import ExportValues
@@ -129,6 +134,13 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
     coat_on = fitted["coat"]
     if coat_on:
         provenance["clearcoat_ior_assumed_by_gltf"] = GLTF_COAT_IOR
+    if coat_on and values.seen_rough_ACEScg is not None:
+        dE = gltf_seen_delta_E(fitted, values.view_cos, values.eta_i, values.seen_rough_ACEScg,
+                               values.roughness, values.working_space)
+        provenance["delta_E_2000_seen_at_roughness"] = (
+            f"mean {dE.mean():.3f}, max {dE.max():.3f} at the metal's roughness "
+            f"{values.roughness:g} under a smooth coat (what the values are fitted to)"
+        )
     if coat_on and abs(values.eta_i - GLTF_COAT_IOR) > 1e-9:
         provenance["note"] = (
             f"fitted for a coat of index {values.eta_i:g}; glTF renders its clear coat "

@@ -43,6 +43,7 @@ import numpy as np
 from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_conductor, fresnel_dielectric
 from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, working_to_ACEScg
+from .gltf_fallback import gltf_clearcoat_floor
 from .seen_jacobian import DeltaEComponents, delta_E_jacobian
 from .tool_fresnel import F82_COS_THETA, f82_tint, schlick
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
@@ -180,9 +181,9 @@ def tool_floor(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
                space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
     """
     Delta E 2000 per angle of :func:`floor_base` under the tool's layering
-    (glTF's at the clear coat factor the export uses).
+    (glTF's at the clear coat factor the export's fit starts from).
     """
-    clearcoat = gltf_clearcoat_factor(mu, eta) if tool == "gltf" and coat else 1.0
+    clearcoat = max(gltf_clearcoat_factor(mu, eta), gltf_clearcoat_floor(eta, coat)) if tool == "gltf" and coat else 1.0
     base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat, space)
     return delta_E_map(target_ACEScg, working_to_ACEScg(layer_only(tool, mu, eta, base, coat, clearcoat), space))
 
@@ -203,7 +204,9 @@ def gltf_clearcoat_factor(mu, eta: float) -> float:
     squares over ``mu``, in [0, 1] (1 for eta_i 1.33 to 2): the start of the
     glTF fit, where the factor is then free with the base colour. The fit
     lowers it where three's metallic base (F90 1) carries the coat's rise
-    towards grazing better than three's coat over it (Cu and Au at 1.5: 0).
+    towards grazing better than three's coat over it (Cu and Au at 1.5: 0),
+    but not below :func:`fitting.exports.gltf_fallback.gltf_clearcoat_floor`
+    (0.5 wherever the coat is visible).
     """
     mu = np.asarray(mu, dtype=np.float64)
     coat = three_clearcoat(mu, np.zeros(3), 1.0)[:, 0] - three_clearcoat(mu, np.zeros(3), coat=False)[:, 0]
@@ -303,7 +306,8 @@ def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant:
 
 
 def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
-                    view_dependent: bool = True, space: str = DEFAULT_WORKING_SPACE) -> dict:
+                    view_dependent: bool = True, space: str = DEFAULT_WORKING_SPACE,
+                    roughness: float = 0.0, rough_target_ACEScg=None, keep_coat: bool = True) -> dict:
     """
     The export values of ``tool`` (keys :data:`fitting.exports.tool_layering.TOOLS`,
     and ``coat``) whose layered result is nearest the seen target
@@ -313,23 +317,38 @@ def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     the constant fit; without it the constant fit alone. Colours and n, k
     per channel are those of the working space ``space``
     (:data:`fitting.exports.colour_space.WORKING_SPACES`).
+
+    glTF's fit with a metal ``roughness`` above 0 and its target there
+    (``rough_target_ACEScg``, :func:`fitting.exports.gltf_fallback.rough_seen_ACEScg`)
+    follows what three draws at that roughness (the material as the viewer
+    shows it; started from the smooth fit's floor). With
+    ``keep_coat`` its ``clearcoatFactor`` is at least
+    :func:`fitting.exports.gltf_fallback.gltf_clearcoat_floor` (``False``:
+    free in [0, 1], the fit before that rule).
     """
     if tool not in TOOLS:
         raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")
     mu = np.asarray(mu, dtype=np.float64)
-    clearcoat = gltf_clearcoat_factor(mu, eta) if tool == "gltf" and coat else 1.0
+    floor = gltf_clearcoat_floor(eta, coat) if tool == "gltf" and keep_coat else 0.0
+    clearcoat = max(gltf_clearcoat_factor(mu, eta), floor) if tool == "gltf" and coat else 1.0
     base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat, space)
     x0, lo, hi = _start_and_bounds(tool, mu, base, coat)
     lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    if tool == "gltf" and coat:
+        lo[3] = floor
     x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
+    target, rough = np.asarray(target_ACEScg, dtype=np.float64), None
+    if tool == "gltf" and roughness > 0.0 and rough_target_ACEScg is not None:
+        target, rough = np.asarray(rough_target_ACEScg, dtype=np.float64), float(roughness)
 
     def pack(x):
-        return _pack(tool, x, coat, clearcoat)
+        values = _pack(tool, x, coat, clearcoat)
+        return values if rough is None else {**values, "roughness": rough}
 
     def residuals(x):
-        return _residuals(tool, pack(x), mu, eta, target_ACEScg, space)
+        return _residuals(tool, pack(x), mu, eta, target, space)
 
-    fit = _solve(tool, pack, residuals, x0, lo, hi, mu, eta, target_ACEScg, 100, space)
+    fit = _solve(tool, pack, residuals, x0, lo, hi, mu, eta, target, 100, space)
     best = fit.x if fit.cost <= 0.5 * np.sum(residuals(x0) ** 2) else x0
     values = _pack(tool, np.asarray(best, dtype=np.float64), coat, clearcoat)
     if view_dependent and tool in ("mtlx", "blender-conductor"):

@@ -212,8 +212,11 @@ def _dfg_table() -> np.ndarray:
     return table
 
 
-def three_dfg(cos_theta, roughness: float) -> np.ndarray:
-    """three's ``texture2D(dfgLUT, vec2(roughness, dotNV)).rg``: bilinear, clamped to edge, (S, 2)."""
+def three_dfg(cos_theta, roughness) -> np.ndarray:
+    """
+    three's ``texture2D(dfgLUT, vec2(roughness, dotNV)).rg``: bilinear, clamped
+    to edge, (S, 2); ``roughness`` one number or one per view angle (S,).
+    """
     table = _dfg_table()
     size = table.shape[0]
 
@@ -223,7 +226,7 @@ def three_dfg(cos_theta, roughness: float) -> np.ndarray:
         return i0, p - i0
 
     v0, fv = axis(_mu(cos_theta))
-    u0, fu = axis(np.full_like(fv, roughness))
+    u0, fu = axis(np.broadcast_to(np.asarray(roughness, dtype=np.float64), fv.shape))
     t00, t01 = table[v0, u0], table[v0, u0 + 1]
     t10, t11 = table[v0 + 1, u0], table[v0 + 1, u0 + 1]
     fu, fv = fu[:, None], fv[:, None]
@@ -231,16 +234,17 @@ def three_dfg(cos_theta, roughness: float) -> np.ndarray:
 
 
 def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = True,
-                    roughness: float = 0.0, clearcoat_roughness: float = 0.0) -> np.ndarray:
+                    roughness=0.0, clearcoat_roughness: float = 0.0) -> np.ndarray:
     """
     The glTF export in three.js: ``MeshPhysicalMaterial`` with metalness 1 and
     ``color`` ``base_color``, environment light only, flat geometry (three adds
     the screen-space change of the normal to every roughness; 0 on a plane).
-    ``clearcoat`` is one factor, or one per view angle (S,).
+    ``clearcoat`` and the metal's ``roughness`` are one number each, or one
+    per view angle (S,).
     """
     mu = _mu(cos_theta)
     F0 = np.asarray(base_color, dtype=np.float64)
-    fab = three_dfg(mu, max(roughness, THREE_MIN_ROUGHNESS))
+    fab = three_dfg(mu, np.maximum(roughness, THREE_MIN_ROUGHNESS))
     FssEss = F0 * fab[:, :1] + fab[:, 1:]
     Ems = 1.0 - fab.sum(axis=1, keepdims=True)
     Favg = F0 + (1.0 - F0) * 0.047619
@@ -283,7 +287,8 @@ def tool_seen(tool: str, values: dict, cos_theta, eta: float) -> np.ndarray:
     """
     The mirror of ``tool`` (a key of :data:`TOOLS`) for an export's ``values``
     (the keys :data:`TOOLS` names, and ``coat``: whether the export has one)
-    at view cosines ``cos_theta``, (S, 3) linear Rec.709.
+    at view cosines ``cos_theta``, (S, 3) linear Rec.709; glTF's may carry
+    the metal's ``roughness`` (one number or one per view angle; else 0).
     """
     coat = bool(values.get("coat", eta > 1.0))
     if tool == "mtlx":
@@ -296,5 +301,6 @@ def tool_seen(tool: str, values: dict, cos_theta, eta: float) -> np.ndarray:
     if tool == "blender":
         return cycles_principled(cos_theta, eta, values["base_color"], values["specular_tint"], coat)
     if tool == "gltf":
-        return three_clearcoat(cos_theta, values["base_color"], values.get("clearcoat", 1.0), coat)
+        return three_clearcoat(cos_theta, values["base_color"], values.get("clearcoat", 1.0), coat,
+                               values.get("roughness", 0.0))
     raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")

@@ -67,6 +67,7 @@ from ..optics.coated_stack import coated_stack, coated_stack_from_metal
 from ..optics.nk import SpectralNK
 from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, check_working_space
 from .naming import check_fit_id, identity
+from .gltf_fallback import rough_seen_ACEScg
 from .seen_fit import fit_channel_conductor, fit_channel_f82, fit_channel_schlick, fit_tool_values
 from .tool_layering import TOOLS
 
@@ -135,6 +136,11 @@ class ExportValues:
     view_cos, seen_ACEScg
         cos theta of the view angles in air (:data:`fitting.colour.seen.SEEN_ANGLES_DEG`)
         and the coated metal seen from air there, linear ACEScg (S, 3).
+    seen_rough_ACEScg
+        The same with the metal at ``roughness`` under a smooth coat
+        (:func:`fitting.exports.gltf_fallback.rough_seen_ACEScg`), what the
+        glTF fallback is fitted to; ``None`` where the glTF values are fitted
+        at roughness 0 (no glTF, no coat or a smooth metal).
     tools
         Per tool (:data:`fitting.exports.tool_layering.TOOLS`) the values its
         export carries, fitted to ``seen_ACEScg`` under the tool's layering,
@@ -177,6 +183,7 @@ class ExportValues:
     tools: dict = field(default_factory=dict)
     fit_id: str | None = None
     working_space: str = DEFAULT_WORKING_SPACE
+    seen_rough_ACEScg: np.ndarray | None = None
 
     def provenance(self, model_kind: str, fidelity: dict | None = None) -> dict:
         """
@@ -304,11 +311,14 @@ def export_values(
     n_rel, k_rel = fit_channel_conductor(mu, target)
     F0, tint = fit_channel_f82(mu, target)
     coat = has_coat(eta)
-    fitted = {tool: fit_tool_values(tool, view, eta, seen, coat, space=working_space) for tool in tools}
+    rough_seen = (rough_seen_ACEScg(view, eta, seen, mu, target_ACEScg, roughness)
+                  if "gltf" in tools and coat and roughness > 0.0 else None)
+    fitted = {tool: fit_tool_values(tool, view, eta, seen, coat, space=working_space, roughness=roughness,
+                                    rough_target_ACEScg=rough_seen) for tool in tools}
     return ExportValues(
         name=name, source=source, eta_i=eta, origin=origin, cos_theta=mu, target=target,
         target_ACEScg=target_ACEScg, n_rel=n_rel, k_rel=k_rel, F0=F0, F82_tint=tint,
         F0_schlick=fit_channel_schlick(mu, target), roughness=roughness,
         coat_roughness=coat_roughness, model=model, view_cos=view, seen_ACEScg=seen,
-        tools=fitted, fit_id=fit_id, working_space=working_space,
+        tools=fitted, fit_id=fit_id, working_space=working_space, seen_rough_ACEScg=rough_seen,
     )
