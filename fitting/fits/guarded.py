@@ -278,12 +278,12 @@ def guard_report(chosen: str, scores: dict[str, GuardScore]) -> dict:
 
 def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_eta, eta_i_range,
                        degree, range_check, starts, paper_max: float, quantise: bool, score,
-                       range_points=None, work: GuardWork | None = None):
+                       range_points=None, work: GuardWork | None = None, factors=CAP_FACTORS):
     """
     Yield ``(label, C, C16, score(C16))`` of the fits of least mean Delta E
     over (``target``, ``mu``, ``eta``, ``weights``) with the first-order
-    Delta E capped at every guard point: the caps of :data:`CAP_FACTORS`
-    times ``paper_max`` in order, from each of ``starts`` (``(suffix,
+    Delta E capped at every guard point: the caps of ``factors``
+    (:data:`CAP_FACTORS`) times ``paper_max`` in order, from each of ``starts`` (``(suffix,
     coefficients)``); the caller stops when one suits it. ``score`` maps
     float16 coefficients to their :class:`GuardScore` (true CIEDE2000);
     ``range_points``, ``work``: as :func:`constrained_mean` (no refit is
@@ -292,7 +292,7 @@ def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_e
     base = np.ones(np.ravel(mu).size) if weights is None else np.ravel(weights)
     mean_problem = Problem(target, mu, eta, eta_i_range, degree, "de2000", None, range_check)
     guard_problem = Problem(guard_target, guard_mu, guard_eta, eta_i_range, degree, "de2000")
-    for factor in CAP_FACTORS:
+    for factor in factors:
         for suffix, x0 in starts:
             label = f"constrained{factor:g}{suffix}"
             cap = threshold = paper_max * factor
