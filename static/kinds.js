@@ -82,12 +82,14 @@ const row = (values) => values.map((v) => v.toFixed(5)).join(", ");
  *   nk(coefficients): [n, k] per channel for the kinds the exact Fresnel draws, else null,
  *   check(coefficients): throws an Error naming the field when malformed,
  *   describe(fit): the editor's text of its coefficients,
+ *   liveInPage: whether the editor solves its live refits in the page (editor/live_solve.js),
  * }
  */
 export const MODEL_KINDS = {
   "coated-conductor": {
     parameters: ["F0", "a", "alpha"],
     shaderKind: 0,
+    liveInPage: true,
     words: packedWords,
     nk: () => null,
     check(C) {
@@ -106,6 +108,7 @@ export const MODEL_KINDS = {
   "rgb-conductor": {
     parameters: ["n", "k"],
     shaderKind: 1,
+    liveInPage: false, // its live step (an exact-Fresnel solve from its own guess) stays the server's
     words: rgbConductorWords,
     nk: (C) => [C.n.slice(), C.k.slice()],
     check(C) {

@@ -10,9 +10,8 @@
 // with M Eq. 1 of the model (fitting/models/coated_conductor.py), A_s the
 // first-order CIEDE2000 metric at the target (fitting/colour/delta_e.py
 // de2000_weights), and the hinge residuals at a check grid (curves_score.py
-// check_grid, weight w). The solver is the server's trust-region iteration
-// (fitting/numerics/trf.py), the same steps, radius rule and stopping
-// tests, with the analytic Jacobian.
+// check_grid, weight w), solved by the server's trust-region iteration
+// (live_trf.js) with the analytic Jacobian.
 //
 // The in-range rule (curves.py constrained/held): while the float16 fit
 // leaves [0, 1] on the scoring grid, the penalty is made ten times stiffer
@@ -21,6 +20,8 @@
 // channel (curves_range.py in_range_fallback). The server also asks an
 // interval proof over the whole domain; the page checks the grid only, and
 // the server's full refit (with the proof) replaces the live fit on release.
+
+import { dot, trf } from "./live_trf.js";
 
 export const ALPHA_MIN = 1e-3;
 export const LIVE = Object.freeze({
@@ -31,7 +32,6 @@ const RANGE_TOLERANCE = 1e-4;
 const SHAPE_SCALES = [0.9, 0.75, 0.5, 0.25, 0.0];
 const MIN_ESCALATION_NFEV = 10;
 const BOUND = [16, 64, 256];
-const EPS = 2.220446049250313e-16;
 
 // ACEScg to XYZ and the ACES white (fitting/colour/colorimetry.py _matrices).
 const M_XYZ = [
@@ -216,164 +216,9 @@ export function evaluate(problem, x, withJ = true) {
   return { f, J, zero };
 }
 
-// ------------------------------------------------------------ the trust-region solver
-
-const dot = (u, v) => { let s = 0; for (let i = 0; i < u.length; i++) s += u[i] * v[i]; return s; };
-const norm = (v) => Math.sqrt(dot(v, v));
-
-function normal({ J, zero }, f, n) {
-  const A = Array.from({ length: n }, () => new Float64Array(n)), g = new Float64Array(n);
-  for (let r = 0; r < f.length; r++) {
-    if (zero[r]) continue;
-    const row = r * n, fr = f[r];
-    for (let i = 0; i < n; i++) {
-      const v = J[row + i];
-      if (v === 0) continue;
-      g[i] += v * fr;
-      const Ai = A[i];
-      for (let k = 0; k <= i; k++) Ai[k] += v * J[row + k];
-    }
-  }
-  for (let i = 0; i < n; i++) for (let k = 0; k < i; k++) A[k][i] = A[i][k];
-  return { A, g };
-}
-
-/** {pivots, M = L^-1} of the Cholesky factor of A, or null when A is not positive definite. */
-function inverseFactor(A) {
-  const n = A.length, L = Array.from({ length: n }, () => new Float64Array(n));
-  for (let i = 0; i < n; i++) {
-    for (let k = 0; k <= i; k++) {
-      let s = A[i][k];
-      for (let j = 0; j < k; j++) s -= L[i][j] * L[k][j];
-      if (i === k) {
-        if (!(s > 0)) return null;
-        L[i][i] = Math.sqrt(s);
-      } else L[i][k] = s / L[k][k];
-    }
-  }
-  const M = Array.from({ length: n }, () => new Float64Array(n));
-  for (let c = 0; c < n; c++) {
-    for (let i = c; i < n; i++) {
-      let s = i === c ? 1 : 0;
-      for (let j = c; j < i; j++) s -= L[i][j] * M[j][c];
-      M[i][c] = s / L[i][i];
-    }
-  }
-  return { pivots: L.map((row, i) => row[i]), M };
-}
-
-const mulVec = (M, v) => M.map((row) => dot(row, v));
-function mulTVec(M, v) {
-  const out = new Float64Array(v.length);
-  for (let i = 0; i < M.length; i++) { const row = M[i], vi = v[i]; for (let j = 0; j <= i; j++) out[j] += row[j] * vi; }
-  return out;
-}
-const solveWith = (M, g) => mulTVec(M, mulVec(M, g)).map((v) => -v);
-const shifted = (H, alpha) => H.map((row, i) => { const r = Float64Array.from(row); r[i] += alpha; return r; });
-
-/** The trust-region step (fitting/numerics/trf.py _step): {p, alpha}. */
-function step(H, g, Delta, alpha, rtol = 0.01, maxIter = 10) {
-  let factor = inverseFactor(H);
-  const fullRank = factor !== null && Math.min(...factor.pivots) > 1e-7 * Math.max(...factor.pivots);
-  let alphaLower = 0;
-  if (fullRank) {
-    const p = solveWith(factor.M, g), pNorm = norm(p);
-    if (pNorm <= Delta) return { p, alpha: 0 };
-    const q = mulVec(factor.M, p);
-    alphaLower = ((pNorm - Delta) * pNorm) / dot(q, q);
-  }
-  let alphaUpper = norm(g) / Delta;
-  const trace = H.reduce((s, row, i) => s + row[i], 0);
-  if (alpha === null || (!fullRank && alpha === 0)) alpha = Math.max(0.001 * alphaUpper, Math.sqrt(alphaLower * alphaUpper));
-  for (let it = 0; it < maxIter; it++) {
-    if (alpha < alphaLower || alpha > alphaUpper) alpha = Math.max(0.001 * alphaUpper, Math.sqrt(alphaLower * alphaUpper));
-    factor = inverseFactor(shifted(H, alpha));
-    if (factor === null) {
-      alphaLower = alpha = Math.max(alpha * 10, EPS * trace, EPS);
-      continue;
-    }
-    const p = solveWith(factor.M, g), pNorm = norm(p), phi = pNorm - Delta;
-    const q = mulVec(factor.M, p), phiPrime = -dot(q, q) / pNorm;
-    if (phi < 0) alphaUpper = alpha;
-    const ratio = phi / phiPrime;
-    alphaLower = Math.max(alphaLower, alpha - ratio);
-    alpha -= ((phi + Delta) * ratio) / Delta;
-    if (Math.abs(phi) < rtol * Delta) break;
-  }
-  factor = inverseFactor(shifted(H, alpha));
-  while (factor === null) {
-    alpha = Math.max(alpha * 10, EPS * trace, EPS);
-    factor = inverseFactor(shifted(H, alpha));
-  }
-  const p = solveWith(factor.M, g), scale = Delta / norm(p);
-  return { p: p.map((v) => v * scale), alpha };
-}
-
-/**
- * min 1/2 |f(x)|^2 from x0 by the server's trust-region iteration
- * (fitting.numerics.trf_least_squares): {x, cost, nfev, njev, status}
- * (status 0: out of evaluations, -1: a Jacobian not finite, 1-4: gtol,
- * ftol, xtol, both).
- */
-export function trf(problem, x0, tol = 1e-10, maxNfev = 4) {
-  const n = problem.n;
-  let x = Float64Array.from(x0);
-  let at = evaluate(problem, x);
-  let nfev = 1, njev = 1, cost = 0.5 * dot(at.f, at.f);
-  let { A, g } = normal(at, at.f, n);
-  let scaleInv = A.map((row, i) => Math.sqrt(row[i]) || 1);
-  let Delta = norm(x.map((v, i) => v * scaleInv[i])) || 1;
-  let alpha = 0, status = null;
-  for (;;) {
-    if (!Number.isFinite(A.reduce((s, row) => s + row.reduce((t, v) => t + v, 0), 0) + g.reduce((s, v) => s + v, 0))) {
-      status = -1;
-      break;
-    }
-    if (Math.max(...g.map(Math.abs)) < tol) status = 1;
-    if (status !== null || nfev === maxNfev) break;
-    const d = scaleInv.map((v) => 1 / v);
-    const H = A.map((row, i) => row.map((v, k) => v * d[i] * d[k])), gh = g.map((v, i) => v * d[i]);
-    let actual = -1, xNew = null, fNew = null, costNew = 0;
-    while (actual <= 0 && nfev < maxNfev) {
-      const taken = step(H, gh, Delta, alpha);
-      alpha = taken.alpha;
-      const ph = taken.p;
-      const Hp = mulVec(H, ph);
-      const predicted = -(0.5 * dot(ph, Hp) + dot(gh, ph));
-      const s = ph.map((v, i) => v * d[i]);
-      xNew = x.map((v, i) => v + s[i]);
-      fNew = evaluate(problem, xNew, false).f;
-      nfev += 1;
-      const phNorm = norm(ph);
-      costNew = 0.5 * dot(fNew, fNew);
-      if (!Number.isFinite(costNew)) {
-        Delta = 0.25 * phNorm;
-        continue;
-      }
-      actual = cost - costNew;
-      const ratio = predicted > 0 ? actual / predicted : predicted === 0 && actual === 0 ? 1 : 0;
-      let DeltaNew = Delta;
-      if (ratio < 0.25) DeltaNew = 0.25 * phNorm;
-      else if (ratio > 0.75 && phNorm > 0.95 * Delta) DeltaNew = 2 * Delta;
-      const ftolOk = actual < tol * cost && ratio > 0.25;
-      const xtolOk = norm(s) < tol * (tol + norm(x));
-      if (ftolOk || xtolOk) {
-        status = ftolOk && xtolOk ? 4 : ftolOk ? 2 : 3;
-        break;
-      }
-      alpha *= Delta / DeltaNew;
-      Delta = DeltaNew;
-    }
-    if (actual > 0) {
-      x = xNew;
-      cost = costNew;
-      at = evaluate(problem, x);
-      njev += 1;
-      ({ A, g } = normal(at, fNew, n));
-      scaleInv = scaleInv.map((v, i) => Math.max(Math.sqrt(A[i][i]), v));
-    }
-  }
-  return { x, cost, nfev, njev, status: status ?? 0 };
+/** The trust-region solve of the live problem from x0 (live_trf.js trf): {x, cost, nfev, njev, status}. */
+export function solveLive(problem, x0, tol = 1e-10, maxNfev = 4) {
+  return trf((x, withJ) => evaluate(problem, x, withJ), x0, problem.n, tol, maxNfev);
 }
 
 // ------------------------------------------------------------ the live step
@@ -474,7 +319,7 @@ export function liveStep(input, settings = LIVE) {
   const solveFrom = (start, weight, check) => {
     const maxNfev = Math.min(settings.maxNfev, Math.max(1, Math.floor(left / 2)));
     const problem = makeProblem({ ...input, check, checkWeight: weight });
-    const result = trf(problem, clipToBounds(start, d1), 1e-10, maxNfev);
+    const result = solveLive(problem, clipToBounds(start, d1), 1e-10, maxNfev);
     left -= result.nfev + result.njev;
     nfevAll += result.nfev; njevAll += result.njev;
     if (maxNfev < settings.maxNfev && result.status === 0) cut = true;

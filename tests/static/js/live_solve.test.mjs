@@ -17,7 +17,7 @@ import { test } from "node:test";
 import { fileURLToPath } from "node:url";
 
 import {
-  checkGrid, LIVE, liveStep, liveTarget, makeProblem, toHalf, trf,
+  checkGrid, LIVE, liveStep, liveTarget, makeProblem, solveLive, toHalf,
 } from "../../../static/editor/live_solve.js";
 
 const ROOT = join(dirname(fileURLToPath(import.meta.url)), "..", "..", "..");
@@ -43,7 +43,7 @@ for (const c of CASES) {
 
   test(`the first solve of ${c.name} is the server's`, () => {
     const problem = makeProblem({ ...c, check: checkGrid(c.range, ...LIVE.checkSamples), checkWeight: LIVE.rangeWeight });
-    const result = trf(problem, c.start, 1e-10, LIVE.maxNfev);
+    const result = solveLive(problem, c.start, 1e-10, LIVE.maxNfev);
     assert.equal(result.nfev, c.first.nfev);
     const diff = maxDiff(Array.from(result.x), c.first.x);
     assert.ok(diff < 1e-8, `coefficients differ by ${diff}`);
