@@ -21,3 +21,12 @@ self.onmessage = ({ data }) => {
     self.postMessage({ id, error: error.message });
   }
 };
+
+// Warm the solver once at start (a grey target): the first drag's steps then run compiled code.
+(() => {
+  const range = [1, 2.5];
+  const edit = { eta_i: 1.5, angle_deg: [0, 90], rgb: [[0.5, 0.5, 0.5], [1, 1, 1]] };
+  const rows = liveTarget([edit], () => Array.from({ length: 12 }, () => [0.5, 0.5, 0.5]), range, 0.5);
+  const start = [0.5, 0, 0, 0.5, 0, 0, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0];
+  for (let i = 0; i < 3; i++) liveStep({ ...rows, range, degree: 2, weights: null, start });
+})();
