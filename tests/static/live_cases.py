@@ -7,7 +7,9 @@ builds it with :data:`fitting.fits.curves.LIVE_SETTINGS` (the blended target,
 its samples and weights, the domain and degree, the start: the float16 fit
 on screen), the first solve's coefficients
 (:func:`fitting.fits.solver.fit_coefficients` with the live step's arguments)
-and the whole live step's float16 coefficients and ``best_effort``.
+and the whole live step's float16 coefficients, ``best_effort`` and whether
+it escalated (its first solve outside [0, 1] on the scoring grid or unproven
+between its points).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ import numpy as np
 from fitting.fits.curves import LIVE_SETTINGS, fit_curves
 from fitting.fits.curves_base import curve_base_from_nk, edited_target
 from fitting.fits.curves_input import check_curves
+from fitting.fits.curves_range import outside_range, proven_in_range
 from fitting.fits.curves_score import angle_mu, check_grid
 from fitting.fits.solver import fit_coefficients
 from fitting.models.pack import to_float16
@@ -40,6 +43,9 @@ CASES = [
     ("Al", 2.0, 20.0, (0.9, 0.9, 1.1)),
     ("Au", 1.5, 78.0, (0.6, 1.4, 1.6)),
     ("Cr", 1.0, 50.0, (1.5, 0.6, 1.3)),
+    # Pulled past what the model follows: the first solve leaves [0, 1] and the step escalates.
+    ("Au", 1.5, 60.0, (1.0, 0.4, 1.0)),
+    ("Au", 1.5, 60.0, (1.0, 0.15, 1.0)),
 ]
 
 
@@ -70,6 +76,9 @@ def live_case(material: str, eta: float, centre: float, gains) -> dict:
                              weights=weights, irls_rounds=0,
                              range_check=(CM.ravel(), CE.ravel(), settings.range_weight), start=start)
     live = fit_curves(curves, base, settings=settings, start=start)
+    first16 = to_float16(first.coefficients)
+    escalated = bool(outside_range(first16, (lo, hi)).any()
+                     or not proven_in_range(first16, (lo, hi), max_cells=settings.proof_cells))
     return {
         "name": f"{material} at {eta:g}, bump at {centre:g} deg x {list(gains)}",
         "target": target.tolist(), "mu": mu.tolist(), "eta": eta_s.tolist(), "weights": weights.tolist(),
@@ -79,7 +88,7 @@ def live_case(material: str, eta: float, centre: float, gains) -> dict:
         "mu_row": mu_row.tolist(),
         "first": {"x": first.coefficients.ravel().tolist(), "nfev": int(first.nfev)},
         "live": {"coefficients16": live.coefficients_float16.astype(np.float64).ravel().tolist(),
-                 "best_effort": bool(live.best_effort)},
+                 "best_effort": bool(live.best_effort), "escalated": escalated},
     }
 
 
