@@ -21,6 +21,8 @@ import { PlotView } from "./editor/plot_view.js";
 import { PreviewView } from "./editor/preview_view.js";
 import { Readout } from "./editor/readout.js";
 import { RefitPipeline, refitBody } from "./editor/refit.js";
+import { LiveRefit } from "./editor/live_page.js";
+import { LIVE } from "./editor/live_solve.js";
 import { Continuing, save as saveEdit } from "./editor/save.js";
 import { linkOf, Studio } from "./editor/studio.js";
 import { createStore, fitted, key, liveStart, SAMPLES, snapshot, unsaved } from "./editor/state.js";
@@ -32,7 +34,7 @@ const state = store.state;
 // Bookkeeping of the page around the state: the latest eta_i request (older
 // curves are dropped), the slider's debounce, the material open (to return
 // to when a switch is declined), and the cold start's prefetched curves.
-const page = { etaRequest: 0, etaTimer: null, picked: null, prefetched: new Map() };
+const page = { etaRequest: 0, etaTimer: null, picked: null, prefetched: new Map(), liveFit: null };
 
 // Timings for benchmarks/editor_speed.py: when the last edit happened, and
 // for each fit shown, the edit it answers and when its curve and its first
@@ -75,6 +77,34 @@ const pipeline = new RefitPipeline({
   busy: (work) => messages.busy("Fitting…", work),
 });
 
+// Live refits while a point is held: solved in the page (live_page.js), the
+// server's live step only for a kind the page does not solve or before the
+// base's rows are in. Each starts from the last one of the drag (the fit on screen).
+const live = new LiveRefit({
+  worker: new Worker(new URL("./editor/live_worker.js", import.meta.url), { type: "module" }),
+  rowsOf: (base, eta) => api.curves(base.id, eta, LIVE.muSamples)
+    .then((c) => (base.kind === "curves" ? c.model : c.reference || c.model)),
+  show({ fit, model, job }) {
+    if (state.base !== job.base || !store.dispatch("liveShown", { model })) return;
+    page.liveFit = fit;
+    const shown = { fit: fit.id, editAt: job.editAt, sentAt: job.editAt, fittedAt: performance.now(), curveAt: null,
+                    frameAt: null, live: "page", solveMs: fit.inPage.ms, coefficients: fit.coefficients, edits: job.edits };
+    telemetry.shown.push(shown);
+    if (telemetry.shown.length > 1000) telemetry.shown.shift();
+    shown.curveAt = performance.now();
+    previewView.hold(true);
+    previewView.showFit(fit);
+  },
+  onError: (text) => say(`The live refit failed in the page: ${text}`),
+});
+
+function liveRefit() {
+  if (!state.pointerDrag || !live.ready(state.base, state.edits)) return false;
+  live.request({ base: state.base, fit: page.liveFit || state.fit, edits: JSON.parse(snapshot(state)),
+                 theta: state.theta, eta: state.eta, editAt: telemetry.lastEditAt });
+  return true;
+}
+
 // Ask for a fit of the edits on screen (await whenFitted() for it).
 function requestRefit() {
   pipeline.request(snapshot(state));
@@ -106,11 +136,14 @@ const plotView = new PlotView({
     const moved = store.dispatch("drag", payload);
     if (moved) {
       telemetry.lastEditAt = performance.now();
-      requestRefit();
+      if (!liveRefit()) requestRefit();
     }
     return moved;
   },
   onDragEnd() {
+    live.drop();
+    page.liveFit = null;
+    previewView.hold(false);
     store.dispatch("dragEnd");
     requestRefit();
   },
@@ -174,9 +207,11 @@ const colourView = new ColourView({
 });
 
 // The views follow the state: the plot and the saved line after every change of it.
-const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved", "colour"]);
+const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved",
+                          "colour", "liveShown"]);
 store.subscribe((name) => {
   if (!RENDERED.has(name)) return;
+  $("fit-source").textContent = state.onScreen === "page" ? "live (in page)" : "server fit";
   plotView.render(state);
   readout.showSaved(state);
 });
@@ -202,6 +237,8 @@ async function setBase(fit) {
   store.dispatch("openBase", fit);
   continuing.opened(fit, savedVersion(fit));
   pipeline.drop(); // answers for the previous material are dropped
+  live.drop();
+  page.liveFit = null;
   plotView.showBase(state);
   previewView.showBase(fit);
   $("name").value = fit.kind === "curves" ? fit.name : `${fit.name} edited`;
@@ -214,6 +251,7 @@ async function setBase(fit) {
   store.dispatch("curves", { base: curves });
   present(fit, curves);
   colourView.refresh().catch((error) => say(error.message));
+  live.prepare(fit, [state.eta]);
 }
 
 // The spectral reference texture of the base (its measured n, k) for the
@@ -254,6 +292,7 @@ async function showEta() {
 
 function setEta(eta) {
   store.dispatch("setEta", eta);
+  if (state.base) live.prepare(state.base, [state.eta]);
   plotView.showEta(state);
   previewView.setEta(eta);
   colourView.setEta(eta);

@@ -86,6 +86,13 @@ function kindOf(k) {
   return Object.freeze({
     name: k.name,
     description: k.description,
+    /**
+     * Whether the editor solves this kind's live refits in the page: the
+     * default kind's, which editor/live_solve.js mirrors; another kind's
+     * live step (the rgb-conductor's exact-Fresnel solve, a plugin's) stays
+     * the server's.
+     */
+    get liveInPage() { return k.name === defaultName; },
     parameters,
     maxDegree,
     splitSum: k.split_sum,

@@ -253,7 +253,8 @@ export class ShaderBall {
     const ball = this.#program();
     if (!ball) return;
     const gl = this.gl, canvas = this.canvas;
-    const scale = Math.min(window.devicePixelRatio || 1, 2);
+    // Half resolution while a handle is held (state.held), as viewports do while dragging.
+    const scale = Math.min(window.devicePixelRatio || 1, 2) * (this.state.held ? 0.5 : 1);
     const width = Math.max(1, Math.round(canvas.clientWidth * scale));
     const height = Math.max(1, Math.round(canvas.clientHeight * scale));
     if (canvas.width !== width || canvas.height !== height) {

@@ -84,6 +84,11 @@ export class PreviewView {
     this.#follow();
   }
 
+  /** Whether a handle is held: the ball draws at half resolution meanwhile. */
+  hold(on) {
+    if (this.ball && Boolean(this.ball.state.held) !== on) this.ball.set({ held: on });
+  }
+
   /** The fit on screen, drawn at once. */
   showFit(fit) {
     if (this.ball) this.ball.setFit(fit);

@@ -31,6 +31,7 @@ export function initialState() {
     theta: [],        // the angles of the curves (degrees)
     baseCurves: null, // the base's curves at `eta` (reference, Lazanyi, model)
     model: null,      // the fit on screen's curve at `eta`
+    onScreen: "server", // whose fit the curve and preview show: "server", or "page" (a live refit in the page)
     selected: null,   // the control point typed entry changes: {channel, handle}
     compare: null,    // compare mode: {fit, label, model: its curve at `eta` (or null while it loads)}
     library: { eta: null, materials: [], query: "", found: null }, // GET /library at an eta_i; found: ?q= ids, best first
@@ -220,7 +221,19 @@ export const ACTIONS = {
   shown(s, { fit, edits = "{}", model = null }) {
     s.fit = fit;
     s.shownEdits = edits;
+    s.onScreen = "server";
     if (model) s.model = model;
+    return true;
+  },
+  /**
+   * A live refit solved in the page while a point is held ({model: its
+   * curve at eta_i}): drawn, never the fit on screen (ids, figures and
+   * downloads stay the server's); false once the drag has ended.
+   */
+  liveShown(s, { model }) {
+    if (!s.pointerDrag) return false;
+    s.model = model;
+    s.onScreen = "page";
     return true;
   },
   saved(s, fitId) {

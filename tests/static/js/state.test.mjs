@@ -218,3 +218,19 @@ test("reopened: the stored edits with no history, the fit saved; compare curves 
   store.dispatch("compareOff");
   assert.equal(s.compare, null);
 });
+
+test("a live fit from the page is drawn while a point is held, never the fit on screen", () => {
+  const store = opened();
+  const s = store.state;
+  assert.equal(s.onScreen, "server");
+  assert.equal(store.dispatch("liveShown", { model: flat(0.6) }), false, "no drag under way: dropped");
+  store.dispatch("drag", { channel: 1, handle: 3, value: 0.7, pointer: true });
+  assert.equal(store.dispatch("liveShown", { model: flat(0.6) }), true);
+  assert.deepEqual(s.model, flat(0.6));
+  assert.equal(s.onScreen, "page");
+  assert.equal(s.fit, BASE, "ids, figures and downloads stay the server fit's");
+  store.dispatch("dragEnd");
+  assert.equal(store.dispatch("liveShown", { model: flat(0.7) }), false, "an answer after the release is dropped");
+  store.dispatch("shown", { fit: { ...BASE, id: "full" }, model: flat(0.65) });
+  assert.equal(s.onScreen, "server");
+});

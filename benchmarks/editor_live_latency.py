@@ -1,0 +1,215 @@
+"""
+Live drag latency of the editor, idle and with the cores kept busy
+=================================================================
+
+Debian's Chromium (headless, software WebGL2 through SwiftShader) drives the
+editor served by a real ``python -m service`` process on 127.0.0.1. Each
+drag holds a control point and moves it (``--moves`` pointer moves, one every
+40 ms): gentle drags (a channel at 50 degrees, a few px per move) and
+extreme ones (green at 60 degrees pulled down 10-14 px a move, an edit the
+model cannot follow); after each the edit is undone, so drags do not pile
+up. Measured, from the pointer events' own time stamps (``event.timeStamp``,
+caught before the page's handlers) and the page's frames
+(``window.cfTelemetry``):
+
+-   ``move_to_frame_ms``: for every pointer move, the time to the first
+    preview frame that shows its refit (of that move or a later one);
+    median, p90, p99 and worst, gentle and extreme;
+-   ``release_to_final_ms``: from the pointer's release to the first frame
+    of the server's full refit;
+-   where a live refit's time goes: ``solve_ms`` (the worker's solve),
+    ``edit_to_result_ms`` (the move's edit to its result on the page: the
+    solve, the wait for the one in flight, the messages) and
+    ``result_to_frame_ms`` (the curve and the WebGL frame drawn);
+-   the same drags twice, in one run: ``idle`` (no load added) and
+    ``busy`` (``--busy`` busy-loop processes, 4 by default, keep both cores
+    of this machine busy), and the ratio busy / idle of the medians.
+
+The load average at the start and end of each phase is recorded beside the
+figures: on a shared machine "idle" means no load added by this run.
+
+Run: ``.venv/bin/python benchmarks/editor_live_latency.py [--drags 20] [--moves 20] [--busy 4]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+from conftest import server_process  # noqa: E402
+
+from benchmarks.record import load_average, write_result  # noqa: E402
+from playwright.sync_api import sync_playwright  # noqa: E402
+
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"]
+READY = ("() => document.body.dataset.ready === 'true' && document.getElementById('preview').dataset.fit"
+         " === document.getElementById('fit-id').textContent")
+SETTLED = ("() => { const id = document.getElementById('fit-id').textContent;"
+           " return !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
+           " && document.getElementById('preview').dataset.fit === id; }")
+# The pointer events' time stamps, caught before the page's own handlers (capture phase).
+LISTEN = """() => {
+  window.cfMoves = []; window.cfReleases = [];
+  document.addEventListener("pointermove", (e) => { if (e.buttons) window.cfMoves.push(e.timeStamp); }, true);
+  document.addEventListener("pointerup", (e) => window.cfReleases.push(e.timeStamp), true);
+}"""
+
+
+def percentile(values, q):
+    values = sorted(values)
+    return values[min(len(values) - 1, int(round(q * (len(values) - 1))))]
+
+
+def summary(values):
+    return {"median_ms": statistics.median(values), "p90_ms": percentile(values, 0.9),
+            "p99_ms": percentile(values, 0.99), "worst_ms": max(values), "n": len(values)}
+
+
+def editor(browser, url):
+    """A page on the editor, ready, after one edit undone (an artist's first touch warms the service's worker)."""
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    page.goto(url)
+    page.wait_for_function(READY, timeout=120_000)
+    page.locator("input[name=channel][value='1']").check()
+    page.locator("circle.handle.c1[data-angle='20']").focus()
+    page.keyboard.press("ArrowUp")
+    page.wait_for_function(SETTLED, timeout=120_000)
+    page.click("#undo")
+    page.wait_for_function(SETTLED, timeout=120_000)
+    page.evaluate(LISTEN)
+    return page
+
+
+def drag(page, d, moves, extreme):
+    """One drag: (move -> frame latencies (ms), moves never shown live, release -> final frame (ms))."""
+    page.evaluate("window.cfTelemetry.shown.length = 0; window.cfMoves.length = 0; window.cfReleases.length = 0")
+    channel, angle = (1, 60) if extreme else (d % 3, 50)
+    page.locator(f"input[name=channel][value='{channel}']").check()
+    handle = page.locator(f"circle.handle.c{channel}[data-angle='{angle}']")
+    handle.scroll_into_view_if_needed()
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    # Each drag ends on its own curve, so that no full refit is served from the store.
+    step = (10 + 0.25 * d) if extreme else (1.5 + 0.1 * d) * (1 if d % 2 == 0 else -1)
+    page.mouse.move(x, y)
+    page.mouse.down()
+    for k in range(1, moves + 1):
+        page.mouse.move(x, y + step * k)
+        page.wait_for_timeout(40)
+    page.wait_for_timeout(150)
+    page.mouse.up()
+    page.wait_for_function(SETTLED, timeout=120_000)
+    page.wait_for_timeout(100)
+    shown = page.evaluate("window.cfTelemetry.shown")
+    moves_at = page.evaluate("window.cfMoves")
+    released = page.evaluate("window.cfReleases")[0]
+    live = [s for s in shown if s.get("live") == "page" and s["frameAt"]]
+    final = [s for s in shown if not s.get("live") and s["frameAt"] and s["frameAt"] > released]
+    parts = [(s["solveMs"], s["curveAt"] - s["editAt"], s["frameAt"] - s["curveAt"]) for s in live]
+    latencies, missed = [], 0
+    for t in moves_at:
+        frames = [s["frameAt"] for s in live if s["editAt"] >= t]
+        if frames:
+            latencies.append(min(frames) - t)
+        else:
+            missed += 1
+    page.click("#undo")
+    page.wait_for_function(SETTLED, timeout=120_000)
+    return latencies, missed, (min(s["frameAt"] for s in final) - released) if final else None, parts
+
+
+def phase(browser, url, drags, moves):
+    """Gentle and extreme drags on one page: the figures of one phase."""
+    page = editor(browser, url)
+    load = [load_average()]
+    out = {}
+    for kind, extreme in (("gentle", False), ("extreme", True)):
+        latencies, missed, releases, parts = [], 0, [], []
+        for d in range(drags):
+            lat, miss, release, part = drag(page, d, moves, extreme)
+            latencies += lat
+            missed += miss
+            parts += part
+            if release is not None:
+                releases.append(release)
+            print(f"{kind} drag {d + 1}/{drags}: {len(lat)} moves, median {statistics.median(lat) if lat else 0:.0f} ms,"
+                  f" release {release or 0:.0f} ms", file=sys.stderr, flush=True)
+        out[kind] = {"move_to_frame_ms": summary(latencies), "moves_not_shown_live": missed,
+                     "release_to_final_ms": summary(releases),
+                     # Where a live refit's time goes: the worker's solve, edit -> result on the
+                     # page (the solve, the wait for the one in flight, the messages), result -> frame drawn.
+                     "solve_ms": summary([p[0] for p in parts]), "edit_to_result_ms": summary([p[1] for p in parts]),
+                     "result_to_frame_ms": summary([p[2] for p in parts])}
+    page.close()
+    load.append(load_average())
+    out["load_average"] = load
+    return out
+
+
+def busy_loops(count):
+    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(count)]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
+    parser.add_argument("--drags", type=int, default=20, help="gentle drags and extreme drags, each")
+    parser.add_argument("--moves", type=int, default=20, help="pointer moves a drag")
+    parser.add_argument("--busy", type=int, default=4, help="busy-loop processes of the busy phase")
+    args = parser.parse_args()
+    load_at_start = load_average()
+    figures: dict = {}
+    with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data", COATED_WARM_POOL="true") as server:
+        url = server.url + "/"
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
+            figures["idle"] = phase(browser, url, args.drags, args.moves)
+            loops = busy_loops(args.busy)
+            try:
+                time.sleep(5)  # the load average follows
+                figures["busy"] = phase(browser, url, args.drags, args.moves)
+            finally:
+                for loop in loops:
+                    loop.kill()
+                    loop.wait()
+            browser.close()
+    figures["busy_over_idle"] = {
+        kind: figures["busy"][kind]["move_to_frame_ms"]["median_ms"] / figures["idle"][kind]["move_to_frame_ms"]["median_ms"]
+        for kind in ("gentle", "extreme")}
+    print(f"{'pointer move -> frame of its refit (ms)':<44} {'median':>7} {'p90':>7} {'p99':>7} {'worst':>7} {'n':>5}")
+    for name in ("idle", "busy"):
+        for kind in ("gentle", "extreme"):
+            s = figures[name][kind]["move_to_frame_ms"]
+            print(f"{name + ', ' + kind:<44} {s['median_ms']:>7.1f} {s['p90_ms']:>7.1f} {s['p99_ms']:>7.1f}"
+                  f" {s['worst_ms']:>7.1f} {s['n']:>5}")
+    print(f"\n{'release -> frame of the full refit (ms)':<44} {'median':>7} {'p90':>7} {'worst':>7} {'n':>5}")
+    for name in ("idle", "busy"):
+        for kind in ("gentle", "extreme"):
+            s = figures[name][kind]["release_to_final_ms"]
+            print(f"{name + ', ' + kind:<44} {s['median_ms']:>7.0f} {s['p90_ms']:>7.0f} {s['worst_ms']:>7.0f} {s['n']:>5}")
+    print(f"\n{'a live refit (ms, median / p99)':<44} {'solve':>13} {'edit->result':>13} {'result->frame':>13}")
+    for name in ("idle", "busy"):
+        for kind in ("gentle", "extreme"):
+            f = figures[name][kind]
+            cells = [f"{f[k]['median_ms']:>6.1f}/{f[k]['p99_ms']:>6.1f}" for k in ("solve_ms", "edit_to_result_ms",
+                                                                                 "result_to_frame_ms")]
+            print(f"{name + ', ' + kind:<44} {cells[0]:>13} {cells[1]:>13} {cells[2]:>13}")
+    print(f"\nbusy / idle (median): {figures['busy_over_idle']}")
+    print(f"load average: idle {figures['idle']['load_average']}, busy {figures['busy']['load_average']}"
+          f" on {os.cpu_count()} cores")
+    write_result("editor_live_latency", figures, load_at_start, busy_processes=args.busy, drags=args.drags,
+                 moves=args.moves)
+
+
+if __name__ == "__main__":
+    main()
