@@ -7,10 +7,11 @@ import assert from "node:assert/strict";
 import { test } from "node:test";
 
 import { LiveRefit, flatCoefficients, liveRows, nestedCoefficients } from "../../../static/editor/live_page.js";
+import { DOMAIN } from "./domain.mjs"; // the server's kinds: the page solves the default kind's live refits
 
 const C = { F0: [[0.9, -0.1, 0.05], [0.7, -0.2, 0.1], [0.4, -0.3, 0.2]], a: [[1, 0, 0], [1, 0, 0], [1, 0, 0]],
             alpha: [[2, 0, 0], [2, 0, 0], [2, 0, 0]] };
-const BASE = { id: "base", model: "coated-conductor", eta_i_range: [1, 2.5], coefficients: C };
+const BASE = { id: "base", model: DOMAIN.default_model, eta_i_range: [1, 2.5], coefficients: C };
 const THETA = Array.from({ length: 46 }, (_, i) => 2 * i);
 
 function harness() {
