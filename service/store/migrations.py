@@ -31,6 +31,10 @@ columns. Versions:
     content-addressed, for the drafts on an inline n, k (``put_fit(...,
     nk=)``), and ``fits.nk_id`` with the index ``fits_by_nk``: the fit that
     refers to one (the drafts' sweep removes those no fit refers to).
+6.  ``materials.name_key``: the name's look-alike key
+    (:func:`service.store.names.name_key`, filled in for the rows there
+    are), and the index ``materials_by_name_key``: a save or a rename
+    finds a material whose name looks the same.
 """
 
 from __future__ import annotations
@@ -39,6 +43,7 @@ import logging
 import time
 from typing import Any, Callable, Union
 
+from .names import name_key
 from .records import FitRecord, SchemaMismatch
 
 __all__ = ["SCHEMA_VERSION", "MIGRATIONS", "migrate", "UPSERT_MATERIAL"]
@@ -50,9 +55,9 @@ Step = Union[str, Callable[[Any, str], None]]
 
 UPSERT_MATERIAL = (
     "INSERT INTO materials (material_id, first_seq, first_saved_at, latest_fit_id, kind, name, "
-    "source, coverage, version) VALUES ({p}, {p}, {p}, {p}, {p}, {p}, {p}, {p}, 1) "
+    "source, coverage, version, name_key) VALUES ({p}, {p}, {p}, {p}, {p}, {p}, {p}, {p}, 1, {p}) "
     "ON CONFLICT (material_id) DO UPDATE SET latest_fit_id = excluded.latest_fit_id, "
-    "kind = excluded.kind, name = excluded.name, source = excluded.source, "
+    "kind = excluded.kind, name = excluded.name, name_key = excluded.name_key, source = excluded.source, "
     "coverage = excluded.coverage, version = materials.version + 1, deleted_at = NULL"
 )
 """A save's summary row (``{p}``: the dialect's placeholder); a new material is version 1,
@@ -136,17 +141,33 @@ _V5: list[Step] = [
     "CREATE INDEX IF NOT EXISTS fits_by_nk ON fits (nk_id)",
 ]
 
+def _fill_name_keys(connection: Any, dialect: str) -> None:
+    """Each material's :func:`name_key` (computed here: SQL has no TR39 skeleton)."""
+    p = "?" if dialect == "sqlite" else "%s"
+    for material_id, name in connection.execute("SELECT material_id, name FROM materials").fetchall():
+        connection.execute(f"UPDATE materials SET name_key = {p} WHERE material_id = {p}",
+                           (name_key(name), material_id))
+
+
+_V6: list[Step] = [
+    "ALTER TABLE materials ADD COLUMN name_key TEXT",
+    _fill_name_keys,
+    "CREATE INDEX IF NOT EXISTS materials_by_name_key ON materials (kind, name_key)",
+]
+
 MIGRATIONS: dict[str, list[tuple[int, str, list[Step]]]] = {
     "sqlite": [(1, "fits, save log, material summaries", _SQLITE_V1),
                (2, "material versions", _V2),
                (3, "saves by fit (the drafts' sweep)", _V3),
                (4, "materials in the bin, by name", _V4),
-               (5, "n, k records of drafts", _V5)],
+               (5, "n, k records of drafts", _V5),
+               (6, "look-alike keys of names", _V6)],
     "postgresql": [(1, "fits, save log, material summaries", _POSTGRES_V1),
                    (2, "material versions", _V2),
                    (3, "saves by fit (the drafts' sweep)", _V3),
                    (4, "materials in the bin, by name", _V4),
-                   (5, "n, k records of drafts", _V5)],
+                   (5, "n, k records of drafts", _V5),
+                   (6, "look-alike keys of names", _V6)],
 }
 SCHEMA_VERSION = max(version for version, _, _ in MIGRATIONS["sqlite"])
 """The schema version this code reads and writes."""

@@ -28,6 +28,7 @@ import time
 from typing import Any, Callable
 
 from .migrations import UPSERT_MATERIAL
+from .names import name_key
 from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict, StoreFull
 
 INT64_MAX = 2**63 - 1
@@ -75,19 +76,24 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
     if stored.kind == "curves":
         # An edited material is found by its name: another one given this name
         # since the save chose its material (a rename at the same moment) wins.
+        # A look-alike of another's name is refused when the name is new to
+        # this material (two look-alikes saved before keys existed both stay saveable).
         holder = _other_holder(connection, p, stored.name, stored.material_id)
-        if holder is not None:
-            row = material_row(connection, p, stored.material_id)
+        version, latest = (row.version, row.latest_fit_id) if row else (0, None)
+        if holder is not None and holder[2] != summary_text(stored.name):
+            if row is None or row.name != summary_text(stored.name):
+                raise NameTaken(_looks_like(stored.name, holder), version=version, latest_fit_id=latest)
+        elif holder is not None:
             raise NameTaken(f"`name` {stored.name!r} was just given to another saved material {holder[0]}: "
                             "save again (the save then goes to that material), or choose another name",
-                            version=row.version if row else 0, latest_fit_id=row.latest_fit_id if row else None)
+                            version=version, latest_fit_id=latest)
     now = time.time()
     (seq,) = connection.execute(
         f"INSERT INTO saves (material_id, fit_id, saved_at) VALUES ({p}, {p}, {p}) RETURNING seq",
         (stored.material_id, stored.id, now)).fetchone()
     connection.execute(UPSERT_MATERIAL.format(p=p), (
         stored.material_id, seq, now, stored.id, stored.kind, summary_text(stored.name),
-        summary_text(stored.source), stored.coverage))
+        summary_text(stored.source), stored.coverage, name_key(stored.name)))
     return stored
 
 
@@ -264,10 +270,24 @@ def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
 
 
 def _other_holder(connection: Any, p: str, name: str, material_id: str):
-    """(id, deleted_at) of an edited material other than ``material_id`` called ``name`` (in the bin or not), or None."""
+    """
+    (id, deleted_at, name) of an edited material other than ``material_id``
+    (in the bin or not) whose name is ``name`` or looks the same
+    (:func:`service.store.names.name_key`), the one called ``name`` first; or None.
+    """
     return connection.execute(
-        f"SELECT material_id, deleted_at FROM materials WHERE kind = 'curves' AND name = {p} "
-        f"AND material_id != {p}", (summary_text(name), material_id)).fetchone()
+        f"SELECT material_id, deleted_at, name FROM materials WHERE kind = 'curves' "
+        f"AND (name = {p} OR name_key = {p}) AND material_id != {p} "
+        f"ORDER BY (name = {p}) DESC, first_seq LIMIT 1",
+        (summary_text(name), name_key(name), material_id, summary_text(name))).fetchone()
+
+
+def _looks_like(name: str, holder: tuple) -> str:
+    """The message of a name that looks the same as another material's (``holder``: :func:`_other_holder`'s)."""
+    where = " (in the bin)" if holder[1] is not None else ""
+    return (f"`name` {name!r} looks the same as {holder[2]!r}, the name of saved material {holder[0]}{where} "
+            "(the same letters up to case, width and look-alike characters: the same Unicode TR39 skeleton); "
+            f"save to that material under {holder[2]!r}, or choose another name")
 
 
 def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
@@ -275,12 +295,15 @@ def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
     row = _saved(connection, p, material_id)
     if row.kind == "curves":  # an edited material is found by its name: names are unique
         holder = _other_holder(connection, p, name, material_id)
+        if holder is not None and holder[2] != summary_text(name):
+            raise NameTaken(_looks_like(name, holder), version=row.version, latest_fit_id=row.latest_fit_id)
         if holder is not None:
             where = " (in the bin)" if holder[1] is not None else ""
             raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
                             "choose another name, or rename that one first", version=row.version,
                             latest_fit_id=row.latest_fit_id)
-    connection.execute(f"UPDATE materials SET name = {p} WHERE material_id = {p}", (summary_text(name), material_id))
+    connection.execute(f"UPDATE materials SET name = {p}, name_key = {p} WHERE material_id = {p}",
+                       (summary_text(name), name_key(name), material_id))
     return material_row(connection, p, material_id)
 
 

@@ -250,6 +250,24 @@ class TestMaterialsManaged:
         store.put_fit(record("4" * 32, material_id=a, kind="curves", name="A2"))
         assert (store.material(a).name, store.material(a).version) == ("A2", 2)
 
+    def test_a_look_alike_name_is_refused_naming_the_material(self, store):
+        a, b, c = "a" * 32, "b" * 32, "c" * 32
+        store.put_fit(record("1" * 32, material_id=a, kind="curves", name="Brass mix"))
+        store.put_fit(record("2" * 32, material_id=b, kind="curves", name="warm"))
+        # Case, a Cyrillic letter, full-width forms, a zero-width space, "rn" for "m": one skeleton.
+        for name in ("brass mix", "Br\u0430ss mix", "\uff22rass mix", "Bra\u200bss mix", "Brass  mix", "Brass rnix"):
+            with pytest.raises(NameTaken, match=f"looks the same as 'Brass mix', the name of saved material {a}"):
+                store.put_fit(record("3" * 32, material_id=c, kind="curves", name=name))
+            with pytest.raises(NameTaken, match=f"looks the same as 'Brass mix', the name of saved material {a}"):
+                store.rename_material(b, name)
+        assert store.material(c) is None and store.material(b).name == "warm"
+        # Its own material may take a look-alike spelling; another name is free.
+        assert store.rename_material(a, "brass mix").name == "brass mix"
+        store.put_fit(record("4" * 32, material_id=c, kind="curves", name="Brass mix 2"))
+        store.delete_material(a)  # the bin keeps the name
+        with pytest.raises(NameTaken, match="in the bin"):
+            store.rename_material(b, "BRASS MIX")
+
     def test_delete_is_a_bin_and_nothing_is_lost(self, store):
         a, b = "a" * 32, "b" * 32
         first = store.put_fit(record("1" * 32, material_id=a, kind="curves", name="A"))
@@ -340,6 +358,28 @@ class TestSQLiteStore:
         try:
             assert store.latest_fit("a" * 32).name == "new"
             assert [m.name for m in store.saved_materials()] == ["new"]
+        finally:
+            store.close()
+
+    def test_names_saved_before_their_keys_get_keys_and_stay_saveable(self, tmp_path):
+        path = tmp_path / "v5.sqlite3"
+        store = SQLiteStore(path)
+        store.put_fit(record("1" * 32, material_id="a" * 32, kind="curves", name="Brass mix"))
+        store.put_fit(record("2" * 32, material_id="b" * 32, kind="curves", name="warm"))
+        store.close()
+        old = sqlite3.connect(path)  # back to version 5: no keys, and two look-alike names
+        old.executescript("DROP INDEX materials_by_name_key; ALTER TABLE materials DROP COLUMN name_key; "
+                          "DELETE FROM schema_migrations WHERE version = 6; "
+                          "UPDATE materials SET name = 'brass mix' WHERE material_id = 'bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb'")
+        old.close()
+        store = SQLiteStore(path)
+        try:
+            assert store.migrated == (5, SCHEMA_VERSION)
+            store.put_fit(record("3" * 32, material_id="a" * 32, kind="curves", name="Brass mix"))
+            store.put_fit(record("4" * 32, material_id="b" * 32, kind="curves", name="brass mix"))
+            assert [store.material(m).version for m in ("a" * 32, "b" * 32)] == [2, 2]
+            with pytest.raises(NameTaken, match="looks the same as"):
+                store.put_fit(record("5" * 32, material_id="c" * 32, kind="curves", name="BRASS MIX"))
         finally:
             store.close()
 
