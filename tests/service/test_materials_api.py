@@ -271,6 +271,13 @@ def test_packs_need_the_token(http, brass):
     assert http.post(f"{API}/packs", json=body, headers=AUTH).status_code == 200
 
 
+def test_a_link_needs_the_token_and_a_saved_fit_s_never_expires(http, brass):
+    fit_id = brass[0]["id"]
+    assert http.post(f"{API}/fits/{fit_id}/link").status_code == 401
+    link = http.post(f"{API}/fits/{fit_id}/link", headers=AUTH)
+    assert link.status_code == 200 and link.json()["expires_at"] is None and not link.json()["draft"]
+
+
 def test_uploads_are_kept_apart_from_saved_materials(http, brass):
     files = {"file": ("lab metal.csv", nk_csv(0.05), "text/csv")}
     upload = http.post(f"{API}/fits/upload", files=files, headers=AUTH)
