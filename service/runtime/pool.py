@@ -70,7 +70,8 @@ class Overloaded(Exception):
     """Too many jobs in flight; ``retry_after`` is a wait estimate in seconds."""
 
     def __init__(self, retry_after: int, limit: int) -> None:
-        super().__init__(f"the service is fitting {limit} materials already (the limit); retry in about {retry_after} s")
+        super().__init__(f"the service is fitting {limit} materials already (the limit); "
+                         f"retry in about {retry_after} s")
         self.retry_after = retry_after
 
 
@@ -128,9 +129,7 @@ _QUARANTINE_KEYS = 1024  # content ids remembered at most
 
 class FitRunner:
     """
-    The bounded fitting pool.
-
-    ``workers`` processes run parts of any cost, ``express_workers`` more
+    The bounded fitting pool: ``workers`` processes run parts of any cost, ``express_workers`` more
     only cheap ones (:data:`EXPRESS_COST_S`), so a library fit or a live
     step never waits for an expensive part to end.
 
@@ -139,8 +138,7 @@ class FitRunner:
     (:meth:`once`); its job's slot stays taken until the job ends, so the
     bound stays true. A job is one function (:meth:`run`) or parts
     submitted under one slot (:meth:`slot`, :meth:`submit`), which idle
-    workers run side by side. Each part may use ``cpu_limit_s`` seconds
-    of CPU time (:class:`JobCPULimit`).
+    workers run side by side. Each part may use ``cpu_limit_s`` seconds of CPU time (:class:`JobCPULimit`).
     """
 
     def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
@@ -159,7 +157,8 @@ class FitRunner:
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
         self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
-        self.shares = Shares(max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers)
+        self.shares = Shares(max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers,
+                             timeout_s * workers)  # a client's bulk jobs: what one request may use, in all
         self._context = process_context()
         self._cancels = CancelRing(self._context)
         self._serial = 0
@@ -224,16 +223,16 @@ class FitRunner:
         if self._in_flight >= self.max_in_flight:
             raise Overloaded(self._retry_after(), self.max_in_flight)
 
-    def _acquire(self, claim: Claim) -> None:
+    def _acquire(self, claim: Claim, cost_s: float) -> None:
         with self._lock:
             if self._in_flight >= self.max_in_flight:
                 raise Overloaded(self._retry_after(), self.max_in_flight)
-            self.shares.admit(claim, self._retry_after())  # a bulk job within its client's share
+            self.shares.admit(claim, self._retry_after(), cost_s)  # a bulk job within its client's share
             self._in_flight += 1
 
-    def _release(self, started: float | None, claim: Claim) -> None:
+    def _release(self, started: float | None, claim: Claim, cost_s: float) -> None:
         with self._lock:
-            self.shares.leave(claim)
+            self.shares.leave(claim, cost_s)
             self._in_flight -= 1
             if started is not None:
                 self.completed += 1
@@ -253,14 +252,14 @@ class FitRunner:
         Overloaded, service.runtime.shares.ShareExceeded
         """
         claim = CLAIM.get()
-        self._acquire(claim)
+        self._acquire(claim, estimate_s)
         started, done, budget = time.perf_counter(), None, BUDGET.set(JobBudget(estimate_s, self.cpu_limit_s))
         try:
             yield
             done = started
         finally:
             BUDGET.reset(budget)
-            self._release(done, claim)
+            self._release(done, claim, estimate_s)
 
     async def submit(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
