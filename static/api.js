@@ -109,6 +109,8 @@ async function send(method, path, body = null) {
 export const renameMaterial = (id, name) => send("PATCH", `/materials/${encodeURIComponent(id)}`, { name });
 export const deleteMaterial = (id) => send("DELETE", `/materials/${encodeURIComponent(id)}`);
 export const restoreMaterial = (id) => send("POST", `/materials/${encodeURIComponent(id)}/restore`);
+// A link to a fit: a draft is then kept the drafts' time to live from now ({expires_at}).
+export const linkFit = (fitId) => send("POST", `/fits/${encodeURIComponent(fitId)}/link`);
 // `?metrics=full`: the editor shows the fit's figure, so its answer waits for the evaluation on the
 // metrics grid (without it an n, k fit answers as soon as it is saved, `metrics.evaluated` false).
 export const fitLibrary = (name, etaRange) =>

@@ -263,7 +263,7 @@ async def scene_pack(scene: PreparedScene, runner: FitRunner) -> dict[str, Any]:
     check_scene_cost(scene, runner)
 
     async def make() -> dict[str, Any]:
-        async with runner.slot():
+        async with runner.slot(scene_parts(scene) * ETA_COST_S):  # its CPU budget follows its parts
             parts = await _scene_parts(scene, runner)
         return _scene_report(scene, parts)
 

@@ -5,7 +5,9 @@ The process runtime
 Where the service's work runs, off the event loop, in processes of its own:
 
 -   :class:`FitRunner`, the fitting pool: bounded, a time limit per job and
-    a CPU-time limit per part (:class:`JobCPULimit`), jobs no request waits
+    a CPU-time limit per part (:class:`JobCPULimit`) and a CPU budget per
+    job proportional to its estimated cost (:class:`JobBudgetExceeded`,
+    :data:`BUDGET_FACTOR`), jobs no request waits
     for cancelled, a dead worker's jobs retried once and then alone, a job
     that kills a worker alone quarantined by its content id;
 -   :class:`PreviewRunner`, the render pool: previews and GL textures in
@@ -14,7 +16,8 @@ Where the service's work runs, off the event loop, in processes of its own:
     :class:`Overloaded` and :class:`PreviewsBusy` (503), :class:`FitTimeout`
     and :class:`PreviewTimeout` (504), :class:`WorkerLost`,
     :class:`WorkersNotStarted`, :class:`Quarantined`, :class:`RenderWorkerLost`
-    and :class:`RendererUnavailable` (503), :class:`JobCPULimit` (422);
+    and :class:`RendererUnavailable` (503), :class:`JobCPULimit` and
+    :class:`JobBudgetExceeded` (422);
 -   the fair shares of the fitting pool (:class:`Shares`): each job's
     :class:`Claim` (its client and kind, set per request in :data:`CLAIM`),
     :class:`ShareExceeded` (503) past a client's share, and the saves per
@@ -31,13 +34,14 @@ half-written result unstuck), ``worker`` and ``render_worker`` (what runs in
 each process), ``fork_server`` and ``preload`` (the processes are forks of a
 fork server forked from the server), ``server`` (uvicorn's adapter) and
 ``mp_private`` (multiprocessing's private state), ``admission`` (the server's connection bounds), ``shares`` (the fair
-shares); docs/architecture.md draws them.
+shares), ``budget`` (each job's CPU budget); docs/architecture.md draws them.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
+from .budget import BUDGET_FACTOR, JobBudgetExceeded
 from .pool import FitRunner, FitTimeout, Overloaded, Quarantined, WorkerLost, WorkersNotStarted
 from .previews import PreviewRunner, PreviewsBusy, PreviewTimeout, RenderWorkerLost
 from .render_worker import RendererUnavailable, renderer
@@ -47,6 +51,7 @@ from .worker import JobCPULimit, freeze_heap, thaw_heap, warm_process
 __all__ = [
     "FitRunner", "PreviewRunner",
     "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
+    "JobBudgetExceeded", "BUDGET_FACTOR",
     "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
     "Shares", "Claim", "CLAIM", "ShareExceeded", "SaveRate", "TooManySaves",
     "renderer", "warm_process", "freeze_heap", "thaw_heap", "start_fork_server", "serve",

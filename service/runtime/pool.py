@@ -35,8 +35,8 @@ Faults:
     no request waits for is cancelled, its worker free within a second.
 -   Each part of a job has a CPU-time limit (``cpu_limit_s``), checked by
     its worker every 0.1 s: past it the part stops with
-    :class:`JobCPULimit`. BLAS runs one thread per worker (the fits'
-    matrices are tiny; threads there only contend for the cores).
+    :class:`JobCPULimit`; each job has a CPU budget proportional to its
+    estimated cost (:mod:`service.runtime.budget`). BLAS: one thread.
 """
 
 from __future__ import annotations
@@ -57,10 +57,11 @@ from .shares import CLAIM, Claim, Shares
 from .turns import Turns
 from .flights import CancelRing, Flights
 from .fork_server import START_ERRORS, fork_server_exited
-from .worker import JobCPULimit, ping, process_context, run_part, warm_process, worker_start
+from .budget import BUDGET, JobBudget, JobBudgetExceeded, charged, part_limit, run_part_timed
+from .worker import JobCPULimit, ping, process_context, warm_process, worker_start
 
 __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
-           "warm_process"]
+           "JobBudgetExceeded", "warm_process"]
 
 log = logging.getLogger("service.runtime.pool")
 
@@ -69,10 +70,8 @@ class Overloaded(Exception):
     """Too many jobs in flight; ``retry_after`` is a wait estimate in seconds."""
 
     def __init__(self, retry_after: int, limit: int) -> None:
-        super().__init__(
-            f"the service is fitting {limit} materials already (the limit); "
-            f"retry in about {retry_after} s"
-        )
+        super().__init__(f"the service is fitting {limit} materials already (the limit); "
+                         f"retry in about {retry_after} s")
         self.retry_after = retry_after
 
 
@@ -130,9 +129,7 @@ _QUARANTINE_KEYS = 1024  # content ids remembered at most
 
 class FitRunner:
     """
-    The bounded fitting pool.
-
-    ``workers`` processes run parts of any cost, ``express_workers`` more
+    The bounded fitting pool: ``workers`` processes run parts of any cost, ``express_workers`` more
     only cheap ones (:data:`EXPRESS_COST_S`), so a library fit or a live
     step never waits for an expensive part to end.
 
@@ -141,8 +138,7 @@ class FitRunner:
     (:meth:`once`); its job's slot stays taken until the job ends, so the
     bound stays true. A job is one function (:meth:`run`) or parts
     submitted under one slot (:meth:`slot`, :meth:`submit`), which idle
-    workers run side by side. Each part may use ``cpu_limit_s`` seconds
-    of CPU time (:class:`JobCPULimit`).
+    workers run side by side. Each part may use ``cpu_limit_s`` seconds of CPU time (:class:`JobCPULimit`).
     """
 
     def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
@@ -161,7 +157,8 @@ class FitRunner:
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
         self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
-        self.shares = Shares(max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers)
+        self.shares = Shares(max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers,
+                             timeout_s * workers)  # a client's bulk jobs: what one request may use, in all
         self._context = process_context()
         self._cancels = CancelRing(self._context)
         self._serial = 0
@@ -226,41 +223,43 @@ class FitRunner:
         if self._in_flight >= self.max_in_flight:
             raise Overloaded(self._retry_after(), self.max_in_flight)
 
-    def _acquire(self, claim: Claim) -> None:
+    def _acquire(self, claim: Claim, cost_s: float) -> None:
         with self._lock:
             if self._in_flight >= self.max_in_flight:
                 raise Overloaded(self._retry_after(), self.max_in_flight)
-            self.shares.admit(claim, self._retry_after())  # a bulk job within its client's share
+            self.shares.admit(claim, self._retry_after(), cost_s)  # a bulk job within its client's share
             self._in_flight += 1
 
-    def _release(self, started: float | None, claim: Claim) -> None:
+    def _release(self, started: float | None, claim: Claim, cost_s: float) -> None:
         with self._lock:
-            self.shares.leave(claim)
+            self.shares.leave(claim, cost_s)
             self._in_flight -= 1
             if started is not None:
                 self.completed += 1
                 self._mean_s = 0.8 * self._mean_s + 0.2 * (time.perf_counter() - started)
 
     @contextlib.asynccontextmanager
-    async def slot(self) -> AsyncIterator[None]:
+    async def slot(self, estimate_s: float = 0.0) -> AsyncIterator[None]:
         """
         One place in the bound for a job of one or more parts
         (:meth:`submit`), held until the job ends; a job that ends without
-        an exception counts as completed and updates the wait estimate.
+        an exception counts as completed and updates the wait estimate. Its
+        parts share a CPU budget of ``estimate_s`` (estimated CPU seconds)
+        times ``BUDGET_FACTOR``, at least ``cpu_limit_s``.
 
         Raises
         ------
         Overloaded, service.runtime.shares.ShareExceeded
         """
         claim = CLAIM.get()
-        self._acquire(claim)
-        started = time.perf_counter()
-        done = None
+        self._acquire(claim, estimate_s)
+        started, done, budget = time.perf_counter(), None, BUDGET.set(JobBudget(estimate_s, self.cpu_limit_s))
         try:
             yield
             done = started
         finally:
-            self._release(done, claim)
+            BUDGET.reset(budget)
+            self._release(done, claim, estimate_s)
 
     async def submit(self, function: Callable[..., Any], *args: Any, cost_s: float = 1.0) -> Any:
         """
@@ -320,16 +319,17 @@ class FitRunner:
         with self._lock:
             self._serial += 1
             serial = self._serial
+        budget, limit_s = part_limit(self.cpu_limit_s)
         try:
-            future = pool.submit(run_part, serial, self.cpu_limit_s, function, *args)  # starts missing workers
+            future = pool.submit(run_part_timed, serial, limit_s, function, *args)  # starts missing workers
         except START_ERRORS as error:
             # The fork server died or is dying: wait until multiprocessing can see that it has exited, so
             # that the pool replacing this one starts another instead of asking it again.
             await fork_server_exited()
             raise _StartFailed(f"a fitting worker could not be started: {error!r}") from error
         began = time.perf_counter()
-        try:
-            return await executors.result(pool, future)  # a pool stuck on a killed worker's result breaks
+        try:  # a pool stuck on a killed worker's result breaks
+            return await charged(executors.result(pool, future), budget, limit_s, self.cpu_limit_s)
         except asyncio.CancelledError:
             self._cancels.cancel(serial, future)
             raise
@@ -360,7 +360,7 @@ class FitRunner:
         ------
         Overloaded, WorkerLost
         """
-        async with self.slot():
+        async with self.slot(cost_s):
             return await self.submit(function, *args, cost_s=cost_s)
 
     async def once(self, key: str, make: Callable[[], Awaitable[Any]]) -> Any:

@@ -17,7 +17,10 @@ and every worker while the writers waited or got 503. The pool
     started in the request inherit it).
 -   :class:`Shares`: admission and accounting. Bulk jobs may hold at most
     ``max_in_flight - reserved`` slots together and ``per_client`` each
-    client; past either the request is answered 503 with ``Retry-After``
+    client, and one client's bulk jobs at most ``client_cost_s`` of
+    estimated CPU seconds together (a scene of 64 x 32 counts its 2,048
+    parts, not one job; a client's first job is always admitted by cost);
+    past any of these the request is answered 503 with ``Retry-After``
     (:class:`ShareExceeded`) while the other clients and every interactive
     request keep theirs. Worker time is charged per client and per kind
     (``charge``); it decays with a half-life of :data:`HALF_LIFE_S`, and a
@@ -86,24 +89,31 @@ class Shares:
 
     ``max_in_flight``: the pool's bound on jobs in flight; ``reserved`` of
     it are kept for interactive jobs; ``per_client``: bulk jobs of one
-    client in flight at most. Thread-safe.
+    client in flight at most; ``client_cost_s``: their estimated CPU
+    seconds together at most (None: no bound). Thread-safe.
     """
 
-    def __init__(self, max_in_flight: int, reserved: int, per_client: int) -> None:
+    def __init__(self, max_in_flight: int, reserved: int, per_client: int,
+                 client_cost_s: float | None = None) -> None:
         if not 0 <= reserved < max_in_flight or per_client < 1:
             raise ValueError(f"`reserved` ({reserved}) must lie in [0, {max_in_flight}) and `per_client` "
                              f"({per_client}) be >= 1")
         self.bulk_max = max_in_flight - reserved
         self.per_client = per_client
+        self.client_cost_s = client_cost_s
         self._lock = threading.Lock()
         self._bulk = 0
         self._bulk_by_client: dict[str, int] = {}
+        self._cost_by_client: dict[str, float] = {}
         self._standing: dict[str, tuple[float, float]] = {}  # client -> (charged s, as of monotonic time)
         self.charged_by_kind = dict.fromkeys(KINDS, 0.0)
         """Worker seconds charged to each kind since the start."""
 
-    def admit(self, claim: Claim, retry_after: int) -> None:
-        """Take a bulk slot for ``claim`` (an interactive claim takes none); :class:`ShareExceeded` past a share."""
+    def admit(self, claim: Claim, retry_after: int, cost_s: float = 0.0) -> None:
+        """
+        Take a bulk slot for ``claim`` (an interactive claim takes none), a
+        job of ``cost_s`` estimated CPU seconds; :class:`ShareExceeded` past a share.
+        """
         if claim.interactive:
             return
         with self._lock:
@@ -112,22 +122,31 @@ class Shares:
                 raise ShareExceeded(retry_after, (
                     f"this client has {held} {claim.kind} jobs in flight, its share of the fitting pool "
                     f"(COATED_CLIENT_BULK_JOBS); retry in about {retry_after} s"))
+            cost = self._cost_by_client.get(claim.client, 0.0)
+            if self.client_cost_s is not None and held and cost + cost_s > self.client_cost_s:
+                raise ShareExceeded(retry_after, (
+                    f"this client's jobs in flight are estimated at {cost:.1f} s of fitting; with this "
+                    f"{claim.kind} job's {cost_s:.1f} s they would pass its share, {self.client_cost_s:g} s "
+                    f"(COATED_FIT_TIMEOUT_S x COATED_FIT_WORKERS); retry in about {retry_after} s"))
             if self._bulk >= self.bulk_max:
                 raise ShareExceeded(retry_after, (
                     f"the fitting pool runs {self._bulk} reads, packs and scenes, their share (the rest is kept "
                     f"for saves); retry in about {retry_after} s"))
             self._bulk += 1
             self._bulk_by_client[claim.client] = held + 1
+            self._cost_by_client[claim.client] = cost + cost_s
 
-    def leave(self, claim: Claim) -> None:
-        """Give back the slot :meth:`admit` took."""
+    def leave(self, claim: Claim, cost_s: float = 0.0) -> None:
+        """Give back the slot :meth:`admit` took (for a job of ``cost_s``)."""
         if claim.interactive:
             return
         with self._lock:
             self._bulk -= 1
             left = self._bulk_by_client.pop(claim.client) - 1
+            cost = self._cost_by_client.pop(claim.client) - cost_s
             if left:
                 self._bulk_by_client[claim.client] = left
+                self._cost_by_client[claim.client] = max(0.0, cost)
 
     def charge(self, claim: Claim, seconds: float) -> None:
         """Charge ``seconds`` of a worker's time to ``claim``'s client and kind."""

@@ -11,6 +11,7 @@ result did not have left out, so the JSON is the core's, key for key.
 
 from __future__ import annotations
 
+import functools
 import unicodedata
 from typing import Annotated, Any, Literal
 
@@ -22,10 +23,10 @@ from fitting.exports.colour_space import WORKING_SPACES as WORKING_SPACE_NAMES
 from fitting.fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
 from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS
 from fitting.optics.bounded import excerpt
-from fitting.optics.catalogue import resolve_material
-from fitting.optics.library import FULL_NAMES, LIBRARY_NAMES
+from fitting.optics.catalogue import catalogue, resolve_material
 
 from ..jobs.nk import MAX_NK_SAMPLES
+from ..store.names import name_key
 
 __all__ = [
     "API_PREFIX", "INT64_MAX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
@@ -92,7 +93,20 @@ Text = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 _BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
 _INVISIBLE = frozenset({"Zs", "Zl", "Zp", "Cc", "Cf", "Cn", "Co", "Cs", "Mn", "Me"})
 """Unicode general categories that show nothing on their own (spaces, controls, format, marks)."""
-_RESERVED = {name.casefold(): name for name in (*LIBRARY_NAMES, *FULL_NAMES.values())}
+
+
+@functools.cache
+def reserved_names() -> dict[str, str]:
+    """
+    The look-alike key (:func:`service.store.names.name_key`) of every
+    name the catalogue answers to (each entry's id, name, other names and
+    symbol: ``Au``, ``gold``, ``Ti.Johnson``), and the one it stands for.
+    """
+    reserved: dict[str, str] = {}
+    for entry in catalogue().values():
+        for name in (entry["name"], *entry["aliases"], entry["symbol"], entry["id"]):
+            reserved.setdefault(name_key(name), name)
+    return reserved
 
 
 def material_name(value: str) -> str:
@@ -101,7 +115,9 @@ def material_name(value: str) -> str:
     the same name) and stripped; ``ValueError`` when it holds a
     bidirectional control (it would show its letters out of order), has no
     visible character (only spaces, zero-width or format characters), or
-    is a built-in material's symbol or name (``Au``, ``Gold``: reserved).
+    is, or looks the same as (:func:`service.store.names.name_key`: case,
+    width, look-alike letters), a catalogue material's name, symbol or id
+    (``Au``, ``Gold``, ``stainless steel 316``: :func:`reserved_names`).
     """
     value = unicodedata.normalize("NFC", value).strip()
     control = next((c for c in value if c in _BIDI_CONTROLS), None)
@@ -109,9 +125,11 @@ def material_name(value: str) -> str:
         raise ValueError(f"`name` must hold no bidirectional control, got U+{ord(control):04X}")
     if all(unicodedata.category(c) in _INVISIBLE for c in value):
         raise ValueError("`name` needs a visible character (spaces, zero-width and format characters show nothing)")
-    reserved = _RESERVED.get(value.casefold())
+    reserved = reserved_names().get(name_key(value))
     if reserved is not None:
-        raise ValueError(f"`name` {value!r} is reserved: {reserved!r} names a built-in material")
+        same = "is" if reserved.casefold() == value.casefold() else "looks the same as"
+        raise ValueError(f"`name` {value!r} is reserved: it {same} {reserved!r}, which names a material of "
+                         "the catalogue (GET /api/v1/library)")
     return value
 
 

@@ -19,7 +19,7 @@ from .common import MaterialName, RequestModel
 from .fits import FitPublic
 
 __all__ = ["MaterialSummary", "MaterialList", "MaterialDetail", "MaterialRename", "VersionSummary",
-           "VersionList", "FitEdit", "LISTING_KINDS"]
+           "VersionList", "FitEdit", "FitLink", "LISTING_KINDS"]
 
 LISTING_KINDS = ("library", "curves", "nk")
 """What ``GET /materials?kind=`` selects: built-in, saved edits (the artist's), n, k uploads."""
@@ -106,3 +106,13 @@ class FitEdit(BaseModel):
     request: dict[str, Any] | None = Field(
         None, description="The curve fit's request, ready to post again (null for library and n, k fits)")
     version: int = Field(0, description="The material's version now (send it as `expected_version`)")
+
+
+class FitLink(BaseModel):
+    """A link that reopens a fit in the editor, and how long it works."""
+
+    fit_id: str
+    url: str = Field(description="The editor's link (`/?fit={fit_id}`), relative to the service")
+    draft: bool = Field(description="Whether it opens an unsaved edit (a draft), kept until `expires_at`")
+    expires_at: float | None = Field(
+        description="Unix time the draft is removed (null: a saved fit, or the base of one, never is)")

@@ -31,14 +31,24 @@ columns. Versions:
     content-addressed, for the drafts on an inline n, k (``put_fit(...,
     nk=)``), and ``fits.nk_id`` with the index ``fits_by_nk``: the fit that
     refers to one (the drafts' sweep removes those no fit refers to).
+6.  ``materials.name_key``: the name's look-alike key
+    (:func:`service.store.names.name_key`, filled in for the rows there
+    are), and the index ``materials_by_name_key``: a save or a rename
+    finds a material whose name looks the same.
+7.  ``fits.base_fit_id`` (filled in from the records there are) and the
+    index ``fits_by_base``: the drafts' sweep keeps every draft a saved
+    fit starts from, and the drafts those start from; ``fits.kept_until``:
+    a draft a link was made to is kept until then (``keep_draft``).
 """
 
 from __future__ import annotations
 
+import json
 import logging
 import time
 from typing import Any, Callable, Union
 
+from .names import name_key
 from .records import FitRecord, SchemaMismatch
 
 __all__ = ["SCHEMA_VERSION", "MIGRATIONS", "migrate", "UPSERT_MATERIAL"]
@@ -50,9 +60,9 @@ Step = Union[str, Callable[[Any, str], None]]
 
 UPSERT_MATERIAL = (
     "INSERT INTO materials (material_id, first_seq, first_saved_at, latest_fit_id, kind, name, "
-    "source, coverage, version) VALUES ({p}, {p}, {p}, {p}, {p}, {p}, {p}, {p}, 1) "
+    "source, coverage, version, name_key) VALUES ({p}, {p}, {p}, {p}, {p}, {p}, {p}, {p}, 1, {p}) "
     "ON CONFLICT (material_id) DO UPDATE SET latest_fit_id = excluded.latest_fit_id, "
-    "kind = excluded.kind, name = excluded.name, source = excluded.source, "
+    "kind = excluded.kind, name = excluded.name, name_key = excluded.name_key, source = excluded.source, "
     "coverage = excluded.coverage, version = materials.version + 1, deleted_at = NULL"
 )
 """A save's summary row (``{p}``: the dialect's placeholder); a new material is version 1,
@@ -136,17 +146,55 @@ _V5: list[Step] = [
     "CREATE INDEX IF NOT EXISTS fits_by_nk ON fits (nk_id)",
 ]
 
+def _fill_name_keys(connection: Any, dialect: str) -> None:
+    """Each material's :func:`name_key` (computed here: SQL has no TR39 skeleton)."""
+    p = "?" if dialect == "sqlite" else "%s"
+    for material_id, name in connection.execute("SELECT material_id, name FROM materials").fetchall():
+        connection.execute(f"UPDATE materials SET name_key = {p} WHERE material_id = {p}",
+                           (name_key(name), material_id))
+
+
+_V6: list[Step] = [
+    "ALTER TABLE materials ADD COLUMN name_key TEXT",
+    _fill_name_keys,
+    "CREATE INDEX IF NOT EXISTS materials_by_name_key ON materials (kind, name_key)",
+]
+
+def _fill_base_fit_ids(connection: Any, dialect: str) -> None:
+    """Each curve fit's ``base_fit_id``, read from its record (the column is new)."""
+    p = "?" if dialect == "sqlite" else "%s"
+    for fit_id, text in connection.execute("SELECT id, record FROM fits WHERE kind = 'curves'").fetchall():
+        try:
+            base = json.loads(text).get("base_fit_id")
+        except (TypeError, ValueError, AttributeError) as error:
+            log.error("stored fit %s cannot be decoded, its base is not known: %s", fit_id, error)
+            continue
+        if isinstance(base, str):
+            connection.execute(f"UPDATE fits SET base_fit_id = {p} WHERE id = {p}", (base, fit_id))
+
+
+_V7: list[Step] = [
+    "ALTER TABLE fits ADD COLUMN base_fit_id TEXT",
+    _fill_base_fit_ids,
+    "CREATE INDEX IF NOT EXISTS fits_by_base ON fits (base_fit_id)",
+    "ALTER TABLE fits ADD COLUMN kept_until DOUBLE PRECISION",
+]
+
 MIGRATIONS: dict[str, list[tuple[int, str, list[Step]]]] = {
     "sqlite": [(1, "fits, save log, material summaries", _SQLITE_V1),
                (2, "material versions", _V2),
                (3, "saves by fit (the drafts' sweep)", _V3),
                (4, "materials in the bin, by name", _V4),
-               (5, "n, k records of drafts", _V5)],
+               (5, "n, k records of drafts", _V5),
+               (6, "look-alike keys of names", _V6),
+               (7, "the base each fit starts from, drafts kept for links", _V7)],
     "postgresql": [(1, "fits, save log, material summaries", _POSTGRES_V1),
                    (2, "material versions", _V2),
                    (3, "saves by fit (the drafts' sweep)", _V3),
                    (4, "materials in the bin, by name", _V4),
-                   (5, "n, k records of drafts", _V5)],
+                   (5, "n, k records of drafts", _V5),
+                   (6, "look-alike keys of names", _V6),
+                   (7, "the base each fit starts from, drafts kept for links", _V7)],
 }
 SCHEMA_VERSION = max(version for version, _, _ in MIGRATIONS["sqlite"])
 """The schema version this code reads and writes."""

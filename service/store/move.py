@@ -26,10 +26,10 @@ from .sqlite import SQLiteStore
 __all__ = ["MoveReport", "store_checksum", "move_sqlite_to_postgres"]
 
 _TABLES = {
-    "fits": ("id", "kind", "material_id", "created_at", "record", "nk_id"),
+    "fits": ("id", "kind", "material_id", "created_at", "record", "nk_id", "base_fit_id"),
     "saves": ("seq", "material_id", "fit_id", "saved_at"),
     "materials": ("material_id", "first_seq", "first_saved_at", "latest_fit_id", "kind", "name",
-                  "source", "coverage", "version", "deleted_at"),
+                  "source", "coverage", "version", "deleted_at", "name_key"),
     "nk_records": ("id", "created_at", "record"),
 }
 _ORDER = {"fits": "id", "saves": "seq", "materials": "material_id", "nk_records": "id"}

@@ -28,6 +28,7 @@ import time
 from typing import Any, Callable
 
 from .migrations import UPSERT_MATERIAL
+from .names import name_key
 from .records import FIT_KINDS, FitRecord, MaterialPage, MaterialRow, NameTaken, StoreConflict, StoreFull
 
 INT64_MAX = 2**63 - 1
@@ -35,7 +36,7 @@ MAX_VERSIONS_PER_MATERIAL = 10_000
 """The most versions one material keeps; a save past them is refused (507): its history is bounded."""
 
 __all__ = ["save", "set_metrics", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
-           "expire_drafts", "material_row", "find_material", "rename", "set_deleted", "version_texts",
+           "expire_drafts", "keep_draft", "material_row", "find_material", "rename", "set_deleted", "version_texts",
            "version_text", "summary_text", "check_expected", "LISTED_KINDS"]
 
 log = logging.getLogger("service.store")
@@ -58,9 +59,9 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
             f"INSERT INTO nk_records (id, created_at, record) VALUES ({p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",
             (record.nk_id, record.created_at, nk_json()))
     connection.execute(
-        f"INSERT INTO fits (id, kind, material_id, created_at, record, nk_id) "
-        f"VALUES ({p}, {p}, {p}, {p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",
-        (record.id, record.kind, record.material_id, record.created_at, text, record.nk_id))
+        f"INSERT INTO fits (id, kind, material_id, created_at, record, nk_id, base_fit_id) "
+        f"VALUES ({p}, {p}, {p}, {p}, {p}, {p}, {p}) ON CONFLICT (id) DO NOTHING",
+        (record.id, record.kind, record.material_id, record.created_at, text, record.nk_id, record.base_fit_id))
     stored = decode(record.id, get_text(connection, p, record.id))
     if not save:  # a draft: stored, reachable by id, listed under no material
         return stored
@@ -75,19 +76,24 @@ def save(connection: Any, p: str, record: FitRecord, text: str, save: bool,
     if stored.kind == "curves":
         # An edited material is found by its name: another one given this name
         # since the save chose its material (a rename at the same moment) wins.
+        # A look-alike of another's name is refused when the name is new to
+        # this material (two look-alikes saved before keys existed both stay saveable).
         holder = _other_holder(connection, p, stored.name, stored.material_id)
-        if holder is not None:
-            row = material_row(connection, p, stored.material_id)
+        version, latest = (row.version, row.latest_fit_id) if row else (0, None)
+        if holder is not None and holder[2] != summary_text(stored.name):
+            if row is None or row.name != summary_text(stored.name):
+                raise NameTaken(_looks_like(stored.name, holder), version=version, latest_fit_id=latest)
+        elif holder is not None:
             raise NameTaken(f"`name` {stored.name!r} was just given to another saved material {holder[0]}: "
                             "save again (the save then goes to that material), or choose another name",
-                            version=row.version if row else 0, latest_fit_id=row.latest_fit_id if row else None)
+                            version=version, latest_fit_id=latest)
     now = time.time()
     (seq,) = connection.execute(
         f"INSERT INTO saves (material_id, fit_id, saved_at) VALUES ({p}, {p}, {p}) RETURNING seq",
         (stored.material_id, stored.id, now)).fetchone()
     connection.execute(UPSERT_MATERIAL.format(p=p), (
         stored.material_id, seq, now, stored.id, stored.kind, summary_text(stored.name),
-        summary_text(stored.source), stored.coverage))
+        summary_text(stored.source), stored.coverage, name_key(stored.name)))
     return stored
 
 
@@ -264,10 +270,24 @@ def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
 
 
 def _other_holder(connection: Any, p: str, name: str, material_id: str):
-    """(id, deleted_at) of an edited material other than ``material_id`` called ``name`` (in the bin or not), or None."""
+    """
+    (id, deleted_at, name) of an edited material other than ``material_id``
+    (in the bin or not) whose name is ``name`` or looks the same
+    (:func:`service.store.names.name_key`), the one called ``name`` first; or None.
+    """
     return connection.execute(
-        f"SELECT material_id, deleted_at FROM materials WHERE kind = 'curves' AND name = {p} "
-        f"AND material_id != {p}", (summary_text(name), material_id)).fetchone()
+        f"SELECT material_id, deleted_at, name FROM materials WHERE kind = 'curves' "
+        f"AND (name = {p} OR name_key = {p}) AND material_id != {p} "
+        f"ORDER BY (name = {p}) DESC, first_seq LIMIT 1",
+        (summary_text(name), name_key(name), material_id, summary_text(name))).fetchone()
+
+
+def _looks_like(name: str, holder: tuple) -> str:
+    """The message of a name that looks the same as another material's (``holder``: :func:`_other_holder`'s)."""
+    where = " (in the bin)" if holder[1] is not None else ""
+    return (f"`name` {name!r} looks the same as {holder[2]!r}, the name of saved material {holder[0]}{where} "
+            "(the same letters up to case, width and look-alike characters: the same Unicode TR39 skeleton); "
+            f"save to that material under {holder[2]!r}, or choose another name")
 
 
 def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
@@ -275,12 +295,15 @@ def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
     row = _saved(connection, p, material_id)
     if row.kind == "curves":  # an edited material is found by its name: names are unique
         holder = _other_holder(connection, p, name, material_id)
+        if holder is not None and holder[2] != summary_text(name):
+            raise NameTaken(_looks_like(name, holder), version=row.version, latest_fit_id=row.latest_fit_id)
         if holder is not None:
             where = " (in the bin)" if holder[1] is not None else ""
             raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
                             "choose another name, or rename that one first", version=row.version,
                             latest_fit_id=row.latest_fit_id)
-    connection.execute(f"UPDATE materials SET name = {p} WHERE material_id = {p}", (summary_text(name), material_id))
+    connection.execute(f"UPDATE materials SET name = {p}, name_key = {p} WHERE material_id = {p}",
+                       (summary_text(name), name_key(name), material_id))
     return material_row(connection, p, material_id)
 
 
@@ -315,23 +338,55 @@ def version_text(connection: Any, p: str, material_id: str, version: int) -> tup
         f"WHERE t.v = {p}", (material_id, version)).fetchone()
 
 
+_KEPT_BASES = (
+    "WITH RECURSIVE kept(id) AS (SELECT f.base_fit_id FROM fits f JOIN saves s ON s.fit_id = f.id "
+    "WHERE f.base_fit_id IS NOT NULL UNION SELECT f.base_fit_id FROM fits f JOIN kept ON f.id = kept.id "
+    "WHERE f.base_fit_id IS NOT NULL)")
+"""The fits a saved fit starts from, and those these start from, to any depth: never swept."""
+
+
+def keep_draft(connection: Any, p: str, fit_id: str, until: float) -> float | None:
+    """
+    Inside a write transaction: keep the draft ``fit_id`` at least until
+    ``until`` (a link to it was made) and return when it expires; None for
+    a saved fit or a saved fit's base (never swept); ``LookupError`` when
+    there is no such fit.
+    """
+    found = connection.execute(
+        f"{_KEPT_BASES} SELECT EXISTS (SELECT 1 FROM saves WHERE saves.fit_id = fits.id) "
+        f"OR id IN (SELECT id FROM kept), coalesce(kept_until, 0) FROM fits WHERE id = {p}", (fit_id,)).fetchone()
+    if found is None:
+        raise LookupError(f"fit {fit_id!r} not found (a draft is kept only for its time to live)")
+    if found[0]:
+        return None
+    until = max(until, float(found[1]))
+    connection.execute(f"UPDATE fits SET kept_until = {p} WHERE id = {p}", (until, fit_id))
+    return until
+
+
 def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) -> int:
     """
     Inside one write transaction that holds the saves' lock: remove the
-    drafts (records no save refers to) created before ``older_than``, then
-    the oldest drafts until those left hold at most ``max_bytes`` (a draft's
-    n, k record counted once, with the newest draft that refers to it),
-    then the n, k records no fit refers to; return how many drafts were
-    removed.
+    drafts (records no save refers to, nor a saved fit as its base, nor a
+    draft so kept as its base: :data:`_KEPT_BASES`) created before
+    ``older_than`` and not kept by a link (:func:`keep_draft`) till now or
+    later, then the oldest drafts until those left hold at most
+    ``max_bytes`` (those a link keeps last; a draft's n, k record counted
+    once, with the newest draft that refers to it), then the n, k records
+    no fit refers to; return how many drafts were removed.
     """
+    now = time.time()
     rows = connection.execute(
-        "SELECT id, created_at, length(record), nk_id FROM fits WHERE NOT EXISTS "
-        "(SELECT 1 FROM saves WHERE saves.fit_id = fits.id) ORDER BY created_at DESC").fetchall()
+        f"{_KEPT_BASES} SELECT id, created_at, length(record), nk_id, coalesce(kept_until, 0) FROM fits "
+        "WHERE NOT EXISTS (SELECT 1 FROM saves WHERE saves.fit_id = fits.id) AND id NOT IN (SELECT id FROM kept) "
+        "ORDER BY created_at DESC").fetchall()
+    # Drafts a link keeps come first: past the quota, the others go before them.
+    rows.sort(key=lambda row: row[4] < now)
     nk_sizes = dict(connection.execute("SELECT id, length(record) FROM nk_records").fetchall())
     kept, doomed, counted = 0, [], set()
-    for fit_id, created_at, size, nk_id in rows:  # newest first: the oldest go past the quota
+    for fit_id, created_at, size, nk_id, until in rows:  # newest first: the oldest go past the quota
         size += nk_sizes.get(nk_id, 0) if nk_id not in counted else 0
-        if created_at < older_than or kept + size > max_bytes:
+        if (created_at < older_than and until < now) or kept + size > max_bytes:
             doomed.append((fit_id,))
         else:
             kept += size

@@ -315,11 +315,21 @@ class Store(Protocol):
 
     def expire_drafts(self, older_than: float, max_bytes: int) -> int:
         """
-        Remove drafts (fits never saved) created before ``older_than`` (a
-        ``time.time()``), then the oldest drafts until all left hold at most
-        ``max_bytes`` of records (each n, k record counted once, with the
-        newest draft that refers to it), then the n, k records no fit
-        refers to any more; return how many drafts were removed.
+        Remove drafts (fits never saved, nor a saved fit's base, nor the
+        base of such a base) created before ``older_than`` (a
+        ``time.time()``) unless a link keeps them till now or later
+        (:meth:`keep_draft`), then the oldest drafts until all left hold at
+        most ``max_bytes`` of records (those a link keeps last; each n, k
+        record counted once, with the newest draft that refers to it), then
+        the n, k records no fit refers to any more; return how many drafts
+        were removed.
+        """
+
+    def keep_draft(self, fit_id: str, until: float) -> float | None:
+        """
+        Keep the draft ``fit_id`` at least until ``until`` (a link to it
+        was made); return when it expires, None when it never does (a saved
+        fit, or a saved fit's base); ``LookupError`` when it is not stored.
         """
 
     def check(self) -> None:

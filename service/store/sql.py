@@ -68,6 +68,9 @@ class SQLStore:
         # Under the saves' lock: no save is half done while the sweep runs.
         return self._write(lambda c: queries.expire_drafts(c, self.placeholder, older_than, max_bytes))
 
+    def keep_draft(self, fit_id: str, until: float) -> float | None:
+        return self._write(lambda c: queries.keep_draft(c, self.placeholder, fit_id, until))
+
     def get_fit(self, fit_id: str) -> FitRecord | None:
         text = self._read(lambda c: queries.get_text(c, self.placeholder, fit_id))
         return None if text is None else self._decode(fit_id, text)

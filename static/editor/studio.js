@@ -39,11 +39,12 @@ export function linkOf(search) {
 
 /**
  * What a link to an unsaved edit must say: it opens a draft, which the
- * service keeps `ttlSeconds` from its refit (then it is gone), and when.
+ * service keeps `ttlSeconds` from when the link was made (`expiresAt`, the
+ * link's answer; then it is gone unless saved), and when.
  */
-export function draftExpiry(fit, ttlSeconds) {
-  if (!ttlSeconds || !fit || !fit.created_at) return " It opens an unsaved edit: save it to keep the link working.";
-  const until = new Date((fit.created_at + ttlSeconds) * 1000);
+export function draftExpiry(expiresAt, ttlSeconds) {
+  if (!ttlSeconds || !expiresAt) return " It opens an unsaved edit: save it to keep the link working.";
+  const until = new Date(expiresAt * 1000);
   const when = until.toLocaleString("en-GB", { dateStyle: "medium", timeStyle: "short" });
   const hours = Math.round(ttlSeconds / 3600);
   return ` It opens an unsaved edit, kept ${hours} h: it expires ${when}. Save to keep it.`;
@@ -222,7 +223,8 @@ export class Studio {
     const state = this.state;
     const isDraft = state.fit && state.fit.id === fitId && unsaved(state);
     if (isDraft && this.draftTtl === undefined) this.draftTtl = (await api.domain()).draft_ttl_s;
-    const draft = isDraft ? draftExpiry(state.fit, this.draftTtl) : "";
+    // The service keeps the draft from now on for its time to live, and says until when.
+    const draft = isDraft ? draftExpiry((await api.linkFit(fitId)).expires_at, this.draftTtl) : "";
     copied.then((ok) => this.#said((ok ? `Link copied: ${link}` : `Link (select and copy it): ${link}`) + draft));
   }
 

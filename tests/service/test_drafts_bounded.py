@@ -176,3 +176,38 @@ def test_drafts_expire_and_count_against_their_quota(tmp_path):
         kept = [http.get(f"{API}/fits/{i}").status_code == 200 for i in ids]
         assert kept[-1] and not kept[0], kept  # the oldest went first
         assert stored_bytes(tmp_path / "quota") - 0 < 200_000
+
+
+def test_a_draft_a_saved_material_or_a_link_refers_to_outlives_its_time_to_live(tmp_path):
+    data = tmp_path / "data"
+    # Made under the default time to live (a save is a full refit: tens of seconds on a busy machine) ...
+    with server_process(data) as server, loopback.Client(base_url=server.url, timeout=120) as http:
+        base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
+        on_draft, loose, linked = (
+            http.post(f"{API}/fits/from-curves", json=step(base, None, value, live=False)).json()["id"]
+            for value in (0.50, 0.55, 0.60))
+        saved = http.post(f"{API}/fits/from-curves", json={**step(on_draft, None, 0.45, live=False),
+                                                          "draft": False, "name": "saved on a draft"})
+        assert saved.status_code == 201, saved.text[:300]
+        saved_id = saved.json()["id"]
+        time.sleep(1.0)
+        link = http.post(f"{API}/fits/{linked}/link")
+        assert link.status_code == 200, link.text
+        created = http.get(f"{API}/fits/{linked}").json()["created_at"]
+        assert link.json()["draft"] and link.json()["expires_at"] >= created + 86_400 + 1.0  # from the link
+        assert http.post(f"{API}/fits/{saved_id}/link").json() == {
+            "fit_id": saved_id, "url": f"/?fit={saved_id}", "draft": False, "expires_at": None}
+        assert http.post(f"{API}/fits/{'0' * 32}/link").status_code == 404
+    # ... then served with drafts kept 1 s: what nothing refers to goes, the rest stays.
+    with server_process(data, COATED_DRAFT_TTL_S="1", COATED_DRAFT_SWEEP_S="0.5") as server, \
+            loopback.Client(base_url=server.url, timeout=120) as http:
+        deadline = time.monotonic() + 30
+        while http.get(f"{API}/fits/{loose}").status_code == 200 and time.monotonic() < deadline:
+            time.sleep(0.25)
+        assert http.get(f"{API}/fits/{loose}").status_code == 404
+        assert http.get(f"{API}/fits/{linked}").status_code == 200  # the link keeps it its day
+        # The saved material reopens on its draft base and saves again.
+        edit = http.get(f"{API}/fits/{saved_id}/edit").json()
+        assert edit["base"] == {"fit": on_draft} and http.get(f"{API}/fits/{on_draft}").status_code == 200
+        again = http.post(f"{API}/fits/from-curves", json={**edit["request"], "expected_version": edit["version"]})
+        assert again.status_code == 200 and again.json()["id"] == saved_id, again.text[:300]

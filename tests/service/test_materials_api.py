@@ -241,12 +241,41 @@ def test_names_are_one_spelling_visible_and_not_a_built_in_material_s(http):
         assert save(http, name, 0.8).status_code == 422
 
 
+def test_look_alike_names_are_one_name_and_every_catalogue_name_is_reserved(http):
+    first = save(http, "Rose brass", 0.88)
+    assert first.status_code == 201, first.text
+    material_id = first.json()["material_id"]
+    # A Cyrillic letter, another case, full width, a zero-width space, "rn" for "m": 409 naming the material.
+    for name in ("R\u043ese brass", "rose brass", "\uff32ose brass", "Rose\u200b brass", "Rose brass rn"):
+        if name.endswith("rn"):
+            assert save(http, "Rose brass m", 0.87).status_code == 201
+        answer = save(http, name, 0.86)
+        assert answer.status_code == 409, answer.text
+        detail = answer.json()["detail"]
+        assert "looks the same as" in detail and "the name of saved material" in detail, detail
+    # Every catalogue entry's names, symbol and id are reserved (not only the library's), through look-alikes.
+    entry = next(e for e in catalogue().values() if not e["library"] and e["aliases"])
+    for name in (entry["name"], entry["aliases"][0].upper(), entry["symbol"], entry["id"], "G\u043eld", "\uff21\uff55"):
+        answer = save(http, name, 0.85)
+        assert answer.status_code == 422 and "reserved" in answer.json()["detail"], answer.text
+        renamed = http.patch(f"{API}/materials/{material_id}", json={"name": name}, headers=AUTH)
+        assert renamed.status_code == 422 and "which names a material of the catalogue" in renamed.json()["detail"]
+    assert http.get(f"{API}/materials/{material_id}").json()["name"] == "Rose brass"
+
+
 def test_packs_need_the_token(http, brass):
     body = {"fit_ids": [brass[0]["id"]], "format": "json"}
     refused = http.post(f"{API}/packs", json=body)
     assert refused.status_code == 401 and "Bearer" in refused.json()["detail"]
     assert http.post(f"{API}/packs", json=body, headers={**AUTH, "Origin": "http://evil.example"}).status_code == 403
     assert http.post(f"{API}/packs", json=body, headers=AUTH).status_code == 200
+
+
+def test_a_link_needs_the_token_and_a_saved_fit_s_never_expires(http, brass):
+    fit_id = brass[0]["id"]
+    assert http.post(f"{API}/fits/{fit_id}/link").status_code == 401
+    link = http.post(f"{API}/fits/{fit_id}/link", headers=AUTH)
+    assert link.status_code == 200 and link.json()["expires_at"] is None and not link.json()["draft"]
 
 
 def test_uploads_are_kept_apart_from_saved_materials(http, brass):

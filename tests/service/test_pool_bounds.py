@@ -12,6 +12,7 @@ import time
 import numpy as np
 import pytest
 
+from service.runtime.budget import BUDGET_FACTOR, JobBudgetExceeded
 from service.runtime.pool import FitRunner, FitTimeout, JobCPULimit, Quarantined, WorkerLost
 
 pytestmark = pytest.mark.slow
@@ -65,6 +66,32 @@ def test_a_part_past_its_cpu_limit_is_stopped_with_a_clear_error():
         return await runner.run(time.time)  # the worker serves the next job
 
     assert asyncio.run(_with_runner(body, timeout_s=60.0, cpu_limit_s=0.05)) > 0
+
+
+def burn(cpu_s: float) -> float:
+    """A part that uses ``cpu_s`` seconds of CPU."""
+    start = time.process_time()
+    while time.process_time() - start < cpu_s:
+        pass
+    return cpu_s
+
+
+def test_a_job_of_parts_has_a_cpu_budget_proportional_to_its_estimate():
+    """Parts within the part limit each, but past their job's budget together: the job is stopped, naming it."""
+    async def body(runner):
+        async with runner.slot(0.1):  # budget: max(0.5, 3 x 0.1) = 0.5 s; three parts of 0.2 s
+            first = [await runner.submit(burn, 0.2, cost_s=0.03) for _ in range(2)]
+            with pytest.raises(JobBudgetExceeded, match=r"CPU budget of 0\.5 s \(3 x its estimated 0\.1 s"):
+                await runner.submit(burn, 0.2, cost_s=0.03)
+            with pytest.raises(JobBudgetExceeded):  # spent: the next part does not start
+                await runner.submit(burn, 0.01, cost_s=0.03)
+        async with runner.slot(1.0):  # a larger estimate, a larger budget: 3 s
+            larger = [await runner.submit(burn, 0.2, cost_s=0.03) for _ in range(3)]
+        return first, larger, await runner.run(burn, 0.2)  # one part alone: the part limit
+
+    assert BUDGET_FACTOR == 3.0
+    first, larger, alone = asyncio.run(_with_runner(body, timeout_s=60.0, cpu_limit_s=0.5))
+    assert first == [0.2, 0.2] and larger == [0.2] * 3 and alone == 0.2
 
 
 def checked_input_for_two_seconds() -> str:

@@ -36,6 +36,22 @@ class TestShares:
         shares.admit(c, 1)
         assert shares.bulk_in_flight() == 3
 
+    def test_a_client_s_bulk_jobs_are_admitted_by_their_estimated_cost(self):
+        shares = Shares(max_in_flight=10, reserved=2, per_client=4, client_cost_s=240.0)
+        a, b = Claim("10.0.0.1", "scene"), Claim("10.0.0.2", "read")
+        shares.admit(a, 1, 2048 * 0.03)  # a 64 x 32 scene: 61 s, not one job
+        shares.admit(a, 1, 2048 * 0.03)
+        shares.admit(a, 1, 2048 * 0.03)
+        with pytest.raises(ShareExceeded, match=r"estimated at 184\.3 s of fitting; with this scene job's 61\.4 s "
+                                                r"they would pass its share, 240 s"):
+            shares.admit(a, 1, 2048 * 0.03)
+        shares.admit(a, 1, 1.0)  # a small read still fits
+        shares.admit(b, 1, 500.0)  # another client's first job is admitted by cost whatever it is
+        shares.leave(a, 2048 * 0.03)
+        shares.leave(a, 1.0)
+        shares.admit(a, 1, 2048 * 0.03)  # the cost given back
+        assert shares.bulk_in_flight() == 4
+
     def test_charged_time_orders_bulk_clients_and_decays(self, monkeypatch):
         import service.runtime.shares as module
 

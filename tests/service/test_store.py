@@ -185,6 +185,41 @@ class TestStoreContract:
         with pytest.raises(TypeError, match="needs the fit's `nk_id`"):
             store.put_fit(record("b" * 32), nk=nk)
 
+    def test_a_draft_a_saved_fit_starts_from_is_kept_with_its_own_base(self, store):
+        # Draft 1 starts from draft 0; the saved fit "s" starts from draft 1; draft 2 is alone.
+        drafts = [store.put_fit(record(f"{i:032x}", kind="curves", created_at=float(i),
+                                       base_fit_id=f"{i - 1:032x}" if i == 1 else None), save=False)
+                  for i in range(3)]
+        saved = store.put_fit(record("5" * 32, kind="curves", name="kept", base_fit_id=drafts[1].id))
+        assert store.expire_drafts(older_than=10.0**12, max_bytes=0) == 1  # only the one nothing refers to
+        assert [store.get_fit(d.id) for d in drafts] == [drafts[0], drafts[1], None]
+        assert store.get_fit(saved.id) == saved
+        # A draft on a kept draft is a draft like any other.
+        store.put_fit(record("6" * 32, kind="curves", base_fit_id=drafts[1].id), save=False)
+        assert store.expire_drafts(older_than=10.0**12, max_bytes=0) == 1 and store.get_fit("6" * 32) is None
+
+    def test_a_draft_a_link_keeps_outlives_its_time_to_live_but_not_the_quota(self, store):
+        import time
+
+        linked, other = (store.put_fit(record(f"{i:032x}", kind="curves", created_at=1.0), save=False)
+                         for i in (1, 2))
+        until = time.time() + 3600
+        assert store.keep_draft(linked.id, until) == until
+        assert store.keep_draft(linked.id, until - 10) == until  # never shortened
+        assert store.expire_drafts(older_than=10.0, max_bytes=10**9) == 1
+        assert store.get_fit(linked.id) == linked and store.get_fit(other.id) is None
+        saved = store.put_fit(record("5" * 32, kind="curves", name="s", base_fit_id=linked.id))
+        assert store.keep_draft(saved.id, until) is None and store.keep_draft(linked.id, until) is None
+        with pytest.raises(LookupError, match="not found"):
+            store.keep_draft("7" * 32, until)
+        # Past the quota, drafts no link keeps go first, then the linked ones.
+        loose = store.put_fit(record("8" * 32, kind="curves", created_at=time.time()), save=False)
+        kept = store.put_fit(record("9" * 32, kind="curves", created_at=1.0), save=False)
+        store.keep_draft(kept.id, until)
+        assert store.expire_drafts(older_than=0.0, max_bytes=len(kept.to_json())) == 1
+        assert store.get_fit(kept.id) == kept and store.get_fit(loose.id) is None
+        assert store.expire_drafts(older_than=0.0, max_bytes=0) == 1 and store.get_fit(kept.id) is None
+
     def test_an_nk_record_already_stored_is_not_written_again(self, store):
         # Content-addressed: a live step on a stored inline n, k makes no JSON of it (0.6 MB at
         # 20,000 samples), and what was stored first stays.
@@ -249,6 +284,24 @@ class TestMaterialsManaged:
         assert store.get_fit("1" * 32).name == "A"
         store.put_fit(record("4" * 32, material_id=a, kind="curves", name="A2"))
         assert (store.material(a).name, store.material(a).version) == ("A2", 2)
+
+    def test_a_look_alike_name_is_refused_naming_the_material(self, store):
+        a, b, c = "a" * 32, "b" * 32, "c" * 32
+        store.put_fit(record("1" * 32, material_id=a, kind="curves", name="Brass mix"))
+        store.put_fit(record("2" * 32, material_id=b, kind="curves", name="warm"))
+        # Case, a Cyrillic letter, full-width forms, a zero-width space, "rn" for "m": one skeleton.
+        for name in ("brass mix", "Br\u0430ss mix", "\uff22rass mix", "Bra\u200bss mix", "Brass  mix", "Brass rnix"):
+            with pytest.raises(NameTaken, match=f"looks the same as 'Brass mix', the name of saved material {a}"):
+                store.put_fit(record("3" * 32, material_id=c, kind="curves", name=name))
+            with pytest.raises(NameTaken, match=f"looks the same as 'Brass mix', the name of saved material {a}"):
+                store.rename_material(b, name)
+        assert store.material(c) is None and store.material(b).name == "warm"
+        # Its own material may take a look-alike spelling; another name is free.
+        assert store.rename_material(a, "brass mix").name == "brass mix"
+        store.put_fit(record("4" * 32, material_id=c, kind="curves", name="Brass mix 2"))
+        store.delete_material(a)  # the bin keeps the name
+        with pytest.raises(NameTaken, match="in the bin"):
+            store.rename_material(b, "BRASS MIX")
 
     def test_delete_is_a_bin_and_nothing_is_lost(self, store):
         a, b = "a" * 32, "b" * 32
@@ -340,6 +393,32 @@ class TestSQLiteStore:
         try:
             assert store.latest_fit("a" * 32).name == "new"
             assert [m.name for m in store.saved_materials()] == ["new"]
+        finally:
+            store.close()
+
+    def test_a_version_5_store_gets_name_keys_and_bases(self, tmp_path):
+        path = tmp_path / "v5.sqlite3"
+        store = SQLiteStore(path)
+        store.put_fit(record("1" * 32, material_id="a" * 32, kind="curves", name="Brass mix"))
+        store.put_fit(record("2" * 32, material_id="b" * 32, kind="curves", name="warm"))
+        store.put_fit(record("9" * 32, kind="curves", created_at=1.0), save=False)
+        store.put_fit(record("8" * 32, material_id="e" * 32, kind="curves", name="on a draft", base_fit_id="9" * 32))
+        store.close()
+        old = sqlite3.connect(path)  # back to version 5: no keys, and two look-alike names
+        old.executescript("DROP INDEX materials_by_name_key; ALTER TABLE materials DROP COLUMN name_key; "
+                          "DROP INDEX fits_by_base; ALTER TABLE fits DROP COLUMN base_fit_id; ALTER TABLE fits DROP COLUMN kept_until; "
+                          "DELETE FROM schema_migrations WHERE version >= 6; "
+                          "UPDATE materials SET name = 'brass mix' WHERE material_id = 'bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb'")
+        old.close()
+        store = SQLiteStore(path)
+        try:
+            assert store.migrated == (5, SCHEMA_VERSION)
+            assert store.expire_drafts(older_than=10.0**12, max_bytes=0) == 0 and store.get_fit("9" * 32)
+            store.put_fit(record("3" * 32, material_id="a" * 32, kind="curves", name="Brass mix"))
+            store.put_fit(record("4" * 32, material_id="b" * 32, kind="curves", name="brass mix"))
+            assert [store.material(m).version for m in ("a" * 32, "b" * 32)] == [2, 2]
+            with pytest.raises(NameTaken, match="looks the same as"):
+                store.put_fit(record("5" * 32, material_id="c" * 32, kind="curves", name="BRASS MIX"))
         finally:
             store.close()
 

@@ -280,9 +280,11 @@ def test_token_is_asked_for_kept_and_sent(page, tmp_path):
         wait_fit(page, base_id)
         assert writes[-1].url.split("?")[0].endswith("/fits/from-curves")
         assert writes[-1].headers.get("authorization") == f"Bearer {token}"
-        # A link to the unsaved edit says that it expires, and when (the service keeps drafts 24 h).
+        # A link to the unsaved edit keeps its draft 24 h from now (the service's answer says until
+        # when) and the message says that it expires, and when.
         page.click("#copy-link")
         expect(page.locator("#manage-message")).to_contain_text("It opens an unsaved edit, kept 24 h: it expires")
+        assert writes[-1].url.endswith("/link") and writes[-1].headers.get("authorization") == f"Bearer {token}"
         page.fill("#name", "Token browser test")
         page.click("#save")
         expect(message).to_contain_text("Saved “Token browser test”")

@@ -7,10 +7,14 @@ Versions and edits
 -   ``GET /api/v1/materials/{material_id}/versions/{version}``: the fit of one save.
 -   ``GET /api/v1/fits/{fit_id}/edit``: what reopens a fit in the editor
     (its base and edited curves; :func:`service.jobs.materials.fit_edit`).
+-   ``POST /api/v1/fits/{fit_id}/link``: the editor's link to a fit; a
+    draft is then kept ``COATED_DRAFT_TTL_S`` from now, and the answer
+    says until when.
 """
 
 from __future__ import annotations
 
+import time
 from typing import Annotated
 
 from fastapi import APIRouter, Path, Query
@@ -19,8 +23,9 @@ from fastapi.concurrency import run_in_threadpool
 from ...jobs.common import stored_fit, with_measured_nk
 from ...jobs.evaluation import ensure_metrics
 from ...jobs.materials import fit_edit, share_url
-from ...schemas import API_PREFIX, INT64_MAX, FitEdit, FitPublic, VersionList, VersionSummary, fit_public
-from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, MaterialIdPath, RunnerDep, StoreDep
+from ...schemas import API_PREFIX, INT64_MAX, FitEdit, FitLink, FitPublic, VersionList, VersionSummary, fit_public
+from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, MaterialIdPath, RunnerDep,
+                    SettingsDep, StoreDep, WriteAccess)
 
 router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
@@ -82,3 +87,16 @@ def get_fit_edit(fit_id: FitIdPath, store: StoreDep) -> FitEdit:
     and the material's name and version now.
     """
     return FitEdit(**fit_edit(store, stored_fit(store, fit_id)))
+
+
+@router.post("/fits/{fit_id}/link", response_model=FitLink, responses={**ERROR_RESPONSES, **NOT_FOUND},
+             tags=["curves"], dependencies=[WriteAccess])
+def link_fit(fit_id: FitIdPath, store: StoreDep, settings: SettingsDep) -> FitLink:
+    """
+    The editor's link to a stored fit. A draft (an unsaved edit) is kept
+    `draft_ttl_s` (`GET /domain`) from now, whatever its age, and removed
+    then unless saved; `expires_at` says when. Past the drafts' quota the
+    drafts no link keeps go first.
+    """
+    expires_at = store.keep_draft(fit_id, time.time() + settings.draft_ttl_s)
+    return FitLink(fit_id=fit_id, url=f"/?fit={fit_id}", draft=expires_at is not None, expires_at=expires_at)

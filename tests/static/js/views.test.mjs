@@ -48,9 +48,10 @@ test("compareFigures: none until the other curve is in at this eta_i; then mean 
 });
 
 test("draftExpiry: a link to an unsaved edit says it expires and when", () => {
-  const fit = { created_at: Date.UTC(2026, 0, 2, 10, 0) / 1000 };
-  const text = draftExpiry(fit, 86400);
+  const expiresAt = Date.UTC(2026, 0, 3, 10, 0) / 1000;  // the link's answer: a day after it was made
+  const text = draftExpiry(expiresAt, 86400);
   assert.match(text, /unsaved edit, kept 24 h: it expires 3 Jan 2026/);
   assert.match(text, /Save to keep it/);
-  assert.match(draftExpiry(fit, null), /save it to keep the link working/);
+  assert.match(draftExpiry(expiresAt, null), /save it to keep the link working/);
+  assert.match(draftExpiry(null, 86400), /save it to keep the link working/);
 });
