@@ -121,7 +121,6 @@ def test_trickling_bodies_and_churning_idle_sockets_leave_another_address_served
         try:
             for t in threads:
                 t.start()
-            started = time.monotonic()
             time.sleep(3)  # the floods in place: 128 bodies, 600 idle sockets, the first trickles closed
             threads.append(threading.Thread(target=_probe, args=(server.url, stop, probes)))
             threads[-1].start()
