@@ -170,7 +170,7 @@ def pick(scores_by: dict, aim: dict, floor: dict) -> str:
     for refs, margin in ((aim, MAX_MARGIN), (floor, 0.0)):
         fine = [n for n in names if _fine(scores_by, n, refs, margin)]
         if fine:
-            return min(fine, key=total.get)
+            return min(fine, key=lambda n: total[n])
 
     def failed(name):
         return [g for g in floor if not _fine(scores_by, name, {g: floor[g]}, 0.0)]
@@ -260,14 +260,15 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     # SLSQP's rows are the points near the cap: both full grids would leave it no
     # iterations in its work); the cap rounds then score on the full grids.
     coarse = [_Grid(base, curves, blend_width, by, CAP_SAMPLES) for by in AUDIT_GRIDS]
-    cap_points = tuple(np.concatenate([getattr(g, key) for g in coarse]) for key in "TME")
+    cap_points = (np.concatenate([g.T for g in coarse]), np.concatenate([g.M for g in coarse]),
+                  np.concatenate([g.E for g in coarse]))
 
     def score_union(C16) -> GuardScore:
         return min((grid.score(C16) for grid in grids.values()), key=lambda s: -s.max)
 
     CM, CE = check_grid(eta_i_range, *CHECK_SAMPLES)
 
-    def capped(mean_samples, starts, levels) -> bool:
+    def capped(mean_samples: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray], starts, levels) -> bool:
         """Constrained refits (least mean on ``mean_samples``, max capped on both grids) until one is fine."""
         for level, bar in levels:
             for label, C, C16, _ in constrained_refits(
@@ -283,8 +284,8 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     in_range_cap = min(scores_by[by][paper].max for by in grids)
     levels = (("", cap), ("-in-range-bar", in_range_cap))[: 1 + (cap < in_range_cap)]
     if not _fine(scores_by, own, aim) and scores_by["angle"][own].mean < scores_by["angle"][paper].mean:
-        starts = (("", candidates[paper].coefficients), ("-from-own", candidates[own].coefficients))
-        capped(samples, starts, levels)
+        capped(samples, (("", candidates[paper].coefficients), ("-from-own", candidates[own].coefficients)),
+               levels)
     if not any(_fine(scores_by, name, floor) for name in candidates):
         # Nothing holds both auditors (each measure's paper fit loses on the other's):
         # least mean on both measures at once, capped there too when its max is over.
