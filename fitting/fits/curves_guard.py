@@ -294,6 +294,13 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
             add("both-measures", both)
         if "both-measures" not in candidates or not _fine(scores_by, "both-measures", aim):
             capped(both_samples, (("-both-measures", both.coefficients),), levels)
+        # Shipped only where it holds both auditors: a both-measures fit that still
+        # loses on one trades the edit's own look (the curves far from the edit)
+        # for a smaller loss, so the paper method's twin stays the fallback.
+        for name in [n for n in candidates if "both-measures" in n and not _fine(scores_by, n, floor)]:
+            del candidates[name]
+            for by in scores_by:
+                scores_by[by].pop(name, None)
     chosen = pick(scores_by, aim, floor)
     if chosen.startswith(paper) or chosen == "both-measures":
         # The paper method's twin: ahead of the auditors' rounding on both figures, not a tie.
