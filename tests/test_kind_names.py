@@ -13,9 +13,12 @@ browser's kinds come from ``GET /api/v1/domain``, static/kinds.js), and a
 preprocessor switch on a kind (``#if CF_RGB_CONDUCTOR``: a macro named after
 a kind, include guards aside) in the GLSL of ``preview_shaders/glsl/``,
 ``static/`` and the JavaScript that carries GLSL. The three.js package
-(web/three/) still names the two built-in kinds its glTF extension's schema
-lists: :data:`THREE_PACKAGE_USES` counts them, and the test fails when a
-file gains one.
+(web/three/), which fetches nothing, reads its kinds from its
+generated/kinds.js and kinds.d.ts: written from the registry by
+``python -m preview_shaders.three_package`` (:data:`GENERATED_KINDS`, the
+registry's copy; tests/preview_shaders/test_three_package_files.py fails when
+they differ from what the registry gives), every other file of it counts
+zero like the editor's.
 """
 
 from __future__ import annotations
@@ -32,14 +35,8 @@ REGISTRIES = {Path("fitting/models/kinds.py"), Path("fitting/fits/kinds.py")}
 NAMES = frozenset(MODEL_KINDS)
 BUILT_IN = ("coated-conductor", "rgb-conductor")
 """The kinds registered by fitting/models/kinds.py (a toy plugin's kind is not loaded here)."""
-THREE_PACKAGE_USES = {
-    "web/three/src/coated_conductor.js": 5,
-    "web/three/src/escape_table.js": 2,
-    "web/three/src/albedo_table.js": 3,
-    "web/three/src/index.d.ts": 4,
-}
-"""The three.js package's remaining kind names and switches (its kinds are not yet generated from the
-registry by ``python -m preview_shaders.three_package``): a file may lose uses, never gain one."""
+GENERATED_KINDS = frozenset({"web/three/src/generated/kinds.js", "web/three/src/generated/kinds.d.ts"})
+"""The three.js package's copy of the registry, generated from it (the only browser files naming kinds)."""
 
 
 def _names_in(node: ast.AST) -> list[str]:
@@ -125,10 +122,17 @@ def test_no_browser_or_glsl_file_names_a_kind():
     wrong = []
     for path in _browser_files():
         relative = path.relative_to(ROOT)
-        if "node_modules" in relative.parts:
+        if "node_modules" in relative.parts or relative.as_posix() in GENERATED_KINDS:
             continue
-        uses = js_kind_uses(path.read_text(encoding="utf-8"))
-        allowed = THREE_PACKAGE_USES.get(relative.as_posix(), 0)
-        if len(uses) > allowed:
-            wrong += [f"{relative}:{use}" for use in uses] + ([f"{relative}: {allowed} allowed"] if allowed else [])
+        wrong += [f"{relative}:{use}" for use in js_kind_uses(path.read_text(encoding="utf-8"))]
     assert not wrong, "\n".join(wrong)
+
+
+def test_the_package_s_generated_kinds_are_the_registry_s():
+    """The files let through are the generator's output, and they name every registered kind."""
+    from preview_shaders import three_package
+
+    assert {f"web/three/src/generated/{name}" for name in three_package.KIND_FILES} == GENERATED_KINDS
+    generated = (ROOT / "web/three/src/generated/kinds.js").read_text(encoding="utf-8")
+    assert generated == three_package.kinds_module()
+    assert {use.split(": ", 1)[1].strip("\"'`") for use in js_kind_uses(generated)} == set(BUILT_IN)

@@ -1,6 +1,6 @@
 """
-The rgb-conductor's albedo table (``rgb_albedo_table.frag``, drawn by the
-three.js package, web/three/src/albedo_table.js) in moderngl against numpy:
+The rgb-conductor's albedo table (``rgb_albedo_table.frag``) in moderngl
+against numpy:
 row 0 the GGX lobe of the exact per-channel conductor Fresnel
 (``cf_rgb_conductor_albedo``) against :func:`fitting.shading.ibl.directional_albedo`
 of :func:`fitting.models.rgb_conductor.rgb_fresnel_conductor`, its mirror

@@ -19,7 +19,8 @@ LOCK = json.loads((ROOT / "scripts" / "three" / "package-lock.json").read_text()
 @pytest.mark.parametrize("path", [
     "/static/three/index.js", "/static/three/coated_conductor.js", "/static/three/albedo_table.js",
     "/static/three/escape_table.js", "/static/three/gltf_loader.js", "/static/three/gltf_exporter.js",
-    "/static/three/packing.js", "/static/three/generated/glsl.js", "/static/three/generated/lut.js",
+    "/static/three/packing.js", "/static/three/kinds.js", "/static/three/generated/glsl.js",
+    "/static/three/generated/kinds.js", "/static/three/generated/lut.js",
     "/static/glsl.js",
     "/vendor/three/build/three.module.js", "/vendor/three/build/three.core.js",
     "/vendor/three/examples/jsm/loaders/GLTFLoader.js",

@@ -223,9 +223,9 @@ def test_static_folder_fetches_nothing_else(images, site, folder):
     assert all(url.startswith(site + "/") for url in requests if not url.startswith("data:")), requests
     assert all((root / path.lstrip("/")).is_file() for path in paths), paths
     assert not [p for p in paths if p.startswith(("/glsl", "/api"))], paths
-    # The package's own modules were loaded from the folder, the GLSL and LUT among them.
-    assert {"/node_modules/coated-conductor-three/src/generated/lut.js",
-            "/node_modules/coated-conductor-three/src/generated/glsl.js"} <= set(paths)
+    # The package's own modules were loaded from the folder, the GLSL, kinds and LUT among them.
+    assert {f"/node_modules/coated-conductor-three/src/generated/{name}"
+            for name in ("lut.js", "glsl.js", "kinds.js")} <= set(paths)
 
 
 @pytest.mark.parametrize("way", ["importmap", "bundler"])

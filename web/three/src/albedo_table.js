@@ -1,20 +1,23 @@
-// The split-sum albedo table of a coated-conductor material in three.js:
-// the project's own albedo_table.frag (coated-conductor kind: the model's
-// split sum F0 A + B - a G(alpha) from the LUT) or rgb_albedo_table.frag
-// (rgb-conductor kind: the GGX lobe of the exact Fresnel by quadrature),
-// drawn by three into an n x 3 float target: row 0 the metal's lobe, row 2
-// the coat's, at NdotV = (i / (n - 1))^2 (cf_albedo_table_lookup reads it).
-// The same tables, from the same GLSL and LUT, as the editor's preview
-// (static/splitsum.js), so the two agree to float rounding. Both come with
-// the package (generated/, written by tools/generate.py): nothing is fetched.
+// The split-sum albedo table of a coated-metal material in three.js: the
+// project's own albedo_table.frag (the model's split sum from the LUT for a
+// kind with the lookup, generated/kinds.js splitSum), drawn by three into an
+// n x 3 float target: row 0 the metal's lobe, row 2 the coat's, at NdotV =
+// (i / (n - 1))^2 (cf_albedo_table_lookup reads it). For a kind without the
+// lookup, row 0 is drawn over by the kind's modelTable (model_albedo_table.frag
+// with its generated cf_preview_model: the GGX lobe of its Fresnel by
+// quadrature). The same tables, from the same GLSL and LUT, as the editor's
+// preview (static/splitsum.js), so the two agree to float rounding. Both come
+// with the package (generated/, `python -m preview_shaders.three_package`):
+// nothing is fetched.
 
 import * as THREE from "three";
 import { lutTexels } from "./lut.js";
 import { TABLE_SOURCES } from "./generated/glsl.js";
 
-// Quadrature points per node of the rgb-conductor's table: the editor's
-// REFERENCE_SAMPLES (static/splitsum.js), the preview's reference albedo.
-export const RGB_SAMPLES = 2048;
+// Quadrature points per node of the model row of a kind without the
+// split-sum lookup: the editor's REFERENCE_SAMPLES (static/splitsum.js), the
+// preview's reference albedo.
+export const MODEL_SAMPLES = 2048;
 
 const VERTEX = `in vec3 position;
 void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }`;
@@ -36,12 +39,21 @@ export async function lutTexture() {
   return { texture, width: lut.width, alphaRange: lut.alphaRange };
 }
 
-/** The table program of each kind (GLSL ES 3.00 without the #version line, which three writes). */
-export function tableSources() {
-  return {
-    "coated-conductor": TABLE_SOURCES["albedo_table.frag"],
-    "rgb-conductor": TABLE_SOURCES["rgb_albedo_table.frag"],
-  };
+/** The split-sum table program (GLSL ES 3.00 without the #version line, which three writes). */
+export function tableSource() {
+  return TABLE_SOURCES["albedo_table.frag"];
+}
+
+/** A pass of `fragmentShader` over rows [0, rows) of a 3-row target (3: the whole), drawn in `order`. */
+function pass(fragmentShader, uniforms, rows, order) {
+  const material = new THREE.RawShaderMaterial({
+    glslVersion: THREE.GLSL3, vertexShader: VERTEX, fragmentShader, uniforms, depthTest: false, depthWrite: false,
+  });
+  const height = (2 * rows) / 3;
+  const mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, height).translate(0, -1 + height / 2, 0), material);
+  mesh.frustumCulled = false;
+  mesh.renderOrder = order;
+  return mesh;
 }
 
 /**
@@ -50,7 +62,8 @@ export function tableSources() {
  * last time; `texture` is the table.
  */
 export class AlbedoTable {
-  constructor(resources, model, words) {
+  /** `kind`: the model's generated entry (kinds.js); `words`: its coefficients packed. */
+  constructor(resources, kind, model, words) {
     this.model = model;
     this.nodes = 2 * (resources.lut.width - 1) + 1;
     this.target = new THREE.WebGLRenderTarget(this.nodes, 3, {
@@ -65,31 +78,18 @@ export class AlbedoTable {
       u_coat_roughness: { value: 0 },
       cf_lut: { value: resources.lut.texture },
       cf_alpha_range: { value: new THREE.Vector2(...resources.lut.alphaRange) },
+      cf_words: { value: words },
+      cf_eta_i_range: { value: new THREE.Vector2(...model.etaIRange) },
+      // The Lazanyi row is not read here; its inputs stay 0.
+      cf_F0_air: { value: new THREE.Vector3() },
+      cf_F82_air: { value: new THREE.Vector3() },
+      u_samples: { value: MODEL_SAMPLES },
     };
-    if (model.kind === "rgb-conductor") {
-      Object.assign(uniforms, {
-        cf_n: { value: new THREE.Vector3(...model.coefficients.n) },
-        cf_k: { value: new THREE.Vector3(...model.coefficients.k) },
-        u_samples: { value: RGB_SAMPLES },
-      });
-    } else {
-      Object.assign(uniforms, {
-        cf_words: { value: words },
-        cf_eta_i_range: { value: new THREE.Vector2(...model.etaIRange) },
-        // The Lazanyi row is not read here; its inputs stay 0.
-        cf_F0_air: { value: new THREE.Vector3() },
-        cf_F82_air: { value: new THREE.Vector3() },
-      });
-    }
     this.uniforms = uniforms;
-    const material = new THREE.RawShaderMaterial({
-      glslVersion: THREE.GLSL3, vertexShader: VERTEX, fragmentShader: resources.tables[model.kind],
-      uniforms, depthTest: false, depthWrite: false,
-    });
-    this.mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);
-    this.mesh.frustumCulled = false;
     this.scene = new THREE.Scene();
-    this.scene.add(this.mesh);
+    // The split-sum rows (the coat's among them), then the model's own row 0 for a kind without the lookup.
+    this.scene.add(pass(resources.table, uniforms, 3, 0));
+    if (!kind.splitSum) this.scene.add(pass(kind.modelTable, uniforms, 1, 1));
     this.camera = new THREE.OrthographicCamera(-1, 1, 1, -1, 0, 1);
     this.drawnFor = null;
   }
@@ -120,7 +120,9 @@ export class AlbedoTable {
 
   dispose() {
     this.target.dispose();
-    this.mesh.geometry.dispose();
-    this.mesh.material.dispose();
+    for (const mesh of this.scene.children) {
+      mesh.geometry.dispose();
+      mesh.material.dispose();
+    }
   }
 }

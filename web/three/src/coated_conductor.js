@@ -1,9 +1,12 @@
 // EXT_materials_coated_conductor in three.js (docs/gltf/EXT_materials_coated_conductor/):
 // a MeshPhysicalMaterial whose metal Fresnel is this project's model, and
 // the GLTFLoader and GLTFExporter plugins that read and write the
-// extension. ES module, no build step, nothing fetched: the GLSL and the
-// split-sum LUT are in generated/ (tools/generate.py); `three` is the
-// package's peer dependency (an import map or a bundler resolves it).
+// extension. ES module, no build step, nothing fetched: the GLSL, the model
+// kinds and the split-sum LUT are in generated/ (`python -m
+// preview_shaders.three_package`); `three` is the package's peer
+// dependency (an import map or a bundler resolves it). Each kind is drawn
+// by its own generated cf_preview_model (generated/kinds.js, kinds.js):
+// no kind is named here.
 //
 //   loader.register((parser) => new CoatedConductorExtension(parser));
 //   const material = await createCoatedConductorMaterial({ model: extension, roughness: 0.2 });
@@ -34,12 +37,13 @@
 
 import * as THREE from "three";
 import { GLSL } from "./generated/glsl.js";
-import { packedWords } from "./packing.js";
-import { AlbedoTable, lutTexture, tableSources } from "./albedo_table.js";
+import { wordsFor } from "./packing.js";
+import { KINDS, checkKindFields, kindNamed } from "./kinds.js";
+import { AlbedoTable, lutTexture, tableSource } from "./albedo_table.js";
 import { EscapeTable, ROUGH_BLEND, internalReflectance } from "./escape_table.js";
 
 export const EXTENSION_NAME = "EXT_materials_coated_conductor";
-export const KINDS = ["coated-conductor", "rgb-conductor"];
+export { KINDS };
 
 // The model's terms, pasted before three's (patched) pars chunk that calls them.
 const HEAD = `
@@ -50,8 +54,6 @@ uniform float cf_rough_blend;
 uniform float cf_coat_ior;
 uniform uint cf_words[14];
 uniform vec2 cf_eta_i_range;
-uniform vec3 cf_n;
-uniform vec3 cf_k;
 
 // The cosine the metal is seen at: inside the coat when there is one
 // (three's USE_CLEARCOAT), else the camera is in the coat's medium.
@@ -91,12 +93,7 @@ vec3 cf_mirror_through_coat(vec3 F, float NdotV)
 // The metal's Fresnel under the coat at cosine c in air, ACEScg.
 vec3 cf_metal_model(float c)
 {
-    float mu = cf_metal_cos(c);
-#if CF_RGB_CONDUCTOR
-    return cf_rgb_conductor(mu, cf_coat_ior, cf_n, cf_k);
-#else
-    return cf_coated_conductor_packed(mu, cf_coat_ior, cf_eta_i_range, cf_words);
-#endif
+    return cf_preview_model(cf_metal_cos(c), cf_coat_ior, cf_eta_i_range, cf_words);
 }
 
 // The coat's weight (three's material.clearcoat), 0 without a coat.
@@ -186,7 +183,7 @@ export function loadResources() {
       for (const [where, pattern, replacement] of PATCHES) {
         if (where === "pars") pars = patch(pars, pattern, replacement);
       }
-      return { glsl: GLSL, pars, tables: tableSources(), lut: await lutTexture() };
+      return { glsl: GLSL, pars, table: tableSource(), lut: await lutTexture() };
     })();
     resources.catch(() => { resources = null; }); // a failure is tried again next time
   }
@@ -197,16 +194,13 @@ const PROPERTIES = new Set([
   "kind", "colorSpace", "etaIRange", "degree", "coefficients", "coatIor", "coatFactor",
   "coatRoughnessFactor", "extensions", "extras",
 ]);
-const FLOAT16_MAX = 65504;
-// A coat index this far outside a coated-conductor's fitted range (float32
-// rounding of the stored range) counts as inside (fitting/exports/gltf_coated.py).
-const RANGE_SLACK = 1e-6;
 
 /**
  * The extension object `model` if it is one this module draws; else an
  * Error naming the field and the rule: the schema's rules
  * (docs/gltf/EXT_materials_coated_conductor/schema/) and the two it cannot
- * state (lo <= hi; a coated-conductor's coatIor inside etaIRange).
+ * state (lo <= hi; the coatIor of a kind polynomial in the coat index
+ * inside etaIRange); the kind's own fields by its generated entry (kinds.js).
  */
 export function checkModel(model) {
   const fail = (what) => { throw new Error(`${EXTENSION_NAME}: ${what}`); };
@@ -227,27 +221,7 @@ export function checkModel(model) {
   for (const p of ["coatFactor", "coatRoughnessFactor"]) {
     if (p in model && !inUnit(model[p])) fail(`\`${p}\` must lie in [0, 1], got ${JSON.stringify(model[p])}`);
   }
-  const C = model.coefficients;
-  if (!C || typeof C !== "object" || Array.isArray(C)) fail("`coefficients` must be an object");
-  const half = (x) => Number.isFinite(x) && Math.abs(x) <= FLOAT16_MAX;
-  const numbers = (row, n) => Array.isArray(row) && row.length === n && row.every(half);
-  if (model.kind === "rgb-conductor") {
-    if (!numbers(C.n, 3) || !numbers(C.k, 3) || !C.n.every((x) => x > 0) || !C.k.every((x) => x >= 0)) {
-      fail("`coefficients` of an rgb-conductor must be n > 0 and k >= 0, three float16 numbers each");
-    }
-  } else {
-    const [lo, hi] = range;
-    if (!(eta >= lo - RANGE_SLACK && eta <= hi + RANGE_SLACK)) {
-      fail(`\`coatIor\` ${eta} lies outside the coated-conductor's etaIRange [${lo}, ${hi}]`);
-    }
-    const d = model.degree;
-    if (![0, 1, 2].includes(d)) fail(`\`degree\` must be 0, 1 or 2, got ${JSON.stringify(d)}`);
-    for (const p of ["F0", "a", "alpha"]) {
-      if (!Array.isArray(C[p]) || C[p].length !== 3 || !C[p].every((row) => numbers(row, d + 1))) {
-        fail(`\`coefficients.${p}\` must be three rows of ${d + 1} float16 numbers`);
-      }
-    }
-  }
+  checkKindFields(kindNamed(model.kind), model, fail);
   return model;
 }
 
@@ -259,10 +233,10 @@ export function checkModel(model) {
  */
 export function coatedConductorHooks(model, resources, fallback = null) {
   checkModel(model);
-  const rgb = model.kind === "rgb-conductor";
-  const words = rgb ? new Uint32Array(14) : packedWords(model.coefficients);
-  const table = new AlbedoTable(resources, model, words);
-  const escape = new EscapeTable(resources.glsl, model, words, table.nodes);
+  const kind = kindNamed(model.kind);
+  const words = wordsFor(kind, model.coefficients);
+  const table = new AlbedoTable(resources, kind, model, words);
+  const escape = new EscapeTable(resources.glsl, kind, model, words, table.nodes);
   const uniforms = {
     cf_albedo: { value: table.texture },
     cf_escape: { value: escape.texture },
@@ -271,15 +245,13 @@ export function coatedConductorHooks(model, resources, fallback = null) {
     cf_coat_ior: { value: model.coatIor },
     cf_words: { value: words },
     cf_eta_i_range: { value: new THREE.Vector2(...(model.etaIRange || [1, 1])) },
-    cf_n: { value: new THREE.Vector3(...(rgb ? model.coefficients.n : [1, 1, 1])) },
-    cf_k: { value: new THREE.Vector3(...(rgb ? model.coefficients.k : [0, 0, 0])) },
   };
   return {
     onBeforeCompile(shader) {
       Object.assign(shader.uniforms, uniforms);
       let fragment = shader.fragmentShader.replace(
         "#include <lights_physical_pars_fragment>",
-        `#define CF_RGB_CONDUCTOR ${rgb ? 1 : 0}\n${resources.glsl}\n${HEAD}\n${resources.pars}`,
+        `${resources.glsl}\n${kind.glsl}\n${HEAD}\n${resources.pars}`,
       );
       for (const [where, pattern, replacement] of PATCHES) {
         if (where === "main") fragment = patch(fragment, pattern, replacement);

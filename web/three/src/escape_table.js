@@ -25,20 +25,15 @@ void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }`;
 const MAIN = `
 uniform uint cf_words[14];
 uniform vec2 cf_eta_i_range;
-uniform vec3 cf_n;
-uniform vec3 cf_k;
 uniform float cf_coat_ior;
 uniform float u_roughness;
 uniform float u_nodes;
 layout(location = 0) out vec4 out_escape;
 
+// The metal's Fresnel: the kind's generated cf_preview_model (generated/kinds.js).
 vec3 cf_escape_metal(float c)
 {
-#if CF_RGB_CONDUCTOR
-    return cf_rgb_conductor(c, cf_coat_ior, cf_n, cf_k);
-#else
-    return cf_coated_conductor_packed(c, cf_coat_ior, cf_eta_i_range, cf_words);
-#endif
+    return cf_preview_model(c, cf_coat_ior, cf_eta_i_range, cf_words);
 }
 
 // The GGX lobe at in-coat cosine mu: its albedo (total) and the part of it
@@ -113,26 +108,24 @@ export function internalReflectance(eta) {
  * the roughness changed since the last time; `texture` is the table.
  */
 export class EscapeTable {
-  constructor(glsl, model, words, nodes) {
+  /** `glsl`: the package's GLSL; `kind`: the model's generated entry (kinds.js); `words`: its coefficients packed. */
+  constructor(glsl, kind, model, words, nodes) {
     this.nodes = nodes;
     this.target = new THREE.WebGLRenderTarget(nodes, 2, {
       type: THREE.FloatType, format: THREE.RGBAFormat, minFilter: THREE.NearestFilter,
       magFilter: THREE.NearestFilter, depthBuffer: false, generateMipmaps: false,
     });
     this.texture = this.target.texture;
-    const rgb = model.kind === "rgb-conductor";
     this.uniforms = {
       cf_words: { value: words },
       cf_eta_i_range: { value: new THREE.Vector2(...model.etaIRange) },
-      cf_n: { value: new THREE.Vector3(...(rgb ? model.coefficients.n : [1, 1, 1])) },
-      cf_k: { value: new THREE.Vector3(...(rgb ? model.coefficients.k : [0, 0, 0])) },
       cf_coat_ior: { value: model.coatIor },
       u_roughness: { value: 0 },
       u_nodes: { value: nodes },
     };
     const material = new THREE.RawShaderMaterial({
       glslVersion: THREE.GLSL3, vertexShader: VERTEX,
-      fragmentShader: `precision highp float;\nprecision highp int;\n#define CF_RGB_CONDUCTOR ${rgb ? 1 : 0}\n${glsl}\n${MAIN}`,
+      fragmentShader: `precision highp float;\nprecision highp int;\n${glsl}\n${kind.glsl}\n${MAIN}`,
       uniforms: this.uniforms, depthTest: false, depthWrite: false,
     });
     this.mesh = new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material);

@@ -3,21 +3,24 @@
 import type { Material, MeshPhysicalMaterial, MeshPhysicalMaterialParameters, WebGLRenderer } from "three";
 import type { GLTF, GLTFLoaderPlugin, GLTFParser } from "three/examples/jsm/loaders/GLTFLoader.js";
 import type { GLTFExporterPlugin, GLTFWriter } from "three/examples/jsm/exporters/GLTFExporter.js";
+import type { KindFields, KindName, PackagedKind } from "./generated/kinds.js";
+
+export type { KindFields, KindName, PackagedKind };
 
 /** "EXT_materials_coated_conductor". */
 export declare const EXTENSION_NAME: "EXT_materials_coated_conductor";
-/** The model kinds the material draws. */
-export declare const KINDS: readonly ["coated-conductor", "rgb-conductor"];
+/** The model kinds the material draws (the project's registry, generated/kinds.js), in its order. */
+export declare const KINDS: readonly KindName[];
+/** Each kind as the package draws it: parameters, maxDegree, sign rules, generated GLSL. */
+export declare const MODEL_KINDS: readonly PackagedKind[];
 
-type Row = readonly number[];
-type Rgb = readonly [number, number, number];
-
-interface ModelCommon {
+/** The fields every extension object has, whatever its kind. */
+export interface ModelCommon {
   /** The space of the model's reflectance: ACEScg. */
   colorSpace: "ACEScg";
   /** [lo, hi], 1 <= lo <= hi <= 3: the coat indices the model was fitted over. */
   etaIRange: readonly [number, number];
-  /** The coat's index of refraction, in [1, 3] (for a coated-conductor inside etaIRange). */
+  /** The coat's index of refraction, in [1, 3] (for a kind polynomial in the coat index, inside etaIRange). */
   coatIor: number;
   /** The coat's weight in [0, 1] (default 1). */
   coatFactor?: number;
@@ -27,21 +30,8 @@ interface ModelCommon {
   extras?: unknown;
 }
 
-/** A coated-conductor model: F0, a, alpha per channel, polynomials of `degree` in the coat index. */
-export interface CoatedConductorModel extends ModelCommon {
-  kind: "coated-conductor";
-  degree: 0 | 1 | 2;
-  coefficients: { F0: readonly [Row, Row, Row]; a: readonly [Row, Row, Row]; alpha: readonly [Row, Row, Row] };
-}
-
-/** An rgb-conductor model: the exact Fresnel of n + i k per channel. */
-export interface RgbConductorModel extends ModelCommon {
-  kind: "rgb-conductor";
-  coefficients: { n: Rgb; k: Rgb };
-}
-
 /** An EXT_materials_coated_conductor extension object. */
-export type ExtensionObject = CoatedConductorModel | RgbConductorModel;
+export type ExtensionObject = ModelCommon & KindFields;
 
 /** What a material drawing the model carries in `userData.coatedConductor`. */
 export interface CoatedConductorData {
@@ -56,11 +46,11 @@ export interface CoatedConductorData {
   dispose(): void;
 }
 
-/** The GLSL, the patched chunk, the table programs and the decoded LUT, made once. */
+/** The GLSL, the patched chunk, the split-sum table program and the decoded LUT, made once. */
 export interface Resources {
   glsl: string;
   pars: string;
-  tables: Record<ExtensionObject["kind"], string>;
+  table: string;
   lut: { texture: import("three").Data3DTexture; width: number; alphaRange: [number, number] };
 }
 

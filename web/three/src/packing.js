@@ -1,8 +1,8 @@
-// The float16 words of a coated-conductor's coefficients, as the shaders
-// unpack them (cf_coated_conductor_packed): the package's own copy of the
-// editor's static/kinds.js halfBits / wordsOf / packedWords (the package
-// imports nothing outside itself); tests/static/js/three_packing.test.mjs
-// checks that the two agree.
+// The float16 words of a model's coefficients, as the shaders unpack them
+// (the kind's cf_preview_model, generated/kinds.js): the package's own copy
+// of the editor's static/kinds.js halfBits / wordsOf / wordsFor (the
+// package imports nothing outside itself); tests/static/js/three_packing.test.mjs
+// checks that the two agree for every kind the server lists.
 
 const f32 = new Float32Array(1);
 const u32 = new Uint32Array(f32.buffer);
@@ -42,15 +42,17 @@ export function wordsOf(halves, count = 14) {
 }
 
 /**
- * The 14 uint32 words of a coated-conductor's coefficients:
- * coefficients[p][c][j] for p in (F0, a, alpha), two halves a word, the
- * earlier in the low 16 bits; powers beyond the degree are 0.
+ * The 14 uint32 words of coefficients of a kind with `parameters` and
+ * `maxDegree` (generated/kinds.js): for each parameter, channel R, G, B,
+ * its value (maxDegree 0) or its maxDegree + 1 powers, those beyond the
+ * model's degree 0; two halves a word, the earlier in the low 16 bits.
  */
-export function packedWords(coefficients) {
+export function wordsFor({ parameters, maxDegree }, coefficients) {
   const halves = [];
-  for (const p of ["F0", "a", "alpha"]) {
+  for (const p of parameters) {
     for (let c = 0; c < 3; c++) {
-      for (let j = 0; j < 3; j++) halves.push(halfBits(coefficients[p][c][j] ?? 0));
+      if (maxDegree === 0) halves.push(halfBits(coefficients[p][c]));
+      else for (let j = 0; j <= maxDegree; j++) halves.push(halfBits(coefficients[p][c][j] ?? 0));
     }
   }
   return wordsOf(halves);
