@@ -86,14 +86,29 @@ def _flood(stop: threading.Event, send, statuses: list[int]) -> None:
             statuses.append(0)
 
 
-def _under(server, fit_id: str, idle: float, floods) -> tuple[list[int], list[float]]:
-    """Writes with the token and the editor's saves while ``floods`` (callables of stop) run."""
+def _until_the_floods_hold(server, jobs, within_s: float = 60.0) -> None:
+    """Wait until the service reports ``jobs(fit_workers)`` fits in flight (``/healthz``): the floods' jobs."""
+    deadline = time.monotonic() + within_s
+    with loopback.Client(base_url=server.url, timeout=30) as http:
+        while True:
+            health = http.get("/healthz").json()
+            if health["fits_in_flight"] >= jobs(health["fit_workers"]):
+                return
+            assert time.monotonic() < deadline, f"the floods held no more than {health['fits_in_flight']} jobs"
+            time.sleep(0.05)
+
+
+def _under(server, fit_id: str, idle: float, floods, jobs) -> tuple[list[int], list[float]]:
+    """
+    Writes with the token and the editor's saves while ``floods`` (callables
+    of stop) run, from when they hold ``jobs(fit_workers)`` fits in flight.
+    """
     stop = threading.Event()
     threads = [threading.Thread(target=flood, args=(stop,), daemon=True) for flood in floods]
     for thread in threads:
         thread.start()
     try:
-        time.sleep(2.0)  # the floods hold what they can get
+        _until_the_floods_hold(server, jobs)
         with loopback.Client(base_url=server.url, timeout=120) as http:
             writes = [http.post(f"{API}/fits", json=nk_body(random.randrange(10**6)), headers=AUTH).status_code
                       for _ in range(10)]
@@ -114,7 +129,8 @@ def test_export_loops_leave_the_writers_their_share(server):
             _flood(stop, lambda: http.get(f"{API}/fits/{fit_id}/pack", params={
                 "format": "mtlx", "eta_i": round(random.uniform(1.0, 3.0), 6)}), statuses)
 
-    writes, saves = _under(server, fit_id, idle, [loop] * 10)
+    # An export is one job on one worker: the loops hold every worker.
+    writes, saves = _under(server, fit_id, idle, [loop] * 10, jobs=lambda workers: workers)
     assert writes.count(201) >= 0.95 * len(writes), writes
     assert statistics.median(saves) <= 3 * idle, (saves, idle)
     assert 200 in statuses and 503 in statuses, sorted(set(statuses))
@@ -132,7 +148,9 @@ def test_maximal_scenes_leave_the_writers_their_share(server):
                 _flood(stop, lambda: http.post(f"{API}/scenes", json=MAX_SCENE), statuses)
         return loop
 
-    writes, saves = _under(server, fit_id, idle, [scene_from(f"127.0.0.{i}") for i in (2, 3, 4)])
+    # A scene is one job whose parts idle workers run side by side: one in flight takes every worker.
+    writes, saves = _under(server, fit_id, idle, [scene_from(f"127.0.0.{i}") for i in (2, 3, 4)],
+                           jobs=lambda workers: 1)
     assert writes.count(201) >= 0.95 * len(writes), writes
     assert statistics.median(saves) <= 3 * idle, (saves, idle)
 

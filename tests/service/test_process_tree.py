@@ -39,6 +39,14 @@ def _alive(pid: int) -> bool:
     return stat.rsplit(")", 1)[1].split()[0] != "Z"
 
 
+def _left_alive(tree: set[int], within_s: float) -> list[int]:
+    """The processes of ``tree`` still running ``within_s`` seconds from now (sooner once none is)."""
+    deadline = time.monotonic() + within_s
+    while (alive := [pid for pid in tree if _alive(pid)]) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return alive
+
+
 def _tree(root: int) -> set[int]:
     """The descendants of ``root`` now (from /proc)."""
     parents: dict[int, list[int]] = {}
@@ -84,8 +92,7 @@ def test_nothing_outlives_a_killed_server(tmp_path):
         assert len(tree) >= 5, tree  # fork server, 2 + 1 workers, render process, resource tracker
         os.kill(server.process.pid, signal.SIGKILL)  # the server alone, as the OOM killer would
         server.process.wait(timeout=30)
-        time.sleep(5.0)
-        assert [pid for pid in tree if _alive(pid)] == []
+        assert _left_alive(tree, within_s=5.0) == []
 
 
 def test_sigterm_drains_for_its_bound_then_cancels_and_exits(tmp_path):
@@ -98,6 +105,5 @@ def test_sigterm_drains_for_its_bound_then_cancels_and_exits(tmp_path):
         log = server.log_text()
         assert took < 3.0 + 10.0, (took, log)
         assert "graceful shutdown exceeded" in log
-        time.sleep(1.0)
-        assert [pid for pid in tree if _alive(pid)] == []
+        assert _left_alive(tree, within_s=1.0) == []
         scene.join(timeout=10)
