@@ -24,7 +24,9 @@ of the means and max of the maxima; ``delta_E_change_max``).
 (``export_speed_numpy_de2000``: the exports against 09bbd13, before the
 CIEDE2000 of their residuals was written out in numpy;
 ``export_speed_jacobians``: against e780278, before the seen fits had exact
-Jacobians and least squares on the Delta E's components, at eta_i 1, 1.5, 2).
+Jacobians and least squares on the Delta E's components, at eta_i 1, 1.5, 2;
+``export_speed_layer_terms``: against 80c7dee, before the layerings kept
+their per-angle terms and glTF's floor bisection its affine terms).
 
 Usage: python benchmarks/export_speed.py [--before REV] [--eta-i 1.0,1.5] [--materials Au,Cu] [--output NAME]
 """

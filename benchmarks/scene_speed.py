@@ -18,7 +18,11 @@ Records benchmarks/results/scene_speed.json (``figures``: the median and
 max CPU ms of each side, their ratio, ``reference_ms``: this checkout's
 median time of the reference alone, and ``delta_E_change_max``).
 
-Usage: python benchmarks/scene_speed.py [--before REV] [--range 1.2:1.8] [--materials Au,Cu]
+``--output NAME`` records benchmarks/results/NAME.json instead
+(``scene_speed_uncertainty_kept``: against 80c7dee, before the data's
+uncertainty was kept across a scene's fits of one range).
+
+Usage: python benchmarks/scene_speed.py [--before REV] [--range 1.2:1.8] [--materials Au,Cu] [--output NAME]
 """
 
 from __future__ import annotations
@@ -68,8 +72,9 @@ def child(root: str, names: list[str], lo: float, hi: float) -> int:
         t = time.process_time()
         reference_ACEScg_grid(material.nk, np.linspace(0.0, 1.0, 100), spec.evaluation_eta_i())
         reference_ms = 1e3 * (time.process_time() - t)
-        degree = result.packed.coefficients.shape[2] - 1
-        return {"ms": ms, "reference_ms": reference_ms, "degree": int(degree),
+        # The chosen candidate: its kind and degree (an rgb-conductor's pack has no power axis).
+        degree = f"{result.choice['model']} {result.choice['degree']}"
+        return {"ms": ms, "reference_ms": reference_ms, "degree": degree,
                 "mean": result.scene.mean, "max": result.scene.max}
 
     return serve(names, answer)
@@ -80,6 +85,8 @@ def main(argv=None) -> int:
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
     parser.add_argument("--range", default="1.2:1.8", help="the scene's eta_i range LO:HI (default 1.2:1.8)")
     parser.add_argument("--materials", default=None, help="library conductors (default all)")
+    parser.add_argument("--output", default="scene_speed",
+                        help="record to write, benchmarks/results/NAME.json (default scene_speed)")
     parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--items", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -118,7 +125,7 @@ def main(argv=None) -> int:
     print(f"\nmedian {figures['before_median_ms']:.0f} ms -> {figures['after_median_ms']:.0f} ms "
           f"({figures['ratio']:.2f}x); max {figures['before_max_ms']:.0f} -> {figures['after_max_ms']:.0f} ms; "
           f"degrees changed {figures['degrees_changed']}; largest Delta E change {figures['delta_E_change_max']:.2e}")
-    print("recorded:", write_result("scene_speed", figures, load_start, materials=items, runs=answers))
+    print("recorded:", write_result(args.output, figures, load_start, materials=items, runs=answers))
     return 0
 
 

@@ -150,15 +150,21 @@ def layer_only(tool: str, mu, eta: float, base, coat: bool = True, clearcoat: fl
         F = fresnel_dielectric(mu, 1.0, eta)[:, None]
         return F + (1.0 - F) * base
     if tool == "gltf":
-        # three's layering is affine in the base: a + b base.
-        a = three_clearcoat(mu, np.zeros(3), clearcoat)
-        b = three_clearcoat(mu, np.ones(3), clearcoat) - a
-        zero = three_clearcoat(mu, np.zeros(3), coat=False)
-        one = three_clearcoat(mu, np.ones(3), coat=False)
-        # Express through the base's own response r = zero + (one - zero) F0.
-        coat_a = a - b * zero / np.maximum(one - zero, 1e-12)
-        return coat_a + b / np.maximum(one - zero, 1e-12) * base
+        coat_a, scale = _gltf_layer_terms(mu, clearcoat)
+        return coat_a + scale * base
     raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")
+
+
+def _gltf_layer_terms(mu, clearcoat: float) -> tuple[np.ndarray, np.ndarray]:
+    """three's coat over a base response r as ``c + s r`` (S, 3): (c, s)."""
+    # three's layering is affine in the base: a + b base.
+    a = three_clearcoat(mu, np.zeros(3), clearcoat)
+    b = three_clearcoat(mu, np.ones(3), clearcoat) - a
+    zero = three_clearcoat(mu, np.zeros(3), coat=False)
+    one = three_clearcoat(mu, np.ones(3), coat=False)
+    # Express through the base's own response r = zero + (one - zero) F0.
+    coat_a = a - b * zero / np.maximum(one - zero, 1e-12)
+    return coat_a, b / np.maximum(one - zero, 1e-12)
 
 
 def floor_base(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
@@ -170,9 +176,12 @@ def floor_base(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     """
     target = ACEScg_to_working(target_ACEScg, space)
     lo, hi = np.zeros_like(target), np.ones_like(target)
+    # glTF's layering is affine in the base: its two terms once, not four layerings per halving.
+    affine = _gltf_layer_terms(mu, clearcoat) if tool == "gltf" and coat else None
     for _ in range(50):
         mid = 0.5 * (lo + hi)
-        above = layer_only(tool, mu, eta, mid, coat, clearcoat) > target
+        layered = layer_only(tool, mu, eta, mid, coat, clearcoat) if affine is None else affine[0] + affine[1] * mid
+        above = layered > target
         hi, lo = np.where(above, mid, hi), np.where(above, lo, mid)
     return 0.5 * (lo + hi)
 

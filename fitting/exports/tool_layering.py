@@ -112,13 +112,46 @@ def _mu(cos_theta) -> np.ndarray:
     return np.clip(np.asarray(cos_theta, dtype=np.float64), 0.0, 1.0)
 
 
+def _per_angles(fn):
+    """
+    ``fn``'s arrays kept (read-only) for the values of its arguments (an
+    array by its bytes): the terms that depend on the view cosines and the
+    coat alone, the same on every evaluation of a fit. The last 64 kept.
+    """
+    cache: dict = {}
+
+    @functools.wraps(fn)
+    def kept(*args):
+        key = tuple((a.shape, a.tobytes()) if isinstance(a, np.ndarray) else a for a in args)
+        hit = cache.get(key)
+        if hit is None:
+            hit = fn(*args)
+            for array in hit:
+                array.setflags(write=False)
+            if len(cache) >= 64:
+                cache.pop(next(iter(cache)))
+            cache[key] = hit
+        return hit
+
+    return kept
+
+
+def _key(x) -> np.ndarray | float:
+    """A number as a float, an array as float64: one cache key per value."""
+    x = np.asarray(x, dtype=np.float64)
+    return x if x.ndim else float(x)
+
+
 def mx_ggx_dir_albedo(cos_theta, alpha: float = _MX_EPS) -> tuple[np.ndarray, np.ndarray]:
     """
     (A, B) of ``mx_ggx_dir_albedo_analytic`` (directional albedo F0 A + F90 B),
     shape (S,), with MaterialX's clamps (NdotV and alpha at least 1e-8).
     """
-    x = np.clip(_mu(cos_theta), _MX_EPS, 1.0)
-    y = max(float(alpha), _MX_EPS)
+    return _mx_albedo(np.clip(_mu(cos_theta), _MX_EPS, 1.0), max(float(alpha), _MX_EPS))
+
+
+@_per_angles
+def _mx_albedo(x: np.ndarray, y: float) -> tuple[np.ndarray, np.ndarray]:
     x2, y2 = x * x, y * y
     c = np.array([
         [0.1003, 0.9345, 1.0, 1.0], [-0.6303, -2.323, -1.765, 0.2281],
@@ -147,13 +180,19 @@ def materialx_layer(cos_theta, eta: float, base: np.ndarray, coat: bool = True) 
     base = np.asarray(base, dtype=np.float64)
     if not coat:
         return base
-    mu = np.clip(_mu(cos_theta), _MX_EPS, 1.0)
+    reflected, throughput = _mx_layer_terms(np.clip(_mu(cos_theta), _MX_EPS, 1.0), float(eta))
+    return reflected[:, None] + throughput[:, None] * base
+
+
+@_per_angles
+def _mx_layer_terms(mu: np.ndarray, eta: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`materialx_layer`'s coat reflection and throughput (S,): its result is affine in the base."""
     A, B = mx_ggx_dir_albedo(mu)
     F = fresnel_dielectric(mu, 1.0, eta)
     comp = _mx_comp(F, A, B)
     F0 = ((eta - 1.0) / (eta + 1.0)) ** 2
     throughput = 1.0 - (F0 * A + B) * comp
-    return (F * comp)[:, None] + throughput[:, None] * base
+    return F * comp, throughput
 
 
 def mtlx_conductor(cos_theta, eta: float, ior, extinction, coat: bool = True) -> np.ndarray:
@@ -184,8 +223,13 @@ def _cycles_coat(mu, eta: float, metal, coat: bool) -> np.ndarray:
     """Cycles' coat over ``metal`` at roughness 0 (both Blender outputs): a white mirror mixed in by the coat's exact Fresnel."""
     if not coat:
         return metal
-    F = fresnel_dielectric(mu, 1.0, eta)[:, None]
+    F = _coat_fresnel(mu, float(eta))[0][:, None]
     return F + (1.0 - F) * metal
+
+
+@_per_angles
+def _coat_fresnel(mu: np.ndarray, eta: float) -> tuple[np.ndarray]:
+    return (fresnel_dielectric(mu, 1.0, eta),)
 
 
 def cycles_principled(cos_theta, eta: float, base_color, specular_tint, coat: bool = True) -> np.ndarray:
@@ -217,6 +261,11 @@ def three_dfg(cos_theta, roughness) -> np.ndarray:
     three's ``texture2D(dfgLUT, vec2(roughness, dotNV)).rg``: bilinear, clamped
     to edge, (S, 2); ``roughness`` one number or one per view angle (S,).
     """
+    return _three_dfg(_mu(cos_theta), _key(roughness))[0]
+
+
+@_per_angles
+def _three_dfg(mu: np.ndarray, roughness) -> tuple[np.ndarray]:
     table = _dfg_table()
     size = table.shape[0]
 
@@ -225,12 +274,12 @@ def three_dfg(cos_theta, roughness) -> np.ndarray:
         i0 = np.minimum(np.floor(p).astype(int), size - 2)
         return i0, p - i0
 
-    v0, fv = axis(_mu(cos_theta))
+    v0, fv = axis(mu)
     u0, fu = axis(np.broadcast_to(np.asarray(roughness, dtype=np.float64), fv.shape))
     t00, t01 = table[v0, u0], table[v0, u0 + 1]
     t10, t11 = table[v0 + 1, u0], table[v0 + 1, u0 + 1]
     fu, fv = fu[:, None], fv[:, None]
-    return (t00 * (1 - fu) + t01 * fu) * (1 - fv) + (t10 * (1 - fu) + t11 * fu) * fv
+    return ((t00 * (1 - fu) + t01 * fu) * (1 - fv) + (t10 * (1 - fu) + t11 * fu) * fv,)
 
 
 def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = True,
@@ -254,10 +303,15 @@ def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = 
     cc = np.clip(np.asarray(clearcoat, dtype=np.float64), 0.0, 1.0)
     if cc.ndim:
         cc = cc[:, None]  # a factor per view angle, (S,): one per row
-    Fcc = schlick(mu, THREE_CLEARCOAT_F0)[:, None]
-    fcc = three_dfg(mu, max(clearcoat_roughness, THREE_MIN_ROUGHNESS))
-    coat_specular = THREE_CLEARCOAT_F0 * fcc[:, :1] + fcc[:, 1:]
+    Fcc, coat_specular = _three_coat_terms(mu, _key(max(clearcoat_roughness, THREE_MIN_ROUGHNESS)))
     return base * (1.0 - cc * Fcc) + cc * coat_specular
+
+
+@_per_angles
+def _three_coat_terms(mu: np.ndarray, clearcoat_roughness: float) -> tuple[np.ndarray, np.ndarray]:
+    """three's clear coat: its Schlick Fresnel (S, 1) and its specular (S, 1)."""
+    fcc = three_dfg(mu, clearcoat_roughness)
+    return schlick(mu, THREE_CLEARCOAT_F0)[:, None], THREE_CLEARCOAT_F0 * fcc[:, :1] + fcc[:, 1:]
 
 
 def view_dependent(values: dict) -> bool:

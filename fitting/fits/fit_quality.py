@@ -21,6 +21,7 @@ What a fit can be trusted for
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import numpy as np
@@ -99,7 +100,25 @@ def _spline_nk(nk: SpectralNK, spline) -> SpectralNK:
     return SpectralNK(grid, n, k, name=nk.name)
 
 
+_UNCERTAINTY_KEPT: dict = {}
+
+
 def data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[str, Any] | None:
+    """
+    :func:`_data_uncertainty`, kept (a copy returned) for the last 16 data
+    and domains: a scene's fits of one material over one range ask for it
+    once each, and it costs more than a fit.
+    """
+    key = (nk.name, nk.wavelength_nm.tobytes(), nk.n.tobytes(), nk.k.tobytes(),
+           tuple(float(v) for v in eta_i_range), float(min_coverage))
+    if key not in _UNCERTAINTY_KEPT:
+        if len(_UNCERTAINTY_KEPT) >= 16:
+            _UNCERTAINTY_KEPT.pop(next(iter(_UNCERTAINTY_KEPT)))
+        _UNCERTAINTY_KEPT[key] = _data_uncertainty(nk, eta_i_range, min_coverage)
+    return copy.deepcopy(_UNCERTAINTY_KEPT[key])
+
+
+def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[str, Any] | None:
     """
     How far a figure measured against ``nk`` (linearly interpolated, as the
     reference does) can be off for the data's gaps and sparse sampling;
