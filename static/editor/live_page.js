@@ -33,7 +33,7 @@ export function nestedCoefficients(x, d1) {
   return C;
 }
 
-/** The eta_i rows of the live target over a domain (curves.py: etaSamples evenly over it). */
+/** The eta_i rows of the live target over a domain (curves_problem.py base_samples: etaSamples evenly over it). */
 export const liveRows = ([lo, hi]) => (hi > lo ? linspace(lo, hi, LIVE.etaSamples) : [lo]);
 
 export class LiveRefit {

@@ -13,7 +13,7 @@
 // check_grid, weight w), solved by the server's trust-region iteration
 // (live_trf.js) with the analytic Jacobian.
 //
-// The in-range rule (curves.py constrained/held): while the float16 fit
+// The in-range rule (curves_steps.py in_range_fit/held_in_range): while the float16 fit
 // leaves [0, 1] on the scoring grid, the penalty is made ten times stiffer
 // (twice at most, within the evaluation budget) with the points where it
 // leaves added; a fit still outside gets its shape term shrunk channel by
