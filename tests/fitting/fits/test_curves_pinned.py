@@ -41,8 +41,8 @@ PINNED = {  # float16 coefficients as little-endian bytes (hex), objective kept,
     "live, past the model": ("323bf1add028f039a2b1e82ea8369eb563339a2e06baae3304b28cbdab3847b02ec1e33a644635c8"
                              "a94412449dc29e3e35420fbdbf39", "de2000", True),
     "rgb-conductor": ("b737873bf93c9b410541e240", "de2000", False),
-    "guarded": ("2a3bc7b80d39dc3995ac8c208a3606b41730613aa9c0513d9430c0c22b41e22fd6c48442b44703d0be4f"
-                "393fa349ffc9fd405c4402c5", "de2000", False),
+    "guarded": ("343b2db91939f239d7b11c2faa369ab51f33d13ceec2763fada8d7bf113cfcabb2c12f3cc446adcde24c5c"
+                "430ac09139e7418aba9e35", "rgb", False),
 }
 
 
