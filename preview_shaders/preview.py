@@ -19,7 +19,7 @@ thread, the spectral reference and metrics on the caller's)::
         eta_i=1.5,              # coating index, [1, 3]
         size=512,               # pixels per side, 64..2048
         compare="none",         # "none" | "lazanyi" | "reference"
-        environment="white_sky",# "white_sky" | "studio"
+        environment="white_sky",# "white_sky" | "studio" | "outdoor"
         roughness=0.0,          # GGX perceptual roughness, [0, 1]
         mode="immersed",        # "immersed" | "coated" (a clear coat of index eta_i)
         coat_roughness=0.0,     # the coat's roughness (mode="coated"), [0, 1]
@@ -89,7 +89,7 @@ __all__ = [
 
 COMPARISONS = ("none", "lazanyi", "reference")
 MODES = ("immersed", "coated")
-ENVIRONMENTS = ("white_sky", "studio")
+ENVIRONMENTS = ("white_sky", "studio", "outdoor")
 SIZE_RANGE = (64, 2048)
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 SPHERE_RADIUS = 0.45

@@ -19,6 +19,7 @@ import { fitOf, FIRST, loadMaterials, prefetch, recall, remember, savedVersion }
 import { Messages } from "./editor/messages.js";
 import { PlotView } from "./editor/plot_view.js";
 import { PreviewView } from "./editor/preview_view.js";
+import { SceneView } from "./editor/scene_view.js";
 import { Readout } from "./editor/readout.js";
 import { RefitPipeline, refitBody } from "./editor/refit.js";
 import { LiveRefit } from "./editor/live_page.js";
@@ -162,6 +163,8 @@ const previewView = new PreviewView({
 });
 const exportSettings = () => ({ etaI: state.eta, roughness: Number($("roughness").value),
                                 coatRoughness: Number($("coat-roughness").value) });
+const sceneView = new SceneView(exportSettings);
+for (const id of ["roughness", "coat-roughness"]) $(id).addEventListener("change", () => sceneView.refresh());
 const readout = new Readout({ onGentler: guard(gentler), pending: () => pipeline.pending, exportSettings });
 for (const id of ["roughness", "coat-roughness"]) $(id).addEventListener("input", () => readout.showDownload());
 // The library, presets and typed entry, the materials an artist manages, compare mode (studio.js).
@@ -226,6 +229,7 @@ function present(fit, curves, edits = "{}") {
   store.dispatch("shown", { fit, edits, model: here ? curves.model : null });
   if (!here) showEta().catch((error) => say(error.message));
   previewView.showFit(fit);
+  sceneView.showFit(fit);
 }
 
 // The model kinds this page draws: the server's registry (GET /domain).
@@ -298,7 +302,10 @@ function setEta(eta) {
   colourView.setEta(eta);
   readout.showDownload();
   clearTimeout(page.etaTimer);
-  page.etaTimer = setTimeout(() => showEta().catch((error) => say(error.message)), 120);
+  page.etaTimer = setTimeout(() => {
+    showEta().catch((error) => say(error.message));
+    sceneView.refresh();
+  }, 120);
 }
 
 // ---------------------------------------------------------------- edits

@@ -116,6 +116,18 @@ class TestSphereValues:
         # The studio is not uniform: it has lights and a floor.
         assert result.radiance[mask].max() > 1.0 and result.radiance[mask].min() < 0.1
 
+    def test_outdoor_is_model_times_its_sky(self, renderer, gold):
+        """The CLI's outdoor environment (a procedural sky and ground): the same
+        model times radiance, bluer than red where the sphere sees the sky."""
+        result = renderer.render_preview(gold, None, 1.5, 64, environment="outdoor")
+        studio = renderer.render_preview(gold, None, 1.5, 64, environment="studio")
+        mask = result.mask
+        expected = _model(gold, result.cos_theta[mask], 1.5) * result.radiance[mask]
+        assert np.abs(result.image[mask] - expected).max() <= GLSL_F32_BOUND
+        assert not np.allclose(result.radiance[mask], studio.radiance[mask])
+        top = result.radiance[:20][mask[:20]]  # the sphere's upper rim reflects the sky
+        assert np.median(top[:, 2]) > np.median(top[:, 0])
+
 
 class TestGolden:
     @pytest.mark.parametrize("name", sorted(CASES))
@@ -167,7 +179,7 @@ class TestInputChecks:
             ({"eta_i": 3.5}, r"`eta_i` must lie in \[1, 3\], got 3.5"),
             ({"eta_i": float("nan")}, r"`eta_i` must lie in \[1, 3\], got nan"),
             ({"compare": "schlick"}, r"`compare` must be one of none, lazanyi, reference"),
-            ({"environment": "beach"}, r"`environment` must be one of white_sky, studio"),
+            ({"environment": "beach"}, r"`environment` must be one of white_sky, studio, outdoor"),
             ({"compare": "reference", "nk": None}, r"`nk` is needed for compare='reference'"),
         ],
     )
