@@ -20,7 +20,8 @@ Dependencies
     is refused (422), not resolved silently to the last.
 -   :data:`SaveRateDep`: the app's saves per client per minute
     (:class:`service.runtime.shares.SaveRate`); a save route counts itself there
-    once its input is valid.
+    once its input is valid (:func:`note_save`: a repeat of the material's
+    latest version adds nothing and is neither counted nor refused).
 -   :data:`PreviewsDep`: the app's render pool (previews and GL textures,
     :class:`service.runtime.previews.PreviewRunner`).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
@@ -33,13 +34,15 @@ import hmac
 from typing import Annotated, Literal
 
 from fastapi import Depends, Form, HTTPException, Path, Query, Request, status
+from fastapi.concurrency import run_in_threadpool
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
 from ..jobs.common import stored_fit
-from ..runtime import FitRunner, PreviewRunner, SaveRate
+from ..runtime import CLAIM, FitRunner, PreviewRunner, SaveRate
 from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody, WorkingSpace
 from ..store import FitRecord, Store
+from ..store.queries import summary_text
 
 __all__ = [
     "SettingsDep",
@@ -57,6 +60,7 @@ __all__ = [
     "SingleFormFields",
     "PreviewsDep",
     "SaveRateDep",
+    "note_save",
     "ERROR_RESPONSES",
     "FIT_ERROR_RESPONSES",
     "NOT_FOUND",
@@ -89,6 +93,23 @@ StoreDep = Annotated[Store, Depends(get_store)]
 RunnerDep = Annotated[FitRunner, Depends(get_runner)]
 PreviewsDep = Annotated[PreviewRunner, Depends(get_previews)]
 SaveRateDep = Annotated[SaveRate, Depends(get_save_rate)]
+
+
+async def note_save(rate: SaveRate, store: Store, material_id: str, fit_id: str, name: str) -> None:
+    """
+    Count a save of fit ``fit_id`` as ``name`` under ``material_id``
+    against its client's saves per minute (429 past them), unless it
+    repeats what the material holds now (that fit its latest, that name, not
+    in the bin): such a save adds no version (the store answers the
+    existing one), so it is neither counted nor refused.
+    """
+    row = await run_in_threadpool(store.material, material_id)
+    if row is not None and row.latest_fit_id == fit_id and row.deleted_at is None \
+            and row.name == summary_text(name):
+        return
+    rate.note(CLAIM.get())
+
+
 FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
 MaterialIdPath = Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
                                      description="A library name or a saved material's id")]

@@ -9,7 +9,10 @@ The bounded process pool every kind of fit runs in (:mod:`service.jobs`).
     run side by side, and recovery from a dead worker.
 -   :class:`Overloaded`, :class:`FitTimeout`, :class:`WorkerLost`,
     :class:`JobCPULimit`: why a job was not answered (the HTTP edge answers
-    503, 504, 503 and 422, the first three with ``Retry-After``).
+    503, 504, 503 and 422, the first three with ``Retry-After``;
+    :mod:`service.runtime.pool_errors`).
+-   :attr:`FitRunner.cannot_start`: why no worker can be started now (what
+    ``/healthz`` answers 503 with), None once one runs a part again.
 
 Fitting is CPU-bound (numpy, scipy): it runs in worker processes, never on
 the event loop, forked by a fork server (:func:`service.runtime.worker.process_context`).
@@ -54,6 +57,7 @@ from typing import Any, AsyncIterator, Awaitable, Callable
 
 from . import executors
 from .shares import CLAIM, Claim, Shares
+from .pool_errors import FitTimeout, Overloaded, Quarantined, StartFailed, WorkerLost, WorkersNotStarted
 from .turns import Turns
 from .flights import CancelRing, Flights
 from .fork_server import START_ERRORS, fork_server_exited
@@ -64,59 +68,6 @@ __all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotSta
            "JobBudgetExceeded", "warm_process"]
 
 log = logging.getLogger("service.runtime.pool")
-
-
-class Overloaded(Exception):
-    """Too many jobs in flight; ``retry_after`` is a wait estimate in seconds."""
-
-    def __init__(self, retry_after: int, limit: int) -> None:
-        super().__init__(f"the service is fitting {limit} materials already (the limit); "
-                         f"retry in about {retry_after} s")
-        self.retry_after = retry_after
-
-
-class FitTimeout(Exception):
-    """A request waited past the time limit; its job goes on and keeps its result."""
-
-    def __init__(self, limit_s: float, retry_after: int = 1) -> None:
-        super().__init__(
-            f"the fit did not finish within the time limit of {limit_s:g} s "
-            "(COATED_FIT_TIMEOUT_S); it was cancelled"
-        )
-        self.retry_after = retry_after
-
-
-class WorkerLost(Exception):
-    """The job's worker process died in the pool twice and then once more alone: the job is the cause."""
-
-    def __init__(self, quarantine_s: float) -> None:
-        super().__init__(
-            "this job stopped its fitting worker process three times (twice in the pool, then alone); "
-            f"it is refused for {quarantine_s:g} s"
-        )
-        self.retry_after = max(1, math.ceil(quarantine_s))
-
-
-class WorkersNotStarted(WorkerLost):
-    """No worker process could be started, three times (the fork server kept dying): 503, try again."""
-
-    def __init__(self) -> None:
-        Exception.__init__(self, "no fitting worker process could be started (their fork server died); try again")
-        self.retry_after = 1
-
-
-class _StartFailed(BrokenProcessPool):
-    """A pool could not start a worker (:data:`service.runtime.fork_server.START_ERRORS`); its fork server has exited since."""
-
-
-class Quarantined(WorkerLost):
-    """A job whose content id stopped its worker recently is refused before it runs (503)."""
-
-    def __init__(self, left_s: float) -> None:
-        Exception.__init__(
-            self, f"this job stopped its fitting worker process three times; it is refused for {left_s:.0f} s more"
-        )
-        self.retry_after = max(1, math.ceil(left_s))
 
 
 EXPRESS_COST_S = 0.1
@@ -170,6 +121,7 @@ class FitRunner:
         self._warming: set[asyncio.Task] = set()
         self.completed = 0
         self.restarts = 0
+        self.cannot_start: str | None = None  # why no worker could be started, until one runs a part again
 
     @property
     def in_flight(self) -> int:
@@ -213,6 +165,21 @@ class FitRunner:
                                    for _ in range(self.workers + self.express_workers)))
         except (BrokenProcessPool, RuntimeError, *START_ERRORS):
             pass  # a pool that broke (or could not start a worker) while warming is replaced by the job that sees it
+        except OSError as error:  # no process could be started at all: set aside, tried again by the next start
+            log.warning("no fitting worker could be started: %r", error)
+            with self._lock:
+                if self._pool is pool:
+                    self._pool = None
+            pool.shutdown(wait=False, cancel_futures=True)
+        else:
+            self.cannot_start = None
+
+    def retry_start(self) -> None:
+        """While no worker could be started (:attr:`cannot_start`): try again in the background (one try at once)."""
+        if self.cannot_start is not None and not self._warming:
+            task = asyncio.get_running_loop().create_task(self.warm_up())
+            self._warming.add(task)
+            task.add_done_callback(self._warming.discard)
 
     def _retry_after(self) -> int:
         waves = math.ceil(max(self._in_flight, 1) / self.workers)
@@ -284,13 +251,14 @@ class FitRunner:
             try:
                 async with self._turns.turn(cost_s, self.shares.rank(claim)):
                     return await self._run_in(pool, function, args)
-            except _StartFailed:
+            except StartFailed as error:
                 # Not the part's doing: it runs on a pool whose workers start, at most twice more.
-                self._restart(pool, "a fitting worker could not be started (its fork server died); the pool was "
+                self._restart(pool, f"a fitting worker could not be started ({error}); the pool was "
                                     "restarted with a new fork server")
                 start_failures += 1
                 if start_failures > 2:
-                    raise WorkersNotStarted() from None
+                    self.cannot_start = f"no fitting worker process could be started, three times: {error}"
+                    raise error.not_started() from None
             except (BrokenProcessPool, RuntimeError) as error:
                 if not isinstance(error, BrokenProcessPool) and "shutdown" not in str(error):
                     raise
@@ -310,8 +278,9 @@ class FitRunner:
                 with self._lock:
                     self._alone = None
                 alone.shutdown(wait=False, cancel_futures=True)
-                if isinstance(error, _StartFailed):
-                    raise WorkersNotStarted() from None
+                if isinstance(error, StartFailed):
+                    self.cannot_start = f"no fitting worker process could be started: {error}"
+                    raise error.not_started() from None
                 self._quarantine_current()
                 raise WorkerLost(self.quarantine_s) from None
 
@@ -326,10 +295,14 @@ class FitRunner:
             # The fork server died or is dying: wait until multiprocessing can see that it has exited, so
             # that the pool replacing this one starts another instead of asking it again.
             await fork_server_exited()
-            raise _StartFailed(f"a fitting worker could not be started: {error!r}") from error
+            raise StartFailed() from error
+        except OSError as error:  # no fork server or process could be made (its socket, no memory, no pid)
+            raise StartFailed(repr(error)) from error
         began = time.perf_counter()
         try:  # a pool stuck on a killed worker's result breaks
-            return await charged(executors.result(pool, future), budget, limit_s, self.cpu_limit_s)
+            result = await charged(executors.result(pool, future), budget, limit_s, self.cpu_limit_s)
+            self.cannot_start = None  # a worker ran it: workers start again
+            return result
         except asyncio.CancelledError:
             self._cancels.cancel(serial, future)
             raise

@@ -12,8 +12,12 @@ refers to any more, saved fits never.
 from __future__ import annotations
 
 import json
+import os
+import signal
 import sqlite3
+import threading
 import time
+from pathlib import Path
 
 import loopback
 import numpy as np
@@ -211,3 +215,53 @@ def test_a_draft_a_saved_material_or_a_link_refers_to_outlives_its_time_to_live(
         assert edit["base"] == {"fit": on_draft} and http.get(f"{API}/fits/{on_draft}").status_code == 200
         again = http.post(f"{API}/fits/from-curves", json={**edit["request"], "expected_version": edit["version"]})
         assert again.status_code == 200 and again.json()["id"] == saved_id, again.text[:300]
+
+
+def _workers(server_pid: int) -> list[int]:
+    """The fitting workers (and any other grandchild) of the server: children of its children, from /proc."""
+    children: dict[int, list[int]] = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                ppid = int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1])
+            except (FileNotFoundError, ProcessLookupError):
+                continue
+            children.setdefault(ppid, []).append(int(entry.name))
+    return [pid for child in children.get(server_pid, []) for pid in children.get(child, [])]
+
+
+def test_a_save_keeps_its_draft_base_while_it_is_fitted(tmp_path):
+    # A save on a draft base whose fit outlasts the draft's time to live (its workers stopped, as a
+    # loaded machine would delay it): the base is kept from the save's start, the save is answered 201.
+    with server_process(tmp_path / "data", COATED_DRAFT_TTL_S="4", COATED_DRAFT_SWEEP_S="0.25") as server, \
+            loopback.Client(base_url=server.url, timeout=120) as http:
+        base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
+        draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5, live=False))
+        assert draft.status_code == 201, draft.text[:300]
+        draft_id, created = draft.json()["id"], http.get(f"{API}/fits/{draft.json()['id']}").json()["created_at"]
+        workers = _workers(server.process.pid)
+        assert workers
+        answers = []
+        for pid in workers:
+            os.kill(pid, signal.SIGSTOP)
+        try:
+            body = {**step(draft_id, None, 0.45, live=False), "draft": False, "name": "saved on a short draft"}
+            save = threading.Thread(target=lambda: answers.append(
+                loopback.post(f"{server.url}{API}/fits/from-curves", json=body, timeout=120)))
+            save.start()
+            deadline = time.monotonic() + 20
+            while http.get("/healthz").json()["fits_in_flight"] < 1:  # the save is in the pool, waiting
+                assert time.monotonic() < deadline, "the save never reached the pool"
+                time.sleep(0.05)
+            assert time.time() < created + 4.0, "the save started after its base expired: the test proves nothing"
+            time.sleep(max(0.0, created + 4.0 + 1.5 - time.time()))  # past the time to live, and six sweeps
+            assert http.get(f"{API}/fits/{draft_id}").status_code == 200  # kept by the save in flight
+        finally:
+            for pid in workers:
+                os.kill(pid, signal.SIGCONT)
+        save.join(timeout=120)
+        assert answers and answers[0].status_code == 201, answers and answers[0].text[:300]
+        saved = answers[0].json()["id"]
+        time.sleep(1.0)  # more sweeps: a saved fit's base never expires
+        assert http.get(f"{API}/fits/{draft_id}").status_code == 200
+        assert http.get(f"{API}/fits/{saved}/edit").json()["base"] == {"fit": draft_id}

@@ -21,6 +21,9 @@ import loopback
 import pytest
 
 from conftest import server_process
+from service.config import Settings
+
+ROOT = Path(__file__).resolve().parents[2]
 
 pytestmark = [pytest.mark.server, pytest.mark.slow]
 
@@ -96,6 +99,11 @@ def test_nothing_outlives_a_killed_server(tmp_path):
 
 
 def test_sigterm_drains_for_its_bound_then_cancels_and_exits(tmp_path):
+    # At the default bound (25 s) a server with jobs in flight exits within 30 s (the grace of Kubernetes
+    # and systemd) when what follows the bound (cancelling the jobs, closing the pools, the store) takes
+    # under 5 s: measured here after a 3 s bound, the default checked against what the docs say.
+    default_s = Settings.model_fields["drain_timeout_s"].default
+    assert default_s == 25.0 and "`COATED_DRAIN_TIMEOUT_S` (25 s" in (ROOT / "docs" / "service.md").read_text()
     with server_process(tmp_path / "data", COATED_DRAIN_TIMEOUT_S="3") as server:
         tree, scene = _busy(server)
         started = time.monotonic()
@@ -103,7 +111,7 @@ def test_sigterm_drains_for_its_bound_then_cancels_and_exits(tmp_path):
         assert server.process.wait(timeout=30) == 128 + signal.SIGTERM
         took = time.monotonic() - started
         log = server.log_text()
-        assert took < 3.0 + 10.0, (took, log)
+        assert took >= 3.0 and default_s + (took - 3.0) < 30.0, (took, log)
         assert "graceful shutdown exceeded" in log
         assert _left_alive(tree, within_s=1.0) == []
         scene.join(timeout=10)

@@ -13,6 +13,7 @@ Fits from edited RGB curves
 
 from __future__ import annotations
 
+import time
 from typing import Annotated
 
 from fastapi import APIRouter, Query, Response, status
@@ -22,11 +23,13 @@ from ...jobs.common import stored_fit
 from ...jobs.curves import error_map, fit_from_curves, prepare_curve_fit
 from ...jobs.nk import angle_curves
 from ...schemas import API_PREFIX, ETA_I_LIMITS, CurveFitPublic, CurveFitRequest, CurvesPublic, ErrorMap, fit_public
-from ...runtime import CLAIM
 from ..deps import (CONFLICT, ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, SaveRateDep,
-                    StoreDep, WriteAccess)
+                    StoreDep, WriteAccess, note_save)
 
 router = APIRouter(prefix=API_PREFIX, tags=["curves"])
+
+KEEP_BASE_MARGIN_S = 60.0
+"""A save on a draft base keeps it for the fit's time limit and this much more."""
 
 
 @router.post("/fits/from-curves", response_model=CurveFitPublic, status_code=status.HTTP_201_CREATED,
@@ -50,8 +53,6 @@ async def create_fit_from_curves(
     target, with a base); with ``curves_eta_i``, ``curves`` holds the fit's
     curves there (one round trip for the editor).
     """
-    if not request.draft:
-        rate.note(CLAIM.get())  # a save: counted against its client's saves per minute (429 past them)
     base = request.base
     fit = await run_in_threadpool(
         lambda: prepare_curve_fit(
@@ -64,6 +65,13 @@ async def create_fit_from_curves(
             model=request.model, live=request.live, start_fit=request.start_fit,
             material_id=request.material_id,
         ))
+    if not request.draft:  # a save: counted against its client's saves per minute (429), unless a repeat
+        await note_save(rate, store, fit.material_id, fit.fit_id, fit.name)
+    if not request.draft and fit.base_record is not None:
+        # A draft base outlives this save's fit (its waits and its run), however short its time to live;
+        # once saved, the save keeps it (a saved fit's base never expires).
+        await run_in_threadpool(store.keep_draft, fit.base_record.id,
+                                time.time() + runner.timeout_s + KEEP_BASE_MARGIN_S)
     record, created, restored = await fit_from_curves(fit, store, runner, request.expected_version)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"

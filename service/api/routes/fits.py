@@ -32,7 +32,7 @@ from ...runtime import CLAIM
 from ...store import FitRecord
 from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
                     MetricsQuery, MinCoverageForm, RoughnessQuery, WorkingSpaceQuery, RunnerDep, SettingsDep,
-                    SingleFormFields, SaveRateDep, StoreDep, WriteAccess)
+                    SingleFormFields, SaveRateDep, StoreDep, WriteAccess, note_save)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -62,8 +62,8 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
     Delta E 2000 of the model and of adjusted Lazanyi on the metrics grid with ``?metrics=full`` (else
     later: ``GET /fits/{id}``).
     """
-    rate.note(CLAIM.get())  # a save: counted against its client's saves per minute (429 past them)
     if request.f0 is not None:  # F0 and F82 colours: n, k from them, no fit to run
+        rate.note(CLAIM.get())  # a save: counted against its client's saves per minute (429)
         return fit_answer(*await fit_from_colours(store, request), response)
     runner.check_capacity()
     if request.material is not None:
@@ -73,6 +73,7 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
         fit = await run_in_threadpool(
             NKFit.data, (request.name or "uploaded").strip(), request.source, *request.nk.arrays(),
             request.eta_i_range, request.objective, settings.metrics_samples, request.model)
+    await note_save(rate, store, fit.material_id, fit.fit_id, fit.name)  # a repeat: not counted
     return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
 
@@ -92,16 +93,15 @@ async def upload_fit(
     metrics: MetricsQuery = "solve",
 ) -> FitPublic:
     """
-    Fit an uploaded n, k file (size limit: COATED_MAX_UPLOAD_BYTES). The
-    file is parsed, never stored or executed as given; the fit keeps its
-    n, k as numbers. The data must cover 90% of 360-830 nm, or `min_coverage` when it asks more.
+    Fit an uploaded n, k file (size limit: COATED_MAX_UPLOAD_BYTES), parsed, never stored or executed as given
+    (the fit keeps its n, k as numbers); it must cover 90% of 360-830 nm, or `min_coverage` when it asks more.
     """
-    rate.note(CLAIM.get())
     runner.check_capacity()
     data = await file.read()
     fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
                                   (eta_i_min, eta_i_max), objective, settings.metrics_samples, model)
     check_coverage(fit.nk, min_coverage)
+    await note_save(rate, store, fit.material_id, fit.fit_id, fit.name)
     return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
 

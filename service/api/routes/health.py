@@ -6,8 +6,10 @@ Health and domain
     pool started), says whether the store can take a save now and which
     store it is (kind, schema version, this replica's connections); 503
     with Retry-After and the reason when this replica cannot serve another
-    client: the store cannot be read (the database restarting), or every
-    connection it accepts has a request in progress. Cheap (no integrity
+    client: the store cannot be read (the database restarting), every
+    connection it accepts has a request in progress, or the fitting pool
+    could not start a worker process (three tries of a job; each probe then
+    tries again in the background, 200 once a worker starts). Cheap (no integrity
     scan, no write), its store probe runs in a thread of its own, so it
     answers while fits run, and its connection has a reserve of its own
     (:mod:`service.runtime.server`), so it answers past every bound.
@@ -65,6 +67,10 @@ async def healthz(request: Request, store: StoreDep, runner: RunnerDep, previews
     held = connections.held() if connections is not None else None
     if held:
         raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, f"not ready: {held}", headers={"Retry-After": "2"})
+    if runner.cannot_start is not None:  # no fit could run: tried again in the background, 200 once it starts
+        runner.retry_start()
+        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, f"not ready: {runner.cannot_start}",
+                            headers={"Retry-After": "2"})
     problem, described = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
         status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
