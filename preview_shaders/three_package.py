@@ -1,6 +1,7 @@
 """
 The generated modules of the three.js package (web/three/, npm
-``coated-conductor-three``): write or check web/three/src/generated/:
+``coated-conductor-three``): write or check web/three/src/generated/ (and
+the same ``glsl.js`` in the Babylon.js package's web/babylon/src/generated/):
 
 -   ``glsl.js``: the project's GLSL (preview_shaders/glsl/) the material
     pastes into three's shaders, its include lines resolved as static/glsl.js
@@ -35,6 +36,9 @@ from fitting.shading.lut import default_lut
 ROOT = Path(__file__).resolve().parents[1]
 GLSL_DIR = ROOT / "preview_shaders" / "glsl"
 OUT = ROOT / "web" / "three" / "src" / "generated"
+# The Babylon.js package (web/babylon/, npm ``coated-conductor-babylon``) pastes
+# the same model GLSL into Babylon's PBR shader: the same glsl.js there.
+OUT_BABYLON = ROOT / "web" / "babylon" / "src" / "generated"
 
 # The material's include files (coated_conductor.js pastes them, in this
 # order) and the albedo table's programs (albedo_table.js picks one a kind).
@@ -116,9 +120,9 @@ def read_lut_module(text: str) -> dict:
 def stale() -> list[str]:
     """The generated files that differ from what their sources give (the LUT compared by its texels)."""
     out = []
-    glsl = OUT / "glsl.js"
-    if not glsl.exists() or glsl.read_text() != glsl_module():
-        out.append(str(glsl.relative_to(ROOT)))
+    for glsl in (OUT / "glsl.js", OUT_BABYLON / "glsl.js"):
+        if not glsl.exists() or glsl.read_text() != glsl_module():
+            out.append(str(glsl.relative_to(ROOT)))
     lut = OUT / "lut.js"
     reference = default_lut()
     try:
@@ -143,7 +147,9 @@ def main(argv: list[str]) -> int:
         print("usage: python -m preview_shaders.three_package [--check]", file=sys.stderr)
         return 2
     OUT.mkdir(parents=True, exist_ok=True)
+    OUT_BABYLON.mkdir(parents=True, exist_ok=True)
     (OUT / "glsl.js").write_text(glsl_module())
+    (OUT_BABYLON / "glsl.js").write_text(glsl_module())
     (OUT / "lut.js").write_text(lut_module())
     return 0
 

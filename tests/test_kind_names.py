@@ -37,9 +37,11 @@ THREE_PACKAGE_USES = {
     "web/three/src/escape_table.js": 2,
     "web/three/src/albedo_table.js": 3,
     "web/three/src/index.d.ts": 4,
+    "web/babylon/src/check_model.js": 3,
 }
-"""The three.js package's remaining kind names and switches (its kinds are not yet generated from the
-registry by ``python -m preview_shaders.three_package``): a file may lose uses, never gain one."""
+"""The three.js and Babylon.js packages' remaining kind names and switches (their kinds are not yet
+generated from the registry by ``python -m preview_shaders.three_package``; the Babylon.js package's
+are its copy of the three.js package's checks of the extension object): a file may lose uses, never gain one."""
 
 
 def _names_in(node: ast.AST) -> list[str]:
