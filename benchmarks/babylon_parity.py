@@ -13,7 +13,7 @@ compared per pixel (tests/static/babylon_pages.py): mean Delta E 2000 over
 the ball's pixels with NdotV >= 0.1, its 99th percentile, max, centre and
 ring near grazing. Prints the table and records it::
 
-    .venv/bin/python benchmarks/babylon_parity.py --materials Au,Cu,Ag,Al,Cr   # about 6 min here, loaded
+    .venv/bin/python benchmarks/babylon_parity.py --materials Au,Cu,Ag,Al,Cr   # 2.5 to 4.5 min here, loaded
     .venv/bin/python benchmarks/babylon_parity.py --materials Au --result -
 """
 
