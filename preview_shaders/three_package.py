@@ -47,6 +47,11 @@ from preview_shaders.kinds import PREVIEW_MODEL_FILE, preview_model_source
 ROOT = Path(__file__).resolve().parents[1]
 GLSL_DIR = ROOT / "preview_shaders" / "glsl"
 OUT = ROOT / "web" / "three" / "src" / "generated"
+# The Babylon.js package (web/babylon/, npm ``coated-conductor-babylon``) pastes
+# the model GLSL into Babylon's PBR shader: its glsl.js carries the shared
+# includes and each built-in kind's model file (BABYLON_KIND_FILES).
+OUT_BABYLON = ROOT / "web" / "babylon" / "src" / "generated"
+BABYLON_KIND_FILES = ("cf_coated_conductor.glsl", "cf_rgb_conductor.glsl")
 
 # The material's include files (coated_conductor.js pastes them, in this
 # order, then the kind's generated code), the split-sum albedo table's
@@ -87,6 +92,13 @@ def glsl_sources() -> dict:
     glsl = "\n".join(_expand(name, seen) for name in INCLUDES)
     tables = {name: _es(_expand(name, set()), name) for name in TABLES}
     return {"GLSL": glsl, "TABLE_SOURCES": tables}
+
+
+def babylon_glsl_module() -> str:
+    """web/babylon/src/generated/glsl.js: the kinds' model files, then the shared includes."""
+    seen: set[str] = set()
+    glsl = "\n".join(_expand(name, seen) for name in (*BABYLON_KIND_FILES, *INCLUDES))
+    return (HEAD.format(source="preview_shaders/glsl/") + f"export const GLSL = {json.dumps(glsl)};\n")
 
 
 def glsl_module() -> str:
@@ -212,9 +224,9 @@ def read_lut_module(text: str) -> dict:
 def stale() -> list[str]:
     """The generated files that differ from what their sources give (the LUT compared by its texels)."""
     out = []
-    glsl = OUT / "glsl.js"
-    if not glsl.exists() or glsl.read_text() != glsl_module():
-        out.append(str(glsl.relative_to(ROOT)))
+    for glsl, text in ((OUT / "glsl.js", glsl_module()), (OUT_BABYLON / "glsl.js", babylon_glsl_module())):
+        if not glsl.exists() or glsl.read_text() != text:
+            out.append(str(glsl.relative_to(ROOT)))
     for name, text in zip(KIND_FILES, (kinds_module(), kinds_types())):
         path = OUT / name
         if not path.exists() or path.read_text() != text:
@@ -244,6 +256,8 @@ def main(argv: list[str]) -> int:
         return 2
     OUT.mkdir(parents=True, exist_ok=True)
     (OUT / "glsl.js").write_text(glsl_module())
+    OUT_BABYLON.mkdir(parents=True, exist_ok=True)
+    (OUT_BABYLON / "glsl.js").write_text(babylon_glsl_module())
     (OUT / "kinds.js").write_text(kinds_module())
     (OUT / "kinds.d.ts").write_text(kinds_types())
     (OUT / "lut.js").write_text(lut_module())

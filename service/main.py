@@ -53,6 +53,13 @@ for the three.js material and its example page."""
 THREE_PACKAGE_DIR = Path(__file__).resolve().parents[1] / "web" / "three" / "src"
 """The three.js material's package (web/three/, npm ``coated-conductor-three``),
 its modules served at ``/static/three/`` for the example page."""
+BABYLON_DIR = Path(__file__).resolve().parents[1] / "scripts" / "babylon" / "node_modules" / "@babylonjs"
+"""Babylon.js (``@babylonjs/core`` and ``@babylonjs/loaders``) as pinned in
+scripts/babylon/package-lock.json (``scripts/bootstrap`` installs them),
+served at ``/vendor/babylon/core/`` and ``/vendor/babylon/loaders/``."""
+BABYLON_PACKAGE_DIR = Path(__file__).resolve().parents[1] / "web" / "babylon" / "src"
+"""The Babylon.js package (web/babylon/, npm ``coated-conductor-babylon``),
+its modules served at ``/static/babylon/``."""
 SWAGGER_UI_DIR = Path(__file__).resolve().parents[1] / "scripts" / "swagger-ui" / "node_modules" / "swagger-ui-dist"
 """Swagger UI as pinned in scripts/swagger-ui/package-lock.json (``scripts/bootstrap``
 installs it), served at ``/vendor/swagger-ui/`` for ``/docs``."""
@@ -172,9 +179,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for part in ("build", "examples/jsm"):
         app.mount(f"/vendor/three/{part}", StaticFiles(directory=THREE_DIR / part, check_dir=False),
                   name=f"three-{part}")
-    # The three.js material's package (web/three/src/) at /static/three/,
-    # before /static, whose directory has no three/.
+    for part in ("core", "loaders"):
+        app.mount(f"/vendor/babylon/{part}", StaticFiles(directory=BABYLON_DIR / part, check_dir=False),
+                  name=f"babylon-{part}")
+    # The three.js and Babylon.js packages (web/*/src/) at /static/three/ and
+    # /static/babylon/, before /static, whose directory has neither.
     app.mount("/static/three", StaticFiles(directory=THREE_PACKAGE_DIR), name="three-package")
+    app.mount("/static/babylon", StaticFiles(directory=BABYLON_PACKAGE_DIR), name="babylon-package")
     # /static/...: the page's modules at a path of their own for other pages.
     app.mount("/static", StaticFiles(directory=STATIC_DIR), name="static")
     # The browser editor (static/), after the API so that /api, /docs and
