@@ -85,8 +85,8 @@ class Refit:
         C16 = np.asarray(C16)
         key = C16.dtype.str.encode() + C16.tobytes()
         if key not in self.seen:
-            mask = outside_range(C16, self.problem.eta_i_range).any(axis=-1)
-            self.seen[key] = mask.reshape(self.range_grid[0].shape)
+            mask = np.asarray(outside_range(C16, self.problem.eta_i_range)).any(axis=-1)
+            self.seen[key] = np.asarray(mask).reshape(self.range_grid[0].shape)
         return self.seen[key]
 
     def in_range(self, C16) -> bool:
