@@ -11,12 +11,20 @@
 // zoom (three's OrbitControls). three is loaded when the view is first
 // opened, never on the editor's start.
 
-import { packURL } from "../api.js";
+import { domain, packURL } from "../api.js";
 
 const $ = (id) => document.getElementById(id);
 
 export const SCENE_LIMIT_BYTES = 64 * 1024 * 1024;
 const LIMIT_TEXT = "64 MB";
+
+// The export a glTF loader reads: the registry's format of glTF's JSON media type (GET /domain).
+const GLTF_MEDIA_TYPE = "model/gltf+json";
+async function gltfFormat() {
+  const format = (await domain()).export_formats.find((f) => f.media_type === GLTF_MEDIA_TYPE);
+  if (!format) throw new Error(`the service lists no export of media type ${GLTF_MEDIA_TYPE}`);
+  return format.name;
+}
 
 export class SceneView {
   /** settings(): {etaI, roughness, coatRoughness}, the preview's. */
@@ -163,7 +171,8 @@ export class SceneView {
   async #material() {
     const t = this.three;
     if (!t || !this.fit) return;
-    const url = packURL(this.fit.id, "gltf", this.settings());
+    const url = packURL(this.fit.id, await gltfFormat(), this.settings());
+    if (!this.fit) return;
     if (url === this.materialFor && t.material) return this.#ready();
     this.materialFor = url;
     $("scene").dataset.state = "loading";
