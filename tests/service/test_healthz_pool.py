@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import shutil
 import signal
+import tempfile
 import time
 from pathlib import Path
 
@@ -36,8 +37,16 @@ def _children(pid: int) -> list[int]:
 
 
 def test_healthz_is_503_while_no_fitting_worker_can_start_and_200_once_one_does(tmp_path):
-    temporary = tmp_path / "tmp"
-    temporary.mkdir()
+    # The server's own temporary directory, short (a Unix socket's path has at most 107
+    # bytes: pytest's tmp_path under a worker's directory can be longer than that allows).
+    temporary = Path(tempfile.mkdtemp(prefix="hz-", dir="/tmp"))
+    try:
+        _check(tmp_path, temporary)
+    finally:
+        shutil.rmtree(temporary, ignore_errors=True)
+
+
+def _check(tmp_path, temporary):
     with server_process(tmp_path / "data", TMPDIR=str(temporary)) as server, \
             loopback.Client(base_url=server.url, timeout=120) as http:
         assert http.post(f"{API}/fits", json={"material": "Au"}).status_code == 201
