@@ -48,13 +48,10 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from conftest import server_process  # noqa: E402
 
+from benchmarks.editor_speed import ARGS, READY, percentile  # noqa: E402  (the same page, flags and statistic)
 from benchmarks.record import load_average, write_result  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"]
-READY = ("() => document.body.dataset.ready === 'true' && document.getElementById('preview').dataset.fit"
-         " === document.getElementById('fit-id').textContent")
 SETTLED = ("() => { const id = document.getElementById('fit-id').textContent;"
            " return !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
            " && document.getElementById('preview').dataset.fit === id; }")
@@ -64,11 +61,6 @@ LISTEN = """() => {
   document.addEventListener("pointermove", (e) => { if (e.buttons) window.cfMoves.push(e.timeStamp); }, true);
   document.addEventListener("pointerup", (e) => window.cfReleases.push(e.timeStamp), true);
 }"""
-
-
-def percentile(values, q):
-    values = sorted(values)
-    return values[min(len(values) - 1, int(round(q * (len(values) - 1))))]
 
 
 def summary(values):
