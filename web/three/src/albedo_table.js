@@ -61,6 +61,21 @@ function pass(fragmentShader, uniforms, rows, order) {
  * {roughness, coatRoughness} when they (or the model) changed since the
  * last time; `texture` is the table.
  */
+/**
+ * Render `scene` through `camera` into `target` without clearing it, then
+ * give the renderer back its render target and autoClear (the tables'
+ * off-screen passes: AlbedoTable, EscapeTable).
+ */
+export function drawInto(renderer, target, scene, camera) {
+  const previous = renderer.getRenderTarget();
+  const autoClear = renderer.autoClear;
+  renderer.autoClear = false;
+  renderer.setRenderTarget(target);
+  renderer.render(scene, camera);
+  renderer.setRenderTarget(previous);
+  renderer.autoClear = autoClear;
+}
+
 export class AlbedoTable {
   /** `kind`: the model's generated entry (kinds.js); `words`: its coefficients packed. */
   constructor(resources, kind, model, words) {
@@ -100,13 +115,7 @@ export class AlbedoTable {
     if (key === this.drawnFor) return false;
     this.uniforms.u_roughness.value = roughness;
     this.uniforms.u_coat_roughness.value = coatRoughness;
-    const previous = renderer.getRenderTarget();
-    const autoClear = renderer.autoClear;
-    renderer.autoClear = false;
-    renderer.setRenderTarget(this.target);
-    renderer.render(this.scene, this.camera);
-    renderer.setRenderTarget(previous);
-    renderer.autoClear = autoClear;
+    drawInto(renderer, this.target, this.scene, this.camera);
     this.drawnFor = key;
     return true;
   }

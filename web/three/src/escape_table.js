@@ -12,6 +12,7 @@
 // every material of a coat index: internalReflectance(eta) computes it.
 
 import * as THREE from "three";
+import { drawInto } from "./albedo_table.js";
 
 export const ESCAPE_SAMPLES = 256;
 export const HEMISPHERE_SAMPLES = 64;
@@ -140,13 +141,7 @@ export class EscapeTable {
   draw(renderer, roughness) {
     if (roughness === this.drawnFor) return false;
     this.uniforms.u_roughness.value = roughness;
-    const previous = renderer.getRenderTarget();
-    const autoClear = renderer.autoClear;
-    renderer.autoClear = false;
-    renderer.setRenderTarget(this.target);
-    renderer.render(this.scene, this.camera);
-    renderer.setRenderTarget(previous);
-    renderer.autoClear = autoClear;
+    drawInto(renderer, this.target, this.scene, this.camera);
     this.drawnFor = roughness;
     return true;
   }
