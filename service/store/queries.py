@@ -10,14 +10,14 @@ The caller owns the transaction and translates driver errors.
 -   :func:`save`: the body of ``put_fit`` (write-once record, save log,
     summary row, the expected-version check).
 -   :func:`set_metrics`: a stored fit's metrics, evaluated after it was saved.
--   :func:`expire_drafts`: the drafts' sweep (age, then quota, then the
-    n, k records no fit refers to); :func:`get_nk`: an n, k record.
+-   :func:`get_nk`: an n, k record.
 -   :func:`get_text`, :func:`latest_texts`, :func:`latest_ids`,
     :func:`version_of`, :func:`page_rows`, :func:`page_of`,
     :func:`material_row`, :func:`find_material`, :func:`version_texts`,
     :func:`version_text`: the reads.
--   :func:`rename`, :func:`set_deleted`: what an artist changes of a
-    material (its summary row only; records and saves stay as written).
+
+The drafts' sweep is :mod:`service.store.drafts`; renames and the bin are
+:mod:`service.store.material_edits`.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ MAX_VERSIONS_PER_MATERIAL = 10_000
 """The most versions one material keeps; a save past them is refused (507): its history is bounded."""
 
 __all__ = ["save", "set_metrics", "get_nk", "get_text", "latest_texts", "latest_ids", "version_of", "page_rows", "page_of",
-           "expire_drafts", "keep_draft", "material_row", "find_material", "rename", "set_deleted", "version_texts",
+           "material_row", "find_material", "version_texts",
            "version_text", "summary_text", "check_expected", "LISTED_KINDS"]
 
 log = logging.getLogger("service.store")
@@ -258,17 +258,6 @@ def find_material(connection: Any, p: str, kind: str, name: str) -> str | None:
     return None if row is None else row[0]
 
 
-def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
-    """The row of a saved, non-library material: LookupError or ValueError otherwise."""
-    row = material_row(connection, p, material_id)
-    if row is None:
-        raise LookupError(f"`material_id` {material_id!r} is not a saved material")
-    if row.kind == "library":
-        raise ValueError(f"`material_id` {material_id!r} is a built-in material: it cannot be "
-                         "renamed or deleted")
-    return row
-
-
 def _other_holder(connection: Any, p: str, name: str, material_id: str):
     """
     (id, deleted_at, name) of an edited material other than ``material_id``
@@ -290,34 +279,6 @@ def _looks_like(name: str, holder: tuple) -> str:
             f"save to that material under {holder[2]!r}, or choose another name")
 
 
-def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
-    """Inside a write transaction holding the saves' lock: the summary of ``material_id`` renamed."""
-    row = _saved(connection, p, material_id)
-    if row.kind == "curves":  # an edited material is found by its name: names are unique
-        holder = _other_holder(connection, p, name, material_id)
-        if holder is not None and holder[2] != summary_text(name):
-            raise NameTaken(_looks_like(name, holder), version=row.version, latest_fit_id=row.latest_fit_id)
-        if holder is not None:
-            where = " (in the bin)" if holder[1] is not None else ""
-            raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
-                            "choose another name, or rename that one first", version=row.version,
-                            latest_fit_id=row.latest_fit_id)
-    connection.execute(f"UPDATE materials SET name = {p}, name_key = {p} WHERE material_id = {p}",
-                       (summary_text(name), name_key(name), material_id))
-    return material_row(connection, p, material_id)
-
-
-def set_deleted(connection: Any, p: str, material_id: str, deleted: bool) -> MaterialRow:
-    """Inside a write transaction: ``material_id`` moved to the bin (``deleted``) or out of it."""
-    row = _saved(connection, p, material_id)
-    if deleted and row.deleted_at is None:
-        connection.execute(f"UPDATE materials SET deleted_at = {p} WHERE material_id = {p}",
-                           (time.time(), material_id))
-    elif not deleted and row.deleted_at is not None:
-        connection.execute(f"UPDATE materials SET deleted_at = NULL WHERE material_id = {p}", (material_id,))
-    return material_row(connection, p, material_id)
-
-
 _VERSIONS = ("(SELECT ROW_NUMBER() OVER (ORDER BY seq) AS v, fit_id, saved_at FROM saves "
              "WHERE material_id = {p}) t")
 
@@ -336,64 +297,3 @@ def version_text(connection: Any, p: str, material_id: str, version: int) -> tup
     return connection.execute(
         f"SELECT t.fit_id, f.record FROM {_VERSIONS.format(p=p)} JOIN fits f ON f.id = t.fit_id "
         f"WHERE t.v = {p}", (material_id, version)).fetchone()
-
-
-_KEPT_BASES = (
-    "WITH RECURSIVE kept(id) AS (SELECT f.base_fit_id FROM fits f JOIN saves s ON s.fit_id = f.id "
-    "WHERE f.base_fit_id IS NOT NULL UNION SELECT f.base_fit_id FROM fits f JOIN kept ON f.id = kept.id "
-    "WHERE f.base_fit_id IS NOT NULL)")
-"""The fits a saved fit starts from, and those these start from, to any depth: never swept."""
-
-
-def keep_draft(connection: Any, p: str, fit_id: str, until: float) -> float | None:
-    """
-    Inside a write transaction: keep the draft ``fit_id`` at least until
-    ``until`` (a link to it was made) and return when it expires; None for
-    a saved fit or a saved fit's base (never swept); ``LookupError`` when
-    there is no such fit.
-    """
-    found = connection.execute(
-        f"{_KEPT_BASES} SELECT EXISTS (SELECT 1 FROM saves WHERE saves.fit_id = fits.id) "
-        f"OR id IN (SELECT id FROM kept), coalesce(kept_until, 0) FROM fits WHERE id = {p}", (fit_id,)).fetchone()
-    if found is None:
-        raise LookupError(f"fit {fit_id!r} not found (a draft is kept only for its time to live)")
-    if found[0]:
-        return None
-    until = max(until, float(found[1]))
-    connection.execute(f"UPDATE fits SET kept_until = {p} WHERE id = {p}", (until, fit_id))
-    return until
-
-
-def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) -> int:
-    """
-    Inside one write transaction that holds the saves' lock: remove the
-    drafts (records no save refers to, nor a saved fit as its base, nor a
-    draft so kept as its base: :data:`_KEPT_BASES`) created before
-    ``older_than`` and not kept by a link (:func:`keep_draft`) till now or
-    later, then the oldest drafts until those left hold at most
-    ``max_bytes`` (those a link keeps last; a draft's n, k record counted
-    once, with the newest draft that refers to it), then the n, k records
-    no fit refers to; return how many drafts were removed.
-    """
-    now = time.time()
-    rows = connection.execute(
-        f"{_KEPT_BASES} SELECT id, created_at, length(record), nk_id, coalesce(kept_until, 0) FROM fits "
-        "WHERE NOT EXISTS (SELECT 1 FROM saves WHERE saves.fit_id = fits.id) AND id NOT IN (SELECT id FROM kept) "
-        "ORDER BY created_at DESC").fetchall()
-    # Drafts a link keeps come first: past the quota, the others go before them.
-    rows.sort(key=lambda row: row[4] < now)
-    nk_sizes = dict(connection.execute("SELECT id, length(record) FROM nk_records").fetchall())
-    kept, doomed, counted = 0, [], set()
-    for fit_id, created_at, size, nk_id, until in rows:  # newest first: the oldest go past the quota
-        size += nk_sizes.get(nk_id, 0) if nk_id not in counted else 0
-        if (created_at < older_than and until < now) or kept + size > max_bytes:
-            doomed.append((fit_id,))
-        else:
-            kept += size
-            counted.add(nk_id)
-    if doomed:
-        # A cursor's: psycopg's connection has no executemany (the sweep failed on PostgreSQL).
-        connection.cursor().executemany(f"DELETE FROM fits WHERE id = {p}", doomed)
-    connection.execute("DELETE FROM nk_records WHERE NOT EXISTS "
-                       "(SELECT 1 FROM fits WHERE fits.nk_id = nk_records.id)")
-    return len(doomed)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import logging
 from typing import Any, Callable, TypeVar
 
-from . import queries, records
+from . import drafts, material_edits, queries, records
 from .records import FitRecord, MaterialPage, MaterialRow, RecordDamaged, VersionRow
 
 __all__ = ["SQLStore"]
@@ -66,10 +66,10 @@ class SQLStore:
 
     def expire_drafts(self, older_than: float, max_bytes: int) -> int:
         # Under the saves' lock: no save is half done while the sweep runs.
-        return self._write(lambda c: queries.expire_drafts(c, self.placeholder, older_than, max_bytes))
+        return self._write(lambda c: drafts.expire_drafts(c, self.placeholder, older_than, max_bytes))
 
     def keep_draft(self, fit_id: str, until: float) -> float | None:
-        return self._write(lambda c: queries.keep_draft(c, self.placeholder, fit_id, until))
+        return self._write(lambda c: drafts.keep_draft(c, self.placeholder, fit_id, until))
 
     def get_fit(self, fit_id: str) -> FitRecord | None:
         text = self._read(lambda c: queries.get_text(c, self.placeholder, fit_id))
@@ -102,13 +102,13 @@ class SQLStore:
         return self._read(lambda c: queries.find_material(c, self.placeholder, kind, name))
 
     def rename_material(self, material_id: str, name: str) -> MaterialRow:
-        return self._write(lambda c: queries.rename(c, self.placeholder, material_id, name))
+        return self._write(lambda c: material_edits.rename(c, self.placeholder, material_id, name))
 
     def delete_material(self, material_id: str) -> MaterialRow:
-        return self._write(lambda c: queries.set_deleted(c, self.placeholder, material_id, True))
+        return self._write(lambda c: material_edits.set_deleted(c, self.placeholder, material_id, True))
 
     def restore_material(self, material_id: str) -> MaterialRow:
-        return self._write(lambda c: queries.set_deleted(c, self.placeholder, material_id, False))
+        return self._write(lambda c: material_edits.set_deleted(c, self.placeholder, material_id, False))
 
     def material_versions(self, material_id: str, before: int | None, limit: int) -> list[VersionRow]:
         rows = self._read(lambda c: queries.version_texts(c, self.placeholder, material_id, before, limit))
