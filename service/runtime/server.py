@@ -37,9 +37,10 @@ client cannot get past:
     ``limit_concurrency`` is off: past it uvicorn answered 503 to
     ``/healthz`` too;
 -   the keep-alive timeout (``keep_alive_s``);
--   :class:`OncePerInterval`: repeated warnings of a flood (slow clients
-    closed, the concurrency limit, invalid requests) are logged once, then
-    counted once a minute, so a flood cannot grow the log.
+-   :class:`service.runtime.flood_log.OncePerInterval`: repeated warnings
+    of a flood (slow clients closed, the concurrency limit, invalid
+    requests) are logged once, then counted once a minute, so a flood
+    cannot grow the log.
 
 This module is the one adapter to uvicorn's internals (its h11 protocol's
 hooks and state, :data:`UVICORN_PRIVATE`); :func:`uvicorn_mismatches` says
@@ -63,7 +64,6 @@ import json
 import logging
 import signal
 import threading
-import time
 
 import h11
 import uvicorn
@@ -72,8 +72,9 @@ from uvicorn.protocols.http.h11_impl import H11Protocol, RequestResponseCycle
 
 from ..config import Settings
 from .admission import BODY_GRACE_S, HEALTH_RESERVE, IDLE_GRACE_S, Admission
+from .flood_log import OVER_BOUND, SLOW_BODY, SLOW_CLIENT, OncePerInterval
 
-__all__ = ["DeadlineH11Protocol", "OncePerInterval", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
+__all__ = ["DeadlineH11Protocol", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
            "HEALTH_RESERVE", "IDLE_GRACE_S", "BODY_GRACE_S", "UVICORN_PRIVATE", "uvicorn_mismatches"]
 
 UVICORN_PRIVATE = {
@@ -119,41 +120,6 @@ def _raw_answer(transport: asyncio.Transport, status: bytes, body: bytes, extra:
     transport.write(b"HTTP/1.1 " + status + b"\r\ncontent-type: application/json\r\ncontent-length: "
                     + str(len(body)).encode() + b"\r\nconnection: close\r\n" + extra + b"\r\n" + body)
     transport.close()
-SLOW_CLIENT = "closed a connection whose request header did not arrive within %g s (COATED_HEADER_TIMEOUT_S)"
-OVER_BOUND = ("closed a connection past the connection bound that sent no request within %g s "
-              "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT)")
-SLOW_BODY = "answered 408 to a request whose body arrived slower than %g bytes per second (COATED_MIN_BODY_RATE)"
-
-
-class OncePerInterval(logging.Filter):
-    """
-    Let the first record of each repeated message through, drop the rest
-    for ``interval_s``, then let one through with the count of those dropped.
-    """
-
-    MESSAGES = ("Exceeded concurrency limit.", "Invalid HTTP request received.", SLOW_CLIENT, OVER_BOUND, SLOW_BODY)
-
-    def __init__(self, interval_s: float = 60.0) -> None:
-        super().__init__()
-        self.interval_s = interval_s
-        self._lock = threading.Lock()
-        self._state: dict[str, tuple[float, int]] = {}
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        if record.msg not in self.MESSAGES:
-            return True
-        now = time.monotonic()
-        with self._lock:
-            last, dropped = self._state.get(record.msg, (-1e18, 0))
-            if now - last < self.interval_s:
-                self._state[record.msg] = (last, dropped + 1)
-                return False
-            self._state[record.msg] = (now, 0)
-        if dropped:
-            record.msg = f"{record.msg} ({dropped} more like it in the last {self.interval_s:g} s)"
-        return True
-
-
 class DeadlineH11Protocol(H11Protocol):
     """uvicorn's h11 protocol with a deadline on each request's header, a minimum body rate and admission."""
 
