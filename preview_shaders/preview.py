@@ -38,7 +38,9 @@ radius 0.45 size; pixel (x, y) (top row first) has its centre at
 cos theta = N.z = sqrt(1 - r^2) with r the distance from the centre over the
 radius.
 
--   :data:`COMPARISONS`, :data:`ENVIRONMENTS`: the accepted values.
+-   :data:`COMPARISONS`, :data:`ENVIRONMENTS`: the accepted values (and
+    their checks, and the sphere's geometry: :mod:`preview_shaders.views`,
+    re-exported).
 -   :class:`PreviewRenderer`, :class:`PreviewResult`.
 -   :func:`reference_image`, :func:`reference_table`, :func:`difference_maps`:
     the spectral reference of a view and the maps against it
@@ -58,7 +60,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fitting.domain import ETA_I_MAX, ETA_I_MIN, check_eta_i
 from fitting.models.baselines import baseline_inputs
 from fitting.models.kinds import model_kind
 from fitting.models.pack import PackedMaterial
@@ -68,6 +69,8 @@ from .gl import GLState, RenderThread, check_gl_error, read_float_target
 from .kinds import PREVIEW_MODEL_FILE, padded_words, preview_model_source, preview_words
 from .reference import (REFERENCE_TABLE_SIZE, REFERENCE_TABLE_TOLERANCE, difference_maps, reference_image,
                         reference_table)
+from .views import (COMPARISONS, ENVIRONMENTS, ETA_I_LIMITS, MODES, SIZE_RANGE, SPHERE_RADIUS, _check_choice,
+                    _check_eta_i, _check_size, _check_unit, sphere_cos_theta)
 
 __all__ = [
     "COMPARISONS",
@@ -86,57 +89,6 @@ __all__ = [
     "sphere_cos_theta",
     "padded_words",
 ]
-
-COMPARISONS = ("none", "lazanyi", "reference")
-MODES = ("immersed", "coated")
-ENVIRONMENTS = ("white_sky", "studio", "outdoor")
-SIZE_RANGE = (64, 2048)
-ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
-SPHERE_RADIUS = 0.45
-"""Sphere radius as a fraction of the image size."""
-
-
-def _check_size(size) -> int:
-    if isinstance(size, bool) or not isinstance(size, (int, np.integer)):
-        raise ValueError(f"`size` must be an integer in [64, 2048], got {size!r}")
-    if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
-        raise ValueError(f"`size` must lie in [64, 2048], got {size}")
-    return int(size)
-
-
-def _check_eta_i(eta_i) -> float:
-    return check_eta_i(eta_i)
-
-
-def _check_unit(name: str, value) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"`{name}` must be a number in [0, 1], got {value!r}")
-    value = float(value)
-    if not (np.isfinite(value) and 0.0 <= value <= 1.0):
-        raise ValueError(f"`{name}` must lie in [0, 1], got {value}")
-    return value
-
-
-def _check_choice(name: str, value, choices) -> str:
-    if value not in choices:
-        raise ValueError(f"`{name}` must be one of {', '.join(choices)}, got {value!r}")
-    return value
-
-
-def sphere_cos_theta(size: int) -> tuple[np.ndarray, np.ndarray]:
-    """
-    cos theta per pixel (top row first) and the sphere mask, from the
-    geometry in float64 (the module docstring gives the geometry).
-    """
-    size = _check_size(size)
-    centre = 0.5 * size
-    radius = SPHERE_RADIUS * size
-    x = (np.arange(size) + 0.5 - centre) / radius
-    y = (size - np.arange(size) - 0.5 - centre) / radius
-    r2 = x[None, :] ** 2 + y[:, None] ** 2
-    mask = r2 < 1.0
-    return np.where(mask, np.sqrt(np.clip(1.0 - r2, 0.0, 1.0)), 0.0), mask
-
 
 @dataclass
 class PreviewResult:
