@@ -37,20 +37,20 @@ to adjusted Lazanyi and per pixel. CPU cost: numpy evaluation per sample
 Bytes: per material as a renderer stores it.
 
 Split sum: ``benchmarks/speed_vs_error_split_sum.py`` (the albedo through the
-LUT against the albedo with the spectral Fresnel). Tables and figures:
-``benchmarks/speed_vs_error_report.py``.
+LUT against the albedo with the spectral Fresnel). Tables:
+``benchmarks/speed_vs_error_report.py``; figures:
+``benchmarks/speed_vs_error_figures.py``.
 
-Fitting settings: the grid size (cos theta x eta_i samples, Gauss-Legendre or
-uniform), the spectral step
-of the fitting reference and the objective, in full cross product; for each,
-the summed fit time of the 22 conductors and their mean float16 Delta E.
+Fitting settings (``benchmarks/speed_vs_error_fit_settings.py``): the grid
+size (cos theta x eta_i samples, Gauss-Legendre or uniform), the spectral
+step of the fitting reference and the objective, in full cross product; for
+each, the summed fit time of the 22 conductors and their mean float16 Delta E.
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
-import itertools
 import sys
 import time
 from pathlib import Path
@@ -60,16 +60,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.speed_vs_error_figures import figure_batch, figure_speed_vs_error  # noqa: E402
+from benchmarks.speed_vs_error_fit_settings import print_fit_settings  # noqa: E402
 from benchmarks.speed_vs_error_report import (  # noqa: E402
     batch_table,
     error_summary,
-    figure_batch,
-    figure_fit_settings,
-    figure_speed_vs_error,
     kinds_table,
     load_average,
     models_table,
-    pareto_front,
     read_batch_report,
     run_header,
     split_sum_table_lines,
@@ -89,7 +87,6 @@ from fitting.colour.reference import evaluation_grid, reference_ACEScg, spectral
 from fitting.fits.kinds import fit_model  # noqa: E402
 from fitting.fits.material import fit_material  # noqa: E402
 from fitting.fits.rgb_conductor import rgb_nk  # noqa: E402
-from fitting.fits.settings import OBJECTIVES, FitSettings  # noqa: E402
 from fitting.models.baselines import baseline_inputs, lazanyi_adjusted, schlick  # noqa: E402
 from fitting.models.coated_conductor import (  # noqa: E402
     coated_conductor_model,
@@ -240,36 +237,6 @@ def model_table() -> dict[str, dict]:
     return {model: error_summary({m: per_material[m][model] for m in LIBRARY_NAMES}) for model in MODELS}
 
 
-def fit_settings_table():
-    grids = [(8, 3, "gauss"), (12, 4, "gauss"), (16, 6, "gauss"), (24, 8, "gauss"),
-             (16, 6, "uniform"), (24, 7, "uniform")]
-    steps = [1.0, 5.0, 10.0, 20.0]
-    references = {}
-    M, E = evaluation_grid(GRID)
-    for name in LIBRARY_NAMES:
-        references[name] = reference_ACEScg(library_material(name), M, E)
-    rows = []
-    for (mu_n, eta_n, kind), step, objective in itertools.product(grids, steps, OBJECTIVES):
-        settings = FitSettings(mu_samples=mu_n, eta_samples=eta_n, grid=kind, step_nm=step,
-                               objective=objective)
-        seconds, errors = 0.0, []
-        for name in LIBRARY_NAMES:
-            fit = fit_material(library_material(name), settings=settings)
-            seconds += fit.timings["total"]
-            model = coated_conductor_model(M, E, fit.coefficients_float16)
-            errors.append(float(delta_E_map(references[name], model).mean()))
-        rows.append({
-            "grid": f"{mu_n}x{eta_n} {kind}", "step_nm": step, "objective": objective,
-            "seconds": seconds, "mean": float(np.mean(errors)), "max_mean": float(np.max(errors)),
-            "default": settings == FitSettings(),
-        })
-    return rows
-
-
-def _key(row) -> str:
-    return f"{row['grid']} {row['step_nm']:g} nm {row['objective']}"
-
-
 def _kind_rows(rows, cpu, shader, models, split, split_costs) -> list[dict]:
     """The model kinds (and adjusted Lazanyi, the yardstick) for :func:`kinds_table`."""
     out = []
@@ -364,25 +331,7 @@ def main() -> None:
     if args.models_only:
         print(f"\nRun time: {time.perf_counter() - t0:.0f} s; load average at the end {load_average()}")
         return
-    fit_rows = fit_settings_table()
-    fit_front = pareto_front({_key(r): (r["seconds"], r["mean"]) for r in fit_rows})
-    print(f"\n## Fitting settings: fit time against error, {len(LIBRARY_NAMES)} conductors\n")
-    print("| grid (cos theta x eta_i) | step (nm) | objective | fit time per conductor (ms) "
-          "| mean dE (f16) | worst conductor mean dE | on front |")
-    print("|---|---:|---|---:|---:|---:|---|")
-    for r in sorted(fit_rows, key=lambda r: r["seconds"]):
-        name = _key(r)
-        mark = " **(default)**" if r["default"] else ""
-        print(f"| {r['grid']}{mark} | {r['step_nm']:g} | {r['objective']} | "
-              f"{r['seconds'] / len(LIBRARY_NAMES) * 1e3:.1f} | {r['mean']:.4f} | {r['max_mean']:.3f} | "
-              f"{'yes' if name in fit_front else ''} |")
-    default = next(r for r in fit_rows if r["default"])
-    print(f"\nDefault setting ({_key(default)}) on the front: "
-          f"**{'yes' if _key(default) in fit_front else 'no'}**")
-    if args.figure:
-        figure_fit_settings(IMAGES / "speed_vs_error_fit_settings.png", fit_rows, fit_front, _key,
-                            len(LIBRARY_NAMES))
-        print("\nwrote docs/images/speed_vs_error_fit_settings.png")
+    print_fit_settings(GRID, IMAGES if args.figure else None)
     print(f"\n(total {time.perf_counter() - t0:.0f} s; load average at the end {load_average()})")
 
 

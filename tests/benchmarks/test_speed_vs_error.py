@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 
 from benchmarks import speed_vs_error as sve
+from benchmarks.speed_vs_error_figures import figure_batch
 from benchmarks.speed_vs_error_report import (
     BATCH_BINS,
     batch_cell,
     batch_rows,
     batch_table,
     error_summary,
-    figure_batch,
     kinds_table,
     models_table,
     pareto_front,
