@@ -26,7 +26,8 @@ Delta E stopped at their cap of 100 (60) short of it.
 
 -   :func:`fit_channel_conductor`, :func:`fit_channel_f82`,
     :func:`fit_channel_schlick`: per-channel least squares of a base
-    Fresnel to a curve (also the naive fits under the coat).
+    Fresnel to a curve (also the naive fits under the coat;
+    :mod:`fitting.exports.channel_fit`, re-exported).
 -   :func:`layer_only`: the tool's layering over a free base response.
 -   :func:`floor_base`, :func:`tool_floor`: the best base response per angle
     in [0, 1] and its Delta E (the tool's floor: a perfect base under its layering).
@@ -41,11 +42,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..colour.delta_e import delta_E_map
-from ..optics.fresnel import fresnel_conductor, fresnel_dielectric
+from ..optics.fresnel import fresnel_dielectric
+from .channel_fit import fit_channel_conductor, fit_channel_f82, fit_channel_schlick, least_squares
 from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, working_to_ACEScg
 from .gltf_fallback import gltf_clearcoat_floor
 from .seen_jacobian import DeltaEComponents, delta_E_jacobian
-from .tool_fresnel import F82_COS_THETA, f82_tint, schlick
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
 __all__ = [
@@ -58,79 +59,6 @@ __all__ = [
 VIEW_DEPENDENT_MAX_NFEV = 60  # a cap: the solves stop by their tolerances in about 25-40
 _SLOPE_ZERO = 1e-6
 MEAN_OBJECTIVE = False  # RMS: measured no better on the mean for W, CuZn, and a larger max
-_TOL = dict(xtol=1e-12, ftol=1e-12, gtol=1e-12)
-
-
-def least_squares(*args, **kwargs):
-    """scipy's ``least_squares``, imported on first use: the export writers are imported by every
-    ``python -m fitting`` command (the CLI's choices come from the format registry), most of which fit
-    nothing here."""
-    from scipy.optimize import least_squares as solve
-
-    return solve(*args, **kwargs)
-
-
-def _conductor_jacobian(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """
-    (S, 2) derivative of the conductor's Fresnel in n and k at ``x``:
-    central differences (step 1e-6 max(1, |x|), one-sided at a bound) of
-    the closed form, the four points in one call.
-    """
-    lo, hi = np.array([N_BOUNDS[0], K_BOUNDS[0]]), np.array([N_BOUNDS[1], K_BOUNDS[1]])
-    h = 1e-6 * np.maximum(1.0, np.abs(x))
-    up, down = np.minimum(x + h, hi), np.maximum(x - h, lo)
-    n = np.array([up[0], down[0], x[0], x[0]])
-    k = np.array([x[1], x[1], up[1], down[1]])
-    R = fresnel_conductor(mu[:, None], 1.0, n, k)
-    return np.stack([(R[:, 0] - R[:, 1]) / (up[0] - down[0]), (R[:, 2] - R[:, 3]) / (up[1] - down[1])], axis=1)
-
-
-def _f82_jacobian(mu: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """(S, 2) derivative of :func:`f82_tint` in F0 and the tint (bilinear in them), exact."""
-    m = F82_COS_THETA
-    w = (1.0 - mu) ** 5
-    u = mu * (1.0 - mu) ** 6 / (m * (1.0 - m) ** 6)
-    Sm = x[0] + (1.0 - x[0]) * (1.0 - m) ** 5
-    return np.stack([1.0 - w - u * (1.0 - (1.0 - m) ** 5) * (1.0 - x[1]), u * Sm], axis=1)
-
-
-def fit_channel_conductor(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per channel, n + i k of an exact conductor in air whose Fresnel is nearest ``T`` (S, 3)."""
-    n_out, k_out = np.empty(3), np.empty(3)
-    lo, hi = [N_BOUNDS[0], K_BOUNDS[0]], [N_BOUNDS[1], K_BOUNDS[1]]
-    for c in range(3):
-        R = T[:, c]
-        # At normal incidence with n = 1, R = k^2 / (4 + k^2): a start from F0.
-        F0 = float(np.clip(R[np.argmax(mu)], 0.0, 0.999))
-        x0 = np.clip([1.0, np.sqrt(4.0 * F0 / (1.0 - F0))], lo, hi)
-        fit = least_squares(
-            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R, x0, jac=lambda x: _conductor_jacobian(mu, x),
-            bounds=(lo, hi), method="trf", **_TOL,
-        )
-        n_out[c], k_out[c] = fit.x
-    return n_out, k_out
-
-
-def fit_channel_f82(mu: np.ndarray, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per channel, F0 and F82 tint in [0, 1] of the F82-tint model nearest ``T``."""
-    F0, tint = np.empty(3), np.empty(3)
-    for c in range(3):
-        R = T[:, c]
-        x0 = np.clip([R[np.argmax(mu)], 1.0], 0.0, 1.0)
-        fit = least_squares(
-            lambda x: f82_tint(mu, x[0], x[1]) - R, x0, jac=lambda x: _f82_jacobian(mu, x),
-            bounds=([0.0, 0.0], [1.0, 1.0]), method="trf", **_TOL,
-        )
-        F0[c], tint[c] = fit.x
-    return F0, tint
-
-
-def fit_channel_schlick(mu: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """Schlick's F0 nearest ``T`` in least squares, closed form, clipped to [0, 1]."""
-    # Schlick is linear in F0: F - w = F0 (1 - w) with w = (1 - mu)^5.
-    w = schlick(mu, 0.0)[:, None]
-    F0 = np.sum((1.0 - w) * (T - w), axis=0) / np.sum((1.0 - w) ** 2)
-    return np.clip(F0, 0.0, 1.0)
 
 
 def layer_only(tool: str, mu, eta: float, base, coat: bool = True, clearcoat: float = 1.0) -> np.ndarray:

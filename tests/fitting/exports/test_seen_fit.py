@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from fitting.colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
-from fitting.exports import export_material, export_values, seen_fit
+from fitting.exports import channel_fit, export_material, export_values, seen_fit
 from fitting.exports.seen_fit import (
     K_BOUNDS, N_BOUNDS, fit_tool_values, gltf_clearcoat_factor, layer_only, seen_delta_E,
     seen_fidelity, tool_floor,
@@ -189,8 +189,8 @@ def test_the_channel_fits_jacobians():
     h = 1e-7
     for x in (np.array([0.3, 0.7]), np.array([0.95, 0.1])):
         fd = np.stack([(f82_tint(mu, *(x + h * e)) - f82_tint(mu, *(x - h * e))) / (2 * h) for e in np.eye(2)], 1)
-        assert np.abs(seen_fit._f82_jacobian(mu, x) - fd).max() < 1e-7
+        assert np.abs(channel_fit._f82_jacobian(mu, x) - fd).max() < 1e-7
     for x in (np.array([0.3, 3.0]), np.array([1.5, 0.2])):
         fd = np.stack([(fresnel_conductor(mu, 1.0, *(x + h * e)) - fresnel_conductor(mu, 1.0, *(x - h * e))) / (2 * h)
                        for e in np.eye(2)], 1)
-        assert np.abs(seen_fit._conductor_jacobian(mu, x) - fd).max() < 1e-6
+        assert np.abs(channel_fit._conductor_jacobian(mu, x) - fd).max() < 1e-6
