@@ -26,7 +26,7 @@ class TestProblem:
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
     @pytest.mark.parametrize("weighted", [False, True])
     def test_residuals_jacobian_is_both_in_one_pass(self, objective, weighted):
-        # The one pass (SLSQP's evaluation in fitting/fits/guarded.py) computes
+        # The one pass (SLSQP's evaluation in fitting/fits/constrained.py) computes
         # Eq. 1, Lab and its derivative in another order than residuals() and
         # jacobian(): a few roundings of values up to ~100 (Lab) times the
         # CIEDE2000 weights: 1e-11 absolute (2^-53 * 100 * 16 = 1.8e-13 per
@@ -45,7 +45,7 @@ class TestProblem:
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
     @pytest.mark.parametrize("weighted", [False, True])
     def test_deferred_jacobian_is_the_one_pass_to_the_bit(self, objective, weighted):
-        # SLSQP's line-search points take the values alone (fitting/fits/guarded.py):
+        # SLSQP's line-search points take the values alone (fitting/fits/constrained.py):
         # the same operations on the same values, so exactly the one pass's.
         mu, eta, _ = fit_grid((1.0, 2.5), 16, 5, "uniform")
         target = coated_conductor_model(mu, eta, KNOWN) * 0.97
