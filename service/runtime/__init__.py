@@ -11,13 +11,18 @@ Where the service's work runs, off the event loop, in processes of its own:
     for cancelled, a dead worker's jobs retried once and then alone, a job
     that kills a worker alone quarantined by its content id;
 -   :class:`PreviewRunner`, the render pool: previews and GL textures in
-    render processes, each with its own GL context (:func:`renderer`);
+    render processes, each with its own GL context (:func:`renderer`); a
+    preview's CPU budget proportional to its estimated cost, one whose
+    estimate passes the limit refused up front (:class:`RenderTooCostly`),
+    one past its budget stopped (:class:`RenderBudgetExceeded`), and each
+    client's previews admitted by their estimates;
 -   the errors they raise, which ``service.api.errors`` maps to statuses:
     :class:`Overloaded` and :class:`PreviewsBusy` (503), :class:`FitTimeout`
     and :class:`PreviewTimeout` (504), :class:`WorkerLost`,
     :class:`WorkersNotStarted`, :class:`Quarantined`, :class:`RenderWorkerLost`
-    and :class:`RendererUnavailable` (503), :class:`JobCPULimit` and
-    :class:`JobBudgetExceeded` (422);
+    and :class:`RendererUnavailable` (503), :class:`JobCPULimit`,
+    :class:`JobBudgetExceeded`, :class:`RenderTooCostly` and
+    :class:`RenderBudgetExceeded` (422);
 -   the fair shares of the fitting pool (:class:`Shares`): each job's
     :class:`Claim` (its client and kind, set per request in :data:`CLAIM`),
     :class:`ShareExceeded` (503) past a client's share, and the saves per
@@ -41,7 +46,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .budget import BUDGET_FACTOR, JobBudgetExceeded
+from .budget import BUDGET_FACTOR, JobBudgetExceeded, RenderBudgetExceeded, RenderTooCostly
 from .pool import FitRunner, FitTimeout, Overloaded, Quarantined, WorkerLost, WorkersNotStarted
 from .previews import PreviewRunner, PreviewsBusy, PreviewTimeout, RenderWorkerLost
 from .render_worker import RendererUnavailable, renderer
@@ -51,7 +56,7 @@ from .worker import JobCPULimit, freeze_heap, thaw_heap, warm_process
 __all__ = [
     "FitRunner", "PreviewRunner",
     "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
-    "JobBudgetExceeded", "BUDGET_FACTOR",
+    "JobBudgetExceeded", "BUDGET_FACTOR", "RenderTooCostly", "RenderBudgetExceeded",
     "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
     "Shares", "Claim", "CLAIM", "ShareExceeded", "SaveRate", "TooManySaves",
     "renderer", "warm_process", "freeze_heap", "thaw_heap", "start_fork_server", "serve",

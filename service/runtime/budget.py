@@ -19,6 +19,13 @@ rough; its limit is the part limit, as before).
     parts (a scene's first failure cancels the rest).
 -   :func:`run_part_timed`: in a worker, a part and the CPU time it used;
     :func:`part_limit` and :func:`charged`: the pool's side of a part.
+
+A render (a preview, one part) has a budget the same way:
+:func:`render_budget_s` is :data:`BUDGET_FACTOR` times its estimated CPU
+seconds, at least :data:`RENDER_BUDGET_FLOOR_S` and at most the CPU-time
+limit of a job; a render whose estimate alone passes that limit is refused
+before it starts (:class:`RenderTooCostly`, 422 naming the limit), and one
+that uses its budget is stopped (:class:`RenderBudgetExceeded`, 422).
 """
 
 from __future__ import annotations
@@ -30,7 +37,19 @@ from typing import Any, Awaitable, Callable
 
 from .worker import JobCPULimit, run_part
 
-__all__ = ["BUDGET_FACTOR", "BUDGET", "JobBudget", "JobBudgetExceeded", "run_part_timed", "part_limit", "charged"]
+__all__ = [
+    "BUDGET_FACTOR",
+    "BUDGET",
+    "JobBudget",
+    "JobBudgetExceeded",
+    "run_part_timed",
+    "part_limit",
+    "charged",
+    "RENDER_BUDGET_FLOOR_S",
+    "render_budget_s",
+    "RenderTooCostly",
+    "RenderBudgetExceeded",
+]
 
 BUDGET_FACTOR = 3.0
 """A job may use this many times its estimated CPU seconds (a 64 x 32 scene: 2,048 parts of 0.03 s, 184 s)."""
@@ -105,3 +124,49 @@ async def charged(answer: Awaitable[tuple[float, Any]], budget: JobBudget | None
     if budget is not None:
         budget.charge(cpu_s)
     return result
+
+
+RENDER_BUDGET_FLOOR_S = 2.0
+"""A render's budget at least (the first render of a view in a render process also compiles its
+program and prefilters its environment: at most 0.45 CPU s more in benchmarks/results/render_cost.json)."""
+
+
+class RenderTooCostly(ValueError):
+    """A render whose estimated CPU seconds pass the CPU-time limit of a job, refused before it starts (422)."""
+
+    def __init__(self, estimate_s: float, limit_s: float) -> None:
+        super().__init__(
+            f"this render is estimated at {estimate_s:.1f} s of CPU, more than the CPU-time limit of a job, "
+            f"{limit_s:g} s (COATED_JOB_CPU_LIMIT_S); ask for a smaller `size` or a smooth view"
+        )
+        self.estimate_s, self.limit_s = estimate_s, limit_s
+
+    def __reduce__(self):
+        return RenderTooCostly, (self.estimate_s, self.limit_s)
+
+
+class RenderBudgetExceeded(ValueError):
+    """A render used its CPU budget and was stopped (422); its render process serves the next one."""
+
+    def __init__(self, budget_s: float, estimate_s: float) -> None:
+        super().__init__(
+            f"the render used its CPU budget of {budget_s:.1f} s ({BUDGET_FACTOR:g} x its estimated "
+            f"{estimate_s:.2f} s, at least {RENDER_BUDGET_FLOOR_S:g} s, at most COATED_JOB_CPU_LIMIT_S) and was "
+            "stopped; ask for a smaller `size`"
+        )
+        self.budget_s, self.estimate_s = budget_s, estimate_s
+
+    def __reduce__(self):
+        return RenderBudgetExceeded, (self.budget_s, self.estimate_s)
+
+
+def render_budget_s(estimate_s: float, cpu_limit_s: float) -> float:
+    """
+    The CPU seconds a render estimated at ``estimate_s`` may use:
+    ``BUDGET_FACTOR x estimate_s``, within [``RENDER_BUDGET_FLOOR_S``,
+    ``cpu_limit_s``]; :class:`RenderTooCostly` when the estimate alone
+    passes ``cpu_limit_s``.
+    """
+    if estimate_s > cpu_limit_s:
+        raise RenderTooCostly(estimate_s, cpu_limit_s)
+    return min(cpu_limit_s, max(RENDER_BUDGET_FLOOR_S, BUDGET_FACTOR * estimate_s))

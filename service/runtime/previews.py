@@ -33,6 +33,15 @@ Bounds and budgets:
 -   A request waits at most ``timeout_s`` (``COATED_PREVIEW_TIMEOUT_S``;
     :class:`PreviewTimeout`); each job may use ``cpu_limit_s`` of CPU
     (``COATED_JOB_CPU_LIMIT_S``; :class:`service.runtime.worker.JobCPULimit`, 422).
+-   A preview comes with its estimated CPU seconds (``cost_s``): its budget
+    is proportional to it (:func:`service.runtime.budget.render_budget_s`:
+    :class:`~service.runtime.budget.RenderBudgetExceeded`, 422, past it; the
+    process stays and serves the next job), and one whose estimate passes
+    ``cpu_limit_s`` is refused before it starts
+    (:class:`~service.runtime.budget.RenderTooCostly`, 422). A client's
+    previews in flight are admitted by their estimates: past its first,
+    together at most ``client_cost_s`` (``COATED_JOB_CPU_LIMIT_S``), or
+    :class:`PreviewsBusy` (503) while other clients keep their places.
 -   A job no request waits for any more (each timed out, or its client
     went away: :class:`service.api.middleware.RequestLimits` cancels the
     request) is cancelled: its process checks every 0.1 s
@@ -67,10 +76,12 @@ from typing import Any, Callable
 
 from . import executors
 from .fork_server import START_ERRORS, fork_server_exited
+from .budget import RenderBudgetExceeded, render_budget_s
 from .pool import FitTimeout, Overloaded, WorkerLost
 from .render_worker import RendererUnavailable, render_worker_start, run_render_part
 from .flights import CancelRing, Flights
-from .worker import process_context
+from .shares import CLAIM
+from .worker import JobCPULimit, process_context
 
 __all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
            "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
@@ -139,12 +150,15 @@ class PreviewRunner:
     """
 
     def __init__(self, workers: int, timeout_s: float, cpu_limit_s: float,
-                 texture_queue: int = TEXTURE_QUEUE, cancel_grace_s: float = CANCEL_GRACE_S) -> None:
+                 texture_queue: int = TEXTURE_QUEUE, cancel_grace_s: float = CANCEL_GRACE_S,
+                 client_cost_s: float | None = None) -> None:
         if workers < 1:
             raise ValueError(f"`workers` must be >= 1, got {workers}")
         self.workers = workers
         self.timeout_s = timeout_s
         self.cpu_limit_s = cpu_limit_s
+        self.client_cost_s = cpu_limit_s if client_cost_s is None else client_cost_s
+        self._by_client: dict[str, tuple[int, float]] = {}  # client -> (previews in flight, their estimate)
         self.texture_queue = texture_queue
         self.cancel_grace_s = cancel_grace_s
         self._context = process_context()
@@ -193,25 +207,38 @@ class PreviewRunner:
         # Jobs queued behind it fail with the process (BrokenProcessPool: 503), not as cancelled.
         process.executor.shutdown(wait=False)
 
-    def _admit(self, what: str) -> None:
-        """Take a place of ``what`` ("preview" | "texture") or refuse (:class:`PreviewsBusy`)."""
+    def _admit(self, what: str, client: str, cost_s: float) -> None:
+        """Take a place of ``what`` ("preview" | "texture") for ``client``'s job of ``cost_s``
+        estimated CPU seconds, or refuse (:class:`PreviewsBusy`)."""
         limit = self.workers if what == "preview" else self.texture_queue
         with self._lock:
+            waves = math.ceil(max(self._counts["preview"], 1) / self.workers)
+            retry = max(1, math.ceil(waves * self._mean_s))
             if self._counts[what] >= limit:
-                waves = math.ceil(max(self._counts["preview"], 1) / self.workers)
-                retry = max(1, math.ceil(waves * self._mean_s))
                 raise PreviewsBusy(retry, (
                     f"{limit} previews are being rendered (COATED_MAX_PREVIEWS_IN_FLIGHT)" if what == "preview"
                     else f"{limit} textures are waiting for a render process"))
+            held, cost = self._by_client.get(client, (0, 0.0))
+            if what == "preview" and held and cost + cost_s > self.client_cost_s:
+                raise PreviewsBusy(retry, (
+                    f"this client's previews in flight are estimated at {cost:.1f} s of CPU; with this one's "
+                    f"{cost_s:.1f} s they would pass its share, {self.client_cost_s:g} s (COATED_JOB_CPU_LIMIT_S)"))
             self._counts[what] += 1
+            if what == "preview":
+                self._by_client[client] = (held + 1, cost + cost_s)
 
-    def _leave(self, what: str, started: float | None = None) -> None:
+    def _leave(self, what: str, started: float | None = None, share: tuple[str, float] = ("", 0.0)) -> None:
         with self._lock:
             self._counts[what] -= 1
+            if what == "preview":
+                held, cost = self._by_client.pop(share[0], (1, 0.0))
+                if held > 1:
+                    self._by_client[share[0]] = (held - 1, max(0.0, cost - share[1]))
             if started is not None and what == "preview":
                 self._mean_s = 0.8 * self._mean_s + 0.2 * (time.perf_counter() - started)
 
-    async def _job(self, what: str, function: Callable[..., Any], args: tuple, submitted: list) -> Any:
+    async def _job(self, what: str, function: Callable[..., Any], args: tuple, submitted: list,
+                   share: tuple[str, float], budget_s: float) -> Any:
         """
         One job in a render process; its place is left when its process is
         free of it (before it was submitted: when its task ends, :meth:`_once`).
@@ -224,7 +251,7 @@ class PreviewRunner:
         try:
             if process.pid is None:  # the process starts (with its GL context) and says who it is
                 process.pid = await asyncio.wrap_future(process.executor.submit(os.getpid))
-            future = process.executor.submit(run_render_part, serial, self.cpu_limit_s, function, *args)
+            future = process.executor.submit(run_render_part, serial, budget_s, function, *args)
         except BaseException as error:
             self._end_job(process)
             if isinstance(error, START_ERRORS):
@@ -244,7 +271,7 @@ class PreviewRunner:
             self._running.pop(serial, None)
             self._end_job(process)
             failed = f.cancelled() or f.exception() is not None
-            self._leave(what, None if failed else started)
+            self._leave(what, None if failed else started, share)
             if not f.cancelled() and isinstance(f.exception(), BrokenProcessPool):
                 self._break(process)
 
@@ -253,6 +280,10 @@ class PreviewRunner:
             return await executors.result(process.executor, future)  # stuck on a killed process's result: broken
         except BrokenProcessPool:
             raise RenderWorkerLost() from None
+        except JobCPULimit:
+            if budget_s >= self.cpu_limit_s:
+                raise
+            raise RenderBudgetExceeded(budget_s, share[1]) from None
         except asyncio.CancelledError:
             self._cancels.cancel(serial, future)
             asyncio.get_running_loop().call_later(self.cancel_grace_s, self._stop_if_running, process, future)
@@ -267,18 +298,24 @@ class PreviewRunner:
                     self.cancel_grace_s)
         self._break(process, kill=True)
 
-    async def _once(self, what: str, key: tuple, function: Callable[..., Any], args: tuple) -> Any:
-        """``function(*args)`` as one job shared by the calls with ``key``, within the time limit."""
+    async def _once(self, what: str, key: tuple, function: Callable[..., Any], args: tuple,
+                    cost_s: float | None = None) -> Any:
+        """
+        ``function(*args)`` as one job shared by the calls with ``key``, within the time limit;
+        with ``cost_s`` (estimated CPU seconds) its budget proportional to it, else the CPU-time limit.
+        """
         key = (what, *key)
+        budget_s = self.cpu_limit_s if cost_s is None else render_budget_s(cost_s, self.cpu_limit_s)
 
         def start() -> asyncio.Task:
-            self._admit(what)
+            share = (CLAIM.get().client, cost_s or 0.0)
+            self._admit(what, *share)
             submitted: list[int] = []
-            task = asyncio.ensure_future(self._job(what, function, args, submitted))
+            task = asyncio.ensure_future(self._job(what, function, args, submitted, share, budget_s))
 
             def finished(t: asyncio.Task) -> None:
                 if not submitted:  # cancelled or refused before its process had it
-                    self._leave(what)
+                    self._leave(what, None, share)
 
             task.add_done_callback(finished)
             return task
@@ -286,15 +323,19 @@ class PreviewRunner:
         task = self._flights.start(key, start)
         return await self._flights.join(key, task, self.timeout_s, lambda: PreviewTimeout(self.timeout_s))
 
-    async def preview(self, key: tuple, function: Callable[..., Any], *args: Any) -> Any:
+    async def preview(self, key: tuple, function: Callable[..., Any], *args: Any, cost_s: float | None = None) -> Any:
         """
-        A preview: refused at once past ``workers`` in flight.
+        A preview: refused at once past ``workers`` in flight, or past its
+        client's share of estimated CPU seconds; ``cost_s``, its estimated
+        CPU seconds, gives its budget (see the module docstring; None: the
+        CPU-time limit).
 
         Raises
         ------
-        PreviewsBusy, PreviewTimeout, RenderWorkerLost, RendererUnavailable, JobCPULimit, ValueError
+        PreviewsBusy, PreviewTimeout, RenderWorkerLost, RendererUnavailable, JobCPULimit,
+        RenderTooCostly, RenderBudgetExceeded, ValueError
         """
-        return await self._once("preview", key, function, args)
+        return await self._once("preview", key, function, args, cost_s)
 
     async def texture(self, key: tuple, function: Callable[..., Any], *args: Any) -> Any:
         """A texture: waits for a render process (at most :data:`TEXTURE_QUEUE` at once); as :meth:`preview`."""

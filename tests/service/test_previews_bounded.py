@@ -7,8 +7,8 @@ while two 1024 px rough coated reference previews render; previews past
 identical ones share a render; a preview whose client goes away, or that
 runs past ``COATED_PREVIEW_TIMEOUT_S`` (504), is cancelled and its process
 freed, and one that does not stop at its checks is stopped (its process
-killed and another started); one past ``COATED_JOB_CPU_LIMIT_S`` is
-stopped (422).
+killed and another started); one estimated past ``COATED_JOB_CPU_LIMIT_S``
+is refused (422; tests/service/test_render_budget.py: each render's budget).
 """
 
 from __future__ import annotations
@@ -150,8 +150,8 @@ def test_time_limit_504_and_cpu_limit_422(tmp_path):
         warm = http.get(f"{API}/preview.png", params={"fit": fit, "size": 64, "eta_i": 1.5})
         assert warm.status_code == 200, warm.text
         answer = http.get(f"{API}/preview.png", params=preview(fit, 2048, 1.5))
-        assert answer.status_code == 422, answer.text
-        assert "CPU-time limit of 1 s (COATED_JOB_CPU_LIMIT_S)" in answer.json()["detail"]
+        assert answer.status_code == 422, answer.text  # estimated past the limit: refused before it renders
+        assert "CPU-time limit of a job, 1 s (COATED_JOB_CPU_LIMIT_S)" in answer.json()["detail"]
         after = http.get(f"{API}/preview.png", params={"fit": fit, "size": 64, "eta_i": 1.5})
         assert after.status_code == 200, after.text  # the service still renders
 

@@ -29,6 +29,8 @@ from typing import Annotated, Literal
 
 from fastapi import APIRouter, Path, Response, status
 
+from preview_shaders.preview import ENVIRONMENTS
+
 from ...jobs.textures import environment_texture
 from ...schemas import API_PREFIX, ErrorBody
 from ..deps import ERROR_RESPONSES, PreviewsDep
@@ -52,7 +54,7 @@ __all__ = ["router"]
     },
 )
 async def get_prefiltered_environment(
-    environment: Annotated[Literal["white_sky", "studio", "outdoor"], Path(description="A preview environment")],
+    environment: Annotated[Literal[ENVIRONMENTS], Path(description="A preview environment")],  # type: ignore[valid-type]
     previews: PreviewsDep,
 ) -> Response:
     """The environment prefiltered at roughness 0, 1/8, ..., 1 as float32 RGB slices (see the headers)."""

@@ -23,6 +23,8 @@ from typing import Annotated, Literal
 from fastapi import APIRouter, Query, Request, Response, status
 from fastapi.concurrency import run_in_threadpool
 
+from preview_shaders.preview import ENVIRONMENTS
+
 from ...jobs.common import stored_fit
 from ...jobs.previews import render_preview
 from ...schemas import API_PREFIX, ETA_I_LIMITS, FIT_ID_PATTERN, ErrorBody
@@ -50,7 +52,8 @@ async def preview_png(
     eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)] = 1.5,
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
     compare: Annotated[Literal["none", "lazanyi", "reference"], Query()] = "none",
-    environment: Annotated[Literal["white_sky", "studio"], Query()] = "white_sky",
+    environment: Annotated[Literal[ENVIRONMENTS], Query(  # type: ignore[valid-type]
+        description="The light around the sphere (as the CLI's `render --environment`)")] = "white_sky",
     roughness: Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False,
                                       description="GGX perceptual roughness of the metal")] = 0.0,
     mode: Annotated[Literal["immersed", "coated"], Query(
