@@ -151,6 +151,10 @@ const PATCHES = [
     "clearcoatSpecularIndirect += clearcoatRadiance * cf_coat_albedo( saturate( dot( geometryClearcoatNormal, geometryViewDir ) ) );"],
   ["pars", /vec3 indirectSpecular = radiance \* singleScattering;\s*indirectSpecular \+= multiScattering \* cosineWeightedIrradiance;/,
     "vec3 indirectSpecular = radiance * cf_metal_albedo( saturate( dot( geometryNormal, geometryViewDir ) ), CF_COAT_WEIGHT( material ) );"],
+  // The model has no multiple-scattering term: direct light is not scaled by
+  // three's compensation (lights_fragment_begin sets it after lights_physical_fragment).
+  ["pars", /reflectedLight\.directSpecular \+= irradiance \* specularBRDF \* material\.multiScatteringCompensation;/,
+    "reflectedLight.directSpecular += irradiance * specularBRDF;"],
   ["main", /#include <lights_physical_fragment>/,
     `#include <lights_physical_fragment>
     // The model has no multiple-scattering term; the coat's F0 is its index's.
