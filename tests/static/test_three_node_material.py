@@ -12,7 +12,9 @@ web/three/src/node_material.js) against its WebGL material:
     package test's shader ball under the white sky, agrees within 0.05 mean
     Delta E 2000 (tests/static/three_node_pages.py): both kinds, coat
     indices 1.0 to 2.0, smooth; and one rough setting with a directional
-    light, which the white sky alone leaves out.
+    light, which the white sky alone leaves out; and a glTF loaded through
+    the package's GLTFLoader plugin, its material turned into the node
+    material by ``useCoatedConductorNodeMaterials``.
 
 Cost: one Node run; one folder and one page (SwiftShader WebGL2, 128 x
 128, two renderers), ten scenes.
@@ -27,7 +29,7 @@ import subprocess
 import numpy as np
 import pytest
 from editor_pages import _CHROMIUM
-from three_node_pages import PACKAGE, draw_both, parity, parity_page, serve, write_folder
+from three_node_pages import PACKAGE, draw_both, draw_gltf, parity, parity_page, serve, write_folder
 
 from fitting.exports import export_material
 from fitting.fits.kinds import fit_model
@@ -98,6 +100,10 @@ def chromium():
 @pytest.mark.slow
 def test_webgl_and_the_node_material_draw_the_same_image(models, chromium, tmp_path):
     write_folder(tmp_path)
+    nk = library_material("Cu")
+    packed = fit_model(nk, (1.0, 2.5), next(iter(MODEL_KINDS))).packed
+    document = export_material(nk, "gltf", 1.5, model=packed)
+    (tmp_path / "coated.gltf").write_bytes(document if isinstance(document, bytes) else document.encode())
     scenes = [(kind, eta_i, model, 0.0, 0.0, False) for kind, eta_i, model in models]
     scenes += [(kind, 1.5, model, 0.3, 0.1, True) for kind, eta_i, model in models if eta_i == 1.5]
     with serve(tmp_path) as site, parity_page(chromium, site) as (page, errors, backend):
@@ -107,4 +113,8 @@ def test_webgl_and_the_node_material_draw_the_same_image(models, chromium, tmp_p
             found = parity(webgl, node)
             assert found["pixels"] > 10_000, found
             assert found["mean"] <= PARITY_MEAN, (kind, eta_i, roughness, lit, found)
+        # A glTF through the loader plugin, its material made a node material by useCoatedConductorNodeMaterials.
+        webgl, node, twin = draw_gltf(page, "coated.gltf", 0.3, 0.1, True)
+        assert twin
+        assert parity(webgl, node)["mean"] <= PARITY_MEAN
         assert errors == []

@@ -38,8 +38,9 @@ THREE = ROOT / "scripts" / "three" / "node_modules" / "three"
 SCRIPT = """
 import * as THREE from "three";
 import { PMREMGenerator as NodePMREMGenerator, RenderTarget, WebGPURenderer } from "three/webgpu";
-import { createCoatedConductorMaterial } from "coated-conductor-three";
-import { createCoatedConductorNodeMaterial } from "coated-conductor-three/webgpu";
+import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
+import { CoatedConductorExtension, createCoatedConductorMaterial } from "coated-conductor-three";
+import { createCoatedConductorNodeMaterial, useCoatedConductorNodeMaterials } from "coated-conductor-three/webgpu";
 
 const [yaw, pitch, distance] = ORBIT;
 const camera = new THREE.PerspectiveCamera(THREE.MathUtils.radToDeg(FOV), WIDTH / HEIGHT, 0.1, 100);
@@ -111,6 +112,20 @@ window.cfDrawBoth = async (model, settings, lit) => {
   glMaterial.dispose();
   nodeMaterial.dispose();
   return images;
+};
+// The glTF at `url` through the loader plugin, its material at `settings` drawn as loaded (WebGL) and
+// after useCoatedConductorNodeMaterials (node): [WebGL, node, whether the node one is the package's].
+window.cfDrawGltf = async (url, settings, lit) => {
+  for (const light of lights) light.visible = lit;
+  const loader = new GLTFLoader();
+  loader.register((parser) => new CoatedConductorExtension(parser));
+  const gltf = await loader.loadAsync(url);
+  let material = null;
+  gltf.scene.traverse((object) => { if (object.isMesh) material = object.material; });
+  Object.assign(material, settings);
+  const holder = new THREE.Mesh(sphere, material);
+  await useCoatedConductorNodeMaterials(holder);
+  return [await drawGL(material), await drawNode(holder.material), holder.material.isCoatedConductorNodeMaterial === true];
 };
 window.cfBackend = gpu.backend.isWebGLBackend ? "WebGL2" : "WebGPU";
 document.body.dataset.ready = "true";
@@ -198,6 +213,16 @@ def draw_both(page, model: dict, roughness: float, coat_roughness: float, lit: b
         [model, {"roughness": roughness, "clearcoatRoughness": coat_roughness}, lit],
     )
     return tuple(from_f32(text).reshape(H, W, 4)[::-1] for text in flat)
+
+
+def draw_gltf(page, url: str, roughness: float, coat_roughness: float, lit: bool = False):
+    """(WebGL, node material, whether the node one is the package's) of the glTF at ``url`` (see :func:`draw_both`)."""
+    a, b, twin = page.evaluate(
+        f"async ([u, s, l]) => {{ {F32_BASE64} const [a, b, t] = await window.cfDrawGltf(u, s, l); "
+        "return [f32(a), f32(b), t]; }",
+        [url, {"roughness": roughness, "clearcoatRoughness": coat_roughness}, lit],
+    )
+    return *(from_f32(text).reshape(H, W, 4)[::-1] for text in (a, b)), twin
 
 
 def parity(webgl: np.ndarray, node: np.ndarray) -> dict:

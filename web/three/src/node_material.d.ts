@@ -7,6 +7,8 @@ import type { ExtensionObject, Resources } from "./index.js";
 /** What a node material drawing the model carries in `userData.coatedConductor`. */
 export interface CoatedConductorNodeData {
   model: ExtensionObject;
+  /** The fallback's KHR_materials_clearcoat values the glTF material was loaded with, or null. */
+  fallback: { KHR_materials_clearcoat: Record<string, unknown> } | null;
   /** Frees the tables (their off-screen render targets and DataTextures). */
   dispose(): void;
 }

@@ -250,7 +250,7 @@ export class CoatedConductorNodeMaterial extends MeshPhysicalNodeMaterial {
       })),
     };
     this.resources = resources;
-    this.userData.coatedConductor = { model, dispose: () => tables.dispose() };
+    this.userData.coatedConductor = { model, fallback: null, dispose: () => tables.dispose() };
     this.setValues({
       metalness: 1, color: 0xffffff, clearcoat: 1, clearcoatRoughness: model.coatRoughnessFactor ?? 0, ...parameters,
     });
@@ -305,7 +305,9 @@ export async function toCoatedConductorNodeMaterial(material) {
   if (!model || material.isCoatedConductorNodeMaterial) return material;
   const parameters = Object.fromEntries(COPIED.filter((key) => material[key] !== undefined)
     .map((key) => [key, material[key]?.clone && !material[key].isTexture ? material[key].clone() : material[key]]));
-  return createCoatedConductorNodeMaterial({ model, ...parameters });
+  const twin = await createCoatedConductorNodeMaterial({ model, ...parameters });
+  twin.userData.coatedConductor.fallback = material.userData.coatedConductor.fallback ?? null;
+  return twin;
 }
 
 /** Replace, in place, every coated material under `root` (a glTF scene) by its node-material twin. */
