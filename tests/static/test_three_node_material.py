@@ -14,7 +14,8 @@ web/three/src/node_material.js) against its WebGL material:
     indices 1.0 to 2.0, smooth; and one rough setting with a directional
     light, which the white sky alone leaves out; and a glTF loaded through
     the package's GLTFLoader plugin, its material turned into the node
-    material by ``useCoatedConductorNodeMaterials``.
+    material by ``useCoatedConductorNodeMaterials``; two node materials of
+    one kind alive together each draw their own model.
 
 Cost: one Node run; one folder and one page (SwiftShader WebGL2, 128 x
 128, two renderers), ten scenes.
@@ -29,7 +30,7 @@ import subprocess
 import numpy as np
 import pytest
 from editor_pages import _CHROMIUM
-from three_node_pages import PACKAGE, draw_both, draw_gltf, parity, parity_page, serve, write_folder
+from three_node_pages import PACKAGE, draw_both, draw_gltf, draw_pair, parity, parity_page, serve, write_folder
 
 from fitting.exports import export_material
 from fitting.fits.kinds import fit_model
@@ -113,6 +114,11 @@ def test_webgl_and_the_node_material_draw_the_same_image(models, chromium, tmp_p
             found = parity(webgl, node)
             assert found["pixels"] > 10_000, found
             assert found["mean"] <= PARITY_MEAN, (kind, eta_i, roughness, lit, found)
+        # Two materials of one kind alive together: each draws its own model (no program shared between them).
+        first, last = (model for kind, eta_i, model in models if kind == models[0][0] and eta_i in (ETAS[0], ETAS[-1]))
+        gl_a, node_a, gl_b, node_b = draw_pair(page, first, last, 0.3, 0.1)
+        assert parity(gl_a, node_a)["mean"] <= PARITY_MEAN and parity(gl_b, node_b)["mean"] <= PARITY_MEAN
+        assert parity(gl_a, gl_b)["mean"] > 1  # the two models differ: the check above can see a swap
         # A glTF through the loader plugin, its material made a node material by useCoatedConductorNodeMaterials.
         webgl, node, twin = draw_gltf(page, "coated.gltf", 0.3, 0.1, True)
         assert twin

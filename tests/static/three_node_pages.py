@@ -113,6 +113,17 @@ window.cfDrawBoth = async (model, settings, lit) => {
   nodeMaterial.dispose();
   return images;
 };
+// Two extension objects' materials made before either is drawn (alive together, as in one scene):
+// [WebGL a, node a, WebGL b, node b].
+window.cfDrawPair = async (a, b, settings) => {
+  const gl = await Promise.all([a, b].map((model) => createCoatedConductorMaterial({ model, ...settings })));
+  const node = await Promise.all([a, b].map((model) => createCoatedConductorNodeMaterial({ model, ...settings })));
+  const images = [await drawGL(gl[0]), await drawNode(node[0]), await drawGL(gl[1]), await drawNode(node[1])];
+  for (const material of gl) material.userData.coatedConductor.dispose();
+  for (const material of [...gl, ...node]) material.dispose();
+  return images;
+};
+
 // The glTF at `url` through the loader plugin, its material at `settings` drawn as loaded (WebGL) and
 // after useCoatedConductorNodeMaterials (node): [WebGL, node, whether the node one is the package's].
 window.cfDrawGltf = async (url, settings, lit) => {
@@ -223,6 +234,15 @@ def draw_gltf(page, url: str, roughness: float, coat_roughness: float, lit: bool
         [url, {"roughness": roughness, "clearcoatRoughness": coat_roughness}, lit],
     )
     return *(from_f32(text).reshape(H, W, 4)[::-1] for text in (a, b)), twin
+
+
+def draw_pair(page, a: dict, b: dict, roughness: float, coat_roughness: float):
+    """(WebGL a, node a, WebGL b, node b): both objects' materials made before either is drawn."""
+    flat = page.evaluate(
+        f"async ([a, b, s]) => {{ {F32_BASE64} return (await window.cfDrawPair(a, b, s)).map(f32); }}",
+        [a, b, {"roughness": roughness, "clearcoatRoughness": coat_roughness}],
+    )
+    return [from_f32(text).reshape(H, W, 4)[::-1] for text in flat]
 
 
 def parity(webgl: np.ndarray, node: np.ndarray) -> dict:

@@ -17,7 +17,8 @@
 // "Combining with the coat"; fitting/shading/coated_layer.py is the numpy twin):
 //   - direct lights: BRDF_GGX's Schlick F is the model at v.h (the cosine
 //     inside the coat when there is a clear coat, Snell), through the coat
-//     with the mirror's series of bounces at NdotV, per polarisation;
+//     with the mirror's series of bounces at NdotV, per polarisation, and
+//     not scaled by three's multiple-scattering compensation;
 //   - image-based light: the metal's single and multiple scattering are
 //     replaced by the model's directional albedo from its split-sum table
 //     (albedo_table.js) through the coat: the mirror's series, and for a

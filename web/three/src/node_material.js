@@ -262,8 +262,11 @@ export class CoatedConductorNodeMaterial extends MeshPhysicalNodeMaterial {
     return new CoatedConductorLightingModel(this.cf, ...flags);
   }
 
+  // Each material its own program: its coefficients, coat index and tables are
+  // uniforms and textures of its own node graph, which a program shared by two
+  // materials (three caches programs by this key) would take from the first.
   customProgramCacheKey() {
-    return `${EXTENSION_NAME}:${this.userData.coatedConductor.model.kind}:${super.customProgramCacheKey()}`;
+    return `${EXTENSION_NAME}:${this.uuid}:${super.customProgramCacheKey()}`;
   }
 
   clone() {
