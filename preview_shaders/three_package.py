@@ -15,7 +15,9 @@ The generated modules of the three.js package (web/three/, npm
     preview generates it (preview_shaders.kinds.preview_model_source), the
     includes not already in ``GLSL`` resolved; ``modelTable``: for a kind
     without the split-sum lookup, model_albedo_table.frag with that function
-    (the metal's row of its albedo table, as the editor draws it), else null.
+    (the metal's row of its albedo table, as the editor draws it), else null;
+    ``glslFunction``: the kind's GLSL function, by which the node material
+    (src/node_models.js) finds the kind's TSL twin.
     The package's JavaScript and GLSL name no kind: they read this module.
 -   ``lut.js``: the split-sum LUT (fitting.shading.lut.default_lut, what
     GET /api/v1/ibl-lut serves) losslessly: A and B once (they repeat across
@@ -148,7 +150,7 @@ def kind_entries() -> list[dict]:
         table = None if kind.split_sum else _es(_expand(MODEL_TABLE, set(), {PREVIEW_MODEL_FILE: source}), MODEL_TABLE)
         entries.append({"name": kind.name, "description": kind.description, "parameters": list(kind.parameters),
                         "maxDegree": kind.max_degree, "splitSum": kind.split_sum, **sign_rules(kind),
-                        "glsl": glsl, "modelTable": table})
+                        "glsl": glsl, "modelTable": table, "glslFunction": kind.glsl_function})
     return entries
 
 
@@ -183,7 +185,9 @@ def kinds_types() -> str:
             "export interface PackagedKind {\n"
             "  name: KindName;\n  description: string;\n  parameters: readonly string[];\n  maxDegree: number;\n"
             "  splitSum: boolean;\n  minimum: Readonly<Record<string, number>>;\n"
-            "  exclusiveMinimum: Readonly<Record<string, number>>;\n  glsl: string;\n  modelTable: string | null;\n}\n"
+            "  exclusiveMinimum: Readonly<Record<string, number>>;\n  glsl: string;\n  modelTable: string | null;\n"
+            "  /** The kind's GLSL function, which names its node-material (TSL) twin in the package. */\n"
+            "  glslFunction: string;\n}\n"
             "export declare const MODEL_KINDS: readonly PackagedKind[];\n"
             f"export declare const DEFAULT_KIND: {json.dumps(DEFAULT_MODEL)};\n")
 

@@ -21,6 +21,8 @@ LOCK = json.loads((ROOT / "scripts" / "three" / "package-lock.json").read_text()
     "/static/three/escape_table.js", "/static/three/gltf_loader.js", "/static/three/gltf_exporter.js",
     "/static/three/packing.js", "/static/three/kinds.js", "/static/three/generated/glsl.js",
     "/static/three/generated/kinds.js", "/static/three/generated/lut.js",
+    "/static/three/node_material.js", "/static/three/node_models.js",
+    "/vendor/three/build/three.webgpu.js", "/vendor/three/build/three.tsl.js",
     "/static/glsl.js",
     "/vendor/three/build/three.module.js", "/vendor/three/build/three.core.js",
     "/vendor/three/examples/jsm/loaders/GLTFLoader.js",

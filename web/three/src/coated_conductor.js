@@ -17,7 +17,8 @@
 // "Combining with the coat"; fitting/shading/coated_layer.py is the numpy twin):
 //   - direct lights: BRDF_GGX's Schlick F is the model at v.h (the cosine
 //     inside the coat when there is a clear coat, Snell), through the coat
-//     with the mirror's series of bounces at NdotV, per polarisation;
+//     with the mirror's series of bounces at NdotV, per polarisation, and
+//     not scaled by three's multiple-scattering compensation;
 //   - image-based light: the metal's single and multiple scattering are
 //     replaced by the model's directional albedo from its split-sum table
 //     (albedo_table.js) through the coat: the mirror's series, and for a
@@ -151,6 +152,10 @@ const PATCHES = [
     "clearcoatSpecularIndirect += clearcoatRadiance * cf_coat_albedo( saturate( dot( geometryClearcoatNormal, geometryViewDir ) ) );"],
   ["pars", /vec3 indirectSpecular = radiance \* singleScattering;\s*indirectSpecular \+= multiScattering \* cosineWeightedIrradiance;/,
     "vec3 indirectSpecular = radiance * cf_metal_albedo( saturate( dot( geometryNormal, geometryViewDir ) ), CF_COAT_WEIGHT( material ) );"],
+  // The model has no multiple-scattering term: direct light is not scaled by
+  // three's compensation (lights_fragment_begin sets it after lights_physical_fragment).
+  ["pars", /reflectedLight\.directSpecular \+= irradiance \* specularBRDF \* material\.multiScatteringCompensation;/,
+    "reflectedLight.directSpecular += irradiance * specularBRDF;"],
   ["main", /#include <lights_physical_fragment>/,
     `#include <lights_physical_fragment>
     // The model has no multiple-scattering term; the coat's F0 is its index's.

@@ -7,6 +7,10 @@ import {
   CoatedConductorExporterExtension, CoatedConductorExtension, EXTENSION_NAME, checkModel,
   createCoatedConductorMaterial, type ExtensionObject,
 } from "coated-conductor-three";
+import {
+  CoatedConductorNodeMaterial, createCoatedConductorNodeMaterial, useCoatedConductorNodeMaterials,
+} from "coated-conductor-three/webgpu";
+import { WebGPURenderer } from "three/webgpu";
 
 const gold: ExtensionObject = {
   kind: "rgb-conductor", colorSpace: "ACEScg", etaIRange: [1, 2.5], coatIor: 1.5,
@@ -27,8 +31,23 @@ export async function draw(renderer: THREE.WebGLRenderer, url: string): Promise<
   return material;
 }
 
+// The same scene with three's node materials (WebGPURenderer; its WebGL2 backend where there is no WebGPU).
+export async function drawNodes(url: string): Promise<CoatedConductorNodeMaterial> {
+  const renderer = new WebGPURenderer({ forceWebGL: true });
+  await renderer.init();
+  const loader = new GLTFLoader();
+  loader.register((parser) => new CoatedConductorExtension(parser));
+  const gltf = await loader.loadAsync(url);
+  await useCoatedConductorNodeMaterials(gltf.scene);
+  const material = await createCoatedConductorNodeMaterial({ model: gold, roughness: 0.3, clearcoatRoughness: 0.1 });
+  console.log(material.isCoatedConductorNodeMaterial, material.userData.coatedConductor.model.kind);
+  return material;
+}
+
 // The types are real: each line below must be an error (tsc fails on an unused directive).
 // @ts-expect-error: "schlick" is not a model kind
 export const notAKind: ExtensionObject = { ...gold, kind: "schlick" };
 // @ts-expect-error: the material needs its model
 export const noModel = createCoatedConductorMaterial({ roughness: 0.3 });
+// @ts-expect-error: the node material needs its model too
+export const noNodeModel = createCoatedConductorNodeMaterial({ roughness: 0.3 });

@@ -20,6 +20,8 @@ export interface PackagedKind {
   exclusiveMinimum: Readonly<Record<string, number>>;
   glsl: string;
   modelTable: string | null;
+  /** The kind's GLSL function, which names its node-material (TSL) twin in the package. */
+  glslFunction: string;
 }
 export declare const MODEL_KINDS: readonly PackagedKind[];
 export declare const DEFAULT_KIND: "coated-conductor";
