@@ -169,6 +169,49 @@ def _step(H, g, Delta, alpha, p_gn, rtol=0.01, max_iter=10):
     return p * (Delta / _norm(p)), alpha
 
 
+def _judge(actual_reduction, predicted_reduction, cost, Delta, step_h_norm, xtol_ok, ftol):
+    """
+    scipy's radius update and stopping tests after a trial step:
+    ``(Delta_new, status)``, status None to go on, 2-4 for the ftol, xtol
+    and both tests (``xtol_ok``: the step under ``xtol (xtol + |x|)``).
+    """
+    if predicted_reduction > 0:
+        ratio = actual_reduction / predicted_reduction
+    elif predicted_reduction == actual_reduction == 0:
+        ratio = 1.0
+    else:
+        ratio = 0.0
+    Delta_new = Delta
+    if ratio < 0.25:
+        Delta_new = 0.25 * step_h_norm
+    elif ratio > 0.75 and step_h_norm > 0.95 * Delta:
+        Delta_new = 2.0 * Delta
+    ftol_ok = actual_reduction < ftol * cost and ratio > 0.25
+    if ftol_ok or xtol_ok:
+        return Delta_new, 4 if ftol_ok and xtol_ok else (2 if ftol_ok else 3)
+    return Delta_new, None
+
+
+def _trial_step(A, g, scale_inv, p_gn, Delta, alpha, H):
+    """
+    The trial step in the unknowns from the normal matrix ``A``, gradient
+    ``g``, scales ``scale_inv`` and Gauss-Newton step ``p_gn`` (None when J
+    is not of full rank): ``(step, its scaled norm, alpha, predicted
+    reduction, H)``, H the scaled normal matrix once formed (None while
+    only the Gauss-Newton step was needed).
+    """
+    if p_gn is not None:
+        p_h_norm = _norm(p_gn * scale_inv)
+        if p_h_norm <= Delta:
+            return p_gn, p_h_norm, 0.0, -0.5 * np.dot(g, p_gn), H  # -(p^T A p / 2 + g^T p) with A p = -g
+    d = 1.0 / scale_inv
+    if H is None:
+        H = A * d * d[:, None]
+    g_h = d * g
+    step_h, alpha = _step(H, g_h, Delta, alpha, None if p_gn is None else p_gn * scale_inv)
+    return d * step_h, _norm(step_h), alpha, -(0.5 * step_h @ H @ step_h + g_h @ step_h), H
+
+
 def trf_least_squares(
     fun: Callable[[np.ndarray], np.ndarray],
     jac: Callable[[np.ndarray], np.ndarray],
@@ -231,25 +274,14 @@ def trf_least_squares(
             status = 1
         if status is not None or nfev == max_nfev:
             break
-        d = 1.0 / scale_inv
         # The Gauss-Newton step once per Jacobian (most steps of these fits
         # are that step); the scaled matrix and the search for alpha only
         # when it is longer than the region.
         p_gn = _gauss_newton(A, g, scale_inv) if J.shape[0] >= J.shape[1] else None
-        p_gn_h = None if p_gn is None else p_gn * scale_inv
-        p_gn_norm = np.inf if p_gn is None else _norm(p_gn_h)
         H, x_norm = None, _norm(x)
         actual_reduction = -1.0
         while actual_reduction <= 0 and nfev < max_nfev:
-            if p_gn_norm <= Delta:
-                step, step_h_norm, alpha = p_gn, p_gn_norm, 0.0
-                predicted_reduction = -0.5 * np.dot(g, p_gn)  # -(p^T H p / 2 + g^T p) with H p = -g
-            else:
-                if H is None:
-                    H = A * d * d[:, None]
-                step_h, alpha = _step(H, d * g, Delta, alpha, p_gn_h)
-                predicted_reduction = -(0.5 * step_h @ H @ step_h + (d * g) @ step_h)
-                step, step_h_norm = d * step_h, _norm(step_h)
+            step, step_h_norm, alpha, predicted_reduction, H = _trial_step(A, g, scale_inv, p_gn, Delta, alpha, H)
             x_new = x + step
             f_new = np.asarray(fun(x_new), dtype=np.float64)
             nfev += 1
@@ -258,21 +290,9 @@ def trf_least_squares(
                 Delta = 0.25 * step_h_norm
                 continue
             actual_reduction = cost - cost_new
-            if predicted_reduction > 0:
-                ratio = actual_reduction / predicted_reduction
-            elif predicted_reduction == actual_reduction == 0:
-                ratio = 1.0
-            else:
-                ratio = 0.0
-            Delta_new = Delta
-            if ratio < 0.25:
-                Delta_new = 0.25 * step_h_norm
-            elif ratio > 0.75 and step_h_norm > 0.95 * Delta:
-                Delta_new = 2.0 * Delta
-            ftol_ok = actual_reduction < ftol * cost and ratio > 0.25
-            xtol_ok = _norm(step) < xtol * (xtol + x_norm)
-            if ftol_ok or xtol_ok:
-                status = 4 if ftol_ok and xtol_ok else (2 if ftol_ok else 3)
+            Delta_new, status = _judge(actual_reduction, predicted_reduction, cost, Delta, step_h_norm,
+                                       _norm(step) < xtol * (xtol + x_norm), ftol)
+            if status is not None:
                 break
             alpha *= Delta / Delta_new
             Delta = Delta_new
