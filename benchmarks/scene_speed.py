@@ -72,8 +72,10 @@ def child(root: str, names: list[str], lo: float, hi: float) -> int:
         t = time.process_time()
         reference_ACEScg_grid(material.nk, np.linspace(0.0, 1.0, 100), spec.evaluation_eta_i())
         reference_ms = 1e3 * (time.process_time() - t)
-        # The chosen candidate: its kind and degree (an rgb-conductor's pack has no power axis).
-        degree = f"{result.choice['model']} {result.choice['degree']}"
+        # The chosen candidate: its kind and degree (an rgb-conductor's pack has no power axis;
+        # a checkout before the rule's record, such as 09bbd13, names only its pack's).
+        choice = result.choice or {"model": result.packed.model, "degree": result.degree}
+        degree = f"{choice['model']} {choice['degree']}"
         return {"ms": ms, "reference_ms": reference_ms, "degree": degree,
                 "mean": result.scene.mean, "max": result.scene.max}
 

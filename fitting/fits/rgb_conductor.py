@@ -38,7 +38,7 @@ from ..colour.reference import reference_ACEScg
 from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, check_eta_i_range
 from ..models.pack import to_float16
 from ..models.rgb_conductor import MODEL_KIND
-from ..optics.fresnel import fresnel_conductor
+from ..optics.fresnel import fresnel_conductor, fresnel_conductor_derivatives
 from ..optics.nk import SpectralNK
 from .evaluate import evaluate_material
 from .result import FitResult
@@ -90,7 +90,8 @@ def _initial_guess(target, mu, eta, weights) -> np.ndarray:
             start = np.clip([n, np.sqrt(max(k2, 0.0))], [lower[c], lower[3 + c]], [upper[c], upper[3 + c]])
             fit = least_squares(
                 lambda x: (fresnel_conductor(mu, eta, x[0], x[1]) - R) * sqrt_w,
-                start, bounds=([lower[c], lower[3 + c]], [upper[c], upper[3 + c]]),
+                start, jac=lambda x: np.stack(fresnel_conductor_derivatives(mu, eta, x[0], x[1])[1:], axis=1)
+                * sqrt_w[:, None], bounds=([lower[c], lower[3 + c]], [upper[c], upper[3 + c]]),
                 method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10,
             )
             if best is None or fit.cost < best.cost:
@@ -165,12 +166,14 @@ def fit_rgb_conductor_coefficients(
     x = _initial_guess(target, mu, eta, base).ravel()
     problem = RGBConductorObjective(target, mu, eta, objective, base)
     options = dict(bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev)
-    result = least_squares(problem.residuals, x, ftol=1e-10, xtol=1e-10, gtol=1e-10, **options)
+    result = least_squares(problem.residuals, x, jac=problem.jacobian, ftol=1e-10, xtol=1e-10, gtol=1e-10,
+                           **options)
     unweighted = RGBConductorObjective(target, mu, eta, objective, None)
 
     def resolve(sample_weights, x):
         again = RGBConductorObjective(target, mu, eta, objective, sample_weights)
-        return again, least_squares(again.residuals, x, ftol=1e-8, xtol=1e-8, gtol=1e-8, **options)
+        return again, least_squares(again.residuals, x, jac=again.jacobian, ftol=1e-8, xtol=1e-8, gtol=1e-8,
+                                    **options)
 
     problem, result, nfev, njev = reweighted(
         problem, result, irls_rounds if objective == "de2000" else 0,

@@ -19,11 +19,11 @@ import itertools
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab
+from ..colour.colorimetry import ACEScg_to_Lab, ACEScg_to_Lab_jacobian
 from ..colour.delta_e import de2000_weights, delta_E_2000
 from ..models.pack import to_float16
 from ..models.rgb_conductor import rgb_conductor_model
-from ..optics.fresnel import fresnel_conductor
+from ..optics.fresnel import fresnel_conductor, fresnel_conductor_derivatives
 
 __all__ = ["N_BOUNDS", "K_BOUNDS", "nk_bounds", "RGBConductorObjective", "quantise_rgb_conductor"]
 
@@ -58,6 +58,25 @@ class RGBConductorObjective:
     def residuals(self, x):
         F = rgb_conductor_model(self.mu, self.eta, x.reshape(2, 3))
         return (self.outputs(F) * np.sqrt(self.w)[:, None]).ravel()
+
+    def jacobian(self, x):
+        """
+        The exact Jacobian (3 S, 6) of :meth:`residuals` in the flattened
+        (n_R, n_G, n_B, k_R, k_G, k_B): each channel's Fresnel derivatives
+        (:func:`fitting.optics.fresnel.fresnel_conductor_derivatives`)
+        through Lab and the CIEDE2000 metric.
+        """
+        C = x.reshape(2, 3)
+        F, dn, dk = fresnel_conductor_derivatives(self.mu[:, None], self.eta[:, None], C[0], C[1])
+        dF = np.stack([dn, dk], axis=1)  # [s, p, c]
+        if self.objective == "rgb":
+            G = np.broadcast_to(np.eye(3), (F.shape[0], 3, 3))
+        else:
+            G = ACEScg_to_Lab_jacobian(F)
+            if self.A is not None:
+                G = self.A @ G
+        J = G[:, :, None, :] * dF[:, None, :, :] * np.sqrt(self.w)[:, None, None, None]  # [s, o, p, c]
+        return J.reshape(3 * F.shape[0], 6)
 
     def score(self, F):
         """

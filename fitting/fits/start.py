@@ -22,23 +22,31 @@ def initial_guess(target, mu, eta, eta_i_range, degree) -> np.ndarray:
     """
     Variable projection on a ladder of constant exponents: for each alpha the
     model is linear in the F0 and a polynomials, solved by least squares per
-    channel; the alpha with the smallest residual wins.
+    channel (every rung's normal equations in one stacked solve; per rung by
+    an SVD where they are singular); the alpha with the smallest residual
+    wins (the first on a tie).
     """
     t = normalised_eta_i(eta, eta_i_range)
-    T = np.stack([t**j for j in range(degree + 1)], axis=-1)
+    d1 = degree + 1
+    T = np.stack([t**j for j in range(d1)], axis=-1)
     x = 1.0 - np.clip(mu, 0.0, 1.0)
     x5 = x**5
-    x0 = np.zeros((3, 3, degree + 1))
-    best = np.full(3, np.inf)
     y = target - x5[:, None]
-    for alpha in ALPHA_CANDIDATES:
-        basis = np.concatenate([(1.0 - x5)[:, None] * T, -(mu * x**alpha)[:, None] * T], axis=1)
-        coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
-        res = ((basis @ coef - y) ** 2).sum(axis=0)
-        for c in np.flatnonzero(res < best):
-            best[c] = res[c]
-            x0[0, c] = coef[: degree + 1, c]
-            x0[1, c] = coef[degree + 1 :, c]
-            x0[2, c] = 0.0
-            x0[2, c, 0] = alpha
+    basis = np.empty((ALPHA_CANDIDATES.size, mu.size, 2 * d1))  # [rung, sample, F0 then a]
+    basis[:, :, :d1] = (1.0 - x5)[:, None] * T
+    basis[:, :, d1:] = -(mu * x ** ALPHA_CANDIDATES[:, None])[:, :, None] * T
+    transposed = basis.transpose(0, 2, 1)
+    try:
+        coef = np.linalg.solve(transposed @ basis, transposed @ y)  # (rungs, 2 d1, 3)
+    except np.linalg.LinAlgError:
+        coef = None
+    if coef is None or not np.all(np.isfinite(coef)):  # samples that leave a rung's basis rank deficient
+        coef = np.stack([np.linalg.lstsq(b, y, rcond=None)[0] for b in basis])
+    residual = ((basis @ coef - y) ** 2).sum(axis=1)  # (rungs, 3)
+    best = np.argmin(residual, axis=0)
+    x0 = np.zeros((3, 3, d1))
+    for c, rung in enumerate(best):
+        x0[0, c] = coef[rung, :d1, c]
+        x0[1, c] = coef[rung, d1:, c]
+        x0[2, c, 0] = ALPHA_CANDIDATES[rung]
     return x0

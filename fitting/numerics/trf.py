@@ -97,11 +97,31 @@ def _inverse_factor(A):
     return L.diagonal(), np.linalg.inv(L)
 
 
-def _step(H, g, Delta, alpha, rtol=0.01, max_iter=10):
+def _gauss_newton(A, g, scale_inv):
+    """
+    The Gauss-Newton step -A^-1 g (in the unknowns) from the normal matrix
+    ``A`` = J^T J and gradient ``g`` = J^T f, or None when J is not of full
+    rank: scipy's test (smallest singular value of J over the largest)
+    read from the Cholesky pivots of the scaled normal matrix, H positive
+    definite with its pivots within 1e-7 of each other, so that the solve
+    is accurate. One factorisation and one solve, without forming the
+    scaled matrix: its pivots are A's over ``scale_inv``.
+    """
+    try:
+        pivots = np.linalg.cholesky(A).diagonal() / scale_inv
+    except np.linalg.LinAlgError:
+        return None
+    if pivots.min() <= 1e-7 * pivots.max():
+        return None
+    return -np.linalg.solve(A, g)
+
+
+def _step(H, g, Delta, alpha, p_gn, rtol=0.01, max_iter=10):
     """
     The trust-region step of scipy's ``solve_lsq_trust_region`` from the
-    normal matrix ``H`` = J^T J and gradient ``g`` = J^T f (scaled): the
-    Gauss-Newton step when it is inside ``Delta``, else
+    normal matrix ``H`` = J^T J and gradient ``g`` = J^T f (scaled), where
+    the Gauss-Newton step ``p_gn`` (scaled; None when J is not of full
+    rank) is longer than ``Delta``:
     :math:`p = -(H + \\alpha I)^{-1} g` with :math:`\\lVert p \\rVert
     \\approx \\Delta` by Newton's method on :math:`\\phi(\\alpha) =
     \\lVert p \\rVert - \\Delta`, where :math:`\\phi' = -\\lVert L^{-1}
@@ -109,18 +129,11 @@ def _step(H, g, Delta, alpha, rtol=0.01, max_iter=10):
     phi and phi' from the SVD, the same numbers). Returns ``(p, alpha)``.
     """
     eye = np.eye(g.size)
-    factor = _inverse_factor(H)
-    # scipy's full rank (smallest singular value of J over eps m times the
-    # largest) read from the factor: H positive definite with its pivots
-    # within 1e-7 of each other, so that the Gauss-Newton solve is accurate.
-    full_rank = factor is not None and factor[0].min() > 1e-7 * factor[0].max()
-    if full_rank:
-        M = factor[1]
-        p = -M.T @ (M @ g)
-        p_norm = _norm(p)
-        if p_norm <= Delta:
-            return p, 0.0
-        q = M @ p
+    full_rank = p_gn is not None
+    factor = _inverse_factor(H) if full_rank else None
+    if factor is not None:
+        p_norm = _norm(p_gn)
+        q = factor[1] @ p_gn
         alpha_lower = (p_norm - Delta) * p_norm / np.dot(q, q)
     else:
         alpha_lower = 0.0
@@ -154,6 +167,49 @@ def _step(H, g, Delta, alpha, rtol=0.01, max_iter=10):
     M = factor[1]
     p = -M.T @ (M @ g)
     return p * (Delta / _norm(p)), alpha
+
+
+def _judge(actual_reduction, predicted_reduction, cost, Delta, step_h_norm, xtol_ok, ftol):
+    """
+    scipy's radius update and stopping tests after a trial step:
+    ``(Delta_new, status)``, status None to go on, 2-4 for the ftol, xtol
+    and both tests (``xtol_ok``: the step under ``xtol (xtol + |x|)``).
+    """
+    if predicted_reduction > 0:
+        ratio = actual_reduction / predicted_reduction
+    elif predicted_reduction == actual_reduction == 0:
+        ratio = 1.0
+    else:
+        ratio = 0.0
+    Delta_new = Delta
+    if ratio < 0.25:
+        Delta_new = 0.25 * step_h_norm
+    elif ratio > 0.75 and step_h_norm > 0.95 * Delta:
+        Delta_new = 2.0 * Delta
+    ftol_ok = actual_reduction < ftol * cost and ratio > 0.25
+    if ftol_ok or xtol_ok:
+        return Delta_new, 4 if ftol_ok and xtol_ok else (2 if ftol_ok else 3)
+    return Delta_new, None
+
+
+def _trial_step(A, g, scale_inv, p_gn, Delta, alpha, H):
+    """
+    The trial step in the unknowns from the normal matrix ``A``, gradient
+    ``g``, scales ``scale_inv`` and Gauss-Newton step ``p_gn`` (None when J
+    is not of full rank): ``(step, its scaled norm, alpha, predicted
+    reduction, H)``, H the scaled normal matrix once formed (None while
+    only the Gauss-Newton step was needed).
+    """
+    if p_gn is not None:
+        p_h_norm = _norm(p_gn * scale_inv)
+        if p_h_norm <= Delta:
+            return p_gn, p_h_norm, 0.0, -0.5 * np.dot(g, p_gn), H  # -(p^T A p / 2 + g^T p) with A p = -g
+    d = 1.0 / scale_inv
+    if H is None:
+        H = A * d * d[:, None]
+    g_h = d * g
+    step_h, alpha = _step(H, g_h, Delta, alpha, None if p_gn is None else p_gn * scale_inv)
+    return d * step_h, _norm(step_h), alpha, -(0.5 * step_h @ H @ step_h + g_h @ step_h), H
 
 
 def trf_least_squares(
@@ -218,37 +274,25 @@ def trf_least_squares(
             status = 1
         if status is not None or nfev == max_nfev:
             break
-        d = 1.0 / scale_inv
-        H, g_h = A * d * d[:, None], d * g
+        # The Gauss-Newton step once per Jacobian (most steps of these fits
+        # are that step); the scaled matrix and the search for alpha only
+        # when it is longer than the region.
+        p_gn = _gauss_newton(A, g, scale_inv) if J.shape[0] >= J.shape[1] else None
+        H, x_norm = None, _norm(x)
         actual_reduction = -1.0
         while actual_reduction <= 0 and nfev < max_nfev:
-            step_h, alpha = _step(H, g_h, Delta, alpha)
-            predicted_reduction = -(0.5 * step_h @ H @ step_h + g_h @ step_h)
-            step = d * step_h
+            step, step_h_norm, alpha, predicted_reduction, H = _trial_step(A, g, scale_inv, p_gn, Delta, alpha, H)
             x_new = x + step
             f_new = np.asarray(fun(x_new), dtype=np.float64)
             nfev += 1
-            step_h_norm = _norm(step_h)
             cost_new = 0.5 * np.dot(f_new, f_new)
             if not math.isfinite(cost_new):  # f not finite there (or beyond 1e154): a smaller region
                 Delta = 0.25 * step_h_norm
                 continue
             actual_reduction = cost - cost_new
-            if predicted_reduction > 0:
-                ratio = actual_reduction / predicted_reduction
-            elif predicted_reduction == actual_reduction == 0:
-                ratio = 1.0
-            else:
-                ratio = 0.0
-            Delta_new = Delta
-            if ratio < 0.25:
-                Delta_new = 0.25 * step_h_norm
-            elif ratio > 0.75 and step_h_norm > 0.95 * Delta:
-                Delta_new = 2.0 * Delta
-            ftol_ok = actual_reduction < ftol * cost and ratio > 0.25
-            xtol_ok = _norm(step) < xtol * (xtol + _norm(x))
-            if ftol_ok or xtol_ok:
-                status = 4 if ftol_ok and xtol_ok else (2 if ftol_ok else 3)
+            Delta_new, status = _judge(actual_reduction, predicted_reduction, cost, Delta, step_h_norm,
+                                       _norm(step) < xtol * (xtol + x_norm), ftol)
+            if status is not None:
                 break
             alpha *= Delta / Delta_new
             Delta = Delta_new

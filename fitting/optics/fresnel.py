@@ -30,7 +30,7 @@ import numpy as np
 
 from ..domain import INDEX_LIMITS, as_float_array
 
-__all__ = ["fresnel_conductor", "fresnel_dielectric"]
+__all__ = ["fresnel_conductor", "fresnel_conductor_derivatives", "fresnel_dielectric"]
 
 
 def fresnel_conductor(cos_theta, eta_i, n, k) -> np.ndarray:
@@ -87,6 +87,48 @@ def fresnel_conductor(cos_theta, eta_i, n, k) -> np.ndarray:
     tiny = np.finfo(np.float64).tiny
     R = 0.5 * (_abs2(num_s) / np.maximum(_abs2(den_s), tiny) + _abs2(num_p) / np.maximum(_abs2(den_p), tiny))
     return np.clip(R, 0.0, 1.0)
+
+
+def fresnel_conductor_derivatives(cos_theta, eta_i, n, k) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """
+    :func:`fresnel_conductor` and its exact derivatives in ``n`` and ``k``:
+    ``(R, dR/dn, dR/dk)``, broadcast over the inputs (for least squares
+    that fit n and k).
+
+    :math:`r_s` and :math:`r_p` are analytic in :math:`\\eta = (n + ik)/\\eta_i`,
+    so with :math:`D = \\bar r_s r_s' + \\bar r_p r_p'` (derivatives in
+    :math:`\\eta`, from the same expressions as :func:`fresnel_conductor`),
+    :math:`\\partial R/\\partial n = \\mathrm{Re}\\,D/\\eta_i` and
+    :math:`\\partial R/\\partial k = -\\mathrm{Im}\\,D/\\eta_i`. Where a
+    clamp of :func:`fresnel_conductor` holds (an index at its limits, R
+    at 0 or 1) or :math:`\\cos\\theta_t = 0` (k = 0 at the critical
+    angle, where R has no derivative) the derivatives are 0.
+    """
+    lo, hi = INDEX_LIMITS
+    mu = np.clip(as_float_array("cos_theta", cos_theta), 0.0, 1.0)
+    n_in, k_in = as_float_array("n", n), as_float_array("k", k)
+    n, k = np.clip(n_in, lo, hi), np.clip(k_in, 0.0, hi)
+    eta_i = np.clip(as_float_array("eta_i", eta_i), lo, hi)
+    eta = (n + 1j * k) / eta_i
+    s = 1.0 - mu * mu
+    cos_t = np.sqrt(1.0 - s / (eta * eta))
+    eta_cos_t = eta * cos_t
+    eta_mu = eta * mu
+    num_s, den_s = mu - eta_cos_t, mu + eta_cos_t
+    num_p, den_p = eta_mu - cos_t, eta_mu + cos_t
+    tiny = np.finfo(np.float64).tiny
+    den_s2, den_p2 = np.maximum(_abs2(den_s), tiny), np.maximum(_abs2(den_p), tiny)
+    R = 0.5 * (_abs2(num_s) / den_s2 + _abs2(num_p) / den_p2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dcos_t = s / (eta**3 * cos_t)  # d cos_t / d eta
+        # r_s' = -2 mu (eta cos_t)' / den_s^2 and r_p' = 2 mu (cos_t - eta cos_t') / den_p^2;
+        # conj(r) r' = conj(num) r' den / |den|^2.
+        D = (np.conj(num_s) * (-2.0 * mu) * (cos_t + eta * dcos_t) / (den_s2 * den_s)
+             + np.conj(num_p) * (2.0 * mu) * (cos_t - eta * dcos_t) / (den_p2 * den_p))
+    D = np.where(np.isfinite(D) & (cos_t != 0.0) & (R > 0.0) & (R < 1.0), D, 0.0) / eta_i
+    dn = np.where((n_in >= lo) & (n_in <= hi), D.real, 0.0)
+    dk = np.where((k_in >= 0.0) & (k_in <= hi), -D.imag, 0.0)
+    return np.clip(R, 0.0, 1.0), dn, dk
 
 
 def _abs2(z: np.ndarray) -> np.ndarray:

@@ -85,6 +85,22 @@ class TestFit:
         assert np.all(np.isfinite(result.coefficients_float16.astype(np.float64)))
 
 
+class TestObjectiveJacobian:
+    @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
+    def test_against_central_differences(self, objective):
+        """The exact (3 S, 6) Jacobian the solves use, against central differences of the residuals."""
+        mu, eta, w = fit_grid((1.0, 2.5), 12, 4)
+        target = reference_ACEScg(library_material("Cu"), mu, eta, 1.0)
+        problem = RGBConductorObjective(target, mu, eta, objective, w)
+        x = np.array([0.3, 0.8, 1.2, 3.2, 2.6, 2.3])
+        h = 1e-6
+        differences = np.stack([(problem.residuals(x + h * e) - problem.residuals(x - h * e)) / (2 * h)
+                                for e in np.eye(6)], axis=1)
+        J = problem.jacobian(x)
+        assert J.shape == (3 * mu.size, 6)
+        np.testing.assert_allclose(J, differences, atol=1e-8 * np.abs(differences).max())
+
+
 class TestFloat16Rounding:
     def _problem(self, name):
         nk = library_material(name)

@@ -8,6 +8,7 @@ from fitting.fits.material import fit_material
 from fitting.fits.objective import Problem
 from fitting.fits.settings import FitSettings, fit_grid
 from fitting.fits.solver import fit_coefficients
+from fitting.fits.start import ALPHA_CANDIDATES, initial_guess
 from fitting.models.coated_conductor import coated_conductor_model
 from fitting.optics.library import library_material
 
@@ -149,3 +150,27 @@ class TestFitCoefficients:
         result = fit_material(library_material("Au"), (1.5, 1.5))
         assert result.degree == 0 and result.coefficients_float16.shape == (3, 3, 1)
         assert result.packed.eta_i_range == (1.5, 1.5)
+
+
+class TestInitialGuess:
+    def test_each_rung_as_its_own_least_squares(self):
+        """The stacked normal equations give each rung's lstsq solution; the best rung per channel wins."""
+        mu, eta, _ = fit_grid((1.0, 2.5), 12, 4)
+        target = reference_ACEScg(library_material("Cu"), mu, eta, 5.0)
+        x0 = initial_guess(target, mu, eta, (1.0, 2.5), 2)
+        t = (eta - 1.0) / 1.5
+        T = np.stack([t**j for j in range(3)], axis=-1)
+        x = 1.0 - mu
+        for c in range(3):
+            alpha = x0[2, c, 0]
+            assert alpha in ALPHA_CANDIDATES and np.all(x0[2, c, 1:] == 0.0)
+            basis = np.concatenate([(1.0 - x**5)[:, None] * T, -(mu * x**alpha)[:, None] * T], axis=1)
+            coef = np.linalg.lstsq(basis, target[:, c] - x**5, rcond=None)[0]
+            np.testing.assert_allclose(np.concatenate([x0[0, c], x0[1, c]]), coef, rtol=1e-9, atol=1e-11)
+
+    def test_rank_deficient_basis(self):
+        """Every sample at normal incidence (the exponent term vanishes): finite, F0 fitted, a zero."""
+        x0 = initial_guess(np.full((8, 3), 0.5), np.ones(8), np.linspace(1.0, 2.0, 8), (1.0, 2.0), 2)
+        assert np.all(np.isfinite(x0))
+        np.testing.assert_allclose(x0[0, :, 0], 0.5)
+        np.testing.assert_allclose(x0[1], 0.0, atol=1e-12)

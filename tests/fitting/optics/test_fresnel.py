@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from fitting.colour.reference import reference_ACEScg
-from fitting.optics.fresnel import fresnel_conductor, fresnel_dielectric
+from fitting.optics.fresnel import fresnel_conductor, fresnel_conductor_derivatives, fresnel_dielectric
 from fitting.optics.nk import SpectralNK
 from precision import F64_FEW_OPS
 
@@ -105,3 +105,25 @@ class TestFresnelConductor:
             reference_ACEScg(nk, [0.5, np.nan], 1.0)
         with pytest.raises(ValueError, match="`eta_i` must be finite"):
             reference_ACEScg(nk, 0.5, np.nan)
+
+
+class TestFresnelConductorDerivatives:
+    @pytest.mark.parametrize("eta_i, n, k", [(1.0, 0.2, 3.5), (1.5, 1.1, 6.0), (2.5, 2.9, 0.3), (1.33, 0.05, 2.0)])
+    def test_against_central_differences(self, eta_i, n, k):
+        """The exact derivatives in n and k against central differences of fresnel_conductor (step 1e-6: error ~1e-10)."""
+        mu = np.linspace(0.0, 1.0, 41)
+        R, dn, dk = fresnel_conductor_derivatives(mu, eta_i, n, k)
+        h = 1e-6
+        np.testing.assert_array_equal(R, fresnel_conductor(mu, eta_i, n, k))
+        fd_n = (fresnel_conductor(mu, eta_i, n + h, k) - fresnel_conductor(mu, eta_i, n - h, k)) / (2 * h)
+        fd_k = (fresnel_conductor(mu, eta_i, n, k + h) - fresnel_conductor(mu, eta_i, n, k - h)) / (2 * h)
+        np.testing.assert_allclose(dn, fd_n, atol=1e-8)
+        np.testing.assert_allclose(dk, fd_k, atol=1e-8)
+
+    def test_broadcast_and_clamps(self):
+        """Per channel (S, 1) x (3,) shapes; an index clamped at its limit has no derivative; grazing (R = 1) none."""
+        R, dn, dk = fresnel_conductor_derivatives(np.linspace(0.0, 1.0, 5)[:, None], 1.5,
+                                                  np.array([0.3, 0.6, 1.2]), np.array([3.0, -1.0, 2.0]))
+        assert R.shape == dn.shape == dk.shape == (5, 3)
+        assert np.all(dk[:, 1] == 0.0) and np.all(dn[0] == 0.0) and np.all(dk[0] == 0.0)
+        assert np.all(np.isfinite(dn)) and np.all(np.isfinite(dk))
