@@ -9,7 +9,7 @@ import {
 } from "coated-conductor-three";
 
 const gold: ExtensionObject = {
-  kind: "rgb-conductor", colorSpace: "ACEScg", etaIRange: [1, 2.5], coatIor: 1.5,
+  kind: "rgb-conductor", colorSpace: "ACEScg", etaIRange: [1, 2.5],
   coefficients: { n: [0.18, 0.42, 1.37], k: [3.42, 2.35, 1.77] },
 };
 
@@ -21,7 +21,7 @@ export async function draw(renderer: THREE.WebGLRenderer, url: string): Promise<
   exporter.register((writer) => new CoatedConductorExporterExtension(writer));
   const written = await exporter.parseAsync(gltf.scene, { binary: false });
   console.log(EXTENSION_NAME, Object.keys(written));
-  const material = await createCoatedConductorMaterial({ model: checkModel(gold), roughness: 0.3 });
+  const material = await createCoatedConductorMaterial({ model: checkModel(gold, 1.8), coatIor: 1.8, roughness: 0.3 });
   const data = material.userData.coatedConductor;
   if (data) console.log(data.readTable(renderer).nodes);
   return material;
@@ -32,3 +32,5 @@ export async function draw(renderer: THREE.WebGLRenderer, url: string): Promise<
 export const notAKind: ExtensionObject = { ...gold, kind: "schlick" };
 // @ts-expect-error: the material needs its model
 export const noModel = createCoatedConductorMaterial({ roughness: 0.3 });
+// @ts-expect-error: the coat is the clear coat's, not the extension's (revision 1's coatIor is gone)
+export const oldCoat: ExtensionObject = { ...gold, coatIor: 1.5 };
