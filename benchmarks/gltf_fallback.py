@@ -22,7 +22,8 @@ Four fits of the same values (base colour, ``clearcoatFactor``):
 
 Each scored at both roughnesses: mean and max Delta E 2000 over the view
 angles 0 to 83 degrees and every metal and index (and per index), the least
-``clearcoatFactor`` where the rule applies, and the CPU time of the glTF fit
+``clearcoatFactor`` where the coat reflects 2 % or more at normal incidence
+(eta_i >= 1.33), and the CPU time of the glTF fit
 per export (median over the points; the rough target included).
 
     .venv/bin/python benchmarks/gltf_fallback.py [--materials Cu,Au]
