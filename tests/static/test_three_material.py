@@ -7,8 +7,9 @@ the white sky), the editor's preview's own parts composed with that stack
 (white sky, studio and outdoor), and the physics; without the plugin the
 same asset renders its fallback, a plausible metal further from the physics,
 with no error; malformed extension objects draw the fallback with a
-warning; the exporter plugin writes the extension back
-(tests/static/three_pages.py says what is compared and how).
+warning; the coat is the material's clear coat (its textures and the index
+in KHR_materials_clearcoat_ior); the exporter plugin writes the extension
+back (tests/static/three_pages.py says what is compared and how).
 
 Cost: the shared server and Chromium, and one page for the module, loaded
 with the first fit and coat index; each other is put on it with
@@ -298,3 +299,75 @@ def test_material_refuses_malformed_extensions(session):
     for message, field in zip(messages, ["`kind`", "`colorSpace`", "`coatIor`", "n > 0",
                                          "`coefficients.F0`", "`degree`", "`clearcoatIor`"], strict=True):
         assert field in message, message
+
+
+# A 1 x 1 PNG (grey), the clear coat's factor and roughness textures.
+PIXEL = ("data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQ"
+         "AAAABJRU5ErkJggg==")
+
+
+def test_the_coat_is_the_clear_coats_textures_included(session):
+    """
+    The coat the model is drawn under is the material's KHR_materials_clearcoat
+    as three loads it (factor, roughness and their textures), its index the
+    nested KHR_materials_clearcoat_ior's: the shader compiles and draws with
+    the coat's textures, and the exporter plugin writes them back with the index.
+    """
+    page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
+    clearcoat = {"clearcoatFactor": 0.8, "clearcoatTexture": {"index": 0}, "clearcoatRoughnessFactor": 0.2,
+                 "clearcoatRoughnessTexture": {"index": 0},
+                 "extensions": {"KHR_materials_clearcoat_ior": {"clearcoatIor": 1.7}}}
+    result = page.evaluate("""async ([model, clearcoat, pixel]) => {
+        const THREE = await import('three');
+        const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+        const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
+        const { CoatedConductorExtension, CoatedConductorExporterExtension } = await import('/static/three/index.js');
+        const json = { asset: { version: '2.0' },
+                       extensionsUsed: ['EXT_materials_coated_conductor', 'KHR_materials_clearcoat',
+                                        'KHR_materials_clearcoat_ior'],
+                       images: [{ uri: pixel }], textures: [{ source: 0 }],
+                       materials: [{ name: 'textured', pbrMetallicRoughness: { metallicFactor: 1 },
+                                     extensions: { EXT_materials_coated_conductor: model,
+                                                   KHR_materials_clearcoat: clearcoat } }] };
+        const loader = new GLTFLoader();
+        loader.register((parser) => new CoatedConductorExtension(parser));
+        const gltf = await loader.parseAsync(JSON.stringify(json), '');
+        const material = await gltf.parser.getDependency('material', 0);
+        const renderer = new THREE.WebGLRenderer({ canvas: document.createElement('canvas') });
+        renderer.setSize(32, 32);
+        const scene = new THREE.Scene();
+        const mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 32, 16), material);
+        scene.add(mesh);
+        const white = new THREE.DataTexture(new Float32Array(16).fill(1), 2, 2, THREE.RGBAFormat, THREE.FloatType);
+        white.mapping = THREE.EquirectangularReflectionMapping;
+        white.needsUpdate = true;
+        const pmrem = new THREE.PMREMGenerator(renderer);
+        scene.environment = pmrem.fromEquirectangular(white).texture;
+        const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 10);
+        camera.position.set(0, 0, 4);
+        const target = new THREE.WebGLRenderTarget(32, 32, { type: THREE.FloatType });
+        renderer.setRenderTarget(target);
+        renderer.render(scene, camera);
+        const pixels = new Float32Array(4 * 32 * 32);
+        renderer.readRenderTargetPixels(target, 0, 0, 32, 32, pixels);
+        renderer.setRenderTarget(null);
+        const centre = Array.from(pixels.slice(4 * (16 * 32 + 16), 4 * (16 * 32 + 16) + 3));
+        const programs = renderer.info.programs.length;
+        const exporter = new GLTFExporter();
+        exporter.register((writer) => new CoatedConductorExporterExtension(writer));
+        const written = await exporter.parseAsync(scene, { binary: false });
+        renderer.dispose(); pmrem.dispose(); target.dispose();
+        return { coatIor: material.userData.coatedConductor?.coatIor, clearcoat: material.clearcoat,
+                 roughness: material.clearcoatRoughness, map: Boolean(material.clearcoatMap),
+                 roughnessMap: Boolean(material.clearcoatRoughnessMap), centre, programs,
+                 written: written.materials[0].extensions, used: written.extensionsUsed };
+    }""", [GOOD_RGB, clearcoat, PIXEL])
+    assert result["coatIor"] == pytest.approx(1.7)
+    assert result["clearcoat"] == pytest.approx(0.8) and result["roughness"] == pytest.approx(0.2)
+    assert result["map"] and result["roughnessMap"]
+    assert result["programs"] >= 1 and all(0.0 < c < 2.0 for c in result["centre"]), result["centre"]
+    written = result["written"]["KHR_materials_clearcoat"]
+    assert "clearcoatTexture" in written and "clearcoatRoughnessTexture" in written
+    assert written["extensions"] == {"KHR_materials_clearcoat_ior": {"clearcoatIor": 1.7}}
+    assert result["written"]["EXT_materials_coated_conductor"] == GOOD_RGB
+    assert {"KHR_materials_clearcoat_ior", "EXT_materials_coated_conductor"} <= set(result["used"])
