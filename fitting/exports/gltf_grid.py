@@ -44,7 +44,10 @@ def grid_asset(rows: list[list[ExportValues]], generator: str) -> tuple[dict, by
     if not rows or not rows[0] or any(len(row) != len(rows[0]) for row in rows):
         raise ValueError("`rows` must be a non-empty grid: rows of equal, non-zero length")
     buffer, views, accessors = sphere_buffer()
-    materials, meshes, nodes, used = [], [], [], []
+    materials: list[dict] = []
+    meshes: list[dict] = []
+    nodes: list[dict] = []
+    used: list[str] = []
     for r, row in enumerate(rows):
         for c, values in enumerate(row):
             material, extensions, _ = gltf_material(values)
