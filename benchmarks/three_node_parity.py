@@ -117,7 +117,7 @@ def main() -> None:
             with serve(Path(folder)) as site, parity_page(browser, site) as (page, errors, backend):
                 for material, kind, scene, eta, model, roughness, coat_roughness in scenes:
                     started = time.perf_counter()
-                    webgl, node = draw_both(page, model, roughness, coat_roughness, scene == "rough_lit")
+                    webgl, node = draw_both(page, model, roughness, coat_roughness, scene == "rough_lit", coat_ior=eta)
                     seconds = time.perf_counter() - started
                     found = parity(webgl, node)
                     rows.append(

@@ -5,17 +5,16 @@ glTF export
 A glTF 2.0 asset (JSON, buffers embedded as a base64 data URI) with one
 material and a small UV sphere that uses it, so the file opens in any glTF
 viewer. The material is metallic (``metallicFactor`` 1), ``roughnessFactor``
-the metal's roughness, with a ``KHR_materials_clearcoat`` coat; its
-``baseColorFactor`` and ``clearcoatFactor`` are fitted so that three.js's
-``MeshPhysicalMaterial`` (its metallic base and its clear coat of fixed
-index 1.5, layered at the view angle in air) follows the physical coat of
-index eta_i on the metal seen from air (:mod:`fitting.exports.seen_fit`): for
-a coat weaker than glTF's 1.5 the fit lowers ``clearcoatFactor``, never below
-0.5 where the coat's own reflectance at normal incidence is 2 % or more
-(eta_i >= 1.33: a coated metal reads as coated); for a rough metal the values
-follow what three draws at the metal's roughness under a smooth coat
-(:mod:`fitting.exports.gltf_fallback`). At eta_i 1
-there is no coat: no ``KHR_materials_clearcoat`` at all. Provenance, with the
+the metal's roughness, with a ``KHR_materials_clearcoat`` coat of factor 1
+(the coat is there, whole) and the coat's roughness, its index eta_i in the
+nested draft ``KHR_materials_clearcoat_ior``; its ``baseColorFactor`` is
+fitted so that three.js's ``MeshPhysicalMaterial`` (its metallic base and its
+clear coat of fixed index 1.5, layered at the view angle in air) follows the
+physical coat of index eta_i on the metal seen from air
+(:mod:`fitting.exports.seen_fit`); for a rough metal it follows what three
+draws at the metal's roughness under a smooth coat
+(:mod:`fitting.exports.gltf_fallback`). At eta_i 1 there is no coat: no
+``KHR_materials_clearcoat`` at all. Provenance, with the
 full fit id, the service version, the coat index and the working space
 (:func:`fitting.exports.naming.identity`), is in the material's and the
 asset's ``extras``; the material's name is ``<name>_<id>_<eta>``
@@ -26,13 +25,15 @@ an ``acescg`` export is for a pipeline that reads the asset's
 
 When the values carry the fit's own model (:attr:`ExportValues.model`), the
 material also has ``EXT_materials_coated_conductor``
-(:mod:`fitting.exports.gltf_coated`), the model and the coat index for a
-viewer that implements it, listed in ``extensionsUsed`` only: the values
-above are its fallback.
+(:mod:`fitting.exports.gltf_coated`), the metal's model for a viewer that
+implements it, composed with the clear coat above, listed in
+``extensionsUsed`` only: the base colour is its fallback.
 
 -   :func:`gltf_document`: the asset as JSON text (the buffer a base64 data URI).
 -   :func:`glb_document`: the same asset as binary glTF (``.glb``: a JSON
-    chunk and a BIN chunk holding the buffer).
+    chunk and a BIN chunk holding the buffer); :func:`glb_bytes` packs any
+    asset and buffer so.
+-   :func:`gltf_material`: the material of ``values`` and the extensions it uses.
 -   :func:`uv_sphere`: the sphere's positions, normals and indices.
 
 References
@@ -48,13 +49,13 @@ import struct
 
 import numpy as np
 
-from .gltf_coated import EXTENSION_NAME, coated_conductor_extension
+from .gltf_coated import CLEARCOAT_IOR, EXTENSION_NAME, clearcoat_object, coated_conductor_extension
 from .gltf_fallback import gltf_seen_delta_E
 from .naming import element_stem, identity
 from .seen_fit import seen_fidelity
 from .values import ExportValues
 
-__all__ = ["MODEL_KIND", "GLTF_COAT_IOR", "gltf_document", "glb_document", "uv_sphere"]
+__all__ = ["MODEL_KIND", "GLTF_COAT_IOR", "gltf_document", "glb_document", "glb_bytes", "gltf_material", "uv_sphere"]
 
 MODEL_KIND = (
     "metallic base colour and clear coat factor, fitted under three.js's clear coat to the "
@@ -114,7 +115,12 @@ def glb_document(values: ExportValues) -> bytes:
     the BIN chunk (padded with zeros), the buffer without a URI.
     """
     asset, buffer = _asset(values)
-    asset["buffers"] = [{"byteLength": len(buffer)}]
+    return glb_bytes(asset, buffer)
+
+
+def glb_bytes(asset: dict, buffer: bytes) -> bytes:
+    """``asset`` (without ``buffers``) and its one buffer as a GLB (glTF 2.0, 4.4)."""
+    asset = {**asset, "buffers": [{"byteLength": len(buffer)}]}
     text = json.dumps(asset, separators=(",", ":")).encode("utf-8")
     text += b" " * (-len(text) % 4)
     binary = _padded(buffer)
@@ -126,8 +132,8 @@ def glb_document(values: ExportValues) -> bytes:
     ])
 
 
-def _asset(values: ExportValues) -> tuple[dict, bytes]:
-    """The asset without ``buffers``, and the buffer's bytes."""
+def gltf_material(values: ExportValues) -> tuple[dict, list[str], dict]:
+    """The glTF material of ``values``, the extensions it uses (in order) and the provenance."""
     fidelity = seen_fidelity(values, "gltf")
     provenance = values.provenance(MODEL_KIND, fidelity)
     fitted = values.tools["gltf"]
@@ -144,9 +150,15 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
     if coat_on and abs(values.eta_i - GLTF_COAT_IOR) > 1e-9:
         provenance["note"] = (
             f"fitted for a coat of index {values.eta_i:g}; glTF renders its clear coat "
-            f"with index {GLTF_COAT_IOR:g}, so the base colour and clearcoatFactor are "
+            f"with index {GLTF_COAT_IOR:g} unless it reads {CLEARCOAT_IOR}, so the base colour is "
             f"fitted to what the metal under the {values.eta_i:g} coat looks like"
         )
+    material, used = _material(values, fitted, coat_on, provenance)
+    return material, used, provenance
+
+
+def sphere_buffer() -> tuple[bytes, list[dict], list[dict]]:
+    """The unit sphere's buffer, its buffer views and accessors (positions 0, normals 1, indices 2)."""
     positions, normals, indices = uv_sphere()
     blobs = [positions.tobytes(), normals.tobytes(), indices.tobytes()]
     offsets = np.cumsum([0] + [len(_padded(b)) for b in blobs])
@@ -161,6 +173,10 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
         {"bufferView": 1, "componentType": _FLOAT, "count": len(normals), "type": "VEC3"},
         {"bufferView": 2, "componentType": _UNSIGNED_SHORT, "count": len(indices), "type": "SCALAR"},
     ]
+    return buffer, views, accessors
+
+
+def _material(values: ExportValues, fitted: dict, coat_on: bool, provenance: dict) -> tuple[dict, list[str]]:
     material = {
         "name": element_stem(values),
         "pbrMetallicRoughness": {
@@ -172,13 +188,11 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
     }
     used = []
     if coat_on:
-        material["extensions"]["KHR_materials_clearcoat"] = {
-            "clearcoatFactor": round(float(fitted["clearcoat"]), 6),
-            "clearcoatRoughnessFactor": round(values.coat_roughness, 6),
-        }
-        used.append("KHR_materials_clearcoat")
+        material["extensions"]["KHR_materials_clearcoat"] = clearcoat_object(
+            values.eta_i, values.coat_roughness, fitted["clearcoat"])
+        used += ["KHR_materials_clearcoat", CLEARCOAT_IOR]
     if values.model is not None:
-        extension, why_not = coated_conductor_extension(values.model, values.eta_i, values.coat_roughness)
+        extension, why_not = coated_conductor_extension(values.model, values.eta_i)
         if extension is None:
             provenance["coated_conductor_extension"] = why_not
         else:
@@ -187,6 +201,13 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
     if not material["extensions"]:
         del material["extensions"]
     material["extras"] = {"coated_fresnel": {**provenance, **identity(values, with_pack=True)}}
+    return material, used
+
+
+def _asset(values: ExportValues) -> tuple[dict, bytes]:
+    """The asset without ``buffers``, and the buffer's bytes."""
+    material, used, provenance = gltf_material(values)
+    buffer, views, accessors = sphere_buffer()
     asset = {
         "asset": {
             "version": "2.0",

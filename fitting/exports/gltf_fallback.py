@@ -25,14 +25,14 @@ at roughness 0 **and** at the material's roughness, with a smooth coat:
     the export's most grazing one to 1 and interpolated linearly in the
     cosine (measured against every angle's own: at most 0.12 Delta E 2000 on
     Cu, Ag, W at eta_i 1.33 and 2, roughness 0.3; a sixth of the time).
--   :func:`gltf_clearcoat_floor`: the rule that keeps the coat. Where the
-    physical coat's own reflectance at normal incidence,
-    :math:`((\\eta_i - 1)/(\\eta_i + 1))^2`, is at least
-    :data:`VISIBLE_COAT_F0` (2 %, eta_i >= 1.33), the fit's
-    ``clearcoatFactor`` is bounded below by :data:`VISIBLE_CLEARCOAT`
-    (0.5): a coated metal reads as coated in a viewer without the plugin,
-    whatever the base colour could carry of the coat's rise towards
-    grazing. Below it the factor is free in [0, 1].
+-   :data:`GLTF_COAT_FACTOR`: the ``clearcoatFactor`` the export writes
+    wherever there is a coat (eta_i > 1): 1, the coat's weight, which
+    ``EXT_materials_coated_conductor`` composes with (the coat's factor,
+    roughness and index are glTF's, not the extension's). The fit is then of
+    the base colour alone, and a coated metal reads as coated in a viewer
+    without the plugin: its factor is above 0.5 wherever the physical coat's
+    own reflectance at normal incidence, :func:`coat_F0`, is at least
+    :data:`VISIBLE_COAT_F0` (2 %, eta_i >= 1.33), and everywhere else too.
 -   :func:`gltf_seen_delta_E`: Delta E 2000 per angle of glTF values drawn
     by three at a metal roughness, against :func:`rough_seen_ACEScg`.
 """
@@ -46,29 +46,19 @@ from ..shading.coated_layer import seen_base
 from .colour_space import DEFAULT_WORKING_SPACE, working_to_ACEScg
 from .tool_layering import three_clearcoat
 
-__all__ = ["ROUGH_NODES", "VISIBLE_COAT_F0", "VISIBLE_CLEARCOAT", "coat_F0", "gltf_clearcoat_floor",
-           "rough_seen_ACEScg", "gltf_seen_delta_E"]
+__all__ = ["ROUGH_NODES", "VISIBLE_COAT_F0", "GLTF_COAT_FACTOR", "coat_F0", "rough_seen_ACEScg", "gltf_seen_delta_E"]
 
 VISIBLE_COAT_F0 = 0.02
 """The coat's own reflectance at normal incidence from which the coat is visible (eta_i about 1.33)."""
 ROUGH_NODES = 16
 """View cosines at which :func:`rough_seen_ACEScg` evaluates the rough lobe."""
-VISIBLE_CLEARCOAT = 0.5
-"""The least ``clearcoatFactor`` of a visible coat."""
+GLTF_COAT_FACTOR = 1.0
+"""The ``clearcoatFactor`` of a coat: its weight, composed with the extension (not fitted)."""
 
 
 def coat_F0(eta: float) -> float:
     """The coat's own reflectance at normal incidence from air, ((eta - 1)/(eta + 1))^2."""
     return ((float(eta) - 1.0) / (float(eta) + 1.0)) ** 2
-
-
-def gltf_clearcoat_floor(eta: float, coat: bool = True) -> float:
-    """
-    The least ``clearcoatFactor`` the glTF fit may take at coat index ``eta``:
-    :data:`VISIBLE_CLEARCOAT` where :func:`coat_F0` is at least
-    :data:`VISIBLE_COAT_F0` (1e-12 below it, for rounding), else 0.
-    """
-    return VISIBLE_CLEARCOAT if coat and coat_F0(eta) >= VISIBLE_COAT_F0 - 1e-12 else 0.0
 
 
 def _curve(cos_model, model_ACEScg):

@@ -41,7 +41,7 @@ from ..models.pack import PACK_MAGIC, PackedMaterial, decode_pack, material_from
 from ..optics.bounded import load_json_bounded
 from ._xml import IDENTITY_ATTRIBUTES
 from .colour_space import check_working_space
-from .gltf_coated import EXTENSION_NAME
+from .gltf_coated import CLEARCOAT_IOR, EXTENSION_NAME, coat_of
 from .naming import check_fit_id
 
 __all__ = ["MAX_IMPORT_BYTES", "ReadBack", "read_fit_file"]
@@ -134,8 +134,13 @@ def _gltf(asset, format: str) -> ReadBack:
             raise ValueError(f"`file` has a damaged {EXTENSION_NAME}: {error}") from None
         if carried.model != model.model or carried.coefficients.tobytes() != model.coefficients.tobytes():
             raise ValueError(f"`file` is inconsistent: {EXTENSION_NAME}'s coefficients are not the fit model's")
-        if abs(float(extension.get("coatIor", -1)) - identity["eta_i"]) > 1e-9:
-            raise ValueError(f"`file` is inconsistent: {EXTENSION_NAME}'s coatIor is not the export's eta_i")
+        try:
+            eta = coat_of(material)[2]
+        except (AttributeError, TypeError, ValueError) as error:
+            raise ValueError(f"`file` has a damaged KHR_materials_clearcoat: {error}") from None
+        if abs(eta - identity["eta_i"]) > 1e-9:
+            raise ValueError(f"`file` is inconsistent: the coat index {EXTENSION_NAME} is drawn under "
+                             f"(KHR_materials_clearcoat, {CLEARCOAT_IOR}) is not the export's eta_i")
     return ReadBack(format, [model], identity)
 
 

@@ -45,7 +45,7 @@ from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_dielectric
 from .channel_fit import fit_channel_conductor, fit_channel_f82, fit_channel_schlick, least_squares
 from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, working_to_ACEScg
-from .gltf_fallback import gltf_clearcoat_floor
+from .gltf_fallback import GLTF_COAT_FACTOR
 from .seen_jacobian import DeltaEComponents, delta_E_jacobian
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
@@ -120,7 +120,7 @@ def tool_floor(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     Delta E 2000 per angle of :func:`floor_base` under the tool's layering
     (glTF's at the clear coat factor the export's fit starts from).
     """
-    clearcoat = max(gltf_clearcoat_factor(mu, eta), gltf_clearcoat_floor(eta, coat)) if tool == "gltf" and coat else 1.0
+    clearcoat = GLTF_COAT_FACTOR if tool == "gltf" and coat else 1.0
     base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat, space)
     return delta_E_map(target_ACEScg, working_to_ACEScg(layer_only(tool, mu, eta, base, coat, clearcoat), space))
 
@@ -139,11 +139,8 @@ def gltf_clearcoat_factor(mu, eta: float) -> float:
     three.js's ``clearcoat`` whose own reflection (F0 0.04, weighted by the
     factor) is nearest the physical coat's reflection at ``eta`` in least
     squares over ``mu``, in [0, 1] (1 for eta_i 1.33 to 2): the start of the
-    glTF fit, where the factor is then free with the base colour. The fit
-    lowers it where three's metallic base (F90 1) carries the coat's rise
-    towards grazing better than three's coat over it (Cu and Au at 1.5: 0),
-    but not below :func:`fitting.exports.gltf_fallback.gltf_clearcoat_floor`
-    (0.5 wherever the coat is visible).
+    glTF fit with the factor free (``keep_coat=False``: a comparison; the
+    export writes the coat's own factor, 1).
     """
     mu = np.asarray(mu, dtype=np.float64)
     coat = three_clearcoat(mu, np.zeros(3), 1.0)[:, 0] - three_clearcoat(mu, np.zeros(3), coat=False)[:, 0]
@@ -258,21 +255,22 @@ def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     glTF's fit with a metal ``roughness`` above 0 and its target there
     (``rough_target_ACEScg``, :func:`fitting.exports.gltf_fallback.rough_seen_ACEScg`)
     follows what three draws at that roughness (the material as the viewer
-    shows it; started from the smooth fit's floor). With
-    ``keep_coat`` its ``clearcoatFactor`` is at least
-    :func:`fitting.exports.gltf_fallback.gltf_clearcoat_floor` (``False``:
-    free in [0, 1], the fit before that rule).
+    shows it; started from the smooth fit's floor). With ``keep_coat`` its
+    ``clearcoatFactor`` is the coat's,
+    :data:`fitting.exports.gltf_fallback.GLTF_COAT_FACTOR` (1), and the base
+    colour alone is fitted (``False``: the factor fitted too, in [0, 1], as
+    the export once wrote it; for comparison).
     """
     if tool not in TOOLS:
         raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")
     mu = np.asarray(mu, dtype=np.float64)
-    floor = gltf_clearcoat_floor(eta, coat) if tool == "gltf" and keep_coat else 0.0
-    clearcoat = max(gltf_clearcoat_factor(mu, eta), floor) if tool == "gltf" and coat else 1.0
+    fixed = tool == "gltf" and coat and keep_coat
+    clearcoat = GLTF_COAT_FACTOR if fixed else gltf_clearcoat_factor(mu, eta) if tool == "gltf" and coat else 1.0
     base = floor_base(tool, mu, eta, target_ACEScg, coat, clearcoat, space)
     x0, lo, hi = _start_and_bounds(tool, mu, base, coat)
     lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
-    if tool == "gltf" and coat:
-        lo[3] = floor
+    if fixed:
+        x0, lo, hi = np.asarray(x0)[:3], lo[:3], hi[:3]
     x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
     target, rough = np.asarray(target_ACEScg, dtype=np.float64), None
     if tool == "gltf" and roughness > 0.0 and rough_target_ACEScg is not None:

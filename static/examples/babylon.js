@@ -79,7 +79,7 @@ async function loadFit(id, eta) {
   previous?.dispose();
   const model = material.pluginManager.getPlugin("CoatedConductor").model;
   document.getElementById("material").textContent =
-    `${material.name}: ${model.kind}, coat index ${model.coatIor}, metal roughness ${material.roughness}.`;
+    `${material.name}: ${model.kind}, coat index ${material.pluginManager.getPlugin("CoatedConductor").coatIor}, metal roughness ${material.roughness}.`;
   await scene.whenReadyAsync();
   return model;
 }

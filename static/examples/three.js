@@ -176,7 +176,7 @@ async function loadFit(id, eta) {
   const info = model.userData.coatedConductor;
   if (!info) throw new Error("the export carries no EXT_materials_coated_conductor (eta_i outside the fit's range?)");
   document.getElementById("material").textContent =
-    `${model.name}: ${info.model.kind}, coat index ${info.model.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}.`;
+    `${model.name}: ${info.model.kind}, coat index ${info.coatIor}, metal roughness ${model.roughness}, coat roughness ${model.clearcoatRoughness}.`;
   return { model, fallback };
 }
 

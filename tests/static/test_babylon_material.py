@@ -25,13 +25,21 @@ pytestmark = [pytest.mark.server, pytest.mark.browser, pytest.mark.slow]
 
 PARITY_MEAN, PARITY_P99, PARITY_CENTRE = 0.05, 0.3, 0.02
 
-GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5], "coatIor": 1.5,
+GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5],
             "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]}}
+
+
+def coat(ior: float) -> dict:
+    """A whole clear coat of index ``ior`` (the draft KHR_materials_clearcoat_ior nested in it)."""
+    return {"clearcoatFactor": 1, "extensions": {"KHR_materials_clearcoat_ior": {"clearcoatIor": ior}}}
+
+
+# (what, extension object, the material's clear coat or None, what the warning names)
 MALFORMED = [
-    ("unknown kind", {**GOOD_RGB, "kind": "schlick"}, "`kind`"),
-    ("coat index below 1", {**GOOD_RGB, "coatIor": 0.5}, "`coatIor`"),
-    ("negative k", {**GOOD_RGB, "coefficients": {"n": [1, 1, 1], "k": [0, -1, 0]}}, "n > 0"),
-    ("unknown property", {**GOOD_RGB, "tint": [1, 0, 0]}, "`tint`"),
+    ("unknown kind", {**GOOD_RGB, "kind": "schlick"}, None, "`kind`"),
+    ("coat index below 1", GOOD_RGB, coat(0.5), "`clearcoatIor`"),
+    ("negative k", {**GOOD_RGB, "coefficients": {"n": [1, 1, 1], "k": [0, -1, 0]}}, None, "n > 0"),
+    ("revision 1's coat", {**GOOD_RGB, "coatIor": 1.5}, None, "`coatIor`"),
 ]
 
 
@@ -60,7 +68,7 @@ def test_babylon_draws_what_three_draws(pages, live_server):
         parity = figures["babylon_vs_three"]
         assert parity["mean"] < PARITY_MEAN and parity["p99"] < PARITY_P99, (eta_i, parity)
         assert parity["centre"] < PARITY_CENTRE, (eta_i, parity)
-        plugin = babylon.evaluate("window.cfBabylon.material.pluginManager.getPlugin('CoatedConductor').model.coatIor")
+        plugin = babylon.evaluate("window.cfBabylon.material.pluginManager.getPlugin('CoatedConductor').coatIor")
         assert plugin == pytest.approx(eta_i)
     assert errors == []
 
@@ -75,15 +83,17 @@ def test_malformed_extensions_draw_the_fallback(pages, live_server):
     _, babylon, _ = pages
     if babylon.evaluate("window.cfBabylon === undefined"):
         open_babylon(babylon, live_server, create_fit(live_server, "Cu", "coated-conductor")["id"], 1.5)
-    objects = [GOOD_RGB] + [o for _, o, _ in MALFORMED]
+    objects = [(GOOD_RGB, coat(1.8))] + [(o, c) for _, o, c, _ in MALFORMED]
     result = babylon.evaluate("""async (objects) => {
         const { LoadAssetContainerAsync } = await import('@babylonjs/core/Loading/sceneLoader.js');
         const { EngineStore } = await import('@babylonjs/core/Engines/engineStore.js');
         const scene = EngineStore.LastCreatedScene;
-        const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor'],
-                       materials: objects.map((o, i) => ({ name: `m${i}`, pbrMetallicRoughness: {
+        const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor',
+                           'KHR_materials_clearcoat', 'KHR_materials_clearcoat_ior'],
+                       materials: objects.map(([o, c], i) => ({ name: `m${i}`, pbrMetallicRoughness: {
                            baseColorFactor: [0.9, 0.6, 0.3, 1], metallicFactor: 1 },
-                           extensions: { EXT_materials_coated_conductor: o } })),
+                           extensions: { EXT_materials_coated_conductor: o,
+                                         ...(c ? { KHR_materials_clearcoat: c } : {}) } })),
                        meshes: [{ primitives: objects.map((_, i) => ({ attributes: { POSITION: 0 }, material: i })) }],
                        accessors: [{ bufferView: 0, componentType: 5126, count: 3, type: 'VEC3',
                                      min: [0, 0, 0], max: [1, 1, 0] }],
@@ -108,5 +118,5 @@ def test_malformed_extensions_draw_the_fallback(pages, live_server):
     assert result["drawn"] == [True] + [False] * len(MALFORMED), result
     ours = [w for w in result["warnings"] if "EXT_materials_coated_conductor" in w]
     assert len(ours) == len(MALFORMED), result["warnings"]
-    for (what, _, field), warning in zip(MALFORMED, ours):
+    for (what, _, _, field), warning in zip(MALFORMED, ours):
         assert field in warning and "draws its fallback" in warning, (what, warning)

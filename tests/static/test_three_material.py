@@ -7,8 +7,9 @@ the white sky), the editor's preview's own parts composed with that stack
 (white sky, studio and outdoor), and the physics; without the plugin the
 same asset renders its fallback, a plausible metal further from the physics,
 with no error; malformed extension objects draw the fallback with a
-warning; the exporter plugin writes the extension back
-(tests/static/three_pages.py says what is compared and how).
+warning; the coat is the material's clear coat (its textures and the index
+in KHR_materials_clearcoat_ior); the exporter plugin writes the extension
+back (tests/static/three_pages.py says what is compared and how).
 
 Cost: the shared server and Chromium, and one page for the module, loaded
 with the first fit and coat index; each other is put on it with
@@ -160,19 +161,30 @@ def test_roughness_and_coat_change_the_render(session):
 
 
 # Malformed or out-of-range extension objects, each with what its warning names.
-GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5], "coatIor": 1.5,
+GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5],
             "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]}}
 GOOD_COATED = {"kind": "coated-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2], "degree": 0,
-               "coatIor": 1.5, "coefficients": {"F0": [[0.9], [0.7], [0.4]], "a": [[0.1], [0.2], [0.1]],
-                                                "alpha": [[5.0], [4.0], [3.0]]}}
+               "coefficients": {"F0": [[0.9], [0.7], [0.4]], "a": [[0.1], [0.2], [0.1]],
+                                "alpha": [[5.0], [4.0], [3.0]]}}
+
+
+def coat(ior) -> dict:
+    """A whole clear coat of index ``ior`` (the draft KHR_materials_clearcoat_ior nested in it)."""
+    return {"clearcoatFactor": 1, "extensions": {"KHR_materials_clearcoat_ior": {"clearcoatIor": ior}}}
+
+
+# (what, extension object, what the warning names, and the material's clear coat if the case is in it)
 MALFORMED = [
     ("not an object", [1, 2, 3], "must be an object"),
     ("null", None, "must be an object"),
     ("unknown kind", {**GOOD_RGB, "kind": "schlick"}, "`kind`"),
     ("colour space", {**GOOD_RGB, "colorSpace": "sRGB"}, "`colorSpace`"),
-    ("coat index below 1", {**GOOD_RGB, "coatIor": 0.5}, "`coatIor`"),
-    ("coat index a string", {**GOOD_RGB, "coatIor": "1.5"}, "`coatIor`"),
-    ("coat index outside the fit", {**GOOD_COATED, "coatIor": 2.4}, "outside"),
+    ("coat index below 1", GOOD_RGB, "`clearcoatIor`", coat(0.5)),
+    ("coat index a string", GOOD_RGB, "`clearcoatIor`", coat("1.5")),
+    ("coat index outside the fit", GOOD_COATED, "outside", coat(2.4)),
+    ("glTF's 1.5 outside the fit", {**GOOD_COATED, "etaIRange": [1.8, 2]}, "outside",
+     {"clearcoatFactor": 0.5}),
+    ("revision 1's coat index", {**GOOD_RGB, "coatIor": 1.5}, "`coatIor`"),
     ("range reversed", {**GOOD_COATED, "etaIRange": [2, 1]}, "`etaIRange`"),
     ("range missing", {k: v for k, v in GOOD_RGB.items() if k != "etaIRange"}, "`etaIRange`"),
     ("n of two", {**GOOD_RGB, "coefficients": {"n": [1, 1], "k": [0, 0, 0]}}, "n > 0"),
@@ -182,7 +194,7 @@ MALFORMED = [
     ("degree 5", {**GOOD_COATED, "degree": 5}, "`degree`"),
     ("beyond float16", {**GOOD_COATED, "coefficients": {**GOOD_COATED["coefficients"],
                                                         "alpha": [[1e6], [4.0], [3.0]]}}, "`coefficients.alpha`"),
-    ("coat factor 2", {**GOOD_RGB, "coatFactor": 2}, "`coatFactor`"),
+    ("revision 1's coat factor", {**GOOD_RGB, "coatFactor": 1}, "`coatFactor`"),
     ("unknown property", {**GOOD_RGB, "tint": [1, 0, 0]}, "`tint`"),
 ]
 
@@ -196,14 +208,16 @@ def test_malformed_extensions_draw_the_fallback(session):
     well-formed ones beside them draw the model.
     """
     page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
-    objects = [GOOD_RGB, GOOD_COATED] + [o for _, o, _ in MALFORMED]
+    objects = [(GOOD_RGB, None), (GOOD_COATED, coat(1.2))] + [(o, (c or [None])[0]) for _, o, _, *c in MALFORMED]
     result = page.evaluate("""async (objects) => {
         const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
         const { CoatedConductorExtension } = await import('/static/three/index.js');
-        const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor'],
-                       materials: objects.map((o, i) => ({ name: `m${i}`, pbrMetallicRoughness: {
+        const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor',
+                           'KHR_materials_clearcoat', 'KHR_materials_clearcoat_ior'],
+                       materials: objects.map(([o, c], i) => ({ name: `m${i}`, pbrMetallicRoughness: {
                            baseColorFactor: [0.9, 0.6, 0.3, 1], metallicFactor: 1 },
-                           extensions: { EXT_materials_coated_conductor: o } })) };
+                           extensions: { EXT_materials_coated_conductor: o,
+                                         ...(c ? { KHR_materials_clearcoat: c } : {}) } })) };
         const warnings = [];
         const warn = console.warn;
         console.warn = (...args) => warnings.push(args.join(' '));
@@ -220,7 +234,7 @@ def test_malformed_extensions_draw_the_fallback(session):
     }""", objects)
     assert result["drawn"] == [True, True] + [False] * len(MALFORMED), result
     assert len(result["warnings"]) == len(MALFORMED), result["warnings"]
-    for (what, _, field), warning in zip(MALFORMED, result["warnings"]):
+    for (what, _, field, *_), warning in zip(MALFORMED, result["warnings"]):
         assert field in warning and "draws its fallback" in warning, (what, warning)
 
 
@@ -267,18 +281,93 @@ def test_material_refuses_malformed_extensions(session):
     page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
     messages = page.evaluate("""async () => {
         const { checkModel } = await import('/static/three/index.js');
-        const good = { kind: 'rgb-conductor', colorSpace: 'ACEScg', etaIRange: [1, 2.5], coatIor: 1.5,
+        const good = { kind: 'rgb-conductor', colorSpace: 'ACEScg', etaIRange: [1, 2.5],
                        coefficients: { n: [0.2, 0.5, 1.3], k: [3, 2.3, 1.9] } };
         const bad = [
-            { ...good, kind: 'schlick' }, { ...good, colorSpace: 'sRGB' }, { ...good, coatIor: 0.5 },
+            { ...good, kind: 'schlick' }, { ...good, colorSpace: 'sRGB' }, { ...good, coatIor: 1.5 },
             { ...good, coefficients: { n: [1, 1] , k: [0, 0, 0] } },
             { ...good, kind: 'coated-conductor', degree: 2, coefficients: { F0: [[1, 0, 0]], a: [], alpha: [] } },
             { ...good, kind: 'coated-conductor', degree: 5 },
         ];
         checkModel(good);
-        return bad.map((m) => { try { checkModel(m); return null; } catch (e) { return e.message; } });
+        checkModel(good, 2.9);
+        const messages = bad.map((m) => { try { checkModel(m); return null; } catch (e) { return e.message; } });
+        try { checkModel(good, 0.5); messages.push(null); } catch (e) { messages.push(e.message); }
+        return messages;
     }""")
     assert all(messages), messages
     for message, field in zip(messages, ["`kind`", "`colorSpace`", "`coatIor`", "n > 0",
-                                         "`coefficients.F0`", "`degree`"]):
+                                         "`coefficients.F0`", "`degree`", "`clearcoatIor`"], strict=True):
         assert field in message, message
+
+
+# A 1 x 1 PNG (grey), the clear coat's factor and roughness textures.
+PIXEL = ("data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQ"
+         "AAAABJRU5ErkJggg==")
+
+
+def test_the_coat_is_the_clear_coats_textures_included(session):
+    """
+    The coat the model is drawn under is the material's KHR_materials_clearcoat
+    as three loads it (factor, roughness and their textures), its index the
+    nested KHR_materials_clearcoat_ior's: the shader compiles and draws with
+    the coat's textures, and the exporter plugin writes them back with the index.
+    """
+    page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
+    clearcoat = {"clearcoatFactor": 0.8, "clearcoatTexture": {"index": 0}, "clearcoatRoughnessFactor": 0.2,
+                 "clearcoatRoughnessTexture": {"index": 0},
+                 "extensions": {"KHR_materials_clearcoat_ior": {"clearcoatIor": 1.7}}}
+    result = page.evaluate("""async ([model, clearcoat, pixel]) => {
+        const THREE = await import('three');
+        const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
+        const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
+        const { CoatedConductorExtension, CoatedConductorExporterExtension } = await import('/static/three/index.js');
+        const json = { asset: { version: '2.0' },
+                       extensionsUsed: ['EXT_materials_coated_conductor', 'KHR_materials_clearcoat',
+                                        'KHR_materials_clearcoat_ior'],
+                       images: [{ uri: pixel }], textures: [{ source: 0 }],
+                       materials: [{ name: 'textured', pbrMetallicRoughness: { metallicFactor: 1 },
+                                     extensions: { EXT_materials_coated_conductor: model,
+                                                   KHR_materials_clearcoat: clearcoat } }] };
+        const loader = new GLTFLoader();
+        loader.register((parser) => new CoatedConductorExtension(parser));
+        const gltf = await loader.parseAsync(JSON.stringify(json), '');
+        const material = await gltf.parser.getDependency('material', 0);
+        const renderer = new THREE.WebGLRenderer({ canvas: document.createElement('canvas') });
+        renderer.setSize(32, 32);
+        const scene = new THREE.Scene();
+        const mesh = new THREE.Mesh(new THREE.SphereGeometry(1, 32, 16), material);
+        scene.add(mesh);
+        const white = new THREE.DataTexture(new Float32Array(16).fill(1), 2, 2, THREE.RGBAFormat, THREE.FloatType);
+        white.mapping = THREE.EquirectangularReflectionMapping;
+        white.needsUpdate = true;
+        const pmrem = new THREE.PMREMGenerator(renderer);
+        scene.environment = pmrem.fromEquirectangular(white).texture;
+        const camera = new THREE.PerspectiveCamera(40, 1, 0.1, 10);
+        camera.position.set(0, 0, 4);
+        const target = new THREE.WebGLRenderTarget(32, 32, { type: THREE.FloatType });
+        renderer.setRenderTarget(target);
+        renderer.render(scene, camera);
+        const pixels = new Float32Array(4 * 32 * 32);
+        renderer.readRenderTargetPixels(target, 0, 0, 32, 32, pixels);
+        renderer.setRenderTarget(null);
+        const centre = Array.from(pixels.slice(4 * (16 * 32 + 16), 4 * (16 * 32 + 16) + 3));
+        const programs = renderer.info.programs.length;
+        const exporter = new GLTFExporter();
+        exporter.register((writer) => new CoatedConductorExporterExtension(writer));
+        const written = await exporter.parseAsync(scene, { binary: false });
+        renderer.dispose(); pmrem.dispose(); target.dispose();
+        return { coatIor: material.userData.coatedConductor?.coatIor, clearcoat: material.clearcoat,
+                 roughness: material.clearcoatRoughness, map: Boolean(material.clearcoatMap),
+                 roughnessMap: Boolean(material.clearcoatRoughnessMap), centre, programs,
+                 written: written.materials[0].extensions, used: written.extensionsUsed };
+    }""", [GOOD_RGB, clearcoat, PIXEL])
+    assert result["coatIor"] == pytest.approx(1.7)
+    assert result["clearcoat"] == pytest.approx(0.8) and result["roughness"] == pytest.approx(0.2)
+    assert result["map"] and result["roughnessMap"]
+    assert result["programs"] >= 1 and all(0.0 < c < 2.0 for c in result["centre"]), result["centre"]
+    written = result["written"]["KHR_materials_clearcoat"]
+    assert "clearcoatTexture" in written and "clearcoatRoughnessTexture" in written
+    assert written["extensions"] == {"KHR_materials_clearcoat_ior": {"clearcoatIor": 1.7}}
+    assert result["written"]["EXT_materials_coated_conductor"] == GOOD_RGB
+    assert {"KHR_materials_clearcoat_ior", "EXT_materials_coated_conductor"} <= set(result["used"])

@@ -69,7 +69,7 @@ def test_each_kind_s_tsl_twin_is_the_registry_s_formula(models):
     """node_models.js on numbers (Node) against ModelKind.evaluate on the float16 coefficients."""
     node = shutil.which("node")
     assert node, "node is part of the project's toolchain (scripts/bootstrap)"
-    objects = [model for _, _, model in models]
+    objects = [{**model, "coatIor": eta_i} for _, eta_i, model in models]  # under the clear coat's index
     done = subprocess.run(
         [node, "--input-type=module", "-e", EVALUATE, json.dumps([objects, MUS])],
         cwd=PACKAGE,
@@ -110,12 +110,12 @@ def test_webgl_and_the_node_material_draw_the_same_image(models, chromium, tmp_p
     with serve(tmp_path) as site, parity_page(chromium, site) as (page, errors, backend):
         assert backend == "WebGL2"  # forceWebGL: the node material on WebGPURenderer's WebGL2 backend
         for kind, eta_i, model, roughness, coat_roughness, lit in scenes:
-            webgl, node = draw_both(page, model, roughness, coat_roughness, lit)
+            webgl, node = draw_both(page, model, roughness, coat_roughness, lit, coat_ior=eta_i)
             found = parity(webgl, node)
             assert found["pixels"] > 10_000, found
             assert found["mean"] <= PARITY_MEAN, (kind, eta_i, roughness, lit, found)
         # Two materials of one kind alive together: each draws its own model (no program shared between them).
-        first, last = (model for kind, eta_i, model in models if kind == models[0][0] and eta_i in (ETAS[0], ETAS[-1]))
+        first, last = ((model, eta_i) for kind, eta_i, model in models if kind == models[0][0] and eta_i in (ETAS[0], ETAS[-1]))
         gl_a, node_a, gl_b, node_b = draw_pair(page, first, last, 0.3, 0.1)
         assert parity(gl_a, node_a)["mean"] <= PARITY_MEAN and parity(gl_b, node_b)["mean"] <= PARITY_MEAN
         assert parity(gl_a, gl_b)["mean"] > 1  # the two models differ: the check above can see a swap

@@ -113,11 +113,11 @@ window.cfDrawBoth = async (model, settings, lit) => {
   nodeMaterial.dispose();
   return images;
 };
-// Two extension objects' materials made before either is drawn (alive together, as in one scene):
-// [WebGL a, node a, WebGL b, node b].
+// Two extension objects' materials, each at its settings, made before either is drawn (alive together,
+// as in one scene): [WebGL a, node a, WebGL b, node b].
 window.cfDrawPair = async (a, b, settings) => {
-  const gl = await Promise.all([a, b].map((model) => createCoatedConductorMaterial({ model, ...settings })));
-  const node = await Promise.all([a, b].map((model) => createCoatedConductorNodeMaterial({ model, ...settings })));
+  const gl = await Promise.all([a, b].map((model, i) => createCoatedConductorMaterial({ model, ...settings[i] })));
+  const node = await Promise.all([a, b].map((model, i) => createCoatedConductorNodeMaterial({ model, ...settings[i] })));
   const images = [await drawGL(gl[0]), await drawNode(node[0]), await drawGL(gl[1]), await drawNode(node[1])];
   for (const material of gl) material.userData.coatedConductor.dispose();
   for (const material of [...gl, ...node]) material.dispose();
@@ -213,15 +213,15 @@ def parity_page(chromium, site: str):
         context.close()
 
 
-def draw_both(page, model: dict, roughness: float, coat_roughness: float, lit: bool = False):
+def draw_both(page, model: dict, roughness: float, coat_roughness: float, lit: bool = False, coat_ior: float = 1.5):
     """
-    (WebGL, node material) images of extension object ``model`` under the
-    white sky (and with ``lit`` a directional light): (H, W, 4) float
+    (WebGL, node material) images of extension object ``model`` under a
+    clear coat of index ``coat_ior``, under the white sky (and with ``lit`` a directional light): (H, W, 4) float
     radiance, top row first.
     """
     flat = page.evaluate(
         f"async ([m, s, l]) => {{ {F32_BASE64} const [a, b] = await window.cfDrawBoth(m, s, l); return [f32(a), f32(b)]; }}",
-        [model, {"roughness": roughness, "clearcoatRoughness": coat_roughness}, lit],
+        [model, {"roughness": roughness, "clearcoatRoughness": coat_roughness, "coatIor": coat_ior}, lit],
     )
     return tuple(from_f32(text).reshape(H, W, 4)[::-1] for text in flat)
 
@@ -236,11 +236,15 @@ def draw_gltf(page, url: str, roughness: float, coat_roughness: float, lit: bool
     return *(from_f32(text).reshape(H, W, 4)[::-1] for text in (a, b)), twin
 
 
-def draw_pair(page, a: dict, b: dict, roughness: float, coat_roughness: float):
-    """(WebGL a, node a, WebGL b, node b): both objects' materials made before either is drawn."""
+def draw_pair(page, a: tuple[dict, float], b: tuple[dict, float], roughness: float, coat_roughness: float):
+    """
+    (WebGL a, node a, WebGL b, node b) of ``a`` and ``b``, each (extension
+    object, coat index): both materials made before either is drawn.
+    """
+    settings = [{"roughness": roughness, "clearcoatRoughness": coat_roughness, "coatIor": eta} for _, eta in (a, b)]
     flat = page.evaluate(
         f"async ([a, b, s]) => {{ {F32_BASE64} return (await window.cfDrawPair(a, b, s)).map(f32); }}",
-        [a, b, {"roughness": roughness, "clearcoatRoughness": coat_roughness}],
+        [a[0], b[0], settings],
     )
     return [from_f32(text).reshape(H, W, 4)[::-1] for text in flat]
 

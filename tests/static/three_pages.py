@@ -143,7 +143,7 @@ def show_fit(page, fit_id: str, eta_i: float) -> None:
     """
     page.evaluate("([id, eta]) => window.cfThree.setFit(id, eta)", [fit_id, eta_i])
     assert page.evaluate("window.cfThree.fit") == {"id": fit_id, "etaI": eta_i}
-    shown = page.evaluate("window.cfThree.balls.model.material.userData.coatedConductor.model.coatIor")
+    shown = page.evaluate("window.cfThree.balls.model.material.userData.coatedConductor.coatIor")
     assert shown == pytest.approx(eta_i), (shown, eta_i)
 
 

@@ -36,7 +36,9 @@ class TestExportOption:
         assert material["pbrMetallicRoughness"]["roughnessFactor"] == 0.5
         assert material["extras"]["coated_fresnel"]["eta_i"] == 2.0
         extension = material["extensions"]["EXT_materials_coated_conductor"]
-        assert extension["kind"] == "coated-conductor" and extension["coatIor"] == 2.0
+        clearcoat = material["extensions"]["KHR_materials_clearcoat"]
+        assert extension["kind"] == "coated-conductor"
+        assert clearcoat["extensions"]["KHR_materials_clearcoat_ior"]["clearcoatIor"] == 2.0
 
     @pytest.mark.slow
     def test_gltf_carries_the_kind(self):

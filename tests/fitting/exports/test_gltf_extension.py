@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from fitting.exports import export_material
-from fitting.exports.gltf_coated import EXTENSION_NAME, SCHEMA_PATH, coated_conductor_extension
+from fitting.exports.gltf_coated import CLEARCOAT_IOR, EXTENSION_NAME, SCHEMA_PATH, coat_of, coated_conductor_extension
 from fitting.fits.kinds import fit_model
 from fitting.models.pack import material_from_json, material_to_json
 from fitting.optics.library import library_material
@@ -53,13 +53,15 @@ class TestSchema:
     @pytest.mark.parametrize("eta_i", [1.0, 1.33, 1.5, 2.5])
     def test_every_export_validates(self, packed, kind, eta_i):
         nk, models = packed
-        extension = extension_of(export_material(nk, "gltf", eta_i, model=models[kind]))
+        material = json.loads(export_material(nk, "gltf", eta_i, model=models[kind]))["materials"][0]
+        extension = material["extensions"][EXTENSION_NAME]
         VALIDATOR.validate(extension)
-        assert extension["kind"] == kind and extension["coatIor"] == eta_i
+        # The coat is glTF's: a whole clear coat of index eta_i (none at 1).
+        assert extension["kind"] == kind and coat_of(material)[::2] == ((1.0, eta_i) if eta_i > 1 else (0.0, 1.0))
 
     def test_single_index_fit_nine_coefficients(self):
         packed = fit_model(library_material("Au"), (1.5, 1.5), "coated-conductor", degree=0).packed
-        extension, why = coated_conductor_extension(packed, 1.5, 0.1)
+        extension, why = coated_conductor_extension(packed, 1.5)
         assert why is None and extension["degree"] == 0
         VALIDATOR.validate(extension)
         assert sum(len(row) for p in ("F0", "a", "alpha") for row in extension["coefficients"][p]) == 9
@@ -73,10 +75,10 @@ class TestSchema:
         lambda e: e.pop("kind"),
         lambda e: e.update(kind="schlick"),
         lambda e: e.update(colorSpace="sRGB"),
-        lambda e: e.update(coatIor=0.9),
-        lambda e: e.update(coatIor=3.5),
+        lambda e: e.update(etaIRange=[0.9, 2.0]),
+        lambda e: e.update(etaIRange=[1.0, 3.5]),
         lambda e: e.update(etaIRange=[1.0]),
-        lambda e: e.update(coatRoughnessFactor=1.5),
+        lambda e: e.update(coatIor=1.5),
         lambda e: e.update(degree=3),
         lambda e: e.pop("degree"),
         lambda e: e["coefficients"].pop("alpha"),
@@ -86,8 +88,8 @@ class TestSchema:
         lambda e: e["coefficients"]["F0"][1].__setitem__(0, 1.0e6),
         lambda e: e["coefficients"].update(n=[1, 1, 1]),
         lambda e: e.update(extra_field=1),
-    ], ids=["no-kind", "unknown-kind", "colour-space", "ior-low", "ior-high", "range-short",
-            "coat-rough", "degree-3", "no-degree", "no-alpha", "two-rows", "long-row",
+    ], ids=["no-kind", "unknown-kind", "colour-space", "range-low", "range-high", "range-short",
+            "revision-1-coat", "degree-3", "no-degree", "no-alpha", "two-rows", "long-row",
             "string", "past-float16", "stray-n", "unknown-property"])
     def test_refuses_malformed_coated_conductor(self, valid, change):
         VALIDATOR.validate(valid["coated-conductor"])
@@ -118,27 +120,29 @@ class TestExport:
     def test_used_not_required_fallback_kept(self, packed):
         nk, models = packed
         asset = json.loads(export_material(nk, "gltf", 1.5, model=models["coated-conductor"]))
-        assert asset["extensionsUsed"] == ["KHR_materials_clearcoat", EXTENSION_NAME]
+        assert asset["extensionsUsed"] == ["KHR_materials_clearcoat", CLEARCOAT_IOR, EXTENSION_NAME]
         assert "extensionsRequired" not in asset
         material = asset["materials"][0]
         assert material["pbrMetallicRoughness"]["metallicFactor"] == 1.0
-        # Fitted with the base colour to the coated metal seen from air.
-        assert 0.0 <= material["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] <= 1.0
-        coat = material["extensions"]["KHR_materials_clearcoat"]["clearcoatRoughnessFactor"]
-        assert material["extensions"][EXTENSION_NAME]["coatRoughnessFactor"] == coat
+        # The coat is the clear coat's, whole, its index in the nested draft; the extension carries the metal.
+        clearcoat = material["extensions"]["KHR_materials_clearcoat"]
+        assert clearcoat["clearcoatFactor"] == 1.0
+        assert clearcoat["extensions"][CLEARCOAT_IOR] == {"clearcoatIor": 1.5}
+        assert not {"coatIor", "coatFactor", "coatRoughnessFactor"} & set(material["extensions"][EXTENSION_NAME])
 
     def test_outside_the_fits_range_omitted_with_reason(self):
         nk = library_material("Cu")
         model = fit_model(nk, (1.2, 2.0), "coated-conductor").packed
         asset = json.loads(export_material(nk, "gltf", 2.5, model=model))
-        assert asset["extensionsUsed"] == ["KHR_materials_clearcoat"]
+        assert asset["extensionsUsed"] == ["KHR_materials_clearcoat", CLEARCOAT_IOR]
         assert EXTENSION_NAME not in asset["materials"][0]["extensions"]
         assert "[1.2, 2]" in asset["materials"][0]["extras"]["coated_fresnel"]["coated_conductor_extension"]
 
     def test_rgb_conductor_any_index(self):
         nk = library_material("Cu")
         model = fit_model(nk, (1.2, 2.0), "rgb-conductor").packed
-        assert extension_of(export_material(nk, "gltf", 2.9, model=model))["coatIor"] == 2.9
+        material = json.loads(export_material(nk, "gltf", 2.9, model=model))["materials"][0]
+        assert EXTENSION_NAME in material["extensions"] and coat_of(material)[2] == 2.9
 
     def test_model_must_be_packed(self):
         with pytest.raises(ValueError, match="`model` must be a PackedMaterial"):
@@ -155,6 +159,6 @@ class TestKhronosValidator:
         code, report = khronos_report(path)
         assert code == 0, report["issues"]
         assert report["issues"]["numErrors"] == 0 and report["issues"]["numWarnings"] == 0, report
-        # The validator does not know the extension: an information, never an error.
+        # The validator knows neither extension (nor the coat index's draft): an information, never an error.
         assert {m["code"] for m in report["issues"]["messages"]} == {"UNSUPPORTED_EXTENSION"}
-        assert report["info"]["extensionsUsed"] == ["KHR_materials_clearcoat", EXTENSION_NAME]
+        assert report["info"]["extensionsUsed"] == ["KHR_materials_clearcoat", CLEARCOAT_IOR, EXTENSION_NAME]

@@ -1,7 +1,8 @@
 """
-The glTF fallback (fitting.exports.gltf_fallback): the clear coat kept
-wherever the physical coat is visible, and the values fitted at the metal's
-roughness no worse there than the smooth fit.
+The glTF fallback (fitting.exports.gltf_fallback): the clear coat whole
+wherever there is a coat (its factor is the coat's, which the extension
+composes with), and the base colour fitted at the metal's roughness no worse
+there than the smooth fit.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ import pytest
 
 from fitting.exports import export_material, export_values
 from fitting.exports.gltf_fallback import (
-    VISIBLE_CLEARCOAT, coat_F0, gltf_clearcoat_floor, gltf_seen_delta_E, rough_seen_ACEScg,
+    GLTF_COAT_FACTOR, VISIBLE_COAT_F0, coat_F0, gltf_seen_delta_E, rough_seen_ACEScg,
 )
 from fitting.exports.seen_fit import fit_tool_values
 from fitting.optics.library import library_material
@@ -22,44 +23,36 @@ pytestmark = pytest.mark.numeric
 ROUGH = 0.3
 
 
-def test_the_rule_bounds_where_the_coat_reflects_two_percent():
-    assert coat_F0(1.33) >= 0.02 > coat_F0(1.32)
-    for eta in (1.33, 1.5, 2.0, 3.0):
-        assert gltf_clearcoat_floor(eta) == VISIBLE_CLEARCOAT == 0.5
-    for eta in (1.0, 1.1, 1.32):
-        assert gltf_clearcoat_floor(eta) == 0.0
-    assert gltf_clearcoat_floor(1.5, coat=False) == 0.0
+def test_the_visible_coat_starts_at_two_percent_and_every_coat_is_whole():
+    assert coat_F0(1.33) >= VISIBLE_COAT_F0 > coat_F0(1.32)
+    # A coat reflecting less than 2 % is whole too (its factor is the coat's, not a fit's).
+    values = export_values(library_material("Cu"), 1.2, roughness=0.0, tools=("gltf",))
+    assert values.tools["gltf"]["clearcoat"] == 1.0
 
 
 @pytest.mark.parametrize("name, eta", [("Cu", 1.33), ("Au", 1.5), ("W", 2.0), ("CuZn", 1.5)])
-def test_the_coat_is_kept_and_the_rough_fit_no_worse_at_its_roughness(name, eta):
+def test_the_coat_is_whole_and_the_rough_fit_no_worse_at_its_roughness(name, eta):
     values = export_values(library_material(name), eta, roughness=ROUGH, coat_roughness=0.0, tools=("gltf",))
     fitted = values.tools["gltf"]
-    assert fitted["clearcoat"] >= 0.5
-    # The fit at roughness 0 keeps the coat too; the old free fit drops it for these metals.
+    # The coat's own factor, which the extension composes with: whole wherever there is a coat.
+    assert fitted["clearcoat"] == GLTF_COAT_FACTOR == 1.0
     smooth = fit_tool_values("gltf", values.view_cos, eta, values.seen_ACEScg)
-    assert smooth["clearcoat"] >= 0.5
+    assert smooth["clearcoat"] == 1.0
+    # The factor fitted too (the export before) drops the coat for these metals.
     free = fit_tool_values("gltf", values.view_cos, eta, values.seen_ACEScg, keep_coat=False)
     assert free["clearcoat"] < 0.5
     # What a viewer without the plugin shows at the metal's roughness: the rough fit is
-    # no worse there than the values fitted at roughness 0 (the export before).
+    # no worse there than the values fitted at roughness 0.
     target = values.seen_rough_ACEScg
     rough_mean = gltf_seen_delta_E(fitted, values.view_cos, eta, target, ROUGH).mean()
     smooth_mean = gltf_seen_delta_E(smooth, values.view_cos, eta, target, ROUGH).mean()
     assert rough_mean <= smooth_mean + 1e-9
-    # The document carries the kept factor and says what it is fitted to.
+    # The document carries the coat and says what the base colour is fitted to.
     asset = json.loads(export_material(values, "gltf", eta))
     material = asset["materials"][0]
-    assert material["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] >= 0.5
+    assert material["extensions"]["KHR_materials_clearcoat"]["clearcoatFactor"] == 1.0
     assert material["pbrMetallicRoughness"]["roughnessFactor"] == pytest.approx(ROUGH)
     assert "at the metal's roughness 0.3" in material["extras"]["coated_fresnel"]["delta_E_2000_seen_at_roughness"]
-
-
-def test_below_the_rule_the_factor_is_free():
-    values = export_values(library_material("Cu"), 1.2, roughness=0.0, tools=("gltf",))
-    assert values.seen_rough_ACEScg is None  # a smooth metal: fitted at roughness 0 only
-    free = fit_tool_values("gltf", values.view_cos, 1.2, values.seen_ACEScg, keep_coat=False)
-    assert values.tools["gltf"]["clearcoat"] == pytest.approx(free["clearcoat"], abs=1e-12)
 
 
 def test_the_rough_target():

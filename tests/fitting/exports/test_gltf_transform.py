@@ -49,14 +49,15 @@ def transform(command: list[str], source: Path, out: Path, config: bool = True) 
 
 @pytest.fixture(scope="module")
 def exported(tmp_path_factory):
-    """Cu exported at eta_i 1.5 with each kind's model: {kind: (path, extension object)}."""
+    """Cu exported at eta_i 1.8 with each kind's model: {kind: (path, extension object and clear coat)}."""
     nk = library_material("Cu")
     out = {}
     for kind in MODEL_KINDS:
-        document = export_material(nk, "gltf", 1.5, model=fit_model(nk, (1.0, 2.5), kind).packed)
+        document = export_material(nk, "gltf", 1.8, model=fit_model(nk, (1.0, 2.5), kind).packed)
         path = tmp_path_factory.mktemp(kind) / "coated.gltf"
         path.write_bytes(document if isinstance(document, bytes) else document.encode())
-        out[kind] = path, json.loads(document)["materials"][0]["extensions"][EXTENSION_NAME]
+        extensions = json.loads(document)["materials"][0]["extensions"]
+        out[kind] = path, {name: extensions[name] for name in (EXTENSION_NAME, "KHR_materials_clearcoat")}
     return out
 
 
@@ -64,8 +65,12 @@ def exported(tmp_path_factory):
 def test_cli_keeps_the_extension(exported, tmp_path, command):
     for kind, (path, extension) in exported.items():
         written = transform(command, path, tmp_path / f"{kind}.glb")
-        assert written["materials"][0]["extensions"][EXTENSION_NAME] == extension, kind
-        assert EXTENSION_NAME in written["extensionsUsed"]
+        extensions = written["materials"][0]["extensions"]
+        assert extensions[EXTENSION_NAME] == extension[EXTENSION_NAME], kind
+        # The coat the metal lies under, its index (the nested draft) included.
+        assert extensions["KHR_materials_clearcoat"] == extension["KHR_materials_clearcoat"], kind
+        assert extensions["KHR_materials_clearcoat"]["extensions"]["KHR_materials_clearcoat_ior"]["clearcoatIor"] == 1.8
+        assert {EXTENSION_NAME, "KHR_materials_clearcoat_ior"} <= set(written["extensionsUsed"])
         assert EXTENSION_NAME not in written.get("extensionsRequired", [])
 
 

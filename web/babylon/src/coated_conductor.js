@@ -132,21 +132,24 @@ function mat3Of(rows) {
 /**
  * The plugin: a PBRMaterial (metallic 1) drawing `model`, an
  * EXT_materials_coated_conductor object (checked: an Error naming the
- * field for a malformed one). The material's clear coat is the model's
- * coat: enabled, its index coatIor, its intensity coatFactor (default 1),
- * its roughness coatRoughnessFactor (default 0).
+ * field for a malformed one), under a clear coat of index `coatIor`
+ * (default 1.5; 1: no coat, the metal in air). The material's clear coat is
+ * the coat: its index set to coatIor; its intensity and roughness (and
+ * textures) are the material's with `coatFromMaterial` (as the glTF loader
+ * read them from KHR_materials_clearcoat), else set to 1 and 0.
  */
 export class CoatedConductorPlugin extends MaterialPluginBase {
-  constructor(material, model) {
-    const checked = checkModel(model);
+  constructor(material, model, coatIor = 1.5, { coatFromMaterial = false } = {}) {
+    const checked = checkModel(model, coatIor);
     super(material, "CoatedConductor", 200, { CF_COATED_CONDUCTOR: false, CF_NK_COEFFICIENTS: false });
     this.model = checked;
+    this.coatIor = coatIor;
     this.registerForExtraEvents = true; // hardBindForSubMesh sets the uniforms at each bind
     // The kind's coefficients (checked): n and k, or F0, a and alpha over the coat index.
     const rgb = hasNK(checked);
     const C = checked.coefficients;
     this._values = {
-      cf_coat_ior: checked.coatIor,
+      cf_coat_ior: coatIor,
       cf_eta_i_range: checked.etaIRange,
       cf_n: rgb ? C.n : [1, 1, 1],
       cf_k: rgb ? C.k : [0, 0, 0],
@@ -155,12 +158,15 @@ export class CoatedConductorPlugin extends MaterialPluginBase {
       cf_alpha: mat3Of(rgb ? null : C.alpha),
     };
     material.metallic = 1;
-    material.clearCoat.isEnabled = true;
-    material.clearCoat.indexOfRefraction = checked.coatIor;
+    if (!coatFromMaterial) {
+      material.clearCoat.isEnabled = true;
+      material.clearCoat.intensity = 1;
+      material.clearCoat.roughness = 0;
+    }
+    material.clearCoat.indexOfRefraction = coatIor;
     // A coat of index 1 is no interface: Babylon's coat off (its Schlick
     // would still reflect at grazing), the metal seen as without a coat.
-    material.clearCoat.intensity = checked.coatIor > 1 ? checked.coatFactor ?? 1 : 0;
-    material.clearCoat.roughness = checked.coatRoughnessFactor ?? 0;
+    if (coatIor <= 1) material.clearCoat.intensity = 0;
     // The coat's F0 from its index against air (not Babylon's remapping of the base's F0).
     material.clearCoat.remapF0OnInterfaceChange = false;
     this._enable(true);

@@ -1,9 +1,10 @@
 // The Babylon.js glTF loader extension of EXT_materials_coated_conductor: a
 // material with the extension gets the CoatedConductorPlugin
 // (coated_conductor.js) after the loader has read its other properties
-// (KHR_materials_clearcoat's, the fallback's coat, included: the plugin sets
-// the coat from the extension); a malformed or out-of-range extension object
-// draws the fallback with a console warning, never an exception.
+// (KHR_materials_clearcoat's included: the coat the metal lies under, its
+// factor, roughness and textures Babylon's, its index the nested draft
+// KHR_materials_clearcoat_ior's, 1.5 without it); a malformed or out-of-range
+// extension object draws the fallback with a console warning, never an exception.
 //
 //   import { registerCoatedConductorExtension } from "coated-conductor-babylon";
 //   registerCoatedConductorExtension();  // before loading
@@ -11,7 +12,7 @@
 import { GLTFLoader } from "@babylonjs/loaders/glTF/2.0/glTFLoader.js";
 import { registerGLTFExtension, unregisterGLTFExtension } from "@babylonjs/loaders/glTF/2.0/glTFLoaderExtensionRegistry.js";
 import { CoatedConductorPlugin } from "./coated_conductor.js";
-import { EXTENSION_NAME, checkModel } from "./check_model.js";
+import { EXTENSION_NAME, checkModel, coatOf } from "./check_model.js";
 
 /** The IGLTFLoaderExtension: one per loader. */
 export class CoatedConductorLoaderExtension {
@@ -29,15 +30,16 @@ export class CoatedConductorLoaderExtension {
     const object = material.extensions?.[EXTENSION_NAME];
     if (object === undefined) return null;
     let model;
+    const coatIor = coatOf(material).ior;
     try {
-      model = checkModel(object);
+      model = checkModel(object, coatIor);
     } catch (error) {
       console.warn(`${error.message}; material ${material.index} (${material.name ?? "unnamed"}) draws its fallback`);
       return null;
     }
     return GLTFLoader.LoadExtensionAsync(context, material, this.name, async () => {
       await this._loader.loadMaterialPropertiesAsync(context, material, babylonMaterial);
-      new CoatedConductorPlugin(babylonMaterial, model);
+      new CoatedConductorPlugin(babylonMaterial, model, coatIor, { coatFromMaterial: true });
     });
   }
 }

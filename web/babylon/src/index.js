@@ -3,7 +3,7 @@
 // extension (gltf_loader.js); the GLSL is inside (generated/), nothing is fetched.
 
 export { CoatedConductorPlugin } from "./coated_conductor.js";
-export { EXTENSION_NAME, KINDS, checkModel } from "./check_model.js";
+export { CLEARCOAT_IOR, EXTENSION_NAME, KINDS, checkModel, coatOf } from "./check_model.js";
 export {
   CoatedConductorLoaderExtension, registerCoatedConductorExtension, unregisterCoatedConductorExtension,
 } from "./gltf_loader.js";

@@ -26,9 +26,14 @@
 //     returned over the hemisphere (escape_table.js); the coat's
 //     EnvironmentBRDF by the table's coat row (the exact dielectric for a
 //     smooth coat);
-//   - the clear coat: its F0 from the coat index coatIor (not 0.04); the
+//   - the clear coat: its F0 from the coat's index (not 0.04); the
 //     base is no longer weighted by three's 1 - clearcoat * Fcc (its
 //     transmission is in the terms above).
+// The coat is the material's own clear coat (three's clearcoat,
+// clearcoatMap, clearcoatRoughness, clearcoatRoughnessMap, as
+// KHR_materials_clearcoat loads them); its index, the draft
+// KHR_materials_clearcoat_ior's clearcoatIor (default 1.5), is the model's
+// coat index: the extension object carries the metal only.
 // A material whose extension object fails the schema's or the range's
 // rules draws its fallback (console.warn), as does every material when the
 // LUT cannot be decoded.
@@ -44,6 +49,8 @@ import { AlbedoTable, lutTexture, tableSource } from "./albedo_table.js";
 import { EscapeTable, ROUGH_BLEND, internalReflectance } from "./escape_table.js";
 
 export const EXTENSION_NAME = "EXT_materials_coated_conductor";
+/** The draft extension carrying the clear coat's index, nested in KHR_materials_clearcoat's object. */
+export const CLEARCOAT_IOR = "KHR_materials_clearcoat_ior";
 export { KINDS };
 
 // The model's terms, pasted before three's (patched) pars chunk that calls them.
@@ -195,19 +202,31 @@ export function loadResources() {
   return resources;
 }
 
-const PROPERTIES = new Set([
-  "kind", "colorSpace", "etaIRange", "degree", "coefficients", "coatIor", "coatFactor",
-  "coatRoughnessFactor", "extensions", "extras",
-]);
+const PROPERTIES = new Set(["kind", "colorSpace", "etaIRange", "degree", "coefficients", "extensions", "extras"]);
 
 /**
- * The extension object `model` if it is one this module draws; else an
- * Error naming the field and the rule: the schema's rules
- * (docs/gltf/EXT_materials_coated_conductor/schema/) and the two it cannot
- * state (lo <= hi; the coatIor of a kind polynomial in the coat index
- * inside etaIRange); the kind's own fields by its generated entry (kinds.js).
+ * The coat a glTF material definition composes the extension with:
+ * {factor, ior}. Its KHR_materials_clearcoat's clearcoatFactor (the
+ * texture, per pixel, is three's), and the index of the nested draft
+ * KHR_materials_clearcoat_ior (1.5 without it); no clear coat, or a factor
+ * of 0, is no coat: the metal in air, {factor: 0, ior: 1}.
  */
-export function checkModel(model) {
+export function coatOf(definition) {
+  const clearcoat = definition?.extensions?.KHR_materials_clearcoat;
+  const factor = clearcoat && typeof clearcoat === "object" ? clearcoat.clearcoatFactor ?? 0 : 0;
+  if (!(factor > 0)) return { factor: 0, ior: 1 };
+  return { factor, ior: clearcoat.extensions?.[CLEARCOAT_IOR]?.clearcoatIor ?? 1.5 };
+}
+
+/**
+ * The extension object `model` if it is one this module draws under a coat
+ * of index `coatIor` (default 1.5, glTF's; 1: no coat); else an Error
+ * naming the field and the rule: the schema's rules
+ * (docs/gltf/EXT_materials_coated_conductor/schema/) and the two it cannot
+ * state (lo <= hi; for a kind polynomial in the coat index, the coat's
+ * index inside etaIRange); the kind's own fields by its generated entry (kinds.js).
+ */
+export function checkModel(model, coatIor = 1.5) {
   const fail = (what) => { throw new Error(`${EXTENSION_NAME}: ${what}`); };
   if (!model || typeof model !== "object" || Array.isArray(model)) fail("the extension must be an object");
   for (const key of Object.keys(model)) {
@@ -215,39 +234,38 @@ export function checkModel(model) {
   }
   if (!KINDS.includes(model.kind)) fail(`\`kind\` must be one of ${KINDS.join(", ")}, got ${JSON.stringify(model.kind)}`);
   if (model.colorSpace !== "ACEScg") fail(`\`colorSpace\` must be "ACEScg", got ${JSON.stringify(model.colorSpace)}`);
-  const inUnit = (x) => typeof x === "number" && x >= 0 && x <= 1;
   const index = (x) => typeof x === "number" && x >= 1 && x <= 3;
   const range = model.etaIRange;
   if (!Array.isArray(range) || range.length !== 2 || !range.every(index) || !(range[0] <= range[1])) {
     fail(`\`etaIRange\` must be [lo, hi] with 1 <= lo <= hi <= 3, got ${JSON.stringify(range)}`);
   }
-  const eta = model.coatIor;
-  if (!index(eta)) fail(`\`coatIor\` must lie in [1, 3], got ${JSON.stringify(eta)}`);
-  for (const p of ["coatFactor", "coatRoughnessFactor"]) {
-    if (p in model && !inUnit(model[p])) fail(`\`${p}\` must lie in [0, 1], got ${JSON.stringify(model[p])}`);
+  if (!index(coatIor)) {
+    fail(`the coat's index (${CLEARCOAT_IOR} \`clearcoatIor\`) must lie in [1, 3], got ${JSON.stringify(coatIor)}`);
   }
-  checkKindFields(kindNamed(model.kind), model, fail);
+  checkKindFields(kindNamed(model.kind), { ...model, coatIor }, fail);
   return model;
 }
 
 /**
  * The hooks that make a MeshPhysicalMaterial draw `model` (an extension
- * object, checked): onBeforeCompile (the patches), onBeforeRender (the
- * albedo table at the material's roughness and clear-coat roughness) and
- * customProgramCacheKey. Set them through the material's parameters.
+ * object, checked) under its clear coat of index `coatIor` (1: no coat):
+ * onBeforeCompile (the patches), onBeforeRender (the albedo table at the
+ * material's roughness and clear-coat roughness) and customProgramCacheKey.
+ * Set them through the material's parameters.
  */
-export function coatedConductorHooks(model, resources, fallback = null) {
-  checkModel(model);
+export function coatedConductorHooks(model, resources, coatIor = 1.5) {
+  checkModel(model, coatIor);
   const kind = kindNamed(model.kind);
   const words = wordsFor(kind, model.coefficients);
-  const table = new AlbedoTable(resources, kind, model, words);
-  const escape = new EscapeTable(resources.glsl, kind, model, words, table.nodes);
+  const drawn = { ...model, coatIor }; // what the tables are drawn for: the metal under its coat
+  const table = new AlbedoTable(resources, kind, drawn, words);
+  const escape = new EscapeTable(resources.glsl, kind, drawn, words, table.nodes);
   const uniforms = {
     cf_albedo: { value: table.texture },
     cf_escape: { value: escape.texture },
-    cf_r_bar: { value: internalReflectance(model.coatIor) },
+    cf_r_bar: { value: internalReflectance(coatIor) },
     cf_rough_blend: { value: 0 },
-    cf_coat_ior: { value: model.coatIor },
+    cf_coat_ior: { value: coatIor },
     cf_words: { value: words },
     cf_eta_i_range: { value: new THREE.Vector2(...(model.etaIRange || [1, 1])) },
   };
@@ -276,7 +294,7 @@ export function coatedConductorHooks(model, resources, fallback = null) {
     // dispose() frees its render target, which Material.dispose leaves.
     userData: {
       coatedConductor: {
-        model, fallback, readTable: (renderer) => table.read(renderer), readEscape: (renderer) => escape.read(renderer),
+        model, coatIor, readTable: (renderer) => table.read(renderer), readEscape: (renderer) => escape.read(renderer),
         dispose: () => { table.dispose(); escape.dispose(); },
       },
     },
@@ -285,18 +303,19 @@ export function coatedConductorHooks(model, resources, fallback = null) {
 
 /**
  * A MeshPhysicalMaterial drawing the coated metal `params.model` (an
- * EXT_materials_coated_conductor object); the other params are
- * MeshPhysicalMaterial's (roughness: the metal's; clearcoat default 1,
- * clearcoatRoughness default model.coatRoughnessFactor). Resolves once the
- * LUT is decoded (the first call only).
+ * EXT_materials_coated_conductor object) under a clear coat of index
+ * `params.coatIor` (default 1.5); the other params are
+ * MeshPhysicalMaterial's (roughness: the metal's; clearcoat, the coat's
+ * weight, default 1, and 0 for no coat: the metal in air; clearcoatRoughness
+ * default 0). Resolves once the LUT is decoded (the first call only).
  */
 export async function createCoatedConductorMaterial(params) {
-  const { model, ...physical } = params;
+  const { model, coatIor = 1.5, ...physical } = params;
   const resources = await loadResources();
-  const hooks = coatedConductorHooks(model, resources);
+  const coated = (physical.clearcoat ?? 1) > 0;
+  const hooks = coatedConductorHooks(model, resources, coated ? coatIor : 1);
   const material = new THREE.MeshPhysicalMaterial({
-    metalness: 1, color: 0xffffff, clearcoat: 1, clearcoatRoughness: model.coatRoughnessFactor ?? 0,
-    ...physical,
+    metalness: 1, color: 0xffffff, clearcoat: 1, clearcoatRoughness: 0, ...physical,
   });
   return Object.assign(material, hooks);
 }

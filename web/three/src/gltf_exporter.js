@@ -1,15 +1,16 @@
 // The GLTFExporter plugin of EXT_materials_coated_conductor: a scene loaded
 // with the extension (gltf_loader.js) is written back with it.
 
-import { EXTENSION_NAME } from "./coated_conductor.js";
+import { CLEARCOAT_IOR, EXTENSION_NAME } from "./coated_conductor.js";
 
 /**
  * The GLTFExporter plugin: a material drawing the model (made by the
  * loader plugin or createCoatedConductorMaterial) is written with its
- * EXT_materials_coated_conductor object, and with the fallback's
- * KHR_materials_clearcoat values it was loaded with (three's own exporter
- * writes the coat the plugin draws, `clearcoat` 1, which is not the
- * fallback's fitted factor); the model is not repeated in `extras`.
+ * EXT_materials_coated_conductor object; its clear coat (three's own
+ * exporter writes KHR_materials_clearcoat from the material's clearcoat
+ * parameters and maps) gets the coat's index in the nested draft
+ * KHR_materials_clearcoat_ior, which three does not write; the model is not
+ * repeated in `extras`.
  *
  *   exporter.register((writer) => new CoatedConductorExporterExtension(writer));
  */
@@ -25,8 +26,10 @@ export class CoatedConductorExporterExtension {
     materialDef.extensions = materialDef.extensions || {};
     materialDef.extensions[this.name] = JSON.parse(JSON.stringify(data.model));
     this.writer.extensionsUsed[this.name] = true;
-    for (const [name, values] of Object.entries(data.fallback ?? {})) {
-      if (materialDef.extensions[name]) materialDef.extensions[name] = JSON.parse(JSON.stringify(values));
+    const clearcoat = materialDef.extensions.KHR_materials_clearcoat;
+    if (clearcoat && data.coatIor > 1) {
+      clearcoat.extensions = { ...clearcoat.extensions, [CLEARCOAT_IOR]: { clearcoatIor: data.coatIor } };
+      this.writer.extensionsUsed[CLEARCOAT_IOR] = true;
     }
     if (materialDef.extras) {
       delete materialDef.extras.coatedConductor;

@@ -6,41 +6,54 @@
 //   loader.register((parser) => new CoatedConductorExtension(parser));
 
 import * as THREE from "three";
-import { EXTENSION_NAME, checkModel, coatedConductorHooks, loadResources } from "./coated_conductor.js";
+import { EXTENSION_NAME, checkModel, coatOf, coatedConductorHooks, loadResources } from "./coated_conductor.js";
 
 /**
  * The GLTFLoader plugin: a material with EXT_materials_coated_conductor
  * becomes a MeshPhysicalMaterial drawing the model (its other properties,
  * read by the loader as usual); without the extension nothing changes. The
- * coat is the extension's (coatFactor, default 1, and coatRoughnessFactor),
- * not KHR_materials_clearcoat's factor, which is the fallback's.
+ * coat is the material's KHR_materials_clearcoat as three's loader reads it
+ * (factor, roughness, their textures), its index the nested draft
+ * KHR_materials_clearcoat_ior's clearcoatIor (1.5 without it); without a
+ * clear coat the metal is seen from air (coatOf).
  */
 export class CoatedConductorExtension {
   constructor(parser) {
     this.parser = parser;
     this.name = EXTENSION_NAME;
-    this.checked = new Map(); // material index -> the checked model, or null
+    this.checked = new Map(); // material index -> {model, coatIor} checked, or null
   }
 
   /**
    * Material `materialIndex`'s extension object if it is one this plugin
-   * draws; null without one, and null with a console warning (once per
-   * material) for one that fails the schema or the range rules: the
-   * specification's consumers draw the fallback then.
+   * draws (under the material's coat); null without one, and null with a
+   * console warning (once per material) for one that fails the schema or
+   * the range rules (a coat index outside [1, 3], or outside a polynomial
+   * kind's etaIRange): the specification's consumers draw the fallback then.
    */
   model(materialIndex) {
+    return this.#checked(materialIndex)?.model ?? null;
+  }
+
+  /** The index of the coat material `materialIndex` is drawn under (1: none), or null if it is not drawn. */
+  coatIor(materialIndex) {
+    return this.#checked(materialIndex)?.coatIor ?? null;
+  }
+
+  #checked(materialIndex) {
     if (!this.checked.has(materialIndex)) {
       const def = this.parser.json.materials?.[materialIndex];
       const object = def?.extensions?.[this.name];
-      let model = null;
+      let checked = null;
       if (object !== undefined) {
         try {
-          model = checkModel(object);
+          const coatIor = coatOf(def).ior;
+          checked = { model: checkModel(object, coatIor), coatIor };
         } catch (error) {
           console.warn(`${error.message}; material ${materialIndex} (${def.name ?? "unnamed"}) draws its fallback`);
         }
       }
-      this.checked.set(materialIndex, model);
+      this.checked.set(materialIndex, checked);
     }
     return this.checked.get(materialIndex);
   }
@@ -64,15 +77,8 @@ export class CoatedConductorExtension {
     if (!model) return;
     const resources = await this.#resources();
     if (!resources) return;
-    Object.assign(materialParams, { clearcoat: model.coatFactor ?? 1,
-                                    clearcoatRoughness: model.coatRoughnessFactor ?? 0 });
-    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources, this.fallback(materialIndex)));
-  }
-
-  /** The fallback's KHR_materials_clearcoat values (the exporter plugin writes them back), or null. */
-  fallback(materialIndex) {
-    const clearcoat = this.parser.json.materials?.[materialIndex]?.extensions?.KHR_materials_clearcoat;
-    return clearcoat && typeof clearcoat === "object" ? { KHR_materials_clearcoat: clearcoat } : null;
+    // The clear coat's parameters are three's KHR_materials_clearcoat plugin's.
+    Object.assign(materialParams, { metalness: 1 }, coatedConductorHooks(model, resources, this.coatIor(materialIndex)));
   }
 
   /**
@@ -90,7 +96,7 @@ export class CoatedConductorExtension {
           const index = this.parser.associations.get(material)?.materials;
           const model = index === undefined ? null : this.model(index);
           if (!model || material.userData.coatedConductor?.readTable) continue;
-          const { userData, ...hooks } = coatedConductorHooks(model, resources, this.fallback(index));
+          const { userData, ...hooks } = coatedConductorHooks(model, resources, this.coatIor(index));
           Object.assign(material, hooks);
           Object.assign(material.userData, userData);
         }

@@ -9,6 +9,8 @@ export type { KindFields, KindName, PackagedKind };
 
 /** "EXT_materials_coated_conductor". */
 export declare const EXTENSION_NAME: "EXT_materials_coated_conductor";
+/** "KHR_materials_clearcoat_ior": the draft carrying the clear coat's index, nested in KHR_materials_clearcoat. */
+export declare const CLEARCOAT_IOR: "KHR_materials_clearcoat_ior";
 /** The model kinds the material draws (the project's registry, generated/kinds.js), in its order. */
 export declare const KINDS: readonly KindName[];
 /** Each kind as the package draws it: parameters, maxDegree, sign rules, generated GLSL. */
@@ -20,12 +22,6 @@ export interface ModelCommon {
   colorSpace: "ACEScg";
   /** [lo, hi], 1 <= lo <= hi <= 3: the coat indices the model was fitted over. */
   etaIRange: readonly [number, number];
-  /** The coat's index of refraction, in [1, 3] (for a kind polynomial in the coat index, inside etaIRange). */
-  coatIor: number;
-  /** The coat's weight in [0, 1] (default 1). */
-  coatFactor?: number;
-  /** The coat's roughness in [0, 1] (default 0). */
-  coatRoughnessFactor?: number;
   extensions?: Record<string, unknown>;
   extras?: unknown;
 }
@@ -36,8 +32,8 @@ export type ExtensionObject = ModelCommon & KindFields;
 /** What a material drawing the model carries in `userData.coatedConductor`. */
 export interface CoatedConductorData {
   model: ExtensionObject;
-  /** The fallback's KHR_materials_clearcoat values it was loaded with, or null. */
-  fallback: { KHR_materials_clearcoat: Record<string, unknown> } | null;
+  /** The index of the clear coat the metal is drawn under (1: no coat, the metal in air). */
+  coatIor: number;
   /** The albedo table as drawn (nodes x 3 RGBA floats, row 0 first). */
   readTable(renderer: WebGLRenderer): { nodes: number; data: number[] };
   /** The escape table as drawn (nodes x 2 RGBA floats, row 0 first). */
@@ -54,8 +50,14 @@ export interface Resources {
   lut: { texture: import("three").Data3DTexture; width: number; alphaRange: [number, number] };
 }
 
-/** `model` if it is an extension object the material draws; throws an Error naming the field and the rule. */
-export declare function checkModel(model: unknown): ExtensionObject;
+/**
+ * `model` if it is an extension object the material draws under a coat of index `coatIor`
+ * (default 1.5; 1: no coat); throws an Error naming the field and the rule.
+ */
+export declare function checkModel(model: unknown, coatIor?: number): ExtensionObject;
+
+/** The coat a glTF material definition composes the extension with (no clear coat: factor 0, index 1). */
+export declare function coatOf(definition: unknown): { factor: number; ior: number };
 
 /** Loads (once) what every material needs: the first call inflates the LUT. */
 export declare function loadResources(): Promise<Resources>;
@@ -64,14 +66,17 @@ export declare function loadResources(): Promise<Resources>;
 export declare function coatedConductorHooks(
   model: ExtensionObject,
   resources: Resources,
-  fallback?: CoatedConductorData["fallback"],
+  coatIor?: number,
 ): Pick<Material, "onBeforeCompile" | "onBeforeRender" | "customProgramCacheKey"> & {
   userData: { coatedConductor: CoatedConductorData };
 };
 
-/** A MeshPhysicalMaterial drawing `params.model`; the other params are MeshPhysicalMaterial's. */
+/**
+ * A MeshPhysicalMaterial drawing `params.model` under a clear coat of index `params.coatIor`
+ * (default 1.5); the other params are MeshPhysicalMaterial's (clearcoat 0: no coat).
+ */
 export declare function createCoatedConductorMaterial(
-  params: MeshPhysicalMaterialParameters & { model: ExtensionObject },
+  params: MeshPhysicalMaterialParameters & { model: ExtensionObject; coatIor?: number },
 ): Promise<MeshPhysicalMaterial>;
 
 /** The GLTFLoader plugin: `loader.register((parser) => new CoatedConductorExtension(parser))`. */
@@ -81,9 +86,10 @@ export declare class CoatedConductorExtension implements GLTFLoaderPlugin {
   readonly parser: GLTFParser;
   /** Material `materialIndex`'s extension object if it is drawn; null (with a warning once) if malformed. */
   model(materialIndex: number): ExtensionObject | null;
+  /** The index of the coat a drawn material lies under (1: none), or null if it is not drawn. */
+  coatIor(materialIndex: number): number | null;
   getMaterialType(materialIndex: number): typeof MeshPhysicalMaterial | null;
   extendMaterialParams(materialIndex: number, materialParams: { [key: string]: any }): Promise<void>;
-  fallback(materialIndex: number): CoatedConductorData["fallback"];
   afterRoot(result: GLTF): Promise<void>;
 }
 

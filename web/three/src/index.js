@@ -5,7 +5,8 @@
 // from the project's registry and GLSL), nothing is fetched.
 
 export {
-  EXTENSION_NAME, KINDS, checkModel, coatedConductorHooks, createCoatedConductorMaterial, loadResources,
+  CLEARCOAT_IOR, EXTENSION_NAME, KINDS, checkModel, coatOf, coatedConductorHooks, createCoatedConductorMaterial,
+  loadResources,
 } from "./coated_conductor.js";
 export { MODEL_KINDS } from "./kinds.js";
 export { CoatedConductorExtension } from "./gltf_loader.js";

@@ -38,8 +38,9 @@ function keeps(kind, p, x) {
 
 /**
  * Check the kind's own fields of extension object `model` (its `degree`,
- * `coefficients`, and for a kind polynomial in the coat index a coatIor
- * inside etaIRange); `fail(what)` throws naming the field and the rule.
+ * `coefficients`, and for a kind polynomial in the coat index the coat's
+ * index `model.coatIor` inside etaIRange); `fail(what)` throws naming the
+ * field and the rule.
  */
 export function checkKindFields(kind, model, fail) {
   const C = model.coefficients;
@@ -55,7 +56,7 @@ export function checkKindFields(kind, model, fail) {
   const [lo, hi] = model.etaIRange;
   const eta = model.coatIor;
   if (!(eta >= lo - RANGE_SLACK && eta <= hi + RANGE_SLACK)) {
-    fail(`\`coatIor\` ${eta} lies outside the ${kind.name}'s etaIRange [${lo}, ${hi}]`);
+    fail(`the coat's index ${eta} lies outside the ${kind.name}'s etaIRange [${lo}, ${hi}]`);
   }
   const d = model.degree;
   if (!(Number.isInteger(d) && d >= 0 && d <= kind.maxDegree)) {

@@ -7,6 +7,8 @@ import type { ExtensionObject, Resources } from "./index.js";
 /** What a node material drawing the model carries in `userData.coatedConductor`. */
 export interface CoatedConductorNodeData {
   model: ExtensionObject;
+  /** The index of the clear coat the metal lies under (1: none). */
+  coatIor: number;
   /** The fallback's KHR_materials_clearcoat values the glTF material was loaded with, or null. */
   fallback: { KHR_materials_clearcoat: Record<string, unknown> } | null;
   /** Frees the tables (their off-screen render targets and DataTextures). */
@@ -18,14 +20,16 @@ export interface CoatedConductorNodeData {
  * node materials (WebGPURenderer on WebGPU or its WebGL2 backend).
  */
 export declare class CoatedConductorNodeMaterial extends MeshPhysicalNodeMaterial {
-  constructor(model: ExtensionObject, resources: Resources, parameters?: MeshPhysicalNodeMaterialParameters);
+  constructor(
+    model: ExtensionObject, resources: Resources, parameters?: MeshPhysicalNodeMaterialParameters, coatIor?: number,
+  );
   readonly isCoatedConductorNodeMaterial: true;
   userData: { coatedConductor: CoatedConductorNodeData; [key: string]: unknown };
 }
 
-/** A CoatedConductorNodeMaterial drawing `params.model`; the other params are MeshPhysicalNodeMaterial's. */
+/** A CoatedConductorNodeMaterial drawing `params.model` under a coat of index `params.coatIor` (default 1.5). */
 export declare function createCoatedConductorNodeMaterial(
-  params: MeshPhysicalNodeMaterialParameters & { model: ExtensionObject },
+  params: MeshPhysicalNodeMaterialParameters & { model: ExtensionObject; coatIor?: number },
 ): Promise<CoatedConductorNodeMaterial>;
 
 /** The node-material twin of a material the GLTFLoader plugin made; any other material as it is. */

@@ -230,29 +230,30 @@ export class CoatedConductorNodeMaterial extends MeshPhysicalNodeMaterial {
     return "CoatedConductorNodeMaterial";
   }
 
-  constructor(model, resources, parameters = {}) {
+  constructor(model, resources, parameters = {}, coatIor = 1.5) {
     super();
-    checkModel(model);
+    checkModel(model, coatIor);
     this.isCoatedConductorNodeMaterial = true;
     const kind = kindNamed(model.kind);
     const node = nodeModelOf(kind);
-    const tables = new NodeTables(resources, kind, model, wordsFor(kind, model.coefficients));
-    const P = Object.fromEntries(Object.entries(node.parameters(model)).map(([p, v]) => [p, uniform(new Vector3(...v))]));
-    const coatIor = uniform(model.coatIor);
-    const F0 = ((model.coatIor - 1) / (model.coatIor + 1)) ** 2;
+    const drawn = { ...model, coatIor }; // the metal under its coat (KHR_materials_clearcoat_ior's index)
+    const tables = new NodeTables(resources, kind, drawn, wordsFor(kind, model.coefficients));
+    const P = Object.fromEntries(Object.entries(node.parameters(drawn)).map(([p, v]) => [p, uniform(new Vector3(...v))]));
+    const eta = uniform(coatIor);
+    const F0 = ((coatIor - 1) / (coatIor + 1)) ** 2;
     this.cf = {
-      coatIor, coatF0: model.coatIor > 1 ? F0 : 0, nodes: tables.nodes, rBar: uniform(internalReflectance(model.coatIor)),
+      coatIor: eta, coatF0: coatIor > 1 ? F0 : 0, nodes: tables.nodes, rBar: uniform(internalReflectance(coatIor)),
       albedo: tables.albedoTexture, escape: tables.escapeTexture,
-      fresnel: (mu) => node.fresnel(TSL, mu, coatIor, P),
+      fresnel: (mu) => node.fresnel(TSL, mu, eta, P),
       // Redraws the tables (if the roughness changed) before each object is drawn; the rough blend.
       roughBlend: uniform(0).onObjectUpdate(() => tables.update({
         roughness: this.roughness, coatRoughness: this.clearcoat > 0 ? this.clearcoatRoughness : 0,
       })),
     };
     this.resources = resources;
-    this.userData.coatedConductor = { model, fallback: null, dispose: () => tables.dispose() };
+    this.userData.coatedConductor = { model, coatIor, fallback: null, dispose: () => tables.dispose() };
     this.setValues({
-      metalness: 1, color: 0xffffff, clearcoat: 1, clearcoatRoughness: model.coatRoughnessFactor ?? 0, ...parameters,
+      metalness: 1, color: 0xffffff, clearcoat: 1, clearcoatRoughness: 0, ...parameters,
     });
   }
 
@@ -270,7 +271,8 @@ export class CoatedConductorNodeMaterial extends MeshPhysicalNodeMaterial {
   }
 
   clone() {
-    return new CoatedConductorNodeMaterial(this.userData.coatedConductor.model, this.resources).copy(this);
+    const { model, coatIor } = this.userData.coatedConductor;
+    return new CoatedConductorNodeMaterial(model, this.resources, {}, coatIor).copy(this);
   }
 
   copy(source) {
@@ -287,14 +289,17 @@ export class CoatedConductorNodeMaterial extends MeshPhysicalNodeMaterial {
 }
 
 /**
- * A CoatedConductorNodeMaterial drawing `params.model`; the other params
- * are MeshPhysicalNodeMaterial's (roughness: the metal's; clearcoat default
- * 1, clearcoatRoughness default model.coatRoughnessFactor). Resolves once
- * the LUT is decoded (the first call only).
+ * A CoatedConductorNodeMaterial drawing `params.model` under a clear coat of
+ * index `params.coatIor` (default 1.5), as createCoatedConductorMaterial;
+ * the other params are MeshPhysicalNodeMaterial's (roughness: the metal's;
+ * clearcoat, the coat's weight, default 1, and 0 for no coat: the metal in
+ * air; clearcoatRoughness default 0). Resolves once the LUT is decoded (the
+ * first call only).
  */
 export async function createCoatedConductorNodeMaterial(params) {
-  const { model, ...physical } = params;
-  return new CoatedConductorNodeMaterial(model, await loadResources(), physical);
+  const { model, coatIor = 1.5, ...physical } = params;
+  const coated = (physical.clearcoat ?? 1) > 0;
+  return new CoatedConductorNodeMaterial(model, await loadResources(), physical, coated ? coatIor : 1);
 }
 
 /**
@@ -306,9 +311,10 @@ export async function createCoatedConductorNodeMaterial(params) {
 export async function toCoatedConductorNodeMaterial(material) {
   const model = material?.userData?.coatedConductor?.model;
   if (!model || material.isCoatedConductorNodeMaterial) return material;
+  const { coatIor = 1.5 } = material.userData.coatedConductor;
   const parameters = Object.fromEntries(COPIED.filter((key) => material[key] !== undefined)
     .map((key) => [key, material[key]?.clone && !material[key].isTexture ? material[key].clone() : material[key]]));
-  const twin = await createCoatedConductorNodeMaterial({ model, ...parameters });
+  const twin = await createCoatedConductorNodeMaterial({ model, coatIor, ...parameters });
   twin.userData.coatedConductor.fallback = material.userData.coatedConductor.fallback ?? null;
   return twin;
 }

@@ -13,7 +13,7 @@ import {
 import { WebGPURenderer } from "three/webgpu";
 
 const gold: ExtensionObject = {
-  kind: "rgb-conductor", colorSpace: "ACEScg", etaIRange: [1, 2.5], coatIor: 1.5,
+  kind: "rgb-conductor", colorSpace: "ACEScg", etaIRange: [1, 2.5],
   coefficients: { n: [0.18, 0.42, 1.37], k: [3.42, 2.35, 1.77] },
 };
 
@@ -25,7 +25,7 @@ export async function draw(renderer: THREE.WebGLRenderer, url: string): Promise<
   exporter.register((writer) => new CoatedConductorExporterExtension(writer));
   const written = await exporter.parseAsync(gltf.scene, { binary: false });
   console.log(EXTENSION_NAME, Object.keys(written));
-  const material = await createCoatedConductorMaterial({ model: checkModel(gold), roughness: 0.3 });
+  const material = await createCoatedConductorMaterial({ model: checkModel(gold, 1.8), coatIor: 1.8, roughness: 0.3 });
   const data = material.userData.coatedConductor;
   if (data) console.log(data.readTable(renderer).nodes);
   return material;
@@ -51,3 +51,5 @@ export const notAKind: ExtensionObject = { ...gold, kind: "schlick" };
 export const noModel = createCoatedConductorMaterial({ roughness: 0.3 });
 // @ts-expect-error: the node material needs its model too
 export const noNodeModel = createCoatedConductorNodeMaterial({ roughness: 0.3 });
+// @ts-expect-error: the coat is the clear coat's, not the extension's (revision 1's coatIor is gone)
+export const oldCoat: ExtensionObject = { ...gold, coatIor: 1.5 };
