@@ -10,7 +10,8 @@ const EPS = 2.220446049250313e-16;
 export const dot = (u, v) => { let s = 0; for (let i = 0; i < u.length; i++) s += u[i] * v[i]; return s; };
 const norm = (v) => Math.sqrt(dot(v, v));
 
-function normal({ J, zero }, f, n) {
+function normal({ J, zero, A: given, g: givenG }, f, n) {
+  if (given) return { A: given, g: givenG }; // the normal equations, summed by `fun` itself
   const A = Array.from({ length: n }, () => new Float64Array(n)), g = new Float64Array(n);
   for (let r = 0; r < f.length; r++) {
     if (zero[r]) continue;
