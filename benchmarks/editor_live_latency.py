@@ -17,18 +17,25 @@ caught before the page's handlers) and the page's frames
     median, p90, p99 and worst, gentle and extreme;
 -   ``release_to_final_ms``: from the pointer's release to the first frame
     of the server's full refit;
--   where a live refit's time goes: ``solve_ms`` (the worker's solve),
-    ``edit_to_result_ms`` (the move's edit to its result on the page: the
-    solve, the wait for the one in flight, the messages) and
-    ``result_to_frame_ms`` (the curve and the WebGL frame drawn);
+-   where a live refit's time goes, each step on the page's clock: the
+    move's event to its edit (the page's handler), the edit to its message
+    posted, the message to the worker's start (the wait for a solve in
+    flight), ``solve_ms`` (the worker's solve), its end to the answer
+    handled on the page (the message back, the main thread's queue), and
+    the answer to the frame drawn (the wait for the next animation frame,
+    the curve and the WebGL ball at half resolution);
 -   the same drags twice, in one run: ``idle`` (no load added) and
-    ``busy`` (``--busy`` busy-loop processes, 4 by default, keep both cores
-    of this machine busy), and the ratio busy / idle of the medians.
+    ``busy``: ``--busy`` busy-loop processes (two a core by default),
+    each pinned to one core, started after the idle phase; the busy phase
+    begins once the 1-minute load average reaches ``--busy-load`` (4 by
+    default; at most 5 minutes' wait, the load reached is recorded);
+-   the figures over all drags of a phase (gentle and extreme together:
+    the target's median and p99), and the ratio busy / idle of the medians.
 
 The load average at the start and end of each phase is recorded beside the
 figures: on a shared machine "idle" means no load added by this run.
 
-Run: ``.venv/bin/python benchmarks/editor_live_latency.py [--drags 20] [--moves 20] [--busy 4]``
+Run: ``.venv/bin/python benchmarks/editor_live_latency.py [--drags 20] [--moves 20] [--busy 4] [--busy-load 4]``
 """
 
 from __future__ import annotations
@@ -198,6 +205,7 @@ def main() -> None:
             try:
                 reached = wait_for_load(args.busy_load, 300)  # the 1-minute average follows within a few minutes
                 print(f"busy phase: load average {reached:.1f}", file=sys.stderr, flush=True)
+                figures["busy_load_reached"] = reached
                 figures["busy"] = phase(browser, url, args.drags, args.moves)
             finally:
                 for loop in loops:

@@ -13,6 +13,7 @@ const sizeFor = (px) => {
   const width = Math.round(Math.min(W_MAX, Math.max(W_MIN, px || W_MAX)));
   return { width, height: Math.round(Math.max(260, 0.625 * width)) };
 };
+const MOVE_EVENT = typeof window !== "undefined" && "onpointerrawupdate" in window ? "pointerrawupdate" : "pointermove";
 export const HANDLE_HIT_PX = 24; // a handle's diameter on screen at least (touch)
 
 function el(name, attributes = {}, parent = null) {
@@ -26,7 +27,7 @@ export class ReflectancePlot {
   /**
    * @param {HTMLElement} container
    * @param {object} hooks  onDrag(channel, handleIndex, value, pointer, event) -> whether the point moved
-   *   (pointer: true while a pointer drags it, with its pointermove event; false for a key press), onDragEnd() (the drag, or
+   *   (pointer: true while a pointer drags it, with its move event; false for a key press), onDragEnd() (the drag, or
    *   a burst of key presses, ended), onSelect(channel, handleIndex) (a point took the focus)
    */
   constructor(container, hooks) {
@@ -46,7 +47,9 @@ export class ReflectancePlot {
     }
     this.dragging = null;
     this.keyBurst = null; // the timer that ends a burst of key presses (one undo step)
-    this.svg.addEventListener("pointermove", (event) => this.#move(event));
+    // A held point follows the pointer's raw updates where the browser has them (a secure context in
+    // Chromium): each as it comes in, not held back to the next animation frame as pointermove is.
+    this.svg.addEventListener(MOVE_EVENT, (event) => this.#move(event));
     this.svg.addEventListener("pointerup", () => this.#release());
     this.svg.addEventListener("pointercancel", () => this.#release());
   }

@@ -138,11 +138,14 @@ function powersAt(eta, [lo, hi], d1) {
  * The live problem: `target` (S x 3 linear ACEScg), `mu`, `eta` (S),
  * `range` [lo, hi], `degree`, `weights` (S, or null), the check points
  * {mu, eta} and weight. The samples' geometry, the target's Lab and metric
- * kept in typed arrays (a solve evaluates them a few thousand times).
+ * kept in typed arrays (a solve evaluates them a few thousand times);
+ * `samples`, another problem's of the same target, reused as they are.
  */
-export function makeProblem({ target, mu, eta, range, degree, weights = null, check, checkWeight }) {
+export function makeProblem({ target, mu, eta, range, degree, weights = null, check, checkWeight, samples = null }) {
   const d1 = degree + 1;
-  const samples = geometry(mu, eta, range, d1), count = samples.count;
+  if (samples) return { n: 9 * d1, d1, range, samples, checks: geometry(check.mu, check.eta, range, d1), checkWeight };
+  samples = geometry(mu, eta, range, d1);
+  const count = samples.count;
   samples.lab = new Float64Array(3 * count);
   samples.A = new Float64Array(9 * count);
   samples.sw = new Float64Array(count);
@@ -387,9 +390,10 @@ export function liveStep(input, settings = LIVE) {
   const grid = scoringGrid(range, d1);
   const baseCheck = checkGrid(range, ...settings.checkSamples);
   let left = settings.maxEvaluations, cut = false, nfevAll = 0, njevAll = 0;
+  const samples = makeProblem({ ...input, check: { mu: [], eta: [] }, checkWeight: 0 }).samples; // kept between rounds
   const solveFrom = (start, weight, check) => {
     const maxNfev = Math.min(settings.maxNfev, Math.max(1, Math.floor(left / 2)));
-    const problem = makeProblem({ ...input, check, checkWeight: weight });
+    const problem = makeProblem({ ...input, check, checkWeight: weight, samples });
     const result = solveLive(problem, clipToBounds(start, d1), 1e-10, maxNfev);
     left -= result.nfev + result.njev;
     nfevAll += result.nfev; njevAll += result.njev;
@@ -415,7 +419,7 @@ export function liveStep(input, settings = LIVE) {
     bestEffort = true;
     // The closer to the edit (by the objective's data term) of the fallback and the fit on screen.
     const data = (c) => {
-      const { f } = evaluate(makeProblem({ ...input, check: { mu: [], eta: [] }, checkWeight: 1 }), c, false);
+      const { f } = evaluate(makeProblem({ ...input, check: { mu: [], eta: [] }, checkWeight: 1, samples }), c, false);
       return dot(f, f);
     };
     const onScreen = Array.from(input.start, toHalf);
