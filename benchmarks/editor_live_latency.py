@@ -62,10 +62,12 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 SETTLED = ("() => { const id = document.getElementById('fit-id').textContent;"
            " return !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
            " && document.getElementById('preview').dataset.fit === id; }")
-# The pointer events' time stamps, caught before the page's own handlers (capture phase).
+# The pointer events' time stamps, caught before the page's own handlers (capture phase): each move's
+# first event (pointerrawupdate where Chromium has it, as the page follows it; else pointermove).
 LISTEN = """() => {
   window.cfMoves = []; window.cfReleases = [];
-  document.addEventListener("pointermove", (e) => { if (e.buttons) window.cfMoves.push(e.timeStamp); }, true);
+  const move = "onpointerrawupdate" in window ? "pointerrawupdate" : "pointermove";
+  document.addEventListener(move, (e) => { if (e.buttons) window.cfMoves.push(e.timeStamp); }, true);
   document.addEventListener("pointerup", (e) => window.cfReleases.push(e.timeStamp), true);
 }"""
 
