@@ -211,15 +211,18 @@ function labInto(rgb) {
 
 /**
  * Residuals f (m) at x and, with `withJ`, the normal equations of the
- * Jacobian J (m x n): A = J^T J (n rows of n) and g = J^T f, summed a
- * sample at a time (a sample's three rows of J are u_o (x) the powers of t,
- * u_o over the nine (parameter, channel) pairs), J itself never formed.
+ * Jacobian J (m x n): A = J^T J (n rows of n) and g = J^T f, J itself
+ * never formed. A sample's three rows of J are u_o (x) T, u_o over the nine
+ * (parameter, channel) pairs and T the powers of t at its eta_i: the
+ * samples' sum_o u_o u_o^T and u_o f_o are summed per eta_i row first, then
+ * spread over the powers of t once a row.
  */
 export function evaluate(problem, x, withJ = true) {
   const { n, d1, samples, checks, checkWeight } = problem;
   const m = 3 * (samples.count + checks.count), f = new Float64Array(m);
   const N = withJ ? new Float64Array(n * n) : null, g = withJ ? new Float64Array(n) : null;
-  const dP = withJ ? DP : null, { lab: labT, A: As, sw: sws, T } = samples;
+  const dP = withJ ? DP : null, { lab: labT, A: As, sw: sws } = samples;
+  const BR = withJ ? new Float64Array(81 * samples.rows) : null, GR = withJ ? new Float64Array(9 * samples.rows) : null;
   let r = 0;
   for (let s = 0; s < samples.count; s++) {
     for (let c = 0; c < 3; c++) F[c] = channelAt(samples, s, x, d1, c, dP, 3 * c);
@@ -234,8 +237,9 @@ export function evaluate(problem, x, withJ = true) {
         for (let p = 0; p < 3; p++) U[9 * o + p * 3 + c] = G * DP[3 * c + p];
       }
     }
-    if (withJ) addSample(N, g, U, f, r - 3, T, s * d1, d1, n);
+    if (withJ) addSample(BR, GR, U, f, r - 3, samples.row[s]);
   }
+  if (withJ) spreadRows(N, g, BR, GR, samples, d1, n);
   for (let k = 0; k < checks.count; k++) {
     for (let c = 0; c < 3; c++, r++) {
       const value = channelAt(checks, k, x, d1, c, dP, 0);
@@ -251,19 +255,29 @@ export function evaluate(problem, x, withJ = true) {
   return { f, A, g };
 }
 
-const U = new Float64Array(27), B = new Float64Array(81);
+const U = new Float64Array(27);
 
-/** A sample's three rows of J (u_o (x) T: u in U[9 o + q], q = 3 p + c) into N's lower triangle and g. */
-function addSample(N, g, U, f, r, T, t, d1, n) {
+/** A sample's sum_o u_o u_o^T (lower triangle) and u_o f_o (u in U[9 o + q], q = 3 p + c) into its row's sums. */
+function addSample(BR, GR, U, f, r, row) {
+  const b = 81 * row, h = 9 * row;
   for (let q = 0; q < 9; q++) {
-    for (let w = 0; w <= q; w++) B[9 * q + w] = U[q] * U[w] + U[9 + q] * U[9 + w] + U[18 + q] * U[18 + w];
-    const gq = U[q] * f[r] + U[9 + q] * f[r + 1] + U[18 + q] * f[r + 2];
-    for (let j = 0; j < d1; j++) {
-      const i = q * d1 + j, Tj = T[t + j], row = i * n;
-      g[i] += gq * Tj;
-      for (let w = 0; w <= q; w++) {
-        const b = B[9 * q + w] * Tj, top = w === q ? j : d1 - 1;
-        for (let jj = 0; jj <= top; jj++) N[row + w * d1 + jj] += b * T[t + jj];
+    for (let w = 0; w <= q; w++) BR[b + 9 * q + w] += U[q] * U[w] + U[9 + q] * U[9 + w] + U[18 + q] * U[18 + w];
+    GR[h + q] += U[q] * f[r] + U[9 + q] * f[r + 1] + U[18 + q] * f[r + 2];
+  }
+}
+
+/** Each eta_i row's sums spread over its powers of t (B (x) T T^T, G (x) T) into N's lower triangle and g. */
+function spreadRows(N, g, BR, GR, samples, d1, n) {
+  for (let row = 0; row < samples.rows; row++) {
+    const t = samples.rowStart[row] * d1, T = samples.T, b = 81 * row;
+    for (let q = 0; q < 9; q++) {
+      for (let j = 0; j < d1; j++) {
+        const i = q * d1 + j, Tj = T[t + j], at = i * n;
+        g[i] += GR[9 * row + q] * Tj;
+        for (let w = 0; w <= q; w++) {
+          const v = BR[b + 9 * q + w] * Tj, top = w === q ? j : d1 - 1;
+          for (let jj = 0; jj <= top; jj++) N[at + w * d1 + jj] += v * T[t + jj];
+        }
       }
     }
   }
@@ -298,10 +312,12 @@ function clipToBounds(x, d1) {
   });
 }
 
-/** The samples' geometry at (mu, eta) arrays: clamped mu, x = 1 - mu, x^5, log x, the powers of t (d1 a point), typed. */
+/** The samples' geometry at (mu, eta) arrays: clamped mu, x = 1 - mu, x^5, log x, the powers of t (d1 a point), typed; their eta_i rows. */
 function geometry(mu, eta, range, d1) {
   const count = mu.length, g = { count, mu: new Float64Array(count), x: new Float64Array(count),
-    x5: new Float64Array(count), logx: new Float64Array(count), T: new Float64Array(count * d1) };
+    x5: new Float64Array(count), logx: new Float64Array(count), T: new Float64Array(count * d1),
+    row: new Int32Array(count), rowStart: [] }; // the points' eta_i rows (same eta_i, same powers of t)
+  const rows = new Map();
   for (let s = 0; s < count; s++) {
     const mm = Math.min(1, Math.max(0, mu[s])), x = 1 - mm;
     g.mu[s] = mm;
@@ -309,7 +325,13 @@ function geometry(mu, eta, range, d1) {
     g.x5[s] = x ** 5;
     g.logx[s] = x > 0 ? Math.log(x) : 0;
     g.T.set(powersAt(eta[s], range, d1), s * d1);
+    if (!rows.has(eta[s])) {
+      rows.set(eta[s], rows.size);
+      g.rowStart.push(s);
+    }
+    g.row[s] = rows.get(eta[s]);
   }
+  g.rows = rows.size;
   return g;
 }
 
