@@ -17,18 +17,25 @@ caught before the page's handlers) and the page's frames
     median, p90, p99 and worst, gentle and extreme;
 -   ``release_to_final_ms``: from the pointer's release to the first frame
     of the server's full refit;
--   where a live refit's time goes: ``solve_ms`` (the worker's solve),
-    ``edit_to_result_ms`` (the move's edit to its result on the page: the
-    solve, the wait for the one in flight, the messages) and
-    ``result_to_frame_ms`` (the curve and the WebGL frame drawn);
+-   where a live refit's time goes, each step on the page's clock: the
+    move's event to its edit (the page's handler), the edit to its message
+    posted, the message to the worker's start (the wait for a solve in
+    flight), ``solve_ms`` (the worker's solve), its end to the answer
+    handled on the page (the message back, the main thread's queue), and
+    the answer to the frame drawn (the wait for the next animation frame,
+    the curve and the WebGL ball at half resolution);
 -   the same drags twice, in one run: ``idle`` (no load added) and
-    ``busy`` (``--busy`` busy-loop processes, 4 by default, keep both cores
-    of this machine busy), and the ratio busy / idle of the medians.
+    ``busy``: ``--busy`` busy-loop processes (two a core by default),
+    each pinned to one core, started after the idle phase; the busy phase
+    begins once the 1-minute load average reaches ``--busy-load`` (4 by
+    default; at most 5 minutes' wait, the load reached is recorded);
+-   the figures over all drags of a phase (gentle and extreme together:
+    the target's median and p99), and the ratio busy / idle of the medians.
 
 The load average at the start and end of each phase is recorded beside the
 figures: on a shared machine "idle" means no load added by this run.
 
-Run: ``.venv/bin/python benchmarks/editor_live_latency.py [--drags 20] [--moves 20] [--busy 4]``
+Run: ``.venv/bin/python benchmarks/editor_live_latency.py [--drags 20] [--moves 20] [--busy 4] [--busy-load 4]``
 """
 
 from __future__ import annotations
@@ -55,15 +62,19 @@ from playwright.sync_api import sync_playwright  # noqa: E402
 SETTLED = ("() => { const id = document.getElementById('fit-id').textContent;"
            " return !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
            " && document.getElementById('preview').dataset.fit === id; }")
-# The pointer events' time stamps, caught before the page's own handlers (capture phase).
+# The pointer events' time stamps, caught before the page's own handlers (capture phase): each move's
+# first event (pointerrawupdate where Chromium has it, as the page follows it; else pointermove).
 LISTEN = """() => {
   window.cfMoves = []; window.cfReleases = [];
-  document.addEventListener("pointermove", (e) => { if (e.buttons) window.cfMoves.push(e.timeStamp); }, true);
+  const move = "onpointerrawupdate" in window ? "pointerrawupdate" : "pointermove";
+  document.addEventListener(move, (e) => { if (e.buttons) window.cfMoves.push(e.timeStamp); }, true);
   document.addEventListener("pointerup", (e) => window.cfReleases.push(e.timeStamp), true);
 }"""
 
 
 def summary(values):
+    if not values:
+        return {"n": 0}
     return {"median_ms": statistics.median(values), "p90_ms": percentile(values, 0.9),
             "p99_ms": percentile(values, 0.99), "worst_ms": max(values), "n": len(values)}
 
@@ -108,7 +119,7 @@ def drag(page, d, moves, extreme):
     released = page.evaluate("window.cfReleases")[0]
     live = [s for s in shown if s.get("live") == "page" and s["frameAt"]]
     final = [s for s in shown if not s.get("live") and s["frameAt"] and s["frameAt"] > released]
-    parts = [(s["solveMs"], s["curveAt"] - s["editAt"], s["frameAt"] - s["curveAt"]) for s in live]
+    parts = [trace(s) for s in live]
     latencies, missed = [], 0
     for t in moves_at:
         frames = [s["frameAt"] for s in live if s["editAt"] >= t]
@@ -119,6 +130,19 @@ def drag(page, d, moves, extreme):
     page.click("#undo")
     page.wait_for_function(SETTLED, timeout=120_000)
     return latencies, missed, (min(s["frameAt"] for s in final) - released) if final else None, parts
+
+
+# Where a live refit's time goes, step by step on the page's clock (ms): the move's event to its edit
+# (the page's handler), the edit to the message posted, the message to the worker's start (the
+# wait for the solve in flight and the message), the solve, its end to the answer handled on the
+# page (the message back and the main thread's queue), the answer to the frame drawn (the wait for
+# the next animation frame, the curve and the WebGL draw).
+STEPS = ("event_to_edit_ms", "edit_to_post_ms", "post_to_solve_ms", "solve_ms", "solve_to_page_ms", "page_to_frame_ms")
+
+
+def trace(s):
+    marks = (s["moveAt"], s["editAt"], s["sentAt"], s["solveStart"], s["solveEnd"], s["fittedAt"], s["frameAt"])
+    return [b - a for a, b in zip(marks, marks[1:])]
 
 
 def phase(browser, url, drags, moves):
@@ -138,26 +162,39 @@ def phase(browser, url, drags, moves):
             print(f"{kind} drag {d + 1}/{drags}: {len(lat)} moves, median {statistics.median(lat) if lat else 0:.0f} ms,"
                   f" release {release or 0:.0f} ms", file=sys.stderr, flush=True)
         out[kind] = {"move_to_frame_ms": summary(latencies), "moves_not_shown_live": missed,
-                     "release_to_final_ms": summary(releases),
-                     # Where a live refit's time goes: the worker's solve, edit -> result on the
-                     # page (the solve, the wait for the one in flight, the messages), result -> frame drawn.
-                     "solve_ms": summary([p[0] for p in parts]), "edit_to_result_ms": summary([p[1] for p in parts]),
-                     "result_to_frame_ms": summary([p[2] for p in parts])}
+                     "release_to_final_ms": summary(releases), "latencies": latencies,
+                     **{step: summary([p[i] for p in parts]) for i, step in enumerate(STEPS)}}
     page.close()
     load.append(load_average())
     out["load_average"] = load
+    # Over every drag of the phase, gentle and extreme together (the target's figure).
+    out["all"] = {"move_to_frame_ms": summary(out["gentle"].pop("latencies") + out["extreme"].pop("latencies"))}
     return out
 
 
 def busy_loops(count):
-    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(count)]
+    """`count` busy-loop processes, pinned round the cores (two a core for count 2 x cores)."""
+    cores = sorted(os.sched_getaffinity(0))
+    code = "import os, sys; os.sched_setaffinity(0, {int(sys.argv[1])})\nwhile True: pass"
+    return [subprocess.Popen([sys.executable, "-c", code, str(cores[k % len(cores)])]) for k in range(count)]
+
+
+def wait_for_load(least, limit_s):
+    """Wait (at most `limit_s`) until the 1-minute load average is at least `least`; the load reached."""
+    end = time.monotonic() + limit_s
+    while load_average() < least and time.monotonic() < end:
+        time.sleep(2)
+    return load_average()
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--drags", type=int, default=20, help="gentle drags and extreme drags, each")
     parser.add_argument("--moves", type=int, default=20, help="pointer moves a drag")
-    parser.add_argument("--busy", type=int, default=4, help="busy-loop processes of the busy phase")
+    parser.add_argument("--busy", type=int, default=2 * (os.cpu_count() or 1),
+                        help="busy-loop processes of the busy phase, pinned round the cores (default two a core)")
+    parser.add_argument("--busy-load", type=float, default=4.0,
+                        help="the busy phase starts once the 1-minute load average is at least this (or after 5 min)")
     args = parser.parse_args()
     load_at_start = load_average()
     figures: dict = {}
@@ -168,7 +205,9 @@ def main() -> None:
             figures["idle"] = phase(browser, url, args.drags, args.moves)
             loops = busy_loops(args.busy)
             try:
-                time.sleep(5)  # the load average follows
+                reached = wait_for_load(args.busy_load, 300)  # the 1-minute average follows within a few minutes
+                print(f"busy phase: load average {reached:.1f}", file=sys.stderr, flush=True)
+                figures["busy_load_reached"] = reached
                 figures["busy"] = phase(browser, url, args.drags, args.moves)
             finally:
                 for loop in loops:
@@ -177,10 +216,10 @@ def main() -> None:
             browser.close()
     figures["busy_over_idle"] = {
         kind: figures["busy"][kind]["move_to_frame_ms"]["median_ms"] / figures["idle"][kind]["move_to_frame_ms"]["median_ms"]
-        for kind in ("gentle", "extreme")}
+        for kind in ("gentle", "extreme", "all")}
     print(f"{'pointer move -> frame of its refit (ms)':<44} {'median':>7} {'p90':>7} {'p99':>7} {'worst':>7} {'n':>5}")
     for name in ("idle", "busy"):
-        for kind in ("gentle", "extreme"):
+        for kind in ("gentle", "extreme", "all"):
             s = figures[name][kind]["move_to_frame_ms"]
             print(f"{name + ', ' + kind:<44} {s['median_ms']:>7.1f} {s['p90_ms']:>7.1f} {s['p99_ms']:>7.1f}"
                   f" {s['worst_ms']:>7.1f} {s['n']:>5}")
@@ -189,13 +228,12 @@ def main() -> None:
         for kind in ("gentle", "extreme"):
             s = figures[name][kind]["release_to_final_ms"]
             print(f"{name + ', ' + kind:<44} {s['median_ms']:>7.0f} {s['p90_ms']:>7.0f} {s['worst_ms']:>7.0f} {s['n']:>5}")
-    print(f"\n{'a live refit (ms, median / p99)':<44} {'solve':>13} {'edit->result':>13} {'result->frame':>13}")
+    print(f"\n{'a live refit (ms, median / p99)':<17}" + "".join(f"{step[:-3]:>17}" for step in STEPS))
     for name in ("idle", "busy"):
         for kind in ("gentle", "extreme"):
             f = figures[name][kind]
-            cells = [f"{f[k]['median_ms']:>6.1f}/{f[k]['p99_ms']:>6.1f}" for k in ("solve_ms", "edit_to_result_ms",
-                                                                                 "result_to_frame_ms")]
-            print(f"{name + ', ' + kind:<44} {cells[0]:>13} {cells[1]:>13} {cells[2]:>13}")
+            print(f"{name + ', ' + kind:<17}" + "".join(f"{f[k]['median_ms']:>8.1f}/{f[k]['p99_ms']:>7.1f} "
+                                                        for k in STEPS))
     print(f"\nbusy / idle (median): {figures['busy_over_idle']}")
     print(f"load average: idle {figures['idle']['load_average']}, busy {figures['busy']['load_average']}"
           f" on {os.cpu_count()} cores")

@@ -88,8 +88,11 @@ const live = new LiveRefit({
   show({ fit, model, job }) {
     if (state.base !== job.base || !store.dispatch("liveShown", { model })) return;
     page.liveFit = fit;
-    const shown = { fit: fit.id, editAt: job.editAt, sentAt: job.editAt, fittedAt: performance.now(), curveAt: null,
-                    frameAt: null, live: "page", solveMs: fit.inPage.ms, coefficients: fit.coefficients, edits: job.edits };
+    // The trace of a live refit (ms, page clock): the move's event, its edit, the message posted, the
+    // worker's solve (its start and end), its answer on the page, the curve set, the frame drawn.
+    const shown = { fit: fit.id, moveAt: job.moveAt, editAt: job.editAt, sentAt: job.sentAt, fittedAt: performance.now(),
+                    solveStart: fit.inPage.startedAt, solveEnd: fit.inPage.endedAt, curveAt: null, frameAt: null,
+                    live: "page", solveMs: fit.inPage.ms, coefficients: fit.coefficients, edits: job.edits };
     telemetry.shown.push(shown);
     if (telemetry.shown.length > 1000) telemetry.shown.shift();
     shown.curveAt = performance.now();
@@ -102,7 +105,7 @@ const live = new LiveRefit({
 function liveRefit() {
   if (!state.pointerDrag || !live.ready(state.base, state.edits)) return false;
   live.request({ base: state.base, fit: page.liveFit || state.fit, edits: JSON.parse(snapshot(state)),
-                 theta: state.theta, eta: state.eta, editAt: telemetry.lastEditAt });
+                 theta: state.theta, eta: state.eta, editAt: telemetry.lastEditAt, moveAt: telemetry.lastMoveAt });
   return true;
 }
 
@@ -133,7 +136,8 @@ const save = () => saveEdit({
 }, continuing);
 
 const plotView = new PlotView({
-  onDrag(payload) {
+  onDrag(payload, event) {
+    if (event) telemetry.lastMoveAt = event.timeStamp;
     const moved = store.dispatch("drag", payload);
     if (moved) {
       telemetry.lastEditAt = performance.now();
@@ -212,11 +216,20 @@ const colourView = new ColourView({
 // The views follow the state: the plot and the saved line after every change of it.
 const RENDERED = new Set(["curves", "drag", "dragEnd", "undo", "redo", "reset", "gentler", "shown", "saved",
                           "colour", "liveShown"]);
-store.subscribe((name) => {
-  if (!RENDERED.has(name)) return;
+// While a pointer holds a point, the plot follows on the next animation frame
+// (once a frame, with the preview's draw): the move's solve is posted first.
+const plotFrame = { pending: 0 };
+function renderPlot() {
+  cancelAnimationFrame(plotFrame.pending);
+  plotFrame.pending = 0;
   $("fit-source").textContent = state.onScreen === "page" ? "live (in page)" : "server fit";
   plotView.render(state);
   readout.showSaved(state);
+}
+store.subscribe((name) => {
+  if (!RENDERED.has(name)) return;
+  if (!(state.pointerDrag && (name === "drag" || name === "liveShown"))) renderPlot();
+  else if (!plotFrame.pending) plotFrame.pending = requestAnimationFrame(renderPlot);
 });
 
 // ---------------------------------------------------------------- the fit on screen

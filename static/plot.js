@@ -13,6 +13,7 @@ const sizeFor = (px) => {
   const width = Math.round(Math.min(W_MAX, Math.max(W_MIN, px || W_MAX)));
   return { width, height: Math.round(Math.max(260, 0.625 * width)) };
 };
+const MOVE_EVENT = typeof window !== "undefined" && "onpointerrawupdate" in window ? "pointerrawupdate" : "pointermove";
 export const HANDLE_HIT_PX = 24; // a handle's diameter on screen at least (touch)
 
 function el(name, attributes = {}, parent = null) {
@@ -25,8 +26,8 @@ function el(name, attributes = {}, parent = null) {
 export class ReflectancePlot {
   /**
    * @param {HTMLElement} container
-   * @param {object} hooks  onDrag(channel, handleIndex, value, pointer) -> whether the point moved
-   *   (pointer: true while a pointer drags it, false for a key press), onDragEnd() (the drag, or
+   * @param {object} hooks  onDrag(channel, handleIndex, value, pointer, event) -> whether the point moved
+   *   (pointer: true while a pointer drags it, with its move event; false for a key press), onDragEnd() (the drag, or
    *   a burst of key presses, ended), onSelect(channel, handleIndex) (a point took the focus)
    */
   constructor(container, hooks) {
@@ -46,7 +47,9 @@ export class ReflectancePlot {
     }
     this.dragging = null;
     this.keyBurst = null; // the timer that ends a burst of key presses (one undo step)
-    this.svg.addEventListener("pointermove", (event) => this.#move(event));
+    // A held point follows the pointer's raw updates where the browser has them (a secure context in
+    // Chromium): each as it comes in, not held back to the next animation frame as pointermove is.
+    this.svg.addEventListener(MOVE_EVENT, (event) => this.#move(event));
     this.svg.addEventListener("pointerup", () => this.#release());
     this.svg.addEventListener("pointercancel", () => this.#release());
   }
@@ -77,6 +80,10 @@ export class ReflectancePlot {
   #axes() {
     const { grid, axis } = this.layers;
     const { W, H } = this;
+    // Drawn again only for a new size or scale (not on every move of a drag).
+    const signature = `${W} ${H} ${this.yMin} ${this.yMax}`;
+    if (signature === this.axesSignature) return;
+    this.axesSignature = signature;
     grid.replaceChildren();
     axis.replaceChildren();
     for (let t = 0; t <= 90; t += 15) {
@@ -91,10 +98,19 @@ export class ReflectancePlot {
     el("text", { x: (M.left + W - M.right) / 2, y: H - 4, "text-anchor": "middle" }, axis).textContent = "angle θ inside the coating";
   }
 
+  // A layer's three curves: its paths kept, their `d` set (none when `rgb` is null).
   #path(layer, theta, rgb, className) {
+    if (!rgb) {
+      layer.replaceChildren();
+      return;
+    }
+    if (layer.childElementCount !== 3) {
+      layer.replaceChildren();
+      for (let c = 0; c < 3; c++) el("path", { class: `${className} c${c}`, "data-channel": c }, layer);
+    }
     for (let c = 0; c < 3; c++) {
       const d = theta.map((t, i) => `${i ? "L" : "M"}${this.x(t).toFixed(1)},${this.y(rgb[i][c]).toFixed(1)}`).join("");
-      el("path", { d, class: `${className} c${c}`, "data-channel": c }, layer);
+      if (layer.children[c].getAttribute("d") !== d) layer.children[c].setAttribute("d", d);
     }
   }
 
@@ -120,8 +136,7 @@ export class ReflectancePlot {
       el("text", { x: x + 4, y: M.top + 12 }, critical).textContent = `max from air ${data.criticalDeg.toFixed(1)}°`;
     }
     for (const name of ["lazanyi", "reference", "target", "compare", "model"]) {
-      this.layers[name].replaceChildren();
-      if (data[name]) this.#path(this.layers[name], data.theta, data[name], name);
+      this.#path(this.layers[name], data.theta, data[name], name);
     }
     this.#handles();
   }
@@ -204,7 +219,7 @@ export class ReflectancePlot {
     point.y = event.clientY;
     const local = point.matrixTransform(this.svg.getScreenCTM().inverse());
     const value = Math.min(1, Math.max(0, this.value(local.y)));
-    if (this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value, true)) this.dragging.moved = true;
+    if (this.hooks.onDrag(this.dragging.channel, this.dragging.handle, value, true, event)) this.dragging.moved = true;
   }
 
   #release() {

@@ -16,6 +16,8 @@ import { LIVE, linspace, modelValues } from "./live_solve.js";
 
 const BLEND_WIDTH = 0.5; // fitting.fits.curves_settings.CurveFitSettings.blend_width (the editor sends none)
 const rowKey = (eta) => Number(eta).toFixed(6);
+const now = () => (typeof performance === "undefined" ? Date.now() : performance.now());
+const origin = () => (typeof performance === "undefined" ? 0 : performance.timeOrigin);
 
 /** The coated-conductor coefficients {F0, a, alpha}[c][j] of a fit, flat (p, c, j) at `d1` powers. */
 export function flatCoefficients(C, d1) {
@@ -111,6 +113,7 @@ export class LiveRefit {
     for (const [name, rows] of this.rows) if (rows) baseRows[name] = rows;
     job.seq = ++this.seq;
     job.degree = degree;
+    job.sentAt = now();
     this.inFlight = job;
     this.worker.postMessage({
       id: job.seq, baseRows, range: [lo, hi], degree, blendWidth: BLEND_WIDTH,
@@ -126,7 +129,9 @@ export class LiveRefit {
       const d1 = job.degree + 1;
       const fit = {
         ...job.fit, id: `in-page-${job.seq}`, coefficients: nestedCoefficients(data.coefficients16, d1),
-        degree: job.degree, inPage: { bestEffort: data.bestEffort, ms: data.ms },
+        degree: job.degree,
+        // The worker's clock is its own: its start and end (epoch ms) on this page's clock.
+        inPage: { bestEffort: data.bestEffort, ms: data.ms, startedAt: data.startedAt - origin(), endedAt: data.endedAt - origin() },
       };
       const mu = job.theta.map((t) => (t === 90 ? 0 : Math.cos((t * Math.PI) / 180)));
       const model = modelValues(data.coefficients16, mu, mu.map(() => job.eta), job.base.eta_i_range, d1);

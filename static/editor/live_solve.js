@@ -137,83 +137,164 @@ function powersAt(eta, [lo, hi], d1) {
 /**
  * The live problem: `target` (S x 3 linear ACEScg), `mu`, `eta` (S),
  * `range` [lo, hi], `degree`, `weights` (S, or null), the check points
- * {mu, eta} and weight. Samples' geometry, the target's Lab and metric kept.
+ * {mu, eta} and weight. The samples' geometry, the target's Lab and metric
+ * kept in typed arrays (a solve evaluates them a few thousand times);
+ * `samples`, another problem's of the same target, reused as they are.
  */
-export function makeProblem({ target, mu, eta, range, degree, weights = null, check, checkWeight }) {
+export function makeProblem({ target, mu, eta, range, degree, weights = null, check, checkWeight, samples = null }) {
   const d1 = degree + 1;
-  const samples = geometry(mu, eta, range, d1).map((g, s) => {
+  if (samples) return { n: 9 * d1, d1, range, samples, checks: geometry(check.mu, check.eta, range, d1), checkWeight };
+  samples = geometry(mu, eta, range, d1);
+  const count = samples.count;
+  samples.lab = new Float64Array(3 * count);
+  samples.A = new Float64Array(9 * count);
+  samples.sw = new Float64Array(count);
+  for (let s = 0; s < count; s++) {
     const { lab } = labAndJacobian(target[s]);
-    return { ...g, lab, A: de2000Weights(lab), sw: weights ? Math.sqrt(weights[s]) : 1 };
-  });
+    samples.lab.set(lab, 3 * s);
+    samples.A.set(de2000Weights(lab).flat(), 9 * s);
+    samples.sw[s] = weights ? Math.sqrt(weights[s]) : 1;
+  }
   return { n: 9 * d1, d1, range, samples, checks: geometry(check.mu, check.eta, range, d1), checkWeight };
 }
 
-/** The parameters F0, a, alpha (raw) of channel c at one sample into P. */
-function paramsAt(g, x, d1, c, P) {
-  for (let p = 0; p < 3; p++) {
-    let v = 0;
-    for (let j = 0; j < d1; j++) v += g.T[j] * x[(p * 3 + c) * d1 + j];
-    P[p] = v;
+/**
+ * The model's value at point k of `geo` in channel c (Eq. 1: F0 + (1 - F0)
+ * (1 - mu)^5 - a mu (1 - mu)^alpha), and with `dP` its derivatives by F0,
+ * a, alpha into dP[o], dP[o + 1], dP[o + 2]. x^alpha as exp(alpha log x).
+ */
+function channelAt(geo, k, x, d1, c, dP, o) {
+  const T = geo.T, t = k * d1;
+  let F0 = 0, a = 0, alpha = 0;
+  for (let j = 0; j < d1; j++) {
+    const tj = T[t + j];
+    F0 += tj * x[c * d1 + j];
+    a += tj * x[(3 + c) * d1 + j];
+    alpha += tj * x[(6 + c) * d1 + j];
   }
+  const muXAlpha = geo.x[k] > 0 ? geo.mu[k] * Math.exp(Math.max(alpha, ALPHA_MIN) * geo.logx[k]) : 0;
+  if (dP) {
+    dP[o] = 1 - geo.x5[k];
+    dP[o + 1] = -muXAlpha;
+    dP[o + 2] = alpha > ALPHA_MIN ? -a * muXAlpha * geo.logx[k] : 0;
+  }
+  return F0 + (1 - F0) * geo.x5[k] - a * muXAlpha;
 }
 
-/** The model's value at one sample and channel, its parameter derivatives (F0, a, alpha) into dP. */
-function modelAt(g, x, d1, c, P, dP) {
-  paramsAt(g, x, d1, c, P);
-  const muXAlpha = g.mu * g.x ** Math.max(P[2], ALPHA_MIN);
-  if (dP) {
-    dP[0] = 1 - g.x5;
-    dP[1] = -muXAlpha;
-    dP[2] = P[2] > ALPHA_MIN ? -P[1] * muXAlpha * g.logx : 0;
+const F = new Float64Array(3), DP = new Float64Array(9), LAB = new Float64Array(3), DLAB = new Float64Array(9);
+
+/** Lab of linear ACEScg into LAB, dLab_o/dRGB_j into DLAB[3 o + j] (labAndJacobian, allocation free). */
+function labInto(rgb) {
+  let f0 = 0, f1 = 0, f2 = 0, df0 = 0, df1 = 0, df2 = 0;
+  for (let i = 0; i < 3; i++) {
+    const X = MN[i][0] * rgb[0] + MN[i][1] * rgb[1] + MN[i][2] * rgb[2];
+    let fi, dfi;
+    if (X > DELTA3) {
+      const root = Math.cbrt(X);
+      fi = root;
+      dfi = 1 / (3 * root * root);
+    } else {
+      fi = X / (3 * DELTA * DELTA) + 4 / 29;
+      dfi = 1 / (3 * DELTA * DELTA);
+    }
+    if (i === 0) { f0 = fi; df0 = dfi; } else if (i === 1) { f1 = fi; df1 = dfi; } else { f2 = fi; df2 = dfi; }
   }
-  return P[0] + (1 - P[0]) * g.x5 - P[1] * muXAlpha;
+  LAB[0] = 116 * f1 - 16;
+  LAB[1] = 500 * (f0 - f1);
+  LAB[2] = 200 * (f1 - f2);
+  for (let j = 0; j < 3; j++) {
+    DLAB[j] = 116 * df1 * MN[1][j];
+    DLAB[3 + j] = 500 * (df0 * MN[0][j] - df1 * MN[1][j]);
+    DLAB[6 + j] = 200 * (df1 * MN[1][j] - df2 * MN[2][j]);
+  }
 }
 
 /**
- * Residuals f (m) and, with `withJ`, the Jacobian J (m x n, flat by rows)
- * at x; `zero[r]` marks a row of J that is all zeros (an inactive hinge).
+ * Residuals f (m) at x and, with `withJ`, the normal equations of the
+ * Jacobian J (m x n): A = J^T J (n rows of n) and g = J^T f, J itself
+ * never formed. A sample's three rows of J are u_o (x) T, u_o over the nine
+ * (parameter, channel) pairs and T the powers of t at its eta_i: the
+ * samples' sum_o u_o u_o^T and u_o f_o are summed per eta_i row first, then
+ * spread over the powers of t once a row.
  */
 export function evaluate(problem, x, withJ = true) {
   const { n, d1, samples, checks, checkWeight } = problem;
-  const m = 3 * (samples.length + checks.length);
-  // The Jacobian's buffer is the problem's, reused: the solver reads it before the next evaluation with it.
-  if (withJ && !problem.buffer) problem.buffer = new Float64Array(m * n);
-  const f = new Float64Array(m), J = withJ ? problem.buffer.fill(0) : null, zero = new Uint8Array(m);
-  const P = [0, 0, 0], dPs = [[0, 0, 0], [0, 0, 0], [0, 0, 0]], F = [0, 0, 0];
+  const m = 3 * (samples.count + checks.count), f = new Float64Array(m);
+  const N = withJ ? new Float64Array(n * n) : null, g = withJ ? new Float64Array(n) : null;
+  const dP = withJ ? DP : null, { lab: labT, A: As, sw: sws } = samples;
+  const BR = withJ ? new Float64Array(81 * samples.rows) : null, GR = withJ ? new Float64Array(9 * samples.rows) : null;
   let r = 0;
-  for (const g of samples) {
-    for (let c = 0; c < 3; c++) F[c] = modelAt(g, x, d1, c, P, withJ ? dPs[c] : null);
-    const { lab, J: dLab } = labAndJacobian(F);
-    const d0 = lab[0] - g.lab[0], d1_ = lab[1] - g.lab[1], d2 = lab[2] - g.lab[2];
+  for (let s = 0; s < samples.count; s++) {
+    for (let c = 0; c < 3; c++) F[c] = channelAt(samples, s, x, d1, c, dP, 3 * c);
+    labInto(F);
+    const d0 = LAB[0] - labT[3 * s], d1_ = LAB[1] - labT[3 * s + 1], d2 = LAB[2] - labT[3 * s + 2], sw = sws[s];
     for (let o = 0; o < 3; o++, r++) {
-      const A = g.A[o];
-      f[r] = g.sw * (A[0] * d0 + A[1] * d1_ + A[2] * d2);
+      const a = 9 * s + 3 * o, A0 = As[a], A1 = As[a + 1], A2 = As[a + 2];
+      f[r] = sw * (A0 * d0 + A1 * d1_ + A2 * d2);
       if (!withJ) continue;
-      const row = r * n;
       for (let c = 0; c < 3; c++) {
-        const G = g.sw * (A[0] * dLab[0][c] + A[1] * dLab[1][c] + A[2] * dLab[2][c]);
-        const dP = dPs[c];
-        for (let p = 0; p < 3; p++) {
-          const Gp = G * dP[p], col = row + (p * 3 + c) * d1;
-          for (let j = 0; j < d1; j++) J[col + j] = Gp * g.T[j];
+        const G = sw * (A0 * DLAB[c] + A1 * DLAB[3 + c] + A2 * DLAB[6 + c]);
+        for (let p = 0; p < 3; p++) U[9 * o + p * 3 + c] = G * DP[3 * c + p];
+      }
+    }
+    if (withJ) addSample(BR, GR, U, f, r - 3, samples.row[s]);
+  }
+  if (withJ) spreadRows(N, g, BR, GR, samples, d1, n);
+  for (let k = 0; k < checks.count; k++) {
+    for (let c = 0; c < 3; c++, r++) {
+      const value = channelAt(checks, k, x, d1, c, dP, 0);
+      f[r] = checkWeight * (Math.min(value, 0) + Math.max(value - 1, 0));
+      if (!withJ || !(value < 0 || value > 1)) continue;
+      for (let p = 0; p < 3; p++) U[p] = checkWeight * DP[p];
+      addHinge(N, g, U, f[r], checks.T, k * d1, c, d1, n);
+    }
+  }
+  if (!withJ) return { f };
+  const A = Array.from({ length: n }, (_, i) => N.subarray(i * n, (i + 1) * n));
+  for (let i = 0; i < n; i++) for (let k = 0; k < i; k++) A[k][i] = A[i][k];
+  return { f, A, g };
+}
+
+const U = new Float64Array(27);
+
+/** A sample's sum_o u_o u_o^T (lower triangle) and u_o f_o (u in U[9 o + q], q = 3 p + c) into its row's sums. */
+function addSample(BR, GR, U, f, r, row) {
+  const b = 81 * row, h = 9 * row;
+  for (let q = 0; q < 9; q++) {
+    for (let w = 0; w <= q; w++) BR[b + 9 * q + w] += U[q] * U[w] + U[9 + q] * U[9 + w] + U[18 + q] * U[18 + w];
+    GR[h + q] += U[q] * f[r] + U[9 + q] * f[r + 1] + U[18 + q] * f[r + 2];
+  }
+}
+
+/** Each eta_i row's sums spread over its powers of t (B (x) T T^T, G (x) T) into N's lower triangle and g. */
+function spreadRows(N, g, BR, GR, samples, d1, n) {
+  for (let row = 0; row < samples.rows; row++) {
+    const t = samples.rowStart[row] * d1, T = samples.T, b = 81 * row;
+    for (let q = 0; q < 9; q++) {
+      for (let j = 0; j < d1; j++) {
+        const i = q * d1 + j, Tj = T[t + j], at = i * n;
+        g[i] += GR[9 * row + q] * Tj;
+        for (let w = 0; w <= q; w++) {
+          const v = BR[b + 9 * q + w] * Tj, top = w === q ? j : d1 - 1;
+          for (let jj = 0; jj <= top; jj++) N[at + w * d1 + jj] += v * T[t + jj];
         }
       }
     }
   }
-  const dP = [0, 0, 0];
-  for (const g of checks) {
-    for (let c = 0; c < 3; c++, r++) {
-      const value = modelAt(g, x, d1, c, P, withJ ? dP : null);
-      f[r] = checkWeight * (Math.min(value, 0) + Math.max(value - 1, 0));
-      if (!(value < 0 || value > 1)) { zero[r] = 1; continue; }
-      if (!withJ) continue;
-      for (let p = 0; p < 3; p++) {
-        const col = r * n + (p * 3 + c) * d1;
-        for (let j = 0; j < d1; j++) J[col + j] = checkWeight * dP[p] * g.T[j];
+}
+
+/** An active hinge's row of J (U[p] T at the columns of channel c) into N's lower triangle and g. */
+function addHinge(N, g, U, fr, T, t, c, d1, n) {
+  for (let p = 0; p < 3; p++) {
+    for (let j = 0; j < d1; j++) {
+      const i = (p * 3 + c) * d1 + j, v = U[p] * T[t + j], row = i * n;
+      g[i] += v * fr;
+      for (let pp = 0; pp <= p; pp++) {
+        const top = pp === p ? j : d1 - 1;
+        for (let jj = 0; jj <= top; jj++) N[row + (pp * 3 + c) * d1 + jj] += v * U[pp] * T[t + jj];
       }
     }
   }
-  return { f, J, zero };
 }
 
 /** The trust-region solve of the live problem from x0 (live_trf.js trf): {x, cost, nfev, njev, status}. */
@@ -231,12 +312,27 @@ function clipToBounds(x, d1) {
   });
 }
 
-/** The samples' geometry (clamped mu, 1 - mu, its fifth power and log, powers of t) at (mu, eta) arrays. */
+/** The samples' geometry at (mu, eta) arrays: clamped mu, x = 1 - mu, x^5, log x, the powers of t (d1 a point), typed; their eta_i rows. */
 function geometry(mu, eta, range, d1) {
-  return mu.map((m, s) => {
-    const mm = Math.min(1, Math.max(0, m)), x = 1 - mm;
-    return { mu: mm, x, x5: x ** 5, logx: x > 0 ? Math.log(x) : 0, T: powersAt(eta[s], range, d1) };
-  });
+  const count = mu.length, g = { count, mu: new Float64Array(count), x: new Float64Array(count),
+    x5: new Float64Array(count), logx: new Float64Array(count), T: new Float64Array(count * d1),
+    row: new Int32Array(count), rowStart: [] }; // the points' eta_i rows (same eta_i, same powers of t)
+  const rows = new Map();
+  for (let s = 0; s < count; s++) {
+    const mm = Math.min(1, Math.max(0, mu[s])), x = 1 - mm;
+    g.mu[s] = mm;
+    g.x[s] = x;
+    g.x5[s] = x ** 5;
+    g.logx[s] = x > 0 ? Math.log(x) : 0;
+    g.T.set(powersAt(eta[s], range, d1), s * d1);
+    if (!rows.has(eta[s])) {
+      rows.set(eta[s], rows.size);
+      g.rowStart.push(s);
+    }
+    g.row[s] = rows.get(eta[s]);
+  }
+  g.rows = rows.size;
+  return g;
 }
 
 const GRIDS = new Map(); // the scoring grid's geometry, per domain and degree (a drag keeps one)
@@ -253,8 +349,8 @@ function scoringGrid(range, d1) {
 
 /** The model of flat coefficients at (mu, eta) arrays: channel values, (S x 3). */
 export function modelValues(x, mu, eta, range, d1) {
-  const P = [0, 0, 0];
-  return geometry(mu, eta, range, d1).map((g) => [0, 1, 2].map((c) => modelAt(g, x, d1, c, P, null)));
+  const geo = geometry(mu, eta, range, d1);
+  return Array.from(mu, (_, s) => [0, 1, 2].map((c) => channelAt(geo, s, x, d1, c, null, 0)));
 }
 
 /**
@@ -263,17 +359,17 @@ export function modelValues(x, mu, eta, range, d1) {
  * outside), or null when none is.
  */
 function outsideMask(C16, range, d1, grid) {
-  const P = [0, 0, 0];
+  const geo = grid.geo;
   let mask = null;
-  grid.geo.forEach((g, k) => {
+  for (let k = 0; k < geo.count; k++) {
     for (let c = 0; c < 3; c++) {
-      const v = modelAt(g, C16, d1, c, P, null);
+      const v = channelAt(geo, k, C16, d1, c, null, 0);
       if (v < -RANGE_TOLERANCE || v > 1 + RANGE_TOLERANCE) {
-        mask ??= new Uint8Array(3 * grid.geo.length);
+        mask ??= new Uint8Array(3 * geo.count);
         mask[3 * k + c] = 1;
       }
     }
-  });
+  }
   return mask;
 }
 
@@ -316,9 +412,10 @@ export function liveStep(input, settings = LIVE) {
   const grid = scoringGrid(range, d1);
   const baseCheck = checkGrid(range, ...settings.checkSamples);
   let left = settings.maxEvaluations, cut = false, nfevAll = 0, njevAll = 0;
+  const samples = makeProblem({ ...input, check: { mu: [], eta: [] }, checkWeight: 0 }).samples; // kept between rounds
   const solveFrom = (start, weight, check) => {
     const maxNfev = Math.min(settings.maxNfev, Math.max(1, Math.floor(left / 2)));
-    const problem = makeProblem({ ...input, check, checkWeight: weight });
+    const problem = makeProblem({ ...input, check, checkWeight: weight, samples });
     const result = solveLive(problem, clipToBounds(start, d1), 1e-10, maxNfev);
     left -= result.nfev + result.njev;
     nfevAll += result.nfev; njevAll += result.njev;
@@ -344,7 +441,7 @@ export function liveStep(input, settings = LIVE) {
     bestEffort = true;
     // The closer to the edit (by the objective's data term) of the fallback and the fit on screen.
     const data = (c) => {
-      const { f } = evaluate(makeProblem({ ...input, check: { mu: [], eta: [] }, checkWeight: 1 }), c, false);
+      const { f } = evaluate(makeProblem({ ...input, check: { mu: [], eta: [] }, checkWeight: 1, samples }), c, false);
       return dot(f, f);
     };
     const onScreen = Array.from(input.start, toHalf);

@@ -10,7 +10,8 @@ const EPS = 2.220446049250313e-16;
 export const dot = (u, v) => { let s = 0; for (let i = 0; i < u.length; i++) s += u[i] * v[i]; return s; };
 const norm = (v) => Math.sqrt(dot(v, v));
 
-function normal({ J, zero }, f, n) {
+function normal({ J, zero, A: given, g: givenG }, f, n) {
+  if (given) return { A: given, g: givenG }; // the normal equations, summed by `fun` itself
   const A = Array.from({ length: n }, () => new Float64Array(n)), g = new Float64Array(n);
   for (let r = 0; r < f.length; r++) {
     if (zero[r]) continue;
@@ -27,48 +28,60 @@ function normal({ J, zero }, f, n) {
   return { A, g };
 }
 
-/** {pivots, M = L^-1} of the Cholesky factor of A, or null when A is not positive definite. */
-function inverseFactor(A) {
+/** {pivots, L} of the Cholesky factor of A (lower, A = L L^T), or null when A is not positive definite. */
+function factorOf(A) {
   const n = A.length, L = Array.from({ length: n }, () => new Float64Array(n));
   for (let i = 0; i < n; i++) {
+    const Li = L[i];
     for (let k = 0; k <= i; k++) {
+      const Lk = L[k];
       let s = A[i][k];
-      for (let j = 0; j < k; j++) s -= L[i][j] * L[k][j];
+      for (let j = 0; j < k; j++) s -= Li[j] * Lk[j];
       if (i === k) {
         if (!(s > 0)) return null;
-        L[i][i] = Math.sqrt(s);
-      } else L[i][k] = s / L[k][k];
+        Li[i] = Math.sqrt(s);
+      } else Li[k] = s / Lk[k];
     }
   }
-  const M = Array.from({ length: n }, () => new Float64Array(n));
-  for (let c = 0; c < n; c++) {
-    for (let i = c; i < n; i++) {
-      let s = i === c ? 1 : 0;
-      for (let j = c; j < i; j++) s -= L[i][j] * M[j][c];
-      M[i][c] = s / L[i][i];
-    }
+  return { pivots: L.map((row, i) => row[i]), L };
+}
+
+/** L^-1 v (forward substitution). */
+function forward(L, v) {
+  const n = v.length, y = new Float64Array(n);
+  for (let i = 0; i < n; i++) {
+    const Li = L[i];
+    let s = v[i];
+    for (let j = 0; j < i; j++) s -= Li[j] * y[j];
+    y[i] = s / Li[i];
   }
-  return { pivots: L.map((row, i) => row[i]), M };
+  return y;
+}
+
+/** L^-T v (back substitution). */
+function backward(L, v) {
+  const n = v.length, z = new Float64Array(n);
+  for (let i = n - 1; i >= 0; i--) {
+    let s = v[i];
+    for (let j = i + 1; j < n; j++) s -= L[j][i] * z[j];
+    z[i] = s / L[i][i];
+  }
+  return z;
 }
 
 const mulVec = (M, v) => M.map((row) => dot(row, v));
-function mulTVec(M, v) {
-  const out = new Float64Array(v.length);
-  for (let i = 0; i < M.length; i++) { const row = M[i], vi = v[i]; for (let j = 0; j <= i; j++) out[j] += row[j] * vi; }
-  return out;
-}
-const solveWith = (M, g) => mulTVec(M, mulVec(M, g)).map((v) => -v);
+const solveWith = (L, g) => backward(L, forward(L, g)).map((v) => -v); // -(L L^T)^-1 g
 const shifted = (H, alpha) => H.map((row, i) => { const r = Float64Array.from(row); r[i] += alpha; return r; });
 
 /** The trust-region step (fitting/numerics/trf.py _step): {p, alpha}. */
 function step(H, g, Delta, alpha, rtol = 0.01, maxIter = 10) {
-  let factor = inverseFactor(H);
+  let factor = factorOf(H);
   const fullRank = factor !== null && Math.min(...factor.pivots) > 1e-7 * Math.max(...factor.pivots);
   let alphaLower = 0;
   if (fullRank) {
-    const p = solveWith(factor.M, g), pNorm = norm(p);
+    const p = solveWith(factor.L, g), pNorm = norm(p);
     if (pNorm <= Delta) return { p, alpha: 0 };
-    const q = mulVec(factor.M, p);
+    const q = forward(factor.L, p);
     alphaLower = ((pNorm - Delta) * pNorm) / dot(q, q);
   }
   let alphaUpper = norm(g) / Delta;
@@ -76,25 +89,25 @@ function step(H, g, Delta, alpha, rtol = 0.01, maxIter = 10) {
   if (alpha === null || (!fullRank && alpha === 0)) alpha = Math.max(0.001 * alphaUpper, Math.sqrt(alphaLower * alphaUpper));
   for (let it = 0; it < maxIter; it++) {
     if (alpha < alphaLower || alpha > alphaUpper) alpha = Math.max(0.001 * alphaUpper, Math.sqrt(alphaLower * alphaUpper));
-    factor = inverseFactor(shifted(H, alpha));
+    factor = factorOf(shifted(H, alpha));
     if (factor === null) {
       alphaLower = alpha = Math.max(alpha * 10, EPS * trace, EPS);
       continue;
     }
-    const p = solveWith(factor.M, g), pNorm = norm(p), phi = pNorm - Delta;
-    const q = mulVec(factor.M, p), phiPrime = -dot(q, q) / pNorm;
+    const p = solveWith(factor.L, g), pNorm = norm(p), phi = pNorm - Delta;
+    const q = forward(factor.L, p), phiPrime = -dot(q, q) / pNorm;
     if (phi < 0) alphaUpper = alpha;
     const ratio = phi / phiPrime;
     alphaLower = Math.max(alphaLower, alpha - ratio);
     alpha -= ((phi + Delta) * ratio) / Delta;
     if (Math.abs(phi) < rtol * Delta) break;
   }
-  factor = inverseFactor(shifted(H, alpha));
+  factor = factorOf(shifted(H, alpha));
   while (factor === null) {
     alpha = Math.max(alpha * 10, EPS * trace, EPS);
-    factor = inverseFactor(shifted(H, alpha));
+    factor = factorOf(shifted(H, alpha));
   }
-  const p = solveWith(factor.M, g), scale = Delta / norm(p);
+  const p = solveWith(factor.L, g), scale = Delta / norm(p);
   return { p: p.map((v) => v * scale), alpha };
 }
 

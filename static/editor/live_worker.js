@@ -1,6 +1,7 @@
 // The module worker of the editor's live refits: builds the live target
 // from the edits and the base's rows, solves the live step
-// (live_solve.js) and answers {id, coefficients16, bestEffort, ms}, or
+// (live_solve.js) and answers {id, coefficients16, bestEffort, ms, startedAt,
+// endedAt (epoch ms: the page puts them on its own clock)}, or
 // {id, error}. One message at a time; the page sends the next when this
 // one answers (live_page.js), so a drag never queues stale work here.
 
@@ -8,6 +9,7 @@ import { liveStep, liveTarget } from "./live_solve.js";
 
 self.onmessage = ({ data }) => {
   const { id, edits, baseRows, range, degree, start, blendWidth } = data;
+  const startedAt = performance.timeOrigin + performance.now();
   try {
     const baseAt = (eta) => {
       const rows = baseRows[eta.toFixed(6)];
@@ -16,7 +18,8 @@ self.onmessage = ({ data }) => {
     };
     const { target, mu, eta } = liveTarget(edits, baseAt, range, blendWidth);
     const result = liveStep({ target, mu, eta, range, degree, weights: null, start });
-    self.postMessage({ id, coefficients16: result.coefficients16, bestEffort: result.bestEffort, ms: result.ms });
+    self.postMessage({ id, coefficients16: result.coefficients16, bestEffort: result.bestEffort, ms: result.ms,
+                       startedAt, endedAt: performance.timeOrigin + performance.now() });
   } catch (error) {
     self.postMessage({ id, error: error.message });
   }

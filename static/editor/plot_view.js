@@ -3,7 +3,7 @@
 // the current eta_i; the eta_i slider and the chips of the edited eta_i;
 // the channel to drag; Undo, Redo, Reset and Save's enabled states.
 // Renders from the state (render(state)); its inputs call `hooks`:
-//   onDrag({channel, handle, value, pointer, all}) -> whether the point moved,
+//   onDrag({channel, handle, value, pointer, all}, pointer event or null) -> whether the point moved,
 //   onDragEnd(), onSelect({channel, handle}), onEta(eta), onUndo(), onRedo(), onReset(), onSave().
 // In compare mode the other fit's curve at eta_i is drawn too (state.compare).
 // The plot's data-eta is the slider's eta_i; data-curves-eta the eta_i of the
@@ -21,8 +21,8 @@ export class PlotView {
     this.hooks = hooks;
     this.state = null;
     this.plot = new ReflectancePlot($("plot"), {
-      onDrag: (c, handle, value, pointer = false) =>
-        hooks.onDrag({ channel: c, handle, value, pointer, all: channel() === "all" }),
+      onDrag: (c, handle, value, pointer = false, event = null) =>
+        hooks.onDrag({ channel: c, handle, value, pointer, all: channel() === "all" }, event),
       onDragEnd: () => hooks.onDragEnd(),
       onSelect: (c, handle) => hooks.onSelect({ channel: c, handle }),
     });
@@ -73,7 +73,18 @@ export class PlotView {
       edited: Boolean(state.edits[key(state.eta)]),
     });
     const etas = Object.keys(state.edits).sort();
+    this.#chips(etas);
+    $("undo").disabled = !state.undo.length;
+    $("redo").disabled = !state.redo.length;
+    $("reset").disabled = !etas.length;
+    $("save").disabled = !etas.length;
+  }
+
+  // The chips of the edited eta_i, made again only when the list changes (not on every move of a drag).
+  #chips(etas) {
     const list = $("edited-etas");
+    if (list.dataset.etas === etas.join(" ") && list.childNodes.length) return;
+    list.dataset.etas = etas.join(" ");
     list.replaceChildren();
     if (!etas.length) {
       list.textContent = "No edits yet.";
@@ -89,9 +100,5 @@ export class PlotView {
         list.append(button, " ");
       }
     }
-    $("undo").disabled = !state.undo.length;
-    $("redo").disabled = !state.redo.length;
-    $("reset").disabled = !etas.length;
-    $("save").disabled = !etas.length;
   }
 }

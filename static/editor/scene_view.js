@@ -1,12 +1,12 @@
 // "Your scene": the fit on screen drawn by three.js on the artist's own
-// mesh (.glb) under their own environment (.hdr), beside the shader ball.
+// mesh (.glb) under their own environment (.hdr or .exr), beside the shader ball.
 // The material is the fit's glTF export at the preview's settings (coat
 // index, metal and coat roughness) loaded through the project's three.js
 // package (/static/three/, EXT_materials_coated_conductor), so it is the
 // model through the whole air / coat / metal stack, as in any three.js
 // scene. Until a file is chosen, the scene is a sphere under three's
-// RoomEnvironment. Files are read in the page (Blob URLs, three's
-// GLTFLoader and HDRLoader); nothing is sent to the server, and three is
+// RoomEnvironment. Files are read in the page (three's GLTFLoader,
+// HDRLoader and EXRLoader); nothing is sent to the server, and three is
 // the service's own pinned copy (/vendor/three/). Drag to orbit, wheel to
 // zoom (three's OrbitControls). three is loaded when the view is first
 // opened, never on the editor's start.
@@ -24,6 +24,42 @@ async function gltfFormat() {
   const format = (await domain()).export_formats.find((f) => f.media_type === GLTF_MEDIA_TYPE);
   if (!format) throw new Error(`the service lists no export of media type ${GLTF_MEDIA_TYPE}`);
   return format.name;
+}
+
+/**
+ * Check that an OpenEXR file's header lies whole inside the file: its
+ * attributes (name, type, size, value; the channels' names of a chlist)
+ * walked with every read bounded, part after part for a multi-part file.
+ * Throws for a header cut short. three's EXRLoader reads each name up to
+ * its null byte with no bound, so a file cut inside its header would keep
+ * the page busy for ever: it is handed only a header that ends.
+ */
+export function checkExrHeader(buffer) {
+  const bytes = new Uint8Array(buffer), view = new DataView(buffer);
+  const fail = (why) => { throw new Error(`its header ${why}`); };
+  if (bytes.length < 8 || view.getUint32(0, true) !== 20000630) fail("has no OpenEXR magic number");
+  let at = 8;
+  const name = (end) => {
+    const zero = bytes.indexOf(0, at);
+    if (zero < 0 || zero >= end) fail("ends inside a name (the file is cut short)");
+    const empty = zero === at;
+    at = zero + 1;
+    return empty;
+  };
+  for (;;) {
+    let attributes = 0;
+    while (!name(bytes.length)) {
+      name(bytes.length); // the attribute's type
+      if (at + 4 > bytes.length) fail("ends inside an attribute (the file is cut short)");
+      const size = view.getUint32(at, true), start = at + 4, end = start + size;
+      if (end > bytes.length) fail("ends inside an attribute (the file is cut short)");
+      const type = new TextDecoder().decode(bytes.subarray(bytes.lastIndexOf(0, at - 2) + 1, at - 1));
+      for (at = start; type === "chlist" && at < end - 1; at += 16) name(end); // name, then 16 bytes a channel
+      at = end;
+      attributes += 1;
+    }
+    if (!(bytes[5] & 16) || attributes === 0) return; // one part, or the empty header after a multi-part's last
+  }
 }
 
 export class SceneView {
@@ -61,8 +97,10 @@ export class SceneView {
   async #open() {
     if (this.opening) return this.opening;
     this.opening = (async () => {
-      const [THREE, { GLTFLoader }, { HDRLoader }, { OrbitControls }, { RoomEnvironment }, plugin] = await Promise.all([
+      const [THREE, { GLTFLoader }, { HDRLoader }, { EXRLoader }, { OrbitControls }, { RoomEnvironment }, plugin] =
+      await Promise.all([
         import("three"), import("three/addons/loaders/GLTFLoader.js"), import("three/addons/loaders/HDRLoader.js"),
+        import("three/addons/loaders/EXRLoader.js"),
         import("three/addons/controls/OrbitControls.js"), import("three/addons/environments/RoomEnvironment.js"),
         import("/static/three/index.js"),
       ]);
@@ -80,7 +118,7 @@ export class SceneView {
       const room = pmrem.fromScene(new RoomEnvironment(), 0.04).texture;
       const group = new THREE.Group();
       scene.add(group);
-      this.three = { THREE, GLTFLoader, HDRLoader, plugin, renderer, scene, camera, controls, pmrem, room, group,
+      this.three = { THREE, GLTFLoader, HDRLoader, EXRLoader, plugin, renderer, scene, camera, controls, pmrem, room, group,
                      material: null, meshName: "sphere", environmentName: "room (built in)" };
       controls.addEventListener("change", () => this.draw());
       new ResizeObserver(() => this.draw()).observe(canvas);
@@ -101,15 +139,17 @@ export class SceneView {
     await this.#material();
   }
 
-  // An uploaded file, read in the page: the mesh (.glb) or the environment (.hdr).
+  // An uploaded file, read in the page: the mesh (.glb) or the environment (.hdr or .exr).
   async #upload(which) {
     const input = $(which === "mesh" ? "scene-mesh" : "scene-environment");
     const file = input.files[0];
     if (!file) return;
     await this.#open();
-    const expected = which === "mesh" ? ".glb" : ".hdr";
-    if (!file.name.toLowerCase().endsWith(expected)) {
-      throw new Error(`${file.name} is not a ${expected} file (the ${which} must be ${expected})`);
+    const expected = which === "mesh" ? [".glb"] : [".hdr", ".exr"];
+    const extension = expected.find((name) => file.name.toLowerCase().endsWith(name));
+    if (!extension) {
+      const text = expected.join(" or ");
+      throw new Error(`${file.name} is not a ${text} file (the ${which} must be ${text})`);
     }
     if (file.size > SCENE_LIMIT_BYTES) {
       throw new Error(`${file.name} is ${(file.size / 1048576).toFixed(0)} MB; the ${which} may be at most ${LIMIT_TEXT}`);
@@ -125,11 +165,14 @@ export class SceneView {
       if (!meshes) throw new Error(`${file.name} has no mesh`);
       this.#setObject(gltf.scene, file.name);
     } else {
+      // Either decoder gives linear RGBA at half float (EXRLoader: its channels as RGBA, alpha 1 where absent).
+      const [Loader, what] = extension === ".exr" ? [t.EXRLoader, "OpenEXR .exr"] : [t.HDRLoader, "Radiance .hdr"];
       let data;
       try {
-        data = new t.HDRLoader().parse(buffer);
+        if (extension === ".exr") checkExrHeader(buffer);
+        data = new Loader().parse(buffer);
       } catch (error) {
-        throw new Error(`${file.name} is not a readable Radiance .hdr: ${error.message}`);
+        throw new Error(`${file.name} is not a readable ${what}: ${error.message}`);
       }
       const texture = new t.THREE.DataTexture(data.data, data.width, data.height, t.THREE.RGBAFormat, data.type);
       texture.mapping = t.THREE.EquirectangularReflectionMapping;

@@ -3,12 +3,14 @@
 screen drawn by three.js and the project's package on a mesh and under an
 environment the artist uploads, read back from the canvas in Chromium
 (SwiftShader WebGL2). The files are written here: a box as a glTF binary
-(positions, normals, indices) and a Radiance .hdr (RGBE, flat scanlines)
-of one colour. Checked: the built-in sphere draws the fit; an uploaded box
-changes the silhouette; an uploaded red sky turns the reflection red; a
-silver fit is less yellow than the gold one; a drag orbits and the wheel
-zooms; files that are not what they say and a wrong extension give a
-message and leave the scene drawn; nothing is sent to the server.
+(positions, normals, indices), a Radiance .hdr (RGBE, flat scanlines) of
+one colour and an OpenEXR image of another (Mitsuba's Bitmap writes it).
+Checked: the built-in sphere draws the fit; an uploaded box changes the
+silhouette; an uploaded red sky (.hdr) turns the reflection red and a
+green one (.exr) green; a silver fit is less yellow than the gold one; a
+drag orbits and the wheel zooms; files that are not what they say and a
+wrong extension give a message and leave the scene drawn; nothing is sent
+to the server.
 
 Cost: one editor page (one extra fit, Ag), three's modules and a few
 PMREM passes at the canvas's size.
@@ -20,6 +22,8 @@ import base64
 import json
 import math
 import struct
+import tempfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -80,6 +84,17 @@ def rgbe_hdr(colour, width=16, height=8) -> bytes:
     pixel = bytes([int(c * scale) for c in colour] + [exponent + 128])
     header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
     return header + pixel * (width * height)
+
+
+def exr_sky(colour, width=16, height=8) -> bytes:
+    """An OpenEXR image of one linear colour everywhere (float RGB), written by Mitsuba's Bitmap (OpenEXR inside)."""
+    import mitsuba as mi
+
+    mi.set_variant("scalar_rgb")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "sky.exr"
+        mi.Bitmap(np.broadcast_to(np.asarray(colour, np.float32), (height, width, 3)).copy()).write(str(path))
+        return path.read_bytes()
 
 
 def pixels(page) -> np.ndarray:
@@ -153,6 +168,15 @@ def test_your_mesh_under_your_environment(pages, editor_url):
     r, g, b = colour_of(red, mask)
     assert r > 3 * g and r > 3 * b
 
+    # An OpenEXR environment (three's EXRLoader): a green sky, the reflection turns green.
+    exr = exr_sky((0.02, 1.0, 0.02))
+    assert exr[:4] == b"\x76\x2f\x31\x01"  # OpenEXR's magic number
+    upload(page, "#scene-environment", "green.exr", exr, "image/x-exr")
+    drawn(page, "box.glb under green.exr")
+    green = pixels(page)
+    r, g, b = colour_of(green, green[..., 3] > 0)
+    assert g > 3 * r and g > 3 * b
+
     # The fit on screen: silver (on the built-in sphere and room again) is bluer against its red than gold.
     page.click("#scene-default")
     drawn(page, "sphere under room")
@@ -170,6 +194,11 @@ def test_your_mesh_under_your_environment(pages, editor_url):
     upload(page, "#scene-environment", "broken.hdr", b"not a radiance file at all")
     expect(page.locator("#scene-status")).to_contain_text("broken.hdr is not a readable Radiance .hdr")
     expect(page.locator("#scene-status")).to_have_class("hint error")
+    # An OpenEXR file cut inside its header (three's loader alone would never return) and one cut in its pixels.
+    upload(page, "#scene-environment", "cut.exr", exr[:100])
+    expect(page.locator("#scene-status")).to_contain_text("cut.exr is not a readable OpenEXR .exr: its header ends")
+    upload(page, "#scene-environment", "short.exr", exr[: len(exr) - 40])
+    expect(page.locator("#scene-status")).to_contain_text("short.exr is not a readable OpenEXR .exr")
     upload(page, "#scene-mesh", "broken.glb", b"glTF\x02\x00\x00\x00garbage")
     expect(page.locator("#scene-status")).to_contain_text("not a readable glTF binary")
     upload(page, "#scene-mesh", "photo.png", b"\x89PNG\r\n")
@@ -179,4 +208,4 @@ def test_your_mesh_under_your_environment(pages, editor_url):
     # Nothing uploaded went to the server, and nothing came from elsewhere.
     host = editor_url.rstrip("/")
     assert all(url.startswith(host) or url.startswith(("blob:", "data:")) for url in requests), requests
-    assert not any(url.endswith((".glb", ".hdr")) for url in requests)
+    assert not any(url.endswith((".glb", ".hdr", ".exr")) for url in requests)
