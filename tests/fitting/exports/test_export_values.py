@@ -129,6 +129,17 @@ class TestColourSpaces:
         )
 
 
+    def test_formats_share_one_target_per_material_and_space(self, cu_values):
+        # Another format of the same n, k and eta_i reuses the seen target and the naive fits
+        # (read-only); another working space reuses the seen target only.
+        again = export_values(library_material("Cu"), 1.5, tools=("gltf",))
+        for name in ("seen_ACEScg", "target_ACEScg", "target", "n_rel", "F82_tint"):
+            assert getattr(again, name) is getattr(cu_values, name) and not getattr(again, name).flags.writeable
+        other = export_values(library_material("Cu"), 1.5, tools=("gltf",), working_space="acescg")
+        assert other.seen_ACEScg is cu_values.seen_ACEScg and other.target is not cu_values.target
+        np.testing.assert_array_equal(other.target, cu_values.target_ACEScg)
+
+
 class TestFidelity:
     def test_every_target_finite_and_ordered(self, cu_values):
         scores = {t: export_fidelity(cu_values, t) for t in TOOL_MODELS}
