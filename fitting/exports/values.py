@@ -247,7 +247,7 @@ class ExportValues:
 
 def _naive_fits(mu, target) -> tuple:
     """``target`` (working space) and its naive fits: n, k; F0, F82 tint; Schlick's F0."""
-    return (target, *fit_channel_conductor(mu, target), *fit_channel_f82(mu, target),
+    return (target, *fit_channel_conductor(mu, target, joint=True), *fit_channel_f82(mu, target, joint=True),
             fit_channel_schlick(mu, target))
 
 

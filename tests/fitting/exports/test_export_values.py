@@ -106,6 +106,13 @@ class TestFits:
         np.testing.assert_allclose(got_F0, F0, atol=1e-7)
         np.testing.assert_allclose(got_tint, tint, atol=1e-6)
 
+    def test_joint_channels_reach_the_per_channel_optimum(self, cu_values):
+        # One solve of the three channels against three: the same optimum to the solves' tolerances
+        # (1e-12 on steps and cost; the conductor's n, k are less well determined: 1e-8).
+        for fit, atol in ((_fit_relative_index, 1e-8), (_fit_f82_tint, 1e-9)):
+            for got, want in zip(fit(MU, cu_values.target, joint=True), fit(MU, cu_values.target)):
+                np.testing.assert_allclose(got, want, atol=atol)
+
     def test_schlick_recovered_and_clipped(self):
         F0 = np.array([0.2, 0.5, 0.9])
         np.testing.assert_allclose(_fit_schlick(MU, schlick(MU, F0)), F0, atol=1e-12)  # a linear
