@@ -14,7 +14,8 @@ one client sees and the CPU the server's process tree spent on it
 Records benchmarks/results/export_downloads.json (``figures``: ``first``
 and ``repeated``, each with the wall ``p50_ms``, ``p90_ms``, ``max_ms`` and
 the server's CPU ``cpu_p50_ms``, ``cpu_max_ms``; ``downloads``, how many of
-each) and prints a table.
+each; ``first_by_format``: the first downloads' server CPU ``cpu_p50_ms``,
+``cpu_max_ms`` per format) and prints a table.
 
 Usage: .venv/bin/python benchmarks/export_downloads.py [--materials Au,Cu,Ag] [--eta-i 1.0,1.5] [--repeats 20]
 """
@@ -58,6 +59,7 @@ def main() -> int:
     materials, etas = args.materials.split(","), [float(e) for e in args.eta_i.split(",")]
     first: dict[str, list[float]] = {"wall": [], "cpu": []}
     repeated: dict[str, list[float]] = {"wall": [], "cpu": []}
+    first_cpu: dict[str, list[float]] = {fmt: [] for fmt in FORMATS}
     with tempfile.TemporaryDirectory() as data:
         ((process, url),) = start_replicas(1, {**os.environ, "COATED_METRICS_IDLE_S": "0"}, data)
         try:
@@ -76,18 +78,26 @@ def main() -> int:
                                 into = first if k == 0 else repeated
                                 into["wall"].append(wall)
                                 into["cpu"].append(tree_cpu(process.pid) - cpu)
+                                if k == 0:
+                                    first_cpu[fmt].append(into["cpu"][-1])
                         print(f"{material} eta_i {eta:g}: first {1e3 * np.median(first['wall'][-4:]):.0f} ms, "
                               f"repeated {1e3 * np.median(repeated['wall'][-4 * args.repeats:]):.1f} ms "
                               f"(medians), load {os.getloadavg()[0]:.2f}", flush=True)
         finally:
             process.terminate()
             process.wait(timeout=60)
-    figures = {"first": stats(first["wall"], first["cpu"]), "repeated": stats(repeated["wall"], repeated["cpu"])}
+    figures = {"first": stats(first["wall"], first["cpu"]), "repeated": stats(repeated["wall"], repeated["cpu"]),
+               "first_by_format": {fmt: {"cpu_p50_ms": float(1e3 * np.median(c)), "cpu_max_ms": float(1e3 * max(c))}
+                                   for fmt, c in first_cpu.items()}}
     print("\n| download | p50 / p90 / max ms | server CPU p50 / max ms | downloads |")
     print("|---|---|---|---|")
     for name, f in figures.items():
+        if name == "first_by_format":
+            continue
         print(f"| {name} | {f['p50_ms']:.1f} / {f['p90_ms']:.1f} / {f['max_ms']:.1f} | "
               f"{f['cpu_p50_ms']:.1f} / {f['cpu_max_ms']:.1f} | {f['downloads']} |")
+    print("first, server CPU p50 / max ms:", ", ".join(
+        f"{fmt} {f['cpu_p50_ms']:.0f} / {f['cpu_max_ms']:.0f}" for fmt, f in figures["first_by_format"].items()))
     print("recorded:", write_result("export_downloads", figures, load_at_start, materials=materials, eta_i=etas,
                                     formats=list(FORMATS), repeats=args.repeats))
     return 0

@@ -37,7 +37,9 @@ curve. Each value is a per-channel least-squares fit to T:
 
 -   :data:`EXPORT_SAMPLES`, :data:`ETA_I_LIMITS`
 -   :class:`ExportValues`: the fitted values and their provenance.
--   :func:`export_values`: computes them.
+-   :func:`export_values`: computes them (the seen target, the target under
+    the coat and its naive fits computed once per measured n, k, coating
+    index and working space, and kept: :data:`TARGET_CACHE_SIZE`).
 -   :func:`project_version`.
 
 References
@@ -51,6 +53,7 @@ Andersson, A. et al. (2024). OpenPBR Surface Specification, metal base.
 from __future__ import annotations
 
 import functools
+import hashlib
 import importlib.metadata
 import tomllib
 from dataclasses import dataclass, field
@@ -60,7 +63,7 @@ import numpy as np
 
 from ..colour.reference import reference_ACEScg
 from ..colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
-from ..domain import ETA_I_MAX, ETA_I_MIN, check_eta_i, check_number
+from ..domain import ETA_I_MAX, ETA_I_MIN, BoundedCache, check_eta_i, check_number
 from ..models.pack import PackedMaterial
 from ..models.rgb_conductor import rgb_fresnel_conductor
 from ..optics.coated_stack import coated_stack, coated_stack_from_metal
@@ -86,6 +89,31 @@ EXPORT_SAMPLES = 100
 
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 """Accepted coating indices (the project's rule, :func:`fitting.domain.check_eta_i`)."""
+
+TARGET_CACHE_SIZE = 64
+"""How many targets of measured n, k are kept (per process): each format of a material at one
+coating index fits its own tools to the same seen target, computed once (about 0.1 MB each)."""
+
+_TARGETS = BoundedCache(TARGET_CACHE_SIZE)
+
+
+def _kept(key, build) -> tuple:
+    """``build()``'s arrays read-only, kept by ``key`` (``None``: not kept)."""
+    def frozen():
+        out = tuple(np.asarray(a, dtype=np.float64) for a in build())
+        for a in out:
+            a.setflags(write=False)
+        return out
+
+    return frozen() if key is None else _TARGETS.get(key, frozen)
+
+
+def _nk_key(nk: SpectralNK) -> str:
+    """A digest of measured n, k (what their targets depend on)."""
+    digest = hashlib.blake2b(digest_size=16)
+    for a in (nk.wavelength_nm, nk.n, nk.k):
+        digest.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
+    return digest.hexdigest()
 
 @functools.cache
 def project_version() -> str:
@@ -217,6 +245,12 @@ class ExportValues:
         return info
 
 
+def _naive_fits(mu, target) -> tuple:
+    """``target`` (working space) and its naive fits: n, k; F0, F82 tint; Schlick's F0."""
+    return (target, *fit_channel_conductor(mu, target, joint=True), *fit_channel_f82(mu, target, joint=True),
+            fit_channel_schlick(mu, target))
+
+
 def has_coat(eta_i: float) -> bool:
     """Whether an export at ``eta_i`` has a coat at all (eta_i 1: no coat, the bare metal)."""
     return float(eta_i) > ETA_I_MIN
@@ -275,10 +309,11 @@ def export_values(
             raise ValueError(f"`tools` must name tools of {', '.join(TOOLS)}, got {tool!r}")
     mu = np.linspace(0.0, 1.0, EXPORT_SAMPLES)
     view = np.cos(np.radians(SEEN_ANGLES_DEG))
+    key = None
     if isinstance(fit_or_nk, SpectralNK):
-        name, source = fit_or_nk.name, fit_or_nk.source
-        target_ACEScg = reference_ACEScg(fit_or_nk, mu, eta, 1.0)
-        seen = seen_ACEScg(fit_or_nk, view, eta)
+        name, source, key = fit_or_nk.name, fit_or_nk.source, (_nk_key(fit_or_nk), eta)
+        target_ACEScg, seen = _kept(key, lambda: (reference_ACEScg(fit_or_nk, mu, eta, 1.0),
+                                                  seen_ACEScg(fit_or_nk, view, eta)))
         origin = "spectral (1 nm) air / coat / metal stack seen from air"
     elif isinstance(fit_or_nk, dict) and callable(fit_or_nk.get("reflectance")):
         name = str(fit_or_nk.get("name", "material"))
@@ -307,18 +342,18 @@ def export_values(
             "or a `reflectance` function, "
             f"got {type(fit_or_nk).__name__}"
         )
-    target = ACEScg_to_working(target_ACEScg, working_space)
-    n_rel, k_rel = fit_channel_conductor(mu, target)
-    F0, tint = fit_channel_f82(mu, target)
+    target, n_rel, k_rel, F0, tint, F0_schlick = _kept(key and (*key, working_space), lambda: (
+        _naive_fits(mu, ACEScg_to_working(target_ACEScg, working_space))))
     coat = has_coat(eta)
-    rough_seen = (rough_seen_ACEScg(view, eta, seen, mu, target_ACEScg, roughness)
-                  if "gltf" in tools and coat and roughness > 0.0 else None)
+    rough_seen = (_kept(key and (*key, "rough", roughness), lambda: (
+        rough_seen_ACEScg(view, eta, seen, mu, target_ACEScg, roughness),))[0]
+        if "gltf" in tools and coat and roughness > 0.0 else None)
     fitted = {tool: fit_tool_values(tool, view, eta, seen, coat, space=working_space, roughness=roughness,
                                     rough_target_ACEScg=rough_seen) for tool in tools}
     return ExportValues(
         name=name, source=source, eta_i=eta, origin=origin, cos_theta=mu, target=target,
         target_ACEScg=target_ACEScg, n_rel=n_rel, k_rel=k_rel, F0=F0, F82_tint=tint,
-        F0_schlick=fit_channel_schlick(mu, target), roughness=roughness,
+        F0_schlick=F0_schlick, roughness=roughness,
         coat_roughness=coat_roughness, model=model, view_cos=view, seen_ACEScg=seen,
         tools=fitted, fit_id=fit_id, working_space=working_space, seen_rough_ACEScg=rough_seen,
     )

@@ -106,6 +106,13 @@ class TestFits:
         np.testing.assert_allclose(got_F0, F0, atol=1e-7)
         np.testing.assert_allclose(got_tint, tint, atol=1e-6)
 
+    def test_joint_channels_reach_the_per_channel_optimum(self, cu_values):
+        # One solve of the three channels against three: the same optimum to the solves' tolerances
+        # (1e-12 on steps and cost; the conductor's n, k are less well determined: 1e-8).
+        for fit, atol in ((_fit_relative_index, 1e-8), (_fit_f82_tint, 1e-9)):
+            for got, want in zip(fit(MU, cu_values.target, joint=True), fit(MU, cu_values.target)):
+                np.testing.assert_allclose(got, want, atol=atol)
+
     def test_schlick_recovered_and_clipped(self):
         F0 = np.array([0.2, 0.5, 0.9])
         np.testing.assert_allclose(_fit_schlick(MU, schlick(MU, F0)), F0, atol=1e-12)  # a linear
@@ -127,6 +134,17 @@ class TestColourSpaces:
         np.testing.assert_allclose(
             lin_rec709_to_ACEScg(cu_values.target), cu_values.target_ACEScg, atol=MATRIX_BOUND
         )
+
+
+    def test_formats_share_one_target_per_material_and_space(self, cu_values):
+        # Another format of the same n, k and eta_i reuses the seen target and the naive fits
+        # (read-only); another working space reuses the seen target only.
+        again = export_values(library_material("Cu"), 1.5, tools=("gltf",))
+        for name in ("seen_ACEScg", "target_ACEScg", "target", "n_rel", "F82_tint"):
+            assert getattr(again, name) is getattr(cu_values, name) and not getattr(again, name).flags.writeable
+        other = export_values(library_material("Cu"), 1.5, tools=("gltf",), working_space="acescg")
+        assert other.seen_ACEScg is cu_values.seen_ACEScg and other.target is not cu_values.target
+        np.testing.assert_array_equal(other.target, cu_values.target_ACEScg)
 
 
 class TestFidelity:
