@@ -87,12 +87,11 @@ function kindOf(k) {
     name: k.name,
     description: k.description,
     /**
-     * Whether the editor solves this kind's live refits in the page: the
-     * default kind's, which editor/live_solve.js mirrors; another kind's
-     * live step (the rgb-conductor's exact-Fresnel solve, a plugin's) stays
-     * the server's.
+     * The editor's own solver of this kind's live step, as the server
+     * names it (`live_solver`: editor/live_page.js's table), or null: the
+     * editor asks the server's live step (a plugin's kind).
      */
-    get liveInPage() { return k.name === defaultName; },
+    liveSolver: k.live_solver ?? null,
     parameters,
     maxDegree,
     splitSum: k.split_sum,

@@ -106,6 +106,11 @@ class ModelKind:
     shader_variant, collapsed_variant
         The ``evaluate.frag`` variant that evaluates the kind as shipped, and
         the one for degree 0 (None: the same).
+    live_solver
+        The browser editor's own solver of the kind's live step (a name of
+        its table in ``static/editor/live_page.js``: ``"polynomial"``, the
+        coated polynomial with the [0, 1] rule, or ``"exact-fresnel"``, per
+        channel n, k), or None: the editor asks the server's live step.
     """
 
     name: str
@@ -123,6 +128,7 @@ class ModelKind:
     split_sum: bool = False
     shader_variant: str | None = None
     collapsed_variant: str | None = None
+    live_solver: str | None = None
 
     @property
     def polynomial(self) -> bool:
@@ -243,6 +249,7 @@ register_model_kind(ModelKind(
     split_sum=True,
     shader_variant="packed",
     collapsed_variant="collapsed",
+    live_solver="polynomial",
 ))
 register_model_kind(ModelKind(
     name="rgb-conductor",
@@ -259,4 +266,5 @@ register_model_kind(ModelKind(
     preview_call="cf_rgb_conductor_packed(NdotV, eta_i, uint[3](words[0], words[1], words[2]))",
     material_template="material_rgb",
     shader_variant="rgb_conductor",
+    live_solver="exact-fresnel",
 ))

@@ -57,6 +57,8 @@ class ModelKindPublic(BaseModel):
                                   "float eta_i, vec2 eta_i_range, uint words[14])`, the kind's reflectance from "
                                   "its float16 coefficients two per word (parameter by parameter, channel R, G, "
                                   "B, then power); its `#include` lines name files served under /glsl/")
+    live_solver: str | None = Field(default=None, description="The editor's own solver of the kind's live step "
+                                    "(`polynomial`, `exact-fresnel`), or null: the editor asks the service's")
 
 
 class Domain(BaseModel):

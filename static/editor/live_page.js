@@ -8,10 +8,12 @@
 // The live target needs the base's reflectance at the live step's angles on
 // its rows (and at each edited eta_i): asked for once per base and eta_i
 // (GET /fits/{id}/curves?samples=12, `rowsOf`) and kept. Until they are in,
-// or for a kind the page does not solve (kinds.js liveInPage), `ready`
-// says no and the editor asks the server's live step instead.
+// or for a kind the page has no solver of (kinds.js liveSolver: the name
+// the server gives the kind's, looked up in SOLVERS), `ready` says no and
+// the editor asks the server's live step instead.
 
 import { modelKind } from "../kinds.js";
+import { rgbConductorValues } from "./live_rgb_conductor.js";
 import { LIVE, linspace, modelValues } from "./live_solve.js";
 
 const BLEND_WIDTH = 0.5; // fitting.fits.curves_settings.CurveFitSettings.blend_width (the editor sends none)
@@ -19,18 +21,39 @@ const rowKey = (eta) => Number(eta).toFixed(6);
 const now = () => (typeof performance === "undefined" ? Date.now() : performance.now());
 const origin = () => (typeof performance === "undefined" ? 0 : performance.timeOrigin);
 
-/** The coated-conductor coefficients {F0, a, alpha}[c][j] of a fit, flat (p, c, j) at `d1` powers. */
-export function flatCoefficients(C, d1) {
+/**
+ * The page's live solvers (live_worker.js solves by the same names), by the
+ * name the server gives a kind's (kinds.js liveSolver): the degree in eta_i
+ * of a live step over a domain, and the model of flat coefficients at (mu,
+ * eta) arrays (S x 3).
+ */
+export const SOLVERS = Object.freeze({
+  polynomial: { degree: ([lo, hi]) => (hi > lo ? 2 : 0), values: modelValues },
+  "exact-fresnel": { degree: () => 0, values: (x, mu, eta) => rgbConductorValues(x, mu, eta) },
+});
+
+const POLYNOMIAL = { parameters: ["F0", "a", "alpha"], maxDegree: 2 }; // the default kind's shape (the tests' form)
+
+/**
+ * A fit's coefficients of a kind's `parameters`, flat (p, c, j) at `d1`
+ * powers, or (p, c) for a kind of `maxDegree` 0 (one number a channel).
+ */
+export function flatCoefficients(C, d1, { parameters, maxDegree } = POLYNOMIAL) {
   const out = [];
-  for (const p of ["F0", "a", "alpha"]) for (let c = 0; c < 3; c++) for (let j = 0; j < d1; j++) out.push(C[p][c][j] ?? 0);
+  for (const p of parameters) {
+    for (let c = 0; c < 3; c++) {
+      if (maxDegree === 0) out.push(C[p][c]);
+      else for (let j = 0; j < d1; j++) out.push(C[p][c][j] ?? 0);
+    }
+  }
   return out;
 }
 
-/** Flat coefficients back to {F0, a, alpha}[c][j]. */
-export function nestedCoefficients(x, d1) {
+/** Flat coefficients back to the API's form (flatCoefficients' inverse). */
+export function nestedCoefficients(x, d1, { parameters, maxDegree } = POLYNOMIAL) {
   const C = {};
-  ["F0", "a", "alpha"].forEach((p, i) => {
-    C[p] = [0, 1, 2].map((c) => x.slice((i * 3 + c) * d1, (i * 3 + c + 1) * d1));
+  parameters.forEach((p, i) => {
+    C[p] = [0, 1, 2].map((c) => (maxDegree === 0 ? x[i * 3 + c] : x.slice((i * 3 + c) * d1, (i * 3 + c + 1) * d1)));
   });
   return C;
 }
@@ -57,7 +80,7 @@ export class LiveRefit {
   /** Whether the page solves live refits of `base` (its kind, its rows in). */
   supports(base) {
     try {
-      return modelKind(base).liveInPage && base.eta_i_range !== undefined;
+      return Object.hasOwn(SOLVERS, modelKind(base).liveSolver ?? "") && base.eta_i_range !== undefined;
     } catch {
       return false;
     }
@@ -108,16 +131,18 @@ export class LiveRefit {
     this.wanted = null;
     if (!job) return;
     const [lo, hi] = job.base.eta_i_range;
-    const degree = hi > lo ? 2 : 0;
+    const kind = modelKind(job.base), solver = kind.liveSolver;
+    const degree = SOLVERS[solver].degree([lo, hi]);
     const baseRows = {};
     for (const [name, rows] of this.rows) if (rows) baseRows[name] = rows;
     job.seq = ++this.seq;
     job.degree = degree;
+    job.kind = kind;
     job.sentAt = now();
     this.inFlight = job;
     this.worker.postMessage({
-      id: job.seq, baseRows, range: [lo, hi], degree, blendWidth: BLEND_WIDTH,
-      start: flatCoefficients(job.fit.coefficients, degree + 1),
+      id: job.seq, solver, baseRows, range: [lo, hi], degree, blendWidth: BLEND_WIDTH,
+      start: flatCoefficients(job.fit.coefficients, degree + 1, kind),
       edits: Object.keys(job.edits).sort().map((eta) => ({ eta_i: Number(eta), angle_deg: job.theta, rgb: job.edits[eta] })),
     });
   }
@@ -128,13 +153,14 @@ export class LiveRefit {
     if (job && data.id === job.seq && data.id === this.seq && !data.error) {
       const d1 = job.degree + 1;
       const fit = {
-        ...job.fit, id: `in-page-${job.seq}`, coefficients: nestedCoefficients(data.coefficients16, d1),
+        ...job.fit, id: `in-page-${job.seq}`, coefficients: nestedCoefficients(data.coefficients16, d1, job.kind),
         degree: job.degree,
         // The worker's clock is its own: its start and end (epoch ms) on this page's clock.
         inPage: { bestEffort: data.bestEffort, ms: data.ms, startedAt: data.startedAt - origin(), endedAt: data.endedAt - origin() },
       };
       const mu = job.theta.map((t) => (t === 90 ? 0 : Math.cos((t * Math.PI) / 180)));
-      const model = modelValues(data.coefficients16, mu, mu.map(() => job.eta), job.base.eta_i_range, d1);
+      const values = SOLVERS[job.kind.liveSolver].values;
+      const model = values(data.coefficients16, mu, mu.map(() => job.eta), job.base.eta_i_range, d1);
       this.io.show({ fit, model, job });
     } else if (data.error && this.io.onError) {
       this.io.onError(data.error);

@@ -1,14 +1,22 @@
 // The module worker of the editor's live refits: builds the live target
-// from the edits and the base's rows, solves the live step
-// (live_solve.js) and answers {id, coefficients16, bestEffort, ms, startedAt,
+// from the edits and the base's rows, solves the live step by the kind's
+// solver (`solver`, live_page.js SOLVERS: live_solve.js for the polynomial
+// with the [0, 1] rule, live_rgb_conductor.js for per-channel n, k) and answers {id, coefficients16, bestEffort, ms, startedAt,
 // endedAt (epoch ms: the page puts them on its own clock)}, or
 // {id, error}. One message at a time; the page sends the next when this
 // one answers (live_page.js), so a drag never queues stale work here.
 
+import { liveStepRGBConductor } from "./live_rgb_conductor.js";
 import { liveStep, liveTarget } from "./live_solve.js";
 
+// By the name the server gives a kind's live solver (kinds.js liveSolver).
+const SOLVE = {
+  polynomial: liveStep,
+  "exact-fresnel": ({ target, mu, eta, weights }) => liveStepRGBConductor({ target, mu, eta, weights }),
+};
+
 self.onmessage = ({ data }) => {
-  const { id, edits, baseRows, range, degree, start, blendWidth } = data;
+  const { id, solver, edits, baseRows, range, degree, start, blendWidth } = data;
   const startedAt = performance.timeOrigin + performance.now();
   try {
     const baseAt = (eta) => {
@@ -17,7 +25,8 @@ self.onmessage = ({ data }) => {
       return rows;
     };
     const { target, mu, eta } = liveTarget(edits, baseAt, range, blendWidth);
-    const result = liveStep({ target, mu, eta, range, degree, weights: null, start });
+    if (!Object.hasOwn(SOLVE, solver)) throw new Error(`no live solver ${solver}`);
+    const result = SOLVE[solver]({ target, mu, eta, range, degree, weights: null, start });
     self.postMessage({ id, coefficients16: result.coefficients16, bestEffort: result.bestEffort, ms: result.ms,
                        startedAt, endedAt: performance.timeOrigin + performance.now() });
   } catch (error) {
@@ -32,4 +41,5 @@ self.onmessage = ({ data }) => {
   const rows = liveTarget([edit], () => Array.from({ length: 12 }, () => [0.5, 0.5, 0.5]), range, 0.5);
   const start = [0.5, 0, 0, 0.5, 0, 0, 0.5, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0];
   for (let i = 0; i < 3; i++) liveStep({ ...rows, range, degree: 2, weights: null, start });
+  liveStepRGBConductor({ ...rows, weights: null });
 })();

@@ -2,7 +2,8 @@
 Live editing in a real Chromium against a real server: a continuous drag
 is refitted in the page while the pointer moves (no request; the first
 move's curve is the server's live step's from the same start), the page
-says so, and on release the server's full refit replaces it: the preview
+says so (for the exact-Fresnel kind too: its n, k the server's live step's),
+and on release the server's full refit replaces it: the preview
 shows the fit whose id is on screen, fitted to the curves on screen; a 503 is retried with
 backoff, its message shown while it lasts and cleared by the next answer.
 """
@@ -145,3 +146,62 @@ def test_503_is_retried_and_its_message_cleared(pages, editor_url):
     assert settled(page) == new_id
     assert len(refused) == 2
     assert message.inner_text() == ""
+
+
+def test_rgb_conductor_drag_is_solved_in_the_page_as_the_server_would(pages, live_server):
+    """The exact-Fresnel kind's live step in the page: no request while the pointer moves, and
+    the first move's n, k the server's live step's on the same edit."""
+    import loopback
+    import numpy as np
+
+    from fitting import curve_base_from_nk, library_material
+
+    angles = np.linspace(0.0, 90.0, 19)
+    mu = np.where(angles == 90.0, 0.0, np.cos(np.radians(angles)))
+    rgb = curve_base_from_nk(library_material("Cu")).rgb(mu, 1.5)
+    rgb[:, 2] *= 1.1
+    body = {"name": "live copper", "base": {"material": "Cu"}, "model": "rgb-conductor",
+            "curves": [{"eta_i": 1.5, "angle_deg": angles.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
+    response = loopback.post(f"{live_server}/api/v1/fits/from-curves", json=body, timeout=300)
+    assert response.status_code == 201, response.text
+    fit = response.json()
+    page = pages.new()
+    open_editor(page, live_server + "/")
+    page.select_option("#material", f"saved:{fit['material_id']}")
+    expect(page.locator("#fit-id")).to_have_text(fit["id"])
+    settled(page)
+    page.locator("input[name=channel][value='2']").check()
+    posted = []
+    page.on("request", lambda r: posted.append(r) if r.url.split("?")[0].endswith("/fits/from-curves") else None)
+    handle = page.locator("circle.handle.c2[data-angle='50']")
+    handle.scroll_into_view_if_needed()
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x, y + 6)
+    page.wait_for_function(f"{IN_PAGE}.length >= 1", timeout=20_000)
+    expect(page.locator("#fit-source")).to_have_text("live (in page)")
+    for step in range(2, 12):
+        page.mouse.move(x, y + 3 * step)
+        page.wait_for_timeout(40)
+    assert posted == [], "no request while the pointer moved"
+    first = page.evaluate(f"{IN_PAGE}[0]")
+    theta = page.evaluate("Array.from({length: 46}, (_, i) => 2 * i)")
+    server = page.evaluate(
+        """async ([base, theta, edits]) => {
+             const body = { name: "live check", base: { fit: base }, draft: true, live: true, start_fit: base,
+                            model: "rgb-conductor",
+                            curves: Object.keys(edits).map((eta) => ({ eta_i: Number(eta), angle_deg: theta,
+                                                                        rgb: edits[eta] })) };
+             const r = await fetch("/api/v1/fits/from-curves", { method: "POST",
+               headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
+             return r.json(); }""", [fit["id"], theta, first["edits"]])
+    assert server["model"] == "rgb-conductor", server
+    page.mouse.up()
+    settled(page)
+    # The page's base rows (the opened fit's curves) and the server's agree to rounding: n, k within
+    # two float16 steps (2^-9 relative; seen: the same float16 values).
+    mine = np.array([first["coefficients"][p] for p in ("n", "k")])
+    theirs = np.array([server["coefficients"][p] for p in ("n", "k")])
+    np.testing.assert_allclose(mine, theirs, rtol=2.0**-9, atol=2.0**-14)

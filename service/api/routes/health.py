@@ -82,7 +82,7 @@ async def healthz(request: Request, store: StoreDep, runner: RunnerDep, previews
 def describe_model_kinds() -> list[ModelKindPublic]:
     """Every registered model kind as the browser draws it (its preview's GLSL generated from the registry)."""
     return [ModelKindPublic(name=kind.name, description=kind.description, parameters=list(kind.parameters),
-                            max_degree=kind.max_degree, split_sum=kind.split_sum,
+                            max_degree=kind.max_degree, split_sum=kind.split_sum, live_solver=kind.live_solver,
                             glsl=preview_model_source(kind, inline=True))
             for kind in MODEL_KINDS.values()]
 
