@@ -126,22 +126,30 @@ class _Grid:
         return guard_score(self.Lab, coated_conductor_model(self.M, self.E, C16, self.range), self.M, self.E)
 
 
+def _channel_cost(grid: _Grid, C: np.ndarray) -> float:
+    """Half the sum of squared rgb residuals of float64 coefficients ``C`` on ``grid``."""
+    r = coated_conductor_model(grid.M, grid.E, C, grid.range).reshape(-1, 3) - grid.T
+    return 0.5 * float(np.sum(r * r))
+
+
 def auditor_fit(grid: _Grid, starts: dict, like: FitResult, degree: int) -> tuple[FitResult, dict]:
     """
     The paper's method as an auditor runs it on ``grid``: rgb least squares
     of the whole target, no [0, 1] constraint, from each of ``starts``
     (coefficients by label), solved channel by channel
-    (:func:`fitting.fits.paper_method.paper_fit`) then polished and
-    quantised jointly from that optimum; the lowest residual, and every
-    start's residual.
+    (:func:`fitting.fits.paper_method.paper_fit`); the start of lowest
+    residual is polished and quantised jointly from its optimum. Gives that
+    fit and every start's residual (at its channels' optimum).
     """
-    fits = {}
+    optima, costs = {}, {}
     for label, C in starts.items():
         start = like.with_coefficients(C, to_float16(C))
-        channels = paper_method_fit(grid.T, grid.M, grid.E, grid.range, degree, _FREE_MAX_NFEV, start, boxed=True)
-        fits[label] = fit_coefficients(grid.T, grid.M, grid.E, grid.range, degree, "rgb", _POLISH_MAX_NFEV,
-                                       start=channels.coefficients)
-    return min(fits.values(), key=lambda fit: fit.cost), {label: float(f.cost) for label, f in fits.items()}
+        optima[label] = paper_method_fit(grid.T, grid.M, grid.E, grid.range, degree, _FREE_MAX_NFEV, start,
+                                         boxed=True).coefficients
+        costs[label] = _channel_cost(grid, optima[label])
+    best = min(costs, key=costs.__getitem__)  # the starts' polish is a joint solve from a converged optimum
+    fit = fit_coefficients(grid.T, grid.M, grid.E, grid.range, degree, "rgb", _POLISH_MAX_NFEV, start=optima[best])
+    return fit, costs
 
 
 def _fine(scores_by, name, refs, margin=MAX_MARGIN) -> bool:
