@@ -73,6 +73,7 @@ CAP_SAMPLES = 50
 
 _BOTH_MAX_NFEV = 100  # the both-measures fit's evaluations per round
 _BOTH_ROUNDS = 4  # its reweightings toward a measure whose mean, or the points whose Delta E, is above the bar
+_BOTH_NFEV = 200  # a round starts only while the rounds before used fewer evaluations than this, together
 _BOTH_POWER = 4  # a sample's weight grows by 1 + (Delta E / the auditors' max) ** this a round
 _BLEND_STEPS = 3  # coefficients tried evenly between two successive rounds of the both-measures fit
 
@@ -135,7 +136,9 @@ def both_measures_fit(base, curves, blend_width, start: FitResult, aim: dict, fl
     on a grid, every sample by 1 + (Delta E / that max) **
     :data:`_BOTH_POWER` (the max pulled down where it is, as Lawson's
     reweighting toward the least max); while a fit is not ``in_range(C16)``,
-    the hinge ten times stiffer. Returns ``(fit, samples)`` of each round,
+    the hinge ten times stiffer; no round started once the rounds before
+    used :data:`_BOTH_NFEV` evaluations (a hard target's solves fall back
+    to the bounded solver, several times dearer). Returns ``(fit, samples)`` of each round,
     ``samples`` = ``(target, mu, eta, weights)``.
     """
     grids = [AuditGrid(base, curves, blend_width, by, UNION_SAMPLES) for by in AUDIT_GRIDS]
@@ -145,13 +148,15 @@ def both_measures_fit(base, curves, blend_width, start: FitResult, aim: dict, fl
     Lab = np.concatenate([g.Lab for g in grids])
     CM, CE = check_grid(base.eta_i_range, *CHECK_SAMPLES)
     scale, boost, stiff = np.ones(len(grids)), np.ones(M.size), 1.0
-    C, rounds = start.coefficients, []
+    C, rounds, spent = start.coefficients, [], 0
     cap = min(ref.max for ref in floor.values())
     for _ in range(_BOTH_ROUNDS):
+        if spent >= _BOTH_NFEV:
+            break
         weights = np.repeat(scale, sizes) * boost
         fit = fit_coefficients(T, M, E, base.eta_i_range, degree, "de2000", _BOTH_MAX_NFEV, True, weights=weights,
                                irls_rounds=0, range_check=(CM.ravel(), CE.ravel(), stiff), start=C)
-        C = fit.coefficients
+        C, spent = fit.coefficients, spent + fit.nfev
         rounds.append((fit, (T, M, E, weights)))
         scores = score(fit.coefficients_float16)
         over = [scores[grid.by].mean > aim[grid.by].mean for grid in grids]
