@@ -17,7 +17,7 @@ could end with the worse max (5 of 8 edits, one by 3 Delta E).
     under both, the fits of least mean with the max capped on both grids
     (:func:`fitting.fits.guarded.constrained_refits`), and, when still
     nothing holds both auditors, the least mean of both measures at once
-    (:func:`both_measures_fit`, its max reweighted down while above the
+    (:func:`fitting.fits.curves_measures.both_measures_fit`, its max reweighted down while above the
     auditors'); kept only when proven inside [0, 1], the
     choice of :func:`pick`. A kept twin of the paper's method is polished
     in float16 (:func:`fitting.fits.polish.polish_float16`) so that it is
@@ -31,16 +31,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab
-from ..colour.delta_e import delta_E_2000
-from ..models.coated_conductor import coated_conductor_model
-from ..models.pack import to_float16
 from .curves_audit import AUDIT_GRIDS, AUDIT_SAMPLES, AUDIT_STARTS, AuditGrid, audit_floor, audit_grid, auditor_fits
+from .curves_measures import CHECK_SAMPLES, blends, both_measures_fit
 from .curves_score import check_grid
 from .guarded import _THREADPOOLS, GuardWork, constrained_refits, guard_report
 from .polish import polish_float16
 from .result import FitResult
-from .solver import fit_coefficients
 from .start import initial_guess
 from .worst_case import MAX_MARGIN, GuardScore
 
@@ -51,17 +47,9 @@ is one the model cannot follow: the answer warns (:func:`edit_warnings`)."""
 
 FOLLOW_MAX = 3.0
 
-CHECK_SAMPLES = (19, 7)
-"""Where the constrained refits keep the model in [0, 1]: the refit's default check grid."""
-
 GUARD_WORK = 3000
 """The constrained refits' work of one curve refit (SLSQP iterations times
 constraint rows, :class:`fitting.fits.guarded.GuardWork`)."""
-
-UNION_SAMPLES = 40
-"""The both-measures fit's samples (:func:`both_measures_fit`): this many
-angles evenly times as many eta_i, and as many cos theta evenly times as
-many eta_i: the mean Delta E of both auditors' grids, four times coarser."""
 
 CAP_FACTORS = (1.0 - MAX_MARGIN, 0.9)
 """The caps of the constrained refits, times the bar, in order: the margin
@@ -70,12 +58,6 @@ below the paper's, and an unreachable cap would spend the work)."""
 
 CAP_SAMPLES = 50
 """The side of each measure's grid where the constrained refits cap the max."""
-
-_BOTH_MAX_NFEV = 100  # the both-measures fit's evaluations per round
-_BOTH_ROUNDS = 4  # its reweightings toward a measure whose mean, or the points whose Delta E, is above the bar
-_BOTH_NFEV = 200  # a round starts only while the rounds before used fewer evaluations than this, together
-_BOTH_POWER = 4  # a sample's weight grows by 1 + (Delta E / the auditors' max) ** this a round
-_BLEND_STEPS = 3  # coefficients tried evenly between two successive rounds of the both-measures fit
 
 __all__ = ["GUARD_WORK", "AUDIT_SAMPLES", "AUDIT_GRIDS", "AUDIT_STARTS", "FOLLOW_MEAN", "FOLLOW_MAX",
            "audit_grid", "guard_curve_choice", "edit_warnings"]
@@ -122,65 +104,6 @@ def pick(scores_by: dict, aim: dict, floor: dict, hard=None) -> str:
 
     return min(names, key=lambda n: (len(failed(n)), [g in failed(n) for g in floor],
                                      _excess(scores_by, n, {g: floor[g] for g in failed(n)}), total[n]))
-
-
-def both_measures_fit(base, curves, blend_width, start: FitResult, aim: dict, floor: dict, score, in_range,
-                      degree: int):
-    """
-    The de2000 fits (least mean Delta E, :func:`fitting.fits.solver.fit_coefficients`)
-    of the whole target on both auditors' measures at once
-    (:data:`UNION_SAMPLES`), held in [0, 1] by the check grid's hinge, from
-    ``start`` then each from the last, at most :data:`_BOTH_ROUNDS`: while a
-    measure's mean stays above ``aim``'s, that measure is weighted up
-    (doubled); while the max (``score(C16)`` by grid) is above ``floor``'s
-    on a grid, every sample by 1 + (Delta E / that max) **
-    :data:`_BOTH_POWER` (the max pulled down where it is, as Lawson's
-    reweighting toward the least max); while a fit is not ``in_range(C16)``,
-    the hinge ten times stiffer; no round started once the rounds before
-    used :data:`_BOTH_NFEV` evaluations (a hard target's solves fall back
-    to the bounded solver, several times dearer). Returns ``(fit, samples)`` of each round,
-    ``samples`` = ``(target, mu, eta, weights)``.
-    """
-    grids = [AuditGrid(base, curves, blend_width, by, UNION_SAMPLES) for by in AUDIT_GRIDS]
-    sizes = [g.M.size for g in grids]
-    T = np.concatenate([g.T for g in grids])
-    M, E = np.concatenate([g.M for g in grids]), np.concatenate([g.E for g in grids])
-    Lab = np.concatenate([g.Lab for g in grids])
-    CM, CE = check_grid(base.eta_i_range, *CHECK_SAMPLES)
-    scale, boost, stiff = np.ones(len(grids)), np.ones(M.size), 1.0
-    C, rounds, spent = start.coefficients, [], 0
-    cap = min(ref.max for ref in floor.values())
-    for _ in range(_BOTH_ROUNDS):
-        if spent >= _BOTH_NFEV:
-            break
-        weights = np.repeat(scale, sizes) * boost
-        fit = fit_coefficients(T, M, E, base.eta_i_range, degree, "de2000", _BOTH_MAX_NFEV, True, weights=weights,
-                               irls_rounds=0, range_check=(CM.ravel(), CE.ravel(), stiff), start=C)
-        C, spent = fit.coefficients, spent + fit.nfev
-        rounds.append((fit, (T, M, E, weights)))
-        scores = score(fit.coefficients_float16)
-        over = [scores[grid.by].mean > aim[grid.by].mean for grid in grids]
-        too_high = any(scores[by].max > floor[by].max for by in floor)
-        outside = not in_range(fit.coefficients_float16)
-        if not (any(over) and not all(over)) and not too_high and not outside:
-            break
-        if any(over) and not all(over):
-            scale = np.where(over, 2.0 * scale, scale)
-        if too_high:
-            model = coated_conductor_model(M, E, fit.coefficients_float16, base.eta_i_range)
-            boost = boost * (1.0 + (delta_E_2000(Lab, ACEScg_to_Lab(model)) / cap) ** _BOTH_POWER)
-            boost /= boost.mean()
-        if outside:
-            stiff *= 10.0
-    return rounds
-
-
-def blends(rounds, steps=_BLEND_STEPS):
-    """Float16 coefficients between each two successive rounds' fits (``(fit, samples)``), ``steps`` evenly inside."""
-    for (a, _), (b, _) in zip(rounds, rounds[1:]):
-        for t in np.linspace(0.0, 1.0, steps + 2)[1:-1]:
-            C = (1.0 - t) * a.coefficients + t * b.coefficients
-            yield a.with_coefficients(C, to_float16(C))
 
 
 @_THREADPOOLS.wrap(limits=1, user_api="blas")
