@@ -11,12 +11,14 @@ could end with the worse max (5 of 8 edits, one by 3 Delta E).
     target on both of the auditors' dense grids (:data:`AUDIT_GRIDS`:
     :data:`AUDIT_SAMPLES` angles evenly, or as many cos theta evenly, times
     as many eta_i), against the paper's method as an auditor runs it on
-    each (:func:`auditor_fit`: plain rgb least squares from several starts,
-    :data:`AUDIT_STARTS`, the lowest residual kept); when the own fit is not
+    each (:mod:`fitting.fits.curves_audit`: plain rgb least squares from
+    several starts, :data:`AUDIT_STARTS`, every distinct optimum that is a
+    reflectance a bar); when the own fit is not
     under both, the fits of least mean with the max capped on both grids
     (:func:`fitting.fits.guarded.constrained_refits`), and, when still
     nothing holds both auditors, the least mean of both measures at once
-    (:func:`both_measures_fit`); kept only when proven inside [0, 1], the
+    (:func:`fitting.fits.curves_measures.both_measures_fit`, its max reweighted down while above the
+    auditors'); kept only when proven inside [0, 1], the
     choice of :func:`pick`. A kept twin of the paper's method is polished
     in float16 (:func:`fitting.fits.polish.polish_float16`) so that it is
     ahead of an auditor's rounding of the same optimum on both figures,
@@ -29,41 +31,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..colour.colorimetry import ACEScg_to_Lab
-from ..colour.reference import evaluation_grid
-from ..models.coated_conductor import coated_conductor_model
-from ..models.pack import to_float16
-from .curves_base import edited_target
-from .curves_score import check_grid, score_grid
+from .curves_audit import AUDIT_GRIDS, AUDIT_SAMPLES, AUDIT_STARTS, AuditGrid, audit_floor, audit_grid, auditor_fits
+from .curves_measures import CHECK_SAMPLES, blends, both_measures_fit
+from .curves_score import check_grid
 from .guarded import _THREADPOOLS, GuardWork, constrained_refits, guard_report
-from .paper_method import paper_fit as paper_method_fit
 from .polish import polish_float16
 from .result import FitResult
-from .solver import fit_coefficients
 from .start import initial_guess
-from .worst_case import MAX_MARGIN, GuardScore, guard_score
-
-AUDIT_SAMPLES = 100
-"""The auditor's grids are :data:`AUDIT_SAMPLES` x :data:`AUDIT_SAMPLES`
-points of the whole blended target, :data:`AUDIT_GRIDS`: where the guard
-scores and caps a curve refit."""
-
-AUDIT_GRIDS = ("angle", "cos_theta")
-"""The two measures an auditor may sample the target by: angles evenly over
-[0, 90] degrees (the editor's error map,
-:data:`fitting.fits.curves_score.SCORE_GRID`, five times as dense) and cos
-theta evenly over [0, 1] (the paper's grid,
-:func:`fitting.colour.reference.evaluation_grid`), each times
-:data:`AUDIT_SAMPLES` eta_i evenly over the domain. The paper's method fitted
-on one measure is not the paper's method fitted on the other (their rgb
-residuals weigh grazing angles differently): the refit is held no worse
-than each auditor's fit on that auditor's own grid."""
-
-AUDIT_STARTS = ("paper", "own", "guess")
-"""The starts of the auditor's paper-method fits: the refit's paper-method
-candidate, its own fit, and the variable-projection initial guess on the
-audit grid (:func:`fitting.fits.start.initial_guess`); the lowest rgb
-residual is the auditor's fit."""
+from .worst_case import MAX_MARGIN, GuardScore
 
 FOLLOW_MEAN = 1.0
 """An edited curve whose fit stays more than this mean Delta E 2000 (one
@@ -72,17 +47,9 @@ is one the model cannot follow: the answer warns (:func:`edit_warnings`)."""
 
 FOLLOW_MAX = 3.0
 
-CHECK_SAMPLES = (19, 7)
-"""Where the constrained refits keep the model in [0, 1]: the refit's default check grid."""
-
 GUARD_WORK = 3000
 """The constrained refits' work of one curve refit (SLSQP iterations times
 constraint rows, :class:`fitting.fits.guarded.GuardWork`)."""
-
-UNION_SAMPLES = 40
-"""The both-measures fit's samples (:func:`both_measures_fit`): this many
-angles evenly times as many eta_i, and as many cos theta evenly times as
-many eta_i: the mean Delta E of both auditors' grids, four times coarser."""
 
 CAP_FACTORS = (1.0 - MAX_MARGIN, 0.9)
 """The caps of the constrained refits, times the bar, in order: the margin
@@ -92,56 +59,8 @@ below the paper's, and an unreachable cap would spend the work)."""
 CAP_SAMPLES = 50
 """The side of each measure's grid where the constrained refits cap the max."""
 
-_FREE_MAX_NFEV = 200  # the unconstrained paper fit's evaluations per channel
-_POLISH_MAX_NFEV = 20  # its joint polish from the channels' optimum
-_BOTH_MAX_NFEV = 100  # the both-measures fit's evaluations per round
-_BOTH_ROUNDS = 3  # its reweightings toward a measure whose mean is above the bar
-
 __all__ = ["GUARD_WORK", "AUDIT_SAMPLES", "AUDIT_GRIDS", "AUDIT_STARTS", "FOLLOW_MEAN", "FOLLOW_MAX",
            "audit_grid", "guard_curve_choice", "edit_warnings"]
-
-
-def audit_grid(eta_i_range, by: str, samples: int = AUDIT_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
-    """(cos_theta, eta_i), flattened, of the auditor's grid sampled ``by`` one of :data:`AUDIT_GRIDS`."""
-    if by == "angle":
-        _, _, M, E = score_grid(eta_i_range, (samples, samples))
-    elif by == "cos_theta":
-        M, E = evaluation_grid(samples, eta_i_range)
-    else:
-        raise ValueError(f"`by` must be one of {', '.join(AUDIT_GRIDS)}, got {by!r}")
-    return M.ravel(), E.ravel()
-
-
-class _Grid:
-    """One auditor's grid: its points, the whole blended target there, and the scores of fits on it."""
-
-    def __init__(self, base, curves, blend_width, by, samples=AUDIT_SAMPLES):
-        self.by = by
-        self.M, self.E = audit_grid(base.eta_i_range, by, samples)
-        self.T = edited_target(base, curves, self.M, self.E, blend_width).reshape(-1, 3)
-        self.Lab = ACEScg_to_Lab(self.T)
-        self.range = base.eta_i_range
-
-    def score(self, C16) -> GuardScore:
-        return guard_score(self.Lab, coated_conductor_model(self.M, self.E, C16, self.range), self.M, self.E)
-
-
-def auditor_fit(grid: _Grid, starts: dict, like: FitResult, degree: int) -> tuple[FitResult, dict]:
-    """
-    The paper's method as an auditor runs it on ``grid``: rgb least squares
-    of the whole target, no [0, 1] constraint, from each of ``starts``
-    (coefficients by label), solved channel by channel
-    (:func:`fitting.fits.paper_method.paper_fit`) then polished and
-    quantised jointly from that optimum; the lowest residual, and every
-    start's residual.
-    """
-    fits = {}
-    for label, C in starts.items():
-        start = like.with_coefficients(C, to_float16(C))
-        channels = paper_method_fit(grid.T, grid.M, grid.E, grid.range, degree, _FREE_MAX_NFEV, start, boxed=True)
-        fits[label] = fit_coefficients(grid.T, grid.M, grid.E, grid.range, degree, "rgb", _POLISH_MAX_NFEV,
-                                       start=channels.coefficients)
-    return min(fits.values(), key=lambda fit: fit.cost), {label: float(f.cost) for label, f in fits.items()}
 
 
 def _fine(scores_by, name, refs, margin=MAX_MARGIN) -> bool:
@@ -156,14 +75,17 @@ def _excess(scores_by, name, refs) -> float:
                for g, ref in refs.items())
 
 
-def pick(scores_by: dict, aim: dict, floor: dict) -> str:
+def pick(scores_by: dict, aim: dict, floor: dict, hard=None) -> str:
     """
     The candidate to keep: of those under ``aim`` on every grid (mean, and
     max by :data:`MAX_MARGIN`), else of those no worse than ``floor`` on
-    every grid, the lowest mean summed over the grids; else the one no
-    worse than ``floor`` on the most grids (the first of
-    :data:`AUDIT_GRIDS`, the editor's, before the others), then least above
-    it (relative excess, mean or max, on the grids it fails).
+    every grid, the lowest mean summed over the grids; else, of those no
+    worse than ``floor`` on the ``hard`` grids (where an auditor's fit is a
+    reflectance, what an auditor would ship), the least above it on the
+    others (relative excess), then the lowest mean; else the one no worse
+    than ``floor`` on the most grids (the first of :data:`AUDIT_GRIDS`, the
+    editor's, before the others), then least above it (relative excess,
+    mean or max, on the grids it fails).
     """
     names = list(next(iter(scores_by.values())))
     total = {n: sum(scores_by[g][n].mean for g in scores_by) for n in names}
@@ -171,39 +93,17 @@ def pick(scores_by: dict, aim: dict, floor: dict) -> str:
         fine = [n for n in names if _fine(scores_by, n, refs, margin)]
         if fine:
             return min(fine, key=lambda n: total[n])
+    hard = [g for g in floor if g in (hard or ())]
+    soft = {g: floor[g] for g in floor if g not in hard}
+    fine = [n for n in names if hard and _fine(scores_by, n, {g: floor[g] for g in hard}, 0.0)]
+    if fine and soft:
+        return min(fine, key=lambda n: (max(0.0, _excess(scores_by, n, soft)), total[n]))
 
     def failed(name):
         return [g for g in floor if not _fine(scores_by, name, {g: floor[g]}, 0.0)]
 
     return min(names, key=lambda n: (len(failed(n)), [g in failed(n) for g in floor],
                                      _excess(scores_by, n, {g: floor[g] for g in failed(n)}), total[n]))
-
-
-def both_measures_fit(base, curves, blend_width, start: FitResult, aim: dict, degree: int):
-    """
-    The de2000 fit (least mean Delta E, :func:`fitting.fits.solver.fit_coefficients`)
-    of the whole target on both auditors' measures at once
-    (:data:`UNION_SAMPLES`), held in [0, 1] by the check grid's hinge, from
-    ``start``; a measure whose mean stays above ``aim``'s is weighted up
-    (doubled, at most :data:`_BOTH_ROUNDS` solves). Returns the fit and its
-    samples ``(target, mu, eta, weights)``.
-    """
-    grids = [_Grid(base, curves, blend_width, by, UNION_SAMPLES) for by in AUDIT_GRIDS]
-    T = np.concatenate([g.T for g in grids])
-    M, E = np.concatenate([g.M for g in grids]), np.concatenate([g.E for g in grids])
-    CM, CE = check_grid(base.eta_i_range, *CHECK_SAMPLES)
-    scale = np.ones(len(grids))
-    C, fit = start.coefficients, None
-    for _ in range(_BOTH_ROUNDS):
-        weights = np.repeat(scale, [g.M.size for g in grids])
-        fit = fit_coefficients(T, M, E, base.eta_i_range, degree, "de2000", _BOTH_MAX_NFEV, True, weights=weights,
-                               irls_rounds=0, range_check=(CM.ravel(), CE.ravel(), 1.0), start=C)
-        C = fit.coefficients
-        over = [grid.score(fit.coefficients_float16).mean > aim[grid.by].mean for grid in grids]
-        if not any(over) or all(over):
-            break
-        scale = np.where(over, 2.0 * scale, scale)
-    return fit, (T, M, E, np.repeat(scale, [g.M.size for g in grids]))
 
 
 @_THREADPOOLS.wrap(limits=1, user_api="blas")
@@ -222,8 +122,9 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     (:class:`fitting.fits.guarded.GuardWork`; None: :data:`GUARD_WORK`), and the report's
     ``work_cut`` says whether the budget stopped one.
 
-    The keep is no worse on mean and max, on each auditor's grid, than that
-    auditor's paper-method fit where it is a reflectance, else than the
+    The keep is no worse on mean and max, on each auditor's grid, than each
+    optimum of that auditor's paper-method fit that is a reflectance
+    (:func:`fitting.fits.curves_audit.audit_floor`), else than the
     in-range paper candidate (:func:`pick`'s ``floor``); it aims under the
     lower of the two, and under the auditors' max even where their fit
     leaves [0, 1] (``aim``).
@@ -231,7 +132,7 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     budget = GuardWork(GUARD_WORK if work is None else work)
     eta_i_range = base.eta_i_range
     degree = candidates[own].degree
-    grids = {by: _Grid(base, curves, blend_width, by) for by in AUDIT_GRIDS}
+    grids = {by: AuditGrid(base, curves, blend_width, by) for by in AUDIT_GRIDS}
     scores_by = {by: {name: grid.score(c.coefficients_float16) for name, c in candidates.items()}
                  for by, grid in grids.items()}
 
@@ -240,26 +141,30 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
         for by, grid in grids.items():
             scores_by[by][name] = grid.score(fit.coefficients_float16)
 
-    audits, costs, aim, floor = {}, {}, {}, {}
+    audits, costs, aim, floor, hard = {}, {}, {}, {}, []
     for by, grid in grids.items():
         starts = {"paper": candidates[paper].coefficients, "own": candidates[own].coefficients,
                   "guess": initial_guess(grid.T, grid.M, grid.E, eta_i_range, degree)}
-        audits[by], costs[by] = auditor_fit(grid, {k: starts[k] for k in AUDIT_STARTS}, candidates[paper], degree)
+        audits[by], costs[by] = auditor_fits(grid, {k: starts[k] for k in AUDIT_STARTS}, candidates[paper], degree,
+                                             in_range)
     for by, grid in grids.items():
-        free, ours = grid.score(audits[by].coefficients_float16), scores_by[by][paper]
-        reflectance = in_range(audits[by].coefficients_float16)
-        aim[by] = GuardScore(min(ours.mean, free.mean) if reflectance else ours.mean, min(ours.max, free.max),
+        ours, free = scores_by[by][paper], audit_floor(audits[by])
+        lowest_max = min([ours.max] + [a.score.max for a in audits[by]])
+        aim[by] = GuardScore(ours.mean if free is None else min(ours.mean, free.mean), lowest_max,
                              ours.eta_i, ours.angle_deg)
-        floor[by] = free if reflectance else ours  # what that auditor would ship, else the in-range paper fit
-        if reflectance:
-            add(f"{paper}-free" + ("" if by == "angle" else f"-{by.replace('_', '-')}"), audits[by])
+        floor[by] = ours if free is None else free  # what that auditor would ship, else the in-range paper fit
+        if free is not None:
+            hard.append(by)
+        for i, a in enumerate(a for a in audits[by] if a.reflectance):
+            add(f"{paper}-free" + ("" if by == "angle" else f"-{by.replace('_', '-')}") + (f"-{i + 1}" if i else ""),
+                a.fit)
     cap = min(ref.max for ref in aim.values())
     union = (np.concatenate([g.T for g in grids.values()]), np.concatenate([g.M for g in grids.values()]),
              np.concatenate([g.E for g in grids.values()]))
     # The constrained refits' caps hold at both measures' points, CAP_SAMPLES a side (the
     # SLSQP's rows are the points near the cap: both full grids would leave it no
     # iterations in its work); the cap rounds then score on the full grids.
-    coarse = [_Grid(base, curves, blend_width, by, CAP_SAMPLES) for by in AUDIT_GRIDS]
+    coarse = [AuditGrid(base, curves, blend_width, by, CAP_SAMPLES) for by in AUDIT_GRIDS]
     cap_points = (np.concatenate([g.T for g in coarse]), np.concatenate([g.M for g in coarse]),
                   np.concatenate([g.E for g in coarse]))
 
@@ -289,20 +194,31 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     if not any(_fine(scores_by, name, floor) for name in candidates):
         # Nothing holds both auditors (each measure's paper fit loses on the other's):
         # least mean on both measures at once, capped there too when its max is over.
-        both, both_samples = both_measures_fit(base, curves, blend_width, candidates[own], aim, degree)
-        if in_range(both.coefficients_float16):
-            add("both-measures", both)
-        if "both-measures" not in candidates or not _fine(scores_by, "both-measures", aim):
+        rounds = both_measures_fit(base, curves, blend_width, candidates[own], aim, floor,
+                                   lambda C16: {by: grid.score(C16) for by, grid in grids.items()}, in_range,
+                                   degree)
+        for i, (fit, _) in enumerate(rounds):
+            if in_range(fit.coefficients_float16):
+                add("both-measures" + (f"-{i + 1}" if i else ""), fit)
+        if not any(_fine(scores_by, n, floor, 0.0) for n in candidates if n.startswith("both-measures")):
+            # One round's max over, the next one's mean: a fit between the two may hold both.
+            for k, fit in enumerate(blends(rounds)):
+                if in_range(fit.coefficients_float16):
+                    add(f"both-measures-blend-{k + 1}", fit)
+                    if _fine(scores_by, f"both-measures-blend-{k + 1}", floor, 0.0):
+                        break
+        if not any(_fine(scores_by, n, aim) for n in candidates if n.startswith("both-measures")):
+            both, both_samples = rounds[-1]
             capped(both_samples, (("-both-measures", both.coefficients),), levels)
         # Shipped only where it holds both auditors: a both-measures fit that still
         # loses on one trades the edit's own look (the curves far from the edit)
         # for a smaller loss, so the paper method's twin stays the fallback.
-        for name in [n for n in candidates if "both-measures" in n and not _fine(scores_by, n, floor)]:
+        for name in [n for n in candidates if "both-measures" in n and not _fine(scores_by, n, floor, 0.0)]:
             del candidates[name]
             for by in scores_by:
                 scores_by[by].pop(name, None)
-    chosen = pick(scores_by, aim, floor)
-    if chosen.startswith(paper) or chosen == "both-measures":
+    chosen = pick(scores_by, aim, floor, hard)
+    if chosen.startswith(paper) or chosen.startswith("both-measures"):
         # The paper method's twin: ahead of the auditors' rounding on both figures, not a tie.
         C16, _ = polish_float16(candidates[chosen].coefficients_float16, *union, eta_i_range)
         after = {by: grid.score(C16) for by, grid in grids.items()}
@@ -313,12 +229,14 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     report = guard_report(chosen, scores_by["angle"])
     report["bar_max"] = aim["angle"].max
     report["by_grid"] = {by: {name: s.to_dict() for name, s in scores.items()} for by, scores in scores_by.items()}
+    best = {by: audits[by][0] for by in grids}
     report["audit"] = {"grid": f"{AUDIT_SAMPLES} x {AUDIT_SAMPLES}", "starts": list(AUDIT_STARTS),
-                       "costs": costs["angle"],
-                       "in_range": bool(in_range(audits["angle"].coefficients_float16)),
-                       **grids["angle"].score(audits["angle"].coefficients_float16).to_dict(),
-                       "by_grid": {by: {"costs": costs[by], "in_range": bool(in_range(audits[by].coefficients_float16)),
-                                        **grids[by].score(audits[by].coefficients_float16).to_dict()}
+                       "costs": costs["angle"], "in_range": best["angle"].reflectance,
+                       **best["angle"].score.to_dict(),
+                       "by_grid": {by: {"costs": costs[by], "in_range": best[by].reflectance,
+                                        **best[by].score.to_dict(),
+                                        "optima": [{"starts": a.starts, "in_range": a.reflectance, **a.score.to_dict()}
+                                                   for a in audits[by]]}
                                    for by in grids}}
     report["work_cut"] = budget.cut
     return chosen, report

@@ -45,7 +45,7 @@ from .materials import resolve_material
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
 
-CURVES_FORMAT = "curves/v3"
+CURVES_FORMAT = "curves/v4"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 DEFAULTS = CurveFitSettings()
 DEFAULT_DOMAIN = DEFAULT_ETA_I_RANGE
