@@ -23,24 +23,23 @@ from __future__ import annotations
 import asyncio
 import time
 from dataclasses import dataclass, replace
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
-from fitting.colour.delta_e import delta_E_map
-from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range, cos_theta_from_angle
+from fitting.domain import DEFAULT_ETA_I_RANGE, check_eta_i_range
 from fitting.fits.curves import LIVE_SETTINGS, CurveFitSettings, fit_curves
-from fitting.fits.curves_base import CurveBase, curve_base_from_coefficients, curve_base_from_nk, edited_target
 from fitting.fits.curves_input import check_curves
-from fitting.models.kinds import DEFAULT_MODEL, model_ACEScg
+from fitting.models.kinds import DEFAULT_MODEL
 from fitting.models.pack import material_from_json, material_to_json
 from fitting.optics.catalogue import catalogue_material
-from fitting.optics.nk import SpectralNK
 
 from ..runtime import FitRunner
 from ..store import FitRecord, Store
 from .common import (FIT_FORMAT_VERSION, check_finite, checked_version, checked_writable, content_address,
-                     draft_nk_reference, fit_record, measured_nk, stored_fit, with_measured_nk)
+                     draft_nk_reference, fit_record, stored_fit, with_measured_nk)
+from .curve_bases import BaseSpec
+from .curve_targets import error_map, snap_to_domain, target_at
 from .materials import resolve_material
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
@@ -49,44 +48,6 @@ CURVES_FORMAT = "curves/v4"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 DEFAULTS = CurveFitSettings()
 DEFAULT_DOMAIN = DEFAULT_ETA_I_RANGE
-
-
-@dataclass(frozen=True)
-class BaseSpec:
-    """What a worker needs to build the base: picklable plain data."""
-
-    kind: Literal["nk", "model"]
-    name: str
-    source: str
-    eta_i_range: tuple[float, float]
-    library_material: str | None = None
-    nk: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] | None = None
-    coefficients: tuple | None = None
-    model: str = DEFAULT_MODEL
-
-    def build(self) -> CurveBase:
-        if self.kind == "model":
-            return curve_base_from_coefficients(
-                np.asarray(self.coefficients), self.eta_i_range, self.name, self.source, self.model
-            )
-        return curve_base_from_nk(self.spectral_nk(), self.eta_i_range)
-
-    def spectral_nk(self) -> SpectralNK:
-        if self.library_material is not None:
-            return catalogue_material(self.library_material)
-        wavelength, n, k = (np.asarray(a, dtype=np.float64) for a in self.nk)
-        return SpectralNK(wavelength, n, k, name=self.name, source=self.source)
-
-    def key(self) -> list:
-        return [self.kind, self.name, self.source, self.library_material,
-                None if self.nk is None else [np.asarray(a) for a in self.nk],
-                None if self.coefficients is None else np.asarray(self.coefficients).ravel(),
-                list(self.eta_i_range), *(() if self.model == DEFAULT_MODEL else (self.model,))]
-
-    def provenance(self) -> dict[str, Any]:
-        return {"kind": self.kind, "name": self.name, "eta_i_range": list(self.eta_i_range),
-                "library_material": self.library_material, "coefficients": self.coefficients,
-                "model": self.model}
 
 
 @dataclass(frozen=True)
@@ -111,19 +72,6 @@ class CurveFit:
 
 def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
     return bool(np.all(np.float32(a) == np.float32(b)))
-
-
-def _snap_to_domain(curves: list[dict], domain: tuple[float, float]) -> list[dict]:
-    """Curves within float32 rounding of a bound of ``domain`` moved onto it."""
-    lo, hi = domain
-    out = []
-    for curve in curves:
-        eta = curve["eta_i"]
-        for bound in (lo, hi):
-            if eta != bound and np.float32(eta) == np.float32(bound):
-                curve = {**curve, "eta_i": bound}
-        out.append(curve)
-    return out
 
 
 def _base_spec(store: Store, name: str, material: str | None, fit: str | None,
@@ -179,7 +127,7 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
     requested = None if eta_i_range is None else check_eta_i_range(eta_i_range)
     base, base_record = _base_spec(store, name, base_material, base_fit, base_nk, requested)
     if base is not None:
-        curves = _snap_to_domain(curves, base.eta_i_range)
+        curves = snap_to_domain(curves, base.eta_i_range)
     check_curves(curves)
     domain = base.eta_i_range if base is not None else check_eta_i_range(requested or DEFAULT_DOMAIN)
     start = None if start_fit is None else _start_coefficients(store, start_fit, domain, model, base, curves)
@@ -330,71 +278,3 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
         # once. (Asking whether it is the latest would race with other saves.)
         record = await asyncio.to_thread(put, record, True, expected_version)
     return record, True, in_bin
-
-
-def _measured_nk_or_refuse(record: FitRecord) -> SpectralNK:
-    nk = measured_nk(record)
-    if nk is None:
-        raise ValueError(f"fit {record.id} has no n, k to compare against")
-    return nk
-
-
-def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
-    """(eta_i rows, target (E, M, 3), against) for a stored fit."""
-    domain = material_from_json(record.material).eta_i_range
-    provenance = record.provenance or {}
-    if record.kind == "curves":
-        request = provenance.get("request", {})
-        curves = check_curves(_snap_to_domain(request.get("curves", []), domain))
-        base = provenance.get("base")
-        if base is None:
-            rows = np.array(sorted(c.eta_i for c in curves))
-            target = np.stack([next(c for c in curves if c.eta_i == e).sampled(mu) for e in rows])
-            return rows, target, "curves"
-        if base["kind"] == "model":
-            grid = curve_base_from_coefficients(np.asarray(base["coefficients"]), domain, base["name"],
-                                                model=base.get("model", DEFAULT_MODEL))
-        else:
-            grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
-        E, M = np.meshgrid(eta, mu, indexing="ij")
-        width = request.get("blend_width", DEFAULTS.blend_width)
-        return eta, edited_target(grid, curves, M, E, width), "edited target"
-    grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
-    E, M = np.meshgrid(eta, mu, indexing="ij")
-    return eta, grid.rgb(M, E), "reference"
-
-
-def target_at(record: FitRecord, mu: np.ndarray, eta_i: float) -> list[list[float]]:
-    """
-    A curve fit's target at one eta_i: the blended edited target (with a
-    base), or the curve at that eta_i (without; ValueError if none is there).
-    """
-    rows, target, against = _target_of(record, mu, np.array([float(eta_i)]))
-    if against == "curves":
-        matches = np.flatnonzero(np.abs(rows - eta_i) < 1e-6)
-        if not matches.size:
-            raise ValueError(f"fit {record.id} has no curve at eta_i {eta_i:g}")
-        return target[matches[0]].tolist()
-    return target[0].tolist()
-
-
-def error_map(record: FitRecord, angles: int, rows: int) -> dict[str, Any]:
-    """
-    Delta E 2000 of the fit's float16 model against what it was fitted to:
-    the spectral reference (5 nm) of its n, k, or for a curve fit the edited
-    target (with a base) or the curves themselves (rows at their eta_i).
-    """
-    packed = material_from_json(record.material)
-    lo, hi = packed.eta_i_range
-    theta = np.linspace(0.0, 90.0, angles)
-    mu = cos_theta_from_angle(theta)
-    eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
-    eta, target, against = _target_of(record, mu, eta)
-    E, M = np.meshgrid(eta, mu, indexing="ij")
-    model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
-    dE = delta_E_map(target, model)
-    return {
-        "fit_id": record.id, "against": against, "theta_deg": theta.tolist(), "eta_i": eta.tolist(),
-        "delta_E": np.round(dE, 4).tolist(), "delta_E_mean": float(dE.mean()),
-        "delta_E_max": float(dE.max()),
-    }
