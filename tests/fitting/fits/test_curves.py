@@ -75,6 +75,7 @@ class TestFitCurves:
         assert result.metrics["delta_E_mean"] < 0.3 and result.metrics["target"]["delta_E_mean"] < 0.4
         assert "Au with RGB curves edited at eta_i 1.5" in result.packed.source
 
+    @pytest.mark.slow  # 4.0 s of CPU in a --durations run (a full refit)
     def test_edit_moves_the_fit(self, gold_base):
         plain = fit_curves([RGBCurve(1.5, MU, gold_base.rgb(MU, 1.5))], base=gold_base)
         edit = gold_base.rgb(MU, 1.5)

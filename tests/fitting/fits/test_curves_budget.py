@@ -66,6 +66,7 @@ def evaluations_of(monkeypatch):
 
 
 class TestWorstEdits:
+    @pytest.mark.slow  # 2.0 s of CPU in a --durations run (a full refit)
     def test_an_edit_the_model_cannot_follow_stays_in_budget_and_range(self, gold_base, monkeypatch):
         counted = evaluations_of(monkeypatch)
         settings = CurveFitSettings()
@@ -91,6 +92,7 @@ class TestWorstEdits:
         assert in_range(result)
         assert result.metrics["best_effort"] is True
 
+    @pytest.mark.slow  # 2.9 s of CPU in a --durations run (a full refit)
     def test_a_small_budget_is_a_flagged_best_effort_in_range(self, gold_base):
         result = fit_curves(green_pulled(gold_base, 0.10), gold_base, max_evaluations=30)
         assert result.metrics["best_effort"] is True
