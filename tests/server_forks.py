@@ -18,8 +18,9 @@ a server for each :meth:`ServerForks.start` and a command for each
 :meth:`ServerForks.run`: the fork sets the process's environment, working
 directory, output (and a server's session), and returns to the top of this
 program, which runs the package's ``__main__`` module as ``python -m``
-does (:func:`runpy.run_module`, ``sys.argv`` and interpreter exit
-included). The server's code, sockets, store, fork server and workers, and
+does (:func:`runpy.run_module` and ``sys.argv``), and exits as the
+interpreter does but for the tear-down of the modules' objects
+(:func:`_exit`). The server's code, sockets, store, fork server and workers, and
 the command's, are those of ``python -m``; only the imports are shared.
 
 The environment that an interpreter reads at its start (``PYTHON*``,
@@ -40,6 +41,7 @@ the servers to their stops, as a ``Popen``'s would be.
 
 from __future__ import annotations
 
+import atexit
 import gc
 import json
 import os
@@ -256,6 +258,46 @@ def _become(request: dict) -> None:
     # The signal handlers are an interpreter's at its start: the program sets none.
 
 
+def _exit(main) -> None:
+    """
+    Run ``main`` and exit as the interpreter does after ``python -m``: the
+    status of its ``SystemExit`` (0 if it returned; 1 and the traceback
+    after another exception), the non-daemon threads joined, the ``atexit``
+    handlers run (multiprocessing's clean-up among them) and the standard
+    streams flushed, then ``os._exit``. The interpreter's tear-down of the
+    modules' objects is left out: in a fork it writes to the pages of the
+    heap shared with the program (copying each): a server's stop took
+    2.2 s instead of 0.3 s at a load of 13, about 0.4 s more on a quiet
+    machine, the process on the CPU all along.
+    """
+    try:
+        main()
+        status = 0
+    except SystemExit as stop:
+        status = _exit_status(stop.code)
+    except BaseException:
+        sys.excepthook(*sys.exc_info())
+        status = 1
+    threading._shutdown()  # what the interpreter's exit calls first: wait for the non-daemon threads
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(status)
+
+
+def _exit_status(code) -> int:
+    """A ``SystemExit``'s code as the interpreter's status: ``None`` 0, an int itself, else printed and 1."""
+    if code is None:
+        return 0
+    if isinstance(code, int):
+        return code & 0xFF
+    print(code, file=sys.stderr)
+    return 1
+
+
 if __name__ == "__main__":
     sys.path[0] = os.getcwd()  # as ``python -m``'s (``-c`` puts '' there)
     import fitting.cli.main  # noqa: F401 (what python -m fitting imports)
@@ -276,5 +318,4 @@ if __name__ == "__main__":
     if started is None:
         sys.exit(0)
     module, sys.argv = started[0], ["-m", *started[1]]  # run_module puts the __main__ file's path first
-    runpy.run_module(module, run_name="__main__", alter_sys=True)
-    sys.exit(0)  # a __main__ that returned (python -m exits 0)
+    _exit(lambda: runpy.run_module(module, run_name="__main__", alter_sys=True))

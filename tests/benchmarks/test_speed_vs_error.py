@@ -238,6 +238,7 @@ class TestBatchSummary:
         with pytest.raises(ValueError, match="not a JSON object"):
             read_batch_report(path)
 
+    @pytest.mark.slow  # 2.5 s at load 3.5 in the quick loop's run, 1.1 s of CPU
     def test_batch_figure_is_a_png(self, report, tmp_path):
         path = tmp_path / "images" / "batch.png"
         figure_batch(path, [report], ["coated-conductor", "rgb-conductor", "lazanyi_adjusted"])

@@ -174,9 +174,12 @@ def test_drafts_expire_and_count_against_their_quota(tmp_path):
     with server_process(tmp_path / "quota", COATED_DRAFT_MAX_BYTES="20000", COATED_DRAFT_SWEEP_S="0.5") as server, \
             loopback.Client(base_url=server.url, timeout=120) as http:
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
-        ids = [http.post(f"{API}/fits/from-curves", json=step(base, None, 0.3 + 0.05 * i, live=False)).json()["id"]
+        # Live steps: drafts as the save above is one, without its full refit each.
+        ids = [http.post(f"{API}/fits/from-curves", json=step(base, None, 0.3 + 0.05 * i)).json()["id"]
                for i in range(6)]
-        time.sleep(1.5)
+        deadline = time.monotonic() + 20  # a sweep every 0.5 s
+        while http.get(f"{API}/fits/{ids[0]}").status_code == 200 and time.monotonic() < deadline:
+            time.sleep(0.1)
         kept = [http.get(f"{API}/fits/{i}").status_code == 200 for i in ids]
         assert kept[-1] and not kept[0], kept  # the oldest went first
         assert stored_bytes(tmp_path / "quota") - 0 < 200_000
@@ -187,8 +190,9 @@ def test_a_draft_a_saved_material_or_a_link_refers_to_outlives_its_time_to_live(
     # Made under the default time to live (a save is a full refit: tens of seconds on a busy machine) ...
     with server_process(data) as server, loopback.Client(base_url=server.url, timeout=120) as http:
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
+        # The drafts are live steps (a draft without a save's full refit); the save on one is a full refit.
         on_draft, loose, linked = (
-            http.post(f"{API}/fits/from-curves", json=step(base, None, value, live=False)).json()["id"]
+            http.post(f"{API}/fits/from-curves", json=step(base, None, value)).json()["id"]
             for value in (0.50, 0.55, 0.60))
         saved = http.post(f"{API}/fits/from-curves", json={**step(on_draft, None, 0.45, live=False),
                                                           "draft": False, "name": "saved on a draft"})
@@ -236,7 +240,7 @@ def test_a_save_keeps_its_draft_base_while_it_is_fitted(tmp_path):
     with server_process(tmp_path / "data", COATED_DRAFT_TTL_S="4", COATED_DRAFT_SWEEP_S="0.25") as server, \
             loopback.Client(base_url=server.url, timeout=120) as http:
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
-        draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5, live=False))
+        draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5))  # a live step: a draft
         assert draft.status_code == 201, draft.text[:300]
         draft_id, created = draft.json()["id"], http.get(f"{API}/fits/{draft.json()['id']}").json()["created_at"]
         workers = _workers(server.process.pid)

@@ -87,6 +87,7 @@ def test_reported_figures_are_over_the_whole_blended_target():
     assert again["delta_E_max"] == pytest.approx(float(dE.max()), rel=1e-9)
 
 
+@pytest.mark.slow  # 2.6 s of CPU in a --durations run (a full refit)
 def test_single_curve_edit_leaves_far_rows_at_the_base():
     base = base_of("Au")
     curves = [pulled(base, 1.5, 0, 50, 0.7)]

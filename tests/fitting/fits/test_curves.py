@@ -67,6 +67,7 @@ class TestFitCurves:
         # precision bound: another CPU's kernels move it by ~1e-10 (solver tol).
         assert dE.mean() < 0.2
 
+    @pytest.mark.slow  # 2.4 s at load 3.5 in the quick loop's run, 1.9 s of CPU (a full refit)
     def test_unedited_base_reproduces_the_material(self, gold_base):
         result = fit_curves([RGBCurve(1.5, MU, gold_base.rgb(MU, 1.5))], base=gold_base, name="Au copy")
         assert result.degree == 2
@@ -75,6 +76,7 @@ class TestFitCurves:
         assert result.metrics["delta_E_mean"] < 0.3 and result.metrics["target"]["delta_E_mean"] < 0.4
         assert "Au with RGB curves edited at eta_i 1.5" in result.packed.source
 
+    @pytest.mark.slow  # 4.0 s of CPU in a --durations run (a full refit)
     def test_edit_moves_the_fit(self, gold_base):
         plain = fit_curves([RGBCurve(1.5, MU, gold_base.rgb(MU, 1.5))], base=gold_base)
         edit = gold_base.rgb(MU, 1.5)

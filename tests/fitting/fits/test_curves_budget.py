@@ -66,6 +66,7 @@ def evaluations_of(monkeypatch):
 
 
 class TestWorstEdits:
+    @pytest.mark.slow  # 2.0 s of CPU in a --durations run (a full refit)
     def test_an_edit_the_model_cannot_follow_stays_in_budget_and_range(self, gold_base, monkeypatch):
         counted = evaluations_of(monkeypatch)
         settings = CurveFitSettings()
@@ -79,6 +80,7 @@ class TestWorstEdits:
         assert chosen["delta_E_mean"] <= paper["delta_E_mean"] and chosen["delta_E_max"] <= paper["delta_E_max"]
         assert result.metrics["warnings"] and "cannot bend that way" in result.metrics["warnings"][0]
 
+    @pytest.mark.slow  # 2.2 s at load 3.5 in the quick loop's run, 1.5 s of CPU (a full refit)
     def test_a_degenerate_base_stays_in_budget_and_range(self, monkeypatch):
         # n = 1, k = 0: the base has no conductor at all.
         nk = SpectralNK(np.array([300.0, 900.0]), np.ones(2), np.zeros(2), name="void", source="user n, k")
@@ -91,11 +93,13 @@ class TestWorstEdits:
         assert in_range(result)
         assert result.metrics["best_effort"] is True
 
+    @pytest.mark.slow  # 2.9 s of CPU in a --durations run (a full refit)
     def test_a_small_budget_is_a_flagged_best_effort_in_range(self, gold_base):
         result = fit_curves(green_pulled(gold_base, 0.10), gold_base, max_evaluations=30)
         assert result.metrics["best_effort"] is True
         assert in_range(result)
 
+    @pytest.mark.slow  # 2.1 s at load 3.5 in the quick loop's run, 1.8 s of CPU (a full refit)
     def test_a_gentle_edit_is_no_best_effort(self, gold_base):
         result = fit_curves(green_pulled(gold_base, 0.5, step=0.2), gold_base)
         assert result.metrics["best_effort"] is False

@@ -60,6 +60,7 @@ def test_zero_steps_is_the_input():
     assert score == guard_score(ACEScg_to_Lab(target), coated_conductor_model(M, E, C16, DOMAIN), M, E)
 
 
+@pytest.mark.slow  # 2.7 s of CPU in a --durations run (a full refit)
 def test_a_refit_that_keeps_the_twin_is_ahead_of_the_papers_method():
     # All three channels scaled at 36 degrees on four rows (benchmarks/curve_edits_vs_paper.py's
     # "Cu 4 scale"): the guard keeps the paper method's twin, which tied with an auditor's fit
