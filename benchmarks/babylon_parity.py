@@ -55,8 +55,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--materials", default="Au,Cu,Ag,Al,Cr", help="comma-separated library materials")
     parser.add_argument("--etas", default=ETAS, help="comma-separated coat indices")
-    parser.add_argument("--result", default="babylon_parity",
-                        help="name of the figures' record, benchmarks/results/NAME.json ('-': none)")
+    parser.add_argument(
+        "--result",
+        default="babylon_parity",
+        help="name of the figures' record, benchmarks/results/NAME.json ('-': none)",
+    )
     args = parser.parse_args()
     materials = args.materials.split(",")
     etas = [float(e) for e in args.etas.split(",")]
@@ -82,16 +85,27 @@ def main() -> None:
                             opened = True
                         show_babylon(babylon, server.url, fit["id"], eta_i)
                         f = measure_babylon(three, babylon)
-                        rows.append({"material": material, "kind": kind, "eta_i": eta_i, **f["babylon_vs_three"],
-                                     "pixels": f["pixels"]})
-                        print(f"{material} {kind} {eta_i}: mean {rows[-1]['mean']:.3f} max {rows[-1]['max']:.3f}",
-                              file=sys.stderr)
+                        rows.append(
+                            {
+                                "material": material,
+                                "kind": kind,
+                                "eta_i": eta_i,
+                                **f["babylon_vs_three"],
+                                "pixels": f["pixels"],
+                            }
+                        )
+                        print(
+                            f"{material} {kind} {eta_i}: mean {rows[-1]['mean']:.3f} max {rows[-1]['max']:.3f}",
+                            file=sys.stderr,
+                        )
             browser.close()
     load = max(load, os.getloadavg()[0])
     print("| material | kind | eta_i | mean | p99 | max | centre | ring |\n|---|---|---:|---:|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['material']} | {r['kind']} | {r['eta_i']} | {r['mean']:.3f} | {r['p99']:.3f} | "
-              f"{r['max']:.3f} | {r['centre']:.3f} | {r['ring']:.3f} |")
+        print(
+            f"| {r['material']} | {r['kind']} | {r['eta_i']} | {r['mean']:.3f} | {r['p99']:.3f} | "
+            f"{r['max']:.3f} | {r['centre']:.3f} | {r['ring']:.3f} |"
+        )
     worst = max(rows, key=lambda r: r["mean"])
     summary = {
         "settings": len(rows),
@@ -103,8 +117,15 @@ def main() -> None:
         "rows": rows,
     }
     if args.result != "-":
-        path = write_result(args.result, summary, load, materials=materials, etas=etas,
-                            seconds=round(time.perf_counter() - started), babylon=babylon_version())
+        path = write_result(
+            args.result,
+            summary,
+            load,
+            materials=materials,
+            etas=etas,
+            seconds=round(time.perf_counter() - started),
+            babylon=babylon_version(),
+        )
         print(f"recorded in {path.relative_to(ROOT)}", file=sys.stderr)
     else:
         print(json.dumps(summary, indent=1))

@@ -67,8 +67,9 @@ def _job(name_kind: tuple[str, str]) -> tuple[float, int]:
     fit = nk_jobs.NKFit.library(name, (1.0, 2.5), "de2000", 100, kind)
     start = time.perf_counter()
     job = nk_jobs._fit_part(fit)
-    evaluation._evaluate_part(fit.nk, name, job["material"], job["evaluation"]["coefficients_float64"], 100,
-                              job["coverage"])
+    evaluation._evaluate_part(
+        fit.nk, name, job["material"], job["evaluation"]["coefficients_float64"], 100, job["coverage"]
+    )
     return time.perf_counter() - start, _blas_threads()
 
 
@@ -85,9 +86,14 @@ def run(initializer, names: list[str]) -> dict:
         out = list(pool.map(_job, names))
         total = time.perf_counter() - start
     seconds = np.array([s for s, _ in out]) * 1e3
-    return {"blas_threads": out[0][1], "jobs": len(names), "median_ms": float(np.median(seconds)),
-            "p90_ms": float(np.percentile(seconds, 90)), "max_ms": float(seconds.max()),
-            "total_s": total}
+    return {
+        "blas_threads": out[0][1],
+        "jobs": len(names),
+        "median_ms": float(np.median(seconds)),
+        "p90_ms": float(np.percentile(seconds, 90)),
+        "max_ms": float(seconds.max()),
+        "total_s": total,
+    }
 
 
 def _spin() -> None:
@@ -107,14 +113,17 @@ def main(argv=None) -> None:
     load_start = os.getloadavg()[0]
     rows = {}
     for busy in (0, args.busy):
-        spinners = [multiprocessing.get_context("spawn").Process(target=_spin, daemon=True)
-                    for _ in range(busy)]
+        spinners = [multiprocessing.get_context("spawn").Process(target=_spin, daemon=True) for _ in range(busy)]
         for p in spinners:
             p.start()
         try:
             # Interleaved so that other load on the machine falls on both alike.
-            for label, init in (("before", warm_process), ("after", _after),
-                                ("before", warm_process), ("after", _after)):
+            for label, init in (
+                ("before", warm_process),
+                ("after", _after),
+                ("before", warm_process),
+                ("after", _after),
+            ):
                 r = run(init, names)
                 key = f"{label}, {busy} busy"
                 best = rows.get(key)
@@ -124,21 +133,30 @@ def main(argv=None) -> None:
             for p in spinners:
                 p.kill()
     load_end = os.getloadavg()[0]
-    print(f"{'workers':<44} {'BLAS threads':>12} {'jobs':>5} {'median ms':>10} {'p90 ms':>8} "
-          f"{'max ms':>8} {'total s':>8}")
+    print(
+        f"{'workers':<44} {'BLAS threads':>12} {'jobs':>5} {'median ms':>10} {'p90 ms':>8} {'max ms':>8} {'total s':>8}"
+    )
     for key, r in rows.items():
         label, busy = key.split(", ")
         what = ("before (warm_process)" if label == "before" else "after (worker_start)") + f", {busy}"
-        print(f"{what:<44} {r['blas_threads']:>12} {r['jobs']:>5} {r['median_ms']:>10.1f} "
-              f"{r['p90_ms']:>8.1f} {r['max_ms']:>8.1f} {r['total_s']:>8.2f}")
+        print(
+            f"{what:<44} {r['blas_threads']:>12} {r['jobs']:>5} {r['median_ms']:>10.1f} "
+            f"{r['p90_ms']:>8.1f} {r['max_ms']:>8.1f} {r['total_s']:>8.2f}"
+        )
     print(f"load average {load_start:.2f} at the start, {load_end:.2f} at the end (best of 2 each)")
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps({
-        "command": "benchmarks/blas_threads.py " + " ".join(argv or sys.argv[1:]),
-        "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "load_average": [round(load_start, 2), round(load_end, 2)],
-        "rows": rows,
-    }, indent=2) + "\n")
+    RESULTS.write_text(
+        json.dumps(
+            {
+                "command": "benchmarks/blas_threads.py " + " ".join(argv or sys.argv[1:]),
+                "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+                "load_average": [round(load_start, 2), round(load_end, 2)],
+                "rows": rows,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
 
 
 if __name__ == "__main__":

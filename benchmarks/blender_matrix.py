@@ -51,8 +51,7 @@ METALS = "Au,Cu,Ag,Al,CuZn,Cr,Ni,W"
 ETA_I = "1.0,1.5,2.0"
 ANGLES_DEG = tuple(range(0, 81, 10))
 CYCLES_ANGLES = ROOT / "tests" / "fitting" / "exports" / "cycles_angles.py"
-TOOLS = {"principled": "blender", "conductor": "blender-conductor",
-         "conductor_ungated": "blender-conductor"}
+TOOLS = {"principled": "blender", "conductor": "blender-conductor", "conductor_ungated": "blender-conductor"}
 GATE = "CONDUCTOR_FROM = (5, 0, 0)"
 
 
@@ -76,9 +75,21 @@ def render_many(python: Path, scripts: list[Path], samples: int, work: Path) -> 
     if not python.exists():
         raise FileNotFoundError(f"{python} is missing: run scripts/bootstrap")
     result = subprocess.run(
-        [str(python), str(CYCLES_ANGLES), *map(str, scripts), "--output", "principled,conductor",
-         "--angles", ",".join(str(a) for a in ANGLES_DEG), "--samples", str(samples)],
-        capture_output=True, text=True, timeout=1800, cwd=work,
+        [
+            str(python),
+            str(CYCLES_ANGLES),
+            *map(str, scripts),
+            "--output",
+            "principled,conductor",
+            "--angles",
+            ",".join(str(a) for a in ANGLES_DEG),
+            "--samples",
+            str(samples),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=1800,
+        cwd=work,
     )
     if result.returncode != 0:
         raise RuntimeError(result.stdout[-3000:] + result.stderr[-3000:])
@@ -127,8 +138,12 @@ def measure(materials: list[str], etas: list[float], samples: int, ungated: bool
                         continue
                     got = rendered[twin]["conductor"] if output == "conductor_ungated" else rendered[script][output]
                     mirror = seen_fidelity(values, tool)
-                    row = {"material": metal, "eta_i": eta, "output": output,
-                           "mirror_mean": round(mirror["delta_E_mean"], 4)}
+                    row = {
+                        "material": metal,
+                        "eta_i": eta,
+                        "output": output,
+                        "mirror_mean": round(mirror["delta_E_mean"], 4),
+                    }
                     if "error" in got:
                         row["absent"] = got["error"]
                     else:
@@ -171,10 +186,15 @@ def main(argv: list[str] | None = None) -> int:
     # Keyed "blender_5_0_1" (the docs' figure markers take dotted paths).
     figures = {"blender_" + version.replace(".", "_"): summary(data["rows"]) for version, data in versions.items()}
     write_result(
-        "blender_matrix", figures, load,
+        "blender_matrix",
+        figures,
+        load,
         what="seen Delta E 2000 of the Blender export rendered by each Blender release (Cycles, plane, "
-             "white world, view angles 0-80 deg), per output; the mirror is the fit's own figure",
-        materials=args.materials, eta_i=args.eta_i, samples=args.samples, angles_deg=list(ANGLES_DEG),
+        "white world, view angles 0-80 deg), per output; the mirror is the fit's own figure",
+        materials=args.materials,
+        eta_i=args.eta_i,
+        samples=args.samples,
+        angles_deg=list(ANGLES_DEG),
         versions=versions,
     )
     print(json.dumps(figures, indent=1))

@@ -99,8 +99,7 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--rounds must lie in [1, 100], got {args.rounds}")
     load = load_average()
     runs: dict[str, list[dict]] = {side: [] for side in SIDES}
-    with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data") as server, \
-            sync_playwright() as p:
+    with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data") as server, sync_playwright() as p:
         browsers = {
             "plain": launch(p, plain=True),
             "tests": launch(p),
@@ -113,8 +112,13 @@ def main(argv: list[str] | None = None) -> None:
             for round_ in range(args.rounds):
                 for side in SIDES if round_ % 2 == 0 else SIDES[::-1]:
                     wall, spent = load_once(browsers[side], url, servers)
-                    runs[side].append({"wall_s": round(wall, 3), "cpu_s": round(sum(spent.values()), 3),
-                                       "kinds": {k: round(v, 3) for k, v in sorted(spent.items())}})
+                    runs[side].append(
+                        {
+                            "wall_s": round(wall, 3),
+                            "cpu_s": round(sum(spent.values()), 3),
+                            "kinds": {k: round(v, 3) for k, v in sorted(spent.items())},
+                        }
+                    )
         finally:
             for browser in browsers.values():
                 browser.close()
@@ -130,9 +134,11 @@ def main(argv: list[str] | None = None) -> None:
             "cpu_s_median_by_kind": kind_median,
         }
         f = figures[side]
-        print(f"{side:<6} {f['cpu_s']['median']:>19.2f} ({f['cpu_s']['max']:.2f}) "
-              f"{kind_median['chromium_renderer']:>9.2f} {kind_median['chromium_browser']:>8.2f} "
-              f"{kind_median['chromium_gpu']:>6.2f} {f['wall_s']['median']:>7.2f}")
+        print(
+            f"{side:<6} {f['cpu_s']['median']:>19.2f} ({f['cpu_s']['max']:.2f}) "
+            f"{kind_median['chromium_renderer']:>9.2f} {kind_median['chromium_browser']:>8.2f} "
+            f"{kind_median['chromium_gpu']:>6.2f} {f['wall_s']['median']:>7.2f}"
+        )
     figures["saved_cpu_s_median"] = round(figures["plain"]["cpu_s"]["median"] - figures["tests"]["cpu_s"]["median"], 3)
     print(f"saved a load (median): {figures['saved_cpu_s_median']:.2f} CPU s")
     path = write_result("browser_page_cost", figures, load, rounds=args.rounds, runs=runs)

@@ -53,16 +53,22 @@ def run_once(root: Path, material: str) -> tuple[float, float]:
     """Wall and CPU seconds of one ``python -m fitting fit MATERIAL --json`` in ``root``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "fitting", "fit", material, "--json"], cwd=root, check=True,
-                   stdout=subprocess.DEVNULL)
+    subprocess.run(
+        [sys.executable, "-m", "fitting", "fit", material, "--json"], cwd=root, check=True, stdout=subprocess.DEVNULL
+    )
     wall = time.perf_counter() - t
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def heavy_modules(root: Path, material: str) -> list[str]:
-    done = subprocess.run([sys.executable, "-c", _HEAVY_PROBE, "fit", material, "--json"], cwd=root,
-                          check=True, capture_output=True, text=True)
+    done = subprocess.run(
+        [sys.executable, "-c", _HEAVY_PROBE, "fit", material, "--json"],
+        cwd=root,
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
@@ -79,17 +85,24 @@ def main(argv=None) -> int:
         for name in roots:  # the first run of each side warms the file cache
             run_once(roots[name], args.material)
         for i in range(args.runs):
-            for name in (("before", "after") if i % 2 == 0 else ("after", "before")):
+            for name in ("before", "after") if i % 2 == 0 else ("after", "before"):
                 runs[name].append(run_once(roots[name], args.material))
-            print(f"run {i + 1}: before {runs['before'][-1][0]:.2f} s wall {runs['before'][-1][1]:.2f} s CPU, "
-                  f"after {runs['after'][-1][0]:.2f} s wall {runs['after'][-1][1]:.2f} s CPU, "
-                  f"load {os.getloadavg()[0]:.2f}", flush=True)
+            print(
+                f"run {i + 1}: before {runs['before'][-1][0]:.2f} s wall {runs['before'][-1][1]:.2f} s CPU, "
+                f"after {runs['after'][-1][0]:.2f} s wall {runs['after'][-1][1]:.2f} s CPU, "
+                f"load {os.getloadavg()[0]:.2f}",
+                flush=True,
+            )
         heavy = {name: heavy_modules(root, args.material) for name, root in roots.items()}
     figures = {"before_commit": args.before, "material": args.material, "runs": args.runs}
     for name, values in runs.items():
         wall, cpu = np.array(values).T
-        figures[name] = {"wall_median_s": float(np.median(wall)), "wall_max_s": float(wall.max()),
-                         "cpu_median_s": float(np.median(cpu)), "cpu_max_s": float(cpu.max())}
+        figures[name] = {
+            "wall_median_s": float(np.median(wall)),
+            "wall_max_s": float(wall.max()),
+            "cpu_median_s": float(np.median(cpu)),
+            "cpu_max_s": float(cpu.max()),
+        }
     figures["cpu_ratio"] = figures["after"]["cpu_median_s"] / figures["before"]["cpu_median_s"]
     figures["heavy_before"], figures["heavy_after"] = heavy["before"], heavy["after"]
     print(json.dumps(figures, indent=1))

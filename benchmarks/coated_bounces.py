@@ -54,7 +54,10 @@ from fitting.optics.library import library_material  # noqa: E402
 from fitting.shading.coated_layer import seen_base  # noqa: E402
 from fitting.shading.ibl import directional_albedo  # noqa: E402
 from fitting.shading.microfacet import (  # noqa: E402
-    alpha_g_from_roughness, sample_visible_normal, smith_G1, smith_G2,
+    alpha_g_from_roughness,
+    sample_visible_normal,
+    smith_G1,
+    smith_G2,
 )
 
 BOUNCES = 24
@@ -107,8 +110,11 @@ def case(nk, eta: float, roughness: float, samples: int) -> dict:
     E = directional_albedo(refracted_cos(MU, eta), roughness, fresnel)
     truth = coat + walk(fresnel, eta, roughness, MU, samples)
     figures = {}
-    variants = [("layer", seen_base(MU, eta, roughness, fresnel)), ("series", series(E, MU, eta)),
-                ("first_bounce", series(E, MU, eta, bounces=False))]
+    variants = [
+        ("layer", seen_base(MU, eta, roughness, fresnel)),
+        ("series", series(E, MU, eta)),
+        ("first_bounce", series(E, MU, eta, bounces=False)),
+    ]
     for name, base in variants:
         dE = delta_E_map(truth, coat + base)
         figures[name] = {"mean": float(dE.mean()), "max": float(dE.max())}
@@ -130,10 +136,13 @@ def main() -> None:
             for roughness in ROUGHNESS:
                 f = case(nk, eta, roughness, args.samples)
                 rows.append({"material": material, "eta_i": eta, "roughness": roughness, **f})
-                print(f"{material} eta {eta} r {roughness}: layer {f['layer']['mean']:.3f} "
-                      f"(max {f['layer']['max']:.3f}), series {f['series']['mean']:.3f}, "
-                      f"first bounce {f['first_bounce']['mean']:.3f}, "
-                      f"luminance ratio {f['luminance_ratio']:.4f}", file=sys.stderr)
+                print(
+                    f"{material} eta {eta} r {roughness}: layer {f['layer']['mean']:.3f} "
+                    f"(max {f['layer']['max']:.3f}), series {f['series']['mean']:.3f}, "
+                    f"first bounce {f['first_bounce']['mean']:.3f}, "
+                    f"luminance ratio {f['luminance_ratio']:.4f}",
+                    file=sys.stderr,
+                )
     # The walk's check: a near-mirror metal gives the mirror's series.
     nk = library_material("Au")
     fresnel = metal_fresnel(nk, 1.5)
@@ -144,16 +153,27 @@ def main() -> None:
     for r in ROUGHNESS:
         of = [row for row in rows if row["roughness"] == r]
         key = f"r{round(100 * r):02d}"  # r10, r30, r60: no dot in a figure's path
-        by[key] = {name: {"mean": float(np.mean([o[name]["mean"] for o in of])),
-                               "worst_mean": float(max(o[name]["mean"] for o in of)),
-                               "worst_max": float(max(o[name]["max"] for o in of))}
-                        for name in ("layer", "series", "first_bounce")}
+        by[key] = {
+            name: {
+                "mean": float(np.mean([o[name]["mean"] for o in of])),
+                "worst_mean": float(max(o[name]["mean"] for o in of)),
+                "worst_max": float(max(o[name]["max"] for o in of)),
+            }
+            for name in ("layer", "series", "first_bounce")
+        }
         by[key]["luminance_ratio_min"] = float(min(o["luminance_ratio"] for o in of))
     figures = {"by_roughness": by, "check_mirror_mean": check, "cases": len(rows)}
     print(figures)
     if args.record != "-":
-        path = write_result(args.record, figures, load, rows=rows, samples=args.samples, bounces=BOUNCES,
-                            seconds=round(time.perf_counter() - started))
+        path = write_result(
+            args.record,
+            figures,
+            load,
+            rows=rows,
+            samples=args.samples,
+            bounces=BOUNCES,
+            seconds=round(time.perf_counter() - started),
+        )
         print(f"recorded in {path.relative_to(ROOT)}", file=sys.stderr)
 
 

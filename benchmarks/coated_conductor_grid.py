@@ -45,8 +45,14 @@ ROUGHNESS, COAT_ROUGHNESS = 0.2, 0.03
 KIND = "coated-conductor"
 SIZE = (960, 640)
 GENERATOR = "coated-fresnel benchmarks/coated_conductor_grid.py"
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                 "--disable-component-update", "--no-first-run"]
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+]
 
 PAGE = """<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>CoatedConductorGrid</title><link rel="icon" href="data:,">
@@ -96,8 +102,11 @@ def build(out: Path) -> dict:
         nk = library_material(metal)
         packed = fit_model(nk, ETA_RANGE, KIND).packed
         for r, eta in enumerate(COAT_INDICES):
-            rows[r].append(export_values(nk, eta, roughness=ROUGHNESS, coat_roughness=COAT_ROUGHNESS,
-                                         model=packed, tools=("gltf",)))
+            rows[r].append(
+                export_values(
+                    nk, eta, roughness=ROUGHNESS, coat_roughness=COAT_ROUGHNESS, model=packed, tools=("gltf",)
+                )
+            )
     asset, buffer = grid_asset(rows, GENERATOR)
     text, binary = grid_gltf(asset, buffer, f"{NAME}.bin")
     (out / "glTF").mkdir(parents=True, exist_ok=True)
@@ -133,8 +142,9 @@ def screenshot(out: Path) -> int:
                     if errors:
                         raise RuntimeError(f"the page failed: {errors}")
                     (out / "screenshot").mkdir(parents=True, exist_ok=True)
-                    page.locator("canvas").screenshot(path=str(out / "screenshot" / "screenshot.jpg"),
-                                                      type="jpeg", quality=88)
+                    page.locator("canvas").screenshot(
+                        path=str(out / "screenshot" / "screenshot.jpg"), type="jpeg", quality=88
+                    )
                     return int(page.evaluate("document.body.dataset.drawn"))
                 finally:
                     browser.close()
@@ -194,9 +204,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-screenshot", action="store_true")
     args = parser.parse_args(argv)
     asset = build(args.out)
-    (args.out / "README.md").write_text(README.format(
-        metals=", ".join(METALS), indices=", ".join(f"{e:g}" for e in COAT_INDICES), kind=KIND,
-        lo=ETA_RANGE[0], hi=ETA_RANGE[1], roughness=ROUGHNESS, coat=COAT_ROUGHNESS, name=NAME))
+    (args.out / "README.md").write_text(
+        README.format(
+            metals=", ".join(METALS),
+            indices=", ".join(f"{e:g}" for e in COAT_INDICES),
+            kind=KIND,
+            lo=ETA_RANGE[0],
+            hi=ETA_RANGE[1],
+            roughness=ROUGHNESS,
+            coat=COAT_ROUGHNESS,
+            name=NAME,
+        )
+    )
     print(f"{len(asset['materials'])} materials written to {args.out}")
     if not args.no_screenshot:
         drawn = screenshot(args.out)

@@ -27,12 +27,9 @@ def main() -> None:
     for name in ("Cr", "Au"):
         packed = fit_material(library_material(name)).packed
         for eta_i in (1.5, 2.5):
-            F0, a, alpha = collapse_to_eta_i(
-                packed.coefficients.astype(np.float64), eta_i, packed.eta_i_range
-            )[..., 0]
+            F0, a, alpha = collapse_to_eta_i(packed.coefficients.astype(np.float64), eta_i, packed.eta_i_range)[..., 0]
             for r in (0.05, 0.3, 0.6):
-                mc = directional_albedo(NDOTV, r, model_fresnel(F0, a, alpha), "coated", eta_i, 0.1,
-                                        samples=16384)
+                mc = directional_albedo(NDOTV, r, model_fresnel(F0, a, alpha), "coated", eta_i, 0.1, samples=16384)
                 error = split_sum_coated(NDOTV, r, F0, a, alpha, eta_i, 0.1) / mc.mean - 1.0
                 print(f"| {name} | {eta_i:g} | {r:g} | {100 * error.max():+.1f} % | {100 * error.min():+.1f} % |")
 

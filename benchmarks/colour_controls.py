@@ -63,7 +63,7 @@ SAMPLES = 46
 
 def srgb_hex_to_linear(hex_colour: str) -> np.ndarray:
     """``#rrggbb`` to linear Rec.709 (the sRGB transfer function, as colour-science's eotf_sRGB)."""
-    v = np.array([int(hex_colour[i:i + 2], 16) for i in (1, 3, 5)], dtype=np.float64) / 255.0
+    v = np.array([int(hex_colour[i : i + 2], 16) for i in (1, 3, 5)], dtype=np.float64) / 255.0
     return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
@@ -83,8 +83,13 @@ def follow(base_hex: str, edge_hex: str, base=None) -> dict:
     schlick = F0 + (1.0 - F0) * (1.0 - F82_COS_THETA) ** 5
     picked = lin_rec709_to_ACEScg(np.stack([F0, tint * schlick]))
     normal, grazing = delta_E_map(picked, fitted)
-    return {"delta_E_normal": float(normal), "delta_E_82": float(grazing), "fit_s": seconds, "fit_cpu_s": cpu,
-            "reachable": bool(all(answer["reachable"]))}
+    return {
+        "delta_E_normal": float(normal),
+        "delta_E_82": float(grazing),
+        "fit_s": seconds,
+        "fit_cpu_s": cpu,
+        "reachable": bool(all(answer["reachable"])),
+    }
 
 
 def main(argv=None) -> dict:
@@ -99,17 +104,25 @@ def main(argv=None) -> dict:
     worst = max(rows, key=lambda name: rows[name]["delta_E_normal"])
     figures = {
         "pairs": len(rows),
-        "normal": {"mean": float(normal.mean()), "max": float(normal.max()), "worst": worst,
-                   "within_1": int(np.sum(normal <= 1.0))},
+        "normal": {
+            "mean": float(normal.mean()),
+            "max": float(normal.max()),
+            "worst": worst,
+            "within_1": int(np.sum(normal <= 1.0)),
+        },
         "at_82": {"mean": float(grazing.mean()), "max": float(grazing.max())},
         "fit_ms": {"median": float(1e3 * np.median(times)), "max": float(1e3 * times.max())},
         "fit_cpu_ms": {"median": float(1e3 * np.median(cpu)), "max": float(1e3 * cpu.max())},
     }
     for name, r in rows.items():
-        print(f"{name:14s} dE normal {r['delta_E_normal']:.3f}  dE 82 deg {r['delta_E_82']:.3f}  "
-              f"fit {1e3 * r['fit_s']:.0f} ms  reachable {r['reachable']}")
-    print(f"normal incidence: mean {figures['normal']['mean']:.3f}, max {figures['normal']['max']:.3f} ({worst}); "
-          f"load {load}")
+        print(
+            f"{name:14s} dE normal {r['delta_E_normal']:.3f}  dE 82 deg {r['delta_E_82']:.3f}  "
+            f"fit {1e3 * r['fit_s']:.0f} ms  reachable {r['reachable']}"
+        )
+    print(
+        f"normal incidence: mean {figures['normal']['mean']:.3f}, max {figures['normal']['max']:.3f} ({worst}); "
+        f"load {load}"
+    )
     write_result("colour_controls", figures, load, per_pair={n: {"base": b, "edge": e, **rows[n]} for n, b, e in PAIRS})
     return figures
 

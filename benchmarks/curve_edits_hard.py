@@ -130,8 +130,12 @@ def audit(base, curves, blend_width, nk, by: str = "angle", samples: int = 100):
     guess = initial_guess(target, mu, eta, base.eta_i_range, 2)
     rng = np.random.default_rng(54)
     own = fit_model(nk, base.eta_i_range).coefficients
-    starts = [guess, own, guess * (1 + 0.1 * rng.standard_normal(guess.shape)),
-              guess * (1 + 0.1 * rng.standard_normal(guess.shape))]
+    starts = [
+        guess,
+        own,
+        guess * (1 + 0.1 * rng.standard_normal(guess.shape)),
+        guess * (1 + 0.1 * rng.standard_normal(guess.shape)),
+    ]
     fits = [fit_coefficients(target, mu, eta, base.eta_i_range, 2, "rgb", start=s) for s in starts]
     best = min(fits, key=lambda f: f.cost)
     return best.coefficients_float16, (mu, eta, ACEScg_to_Lab(target))
@@ -155,20 +159,32 @@ def judge(label, material, specs, extreme, samples):
     for by in ("angle", "mu"):
         P16, grid = audit(base, curves, blend, nk, by, samples)
         (mean, max_), (paper_mean, paper_max) = score(C16, base, grid), score(P16, base, grid)
-        by_grid[by] = {"mean": mean, "max": max_, "paper_mean": paper_mean, "paper_max": paper_max,
-                       "paper_is_reflectance": bool(proven_in_range(P16, base.eta_i_range)),
-                       "no_worse": mean <= paper_mean + TOLERANCE_MEAN and max_ <= paper_max + TOLERANCE_MAX}
+        by_grid[by] = {
+            "mean": mean,
+            "max": max_,
+            "paper_mean": paper_mean,
+            "paper_max": paper_max,
+            "paper_is_reflectance": bool(proven_in_range(P16, base.eta_i_range)),
+            "no_worse": mean <= paper_mean + TOLERANCE_MEAN and max_ <= paper_max + TOLERANCE_MAX,
+        }
     by_curve = result.metrics.get("by_curve", [])
     not_followed = [c for c in by_curve if c["delta_E_mean"] > FOLLOW_MEAN or c["delta_E_max"] > FOLLOW_MAX]
     warnings = result.metrics.get("warnings", [])
     angle = by_grid["angle"]
-    return {"edit": label, "material": material, "extreme": extreme, "grid": f"{samples} x {samples}",
-            **{key: angle[key] for key in ("mean", "max", "paper_mean", "paper_max", "paper_is_reflectance",
-                                           "no_worse")},
-            "not_followed": len(not_followed), "warned": len(warnings) >= len(not_followed) > 0,
-            "warnings": warnings, "kept": result.metrics.get("guard", {}).get("chosen"), "seconds": seconds,
-            "cos_theta_evenly": by_grid["mu"],
-            "both_grids_no_worse": all(g["no_worse"] for g in by_grid.values() if g["paper_is_reflectance"])}
+    return {
+        "edit": label,
+        "material": material,
+        "extreme": extreme,
+        "grid": f"{samples} x {samples}",
+        **{key: angle[key] for key in ("mean", "max", "paper_mean", "paper_max", "paper_is_reflectance", "no_worse")},
+        "not_followed": len(not_followed),
+        "warned": len(warnings) >= len(not_followed) > 0,
+        "warnings": warnings,
+        "kept": result.metrics.get("guard", {}).get("chosen"),
+        "seconds": seconds,
+        "cos_theta_evenly": by_grid["mu"],
+        "both_grids_no_worse": all(g["no_worse"] for g in by_grid.values() if g["paper_is_reflectance"]),
+    }
 
 
 def set_figures(rows) -> dict:
@@ -177,10 +193,12 @@ def set_figures(rows) -> dict:
     on_mu = [r["cos_theta_evenly"] for r in rows if r["cos_theta_evenly"]["paper_is_reflectance"]]
     unfollowed = [r for r in rows if r["not_followed"]]
     return {
-        "edits": len(rows), "extreme": sum(r["extreme"] for r in rows),
+        "edits": len(rows),
+        "extreme": sum(r["extreme"] for r in rows),
         "paper_is_reflectance": len(judged),
         "no_worse_where_paper_is_reflectance": sum(r["no_worse"] for r in judged),
-        "not_followed": len(unfollowed), "not_followed_warned": sum(r["warned"] for r in unfollowed),
+        "not_followed": len(unfollowed),
+        "not_followed_warned": sum(r["warned"] for r in unfollowed),
         "cos_theta_evenly_paper_is_reflectance": len(on_mu),
         "cos_theta_evenly_no_worse_where_paper_is_reflectance": sum(g["no_worse"] for g in on_mu),
         "both_grids_no_worse": sum(r["both_grids_no_worse"] for r in rows),
@@ -200,12 +218,15 @@ def main(argv=None) -> int:
             row = {"set": name, **judge(label, material, specs, extreme, samples)}
             mine.append(row)
             mu = row["cos_theta_evenly"]
-            print(f"{label:34s} angle {row['mean']:.3f} / {row['max']:.2f} paper {row['paper_mean']:.3f} / "
-                  f"{row['paper_max']:.2f}{'' if row['paper_is_reflectance'] else ' (not a reflectance)'}  "
-                  f"mu {mu['mean']:.3f} / {mu['max']:.2f} paper {mu['paper_mean']:.3f} / {mu['paper_max']:.2f}"
-                  f"{'' if mu['paper_is_reflectance'] else ' (not a reflectance)'}  both {row['both_grids_no_worse']}"
-                  f"  not followed {row['not_followed']} warned {len(row['warnings'])}  {row['kept']}"
-                  f"  {row['seconds']:.1f} s", flush=True)
+            print(
+                f"{label:34s} angle {row['mean']:.3f} / {row['max']:.2f} paper {row['paper_mean']:.3f} / "
+                f"{row['paper_max']:.2f}{'' if row['paper_is_reflectance'] else ' (not a reflectance)'}  "
+                f"mu {mu['mean']:.3f} / {mu['max']:.2f} paper {mu['paper_mean']:.3f} / {mu['paper_max']:.2f}"
+                f"{'' if mu['paper_is_reflectance'] else ' (not a reflectance)'}  both {row['both_grids_no_worse']}"
+                f"  not followed {row['not_followed']} warned {len(row['warnings'])}  {row['kept']}"
+                f"  {row['seconds']:.1f} s",
+                flush=True,
+            )
         rows += mine
         figures.update(set_figures(mine) if name == "issue" else {name: set_figures(mine)})
     path = write_result("curve_edits_hard", figures, load, rows=rows)

@@ -37,7 +37,13 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from fitting import (  # noqa: E402
-    CurveFitSettings, RGBCurve, curve_base_from_nk, edited_target, fit_coefficients, fit_curves, library_material,
+    CurveFitSettings,
+    RGBCurve,
+    curve_base_from_nk,
+    edited_target,
+    fit_coefficients,
+    fit_curves,
+    library_material,
 )
 from fitting.fits.curves import score_grid, whole_target_error  # noqa: E402
 from fitting.fits.curves_range import proven_in_range  # noqa: E402
@@ -71,11 +77,9 @@ def edits():
     for material in ("Au", "Cu", "Al", "Cr", "Ag"):
         for n in (1, 2, 4):
             at = etas[:n]
-            out.append((f"{material} {n} gentle", material,
-                        [("add", k % 3, 50 + 5 * k, -0.06) for k in range(n)], at))
+            out.append((f"{material} {n} gentle", material, [("add", k % 3, 50 + 5 * k, -0.06) for k in range(n)], at))
             out.append((f"{material} {n} scale", material, [("scale", 0, 36, -0.25)] * n, at))
-            out.append((f"{material} {n} extreme", material,
-                        [("to", k % 3, 60 + 6 * k, 0.0) for k in range(n)], at))
+            out.append((f"{material} {n} extreme", material, [("to", k % 3, 60 + 6 * k, 0.0) for k in range(n)], at))
     return out
 
 
@@ -97,8 +101,10 @@ def main() -> None:
         wanted = set(args.edits.split(","))
         cases = [case for case in cases if case[0] in wanted]
     load_at_start = load_average()
-    print(f"{'edit':<18} {'default dE':>10} {'paper dE':>9} {'default max':>11} {'paper max':>9}"
-          f" {'at (deg, eta)':>14} {'range':>15} {'paper range':>15} {'kept':>7} {'ms':>6}")
+    print(
+        f"{'edit':<18} {'default dE':>10} {'paper dE':>9} {'default max':>11} {'paper max':>9}"
+        f" {'at (deg, eta)':>14} {'range':>15} {'paper range':>15} {'kept':>7} {'ms':>6}"
+    )
     rows = []
     for label, material, specs, at in cases:
         base = curve_base_from_nk(library_material(material), (1.0, 2.5))
@@ -110,36 +116,55 @@ def main() -> None:
         P = paper_fit(base, curves, settings.blend_width)
         paper = whole_target_error(base, curves, P, settings.blend_width)
         reflectance = proven_in_range(P, base.eta_i_range)
-        rows.append({"edit": label, "mean": ours["delta_E_mean"], "max": ours["delta_E_max"],
-                     "paper_mean": paper["delta_E_mean"], "paper_max": paper["delta_E_max"],
-                     "paper_is_reflectance": reflectance, "kept": result.metrics["objective"], "ms": ms})
-        print(f"{label:<18} {ours['delta_E_mean']:>10.3f} {paper['delta_E_mean']:>9.3f}"
-              f" {ours['delta_E_max']:>11.2f} {paper['delta_E_max']:>9.2f}"
-              f" {ours['at_theta_deg']:>7.0f}, {ours['at_eta_i']:.2f}"
-              f" [{ours['model_min']:.3f}, {ours['model_max']:.3f}]"
-              f" [{paper['model_min']:.3f}, {paper['model_max']:.3f}]{'' if reflectance else '*'}"
-              f" {result.metrics['objective']:>7} {ms:>6.0f}")
+        rows.append(
+            {
+                "edit": label,
+                "mean": ours["delta_E_mean"],
+                "max": ours["delta_E_max"],
+                "paper_mean": paper["delta_E_mean"],
+                "paper_max": paper["delta_E_max"],
+                "paper_is_reflectance": reflectance,
+                "kept": result.metrics["objective"],
+                "ms": ms,
+            }
+        )
+        print(
+            f"{label:<18} {ours['delta_E_mean']:>10.3f} {paper['delta_E_mean']:>9.3f}"
+            f" {ours['delta_E_max']:>11.2f} {paper['delta_E_max']:>9.2f}"
+            f" {ours['at_theta_deg']:>7.0f}, {ours['at_eta_i']:.2f}"
+            f" [{ours['model_min']:.3f}, {ours['model_max']:.3f}]"
+            f" [{paper['model_min']:.3f}, {paper['model_max']:.3f}]{'' if reflectance else '*'}"
+            f" {result.metrics['objective']:>7} {ms:>6.0f}"
+        )
     worse_mean = [r for r in rows if r["mean"] > r["paper_mean"] + 1e-9]
     worse_max = [r for r in rows if r["max"] > r["paper_max"] + 1e-9]
     figures = {
         "edits": len(rows),
-        "worse_mean": len(worse_mean), "worse_max": len(worse_max),
+        "worse_mean": len(worse_mean),
+        "worse_max": len(worse_max),
         "worse_mean_paper_reflectance": sum(r["paper_is_reflectance"] for r in worse_mean),
         "worse_max_paper_reflectance": sum(r["paper_is_reflectance"] for r in worse_max),
         "paper_not_reflectance": sum(not r["paper_is_reflectance"] for r in rows),
         "no_worse_on_both_where_paper_is_reflectance": sum(
             r["mean"] <= r["paper_mean"] + 1e-9 and r["max"] <= r["paper_max"] + 1e-9
-            for r in rows if r["paper_is_reflectance"]),
+            for r in rows
+            if r["paper_is_reflectance"]
+        ),
         "paper_is_reflectance": sum(r["paper_is_reflectance"] for r in rows),
     }
-    print(f"\n{len(rows)} edits (* the paper's fit leaves [0, 1] on {figures['paper_not_reflectance']}); "
-          f"default worse than the paper's method on the mean on {len(worse_mean)} "
-          f"({figures['worse_mean_paper_reflectance']} where the paper's fit is a reflectance), "
-          f"on the max on {len(worse_max)} ({figures['worse_max_paper_reflectance']})")
+    print(
+        f"\n{len(rows)} edits (* the paper's fit leaves [0, 1] on {figures['paper_not_reflectance']}); "
+        f"default worse than the paper's method on the mean on {len(worse_mean)} "
+        f"({figures['worse_mean_paper_reflectance']} where the paper's fit is a reflectance), "
+        f"on the max on {len(worse_max)} ({figures['worse_max_paper_reflectance']})"
+    )
     if args.edits:
         return
-    print("recorded:", write_result("curve_edits_vs_paper" + ("_quick" if args.quick else ""), figures,
-                                    load_at_start, rows=rows))
+    print(
+        "recorded:",
+        write_result("curve_edits_vs_paper" + ("_quick" if args.quick else ""), figures, load_at_start, rows=rows),
+    )
+
 
 if __name__ == "__main__":
     main()

@@ -33,8 +33,14 @@ from benchmarks.record import load_average, write_result  # noqa: E402
 BEFORE = "b4bb5aa"
 """The last commit whose curve guard judged the angle grid alone."""
 
-EDITS = ("Pd blue lift", "W gentle step", "Co red crossing green", "Al two tints", "Au red pulled to 0.1",
-         "Ni steep red step")
+EDITS = (
+    "Pd blue lift",
+    "W gentle step",
+    "Co red crossing green",
+    "Al two tints",
+    "Au red pulled to 0.1",
+    "Ni steep red step",
+)
 
 _WORKER = """
 import json, sys, time
@@ -58,42 +64,66 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     load = load_average()
     with tempfile.TemporaryDirectory() as old:
-        archive = subprocess.run(["git", "archive", args.before, "fitting"], cwd=ROOT, check=True,
-                                 capture_output=True).stdout
+        archive = subprocess.run(
+            ["git", "archive", args.before, "fitting"], cwd=ROOT, check=True, capture_output=True
+        ).stdout
         subprocess.run(["tar", "-x", "-C", old], input=archive, check=True)
-        workers = {name: subprocess.Popen([sys.executable, "-c", _WORKER, path, str(ROOT)], stdin=subprocess.PIPE,
-                                          stdout=subprocess.PIPE, text=True, cwd=ROOT)
-                   for name, path in (("before", old), ("now", str(ROOT)))}
+        workers = {
+            name: subprocess.Popen(
+                [sys.executable, "-c", _WORKER, path, str(ROOT)],
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                text=True,
+                cwd=ROOT,
+            )
+            for name, path in (("before", old), ("now", str(ROOT)))
+        }
         times = {edit: {"before": [], "now": []} for edit in EDITS}
         cpu = {edit: {"before": [], "now": []} for edit in EDITS}
         for r in range(args.rounds):
             for edit in EDITS:
-                for name in (("before", "now") if r % 2 == 0 else ("now", "before")):
+                for name in ("before", "now") if r % 2 == 0 else ("now", "before"):
                     worker = workers[name]
                     worker.stdin.write(edit + "\n")
                     worker.stdin.flush()
                     wall, seconds = json.loads(worker.stdout.readline())
                     times[edit][name].append(wall)
                     cpu[edit][name].append(seconds)
-            print(f"round {r + 1}: " + ", ".join(f"{e} {times[e]['before'][-1]:.1f} / {times[e]['now'][-1]:.1f} s"
-                                                 for e in EDITS), flush=True)
+            print(
+                f"round {r + 1}: "
+                + ", ".join(f"{e} {times[e]['before'][-1]:.1f} / {times[e]['now'][-1]:.1f} s" for e in EDITS),
+                flush=True,
+            )
         for worker in workers.values():
             worker.stdin.close()
             worker.wait(timeout=60)
-    rows = [{"edit": e, "before_s": float(np.median(t["before"])), "now_s": float(np.median(t["now"])),
-             "ratio": float(np.median(t["now"]) / np.median(t["before"])), "before": t["before"], "now": t["now"],
-             "before_cpu_s": float(np.median(cpu[e]["before"])), "now_cpu_s": float(np.median(cpu[e]["now"])),
-             "cpu_ratio": float(np.median(cpu[e]["now"]) / np.median(cpu[e]["before"]))}
-            for e, t in times.items()]
-    figures = {"before_commit": args.before, "rounds": args.rounds, "edits": len(rows),
-               "before_median_s": float(np.median([r["before_s"] for r in rows])),
-               "now_median_s": float(np.median([r["now_s"] for r in rows])),
-               "ratio_median": float(np.median([r["ratio"] for r in rows])),
-               "ratio_worst": max(r["ratio"] for r in rows),
-               "before_cpu_median_s": float(np.median([r["before_cpu_s"] for r in rows])),
-               "now_cpu_median_s": float(np.median([r["now_cpu_s"] for r in rows])),
-               "cpu_ratio_median": float(np.median([r["cpu_ratio"] for r in rows])),
-               "cpu_ratio_worst": max(r["cpu_ratio"] for r in rows)}
+    rows = [
+        {
+            "edit": e,
+            "before_s": float(np.median(t["before"])),
+            "now_s": float(np.median(t["now"])),
+            "ratio": float(np.median(t["now"]) / np.median(t["before"])),
+            "before": t["before"],
+            "now": t["now"],
+            "before_cpu_s": float(np.median(cpu[e]["before"])),
+            "now_cpu_s": float(np.median(cpu[e]["now"])),
+            "cpu_ratio": float(np.median(cpu[e]["now"]) / np.median(cpu[e]["before"])),
+        }
+        for e, t in times.items()
+    ]
+    figures = {
+        "before_commit": args.before,
+        "rounds": args.rounds,
+        "edits": len(rows),
+        "before_median_s": float(np.median([r["before_s"] for r in rows])),
+        "now_median_s": float(np.median([r["now_s"] for r in rows])),
+        "ratio_median": float(np.median([r["ratio"] for r in rows])),
+        "ratio_worst": max(r["ratio"] for r in rows),
+        "before_cpu_median_s": float(np.median([r["before_cpu_s"] for r in rows])),
+        "now_cpu_median_s": float(np.median([r["now_cpu_s"] for r in rows])),
+        "cpu_ratio_median": float(np.median([r["cpu_ratio"] for r in rows])),
+        "cpu_ratio_worst": max(r["cpu_ratio"] for r in rows),
+    }
     path = write_result("curve_guard_cost", figures, load, rows=rows)
     print(f"wrote {path}: {figures}")
     return 0

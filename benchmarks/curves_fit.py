@@ -61,12 +61,18 @@ def scenarios(materials: list[str]):
         lift = np.clip(ref22 + 0.05 * np.exp(-(((angle - 75.0) / 10.0) ** 2))[:, None], 0.0, 1.0)
         yield name, "unedited", base, [dict(eta_i=1.5, angle_deg=angle, rgb=ref15)]
         yield name, "red bump", base, [dict(eta_i=1.5, angle_deg=angle, rgb=bump)]
-        yield name, "two edits", base, [
-            dict(eta_i=1.5, angle_deg=angle, rgb=tint), dict(eta_i=2.2, angle_deg=angle, rgb=lift)
-        ]
-        yield name, "no base, 3 curves", None, [
-            dict(eta_i=e, angle_deg=angle, rgb=base.rgb(mu, e)) for e in (1.0, 1.75, 2.5)
-        ]
+        yield (
+            name,
+            "two edits",
+            base,
+            [dict(eta_i=1.5, angle_deg=angle, rgb=tint), dict(eta_i=2.2, angle_deg=angle, rgb=lift)],
+        )
+        yield (
+            name,
+            "no base, 3 curves",
+            None,
+            [dict(eta_i=e, angle_deg=angle, rgb=base.rgb(mu, e)) for e in (1.0, 1.75, 2.5)],
+        )
 
 
 def main() -> None:

@@ -60,13 +60,27 @@ def main() -> int:
     summary = {
         "widest_gap_in_library_nm": max(r["widest_gap_nm"] for r in rows.values()),
         "conductors_moved_over_2_by_gap_nm": {
-            str(x): sum(r["worst_delta_E_by_gap_nm"][x] > 2 for r in rows.values()) for x in WIDTHS},
-        "worst_delta_E_by_gap_nm": {str(x): max(r["worst_delta_E_by_gap_nm"][x] for r in rows.values()) for x in WIDTHS},
+            str(x): sum(r["worst_delta_E_by_gap_nm"][x] > 2 for r in rows.values()) for x in WIDTHS
+        },
+        "worst_delta_E_by_gap_nm": {
+            str(x): max(r["worst_delta_E_by_gap_nm"][x] for r in rows.values()) for x in WIDTHS
+        },
     }
     print(json.dumps(summary, indent=1))
     out = Path(__file__).resolve().parent / "results" / "data_gaps.json"
-    out.write_text(json.dumps({"command": "python benchmarks/data_gaps.py", "date": datetime.now(timezone.utc).isoformat(timespec="minutes"), "load_average": os.getloadavg(),
-                               "summary": summary, "materials": rows}, indent=1) + "\n")
+    out.write_text(
+        json.dumps(
+            {
+                "command": "python benchmarks/data_gaps.py",
+                "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+                "load_average": os.getloadavg(),
+                "summary": summary,
+                "materials": rows,
+            },
+            indent=1,
+        )
+        + "\n"
+    )
     return 0
 
 

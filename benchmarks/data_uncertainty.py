@@ -51,7 +51,7 @@ def gapped(nk: SpectralNK, centre: float) -> SpectralNK:
     first = int(np.searchsorted(w, centre - GAP_NM / 2))
     last = int(np.searchsorted(w, w[first] + GAP_NM + 0.5)) - 1
     keep = np.ones(w.size, dtype=bool)
-    keep[first + 1:last] = False
+    keep[first + 1 : last] = False
     return SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name, source=nk.source)
 
 
@@ -68,13 +68,24 @@ def main() -> int:
             real = evaluate_material(full, fit, baselines=False)["model_float16"]["delta_E_mean"]
             uncertainty = fit.quality["uncertainty"]["delta_E_mean"]
             warned = any(w.startswith("data uncertainty") for w in fit.quality["warnings"])
-            row = {"page": label, "centre_nm": centre, "gap_nm": [a, b], "reported": reported, "real": real,
-                   "uncertainty": uncertainty, "parts": fit.quality["uncertainty"]["parts"], "warned": warned,
-                   "half_of_real": uncertainty >= 0.5 * real,
-                   "half_of_understated": uncertainty >= 0.5 * max(real - reported, 0.0)}
+            row = {
+                "page": label,
+                "centre_nm": centre,
+                "gap_nm": [a, b],
+                "reported": reported,
+                "real": real,
+                "uncertainty": uncertainty,
+                "parts": fit.quality["uncertainty"]["parts"],
+                "warned": warned,
+                "half_of_real": uncertainty >= 0.5 * real,
+                "half_of_understated": uncertainty >= 0.5 * max(real - reported, 0.0),
+            }
             rows.append(row)
-            print(f"{label:20s} {centre} gap {a:.0f}-{b:.0f} nm  reported {reported:.3f}  real {real:.3f}  "
-                  f"uncertainty {uncertainty:.3f}  warned {warned}", flush=True)
+            print(
+                f"{label:20s} {centre} gap {a:.0f}-{b:.0f} nm  reported {reported:.3f}  real {real:.3f}  "
+                f"uncertainty {uncertainty:.3f}  warned {warned}",
+                flush=True,
+            )
     understated = [r for r in rows if r["real"] > 2 * r["reported"]]
     figures = {
         "cases": len(rows),

@@ -74,8 +74,13 @@ def figures(text: str) -> list[dict[str, Any]]:
     """Every marker of ``text``: its line, key, format, the quoted number and the recorded one (or the error)."""
     out = []
     for match in MARKER.finditer(text):
-        item = {"line": text.count("\n", 0, match.start()) + 1, "key": f"{match['name']}:{match['path']}",
-                "format": match["format"], "quoted": match["number"], "span": match.span("number")}
+        item = {
+            "line": text.count("\n", 0, match.start()) + 1,
+            "key": f"{match['name']}:{match['path']}",
+            "format": match["format"],
+            "quoted": match["number"],
+            "span": match.span("number"),
+        }
         try:
             item["recorded"] = format(recorded(match["name"], match["path"]), match["format"])
         except (LookupError, ValueError, TypeError) as error:
@@ -111,8 +116,10 @@ def main(argv=None) -> int:
             text = page.read_text(encoding="utf-8")
         for item in stale(text):
             bad += 1
-            print(f"{page}:{item['line']}: {item['key']}: quoted {item['quoted']}, "
-                  f"recorded {item.get('recorded', item.get('error'))}")
+            print(
+                f"{page}:{item['line']}: {item['key']}: quoted {item['quoted']}, "
+                f"recorded {item.get('recorded', item.get('error'))}"
+            )
     return 1 if bad else 0
 
 

@@ -53,7 +53,10 @@ from fitting.colour.reference import reference_ACEScg  # noqa: E402
 from fitting.colour.seen import SEEN_ANGLES_DEG, seen_ACEScg  # noqa: E402
 from fitting.exports.colour_space import ACEScg_to_lin_rec709, lin_rec709_to_ACEScg  # noqa: E402
 from fitting.exports.seen_fit import (  # noqa: E402
-    fit_channel_conductor, fit_channel_f82, fit_channel_schlick, layer_only,
+    fit_channel_conductor,
+    fit_channel_f82,
+    fit_channel_schlick,
+    layer_only,
 )
 from fitting.exports.tool_fresnel import f82_tint, schlick  # noqa: E402
 from fitting.optics.edge_tint import F0_F82_from_nk, F0_F82_under_coat, nk_from_F0_F82  # noqa: E402
@@ -83,8 +86,7 @@ def bases(view, eta, air):
         "f82_air": f82_tint(view, F0, tint),
         "schlick_air": schlick(view, F0s),
         "filament_remap": schlick(view, filament_f0(F0s)),
-        "relative_index": f82_tint(view, *(np.clip(v, 0.0, 1.0) for v in F0_F82_from_nk(
-            *_index(F0, tint), eta))),
+        "relative_index": f82_tint(view, *(np.clip(v, 0.0, 1.0) for v in F0_F82_from_nk(*_index(F0, tint), eta))),
         "remap": f82_tint(view, rF0, rtint),
     }
 
@@ -107,11 +109,13 @@ def main(argv: list[str] | None = None) -> int:
         exact = np.stack([fresnel_conductor(mu, 1.0, index.n[c], index.k[c]) for c in range(3)], axis=-1)
         back_F0, back_tint = F0_F82_from_nk(index.n, index.k)
         inversion[name] = {
-            "vs_f82_curve": float(delta_E_map(lin_rec709_to_ACEScg(f82_tint(mu, F0, tint)),
-                                              lin_rec709_to_ACEScg(exact)).mean()),
+            "vs_f82_curve": float(
+                delta_E_map(lin_rec709_to_ACEScg(f82_tint(mu, F0, tint)), lin_rec709_to_ACEScg(exact)).mean()
+            ),
             "vs_reference": float(delta_E_map(lin_rec709_to_ACEScg(air_rec709), lin_rec709_to_ACEScg(exact)).mean()),
-            "anchor_residual": float(max(np.max(np.abs(back_F0 - F0)),
-                                         np.max(np.abs(back_tint - tint) * index.reachable))),
+            "anchor_residual": float(
+                max(np.max(np.abs(back_F0 - F0)), np.max(np.abs(back_tint - tint) * index.reachable))
+            ),
             "reachable": bool(index.reachable.all()),
         }
         for eta in ETAS:
@@ -120,12 +124,19 @@ def main(argv: list[str] | None = None) -> int:
                 layered = layer_only("blender", view, eta, base)
                 dE = delta_E_map(seen, lin_rec709_to_ACEScg(layered))
                 rows.setdefault(f"eta_i_{eta:g}".replace(".", "_"), {}).setdefault(convention, {})[name] = [
-                    float(dE.mean()), float(dE.max())]
+                    float(dE.mean()),
+                    float(dE.max()),
+                ]
         print(name, {c: round(rows["eta_i_1_5"][c][name][0], 3) for c in CONVENTIONS}, flush=True)
-    figures = {"inversion": {
-        key: {"mean": round(float(np.mean([r[key] for r in inversion.values()])), 4),
-              "max": round(float(np.max([r[key] for r in inversion.values()])), 4)}
-        for key in ("vs_f82_curve", "vs_reference", "anchor_residual")}}
+    figures = {
+        "inversion": {
+            key: {
+                "mean": round(float(np.mean([r[key] for r in inversion.values()])), 4),
+                "max": round(float(np.max([r[key] for r in inversion.values()])), 4),
+            }
+            for key in ("vs_f82_curve", "vs_reference", "anchor_residual")
+        }
+    }
     figures["inversion"]["unreachable"] = sorted(m for m, r in inversion.items() if not r["reachable"])
     for eta_key, by_convention in rows.items():
         figures[eta_key] = {}
@@ -134,8 +145,10 @@ def main(argv: list[str] | None = None) -> int:
             maxima = np.array([v[1] for v in by_convention[convention].values()])
             worst = max(by_convention[convention], key=lambda m: by_convention[convention][m][0])
             figures[eta_key][convention] = {
-                "mean": round(float(means.mean()), 3), "max_of_means": round(float(means.max()), 3),
-                "worst": worst, "max_angle": round(float(maxima.max()), 2),
+                "mean": round(float(means.mean()), 3),
+                "max_of_means": round(float(means.max()), 3),
+                "worst": worst,
+                "max_angle": round(float(maxima.max()), 2),
             }
         remap = np.array([v[0] for v in by_convention["remap"].values()])
         filament = np.array([v[0] for v in by_convention["filament_remap"].values()])
@@ -144,8 +157,9 @@ def main(argv: list[str] | None = None) -> int:
         figures[eta_key]["remap_worse_than_nothing"] = int(np.sum(remap > nothing))
     for key, value in figures.items():
         print(key, value)
-    path = write_result("edge_tint", figures, load, materials=args.materials.split(","),
-                        rows=rows, inversion_rows=inversion)
+    path = write_result(
+        "edge_tint", figures, load, materials=args.materials.split(","), rows=rows, inversion_rows=inversion
+    )
     print(f"wrote {path.relative_to(ROOT)}")
     return 0
 

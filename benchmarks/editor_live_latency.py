@@ -59,9 +59,11 @@ from benchmarks.editor_speed import ARGS, READY, percentile  # noqa: E402  (the 
 from benchmarks.record import load_average, write_result  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
-SETTLED = ("() => { const id = document.getElementById('fit-id').textContent;"
-           " return !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
-           " && document.getElementById('preview').dataset.fit === id; }")
+SETTLED = (
+    "() => { const id = document.getElementById('fit-id').textContent;"
+    " return !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
+    " && document.getElementById('preview').dataset.fit === id; }"
+)
 # The pointer events' time stamps, caught before the page's own handlers (capture phase): each move's
 # first event (pointerrawupdate where Chromium has it, as the page follows it; else pointermove).
 LISTEN = """() => {
@@ -75,8 +77,13 @@ LISTEN = """() => {
 def summary(values):
     if not values:
         return {"n": 0}
-    return {"median_ms": statistics.median(values), "p90_ms": percentile(values, 0.9),
-            "p99_ms": percentile(values, 0.99), "worst_ms": max(values), "n": len(values)}
+    return {
+        "median_ms": statistics.median(values),
+        "p90_ms": percentile(values, 0.9),
+        "p99_ms": percentile(values, 0.99),
+        "worst_ms": max(values),
+        "n": len(values),
+    }
 
 
 def editor(browser, url):
@@ -159,11 +166,19 @@ def phase(browser, url, drags, moves):
             parts += part
             if release is not None:
                 releases.append(release)
-            print(f"{kind} drag {d + 1}/{drags}: {len(lat)} moves, median {statistics.median(lat) if lat else 0:.0f} ms,"
-                  f" release {release or 0:.0f} ms", file=sys.stderr, flush=True)
-        out[kind] = {"move_to_frame_ms": summary(latencies), "moves_not_shown_live": missed,
-                     "release_to_final_ms": summary(releases), "latencies": latencies,
-                     **{step: summary([p[i] for p in parts]) for i, step in enumerate(STEPS)}}
+            print(
+                f"{kind} drag {d + 1}/{drags}: {len(lat)} moves, median {statistics.median(lat) if lat else 0:.0f} ms,"
+                f" release {release or 0:.0f} ms",
+                file=sys.stderr,
+                flush=True,
+            )
+        out[kind] = {
+            "move_to_frame_ms": summary(latencies),
+            "moves_not_shown_live": missed,
+            "release_to_final_ms": summary(releases),
+            "latencies": latencies,
+            **{step: summary([p[i] for p in parts]) for i, step in enumerate(STEPS)},
+        }
     page.close()
     load.append(load_average())
     out["load_average"] = load
@@ -191,10 +206,18 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[1])
     parser.add_argument("--drags", type=int, default=20, help="gentle drags and extreme drags, each")
     parser.add_argument("--moves", type=int, default=20, help="pointer moves a drag")
-    parser.add_argument("--busy", type=int, default=2 * (os.cpu_count() or 1),
-                        help="busy-loop processes of the busy phase, pinned round the cores (default two a core)")
-    parser.add_argument("--busy-load", type=float, default=4.0,
-                        help="the busy phase starts once the 1-minute load average is at least this (or after 5 min)")
+    parser.add_argument(
+        "--busy",
+        type=int,
+        default=2 * (os.cpu_count() or 1),
+        help="busy-loop processes of the busy phase, pinned round the cores (default two a core)",
+    )
+    parser.add_argument(
+        "--busy-load",
+        type=float,
+        default=4.0,
+        help="the busy phase starts once the 1-minute load average is at least this (or after 5 min)",
+    )
     args = parser.parse_args()
     load_at_start = load_average()
     figures: dict = {}
@@ -215,30 +238,41 @@ def main() -> None:
                     loop.wait()
             browser.close()
     figures["busy_over_idle"] = {
-        kind: figures["busy"][kind]["move_to_frame_ms"]["median_ms"] / figures["idle"][kind]["move_to_frame_ms"]["median_ms"]
-        for kind in ("gentle", "extreme", "all")}
+        kind: figures["busy"][kind]["move_to_frame_ms"]["median_ms"]
+        / figures["idle"][kind]["move_to_frame_ms"]["median_ms"]
+        for kind in ("gentle", "extreme", "all")
+    }
     print(f"{'pointer move -> frame of its refit (ms)':<44} {'median':>7} {'p90':>7} {'p99':>7} {'worst':>7} {'n':>5}")
     for name in ("idle", "busy"):
         for kind in ("gentle", "extreme", "all"):
             s = figures[name][kind]["move_to_frame_ms"]
-            print(f"{name + ', ' + kind:<44} {s['median_ms']:>7.1f} {s['p90_ms']:>7.1f} {s['p99_ms']:>7.1f}"
-                  f" {s['worst_ms']:>7.1f} {s['n']:>5}")
+            print(
+                f"{name + ', ' + kind:<44} {s['median_ms']:>7.1f} {s['p90_ms']:>7.1f} {s['p99_ms']:>7.1f}"
+                f" {s['worst_ms']:>7.1f} {s['n']:>5}"
+            )
     print(f"\n{'release -> frame of the full refit (ms)':<44} {'median':>7} {'p90':>7} {'worst':>7} {'n':>5}")
     for name in ("idle", "busy"):
         for kind in ("gentle", "extreme"):
             s = figures[name][kind]["release_to_final_ms"]
-            print(f"{name + ', ' + kind:<44} {s['median_ms']:>7.0f} {s['p90_ms']:>7.0f} {s['worst_ms']:>7.0f} {s['n']:>5}")
+            print(
+                f"{name + ', ' + kind:<44} {s['median_ms']:>7.0f} {s['p90_ms']:>7.0f} {s['worst_ms']:>7.0f} {s['n']:>5}"
+            )
     print(f"\n{'a live refit (ms, median / p99)':<17}" + "".join(f"{step[:-3]:>17}" for step in STEPS))
     for name in ("idle", "busy"):
         for kind in ("gentle", "extreme"):
             f = figures[name][kind]
-            print(f"{name + ', ' + kind:<17}" + "".join(f"{f[k]['median_ms']:>8.1f}/{f[k]['p99_ms']:>7.1f} "
-                                                        for k in STEPS))
+            print(
+                f"{name + ', ' + kind:<17}"
+                + "".join(f"{f[k]['median_ms']:>8.1f}/{f[k]['p99_ms']:>7.1f} " for k in STEPS)
+            )
     print(f"\nbusy / idle (median): {figures['busy_over_idle']}")
-    print(f"load average: idle {figures['idle']['load_average']}, busy {figures['busy']['load_average']}"
-          f" on {os.cpu_count()} cores")
-    write_result("editor_live_latency", figures, load_at_start, busy_processes=args.busy, drags=args.drags,
-                 moves=args.moves)
+    print(
+        f"load average: idle {figures['idle']['load_average']}, busy {figures['busy']['load_average']}"
+        f" on {os.cpu_count()} cores"
+    )
+    write_result(
+        "editor_live_latency", figures, load_at_start, busy_processes=args.busy, drags=args.drags, moves=args.moves
+    )
 
 
 if __name__ == "__main__":

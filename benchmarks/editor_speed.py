@@ -50,10 +50,20 @@ from conftest import server_process  # noqa: E402
 from benchmarks.record import load_average, write_result  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
 
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"]
-READY = ("() => document.body.dataset.ready === 'true' && document.getElementById('preview').dataset.fit"
-         " === document.getElementById('fit-id').textContent")
+ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+    "--disable-quic",
+]
+READY = (
+    "() => document.body.dataset.ready === 'true' && document.getElementById('preview').dataset.fit"
+    " === document.getElementById('fit-id').textContent"
+)
 
 
 def percentile(values, q):
@@ -101,8 +111,11 @@ def drag_latencies(page, drags, extreme=False, variant=0):
         if os.environ.get("EDITOR_SPEED_TRACE"):
             for s in shown:
                 print({k: round(v - s["editAt"]) if k.endswith("At") and v else v for k, v in s.items()})
-        out += [(s["curveAt"] - s["editAt"], s["frameAt"] - s["editAt"], s.get("live", False))
-                for s in shown if s["frameAt"]]
+        out += [
+            (s["curveAt"] - s["editAt"], s["frameAt"] - s["editAt"], s.get("live", False))
+            for s in shown
+            if s["frameAt"]
+        ]
     return out
 
 
@@ -203,19 +216,27 @@ def main() -> None:
         figures["cold_start_s"] = {"first": first, "second": second}
     if latencies:
         print(f"\n{'drags (ms)':<44} {'gentle':>8} {'p99':>7} {'n':>4}   {'extreme':>8} {'p99':>7} {'n':>4}")
-        rows = [("edit -> refitted curve, live", 0, True, "drag_to_curve_ms"),
-                ("edit -> WebGL frame of the refit, live", 1, True, "drag_to_frame_ms"),
-                ("release -> WebGL frame of the full refit", 1, False, "release_to_frame_ms")]
+        rows = [
+            ("edit -> refitted curve, live", 0, True, "drag_to_curve_ms"),
+            ("edit -> WebGL frame of the refit, live", 1, True, "drag_to_frame_ms"),
+            ("release -> WebGL frame of the full refit", 1, False, "release_to_frame_ms"),
+        ]
         for label, column, live, key in rows:
             cells = []
             for kind, runs in (("gentle", latencies), ("extreme", extremes)):
                 values = [r[column] for r in runs if r[2] == live]
                 if values:
                     figures.setdefault(key, {})[kind] = {
-                        "median_ms": statistics.median(values), "p90_ms": percentile(values, 0.9),
-                        "p99_ms": percentile(values, 0.99), "n": len(values)}
-                cells.append(f"{statistics.median(values):>8.0f} {percentile(values, 0.99):>7.0f} {len(values):>4}"
-                             if values else f"{'-':>8} {'-':>7} {0:>4}")
+                        "median_ms": statistics.median(values),
+                        "p90_ms": percentile(values, 0.9),
+                        "p99_ms": percentile(values, 0.99),
+                        "n": len(values),
+                    }
+                cells.append(
+                    f"{statistics.median(values):>8.0f} {percentile(values, 0.99):>7.0f} {len(values):>4}"
+                    if values
+                    else f"{'-':>8} {'-':>7} {0:>4}"
+                )
             print(f"{label:<44} {cells[0]}   {cells[1]}")
     for name, fps in orbits.items():
         label = f"orbit fps at 1024 x 768 (canvas {size[0]} x {size[1]}), {name}"

@@ -28,8 +28,10 @@ from conftest import server_process  # noqa: E402
 from benchmarks.editor_speed import ARGS, READY  # noqa: E402
 from playwright.sync_api import expect, sync_playwright  # noqa: E402
 
-SETTLED = ("() => !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
-           " && document.getElementById('preview').dataset.fit === document.getElementById('fit-id').textContent")
+SETTLED = (
+    "() => !document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
+    " && document.getElementById('preview').dataset.fit === document.getElementById('fit-id').textContent"
+)
 
 
 def settle(page) -> str:
@@ -99,7 +101,9 @@ def shoot(page, out: Path) -> None:
     settle(page)
     key_edit(page, channel=0, angle=36, key="Shift+ArrowDown")
     save(page, "Warm silver", "Saved “Warm silver”")
-    page.locator("#saved-list li", has_text="Warm silver").get_by_role("button", name="Delete Warm silver (to the bin)").click()
+    page.locator("#saved-list li", has_text="Warm silver").get_by_role(
+        "button", name="Delete Warm silver (to the bin)"
+    ).click()
     expect(page.locator("#bin-count")).to_have_text("1")
     item = page.locator("#saved-list li", has_text="Pale copper")
     item.get_by_role("button", name="Rename Pale copper").click()
@@ -127,7 +131,9 @@ def shoot(page, out: Path) -> None:
     page.wait_for_function("document.getElementById('preview-compare').dataset.fit")
     page.wait_for_timeout(500)
     page.evaluate("window.scrollTo(0, 0)")
-    page.screenshot(path=out / "editor_compare.png", clip=clip(page, "#plot-heading", "#compare-readout", "#compare-caption"))
+    page.screenshot(
+        path=out / "editor_compare.png", clip=clip(page, "#plot-heading", "#compare-readout", "#compare-caption")
+    )
 
 
 def shoot_window(page, out: Path) -> None:
@@ -159,8 +165,11 @@ def main() -> None:
             browser.close()
             if errors:
                 raise SystemExit(f"the page logged errors: {errors}")
-    print("wrote", *(args.out / f"editor_{v}.png" for v in ("library", "entry", "materials", "compare")),
-          args.out / "editor.png")
+    print(
+        "wrote",
+        *(args.out / f"editor_{v}.png" for v in ("library", "entry", "materials", "compare")),
+        args.out / "editor.png",
+    )
 
 
 if __name__ == "__main__":

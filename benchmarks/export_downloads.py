@@ -45,8 +45,14 @@ FORMATS = ("mtlx", "openpbr", "blender", "gltf")
 
 def stats(wall: list[float], cpu: list[float]) -> dict:
     w, c = np.asarray(wall) * 1e3, np.asarray(cpu) * 1e3
-    return {"p50_ms": float(np.median(w)), "p90_ms": float(np.percentile(w, 90)), "max_ms": float(w.max()),
-            "cpu_p50_ms": float(np.median(c)), "cpu_max_ms": float(c.max()), "downloads": int(w.size)}
+    return {
+        "p50_ms": float(np.median(w)),
+        "p90_ms": float(np.percentile(w, 90)),
+        "max_ms": float(w.max()),
+        "cpu_p50_ms": float(np.median(c)),
+        "cpu_max_ms": float(c.max()),
+        "downloads": int(w.size),
+    }
 
 
 def main() -> int:
@@ -80,26 +86,50 @@ def main() -> int:
                                 into["cpu"].append(tree_cpu(process.pid) - cpu)
                                 if k == 0:
                                     first_cpu[fmt].append(into["cpu"][-1])
-                        print(f"{material} eta_i {eta:g}: first {1e3 * np.median(first['wall'][-4:]):.0f} ms, "
-                              f"repeated {1e3 * np.median(repeated['wall'][-4 * args.repeats:]):.1f} ms "
-                              f"(medians), load {os.getloadavg()[0]:.2f}", flush=True)
+                        print(
+                            f"{material} eta_i {eta:g}: first {1e3 * np.median(first['wall'][-4:]):.0f} ms, "
+                            f"repeated {1e3 * np.median(repeated['wall'][-4 * args.repeats :]):.1f} ms "
+                            f"(medians), load {os.getloadavg()[0]:.2f}",
+                            flush=True,
+                        )
         finally:
             process.terminate()
             process.wait(timeout=60)
-    figures = {"first": stats(first["wall"], first["cpu"]), "repeated": stats(repeated["wall"], repeated["cpu"]),
-               "first_by_format": {fmt: {"cpu_p50_ms": float(1e3 * np.median(c)), "cpu_max_ms": float(1e3 * max(c))}
-                                   for fmt, c in first_cpu.items()}}
+    figures = {
+        "first": stats(first["wall"], first["cpu"]),
+        "repeated": stats(repeated["wall"], repeated["cpu"]),
+        "first_by_format": {
+            fmt: {"cpu_p50_ms": float(1e3 * np.median(c)), "cpu_max_ms": float(1e3 * max(c))}
+            for fmt, c in first_cpu.items()
+        },
+    }
     print("\n| download | p50 / p90 / max ms | server CPU p50 / max ms | downloads |")
     print("|---|---|---|---|")
     for name, f in figures.items():
         if name == "first_by_format":
             continue
-        print(f"| {name} | {f['p50_ms']:.1f} / {f['p90_ms']:.1f} / {f['max_ms']:.1f} | "
-              f"{f['cpu_p50_ms']:.1f} / {f['cpu_max_ms']:.1f} | {f['downloads']} |")
-    print("first, server CPU p50 / max ms:", ", ".join(
-        f"{fmt} {f['cpu_p50_ms']:.0f} / {f['cpu_max_ms']:.0f}" for fmt, f in figures["first_by_format"].items()))
-    print("recorded:", write_result("export_downloads", figures, load_at_start, materials=materials, eta_i=etas,
-                                    formats=list(FORMATS), repeats=args.repeats))
+        print(
+            f"| {name} | {f['p50_ms']:.1f} / {f['p90_ms']:.1f} / {f['max_ms']:.1f} | "
+            f"{f['cpu_p50_ms']:.1f} / {f['cpu_max_ms']:.1f} | {f['downloads']} |"
+        )
+    print(
+        "first, server CPU p50 / max ms:",
+        ", ".join(
+            f"{fmt} {f['cpu_p50_ms']:.0f} / {f['cpu_max_ms']:.0f}" for fmt, f in figures["first_by_format"].items()
+        ),
+    )
+    print(
+        "recorded:",
+        write_result(
+            "export_downloads",
+            figures,
+            load_at_start,
+            materials=materials,
+            eta_i=etas,
+            formats=list(FORMATS),
+            repeats=args.repeats,
+        ),
+    )
     return 0
 
 

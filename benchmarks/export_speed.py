@@ -81,9 +81,14 @@ def key(eta: float) -> str:
 def summary(before: list[float], after: list[float]) -> dict:
     """Milliseconds of the same items before and after: medians, their ratio, the worst of each, the count."""
     a, b = np.array(before), np.array(after)
-    return {"before_median_ms": float(np.median(a)), "after_median_ms": float(np.median(b)),
-            "ratio": float(np.median(b) / np.median(a)), "before_max_ms": float(a.max()),
-            "after_max_ms": float(b.max()), "items": int(a.size)}
+    return {
+        "before_median_ms": float(np.median(a)),
+        "after_median_ms": float(np.median(b)),
+        "ratio": float(np.median(b) / np.median(a)),
+        "before_max_ms": float(a.max()),
+        "after_max_ms": float(b.max()),
+        "items": int(a.size),
+    }
 
 
 def main(argv=None) -> int:
@@ -91,8 +96,9 @@ def main(argv=None) -> int:
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
     parser.add_argument("--eta-i", default="1.0,1.5", help="coating indices (default 1.0,1.5)")
     parser.add_argument("--materials", default=None, help="library conductors (default all)")
-    parser.add_argument("--output", default="export_speed",
-                        help="record to write, benchmarks/results/NAME.json (default export_speed)")
+    parser.add_argument(
+        "--output", default="export_speed", help="record to write, benchmarks/results/NAME.json (default export_speed)"
+    )
     parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--items", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -111,10 +117,13 @@ def main(argv=None) -> int:
             sides["before"] = Side(__file__, before_root, "--items", ",".join(items))
             sides["after"] = Side(__file__, ROOT, "--items", ",".join(items))
             for i, item in enumerate(items):
-                for name in (("before", "after") if i % 2 == 0 else ("after", "before")):
+                for name in ("before", "after") if i % 2 == 0 else ("after", "before"):
                     answers[name][item] = sides[name].ask(item)
-                print(f"{item:>12} {answers['before'][item]['ms']:8.0f} ms -> {answers['after'][item]['ms']:6.0f} ms"
-                      f"  load {os.getloadavg()[0]:.2f}", flush=True)
+                print(
+                    f"{item:>12} {answers['before'][item]['ms']:8.0f} ms -> {answers['after'][item]['ms']:6.0f} ms"
+                    f"  load {os.getloadavg()[0]:.2f}",
+                    flush=True,
+                )
         finally:
             for side in sides.values():
                 side.close()
@@ -123,34 +132,48 @@ def main(argv=None) -> int:
     print("\n| coating | before median / max ms | after median / max ms | after / before (medians) |")
     print("|---|---|---|---|")
     for name, group in groups.items():
-        figures[name] = summary([answers["before"][i]["ms"] for i in group],
-                                [answers["after"][i]["ms"] for i in group])
+        figures[name] = summary([answers["before"][i]["ms"] for i in group], [answers["after"][i]["ms"] for i in group])
         f = figures[name]
-        print(f"| {name} | {f['before_median_ms']:.0f} / {f['before_max_ms']:.0f} | "
-              f"{f['after_median_ms']:.0f} / {f['after_max_ms']:.0f} | {f['ratio']:.2f} |")
+        print(
+            f"| {name} | {f['before_median_ms']:.0f} / {f['before_max_ms']:.0f} | "
+            f"{f['after_median_ms']:.0f} / {f['after_max_ms']:.0f} | {f['ratio']:.2f} |"
+        )
     tools = list(answers["after"][items[0]]["delta_E"])
-    figures["delta_E"] = {tool: {
-        "mean": float(np.mean([answers["after"][i]["delta_E"][tool]["delta_E_mean"] for i in items])),
-        "max": float(np.max([answers["after"][i]["delta_E"][tool]["delta_E_max"] for i in items])),
-    } for tool in tools}
-    figures["delta_E_before"] = {tool: {
-        "mean": float(np.mean([answers["before"][i]["delta_E"][tool]["delta_E_mean"] for i in items])),
-        "max": float(np.max([answers["before"][i]["delta_E"][tool]["delta_E_max"] for i in items])),
-    } for tool in tools}
+    figures["delta_E"] = {
+        tool: {
+            "mean": float(np.mean([answers["after"][i]["delta_E"][tool]["delta_E_mean"] for i in items])),
+            "max": float(np.max([answers["after"][i]["delta_E"][tool]["delta_E_max"] for i in items])),
+        }
+        for tool in tools
+    }
+    figures["delta_E_before"] = {
+        tool: {
+            "mean": float(np.mean([answers["before"][i]["delta_E"][tool]["delta_E_mean"] for i in items])),
+            "max": float(np.max([answers["before"][i]["delta_E"][tool]["delta_E_max"] for i in items])),
+        }
+        for tool in tools
+    }
     for stat in ("delta_E_mean", "delta_E_max"):  # the largest rise of one tool's figure on one item, and where
-        rise, where = max((answers["after"][i]["delta_E"][tool][stat] - answers["before"][i]["delta_E"][tool][stat],
-                           f"{tool} {i}") for i in items for tool in tools)
+        rise, where = max(
+            (answers["after"][i]["delta_E"][tool][stat] - answers["before"][i]["delta_E"][tool][stat], f"{tool} {i}")
+            for i in items
+            for tool in tools
+        )
         figures[f"delta_E_rise_{stat[8:]}"] = {"value": float(rise), "at": where}
-    figures["delta_E_change_max"] = float(max(
-        abs(answers["after"][i]["delta_E"][tool][stat] - answers["before"][i]["delta_E"][tool][stat])
-        for i in items for tool in tools for stat in ("delta_E_mean", "delta_E_max")))
+    figures["delta_E_change_max"] = float(
+        max(
+            abs(answers["after"][i]["delta_E"][tool][stat] - answers["before"][i]["delta_E"][tool][stat])
+            for i in items
+            for tool in tools
+            for stat in ("delta_E_mean", "delta_E_max")
+        )
+    )
     print("\n| tool | Delta E 2000 mean (of the means) | max (of the maxima) |")
     print("|---|---|---|")
     for tool, d in figures["delta_E"].items():
         print(f"| {tool} | {d['mean']:.3f} | {d['max']:.2f} |")
     print(f"\nlargest change of a Delta E between the two checkouts: {figures['delta_E_change_max']:.2e}")
-    print("recorded:", write_result(args.output, figures, load_start, materials=materials, eta_i=etas,
-                                    runs=answers))
+    print("recorded:", write_result(args.output, figures, load_start, materials=materials, eta_i=etas, runs=answers))
     return 0
 
 

@@ -59,14 +59,31 @@ def cycles(values, work: Path, size: int, samples: int) -> list[np.ndarray]:
     script.write_bytes(export_material(values, "blender", values.eta_i))
     gltf.write_bytes(export_material(values, "gltf", values.eta_i))
     images = []
-    for source, extra in ((script, ["--output", "principled"]), (script, ["--output", "conductor"]),
-                          (gltf, ["--gltf"])):
+    for source, extra in (
+        (script, ["--output", "principled"]),
+        (script, ["--output", "conductor"]),
+        (gltf, ["--gltf"]),
+    ):
         png = work / f"{values.name}-{len(images)}.png"
         subprocess.run(
-            [str(BLENDER_PYTHON), str(PREVIEW), str(source), *extra, "--values",
-             str(work / "values.json"), "--render", str(png), "--size", str(size),
-             "--samples", str(samples)],
-            check=True, capture_output=True, timeout=600, cwd=work,
+            [
+                str(BLENDER_PYTHON),
+                str(PREVIEW),
+                str(source),
+                *extra,
+                "--values",
+                str(work / "values.json"),
+                "--render",
+                str(png),
+                "--size",
+                str(size),
+                "--samples",
+                str(samples),
+            ],
+            check=True,
+            capture_output=True,
+            timeout=600,
+            cwd=work,
         )
         with Image.open(png) as image:
             images.append(np.asarray(image.convert("RGB")))
@@ -92,12 +109,13 @@ def materialx(values, size: int, thread: RenderThread) -> list[np.ndarray]:
     """Reference, then the mtlx and openpbr documents as MaterialX's GLSL renders them, uint8."""
     images = [white_sky(values, size)[0]]
     for format in ("mtlx", "openpbr"):
-        rgb, coverage = render_materialx(
-            export_material(values, format, values.eta_i).decode(), size, thread)
+        rgb, coverage = render_materialx(export_material(values, format, values.eta_i).decode(), size, thread)
         centre = rgb[size // 2, size // 2]
-        print(f"{values.name} {format}: centre pixel (cos theta 1), linear Rec.709 "
-              f"{np.round(centre.astype(np.float64), 3).tolist()}; reference under the coat "
-              f"{np.round(values.target[-1], 3).tolist()}")
+        print(
+            f"{values.name} {format}: centre pixel (cos theta 1), linear Rec.709 "
+            f"{np.round(centre.astype(np.float64), 3).tolist()}; reference under the coat "
+            f"{np.round(values.target[-1], 3).tolist()}"
+        )
         rgb = np.where(coverage[..., None], lin_rec709_to_ACEScg(rgb), 0.18)
         images.append(to_uint8(ACEScg_to_sRGB(rgb)))
     return images
@@ -108,7 +126,7 @@ def grid(rows: list[list[np.ndarray]], gap: int = 2) -> Image.Image:
     out = np.full((len(rows) * (h + gap) - gap, len(rows[0]) * (w + gap) - gap, 3), 255, np.uint8)
     for i, row in enumerate(rows):
         for j, image in enumerate(row):
-            out[i * (h + gap): i * (h + gap) + h, j * (w + gap): j * (w + gap) + w] = image
+            out[i * (h + gap) : i * (h + gap) + h, j * (w + gap) : j * (w + gap) + w] = image
     return Image.fromarray(out)
 
 

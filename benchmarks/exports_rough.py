@@ -84,20 +84,24 @@ def mitsuba_reflectance(nk, alpha: float | None, theta: float) -> np.ndarray:
                 "type": "orthographic",
                 "to_world": T.look_at(origin=(5 * direction).tolist(), target=[0, 0, 0], up=[0, 1, 0])
                 @ T.scale([0.01, 0.01, 1.0]),
-                "film": {"type": "hdrfilm", "width": 4, "height": 4, "rfilter": {"type": "box"},
-                         "pixel_format": "rgb"},
+                "film": {"type": "hdrfilm", "width": 4, "height": 4, "rfilter": {"type": "box"}, "pixel_format": "rgb"},
                 "sampler": {"type": "independent", "sample_count": MITSUBA_SPP},
             },
             "sky": {"type": "constant", "radiance": {"type": "d65"}},
         }
         if with_metal:
             bsdf = {"eta": spectrum(nk.n[keep] / ETA), "k": spectrum(nk.k[keep] / ETA)}
-            bsdf.update({"type": "conductor"} if alpha is None else
-                        {"type": "roughconductor", "distribution": "ggx", "alpha": alpha})
-            d["metal"] = {"type": "rectangle", "to_world": T.translate([0, 0, -1e-3]) @ T.scale(100.0),
-                          "bsdf": bsdf}
-            d["coat"] = {"type": "rectangle", "to_world": T.scale(100.0),
-                         "bsdf": {"type": "dielectric", "int_ior": ETA, "ext_ior": 1.0}}
+            bsdf.update(
+                {"type": "conductor"}
+                if alpha is None
+                else {"type": "roughconductor", "distribution": "ggx", "alpha": alpha}
+            )
+            d["metal"] = {"type": "rectangle", "to_world": T.translate([0, 0, -1e-3]) @ T.scale(100.0), "bsdf": bsdf}
+            d["coat"] = {
+                "type": "rectangle",
+                "to_world": T.scale(100.0),
+                "bsdf": {"type": "dielectric", "int_ior": ETA, "ext_ior": 1.0},
+            }
         return mi.load_dict(d)
 
     if theta not in _SKY:
@@ -112,9 +116,22 @@ def cycles(values, samples: int) -> np.ndarray:
         script = Path(tmp) / "export.py"
         script.write_bytes(export_material(values, "blender", ETA))
         result = subprocess.run(
-            [str(BLENDER_PYTHON), str(CYCLES_ANGLES), str(script), "--output", "conductor",
-             "--angles", ",".join(f"{a:g}" for a in ANGLES), "--samples", str(samples)],
-            capture_output=True, text=True, timeout=900, cwd=tmp, check=True,
+            [
+                str(BLENDER_PYTHON),
+                str(CYCLES_ANGLES),
+                str(script),
+                "--output",
+                "conductor",
+                "--angles",
+                ",".join(f"{a:g}" for a in ANGLES),
+                "--samples",
+                str(samples),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=900,
+            cwd=tmp,
+            check=True,
         )
     line = [ln for ln in result.stdout.splitlines() if ln.startswith("CYCLES_ANGLES ")][-1]
     rendered = json.loads(line.split(" ", 1)[1])
@@ -133,14 +150,14 @@ def main(argv: list[str] | None = None) -> int:
     for name in METALS:
         nk = library_material(name)
         ref0 = np.array([mitsuba_reflectance(nk, None, a) for a in ANGLES])
-        ref = np.array([mitsuba_reflectance(nk, args.roughness ** 2, a) for a in ANGLES])
+        ref = np.array([mitsuba_reflectance(nk, args.roughness**2, a) for a in ANGLES])
         seen = seen_ACEScg(nk, mu, ETA)
         row = {"reference_vs_seen": delta_E_map(seen, lin_rec709_to_ACEScg(ref0)).tolist()}
         for rough in (0.0, args.roughness):
-            values = export_values(nk, ETA, roughness=rough, coat_roughness=0.0,
-                                   tools=("blender", "blender-conductor"))
-            constant = fit_tool_values("blender-conductor", values.view_cos, ETA, values.seen_ACEScg,
-                                       view_dependent=False)
+            values = export_values(nk, ETA, roughness=rough, coat_roughness=0.0, tools=("blender", "blender-conductor"))
+            constant = fit_tool_values(
+                "blender-conductor", values.view_cos, ETA, values.seen_ACEScg, view_dependent=False
+            )
             flat = dataclasses.replace(values, tools={**values.tools, "blender-conductor": constant})
             target = lin_rec709_to_ACEScg(ref if rough else ref0)
             key = f"roughness_{rough:g}".replace(".", "_")
@@ -149,15 +166,27 @@ def main(argv: list[str] | None = None) -> int:
                 dE = delta_E_map(target, lin_rec709_to_ACEScg(cycles(v, args.samples)))
                 row[key][label] = dE.tolist()
                 row[key][label + "_mean"] = float(dE.mean())
-                print(f"{name} roughness {rough:g} {label}: Delta E at {ANGLES} = {np.round(dE, 3)}, "
-                      f"mean {dE.mean():.3f}", flush=True)
+                print(
+                    f"{name} roughness {rough:g} {label}: Delta E at {ANGLES} = {np.round(dE, 3)}, "
+                    f"mean {dE.mean():.3f}",
+                    flush=True,
+                )
         print(f"{name} reference vs seen model (roughness 0): {np.round(row['reference_vs_seen'], 3)}")
         figures[name] = row
     elapsed = time.time() - started
     print(f"{elapsed:.0f} s")
     if not args.no_record:
-        write_result("exports_rough", figures, load, angles_deg=list(ANGLES), roughness=args.roughness,
-                     samples=args.samples, mitsuba_spp=MITSUBA_SPP, eta_i=ETA, seconds=round(elapsed, 1))
+        write_result(
+            "exports_rough",
+            figures,
+            load,
+            angles_deg=list(ANGLES),
+            roughness=args.roughness,
+            samples=args.samples,
+            mitsuba_spp=MITSUBA_SPP,
+            eta_i=ETA,
+            seconds=round(elapsed, 1),
+        )
     return 0
 
 

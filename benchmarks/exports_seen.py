@@ -119,8 +119,9 @@ def material_rows(name: str, eta: float) -> dict:
         }
         if tool in CONDUCTOR_TOOLS:
             # The constant index (slopes 0): the conductor exports before the view-dependent one.
-            constant = seen_delta_E(tool, fit_tool_values(tool, mu, eta, target, coat, view_dependent=False),
-                                    mu, eta, target)
+            constant = seen_delta_E(
+                tool, fit_tool_values(tool, mu, eta, target, coat, view_dependent=False), mu, eta, target
+            )
             out[tool]["constant"] = [float(constant.mean()), float(constant.max())]
     return out
 
@@ -165,18 +166,34 @@ def conductor_search(tool: str, name: str, eta: float) -> dict:
     best, by_kind = None, {}
     for kind, x0 in search_starts(x_shipped):
         x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
-        fit = least_squares(lambda x: np.sqrt(delta_E(x) + 1e-6), x0, bounds=(lo, hi), method="trf",
-                            x_scale="jac", diff_step=1e-6, max_nfev=SEARCH_MAX_NFEV)
+        fit = least_squares(
+            lambda x: np.sqrt(delta_E(x) + 1e-6),
+            x0,
+            bounds=(lo, hi),
+            method="trf",
+            x_scale="jac",
+            diff_step=1e-6,
+            max_nfev=SEARCH_MAX_NFEV,
+        )
         dE = delta_E(fit.x)
         mean = float(dE.mean())
         by_kind[kind] = min(by_kind.get(kind, np.inf), mean)
         if best is None or mean < best["mean"]:
-            best = {"mean": mean, "max": float(dE.max()), "from": kind,
-                    "ior": fit.x[:3].tolist(), "extinction": fit.x[3:].tolist()}
+            best = {
+                "mean": mean,
+                "max": float(dE.max()),
+                "from": kind,
+                "ior": fit.x[:3].tolist(),
+                "extinction": fit.x[3:].tolist(),
+            }
     shipped_dE = delta_E(x_shipped)
-    return {"shipped": [float(shipped_dE.mean()), float(shipped_dE.max())], "best": best,
-            "best_by_start": by_kind, "starts": len(search_starts(x_shipped)),
-            "cpu_s": round(time.process_time() - started, 1)}
+    return {
+        "shipped": [float(shipped_dE.mean()), float(shipped_dE.max())],
+        "best": best,
+        "best_by_start": by_kind,
+        "starts": len(search_starts(x_shipped)),
+        "cpu_s": round(time.process_time() - started, 1),
+    }
 
 
 def view_dependent_index(tool: str, name: str, eta: float) -> dict:
@@ -196,12 +213,18 @@ def view_dependent_index(tool: str, name: str, eta: float) -> dict:
 
     shipped = fit_tool_values(tool, mu, eta, target, True, view_dependent=False)
     x0 = np.r_[shipped["ior"], [0.0] * 3, shipped["extinction"], [0.0] * 3]
-    fit = least_squares(lambda x: np.sqrt(delta_E(x) + 1e-6), x0, method="trf", x_scale="jac",
-                        diff_step=1e-6, max_nfev=SEARCH_MAX_NFEV)
+    fit = least_squares(
+        lambda x: np.sqrt(delta_E(x) + 1e-6), x0, method="trf", x_scale="jac", diff_step=1e-6, max_nfev=SEARCH_MAX_NFEV
+    )
     dE, dE0 = delta_E(fit.x), delta_E(x0)
-    return {"shipped": [float(dE0.mean()), float(dE0.max())], "view_dependent": [float(dE.mean()), float(dE.max())],
-            "ior": fit.x[0:3].tolist(), "ior_per_facing": fit.x[3:6].tolist(),
-            "extinction": fit.x[6:9].tolist(), "extinction_per_facing": fit.x[9:12].tolist()}
+    return {
+        "shipped": [float(dE0.mean()), float(dE0.max())],
+        "view_dependent": [float(dE.mean()), float(dE.max())],
+        "ior": fit.x[0:3].tolist(),
+        "ior_per_facing": fit.x[3:6].tolist(),
+        "extinction": fit.x[6:9].tolist(),
+        "extinction_per_facing": fit.x[9:12].tolist(),
+    }
 
 
 def run_conductor_search(names: list[str], etas: list[float], record: bool, argv, view_dependent: bool) -> int:
@@ -217,23 +240,37 @@ def run_conductor_search(names: list[str], etas: list[float], record: bool, argv
                 row = (view_dependent_index if view_dependent else conductor_search)(tool, name, eta)
                 found.setdefault(eta_key(eta), {}).setdefault(tool, {})[name] = row
                 if view_dependent:
-                    print(f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, view-dependent "
-                          f"{row['view_dependent'][0]:.3f} / max {row['view_dependent'][1]:.2f}", flush=True)
+                    print(
+                        f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, view-dependent "
+                        f"{row['view_dependent'][0]:.3f} / max {row['view_dependent'][1]:.2f}",
+                        flush=True,
+                    )
                     continue
                 b = row["best"]
-                print(f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, best of {row['starts']} "
-                      f"starts {b['mean']:.3f} / max {b['max']:.2f} (from {b['from']}; n {np.round(b['ior'], 3)}, "
-                      f"k {np.round(b['extinction'], 3)}); {row['cpu_s']:.0f} s CPU", flush=True)
+                print(
+                    f"eta_i {eta:g} {tool} {name}: shipped {row['shipped'][0]:.3f}, best of {row['starts']} "
+                    f"starts {b['mean']:.3f} / max {b['max']:.2f} (from {b['from']}; n {np.round(b['ior'], 3)}, "
+                    f"k {np.round(b['extinction'], 3)}); {row['cpu_s']:.0f} s CPU",
+                    flush=True,
+                )
     elapsed = time.time() - started
     load = os.getloadavg()
     print(f"{elapsed:.0f} s, load average {load[0]:.1f}")
     if record:
         data = json.loads(RESULT.read_text()) if RESULT.exists() else {}
-        run = {"command": "benchmarks/exports_seen.py " + " ".join(argv),
-               "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-               "starts": {"grid_n": SEARCH_GRID_N, "grid_k": SEARCH_GRID_K, "random": SEARCH_RANDOM,
-                          "max_nfev": SEARCH_MAX_NFEV},
-               "found": found, "seconds": round(elapsed, 1), "load_average": round(load[0], 2)}
+        run = {
+            "command": "benchmarks/exports_seen.py " + " ".join(argv),
+            "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+            "starts": {
+                "grid_n": SEARCH_GRID_N,
+                "grid_k": SEARCH_GRID_K,
+                "random": SEARCH_RANDOM,
+                "max_nfev": SEARCH_MAX_NFEV,
+            },
+            "found": found,
+            "seconds": round(elapsed, 1),
+            "load_average": round(load[0], 2),
+        }
         if view_dependent:
             run["starts"] = {"shipped": 1, "max_nfev": SEARCH_MAX_NFEV}
         data["view_dependent_index" if view_dependent else "conductor_search"] = run
@@ -253,14 +290,19 @@ def figures(record: dict) -> dict:
     what docs/exports.md's seen tables quote.
     """
     return {
-        "summary_by_eta": {tool: {eta_key(eta): cell for eta, cell in cells.items()}
-                           for tool, cells in record["summary"].items()},
+        "summary_by_eta": {
+            tool: {eta_key(eta): cell for eta, cell in cells.items()} for tool, cells in record["summary"].items()
+        },
         "material_by_eta": {eta_key(eta): rows for eta, rows in record["per_material"].items()},
         # The conductor tools' constant index (slopes 0): mean over the metals, max.
         "constant_by_eta": {
-            tool: {eta_key(eta): [float(np.mean([r[tool]["constant"][0] for r in rows.values()])),
-                                  float(np.max([r[tool]["constant"][1] for r in rows.values()]))]
-                   for eta, rows in record["per_material"].items()}
+            tool: {
+                eta_key(eta): [
+                    float(np.mean([r[tool]["constant"][0] for r in rows.values()])),
+                    float(np.max([r[tool]["constant"][1] for r in rows.values()])),
+                ]
+                for eta, rows in record["per_material"].items()
+            }
             for tool in CONDUCTOR_TOOLS
         },
     }
@@ -271,10 +313,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--eta-i", default=None, help="default 1.0,1.33,1.5,2.0 (--conductor-search: 1.5)")
     parser.add_argument("--materials", default=None, help="default all (--conductor-search: W,CuZn)")
     parser.add_argument("--no-record", action="store_true")
-    parser.add_argument("--conductor-search", action="store_true",
-                        help="the multi-start search of the conductor exports' values")
-    parser.add_argument("--view-dependent", action="store_true",
-                        help="the conductor with n, k affine in 1 - cos theta, in the mirrors")
+    parser.add_argument(
+        "--conductor-search", action="store_true", help="the multi-start search of the conductor exports' values"
+    )
+    parser.add_argument(
+        "--view-dependent", action="store_true", help="the conductor with n, k affine in 1 - cos theta, in the mirrors"
+    )
     args = parser.parse_args(argv)
     argv = sys.argv[1:] if argv is None else argv
     search = args.conductor_search or args.view_dependent
@@ -298,30 +342,40 @@ def main(argv: list[str] | None = None) -> int:
             worst = max(names, key=lambda n: rows[n][tool]["seen"][0])
             cell["worst"] = [worst, rows[worst][tool]["seen"][0]]
             summary.setdefault(tool, {})[f"{eta:g}"] = cell
-            print(f"| {tool} | {eta:g} | {cell['seen'][0]:.3f} / {cell['seen'][1]:.2f} | "
-                  f"{cell['floor'][0]:.3f} / {cell['floor'][1]:.2f} | "
-                  f"{cell['naive'][0]:.3f} / {cell['naive'][1]:.2f} | {worst} {cell['worst'][1]:.2f} |")
+            print(
+                f"| {tool} | {eta:g} | {cell['seen'][0]:.3f} / {cell['seen'][1]:.2f} | "
+                f"{cell['floor'][0]:.3f} / {cell['floor'][1]:.2f} | "
+                f"{cell['naive'][0]:.3f} / {cell['naive'][1]:.2f} | {worst} {cell['worst'][1]:.2f} |"
+            )
     for eta in etas:
         rows = results[f"{eta:g}"]
         for tool in CONDUCTOR_TOOLS:
             held = [n for n in names if rows[n]["holdable_in_rec709"]]
             over = [n for n in held if rows[n][tool]["seen"][0] >= 1.0]
-            print(f"eta_i {eta:g} {tool}: {len(held)} of {len(names)} metals holdable in Rec.709; "
-                  f"seen mean >= 1.0 on {over or 'none'}")
+            print(
+                f"eta_i {eta:g} {tool}: {len(held)} of {len(names)} metals holdable in Rec.709; "
+                f"seen mean >= 1.0 on {over or 'none'}"
+            )
     elapsed = time.time() - started
     load = os.getloadavg()
     print(f"{elapsed:.0f} s, load average {load[0]:.1f}")
     if not args.no_record:
         RESULT.parent.mkdir(parents=True, exist_ok=True)
         # The conductor searches' records are their own runs': kept across this one.
-        kept = {k: v for k, v in (json.loads(RESULT.read_text()) if RESULT.exists() else {}).items()
-                if k in ("conductor_search", "view_dependent_index")}
+        kept = {
+            k: v
+            for k, v in (json.loads(RESULT.read_text()) if RESULT.exists() else {}).items()
+            if k in ("conductor_search", "view_dependent_index")
+        }
         record = {
             "command": "benchmarks/exports_seen.py " + " ".join(argv),
             "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
             "angles_deg": [float(SEEN_ANGLES_DEG[0]), float(SEEN_ANGLES_DEG[-1])],
-            "summary": summary, "per_material": results,
-            "seconds": round(elapsed, 1), "load_average": round(load[0], 2), **kept,
+            "summary": summary,
+            "per_material": results,
+            "seconds": round(elapsed, 1),
+            "load_average": round(load[0], 2),
+            **kept,
         }
         record["figures"] = figures(record)
         RESULT.write_text(json.dumps(record, indent=1) + "\n")

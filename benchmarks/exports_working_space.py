@@ -67,8 +67,9 @@ TOOLS = ("mtlx", "openpbr", "blender", "blender-conductor")
 
 def materialx_mean(nk, values, fmt: str, target, thread) -> float:
     """Seen mean Delta E of a MaterialX render (pixels in ``target``, or the document's space when None)."""
-    image, _ = render_materialx(export_material(values, fmt, values.eta_i).decode(), SIZE, thread,
-                                target_colorspace=target)
+    image, _ = render_materialx(
+        export_material(values, fmt, values.eta_i).decode(), SIZE, thread, target_colorspace=target
+    )
     space = target or values.working_space
     mu, mask = sphere_cos_theta(SIZE)
     theta = np.degrees(np.arccos(np.clip(mu, 0.0, 1.0)))
@@ -85,10 +86,23 @@ def cycles_mean(nk, values, output: str, samples: int, work: Path) -> float:
     script = work / f"{values.name}-{values.working_space}.py"
     script.write_bytes(export_material(values, "blender", values.eta_i))
     result = subprocess.run(
-        [str(BLENDER_PYTHON), str(CYCLES_ANGLES), str(script), "--output", output,
-         "--angles", ",".join(str(a) for a in ANGLES_DEG), "--samples", str(samples),
-         "--working-space", values.working_space],
-        check=True, capture_output=True, text=True, timeout=900,
+        [
+            str(BLENDER_PYTHON),
+            str(CYCLES_ANGLES),
+            str(script),
+            "--output",
+            output,
+            "--angles",
+            ",".join(str(a) for a in ANGLES_DEG),
+            "--samples",
+            str(samples),
+            "--working-space",
+            values.working_space,
+        ],
+        check=True,
+        capture_output=True,
+        text=True,
+        timeout=900,
     )
     line = next(x for x in result.stdout.splitlines() if x.startswith("CYCLES_ANGLES "))
     rgb = json.loads(line.split(" ", 1)[1])
@@ -111,16 +125,16 @@ def main(argv: list[str] | None = None) -> int:
             nk = library_material(metal)
             row = {}
             for space in ("lin_rec709", "acescg"):
-                values = export_values(nk, args.eta_i, roughness=0.0, coat_roughness=0.0,
-                                       tools=TOOLS, working_space=space)
+                values = export_values(
+                    nk, args.eta_i, roughness=0.0, coat_roughness=0.0, tools=TOOLS, working_space=space
+                )
                 for tool in TOOLS:
                     row[f"mirror_{tool}_{space}"] = seen_fidelity(values, tool)["delta_E_mean"]
                 for fmt in ("mtlx", "openpbr"):
                     target = "acescg" if space == "acescg" else None
                     row[f"materialx_{fmt}_{space}"] = materialx_mean(nk, values, fmt, target, thread)
                     other = "lin_rec709" if space == "acescg" else "acescg"
-                    row[f"materialx_{fmt}_{space}_in_{other}_host"] = materialx_mean(
-                        nk, values, fmt, other, thread)
+                    row[f"materialx_{fmt}_{space}_in_{other}_host"] = materialx_mean(nk, values, fmt, other, thread)
                 if not args.no_cycles:
                     for output, tool in (("principled", "blender"), ("conductor", "blender-conductor")):
                         row[f"cycles_{tool}_{space}"] = cycles_mean(nk, values, output, args.samples, Path(tmp))
@@ -144,11 +158,19 @@ def main(argv: list[str] | None = None) -> int:
             cross = f"{key}_{space}_in_{other}_host"
             if cross in first:
                 figures[key][f"{space}_document_in_{other}_host_mean"] = round(
-                    float(np.mean([r[cross] for r in rows.values()])), 3)
+                    float(np.mean([r[cross] for r in rows.values()])), 3
+                )
     for key, value in figures.items():
         print(f"{key}: {value}")
-    path = write_result("exports_working_space", figures, load, eta_i=args.eta_i,
-                        materials=args.materials.split(","), samples=args.samples, rows=rows)
+    path = write_result(
+        "exports_working_space",
+        figures,
+        load,
+        eta_i=args.eta_i,
+        materials=args.materials.split(","),
+        samples=args.samples,
+        rows=rows,
+    )
     print(f"wrote {path.relative_to(ROOT)}")
     return 0
 

@@ -89,8 +89,10 @@ CASES: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {
 
 def _strict_json(text: str):
     """``text`` parsed as JSON that holds no NaN or infinity (ValueError otherwise)."""
+
     def refuse(token):
         raise ValueError(f"not JSON: {token}")
+
     return json.loads(text, parse_constant=refuse)
 
 
@@ -102,17 +104,31 @@ def _rule(message: str) -> str:
 def run_cli(name: str, table, directory: Path) -> dict:
     w, n, k = table
     path = directory / "case.csv"
-    path.write_text("wavelength_nm,n,k\n" + "".join(
-        f"{float(a)!r},{float(b)!r},{float(c)!r}\n" for a, b, c in zip(w, n, k)))
-    done = subprocess.run([sys.executable, "-m", "fitting", "fit", "--nk", str(path), "--name", "case", "--json"],
-                          cwd=ROOT, capture_output=True, text=True, timeout=600)
+    path.write_text(
+        "wavelength_nm,n,k\n" + "".join(f"{float(a)!r},{float(b)!r},{float(c)!r}\n" for a, b, c in zip(w, n, k))
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "fitting", "fit", "--nk", str(path), "--name", "case", "--json"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     if done.returncode != 0:
-        return {"accepted": False, "exit": done.returncode, "rule": _rule(done.stderr.strip().splitlines()[-1]),
-                "json_valid": True}
+        return {
+            "accepted": False,
+            "exit": done.returncode,
+            "rule": _rule(done.stderr.strip().splitlines()[-1]),
+            "json_valid": True,
+        }
     view = _strict_json(done.stdout)
-    return {"accepted": True, "coefficients": view["coefficients"],
-            "warnings": view["fit"].get("quality", {}).get("warnings", []),
-            "delta_E_mean": view["metrics"]["figure"]["delta_E_mean"], "json_valid": True}
+    return {
+        "accepted": True,
+        "coefficients": view["coefficients"],
+        "warnings": view["fit"].get("quality", {}).get("warnings", []),
+        "delta_E_mean": view["metrics"]["figure"]["delta_E_mean"],
+        "json_valid": True,
+    }
 
 
 def run_service(url: str, name: str, table) -> dict:
@@ -125,9 +141,14 @@ def run_service(url: str, name: str, table) -> dict:
         message = detail if isinstance(detail, str) else json.dumps(detail)
         return {"accepted": False, "status": response.status_code, "rule": _rule(message), "json_valid": True}
     details = answer["metrics"]["details"]
-    return {"accepted": True, "status": response.status_code, "coefficients": answer["coefficients"],
-            "warnings": details.get("quality", {}).get("warnings", []),
-            "delta_E_mean": answer["metrics"]["figure"]["delta_E_mean"], "json_valid": True}
+    return {
+        "accepted": True,
+        "status": response.status_code,
+        "coefficients": answer["coefficients"],
+        "warnings": details.get("quality", {}).get("warnings", []),
+        "delta_E_mean": answer["metrics"]["figure"]["delta_E_mean"],
+        "json_valid": True,
+    }
 
 
 def same_answer(cli: dict, service: dict) -> bool:
@@ -148,9 +169,14 @@ def _free_port() -> int:
 def start_server(data: str) -> tuple[subprocess.Popen, str]:
     port = _free_port()
     env = {**os.environ, "COATED_FIT_WORKERS": "1"}
-    process = subprocess.Popen([sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
-                               cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                               start_new_session=True)
+    process = subprocess.Popen(
+        [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
+        cwd=ROOT,
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     url = f"http://127.0.0.1:{port}"
     deadline = time.monotonic() + 180
     while True:
@@ -176,8 +202,11 @@ def main() -> int:
                 service = run_service(url, name, table)
                 finite = all(math.isfinite(x["delta_E_mean"]) for x in (cli, service) if x["accepted"])
                 rows[name] = {"cli": cli, "service": service, "same": same_answer(cli, service), "finite": finite}
-                print(f"{name:48s} cli {'fit' if cli['accepted'] else 'refused':7s} service "
-                      f"{'fit' if service['accepted'] else 'refused':7s} same {rows[name]['same']}", flush=True)
+                print(
+                    f"{name:48s} cli {'fit' if cli['accepted'] else 'refused':7s} service "
+                    f"{'fit' if service['accepted'] else 'refused':7s} same {rows[name]['same']}",
+                    flush=True,
+                )
         finally:
             process.terminate()
             process.wait(30)
@@ -188,8 +217,9 @@ def main() -> int:
         "refused": sum(not r["cli"]["accepted"] for r in rows.values()),
         "finite_figures": sum(r["finite"] for r in rows.values()),
         "valid_json": sum(r["cli"]["json_valid"] and r["service"]["json_valid"] for r in rows.values()),
-        "outlier_warned": sum(any(w.startswith("outlier") for w in r["cli"].get("warnings", []))
-                              for r in rows.values()),
+        "outlier_warned": sum(
+            any(w.startswith("outlier") for w in r["cli"].get("warnings", [])) for r in rows.values()
+        ),
     }
     path = write_result("finite_inputs", figures, load, cases=rows)
     print(f"wrote {path}: {figures}")

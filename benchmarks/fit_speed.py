@@ -59,8 +59,10 @@ def naive_fit(nk):
     x0[0, :, 0] = reference_ACEScg(nk, 1.0, 1.0)
     x0[2, :, 0] = 6.0
     result = least_squares(
-        lambda x: (naive_model(x, mu, eta) - target).ravel(), x0.ravel(),
-        method="trf", jac="2-point",
+        lambda x: (naive_model(x, mu, eta) - target).ravel(),
+        x0.ravel(),
+        method="trf",
+        jac="2-point",
     )
     C16 = result.x.astype(np.float16)
     t2 = time.perf_counter()
@@ -77,37 +79,43 @@ def main(argv=None) -> int:
     fit_material(library_material(names[0]))  # warm caches (colour-science, weights)
     M, E = evaluation_grid(100, ETA_I_RANGE)
     rows = []
-    print(f"{'material':8s} {'naive ref':>10s} {'naive fit':>10s} {'naive dE':>9s} "
-          f"{'ours ref':>9s} {'ours fit':>9s} {'ours total':>10s} {'ours dE':>8s}")
+    print(
+        f"{'material':8s} {'naive ref':>10s} {'naive fit':>10s} {'naive dE':>9s} "
+        f"{'ours ref':>9s} {'ours fit':>9s} {'ours total':>10s} {'ours dE':>8s}"
+    )
     for name in names:
         nk = library_material(name)
         ref = reference_ACEScg(nk, M, E)
         C16, naive_ref, naive_fit_s = naive_fit(nk)
-        naive_dE = error_metrics(
-            ref, naive_model(C16.astype(np.float64), M.ravel(), E.ravel()).reshape(ref.shape)
-        ).mean
+        naive_dE = error_metrics(ref, naive_model(C16.astype(np.float64), M.ravel(), E.ravel()).reshape(ref.shape)).mean
         runs = [fit_material(nk, ETA_I_RANGE) for _ in range(args.repeats)]
         best = min(runs, key=lambda r: r.timings["total"])
         ours_total = float(np.median([r.timings["total"] for r in runs]))
         ours_ref = float(np.median([r.timings["reference"] for r in runs]))
-        ours_dE = error_metrics(
-            ref, coated_conductor_model(M, E, best.coefficients_float16, ETA_I_RANGE)
-        ).mean
+        ours_dE = error_metrics(ref, coated_conductor_model(M, E, best.coefficients_float16, ETA_I_RANGE)).mean
         rows.append((naive_ref, naive_fit_s, naive_dE, ours_ref, ours_total - ours_ref, ours_total, ours_dE))
-        print(f"{name:8s} {naive_ref*1e3:8.1f}ms {naive_fit_s*1e3:8.1f}ms {naive_dE:9.4f} "
-              f"{ours_ref*1e3:7.1f}ms {(ours_total-ours_ref)*1e3:7.1f}ms {ours_total*1e3:8.1f}ms {ours_dE:8.4f}",
-              flush=True)
+        print(
+            f"{name:8s} {naive_ref * 1e3:8.1f}ms {naive_fit_s * 1e3:8.1f}ms {naive_dE:9.4f} "
+            f"{ours_ref * 1e3:7.1f}ms {(ours_total - ours_ref) * 1e3:7.1f}ms {ours_total * 1e3:8.1f}ms {ours_dE:8.4f}",
+            flush=True,
+        )
     a = np.array(rows)
     med = np.median(a, axis=0)
     naive_total = np.median(a[:, 0] + a[:, 1])
     print()
     print(f"median over {len(names)} conductors")
-    print(f"  straightforward: reference {med[0]*1e3:.1f} ms + fit {med[1]*1e3:.1f} ms = {naive_total*1e3:.1f} ms, "
-          f"mean Delta E 2000 {a[:, 2].mean():.4f}")
-    print(f"  ours:            reference {med[3]*1e3:.1f} ms + fit {med[4]*1e3:.1f} ms = {med[5]*1e3:.1f} ms, "
-          f"mean Delta E 2000 {a[:, 6].mean():.4f}")
-    print(f"  speed-up (median total): {naive_total / med[5]:.1f}x; ours no worse on "
-          f"{int(np.sum(a[:, 6] <= a[:, 2] + 1e-12))}/{len(names)} conductors")
+    print(
+        f"  straightforward: reference {med[0] * 1e3:.1f} ms + fit {med[1] * 1e3:.1f} ms = {naive_total * 1e3:.1f} ms, "
+        f"mean Delta E 2000 {a[:, 2].mean():.4f}"
+    )
+    print(
+        f"  ours:            reference {med[3] * 1e3:.1f} ms + fit {med[4] * 1e3:.1f} ms = {med[5] * 1e3:.1f} ms, "
+        f"mean Delta E 2000 {a[:, 6].mean():.4f}"
+    )
+    print(
+        f"  speed-up (median total): {naive_total / med[5]:.1f}x; ours no worse on "
+        f"{int(np.sum(a[:, 6] <= a[:, 2] + 1e-12))}/{len(names)} conductors"
+    )
     figures = {
         "conductors": len(names),
         "straightforward_ms": {"reference": med[0] * 1e3, "fit": med[1] * 1e3, "total": naive_total * 1e3},

@@ -70,8 +70,11 @@ def main(argv=None) -> int:
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
     parser.add_argument("--rounds", type=int, default=5, help="rounds over the 22 conductors")
     parser.add_argument("--repeats", type=int, default=5, help="timing repeats of each fit")
-    parser.add_argument("--output", default="fit_time_guard",
-                        help="record to write, benchmarks/results/NAME.json (default fit_time_guard)")
+    parser.add_argument(
+        "--output",
+        default="fit_time_guard",
+        help="record to write, benchmarks/results/NAME.json (default fit_time_guard)",
+    )
     parser.add_argument("--child", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
@@ -93,9 +96,14 @@ def main(argv=None) -> int:
                     for side in sides:
                         ms[side.root][name] = side.ask(name)
                 a, b = (float(np.median(list(ms[s.root].values()))) for s in (before, after))
-                rounds.append({"before": {"median_ms": a, "ms": ms[before.root]},
-                               "after": {"median_ms": b, "ms": ms[after.root]}, "ratio": b / a,
-                               "load": os.getloadavg()[0]})
+                rounds.append(
+                    {
+                        "before": {"median_ms": a, "ms": ms[before.root]},
+                        "after": {"median_ms": b, "ms": ms[after.root]},
+                        "ratio": b / a,
+                        "load": os.getloadavg()[0],
+                    }
+                )
                 print(f"{i + 1:5d} {a:10.1f} {b:9.1f} {b / a:6.2f} {os.getloadavg()[0]:5.2f}", flush=True)
         finally:
             for side in (before, after):
@@ -106,15 +114,26 @@ def main(argv=None) -> int:
     ratios = [r["ratio"] for r in rounds]
     # Each conductor's own ratio (its medians over the rounds): where the
     # median over the 22 falls moves with which conductors the guard refits.
-    own = {name: float(np.median([r["after"]["ms"][name] for r in rounds])
-                       / np.median([r["before"]["ms"][name] for r in rounds])) for name in rounds[0]["before"]["ms"]}
-    figures = {"before_commit": args.before, "before_median_ms": before_ms, "after_median_ms": after_ms,
-               "ratio": after_ms / before_ms, "ratio_min": min(ratios), "ratio_max": max(ratios),
-               "rounds": len(rounds), "conductor_ratio_median": float(np.median(list(own.values()))),
-               "conductor_ratio_max": max(own.values()), "conductor_ratios": own}
+    own = {
+        name: float(
+            np.median([r["after"]["ms"][name] for r in rounds]) / np.median([r["before"]["ms"][name] for r in rounds])
+        )
+        for name in rounds[0]["before"]["ms"]
+    }
+    figures = {
+        "before_commit": args.before,
+        "before_median_ms": before_ms,
+        "after_median_ms": after_ms,
+        "ratio": after_ms / before_ms,
+        "ratio_min": min(ratios),
+        "ratio_max": max(ratios),
+        "rounds": len(rounds),
+        "conductor_ratio_median": float(np.median(list(own.values()))),
+        "conductor_ratio_max": max(own.values()),
+        "conductor_ratios": own,
+    }
     print(json.dumps(figures, indent=1))
-    print("recorded:", write_result(args.output, figures, load_start, repeats=args.repeats,
-                                    runs=rounds))
+    print("recorded:", write_result(args.output, figures, load_start, repeats=args.repeats, runs=rounds))
     return 0
 
 

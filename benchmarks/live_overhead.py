@@ -49,7 +49,7 @@ from conftest import server_process  # noqa: E402
 from benchmarks.record import load_average, write_result  # noqa: E402
 from fitting import curve_base_from_nk, library_material  # noqa: E402
 
-GC_TRACE = '''
+GC_TRACE = """
 import gc, os, sys, time
 _start = [0.0]
 def _trace(phase, info):
@@ -59,21 +59,25 @@ def _trace(phase, info):
         sys.stderr.write(f"GC_PAUSE pid={os.getpid()} generation={info['generation']} "
                          f"ms={(time.perf_counter() - _start[0]) * 1e3:.1f}\\n")
 gc.callbacks.append(_trace)
-'''
+"""
 
 
 def post(url: str, body: dict) -> dict:
     origin = url.split("/api/")[0]
-    request = urllib.request.Request(url, data=json.dumps(body).encode(),
-                                     headers={"Content-Type": "application/json", "Origin": origin})
+    request = urllib.request.Request(
+        url, data=json.dumps(body).encode(), headers={"Content-Type": "application/json", "Origin": origin}
+    )
     with urllib.request.urlopen(request, timeout=60) as answer:
         return json.loads(answer.read())
 
 
 def percentiles(values) -> dict[str, float]:
     values = np.asarray(values, dtype=np.float64)
-    return {"p50": float(np.percentile(values, 50)), "p99": float(np.percentile(values, 99)),
-            "max": float(values.max())}
+    return {
+        "p50": float(np.percentile(values, 50)),
+        "p99": float(np.percentile(values, 99)),
+        "max": float(values.max()),
+    }
 
 
 def main(argv=None) -> int:
@@ -105,9 +109,14 @@ def main(argv=None) -> int:
                 for s in np.linspace(0.02 + 1e-3 * drag, 1.0, args.steps):  # another curve each drag
                     rgb = rgb0.copy()
                     rgb[:, 1] += s * (0.10 - rgb0[int(np.argmin(np.abs(angle - 60.0))), 1]) * bump
-                    body = {"name": "Live gold", "base": {"fit": base["id"]}, "draft": True, "live": True,
-                            "start_fit": start,
-                            "curves": [{"eta_i": 1.5, "angle_deg": angle.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
+                    body = {
+                        "name": "Live gold",
+                        "base": {"fit": base["id"]},
+                        "draft": True,
+                        "live": True,
+                        "start_fit": start,
+                        "curves": [{"eta_i": 1.5, "angle_deg": angle.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
+                    }
                     t0 = time.perf_counter()
                     fit = post(route, body)
                     wall = 1e3 * (time.perf_counter() - t0)
@@ -128,7 +137,9 @@ def main(argv=None) -> int:
     if args.gc_trace:
         print(f"collections over 5 ms during the measured drags: {figures['gc_pauses_during_drags']}")
     if args.output != "-":
-        print("recorded:", write_result(args.output, figures, load_at_start, drags=args.drags, steps_per_drag=args.steps))
+        print(
+            "recorded:", write_result(args.output, figures, load_at_start, drags=args.drags, steps_per_drag=args.steps)
+        )
     return 0
 
 

@@ -56,9 +56,11 @@ def main() -> int:
     parser.add_argument("--materials", default="Au,Cu,Cr")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    print("| material | fit ms | reference as defined ms | grid reference ms (float32) "
-          "| evaluate_material ms (float32) | fit + evaluate ms (float32) "
-          "| Delta E mean / max minus the definition's: float64 | float32 |")
+    print(
+        "| material | fit ms | reference as defined ms | grid reference ms (float32) "
+        "| evaluate_material ms (float32) | fit + evaluate ms (float32) "
+        "| Delta E mean / max minus the definition's: float64 | float32 |"
+    )
     print("|---|---:|---:|---:|---:|---:|---|---|")
     with threadpool_limits(limits=1):
         for name in args.materials.split(","):
@@ -81,9 +83,11 @@ def main() -> int:
             for dtype in ("float64", "float32"):
                 b = evaluate_material(nk, result, baselines=False, dtype=dtype)["model_float16"]
                 diffs.append(f"{abs(a.mean - b['delta_E_mean']):.1e} / {abs(a.max - b['delta_E_max']):.1e}")
-            print(f"| {name} | {fit:.1f} | {slow:.1f} | {grid:.1f} ({grid32:.1f}) | {evaluate:.1f} "
-                  f"({evaluate32:.1f}) | {fit + evaluate:.1f} ({fit + evaluate32:.1f}) | "
-                  f"{diffs[0]} | {diffs[1]} |")
+            print(
+                f"| {name} | {fit:.1f} | {slow:.1f} | {grid:.1f} ({grid32:.1f}) | {evaluate:.1f} "
+                f"({evaluate32:.1f}) | {fit + evaluate:.1f} ({fit + evaluate32:.1f}) | "
+                f"{diffs[0]} | {diffs[1]} |"
+            )
     return 0
 
 

@@ -49,8 +49,13 @@ API = "/api/v1"
 from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.service_load import percentiles, start_replicas  # noqa: E402
 
-ROUGH_COATED_REFERENCE = {"roughness": 0.3, "mode": "coated", "coat_roughness": 0.1,
-                          "environment": "studio", "compare": "reference"}
+ROUGH_COATED_REFERENCE = {
+    "roughness": 0.3,
+    "mode": "coated",
+    "coat_roughness": 0.1,
+    "environment": "studio",
+    "compare": "reference",
+}
 """The preview of the issue's measurement: rough, coated, split with the spectral reference."""
 
 
@@ -74,8 +79,12 @@ def previews_at_once(url: str, fit_id: str, count: int, size: int, round_: int) 
     results: list[tuple[int, float]] = [(0, 0.0)] * count
 
     def one(i: int) -> None:
-        params = {"fit": fit_id, "size": size, "eta_i": round(1.3 + 0.1 * i + 0.01 * round_, 3),
-                  **ROUGH_COATED_REFERENCE}
+        params = {
+            "fit": fit_id,
+            "size": size,
+            "eta_i": round(1.3 + 0.1 * i + 0.01 * round_, 3),
+            **ROUGH_COATED_REFERENCE,
+        }
         with httpx.Client(base_url=url, timeout=600) as http:
             start = time.perf_counter()
             response = http.get(f"{API}/preview.png", params=params)
@@ -102,8 +111,12 @@ def main() -> int:
     args = parser.parse_args()
 
     with tempfile.TemporaryDirectory() as data:
-        env = {**os.environ, "COATED_FIT_WORKERS": "1", "COATED_METRICS_SAMPLES": "30",
-               "COATED_MAX_PREVIEWS_IN_FLIGHT": str(args.previews)}
+        env = {
+            **os.environ,
+            "COATED_FIT_WORKERS": "1",
+            "COATED_METRICS_SAMPLES": "30",
+            "COATED_MAX_PREVIEWS_IN_FLIGHT": str(args.previews),
+        }
         [(server, url)] = start_replicas(1, env, data)
         try:
             fit_id = httpx.post(f"{url}{API}/fits", json={"material": "Au"}, timeout=120).json()["id"]
@@ -111,8 +124,9 @@ def main() -> int:
             if any(status != 200 for status, _ in warm):
                 raise SystemExit(f"the warm-up previews answered {warm}")
             stop_file = os.path.join(data, "stop")
-            prober = subprocess.Popen([sys.executable, __file__, "--probe", url, stop_file, "900"],
-                                      stdout=subprocess.PIPE, text=True)
+            prober = subprocess.Popen(
+                [sys.executable, __file__, "--probe", url, stop_file, "900"], stdout=subprocess.PIPE, text=True
+            )
             time.sleep(args.idle)  # the control: the probe alone
             answers = []
             started, since = time.perf_counter(), time.time()
@@ -132,28 +146,40 @@ def main() -> int:
     statuses: dict[str, int] = {}
     for status, _ in answers:
         statuses[str(status)] = statuses.get(str(status), 0) + 1
-    print(f"previews and /healthz: {args.rounds} round(s) of {args.previews} previews at once, "
-          f"{args.size} px rough coated reference, machine {os.cpu_count()} CPUs, load {load_at_start}\n")
+    print(
+        f"previews and /healthz: {args.rounds} round(s) of {args.previews} previews at once, "
+        f"{args.size} px rough coated reference, machine {os.cpu_count()} CPUs, load {load_at_start}\n"
+    )
     print("| quantity | value |\n|---|---|")
     print(f"| previews answered | {', '.join(f'{k}: {v}' for k, v in sorted(statuses.items()))} |")
     print(f"| preview seconds (min / max) | {min(seconds):.1f} / {max(seconds):.1f} |")
     print(f"| /healthz idle, no previews: requests | {len(idle)} |")
     print(f"| /healthz idle: p50 / p95 / p99 / max ms | {i50:.1f} / {i95:.1f} / {i99:.1f} / {iworst:.1f} |")
     print(f"| /healthz during the previews: requests | {len(during)} |")
-    print(f"| /healthz during the previews: p50 / p95 / p99 / max ms | "
-          f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+    print(
+        f"| /healthz during the previews: p50 / p95 / p99 / max ms | {p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |"
+    )
     print(f"| /healthz answers other than 200 | {probed['errors']} |")
     figures = {
         "healthz_ms": {"p50": p50, "p95": p95, "p99": p99, "max": worst},
-        "healthz_requests": len(during), "healthz_errors": probed["errors"],
+        "healthz_requests": len(during),
+        "healthz_errors": probed["errors"],
         "idle_healthz_ms": {"p50": i50, "p95": i95, "p99": i99, "max": iworst},
         "idle_healthz_requests": len(idle),
-        "preview_statuses": statuses, "preview_s": {"min": min(seconds), "max": max(seconds)},
+        "preview_statuses": statuses,
+        "preview_s": {"min": min(seconds), "max": max(seconds)},
         "wall_s": wall,
     }
-    path = write_result(args.name, figures, load_at_start, rounds=args.rounds, previews=args.previews,
-                        size=args.size, preview=ROUGH_COATED_REFERENCE,
-                        loadavg=Path("/proc/loadavg").read_text().strip())
+    path = write_result(
+        args.name,
+        figures,
+        load_at_start,
+        rounds=args.rounds,
+        previews=args.previews,
+        size=args.size,
+        preview=ROUGH_COATED_REFERENCE,
+        loadavg=Path("/proc/loadavg").read_text().strip(),
+    )
     print(f"\nrecorded in {path.relative_to(ROOT)}")
     return 0 if set(statuses) == {"200"} else 1
 

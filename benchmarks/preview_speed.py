@@ -54,10 +54,10 @@ def main() -> int:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--material", default="Au")
     parser.add_argument("--eta-i", type=float, default=1.5)
-    parser.add_argument("--maps", action="store_true",
-                        help="also time the reference preview with its Delta E and FLIP maps")
-    parser.add_argument("--per-pixel", action="store_true",
-                        help="also time the reference integrated per pixel (slow)")
+    parser.add_argument(
+        "--maps", action="store_true", help="also time the reference preview with its Delta E and FLIP maps"
+    )
+    parser.add_argument("--per-pixel", action="store_true", help="also time the reference integrated per pixel (slow)")
     args = parser.parse_args()
     load_at_start = load_average()
     nk = library_material(args.material)
@@ -65,9 +65,9 @@ def main() -> int:
     rows = []
     with PreviewRenderer() as renderer:
         for size in SIZES:
+
             def render(compare, differences=False):
-                return lambda: renderer.render_preview(
-                    packed, nk, args.eta_i, size, compare, differences=differences)
+                return lambda: renderer.render_preview(packed, nk, args.eta_i, size, compare, differences=differences)
 
             model = median_time(render("none"), args.repeat)
             reference = median_time(render("reference"), args.repeat)
@@ -76,12 +76,22 @@ def main() -> int:
                 maps = median_time(render("reference", True), args.repeat)
             if args.per_pixel:
                 shot = renderer.render_preview(packed, nk, args.eta_i, size, "none")
-                per_pixel = median_time(lambda: reference_image(
-                    nk, shot.cos_theta, shot.mask, shot.radiance, args.eta_i, per_pixel=True,
-                ), 1)
+                per_pixel = median_time(
+                    lambda: reference_image(
+                        nk,
+                        shot.cos_theta,
+                        shot.mask,
+                        shot.radiance,
+                        args.eta_i,
+                        per_pixel=True,
+                    ),
+                    1,
+                )
             rows.append((size, model, reference, per_pixel, maps))
-    print(f"preview speed: {args.material} at eta_i {args.eta_i}, white sky, median of "
-          f"{args.repeat}, machine {os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}")
+    print(
+        f"preview speed: {args.material} at eta_i {args.eta_i}, white sky, median of "
+        f"{args.repeat}, machine {os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}"
+    )
     print()
     header = "| size | model only ms | reference preview ms | ratio |"
     header += " with Delta E + FLIP maps ms |" if args.maps else ""
@@ -95,12 +105,19 @@ def main() -> int:
         if per_pixel is not None:
             line += f" {per_pixel * 1e3:.0f} |"
         print(line)
-    figures = {str(size): {"model_ms": model * 1e3, "reference_ms": reference * 1e3, "ratio": reference / model,
-                           **({} if maps is None else {"maps_ms": maps * 1e3}),
-                           **({} if per_pixel is None else {"per_pixel_ms": per_pixel * 1e3})}
-               for size, model, reference, per_pixel, maps in rows}
-    path = write_result("preview_speed", figures, load_at_start, material=args.material, eta_i=args.eta_i,
-                        repeat=args.repeat)
+    figures = {
+        str(size): {
+            "model_ms": model * 1e3,
+            "reference_ms": reference * 1e3,
+            "ratio": reference / model,
+            **({} if maps is None else {"maps_ms": maps * 1e3}),
+            **({} if per_pixel is None else {"per_pixel_ms": per_pixel * 1e3}),
+        }
+        for size, model, reference, per_pixel, maps in rows
+    }
+    path = write_result(
+        "preview_speed", figures, load_at_start, material=args.material, eta_i=args.eta_i, repeat=args.repeat
+    )
     print(f"\nwrote {path}")
     return 0
 

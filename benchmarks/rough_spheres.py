@@ -79,10 +79,14 @@ def main() -> None:
                 png = encode_png(to_uint8(ACEScg_to_sRGB(np.where(np.tile(mask, 3)[..., None], strip, 0.0))))
                 (args.images / f"rough_{name}_{eta_i:g}_{r:g}.png").write_bytes(png)
                 rows.append(row)
-    print(f"{args.size} x {args.size} px, Mitsuba {args.spp} spp, MC {args.samples} draws per NdotV; "
-          f"means over the sphere's pixels with NdotV >= 0.2 ({time.perf_counter() - t0:.0f} s)\n")
-    print("| material | eta_i | roughness | FLIP model | FLIP adj. Lazanyi | dE2000 model | "
-          "dE2000 adj. Lazanyi | noise floor FLIP | noise floor dE2000 |")
+    print(
+        f"{args.size} x {args.size} px, Mitsuba {args.spp} spp, MC {args.samples} draws per NdotV; "
+        f"means over the sphere's pixels with NdotV >= 0.2 ({time.perf_counter() - t0:.0f} s)\n"
+    )
+    print(
+        "| material | eta_i | roughness | FLIP model | FLIP adj. Lazanyi | dE2000 model | "
+        "dE2000 adj. Lazanyi | noise floor FLIP | noise floor dE2000 |"
+    )
     print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     for name, eta_i, r, fm, dm, fl, dl, fs, ds in rows:
         print(f"| {name} | {eta_i:g} | {r:g} | {fm:.4f} | {fl:.4f} | {dm:.3f} | {dl:.3f} | {fs:.4f} | {ds:.3f} |")

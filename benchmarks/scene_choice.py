@@ -98,18 +98,32 @@ def _check(report: dict, rule: dict) -> dict:
     general = report["general"]["delta_E_2000"]
     candidates = report["choice"]["candidates"]
     labels = list(candidates)
-    chosen = "general fit" if report["choice"]["from_general_fit"] else next(
-        label for label in labels if label.startswith(report["model"])
-        and (label == report["model"] or label.endswith(f"degree {report['degree']}")))
-    eligible = [label for label in labels
-                if candidates[label]["mean"] <= general["mean"] and candidates[label]["max"] <= general["max"]]
-    dearer = labels[labels.index(chosen) + 1:]
+    chosen = (
+        "general fit"
+        if report["choice"]["from_general_fit"]
+        else next(
+            label
+            for label in labels
+            if label.startswith(report["model"])
+            and (label == report["model"] or label.endswith(f"degree {report['degree']}"))
+        )
+    )
+    eligible = [
+        label
+        for label in labels
+        if candidates[label]["mean"] <= general["mean"] and candidates[label]["max"] <= general["max"]
+    ]
+    dearer = labels[labels.index(chosen) + 1 :]
     return {
         "chosen": chosen,
         "no_worse_than_general": shipped["mean"] <= general["mean"] and shipped["max"] <= general["max"],
-        "no_worse_than_dearer": None if rule else all(
+        "no_worse_than_dearer": None
+        if rule
+        else all(
             shipped["mean"] <= candidates[d]["mean"] and shipped["max"] <= candidates[d]["max"]
-            for d in dearer if d in eligible),
+            for d in dearer
+            if d in eligible
+        ),
     }
 
 
@@ -122,23 +136,41 @@ def main(argv=None) -> int:
     for name, eta_i in SCENES:
         nk = pages[name]
         for rule in RULES:
-            scene = parse_scene({**rule, "materials": [{"name": name, "eta_i": eta_i, "nk": {
-                "wavelength_nm": nk.wavelength_nm.tolist(), "n": nk.n.tolist(), "k": nk.k.tolist()}}]})
+            scene = parse_scene(
+                {
+                    **rule,
+                    "materials": [
+                        {
+                            "name": name,
+                            "eta_i": eta_i,
+                            "nk": {"wavelength_nm": nk.wavelength_nm.tolist(), "n": nk.n.tolist(), "k": nk.k.tolist()},
+                        }
+                    ],
+                }
+            )
             t0 = time.perf_counter()
             result = fit_scene_material(scene.materials[0], None, scene.max_delta_e, scene.prefer)
             seconds.append(time.perf_counter() - t0)
             report = result.report()
-            row = {"page": name, "eta_i": eta_i, "rule": report["choice"]["rule"],
-                   "shipped": {k: report["delta_E_2000"][k] for k in ("mean", "max")},
-                   "general": {k: report["general"]["delta_E_2000"][k] for k in ("mean", "max")},
-                   "coefficients": report["coefficients"],
-                   "candidates": {k: {"mean": v["mean"], "max": v["max"]}
-                                  for k, v in report["choice"]["candidates"].items()},
-                   **_check(report, rule)}
+            row = {
+                "page": name,
+                "eta_i": eta_i,
+                "rule": report["choice"]["rule"],
+                "shipped": {k: report["delta_E_2000"][k] for k in ("mean", "max")},
+                "general": {k: report["general"]["delta_E_2000"][k] for k in ("mean", "max")},
+                "coefficients": report["coefficients"],
+                "candidates": {
+                    k: {"mean": v["mean"], "max": v["max"]} for k, v in report["choice"]["candidates"].items()
+                },
+                **_check(report, rule),
+            }
             rows.append(row)
-            print(f"{name:18s} {str(eta_i):28s} {row['rule']:22s} {row['chosen']:27s} "
-                  f"{row['shipped']['mean']:.4f} / {row['shipped']['max']:.4f}  general "
-                  f"{row['general']['mean']:.4f} / {row['general']['max']:.4f}", flush=True)
+            print(
+                f"{name:18s} {str(eta_i):28s} {row['rule']:22s} {row['chosen']:27s} "
+                f"{row['shipped']['mean']:.4f} / {row['shipped']['max']:.4f}  general "
+                f"{row['general']['mean']:.4f} / {row['general']['max']:.4f}",
+                flush=True,
+            )
     default = [r for r in rows if r["rule"] == "no dearer one better"]
     figures = {
         "scenes": len(SCENES),
@@ -146,10 +178,12 @@ def main(argv=None) -> int:
         "runs": len(rows),
         "no_worse_than_general": sum(r["no_worse_than_general"] for r in rows),
         "default_no_worse_than_dearer": sum(bool(r["no_worse_than_dearer"]) for r in default),
-        "default_chosen": {label.replace(" ", "_"): count
-                           for label, count in Counter(r["chosen"] for r in default).items()},
-        "default_mean_ratio_to_general_median": sorted(
-            r["shipped"]["mean"] / r["general"]["mean"] for r in default)[len(default) // 2],
+        "default_chosen": {
+            label.replace(" ", "_"): count for label, count in Counter(r["chosen"] for r in default).items()
+        },
+        "default_mean_ratio_to_general_median": sorted(r["shipped"]["mean"] / r["general"]["mean"] for r in default)[
+            len(default) // 2
+        ],
         "default_mean_ratio_to_general_worst": max(r["shipped"]["mean"] / r["general"]["mean"] for r in default),
         "seconds_median": sorted(seconds)[len(seconds) // 2],
         "seconds_worst": max(seconds),

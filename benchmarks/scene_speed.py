@@ -76,8 +76,13 @@ def child(root: str, names: list[str], lo: float, hi: float) -> int:
         # a checkout before the rule's record, such as 09bbd13, names only its pack's).
         choice = result.choice or {"model": result.packed.model, "degree": result.degree}
         degree = f"{choice['model']} {choice['degree']}"
-        return {"ms": ms, "reference_ms": reference_ms, "degree": degree,
-                "mean": result.scene.mean, "max": result.scene.max}
+        return {
+            "ms": ms,
+            "reference_ms": reference_ms,
+            "degree": degree,
+            "mean": result.scene.mean,
+            "max": result.scene.max,
+        }
 
     return serve(names, answer)
 
@@ -87,8 +92,9 @@ def main(argv=None) -> int:
     parser.add_argument("--before", default=BEFORE, help=f"the commit to compare against (default {BEFORE})")
     parser.add_argument("--range", default="1.2:1.8", help="the scene's eta_i range LO:HI (default 1.2:1.8)")
     parser.add_argument("--materials", default=None, help="library conductors (default all)")
-    parser.add_argument("--output", default="scene_speed",
-                        help="record to write, benchmarks/results/NAME.json (default scene_speed)")
+    parser.add_argument(
+        "--output", default="scene_speed", help="record to write, benchmarks/results/NAME.json (default scene_speed)"
+    )
     parser.add_argument("--child", help=argparse.SUPPRESS)
     parser.add_argument("--items", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -107,26 +113,35 @@ def main(argv=None) -> int:
             sides["before"] = Side(__file__, before_root, *common)
             sides["after"] = Side(__file__, ROOT, *common)
             for i, item in enumerate(items):
-                for name in (("before", "after") if i % 2 == 0 else ("after", "before")):
+                for name in ("before", "after") if i % 2 == 0 else ("after", "before"):
                     answers[name][item] = sides[name].ask(item)
                 b, a = answers["before"][item], answers["after"][item]
-                print(f"{item:>5} {b['ms']:7.0f} ms -> {a['ms']:5.0f} ms (reference {b['reference_ms']:4.0f} -> "
-                      f"{a['reference_ms']:3.0f} ms)  degree {b['degree']}/{a['degree']}  "
-                      f"mean {b['mean']:.4f}/{a['mean']:.4f}  load {os.getloadavg()[0]:.2f}", flush=True)
+                print(
+                    f"{item:>5} {b['ms']:7.0f} ms -> {a['ms']:5.0f} ms (reference {b['reference_ms']:4.0f} -> "
+                    f"{a['reference_ms']:3.0f} ms)  degree {b['degree']}/{a['degree']}  "
+                    f"mean {b['mean']:.4f}/{a['mean']:.4f}  load {os.getloadavg()[0]:.2f}",
+                    flush=True,
+                )
         finally:
             for side in sides.values():
                 side.close()
     before = [answers["before"][i]["ms"] for i in items]
     after = [answers["after"][i]["ms"] for i in items]
-    figures = {"before_commit": args.before, "eta_i_range": [lo, hi], **summary(before, after),
-               "reference_ms": float(np.median([answers["after"][i]["reference_ms"] for i in items])),
-               "degrees_changed": sum(answers["before"][i]["degree"] != answers["after"][i]["degree"]
-                                      for i in items),
-               "delta_E_change_max": float(max(abs(answers["after"][i][k] - answers["before"][i][k])
-                                               for i in items for k in ("mean", "max")))}
-    print(f"\nmedian {figures['before_median_ms']:.0f} ms -> {figures['after_median_ms']:.0f} ms "
-          f"({figures['ratio']:.2f}x); max {figures['before_max_ms']:.0f} -> {figures['after_max_ms']:.0f} ms; "
-          f"degrees changed {figures['degrees_changed']}; largest Delta E change {figures['delta_E_change_max']:.2e}")
+    figures = {
+        "before_commit": args.before,
+        "eta_i_range": [lo, hi],
+        **summary(before, after),
+        "reference_ms": float(np.median([answers["after"][i]["reference_ms"] for i in items])),
+        "degrees_changed": sum(answers["before"][i]["degree"] != answers["after"][i]["degree"] for i in items),
+        "delta_E_change_max": float(
+            max(abs(answers["after"][i][k] - answers["before"][i][k]) for i in items for k in ("mean", "max"))
+        ),
+    }
+    print(
+        f"\nmedian {figures['before_median_ms']:.0f} ms -> {figures['after_median_ms']:.0f} ms "
+        f"({figures['ratio']:.2f}x); max {figures['before_max_ms']:.0f} -> {figures['after_max_ms']:.0f} ms; "
+        f"degrees changed {figures['degrees_changed']}; largest Delta E change {figures['delta_E_change_max']:.2e}"
+    )
     print("recorded:", write_result(args.output, figures, load_start, materials=items, runs=answers))
     return 0
 

@@ -77,7 +77,7 @@ def stat_fields(pid: int | str) -> list[str]:
     reaped children's, ``[19]`` start time); ``OSError`` once it is gone.
     """
     stat = Path(f"/proc/{pid}/stat").read_text()
-    return stat[stat.rfind(")") + 2:].split()
+    return stat[stat.rfind(")") + 2 :].split()
 
 
 def processes() -> Iterator[tuple[int, list[str], str]]:
@@ -95,8 +95,11 @@ def processes() -> Iterator[tuple[int, list[str], str]]:
 
 def session_cpu(session: int) -> dict[int, tuple[int, str, float]]:
     """Every live process of ``session``: pid -> (parent pid, command line, CPU seconds with its reaped children)."""
-    return {pid: (int(fields[1]), command, sum(int(f) for f in fields[11:15]) / TICK)
-            for pid, fields, command in processes() if int(fields[3]) == session}
+    return {
+        pid: (int(fields[1]), command, sum(int(f) for f in fields[11:15]) / TICK)
+        for pid, fields, command in processes()
+        if int(fields[3]) == session
+    }
 
 
 def by_kind(processes: dict[int, tuple[int, str, float]], server: int) -> Counter:
@@ -122,10 +125,16 @@ def start(root: Path, workers: int | None) -> dict:
     with tempfile.TemporaryDirectory() as data:
         t0 = time.monotonic()
         process = subprocess.Popen(
-            [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data], cwd=root, env=env,
-            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
-        return measured(process, port, t0, f"the server of {root}",
-                        lambda: process.stderr.read().decode(errors="replace")[-2000:])
+            [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
+            cwd=root,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            start_new_session=True,
+        )
+        return measured(
+            process, port, t0, f"the server of {root}", lambda: process.stderr.read().decode(errors="replace")[-2000:]
+        )
 
 
 def measured(process, port: int, t0: float, what: str, output=lambda: "") -> dict:
@@ -167,8 +176,9 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--before", default=BEFORE, help=f"the earlier commit (default {BEFORE})")
     parser.add_argument("--rounds", type=int, default=10, help="counted starts of each side (default 10)")
-    parser.add_argument("--workers", type=int, default=None,
-                        help="COATED_FIT_WORKERS (default: the service's, one per core)")
+    parser.add_argument(
+        "--workers", type=int, default=None, help="COATED_FIT_WORKERS (default: the service's, one per core)"
+    )
     args = parser.parse_args(argv)
     if not 1 <= args.rounds <= 100:
         parser.error(f"--rounds must lie in [1, 100], got {args.rounds}")
@@ -181,25 +191,34 @@ def main(argv=None) -> int:
             start(root, args.workers)  # bytecode caches, not counted
         runs = {name: [] for name in sides}
         for i in range(args.rounds):
-            for name in (("before", "now") if i % 2 == 0 else ("now", "before")):
+            for name in ("before", "now") if i % 2 == 0 else ("now", "before"):
                 runs[name].append(start(sides[name], args.workers))
     figures = {name: summary(side) for name, side in runs.items()}
     figures["ratio_cpu_median"] = figures["now"]["cpu_s"]["median"] / figures["before"]["cpu_s"]["median"]
     figures["ratio_ready_median"] = figures["now"]["ready_s"]["median"] / figures["before"]["ready_s"]["median"]
     kinds = sorted({k for side in ("before", "now") for k in figures[side]["cpu_s_median_by_kind"]})
-    print(f"python -m service, {args.rounds} starts a side (COATED_FIT_WORKERS={args.workers or 'default'}); "
-          f"before = {args.before}")
+    print(
+        f"python -m service, {args.rounds} starts a side (COATED_FIT_WORKERS={args.workers or 'default'}); "
+        f"before = {args.before}"
+    )
     print(f"{'':<36}{'before':>10}{'now':>10}")
-    for label, key in (("ready s, median", ("ready_s", "median")), ("ready s, max", ("ready_s", "max")),
-                       ("CPU s, median", ("cpu_s", "median")), ("CPU s, max", ("cpu_s", "max"))):
+    for label, key in (
+        ("ready s, median", ("ready_s", "median")),
+        ("ready s, max", ("ready_s", "max")),
+        ("CPU s, median", ("cpu_s", "median")),
+        ("CPU s, max", ("cpu_s", "max")),
+    ):
         print(f"{label:<36}" + "".join(f"{figures[s][key[0]][key[1]]:>10.2f}" for s in ("before", "now")))
     for kind in kinds:
-        print(f"{'  CPU s, ' + kind + ', median':<36}"
-              + "".join(f"{figures[s]['cpu_s_median_by_kind'].get(kind, 0.0):>10.2f}" for s in ("before", "now")))
-    print(f"ratio of the medians (now / before): CPU {figures['ratio_cpu_median']:.2f}, "
-          f"ready {figures['ratio_ready_median']:.2f}")
-    write_result("server_start", figures, load, before=args.before, rounds=args.rounds,
-                 workers=args.workers, runs=runs)
+        print(
+            f"{'  CPU s, ' + kind + ', median':<36}"
+            + "".join(f"{figures[s]['cpu_s_median_by_kind'].get(kind, 0.0):>10.2f}" for s in ("before", "now"))
+        )
+    print(
+        f"ratio of the medians (now / before): CPU {figures['ratio_cpu_median']:.2f}, "
+        f"ready {figures['ratio_ready_median']:.2f}"
+    )
+    write_result("server_start", figures, load, before=args.before, rounds=args.rounds, workers=args.workers, runs=runs)
     return 0
 
 

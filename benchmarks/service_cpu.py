@@ -42,8 +42,10 @@ def tree_cpu(pid: int) -> float:
     for process in (root, *root.children(recursive=True)):
         try:
             tasks = os.listdir(f"/proc/{process.pid}/task")
-            total += sum(int(Path(f"/proc/{process.pid}/task/{tid}/schedstat").read_text().split()[0])
-                         for tid in tasks) * 1e-9
+            total += (
+                sum(int(Path(f"/proc/{process.pid}/task/{tid}/schedstat").read_text().split()[0]) for tid in tasks)
+                * 1e-9
+            )
         except (OSError, ValueError, IndexError):
             try:
                 times = process.cpu_times()
@@ -62,8 +64,11 @@ def bare_fit_cpu(body: dict) -> float:
     if "material" in body:
         nk = library_material(body["material"])
     else:
-        nk = SpectralNK(*(np.asarray(body["nk"][key], dtype=np.float64) for key in ("wavelength_nm", "n", "k")),
-                        name=body["name"], source="")
+        nk = SpectralNK(
+            *(np.asarray(body["nk"][key], dtype=np.float64) for key in ("wavelength_nm", "n", "k")),
+            name=body["name"],
+            source="",
+        )
     start = time.process_time()
     fit_model(nk, tuple(body.get("eta_i_range", (1.0, 2.5))))
     return time.process_time() - start
@@ -125,9 +130,19 @@ def cpu_figures(measured: dict[str, list], evaluations: list[float] = ()) -> dic
     extra = {}
     if len(evaluations):
         ms = np.asarray(evaluations) * 1e3
-        extra = {"evaluation_ms_p50": float(np.median(ms)), "evaluation_ms_max": float(ms.max()),
-                 "evaluations": int(ms.size)}
-    return {**extra, "service_ms_p50": float(np.median(cpu)), "service_ms_p90": float(np.percentile(cpu, 90)),
-            "bare_ms_p50": float(np.median(bare)), "bare_ms_p90": float(np.percentile(bare, 90)),
-            "ratio_p50": float(np.median(ratio)), "ratio_p90": float(np.percentile(ratio, 90)),
-            "ratio_of_medians": float(np.median(cpu) / np.median(bare)), "n": int(cpu.size)}
+        extra = {
+            "evaluation_ms_p50": float(np.median(ms)),
+            "evaluation_ms_max": float(ms.max()),
+            "evaluations": int(ms.size),
+        }
+    return {
+        **extra,
+        "service_ms_p50": float(np.median(cpu)),
+        "service_ms_p90": float(np.percentile(cpu, 90)),
+        "bare_ms_p50": float(np.median(bare)),
+        "bare_ms_p90": float(np.percentile(bare, 90)),
+        "ratio_p50": float(np.median(ratio)),
+        "ratio_p90": float(np.percentile(ratio, 90)),
+        "ratio_of_medians": float(np.median(cpu) / np.median(bare)),
+        "n": int(cpu.size),
+    }

@@ -76,7 +76,7 @@ def free_port() -> int:
 def nk_body(name: str) -> dict:
     """A smooth gold-like n, k over 350-850 nm."""
     wavelength = np.linspace(350.0, 850.0, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2)
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2))
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return {"name": name, "nk": {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}}
 
@@ -113,8 +113,9 @@ def read_packs(url: str, fit_id: str, stop: threading.Event, out: list[float]) -
             out.append(elapsed)
 
 
-def post_fits(url: str, client: int, stop: threading.Event, counts: dict, lock: threading.Lock,
-              saved: list[str]) -> None:
+def post_fits(
+    url: str, client: int, stop: threading.Event, counts: dict, lock: threading.Lock, saved: list[str]
+) -> None:
     with httpx.Client(base_url=url, timeout=300) as http:
         j = 0
         while not stop.is_set():
@@ -147,8 +148,8 @@ def probe(url: str, fit_id: str, seconds: float) -> int:
 def burst(url: str, fit_id: str, count: int) -> tuple[dict, dict, float]:
     """``count`` fits posted at once while a separate process probes; (probe, status counts, s)."""
     prober = subprocess.Popen(
-        [sys.executable, __file__, "--probe", url, fit_id, "--duration", "12"],
-        stdout=subprocess.PIPE, text=True)
+        [sys.executable, __file__, "--probe", url, fit_id, "--duration", "12"], stdout=subprocess.PIPE, text=True
+    )
     time.sleep(1.0)  # the probe runs before, during and after the burst
     counts: dict = {}
     lock = threading.Lock()
@@ -195,7 +196,12 @@ def start_replicas(count: int, env: dict[str, str], data: str) -> list[tuple[sub
         port = free_port()
         process = subprocess.Popen(
             [sys.executable, "-m", "service", "--port", str(port), "--data-dir", f"{data}/{i}"],
-            cwd=ROOT, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+            cwd=ROOT,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
         servers.append((process, f"http://127.0.0.1:{port}"))
     deadline = time.monotonic() + 180
     for process, url in servers:
@@ -220,14 +226,22 @@ def main() -> int:
     parser.add_argument("--idle", type=float, default=5.0, help="seconds of idle pack reads (default 5)")
     parser.add_argument("--fit-clients", type=int, default=4)
     parser.add_argument("--readers", type=int, default=2)
-    parser.add_argument("--workers", type=int, default=None,
-                        help="fit workers per replica (default: the CPUs shared among the replicas)")
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="fit workers per replica (default: the CPUs shared among the replicas)",
+    )
     parser.add_argument("--store", choices=("sqlite", "postgresql"), default="sqlite")
     parser.add_argument("--replicas", type=int, default=1, help="service processes (PostgreSQL store only)")
     parser.add_argument("--metrics-samples", type=int, default=100)
     parser.add_argument("--burst", type=int, default=200, help="fits posted at once (default 200)")
-    parser.add_argument("--latency-fits", type=int, default=40,
-                        help="sequential fits of unseen data for the REST fit latency (default 40)")
+    parser.add_argument(
+        "--latency-fits",
+        type=int,
+        default=40,
+        help="sequential fits of unseen data for the REST fit latency (default 40)",
+    )
     args = parser.parse_args()
 
     if args.replicas > 1 and args.store != "postgresql":
@@ -236,8 +250,12 @@ def main() -> int:
     postgres = None
     with tempfile.TemporaryDirectory() as data:
         # No background evaluation of the metrics: each figure is the CPU of what it names.
-        env = {**os.environ, "COATED_FIT_WORKERS": str(args.workers),
-               "COATED_METRICS_SAMPLES": str(args.metrics_samples), "COATED_METRICS_IDLE_S": "0"}
+        env = {
+            **os.environ,
+            "COATED_FIT_WORKERS": str(args.workers),
+            "COATED_METRICS_SAMPLES": str(args.metrics_samples),
+            "COATED_METRICS_IDLE_S": "0",
+        }
         if args.store == "postgresql":
             sys.path.insert(0, str(ROOT / "tests"))
             from postgres_server import PostgresServer
@@ -257,11 +275,14 @@ def main() -> int:
                 stop, lock = threading.Event(), threading.Lock()
                 latencies: list[float] = []
                 counts: dict = {}
-                threads = [threading.Thread(target=read_packs, args=(urls[i % len(urls)], fit_id, stop, latencies))
-                           for i in range(args.readers)]
-                threads += [threading.Thread(target=post_fits,
-                                             args=(urls[i % len(urls)], i, stop, counts, lock, saved))
-                            for i in range(fit_clients)]
+                threads = [
+                    threading.Thread(target=read_packs, args=(urls[i % len(urls)], fit_id, stop, latencies))
+                    for i in range(args.readers)
+                ]
+                threads += [
+                    threading.Thread(target=post_fits, args=(urls[i % len(urls)], i, stop, counts, lock, saved))
+                    for i in range(fit_clients)
+                ]
                 start = time.perf_counter()
                 for thread in threads:
                     thread.start()
@@ -284,54 +305,72 @@ def main() -> int:
                 postgres.close()
 
     fits = counts.get(201, 0)
-    print(f"service load: {args.workers} fit workers, {args.fit_clients} fit clients, "
-          f"{args.readers} pack readers, {args.duration:g} s, metrics grid "
-          f"{args.metrics_samples}x{args.metrics_samples}, machine {os.cpu_count()} CPUs, "
-          f"store {args.store}, {args.replicas} replica(s)")
+    print(
+        f"service load: {args.workers} fit workers, {args.fit_clients} fit clients, "
+        f"{args.readers} pack readers, {args.duration:g} s, metrics grid "
+        f"{args.metrics_samples}x{args.metrics_samples}, machine {os.cpu_count()} CPUs, "
+        f"store {args.store}, {args.replicas} replica(s)"
+    )
     print()
     print("| quantity | value |")
     print("|---|---|")
     ms = np.asarray(latency) * 1e3
     figures: dict = {"fits_per_s": fits / elapsed}
     if ms.size:
-        figures["rest_fit_unseen_ms"] = {"first": float(ms[0]), "p50": float(np.percentile(ms, 50)),
-                                         "p90": float(np.percentile(ms, 90)), "n": int(ms.size)}
+        figures["rest_fit_unseen_ms"] = {
+            "first": float(ms[0]),
+            "p50": float(np.percentile(ms, 50)),
+            "p90": float(np.percentile(ms, 90)),
+            "n": int(ms.size),
+        }
         print(f"| REST fit of unseen data, one client: fits | {ms.size} |")
-        print(f"| REST fit of unseen data: first / p50 / p90 ms | {ms[0]:.0f} / "
-              f"{np.percentile(ms, 50):.0f} / {np.percentile(ms, 90):.0f} |")
+        print(
+            f"| REST fit of unseen data: first / p50 / p90 ms | {ms[0]:.0f} / "
+            f"{np.percentile(ms, 50):.0f} / {np.percentile(ms, 90):.0f} |"
+        )
         figures["rest_fit_cpu"] = cpu_figures(measured)
-        print(f"| REST fit of unseen data: service CPU / bare fit CPU ms (p50), ratio p50 / p90 | "
-              f"{figures['rest_fit_cpu']['service_ms_p50']:.1f} / {figures['rest_fit_cpu']['bare_ms_p50']:.1f}, "
-              f"{figures['rest_fit_cpu']['ratio_p50']:.2f} / {figures['rest_fit_cpu']['ratio_p90']:.2f} |")
+        print(
+            f"| REST fit of unseen data: service CPU / bare fit CPU ms (p50), ratio p50 / p90 | "
+            f"{figures['rest_fit_cpu']['service_ms_p50']:.1f} / {figures['rest_fit_cpu']['bare_ms_p50']:.1f}, "
+            f"{figures['rest_fit_cpu']['ratio_p50']:.2f} / {figures['rest_fit_cpu']['ratio_p90']:.2f} |"
+        )
     print(f"| fits answered 201 | {fits} |")
     print(f"| fits per second | {fits / elapsed:.2f} |")
     print(f"| fits refused 503 (Retry-After) | {counts.get(503, 0)} |")
     print(f"| other answers | {sum(v for k, v in counts.items() if k not in (201, 503))} |")
     every = all(set(saved) <= set(ids) for ids in listings)
     twice = sum(len(ids) - len(set(ids)) for ids in listings)
-    print(f"| saves answered 201: listed by every replica / listed twice | "
-          f"{'all ' + str(len(saved)) if every else 'NOT all'} / {twice} |")
+    print(
+        f"| saves answered 201: listed by every replica / listed twice | "
+        f"{'all ' + str(len(saved)) if every else 'NOT all'} / {twice} |"
+    )
     figures["saves"] = {"answered": len(saved), "listed_by_every_replica": every, "listed_twice": twice}
     for label, samples in (("idle", idle), ("under load", loaded)):
         p50, p95, p99, worst = percentiles(samples)
         print(f"| pack download {label}: requests | {len(samples)} |")
-        print(f"| pack download {label}: p50 / p95 / p99 / max ms | "
-              f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+        print(f"| pack download {label}: p50 / p95 / p99 / max ms | {p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
         figures[f"pack_{label.replace(' ', '_')}_ms"] = {"p50": p50, "p95": p95, "p99": p99, "max": worst}
     if args.burst:
-        print(f"| burst: {args.burst} fits at once, answers | "
-              f"{', '.join(f'{k}: {v}' for k, v in sorted(burst_counts.items(), key=str))} ({burst_s:.1f} s) |")
+        print(
+            f"| burst: {args.burst} fits at once, answers | "
+            f"{', '.join(f'{k}: {v}' for k, v in sorted(burst_counts.items(), key=str))} ({burst_s:.1f} s) |"
+        )
         for key, label in (("healthz", "/healthz"), ("pack", "pack download")):
             p50, p95, p99, worst = percentiles(probed[key])
             print(f"| burst, separate process: {label} requests | {len(probed[key])} |")
-            print(f"| burst, separate process: {label} p50 / p95 / p99 / max ms | "
-                  f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |")
+            print(
+                f"| burst, separate process: {label} p50 / p95 / p99 / max ms | "
+                f"{p50:.1f} / {p95:.1f} / {p99:.1f} / {worst:.1f} |"
+            )
         print(f"| burst, separate process: answers other than 200 | {probed['errors']} |")
         figures["burst_p99_ms"] = {key: percentiles(probed[key])[2] for key in ("healthz", "pack")}
         figures["burst_answers"] = {str(k): v for k, v in burst_counts.items()}
     # One record per store and replica count (the PostgreSQL runs do not overwrite the SQLite one).
-    name = "service_load" if args.store == "sqlite" and args.replicas == 1 else (
-        f"service_load_{args.store}_{args.replicas}")
+    name = (
+        "service_load"
+        if args.store == "sqlite" and args.replicas == 1
+        else (f"service_load_{args.store}_{args.replicas}")
+    )
     write_result(name, figures, load_at_start)
     return 0
 

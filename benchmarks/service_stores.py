@@ -57,8 +57,9 @@ def load_round(url: str, clients: int, seconds: float, tag: str) -> tuple[dict, 
     stop, lock = threading.Event(), threading.Lock()
     counts: dict = {}
     saved: list[str] = []
-    threads = [threading.Thread(target=post_fits, args=(url, f"{tag}-{i}", stop, counts, lock, saved))
-               for i in range(clients)]
+    threads = [
+        threading.Thread(target=post_fits, args=(url, f"{tag}-{i}", stop, counts, lock, saved)) for i in range(clients)
+    ]
     start = time.perf_counter()
     for thread in threads:
         thread.start()
@@ -77,8 +78,12 @@ def main() -> int:
     parser.add_argument("--rounds", type=int, default=2, help="load rounds per store (default 2)")
     parser.add_argument("--latency-fits", type=int, default=30, help="REST fits of unseen data per store")
     parser.add_argument("--workers", type=int, default=None, help="fit workers per service (default: every CPU)")
-    parser.add_argument("--evaluations", type=int, default=10,
-                        help="fits per store whose metrics are then asked for (their evaluation's CPU)")
+    parser.add_argument(
+        "--evaluations",
+        type=int,
+        default=10,
+        help="fits per store whose metrics are then asked for (their evaluation's CPU)",
+    )
     args = parser.parse_args()
     workers = args.workers or os.cpu_count() or 1
 
@@ -94,7 +99,8 @@ def main() -> int:
             env = {**os.environ, "COATED_FIT_WORKERS": str(workers), "COATED_METRICS_IDLE_S": "0"}
             (servers["sqlite"],) = start_replicas(1, env, f"{data}/sqlite")
             (servers["postgresql"],) = start_replicas(
-                1, {**env, "COATED_STORE_URL": postgres.database("bench")}, f"{data}/postgresql")
+                1, {**env, "COATED_STORE_URL": postgres.database("bench")}, f"{data}/postgresql"
+            )
             try:
                 # Latency and CPU: fit by fit, each store in turn, each its own unseen data.
                 bodies = unseen_fit_bodies(2 * args.latency_fits)
@@ -105,18 +111,23 @@ def main() -> int:
                         one = fit_latencies(url, [bodies[2 * j + STORES.index(store)]], process.pid)
                         for key, values in one.items():
                             measured[store][key] += values
-                evaluated = {store: evaluation_cpu(servers[store][1], servers[store][0].pid,
-                                                   measured[store]["ids"][:args.evaluations])
-                             for store in STORES}
+                evaluated = {
+                    store: evaluation_cpu(
+                        servers[store][1], servers[store][0].pid, measured[store]["ids"][: args.evaluations]
+                    )
+                    for store in STORES
+                }
                 # Throughput: rounds in turn, the order swapped every round.
                 rounds: dict[str, list] = {store: [] for store in STORES}
                 for r in range(args.rounds):
-                    for store in (STORES if r % 2 == 0 else STORES[::-1]):
-                        counts, elapsed = load_round(servers[store][1], args.fit_clients, args.duration,
-                                                     f"{store}{r}")
+                    for store in STORES if r % 2 == 0 else STORES[::-1]:
+                        counts, elapsed = load_round(servers[store][1], args.fit_clients, args.duration, f"{store}{r}")
                         rounds[store].append((counts, elapsed))
-                        print(f"round {r + 1} {store}: {counts.get(201, 0) / elapsed:.2f} fits/s, "
-                              f"load {os.getloadavg()[0]:.2f}", flush=True)
+                        print(
+                            f"round {r + 1} {store}: {counts.get(201, 0) / elapsed:.2f} fits/s, "
+                            f"load {os.getloadavg()[0]:.2f}",
+                            flush=True,
+                        )
             finally:
                 for process, _ in servers.values():
                     process.terminate()
@@ -135,28 +146,47 @@ def main() -> int:
             "rounds": [c.get(201, 0) / e for c, e in rounds[store]],
             "refused": sum(c.get(503, 0) for c, _ in rounds[store]),
             "other": sum(v for c, _ in rounds[store] for k, v in c.items() if k not in (201, 503)),
-            "rest_fit_unseen_ms": {"p50": float(np.median(wall)), "p90": float(np.percentile(wall, 90)),
-                                   "max": float(wall.max()), "n": int(wall.size)},
+            "rest_fit_unseen_ms": {
+                "p50": float(np.median(wall)),
+                "p90": float(np.percentile(wall, 90)),
+                "max": float(wall.max()),
+                "n": int(wall.size),
+            },
             "rest_fit_cpu": cpu_figures(measured[store], evaluated[store]),
         }
     figures["postgresql_over_sqlite"] = figures["postgresql"]["fits_per_s"] / figures["sqlite"]["fits_per_s"]
-    figures["slower_store_over_faster"] = min(figures["postgresql_over_sqlite"],
-                                              1 / figures["postgresql_over_sqlite"])
-    print(f"\nservice on each store: {workers} fit workers each, {args.fit_clients} fit clients, "
-          f"{args.rounds} x {args.duration:g} s per store in turns, machine {os.cpu_count()} CPUs")
-    print("\n| store | fits/s (rounds) | refused 503 | REST fit p50 / p90 ms | service CPU / bare fit CPU ms "
-          "(p50) | ratio p50 / p90 | evaluation CPU ms (p50) |")
+    figures["slower_store_over_faster"] = min(figures["postgresql_over_sqlite"], 1 / figures["postgresql_over_sqlite"])
+    print(
+        f"\nservice on each store: {workers} fit workers each, {args.fit_clients} fit clients, "
+        f"{args.rounds} x {args.duration:g} s per store in turns, machine {os.cpu_count()} CPUs"
+    )
+    print(
+        "\n| store | fits/s (rounds) | refused 503 | REST fit p50 / p90 ms | service CPU / bare fit CPU ms "
+        "(p50) | ratio p50 / p90 | evaluation CPU ms (p50) |"
+    )
     print("|---|---|---|---|---|---|---|")
     for store in STORES:
         f = figures[store]
         c = f["rest_fit_cpu"]
-        print(f"| {store} | {f['fits_per_s']:.2f} ({', '.join(f'{x:.1f}' for x in f['rounds'])}) | "
-              f"{f['refused']} | {f['rest_fit_unseen_ms']['p50']:.0f} / {f['rest_fit_unseen_ms']['p90']:.0f} | "
-              f"{c['service_ms_p50']:.1f} / {c['bare_ms_p50']:.1f} | {c['ratio_p50']:.2f} / {c['ratio_p90']:.2f} | "
-              f"{c['evaluation_ms_p50']:.1f} |")
+        print(
+            f"| {store} | {f['fits_per_s']:.2f} ({', '.join(f'{x:.1f}' for x in f['rounds'])}) | "
+            f"{f['refused']} | {f['rest_fit_unseen_ms']['p50']:.0f} / {f['rest_fit_unseen_ms']['p90']:.0f} | "
+            f"{c['service_ms_p50']:.1f} / {c['bare_ms_p50']:.1f} | {c['ratio_p50']:.2f} / {c['ratio_p90']:.2f} | "
+            f"{c['evaluation_ms_p50']:.1f} |"
+        )
     print(f"\nPostgreSQL / SQLite fits per second: {figures['postgresql_over_sqlite']:.3f}")
-    print("recorded:", write_result("service_stores", figures, load_at_start, workers=workers,
-                                    fit_clients=args.fit_clients, rounds=args.rounds, duration_s=args.duration))
+    print(
+        "recorded:",
+        write_result(
+            "service_stores",
+            figures,
+            load_at_start,
+            workers=workers,
+            fit_clients=args.fit_clients,
+            rounds=args.rounds,
+            duration_s=args.duration,
+        ),
+    )
     return 0
 
 

@@ -92,8 +92,17 @@ LABELS = {
     "collapsed_lean": "model, lean scene-specialised",
     "lazanyi_lean": "adjusted Lazanyi, lean (n, a from CPU)",
 }
-CONSTANT_FORMS = ("packed", "floats", "lean", "collapsed", "collapsed_lean", "lazanyi", "lazanyi_lean",
-                  LAZANYI_SCENE, "schlick")
+CONSTANT_FORMS = (
+    "packed",
+    "floats",
+    "lean",
+    "collapsed",
+    "collapsed_lean",
+    "lazanyi",
+    "lazanyi_lean",
+    LAZANYI_SCENE,
+    "schlick",
+)
 """The variants also timed with the material's values compiled in (``@const``)."""
 C = CONSTANTS_SUFFIX
 PAIRS = {
@@ -119,8 +128,14 @@ def paired_ratio(numerator: np.ndarray, denominator: np.ndarray, rng) -> dict[st
     r = numerator / denominator
     boot = np.median(r[rng.integers(0, r.size, size=(10_000, r.size))], axis=1)
     low, high = np.percentile(boot, [2.5, 97.5])
-    return {"median": float(np.median(r)), "low": float(low), "high": float(high),
-            "ratio_of_medians": float(np.median(numerator) / np.median(denominator))}
+    return {
+        "median": float(np.median(r)),
+        "low": float(low),
+        "high": float(high),
+        "ratio_of_medians": float(np.median(numerator) / np.median(denominator)),
+    }
+
+
 SPLIT_LABELS = {
     "split_sum_model": "split sum, model (3 alpha lookups, 24 fetches)",
     "split_sum_lazanyi": "split sum, adjusted Lazanyi (alpha = 6, 8 fetches)",
@@ -152,15 +167,25 @@ def main() -> None:
     with RenderThread("shader-cost") as thread:
         device = f"{thread.renderer}, {thread.version}"
         print(f"device: {device}")
-        print(f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
-              f"{args.repeats} (one warm-up render before each; variants interleaved); "
-              f"scene eta_i {inputs.collapse_eta_i}\n")
+        print(
+            f"{args.width} x {args.height} RGBA32F, {args.material}, median of "
+            f"{args.repeats} (one warm-up render before each; variants interleaved); "
+            f"scene eta_i {inputs.collapse_eta_i}\n"
+        )
         names = TIMING_VARIANTS + tuple(v + CONSTANTS_SUFFIX for v in CONSTANT_FORMS)
         samples = time_variants(thread, inputs, names, args.width, args.height, args.repeats)
         split = time_split_sum(
-            thread, lut, F0, a, alpha, external_medium_F0(air["F0_air"], 1.5),
-            lazanyi_a(air["F0_air"], air["F82_air"]), air["F0_air"],
-            args.width, args.height, args.repeats,
+            thread,
+            lut,
+            F0,
+            a,
+            alpha,
+            external_medium_F0(air["F0_air"], 1.5),
+            lazanyi_a(air["F0_air"], air["F82_air"]),
+            air["F0_air"],
+            args.width,
+            args.height,
+            args.repeats,
         )
 
     # Medians in ms (timer query in us); quartiles of the wall time.
@@ -173,27 +198,34 @@ def main() -> None:
         fixed = times[FIXED] if net else 0.0
         return (times[variant] - fixed) / (times[base] - fixed)
 
-    print("Ratios to adjusted Lazanyi; net = with the fixed cost of the pass "
-          "subtracted from both sides.\n")
-    print("| variant | timer query (us) | wall (ms) [IQR] | wall ratio | wall net ratio "
-          "| CPU (ms) | CPU net ratio |")
+    print("Ratios to adjusted Lazanyi; net = with the fixed cost of the pass subtracted from both sides.\n")
+    print("| variant | timer query (us) | wall (ms) [IQR] | wall ratio | wall net ratio | CPU (ms) | CPU net ratio |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for v in names:
         net = "" if v == FIXED else f"{ratio(wall, v, net=True):.2f}x"
         cpu_net = "" if v == FIXED else f"{ratio(cpu, v, net=True):.2f}x"
         label = LABELS[v.removesuffix(C)] + (", compiled-in constants" if v.endswith(C) else "")
-        print(f"| {label} | {query[v]:.0f} | {wall[v]:.1f} [{wall_q[v][0]:.1f}, "
-              f"{wall_q[v][1]:.1f}] | {ratio(wall, v):.2f}x | {net} | {cpu[v]:.1f} | {cpu_net} |")
-    print("\nScene-specialised model against Lazanyi at the same constant eta_i: "
-          f"wall {ratio(wall, 'collapsed', LAZANYI_SCENE):.2f}x, "
-          f"net {ratio(wall, 'collapsed', LAZANYI_SCENE, net=True):.2f}x; "
-          f"CPU net {ratio(cpu, 'collapsed', LAZANYI_SCENE, net=True):.2f}x")
+        print(
+            f"| {label} | {query[v]:.0f} | {wall[v]:.1f} [{wall_q[v][0]:.1f}, "
+            f"{wall_q[v][1]:.1f}] | {ratio(wall, v):.2f}x | {net} | {cpu[v]:.1f} | {cpu_net} |"
+        )
+    print(
+        "\nScene-specialised model against Lazanyi at the same constant eta_i: "
+        f"wall {ratio(wall, 'collapsed', LAZANYI_SCENE):.2f}x, "
+        f"net {ratio(wall, 'collapsed', LAZANYI_SCENE, net=True):.2f}x; "
+        f"CPU net {ratio(cpu, 'collapsed', LAZANYI_SCENE, net=True):.2f}x"
+    )
 
     rng = np.random.default_rng(0)
-    pairs: dict[str, dict] = {name: {"variant": v, "against": base,
-                    "cpu": paired_ratio(samples[v][:, 2], samples[base][:, 2], rng),
-                    "wall": paired_ratio(samples[v][:, 1], samples[base][:, 1], rng)}
-             for name, (v, base) in PAIRS.items()}
+    pairs: dict[str, dict] = {
+        name: {
+            "variant": v,
+            "against": base,
+            "cpu": paired_ratio(samples[v][:, 2], samples[base][:, 2], rng),
+            "wall": paired_ratio(samples[v][:, 1], samples[base][:, 1], rng),
+        }
+        for name, (v, base) in PAIRS.items()
+    }
     print("\nLike for like, per-round ratios: median [95 % bootstrap interval]\n")
     print("| pair | against | CPU ratio | wall ratio |")
     print("|---|---|---:|---:|")
@@ -206,32 +238,55 @@ def main() -> None:
     sw = {v: np.median(s[:, 1]) * 1e3 for v, s in split.items()}
     sc = {v: np.median(s[:, 2]) * 1e3 for v, s in split.items()}
     fixed = "split_sum_fixed"
-    print("\nSplit-sum lookups (fitting.shading.ibl LUT, 16 x 64 x 64 RGB32F 3D texture, "
-          "texelFetch); net ratio to adjusted Lazanyi's split sum, fixed cost subtracted.\n")
+    print(
+        "\nSplit-sum lookups (fitting.shading.ibl LUT, 16 x 64 x 64 RGB32F 3D texture, "
+        "texelFetch); net ratio to adjusted Lazanyi's split sum, fixed cost subtracted.\n"
+    )
     print("| variant | timer query (us) | wall (ms) | wall net ratio | CPU (ms) | CPU net ratio |")
     print("|---|---:|---:|---:|---:|---:|")
     for v in SPLIT_SUM_VARIANTS:
+
         def net(times):
             return (times[v] - times[fixed]) / (times["split_sum_lazanyi"] - times[fixed])
+
         wn = "" if v == fixed else f"{net(sw):.2f}x"
         cn = "" if v == fixed else f"{net(sc):.2f}x"
         print(f"| {SPLIT_LABELS[v]} | {sq[v]:.0f} | {sw[v]:.1f} | {wn} | {sc[v]:.1f} | {cn} |")
 
     figures = {
         "device": device,
-        "variant": {v: {"wall_ms": float(wall[v]), "cpu_ms": float(cpu[v]), "wall_ratio": float(ratio(wall, v)),
-                        **({} if v == FIXED else {"wall_net_ratio": float(ratio(wall, v, net=True)),
-                                                  "cpu_net_ratio": float(ratio(cpu, v, net=True))})}
-                    for v in names},
+        "variant": {
+            v: {
+                "wall_ms": float(wall[v]),
+                "cpu_ms": float(cpu[v]),
+                "wall_ratio": float(ratio(wall, v)),
+                **(
+                    {}
+                    if v == FIXED
+                    else {
+                        "wall_net_ratio": float(ratio(wall, v, net=True)),
+                        "cpu_net_ratio": float(ratio(cpu, v, net=True)),
+                    }
+                ),
+            }
+            for v in names
+        },
         "pairs": pairs,
         "scene_specialised_against_lazanyi_scene": {
             "wall_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE)),
             "wall_net_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE, net=True)),
-            "cpu_net_ratio": float(ratio(cpu, "collapsed", LAZANYI_SCENE, net=True))},
+            "cpu_net_ratio": float(ratio(cpu, "collapsed", LAZANYI_SCENE, net=True)),
+        },
         "split_sum": {v: {"wall_ms": float(sw[v]), "cpu_ms": float(sc[v])} for v in SPLIT_SUM_VARIANTS},
     }
-    path = write_result("shader_cost", figures, load_at_start, material=args.material, repeats=args.repeats,
-                        size=[args.width, args.height])
+    path = write_result(
+        "shader_cost",
+        figures,
+        load_at_start,
+        material=args.material,
+        repeats=args.repeats,
+        size=[args.width, args.height],
+    )
     print(f"\nwrote {path}")
 
 

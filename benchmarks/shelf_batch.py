@@ -35,14 +35,17 @@ KINDS = ("coated-conductor", "rgb-conductor")
 
 
 def _table(summary: dict) -> str:
-    lines = ["| model | pages | mean | median | p90 | max | below adjusted Lazanyi |",
-             "|---|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        "| model | pages | mean | median | p90 | max | below adjusted Lazanyi |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
     for name, entry in summary["delta_E_mean"].items():
         beats = entry.get("beats_lazanyi_adjusted")
         lines.append(
             f"| {name} | {entry['pages']} | {entry.get('mean', float('nan')):.3f} | "
             f"{entry.get('median', float('nan')):.3f} | {entry.get('p90', float('nan')):.3f} | "
-            f"{entry.get('max', float('nan')):.2f} | {'' if beats is None else f'{100 * beats:.1f}%'} |")
+            f"{entry.get('max', float('nan')):.2f} | {'' if beats is None else f'{100 * beats:.1f}%'} |"
+        )
     return "\n".join(lines)
 
 
@@ -69,19 +72,28 @@ def main() -> None:
                 reason = "coverage" if reason.startswith("covers") else reason.split(":")[0]
                 skipped[reason] = skipped.get(reason, 0) + 1
     summary = result.summary
-    print(f"{len(pages)} pages: {summary['fitted']} fitted, {summary['skipped']} skipped, "
-          f"{summary['failed']} failed in {wall:.0f} s ({args.workers} worker)")
+    print(
+        f"{len(pages)} pages: {summary['fitted']} fitted, {summary['skipped']} skipped, "
+        f"{summary['failed']} failed in {wall:.0f} s ({args.workers} worker)"
+    )
     print(_table(summary))
     for page, reason in failed.items():
         print(f"failed: {page}: {reason}")
     if not args.no_record:
         figures = {
-            "pages": summary["pages"], "fitted": summary["fitted"], "skipped": summary["skipped"],
-            "failed": summary["failed"], "wall_s": round(wall, 1), "workers": args.workers,
-            "delta_E_mean": summary["delta_E_mean"], "failed_pages": failed, "skipped_by_reason": skipped,
+            "pages": summary["pages"],
+            "fitted": summary["fitted"],
+            "skipped": summary["skipped"],
+            "failed": summary["failed"],
+            "wall_s": round(wall, 1),
+            "workers": args.workers,
+            "delta_E_mean": summary["delta_E_mean"],
+            "failed_pages": failed,
+            "skipped_by_reason": skipped,
         }
-        path = write_result("shelf_batch", figures, load, kinds=list(KINDS),
-                            selection=args.pages or f"shelf {args.shelf}")
+        path = write_result(
+            "shelf_batch", figures, load, kinds=list(KINDS), selection=args.pages or f"shelf {args.shelf}"
+        )
         print(f"recorded in {path.relative_to(ROOT)}", file=sys.stderr)
 
 

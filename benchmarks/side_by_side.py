@@ -31,8 +31,13 @@ ROOT = Path(__file__).resolve().parents[1]
 INSTALLED = ("scripts/three/node_modules",)
 """What ``scripts/bootstrap`` installs in the tree (git-ignored) that the core reads: linked into a worktree."""
 
-SUITE_INSTALLED = (".venv", ".venv-blender", "scripts/gltf-validator/node_modules", "scripts/swagger-ui/node_modules",
-                   *INSTALLED)
+SUITE_INSTALLED = (
+    ".venv",
+    ".venv-blender",
+    "scripts/gltf-validator/node_modules",
+    "scripts/swagger-ui/node_modules",
+    *INSTALLED,
+)
 """What ``scripts/bootstrap`` installs in the tree (git-ignored) that the test suite reads."""
 
 
@@ -41,16 +46,18 @@ def checkout(rev: str, installed: tuple[str, ...] = INSTALLED) -> Iterator[Path]
     """A detached git worktree of ``rev`` in a temporary directory (``installed`` linked), removed after."""
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp) / "before"
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "--detach", str(root), rev],
-                       check=True, capture_output=True)
+        subprocess.run(
+            ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(root), rev], check=True, capture_output=True
+        )
         for path in installed:
             if (ROOT / path).exists() and not (root / path).exists():
                 (root / path).symlink_to(ROOT / path, target_is_directory=True)
         try:
             yield root
         finally:
-            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(root)],
-                           check=False, capture_output=True)
+            subprocess.run(
+                ["git", "-C", str(ROOT), "worktree", "remove", "--force", str(root)], check=False, capture_output=True
+            )
 
 
 class Side:
@@ -60,7 +67,11 @@ class Side:
         self.root = str(root)
         self.process = subprocess.Popen(
             [sys.executable, str(script), "--child", self.root, *args],
-            cwd=tempfile.gettempdir(), stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+            cwd=tempfile.gettempdir(),
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
         self.names = self._answer()
 
     def ask(self, name: str):

@@ -103,25 +103,41 @@ IMAGES = ROOT / "docs" / "images"
 GRID = 100
 WIDTH, HEIGHT = 2560, 1440
 
+
 def kind_label(kind: str) -> str:
     """A model kind's label: "<kind> kind, float16", the default kind (the paper's) marked ours."""
     return f"{kind} kind{' (ours)' if kind == DEFAULT_MODEL else ''}, float16"
 
+
 MODELS = {
     # name: (label, shader variant or None, bytes per material, how stored)
     "schlick_air": ("Schlick, air F0", "schlick", 12, "F0 RGB, 3 float32"),
-    "schlick_exact_F0": ("Schlick, exact F0", "schlick", 12,
-                         "F0 RGB at the scene's eta_i, 3 float32 (a table for varying eta_i)"),
+    "schlick_exact_F0": (
+        "Schlick, exact F0",
+        "schlick",
+        12,
+        "F0 RGB at the scene's eta_i, 3 float32 (a table for varying eta_i)",
+    ),
     "lazanyi_adjusted": ("adjusted Lazanyi", "lazanyi", 24, "F0, F82 RGB, 6 float32"),
     "ours_float32": ("ours, float32", "floats", 108, "27 float32"),
     # Every model kind as shipped: float16, named as the batch names it.
-    **{kind: (kind_label(kind), MODEL_VARIANTS[kind],
-              2 * coefficient_count(kind), f"{coefficient_count(kind)} float16")
-       for kind in MODEL_KINDS},
+    **{
+        kind: (
+            kind_label(kind),
+            MODEL_VARIANTS[kind],
+            2 * coefficient_count(kind),
+            f"{coefficient_count(kind)} float16",
+        )
+        for kind in MODEL_KINDS
+    },
     "ours_scene": ("ours, scene-specialised", "collapsed", 18, "9 float16 at one eta_i"),
     "exact_rgb": ("exact RGB conductor Fresnel (n, k in air)", "exact", 24, "n, k RGB, 6 float32"),
-    "spectral": ("exact spectral reference", None, 2 * 4 * spectral_grid(1.0).size,
-                 "n, k at 471 wavelengths (1 nm), float32"),
+    "spectral": (
+        "exact spectral reference",
+        None,
+        2 * 4 * spectral_grid(1.0).size,
+        "n, k at 471 wavelengths (1 nm), float32",
+    ),
 }
 
 
@@ -242,29 +258,46 @@ def _kind_rows(rows, cpu, shader, models, split, split_costs) -> list[dict]:
     out = []
     for name, split_variant in (*KIND_SPLIT_SUM.items(), ("lazanyi_adjusted", "split_sum_lazanyi")):
         label, variant, size, _ = MODELS[name]
-        out.append({
-            "name": name, "label": label, "bytes": size, "mean": rows[name]["mean"], "max": rows[name]["max"],
-            "shader_ns_px": shader[variant] * 1e3 / (WIDTH * HEIGHT), "shader_ratio": models["ratio"][name],
-            "cpu_ns": cpu[name],
-            "split_mean": split[split_variant]["mean"] if split_variant else None,
-            "split_ratio": split_costs["raw"][split_variant] if split_variant else None,
-        })
+        out.append(
+            {
+                "name": name,
+                "label": label,
+                "bytes": size,
+                "mean": rows[name]["mean"],
+                "max": rows[name]["max"],
+                "shader_ns_px": shader[variant] * 1e3 / (WIDTH * HEIGHT),
+                "shader_ratio": models["ratio"][name],
+                "cpu_ns": cpu[name],
+                "split_mean": split[split_variant]["mean"] if split_variant else None,
+                "split_ratio": split_costs["raw"][split_variant] if split_variant else None,
+            }
+        )
     return out
 
 
 def _figures(rows, cpu, models, split, split_costs, reports) -> None:
     size = {m: 20 + MODELS[m][2] / 8 for m in MODELS}
     panels = [
-        {"title": "Fresnel term, shader", "front": [MODELS[m][0] for m in models["shader"]],
-         "xlabel": f"shader cost at {WIDTH} x {HEIGHT}, relative to adjusted Lazanyi (llvmpipe)",
-         "points": {MODELS[m][0]: (models["ratio"][m], rows[m]["mean"], size[m]) for m in MODELS if models["ratio"][m]}},
-        {"title": "Fresnel term, numpy", "front": [MODELS[m][0] for m in models["cpu"]],
-         "xlabel": "CPU cost per sample (ns, numpy)",
-         "points": {MODELS[m][0]: (cpu[m], rows[m]["mean"], size[m]) for m in MODELS}},
-        {"title": f"split sum: directional albedo, {len(SPLIT_ETA_I)} eta_i x {len(SPLIT_ROUGHNESS)} roughness",
-         "front": [SPLIT_VARIANTS[v][0] for v in split_costs["front"]],
-         "xlabel": "split-sum shader cost, relative to adjusted Lazanyi's (llvmpipe)",
-         "points": {SPLIT_VARIANTS[v][0]: (split_costs["raw"][v], split[v]["mean"], 30) for v in SPLIT_VARIANTS}},
+        {
+            "title": "Fresnel term, shader",
+            "front": [MODELS[m][0] for m in models["shader"]],
+            "xlabel": f"shader cost at {WIDTH} x {HEIGHT}, relative to adjusted Lazanyi (llvmpipe)",
+            "points": {
+                MODELS[m][0]: (models["ratio"][m], rows[m]["mean"], size[m]) for m in MODELS if models["ratio"][m]
+            },
+        },
+        {
+            "title": "Fresnel term, numpy",
+            "front": [MODELS[m][0] for m in models["cpu"]],
+            "xlabel": "CPU cost per sample (ns, numpy)",
+            "points": {MODELS[m][0]: (cpu[m], rows[m]["mean"], size[m]) for m in MODELS},
+        },
+        {
+            "title": f"split sum: directional albedo, {len(SPLIT_ETA_I)} eta_i x {len(SPLIT_ROUGHNESS)} roughness",
+            "front": [SPLIT_VARIANTS[v][0] for v in split_costs["front"]],
+            "xlabel": "split-sum shader cost, relative to adjusted Lazanyi's (llvmpipe)",
+            "points": {SPLIT_VARIANTS[v][0]: (split_costs["raw"][v], split[v]["mean"], 30) for v in SPLIT_VARIANTS},
+        },
     ]
     figure_speed_vs_error(IMAGES / "speed_vs_error.png", panels)
     if reports:
@@ -273,13 +306,22 @@ def _figures(rows, cpu, models, split, split_costs, reports) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description="Speed against error for the 22 conductors.")
-    parser.add_argument("--batch-report", type=Path, metavar="REPORT_JSON", action="append", default=[],
-                        help="add the accuracy summary of a python -m fitting batch report.json (repeatable)")
+    parser.add_argument(
+        "--batch-report",
+        type=Path,
+        metavar="REPORT_JSON",
+        action="append",
+        default=[],
+        help="add the accuracy summary of a python -m fitting batch report.json (repeatable)",
+    )
     parser.add_argument("--batch-only", action="store_true", help="print only the batch summaries")
     parser.add_argument("--figure", action="store_true", help="write the PNGs to docs/images/")
     parser.add_argument("--repeats", type=int, default=7, help="shader timing rounds")
-    parser.add_argument("--models-only", action="store_true",
-                        help="the models, kinds and split-sum tables only (skip the fitting-settings sweep)")
+    parser.add_argument(
+        "--models-only",
+        action="store_true",
+        help="the models, kinds and split-sum tables only (skip the fitting-settings sweep)",
+    )
     args = parser.parse_args()
     if args.batch_only and not args.batch_report:
         parser.error("--batch-only needs --batch-report")
@@ -304,22 +346,31 @@ def main() -> None:
     pixels = WIDTH * HEIGHT
     print("\n".join(header) + f", GL: {renderer}\n")
     lines, models = models_table(MODELS, rows, cpu, shader, pixels)
-    print(f"## Models: {len(LIBRARY_NAMES)} conductors, {GRID} x {GRID} grid, Delta E 2000 against the 1 nm "
-          "reference\n\n" + "\n".join(lines))
+    print(
+        f"## Models: {len(LIBRARY_NAMES)} conductors, {GRID} x {GRID} grid, Delta E 2000 against the 1 nm "
+        "reference\n\n" + "\n".join(lines)
+    )
     if FIT_FAILURES:
-        print(f"\nDegree-0 fits refused by the fitting core ({len(FIT_FAILURES)}; the general fit "
-              "collapsed to that eta_i is used instead): " + "; ".join(FIT_FAILURES))
-    print(f"\nShader wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
-          + ", ".join(f"{v} {t:.0f}" for v, t in shader.items()))
+        print(
+            f"\nDegree-0 fits refused by the fitting core ({len(FIT_FAILURES)}; the general fit "
+            "collapsed to that eta_i is used instead): " + "; ".join(FIT_FAILURES)
+        )
+    print(
+        f"\nShader wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
+        + ", ".join(f"{v} {t:.0f}" for v, t in shader.items())
+    )
     print("\nBytes: " + "; ".join(f"{MODELS[m][0]}: {MODELS[m][3]}" for m in MODELS))
-    lines, split_costs = split_sum_table_lines(SPLIT_VARIANTS, split, split_cpu, split_shader, pixels,
-                                               SPLIT_ROUGHNESS)
-    print(f"\n## Split-sum variants: {len(LIBRARY_NAMES)} conductors x eta_i {', '.join(map(str, SPLIT_ETA_I))} "
-          f"x roughness {', '.join(map(str, SPLIT_ROUGHNESS))} x {len(SPLIT_NDOTV)} NdotV, Delta E 2000 of the "
-          "directional albedo against the spectral one\n\n" + "\n".join(lines))
-    print(f"\nSplit-sum pass wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
-          + ", ".join(f"{v} {t:.0f}" for v, t in split_shader.items())
-          + "; net: the pass with no split sum (split_sum_fixed) subtracted from both sides.")
+    lines, split_costs = split_sum_table_lines(SPLIT_VARIANTS, split, split_cpu, split_shader, pixels, SPLIT_ROUGHNESS)
+    print(
+        f"\n## Split-sum variants: {len(LIBRARY_NAMES)} conductors x eta_i {', '.join(map(str, SPLIT_ETA_I))} "
+        f"x roughness {', '.join(map(str, SPLIT_ROUGHNESS))} x {len(SPLIT_NDOTV)} NdotV, Delta E 2000 of the "
+        "directional albedo against the spectral one\n\n" + "\n".join(lines)
+    )
+    print(
+        f"\nSplit-sum pass wall time (us, median of {args.repeats}, {WIDTH} x {HEIGHT}): "
+        + ", ".join(f"{v} {t:.0f}" for v, t in split_shader.items())
+        + "; net: the pass with no split sum (split_sum_fixed) subtracted from both sides."
+    )
     print("\n## Model kinds side by side\n")
     print("\n".join(kinds_table(_kind_rows(rows, cpu, shader, models, split, split_costs), reports)))
     for report in reports:

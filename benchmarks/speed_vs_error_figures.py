@@ -47,12 +47,22 @@ def figure_speed_vs_error(path: Path, panels: list[dict[str, Any]]) -> None:
         for index, (label, (cost, error, size)) in enumerate(panel["points"].items()):
             ax.scatter(cost, max(error, floor), s=size, zorder=3, color=f"C{index % 10}")
             # Labels alternate above and below their point: neighbours of equal error overlap less.
-            ax.annotate(label, (cost, max(error, floor)), textcoords="offset points",
-                        xytext=(5, 4 if index % 2 == 0 else -10), fontsize=7)
+            ax.annotate(
+                label,
+                (cost, max(error, floor)),
+                textcoords="offset points",
+                xytext=(5, 4 if index % 2 == 0 else -10),
+                fontsize=7,
+            )
         if panel["front"]:
-            ax.plot([panel["points"][m][0] for m in panel["front"]],
-                    [max(panel["points"][m][1], floor) for m in panel["front"]],
-                    "k--", lw=1, zorder=2, label="Pareto front")
+            ax.plot(
+                [panel["points"][m][0] for m in panel["front"]],
+                [max(panel["points"][m][1], floor) for m in panel["front"]],
+                "k--",
+                lw=1,
+                zorder=2,
+                label="Pareto front",
+            )
             ax.legend(loc="lower left", fontsize=8)
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -72,8 +82,7 @@ def figure_batch(path: Path, reports: list[dict[str, Any]], names: list[str]) ->
     """The share of fitted pages at or below each mean Delta E 2000 (an empirical CDF), one
     panel per batch report, one line per name of ``names`` the report holds."""
     plt = _pyplot()
-    fig, axes = plt.subplots(1, len(reports), figsize=(6 * len(reports), 4.4), constrained_layout=True,
-                             squeeze=False)
+    fig, axes = plt.subplots(1, len(reports), figsize=(6 * len(reports), 4.4), constrained_layout=True, squeeze=False)
     for ax, report in zip(axes[0], reports):
         fitted = [p for p in report["pages"] if p["status"] == "fitted"]
         held = {r["name"] for r in batch_rows(report)}
@@ -82,8 +91,14 @@ def figure_batch(path: Path, reports: list[dict[str, Any]], names: list[str]) ->
                 continue
             values = np.sort([p[f"{name}_delta_E_mean"] for p in fitted])
             # One colour per name in every panel; the yardstick dashed.
-            ax.step(np.maximum(values, 1e-3), np.arange(1, values.size + 1) / values.size, where="post",
-                    label=name, color=f"C{index}", ls="--" if name == "lazanyi_adjusted" else "-")
+            ax.step(
+                np.maximum(values, 1e-3),
+                np.arange(1, values.size + 1) / values.size,
+                where="post",
+                label=name,
+                color=f"C{index}",
+                ls="--" if name == "lazanyi_adjusted" else "-",
+            )
         ax.set_xscale("log")
         ax.set_xlabel("mean Delta E 2000 of a page (100 x 100, eta_i 1-2.5)")
         ax.set_ylabel("share of fitted pages at or below")
@@ -107,13 +122,17 @@ def figure_fit_settings(path: Path, fit_rows: list[dict], fit_front: list[str], 
 
     for objective in dict.fromkeys(r["objective"] for r in fit_rows):
         pts = [r for r in fit_rows if r["objective"] == objective]
-        ax.scatter([ms(r) for r in pts], [r["mean"] for r in pts], marker=markers.get(objective, "o"),
-                   label=objective, alpha=0.8)
+        ax.scatter(
+            [ms(r) for r in pts],
+            [r["mean"] for r in pts],
+            marker=markers.get(objective, "o"),
+            label=objective,
+            alpha=0.8,
+        )
     front_rows = sorted((r for r in fit_rows if key(r) in fit_front), key=lambda r: r["seconds"])
     ax.plot([ms(r) for r in front_rows], [r["mean"] for r in front_rows], "k--", lw=1, label="Pareto front")
     default = next(r for r in fit_rows if r["default"])
-    ax.scatter([ms(default)], [default["mean"]], s=160, facecolors="none", edgecolors="red",
-               label="default setting")
+    ax.scatter([ms(default)], [default["mean"]], s=160, facecolors="none", edgecolors="red", label="default setting")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("fit time per conductor (ms)")

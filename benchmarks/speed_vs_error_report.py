@@ -62,9 +62,11 @@ def load_average() -> str:
 def run_header(argv: list[str], renderer: str | None = None) -> list[str]:
     """Lines naming the command, the date (UTC), the load average and the cores of this run."""
     command = " ".join([".venv/bin/python benchmarks/speed_vs_error.py", *map(shlex.quote, argv)])
-    lines = [f"Command: `{command}`",
-             f"Run: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average {load_average()} "
-             f"(1, 5, 15 min) at the start, {os.cpu_count()} cores"]
+    lines = [
+        f"Command: `{command}`",
+        f"Run: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, load average {load_average()} "
+        f"(1, 5, 15 min) at the start, {os.cpu_count()} cores",
+    ]
     if renderer:
         lines[-1] += f", GL: {renderer}"
     return lines
@@ -82,8 +84,13 @@ def error_summary(per_material: dict[str, np.ndarray]) -> dict[str, Any]:
     means = {m: float(np.mean(e)) for m, e in per_material.items()}
     maxes = {m: float(np.max(e)) for m, e in per_material.items()}
     worst = max(means, key=means.get)
-    return {"mean": float(np.mean(list(means.values()))), "max": max(maxes.values()),
-            "worst": worst, "worst_mean": means[worst], "worst_max": maxes[worst]}
+    return {
+        "mean": float(np.mean(list(means.values()))),
+        "max": max(maxes.values()),
+        "worst": worst,
+        "worst_mean": means[worst],
+        "worst_max": maxes[worst],
+    }
 
 
 def pareto_front(points: dict[str, tuple[float, float]]) -> list[str]:
@@ -92,16 +99,16 @@ def pareto_front(points: dict[str, tuple[float, float]]) -> list[str]:
     front = []
     for name, (cost, error) in points.items():
         dominated = any(
-            (c <= cost and e <= error) and (c < cost or e < error)
-            for other, (c, e) in points.items() if other != name
+            (c <= cost and e <= error) and (c < cost or e < error) for other, (c, e) in points.items() if other != name
         )
         if not dominated:
             front.append(name)
     return sorted(front, key=lambda n: points[n][0])
 
 
-def models_table(models: dict[str, tuple], rows: dict[str, dict], cpu: dict[str, float],
-                 shader: dict[str, float], pixels: int) -> tuple[list[str], dict[str, Any]]:
+def models_table(
+    models: dict[str, tuple], rows: dict[str, dict], cpu: dict[str, float], shader: dict[str, float], pixels: int
+) -> tuple[list[str], dict[str, Any]]:
     """
     The Markdown table of the Fresnel models. ``models``: name to (label,
     shader variant or None, bytes per material, how stored); ``rows``:
@@ -117,20 +124,30 @@ def models_table(models: dict[str, tuple], rows: dict[str, dict], cpu: dict[str,
         "cpu": pareto_front({m: (cpu[m], rows[m]["mean"]) for m in models}),
         "bytes": pareto_front({m: (models[m][2], rows[m]["mean"]) for m in models}),
     }
-    lines = ["| model | mean dE (22) | max dE (22) | worst conductor: mean / max | shader cost vs adj. Lazanyi "
-             "| shader ns/pixel | CPU ns/sample | bytes/material | on front (shader / CPU / bytes) |",
-             "|---|---:|---:|---|---:|---:|---:|---:|---|"]
+    lines = [
+        "| model | mean dE (22) | max dE (22) | worst conductor: mean / max | shader cost vs adj. Lazanyi "
+        "| shader ns/pixel | CPU ns/sample | bytes/material | on front (shader / CPU / bytes) |",
+        "|---|---:|---:|---|---:|---:|---:|---:|---|",
+    ]
     for m, (label, variant, size, _) in models.items():
         r = rows[m]
         cost = (f"{ratio[m]:.2f}x", f"{shader[variant] * 1e3 / pixels:.2f}") if variant else ("n/a (no shader)", "n/a")
         on = " / ".join("yes" if m in f else "no" for f in fronts.values())
-        lines.append(f"| {label} | {r['mean']:.3f} | {r['max']:.2f} | {r['worst']}: {r['worst_mean']:.3f} / "
-                     f"{r['worst_max']:.2f} | {cost[0]} | {cost[1]} | {cpu[m]:.0f} | {size} | {on} |")
+        lines.append(
+            f"| {label} | {r['mean']:.3f} | {r['max']:.2f} | {r['worst']}: {r['worst_mean']:.3f} / "
+            f"{r['worst_max']:.2f} | {cost[0]} | {cost[1]} | {cpu[m]:.0f} | {size} | {on} |"
+        )
     return lines, {"ratio": ratio, **fronts}
 
 
-def split_sum_table_lines(variants: dict[str, tuple], split: dict[str, dict], cpu: dict[str, float],
-                          shader: dict[str, float], pixels: int, roughness) -> tuple[list[str], dict[str, Any]]:
+def split_sum_table_lines(
+    variants: dict[str, tuple],
+    split: dict[str, dict],
+    cpu: dict[str, float],
+    shader: dict[str, float],
+    pixels: int,
+    roughness,
+) -> tuple[list[str], dict[str, Any]]:
     """
     The Markdown table of the split-sum variants. ``variants``: name to
     (label, ``ibl.frag`` pass, LUT fetches); ``split``: :func:`error_summary`
@@ -145,16 +162,21 @@ def split_sum_table_lines(variants: dict[str, tuple], split: dict[str, dict], cp
     raw = {v: shader[spec[1]] / base for v, spec in variants.items()}
     net = {v: (shader[spec[1]] - fixed) / (base - fixed) for v, spec in variants.items()}
     front = pareto_front({v: (raw[v], split[v]["mean"]) for v in variants})
-    lines = ["| variant | mean dE | max dE | worst conductor: mean / max | mean dE at roughness "
-             + " / ".join(f"{r:g}" for r in roughness) + " | shader ns/pixel | shader vs adj. Lazanyi's "
-             "(raw / net) | CPU ns/sample | LUT fetches | on front (shader) |",
-             "|---|---:|---:|---|---|---:|---:|---:|---:|---|"]
+    lines = [
+        "| variant | mean dE | max dE | worst conductor: mean / max | mean dE at roughness "
+        + " / ".join(f"{r:g}" for r in roughness)
+        + " | shader ns/pixel | shader vs adj. Lazanyi's "
+        "(raw / net) | CPU ns/sample | LUT fetches | on front (shader) |",
+        "|---|---:|---:|---|---|---:|---:|---:|---:|---|",
+    ]
     for v, (label, variant, fetches) in variants.items():
         r = split[v]
-        lines.append(f"| {label} | {r['mean']:.3f} | {r['max']:.2f} | {r['worst']}: {r['worst_mean']:.3f} / "
-                     f"{r['worst_max']:.2f} | {' / '.join(f'{e:.3f}' for e in r['by_roughness'])} | "
-                     f"{shader[variant] * 1e3 / pixels:.2f} | {raw[v]:.2f}x / {net[v]:.2f}x | "
-                     f"{cpu[v]:.0f} | {fetches} | {'yes' if v in front else 'no'} |")
+        lines.append(
+            f"| {label} | {r['mean']:.3f} | {r['max']:.2f} | {r['worst']}: {r['worst_mean']:.3f} / "
+            f"{r['worst_max']:.2f} | {' / '.join(f'{e:.3f}' for e in r['by_roughness'])} | "
+            f"{shader[variant] * 1e3 / pixels:.2f} | {raw[v]:.2f}x / {net[v]:.2f}x | "
+            f"{cpu[v]:.0f} | {fetches} | {'yes' if v in front else 'no'} |"
+        )
     return lines, {"raw": raw, "net": net, "front": front}
 
 
@@ -196,9 +218,16 @@ def batch_rows(report: dict[str, Any]) -> list[dict[str, Any]]:
             continue
         values = np.array([p[f"{name}_delta_E_mean"] for p in fitted], dtype=np.float64)
         shares = np.histogram(values, bins=np.array(BATCH_BINS))[0] / values.size
-        rows.append({"name": name, "kind": name in kinds, "pages": entry["pages"],
-                     **{k: entry[k] for k in ("mean", "median", "p90", "max")},
-                     "shares": shares.tolist(), "beats": entry.get("beats_lazanyi_adjusted")})
+        rows.append(
+            {
+                "name": name,
+                "kind": name in kinds,
+                "pages": entry["pages"],
+                **{k: entry[k] for k in ("mean", "median", "p90", "max")},
+                "shares": shares.tolist(),
+                "beats": entry.get("beats_lazanyi_adjusted"),
+            }
+        )
     return rows
 
 
@@ -207,18 +236,24 @@ def batch_table(report: dict[str, Any]) -> list[str]:
     summary, config = report["summary"], report["config"]
     lo, hi = config["eta_i_range"]
     bins = [f"{a:g}-{b:g}" if b != float("inf") else f">{a:g}" for a, b in zip(BATCH_BINS[:-1], BATCH_BINS[1:])]
-    lines = [f"## Database batch: {summary['fitted']} of {summary['pages']} pages fitted "
-             f"({summary['skipped']} skipped, {summary['failed']} failed), grid {config['grid']}, "
-             f"eta_i {lo:g}-{hi:g}", "",
-             f"From `{report.get('path', 'report.json')}`. Per-page mean Delta E 2000 against the "
-             f"{config.get('reference_step_nm', 1):g} nm spectral reference.", "",
-             "| model | mean | median | p90 | max | " + " | ".join(f"share {b}" for b in bins)
-             + " | beats adj. Lazanyi |",
-             "|---|" + "---:|" * (4 + len(bins) + 1)]
+    lines = [
+        f"## Database batch: {summary['fitted']} of {summary['pages']} pages fitted "
+        f"({summary['skipped']} skipped, {summary['failed']} failed), grid {config['grid']}, "
+        f"eta_i {lo:g}-{hi:g}",
+        "",
+        f"From `{report.get('path', 'report.json')}`. Per-page mean Delta E 2000 against the "
+        f"{config.get('reference_step_nm', 1):g} nm spectral reference.",
+        "",
+        "| model | mean | median | p90 | max | " + " | ".join(f"share {b}" for b in bins) + " | beats adj. Lazanyi |",
+        "|---|" + "---:|" * (4 + len(bins) + 1),
+    ]
     for r in batch_rows(report):
         beats = "" if r["beats"] is None else format(r["beats"], ".1%")
-        lines.append(f"| {r['name']} | {r['mean']:.3f} | {r['median']:.3f} | {r['p90']:.3f} | {r['max']:.2f} | "
-                     + " | ".join(f"{v:.0%}" for v in r["shares"]) + f" | {beats} |")
+        lines.append(
+            f"| {r['name']} | {r['mean']:.3f} | {r['median']:.3f} | {r['p90']:.3f} | {r['max']:.2f} | "
+            + " | ".join(f"{v:.0%}" for v in r["shares"])
+            + f" | {beats} |"
+        )
     return lines
 
 
@@ -241,16 +276,32 @@ def kinds_table(rows: list[dict[str, Any]], reports: list[dict[str, Any]]) -> li
     no shader), ``cpu_ns``, ``split_mean`` and ``split_ratio`` (its split sum;
     None with no split-sum table). Batch columns: one per report.
     """
-    head = ("| model | bytes/material | mean dE (22) | max dE (22) | shader ns/pixel | shader vs adj. Lazanyi "
-            "| CPU ns/sample | split sum mean dE | split-sum shader vs adj. Lazanyi's")
+    head = (
+        "| model | bytes/material | mean dE (22) | max dE (22) | shader ns/pixel | shader vs adj. Lazanyi "
+        "| CPU ns/sample | split sum mean dE | split-sum shader vs adj. Lazanyi's"
+    )
     head += "".join(f" | batch {batch_label(b)}: median / p90 / max; beats adj. Lazanyi" for b in reports)
     lines = [head + " |", "|---|" + "---:|" * 8 + "---|" * len(reports)]
     for r in rows:
-        shader = ("n/a (no shader)", "n/a") if r["shader_ratio"] is None else (
-            f"{r['shader_ns_px']:.2f}", f"{r['shader_ratio']:.2f}x")
-        split = ("no split-sum table", "n/a") if r["split_mean"] is None else (
-            f"{r['split_mean']:.3f}", f"{r['split_ratio']:.2f}x")
-        cells = [r["label"], f"{r['bytes']}", f"{r['mean']:.3f}", f"{r['max']:.2f}", *shader,
-                 f"{r['cpu_ns']:.0f}", *split, *(batch_cell(b, r["name"]) for b in reports)]
+        shader = (
+            ("n/a (no shader)", "n/a")
+            if r["shader_ratio"] is None
+            else (f"{r['shader_ns_px']:.2f}", f"{r['shader_ratio']:.2f}x")
+        )
+        split = (
+            ("no split-sum table", "n/a")
+            if r["split_mean"] is None
+            else (f"{r['split_mean']:.3f}", f"{r['split_ratio']:.2f}x")
+        )
+        cells = [
+            r["label"],
+            f"{r['bytes']}",
+            f"{r['mean']:.3f}",
+            f"{r['max']:.2f}",
+            *shader,
+            f"{r['cpu_ns']:.0f}",
+            *split,
+            *(batch_cell(b, r["name"]) for b in reports),
+        ]
         lines.append("| " + " | ".join(cells) + " |")
     return lines

@@ -84,8 +84,9 @@ table (its Fresnel is not linear in a few parameters the LUT could hold;
 the rough preview refuses it, docs/shading.md)."""
 
 
-def split_sum_albedos(nk, coefficients, eta_i_range, eta_i: float, roughness: float,
-                      NdotV=SPLIT_NDOTV, air=None, lut=None) -> dict[str, np.ndarray]:
+def split_sum_albedos(
+    nk, coefficients, eta_i_range, eta_i: float, roughness: float, NdotV=SPLIT_NDOTV, air=None, lut=None
+) -> dict[str, np.ndarray]:
     """
     The directional albedo (len(NdotV), 3), linear ACEScg, of the spectral
     ``reference`` and of every :data:`SPLIT_VARIANTS` entry at one eta_i
@@ -107,8 +108,9 @@ def split_sum_albedos(nk, coefficients, eta_i_range, eta_i: float, roughness: fl
     }
 
 
-def split_sum_errors(name: str, eta_i=SPLIT_ETA_I, roughness=SPLIT_ROUGHNESS,
-                     NdotV=SPLIT_NDOTV) -> dict[str, np.ndarray]:
+def split_sum_errors(
+    name: str, eta_i=SPLIT_ETA_I, roughness=SPLIT_ROUGHNESS, NdotV=SPLIT_NDOTV
+) -> dict[str, np.ndarray]:
     """Delta E 2000 of every split-sum variant against the reference for library conductor
     ``name``, each (len(eta_i), len(roughness), len(NdotV))."""
     nk = library_material(name)
@@ -117,15 +119,15 @@ def split_sum_errors(name: str, eta_i=SPLIT_ETA_I, roughness=SPLIT_ROUGHNESS,
     out = {v: np.empty((len(eta_i), len(roughness), len(NdotV))) for v in SPLIT_VARIANTS}
     for i, eta in enumerate(eta_i):
         for j, r in enumerate(roughness):
-            albedo = split_sum_albedos(nk, fit.coefficients_float16, fit.eta_i_range, float(eta), float(r),
-                                       NdotV, air)
+            albedo = split_sum_albedos(nk, fit.coefficients_float16, fit.eta_i_range, float(eta), float(r), NdotV, air)
             for v in SPLIT_VARIANTS:
                 out[v][i, j] = delta_E_map(albedo["reference"], albedo[v])
     return out
 
 
-def split_sum_table(names=LIBRARY_NAMES, eta_i=SPLIT_ETA_I, roughness=SPLIT_ROUGHNESS,
-                    NdotV=SPLIT_NDOTV) -> dict[str, dict]:
+def split_sum_table(
+    names=LIBRARY_NAMES, eta_i=SPLIT_ETA_I, roughness=SPLIT_ROUGHNESS, NdotV=SPLIT_NDOTV
+) -> dict[str, dict]:
     """Per variant: :func:`error_summary` over the conductors, and
     ``by_roughness`` (the mean over conductors, eta_i and NdotV at each roughness)."""
     errors = {name: split_sum_errors(name, eta_i, roughness, NdotV) for name in names}
@@ -180,7 +182,16 @@ def split_sum_shader_us(repeats: int, width: int, height: int) -> dict[str, floa
     _, air, (F0, a, alpha) = _au_inputs()
     with RenderThread("speed-vs-error-split-sum") as thread:
         samples = time_split_sum(
-            thread, default_lut(), F0, a, alpha, external_medium_F0(air["F0_air"], 1.5),
-            lazanyi_a(air["F0_air"], air["F82_air"]), air["F0_air"], width, height, repeats,
+            thread,
+            default_lut(),
+            F0,
+            a,
+            alpha,
+            external_medium_F0(air["F0_air"], 1.5),
+            lazanyi_a(air["F0_air"], air["F82_air"]),
+            air["F0_air"],
+            width,
+            height,
+            repeats,
         )
     return {v: float(np.median(s[:, 1])) * 1e6 for v, s in samples.items()}

@@ -98,6 +98,7 @@ def _bounded(name: str, low: float, high: float, kind: type = float):
         if not low <= value <= high:
             raise argparse.ArgumentTypeError(f"--{name} must lie in [{low:g}, {high:g}], got {text}")
         return value
+
     return parse
 
 
@@ -114,7 +115,7 @@ def main(argv: list[str] | None = None) -> int:
     size = args.mb << 20
     runs: dict[str, list[tuple[str, float | None]]] = {side: [] for side in SIDES}
     for i, kill in enumerate(kills):
-        for side in (SIDES if i % 2 == 0 else SIDES[::-1]):
+        for side in SIDES if i % 2 == 0 else SIDES[::-1]:
             runs[side].append(asyncio.run(trial(side, size, kill, args.limit)))
             print(f"trial {i} {side}: kill after {kill:.2f} s -> {runs[side][-1][0]}", flush=True)
     figures = {}
@@ -124,17 +125,24 @@ def main(argv: list[str] | None = None) -> int:
         outcomes = [outcome for outcome, _ in runs[side]]
         seconds = [s for _, s in runs[side] if s is not None]
         figures[side] = {
-            "trials": len(outcomes), **{k: outcomes.count(k) for k in ("answered", "broken", "hung")},
+            "trials": len(outcomes),
+            **{k: outcomes.count(k) for k in ("answered", "broken", "hung")},
             "seconds_median": round(statistics.median(seconds), 2) if seconds else None,
             "seconds_max": round(max(seconds), 2) if seconds else None,
         }
         f = figures[side]
-        print(f"| {side} | {f['trials']} | {f['answered']} | {f['broken']} | {f['hung']} | "
-              f"{f['seconds_median']} / {f['seconds_max']} |")
-    path = write_result("stuck_pools", figures, load_at_start, kills_s=[round(k, 3) for k in kills],
-                        settings={"mb": args.mb, "limit_s": args.limit, "stuck_s": executors.STUCK_S,
-                                  "watch_s": executors.WATCH_S},
-                        runs={side: [[o, None if s is None else round(s, 3)] for o, s in runs[side]] for side in SIDES})
+        print(
+            f"| {side} | {f['trials']} | {f['answered']} | {f['broken']} | {f['hung']} | "
+            f"{f['seconds_median']} / {f['seconds_max']} |"
+        )
+    path = write_result(
+        "stuck_pools",
+        figures,
+        load_at_start,
+        kills_s=[round(k, 3) for k in kills],
+        settings={"mb": args.mb, "limit_s": args.limit, "stuck_s": executors.STUCK_S, "watch_s": executors.WATCH_S},
+        runs={side: [[o, None if s is None else round(s, 3)] for o, s in runs[side]] for side in SIDES},
+    )
     print(f"\nrecorded {path.relative_to(ROOT)}")
     return 0
 

@@ -113,7 +113,7 @@ class Sampler(threading.Thread):
                 stat = Path(f"/proc/{pid}/stat").read_text()
             except OSError:
                 continue
-            fields = stat[stat.rfind(")") + 2:].split()
+            fields = stat[stat.rfind(")") + 2 :].split()
             ticks, key = int(fields[11]) + int(fields[12]), (pid, fields[19])
             parent = self.classes.get(fields[1])
             entry = self.seen.get(key)
@@ -159,25 +159,40 @@ def main(argv=None) -> int:
     machine, seconds, speed = result["machine_seconds"], result["seconds"], result["calibration_s"]
     classes = sampler.totals()
     classes["not_seen"] = machine["busy"] - sum(classes.values())
-    rows = {k: {"class": LABELS[k], "cpu_seconds": round(classes[k], 1),
-                "share": round(classes[k] / machine["busy"], 3)} for k in sorted(LABELS, key=lambda k: -classes[k])}
-    print(f"scripts/test: {seconds:.0f} s wall, returncode {result['returncode']}; machine: busy {machine['busy']} s, "
-          f"idle {machine['idle']} s, steal {machine['steal']} s of CPU time ({os.cpu_count()} cores); "
-          f"calibration loop {speed} s")
+    rows = {
+        k: {"class": LABELS[k], "cpu_seconds": round(classes[k], 1), "share": round(classes[k] / machine["busy"], 3)}
+        for k in sorted(LABELS, key=lambda k: -classes[k])
+    }
+    print(
+        f"scripts/test: {seconds:.0f} s wall, returncode {result['returncode']}; machine: busy {machine['busy']} s, "
+        f"idle {machine['idle']} s, steal {machine['steal']} s of CPU time ({os.cpu_count()} cores); "
+        f"calibration loop {speed} s"
+    )
     print(f"{'class':<54} {'CPU s':>8} {'share':>6}")
     for row in rows.values():
         print(f"{row['class']:<54} {row['cpu_seconds']:>8.1f} {row['share']:>6.1%}")
     for failure in result["failures"]:
         print(failure)
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps({
-        "command": "benchmarks/suite_cpu.py " + " ".join(argv if argv is not None else sys.argv[1:]),
-        "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "cpu": cpu(), "wall_seconds": seconds, "returncode": result["returncode"],
-        "summary": result["summaries"][-1:], "failures": result["failures"],
-        "load_average": result["load_average"], "calibration_s": speed,
-        "machine_seconds": machine, "classes": rows,
-    }, indent=2) + "\n")
+    RESULTS.write_text(
+        json.dumps(
+            {
+                "command": "benchmarks/suite_cpu.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+                "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+                "cpu": cpu(),
+                "wall_seconds": seconds,
+                "returncode": result["returncode"],
+                "summary": result["summaries"][-1:],
+                "failures": result["failures"],
+                "load_average": result["load_average"],
+                "calibration_s": speed,
+                "machine_seconds": machine,
+                "classes": rows,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
     return result["returncode"]
 
 

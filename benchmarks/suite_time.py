@@ -139,16 +139,21 @@ def mode_figures(rows: list[dict]) -> dict:
     for mode in dict.fromkeys(r["mode"] for r in rows):
         mine = [r for r in rows if r["mode"] == mode]
         seconds = [r["seconds"] for r in mine]
-        figures[mode] = {"runs": len(mine), "median_s": round(statistics.median(seconds), 1),
-                         "worst_s": max(seconds), "all_passed": all(r["returncode"] == 0 for r in mine)}
+        figures[mode] = {
+            "runs": len(mine),
+            "median_s": round(statistics.median(seconds), 1),
+            "worst_s": max(seconds),
+            "all_passed": all(r["returncode"] == 0 for r in mine),
+        }
     return figures
 
 
 def full_suite(root: Path, log: Path | None = None, name: str = "full.log") -> dict:
     """:data:`FULL_SUITE` in the checkout ``root``, timed, after its bytecode caches (as ``scripts/test`` writes them)."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    subprocess.run([sys.executable, "-m", "compileall", "-q", *COMPILED], cwd=root, env=env,
-                   capture_output=True, check=True)
+    subprocess.run(
+        [sys.executable, "-m", "compileall", "-q", *COMPILED], cwd=root, env=env, capture_output=True, check=True
+    )
     return timed([sys.executable, *FULL_SUITE], root, log, name, env)
 
 
@@ -165,11 +170,17 @@ def timed(command: list[str], cwd: Path, log: Path | None, name: str, env: dict 
         (log / name).write_text(output)
     summaries = SUMMARY.findall(output)
     shown = command if command[0] == "scripts/test" else ["python", *command[1:]]
-    return {"command": " ".join(shown), "seconds": round(seconds, 1),
-            "returncode": done.returncode, "summaries": summaries,
-            "failures": FAILURE.findall(output)[:50],  # what failed, when a run did
-            "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)],
-            "machine_seconds": ticks, "calibration_s": speed, "calibration_memory_s": memory}
+    return {
+        "command": " ".join(shown),
+        "seconds": round(seconds, 1),
+        "returncode": done.returncode,
+        "summaries": summaries,
+        "failures": FAILURE.findall(output)[:50],  # what failed, when a run did
+        "load_average": [round(load_start, 2), round(os.getloadavg()[0], 2)],
+        "machine_seconds": ticks,
+        "calibration_s": speed,
+        "calibration_memory_s": memory,
+    }
 
 
 def side_by_side(before: str, rounds: int, log: Path | None) -> dict:
@@ -179,19 +190,24 @@ def side_by_side(before: str, rounds: int, log: Path | None) -> dict:
     rows = []
     with checkout(before, SUITE_INSTALLED) as root:
         for i in range(rounds):
-            for side in (("before", "now") if i % 2 == 0 else ("now", "before")):
+            for side in ("before", "now") if i % 2 == 0 else ("now", "before"):
                 row = full_suite(root if side == "before" else ROOT, log, f"full-{side}-{i}.log")
                 rows.append({"checkout": side, **row})
-                print(f"round {i}, {side}: {row['seconds']:.1f} s, busy {row['machine_seconds']['busy']:.1f} s, "
-                      f"calibration {row['calibration_s']:.3f} s, memory {row['calibration_memory_s']:.3f} s, "
-                      f"{'; '.join(row['summaries'])}", flush=True)
+                print(
+                    f"round {i}, {side}: {row['seconds']:.1f} s, busy {row['machine_seconds']['busy']:.1f} s, "
+                    f"calibration {row['calibration_s']:.3f} s, memory {row['calibration_memory_s']:.3f} s, "
+                    f"{'; '.join(row['summaries'])}",
+                    flush=True,
+                )
     figures = {}
     for side in ("before", "now"):
         mine = [r for r in rows if r["checkout"] == side]
-        figures[side] = {"seconds": statistics.median(r["seconds"] for r in mine),
-                         "busy_seconds": statistics.median(r["machine_seconds"]["busy"] for r in mine),
-                         "idle_seconds": statistics.median(r["machine_seconds"]["idle"] for r in mine),
-                         "summaries": [r["summaries"][-1:] for r in mine]}
+        figures[side] = {
+            "seconds": statistics.median(r["seconds"] for r in mine),
+            "busy_seconds": statistics.median(r["machine_seconds"]["busy"] for r in mine),
+            "idle_seconds": statistics.median(r["machine_seconds"]["idle"] for r in mine),
+            "summaries": [r["summaries"][-1:] for r in mine],
+        }
     figures["ratio_seconds"] = figures["now"]["seconds"] / figures["before"]["seconds"]
     figures["ratio_busy"] = figures["now"]["busy_seconds"] / figures["before"]["busy_seconds"]
     return {"before": before, "rounds": rounds, "figures": figures, "rows": rows}
@@ -201,21 +217,33 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--no-other-cpus", action="store_true", help="leave out --other-cpus")
     parser.add_argument("--log", type=Path, help="keep each mode's whole output in this directory")
-    parser.add_argument("--before", metavar="REV",
-                        help="instead: the full suite of this commit and of this checkout, in turns")
-    parser.add_argument("--rounds", type=int, default=1,
-                        help="runs of the quick loop and of the full suite each (with --before: full runs of each "
-                             "side); default 1")
-    parser.add_argument("--name", default=SIDE_BY_SIDE.stem,
-                        help=f"with --before: the record, benchmarks/results/NAME.json (default {SIDE_BY_SIDE.stem})")
+    parser.add_argument(
+        "--before", metavar="REV", help="instead: the full suite of this commit and of this checkout, in turns"
+    )
+    parser.add_argument(
+        "--rounds",
+        type=int,
+        default=1,
+        help="runs of the quick loop and of the full suite each (with --before: full runs of each side); default 1",
+    )
+    parser.add_argument(
+        "--name",
+        default=SIDE_BY_SIDE.stem,
+        help=f"with --before: the record, benchmarks/results/NAME.json (default {SIDE_BY_SIDE.stem})",
+    )
     args = parser.parse_args(argv)
     if not 1 <= args.rounds <= 5:
         parser.error(f"--rounds must lie in [1, 5], got {args.rounds}")
     if not re.fullmatch(r"suite_time_[a-z0-9_]+", args.name):
         parser.error(f"--name must be suite_time_ and lower-case letters, digits or _, got {args.name!r}")
     if args.before is not None:
-        if subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{args.before}^{{commit}}"],
-                          capture_output=True).returncode != 0:
+        if (
+            subprocess.run(
+                ["git", "-C", str(ROOT), "rev-parse", "--verify", "--quiet", f"{args.before}^{{commit}}"],
+                capture_output=True,
+            ).returncode
+            != 0
+        ):
             parser.error(f"--before must name a commit of this repository, got {args.before!r}")
         result = side_by_side(args.before, args.rounds, args.log)
         f = result["figures"]
@@ -223,21 +251,33 @@ def main(argv=None) -> int:
         for side in ("before", "now"):
             print(f"{side:<8}{f[side]['seconds']:>9.1f}{f[side]['busy_seconds']:>9.1f}{f[side]['idle_seconds']:>9.1f}")
         print(f"now / before: wall {f['ratio_seconds']:.3f}, busy {f['ratio_busy']:.3f}")
-        (SIDE_BY_SIDE.parent / f"{args.name}.json").write_text(json.dumps({
-            "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
-            "date": datetime.now(timezone.utc).isoformat(timespec="minutes"), "cpu": cpu(), **result,
-        }, indent=2) + "\n")
+        (SIDE_BY_SIDE.parent / f"{args.name}.json").write_text(
+            json.dumps(
+                {
+                    "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+                    "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+                    "cpu": cpu(),
+                    **result,
+                },
+                indent=2,
+            )
+            + "\n"
+        )
         return max(r["returncode"] for r in result["rows"])
     rows = [run(mode, args.log, i) for i in range(args.rounds) for mode in (["--quick"], [])]
     rows += [] if args.no_other_cpus else [run(["--other-cpus"], args.log)]
     figures = mode_figures(rows)
-    print(f"{'command':<28} {'round':>5} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "
-          f"{'calib s':>7} {'mem s':>6}  tests")
+    print(
+        f"{'command':<28} {'round':>5} {'wall s':>8} {'min':>6} {'rc':>3} {'load':>11} {'busy s':>7} {'idle s':>7} "
+        f"{'calib s':>7} {'mem s':>6}  tests"
+    )
     for r in rows:
-        print(f"{r['command']:<28} {r['round']:>5} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
-              f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f} {r['machine_seconds']['busy']:>7.1f} "
-              f"{r['machine_seconds']['idle']:>7.1f} {r['calibration_s']:>7.3f} {r['calibration_memory_s']:>6.3f}  "
-              f"{'; '.join(r['summaries'])}")
+        print(
+            f"{r['command']:<28} {r['round']:>5} {r['seconds']:>8.1f} {r['seconds'] / 60:>6.2f} {r['returncode']:>3} "
+            f"{r['load_average'][0]:>5.2f}-{r['load_average'][1]:<5.2f} {r['machine_seconds']['busy']:>7.1f} "
+            f"{r['machine_seconds']['idle']:>7.1f} {r['calibration_s']:>7.3f} {r['calibration_memory_s']:>6.3f}  "
+            f"{'; '.join(r['summaries'])}"
+        )
     print(f"\n{'mode':<12} {'runs':>4} {'median s':>9} {'worst s':>8}  all passed")
     for mode, f in figures.items():
         print(f"{mode:<12} {f['runs']:>4} {f['median_s']:>9.1f} {f['worst_s']:>8.1f}  {f['all_passed']}")
@@ -245,11 +285,20 @@ def main(argv=None) -> int:
         for failure in r["failures"]:
             print(f"{r['command']}: {failure}")
     RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps({
-        "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
-        "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
-        "cpu": cpu(), "rounds": args.rounds, "figures": figures, "rows": rows,
-    }, indent=2) + "\n")
+    RESULTS.write_text(
+        json.dumps(
+            {
+                "command": "benchmarks/suite_time.py " + " ".join(argv if argv is not None else sys.argv[1:]),
+                "date": datetime.now(timezone.utc).isoformat(timespec="minutes"),
+                "cpu": cpu(),
+                "rounds": args.rounds,
+                "figures": figures,
+                "rows": rows,
+            },
+            indent=2,
+        )
+        + "\n"
+    )
     return max(r["returncode"] for r in rows)
 
 

@@ -78,19 +78,31 @@ def _cell(f: dict | None, keys=("mean", "max"), fmt=".3f") -> str:
 
 
 def _row(material, kind, env, eta_i, r, c, f) -> str:
-    cells = [material, kind, env, f"{eta_i:g}", f"{r:g}", f"{c:g}",
-             _cell(f.get("composed"), ("mean", "p99", "max", "centre", "ring"), ".4f"),
-             _cell(f.get("physics"), ("mean", "centre", "ring")), _cell(f.get("fit_vs_physics"), ("mean",)),
-             _cell(f.get("fallback"), ("mean", "centre")),
-             _cell(f["preview"] if env == "white_sky" else f.get("preview_rec709"), ("mean", "p99", "max"), ".4f"),
-             _cell(f.get("preview_bare") if env == "white_sky" else f["preview"], ("mean", "max"))]
+    cells = [
+        material,
+        kind,
+        env,
+        f"{eta_i:g}",
+        f"{r:g}",
+        f"{c:g}",
+        _cell(f.get("composed"), ("mean", "p99", "max", "centre", "ring"), ".4f"),
+        _cell(f.get("physics"), ("mean", "centre", "ring")),
+        _cell(f.get("fit_vs_physics"), ("mean",)),
+        _cell(f.get("fallback"), ("mean", "centre")),
+        _cell(f["preview"] if env == "white_sky" else f.get("preview_rec709"), ("mean", "p99", "max"), ".4f"),
+        _cell(f.get("preview_bare") if env == "white_sky" else f["preview"], ("mean", "max")),
+    ]
     return "| " + " | ".join(cells) + " |"
 
 
 def _spread(fs: list[dict]) -> dict[str, float]:
     """Mean of the settings' means, the worst setting's mean and the worst pixel."""
-    return {"mean": sum(f["mean"] for f in fs) / len(fs), "worst_mean": max(f["mean"] for f in fs),
-            "worst_max": max(f["max"] for f in fs), "settings": len(fs)}
+    return {
+        "mean": sum(f["mean"] for f in fs) / len(fs),
+        "worst_mean": max(f["mean"] for f in fs),
+        "worst_max": max(f["max"] for f in fs),
+        "settings": len(fs),
+    }
 
 
 def _by_kind(rows: list[tuple], name: str) -> dict:
@@ -120,9 +132,12 @@ def figures(rows: list[tuple]) -> dict:
         good = [r for r in of if r[6]["fit_vs_physics"]["mean"] < FIT_ERROR_BELOW]
         worse = [r for r in of if r[6]["physics"]["mean"] > r[6]["fallback"]["mean"]]
         out[label] = {
-            "composed": _by_kind(of, "composed"), "physics": _by_kind(of, "physics"),
-            "fit_vs_physics": _by_kind(of, "fit_vs_physics"), "fallback": _by_kind(of, "fallback"),
-            "preview": _by_kind(of, "preview"), "preview_bare": _by_kind(of, "preview_bare"),
+            "composed": _by_kind(of, "composed"),
+            "physics": _by_kind(of, "physics"),
+            "fit_vs_physics": _by_kind(of, "fit_vs_physics"),
+            "fallback": _by_kind(of, "fallback"),
+            "preview": _by_kind(of, "preview"),
+            "preview_bare": _by_kind(of, "preview_bare"),
             "physics_where_fit_good": _spread([r[6]["physics"] for r in good]) if good else None,
             "fit_good_settings": len(good),
             "worse_than_fallback": len(worse),
@@ -137,11 +152,15 @@ def figures(rows: list[tuple]) -> dict:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--materials", default=",".join(LIBRARY_NAMES), help="comma-separated library materials")
-    parser.add_argument("--rough-materials", default="Au,Cu,Cr,Al",
-                        help="comma-separated materials also measured rough and under the coloured skies")
+    parser.add_argument(
+        "--rough-materials",
+        default="Au,Cu,Cr,Al",
+        help="comma-separated materials also measured rough and under the coloured skies",
+    )
     parser.add_argument("--record", default=str(RECORD), help="file for the table ('-': none)")
-    parser.add_argument("--result", default="three_stack",
-                        help="name of the figures' record, benchmarks/results/NAME.json ('-': none)")
+    parser.add_argument(
+        "--result", default="three_stack", help="name of the figures' record, benchmarks/results/NAME.json ('-': none)"
+    )
     args = parser.parse_args()
     materials = args.materials.split(",")
     rough_materials = [m for m in args.rough_materials.split(",") if m]
@@ -153,10 +172,16 @@ def main() -> None:
         f = measure_three(page, server.url, nk, fit, eta_i, roughness, coat_roughness, env)
         rows.append((material, kind, env, eta_i, roughness, coat_roughness, f))
         key = "composed" if env == "white_sky" else "preview_rec709"
-        print(f"{material} {kind} {env} {eta_i} {roughness} {coat_roughness}: {key} "
-              f"{f[key]['mean']:.4f}" + (f", physics {f['physics']['mean']:.3f}, fallback "
-                                         f"{f['fallback']['mean']:.3f}" if env == "white_sky" else ""),
-              file=sys.stderr)
+        print(
+            f"{material} {kind} {env} {eta_i} {roughness} {coat_roughness}: {key} "
+            f"{f[key]['mean']:.4f}"
+            + (
+                f", physics {f['physics']['mean']:.3f}, fallback {f['fallback']['mean']:.3f}"
+                if env == "white_sky"
+                else ""
+            ),
+            file=sys.stderr,
+        )
 
     with tempfile.TemporaryDirectory() as tmp, server_process(Path(tmp) / "data") as server:
         with sync_playwright() as p:
@@ -215,8 +240,15 @@ def main() -> None:
         )
         print(f"recorded in {path.relative_to(ROOT) if path.is_relative_to(ROOT) else path}", file=sys.stderr)
     if args.result != "-":
-        path = write_result(args.result, summary, load, materials=materials, rough_materials=rough_materials,
-                            seconds=round(time.perf_counter() - started), three=three_version())
+        path = write_result(
+            args.result,
+            summary,
+            load,
+            materials=materials,
+            rough_materials=rough_materials,
+            seconds=round(time.perf_counter() - started),
+            three=three_version(),
+        )
         print(f"recorded in {path.relative_to(ROOT)}", file=sys.stderr)
     else:
         print(json.dumps(summary, indent=1))

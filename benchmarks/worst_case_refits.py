@@ -93,11 +93,14 @@ def main() -> None:
         "Cu green 0.10 at 60, 16 samples": (cu, "Cu", lambda s: pulled(cu, 1, 60, 0.10, 16, s), 16),
         "degenerate base (n 1, k 0), 16 samples": (void, None, lambda s: flat, 16),
     }
-    starts = {name: fit_material(library_material(name)).coefficients_float16.astype(np.float64)
-              for name in ("Au", "Cu")}
+    starts = {
+        name: fit_material(library_material(name)).coefficients_float16.astype(np.float64) for name in ("Au", "Cu")
+    }
     load_at_start = load_average()
-    print(f"{'edit':<40} {'full s':>7} {'max s':>6} {'cpu s':>6} {'best':>5} {'kept':>18} {'range':>15}"
-          f"   {'live p50 ms':>11} {'p99 ms':>7}")
+    print(
+        f"{'edit':<40} {'full s':>7} {'max s':>6} {'cpu s':>6} {'best':>5} {'kept':>18} {'range':>15}"
+        f"   {'live p50 ms':>11} {'p99 ms':>7}"
+    )
     figures = {}
     for label, (base, start_name, make, _) in cases.items():
         seconds, cpu = [], []
@@ -116,19 +119,26 @@ def main() -> None:
             start = step.coefficients_float16.astype(np.float64)
         kept = (result.metrics.get("guard") or {}).get("chosen", result.metrics["objective"])
         span = f"[{target['model_min']:.3f}, {target['model_max']:.4f}]"
-        print(f"{label:<40} {statistics.median(seconds):>7.2f} {max(seconds):>6.2f} {statistics.median(cpu):>6.2f} "
-              f"{str(result.metrics['best_effort']):>5} {kept:>18} {span:>15}   "
-              f"{percentile(live, 0.5):>11.0f} {percentile(live, 0.99):>7.0f}")
+        print(
+            f"{label:<40} {statistics.median(seconds):>7.2f} {max(seconds):>6.2f} {statistics.median(cpu):>6.2f} "
+            f"{str(result.metrics['best_effort']):>5} {kept:>18} {span:>15}   "
+            f"{percentile(live, 0.5):>11.0f} {percentile(live, 0.99):>7.0f}"
+        )
         figures[label] = {
             "full_s": {"median": statistics.median(seconds), "max": max(seconds)},
-            "full_cpu_s": statistics.median(cpu), "best_effort": bool(result.metrics["best_effort"]),
-            "kept": kept, "model_min": target["model_min"], "model_max": target["model_max"],
-            "delta_E_mean": target["delta_E_mean"], "delta_E_max": target["delta_E_max"],
+            "full_cpu_s": statistics.median(cpu),
+            "best_effort": bool(result.metrics["best_effort"]),
+            "kept": kept,
+            "model_min": target["model_min"],
+            "model_max": target["model_max"],
+            "delta_E_mean": target["delta_E_mean"],
+            "delta_E_max": target["delta_E_max"],
             "live_ms": {"p50": percentile(live, 0.5), "p99": percentile(live, 0.99)},
         }
     figures["worst_full_s"] = max(f["full_s"]["max"] for f in figures.values())
     print(f"\nload average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print("recorded:", write_result("worst_case_refits", figures, load_at_start, repeats=args.repeats))
+
 
 if __name__ == "__main__":
     main()

@@ -91,24 +91,46 @@ ANGLE_LIMITS_DEG: tuple[float, float] = (0.0, 90.0)
 """Angles theta in the coating, degrees: normal to grazing incidence."""
 
 COAT_PRESETS: tuple[tuple[str, str, float, str], ...] = (
-    ("air", "Air (uncoated)", 1.0,
-     "Vacuum is 1; dry air at 15 C and 101.325 kPa is 1.00028 at 589 nm (Ciddor 1996, Appl. Opt. 35, "
-     "1566), which no render tells apart from 1"),
-    ("water", "Water", 1.333,
-     "1.3330 at 589 nm and 20 C (Daimon and Masumura 2007, Appl. Opt. 46, 3811)"),
-    ("acrylic", "Lacquer, acrylic (PMMA)", 1.49,
-     "PMMA 1.4905 at 589 nm (Sultanova, Kasarova and Nikolov 2009, Acta Phys. Pol. A 116, 585); "
-     "clear acrylic and nitrocellulose lacquers lie at 1.49-1.51"),
-    ("glass", "Glass (crown)", 1.5,
-     "Soda-lime and crown glasses 1.50-1.52 at 589 nm (Schott N-BK7: 1.5168 at 587.6 nm)"),
-    ("polyurethane", "Varnish, polyurethane", 1.5,
-     "Polyurethane clear coats about 1.50 at 589 nm (cured two-part automotive clear coats 1.49-1.52)"),
-    ("polycarbonate", "Polycarbonate", 1.585,
-     "1.5855 at 589 nm (Sultanova, Kasarova and Nikolov 2009, Acta Phys. Pol. A 116, 585)"),
-    ("sapphire", "Sapphire", 1.768,
-     "Ordinary ray 1.7681 at 589 nm (Malitson and Dodge 1972, J. Opt. Soc. Am. 62, 1405)"),
-    ("diamond", "Diamond", 2.417,
-     "2.4175 at 589 nm (Phillip and Taft 1964, Phys. Rev. 136, A1445)"),
+    (
+        "air",
+        "Air (uncoated)",
+        1.0,
+        "Vacuum is 1; dry air at 15 C and 101.325 kPa is 1.00028 at 589 nm (Ciddor 1996, Appl. Opt. 35, "
+        "1566), which no render tells apart from 1",
+    ),
+    ("water", "Water", 1.333, "1.3330 at 589 nm and 20 C (Daimon and Masumura 2007, Appl. Opt. 46, 3811)"),
+    (
+        "acrylic",
+        "Lacquer, acrylic (PMMA)",
+        1.49,
+        "PMMA 1.4905 at 589 nm (Sultanova, Kasarova and Nikolov 2009, Acta Phys. Pol. A 116, 585); "
+        "clear acrylic and nitrocellulose lacquers lie at 1.49-1.51",
+    ),
+    (
+        "glass",
+        "Glass (crown)",
+        1.5,
+        "Soda-lime and crown glasses 1.50-1.52 at 589 nm (Schott N-BK7: 1.5168 at 587.6 nm)",
+    ),
+    (
+        "polyurethane",
+        "Varnish, polyurethane",
+        1.5,
+        "Polyurethane clear coats about 1.50 at 589 nm (cured two-part automotive clear coats 1.49-1.52)",
+    ),
+    (
+        "polycarbonate",
+        "Polycarbonate",
+        1.585,
+        "1.5855 at 589 nm (Sultanova, Kasarova and Nikolov 2009, Acta Phys. Pol. A 116, 585)",
+    ),
+    (
+        "sapphire",
+        "Sapphire",
+        1.768,
+        "Ordinary ray 1.7681 at 589 nm (Malitson and Dodge 1972, J. Opt. Soc. Am. 62, 1405)",
+    ),
+    ("diamond", "Diamond", 2.417, "2.4175 at 589 nm (Phillip and Taft 1964, Phys. Rev. 136, A1445)"),
 )
 """Coat presets ``(key, display name, eta_i, source)``: common clear coats by their
 index at 589 nm, inside [ETA_I_MIN, ETA_I_MAX]. A coat's index falls by about 0.01-0.02
@@ -168,16 +190,11 @@ def check_eta_i_range(eta_i_range) -> tuple[float, float]:
     try:
         lo, hi = (float(v) for v in eta_i_range)
     except (TypeError, ValueError):
-        raise ValueError(
-            f"`eta_i_range` must be two numbers [lo, hi], got {eta_i_range!r}"
-        ) from None
+        raise ValueError(f"`eta_i_range` must be two numbers [lo, hi], got {eta_i_range!r}") from None
     if not (np.isfinite(lo) and np.isfinite(hi)):
         raise ValueError(f"`eta_i_range` must be finite, got [{lo}, {hi}]")
     if not (ETA_I_MIN <= lo <= hi <= ETA_I_MAX):
-        raise ValueError(
-            f"`eta_i_range` must satisfy {ETA_I_MIN:g} <= lo <= hi <= {ETA_I_MAX:g}, "
-            f"got [{lo:g}, {hi:g}]"
-        )
+        raise ValueError(f"`eta_i_range` must satisfy {ETA_I_MIN:g} <= lo <= hi <= {ETA_I_MAX:g}, got [{lo:g}, {hi:g}]")
     return lo, hi
 
 

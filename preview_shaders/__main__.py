@@ -43,9 +43,7 @@ def _render(args) -> int:
         if args.material is None:
             raise ValueError("`--material` or `--fit` is required")
         if args.material not in LIBRARY_NAMES:
-            raise ValueError(
-                f"`--material` must be one of {', '.join(LIBRARY_NAMES)}, got {args.material!r}"
-            )
+            raise ValueError(f"`--material` must be one of {', '.join(LIBRARY_NAMES)}, got {args.material!r}")
         from fitting.fits.material import fit_material
 
         nk = library_material(args.material)
@@ -55,13 +53,23 @@ def _render(args) -> int:
         nk = library_material(packed.name) if packed.name in LIBRARY_NAMES else None
     with PreviewRenderer() as renderer:
         result = renderer.render_preview(
-            packed, nk, args.eta_i, args.size, args.compare, args.environment,
-            roughness=args.roughness, mode=args.mode, coat_roughness=args.coat_roughness,
+            packed,
+            nk,
+            args.eta_i,
+            args.size,
+            args.compare,
+            args.environment,
+            roughness=args.roughness,
+            mode=args.mode,
+            coat_roughness=args.coat_roughness,
         )
     args.output.write_bytes(result.png)
-    print(f"wrote {args.output} ({packed.name}, eta_i {args.eta_i:g}, {args.size} px, "
-          f"compare {args.compare}, {args.environment}, {args.mode}, roughness {args.roughness:g}"
-          + (f", coat roughness {args.coat_roughness:g}" if args.mode == "coated" else "") + ")")
+    print(
+        f"wrote {args.output} ({packed.name}, eta_i {args.eta_i:g}, {args.size} px, "
+        f"compare {args.compare}, {args.environment}, {args.mode}, roughness {args.roughness:g}"
+        + (f", coat roughness {args.coat_roughness:g}" if args.mode == "coated" else "")
+        + ")"
+    )
     if result.delta_E is not None:
         print(f"mean Delta E 2000 over the sphere: {result.delta_E_mean:.4f}")
         print(f"mean FLIP over the sphere: {result.flip_mean:.4f}")
@@ -76,22 +84,23 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m preview_shaders")
     commands = parser.add_subparsers(dest="command", required=True)
     render = commands.add_parser("render", help="render the preview sphere to a PNG")
-    render.add_argument("--material", help="built-in conductor (fitted on the spot), "
-                        "or the material's name in --fit")
+    render.add_argument("--material", help="built-in conductor (fitted on the spot), or the material's name in --fit")
     render.add_argument("--fit", type=Path, help="a coefficient pack, binary or JSON")
     render.add_argument("--eta-i", type=float, default=1.5, help="coating index, [1, 3]")
     render.add_argument("--size", type=int, default=512, help="pixels per side, 64..2048")
     render.add_argument("--compare", default="none", help=" | ".join(COMPARISONS))
     render.add_argument("--environment", default="white_sky", help=" | ".join(ENVIRONMENTS))
-    render.add_argument("--roughness", type=float, default=0.0,
-                        help="GGX perceptual roughness, [0, 1] (0: the smooth sphere)")
+    render.add_argument(
+        "--roughness", type=float, default=0.0, help="GGX perceptual roughness, [0, 1] (0: the smooth sphere)"
+    )
     render.add_argument("--mode", default="immersed", help=" | ".join(MODES))
-    render.add_argument("--coat-roughness", type=float, default=0.0,
-                        help="with --mode coated: the coat's roughness, [0, 1]")
-    render.add_argument("--delta-e-map", type=Path, help="with --compare reference: "
-                        "Delta E 2000 map PNG (viridis, 0..2)")
-    render.add_argument("--flip-map", type=Path, help="with --compare reference: "
-                        "FLIP map PNG (magma, 0..1)")
+    render.add_argument(
+        "--coat-roughness", type=float, default=0.0, help="with --mode coated: the coat's roughness, [0, 1]"
+    )
+    render.add_argument(
+        "--delta-e-map", type=Path, help="with --compare reference: Delta E 2000 map PNG (viridis, 0..2)"
+    )
+    render.add_argument("--flip-map", type=Path, help="with --compare reference: FLIP map PNG (magma, 0..1)")
     render.add_argument("-o", "--output", type=Path, required=True)
     args = parser.parse_args(argv)
     try:

@@ -58,9 +58,7 @@ def ACEScg_to_sRGB(RGB) -> np.ndarray:
     """
     linear = np.asarray(RGB, dtype=np.float64) @ ACEScg_to_sRGB_matrix().T
     linear = np.clip(linear, 0.0, 1.0)
-    return np.where(
-        linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1.0 / 2.4) - 0.055
-    )
+    return np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1.0 / 2.4) - 0.055)
 
 
 def to_uint8(encoded) -> np.ndarray:

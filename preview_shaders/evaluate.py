@@ -44,8 +44,16 @@ __all__ = [
 ]
 
 VARIANTS = (
-    "packed", "floats", "collapsed", "lazanyi", "schlick", "exact", "rgb_conductor",
-    "lean", "collapsed_lean", "lazanyi_lean",
+    "packed",
+    "floats",
+    "collapsed",
+    "lazanyi",
+    "schlick",
+    "exact",
+    "rgb_conductor",
+    "lean",
+    "collapsed_lean",
+    "lazanyi_lean",
 )
 """Model from float16 halves in uint32, model from float coefficients,
 scene-specialised model (Eq. 1 only), adjusted Lazanyi, Schlick, exact RGB
@@ -134,9 +142,7 @@ def shader_inputs(
         coefficients=halves.astype(np.float32).ravel(),
         eta_i_range=packed.eta_i_range,
         collapse_eta_i=float(collapse_eta_i),
-        collapsed=collapse_to_eta_i(
-            packed.coefficients.astype(np.float64), collapse_eta_i, packed.eta_i_range
-        )[..., 0],
+        collapsed=collapse_to_eta_i(packed.coefficients.astype(np.float64), collapse_eta_i, packed.eta_i_range)[..., 0],
         F0_air=np.asarray(F0_air, dtype=np.float64),
         F82_air=np.asarray(F82_air, dtype=np.float64),
         n=np.asarray((1.0, 1.0, 1.0) if n is None else n, dtype=np.float64),
@@ -210,8 +216,7 @@ def _program(state: GLState, variant: str, inputs: ShaderInputs, constants: bool
     source = constants_source(variant, inputs) if constants else ""
     program, vao = state.program(
         "evaluate.frag",
-        {"CF_VARIANT": TIMING_VARIANTS.index(variant), "CF_WRITE_INPUTS": write_inputs,
-         "CF_CONSTANTS": int(constants)},
+        {"CF_VARIANT": TIMING_VARIANTS.index(variant), "CF_WRITE_INPUTS": write_inputs, "CF_CONSTANTS": int(constants)},
         {"cf_constants.glsl": source},
     )
     if not constants:
@@ -342,7 +347,5 @@ def time_variants(
     """
     for variant in variants:
         if variant.removesuffix(CONSTANTS_SUFFIX) not in TIMING_VARIANTS:
-            raise ValueError(
-                f"`variants` must name {', '.join(TIMING_VARIANTS)}, got {variant!r}"
-            )
+            raise ValueError(f"`variants` must name {', '.join(TIMING_VARIANTS)}, got {variant!r}")
     return thread.call(_time_variants, inputs, tuple(variants), width, height, rounds)

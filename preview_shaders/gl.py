@@ -51,8 +51,7 @@ GL_VERSION = 430
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 
-def load_shader_source(name: str, defines: dict[str, int] | None = None,
-                       sources: dict[str, str] | None = None) -> str:
+def load_shader_source(name: str, defines: dict[str, int] | None = None, sources: dict[str, str] | None = None) -> str:
     """
     Source of ``glsl/<name>`` with ``#include "file"`` lines replaced by the
     file (recursively; each file is included once, its include guard covers
@@ -148,7 +147,9 @@ class GLState:
             target.release()
 
     def program(
-        self, fragment: str, defines: dict[str, int] | None = None,
+        self,
+        fragment: str,
+        defines: dict[str, int] | None = None,
         sources: dict[str, str] | None = None,
     ) -> tuple[moderngl.Program, moderngl.VertexArray]:
         """A full-screen program (``fullscreen.vert`` + ``fragment``, with the generated

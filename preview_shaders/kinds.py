@@ -44,18 +44,20 @@ def preview_model_source(kind: ModelKind, inline: bool = False) -> str:
     own = Path(kind.glsl_file)
     shared = not own.is_absolute() and (GLSL_DIR / own).is_file()
     code = f'#include "{kind.glsl_file}"' if shared or not inline else own.read_text(encoding="utf-8").rstrip("\n")
-    return "\n".join([
-        "#ifndef CF_PREVIEW_MODEL_GLSL",
-        "#define CF_PREVIEW_MODEL_GLSL",
-        code,
-        f"// The {kind.name} kind from its float16 coefficients, two per word (fitting.models.kinds).",
-        f"vec3 cf_preview_model(float NdotV, float eta_i, vec2 eta_i_range, uint words[{PREVIEW_WORDS}])",
-        "{",
-        f"    return {kind.preview_call};",
-        "}",
-        "#endif",
-        "",
-    ])
+    return "\n".join(
+        [
+            "#ifndef CF_PREVIEW_MODEL_GLSL",
+            "#define CF_PREVIEW_MODEL_GLSL",
+            code,
+            f"// The {kind.name} kind from its float16 coefficients, two per word (fitting.models.kinds).",
+            f"vec3 cf_preview_model(float NdotV, float eta_i, vec2 eta_i_range, uint words[{PREVIEW_WORDS}])",
+            "{",
+            f"    return {kind.preview_call};",
+            "}",
+            "#endif",
+            "",
+        ]
+    )
 
 
 def _padded(packed: PackedMaterial) -> np.ndarray:

@@ -89,8 +89,7 @@ def materialx_glsl(document_text: str, target_colorspace: str | None = None) -> 
         generator.setColorManagementSystem(cms)
         context.getOptions().targetColorSpaceOverride = target_colorspace
     shader = generator.generate(materials[0].getName(), materials[0], context)
-    return (shader.getSourceCode(mx_gen_shader.VERTEX_STAGE),
-            shader.getSourceCode(mx_gen_shader.PIXEL_STAGE))
+    return (shader.getSourceCode(mx_gen_shader.VERTEX_STAGE), shader.getSourceCode(mx_gen_shader.PIXEL_STAGE))
 
 
 def _sphere_buffer() -> np.ndarray:
@@ -121,9 +120,14 @@ def _render(state: GLState, vertex: str, pixel: str, size: int) -> np.ndarray:
     program["u_viewPosition"].value = (0.0, 0.0, 1.0e4)
     white = ctx.texture((8, 4), 4, np.ones((4, 8, 4), np.float32).tobytes(), dtype="f4")
     white.use(0)
-    for name, value in (("u_envRadiance", 0), ("u_envIrradiance", 0), ("u_envRadianceMips", 1),
-                        ("u_envRadianceSamples", ENVIRONMENT_SAMPLES), ("u_envLightIntensity", 1.0),
-                        ("u_numActiveLightSources", 0)):
+    for name, value in (
+        ("u_envRadiance", 0),
+        ("u_envIrradiance", 0),
+        ("u_envRadianceMips", 1),
+        ("u_envRadianceSamples", ENVIRONMENT_SAMPLES),
+        ("u_envLightIntensity", 1.0),
+        ("u_numActiveLightSources", 0),
+    ):
         if name in program:
             program[name].value = value
     fbo, targets = state.float_targets((size, size), 1)
@@ -144,8 +148,9 @@ def _render(state: GLState, vertex: str, pixel: str, size: int) -> np.ndarray:
     return image.reshape(size, size, 4)[::-1].copy()
 
 
-def render_materialx(document_text: str, size: int = 128, thread: RenderThread | None = None,
-                     target_colorspace: str | None = None):
+def render_materialx(
+    document_text: str, size: int = 128, thread: RenderThread | None = None, target_colorspace: str | None = None
+):
     """
     The sphere of a MaterialX document's material under a uniform white
     environment (see the module docstring).

@@ -67,10 +67,26 @@ from fitting.models.pack import PackedMaterial
 from .display import ACEScg_to_sRGB, encode_png, to_uint8
 from .gl import GLState, RenderThread, check_gl_error, read_float_target
 from .kinds import PREVIEW_MODEL_FILE, padded_words, preview_model_source, preview_words
-from .reference import (REFERENCE_TABLE_SIZE, REFERENCE_TABLE_TOLERANCE, difference_maps, reference_image,
-                        reference_table)
-from .views import (COMPARISONS, ENVIRONMENTS, ETA_I_LIMITS, MODES, SIZE_RANGE, SPHERE_RADIUS, _check_choice,
-                    _check_eta_i, _check_size, _check_unit, sphere_cos_theta)
+from .reference import (
+    REFERENCE_TABLE_SIZE,
+    REFERENCE_TABLE_TOLERANCE,
+    difference_maps,
+    reference_image,
+    reference_table,
+)
+from .views import (
+    COMPARISONS,
+    ENVIRONMENTS,
+    ETA_I_LIMITS,
+    MODES,
+    SIZE_RANGE,
+    SPHERE_RADIUS,
+    _check_choice,
+    _check_eta_i,
+    _check_size,
+    _check_unit,
+    sphere_cos_theta,
+)
 
 __all__ = [
     "COMPARISONS",
@@ -89,6 +105,7 @@ __all__ = [
     "sphere_cos_theta",
     "padded_words",
 ]
+
 
 @dataclass
 class PreviewResult:
@@ -125,18 +142,22 @@ class PreviewResult:
     coat_roughness: float = 0.0
 
 
-def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, size,
-                   environment, split_column):
+def _render_layers(state: GLState, model, eta_i_range, F0_air, F82_air, eta_i, size, environment, split_column):
     """On the render thread: colour, geometry and radiance, top row first."""
     ctx = state.ctx
     program, vao = state.program(
-        "preview.frag", sources={PREVIEW_MODEL_FILE: preview_model_source(model_kind(model[0]))})
+        "preview.frag", sources={PREVIEW_MODEL_FILE: preview_model_source(model_kind(model[0]))}
+    )
     _, words = model
     uniforms = {
-        "u_centre": (0.5 * size, 0.5 * size), "u_radius": SPHERE_RADIUS * size,
-        "u_split_column": float(split_column), "u_environment": ENVIRONMENTS.index(environment),
-        "u_eta_i": eta_i, "cf_eta_i_range": tuple(float(v) for v in eta_i_range),
-        "cf_F0_air": tuple(float(v) for v in F0_air), "cf_F82_air": tuple(float(v) for v in F82_air),
+        "u_centre": (0.5 * size, 0.5 * size),
+        "u_radius": SPHERE_RADIUS * size,
+        "u_split_column": float(split_column),
+        "u_environment": ENVIRONMENTS.index(environment),
+        "u_eta_i": eta_i,
+        "cf_eta_i_range": tuple(float(v) for v in eta_i_range),
+        "cf_F0_air": tuple(float(v) for v in F0_air),
+        "cf_F82_air": tuple(float(v) for v in F82_air),
     }
     for name, value in uniforms.items():
         # A kind that does not read a uniform (the rgb-conductor's domain) leaves it to the compiler.
@@ -228,8 +249,9 @@ class PreviewRenderer:
                     f"`roughness` > 0 and `mode` coated need a model kind with the split-sum lookup "
                     f"(coated-conductor), got {packed.model!r}"
                 )
-            return self._render_rough(packed, nk, eta_i, size, compare, environment, step_nm,
-                                      roughness, mode, coat_roughness, differences)
+            return self._render_rough(
+                packed, nk, eta_i, size, compare, environment, step_nm, roughness, mode, coat_roughness, differences
+            )
 
         baseline = baseline_inputs(nk) if nk is not None else None
         F0_air = baseline["F0_air"] if baseline else np.zeros(3)
@@ -261,13 +283,14 @@ class PreviewRenderer:
             environment=environment,
         )
         if compare == "reference" and differences:
-            (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
-                difference_maps(model, comparison, mask)
+            (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = difference_maps(
+                model, comparison, mask
             )
         return result
 
-    def _render_rough(self, packed, nk, eta_i, size, compare, environment, step_nm,
-                      roughness, mode, coat_roughness, differences=True) -> PreviewResult:
+    def _render_rough(
+        self, packed, nk, eta_i, size, compare, environment, step_nm, roughness, mode, coat_roughness, differences=True
+    ) -> PreviewResult:
         from fitting.shading.ibl import default_lut
 
         from .rough import prefiltered_environment, render_rough_layers, rough_reference_image
@@ -290,8 +313,14 @@ class PreviewRenderer:
         }
 
         def layers(split_column):
-            return self.thread.call(render_rough_layers, lut.data, lut.alpha_range, prefiltered,
-                                    {**uniforms, "u_split_column": float(split_column)}, size)
+            return self.thread.call(
+                render_rough_layers,
+                lut.data,
+                lut.alpha_range,
+                prefiltered,
+                {**uniforms, "u_split_column": float(split_column)},
+                size,
+            )
 
         model, geometry, radiance, coat_radiance = layers(size)
         mask = geometry[..., 1] > 0.5
@@ -301,20 +330,30 @@ class PreviewRenderer:
         if compare == "lazanyi":
             comparison = layers(0)[0][..., :3]
         elif compare == "reference":
-            comparison = rough_reference_image(nk, cos_theta, mask, radiance, coat_radiance, eta_i,
-                                               roughness, mode, coat_roughness, step_nm)
+            comparison = rough_reference_image(
+                nk, cos_theta, mask, radiance, coat_radiance, eta_i, roughness, mode, coat_roughness, step_nm
+            )
         image = model.copy()
         if comparison is not None:
             image[:, size // 2 :] = comparison[:, size // 2 :]
         result = PreviewResult(
-            image=image, png=encode_png(to_uint8(ACEScg_to_sRGB(image))), model=model,
-            comparison=comparison, cos_theta=cos_theta, mask=mask, radiance=radiance[..., :3],
-            compare=compare, eta_i=eta_i, environment=environment,
-            roughness=roughness, mode=mode, coat_roughness=coat_roughness,
+            image=image,
+            png=encode_png(to_uint8(ACEScg_to_sRGB(image))),
+            model=model,
+            comparison=comparison,
+            cos_theta=cos_theta,
+            mask=mask,
+            radiance=radiance[..., :3],
+            compare=compare,
+            eta_i=eta_i,
+            environment=environment,
+            roughness=roughness,
+            mode=mode,
+            coat_roughness=coat_roughness,
         )
         if compare == "reference" and differences:
-            (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = (
-                difference_maps(model, comparison, mask)
+            (result.delta_E, result.delta_E_mean, result.flip, result.flip_mean) = difference_maps(
+                model, comparison, mask
             )
         return result
 
@@ -326,8 +365,15 @@ class PreviewRenderer:
         environment = _check_choice("environment", environment, ENVIRONMENTS)
         baseline = baseline_inputs(nk)
         layers = self.thread.call(
-            _render_layers, _model_words(packed), packed.eta_i_range, baseline["F0_air"],
-            baseline["F82_air"], eta_i, size, environment, size // 2,
+            _render_layers,
+            _model_words(packed),
+            packed.eta_i_range,
+            baseline["F0_air"],
+            baseline["F82_air"],
+            eta_i,
+            size,
+            environment,
+            size // 2,
         )
         return layers[0][..., :3]
 

@@ -18,8 +18,7 @@ from fitting.colour.reference import reference_ACEScg, reference_ACEScg_grid
 
 from .display import ACEScg_to_sRGB
 
-__all__ = ["REFERENCE_TABLE_SIZE", "REFERENCE_TABLE_TOLERANCE", "reference_table", "reference_image",
-           "difference_maps"]
+__all__ = ["REFERENCE_TABLE_SIZE", "REFERENCE_TABLE_TOLERANCE", "reference_table", "reference_image", "difference_maps"]
 
 REFERENCE_TABLE_SIZE = 513
 """Nodes of the cos theta table of the spectral reference (uniform over [0, 1])."""
@@ -61,8 +60,7 @@ def reference_table(nk, eta_i, step_nm: float = 1.0, nodes: int = REFERENCE_TABL
     return exact
 
 
-def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0,
-                    per_pixel: bool = False) -> np.ndarray:
+def reference_image(nk, cos_theta, mask, radiance, eta_i, step_nm: float = 1.0, per_pixel: bool = False) -> np.ndarray:
     """
     The spectral reference of a rendered view: on the sphere, the exact
     reflectance of ``nk`` at each pixel's cos theta times the radiance the

@@ -173,8 +173,7 @@ def _load_or_prefilter(thread, environment_index: int) -> np.ndarray:
     width, height = EQUIRECT_SIZE
     try:
         data = np.load(path, allow_pickle=False)
-        if data.shape == (ROUGHNESS_NODES, height, width, 3) and data.dtype == np.float32 \
-                and np.all(np.isfinite(data)):
+        if data.shape == (ROUGHNESS_NODES, height, width, 3) and data.dtype == np.float32 and np.all(np.isfinite(data)):
             return data
     except (OSError, ValueError):
         pass
@@ -239,8 +238,18 @@ def _albedo_at(table, cos_theta):
     return np.stack([np.interp(cos_theta, mu, E[:, c]) for c in range(3)], axis=-1)
 
 
-def rough_reference_image(nk, cos_theta, mask, radiance, coat_radiance, eta_i, roughness,
-                          mode="immersed", coat_roughness=0.0, step_nm: float = 1.0):
+def rough_reference_image(
+    nk,
+    cos_theta,
+    mask,
+    radiance,
+    coat_radiance,
+    eta_i,
+    roughness,
+    mode="immersed",
+    coat_roughness=0.0,
+    step_nm: float = 1.0,
+):
     """
     The spectral reference of a rough view under the same prefiltered
     lighting: ``immersed``, E_ref(mu) times the radiance prefiltered at
@@ -279,8 +288,12 @@ def render_rough_layers(state: GLState, lut_data, alpha_range, prefiltered, unif
     env = ctx.texture3d((width, height, nodes), 3, np.ascontiguousarray(prefiltered, "f4").tobytes(), dtype="f4")
     env.filter = (ctx.LINEAR, ctx.LINEAR)
     env.repeat_x, env.repeat_y, env.repeat_z = True, False, False
-    for name, value in {**uniforms, "cf_alpha_range": tuple(float(v) for v in alpha_range),
-                        "cf_lut": 0, "u_prefiltered": 1}.items():
+    for name, value in {
+        **uniforms,
+        "cf_alpha_range": tuple(float(v) for v in alpha_range),
+        "cf_lut": 0,
+        "u_prefiltered": 1,
+    }.items():
         if name in program:
             program[name].value = value
     fbo, targets = state.float_targets((size, size), 4)

@@ -183,8 +183,12 @@ def _time_split_sum(state: GLState, lut, per_variant, width, height, rounds):
     programs = {}
     for index, variant in enumerate(SPLIT_SUM_VARIANTS, start=1):
         program, vao = state.program("ibl.frag", {"CF_IBL_PASS": index})
-        values = {**per_variant[variant], "cf_alpha_range": tuple(float(v) for v in lut.alpha_range), "cf_lut": 0,
-                  "u_grid": (0.0, 1.0 / (width - 1), 0.0, 1.0 / (height - 1))}
+        values = {
+            **per_variant[variant],
+            "cf_alpha_range": tuple(float(v) for v in lut.alpha_range),
+            "cf_lut": 0,
+            "u_grid": (0.0, 1.0 / (width - 1), 0.0, 1.0 / (height - 1)),
+        }
         for name, value in values.items():
             if name in program:
                 program[name].value = value
@@ -200,8 +204,17 @@ def _time_split_sum(state: GLState, lut, per_variant, width, height, rounds):
 
 
 def time_split_sum(
-    thread: RenderThread, lut: SplitSumLUT, F0, a, alpha, F0_lazanyi, a_lazanyi, F0_air,
-    width: int = 2560, height: int = 1440, rounds: int = 15,
+    thread: RenderThread,
+    lut: SplitSumLUT,
+    F0,
+    a,
+    alpha,
+    F0_lazanyi,
+    a_lazanyi,
+    F0_air,
+    width: int = 2560,
+    height: int = 1440,
+    rounds: int = 15,
 ) -> dict[str, np.ndarray]:
     """
     Time full-screen split-sum passes of :data:`SPLIT_SUM_VARIANTS` (NdotV
@@ -216,6 +229,7 @@ def time_split_sum(
     dict
         Per variant a (rounds, 3) array: GL timer query (ns), wall (s), CPU (s).
     """
+
     def vec3(values):
         return tuple(float(v) for v in values)
 

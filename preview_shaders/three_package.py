@@ -100,14 +100,15 @@ def babylon_glsl_module() -> str:
     """web/babylon/src/generated/glsl.js: the kinds' model files, then the shared includes."""
     seen: set[str] = set()
     glsl = "\n".join(_expand(name, seen) for name in (*BABYLON_KIND_FILES, *INCLUDES))
-    return (HEAD.format(source="preview_shaders/glsl/") + f"export const GLSL = {json.dumps(glsl)};\n")
+    return HEAD.format(source="preview_shaders/glsl/") + f"export const GLSL = {json.dumps(glsl)};\n"
 
 
 def glsl_module() -> str:
     sources = glsl_sources()
-    return (HEAD.format(source="preview_shaders/glsl/") +
-            f"export const GLSL = {json.dumps(sources['GLSL'])};\n"
-            f"export const TABLE_SOURCES = {json.dumps(sources['TABLE_SOURCES'], indent=2)};\n")
+    return (
+        HEAD.format(source="preview_shaders/glsl/") + f"export const GLSL = {json.dumps(sources['GLSL'])};\n"
+        f"export const TABLE_SOURCES = {json.dumps(sources['TABLE_SOURCES'], indent=2)};\n"
+    )
 
 
 def sign_rules(kind: ModelKind) -> dict:
@@ -148,18 +149,30 @@ def kind_entries() -> list[dict]:
         source = preview_model_source(kind, inline=True)
         glsl = _expand(PREVIEW_MODEL_FILE, set(common), {PREVIEW_MODEL_FILE: source})
         table = None if kind.split_sum else _es(_expand(MODEL_TABLE, set(), {PREVIEW_MODEL_FILE: source}), MODEL_TABLE)
-        entries.append({"name": kind.name, "description": kind.description, "parameters": list(kind.parameters),
-                        "maxDegree": kind.max_degree, "splitSum": kind.split_sum, **sign_rules(kind),
-                        "glsl": glsl, "modelTable": table, "glslFunction": kind.glsl_function})
+        entries.append(
+            {
+                "name": kind.name,
+                "description": kind.description,
+                "parameters": list(kind.parameters),
+                "maxDegree": kind.max_degree,
+                "splitSum": kind.split_sum,
+                **sign_rules(kind),
+                "glsl": glsl,
+                "modelTable": table,
+                "glslFunction": kind.glsl_function,
+            }
+        )
     return entries
 
 
 def kinds_module() -> str:
     entries = kind_entries()
-    return (HEAD.format(source="fitting.models.kinds (the model kinds' registry)") +
-            "// Each kind the package draws: its extension object's fields and the GLSL that draws it.\n"
-            f"export const MODEL_KINDS = Object.freeze({json.dumps(entries, indent=2)});\n"
-            f"export const DEFAULT_KIND = {json.dumps(DEFAULT_MODEL)};\n")
+    return (
+        HEAD.format(source="fitting.models.kinds (the model kinds' registry)")
+        + "// Each kind the package draws: its extension object's fields and the GLSL that draws it.\n"
+        f"export const MODEL_KINDS = Object.freeze({json.dumps(entries, indent=2)});\n"
+        f"export const DEFAULT_KIND = {json.dumps(DEFAULT_MODEL)};\n"
+    )
 
 
 def _kind_type(kind: ModelKind) -> str:
@@ -175,21 +188,23 @@ def _kind_type(kind: ModelKind) -> str:
 def kinds_types() -> str:
     kinds = list(MODEL_KINDS.values())
     union = "\n".join(f"  | {_kind_type(kind)}" for kind in kinds)
-    return (HEAD.format(source="fitting.models.kinds (the model kinds' registry)") +
-            "type Row = readonly number[];\ntype Rgb = readonly [number, number, number];\n\n"
-            "/** A registered kind's name. */\n"
-            f"export type KindName = {' | '.join(json.dumps(kind.name) for kind in kinds)};\n"
-            "/** Each kind's own fields of the extension object (its name, degree, coefficients). */\n"
-            f"export type KindFields =\n{union};\n\n"
-            "/** A kind as the package draws it. */\n"
-            "export interface PackagedKind {\n"
-            "  name: KindName;\n  description: string;\n  parameters: readonly string[];\n  maxDegree: number;\n"
-            "  splitSum: boolean;\n  minimum: Readonly<Record<string, number>>;\n"
-            "  exclusiveMinimum: Readonly<Record<string, number>>;\n  glsl: string;\n  modelTable: string | null;\n"
-            "  /** The kind's GLSL function, which names its node-material (TSL) twin in the package. */\n"
-            "  glslFunction: string;\n}\n"
-            "export declare const MODEL_KINDS: readonly PackagedKind[];\n"
-            f"export declare const DEFAULT_KIND: {json.dumps(DEFAULT_MODEL)};\n")
+    return (
+        HEAD.format(source="fitting.models.kinds (the model kinds' registry)")
+        + "type Row = readonly number[];\ntype Rgb = readonly [number, number, number];\n\n"
+        "/** A registered kind's name. */\n"
+        f"export type KindName = {' | '.join(json.dumps(kind.name) for kind in kinds)};\n"
+        "/** Each kind's own fields of the extension object (its name, degree, coefficients). */\n"
+        f"export type KindFields =\n{union};\n\n"
+        "/** A kind as the package draws it. */\n"
+        "export interface PackagedKind {\n"
+        "  name: KindName;\n  description: string;\n  parameters: readonly string[];\n  maxDegree: number;\n"
+        "  splitSum: boolean;\n  minimum: Readonly<Record<string, number>>;\n"
+        "  exclusiveMinimum: Readonly<Record<string, number>>;\n  glsl: string;\n  modelTable: string | null;\n"
+        "  /** The kind's GLSL function, which names its node-material (TSL) twin in the package. */\n"
+        "  glslFunction: string;\n}\n"
+        "export declare const MODEL_KINDS: readonly PackagedKind[];\n"
+        f"export declare const DEFAULT_KIND: {json.dumps(DEFAULT_MODEL)};\n"
+    )
 
 
 def lut_planes(data: np.ndarray) -> bytes:
@@ -205,19 +220,26 @@ def lut_texels(fields: dict) -> np.ndarray:
     w, h, d = fields["width"], fields["height"], fields["depth"]
     planes = np.frombuffer(zlib.decompress(base64.b64decode(fields["deflated"])), np.uint8)
     values = planes.reshape(4, -1).T.copy().view("<f4").ravel()
-    AB, G = values[:2 * w * h].reshape(h, w, 2), values[2 * w * h:].reshape(d, h, w)
+    AB, G = values[: 2 * w * h].reshape(h, w, 2), values[2 * w * h :].reshape(d, h, w)
     return np.concatenate([np.broadcast_to(AB, (d, h, w, 2)), G[..., None]], axis=-1)
 
 
 def lut_module() -> str:
     lut = default_lut()
     depth, height, width = lut.shape
-    fields = {"width": width, "height": height, "depth": depth, "alphaRange": [float(v) for v in lut.alpha_range],
-              "deflated": base64.b64encode(zlib.compress(lut_planes(np.asarray(lut.data)), 9)).decode()}
-    return (HEAD.format(source="fitting.shading.lut.default_lut (GET /api/v1/ibl-lut)") +
-            "// The split-sum LUT: A and B (width x height x 2), then G (depth x height x width),\n"
-            "// float32 little-endian in byte planes, deflated, base64 (albedo_table.js lutTexels decodes it).\n"
-            f"export const LUT = {json.dumps(fields)};\n")
+    fields = {
+        "width": width,
+        "height": height,
+        "depth": depth,
+        "alphaRange": [float(v) for v in lut.alpha_range],
+        "deflated": base64.b64encode(zlib.compress(lut_planes(np.asarray(lut.data)), 9)).decode(),
+    }
+    return (
+        HEAD.format(source="fitting.shading.lut.default_lut (GET /api/v1/ibl-lut)")
+        + "// The split-sum LUT: A and B (width x height x 2), then G (depth x height x width),\n"
+        "// float32 little-endian in byte planes, deflated, base64 (albedo_table.js lutTexels decodes it).\n"
+        f"export const LUT = {json.dumps(fields)};\n"
+    )
 
 
 def read_lut_module(text: str) -> dict:
@@ -239,9 +261,11 @@ def stale() -> list[str]:
     reference = default_lut()
     try:
         fields = read_lut_module(lut.read_text())
-        same = (fields["alphaRange"] == [float(v) for v in reference.alpha_range]
-                and (fields["depth"], fields["height"], fields["width"]) == reference.shape
-                and np.array_equal(lut_texels(fields), reference.data))
+        same = (
+            fields["alphaRange"] == [float(v) for v in reference.alpha_range]
+            and (fields["depth"], fields["height"], fields["width"]) == reference.shape
+            and np.array_equal(lut_texels(fields), reference.data)
+        )
     except (OSError, ValueError, KeyError, IndexError):
         same = False
     if not same:

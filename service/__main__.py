@@ -61,15 +61,18 @@ def _settings(overrides: dict) -> Settings | None:
 def migrate_command(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog=f"{PROG} migrate", description=__doc__.split("\n\n")[1])
     parser.add_argument("--data-dir", default=None, help="SQLite store directory (without COATED_STORE_URL)")
-    parser.add_argument("--from-sqlite", default=None, metavar="FILE",
-                        help="copy this SQLite store (store.sqlite3) into the PostgreSQL store")
+    parser.add_argument(
+        "--from-sqlite",
+        default=None,
+        metavar="FILE",
+        help="copy this SQLite store (store.sqlite3) into the PostgreSQL store",
+    )
     args = parser.parse_args(argv)
     settings = _settings({} if args.data_dir is None else {"data_dir": args.data_dir})
     if settings is None:
         return 2
     if args.from_sqlite is not None and settings.store_url is None:
-        print(f"{PROG} migrate: --from-sqlite needs COATED_STORE_URL=postgresql://... (the target)",
-              file=sys.stderr)
+        print(f"{PROG} migrate: --from-sqlite needs COATED_STORE_URL=postgresql://... (the target)", file=sys.stderr)
         return 2
     try:
         store = open_store(settings, migrate=True)
@@ -97,8 +100,11 @@ def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["migrate"]:
         return migrate_command(argv[1:])
-    parser = argparse.ArgumentParser(prog=PROG, description=__doc__.split("\n")[1],
-                                     epilog=f"{PROG} migrate --help: the schema and the move to PostgreSQL")
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description=__doc__.split("\n")[1],
+        epilog=f"{PROG} migrate --help: the schema and the move to PostgreSQL",
+    )
     parser.add_argument("--host", default="127.0.0.1", help="bind address (default 127.0.0.1)")
     parser.add_argument("--port", type=int, default=8000, help="TCP port (default 8000)")
     parser.add_argument("--data-dir", default=None, help="store directory (default ./data or COATED_DATA_DIR)")

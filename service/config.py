@@ -235,11 +235,14 @@ class Settings(BaseSettings):
     def _check_store(self) -> "Settings":
         url = self.store_url.get_secret_value() if self.store_url else ""
         if self.store_url is not None and not url.startswith(("postgresql://", "postgres://")):
-            raise ValueError("`store_url` (COATED_STORE_URL) must be a postgresql:// URL, or unset "
-                             "for the SQLite store under the data directory")
+            raise ValueError(
+                "`store_url` (COATED_STORE_URL) must be a postgresql:// URL, or unset "
+                "for the SQLite store under the data directory"
+            )
         if self.store_pool_min > self.store_pool_max:
-            raise ValueError(f"`store_pool_min` ({self.store_pool_min}) must not exceed "
-                             f"`store_pool_max` ({self.store_pool_max})")
+            raise ValueError(
+                f"`store_pool_min` ({self.store_pool_min}) must not exceed `store_pool_max` ({self.store_pool_max})"
+            )
         return self
 
     @property

@@ -48,10 +48,23 @@ from .jobs.common import FIT_FORMAT_VERSION, measured_nk, stored_fit
 from .store import FitRecord
 
 __all__ = [
-    "PACK_MEDIA_TYPES", "is_export", "PACK_CONTENT", "TEMPLATE_DIR", "render_pack",
-    "render_export", "export_key", "kept_export", "export_download", "render_export_pack", "pack_response", "export_response",
-    "download_name", "unique_names",
-    "glsl_identifier", "IBL_LUT_FILENAME", "ibl_lut_file",
+    "PACK_MEDIA_TYPES",
+    "is_export",
+    "PACK_CONTENT",
+    "TEMPLATE_DIR",
+    "render_pack",
+    "render_export",
+    "export_key",
+    "kept_export",
+    "export_download",
+    "render_export_pack",
+    "pack_response",
+    "export_response",
+    "download_name",
+    "unique_names",
+    "glsl_identifier",
+    "IBL_LUT_FILENAME",
+    "ibl_lut_file",
 ]
 
 IBL_LUT_FILENAME = "cf_ibl_lut.cflut"
@@ -96,21 +109,33 @@ def render_pack(records: list[FitRecord], format: str, pack_name: str) -> bytes:
         materials = []
         for record in records:
             view = material_from_json(record.material)
-            materials.append(PackedMaterial(
-                view.name, view.coefficients, view.eta_i_range, view.source, model=view.model,
-                metrics={"fit_id": record.id, **{
-                    key: record.metrics[key] for key in ("figure", "grid", "model_float16", "lazanyi_adjusted")
-                    if key in record.metrics
-                }},
-            ))
+            materials.append(
+                PackedMaterial(
+                    view.name,
+                    view.coefficients,
+                    view.eta_i_range,
+                    view.source,
+                    model=view.model,
+                    metrics={
+                        "fit_id": record.id,
+                        **{
+                            key: record.metrics[key]
+                            for key in ("figure", "grid", "model_float16", "lazanyi_adjusted")
+                            if key in record.metrics
+                        },
+                    },
+                )
+            )
         return pack_to_json(materials).encode("utf-8")
-    materials = [SnippetMaterial(r.name, r.source, r.id, headline(r.metrics), material_from_json(r.material))
-                 for r in records]
+    materials = [
+        SnippetMaterial(r.name, r.source, r.id, headline(r.metrics), material_from_json(r.material)) for r in records
+    ]
     return snippet(format, materials, pack_name, FIT_FORMAT_VERSION).encode("utf-8")
 
 
-def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03,
-                  working_space: str = "lin_rec709") -> bytes:
+def render_export(
+    record: FitRecord, format: str, eta_i: float, roughness=0.2, coat_roughness=0.03, working_space: str = "lin_rec709"
+) -> bytes:
     """
     The export of one stored fit in ``format`` (one of
     :data:`fitting.exports.EXPORT_FORMATS`) for the coating index ``eta_i`` and
@@ -132,8 +157,16 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
     if record.kind != "curves":
         nk = measured_nk(record)
         if nk is not None:
-            return export_material(nk, format, eta_i, roughness, coat_roughness, model=packed,
-                                   fit_id=record.id, working_space=working_space)
+            return export_material(
+                nk,
+                format,
+                eta_i,
+                roughness,
+                coat_roughness,
+                model=packed,
+                fit_id=record.id,
+                working_space=working_space,
+            )
     lo, hi = packed.eta_i_range
     if not lo <= eta_i <= hi:
         raise ValueError(
@@ -141,23 +174,33 @@ def render_export(record: FitRecord, format: str, eta_i: float, roughness=0.2, c
             f"made from curves, got {eta_i:g}"
         )
     model = {
-        "name": record.name, "source": record.source,
+        "name": record.name,
+        "source": record.source,
         "origin": f"float16 model curve of fit {record.id} (edited curves) under the coat",
-        "reflectance": lambda mu, eta: model_ACEScg(
-            packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
+        "reflectance": lambda mu, eta: model_ACEScg(packed.model, mu, eta, packed.coefficients, packed.eta_i_range),
     }
-    return export_material(model, format, eta_i, roughness, coat_roughness, model=packed,
-                           fit_id=record.id, working_space=working_space)
+    return export_material(
+        model, format, eta_i, roughness, coat_roughness, model=packed, fit_id=record.id, working_space=working_space
+    )
 
 
-def export_key(fit_id: str, format: str, eta_i: float, roughness: float, coat_roughness: float,
-               working_space: str = "lin_rec709") -> str:
+def export_key(
+    fit_id: str, format: str, eta_i: float, roughness: float, coat_roughness: float, working_space: str = "lin_rec709"
+) -> str:
     """The key of one export of a fit (:func:`kept_export`)."""
     return f"export {fit_id} {format} {eta_i!r} {roughness!r} {coat_roughness!r} {working_space}"
 
 
-async def kept_export(cache, runner, record: FitRecord, format: str, eta_i: float, roughness: float,
-                      coat_roughness: float, working_space: str = "lin_rec709") -> tuple[str, bytes]:
+async def kept_export(
+    cache,
+    runner,
+    record: FitRecord,
+    format: str,
+    eta_i: float,
+    roughness: float,
+    coat_roughness: float,
+    working_space: str = "lin_rec709",
+) -> tuple[str, bytes]:
     """
     ``(record.name, render_export(...))`` of ``record``, made in
     ``runner``'s pool (its CPU limit and time limit; identical requests
@@ -168,15 +211,25 @@ async def kept_export(cache, runner, record: FitRecord, format: str, eta_i: floa
     key = export_key(record.id, format, eta_i, roughness, coat_roughness, working_space)
 
     async def make() -> tuple[str, bytes]:
-        body = await runner.run(render_export, record, format, eta_i, roughness, coat_roughness, working_space,
-                                cost_s=1.0)
+        body = await runner.run(
+            render_export, record, format, eta_i, roughness, coat_roughness, working_space, cost_s=1.0
+        )
         return record.name, body
 
     return await cache.get_or_make(key, lambda: runner.once(key, make))
 
 
-async def export_download(cache, store, runner, fit_id: str, format: str, eta_i: float, roughness: float,
-                          coat_roughness: float, working_space: str = "lin_rec709"):
+async def export_download(
+    cache,
+    store,
+    runner,
+    fit_id: str,
+    format: str,
+    eta_i: float,
+    roughness: float,
+    coat_roughness: float,
+    working_space: str = "lin_rec709",
+):
     """
     The download of one export of the stored fit ``fit_id``: from ``cache``
     when it was made before (without reading the store), else made by
@@ -190,12 +243,17 @@ async def export_download(cache, store, runner, fit_id: str, format: str, eta_i:
     if kept is None:
         record = await run_in_threadpool(stored_fit, store, fit_id)
         kept = await kept_export(cache, runner, record, format, eta_i, roughness, coat_roughness, working_space)
-    return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness,
-                           working_space)
+    return export_response(kept[1], format, eta_i, f"{kept[0]}-{fit_id[:8]}", roughness, coat_roughness, working_space)
 
 
-def render_export_pack(records: list[FitRecord], format: str, eta_i: float, roughness=0.2,
-                       coat_roughness=0.03, working_space: str = "lin_rec709") -> bytes:
+def render_export_pack(
+    records: list[FitRecord],
+    format: str,
+    eta_i: float,
+    roughness=0.2,
+    coat_roughness=0.03,
+    working_space: str = "lin_rec709",
+) -> bytes:
     """
     The exports of several fits for one ``eta_i``, roughnesses and working
     space (:func:`render_export`): a zip archive with one
@@ -244,13 +302,21 @@ def pack_response(records: list[FitRecord], format: str, stem: str):
     body = render_pack(records, format, stem)
     media_type, _ = PACK_MEDIA_TYPES[format]
     return Response(
-        body, media_type=media_type,
+        body,
+        media_type=media_type,
         headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
     )
 
 
-def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness=0.2, coat_roughness=0.03,
-                    working_space: str = "lin_rec709"):
+def export_response(
+    body: bytes,
+    format: str,
+    eta_i: float,
+    stem: str,
+    roughness=0.2,
+    coat_roughness=0.03,
+    working_space: str = "lin_rec709",
+):
     """
     An export's bytes (:func:`render_export`) as a download named for
     ``eta_i``, the roughnesses and (when not ``lin_rec709``) the working space.
@@ -261,7 +327,8 @@ def export_response(body: bytes, format: str, eta_i: float, stem: str, roughness
     if working_space != "lin_rec709":
         stem += f"-{working_space}"
     return Response(
-        body, media_type=export_format(format).media_type,
+        body,
+        media_type=export_format(format).media_type,
         headers={"Content-Disposition": f'attachment; filename="{download_name(stem, format)}"'},
     )
 

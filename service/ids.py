@@ -51,6 +51,7 @@ def content_address(*parts: Any) -> str:
     between parts (a NUL in a name is just a character) and two different
     inputs never share an encoding.
     """
-    text = json.dumps([_canonical(p) for p in parts], sort_keys=True, ensure_ascii=True,
-                      separators=(",", ":"), allow_nan=False)
+    text = json.dumps(
+        [_canonical(p) for p in parts], sort_keys=True, ensure_ascii=True, separators=(",", ":"), allow_nan=False
+    )
     return hashlib.sha256(text.encode("ascii")).hexdigest()[:32]

@@ -30,8 +30,20 @@ from fitting.cli.plugins import load_plugins
 from .api.errors import install_error_handlers
 from .api.middleware import ClaimWork, FrameDenial, HostAllowList, RequestLimits
 from .api.routes import (
-    colours, curves, environments, fits, health, ibl, imports, library, materials, packs, preview, reference_texture,
-    scenes, versions,
+    colours,
+    curves,
+    environments,
+    fits,
+    health,
+    ibl,
+    imports,
+    library,
+    materials,
+    packs,
+    preview,
+    reference_texture,
+    scenes,
+    versions,
 )
 from .config import Settings
 from .runtime import FitRunner, PreviewRunner, SaveRate, freeze_heap, thaw_heap, warm_process
@@ -78,8 +90,7 @@ def _offline_docs(app: FastAPI) -> None:
     from fastapi.openapi.docs import get_swagger_ui_html
     from fastapi.responses import PlainTextResponse
 
-    app.mount("/vendor/swagger-ui", StaticFiles(directory=SWAGGER_UI_DIR, check_dir=False),
-              name="swagger-ui")
+    app.mount("/vendor/swagger-ui", StaticFiles(directory=SWAGGER_UI_DIR, check_dir=False), name="swagger-ui")
 
     @app.get("/docs", include_in_schema=False)
     async def docs():
@@ -87,9 +98,11 @@ def _offline_docs(app: FastAPI) -> None:
             return PlainTextResponse(
                 f"the API docs need Swagger UI at {SWAGGER_UI_DIR}: run scripts/bootstrap "
                 "(npm ci in scripts/swagger-ui); the API itself is described at /openapi.json",
-                status_code=503)
+                status_code=503,
+            )
         return get_swagger_ui_html(
-            openapi_url=app.openapi_url, title=f"{app.title} - API docs",
+            openapi_url=app.openapi_url,
+            title=f"{app.title} - API docs",
             swagger_js_url="/vendor/swagger-ui/swagger-ui-bundle.js",
             swagger_css_url="/vendor/swagger-ui/swagger-ui.css",
             swagger_favicon_url="/vendor/swagger-ui/favicon-32x32.png",
@@ -103,7 +116,8 @@ async def _sweep_drafts(store, settings: Settings) -> None:
     while True:
         try:
             removed = await asyncio.to_thread(
-                store.expire_drafts, time.time() - settings.draft_ttl_s, settings.draft_max_bytes)
+                store.expire_drafts, time.time() - settings.draft_ttl_s, settings.draft_max_bytes
+            )
             if removed:
                 log.info("removed %d drafts (COATED_DRAFT_TTL_S, COATED_DRAFT_MAX_BYTES)", removed)
         except StoreError as error:
@@ -129,12 +143,16 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def lifespan(app: FastAPI):
         store = await asyncio.to_thread(open_store, settings)
         await asyncio.to_thread(store.check)
-        runner = FitRunner(settings.fit_workers, settings.max_in_flight, settings.fit_timeout_s,
-                           settings.job_cpu_limit_s, express_workers=settings.fit_express_workers,
-                           client_bulk_jobs=settings.client_bulk_jobs)
+        runner = FitRunner(
+            settings.fit_workers,
+            settings.max_in_flight,
+            settings.fit_timeout_s,
+            settings.job_cpu_limit_s,
+            express_workers=settings.fit_express_workers,
+            client_bulk_jobs=settings.client_bulk_jobs,
+        )
         # Its processes start on the first preview: a service that draws none starts none.
-        previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s,
-                                 settings.job_cpu_limit_s)
+        previews = PreviewRunner(settings.max_previews_in_flight, settings.preview_timeout_s, settings.job_cpu_limit_s)
         app.state.store, app.state.runner, app.state.previews = store, runner, previews
         # New fits' metrics, evaluated when the pool is idle (or when asked for).
         app.state.evaluations = Evaluations(store, runner, settings.metrics_idle_s or None)
@@ -162,26 +180,44 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         title="Coated-metal Fresnel service",
         version="1.0.0",
         summary="Fit the coated-conductor Fresnel model (Vernooij 2024) to measured n, k "
-                "and download float16 coefficient packs.",
+        "and download float16 coefficient packs.",
         lifespan=lifespan,
         docs_url=None,  # served below from local Swagger UI assets (works offline)
         redoc_url=None,  # ReDoc's page loads its script and fonts from CDNs: /docs covers it
     )
     app.state.settings = settings
     install_error_handlers(app)
-    for module in (health, materials, versions, library, imports, fits, packs, preview, reference_texture,
-                   environments, curves, colours, scenes, ibl):
+    for module in (
+        health,
+        materials,
+        versions,
+        library,
+        imports,
+        fits,
+        packs,
+        preview,
+        reference_texture,
+        environments,
+        curves,
+        colours,
+        scenes,
+        ibl,
+    ):
         app.include_router(module.router)
     _offline_docs(app)
     app.mount("/glsl", StaticFiles(directory=GLSL_DIR), name="glsl")
     # check_dir=False: without scripts/bootstrap's three the service still
     # starts, and only the three.js example's files answer 404.
     for part in ("build", "examples/jsm"):
-        app.mount(f"/vendor/three/{part}", StaticFiles(directory=THREE_DIR / part, check_dir=False),
-                  name=f"three-{part}")
+        app.mount(
+            f"/vendor/three/{part}", StaticFiles(directory=THREE_DIR / part, check_dir=False), name=f"three-{part}"
+        )
     for part in ("core", "loaders"):
-        app.mount(f"/vendor/babylon/{part}", StaticFiles(directory=BABYLON_DIR / part, check_dir=False),
-                  name=f"babylon-{part}")
+        app.mount(
+            f"/vendor/babylon/{part}",
+            StaticFiles(directory=BABYLON_DIR / part, check_dir=False),
+            name=f"babylon-{part}",
+        )
     # The three.js and Babylon.js packages (web/*/src/) at /static/three/ and
     # /static/babylon/, before /static, whose directory has neither.
     app.mount("/static/three", StaticFiles(directory=THREE_PACKAGE_DIR), name="three-package")
@@ -193,14 +229,22 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.mount("/", StaticFiles(directory=STATIC_DIR, html=True), name="editor")
     if settings.cors_origins:
         app.add_middleware(
-            CORSMiddleware, allow_origins=settings.cors_origins,
-            allow_methods=["GET", "POST", "PATCH", "DELETE"], allow_headers=["Authorization", "Content-Type"],
+            CORSMiddleware,
+            allow_origins=settings.cors_origins,
+            allow_methods=["GET", "POST", "PATCH", "DELETE"],
+            allow_headers=["Authorization", "Content-Type"],
         )
     token = settings.api_token.get_secret_value() if settings.api_token else None
-    app.add_middleware(ClaimWork, token=token, scene_path=f"{API_PREFIX}/scenes", pack_path=f"{API_PREFIX}/packs",
-                       save_paths=tuple(f"{API_PREFIX}/fits{p}" for p in ("", "/upload", "/from-curves")))
     app.add_middleware(
-        RequestLimits, max_body_bytes=settings.max_body_bytes,
+        ClaimWork,
+        token=token,
+        scene_path=f"{API_PREFIX}/scenes",
+        pack_path=f"{API_PREFIX}/packs",
+        save_paths=tuple(f"{API_PREFIX}/fits{p}" for p in ("", "/upload", "/from-curves")),
+    )
+    app.add_middleware(
+        RequestLimits,
+        max_body_bytes=settings.max_body_bytes,
         max_upload_bytes=settings.max_upload_bytes,
         upload_paths=(f"{API_PREFIX}/fits/upload", f"{API_PREFIX}/fits/import"),
         body_timeout_s=settings.body_timeout_s,

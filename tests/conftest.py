@@ -102,8 +102,12 @@ class ServerProcess:
             self.process = SERVER_FORKS.start(argv, env, log)
         else:
             self.process = subprocess.Popen(
-                [sys.executable, "-m", "service", *argv], cwd=ROOT, env=env, stdout=self._log_file,
-                stderr=subprocess.STDOUT, start_new_session=True,
+                [sys.executable, "-m", "service", *argv],
+                cwd=ROOT,
+                env=env,
+                stdout=self._log_file,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
             )
 
     def wait_ready(self, timeout_s: float = SERVER_START_TIMEOUT_S) -> None:
@@ -158,8 +162,9 @@ def server_process(data_dir: Path, spawn: bool = False, **env: str) -> Iterator[
         server.stop()
 
 
-def run_command(module: str, *args: str, cwd: Path = ROOT, timeout: float | None = 300,
-                env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+def run_command(
+    module: str, *args: str, cwd: Path = ROOT, timeout: float | None = 300, env: dict[str, str] | None = None
+) -> subprocess.CompletedProcess:
     """
     ``python -m MODULE ARGS`` (``fitting``, ``service`` or ``preview_shaders``) as ``subprocess.run``
     with ``capture_output=True, text=True`` runs it: forked from
@@ -169,8 +174,9 @@ def run_command(module: str, *args: str, cwd: Path = ROOT, timeout: float | None
     env = dict(os.environ) if env is None else env
     if SERVER_FORKS.can_fork(env):
         return SERVER_FORKS.run(module, list(args), env, cwd, timeout)
-    return subprocess.run([sys.executable, "-m", module, *args], cwd=cwd, env=env, capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", module, *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout
+    )
 
 
 def app_client(tmp_path: Path, **overrides):
@@ -186,8 +192,14 @@ def app_client(tmp_path: Path, **overrides):
     from service.main import create_app
 
     # TestClient sends `Host: testserver`; it is allowed here as a deployment would name its host.
-    options = {"data_dir": tmp_path / "data", "fit_workers": 1, "warm_pool": False, "freeze_heap": False,
-               "allowed_hosts": ["localhost", "127.0.0.1", "::1", "testserver"], **overrides}
+    options = {
+        "data_dir": tmp_path / "data",
+        "fit_workers": 1,
+        "warm_pool": False,
+        "freeze_heap": False,
+        "allowed_hosts": ["localhost", "127.0.0.1", "::1", "testserver"],
+        **overrides,
+    }
     return TestClient(create_app(Settings(**options)))
 
 
@@ -260,17 +272,30 @@ SLOW_S = 2.0
 """A test taking longer than this (setup, call and teardown) is ``slow``."""
 
 _IMPLY_SLOW = ("gl", "server", "browser")
-PROCESS_FIXTURES = frozenset({
-    "shared", "fitted", "live_server", "browser_server", "editor_url", "pages", "page", "curve_fit", "rgb_fit",
-    "hostile_run", "chromium", "postgres_server", "postgres_url",
-})
+PROCESS_FIXTURES = frozenset(
+    {
+        "shared",
+        "fitted",
+        "live_server",
+        "browser_server",
+        "editor_url",
+        "pages",
+        "page",
+        "curve_fit",
+        "rgb_fit",
+        "hostile_run",
+        "chromium",
+        "postgres_server",
+        "postgres_url",
+    }
+)
 """
 Fixtures (by name, in any module) that start a process: the fitting pool's
 workers on their first fit, a server, Chromium. A test using one, directly
 or through another fixture, is ``slow``. The list is measured: a fixture
 not in it that starts a process fails the test that set it up, naming it.
 """
-_started: list[str] = []      # what the running test started
+_started: list[str] = []  # what the running test started
 _fixture_started: dict[str, list[str]] = {}  # fixture name -> what its set-up started
 _unmarked_slow: list[tuple[float, str]] = []
 
@@ -284,12 +309,14 @@ def _watch(what: str, function):
         if threading.get_ident() not in _old_threads:
             _started.append(what)
         return function(*args, **kwargs)
+
     return wrapper
 
 
 subprocess.Popen.__init__ = _watch("a process (subprocess)", subprocess.Popen.__init__)
 multiprocessing.process.BaseProcess.start = _watch(
-    "a process (multiprocessing)", multiprocessing.process.BaseProcess.start)
+    "a process (multiprocessing)", multiprocessing.process.BaseProcess.start
+)
 moderngl.create_context = _watch("a GL context", moderngl.create_context)
 ServerForks.start = _watch("a process (a server forked by tests/server_forks.py)", ServerForks.start)
 ServerForks.run = _watch("a process (a command forked by tests/server_forks.py)", ServerForks.run)
@@ -323,8 +350,9 @@ def pytest_unconfigure(config):
 
 def pytest_collection_modifyitems(config, items):
     for item in items:
-        if any(item.get_closest_marker(name) for name in _IMPLY_SLOW) \
-                or PROCESS_FIXTURES.intersection(item.fixturenames):
+        if any(item.get_closest_marker(name) for name in _IMPLY_SLOW) or PROCESS_FIXTURES.intersection(
+            item.fixturenames
+        ):
             item.add_marker(pytest.mark.slow)
     # The longest modules first: pytest-xdist hands out modules in this order,
     # so a long browser module collected last (tests/static/) would run on one
@@ -362,8 +390,8 @@ def pytest_runtest_teardown(item, nextitem):
 
 
 _durations: dict[str, float] = {}
-_module_s: dict[str, float] = {}   # test module -> seconds of its tests (setup, call, teardown)
-_worker_s: dict[str, float] = {}   # pytest-xdist worker -> seconds of the tests it ran
+_module_s: dict[str, float] = {}  # test module -> seconds of its tests (setup, call, teardown)
+_worker_s: dict[str, float] = {}  # pytest-xdist worker -> seconds of the tests it ran
 
 
 def pytest_runtest_logreport(report):
@@ -394,11 +422,18 @@ def pytest_runtest_makereport(item, call):
         # What the test's set-up and call started; a teardown may end a
         # module's fixtures, whose processes belong to the tests that used them.
         item.stash[_STARTED] = list(_started)
-    if call.when == "teardown" and item.stash.get(_STARTED, None) and item.get_closest_marker("slow") is None \
-            and report.passed:
+    if (
+        call.when == "teardown"
+        and item.stash.get(_STARTED, None)
+        and item.get_closest_marker("slow") is None
+        and report.passed
+    ):
         fixtures = sorted(name for name in item.fixturenames if name in _fixture_started)
-        where = f" in the set-up of the fixture(s) {', '.join(fixtures)} (add them to " \
-                "tests/conftest.py's PROCESS_FIXTURES)" if fixtures else ""
+        where = (
+            f" in the set-up of the fixture(s) {', '.join(fixtures)} (add them to tests/conftest.py's PROCESS_FIXTURES)"
+            if fixtures
+            else ""
+        )
         report.outcome = "failed"
         report.longrepr = (
             f"{item.nodeid} started {', '.join(sorted(set(item.stash[_STARTED])))}{where} but is not "

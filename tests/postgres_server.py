@@ -43,8 +43,10 @@ def postgres_bin_dir() -> Path:
     """The newest ``/usr/lib/postgresql/*/bin`` with ``initdb``; RuntimeError naming the fix if none."""
     found = sorted(glob.glob("/usr/lib/postgresql/*/bin/initdb"), key=lambda p: int(Path(p).parts[-3]))
     if not found:
-        raise RuntimeError("PostgreSQL is not installed (no /usr/lib/postgresql/*/bin/initdb): "
-                           "run scripts/bootstrap, which installs the Debian package `postgresql`")
+        raise RuntimeError(
+            "PostgreSQL is not installed (no /usr/lib/postgresql/*/bin/initdb): "
+            "run scripts/bootstrap, which installs the Debian package `postgresql`"
+        )
     return Path(found[-1]).parent
 
 
@@ -70,8 +72,10 @@ class PostgresServer:
             try:
                 account = pwd.getpwnam(user)
             except KeyError:
-                raise RuntimeError(f"no system user {user!r} to run PostgreSQL as (it refuses root): "
-                                   "run scripts/bootstrap, whose Debian package `postgresql` makes it") from None
+                raise RuntimeError(
+                    f"no system user {user!r} to run PostgreSQL as (it refuses root): "
+                    "run scripts/bootstrap, whose Debian package `postgresql` makes it"
+                ) from None
             os.chown(self.root, account.pw_uid, account.pw_gid)
             self._as = ["setpriv", f"--reuid={account.pw_uid}", f"--regid={account.pw_gid}", "--clear-groups"]
         self.root.chmod(0o700)
@@ -79,21 +83,36 @@ class PostgresServer:
         pwfile.write_text(self._admin_password + "\n")
         if self._as:
             os.chown(pwfile, account.pw_uid, account.pw_gid)
-        self._run(self.bin / "initdb", "-D", self.data, "-U", "admin", "--auth-local=trust",
-                  "--auth-host=scram-sha-256", f"--pwfile={pwfile}", "-E", "UTF8", "--no-instructions")
+        self._run(
+            self.bin / "initdb",
+            "-D",
+            self.data,
+            "-U",
+            "admin",
+            "--auth-local=trust",
+            "--auth-host=scram-sha-256",
+            f"--pwfile={pwfile}",
+            "-E",
+            "UTF8",
+            "--no-instructions",
+        )
         pwfile.unlink()
         self.start()
         with self.admin() as connection:
-            connection.execute(f"CREATE ROLE {ROLE} LOGIN PASSWORD '{self.password}' "
-                               f"CONNECTION LIMIT {ROLE_CONNECTION_LIMIT}")
+            connection.execute(
+                f"CREATE ROLE {ROLE} LOGIN PASSWORD '{self.password}' CONNECTION LIMIT {ROLE_CONNECTION_LIMIT}"
+            )
         self._databases = 0
 
     def _run(self, *command, check: bool = True) -> subprocess.CompletedProcess:
-        result = subprocess.run([*self._as, *map(str, command)], capture_output=True, text=True,
-                                timeout=120, cwd=self.root)
+        result = subprocess.run(
+            [*self._as, *map(str, command)], capture_output=True, text=True, timeout=120, cwd=self.root
+        )
         if check and result.returncode != 0:
-            raise RuntimeError(f"{' '.join(map(str, command))} failed ({result.returncode}):\n"
-                               f"{result.stdout}\n{result.stderr}\n{self.log_text()}")
+            raise RuntimeError(
+                f"{' '.join(map(str, command))} failed ({result.returncode}):\n"
+                f"{result.stdout}\n{result.stderr}\n{self.log_text()}"
+            )
         return result
 
     def log_text(self) -> str:
@@ -103,8 +122,10 @@ class PostgresServer:
 
     def start(self) -> None:
         """Start on the same port (and data) as before."""
-        options = (f"-c listen_addresses=127.0.0.1 -p {self.port} -c unix_socket_directories={self.root} "
-                   f"-c max_connections={MAX_CONNECTIONS} -c superuser_reserved_connections=3")
+        options = (
+            f"-c listen_addresses=127.0.0.1 -p {self.port} -c unix_socket_directories={self.root} "
+            f"-c max_connections={MAX_CONNECTIONS} -c superuser_reserved_connections=3"
+        )
         self._run(self.bin / "pg_ctl", "-D", self.data, "-l", self.log, "-o", options, "-w", "-t", "60", "start")
 
     def stop(self, mode: str = "fast") -> None:
@@ -117,8 +138,15 @@ class PostgresServer:
         self.start()
 
     def admin(self) -> psycopg.Connection:
-        return psycopg.connect(host="127.0.0.1", port=self.port, user="admin", dbname="postgres",
-                               password=self._admin_password, autocommit=True, connect_timeout=10)
+        return psycopg.connect(
+            host="127.0.0.1",
+            port=self.port,
+            user="admin",
+            dbname="postgres",
+            password=self._admin_password,
+            autocommit=True,
+            connect_timeout=10,
+        )
 
     def url_of(self, dbname: str) -> str:
         return f"postgresql://{ROLE}:{self.password}@127.0.0.1:{self.port}/{dbname}"

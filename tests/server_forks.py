@@ -66,6 +66,7 @@ starting so): the service's settings, the temporary directory (read when
 first used) and pytest's name of the running test.
 """
 
+
 def forkable(base: dict[str, str], env: dict[str, str]) -> bool:
     """Whether a server with environment ``env`` can be forked from a program started with ``base``."""
     changed = {key for key in base.keys() | env.keys() if base.get(key) != env.get(key)}
@@ -126,11 +127,25 @@ class ServerForks:
         from this process's), in its own session, its output appended to
         ``log``.
         """
-        return self._fork(module="service", argv=argv, env=env, cwd=str(ROOT), stdout=str(log), stderr=str(log),
-                          append=True, session=True)
+        return self._fork(
+            module="service",
+            argv=argv,
+            env=env,
+            cwd=str(ROOT),
+            stdout=str(log),
+            stderr=str(log),
+            append=True,
+            session=True,
+        )
 
-    def run(self, module: str, argv: list[str], env: dict[str, str], cwd: Path, timeout: float | None = None,
-            ) -> subprocess.CompletedProcess:
+    def run(
+        self,
+        module: str,
+        argv: list[str],
+        env: dict[str, str],
+        cwd: Path,
+        timeout: float | None = None,
+    ) -> subprocess.CompletedProcess:
         """
         ``subprocess.run([sys.executable, "-m", module, *argv], cwd=cwd,
         env=env, capture_output=True, text=True, timeout=timeout)`` for
@@ -142,16 +157,25 @@ class ServerForks:
         """
         with tempfile.TemporaryDirectory(prefix="server-forks-run-") as directory:
             out, err = Path(directory) / "stdout", Path(directory) / "stderr"
-            process = self._fork(module=module, argv=list(argv), env=env, cwd=str(cwd), stdout=str(out),
-                                 stderr=str(err), append=False, session=False)
+            process = self._fork(
+                module=module,
+                argv=list(argv),
+                env=env,
+                cwd=str(cwd),
+                stdout=str(out),
+                stderr=str(err),
+                append=False,
+                session=False,
+            )
             try:
                 returncode = process.wait(timeout)
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.wait()
                 raise
-            return subprocess.CompletedProcess([sys.executable, "-m", module, *argv], returncode,
-                                               out.read_text(), err.read_text())
+            return subprocess.CompletedProcess(
+                [sys.executable, "-m", module, *argv], returncode, out.read_text(), err.read_text()
+            )
 
     def _fork(self, **request) -> ForkedProcess:
         if request["module"] not in PROGRAMS:
@@ -162,7 +186,11 @@ class ServerForks:
             self.environment = dict(os.environ)
             self.program = subprocess.Popen(
                 [sys.executable, "-c", "import runpy; runpy.run_path('tests/server_forks.py', run_name='__main__')"],
-                cwd=ROOT, env=self.environment, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                cwd=ROOT,
+                env=self.environment,
+                stdin=subprocess.PIPE,
+                stdout=subprocess.PIPE,
+                text=True,
             )
             self.request(op="ready")
         answer = self.request(op="start", **request)
@@ -186,6 +214,7 @@ class ServerForks:
 
 
 # -- the program ---------------------------------------------------------------
+
 
 def _returncode(status: int) -> int:
     return -os.WTERMSIG(status) if os.WIFSIGNALED(status) else os.WEXITSTATUS(status)
@@ -303,6 +332,7 @@ if __name__ == "__main__":
     import fitting.cli.main  # noqa: F401 (what python -m fitting imports)
     import preview_shaders.display  # noqa: F401 (what python -m preview_shaders imports; no GL context here)
     import preview_shaders.preview  # noqa: F401
+
     # What python -m service imports, at its start and then in main (not service.__main__ itself, which
     # run_module executes as __main__, as -m does).
     import service.runtime.fork_server  # noqa: F401

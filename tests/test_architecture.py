@@ -149,24 +149,31 @@ def _python_files_outside(folders: tuple[str, ...]) -> list[Path]:
 
 def test_only_the_tools_import_the_benchmarks():
     """fitting/, service/ and preview_shaders/ never import benchmarks/; fitting/ never preview_shaders/."""
-    wrong = [f"{n} imports {t}" for n, ts in GRAPH.items() for t in ts
-             if (t.startswith("benchmarks") and not n.startswith("benchmarks"))
-             or (n.startswith("fitting") and t.startswith("preview_shaders"))]
+    wrong = [
+        f"{n} imports {t}"
+        for n, ts in GRAPH.items()
+        for t in ts
+        if (t.startswith("benchmarks") and not n.startswith("benchmarks"))
+        or (n.startswith("fitting") and t.startswith("preview_shaders"))
+    ]
     assert not wrong, "\n".join(wrong)
 
 
 def test_no_fitting_layer_imports_a_higher_one():
     wrong = [
         f"{name} (layer {_layer(name)}) imports {target} (layer {_layer(target)})"
-        for name, targets in GRAPH.items() if name.startswith("fitting")
-        for target in sorted(targets) if target.startswith("fitting") and _layer(target) > _layer(name)
+        for name, targets in GRAPH.items()
+        if name.startswith("fitting")
+        for target in sorted(targets)
+        if target.startswith("fitting") and _layer(target) > _layer(name)
     ]
     assert not wrong, "\n".join(wrong)
 
 
 def test_fitting_never_imports_the_service():
-    wrong = [f"{n} imports {t}" for n, ts in GRAPH.items() if n.startswith("fitting")
-             for t in ts if t.startswith("service")]
+    wrong = [
+        f"{n} imports {t}" for n, ts in GRAPH.items() if n.startswith("fitting") for t in ts if t.startswith("service")
+    ]
     assert not wrong, "\n".join(wrong)
 
 
@@ -233,8 +240,13 @@ def test_service_no_route_imports_another_route():
 
 def test_the_runtime_is_used_through_its_public_surface():
     """Outside service/runtime/, the service imports the runtime's package (its __init__'s names), never its modules."""
-    wrong = [f"{n} imports {t}" for n, ts in GRAPH.items() if n.startswith("service") and not n.startswith("service.runtime")
-             for t in ts if t.startswith("service.runtime.")]
+    wrong = [
+        f"{n} imports {t}"
+        for n, ts in GRAPH.items()
+        if n.startswith("service") and not n.startswith("service.runtime")
+        for t in ts
+        if t.startswith("service.runtime.")
+    ]
     assert "service.runtime" in GRAPH["service.main"]
     assert not wrong, "\n".join(wrong)
 

@@ -93,13 +93,17 @@ def test_every_marked_figure_is_the_recorded_one(page):
     wrong = stale(page.read_text(encoding="utf-8"))
     assert not wrong, "\n".join(
         f"{page.name}:{w['line']}: {w['key']} quotes {w['quoted']}, recorded {w.get('recorded', w.get('error'))}"
-        for w in wrong)
+        for w in wrong
+    )
 
 
 def test_the_readme_quotes_the_editor_and_rest_figures_from_their_records():
     keys = {f["key"] for f in figures((docs_figures.ROOT / "README.md").read_text(encoding="utf-8"))}
-    assert {"editor_speed:drag_to_frame_ms.gentle.median_ms", "editor_speed:drag_to_frame_ms.gentle.p90_ms",
-            "service_load:rest_fit_unseen_ms.p50"} <= keys
+    assert {
+        "editor_speed:drag_to_frame_ms.gentle.median_ms",
+        "editor_speed:drag_to_frame_ms.gentle.p90_ms",
+        "service_load:rest_fit_unseen_ms.p50",
+    } <= keys
 
 
 def test_every_record_says_how_it_was_made():
@@ -138,8 +142,13 @@ def test_the_readme_headline_figures_are_short_marked_and_linked():
         assert MARKER.search(figure) and not unmarked_numbers(figure), (what, unmarked_numbers(figure))
         assert "](docs/results.md#" in record, what
     assert len(readme.splitlines()) < README_LINES_MAX
-    long = [cell[:60] for line in readme.splitlines() if line.startswith("|")
-            for cell in line.strip().strip("|").split(" | ") if len(cell.strip()) > README_CELL_MAX]
+    long = [
+        cell[:60]
+        for line in readme.splitlines()
+        if line.startswith("|")
+        for cell in line.strip().strip("|").split(" | ")
+        if len(cell.strip()) > README_CELL_MAX
+    ]
     assert not long, long
 
 

@@ -57,8 +57,12 @@ def js_format_literals(source: str) -> list[str]:
 
 
 def test_the_checks_see_what_they_must_refuse():
-    for text in ('x = format == "openpbr"', 'x = f in ("mtlx", "openpbr")', 'T = {"openpbr": 1}',
-                 'p.add_argument("--export", choices=("openpbr", "x"))'):
+    for text in (
+        'x = format == "openpbr"',
+        'x = f in ("mtlx", "openpbr")',
+        'T = {"openpbr": 1}',
+        'p.add_argument("--export", choices=("openpbr", "x"))',
+    ):
         assert format_name_uses(text), text
     assert not format_name_uses("x = format in EXPORT_FORMATS")
     assert js_format_literals('export const EXPORTS = new Set(["mtlx", "gltf"]);')

@@ -60,8 +60,9 @@ def kind_name_uses(source: str, file_name: str = "<source>") -> list[str]:
         elif isinstance(node, ast.Dict):
             names = [n for key in node.keys if key is not None for n in _names_in(key)]
         elif isinstance(node, ast.match_case):
-            names = [n for sub in ast.walk(node.pattern) if isinstance(sub, ast.MatchValue)
-                     for n in _names_in(sub.value)]
+            names = [
+                n for sub in ast.walk(node.pattern) if isinstance(sub, ast.MatchValue) for n in _names_in(sub.value)
+            ]
         else:
             continue
         if names:
@@ -73,8 +74,13 @@ def kind_name_uses(source: str, file_name: str = "<source>") -> list[str]:
 def test_the_check_sees_what_it_must_refuse():
     """The reader finds each form (the test can fail)."""
     name = next(iter(NAMES))
-    for text in (f"x = model == {name!r}", f"x = {name!r} != model", f"x = kind in ({name!r}, 'y')",
-                 f"T = {{{name!r}: 1}}", f"match m:\n    case {name!r}:\n        pass"):
+    for text in (
+        f"x = model == {name!r}",
+        f"x = {name!r} != model",
+        f"x = kind in ({name!r}, 'y')",
+        f"T = {{{name!r}: 1}}",
+        f"match m:\n    case {name!r}:\n        pass",
+    ):
         assert kind_name_uses(text), text
     assert not kind_name_uses(f"CANDIDATES = (({name!r}, 0),)\nx = model == DEFAULT_MODEL")
 
@@ -98,16 +104,23 @@ def js_kind_uses(source: str) -> list[str]:
     """Each string literal that is a kind's name, and each preprocessor switch on a kind, as ``line: text``."""
     names = "|".join(map(re.escape, sorted(NAMES)))
     macros = "|".join(_macro(name) for name in sorted(NAMES))
-    patterns = [re.compile(r"""["'`](%s)["'`]""" % names),
-                re.compile(r"^[ \t]*#[ \t]*(?:if|ifdef|ifndef|elif|define)\b.*\b(%s)\b" % macros, re.M)]
+    patterns = [
+        re.compile(r"""["'`](%s)["'`]""" % names),
+        re.compile(r"^[ \t]*#[ \t]*(?:if|ifdef|ifndef|elif|define)\b.*\b(%s)\b" % macros, re.M),
+    ]
     found = [(m.start(), m.group(0).strip()) for pattern in patterns for m in pattern.finditer(source)]
     return [f"{source.count(chr(10), 0, at) + 1}: {text}" for at, text in sorted(found)]
 
 
 def test_the_browser_check_sees_what_it_must_refuse():
     assert set(BUILT_IN) <= NAMES
-    for text in ('if (model.kind === "rgb-conductor") x();', "const KINDS = ['coated-conductor'];",
-                 "#if CF_RGB_CONDUCTOR\n", "  #define CF_COATED_CONDUCTOR 1", "#ifdef CF_RGB_CONDUCTOR"):
+    for text in (
+        'if (model.kind === "rgb-conductor") x();',
+        "const KINDS = ['coated-conductor'];",
+        "#if CF_RGB_CONDUCTOR\n",
+        "  #define CF_COATED_CONDUCTOR 1",
+        "#ifdef CF_RGB_CONDUCTOR",
+    ):
         assert js_kind_uses(text), text
     for text in ("#ifndef CF_RGB_CONDUCTOR_GLSL", "// the coated-conductor model", "kind.name === defaultModelKind()"):
         assert not js_kind_uses(text), text
@@ -115,7 +128,9 @@ def test_the_browser_check_sees_what_it_must_refuse():
 
 def _browser_files():
     yield from (p for p in sorted((ROOT / "static").rglob("*")) if p.suffix in (".js", ".html", ".frag", ".glsl"))
-    yield from (p for p in sorted((ROOT / "preview_shaders" / "glsl").iterdir()) if p.suffix in (".frag", ".vert", ".glsl"))
+    yield from (
+        p for p in sorted((ROOT / "preview_shaders" / "glsl").iterdir()) if p.suffix in (".frag", ".vert", ".glsl")
+    )
     for package in sorted((ROOT / "web").iterdir()):
         if (package / "src").is_dir():
             yield from (p for p in sorted((package / "src").rglob("*")) if p.suffix in (".js", ".mjs", ".ts"))

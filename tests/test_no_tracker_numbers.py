@@ -46,6 +46,10 @@ def test_the_check_sees_a_tracker_number():
 
 def test_no_tracker_numbers_in_code_or_docs():
     this = Path(__file__).resolve()
-    wrong = [f"{path.relative_to(ROOT)}:{use}" for path in _files() if path.resolve() != this
-             for use in tracker_numbers(path.read_text(encoding="utf-8", errors="replace"))]
+    wrong = [
+        f"{path.relative_to(ROOT)}:{use}"
+        for path in _files()
+        if path.resolve() != this
+        for use in tracker_numbers(path.read_text(encoding="utf-8", errors="replace"))
+    ]
     assert not wrong, "\n".join(wrong)

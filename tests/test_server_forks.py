@@ -30,23 +30,28 @@ pytestmark = [pytest.mark.server, pytest.mark.slow]
 BASE = {"PATH": "/usr/bin", "HOME": "/root", "OPENBLAS_CORETYPE": "Haswell", "COATED_FIT_WORKERS": "1"}
 
 
-@pytest.mark.parametrize("env, expected", [
-    (BASE, True),
-    ({**BASE, "COATED_FIT_WORKERS": "2", "COATED_FIT_QUEUE": "0"}, True),  # the service's settings
-    ({**BASE, "TMPDIR": "/tmp/x"}, True),  # read when first used
-    ({**BASE, "PYTEST_CURRENT_TEST": "tests/a.py::t (call)"}, True),
-    ({k: v for k, v in BASE.items() if k != "COATED_FIT_WORKERS"}, True),
-    ({**BASE, "OPENBLAS_CORETYPE": "Prescott"}, False),  # read by OpenBLAS when numpy is imported
-    ({**BASE, "PYTHONHASHSEED": "1"}, False),  # read by the interpreter at its start
-    ({k: v for k, v in BASE.items() if k != "PATH"}, False),
-])
+@pytest.mark.parametrize(
+    "env, expected",
+    [
+        (BASE, True),
+        ({**BASE, "COATED_FIT_WORKERS": "2", "COATED_FIT_QUEUE": "0"}, True),  # the service's settings
+        ({**BASE, "TMPDIR": "/tmp/x"}, True),  # read when first used
+        ({**BASE, "PYTEST_CURRENT_TEST": "tests/a.py::t (call)"}, True),
+        ({k: v for k, v in BASE.items() if k != "COATED_FIT_WORKERS"}, True),
+        ({**BASE, "OPENBLAS_CORETYPE": "Prescott"}, False),  # read by OpenBLAS when numpy is imported
+        ({**BASE, "PYTHONHASHSEED": "1"}, False),  # read by the interpreter at its start
+        ({k: v for k, v in BASE.items() if k != "PATH"}, False),
+    ],
+)
 def test_a_fork_takes_only_the_service_s_variables(env, expected):
     assert forkable(BASE, env) is expected
 
 
 def test_a_forked_server_reads_its_settings_leads_its_session_and_exits_as_the_command(tmp_path):
-    with server_process(tmp_path / "data", COATED_FIT_WORKERS="3") as server, \
-            loopback.Client(base_url=server.url, timeout=30) as http:
+    with (
+        server_process(tmp_path / "data", COATED_FIT_WORKERS="3") as server,
+        loopback.Client(base_url=server.url, timeout=30) as http,
+    ):
         process = server.process
         assert isinstance(process, ForkedProcess)
         health = http.get("/healthz").json()
@@ -71,8 +76,10 @@ def test_a_forked_server_that_cannot_start_says_why_with_the_command_s_status(tm
 
 
 def test_an_environment_a_fork_cannot_take_starts_the_command(tmp_path):
-    with server_process(tmp_path / "data", PYTHONHASHSEED="7") as server, \
-            loopback.Client(base_url=server.url, timeout=30) as http:
+    with (
+        server_process(tmp_path / "data", PYTHONHASHSEED="7") as server,
+        loopback.Client(base_url=server.url, timeout=30) as http,
+    ):
         assert isinstance(server.process, subprocess.Popen)
         assert server.process.args[1:3] == ["-m", "service"]
         assert http.get("/healthz").json()["status"] == "ok"
@@ -81,8 +88,10 @@ def test_an_environment_a_fork_cannot_take_starts_the_command(tmp_path):
 def test_a_forked_command_is_the_command_s_run(tmp_path):
     """run_command forks python -m fitting: the same exit statuses, output streams and working directory."""
     argv = ["fit", "Au", "--eta-range", "1:2", "--no-metrics", "--json"]
-    forked, spawned = run_command("fitting", *argv), subprocess.run(
-        [sys.executable, "-m", "fitting", *argv], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    forked, spawned = (
+        run_command("fitting", *argv),
+        subprocess.run([sys.executable, "-m", "fitting", *argv], cwd=ROOT, capture_output=True, text=True, timeout=300),
+    )
     assert forked.args == spawned.args and forked.returncode == spawned.returncode == 0
     views = [json.loads(result.stdout) for result in (forked, spawned)]
     for view in views:
@@ -93,14 +102,21 @@ def test_a_forked_command_is_the_command_s_run(tmp_path):
     assert refused.stderr.startswith("error: `material` must name a conductor of the library")
     usage = run_command("fitting", "--no-such-option")
     assert usage.returncode == 2 and usage.stderr.startswith("usage: python -m fitting")
-    (tmp_path / "metal.csv").write_text("wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n"
-                                        "650,0.6,3.0\n750,0.7,3.8\n850,0.8,4.5\n")
+    (tmp_path / "metal.csv").write_text(
+        "wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n650,0.6,3.0\n750,0.7,3.8\n850,0.8,4.5\n"
+    )
     # Relative paths are the working directory's. (The command itself needs the repository on PYTHONPATH
     # when run from elsewhere, an environment a fork cannot take; the fork has the package imported.)
     argv = ["fit", "--nk", "metal.csv", "--no-metrics", "-o"]
     forked = run_command("fitting", *argv, "forked.cfpk", cwd=tmp_path)
-    spawned = subprocess.run([sys.executable, "-m", "fitting", *argv, "spawned.cfpk"], cwd=tmp_path,
-                             env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=300)
+    spawned = subprocess.run(
+        [sys.executable, "-m", "fitting", *argv, "spawned.cfpk"],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert forked.returncode == spawned.returncode == 0, forked.stderr + spawned.stderr
     assert (tmp_path / "forked.cfpk").read_bytes() == (tmp_path / "spawned.cfpk").read_bytes()
 

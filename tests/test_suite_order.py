@@ -17,10 +17,12 @@ from types import SimpleNamespace
 from xdist.scheduler import LoadScopeScheduling
 
 COLLECTION = [
-    "tests/static/test_editor_a.py::test_one", "tests/static/test_editor_a.py::test_two",
+    "tests/static/test_editor_a.py::test_one",
+    "tests/static/test_editor_a.py::test_two",
     "tests/service/test_server_b.py::test_one",
     *(f"tests/fitting/test_many.py::test_{i}" for i in range(9)),
-    "tests/fitting/test_class.py::TestOne::test_a", "tests/fitting/test_class.py::TestOne::test_b",
+    "tests/fitting/test_class.py::TestOne::test_a",
+    "tests/fitting/test_class.py::TestOne::test_b",
     "tests/fitting/test_class.py::TestTwo::test_a",
     *(f"tests/fitting/test_more.py::test_{i}" for i in range(5)),
 ]
@@ -61,8 +63,12 @@ def handed_out(config) -> list[str]:
 def test_the_suite_keeps_its_own_order(pytestconfig):
     assert pytestconfig.option.loadscopereorder is False
     assert handed_out(two_workers(pytestconfig)) == [
-        "tests/static/test_editor_a.py", "tests/service/test_server_b.py", "tests/fitting/test_many.py",
-        "tests/fitting/test_class.py::TestOne", "tests/fitting/test_class.py::TestTwo", "tests/fitting/test_more.py",
+        "tests/static/test_editor_a.py",
+        "tests/service/test_server_b.py",
+        "tests/fitting/test_many.py",
+        "tests/fitting/test_class.py::TestOne",
+        "tests/fitting/test_class.py::TestTwo",
+        "tests/fitting/test_more.py",
     ]
 
 

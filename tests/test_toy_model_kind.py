@@ -22,8 +22,7 @@ from fitting.fits.pipeline import FitKind
 from fitting.fits.result import FitResult
 from fitting.fits.settings import FitSettings
 from fitting.models.kinds import MODEL_KINDS, ModelKind, register_model_kind, unregister_model_kind
-from fitting.models.pack import (decode_pack, encode_pack, material_to_json, pack_from_json, pack_to_json,
-                                 to_float16)
+from fitting.models.pack import decode_pack, encode_pack, material_to_json, pack_from_json, pack_to_json, to_float16
 from fitting.optics.library import library_material
 from preview_shaders.preview import PreviewRenderer
 from fitting.exports.snippets import SnippetMaterial, snippet
@@ -73,20 +72,34 @@ def toy_model(cos_theta, eta_i, coefficients, eta_i_range) -> np.ndarray:
     return F0 + (1.0 - F0) * (1.0 - mu[..., None]) ** 5
 
 
-def toy_solve(target, mu, eta, eta_i_range, degree, objective, max_nfev, quantise, weights=None,
-              irls_rounds=2) -> FitResult:
+def toy_solve(
+    target, mu, eta, eta_i_range, degree, objective, max_nfev, quantise, weights=None, irls_rounds=2
+) -> FitResult:
     """Least squares of F0 in linear RGB (the toy ignores the objective and the coating)."""
     t0 = time.perf_counter()
     w = np.ones(len(mu)) if weights is None else np.asarray(weights)
     solution = least_squares(
         lambda x: ((toy_model(mu, eta, x[None, :], eta_i_range) - target) * np.sqrt(w)[:, None]).ravel(),
-        np.full(3, 0.5), bounds=(0.0, 1.0), max_nfev=max_nfev)
+        np.full(3, 0.5),
+        bounds=(0.0, 1.0),
+        max_nfev=max_nfev,
+    )
     C = solution.x[None, :]
     C16 = to_float16(C)
     residual = (toy_model(mu, eta, C16.astype(np.float64), eta_i_range) - target) * np.sqrt(w)[:, None]
-    return FitResult.from_solve(solution, C, C16, eta_i_range, 0, objective, solution.nfev,
-                                solution.njev or 0, 0.5 * float(np.sum(residual ** 2)),
-                                {"fit": time.perf_counter() - t0, "quantise": 0.0}, model=TOY)
+    return FitResult.from_solve(
+        solution,
+        C,
+        C16,
+        eta_i_range,
+        0,
+        objective,
+        solution.nfev,
+        solution.njev or 0,
+        0.5 * float(np.sum(residual**2)),
+        {"fit": time.perf_counter() - t0, "quantise": 0.0},
+        model=TOY,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -94,13 +107,22 @@ def toy(tmp_path_factory):
     folder = tmp_path_factory.mktemp("toy_kind")
     (folder / "cf_toy_schlick.glsl").write_text(TOY_GLSL)
     (folder / "material_toy.glsl").write_text(TOY_TEMPLATE)
-    kind = register_model_kind(ModelKind(
-        name=TOY, code=200, description="toy: Schlick with a constant F0", parameters=("F0",),
-        max_degree=0, check=check_toy, evaluate=toy_model,
-        glsl_file=str(folder / "cf_toy_schlick.glsl"), hlsl_file=str(folder / "none.hlsl"),
-        glsl_function="cf_toy_schlick", preview_call="cf_toy_schlick_packed(NdotV, eta_i, words)",
-        material_template=str(folder / "material_toy"),
-    ))
+    kind = register_model_kind(
+        ModelKind(
+            name=TOY,
+            code=200,
+            description="toy: Schlick with a constant F0",
+            parameters=("F0",),
+            max_degree=0,
+            check=check_toy,
+            evaluate=toy_model,
+            glsl_file=str(folder / "cf_toy_schlick.glsl"),
+            hlsl_file=str(folder / "none.hlsl"),
+            glsl_function="cf_toy_schlick",
+            preview_call="cf_toy_schlick_packed(NdotV, eta_i, words)",
+            material_template=str(folder / "material_toy"),
+        )
+    )
     register_fit_kind(FitKind(name=TOY, settings=FitSettings(), solve=toy_solve, bounded=True))
     try:
         yield kind
@@ -131,13 +153,13 @@ def test_the_packs_carry_the_toy(fitted, toy):
     assert back == fitted.packed and back.model == TOY
     (again,) = pack_from_json(pack_to_json([fitted.packed]))
     assert again == fitted.packed
-    assert material_to_json(fitted.packed)["coefficients"] == {
-        "F0": [float(v) for v in fitted.packed.coefficients[0]]}
+    assert material_to_json(fitted.packed)["coefficients"] == {"F0": [float(v) for v in fitted.packed.coefficients[0]]}
 
 
 def toy_record(fitted) -> SnippetMaterial:
-    return SnippetMaterial(name="toy gold", source="test", fit_id="d" * 32, quality=headline(fitted.metrics),
-                           packed=fitted.packed)
+    return SnippetMaterial(
+        name="toy gold", source="test", fit_id="d" * 32, quality=headline(fitted.metrics), packed=fitted.packed
+    )
 
 
 def test_the_glsl_snippet_has_the_toy(fitted):
@@ -193,8 +215,10 @@ def test_the_headless_preview_draws_the_toy(fitted):
     with PreviewRenderer() as renderer:
         view = renderer.render_preview(fitted.packed, size=64)
     mask = view.mask
-    expected = toy_model(view.cos_theta[mask].astype(np.float64), 1.5,
-                         fitted.packed.coefficients.astype(np.float64), None) * view.radiance[mask]
+    expected = (
+        toy_model(view.cos_theta[mask].astype(np.float64), 1.5, fitted.packed.coefficients.astype(np.float64), None)
+        * view.radiance[mask]
+    )
     # The same float32 Schlick as above at the preview's own cos theta, times
     # the white sky's radiance (1): 1e-6.
     assert np.abs(view.model[mask] - expected).max() < 1e-6

@@ -41,6 +41,13 @@ def Material "{prim}"
 """
 
 
-register_export_format(ExportFormat(
-    name="usda", label="USD preview surface (.usda)", media_type="model/vnd.usda",
-    extension="usda", tools=(), write=usda_document))
+register_export_format(
+    ExportFormat(
+        name="usda",
+        label="USD preview surface (.usda)",
+        media_type="model/vnd.usda",
+        extension="usda",
+        tools=(),
+        write=usda_document,
+    )
+)

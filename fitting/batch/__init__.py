@@ -21,7 +21,14 @@ from .runner import BatchResult, run_batch
 from .selection import read_page_list, select_pages
 
 __all__ = [
-    "DEFAULT_MODEL_KIND", "KindFit", "batch_kinds",
-    "fit_page", "OUTPUT_FILES", "accuracy_summary", "BatchResult", "run_batch",
-    "read_page_list", "select_pages",
+    "DEFAULT_MODEL_KIND",
+    "KindFit",
+    "batch_kinds",
+    "fit_page",
+    "OUTPUT_FILES",
+    "accuracy_summary",
+    "BatchResult",
+    "run_batch",
+    "read_page_list",
+    "select_pages",
 ]

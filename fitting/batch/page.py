@@ -60,8 +60,15 @@ def screen_page(page: str, min_coverage: float = DEFAULT_MIN_COVERAGE):
     coverage = visible_coverage((lo, hi))
     data_range = [float(lo), float(hi)]
     if coverage < min_coverage:
-        return None, (f"covers {coverage:.1%} of {VISIBLE_RANGE_NM[0]:g}-{VISIBLE_RANGE_NM[1]:g} nm "
-                      f"(data {lo:g}-{hi:g} nm), needs {min_coverage:.0%}"), coverage, data_range
+        return (
+            None,
+            (
+                f"covers {coverage:.1%} of {VISIBLE_RANGE_NM[0]:g}-{VISIBLE_RANGE_NM[1]:g} nm "
+                f"(data {lo:g}-{hi:g} nm), needs {min_coverage:.0%}"
+            ),
+            coverage,
+            data_range,
+        )
     try:  # a gap inside the visible range is data the fit refuses, not a failed fit
         check_gaps(nk)
     except ValueError as error:
@@ -95,8 +102,14 @@ def fit_page(
     """
     t0 = time.perf_counter()
     record: dict[str, Any] = {
-        "page": page, "status": "skipped", "reason": None, "coverage": None,
-        "wavelength_range_nm": None, "kinds": {}, "baselines": {}, "materials": {},
+        "page": page,
+        "status": "skipped",
+        "reason": None,
+        "coverage": None,
+        "wavelength_range_nm": None,
+        "kinds": {},
+        "baselines": {},
+        "materials": {},
     }
     with threadpool_limits(limits=1):
         nk, reason, coverage, data_range = screen_page(page, min_coverage)
@@ -116,10 +129,8 @@ def fit_page(
                 record["baselines"][name] = {"delta_E_mean": m.mean, "delta_E_max": m.max}
             record["status"] = "fitted"
         except Exception as error:  # a page the fit cannot serve is reported, never fatal
-            record.update(status="failed", reason=_reason(error), kinds={}, baselines={},
-                          materials={})
+            record.update(status="failed", reason=_reason(error), kinds={}, baselines={}, materials={})
         if not all(np.isfinite(v["delta_E_mean"]) for v in record["kinds"].values()):
-            record.update(status="failed", reason="non-finite Delta E", kinds={},
-                          baselines={}, materials={})
+            record.update(status="failed", reason="non-finite Delta E", kinds={}, baselines={}, materials={})
     record["seconds"] = time.perf_counter() - t0
     return record

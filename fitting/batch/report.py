@@ -81,8 +81,14 @@ def report_rows(records: list[dict[str, Any]], kinds, baselines) -> list[dict[st
     rows = []
     for r in sorted(records, key=lambda r: r["page"]):
         lo, hi = r["wavelength_range_nm"] or (None, None)
-        row = {"page": r["page"], "status": r["status"], "reason": r["reason"] or "",
-               "coverage": r["coverage"], "wavelength_min_nm": lo, "wavelength_max_nm": hi}
+        row = {
+            "page": r["page"],
+            "status": r["status"],
+            "reason": r["reason"] or "",
+            "coverage": r["coverage"],
+            "wavelength_min_nm": lo,
+            "wavelength_max_nm": hi,
+        }
         for name in (*kinds, *baselines):
             m = r["kinds"].get(name) or r["baselines"].get(name) or {}
             row[f"{name}_delta_E_mean"] = m.get("delta_E_mean")
@@ -112,8 +118,10 @@ def accuracy_summary(records: list[dict[str, Any]], kinds, baselines) -> dict[st
         entry: dict[str, Any] = {"pages": int(values.size)}
         if values.size:
             entry.update(
-                mean=float(values.mean()), median=float(np.median(values)),
-                p90=float(np.quantile(values, 0.9)), max=float(values.max()),
+                mean=float(values.mean()),
+                median=float(np.median(values)),
+                p90=float(np.quantile(values, 0.9)),
+                max=float(values.max()),
             )
             if source == "kinds" and "lazanyi_adjusted" in baselines:
                 laz = np.array([r["baselines"]["lazanyi_adjusted"]["delta_E_mean"] for r in fitted])
@@ -127,8 +135,7 @@ def _csv(rows: list[dict[str, Any]], columns: list[str]) -> bytes:
     writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
     writer.writeheader()
     for row in rows:
-        writer.writerow({k: ("" if v is None else repr(v) if isinstance(v, float) else v)
-                         for k, v in row.items()})
+        writer.writerow({k: ("" if v is None else repr(v) if isinstance(v, float) else v) for k, v in row.items()})
     return buffer.getvalue().encode("utf-8")
 
 
@@ -159,12 +166,10 @@ def write_outputs(
     _write(directory / "report.csv", _csv(rows, columns))
     summary = accuracy_summary(records, kinds, baselines)
     report = {"config": config, "summary": summary, "pages": rows}
-    _write(directory / "report.json",
-           (json.dumps(report, indent=1, sort_keys=True) + "\n").encode("utf-8"))
+    _write(directory / "report.json", (json.dumps(report, indent=1, sort_keys=True) + "\n").encode("utf-8"))
     seconds = sum(r["seconds"] for r in records)
     timing_rows = [{"page": r["page"], "seconds": round(r["seconds"], 4)} for r in records]
     text = _csv(timing_rows, ["page", "seconds"]).decode("utf-8")
-    text += (f"# pages {len(records)}, sum of page seconds {seconds:.1f}, "
-             f"wall of the last run {wall_s:.1f} s\n")
+    text += f"# pages {len(records)}, sum of page seconds {seconds:.1f}, wall of the last run {wall_s:.1f} s\n"
     _write(directory / "timings.csv", text.encode("utf-8"))
     return summary

@@ -63,8 +63,10 @@ class Progress:
         rate = (self.done - self.start_done) / elapsed if elapsed > 0 else 0.0
         left = (self.total - self.done) / rate if rate > 0 else float("nan")
         bar = "#" * int(fraction * 30)
-        text = (f"[{bar:<30s}] {self.done}/{self.total} pages  {rate:5.2f} pages/s  "
-                f"{'left ' + format(left, '.0f') + ' s' if left == left else ''}")
+        text = (
+            f"[{bar:<30s}] {self.done}/{self.total} pages  {rate:5.2f} pages/s  "
+            f"{'left ' + format(left, '.0f') + ' s' if left == left else ''}"
+        )
         self.stream.write(("\r" + text) if self.tty else (text + "\n"))
         if self.tty and self.done == self.total:
             self.stream.write("\n")
@@ -86,9 +88,13 @@ class BatchResult:
 def _config(pages, kinds, eta_i_range, samples, min_coverage) -> dict[str, Any]:
     digest = hashlib.sha256("\n".join(pages).encode("utf-8")).hexdigest()[:32]
     return {
-        "pages": len(pages), "pages_sha256": digest, "model_kinds": list(kinds),
-        "eta_i_range": list(eta_i_range), "grid": f"{samples}x{samples}",
-        "reference_step_nm": 1.0, "min_coverage": min_coverage,
+        "pages": len(pages),
+        "pages_sha256": digest,
+        "model_kinds": list(kinds),
+        "eta_i_range": list(eta_i_range),
+        "grid": f"{samples}x{samples}",
+        "reference_step_nm": 1.0,
+        "min_coverage": min_coverage,
         "baselines": list(REPORTED_BASELINES),
     }
 
@@ -127,8 +133,7 @@ def _dask(todo, args, sink, scheduler, config):
     client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
     try:
         futures = {
-            client.submit(fit_page, page, *args, key=f"fit_page-{token}-{page}", pure=False): page
-            for page in todo
+            client.submit(fit_page, page, *args, key=f"fit_page-{token}-{page}", pure=False): page for page in todo
         }
         try:
             for future in as_completed(futures):
@@ -137,9 +142,19 @@ def _dask(todo, args, sink, scheduler, config):
                     sink(future.result())
                 except KilledWorker:
                     # The page itself took down every worker it ran on.
-                    sink({"page": page, "status": "failed", "reason": "its worker died on every try",
-                          "coverage": None, "wavelength_range_nm": None, "kinds": {},
-                          "baselines": {}, "materials": {}, "seconds": 0.0})
+                    sink(
+                        {
+                            "page": page,
+                            "status": "failed",
+                            "reason": "its worker died on every try",
+                            "coverage": None,
+                            "wavelength_range_nm": None,
+                            "kinds": {},
+                            "baselines": {},
+                            "materials": {},
+                            "seconds": 0.0,
+                        }
+                    )
         finally:
             client.cancel(list(futures))
     finally:

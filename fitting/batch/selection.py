@@ -48,8 +48,7 @@ def read_page_list(path: str | Path) -> list[str]:
     and lines starting with ``#`` are ignored.
     """
     text = Path(path).read_text(encoding="utf-8")
-    return [line.strip() for line in text.splitlines()
-            if line.strip() and not line.strip().startswith("#")]
+    return [line.strip() for line in text.splitlines() if line.strip() and not line.strip().startswith("#")]
 
 
 def select_pages(

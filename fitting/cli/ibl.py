@@ -76,8 +76,7 @@ def _cmd_ibl(args) -> int:
         split = split_sum_coated(mu, args.roughness, F0, a, alpha, eta_i, args.coat_roughness)
     else:
         split = split_sum_model(mu, args.roughness, F0, a, alpha)
-    common = dict(mode=args.mode, eta_i=eta_i, coat_roughness=args.coat_roughness,
-                  samples=args.samples, seed=args.seed)
+    common = dict(mode=args.mode, eta_i=eta_i, coat_roughness=args.coat_roughness, samples=args.samples, seed=args.seed)
     mc = directional_albedo(mu, args.roughness, model_fresnel(F0, a, alpha), **common)
     reference = directional_albedo(mu, args.roughness, spectral_fresnel(nk, eta_i), **common)
     view = {
@@ -90,13 +89,14 @@ def _cmd_ibl(args) -> int:
     if args.json:
         print(json.dumps(view))
         return 0
-    print(f"{packed.name}, {args.mode}, eta_i {eta_i:g}, roughness {args.roughness:g}, "
-          f"{args.samples} MC samples per NdotV (linear ACEScg)")
+    print(
+        f"{packed.name}, {args.mode}, eta_i {eta_i:g}, roughness {args.roughness:g}, "
+        f"{args.samples} MC samples per NdotV (linear ACEScg)"
+    )
     print("NdotV  split sum (R G B)        MC model (R G B)         stderr    MC spectral reference")
     for i, m in enumerate(mu):
         fmt = lambda v: " ".join(f"{x:.4f}" for x in v)  # noqa: E731
-        print(f"{m:5.2f}  {fmt(split[i])}  {fmt(mc.mean[i])}  {mc.stderr[i].max():.1e}  "
-              f"{fmt(reference.mean[i])}")
+        print(f"{m:5.2f}  {fmt(split[i])}  {fmt(mc.mean[i])}  {mc.stderr[i].max():.1e}  {fmt(reference.mean[i])}")
     return 0
 
 
@@ -120,13 +120,26 @@ def add_ibl_parsers(sub) -> None:
     p.add_argument("--page", metavar="SHELF/BOOK/PAGE", help="any refractiveindex.info page")
     p.add_argument("--name", help="material name for --nk or --page")
     p.add_argument("--eta-i", type=float, default=1.0, help="index of the medium or coat (default 1)")
-    p.add_argument("--roughness", type=_unit_interval("--roughness"), default=0.5,
-                   help="perceptual roughness of the metal, [0, 1] (default 0.5)")
+    p.add_argument(
+        "--roughness",
+        type=_unit_interval("--roughness"),
+        default=0.5,
+        help="perceptual roughness of the metal, [0, 1] (default 0.5)",
+    )
     p.add_argument("--mode", choices=MODES, default="immersed")
-    p.add_argument("--coat-roughness", type=_unit_interval("--coat-roughness"), default=0.0,
-                   help="perceptual roughness of the coat (coated mode; default 0)")
-    p.add_argument("--n-dot-v", type=_n_dot_v, default=DEFAULT_N_DOT_V, metavar="LIST",
-                   help="comma-separated NdotV in (0, 1] (default 0.05,0.1,0.2,...,1)")
+    p.add_argument(
+        "--coat-roughness",
+        type=_unit_interval("--coat-roughness"),
+        default=0.0,
+        help="perceptual roughness of the coat (coated mode; default 0)",
+    )
+    p.add_argument(
+        "--n-dot-v",
+        type=_n_dot_v,
+        default=DEFAULT_N_DOT_V,
+        metavar="LIST",
+        help="comma-separated NdotV in (0, 1] (default 0.05,0.1,0.2,...,1)",
+    )
     p.add_argument("--samples", type=int, default=MC_SAMPLES, help=f"MC draws per NdotV (default {MC_SAMPLES})")
     p.add_argument("--seed", type=int, default=0, help="seed of the Monte Carlo (default 0)")
     p.add_argument("--json", action="store_true", help="print JSON")

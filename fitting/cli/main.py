@@ -51,8 +51,10 @@ def _cmd_library(args) -> int:
 
     for entry in search_catalogue(args.query):
         lo, hi = entry["wavelength_range_nm"]
-        print(f"{entry['id']:28s} {entry['name']:30s} {entry['symbol']:10s} {entry['category']:15s} "
-              f"{lo:7.1f}-{hi:8.1f} nm  {entry['label']}")
+        print(
+            f"{entry['id']:28s} {entry['name']:30s} {entry['symbol']:10s} {entry['category']:15s} "
+            f"{lo:7.1f}-{hi:8.1f} nm  {entry['label']}"
+        )
     return 0
 
 
@@ -67,8 +69,7 @@ def _cmd_fit(args) -> int:
     if args.export is not None:
         return _write_export(nk, args)
     extra = {} if args.max_gap_nm is None else {"max_gap_nm": args.max_gap_nm}
-    result = fit_model(nk, args.eta_range, args.model, objective=args.objective,
-                       evaluate=not args.no_metrics, **extra)
+    result = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=not args.no_metrics, **extra)
     for warning in result.quality.get("warnings", []):
         # Sparse data, outliers or a model outside [0, 1] are said, and refused with --strict.
         if args.strict:
@@ -76,8 +77,10 @@ def _cmd_fit(args) -> int:
             return 3
         print(f"warning: {warning}", file=sys.stderr)
     if not result.success:
-        what = (f"the fit of {nk.name!r} did not converge (solver status {result.status}: "
-                f"{result.message}); its coefficients are the best found")
+        what = (
+            f"the fit of {nk.name!r} did not converge (solver status {result.status}: "
+            f"{result.message}); its coefficients are the best found"
+        )
         if args.strict:
             print(f"error: {what}; nothing written (--strict)", file=sys.stderr)
             return 3
@@ -89,8 +92,10 @@ def _cmd_fit(args) -> int:
     try:
         text = json.dumps(view, indent=2, allow_nan=False)
     except ValueError:
-        print(f"error: the fit of {nk.name!r} gave non-finite figures: the data cannot be fitted; "
-              "nothing written", file=sys.stderr)
+        print(
+            f"error: the fit of {nk.name!r} gave non-finite figures: the data cannot be fitted; nothing written",
+            file=sys.stderr,
+        )
         return 3
     if args.output:
         Path(args.output).write_bytes(encode_pack([result.packed]))
@@ -106,8 +111,9 @@ def _write_export(nk, args) -> int:
 
     # The fit's own float16 model travels in the glTF export's extension.
     model = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=False).packed
-    body = export_material(nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model,
-                           working_space=args.working_space)
+    body = export_material(
+        nk, args.export, args.eta_i, args.roughness, args.coat_roughness, model, working_space=args.working_space
+    )
     if args.output:
         Path(args.output).write_bytes(body)
         print(f"wrote {args.output}", file=sys.stderr)
@@ -153,41 +159,61 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_library)
 
     p = sub.add_parser("fit", help="fit a library material or an n, k file")
-    p.add_argument("material", nargs="?",
-                   help="a library conductor by name, symbol or id, any case: gold, Au, Ti.Johnson")
+    p.add_argument(
+        "material", nargs="?", help="a library conductor by name, symbol or id, any case: gold, Au, Ti.Johnson"
+    )
     p.add_argument("--nk", metavar="FILE", help="n, k file: CSV, JSON or refractiveindex.info YAML")
-    p.add_argument("--page", metavar="SHELF/BOOK/PAGE",
-                   help="any refractiveindex.info page, e.g. main/SiO2/Malitson")
+    p.add_argument("--page", metavar="SHELF/BOOK/PAGE", help="any refractiveindex.info page, e.g. main/SiO2/Malitson")
     p.add_argument("--name", help="material name for --nk or --page")
-    p.add_argument("--eta-range", type=parse_eta_range, default=DEFAULT_ETA_I_RANGE, metavar="LO:HI",
-                   help="eta_i domain of the fit (default 1:2.5)")
+    p.add_argument(
+        "--eta-range",
+        type=parse_eta_range,
+        default=DEFAULT_ETA_I_RANGE,
+        metavar="LO:HI",
+        help="eta_i domain of the fit (default 1:2.5)",
+    )
     p.add_argument("--objective", choices=OBJECTIVES, default=DEFAULT_OBJECTIVE)
-    p.add_argument("--model", choices=MODEL_KINDS, default=DEFAULT_MODEL,
-                   help="model kind (default %(default)s)")
+    p.add_argument("--model", choices=MODEL_KINDS, default=DEFAULT_MODEL, help="model kind (default %(default)s)")
     p.add_argument("-o", "--output", metavar="FILE", help="write the binary pack here")
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
-    p.add_argument("--export", choices=EXPORT_FORMATS,
-                   help="write this export (docs/exports.md) to -o or stdout instead of a pack")
-    p.add_argument("--snippet", choices=("glsl", "hlsl"),
-                   help="write a ready-to-paste GLSL or HLSL snippet of the fit to -o or stdout instead of a pack")
-    p.add_argument("--eta-i", type=float, default=1.5,
-                   help="coating index of --export, [1, 3] (default 1.5)")
+    p.add_argument(
+        "--export", choices=EXPORT_FORMATS, help="write this export (docs/exports.md) to -o or stdout instead of a pack"
+    )
+    p.add_argument(
+        "--snippet",
+        choices=("glsl", "hlsl"),
+        help="write a ready-to-paste GLSL or HLSL snippet of the fit to -o or stdout instead of a pack",
+    )
+    p.add_argument("--eta-i", type=float, default=1.5, help="coating index of --export, [1, 3] (default 1.5)")
     p.add_argument("--roughness", type=float, default=0.2, help="metal roughness of --export, [0, 1]")
-    p.add_argument("--coat-roughness", type=float, default=0.03,
-                   help="coat roughness of --export, [0, 1]")
-    p.add_argument("--working-space", choices=WORKING_SPACES, default=DEFAULT_WORKING_SPACE,
-                   help="working space --export is fitted and written in (default %(default)s)")
-    p.add_argument("--strict", action="store_true",
-                   help="exit with status 3 (writing nothing) on any warning: the fit does not "
-                        "converge, its model is not proven inside [0, 1], or the data are sparse, "
-                        "gapped or hold an outlier")
-    p.add_argument("--max-gap-nm", type=float, default=None, metavar="NM",
-                   help="largest gap between samples inside 360-830 nm accepted (default 120; "
-                        "larger fits sparse data with a warning in the result and the pack)")
+    p.add_argument("--coat-roughness", type=float, default=0.03, help="coat roughness of --export, [0, 1]")
+    p.add_argument(
+        "--working-space",
+        choices=WORKING_SPACES,
+        default=DEFAULT_WORKING_SPACE,
+        help="working space --export is fitted and written in (default %(default)s)",
+    )
+    p.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit with status 3 (writing nothing) on any warning: the fit does not "
+        "converge, its model is not proven inside [0, 1], or the data are sparse, "
+        "gapped or hold an outlier",
+    )
+    p.add_argument(
+        "--max-gap-nm",
+        type=float,
+        default=None,
+        metavar="NM",
+        help="largest gap between samples inside 360-830 nm accepted (default 120; "
+        "larger fits sparse data with a warning in the result and the pack)",
+    )
     p.set_defaults(func=_cmd_fit)
 
-    p = sub.add_parser("reproduce", help="print Table 1 and write the results page (Table 1, Section 4.3, the worst point)")
+    p = sub.add_parser(
+        "reproduce", help="print Table 1 and write the results page (Table 1, Section 4.3, the worst point)"
+    )
     where = p.add_mutually_exclusive_group()
     where.add_argument("-o", "--output", metavar="FILE", help="write the page here (default: a new temporary file)")
     where.add_argument("--write-docs", action="store_true", help="update docs/results.md")

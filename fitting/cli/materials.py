@@ -20,8 +20,7 @@ def material_nk(args):
 
     given = [v is not None for v in (args.material, args.nk, args.page)]
     if sum(given) != 1:
-        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE",
-              file=sys.stderr)
+        print("error: give one of a library material name, --nk FILE or --page SHELF/BOOK/PAGE", file=sys.stderr)
         return None
     if args.nk is not None:
         path = Path(args.nk)

@@ -50,7 +50,8 @@ def load_plugins(value: str | None = None) -> list[str]:
                 importlib.import_module(name)
             else:
                 raise ValueError(
-                    f"`{PLUGINS_VARIABLE}` must list module names or .py files separated by commas, got {name!r}")
+                    f"`{PLUGINS_VARIABLE}` must list module names or .py files separated by commas, got {name!r}"
+                )
         except ImportError as error:
             raise ValueError(f"`{PLUGINS_VARIABLE}` names {name!r}, which cannot be imported: {error}") from error
     return names

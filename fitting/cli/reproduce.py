@@ -42,8 +42,7 @@ from .reproduce_worst import SHELF_SAMPLE, worst_point_section
 
 __all__ = ["PAPER_TABLE_1", "END_MARKER", "DOCS_PAGE", "reproduce_material", "reproduce", "write_page", "run"]
 
-END_MARKER = ("<!-- end of the part written by python -m fitting reproduce: "
-              "what follows is kept by --write-docs -->")
+END_MARKER = "<!-- end of the part written by python -m fitting reproduce: what follows is kept by --write-docs -->"
 """The line after which the results page is kept as it is when the page is written again."""
 DOCS_PAGE = Path(__file__).resolve().parents[2] / "docs" / "results.md"
 
@@ -156,10 +155,10 @@ def _figures(results: list[dict]) -> dict:
         "objective": d,
         "mean_f16": {objective: mean(f"ours_f16_{objective}") for objective in sorted({d, "rgb"})},
         "baseline_mean": {key: mean(key) for key in BASELINE_KEYS},
-        "beats_every_baseline": sum(all(r[f"ours_f16_{d}"].mean < r[k].mean for k in BASELINE_KEYS)
-                                    for r in results),
-        "conductor": {r["name"]: {"mean_f16": r[f"ours_f16_{d}"].mean, "max_f16": r[f"ours_f16_{d}"].max}
-                      for r in results},
+        "beats_every_baseline": sum(all(r[f"ours_f16_{d}"].mean < r[k].mean for k in BASELINE_KEYS) for r in results),
+        "conductor": {
+            r["name"]: {"mean_f16": r[f"ours_f16_{d}"].mean, "max_f16": r[f"ours_f16_{d}"].max} for r in results
+        },
         "float16_increase": increases,
         "float16_increase_max": max(v["increase"] for v in increases.values()),
     }

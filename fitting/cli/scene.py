@@ -112,7 +112,9 @@ def add_scene_parser(subparsers) -> argparse.ArgumentParser:
     )
     parser.add_argument("file", metavar="FILE", help="scene description (JSON)")
     parser.add_argument(
-        "-o", "--output", metavar="PACK",
+        "-o",
+        "--output",
+        metavar="PACK",
         help="write the scene pack here (.json: JSON view, else binary); never overwrites",
     )
     parser.add_argument("--json", action="store_true", help="print the JSON report")

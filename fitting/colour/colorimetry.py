@@ -129,9 +129,7 @@ def colour_science_constants() -> tuple[np.ndarray, np.ndarray]:
     XYZ_w = W_XYZ.sum(axis=1)
     acescg = colour.RGB_COLOURSPACES["ACEScg"]
     XYZ_wr = acescg.matrix_RGB_to_XYZ @ np.ones(3)
-    cat = colour.adaptation.matrix_chromatic_adaptation_VonKries(
-        XYZ_w, XYZ_wr, transform="CAT02"
-    )
+    cat = colour.adaptation.matrix_chromatic_adaptation_VonKries(XYZ_w, XYZ_wr, transform="CAT02")
     W = acescg.matrix_XYZ_to_RGB @ cat @ W_XYZ
     # A perfect reflector maps to (1, 1, 1) exactly.
     W /= W.sum(axis=1, keepdims=True)
@@ -229,16 +227,12 @@ def ACEScg_to_XYZ(RGB) -> np.ndarray:
 
 
 def _f_lab(t: np.ndarray) -> np.ndarray:
-    return np.where(
-        t > _DELTA3, np.cbrt(t), t / (3.0 * _DELTA * _DELTA) + 4.0 / 29.0
-    )
+    return np.where(t > _DELTA3, np.cbrt(t), t / (3.0 * _DELTA * _DELTA) + 4.0 / 29.0)
 
 
 def _df_lab(t: np.ndarray) -> np.ndarray:
     safe = np.maximum(t, _DELTA3)
-    return np.where(
-        t > _DELTA3, 1.0 / (3.0 * np.cbrt(safe) ** 2), 1.0 / (3.0 * _DELTA * _DELTA)
-    )
+    return np.where(t > _DELTA3, 1.0 / (3.0 * np.cbrt(safe) ** 2), 1.0 / (3.0 * _DELTA * _DELTA))
 
 
 def ACEScg_to_Lab(RGB) -> np.ndarray:

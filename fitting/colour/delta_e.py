@@ -52,18 +52,33 @@ def delta_E_2000(Lab_1, Lab_2) -> np.ndarray:
     C_p_1_m_2 = C_p_1 * C_p_2
     # colour-science's np.select (the first condition that holds, else 0) as
     # nested selections: the same values, a fraction of the time.
-    delta_h_p = np.where(C_p_1_m_2 == 0, 0, np.where(
-        np.fabs(h_p_2_s_1) <= 180, h_p_2_s_1, np.where(
-            h_p_2_s_1 > 180, h_p_2_s_1 - 360, np.where(h_p_2_s_1 < -180, h_p_2_s_1 + 360, 0))))
+    delta_h_p = np.where(
+        C_p_1_m_2 == 0,
+        0,
+        np.where(
+            np.fabs(h_p_2_s_1) <= 180,
+            h_p_2_s_1,
+            np.where(h_p_2_s_1 > 180, h_p_2_s_1 - 360, np.where(h_p_2_s_1 < -180, h_p_2_s_1 + 360, 0)),
+        ),
+    )
     delta_H_p = 2 * np.sqrt(C_p_1_m_2) * np.sin(np.deg2rad(delta_h_p / 2))
     L_bar_p = (L_1 + L_2) / 2
     C_bar_p = (C_p_1 + C_p_2) / 2
     a_h_p_1_s_2 = np.fabs(h_p_1 - h_p_2)
     h_p_1_a_2 = h_p_1 + h_p_2
-    h_bar_p = np.where(C_p_1_m_2 == 0, h_p_1_a_2, np.where(
-        a_h_p_1_s_2 <= 180, h_p_1_a_2 / 2, np.where(
-            (a_h_p_1_s_2 > 180) & (h_p_1_a_2 < 360), (h_p_1_a_2 + 360) / 2, np.where(
-                (a_h_p_1_s_2 > 180) & (h_p_1_a_2 >= 360), (h_p_1_a_2 - 360) / 2, 0))))
+    h_bar_p = np.where(
+        C_p_1_m_2 == 0,
+        h_p_1_a_2,
+        np.where(
+            a_h_p_1_s_2 <= 180,
+            h_p_1_a_2 / 2,
+            np.where(
+                (a_h_p_1_s_2 > 180) & (h_p_1_a_2 < 360),
+                (h_p_1_a_2 + 360) / 2,
+                np.where((a_h_p_1_s_2 > 180) & (h_p_1_a_2 >= 360), (h_p_1_a_2 - 360) / 2, 0),
+            ),
+        ),
+    )
     T = (
         1
         - 0.17 * np.cos(np.deg2rad(h_bar_p - 30))
@@ -114,13 +129,18 @@ def de2000_weights(Lab_ref: np.ndarray) -> np.ndarray:
     SL = 1.0 + 0.015 * (L - 50.0) ** 2 / np.sqrt(20.0 + (L - 50.0) ** 2)
     SC = 1.0 + 0.045 * C1
     T = (
-        1.0 - 0.17 * np.cos(np.radians(h_deg - 30.0)) + 0.24 * np.cos(np.radians(2.0 * h_deg))
-        + 0.32 * np.cos(np.radians(3.0 * h_deg + 6.0)) - 0.20 * np.cos(np.radians(4.0 * h_deg - 63.0))
+        1.0
+        - 0.17 * np.cos(np.radians(h_deg - 30.0))
+        + 0.24 * np.cos(np.radians(2.0 * h_deg))
+        + 0.32 * np.cos(np.radians(3.0 * h_deg + 6.0))
+        - 0.20 * np.cos(np.radians(4.0 * h_deg - 63.0))
     )
     SH = 1.0 + 0.015 * C1 * T
     C17 = C1**7
-    RT = -np.sin(np.radians(2.0 * 30.0 * np.exp(-(((h_deg - 275.0) / 25.0) ** 2)))) * 2.0 * np.sqrt(
-        C17 / (C17 + 25.0**7)
+    RT = (
+        -np.sin(np.radians(2.0 * 30.0 * np.exp(-(((h_deg - 275.0) / 25.0) ** 2))))
+        * 2.0
+        * np.sqrt(C17 / (C17 + 25.0**7))
     )
     A = np.zeros((L.size, 3, 3))
     A[:, 0, 0] = 1.0 / SL
@@ -195,30 +215,57 @@ def delta_E_2000_components(Lab_1, Lab_2) -> tuple[np.ndarray, np.ndarray]:
     C_p_1_m_2 = C_p_1 * C_p_2
     dC_p_1_m_2 = C_p_2[..., None] * dC_p_1 + C_p_1[..., None] * dC_p_2
     chroma = (C_p_1_m_2 != 0)[..., None]
-    delta_h_p = np.where(C_p_1_m_2 == 0, 0, np.where(
-        np.fabs(h_p_2_s_1) <= 180, h_p_2_s_1, np.where(
-            h_p_2_s_1 > 180, h_p_2_s_1 - 360, np.where(h_p_2_s_1 < -180, h_p_2_s_1 + 360, 0))))
+    delta_h_p = np.where(
+        C_p_1_m_2 == 0,
+        0,
+        np.where(
+            np.fabs(h_p_2_s_1) <= 180,
+            h_p_2_s_1,
+            np.where(h_p_2_s_1 > 180, h_p_2_s_1 - 360, np.where(h_p_2_s_1 < -180, h_p_2_s_1 + 360, 0)),
+        ),
+    )
     ddelta_h_p = np.where(chroma, dh_p_2 - dh_p_1, 0.0)
     root_m = np.sqrt(C_p_1_m_2)
     half = np.deg2rad(delta_h_p / 2)
     delta_H_p = 2 * root_m * np.sin(half)
-    ddelta_H_p = np.where(chroma, (np.sin(half) / safe(root_m))[..., None] * dC_p_1_m_2
-                          + (root_m * np.cos(half) / deg)[..., None] * ddelta_h_p, 0.0)
+    ddelta_H_p = np.where(
+        chroma,
+        (np.sin(half) / safe(root_m))[..., None] * dC_p_1_m_2 + (root_m * np.cos(half) / deg)[..., None] * ddelta_h_p,
+        0.0,
+    )
     L_bar_p = (L_1 + L_2) / 2
     C_bar_p = (C_p_1 + C_p_2) / 2
     dC_bar_p = (dC_p_1 + dC_p_2) / 2
     a_h_p_1_s_2 = np.fabs(h_p_1 - h_p_2)
     h_p_1_a_2 = h_p_1 + h_p_2
-    h_bar_p = np.where(C_p_1_m_2 == 0, h_p_1_a_2, np.where(
-        a_h_p_1_s_2 <= 180, h_p_1_a_2 / 2, np.where(
-            (a_h_p_1_s_2 > 180) & (h_p_1_a_2 < 360), (h_p_1_a_2 + 360) / 2, np.where(
-                (a_h_p_1_s_2 > 180) & (h_p_1_a_2 >= 360), (h_p_1_a_2 - 360) / 2, 0))))
+    h_bar_p = np.where(
+        C_p_1_m_2 == 0,
+        h_p_1_a_2,
+        np.where(
+            a_h_p_1_s_2 <= 180,
+            h_p_1_a_2 / 2,
+            np.where(
+                (a_h_p_1_s_2 > 180) & (h_p_1_a_2 < 360),
+                (h_p_1_a_2 + 360) / 2,
+                np.where((a_h_p_1_s_2 > 180) & (h_p_1_a_2 >= 360), (h_p_1_a_2 - 360) / 2, 0),
+            ),
+        ),
+    )
     dh_bar_p = np.where(chroma, (dh_p_1 + dh_p_2) / 2, dh_p_1 + dh_p_2)
     rad = np.deg2rad
-    T = (1 - 0.17 * np.cos(rad(h_bar_p - 30)) + 0.24 * np.cos(rad(2 * h_bar_p))
-         + 0.32 * np.cos(rad(3 * h_bar_p + 6)) - 0.20 * np.cos(rad(4 * h_bar_p - 63)))
-    dT_dh = (0.17 * np.sin(rad(h_bar_p - 30)) - 0.48 * np.sin(rad(2 * h_bar_p))
-             - 0.96 * np.sin(rad(3 * h_bar_p + 6)) + 0.80 * np.sin(rad(4 * h_bar_p - 63))) / deg
+    T = (
+        1
+        - 0.17 * np.cos(rad(h_bar_p - 30))
+        + 0.24 * np.cos(rad(2 * h_bar_p))
+        + 0.32 * np.cos(rad(3 * h_bar_p + 6))
+        - 0.20 * np.cos(rad(4 * h_bar_p - 63))
+    )
+    dT_dh = (
+        0.17 * np.sin(rad(h_bar_p - 30))
+        - 0.48 * np.sin(rad(2 * h_bar_p))
+        - 0.96 * np.sin(rad(3 * h_bar_p + 6))
+        + 0.80 * np.sin(rad(4 * h_bar_p - 63))
+    ) / deg
     dT = dT_dh[..., None] * dh_bar_p
     delta_theta = 30 * np.exp(-(((h_bar_p - 275) / 25) ** 2))
     ddelta_theta = (delta_theta * -2 * (h_bar_p - 275) / 625)[..., None] * dh_bar_p
@@ -233,17 +280,21 @@ def delta_E_2000_components(Lab_1, Lab_2) -> tuple[np.ndarray, np.ndarray]:
     S_H = 1 + 0.015 * C_bar_p * T
     dS_H = 0.015 * (T[..., None] * dC_bar_p + C_bar_p[..., None] * dT)
     R_T = -np.sin(rad(2 * delta_theta)) * R_C
-    dR_T = (-np.cos(rad(2 * delta_theta)) * 2 / deg * R_C)[..., None] * ddelta_theta \
-        - np.sin(rad(2 * delta_theta))[..., None] * dR_C
+    dR_T = (-np.cos(rad(2 * delta_theta)) * 2 / deg * R_C)[..., None] * ddelta_theta - np.sin(rad(2 * delta_theta))[
+        ..., None
+    ] * dR_C
     ell, c, h = (L_2 - L_1) / S_L, (C_p_2 - C_p_1) / S_C, delta_H_p / S_H
     dell = (dL_2 - ell[..., None] * dS_L) / S_L[..., None]
     dc = ((dC_p_2 - dC_p_1) - c[..., None] * dS_C) / S_C[..., None]
     dh = (ddelta_H_p - h[..., None] * dS_H) / S_H[..., None]
     s = np.sqrt(1 - R_T**2 / 4)
     v = np.stack([ell, c + R_T * h / 2, s * h], axis=-1)
-    dv = np.stack([
-        dell,
-        dc + (R_T / 2)[..., None] * dh + (h / 2)[..., None] * dR_T,
-        s[..., None] * dh - (R_T * h / (4 * s))[..., None] * dR_T,
-    ], axis=-2)
+    dv = np.stack(
+        [
+            dell,
+            dc + (R_T / 2)[..., None] * dh + (h / 2)[..., None] * dR_T,
+            s[..., None] * dh - (R_T * h / (4 * s))[..., None] * dR_T,
+        ],
+        axis=-2,
+    )
     return v, dv

@@ -27,7 +27,12 @@ import math
 import numpy as np
 
 from ..domain import (
-    DEFAULT_ETA_I_RANGE, DEFAULT_MIN_COVERAGE, ETA_I_MIN, VISIBLE_RANGE_NM, as_finite_array, check_choice,
+    DEFAULT_ETA_I_RANGE,
+    DEFAULT_MIN_COVERAGE,
+    ETA_I_MIN,
+    VISIBLE_RANGE_NM,
+    as_finite_array,
+    check_choice,
     check_step_nm,
 )
 from ..optics.fresnel import fresnel_conductor
@@ -35,8 +40,13 @@ from ..optics.nk import SpectralNK, resample_nk
 from .colorimetry import spectral_to_ACEScg_weights
 
 __all__ = [
-    "spectral_grid", "spectral_weights", "reference_ACEScg", "spectral_integral", "reference_ACEScg_grid",
-    "evaluation_grid", "DTYPES",
+    "spectral_grid",
+    "spectral_weights",
+    "reference_ACEScg",
+    "spectral_integral",
+    "reference_ACEScg_grid",
+    "evaluation_grid",
+    "DTYPES",
 ]
 
 
@@ -97,8 +107,15 @@ def reference_ACEScg(
     return spectral_integral(fresnel_conductor, nk, cos_theta, eta_i, step_nm, min_coverage)
 
 
-def spectral_integral(reflectance, nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
-                      min_coverage: float = DEFAULT_MIN_COVERAGE, chunk_values: int = 32_768) -> np.ndarray:
+def spectral_integral(
+    reflectance,
+    nk: SpectralNK,
+    cos_theta,
+    eta_i,
+    step_nm: float = 1.0,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    chunk_values: int = 32_768,
+) -> np.ndarray:
     """
     ``reflectance(mu (P, 1), eta_i (P, 1), n (L,), k (L,)) -> (P, L)`` of
     ``nk`` resampled at the ``step_nm`` nodes, integrated to linear ACEScg
@@ -114,9 +131,7 @@ def spectral_integral(reflectance, nk: SpectralNK, cos_theta, eta_i, step_nm: fl
     """
     nodes, W = spectral_weights(step_nm)
     sampled = resample_nk(nk, nodes, min_coverage)
-    mu, eta = np.broadcast_arrays(
-        as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
-    )
+    mu, eta = np.broadcast_arrays(as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i))
     if np.any(eta < ETA_I_MIN):
         raise ValueError(f"`eta_i` must be >= {ETA_I_MIN:g}, got {eta.min():g}")
     shape = mu.shape
@@ -157,24 +172,24 @@ def _fresnel_ACEScg_into(RE, s_t0, B, c, s, s2, sqrt2_mu, WT, buffers) -> np.nda
     np.subtract(RE, s_t0, out=t0, casting="same_kind")
     np.multiply(t0, t0, out=X)
     X += B
-    np.sqrt(X, out=X)                      # X = |eta^2 - s|
+    np.sqrt(X, out=X)  # X = |eta^2 - s|
     np.abs(t0, out=P)
     P += X
-    np.maximum(P, tiny, out=P)             # 0 only when index matched at grazing
+    np.maximum(P, tiny, out=P)  # 0 only when index matched at grazing
     np.divide(B, P, out=Q)
     np.greater_equal(t0, 0.0, out=positive)
-    np.copyto(Q, P, where=positive)        # Q = 2 a^2
+    np.copyto(Q, P, where=positive)  # Q = 2 a^2
     np.sqrt(Q, out=Q)
-    Q *= sqrt2_mu                          # Q = 2 mu a
-    np.add(X, c, out=P)                    # P = X + c
+    Q *= sqrt2_mu  # Q = 2 mu a
+    np.add(X, c, out=P)  # P = X + c
     X *= c
-    X += s2                                # X = c X + s^2
+    X += s2  # X = c X + s^2
     np.multiply(Q, s, out=t0)
-    t0 += X                                # t0 = c X + s^2 + 2 mu a s
+    t0 += X  # t0 = c X + s^2 + 2 mu a s
     np.subtract(P, Q, out=R)
-    R *= X                                 # numerator
+    R *= X  # numerator
     P += Q
-    P *= t0                                # denominator
+    P *= t0  # denominator
     # Zero only for the index-matched interface at grazing, where the
     # numerator is 0 too: R = 0, as the complex form gives.
     np.maximum(P, tiny, out=P)
@@ -198,8 +213,13 @@ def _buffers(rows: int, L: int, dtype) -> tuple:
     """
     dtype = np.dtype(dtype)
     R64 = None if dtype == np.float64 else np.empty((rows, L))
-    return (*(np.empty((rows, L), dtype) for _ in range(5)), np.empty((rows, L), dtype=bool),
-            R64, np.empty((rows, 3)), np.finfo(dtype).tiny)
+    return (
+        *(np.empty((rows, L), dtype) for _ in range(5)),
+        np.empty((rows, L), dtype=bool),
+        R64,
+        np.empty((rows, 3)),
+        np.finfo(dtype).tiny,
+    )
 
 
 def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out, loop_mu: bool, dtype=np.float64) -> None:
@@ -254,7 +274,7 @@ def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out, loop_mu: bool, dtype=np.floa
             out[:, j] = _fresnel_ACEScg_into(RE, s, B, c, s, s * s, math.sqrt(2.0) * m, WT, buffers)
         return
     for m0 in range(0, mu.size, _BLOCK):
-        m = mu[m0:m0 + _BLOCK]
+        m = mu[m0 : m0 + _BLOCK]
         c = (m * m)[:, None]
         s_t0 = 1.0 - c
         s2, sqrt2_mu = s_t0 * s_t0, (math.sqrt(2.0) * m)[:, None]
@@ -263,8 +283,7 @@ def _fresnel_ACEScg_block(mu, eta_i, n, k, WT, out, loop_mu: bool, dtype=np.floa
         for i, e in enumerate(eta_i.tolist()):
             e2 = e * e
             B = (im0 / (e2 * e2)).astype(dtype, copy=False)
-            out[i, m0:m0 + m.size] = _fresnel_ACEScg_into(
-                re0 / e2, s_t0, B, c, s, s2, sqrt2_mu, WT, buffers)
+            out[i, m0 : m0 + m.size] = _fresnel_ACEScg_into(re0 / e2, s_t0, B, c, s, s2, sqrt2_mu, WT, buffers)
 
 
 def reference_ACEScg_grid(
@@ -327,9 +346,7 @@ def reference_ACEScg_grid(
     sampled = resample_nk(nk, nodes, min_coverage)
     mu_u, mu_inverse = np.unique(mu, return_inverse=True)
     eta_u, eta_inverse = np.unique(eta, return_inverse=True)
-    nk_u, nk_inverse = np.unique(
-        np.stack([sampled.n, sampled.k], axis=1), axis=0, return_inverse=True
-    )
+    nk_u, nk_inverse = np.unique(np.stack([sampled.n, sampled.k], axis=1), axis=0, return_inverse=True)
     WT = np.zeros((nk_u.shape[0], 3))
     np.add.at(WT, nk_inverse.reshape(-1), W.T)
     n, k = nk_u[:, 0].copy(), nk_u[:, 1].copy()

@@ -38,7 +38,10 @@ SEEN_ANGLES_DEG.setflags(write=False)
 
 
 def seen_ACEScg(
-    nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
+    nk: SpectralNK,
+    cos_theta,
+    eta_i,
+    step_nm: float = 1.0,
     min_coverage: float = DEFAULT_MIN_COVERAGE,
 ) -> np.ndarray:
     """

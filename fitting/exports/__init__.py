@@ -36,8 +36,7 @@ and written in one working space (:data:`WORKING_SPACES`).
 
 from __future__ import annotations
 
-from .formats import (EXPORT_FORMATS, ExportFormat, export_format, register_export_format,
-                      unregister_export_format)
+from .formats import EXPORT_FORMATS, ExportFormat, export_format, register_export_format, unregister_export_format
 from .colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES, check_working_space
 from .seen_fit import seen_fidelity
 from .tool_fresnel import TOOL_MODELS, export_fidelity, tool_curve
@@ -64,14 +63,21 @@ __all__ = [
     "tool_curve",
 ]
 
+
 def check_format(format: str) -> str:
     """``format`` if it is one of :data:`EXPORT_FORMATS`, else ``ValueError``."""
     return export_format(format).name
 
 
 def export_material(
-    fit_or_nk, format: str, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
-    model=None, fit_id: str | None = None, working_space: str | None = None,
+    fit_or_nk,
+    format: str,
+    eta_i,
+    roughness: float = 0.2,
+    coat_roughness: float = 0.03,
+    model=None,
+    fit_id: str | None = None,
+    working_space: str | None = None,
 ) -> bytes:
     """
     The export of a material for one coating index, as bytes (UTF-8 text but for ``glb``).
@@ -114,9 +120,7 @@ def export_material(
     eta = check_eta_i(eta_i)
     if isinstance(fit_or_nk, ExportValues):
         if abs(fit_or_nk.eta_i - eta) > 1e-12:
-            raise ValueError(
-                f"`eta_i` must be the values' own {fit_or_nk.eta_i:g} for ExportValues, got {eta_i}"
-            )
+            raise ValueError(f"`eta_i` must be the values' own {fit_or_nk.eta_i:g} for ExportValues, got {eta_i}")
         values = fit_or_nk
         if working_space is not None and check_working_space(working_space) != values.working_space:
             raise ValueError(
@@ -130,6 +134,14 @@ def export_material(
                 f"{format} export (export_values(..., tools=None) fits them all)"
             )
     else:
-        values = export_values(fit_or_nk, eta, roughness, coat_roughness, model, writer.tools,
-                               fit_id=fit_id, working_space=working_space or DEFAULT_WORKING_SPACE)
+        values = export_values(
+            fit_or_nk,
+            eta,
+            roughness,
+            coat_roughness,
+            model,
+            writer.tools,
+            fit_id=fit_id,
+            working_space=working_space or DEFAULT_WORKING_SPACE,
+        )
     return writer.document(values)

@@ -52,8 +52,9 @@ def document(provenance: dict, identity: dict) -> ET.Element:
     The ``materialx`` element: its ``colorspace`` the export's working space
     (every colour in it is in that space) and the identity attributes.
     """
-    root = ET.Element("materialx", version=MATERIALX_VERSION, colorspace=identity["working_space"],
-                      **identity_attributes(identity))
+    root = ET.Element(
+        "materialx", version=MATERIALX_VERSION, colorspace=identity["working_space"], **identity_attributes(identity)
+    )
     root.append(ET.Comment(comment_text(provenance)))
     return root
 

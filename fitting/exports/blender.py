@@ -263,10 +263,8 @@ def _floats(values) -> tuple[float, ...]:
 def blender_script(values: ExportValues) -> str:
     """The Blender Python script of ``values``, UTF-8 text."""
     provenance = values.provenance(MODEL_KIND, seen_fidelity(values, "blender"))
-    provenance["delta_E_2000_seen_physical_conductor"] = (
-        "mean {delta_E_mean:.3f}, max {delta_E_max:.3f}".format(
-            **seen_fidelity(values, "blender-conductor")
-        )
+    provenance["delta_E_2000_seen_physical_conductor"] = "mean {delta_E_mean:.3f}, max {delta_E_max:.3f}".format(
+        **seen_fidelity(values, "blender-conductor")
     )
     principled, conductor = values.tools["blender"], values.tools["blender-conductor"]
     header = "\n".join(

@@ -53,8 +53,7 @@ def node_values(material) -> dict:
     custom = material.get("coated_fresnel")
     # The glTF importer keeps a material's extras as a property group.
     custom = custom.to_dict() if hasattr(custom, "to_dict") else custom
-    return {"material": material.name, "nodes": out, "links": links,
-            "custom": {"coated_fresnel": custom}}
+    return {"material": material.name, "nodes": out, "links": links, "custom": {"coated_fresnel": custom}}
 
 
 def render_sphere(material, path: str, size: int, samples: int, sphere=None) -> None:

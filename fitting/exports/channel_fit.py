@@ -86,8 +86,7 @@ def _per_channel(mu: np.ndarray, T: np.ndarray, model, jacobian, x0, lo, hi) -> 
         J[rows, 2 * col], J[rows, 2 * col + 1] = D[:, 0], D[:, 1]
         return J
 
-    fit = least_squares(residuals, np.ravel(x0), jac=jac, bounds=(np.tile(lo, 3), np.tile(hi, 3)), method="trf",
-                        **_TOL)
+    fit = least_squares(residuals, np.ravel(x0), jac=jac, bounds=(np.tile(lo, 3), np.tile(hi, 3)), method="trf", **_TOL)
     return fit.x.reshape(3, 2)
 
 
@@ -100,8 +99,15 @@ def fit_channel_conductor(mu: np.ndarray, T: np.ndarray, joint: bool = False) ->
     if joint:
         F0 = np.clip(T[np.argmax(mu)], 0.0, 0.999)
         x0 = np.clip(np.stack([np.ones(3), np.sqrt(4.0 * F0 / (1.0 - F0))], axis=1), lo, hi)
-        x = _per_channel(mu, T, lambda m, n, k: fresnel_conductor(m[:, None], 1.0, n, k), _conductor_jacobian,
-                         x0, np.asarray(lo), np.asarray(hi))
+        x = _per_channel(
+            mu,
+            T,
+            lambda m, n, k: fresnel_conductor(m[:, None], 1.0, n, k),
+            _conductor_jacobian,
+            x0,
+            np.asarray(lo),
+            np.asarray(hi),
+        )
         return x[:, 0].copy(), x[:, 1].copy()
     n_out, k_out = np.empty(3), np.empty(3)
     for c in range(3):
@@ -110,8 +116,12 @@ def fit_channel_conductor(mu: np.ndarray, T: np.ndarray, joint: bool = False) ->
         F0 = float(np.clip(R[np.argmax(mu)], 0.0, 0.999))
         x0 = np.clip([1.0, np.sqrt(4.0 * F0 / (1.0 - F0))], lo, hi)
         fit = least_squares(
-            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R, x0, jac=lambda x: _conductor_jacobian(mu, x),
-            bounds=(lo, hi), method="trf", **_TOL,
+            lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R,
+            x0,
+            jac=lambda x: _conductor_jacobian(mu, x),
+            bounds=(lo, hi),
+            method="trf",
+            **_TOL,
         )
         n_out[c], k_out[c] = fit.x
     return n_out, k_out
@@ -129,8 +139,12 @@ def fit_channel_f82(mu: np.ndarray, T: np.ndarray, joint: bool = False) -> tuple
         R = T[:, c]
         x0 = np.clip([R[np.argmax(mu)], 1.0], 0.0, 1.0)
         fit = least_squares(
-            lambda x: f82_tint(mu, x[0], x[1]) - R, x0, jac=lambda x: _f82_jacobian(mu, x),
-            bounds=([0.0, 0.0], [1.0, 1.0]), method="trf", **_TOL,
+            lambda x: f82_tint(mu, x[0], x[1]) - R,
+            x0,
+            jac=lambda x: _f82_jacobian(mu, x),
+            bounds=([0.0, 0.0], [1.0, 1.0]),
+            method="trf",
+            **_TOL,
         )
         F0[c], tint[c] = fit.x
     return F0, tint

@@ -26,8 +26,13 @@ import numpy as np
 from ..colour.colorimetry import colour_science
 
 __all__ = [
-    "WORKING_SPACES", "DEFAULT_WORKING_SPACE", "check_working_space",
-    "ACEScg_to_lin_rec709", "lin_rec709_to_ACEScg", "ACEScg_to_working", "working_to_ACEScg",
+    "WORKING_SPACES",
+    "DEFAULT_WORKING_SPACE",
+    "check_working_space",
+    "ACEScg_to_lin_rec709",
+    "lin_rec709_to_ACEScg",
+    "ACEScg_to_working",
+    "working_to_ACEScg",
 ]
 
 WORKING_SPACES = ("lin_rec709", "acescg")
@@ -38,18 +43,14 @@ DEFAULT_WORKING_SPACE = "lin_rec709"
 def check_working_space(working_space) -> str:
     """``working_space`` if one of :data:`WORKING_SPACES`, else ``ValueError`` naming the rule."""
     if working_space not in WORKING_SPACES:
-        raise ValueError(
-            f"`working_space` must be one of {', '.join(WORKING_SPACES)}, got {working_space!r}"
-        )
+        raise ValueError(f"`working_space` must be one of {', '.join(WORKING_SPACES)}, got {working_space!r}")
     return working_space
 
 
 @functools.cache
 def _ACEScg_to_rec709() -> np.ndarray:
     colour = colour_science()
-    M = colour.RGB_to_RGB(
-        np.eye(3), "ACEScg", "ITU-R BT.709", chromatic_adaptation_transform="CAT02"
-    ).T
+    M = colour.RGB_to_RGB(np.eye(3), "ACEScg", "ITU-R BT.709", chromatic_adaptation_transform="CAT02").T
     M.setflags(write=False)
     return M
 

@@ -34,8 +34,15 @@ from .mtlx import mtlx_document
 from .openpbr import openpbr_document
 from .values import ExportValues
 
-__all__ = ["ExportFormat", "EXPORT_FORMATS", "EXPORT_OPTIONS", "register_export_format",
-           "unregister_export_format", "export_format", "describe_export_formats"]
+__all__ = [
+    "ExportFormat",
+    "EXPORT_FORMATS",
+    "EXPORT_OPTIONS",
+    "register_export_format",
+    "unregister_export_format",
+    "export_format",
+    "describe_export_formats",
+]
 
 EXPORT_OPTIONS = ("eta_i", "roughness", "coat_roughness", "working_space")
 """The options every export takes: the coating index, the two perceptual roughnesses and the
@@ -110,22 +117,65 @@ def export_format(name: str) -> ExportFormat:
 
 def describe_export_formats() -> list[dict]:
     """The registry for clients (``GET /api/v1/domain``): name, label, media type, extension, options."""
-    return [{"name": f.name, "label": f.label, "media_type": f.media_type, "extension": f.extension,
-             "options": list(f.options)} for f in EXPORT_FORMATS.values()]
+    return [
+        {
+            "name": f.name,
+            "label": f.label,
+            "media_type": f.media_type,
+            "extension": f.extension,
+            "options": list(f.options),
+        }
+        for f in EXPORT_FORMATS.values()
+    ]
 
 
-register_export_format(ExportFormat(
-    name="mtlx", label="MaterialX, conductor under a coat (.mtlx)", media_type="application/xml",
-    extension="mtlx", tools=("mtlx",), write=mtlx_document))
-register_export_format(ExportFormat(
-    name="openpbr", label="OpenPBR surface, MaterialX (.openpbr.mtlx)", media_type="application/xml",
-    extension="openpbr.mtlx", tools=("openpbr",), write=openpbr_document))
-register_export_format(ExportFormat(
-    name="blender", label="Blender script (.py)", media_type="text/x-python; charset=utf-8",
-    extension="py", tools=("blender", "blender-conductor"), write=blender_script))
-register_export_format(ExportFormat(
-    name="gltf", label="glTF asset (.gltf)", media_type="model/gltf+json",
-    extension="gltf", tools=("gltf",), write=gltf_document))
-register_export_format(ExportFormat(
-    name="glb", label="glTF binary asset (.glb)", media_type="model/gltf-binary",
-    extension="glb", tools=("gltf",), write=glb_document))
+register_export_format(
+    ExportFormat(
+        name="mtlx",
+        label="MaterialX, conductor under a coat (.mtlx)",
+        media_type="application/xml",
+        extension="mtlx",
+        tools=("mtlx",),
+        write=mtlx_document,
+    )
+)
+register_export_format(
+    ExportFormat(
+        name="openpbr",
+        label="OpenPBR surface, MaterialX (.openpbr.mtlx)",
+        media_type="application/xml",
+        extension="openpbr.mtlx",
+        tools=("openpbr",),
+        write=openpbr_document,
+    )
+)
+register_export_format(
+    ExportFormat(
+        name="blender",
+        label="Blender script (.py)",
+        media_type="text/x-python; charset=utf-8",
+        extension="py",
+        tools=("blender", "blender-conductor"),
+        write=blender_script,
+    )
+)
+register_export_format(
+    ExportFormat(
+        name="gltf",
+        label="glTF asset (.gltf)",
+        media_type="model/gltf+json",
+        extension="gltf",
+        tools=("gltf",),
+        write=gltf_document,
+    )
+)
+register_export_format(
+    ExportFormat(
+        name="glb",
+        label="glTF binary asset (.glb)",
+        media_type="model/gltf-binary",
+        extension="glb",
+        tools=("gltf",),
+        write=glb_document,
+    )
+)

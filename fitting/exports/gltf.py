@@ -58,8 +58,7 @@ from .values import ExportValues
 __all__ = ["MODEL_KIND", "GLTF_COAT_IOR", "gltf_document", "glb_document", "glb_bytes", "gltf_material", "uv_sphere"]
 
 MODEL_KIND = (
-    "metallic base colour and clear coat factor, fitted under three.js's clear coat to the "
-    "coated metal seen from air"
+    "metallic base colour and clear coat factor, fitted under three.js's clear coat to the coated metal seen from air"
 )
 GLTF_COAT_IOR = 1.5
 """The index of refraction glTF's KHR_materials_clearcoat assumes."""
@@ -101,10 +100,12 @@ def _padded(data: bytes) -> bytes:
 def gltf_document(values: ExportValues) -> str:
     """The glTF 2.0 asset of ``values`` as JSON text."""
     asset, buffer = _asset(values)
-    asset["buffers"] = [{
-        "byteLength": len(buffer),
-        "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii"),
-    }]
+    asset["buffers"] = [
+        {
+            "byteLength": len(buffer),
+            "uri": "data:application/octet-stream;base64," + base64.b64encode(buffer).decode("ascii"),
+        }
+    ]
     return json.dumps(asset, indent=1) + "\n"
 
 
@@ -125,11 +126,15 @@ def glb_bytes(asset: dict, buffer: bytes) -> bytes:
     text += b" " * (-len(text) % 4)
     binary = _padded(buffer)
     total = 12 + 8 + len(text) + 8 + len(binary)
-    return b"".join([
-        struct.pack("<4sII", b"glTF", 2, total),
-        struct.pack("<II", len(text), _CHUNK_JSON), text,
-        struct.pack("<II", len(binary), _CHUNK_BIN), binary,
-    ])
+    return b"".join(
+        [
+            struct.pack("<4sII", b"glTF", 2, total),
+            struct.pack("<II", len(text), _CHUNK_JSON),
+            text,
+            struct.pack("<II", len(binary), _CHUNK_BIN),
+            binary,
+        ]
+    )
 
 
 def gltf_material(values: ExportValues) -> tuple[dict, list[str], dict]:
@@ -141,8 +146,9 @@ def gltf_material(values: ExportValues) -> tuple[dict, list[str], dict]:
     if coat_on:
         provenance["clearcoat_ior_assumed_by_gltf"] = GLTF_COAT_IOR
     if coat_on and values.seen_rough_ACEScg is not None:
-        dE = gltf_seen_delta_E(fitted, values.view_cos, values.eta_i, values.seen_rough_ACEScg,
-                               values.roughness, values.working_space)
+        dE = gltf_seen_delta_E(
+            fitted, values.view_cos, values.eta_i, values.seen_rough_ACEScg, values.roughness, values.working_space
+        )
         provenance["delta_E_2000_seen_at_roughness"] = (
             f"mean {dE.mean():.3f}, max {dE.max():.3f} at the metal's roughness "
             f"{values.roughness:g} under a smooth coat (what the values are fitted to)"
@@ -168,8 +174,14 @@ def sphere_buffer() -> tuple[bytes, list[dict], list[dict]]:
         for i, target in enumerate((_ARRAY_BUFFER, _ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER))
     ]
     accessors = [
-        {"bufferView": 0, "componentType": _FLOAT, "count": len(positions), "type": "VEC3",
-         "min": positions.min(axis=0).tolist(), "max": positions.max(axis=0).tolist()},
+        {
+            "bufferView": 0,
+            "componentType": _FLOAT,
+            "count": len(positions),
+            "type": "VEC3",
+            "min": positions.min(axis=0).tolist(),
+            "max": positions.max(axis=0).tolist(),
+        },
         {"bufferView": 1, "componentType": _FLOAT, "count": len(normals), "type": "VEC3"},
         {"bufferView": 2, "componentType": _UNSIGNED_SHORT, "count": len(indices), "type": "SCALAR"},
     ]
@@ -189,7 +201,8 @@ def _material(values: ExportValues, fitted: dict, coat_on: bool, provenance: dic
     used = []
     if coat_on:
         material["extensions"]["KHR_materials_clearcoat"] = clearcoat_object(
-            values.eta_i, values.coat_roughness, fitted["clearcoat"])
+            values.eta_i, values.coat_roughness, fitted["clearcoat"]
+        )
         used += ["KHR_materials_clearcoat", CLEARCOAT_IOR]
     if values.model is not None:
         extension, why_not = coated_conductor_extension(values.model, values.eta_i)
@@ -218,10 +231,12 @@ def _asset(values: ExportValues) -> tuple[dict, bytes]:
         "scene": 0,
         "scenes": [{"nodes": [0]}],
         "nodes": [{"mesh": 0, "name": "sphere"}],
-        "meshes": [{
-            "name": "sphere",
-            "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}],
-        }],
+        "meshes": [
+            {
+                "name": "sphere",
+                "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": 0}],
+            }
+        ],
         "materials": [material],
         "accessors": accessors,
         "bufferViews": views,

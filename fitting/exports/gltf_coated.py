@@ -35,14 +35,24 @@ from pathlib import Path
 from ..models.kinds import model_kind
 from ..models.pack import PackedMaterial, material_to_json
 
-__all__ = ["EXTENSION_NAME", "CLEARCOAT_IOR", "SCHEMA_PATH", "coated_conductor_extension", "clearcoat_object",
-           "coat_of"]
+__all__ = [
+    "EXTENSION_NAME",
+    "CLEARCOAT_IOR",
+    "SCHEMA_PATH",
+    "coated_conductor_extension",
+    "clearcoat_object",
+    "coat_of",
+]
 
 EXTENSION_NAME = "EXT_materials_coated_conductor"
 CLEARCOAT_IOR = "KHR_materials_clearcoat_ior"
 """The draft extension (KhronosGroup/glTF pull request 2530) carrying the coat's index, nested in the clear coat."""
 SCHEMA_PATH = (
-    Path(__file__).resolve().parents[2] / "docs" / "gltf" / EXTENSION_NAME / "schema"
+    Path(__file__).resolve().parents[2]
+    / "docs"
+    / "gltf"
+    / EXTENSION_NAME
+    / "schema"
     / f"material.{EXTENSION_NAME}.schema.json"
 )
 """The extension's JSON Schema (draft 2020-12)."""

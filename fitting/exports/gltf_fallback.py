@@ -74,8 +74,9 @@ def _curve(cos_model, model_ACEScg):
     return fresnel
 
 
-def rough_seen_ACEScg(view_cos, eta: float, seen_ACEScg, cos_model, model_ACEScg,
-                      roughness: float, rough_nodes: int | None = ROUGH_NODES) -> np.ndarray:
+def rough_seen_ACEScg(
+    view_cos, eta: float, seen_ACEScg, cos_model, model_ACEScg, roughness: float, rough_nodes: int | None = ROUGH_NODES
+) -> np.ndarray:
     """
     The coated metal seen from air at view cosines ``view_cos`` (S,) with a
     metal of perceptual ``roughness`` under a smooth coat of index ``eta``,
@@ -96,14 +97,20 @@ def rough_seen_ACEScg(view_cos, eta: float, seen_ACEScg, cos_model, model_ACEScg
     return np.maximum(seen + change, 0.0)
 
 
-def gltf_seen_delta_E(values: dict, view_cos, eta: float, target_ACEScg, roughness: float = 0.0,
-                      space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+def gltf_seen_delta_E(
+    values: dict, view_cos, eta: float, target_ACEScg, roughness: float = 0.0, space: str = DEFAULT_WORKING_SPACE
+) -> np.ndarray:
     """
     Delta E 2000 per angle of the glTF ``values`` (``base_color``,
     ``clearcoat``, ``coat``, in the working space ``space``) drawn by three
     at metal ``roughness`` with a smooth coat, against ``target_ACEScg``
     (:func:`rough_seen_ACEScg` at that roughness).
     """
-    rgb = three_clearcoat(view_cos, values["base_color"], values.get("clearcoat", 1.0),
-                          bool(values.get("coat", eta > 1.0)), roughness=roughness)
+    rgb = three_clearcoat(
+        view_cos,
+        values["base_color"],
+        values.get("clearcoat", 1.0),
+        bool(values.get("coat", eta > 1.0)),
+        roughness=roughness,
+    )
     return delta_E_map(target_ACEScg, working_to_ACEScg(rgb, space))

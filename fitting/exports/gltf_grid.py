@@ -54,14 +54,15 @@ def grid_asset(rows: list[list[ExportValues]], generator: str) -> tuple[dict, by
             used += [name for name in extensions if name not in used]
             index = len(materials)
             materials.append(material)
-            meshes.append({
-                "name": material["name"],
-                "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": index}],
-            })
+            meshes.append(
+                {
+                    "name": material["name"],
+                    "primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "material": index}],
+                }
+            )
             x = (c - (len(row) - 1) / 2) * SPACING
             y = ((len(rows) - 1) / 2 - r) * SPACING
-            nodes.append({"name": f"{values.name} eta_i {values.eta_i:g}", "mesh": index,
-                          "translation": [x, y, 0.0]})
+            nodes.append({"name": f"{values.name} eta_i {values.eta_i:g}", "mesh": index, "translation": [x, y, 0.0]})
     asset = {
         "asset": {"version": "2.0", "generator": generator},
         **({"extensionsUsed": used} if used else {}),

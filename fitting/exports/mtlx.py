@@ -105,17 +105,44 @@ def mtlx_document(values: ExportValues) -> str:
     coat_on = fitted["coat"]
 
     nodedef = ET.SubElement(
-        root, "nodedef", name=nodedef_name, node=node, nodegroup="pbr",
-        doc=(f"{values.name} under a clear coat: conductor_bsdf, dielectric_bsdf coat" if coat_on
-             else f"{values.name}: conductor_bsdf, no coat"),
+        root,
+        "nodedef",
+        name=nodedef_name,
+        node=node,
+        nodegroup="pbr",
+        doc=(
+            f"{values.name} under a clear coat: conductor_bsdf, dielectric_bsdf coat"
+            if coat_on
+            else f"{values.name}: conductor_bsdf, no coat"
+        ),
     )
-    add_input(nodedef, "base_roughness", "float", value=number(values.roughness),
-              uimin="0.0", uimax="1.0", uiname="Metal Roughness")
+    add_input(
+        nodedef,
+        "base_roughness",
+        "float",
+        value=number(values.roughness),
+        uimin="0.0",
+        uimax="1.0",
+        uiname="Metal Roughness",
+    )
     if coat_on:
-        add_input(nodedef, "coat_roughness", "float", value=number(values.coat_roughness),
-                  uimin="0.0", uimax="1.0", uiname="Coat Roughness")
-        add_input(nodedef, "coat_ior", "float", value=number(values.eta_i), uiname="Coat IOR",
-                  doc="The metal's values are fitted for this coat index; change it and re-export")
+        add_input(
+            nodedef,
+            "coat_roughness",
+            "float",
+            value=number(values.coat_roughness),
+            uimin="0.0",
+            uimax="1.0",
+            uiname="Coat Roughness",
+        )
+        add_input(
+            nodedef,
+            "coat_ior",
+            "float",
+            value=number(values.eta_i),
+            uiname="Coat IOR",
+            doc="The metal's values are fitted for this coat index; change it and re-export",
+        )
     ET.SubElement(nodedef, "output", name="out", type="surfaceshader")
 
     graph = ET.SubElement(root, "nodegraph", name=f"NG_{node}", nodedef=nodedef_name)
@@ -144,7 +171,10 @@ def mtlx_document(values: ExportValues) -> str:
         add_input(shader, "coat_roughness", "float", value=number(values.coat_roughness))
         add_input(shader, "coat_ior", "float", value=number(values.eta_i))
     material = ET.SubElement(
-        root, "surfacematerial", name=ident, type="material",
+        root,
+        "surfacematerial",
+        name=ident,
+        type="material",
         doc="; ".join(f"{k}: {v}" for k, v in provenance.items()),
         **identity_attributes(identity(values, with_pack=True)),
     )

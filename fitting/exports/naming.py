@@ -31,8 +31,16 @@ import numpy as np
 from ..models.pack import encode_pack
 from ._xml import element_name
 
-__all__ = ["FIT_ID_LENGTH", "SHORT_ID_LENGTH", "export_id", "eta_tag", "element_stem", "identity",
-           "check_fit_id", "carried_pack"]
+__all__ = [
+    "FIT_ID_LENGTH",
+    "SHORT_ID_LENGTH",
+    "export_id",
+    "eta_tag",
+    "element_stem",
+    "identity",
+    "check_fit_id",
+    "carried_pack",
+]
 
 FIT_ID_LENGTH = 32
 """Hex digits of a fit id (SHA-256, as the service's content addresses)."""

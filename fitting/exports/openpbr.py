@@ -64,7 +64,10 @@ def openpbr_document(values: ExportValues) -> str:
     ):
         add_input(shader, name, type_, value=value)
     material = ET.SubElement(
-        root, "surfacematerial", name=ident, type="material",
+        root,
+        "surfacematerial",
+        name=ident,
+        type="material",
         doc="; ".join(f"{k}: {v}" for k, v in provenance.items()),
         **identity_attributes(identity(values, with_pack=True)),
     )

@@ -78,8 +78,9 @@ class ReadBack:
 
 def _carried(text, where: str) -> PackedMaterial:
     if not isinstance(text, str) or not text:
-        raise ValueError(f"`file` carries no fit model ({where}): not an export of this service, "
-                         "or one made without its fit")
+        raise ValueError(
+            f"`file` carries no fit model ({where}): not an export of this service, or one made without its fit"
+        )
     try:
         data = base64.b64decode(text.encode("ascii"), validate=True)
     except (binascii.Error, UnicodeEncodeError):
@@ -126,10 +127,15 @@ def _gltf(asset, format: str) -> ReadBack:
     extension = (material.get("extensions") or {}).get(EXTENSION_NAME)
     if extension is not None:
         try:
-            carried = material_from_json({"name": model.name, "model": extension["kind"],
-                                          "eta_i_range": extension["etaIRange"],
-                                          "coefficients": extension["coefficients"],
-                                          **({"degree": extension["degree"]} if "degree" in extension else {})})
+            carried = material_from_json(
+                {
+                    "name": model.name,
+                    "model": extension["kind"],
+                    "eta_i_range": extension["etaIRange"],
+                    "coefficients": extension["coefficients"],
+                    **({"degree": extension["degree"]} if "degree" in extension else {}),
+                }
+            )
         except (KeyError, TypeError, ValueError) as error:
             raise ValueError(f"`file` has a damaged {EXTENSION_NAME}: {error}") from None
         if carried.model != model.model or carried.coefficients.tobytes() != model.coefficients.tobytes():
@@ -139,8 +145,10 @@ def _gltf(asset, format: str) -> ReadBack:
         except (AttributeError, TypeError, ValueError) as error:
             raise ValueError(f"`file` has a damaged KHR_materials_clearcoat: {error}") from None
         if abs(eta - identity["eta_i"]) > 1e-9:
-            raise ValueError(f"`file` is inconsistent: the coat index {EXTENSION_NAME} is drawn under "
-                             f"(KHR_materials_clearcoat, {CLEARCOAT_IOR}) is not the export's eta_i")
+            raise ValueError(
+                f"`file` is inconsistent: the coat index {EXTENSION_NAME} is drawn under "
+                f"(KHR_materials_clearcoat, {CLEARCOAT_IOR}) is not the export's eta_i"
+            )
     return ReadBack(format, [model], identity)
 
 
@@ -155,7 +163,7 @@ def _glb(data: bytes) -> ReadBack:
     chunk_length, chunk_type = struct.unpack_from("<II", data, 12)
     if chunk_type != _GLB_JSON or 20 + chunk_length > len(data):
         raise ValueError("`file` is a damaged GLB: its first chunk is not a whole JSON chunk")
-    return _gltf(_json(data[20:20 + chunk_length]), "glb")
+    return _gltf(_json(data[20 : 20 + chunk_length]), "glb")
 
 
 def _materialx(text: str) -> ReadBack:
@@ -176,15 +184,22 @@ def _materialx(text: str) -> ReadBack:
         raise ValueError(f"`file` is inconsistent: the document and the material differ in {', '.join(differing)}")
     identity = _identity(found, "MaterialX attributes")
     if root.get("colorspace") != identity["working_space"]:
-        raise ValueError(f"`file` is inconsistent: colorspace {root.get('colorspace')!r} is not the "
-                         f"export's working space {identity['working_space']!r}")
+        raise ValueError(
+            f"`file` is inconsistent: colorspace {root.get('colorspace')!r} is not the "
+            f"export's working space {identity['working_space']!r}"
+        )
     model = _carried(found.get("pack"), IDENTITY_ATTRIBUTES["pack"])
-    shaders = [node for node in root if node.tag not in ("nodedef", "nodegraph", "surfacematerial")
-               and node.get("type") == "surfaceshader"]
+    shaders = [
+        node
+        for node in root
+        if node.tag not in ("nodedef", "nodegraph", "surfacematerial") and node.get("type") == "surfaceshader"
+    ]
     coat = [i for shader in shaders for i in shader.findall("input") if i.get("name") == "coat_ior"]
     if coat and abs(float(coat[0].get("value", "nan")) - identity["eta_i"]) > 5e-6 * identity["eta_i"]:
-        raise ValueError(f"`file` is inconsistent: its coat_ior {coat[0].get('value')} is not the "
-                         f"export's eta_i {identity['eta_i']:g}")
+        raise ValueError(
+            f"`file` is inconsistent: its coat_ior {coat[0].get('value')} is not the "
+            f"export's eta_i {identity['eta_i']:g}"
+        )
     openpbr = any(shader.tag == "open_pbr_surface" for shader in shaders)
     return ReadBack("openpbr" if openpbr else "mtlx", [model], identity)
 
@@ -196,8 +211,12 @@ def _blender(text: str) -> ReadBack:
     except SyntaxError as error:
         raise ValueError(f"`file` is a damaged Blender script: {error.msg} at line {error.lineno}") from None
     for node in tree.body:
-        if (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)
-                and node.targets[0].id in ("IDENTITY", "PACK", "ETA_I", "WORKING_SPACE")):
+        if (
+            isinstance(node, ast.Assign)
+            and len(node.targets) == 1
+            and isinstance(node.targets[0], ast.Name)
+            and node.targets[0].id in ("IDENTITY", "PACK", "ETA_I", "WORKING_SPACE")
+        ):
             try:
                 constants[node.targets[0].id] = ast.literal_eval(node.value)
             except ValueError:
@@ -225,8 +244,10 @@ def _pack_json(text: str) -> ReadBack:
         materials = pack_from_json(text)
     except ValueError as error:
         raise ValueError(f"`file` is not a pack's JSON view: {error}") from None
-    fit_ids = [((m.get("metrics") or {}).get("fit_id") if isinstance(m, dict) else None)
-               for m in (view.get("materials", []) if isinstance(view, dict) else [])]
+    fit_ids = [
+        ((m.get("metrics") or {}).get("fit_id") if isinstance(m, dict) else None)
+        for m in (view.get("materials", []) if isinstance(view, dict) else [])
+    ]
     for fit_id in fit_ids:
         check_fit_id(fit_id)
     return ReadBack("json", materials, {"fit_ids": fit_ids} if any(fit_ids) else {})
@@ -265,5 +286,6 @@ def read_fit_file(data: bytes) -> ReadBack:
         return _materialx(text)
     if head.startswith(_BLENDER_FIRST_LINE):
         return _blender(text)
-    raise ValueError("`file` is not a pack, its JSON view, a glTF/GLB, a MaterialX document or a Blender "
-                     "script of this service")
+    raise ValueError(
+        "`file` is not a pack, its JSON view, a glTF/GLB, a MaterialX document or a Blender script of this service"
+    )

@@ -50,10 +50,19 @@ from .seen_jacobian import DeltaEComponents, delta_E_jacobian
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
 __all__ = [
-    "N_BOUNDS", "K_BOUNDS",
-    "fit_channel_conductor", "fit_channel_f82", "fit_channel_schlick",
-    "gltf_clearcoat_factor", "layer_only", "floor_base", "tool_floor", "fit_tool_values",
-    "fit_view_dependent_index", "seen_delta_E", "seen_fidelity",
+    "N_BOUNDS",
+    "K_BOUNDS",
+    "fit_channel_conductor",
+    "fit_channel_f82",
+    "fit_channel_schlick",
+    "gltf_clearcoat_factor",
+    "layer_only",
+    "floor_base",
+    "tool_floor",
+    "fit_tool_values",
+    "fit_view_dependent_index",
+    "seen_delta_E",
+    "seen_fidelity",
 ]
 
 VIEW_DEPENDENT_MAX_NFEV = 60  # a cap: the solves stop by their tolerances in about 25-40
@@ -95,8 +104,15 @@ def _gltf_layer_terms(mu, clearcoat: float) -> tuple[np.ndarray, np.ndarray]:
     return coat_a, b / np.maximum(one - zero, 1e-12)
 
 
-def floor_base(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
-               clearcoat: float = 1.0, space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+def floor_base(
+    tool: str,
+    mu,
+    eta: float,
+    target_ACEScg,
+    coat: bool = True,
+    clearcoat: float = 1.0,
+    space: str = DEFAULT_WORKING_SPACE,
+) -> np.ndarray:
     """
     The base response in [0, 1] per angle and channel of the working space
     ``space`` whose layered result is nearest the target (each channel's
@@ -114,8 +130,9 @@ def floor_base(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     return 0.5 * (lo + hi)
 
 
-def tool_floor(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
-               space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+def tool_floor(
+    tool: str, mu, eta: float, target_ACEScg, coat: bool = True, space: str = DEFAULT_WORKING_SPACE
+) -> np.ndarray:
     """
     Delta E 2000 per angle of :func:`floor_base` under the tool's layering
     (glTF's at the clear coat factor the export's fit starts from).
@@ -125,8 +142,9 @@ def tool_floor(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
     return delta_E_map(target_ACEScg, working_to_ACEScg(layer_only(tool, mu, eta, base, coat, clearcoat), space))
 
 
-def seen_delta_E(tool: str, values: dict, mu, eta: float, target_ACEScg,
-                 space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+def seen_delta_E(
+    tool: str, values: dict, mu, eta: float, target_ACEScg, space: str = DEFAULT_WORKING_SPACE
+) -> np.ndarray:
     """
     Delta E 2000 per angle of the tool's result for ``values`` (colours and
     n, k per channel of the working space ``space``) against the target.
@@ -174,8 +192,9 @@ def _start_and_bounds(tool: str, mu, base: np.ndarray, coat: bool):
     return F0, [0.0] * 3, [1.0] * 3
 
 
-def _residuals(tool: str, values: dict, mu, eta: float, target_ACEScg,
-               space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+def _residuals(
+    tool: str, values: dict, mu, eta: float, target_ACEScg, space: str = DEFAULT_WORKING_SPACE
+) -> np.ndarray:
     dE = seen_delta_E(tool, values, mu, eta, target_ACEScg, space)
     # sqrt: the sum of squares is then the sum of Delta E, so the fit
     # minimises the mean Delta E over the angles (what is scored), not
@@ -183,8 +202,19 @@ def _residuals(tool: str, values: dict, mu, eta: float, target_ACEScg,
     return np.sqrt(dE + 1e-6) if MEAN_OBJECTIVE else dE
 
 
-def _solve(tool: str, pack, residuals, x0, lo, hi, mu, eta: float, target_ACEScg, max_nfev: int,
-           space: str = DEFAULT_WORKING_SPACE):
+def _solve(
+    tool: str,
+    pack,
+    residuals,
+    x0,
+    lo,
+    hi,
+    mu,
+    eta: float,
+    target_ACEScg,
+    max_nfev: int,
+    space: str = DEFAULT_WORKING_SPACE,
+):
     """
     scipy's bounded ``trf`` on the sum of squared Delta E from ``x0``
     (``x_scale="jac"``, xtol 1e-8, ftol 1e-6, gtol 1e-8), with exact
@@ -194,17 +224,27 @@ def _solve(tool: str, pack, residuals, x0, lo, hi, mu, eta: float, target_ACEScg
     working space ``space``.
     """
     if MEAN_OBJECTIVE:
-        fun, jac = residuals, (lambda x: delta_E_jacobian(tool, pack, x, lo, hi, mu, eta, target_ACEScg, True,
-                                                          space))
+        fun, jac = residuals, (lambda x: delta_E_jacobian(tool, pack, x, lo, hi, mu, eta, target_ACEScg, True, space))
     else:
         problem = DeltaEComponents(tool, pack, lo, hi, mu, eta, target_ACEScg, space)
         fun, jac = problem.fun, problem.jac
-    return least_squares(fun, x0, jac=jac, bounds=(lo, hi), method="trf", x_scale="jac",
-                         xtol=1e-8, ftol=1e-6, gtol=1e-8, max_nfev=max_nfev)
+    return least_squares(
+        fun,
+        x0,
+        jac=jac,
+        bounds=(lo, hi),
+        method="trf",
+        x_scale="jac",
+        xtol=1e-8,
+        ftol=1e-6,
+        gtol=1e-8,
+        max_nfev=max_nfev,
+    )
 
 
-def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant: dict,
-                             space: str = DEFAULT_WORKING_SPACE) -> dict:
+def fit_view_dependent_index(
+    tool: str, mu, eta: float, target_ACEScg, constant: dict, space: str = DEFAULT_WORKING_SPACE
+) -> dict:
     """
     The conductor values of ``tool`` (``mtlx``, ``blender-conductor``) with
     each channel's n and k affine in the facing 1 - cos theta: ``ior``,
@@ -225,8 +265,13 @@ def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant:
         return np.where(np.abs(d) < _SLOPE_ZERO, 0.0, d)  # both ends on a bound: 0, not 1e-9
 
     def pack(x):
-        return {"ior": x[0:3], "ior_per_facing": slope(x[3:6] - x[0:3]), "extinction": x[6:9],
-                "extinction_per_facing": slope(x[9:12] - x[6:9]), "coat": constant["coat"]}
+        return {
+            "ior": x[0:3],
+            "ior_per_facing": slope(x[3:6] - x[0:3]),
+            "extinction": x[6:9],
+            "extinction_per_facing": slope(x[9:12] - x[6:9]),
+            "coat": constant["coat"],
+        }
 
     def residuals(x):
         return _residuals(tool, pack(x), mu, eta, target_ACEScg, space)
@@ -239,9 +284,18 @@ def fit_view_dependent_index(tool: str, mu, eta: float, target_ACEScg, constant:
     return flat
 
 
-def fit_tool_values(tool: str, mu, eta: float, target_ACEScg, coat: bool = True,
-                    view_dependent: bool = True, space: str = DEFAULT_WORKING_SPACE,
-                    roughness: float = 0.0, rough_target_ACEScg=None, keep_coat: bool = True) -> dict:
+def fit_tool_values(
+    tool: str,
+    mu,
+    eta: float,
+    target_ACEScg,
+    coat: bool = True,
+    view_dependent: bool = True,
+    space: str = DEFAULT_WORKING_SPACE,
+    roughness: float = 0.0,
+    rough_target_ACEScg=None,
+    keep_coat: bool = True,
+) -> dict:
     """
     The export values of ``tool`` (keys :data:`fitting.exports.tool_layering.TOOLS`,
     and ``coat``) whose layered result is nearest the seen target
@@ -299,6 +353,5 @@ def seen_fidelity(values, tool: str) -> dict:
     """
     if tool not in values.tools:
         raise ValueError(f"`tool` must be one of the fitted {', '.join(values.tools)}, got {tool!r}")
-    dE = seen_delta_E(tool, values.tools[tool], values.view_cos, values.eta_i, values.seen_ACEScg,
-                      values.working_space)
+    dE = seen_delta_E(tool, values.tools[tool], values.view_cos, values.eta_i, values.seen_ACEScg, values.working_space)
     return {"delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max())}

@@ -90,8 +90,18 @@ def _to_ACEScg(space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
     return working_to_ACEScg(np.eye(3), space).T  # ACEScg = this @ rgb of the working space (a linear map)
 
 
-def delta_E_jacobian(tool: str, pack, x, lo, hi, mu, eta: float, target_ACEScg,
-                     square_root: bool = False, space: str = DEFAULT_WORKING_SPACE) -> np.ndarray:
+def delta_E_jacobian(
+    tool: str,
+    pack,
+    x,
+    lo,
+    hi,
+    mu,
+    eta: float,
+    target_ACEScg,
+    square_root: bool = False,
+    space: str = DEFAULT_WORKING_SPACE,
+) -> np.ndarray:
     """
     The (S, n) Jacobian of the Delta E 2000 per angle of ``pack(x)`` (values
     in the working space ``space``) against ``target_ACEScg`` (of its
@@ -114,8 +124,9 @@ class DeltaEComponents:
     the Delta E, and ``jac(x)`` (3 S, n).
     """
 
-    def __init__(self, tool: str, pack, lo, hi, mu, eta: float, target_ACEScg,
-                 space: str = DEFAULT_WORKING_SPACE) -> None:
+    def __init__(
+        self, tool: str, pack, lo, hi, mu, eta: float, target_ACEScg, space: str = DEFAULT_WORKING_SPACE
+    ) -> None:
         self.tool, self.pack, self.lo, self.hi, self.mu, self.eta = tool, pack, lo, hi, mu, eta
         self.target_Lab = ACEScg_to_Lab(target_ACEScg)
         self.M = _to_ACEScg(space)  # the values are in the working space ``space``

@@ -37,14 +37,24 @@ import numpy as np
 from ..models.kinds import MODEL_KINDS, model_kind
 from ..models.pack import PackedMaterial
 
-__all__ = ["GLSL_DIR", "TEMPLATE_DIR", "SPLIT_SUM_FUNCTIONS", "SnippetMaterial", "snippet", "model_source",
-           "glsl_identifier"]
+__all__ = [
+    "GLSL_DIR",
+    "TEMPLATE_DIR",
+    "SPLIT_SUM_FUNCTIONS",
+    "SnippetMaterial",
+    "snippet",
+    "model_source",
+    "glsl_identifier",
+]
 
 TEMPLATE_DIR = Path(__file__).with_name("templates")
 GLSL_DIR = Path(__file__).resolve().parents[2] / "preview_shaders" / "glsl"
 """The project's GLSL files (read as files: ``fitting`` never imports ``preview_shaders``)."""
 SPLIT_SUM_FUNCTIONS = (
-    "cf_split_sum_model", "cf_split_sum_schlick", "cf_split_sum_lazanyi", "cf_average_fresnel",
+    "cf_split_sum_model",
+    "cf_split_sum_schlick",
+    "cf_split_sum_lazanyi",
+    "cf_average_fresnel",
 )
 """The split-sum functions a snippet with a split-sum kind carries (cf_ibl)."""
 
@@ -189,9 +199,16 @@ def _material_block(language: str, material: SnippetMaterial, ident: str) -> str
     values = {p: ", ".join(_literal(v) for v in C[i].ravel()) for i, p in enumerate(kind.parameters)}
     lo, hi = packed.eta_i_range
     return _template(_material_template(kind.material_template, language)).substitute(
-        name=_comment(material.name, 80), source=_comment(material.source), fit_id=material.fit_id,
-        model=kind.name, quality=_comment(material.quality, 400), prefix=f"cf_{ident}", ident=ident,
-        eta_lo=_literal(lo), eta_hi=_literal(hi), **values,
+        name=_comment(material.name, 80),
+        source=_comment(material.source),
+        fit_id=material.fit_id,
+        model=kind.name,
+        quality=_comment(material.quality, 400),
+        prefix=f"cf_{ident}",
+        ident=ident,
+        eta_lo=_literal(lo),
+        eta_hi=_literal(hi),
+        **values,
     )
 
 
@@ -219,6 +236,9 @@ def snippet(language: str, materials: list[SnippetMaterial], pack_name: str, fit
         used |= _symbols(language, ident, material.packed)
         blocks.append(_material_block(language, material, ident))
     return _template(TEMPLATE_DIR / f"pack.{language}").substitute(
-        pack_name=_comment(pack_name, 80), count=len(materials), fit_format=fit_format,
-        model=model, materials="".join(blocks),
+        pack_name=_comment(pack_name, 80),
+        count=len(materials),
+        fit_format=fit_format,
+        model=model,
+        materials="".join(blocks),
     )

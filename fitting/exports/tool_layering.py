@@ -89,8 +89,15 @@ THREE_CLEARCOAT_F0 = 0.04
 """three.js's clear coat F0 (index 1.5), fixed."""
 
 _DFG_PATH = (
-    Path(__file__).resolve().parents[2] / "scripts" / "three" / "node_modules" / "three"
-    / "src" / "renderers" / "shaders" / "DFGLUTData.js"
+    Path(__file__).resolve().parents[2]
+    / "scripts"
+    / "three"
+    / "node_modules"
+    / "three"
+    / "src"
+    / "renderers"
+    / "shaders"
+    / "DFGLUTData.js"
 )
 
 TOOLS = {
@@ -153,15 +160,22 @@ def mx_ggx_dir_albedo(cos_theta, alpha: float = _MX_EPS) -> tuple[np.ndarray, np
 @_per_angles
 def _mx_albedo(x: np.ndarray, y: float) -> tuple[np.ndarray, np.ndarray]:
     x2, y2 = x * x, y * y
-    c = np.array([
-        [0.1003, 0.9345, 1.0, 1.0], [-0.6303, -2.323, -1.765, 0.2281],
-        [9.748, 2.229, 8.263, 15.94], [-2.038, -3.748, 11.53, -55.83],
-        [29.34, 1.424, 28.96, 13.08], [-8.245, -0.7684, -7.507, 41.26],
-        [-26.44, 1.436, -36.11, 54.9], [19.99, 0.2913, 15.86, 300.2],
-        [-5.448, 0.6286, 33.37, -285.1],
-    ])
-    terms = np.stack([np.ones_like(x), x, np.full_like(x, y), x * y, x2, np.full_like(x, y2),
-                      x2 * y, x * y2, x2 * y2], axis=-1)
+    c = np.array(
+        [
+            [0.1003, 0.9345, 1.0, 1.0],
+            [-0.6303, -2.323, -1.765, 0.2281],
+            [9.748, 2.229, 8.263, 15.94],
+            [-2.038, -3.748, 11.53, -55.83],
+            [29.34, 1.424, 28.96, 13.08],
+            [-8.245, -0.7684, -7.507, 41.26],
+            [-26.44, 1.436, -36.11, 54.9],
+            [19.99, 0.2913, 15.86, 300.2],
+            [-5.448, 0.6286, 33.37, -285.1],
+        ]
+    )
+    terms = np.stack(
+        [np.ones_like(x), x, np.full_like(x, y), x * y, x2, np.full_like(x, y2), x2 * y, x * y2, x2 * y2], axis=-1
+    )
     r = terms @ c
     AB = np.clip(r[:, :2] / r[:, 2:], 0.0, 1.0)
     return AB[:, 0], AB[:, 1]
@@ -203,8 +217,9 @@ def mtlx_conductor(cos_theta, eta: float, ior, extinction, coat: bool = True) ->
     return materialx_layer(mu, eta, F * _mx_comp(F, A, B), coat)
 
 
-def openpbr_metal(cos_theta, eta: float, base_color, specular_color, coat: bool = True,
-                  coat_darkening: float = 1.0) -> np.ndarray:
+def openpbr_metal(
+    cos_theta, eta: float, base_color, specular_color, coat: bool = True, coat_darkening: float = 1.0
+) -> np.ndarray:
     """The ``openpbr`` export: metallic ``open_pbr_surface``, roughness 0, coat ``eta``."""
     mu = np.clip(_mu(cos_theta), _MX_EPS, 1.0)
     base_color = np.asarray(base_color, dtype=np.float64)
@@ -249,7 +264,7 @@ def _dfg_table() -> np.ndarray:
     if not _DFG_PATH.exists():
         raise FileNotFoundError(f"three.js is not installed ({_DFG_PATH}): run scripts/bootstrap")
     text = _DFG_PATH.read_text()
-    body = text[text.index("Uint16Array"):text.index("] )")]
+    body = text[text.index("Uint16Array") : text.index("] )")]
     halves = np.array([int(h, 16) for h in re.findall(r"0x([0-9a-fA-F]{4})", body)], dtype=np.uint16)
     table = halves.view(np.float16).astype(np.float64).reshape(16, 16, 2)  # [dotNV, roughness, (scale, bias)]
     table.setflags(write=False)
@@ -282,8 +297,9 @@ def _three_dfg(mu: np.ndarray, roughness) -> tuple[np.ndarray]:
     return ((t00 * (1 - fu) + t01 * fu) * (1 - fv) + (t10 * (1 - fu) + t11 * fu) * fv,)
 
 
-def three_clearcoat(cos_theta, base_color, clearcoat: float = 1.0, coat: bool = True,
-                    roughness=0.0, clearcoat_roughness: float = 0.0) -> np.ndarray:
+def three_clearcoat(
+    cos_theta, base_color, clearcoat: float = 1.0, coat: bool = True, roughness=0.0, clearcoat_roughness: float = 0.0
+) -> np.ndarray:
     """
     The glTF export in three.js: ``MeshPhysicalMaterial`` with metalness 1 and
     ``color`` ``base_color``, environment light only, flat geometry (three adds
@@ -331,8 +347,9 @@ def conductor_index(values: dict, cos_theta) -> tuple[np.ndarray, np.ndarray]:
     n, k = (np.asarray(values[key], dtype=np.float64) for key in ("ior", "extinction"))
     if not view_dependent(values):
         return n, k
-    n_slope, k_slope = (np.asarray(values.get(key, 0.0), dtype=np.float64)
-                        for key in ("ior_per_facing", "extinction_per_facing"))
+    n_slope, k_slope = (
+        np.asarray(values.get(key, 0.0), dtype=np.float64) for key in ("ior_per_facing", "extinction_per_facing")
+    )
     facing = (1.0 - _mu(cos_theta))[..., None]
     return np.maximum(n + n_slope * facing, N_BOUNDS[0]), np.maximum(k + k_slope * facing, K_BOUNDS[0])
 
@@ -350,11 +367,13 @@ def tool_seen(tool: str, values: dict, cos_theta, eta: float) -> np.ndarray:
     if tool == "blender-conductor":
         return cycles_conductor_mix(cos_theta, eta, *conductor_index(values, cos_theta), coat)
     if tool == "openpbr":
-        return openpbr_metal(cos_theta, eta, values["base_color"], values["specular_color"], coat,
-                             values.get("coat_darkening", 1.0))
+        return openpbr_metal(
+            cos_theta, eta, values["base_color"], values["specular_color"], coat, values.get("coat_darkening", 1.0)
+        )
     if tool == "blender":
         return cycles_principled(cos_theta, eta, values["base_color"], values["specular_tint"], coat)
     if tool == "gltf":
-        return three_clearcoat(cos_theta, values["base_color"], values.get("clearcoat", 1.0), coat,
-                               values.get("roughness", 0.0))
+        return three_clearcoat(
+            cos_theta, values["base_color"], values.get("clearcoat", 1.0), coat, values.get("roughness", 0.0)
+        )
     raise ValueError(f"`tool` must be one of {', '.join(TOOLS)}, got {tool!r}")

@@ -99,6 +99,7 @@ _TARGETS = BoundedCache(TARGET_CACHE_SIZE)
 
 def _kept(key, build) -> tuple:
     """``build()``'s arrays read-only, kept by ``key`` (``None``: not kept)."""
+
     def frozen():
         out = tuple(np.asarray(a, dtype=np.float64) for a in build())
         for a in out:
@@ -114,6 +115,7 @@ def _nk_key(nk: SpectralNK) -> str:
     for a in (nk.wavelength_nm, nk.n, nk.k):
         digest.update(np.ascontiguousarray(a, dtype="<f8").tobytes())
     return digest.hexdigest()
+
 
 @functools.cache
 def project_version() -> str:
@@ -247,8 +249,12 @@ class ExportValues:
 
 def _naive_fits(mu, target) -> tuple:
     """``target`` (working space) and its naive fits: n, k; F0, F82 tint; Schlick's F0."""
-    return (target, *fit_channel_conductor(mu, target, joint=True), *fit_channel_f82(mu, target, joint=True),
-            fit_channel_schlick(mu, target))
+    return (
+        target,
+        *fit_channel_conductor(mu, target, joint=True),
+        *fit_channel_f82(mu, target, joint=True),
+        fit_channel_schlick(mu, target),
+    )
 
 
 def has_coat(eta_i: float) -> bool:
@@ -257,8 +263,13 @@ def has_coat(eta_i: float) -> bool:
 
 
 def export_values(
-    fit_or_nk, eta_i, roughness: float = 0.2, coat_roughness: float = 0.03,
-    model: PackedMaterial | None = None, tools=None, fit_id: str | None = None,
+    fit_or_nk,
+    eta_i,
+    roughness: float = 0.2,
+    coat_roughness: float = 0.03,
+    model: PackedMaterial | None = None,
+    tools=None,
+    fit_id: str | None = None,
     working_space: str = DEFAULT_WORKING_SPACE,
 ) -> ExportValues:
     """
@@ -312,8 +323,9 @@ def export_values(
     key = None
     if isinstance(fit_or_nk, SpectralNK):
         name, source, key = fit_or_nk.name, fit_or_nk.source, (_nk_key(fit_or_nk), eta)
-        target_ACEScg, seen = _kept(key, lambda: (reference_ACEScg(fit_or_nk, mu, eta, 1.0),
-                                                  seen_ACEScg(fit_or_nk, view, eta)))
+        target_ACEScg, seen = _kept(
+            key, lambda: (reference_ACEScg(fit_or_nk, mu, eta, 1.0), seen_ACEScg(fit_or_nk, view, eta))
+        )
         origin = "spectral (1 nm) air / coat / metal stack seen from air"
     elif isinstance(fit_or_nk, dict) and callable(fit_or_nk.get("reflectance")):
         name = str(fit_or_nk.get("name", "material"))
@@ -342,18 +354,44 @@ def export_values(
             "or a `reflectance` function, "
             f"got {type(fit_or_nk).__name__}"
         )
-    target, n_rel, k_rel, F0, tint, F0_schlick = _kept(key and (*key, working_space), lambda: (
-        _naive_fits(mu, ACEScg_to_working(target_ACEScg, working_space))))
+    target, n_rel, k_rel, F0, tint, F0_schlick = _kept(
+        key and (*key, working_space), lambda: _naive_fits(mu, ACEScg_to_working(target_ACEScg, working_space))
+    )
     coat = has_coat(eta)
-    rough_seen = (_kept(key and (*key, "rough", roughness), lambda: (
-        rough_seen_ACEScg(view, eta, seen, mu, target_ACEScg, roughness),))[0]
-        if "gltf" in tools and coat and roughness > 0.0 else None)
-    fitted = {tool: fit_tool_values(tool, view, eta, seen, coat, space=working_space, roughness=roughness,
-                                    rough_target_ACEScg=rough_seen) for tool in tools}
+    rough_seen = (
+        _kept(
+            key and (*key, "rough", roughness),
+            lambda: (rough_seen_ACEScg(view, eta, seen, mu, target_ACEScg, roughness),),
+        )[0]
+        if "gltf" in tools and coat and roughness > 0.0
+        else None
+    )
+    fitted = {
+        tool: fit_tool_values(
+            tool, view, eta, seen, coat, space=working_space, roughness=roughness, rough_target_ACEScg=rough_seen
+        )
+        for tool in tools
+    }
     return ExportValues(
-        name=name, source=source, eta_i=eta, origin=origin, cos_theta=mu, target=target,
-        target_ACEScg=target_ACEScg, n_rel=n_rel, k_rel=k_rel, F0=F0, F82_tint=tint,
-        F0_schlick=F0_schlick, roughness=roughness,
-        coat_roughness=coat_roughness, model=model, view_cos=view, seen_ACEScg=seen,
-        tools=fitted, fit_id=fit_id, working_space=working_space, seen_rough_ACEScg=rough_seen,
+        name=name,
+        source=source,
+        eta_i=eta,
+        origin=origin,
+        cos_theta=mu,
+        target=target,
+        target_ACEScg=target_ACEScg,
+        n_rel=n_rel,
+        k_rel=k_rel,
+        F0=F0,
+        F82_tint=tint,
+        F0_schlick=F0_schlick,
+        roughness=roughness,
+        coat_roughness=coat_roughness,
+        model=model,
+        view_cos=view,
+        seen_ACEScg=seen,
+        tools=fitted,
+        fit_id=fit_id,
+        working_space=working_space,
+        seen_rough_ACEScg=rough_seen,
     )

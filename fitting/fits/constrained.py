@@ -82,9 +82,17 @@ class GuardWork:
 _MIN_ITERATIONS = 5  # a budget-shortened SLSQP solve with fewer iterations is not started
 
 
-def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0, cap: float,
-                     degree: int, max_iterations: int = _SLSQP_ITERATIONS, range_points=None,
-                     work: GuardWork | None = None):
+def constrained_mean(
+    mean_problem: Problem,
+    guard_problem: Problem,
+    weights,
+    x0,
+    cap: float,
+    degree: int,
+    max_iterations: int = _SLSQP_ITERATIONS,
+    range_points=None,
+    work: GuardWork | None = None,
+):
     """
     Coefficients minimising the weighted mean of the first-order Delta E
     2000 over the fitting samples subject to Delta E <= ``cap`` at every
@@ -119,12 +127,18 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
         F0 = model_at(x)
         near = np.stack([F0 < 0.05, F0 > 0.95], axis=-1)  # (K, 3, 2): point, channel, lower / upper end
     for _ in range(_ACTIVE_ROUNDS):
-        both = _Cached(Problem(
-            np.concatenate([mean_problem.target, gT[active]]),
-            np.concatenate([mean_problem.mu, gM[active]]),
-            np.concatenate([mean_problem.eta, gE[active]]),
-            mean_problem.range, degree, "de2000", None, None,
-        ))
+        both = _Cached(
+            Problem(
+                np.concatenate([mean_problem.target, gT[active]]),
+                np.concatenate([mean_problem.mu, gM[active]]),
+                np.concatenate([mean_problem.eta, gE[active]]),
+                mean_problem.range,
+                degree,
+                "de2000",
+                None,
+                None,
+            )
+        )
 
         def objective(x):
             r = both.residuals(x)
@@ -149,8 +163,15 @@ def constrained_mean(mean_problem: Problem, guard_problem: Problem, weights, x0,
             return None
         optimize, threadpools = scipy_optimize()  # the constrained refits alone import scipy.optimize
         with threadpools.limit(limits=1, user_api="blas"):
-            result = optimize.minimize(objective, x, jac=gradient, method="SLSQP", bounds=list(zip(lower, upper)),
-                              constraints=constraints, options={"maxiter": iterations, "ftol": 1e-9})
+            result = optimize.minimize(
+                objective,
+                x,
+                jac=gradient,
+                method="SLSQP",
+                bounds=list(zip(lower, upper)),
+                constraints=constraints,
+                options={"maxiter": iterations, "ftol": 1e-9},
+            )
         if work is not None:
             work.spend(rows, result.nit)
         if not np.all(np.isfinite(result.x)):

@@ -34,8 +34,16 @@ from .result import FitResult
 from .solver import fit_coefficients
 from .worst_case import GuardScore, guard_score
 
-__all__ = ["AUDIT_SAMPLES", "AUDIT_GRIDS", "AUDIT_STARTS", "AuditGrid", "AuditorFit", "audit_grid",
-           "auditor_fits", "audit_floor"]
+__all__ = [
+    "AUDIT_SAMPLES",
+    "AUDIT_GRIDS",
+    "AUDIT_STARTS",
+    "AuditGrid",
+    "AuditorFit",
+    "audit_grid",
+    "auditor_fits",
+    "audit_floor",
+]
 
 AUDIT_SAMPLES = 100
 """The auditor's grids are :data:`AUDIT_SAMPLES` x :data:`AUDIT_SAMPLES`
@@ -117,8 +125,9 @@ def auditor_fits(grid: AuditGrid, starts: dict, like: FitResult, degree: int, in
     optima, costs = {}, {}
     for label, C in starts.items():
         start = like.with_coefficients(C, to_float16(C))
-        optima[label] = paper_method_fit(grid.T, grid.M, grid.E, grid.range, degree, _FREE_MAX_NFEV, start,
-                                         boxed=True).coefficients
+        optima[label] = paper_method_fit(
+            grid.T, grid.M, grid.E, grid.range, degree, _FREE_MAX_NFEV, start, boxed=True
+        ).coefficients
         costs[label] = grid.cost(optima[label])
     groups: list[list[str]] = []
     for label in sorted(costs, key=costs.__getitem__):
@@ -133,7 +142,9 @@ def auditor_fits(grid: AuditGrid, starts: dict, like: FitResult, degree: int, in
             fit = fit_coefficients(grid.T, grid.M, grid.E, grid.range, degree, "rgb", _POLISH_MAX_NFEV, start=C)
         else:
             fit = like.with_coefficients(C, to_float16(C))
-        out.append(AuditorFit(fit, group, grid.score(fit.coefficients_float16), bool(in_range(fit.coefficients_float16))))
+        out.append(
+            AuditorFit(fit, group, grid.score(fit.coefficients_float16), bool(in_range(fit.coefficients_float16)))
+        )
     return out, costs
 
 

@@ -137,7 +137,10 @@ def curve_base_from_nk(nk: SpectralNK, eta_i_range=DEFAULT_ETA_I_RANGE) -> Curve
 
 
 def curve_base_from_coefficients(
-    coefficients, eta_i_range=DEFAULT_ETA_I_RANGE, name: str = "fit", source: str = "",
+    coefficients,
+    eta_i_range=DEFAULT_ETA_I_RANGE,
+    name: str = "fit",
+    source: str = "",
     model: str = DEFAULT_MODEL,
 ) -> CurveBase:
     """
@@ -215,9 +218,7 @@ def edited_target(
     :math:`w_k` from :func:`blend_weights`. At :math:`\\eta_i = e_k`,
     :math:`T` is the curve itself.
     """
-    mu, eta = np.broadcast_arrays(
-        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
-    )
+    mu, eta = np.broadcast_arrays(np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64))
     T = base.rgb(mu, eta)
     W = blend_weights(eta, [c.eta_i for c in curves], blend_width)
     for k, curve in enumerate(curves):

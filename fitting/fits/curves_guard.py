@@ -59,20 +59,32 @@ below the paper's, and an unreachable cap would spend the work)."""
 CAP_SAMPLES = 50
 """The side of each measure's grid where the constrained refits cap the max."""
 
-__all__ = ["GUARD_WORK", "AUDIT_SAMPLES", "AUDIT_GRIDS", "AUDIT_STARTS", "FOLLOW_MEAN", "FOLLOW_MAX",
-           "audit_grid", "guard_curve_choice", "edit_warnings"]
+__all__ = [
+    "GUARD_WORK",
+    "AUDIT_SAMPLES",
+    "AUDIT_GRIDS",
+    "AUDIT_STARTS",
+    "FOLLOW_MEAN",
+    "FOLLOW_MAX",
+    "audit_grid",
+    "guard_curve_choice",
+    "edit_warnings",
+]
 
 
 def _fine(scores_by, name, refs, margin=MAX_MARGIN) -> bool:
     """Whether candidate ``name`` is no worse than ``refs`` on every grid: mean, and max by ``margin``."""
-    return all(scores_by[g][name].mean <= ref.mean and scores_by[g][name].max <= ref.max * (1.0 - margin)
-               for g, ref in refs.items())
+    return all(
+        scores_by[g][name].mean <= ref.mean and scores_by[g][name].max <= ref.max * (1.0 - margin)
+        for g, ref in refs.items()
+    )
 
 
 def _excess(scores_by, name, refs) -> float:
     """The largest relative excess of candidate ``name`` over ``refs``' mean or max on any grid (<= 0: none)."""
-    return max(max(scores_by[g][name].mean / ref.mean - 1.0, scores_by[g][name].max / ref.max - 1.0)
-               for g, ref in refs.items())
+    return max(
+        max(scores_by[g][name].mean / ref.mean - 1.0, scores_by[g][name].max / ref.max - 1.0) for g, ref in refs.items()
+    )
 
 
 def pick(scores_by: dict, aim: dict, floor: dict, hard=None) -> str:
@@ -102,13 +114,29 @@ def pick(scores_by: dict, aim: dict, floor: dict, hard=None) -> str:
     def failed(name):
         return [g for g in floor if not _fine(scores_by, name, {g: floor[g]}, 0.0)]
 
-    return min(names, key=lambda n: (len(failed(n)), [g in failed(n) for g in floor],
-                                     _excess(scores_by, n, {g: floor[g] for g in failed(n)}), total[n]))
+    return min(
+        names,
+        key=lambda n: (
+            len(failed(n)),
+            [g in failed(n) for g in floor],
+            _excess(scores_by, n, {g: floor[g] for g in failed(n)}),
+            total[n],
+        ),
+    )
 
 
 @_THREADPOOLS.wrap(limits=1, user_api="blas")
-def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, FitResult], own: str,
-                       paper: str, samples, in_range, work: int | None = None) -> tuple[str, dict]:
+def guard_curve_choice(
+    base,
+    curves,
+    blend_width: float,
+    candidates: dict[str, FitResult],
+    own: str,
+    paper: str,
+    samples,
+    in_range,
+    work: int | None = None,
+) -> tuple[str, dict]:
     """
     The name of the candidate to keep, and the guard's report
     (:func:`fitting.fits.guarded.guard_report` on the angle grid, with
@@ -133,8 +161,9 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     eta_i_range = base.eta_i_range
     degree = candidates[own].degree
     grids = {by: AuditGrid(base, curves, blend_width, by) for by in AUDIT_GRIDS}
-    scores_by = {by: {name: grid.score(c.coefficients_float16) for name, c in candidates.items()}
-                 for by, grid in grids.items()}
+    scores_by = {
+        by: {name: grid.score(c.coefficients_float16) for name, c in candidates.items()} for by, grid in grids.items()
+    }
 
     def add(name, fit):
         candidates[name] = fit
@@ -143,30 +172,43 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
 
     audits, costs, aim, floor, hard = {}, {}, {}, {}, []
     for by, grid in grids.items():
-        starts = {"paper": candidates[paper].coefficients, "own": candidates[own].coefficients,
-                  "guess": initial_guess(grid.T, grid.M, grid.E, eta_i_range, degree)}
-        audits[by], costs[by] = auditor_fits(grid, {k: starts[k] for k in AUDIT_STARTS}, candidates[paper], degree,
-                                             in_range)
+        starts = {
+            "paper": candidates[paper].coefficients,
+            "own": candidates[own].coefficients,
+            "guess": initial_guess(grid.T, grid.M, grid.E, eta_i_range, degree),
+        }
+        audits[by], costs[by] = auditor_fits(
+            grid, {k: starts[k] for k in AUDIT_STARTS}, candidates[paper], degree, in_range
+        )
     for by, grid in grids.items():
         ours, free = scores_by[by][paper], audit_floor(audits[by])
         lowest_max = min([ours.max] + [a.score.max for a in audits[by]])
-        aim[by] = GuardScore(ours.mean if free is None else min(ours.mean, free.mean), lowest_max,
-                             ours.eta_i, ours.angle_deg)
+        aim[by] = GuardScore(
+            ours.mean if free is None else min(ours.mean, free.mean), lowest_max, ours.eta_i, ours.angle_deg
+        )
         floor[by] = ours if free is None else free  # what that auditor would ship, else the in-range paper fit
         if free is not None:
             hard.append(by)
         for i, a in enumerate(a for a in audits[by] if a.reflectance):
-            add(f"{paper}-free" + ("" if by == "angle" else f"-{by.replace('_', '-')}") + (f"-{i + 1}" if i else ""),
-                a.fit)
+            add(
+                f"{paper}-free" + ("" if by == "angle" else f"-{by.replace('_', '-')}") + (f"-{i + 1}" if i else ""),
+                a.fit,
+            )
     cap = min(ref.max for ref in aim.values())
-    union = (np.concatenate([g.T for g in grids.values()]), np.concatenate([g.M for g in grids.values()]),
-             np.concatenate([g.E for g in grids.values()]))
+    union = (
+        np.concatenate([g.T for g in grids.values()]),
+        np.concatenate([g.M for g in grids.values()]),
+        np.concatenate([g.E for g in grids.values()]),
+    )
     # The constrained refits' caps hold at both measures' points, CAP_SAMPLES a side (the
     # SLSQP's rows are the points near the cap: both full grids would leave it no
     # iterations in its work); the cap rounds then score on the full grids.
     coarse = [AuditGrid(base, curves, blend_width, by, CAP_SAMPLES) for by in AUDIT_GRIDS]
-    cap_points = (np.concatenate([g.T for g in coarse]), np.concatenate([g.M for g in coarse]),
-                  np.concatenate([g.E for g in coarse]))
+    cap_points = (
+        np.concatenate([g.T for g in coarse]),
+        np.concatenate([g.M for g in coarse]),
+        np.concatenate([g.E for g in coarse]),
+    )
 
     def score_union(C16) -> GuardScore:
         return min((grid.score(C16) for grid in grids.values()), key=lambda s: -s.max)
@@ -177,8 +219,19 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
         """Constrained refits (least mean on ``mean_samples``, max capped on both grids) until one is fine."""
         for level, bar in levels:
             for label, C, C16, _ in constrained_refits(
-                    *mean_samples, *cap_points, eta_i_range, degree, None, starts, bar, True, score_union,
-                    range_points=(CM.ravel(), CE.ravel()), work=budget, factors=CAP_FACTORS):
+                *mean_samples,
+                *cap_points,
+                eta_i_range,
+                degree,
+                None,
+                starts,
+                bar,
+                True,
+                score_union,
+                range_points=(CM.ravel(), CE.ravel()),
+                work=budget,
+                factors=CAP_FACTORS,
+            ):
                 if not in_range(C16):
                     continue
                 add(label + level, candidates[own].with_coefficients(C, C16))
@@ -189,14 +242,21 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
     in_range_cap = min(scores_by[by][paper].max for by in grids)
     levels = (("", cap), ("-in-range-bar", in_range_cap))[: 1 + (cap < in_range_cap)]
     if not _fine(scores_by, own, aim) and scores_by["angle"][own].mean < scores_by["angle"][paper].mean:
-        capped(samples, (("", candidates[paper].coefficients), ("-from-own", candidates[own].coefficients)),
-               levels)
+        capped(samples, (("", candidates[paper].coefficients), ("-from-own", candidates[own].coefficients)), levels)
     if not any(_fine(scores_by, name, floor) for name in candidates):
         # Nothing holds both auditors (each measure's paper fit loses on the other's):
         # least mean on both measures at once, capped there too when its max is over.
-        rounds = both_measures_fit(base, curves, blend_width, candidates[own], aim, floor,
-                                   lambda C16: {by: grid.score(C16) for by, grid in grids.items()}, in_range,
-                                   degree)
+        rounds = both_measures_fit(
+            base,
+            curves,
+            blend_width,
+            candidates[own],
+            aim,
+            floor,
+            lambda C16: {by: grid.score(C16) for by, grid in grids.items()},
+            in_range,
+            degree,
+        )
         for i, (fit, _) in enumerate(rounds):
             if in_range(fit.coefficients_float16):
                 add("both-measures" + (f"-{i + 1}" if i else ""), fit)
@@ -222,22 +282,31 @@ def guard_curve_choice(base, curves, blend_width: float, candidates: dict[str, F
         # The paper method's twin: ahead of the auditors' rounding on both figures, not a tie.
         C16, _ = polish_float16(candidates[chosen].coefficients_float16, *union, eta_i_range)
         after = {by: grid.score(C16) for by, grid in grids.items()}
-        if in_range(C16) and all(after[by].mean <= scores_by[by][chosen].mean
-                                 and after[by].max <= scores_by[by][chosen].max for by in grids):
+        if in_range(C16) and all(
+            after[by].mean <= scores_by[by][chosen].mean and after[by].max <= scores_by[by][chosen].max for by in grids
+        ):
             add(f"{chosen}-polished", candidates[chosen].with_coefficients(C16.astype(np.float64), C16))
             chosen = f"{chosen}-polished"
     report = guard_report(chosen, scores_by["angle"])
     report["bar_max"] = aim["angle"].max
     report["by_grid"] = {by: {name: s.to_dict() for name, s in scores.items()} for by, scores in scores_by.items()}
     best = {by: audits[by][0] for by in grids}
-    report["audit"] = {"grid": f"{AUDIT_SAMPLES} x {AUDIT_SAMPLES}", "starts": list(AUDIT_STARTS),
-                       "costs": costs["angle"], "in_range": best["angle"].reflectance,
-                       **best["angle"].score.to_dict(),
-                       "by_grid": {by: {"costs": costs[by], "in_range": best[by].reflectance,
-                                        **best[by].score.to_dict(),
-                                        "optima": [{"starts": a.starts, "in_range": a.reflectance, **a.score.to_dict()}
-                                                   for a in audits[by]]}
-                                   for by in grids}}
+    report["audit"] = {
+        "grid": f"{AUDIT_SAMPLES} x {AUDIT_SAMPLES}",
+        "starts": list(AUDIT_STARTS),
+        "costs": costs["angle"],
+        "in_range": best["angle"].reflectance,
+        **best["angle"].score.to_dict(),
+        "by_grid": {
+            by: {
+                "costs": costs[by],
+                "in_range": best[by].reflectance,
+                **best[by].score.to_dict(),
+                "optima": [{"starts": a.starts, "in_range": a.reflectance, **a.score.to_dict()} for a in audits[by]],
+            }
+            for by in grids
+        },
+    }
     report["work_cut"] = budget.cut
     return chosen, report
 
@@ -254,7 +323,8 @@ def edit_warnings(by_curve, mean: float = FOLLOW_MEAN, most: float = FOLLOW_MAX)
         if row["delta_E_mean"] > mean or row["delta_E_max"] > most:
             at = row.get("max_at") or {}
             where = f" (max {row['delta_E_max']:.2f}" + (
-                f" at {at['theta_deg']:.0f} degrees)" if "theta_deg" in at else ")")
+                f" at {at['theta_deg']:.0f} degrees)" if "theta_deg" in at else ")"
+            )
             out.append(
                 f"edit not followed: the fit stays {row['delta_E_mean']:.2f} mean Delta E 2000 from the "
                 f"edited curve at eta_i {row['eta_i']:g}{where}; the model cannot bend that way"

@@ -90,9 +90,7 @@ class RGBCurve:
             mu = np.asarray(self.cos_theta, dtype=np.float64)
             rgb = np.asarray(self.rgb, dtype=np.float64)
         except (TypeError, ValueError):
-            raise ValueError(
-                f"`{_where(label, 'cos_theta')}` and `{_where(label, 'rgb')}` must be numbers"
-            ) from None
+            raise ValueError(f"`{_where(label, 'cos_theta')}` and `{_where(label, 'rgb')}` must be numbers") from None
         if mu.ndim != 1:
             raise ValueError(f"`{_where(label, 'cos_theta')}` must be a list of numbers")
         if not CURVE_MIN_SAMPLES <= mu.size <= CURVE_MAX_SAMPLES:
@@ -126,10 +124,7 @@ class RGBCurve:
         mu, rgb = mu[order], np.clip(rgb[order], 0.0, 1.0)
         repeated = np.flatnonzero(np.diff(mu) <= 0.0)
         if repeated.size:
-            raise ValueError(
-                f"`{_where(label, 'cos_theta')}` must not repeat a value, got "
-                f"{mu[repeated[0]]:g} twice"
-            )
+            raise ValueError(f"`{_where(label, 'cos_theta')}` must not repeat a value, got {mu[repeated[0]]:g} twice")
         for array in (mu, rgb):
             array.setflags(write=False)
         object.__setattr__(self, "eta_i", eta_i)
@@ -149,9 +144,7 @@ class RGBCurve:
         bad = np.flatnonzero(~np.isfinite(angle) | (angle < lo) | (angle > hi))
         if bad.size:
             i = bad[0]
-            raise ValueError(
-                f"`{_where(label, 'angle_deg')}[{i}]` must lie in [{lo:g}, {hi:g}], got {angle[i]:g}"
-            )
+            raise ValueError(f"`{_where(label, 'angle_deg')}[{i}]` must lie in [{lo:g}, {hi:g}], got {angle[i]:g}")
         return cls(eta_i, cos_theta_from_angle(angle), rgb, label)
 
     def sampled(self, cos_theta) -> np.ndarray:
@@ -195,8 +188,6 @@ def check_curves(curves: Sequence[RGBCurve | Mapping[str, Any]]) -> list[RGBCurv
             raise ValueError(f"`{label}` must be a curve, got {type(curve).__name__}")
         for j, other in enumerate(out):
             if abs(other.eta_i - curve.eta_i) < 1e-6:
-                raise ValueError(
-                    f"`{label}.eta_i` must differ from `curves[{j}].eta_i`, both are {curve.eta_i:g}"
-                )
+                raise ValueError(f"`{label}.eta_i` must differ from `curves[{j}].eta_i`, both are {curve.eta_i:g}")
         out.append(curve)
     return out

@@ -45,8 +45,9 @@ _BOTH_POWER = 4  # a sample's weight grows by 1 + (Delta E / the auditors' max) 
 _BLEND_STEPS = 3  # coefficients tried evenly between two successive rounds of the both-measures fit
 
 
-def both_measures_fit(base, curves, blend_width, start: FitResult, aim: dict, floor: dict, score, in_range,
-                      degree: int):
+def both_measures_fit(
+    base, curves, blend_width, start: FitResult, aim: dict, floor: dict, score, in_range, degree: int
+):
     """
     The de2000 fits (least mean Delta E, :func:`fitting.fits.solver.fit_coefficients`)
     of the whole target on both auditors' measures at once
@@ -75,8 +76,20 @@ def both_measures_fit(base, curves, blend_width, start: FitResult, aim: dict, fl
         if spent >= _BOTH_NFEV:
             break
         weights = np.repeat(scale, sizes) * boost
-        fit = fit_coefficients(T, M, E, base.eta_i_range, degree, "de2000", _BOTH_MAX_NFEV, True, weights=weights,
-                               irls_rounds=0, range_check=(CM.ravel(), CE.ravel(), stiff), start=C)
+        fit = fit_coefficients(
+            T,
+            M,
+            E,
+            base.eta_i_range,
+            degree,
+            "de2000",
+            _BOTH_MAX_NFEV,
+            True,
+            weights=weights,
+            irls_rounds=0,
+            range_check=(CM.ravel(), CE.ravel(), stiff),
+            start=C,
+        )
         C, spent = fit.coefficients, spent + fit.nfev
         rounds.append((fit, (T, M, E, weights)))
         scores = score(fit.coefficients_float16)

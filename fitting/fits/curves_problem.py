@@ -97,8 +97,7 @@ def _domain(curves: list[RGBCurve], base: CurveBase | None, eta_i_range) -> tupl
         if eta_i_range is not None and check_eta_i_range(eta_i_range) != base.eta_i_range:
             lo, hi = base.eta_i_range
             raise ValueError(
-                f"`eta_i_range` must be the base's domain [{lo:g}, {hi:g}] or omitted, "
-                f"got {list(eta_i_range)}"
+                f"`eta_i_range` must be the base's domain [{lo:g}, {hi:g}] or omitted, got {list(eta_i_range)}"
             )
         eta_i_range = base.eta_i_range
     else:
@@ -106,9 +105,7 @@ def _domain(curves: list[RGBCurve], base: CurveBase | None, eta_i_range) -> tupl
     lo, hi = eta_i_range
     for i, curve in enumerate(curves):
         if not lo - 1e-9 <= curve.eta_i <= hi + 1e-9:
-            raise ValueError(
-                f"`curves[{i}].eta_i` must lie in the domain [{lo:g}, {hi:g}], got {curve.eta_i:g}"
-            )
+            raise ValueError(f"`curves[{i}].eta_i` must lie in the domain [{lo:g}, {hi:g}], got {curve.eta_i:g}")
     return eta_i_range
 
 
@@ -154,8 +151,12 @@ def curve_samples(curves: list[RGBCurve], settings: CurveFitSettings, max_degree
 
 
 def curve_problem(
-    curves: Sequence[RGBCurve | Mapping[str, Any]], base: CurveBase | None, eta_i_range, name: str,
-    settings: CurveFitSettings, model: str,
+    curves: Sequence[RGBCurve | Mapping[str, Any]],
+    base: CurveBase | None,
+    eta_i_range,
+    name: str,
+    settings: CurveFitSettings,
+    model: str,
 ) -> CurveProblem:
     """
     The :class:`CurveProblem` of :func:`fitting.fits.curves.fit_curves`'

@@ -26,7 +26,16 @@ from ..models.range_bound import certify_range
 from ..models.pack import to_float16
 from .curves_score import SCORE_GRID, check_grid
 
-__all__ = ["RANGE_TOLERANCE", "PROOF_CELLS", "outside_range", "proven_in_range", "range_report", "escape_points", "in_range_fallback", "EvaluationBudget"]
+__all__ = [
+    "RANGE_TOLERANCE",
+    "PROOF_CELLS",
+    "outside_range",
+    "proven_in_range",
+    "range_report",
+    "escape_points",
+    "in_range_fallback",
+    "EvaluationBudget",
+]
 
 RANGE_TOLERANCE = 1e-4
 """float16 rounding of a fit on the boundary."""
@@ -120,8 +129,7 @@ def in_range_fallback(C16, eta_i_range, max_cells: int = PROOF_CELLS) -> np.ndar
     C = np.asarray(C16, dtype=np.float64).copy()
     bad = outside_range(to_float16(C), eta_i_range).any(axis=0)
     # The whole domain, not the grid only (no proof asked of a channel the grid already refutes).
-    bad |= np.array([not bad[c] and not proven_in_range(to_float16(C), eta_i_range, c, max_cells)
-                     for c in range(3)])
+    bad |= np.array([not bad[c] and not proven_in_range(to_float16(C), eta_i_range, c, max_cells) for c in range(3)])
     if not bad.any():
         return to_float16(C)
     rows = check_grid(eta_i_range, 2, SCORE_GRID[1])[1][:, 0]
@@ -133,8 +141,9 @@ def in_range_fallback(C16, eta_i_range, max_cells: int = PROOF_CELLS) -> np.ndar
         a = C[1, c, :].copy()
         for scale in _SHAPE_SCALES:
             C[1, c, :] = scale * a
-            if (not outside_range(to_float16(C), eta_i_range)[:, c].any()
-                    and proven_in_range(to_float16(C), eta_i_range, c, max_cells)):
+            if not outside_range(to_float16(C), eta_i_range)[:, c].any() and proven_in_range(
+                to_float16(C), eta_i_range, c, max_cells
+            ):
                 break
     return to_float16(C)
 

@@ -70,15 +70,30 @@ def _scored_target(base, curves, blend_width, shape):
     """
     objects, values = (base, *curves), (float(blend_width), tuple(shape))
     last = _LAST[0]
-    if (last is None or len(last[0]) != len(objects) or last[1] != values
-            or not all(a is b for a, b in zip(last[0], objects))):
+    if (
+        last is None
+        or len(last[0]) != len(objects)
+        or last[1] != values
+        or not all(a is b for a, b in zip(last[0], objects))
+    ):
         grid = score_grid(base.eta_i_range, shape)
-        last = _LAST[0] = (objects, values, grid, ACEScg_to_Lab(edited_target(base, curves, grid[2], grid[3], blend_width)))
+        last = _LAST[0] = (
+            objects,
+            values,
+            grid,
+            ACEScg_to_Lab(edited_target(base, curves, grid[2], grid[3], blend_width)),
+        )
     return last[2], last[3]
 
 
-def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients, blend_width: float,
-                       shape=SCORE_GRID, model: str = DEFAULT_MODEL) -> dict[str, Any]:
+def whole_target_error(
+    base: CurveBase,
+    curves: Sequence[RGBCurve],
+    coefficients,
+    blend_width: float,
+    shape=SCORE_GRID,
+    model: str = DEFAULT_MODEL,
+) -> dict[str, Any]:
     """
     Delta E 2000 of the model (of kind ``model``) of ``coefficients`` against the whole blended
     target (:func:`edited_target`) on the scoring grid: ``against`` in words,
@@ -92,9 +107,12 @@ def whole_target_error(base: CurveBase, curves: Sequence[RGBCurve], coefficients
     grid = f"{theta.size} angles x {rows.size} eta_i"
     return {
         "against": f"{AGAINST_CURVES} (the whole edited target, {grid})",
-        "delta_E_mean": float(dE.mean()), "delta_E_max": float(dE.max()),
+        "delta_E_mean": float(dE.mean()),
+        "delta_E_max": float(dE.max()),
         "max_at": {"eta_i": float(rows[j]), "theta_deg": float(theta[i])},
-        "at_theta_deg": float(theta[i]), "at_eta_i": float(rows[j]),
-        "model_min": float(RGB.min()), "model_max": float(RGB.max()),
+        "at_theta_deg": float(theta[i]),
+        "at_eta_i": float(rows[j]),
+        "model_min": float(RGB.min()),
+        "model_max": float(RGB.max()),
         "grid": grid,
     }

@@ -89,13 +89,21 @@ class CurveFitSettings:
         check_int("max_evaluations", self.max_evaluations, 1, 100_000)
         check_int("proof_cells", self.proof_cells, 256, 4_000_000)
         check = self.check_samples
-        if not (isinstance(check, tuple) and len(check) == 2
-                and all(isinstance(n, int) and 2 <= n <= 256 for n in check)):
+        if not (
+            isinstance(check, tuple) and len(check) == 2 and all(isinstance(n, int) and 2 <= n <= 256 for n in check)
+        ):
             raise ValueError(f"`check_samples` must be two integers in [2, 256], got {check!r}")
 
 
-LIVE_SETTINGS = CurveFitSettings(irls_rounds=0, max_nfev=4, compare_rgb=False, quantise=False,
-                                 check_samples=(10, 4), max_evaluations=24, proof_cells=4_000)
+LIVE_SETTINGS = CurveFitSettings(
+    irls_rounds=0,
+    max_nfev=4,
+    compare_rgb=False,
+    quantise=False,
+    check_samples=(10, 4),
+    max_evaluations=24,
+    proof_cells=4_000,
+)
 """The settings of a live refit, while a curve is being dragged: one solve of
 at most 4 evaluations (no reweighting round, no paper-method candidate,
 float16 by rounding to nearest, the [0, 1] check grid coarser at first),

@@ -39,8 +39,16 @@ from .curves_score import SCORE_GRID, check_grid, score_grid, whole_target_error
 from .metrics import curve_metrics
 from .result import FitResult
 
-__all__ = ["Refit", "bounded_fit", "one_solve", "in_range_fit", "held_in_range", "live_answer",
-           "guarded_choice", "scored"]
+__all__ = [
+    "Refit",
+    "bounded_fit",
+    "one_solve",
+    "in_range_fit",
+    "held_in_range",
+    "live_answer",
+    "guarded_choice",
+    "scored",
+]
 
 _RGB_GRID = (24, 16)  # the paper-method candidate's samples: every other angle and eta_i of SCORE_GRID
 _RGB_MAX_NFEV = 200  # as the paper-method fits (fit_coefficients' default): rgb solves are cheap
@@ -77,8 +85,12 @@ class Refit:
     @classmethod
     def of(cls, problem: CurveProblem, start) -> Refit:
         """The shared state of a refit of ``problem`` from ``start`` (or None), its whole budget left."""
-        return cls(problem, start, EvaluationBudget(problem.settings.max_evaluations),
-                   check_grid(problem.eta_i_range, *SCORE_GRID))
+        return cls(
+            problem,
+            start,
+            EvaluationBudget(problem.settings.max_evaluations),
+            check_grid(problem.eta_i_range, *SCORE_GRID),
+        )
 
     def outside(self, C16) -> np.ndarray:
         """Mask of the range grid's points where the float16 fit ``C16`` leaves [0, 1]."""
@@ -92,7 +104,8 @@ class Refit:
     def in_range(self, C16) -> bool:
         """Whether ``C16`` is inside [0, 1] on the range grid and proven so over the whole domain."""
         return not self.outside(C16).any() and proven_in_range(
-            C16, self.problem.eta_i_range, max_cells=self.problem.settings.proof_cells)
+            C16, self.problem.eta_i_range, max_cells=self.problem.settings.proof_cells
+        )
 
 
 def bounded_fit(problem: CurveProblem) -> FitResult:
@@ -103,14 +116,28 @@ def bounded_fit(problem: CurveProblem) -> FitResult:
     """
     settings = problem.settings
     return problem.solver.solve(
-        problem.target, problem.mu, problem.eta, problem.eta_i_range, problem.degree, settings.objective,
-        max(settings.max_nfev, _RGB_MAX_NFEV), settings.quantise, weights=problem.weights,
+        problem.target,
+        problem.mu,
+        problem.eta,
+        problem.eta_i_range,
+        problem.degree,
+        settings.objective,
+        max(settings.max_nfev, _RGB_MAX_NFEV),
+        settings.quantise,
+        weights=problem.weights,
         irls_rounds=settings.irls_rounds,
     )
 
 
-def one_solve(refit: Refit, objective: str, range_weight: float, check_samples: tuple[int, int], dense=None,
-              start=None, extra_check=None) -> FitResult:
+def one_solve(
+    refit: Refit,
+    objective: str,
+    range_weight: float,
+    check_samples: tuple[int, int],
+    dense=None,
+    start=None,
+    extra_check=None,
+) -> FitResult:
     """
     One solve of the problem's samples by ``objective`` (or, with ``dense``
     = (target, mu, eta), the paper's method: rgb on those, unweighted, from
@@ -132,15 +159,32 @@ def one_solve(refit: Refit, objective: str, range_weight: float, check_samples: 
         # An unbounded and a bounded solve at most (fitting.fits.solver.solve).
         wanted = _RGB_MAX_NFEV
         max_nfev = budget.per_solve(wanted, 2)
-        result = problem.solver.solve(*dense, problem.eta_i_range, problem.degree, "rgb", max_nfev,
-                                      settings.quantise, irls_rounds=0, range_check=range_check)
+        result = problem.solver.solve(
+            *dense,
+            problem.eta_i_range,
+            problem.degree,
+            "rgb",
+            max_nfev,
+            settings.quantise,
+            irls_rounds=0,
+            range_check=range_check,
+        )
     else:
         wanted, rounds = settings.max_nfev, 1 + (settings.irls_rounds if objective == "de2000" else 0)
         max_nfev = budget.per_solve(wanted, 2 * rounds)
         result = problem.solver.solve(
-            problem.target, problem.mu, problem.eta, problem.eta_i_range, problem.degree, objective, max_nfev,
-            settings.quantise, weights=problem.weights, irls_rounds=settings.irls_rounds,
-            range_check=range_check, start=start,
+            problem.target,
+            problem.mu,
+            problem.eta,
+            problem.eta_i_range,
+            problem.degree,
+            objective,
+            max_nfev,
+            settings.quantise,
+            weights=problem.weights,
+            irls_rounds=settings.irls_rounds,
+            range_check=range_check,
+            start=start,
         )
     budget.spend(result, max_nfev, wanted)
     return result
@@ -165,10 +209,12 @@ def in_range_fit(refit: Refit, objective: str, dense=None) -> FitResult:
         if refit.in_range(result.coefficients_float16) or not refit.budget.allows(_MIN_ESCALATION_NFEV):
             break
         C16 = result.coefficients_float16
-        points = escape_points(C16, problem.eta_i_range, refit.outside(C16), *refit.range_grid, check[1],
-                               settings.proof_cells)
-        extra = points if extra is None else (
-            np.concatenate([extra[0], points[0]]), np.concatenate([extra[1], points[1]]))
+        points = escape_points(
+            C16, problem.eta_i_range, refit.outside(C16), *refit.range_grid, check[1], settings.proof_cells
+        )
+        extra = (
+            points if extra is None else (np.concatenate([extra[0], points[0]]), np.concatenate([extra[1], points[1]]))
+        )
         if refit.start is None or dense is not None:
             # A fit from its own guess: stiffer on a finer grid, started
             # again, with the points where it left [0, 1] added.
@@ -190,8 +236,9 @@ def held_in_range(refit: Refit, result: FitResult) -> FitResult:
     """
     problem = refit.problem
     if problem.settings.range_weight > 0 and not refit.in_range(result.coefficients_float16):
-        result.coefficients_float16 = in_range_fallback(result.coefficients_float16, problem.eta_i_range,
-                                                        problem.settings.proof_cells)
+        result.coefficients_float16 = in_range_fallback(
+            result.coefficients_float16, problem.eta_i_range, problem.settings.proof_cells
+        )
         result.best_effort = True
     return result
 
@@ -210,8 +257,9 @@ def live_answer(refit: Refit, result: FitResult) -> FitResult:
     on_screen = to_float16(np.asarray(refit.start, dtype=np.float64))
     base, curves, blend_width = problem.base, problem.curves, problem.settings.blend_width
     if refit.in_range(on_screen) and (
-            whole_target_error(base, curves, on_screen, blend_width)["delta_E_mean"]
-            < whole_target_error(base, curves, result.coefficients_float16, blend_width)["delta_E_mean"]):
+        whole_target_error(base, curves, on_screen, blend_width)["delta_E_mean"]
+        < whole_target_error(base, curves, result.coefficients_float16, blend_width)["delta_E_mean"]
+    ):
         result.coefficients_float16 = on_screen
     return result
 
@@ -235,8 +283,15 @@ def guarded_choice(refit: Refit, result: FitResult) -> tuple[FitResult, str]:
     dense = (dense_target.reshape(-1, 3), rgb_M.ravel(), rgb_E.ravel())
     candidates = {settings.objective: result, "rgb": held_in_range(refit, in_range_fit(refit, "rgb", dense))}
     chosen, guard = guard_curve_choice(
-        problem.base, problem.curves, settings.blend_width, candidates, settings.objective, "rgb",
-        (problem.target, problem.mu, problem.eta, problem.weights), refit.in_range)
+        problem.base,
+        problem.curves,
+        settings.blend_width,
+        candidates,
+        settings.objective,
+        "rgb",
+        (problem.target, problem.mu, problem.eta, problem.weights),
+        refit.in_range,
+    )
     kept = candidates[chosen]
     kept.guard = guard
     return kept, kept.objective
@@ -266,8 +321,9 @@ def scored(problem: CurveProblem, result: FitResult, objective: str, budget_cut:
     if unfollowed:  # an edit the model family cannot bend to: where and by how much
         metrics["warnings"] = unfollowed
     if problem.base is not None:
-        target = metrics["target"] = whole_target_error(problem.base, problem.curves, C16,
-                                                        problem.settings.blend_width, model=model)
+        target = metrics["target"] = whole_target_error(
+            problem.base, problem.curves, C16, problem.settings.blend_width, model=model
+        )
         # With a base the figure is the whole edited target's (what the editor's error map shows).
         metrics["figure"] = {key: target[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at")}
     if result.guard is not None:
@@ -277,7 +333,11 @@ def scored(problem: CurveProblem, result: FitResult, objective: str, budget_cut:
     result.error = error
     result.metrics = metrics
     result.packed = PackedMaterial(
-        name=problem.name, coefficients=C16, eta_i_range=eta_i_range, source=problem.source[:4000],
-        metrics=metrics, model=model,
+        name=problem.name,
+        coefficients=C16,
+        eta_i_range=eta_i_range,
+        source=problem.source[:4000],
+        metrics=metrics,
+        model=model,
     )
     return result

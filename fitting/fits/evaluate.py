@@ -35,8 +35,12 @@ __all__ = ["evaluate_errors", "grid_models", "score_on_grid", "evaluate_material
 
 
 def evaluate_errors(
-    nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
+    nk: SpectralNK,
+    result: FitResult,
+    samples: int = 100,
+    baselines: bool = True,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    dtype: str = "float64",
 ) -> dict[str, ErrorMetrics]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
@@ -60,14 +64,22 @@ def grid_models(result: FitResult, cos_theta, eta_i) -> dict[str, np.ndarray]:
     """
     return {
         name: model_ACEScg(result.model, cos_theta, eta_i, coefficients, result.eta_i_range)
-        for name, coefficients in (("model_float16", result.coefficients_float16),
-                                   ("model_float64", result.coefficients))
+        for name, coefficients in (
+            ("model_float16", result.coefficients_float16),
+            ("model_float64", result.coefficients),
+        )
     }
 
 
 def score_on_grid(
-    nk: SpectralNK, cos_theta, eta_i, models, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64", reference=None,
+    nk: SpectralNK,
+    cos_theta,
+    eta_i,
+    models,
+    baselines: bool = True,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    dtype: str = "float64",
+    reference=None,
 ) -> dict[str, ErrorMetrics]:
     """
     :func:`fitting.fits.metrics.grid_metrics` of ``models`` (name to (E, M, 3)
@@ -85,13 +97,18 @@ def score_on_grid(
         ref = reference_ACEScg_grid(nk, cos_theta[0], eta_i[:, 0], 1.0, min_coverage, dtype)
     if baselines:
         models = {**models, **baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage)}
-    return grid_metrics(ref, models, eta_i[:, 0],
-                        f"{AGAINST_MEASURED}, {eta_i.shape[0]} x {eta_i.shape[1]} grid", cos_theta[0])
+    return grid_metrics(
+        ref, models, eta_i[:, 0], f"{AGAINST_MEASURED}, {eta_i.shape[0]} x {eta_i.shape[1]} grid", cos_theta[0]
+    )
 
 
 def evaluate_material(
-    nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
+    nk: SpectralNK,
+    result: FitResult,
+    samples: int = 100,
+    baselines: bool = True,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    dtype: str = "float64",
 ) -> dict[str, Any]:
     """
     :func:`evaluate_errors` as the JSON a fit carries (``FitResult.metrics``,
@@ -100,9 +117,7 @@ def evaluate_material(
     :meth:`~fitting.fits.metrics.ErrorMetrics.to_dict` by name, ``coverage``.
     Sets ``result.error`` to the float16 model's :class:`ErrorMetrics`.
     """
-    return metrics_json(
-        evaluate_errors(nk, result, samples, baselines, min_coverage, dtype), result, samples
-    )
+    return metrics_json(evaluate_errors(nk, result, samples, baselines, min_coverage, dtype), result, samples)
 
 
 def metrics_json(errors: dict[str, ErrorMetrics], result: FitResult, samples: int) -> dict[str, Any]:

@@ -34,8 +34,15 @@ from ..models.range_bound import certify_range
 from ..optics.nk import SpectralNK
 from ..optics.quality import UNCERTAIN_GAP_NM, visible_gaps
 
-__all__ = ["fit_quality", "out_of_range_message", "provenance", "in_range_verdict",
-           "SPARSE_SAMPLES", "data_uncertainty", "uncertainty_warning"]
+__all__ = [
+    "fit_quality",
+    "out_of_range_message",
+    "provenance",
+    "in_range_verdict",
+    "SPARSE_SAMPLES",
+    "data_uncertainty",
+    "uncertainty_warning",
+]
 
 SPARSE_SAMPLES = 12
 """Data with fewer samples than this inside 360-830 nm (a spacing near 40 nm
@@ -51,10 +58,14 @@ def out_of_range_message(range_report: dict[str, Any]) -> str:
     """The words of a model not proven in [0, 1] (``range_report``: :meth:`RangeCertificate.to_dict`)."""
     worst = range_report["worst"]
     if range_report["in_range"] is False:
-        return (f"the model leaves [0, 1]: {worst['value']:.4f} in {worst['channel']} at "
-                f"cos theta {worst['cos_theta']:.4g}, eta_i {worst['eta_i']:.4g}")
-    return (f"the model is not proven inside [0, 1] (bounds {range_report['proven_min']:.4f} to "
-            f"{range_report['proven_max']:.4f})")
+        return (
+            f"the model leaves [0, 1]: {worst['value']:.4f} in {worst['channel']} at "
+            f"cos theta {worst['cos_theta']:.4g}, eta_i {worst['eta_i']:.4g}"
+        )
+    return (
+        f"the model is not proven inside [0, 1] (bounds {range_report['proven_min']:.4f} to "
+        f"{range_report['proven_max']:.4f})"
+    )
 
 
 def fit_quality(coefficients_float16, eta_i_range, warnings=()) -> dict[str, Any]:
@@ -109,8 +120,14 @@ def data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[s
     and domains: a scene's fits of one material over one range ask for it
     once each, and it costs more than a fit.
     """
-    key = (nk.name, nk.wavelength_nm.tobytes(), nk.n.tobytes(), nk.k.tobytes(),
-           tuple(float(v) for v in eta_i_range), float(min_coverage))
+    key = (
+        nk.name,
+        nk.wavelength_nm.tobytes(),
+        nk.n.tobytes(),
+        nk.k.tobytes(),
+        tuple(float(v) for v in eta_i_range),
+        float(min_coverage),
+    )
     if key not in _UNCERTAINTY_KEPT:
         if len(_UNCERTAINTY_KEPT) >= 16:
             _UNCERTAINTY_KEPT.pop(next(iter(_UNCERTAINTY_KEPT)))
@@ -158,8 +175,9 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
 
     base = reference(nk)
     parts: dict[str, float] = {}
-    parts["splines"] = max(spread(_spline_nk(nk, spline))
-                           for spline in (PchipInterpolator, Akima1DInterpolator, CubicSpline))
+    parts["splines"] = max(
+        spread(_spline_nk(nk, spline)) for spline in (PchipInterpolator, Akima1DInterpolator, CubicSpline)
+    )
     left_out = []
     for i in np.unique(np.round(np.linspace(0, inner.size - 1, min(inner.size, _MOST_LEFT_OUT))).astype(int)):
         keep = np.ones(w.size, dtype=bool)
@@ -190,8 +208,9 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
     }
 
 
-def uncertainty_warning(uncertainty: dict[str, Any] | None, nk: SpectralNK, eta_i_range,
-                        kind: str, coefficients_float16) -> tuple[float | None, str | None]:
+def uncertainty_warning(
+    uncertainty: dict[str, Any] | None, nk: SpectralNK, eta_i_range, kind: str, coefficients_float16
+) -> tuple[float | None, str | None]:
     """
     The fit's own mean Delta E 2000 on the uncertainty's grid, and the
     warning to carry when ``uncertainty`` exceeds it (else None).

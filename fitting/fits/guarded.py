@@ -37,7 +37,16 @@ from .paper_method import paper_fit
 from .solver import fit_coefficients
 from .worst_case import MAX_MARGIN, GuardScore, choose, guard_score
 
-__all__ = ["PAPER", "MEAN", "CAP_FACTORS", "GuardWork", "constrained_mean", "constrained_refits", "guarded_fit", "guard_report"]
+__all__ = [
+    "PAPER",
+    "MEAN",
+    "CAP_FACTORS",
+    "GuardWork",
+    "constrained_mean",
+    "constrained_refits",
+    "guarded_fit",
+    "guard_report",
+]
 
 PAPER = "paper"
 """Name of the paper-method candidate."""
@@ -80,7 +89,9 @@ def _quantise_capped(mean_problem, guard_problem, weights, C, cap, quantise: boo
         np.concatenate([mean_problem.target, guard_problem.target]),
         np.concatenate([mean_problem.mu, guard_problem.mu]),
         np.concatenate([mean_problem.eta, guard_problem.eta]),
-        mean_problem.range, C.shape[2] - 1, "de2000",
+        mean_problem.range,
+        C.shape[2] - 1,
+        "de2000",
         np.concatenate([w / np.maximum(dE, 0.02), 1.0 / np.maximum(gdE, 0.02)]),
         mean_problem.check,
     )
@@ -101,13 +112,28 @@ def _quantise_capped(mean_problem, guard_problem, weights, C, cap, quantise: boo
 
 def guard_report(chosen: str, scores: dict[str, GuardScore]) -> dict:
     """The JSON of a guarded choice: what was kept and every candidate's figures."""
-    return {"chosen": chosen, "margin": MAX_MARGIN,
-            "candidates": {name: s.to_dict() for name, s in scores.items()}}
+    return {"chosen": chosen, "margin": MAX_MARGIN, "candidates": {name: s.to_dict() for name, s in scores.items()}}
 
 
-def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_eta, eta_i_range,
-                       degree, range_check, starts, paper_max: float, quantise: bool, score,
-                       range_points=None, work: GuardWork | None = None, factors=CAP_FACTORS):
+def constrained_refits(
+    target,
+    mu,
+    eta,
+    weights,
+    guard_target,
+    guard_mu,
+    guard_eta,
+    eta_i_range,
+    degree,
+    range_check,
+    starts,
+    paper_max: float,
+    quantise: bool,
+    score,
+    range_points=None,
+    work: GuardWork | None = None,
+    factors=CAP_FACTORS,
+):
     """
     Yield ``(label, C, C16, score(C16))`` of the fits of least mean Delta E
     over (``target``, ``mu``, ``eta``, ``weights``) with the first-order
@@ -132,8 +158,9 @@ def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_e
                 # The constraint is on the first-order Delta E (the de2000
                 # objective's); the score is the true CIEDE2000, which can
                 # read a little higher: the cap is lowered by their ratio.
-                C = constrained_mean(mean_problem, guard_problem, base, x0, cap, degree,
-                                     range_points=range_points, work=work)
+                C = constrained_mean(
+                    mean_problem, guard_problem, base, x0, cap, degree, range_points=range_points, work=work
+                )
                 if C is None:
                     break
                 C16 = _quantise_capped(mean_problem, guard_problem, base, C, cap, quantise)
@@ -148,8 +175,21 @@ def constrained_refits(target, mu, eta, weights, guard_target, guard_mu, guard_e
 
 @_THREADPOOLS.wrap(limits=1, user_api="blas")
 def guarded_fit(
-    target, mu, eta, eta_i_range, degree, objective, max_nfev, quantise, weights,
-    irls_rounds, guard_target, guard_mu, guard_eta, range_check=None, mean_fit: FitResult | None = None,
+    target,
+    mu,
+    eta,
+    eta_i_range,
+    degree,
+    objective,
+    max_nfev,
+    quantise,
+    weights,
+    irls_rounds,
+    guard_target,
+    guard_mu,
+    guard_eta,
+    range_check=None,
+    mean_fit: FitResult | None = None,
 ) -> FitResult:
     """
     The fit of ``target`` at (``mu``, ``eta``) as
@@ -161,9 +201,19 @@ def guarded_fit(
     """
     t0 = time.perf_counter()
     if mean_fit is None:
-        mean_fit = fit_coefficients(target, mu, eta, eta_i_range, degree, objective, max_nfev,
-                                    quantise, weights=weights, irls_rounds=irls_rounds,
-                                    range_check=range_check)
+        mean_fit = fit_coefficients(
+            target,
+            mu,
+            eta,
+            eta_i_range,
+            degree,
+            objective,
+            max_nfev,
+            quantise,
+            weights=weights,
+            irls_rounds=irls_rounds,
+            range_check=range_check,
+        )
     degree = mean_fit.degree
     gT = np.asarray(guard_target, dtype=np.float64).reshape(-1, 3)
     gM, gE = np.ravel(guard_mu), np.ravel(guard_eta)
@@ -178,8 +228,21 @@ def guarded_fit(
     if choose(scores, PAPER) != MEAN:
         starts = (("", paper.coefficients), ("-from-mean", mean_fit.coefficients))
         for label, C, C16, s_ in constrained_refits(
-                target, mu, eta, weights, gT, gM, gE, eta_i_range, degree, range_check, starts,
-                scores[PAPER].max, quantise, score):
+            target,
+            mu,
+            eta,
+            weights,
+            gT,
+            gM,
+            gE,
+            eta_i_range,
+            degree,
+            range_check,
+            starts,
+            scores[PAPER].max,
+            quantise,
+            score,
+        ):
             candidates[label] = _candidate(mean_fit, C, C16, eta_i_range, degree, objective)
             scores[label] = s_
             if choose(scores, PAPER) == label:

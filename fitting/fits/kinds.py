@@ -29,8 +29,7 @@ from .result import FitResult
 from .rgb_conductor import RGB_CONDUCTOR_FIT
 from .settings import FitSettings
 
-__all__ = ["FIT_KINDS", "register_fit_kind", "unregister_fit_kind", "fit_kind", "fit_model",
-           "evaluate_model"]
+__all__ = ["FIT_KINDS", "register_fit_kind", "unregister_fit_kind", "fit_kind", "fit_model", "evaluate_model"]
 
 FIT_KINDS: dict[str, FitKind] = {}
 """The fit of each model kind, by name."""
@@ -95,8 +94,12 @@ def fit_model(
 
 
 def evaluate_model(
-    nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
+    nk: SpectralNK,
+    result: FitResult,
+    samples: int = 100,
+    baselines: bool = True,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    dtype: str = "float64",
 ) -> dict[str, Any]:
     """
     :func:`fitting.fits.evaluate.evaluate_material` for a fit of any kind;

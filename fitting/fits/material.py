@@ -32,14 +32,24 @@ from .worst_case import guard_reference
 
 __all__ = ["COATED_CONDUCTOR_FIT", "fit_material"]
 
-def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitResult,
-           rows=None) -> FitResult:
+
+def _guard(nk, target, mu, eta, weights, eta_i_range, settings, mean_fit: FitResult, rows=None) -> FitResult:
     """The max guarded against the paper's method on a subsample of the scoring grid (at ``rows``: a scene's set)."""
-    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage,
-                                                        rows=rows)
+    guard_mu, guard_eta, guard_target = guard_reference(nk, eta_i_range, settings.min_coverage, rows=rows)
     return guarded_fit(
-        target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
-        settings.quantise, weights, settings.irls_rounds, guard_target, guard_mu, guard_eta,
+        target,
+        mu,
+        eta,
+        eta_i_range,
+        settings.degree,
+        settings.objective,
+        settings.max_nfev,
+        settings.quantise,
+        weights,
+        settings.irls_rounds,
+        guard_target,
+        guard_mu,
+        guard_eta,
         mean_fit=mean_fit,
     )
 
@@ -49,8 +59,9 @@ def _quality(result: FitResult, eta_i_range, warnings) -> dict:
     return fit_quality(result.coefficients_float16, eta_i_range, warnings)
 
 
-COATED_CONDUCTOR_FIT = FitKind(name=DEFAULT_MODEL, settings=FitSettings(), solve=fit_coefficients,
-                               guard=_guard, quality=_quality)
+COATED_CONDUCTOR_FIT = FitKind(
+    name=DEFAULT_MODEL, settings=FitSettings(), solve=fit_coefficients, guard=_guard, quality=_quality
+)
 """The coated-conductor's fit (:mod:`fitting.fits.pipeline`; registered in :mod:`fitting.fits.kinds`)."""
 
 

@@ -106,8 +106,9 @@ def headline(metrics: dict[str, Any] | None) -> str:
     figure = (metrics or {}).get("figure")
     if not figure:
         return "Delta E 2000: not measured"
-    text = (f"Delta E 2000 against {figure['against']}: mean {figure['delta_E_mean']:.3f}, "
-            f"max {figure['delta_E_max']:.3f}")
+    text = (
+        f"Delta E 2000 against {figure['against']}: mean {figure['delta_E_mean']:.3f}, max {figure['delta_E_max']:.3f}"
+    )
     at = figure.get("max_at")
     if at:
         text += f" at eta_i {at['eta_i']:.3g}, theta {at['theta_deg']:.1f} deg"
@@ -149,7 +150,9 @@ class ErrorMetrics:
     def figure(self) -> dict[str, Any]:
         """The one figure (module docstring): what, mean, max and where the max is."""
         return {
-            "against": self.against, "delta_E_mean": self.mean, "delta_E_max": self.max,
+            "against": self.against,
+            "delta_E_mean": self.mean,
+            "delta_E_max": self.max,
             "max_at": None if self.max_at is None else self.max_at.to_dict(),
         }
 
@@ -184,16 +187,13 @@ class ErrorMetrics:
             out["max_at"] = self.max_at.to_dict()
         if self.layout == "curves":
             out["by_curve"] = [
-                {"eta_i": r.eta_i, "delta_E_mean": r.mean, "delta_E_max": r.max}
-                for r in self.rows or ()
+                {"eta_i": r.eta_i, "delta_E_mean": r.mean, "delta_E_max": r.max} for r in self.rows or ()
             ]
             return out
         if self.rmse is not None:
             out["rmse"] = self.rmse
         if self.rows is not None:
-            out["by_eta_i"] = {
-                f"{r.eta_i:g}": {"delta_E_mean": r.mean, "delta_E_max": r.max} for r in self.rows
-            }
+            out["by_eta_i"] = {f"{r.eta_i:g}": {"delta_E_mean": r.mean, "delta_E_max": r.max} for r in self.rows}
         return out
 
 
@@ -213,8 +213,9 @@ def error_metrics(reference_RGB, model_RGB, eta_i_rows=None, against: str = "") 
     return grid_metrics(reference_RGB, {"model": model_RGB}, eta_i_rows, against)["model"]
 
 
-def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "",
-                 cos_theta_columns=None) -> dict[str, ErrorMetrics]:
+def grid_metrics(
+    reference_RGB, models, eta_i_rows=None, against: str = "", cos_theta_columns=None
+) -> dict[str, ErrorMetrics]:
     """
     :func:`error_metrics` of each of ``models`` (a mapping of name to (E, M,
     3) linear ACEScg) against the one ``reference_RGB``, keyed as
@@ -228,7 +229,8 @@ def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "",
     if eta_i_rows is not None:
         grid = np.asarray(eta_i_rows, dtype=np.float64)
         breakdown = [
-            (eta, int(np.argmin(np.abs(grid - eta)))) for eta in BREAKDOWN_ETA_I
+            (eta, int(np.argmin(np.abs(grid - eta))))
+            for eta in BREAKDOWN_ETA_I
             if grid.min() - 1e-9 <= eta <= grid.max() + 1e-9
         ]
     out = {}
@@ -245,9 +247,9 @@ def grid_metrics(reference_RGB, models, eta_i_rows=None, against: str = "",
             mean=float(dE.mean()),
             max=float(dE.max()),
             against=against,
-            rows=None if eta_i_rows is None else tuple(
-                EtaRow(eta, float(dE[i].mean()), float(dE[i].max())) for eta, i in breakdown
-            ),
+            rows=None
+            if eta_i_rows is None
+            else tuple(EtaRow(eta, float(dE[i].mean()), float(dE[i].max())) for eta, i in breakdown),
             rmse=float(np.sqrt(np.mean((reference_RGB - model_RGB) ** 2))),
             max_at=max_at,
         )
@@ -282,7 +284,11 @@ def delta_E_summary(reference_RGB, model_RGB, against: str = "", layout: str = "
 
 
 def baseline_metrics(
-    nk, cos_theta, eta_i, reference_RGB, min_coverage: float = DEFAULT_MIN_COVERAGE,
+    nk,
+    cos_theta,
+    eta_i,
+    reference_RGB,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
     against: str = "",
 ) -> dict[str, ErrorMetrics]:
     """
@@ -291,6 +297,4 @@ def baseline_metrics(
     (E, M) indexed [eta_i, cos_theta]; keyed by baseline name.
     """
     rows = np.asarray(eta_i)[:, 0]
-    return grid_metrics(
-        reference_RGB, baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage), rows, against
-    )
+    return grid_metrics(reference_RGB, baselines_ACEScg(nk, cos_theta, eta_i, 1.0, min_coverage), rows, against)

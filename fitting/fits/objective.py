@@ -46,13 +46,13 @@ def delta_E_gradients(r, J):
 class Problem:
     """Residuals and Jacobian of one fit (flattened samples S, 3 outputs each)."""
 
-    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None,
-                 range_check=None):
+    def __init__(self, target_RGB, cos_theta, eta_i, eta_i_range, degree, objective, weights=None, range_check=None):
         # range_check: (mu, eta, weight) of points where the model must stay
         # in [0, 1]: one hinge residual weight * (min(F, 0) + max(F - 1, 0))
         # per point and channel, 0 while the model is inside.
-        self.check = None if range_check is None else (
-            np.ravel(range_check[0]), np.ravel(range_check[1]), float(range_check[2]))
+        self.check = (
+            None if range_check is None else (np.ravel(range_check[0]), np.ravel(range_check[1]), float(range_check[2]))
+        )
         self.mu = np.ravel(cos_theta)
         self.eta = np.ravel(eta_i)
         self.range = eta_i_range

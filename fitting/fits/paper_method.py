@@ -72,8 +72,8 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
             dalpha = np.where(P[:, 2] > ALPHA_MIN, -P[:, 1] * mu_xa * log_x, 0.0)
             J = np.empty((m.size, 3 * d1))
             J[:, :d1] = dF0  # the F0 columns do not depend on the coefficients
-            np.multiply(-mu_xa[:, None], T, out=J[:, d1:2 * d1])
-            np.multiply(dalpha[:, None], T, out=J[:, 2 * d1:])
+            np.multiply(-mu_xa[:, None], T, out=J[:, d1 : 2 * d1])
+            np.multiply(dalpha[:, None], T, out=J[:, 2 * d1 :])
             return J
 
         x0 = C[:, c, :].ravel()
@@ -86,8 +86,16 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
             lo, hi = lower[:, c].ravel(), upper[:, c].ravel()
             with threadpools.limit(limits=1, user_api="blas"):
                 fit = optimize.least_squares(
-                    residuals, np.clip(x0, lo, hi), jac=jacobian, method="trf", bounds=(lo, hi),
-                    xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=max_nfev)
+                    residuals,
+                    np.clip(x0, lo, hi),
+                    jac=jacobian,
+                    method="trf",
+                    bounds=(lo, hi),
+                    xtol=1e-10,
+                    ftol=1e-10,
+                    gtol=1e-10,
+                    max_nfev=max_nfev,
+                )
             xc = fit.x.reshape(3, d1)
             if fit.status < 0 or not np.all(np.isfinite(xc)):
                 return None
@@ -95,8 +103,9 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
     return C
 
 
-def paper_fit(target, mu, eta, eta_i_range, degree, max_nfev, mean_fit: FitResult, range_check=None,
-              boxed: bool = False) -> FitResult:
+def paper_fit(
+    target, mu, eta, eta_i_range, degree, max_nfev, mean_fit: FitResult, range_check=None, boxed: bool = False
+) -> FitResult:
     """
     The paper's method on the guard points: plain rgb least squares,
     float16 by rounding to nearest (as the paper ships it). Warm-started
@@ -107,9 +116,23 @@ def paper_fit(target, mu, eta, eta_i_range, degree, max_nfev, mean_fit: FitResul
     coefficients' box is solved inside it, channel by channel too
     (:func:`_paper_channels`).
     """
-    C = None if range_check is not None else _paper_channels(
-        target, mu, eta, eta_i_range, mean_fit.coefficients, max_nfev, boxed)
+    C = (
+        None
+        if range_check is not None
+        else _paper_channels(target, mu, eta, eta_i_range, mean_fit.coefficients, max_nfev, boxed)
+    )
     if C is None:
-        return fit_coefficients(target, mu, eta, eta_i_range, degree, "rgb", max_nfev, False,
-                                irls_rounds=0, range_check=range_check, start=mean_fit.coefficients)
+        return fit_coefficients(
+            target,
+            mu,
+            eta,
+            eta_i_range,
+            degree,
+            "rgb",
+            max_nfev,
+            False,
+            irls_rounds=0,
+            range_check=range_check,
+            start=mean_fit.coefficients,
+        )
     return mean_fit.with_coefficients(C, to_float16(C))

@@ -91,8 +91,12 @@ def with_metrics(result: FitResult, metrics: dict[str, Any], name: str | None = 
     packed = result.packed
     result.metrics = metrics
     result.packed = PackedMaterial(
-        name=name or packed.name, coefficients=packed.coefficients, eta_i_range=packed.eta_i_range,
-        source=packed.source, metrics=metrics, model=packed.model,
+        name=name or packed.name,
+        coefficients=packed.coefficients,
+        eta_i_range=packed.eta_i_range,
+        source=packed.source,
+        metrics=metrics,
+        model=packed.model,
     )
     return result
 
@@ -151,25 +155,36 @@ def fit_spectral(
     target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
     t_ref = time.perf_counter()
     result = kind.solve(
-        target, mu, eta, eta_i_range, settings.degree, settings.objective, settings.max_nfev,
-        settings.quantise, weights=weights, irls_rounds=settings.irls_rounds,
+        target,
+        mu,
+        eta,
+        eta_i_range,
+        settings.degree,
+        settings.objective,
+        settings.max_nfev,
+        settings.quantise,
+        weights=weights,
+        irls_rounds=settings.irls_rounds,
     )
     if kind.guard is not None and settings.guard_max and settings.objective != "rgb":
         result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result, rows=rows)
     result.coverage = coverage
     result.settings = settings
     result.timings["reference"] = t_ref - t0
-    result.quality = (kind.quality(result, eta_i_range, warnings) if kind.quality is not None
-                      else {"warnings": list(warnings)})
+    result.quality = (
+        kind.quality(result, eta_i_range, warnings) if kind.quality is not None else {"warnings": list(warnings)}
+    )
     if uncertainty is not None:
-        own, warning = uncertainty_warning(uncertainty, nk, eta_i_range, model.name,
-                                           result.coefficients_float16)
+        own, warning = uncertainty_warning(uncertainty, nk, eta_i_range, model.name, result.coefficients_float16)
         result.quality["uncertainty"] = {**uncertainty, "fit_delta_E_mean": own}
         if warning is not None:
             result.quality["warnings"] = [*result.quality["warnings"], warning]
     result.packed = PackedMaterial(
-        name=nk.name, coefficients=result.coefficients_float16, eta_i_range=eta_i_range,
-        source=provenance(nk.source, result.quality), model=result.model,
+        name=nk.name,
+        coefficients=result.coefficients_float16,
+        eta_i_range=eta_i_range,
+        source=provenance(nk.source, result.quality),
+        model=result.model,
     )
     if evaluate:
         t_eval = time.perf_counter()

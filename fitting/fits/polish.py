@@ -96,9 +96,14 @@ def polish_float16(C16, target_RGB, cos_theta, eta_i, eta_i_range, steps: int = 
         moves = _neighbours(C16)
         predicted = _predicted(problem, C16, moves, where)
         p_mean, p_max = predicted.mean(axis=1), predicted.max(axis=1)
-        picks = np.unique(np.concatenate([
-            np.argsort(np.where(p_max <= peak, p_mean, np.inf))[:by_mean],
-            np.argsort(np.where(p_mean <= mean, p_max, np.inf))[:by_max]]))
+        picks = np.unique(
+            np.concatenate(
+                [
+                    np.argsort(np.where(p_max <= peak, p_mean, np.inf))[:by_mean],
+                    np.argsort(np.where(p_mean <= mean, p_max, np.inf))[:by_max],
+                ]
+            )
+        )
         means, maxes, dE = _figures(target_Lab, mu, eta, eta_i_range, moves[picks])
         lower_mean = (means < mean) & (maxes <= peak)
         lower_max = (maxes < peak) & (means <= mean)

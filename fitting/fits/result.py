@@ -102,8 +102,18 @@ class FitResult:
 
     @classmethod
     def from_solve(
-        cls, solution, coefficients, coefficients_float16, eta_i_range, degree: int, objective: str,
-        nfev: int, njev: int, cost_float16: float, timings: dict[str, float], model: str = DEFAULT_MODEL,
+        cls,
+        solution,
+        coefficients,
+        coefficients_float16,
+        eta_i_range,
+        degree: int,
+        objective: str,
+        nfev: int,
+        njev: int,
+        cost_float16: float,
+        timings: dict[str, float],
+        model: str = DEFAULT_MODEL,
     ) -> "FitResult":
         """
         The result of a least-squares fit of any kind: ``solution`` is the
@@ -128,6 +138,7 @@ class FitResult:
             timings=dict(timings),
             model=model,
         )
+
     guard: dict[str, Any] | None = None  # The worst-case guard's candidates (fitting.fits.guarded)
     quality: dict[str, Any] = field(default_factory=dict)  # Range proof and data warnings (fitting.fits.fit_quality)
 
@@ -138,9 +149,13 @@ class FitResult:
         (:mod:`fitting.fits.guarded`, :mod:`fitting.fits.curves_guard`).
         """
         return dataclasses.replace(
-            self, coefficients=np.asarray(coefficients, dtype=np.float64),
-            coefficients_float16=coefficients_float16, timings=dict(self.timings),
-            metrics={}, packed=None, error=None,
+            self,
+            coefficients=np.asarray(coefficients, dtype=np.float64),
+            coefficients_float16=coefficients_float16,
+            timings=dict(self.timings),
+            metrics={},
+            packed=None,
+            error=None,
         )
 
     @property

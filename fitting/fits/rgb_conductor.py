@@ -90,9 +90,15 @@ def _initial_guess(target, mu, eta, weights) -> np.ndarray:
             start = np.clip([n, np.sqrt(max(k2, 0.0))], [lower[c], lower[3 + c]], [upper[c], upper[3 + c]])
             fit = least_squares(
                 lambda x: (fresnel_conductor(mu, eta, x[0], x[1]) - R) * sqrt_w,
-                start, jac=lambda x: np.stack(fresnel_conductor_derivatives(mu, eta, x[0], x[1])[1:], axis=1)
-                * sqrt_w[:, None], bounds=([lower[c], lower[3 + c]], [upper[c], upper[3 + c]]),
-                method="trf", xtol=1e-10, ftol=1e-10, gtol=1e-10,
+                start,
+                jac=lambda x: (
+                    np.stack(fresnel_conductor_derivatives(mu, eta, x[0], x[1])[1:], axis=1) * sqrt_w[:, None]
+                ),
+                bounds=([lower[c], lower[3 + c]], [upper[c], upper[3 + c]]),
+                method="trf",
+                xtol=1e-10,
+                ftol=1e-10,
+                gtol=1e-10,
             )
             if best is None or fit.cost < best.cost:
                 best = fit
@@ -166,18 +172,20 @@ def fit_rgb_conductor_coefficients(
     x = _initial_guess(target, mu, eta, base).ravel()
     problem = RGBConductorObjective(target, mu, eta, objective, base)
     options = dict(bounds=bounds, method="trf", x_scale="jac", max_nfev=max_nfev)
-    result = least_squares(problem.residuals, x, jac=problem.jacobian, ftol=1e-10, xtol=1e-10, gtol=1e-10,
-                           **options)
+    result = least_squares(problem.residuals, x, jac=problem.jacobian, ftol=1e-10, xtol=1e-10, gtol=1e-10, **options)
     unweighted = RGBConductorObjective(target, mu, eta, objective, None)
 
     def resolve(sample_weights, x):
         again = RGBConductorObjective(target, mu, eta, objective, sample_weights)
-        return again, least_squares(again.residuals, x, jac=again.jacobian, ftol=1e-8, xtol=1e-8, gtol=1e-8,
-                                    **options)
+        return again, least_squares(again.residuals, x, jac=again.jacobian, ftol=1e-8, xtol=1e-8, gtol=1e-8, **options)
 
     problem, result, nfev, njev = reweighted(
-        problem, result, irls_rounds if objective == "de2000" else 0,
-        lambda _, x: np.linalg.norm(unweighted.residuals(x).reshape(-1, 3), axis=1), base, resolve,
+        problem,
+        result,
+        irls_rounds if objective == "de2000" else 0,
+        lambda _, x: np.linalg.norm(unweighted.residuals(x).reshape(-1, 3), axis=1),
+        base,
+        resolve,
     )
     t_fit = time.perf_counter()
     C = result.x.reshape(2, 3)
@@ -186,8 +194,17 @@ def fit_rgb_conductor_coefficients(
     cost16 = 0.5 * float(np.sum(problem.residuals(C16.astype(np.float64).ravel()) ** 2))
     t_end = time.perf_counter()
     return FitResult.from_solve(
-        result, C, C16, eta_i_range, 0, objective, nfev, njev, cost16,
-        {"fit": t_fit - t_start, "quantise": t_end - t_fit}, model=MODEL_KIND,
+        result,
+        C,
+        C16,
+        eta_i_range,
+        0,
+        objective,
+        nfev,
+        njev,
+        cost16,
+        {"fit": t_fit - t_start, "quantise": t_end - t_fit},
+        model=MODEL_KIND,
     )
 
 
@@ -221,8 +238,12 @@ def fit_rgb_conductor(
 
 
 def evaluate_rgb_conductor(
-    nk: SpectralNK, result: FitResult, samples: int = 100, baselines: bool = True,
-    min_coverage: float = DEFAULT_MIN_COVERAGE, dtype: str = "float64",
+    nk: SpectralNK,
+    result: FitResult,
+    samples: int = 100,
+    baselines: bool = True,
+    min_coverage: float = DEFAULT_MIN_COVERAGE,
+    dtype: str = "float64",
 ) -> dict[str, Any]:
     """
     Delta E 2000 and RMSE against the 1 nm reference on the paper's grid
@@ -238,10 +259,11 @@ def evaluate_rgb_conductor(
 RGB_CONDUCTOR_FIT = FitKind(
     name=MODEL_KIND,
     settings=DEFAULT_SETTINGS,
-    solve=lambda target, mu, eta, eta_i_range, degree, objective, max_nfev, quantise, weights=None,
-    irls_rounds=2: fit_rgb_conductor_coefficients(
-        target, mu, eta, eta_i_range, objective, max_nfev, quantise, weights=weights,
-        irls_rounds=irls_rounds),
+    solve=lambda target, mu, eta, eta_i_range, degree, objective, max_nfev, quantise, weights=None, irls_rounds=2: (
+        fit_rgb_conductor_coefficients(
+            target, mu, eta, eta_i_range, objective, max_nfev, quantise, weights=weights, irls_rounds=irls_rounds
+        )
+    ),
     bounded=True,
 )
 """The rgb-conductor's fit (:mod:`fitting.fits.pipeline`; registered in :mod:`fitting.fits.kinds`)."""
@@ -249,8 +271,6 @@ RGB_CONDUCTOR_FIT = FitKind(
 
 RGB_NK_SAMPLES = 64
 """Values of cos theta, evenly over [0, 1], at which (n_c, k_c) are fitted."""
-
-
 
 
 def rgb_nk(
@@ -304,7 +324,10 @@ def rgb_nk(
             lambda x: fresnel_conductor(mu, 1.0, x[0], x[1]) - R,
             np.clip(x0, [N_BOUNDS[0], K_BOUNDS[0]], [N_BOUNDS[1], K_BOUNDS[1]]),
             bounds=([N_BOUNDS[0], K_BOUNDS[0]], [N_BOUNDS[1], K_BOUNDS[1]]),
-            method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+            method="trf",
+            xtol=1e-12,
+            ftol=1e-12,
+            gtol=1e-12,
         )
         n_out[c], k_out[c] = fit.x
     return n_out, k_out

@@ -97,8 +97,7 @@ def choose_candidate(
     if GENERAL in errors:
         ordered = [c for c in ordered if _no_worse(errors[c], errors[GENERAL])]
     worse = [c for c in errors if c not in ordered]
-    note = "" if not worse else "; worse than the general fit on mean or max: " + ", ".join(
-        _label(*c) for c in worse)
+    note = "" if not worse else "; worse than the general fit on mean or max: " + ", ".join(_label(*c) for c in worse)
     if prefer == "accuracy":
         best = min(ordered, key=lambda c: errors[c].mean)
         return best, (
@@ -109,18 +108,20 @@ def choose_candidate(
         for candidate in ordered:
             if errors[candidate].mean <= max_delta_e:
                 cheaper = ordered[: ordered.index(candidate)]
-                why = "" if not cheaper else "; cheaper candidates miss it: " + ", ".join(
-                    f"{_label(*c)} {errors[c].mean:.4f}" for c in cheaper
+                why = (
+                    ""
+                    if not cheaper
+                    else "; cheaper candidates miss it: "
+                    + ", ".join(f"{_label(*c)} {errors[c].mean:.4f}" for c in cheaper)
                 )
                 return candidate, (
                     f"max_delta_e {max_delta_e:g}: {_label(*candidate)} is the cheapest candidate "
                     f"within it (mean Delta E 2000 {errors[candidate].mean:.4f}){why}{note}"
                 )
     for i, candidate in enumerate(ordered):
-        if all(_no_worse(errors[candidate], errors[d]) for d in ordered[i + 1:]):
+        if all(_no_worse(errors[candidate], errors[d]) for d in ordered[i + 1 :]):
             break
-    head = (f"max_delta_e {max_delta_e:g}: no candidate is within it; " if max_delta_e is not None
-            else "")
+    head = f"max_delta_e {max_delta_e:g}: no candidate is within it; " if max_delta_e is not None else ""
     return candidate, (
         f"{head}{_label(*candidate)} is the cheapest candidate no worse on mean and max than every "
         f"dearer one (mean Delta E 2000 {errors[candidate].mean:.4f}, max "
@@ -157,8 +158,10 @@ def general_domain(spec: EtaSpec) -> tuple[float, float]:
 
 
 def fit_scene_material(
-    entry: SceneMaterial, settings: FitSettings | None = None,
-    max_delta_e: float | None = None, prefer: str | None = None,
+    entry: SceneMaterial,
+    settings: FitSettings | None = None,
+    max_delta_e: float | None = None,
+    prefer: str | None = None,
 ) -> SceneMaterialResult:
     """
     Fit one scene material: every candidate of :data:`CANDIDATES` (the
@@ -185,7 +188,9 @@ def fit_scene_material(
     against = f"spectral reference 1 nm, {M.shape[1]} x {M.shape[0]} (cos theta x the scene's eta_i)"
     general_fit = fit_model(entry.nk, general_domain(spec), DEFAULT_MODEL, settings, degree=2)
     general = PackedMaterial(
-        entry.name, general_fit.coefficients_float16, general_fit.eta_i_range,
+        entry.name,
+        general_fit.coefficients_float16,
+        general_fit.eta_i_range,
         source=entry.nk.source,
     )
     general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
@@ -198,30 +203,43 @@ def fit_scene_material(
         fit = fits[candidate] = _fit_candidate(entry, kind, degree, settings)
         # Scored as shipped: float16 coefficients, the pack's float32 domain.
         errors[candidate] = _error(
-            ref, model_ACEScg(kind, M, E, fit.packed.coefficients, fit.packed.eta_i_range), against)
+            ref, model_ACEScg(kind, M, E, fit.packed.coefficients, fit.packed.eta_i_range), against
+        )
         if kind == DEFAULT_MODEL:
             by_degree[degree] = errors[candidate]
     fits[GENERAL] = general_fit
     candidate, reason = choose_candidate(errors, max_delta_e, prefer)
-    rule = ("prefer accuracy" if prefer == "accuracy" else
-            f"max_delta_e {max_delta_e:g}" if max_delta_e is not None else "no dearer one better")
+    rule = (
+        "prefer accuracy"
+        if prefer == "accuracy"
+        else f"max_delta_e {max_delta_e:g}"
+        if max_delta_e is not None
+        else "no dearer one better"
+    )
     choice = {
-        "rule": rule, "model": DEFAULT_MODEL if candidate == GENERAL else candidate[0],
-        "degree": candidate[1], "from_general_fit": candidate == GENERAL, "reason": reason,
+        "rule": rule,
+        "model": DEFAULT_MODEL if candidate == GENERAL else candidate[0],
+        "degree": candidate[1],
+        "from_general_fit": candidate == GENERAL,
+        "reason": reason,
         "candidates": {_label(*c): errors[c].to_dict() for c in (*CANDIDATES, GENERAL) if c in errors},
     }
     scene_error, fit = errors[candidate], fits[candidate]
     if candidate == GENERAL:
         packed = PackedMaterial(
-            entry.name, general.coefficients, general.eta_i_range, source=entry.nk.source,
-            metrics={"delta_E_2000": general_error.to_dict(), "eta_i": spec.to_json(),
-                     "from_general_fit": True},
+            entry.name,
+            general.coefficients,
+            general.eta_i_range,
+            source=entry.nk.source,
+            metrics={"delta_E_2000": general_error.to_dict(), "eta_i": spec.to_json(), "from_general_fit": True},
         )
     else:
         packed = PackedMaterial(
-            entry.name, fit.packed.coefficients, spec.domain, source=entry.nk.source,
-            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(),
-                     "from_general_fit": False},
+            entry.name,
+            fit.packed.coefficients,
+            spec.domain,
+            source=entry.nk.source,
+            metrics={"delta_E_2000": scene_error.to_dict(), "eta_i": spec.to_json(), "from_general_fit": False},
             model=candidate[0],
         )
     scene_model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
@@ -244,9 +262,7 @@ def fit_scene(scene: Scene, settings: FitSettings | None = None) -> SceneResult:
     result = SceneResult(scene)
     for entry in scene.materials:
         try:
-            result.materials.append(
-                fit_scene_material(entry, settings, scene.max_delta_e, scene.prefer)
-            )
+            result.materials.append(fit_scene_material(entry, settings, scene.max_delta_e, scene.prefer))
         except ValueError as error:
             raise ValueError(f"material {entry.name!r}: {error}") from None
     return result

@@ -131,8 +131,6 @@ class SceneResult:
                 "coefficients": sum(m.coefficients for m in self.materials),
                 "general_coefficients": 27 * len(self.materials),
                 "delta_E_2000_mean": float(np.mean([m.scene.mean for m in self.materials])),
-                "general_delta_E_2000_mean": float(
-                    np.mean([m.general_error.mean for m in self.materials])
-                ),
+                "general_delta_E_2000_mean": float(np.mean([m.general_error.mean for m in self.materials])),
             },
         }

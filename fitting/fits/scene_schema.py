@@ -187,9 +187,7 @@ def parse_eta_i(value: Any, where: str = "eta_i") -> EtaSpec:
     if isinstance(value, dict):
         unknown = set(value) - {"min", "max"}
         if unknown or not {"min", "max"} <= set(value):
-            raise ValueError(
-                f"`{where}` as a range must be {{\"min\": lo, \"max\": hi}}, got keys {sorted(value)}"
-            )
+            raise ValueError(f'`{where}` as a range must be {{"min": lo, "max": hi}}, got keys {sorted(value)}')
         lo = _check_eta_value(value["min"], f"{where}.min")
         hi = _check_eta_value(value["max"], f"{where}.max")
         if hi < lo:
@@ -203,7 +201,7 @@ def parse_eta_i(value: Any, where: str = "eta_i") -> EtaSpec:
         if len(value) > MAX_ETA_I_VALUES:
             raise ValueError(
                 f"`{where}` must hold at most {MAX_ETA_I_VALUES} values, got {len(value)}; "
-                "give a range {\"min\", \"max\"} instead"
+                'give a range {"min", "max"} instead'
             )
         values = sorted({_check_eta_value(v, f"{where}[{i}]") for i, v in enumerate(value)})
         return EtaSpec("one" if len(values) == 1 else "set", tuple(values))
@@ -225,9 +223,7 @@ def _nk_from_json(view: Any, name: str, where: str) -> SpectralNK:
         raise ValueError(f"`{where}`: {error}") from None
 
 
-def parse_scene(
-    data: str | bytes | dict, resolve: Callable[[str], SpectralNK] | None = None
-) -> Scene:
+def parse_scene(data: str | bytes | dict, resolve: Callable[[str], SpectralNK] | None = None) -> Scene:
     """
     Validate a scene description (see the module docstring).
 
@@ -254,15 +250,15 @@ def parse_scene(
         raise ValueError("scene must be a JSON object with a `materials` list")
     unknown = set(data) - {"name", "materials", "max_delta_e", "prefer"}
     if unknown:
-        raise ValueError(
-            f"scene has unknown keys {sorted(unknown)}; allowed: name, materials, max_delta_e, prefer"
-        )
+        raise ValueError(f"scene has unknown keys {sorted(unknown)}; allowed: name, materials, max_delta_e, prefer")
     max_delta_e, prefer = data.get("max_delta_e"), data.get("prefer")
     if max_delta_e is not None and prefer is not None:
         raise ValueError("give at most one of `max_delta_e` and `prefer`")
     if max_delta_e is not None:
-        if isinstance(max_delta_e, bool) or not isinstance(max_delta_e, (int, float)) or not (
-            np.isfinite(max_delta_e) and 0.0 < max_delta_e <= 100.0
+        if (
+            isinstance(max_delta_e, bool)
+            or not isinstance(max_delta_e, (int, float))
+            or not (np.isfinite(max_delta_e) and 0.0 < max_delta_e <= 100.0)
         ):
             raise ValueError(f"`max_delta_e` must be a number in (0, 100], got {max_delta_e!r}")
         max_delta_e = float(max_delta_e)
@@ -275,9 +271,7 @@ def parse_scene(
     if not isinstance(entries, list) or not entries:
         raise ValueError("`materials` must be a non-empty list")
     if len(entries) > MAX_SCENE_MATERIALS:
-        raise ValueError(
-            f"`materials` must hold at most {MAX_SCENE_MATERIALS} entries, got {len(entries)}"
-        )
+        raise ValueError(f"`materials` must hold at most {MAX_SCENE_MATERIALS} entries, got {len(entries)}")
     resolve = resolve or catalogue_material
     materials, seen = [], set()
     for i, entry in enumerate(entries):
@@ -286,18 +280,14 @@ def parse_scene(
             raise ValueError(f"`{where}` must be an object")
         unknown = set(entry) - {"name", "material", "nk", "eta_i"}
         if unknown:
-            raise ValueError(
-                f"`{where}` has unknown keys {sorted(unknown)}; allowed: name, material, nk, eta_i"
-            )
+            raise ValueError(f"`{where}` has unknown keys {sorted(unknown)}; allowed: name, material, nk, eta_i")
         if ("material" in entry) == ("nk" in entry):
             raise ValueError(f"`{where}` must give exactly one of `material` and `nk`")
         if "eta_i" not in entry:
             raise ValueError(f"`{where}.eta_i` is required (1 for uncoated)")
         material = entry.get("material", "")
         if "material" in entry and (not isinstance(material, str) or not material):
-            raise ValueError(
-                f"`{where}.material` must be a material name, e.g. gold, Au or TiN"
-            )
+            raise ValueError(f"`{where}.material` must be a material name, e.g. gold, Au or TiN")
         name = entry.get("name", material)
         if not isinstance(name, str) or not name.strip() or len(name) > _NAME_MAX:
             raise ValueError(

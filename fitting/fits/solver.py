@@ -71,7 +71,6 @@ def reweighted(problem, result, rounds: int, delta_E, base, resolve):
     return problem, result, nfev, njev
 
 
-
 def solve(problem: Problem, x0: np.ndarray, bounds, tol: float, max_nfev: int):
     """
     TRF from ``x0``, unbounded first (:func:`fitting.numerics.trf_least_squares`:
@@ -86,8 +85,17 @@ def solve(problem: Problem, x0: np.ndarray, bounds, tol: float, max_nfev: int):
     optimize, threadpools = scipy_optimize()  # the rare bounded solve only
     with threadpools.limit(limits=1, user_api="blas"):
         bounded = optimize.least_squares(
-            problem.residuals, x0, bounds=(lower, upper), jac=problem.jacobian, method="trf",
-            x_scale="jac", ftol=tol, xtol=tol, gtol=tol, max_nfev=max_nfev)
+            problem.residuals,
+            x0,
+            bounds=(lower, upper),
+            jac=problem.jacobian,
+            method="trf",
+            x_scale="jac",
+            ftol=tol,
+            xtol=tol,
+            gtol=tol,
+            max_nfev=max_nfev,
+        )
     bounded.nfev += result.nfev
     bounded.njev = (bounded.njev or 0) + (result.njev or 0)
     return bounded
@@ -244,8 +252,12 @@ def fit_coefficients(
 
     # Mean Delta E, not its RMS (de2000 only).
     problem, result, nfev, njev = reweighted(
-        problem, result, irls_rounds if objective == "de2000" else 0, delta_E,
-        np.ones(mu.size) if weights is None else weights, resolve,
+        problem,
+        result,
+        irls_rounds if objective == "de2000" else 0,
+        delta_E,
+        np.ones(mu.size) if weights is None else weights,
+        resolve,
     )
     t_fit = time.perf_counter()
     C = result.x.reshape(problem.shape)
@@ -256,6 +268,14 @@ def fit_coefficients(
     cost16 = 0.5 * float(np.sum(problem.residuals(C16.astype(np.float64).ravel()) ** 2))
     t_end = time.perf_counter()
     return FitResult.from_solve(
-        result, C, C16, eta_i_range, degree, objective, nfev, njev, cost16,
+        result,
+        C,
+        C16,
+        eta_i_range,
+        degree,
+        objective,
+        nfev,
+        njev,
+        cost16,
         {"fit": t_fit - t_start, "quantise": t_end - t_fit},
     )

@@ -80,8 +80,12 @@ class GuardScore:
     angle_deg: float
 
     def to_dict(self) -> dict[str, float]:
-        return {"delta_E_mean": self.mean, "delta_E_max": self.max,
-                "max_eta_i": self.eta_i, "max_angle_deg": self.angle_deg}
+        return {
+            "delta_E_mean": self.mean,
+            "delta_E_max": self.max,
+            "max_eta_i": self.eta_i,
+            "max_angle_deg": self.angle_deg,
+        }
 
 
 def guard_grid(eta_i_range, shape: tuple[int, int] = GUARD_GRID, samples: int = 100, rows=None):
@@ -106,8 +110,7 @@ def guard_grid(eta_i_range, shape: tuple[int, int] = GUARD_GRID, samples: int = 
     return M.ravel(), E.ravel()
 
 
-def guard_reference(nk, eta_i_range, min_coverage: float, shape: tuple[int, int] = GUARD_GRID,
-                    rows=None):
+def guard_reference(nk, eta_i_range, min_coverage: float, shape: tuple[int, int] = GUARD_GRID, rows=None):
     """
     The guard points of ``nk`` over ``eta_i_range`` (or at its eta_i
     ``rows``, :func:`guard_grid`): (cos_theta, eta_i,
@@ -132,7 +135,9 @@ def score_of(dE, cos_theta, eta_i) -> GuardScore:
     """:class:`GuardScore` of the Delta E 2000 ``dE`` (S,) at (``cos_theta``, ``eta_i``) (S,)."""
     i = int(np.argmax(dE))
     return GuardScore(
-        mean=float(dE.mean()), max=float(dE[i]), eta_i=float(np.ravel(eta_i)[i]),
+        mean=float(dE.mean()),
+        max=float(dE[i]),
+        eta_i=float(np.ravel(eta_i)[i]),
         angle_deg=float(np.degrees(np.arccos(np.clip(np.ravel(cos_theta)[i], 0.0, 1.0)))),
     )
 
@@ -145,8 +150,9 @@ def choose(scores: dict[str, GuardScore], paper: str, margin: float = MAX_MARGIN
     never worse than the paper method on both figures).
     """
     ref = scores[paper]
-    fine = [name for name, s in scores.items()
-            if name != paper and s.mean <= ref.mean and s.max <= ref.max * (1.0 - margin)]
+    fine = [
+        name for name, s in scores.items() if name != paper and s.mean <= ref.mean and s.max <= ref.max * (1.0 - margin)
+    ]
     if not fine:
         return paper
     return min(fine, key=lambda name: scores[name].mean)

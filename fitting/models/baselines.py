@@ -119,9 +119,7 @@ def lazanyi_adjusted(cos_theta, eta_i, F0_air, F82_air, exact_F0=None) -> np.nda
     numpy.ndarray
         ``broadcast(cos_theta, eta_i).shape + (3,)``, linear ACEScg.
     """
-    mu, eta_i = np.broadcast_arrays(
-        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
-    )
+    mu, eta_i = np.broadcast_arrays(np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64))
     F0 = external_medium_F0(F0_air, eta_i) if exact_F0 is None else np.asarray(exact_F0)
     a = lazanyi_a(F0_air, F82_air)
     m = np.clip(mu, 0.0, 1.0)[..., None]
@@ -153,7 +151,11 @@ def _baseline(name: str, mu: np.ndarray, eta: np.ndarray, inputs: dict, exact_F0
 
 
 def baseline_ACEScg(
-    name: str, nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
+    name: str,
+    nk: SpectralNK,
+    cos_theta,
+    eta_i,
+    step_nm: float = 1.0,
     min_coverage: float = DEFAULT_MIN_COVERAGE,
 ) -> np.ndarray:
     """
@@ -167,16 +169,17 @@ def baseline_ACEScg(
     """
     if name not in BASELINES:
         raise ValueError(f"`name` must be one of {', '.join(BASELINES)}, got {name!r}")
-    mu, eta = np.broadcast_arrays(
-        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
-    )
+    mu, eta = np.broadcast_arrays(np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64))
     inputs = baseline_inputs(nk, step_nm, min_coverage)
     exact_F0 = _exact_F0(nk, eta, step_nm, min_coverage) if name.endswith("exact_F0") else None
     return _baseline(name, mu, eta, inputs, exact_F0)
 
 
 def baselines_ACEScg(
-    nk: SpectralNK, cos_theta, eta_i, step_nm: float = 1.0,
+    nk: SpectralNK,
+    cos_theta,
+    eta_i,
+    step_nm: float = 1.0,
     min_coverage: float = DEFAULT_MIN_COVERAGE,
 ) -> dict[str, np.ndarray]:
     """
@@ -184,12 +187,9 @@ def baselines_ACEScg(
     :func:`baseline_ACEScg` of each, with the metal's F0 and F82 in air and
     the exact F0 per eta_i computed once for all four.
     """
-    mu, eta = np.broadcast_arrays(
-        np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64)
-    )
+    mu, eta = np.broadcast_arrays(np.asarray(cos_theta, dtype=np.float64), np.asarray(eta_i, dtype=np.float64))
     inputs = baseline_inputs(nk, step_nm, min_coverage)
     exact_F0 = _exact_F0(nk, eta, step_nm, min_coverage)
     return {
-        name: _baseline(name, mu, eta, inputs, exact_F0 if name.endswith("exact_F0") else None)
-        for name in BASELINES
+        name: _baseline(name, mu, eta, inputs, exact_F0 if name.endswith("exact_F0") else None) for name in BASELINES
     }

@@ -167,9 +167,7 @@ def model_from_parameters(cos_theta, F0, a, alpha) -> np.ndarray:
     return F0 + (1.0 - F0) * x5 - a * mu * x ** np.maximum(alpha, ALPHA_MIN)
 
 
-def coated_conductor_model(
-    cos_theta, eta_i, coefficients, eta_i_range=DEFAULT_ETA_I_RANGE
-) -> np.ndarray:
+def coated_conductor_model(cos_theta, eta_i, coefficients, eta_i_range=DEFAULT_ETA_I_RANGE) -> np.ndarray:
     """
     Evaluate the coated-conductor model (Vernooij 2024, Eq. 1 and 2).
 
@@ -215,9 +213,7 @@ class ModelAt:
     """
 
     def __init__(self, cos_theta, eta_i, eta_i_range=DEFAULT_ETA_I_RANGE) -> None:
-        mu, eta_i = np.broadcast_arrays(
-            as_float_array("cos_theta", cos_theta), as_float_array("eta_i", eta_i)
-        )
+        mu, eta_i = np.broadcast_arrays(as_float_array("cos_theta", cos_theta), as_float_array("eta_i", eta_i))
         self.t = normalised_eta_i(eta_i, eta_i_range)
         self.powers: dict[int, np.ndarray] = {}
         self.mu = np.clip(mu[..., None], 0.0, 1.0)

@@ -202,8 +202,7 @@ def kind_of_code(code: int) -> ModelKind:
         if kind.code == code:
             return kind
     raise ValueError(
-        f"`data` has model kind code {code}, must be one of "
-        f"{', '.join(str(k.code) for k in MODEL_KINDS.values())}"
+        f"`data` has model kind code {code}, must be one of {', '.join(str(k.code) for k in MODEL_KINDS.values())}"
     )
 
 
@@ -232,39 +231,44 @@ def coefficient_count(model: str, degree: int = 2) -> int:
     return model_kind(model).count(degree)
 
 
-register_model_kind(ModelKind(
-    name="coated-conductor",
-    code=0,
-    description="Vernooij (2024) coated-conductor model, Eq. 1 and 2: F0, a, alpha per channel, "
-                "polynomial in t of degree 0-2 (up to 27 float16)",
-    parameters=COATED_PARAMETERS,
-    max_degree=2,
-    check=check_coefficients,
-    evaluate=coated_conductor_model,
-    glsl_file="cf_coated_conductor.glsl",
-    hlsl_file="cf_coated_conductor.hlsl",
-    glsl_function="cf_coated_conductor",
-    preview_call="cf_coated_conductor_packed(NdotV, eta_i, eta_i_range, words)",
-    material_template="material",
-    split_sum=True,
-    shader_variant="packed",
-    collapsed_variant="collapsed",
-    live_solver="polynomial",
-))
-register_model_kind(ModelKind(
-    name="rgb-conductor",
-    code=1,
-    description="exact Fresnel per channel of a fitted RGB n + i k under the coat, 6 float16",
-    parameters=NK_PARAMETERS,
-    max_degree=0,
-    check=check_rgb_conductor_coefficients,
-    evaluate=lambda cos_theta, eta_i, coefficients, eta_i_range: rgb_conductor_model(
-        cos_theta, eta_i, coefficients),
-    glsl_file="cf_rgb_conductor.glsl",
-    hlsl_file="cf_rgb_conductor.hlsl",
-    glsl_function="cf_rgb_conductor",
-    preview_call="cf_rgb_conductor_packed(NdotV, eta_i, uint[3](words[0], words[1], words[2]))",
-    material_template="material_rgb",
-    shader_variant="rgb_conductor",
-    live_solver="exact-fresnel",
-))
+register_model_kind(
+    ModelKind(
+        name="coated-conductor",
+        code=0,
+        description="Vernooij (2024) coated-conductor model, Eq. 1 and 2: F0, a, alpha per channel, "
+        "polynomial in t of degree 0-2 (up to 27 float16)",
+        parameters=COATED_PARAMETERS,
+        max_degree=2,
+        check=check_coefficients,
+        evaluate=coated_conductor_model,
+        glsl_file="cf_coated_conductor.glsl",
+        hlsl_file="cf_coated_conductor.hlsl",
+        glsl_function="cf_coated_conductor",
+        preview_call="cf_coated_conductor_packed(NdotV, eta_i, eta_i_range, words)",
+        material_template="material",
+        split_sum=True,
+        shader_variant="packed",
+        collapsed_variant="collapsed",
+        live_solver="polynomial",
+    )
+)
+register_model_kind(
+    ModelKind(
+        name="rgb-conductor",
+        code=1,
+        description="exact Fresnel per channel of a fitted RGB n + i k under the coat, 6 float16",
+        parameters=NK_PARAMETERS,
+        max_degree=0,
+        check=check_rgb_conductor_coefficients,
+        evaluate=lambda cos_theta, eta_i, coefficients, eta_i_range: rgb_conductor_model(
+            cos_theta, eta_i, coefficients
+        ),
+        glsl_file="cf_rgb_conductor.glsl",
+        hlsl_file="cf_rgb_conductor.hlsl",
+        glsl_function="cf_rgb_conductor",
+        preview_call="cf_rgb_conductor_packed(NdotV, eta_i, uint[3](words[0], words[1], words[2]))",
+        material_template="material_rgb",
+        shader_variant="rgb_conductor",
+        live_solver="exact-fresnel",
+    )
+)

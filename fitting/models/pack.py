@@ -80,9 +80,7 @@ def to_float16(values, name: str = "coefficients") -> np.ndarray:
         halves = array.astype(np.float16)
     if not np.all(np.isfinite(halves)):
         worst = float(np.max(np.abs(array)))
-        raise ValueError(
-            f"`{name}` must lie within the float16 range +/-{FLOAT16_MAX:g}, got {worst:g}"
-        )
+        raise ValueError(f"`{name}` must lie within the float16 range +/-{FLOAT16_MAX:g}, got {worst:g}")
     return halves
 
 
@@ -115,8 +113,7 @@ class PackedMaterial:
         halves = to_float16(C)
         if not np.array_equal(halves.astype(np.float64), C):
             raise ValueError(
-                "`coefficients` must be exactly representable in float16; round "
-                "them with `to_float16` first"
+                "`coefficients` must be exactly representable in float16; round them with `to_float16` first"
             )
         lo, hi = check_eta_i_range(self.eta_i_range)
         # The pack stores the domain as float32.
@@ -252,9 +249,7 @@ def decode_pack(data: bytes) -> list[PackedMaterial]:
         halves = np.frombuffer(raw, dtype="<f2").astype(np.float16).reshape(shape)
         if not np.all(np.isfinite(halves)):
             raise ValueError("`data` holds a coefficient that is not finite")
-        materials.append(
-            PackedMaterial(texts[0], halves, (lo, hi), source=texts[1], model=model)
-        )
+        materials.append(PackedMaterial(texts[0], halves, (lo, hi), source=texts[1], model=model))
     if reader.offset != reader.end:
         raise ValueError(
             f"`data` has the wrong length: {reader.end - reader.offset} unexpected bytes after the last material"
@@ -282,8 +277,7 @@ def material_to_json(material: PackedMaterial) -> dict[str, Any]:
     if kind.polynomial:
         view["degree"] = material.degree
         view["coefficients"] = {
-            p: [[float(v) for v in C[i, c]] for c in range(3)]
-            for i, p in enumerate(kind.parameters)
+            p: [[float(v) for v in C[i, c]] for c in range(3)] for i, p in enumerate(kind.parameters)
         }
     else:
         view["coefficients"] = {p: [float(v) for v in C[i]] for i, p in enumerate(kind.parameters)}
@@ -348,8 +342,7 @@ def pack_from_json(text: str | bytes) -> list[PackedMaterial]:
             f"pack JSON `version` must be one of {', '.join(map(str, PACK_VERSIONS))}, got {view.get('version')!r}"
         )
     if view["version"] == 1 and any(
-        isinstance(m, dict) and _code(m.get("model", DEFAULT_MODEL)) != 0
-        for m in view.get("materials") or []
+        isinstance(m, dict) and _code(m.get("model", DEFAULT_MODEL)) != 0 for m in view.get("materials") or []
     ):
         raise ValueError("pack JSON `version` 1 holds only coated-conductor materials")
     materials = view.get("materials")

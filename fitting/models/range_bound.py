@@ -124,9 +124,13 @@ class RangeCertificate:
 
     def to_dict(self) -> dict:
         mu, eta, channel, value = self.worst
-        return {"in_range": self.in_range, "proven_min": self.lower, "proven_max": self.upper,
-                "worst": {"cos_theta": mu, "eta_i": eta, "channel": "RGB"[channel], "value": value},
-                "cells": self.cells}
+        return {
+            "in_range": self.in_range,
+            "proven_min": self.lower,
+            "proven_max": self.upper,
+            "worst": {"cos_theta": mu, "eta_i": eta, "channel": "RGB"[channel], "value": value},
+            "cells": self.cells,
+        }
 
 
 def quadratic_range(c, t0, t1):
@@ -205,6 +209,7 @@ def _centred_enclosure(C, x0, x1, t0, t1, centre):
     al_lo, al_hi = quadratic_range(C[2][None], t0, t1)
     clamp_may_act = al_lo < ALPHA_MIN
     al_lo, al_hi = np.maximum(al_lo, ALPHA_MIN), np.maximum(al_hi, ALPHA_MIN)
+
     # Derivatives of the quadratics in t (linear: their ends).
     def slope(c):
         d0, d1 = c[..., 1] + 2.0 * c[..., 2] * t0, c[..., 1] + 2.0 * c[..., 2] * t1
@@ -233,14 +238,14 @@ def _centred_enclosure(C, x0, x1, t0, t1, centre):
         v_lo, v_hi = _product(ada_lo, ada_hi, np.log(x0), np.log(x1))
         s_lo, s_hi = _product(g_lo, g_hi, da_lo + v_lo, da_hi + v_hi)
         dt_lo, dt_hi = u_lo - s_hi, u_hi - s_lo
-        radius = (hx * np.maximum(np.abs(dx_lo), np.abs(dx_hi))
-                  + ht * np.maximum(np.abs(dt_lo), np.abs(dt_hi)))
+        radius = hx * np.maximum(np.abs(dx_lo), np.abs(dx_hi)) + ht * np.maximum(np.abs(dt_lo), np.abs(dt_hi))
     radius = np.where(np.isfinite(radius) & inner[:, None], radius, np.inf)
     return centre - radius - ROUNDING_SLACK, centre + radius + ROUNDING_SLACK
 
 
-def certify_range(coefficients, eta_i_range, slack: float = RANGE_SLACK,
-                  max_cells: int = _MAX_CELLS) -> RangeCertificate:
+def certify_range(
+    coefficients, eta_i_range, slack: float = RANGE_SLACK, max_cells: int = _MAX_CELLS
+) -> RangeCertificate:
     """
     Prove (or refute) that the model of ``coefficients`` over
     ``eta_i_range`` lies in [-``slack``, 1 + ``slack``] for every
@@ -271,8 +276,10 @@ def certify_range(coefficients, eta_i_range, slack: float = RANGE_SLACK,
     while x0.size:
         examined += x0.size
         # The model at each cell's corners and centre: counterexamples and the extremes found.
-        samples = [(xp, tp, coated_conductor_model(1.0 - xp, to_eta(tp), C, eta_i_range))
-                   for xp, tp in ((x0, t0), (x1, t1), (x0, t1), (x1, t0), (0.5 * (x0 + x1), 0.5 * (t0 + t1)))]
+        samples = [
+            (xp, tp, coated_conductor_model(1.0 - xp, to_eta(tp), C, eta_i_range))
+            for xp, tp in ((x0, t0), (x1, t1), (x0, t1), (x1, t0), (0.5 * (x0 + x1), 0.5 * (t0 + t1)))
+        ]
         lo, hi = _enclosure(C, x0, x1, t0, t1)
         # The centred form where the first cannot decide, once a proof has examined
         # _CENTRED_AFTER cells (it costs more per cell; most proofs end before), about
@@ -310,7 +317,9 @@ def certify_range(coefficients, eta_i_range, slack: float = RANGE_SLACK,
             t0, t1 = np.concatenate([t0, t0]), np.concatenate([t1, t1])
         else:
             x0, x1, t0, t1 = (
-                np.concatenate([x0, xm, x0, xm]), np.concatenate([xm, x1, xm, x1]),
-                np.concatenate([t0, t0, tm, tm]), np.concatenate([tm, tm, t1, t1]),
+                np.concatenate([x0, xm, x0, xm]),
+                np.concatenate([xm, x1, xm, x1]),
+                np.concatenate([t0, t0, tm, tm]),
+                np.concatenate([tm, tm, t1, t1]),
             )
     return RangeCertificate(verdict, float(lower), float(upper), worst, examined)

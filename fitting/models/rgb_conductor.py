@@ -64,8 +64,7 @@ def check_rgb_conductor_coefficients(coefficients) -> np.ndarray:
     C = np.asarray(coefficients, dtype=np.float64)
     if C.shape != (2, 3):
         raise ValueError(
-            "`coefficients` of an rgb-conductor must have shape (2, 3) "
-            f"(parameter n/k, channel R/G/B), got {C.shape}"
+            f"`coefficients` of an rgb-conductor must have shape (2, 3) (parameter n/k, channel R/G/B), got {C.shape}"
         )
     if not np.all(np.isfinite(C)):
         raise ValueError("`coefficients` must be finite")
@@ -101,9 +100,7 @@ def rgb_conductor_model(cos_theta, eta_i, coefficients) -> np.ndarray:
         reflection gives 1).
     """
     C = check_rgb_conductor_coefficients(coefficients)
-    mu, eta = np.broadcast_arrays(
-        as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i)
-    )
+    mu, eta = np.broadcast_arrays(as_finite_array("cos_theta", cos_theta), as_finite_array("eta_i", eta_i))
     return fresnel_conductor(mu[..., None], eta[..., None], C[0], C[1])
 
 
@@ -119,9 +116,7 @@ def rgb_fresnel_conductor(cos_theta, eta_i, n_rgb, k_rgb) -> np.ndarray:
     n_rgb = np.asarray(n_rgb, dtype=np.float64)
     k_rgb = np.asarray(k_rgb, dtype=np.float64)
     if n_rgb.shape != (3,) or k_rgb.shape != (3,):
-        raise ValueError(
-            f"`n_rgb` and `k_rgb` must have shape (3,), got {n_rgb.shape} and {k_rgb.shape}"
-        )
+        raise ValueError(f"`n_rgb` and `k_rgb` must have shape (3,), got {n_rgb.shape} and {k_rgb.shape}")
     if not (np.all(np.isfinite(n_rgb)) and np.all(n_rgb > 0)):
         raise ValueError(f"`n_rgb` must be finite and > 0, got {n_rgb.tolist()}")
     if not (np.all(np.isfinite(k_rgb)) and np.all(k_rgb >= 0)):

@@ -290,8 +290,15 @@ def trf_least_squares(
                 Delta = 0.25 * step_h_norm
                 continue
             actual_reduction = cost - cost_new
-            Delta_new, status = _judge(actual_reduction, predicted_reduction, cost, Delta, step_h_norm,
-                                       _norm(step) < xtol * (xtol + x_norm), ftol)
+            Delta_new, status = _judge(
+                actual_reduction,
+                predicted_reduction,
+                cost,
+                Delta,
+                step_h_norm,
+                _norm(step) < xtol * (xtol + x_norm),
+                ftol,
+            )
             if status is not None:
                 break
             alpha *= Delta / Delta_new
@@ -302,5 +309,13 @@ def trf_least_squares(
             njev += 1
             A, g = J.T @ J, J.T @ f
             scale_inv = np.maximum(np.sqrt(A.diagonal()), scale_inv)
-    return TRFResult(x=x, cost=float(cost), fun=f, grad=g, optimality=float(np.max(np.abs(g))),
-                     nfev=nfev, njev=njev, status=0 if status is None else status)
+    return TRFResult(
+        x=x,
+        cost=float(cost),
+        fun=f,
+        grad=g,
+        optimality=float(np.max(np.abs(g))),
+        nfev=nfev,
+        njev=njev,
+        status=0 if status is None else status,
+    )

@@ -116,8 +116,7 @@ def _json_depth(text: str) -> int:
     """Deepest bracket nesting of a JSON text, strings skipped (C-speed: regex + numpy)."""
     structure = _JSON_STRING.sub("", text)
     codes = np.frombuffer(structure.encode("utf-8", "surrogatepass"), dtype=np.uint8)
-    steps = (np.isin(codes, (0x5B, 0x7B)).astype(np.int32)
-             - np.isin(codes, (0x5D, 0x7D)).astype(np.int32))
+    steps = np.isin(codes, (0x5B, 0x7B)).astype(np.int32) - np.isin(codes, (0x5D, 0x7D)).astype(np.int32)
     return int(np.cumsum(steps).max(initial=0))
 
 
@@ -125,8 +124,9 @@ class _NonFiniteLiteral(ValueError):
     pass
 
 
-_NUMBER = re.compile(r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf(?:inity)?|nan)",
-                     re.IGNORECASE | re.ASCII)
+_NUMBER = re.compile(
+    r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|inf(?:inity)?|nan)", re.IGNORECASE | re.ASCII
+)
 
 
 def is_number(text: str) -> bool:
@@ -155,8 +155,7 @@ def _refuse_constant(name: str) -> float:
     raise _NonFiniteLiteral(f"JSON numbers must be finite: the literal `{name}` is not accepted")
 
 
-def load_json_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
-                      max_chars: int = MAX_TEXT_CHARS) -> Any:
+def load_json_bounded(text: str | bytes, max_depth: int = MAX_DEPTH, max_chars: int = MAX_TEXT_CHARS) -> Any:
     """
     Parse JSON text whose size is at most ``max_chars`` and whose arrays and
     objects nest at most ``max_depth`` deep (scanned before parsing, so deep
@@ -181,9 +180,7 @@ def load_json_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
     try:
         return json.loads(text, parse_constant=_refuse_constant)
     except json.JSONDecodeError as error:
-        raise ValueError(
-            f"JSON is not valid: {error.msg} at line {error.lineno} column {error.colno}"
-        ) from None
+        raise ValueError(f"JSON is not valid: {error.msg} at line {error.lineno} column {error.colno}") from None
     except RecursionError:  # unreachable after the depth scan; kept as a guard
         raise ValueError(f"JSON must nest at most {max_depth} levels deep") from None
     except _NonFiniteLiteral as error:
@@ -211,11 +208,13 @@ def _yaml_loader(max_depth: int, max_nodes: int):
 
     try:
         from yaml._yaml import CParser  # libyaml: fast, and its parser is not recursive
+
         parser_bases: tuple[type, ...] = (CParser,)
     except ImportError:  # pragma: no cover - PyYAML without libyaml
         from yaml.parser import Parser
         from yaml.reader import Reader
         from yaml.scanner import Scanner
+
         parser_bases = (Reader, Scanner, Parser)
 
     class BoundedComposer(Composer):
@@ -285,8 +284,9 @@ def _yaml_loader(max_depth: int, max_nodes: int):
 _LOADERS: dict[tuple[int, int], type] = {}
 
 
-def load_yaml_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
-                      max_nodes: int = MAX_YAML_NODES, max_chars: int = MAX_TEXT_CHARS) -> Any:
+def load_yaml_bounded(
+    text: str | bytes, max_depth: int = MAX_DEPTH, max_nodes: int = MAX_YAML_NODES, max_chars: int = MAX_TEXT_CHARS
+) -> Any:
     """
     Safe-load one YAML document of at most ``max_chars`` characters,
     ``max_nodes`` nodes and ``max_depth`` levels of nesting; aliases and
@@ -321,16 +321,14 @@ def load_yaml_bounded(text: str | bytes, max_depth: int = MAX_DEPTH,
         # A tagged scalar that does not construct (`!!float abc`, a date out
         # of range, an integer of 5,000 digits): Python's message may repeat
         # the whole scalar, so only an excerpt is kept.
-        raise ValueError(
-            f"YAML is not valid: a value could not be read ({excerpt(str(error), 80)[1:-1]})"
-        ) from None
+        raise ValueError(f"YAML is not valid: a value could not be read ({excerpt(str(error), 80)[1:-1]})") from None
     finally:
         loader.dispose()
 
 
-def csv_rows_bounded(text: str, max_rows: int = MAX_SAMPLES + 1,
-                     max_columns: int = MAX_CSV_COLUMNS,
-                     max_line_chars: int = MAX_LINE_CHARS) -> list[list[str]]:
+def csv_rows_bounded(
+    text: str, max_rows: int = MAX_SAMPLES + 1, max_columns: int = MAX_CSV_COLUMNS, max_line_chars: int = MAX_LINE_CHARS
+) -> list[list[str]]:
     """
     The non-blank rows of a CSV text, refusing more than ``max_rows`` lines,
     a line or a (quoted, multi-line) field longer than ``max_line_chars``, or
@@ -343,21 +341,16 @@ def csv_rows_bounded(text: str, max_rows: int = MAX_SAMPLES + 1,
         raise ValueError(f"CSV must have at most {max_rows} lines, got {lines}")
     longest = max(map(len, text.splitlines()), default=0)
     if longest > max_line_chars:
-        raise ValueError(
-            f"CSV lines must be at most {max_line_chars} characters long, got {longest}"
-        )
+        raise ValueError(f"CSV lines must be at most {max_line_chars} characters long, got {longest}")
     rows = []
     try:
         for line, row in enumerate(csv.reader(io.StringIO(text)), start=1):
             if len(row) > max_columns:
-                raise ValueError(
-                    f"CSV line {line} must have at most {max_columns} columns, got {len(row)}"
-                )
+                raise ValueError(f"CSV line {line} must have at most {max_columns} columns, got {len(row)}")
             longest = max(map(len, row), default=0)
             if longest > max_line_chars:  # a quoted field spanning lines
                 raise ValueError(
-                    f"CSV fields must be at most {max_line_chars} characters long, "
-                    f"got {longest} in row {line}"
+                    f"CSV fields must be at most {max_line_chars} characters long, got {longest} in row {line}"
                 )
             if row and any(cell.strip() for cell in row):
                 rows.append(row)
@@ -366,8 +359,7 @@ def csv_rows_bounded(text: str, max_rows: int = MAX_SAMPLES + 1,
     return rows
 
 
-def check_sample_count(lo: float, hi: float, step: float, what: str,
-                       limit: int = MAX_SAMPLES) -> int:
+def check_sample_count(lo: float, hi: float, step: float, what: str, limit: int = MAX_SAMPLES) -> int:
     """
     The number of samples ``step`` apart over ``[lo, hi]`` (same unit),
     refused when the range is not finite and increasing or when the count
@@ -378,7 +370,6 @@ def check_sample_count(lo: float, hi: float, step: float, what: str,
     count = math.floor((hi - lo) / step + 0.5) + 1
     if count > limit:
         raise ValueError(
-            f"{what} [{lo:g}, {hi:g}] would need {count} samples {step:g} apart; "
-            f"at most {limit} are allowed"
+            f"{what} [{lo:g}, {hi:g}] would need {count} samples {step:g} apart; at most {limit} are allowed"
         )
     return max(2, count)

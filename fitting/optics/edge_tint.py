@@ -92,8 +92,15 @@ from ..domain import check_eta_i
 from .coated_stack import coated_stack
 from .fresnel import fresnel_conductor, fresnel_dielectric
 
-__all__ = ["F82_COS_THETA", "UNDER_COAT_ANCHOR_COS", "EdgeTintIndex", "gulbrandsen_nk", "nk_from_F0_F82", "F0_F82_from_nk",
-           "F0_F82_under_coat"]
+__all__ = [
+    "F82_COS_THETA",
+    "UNDER_COAT_ANCHOR_COS",
+    "EdgeTintIndex",
+    "gulbrandsen_nk",
+    "nk_from_F0_F82",
+    "F0_F82_from_nk",
+    "F0_F82_under_coat",
+]
 
 F82_COS_THETA = 1.0 / 7.0
 """cos 82 degrees as Hoffman's model takes it."""
@@ -174,8 +181,10 @@ def _channel(F0: float, tint: float) -> tuple[float, float, float]:
         return float(fresnel_conductor(F82_COS_THETA, 1.0, n, _k_of(n, F0))) - target
 
     values = np.array([g(n) for n in n_grid])
-    roots = [brentq(g, n_grid[i], n_grid[i + 1], xtol=1e-12, rtol=1e-14)
-             for i in np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) <= 0.0)]
+    roots = [
+        brentq(g, n_grid[i], n_grid[i + 1], xtol=1e-12, rtol=1e-14)
+        for i in np.flatnonzero(np.sign(values[:-1]) * np.sign(values[1:]) <= 0.0)
+    ]
     if not roots:
         best = float(n_grid[np.argmin(np.abs(values))])
         return best, float(_k_of(best, F0)), g(best) / _schlick82(F0)

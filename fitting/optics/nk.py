@@ -47,6 +47,7 @@ included, stays finite up to it (the Fresnel terms square |n + ik|^2; 1e20
 overflows float32). The CLI, the service and the scenes refuse the same
 values through :func:`resample_nk`."""
 
+
 def _format_value(value: float) -> str:
     return f"{value:.6g}"
 
@@ -61,9 +62,7 @@ def _check_1d_finite(name: str, values: Any) -> np.ndarray:
     bad = np.flatnonzero(~np.isfinite(array))
     if bad.size:
         index = int(bad[0])
-        raise ValueError(
-            f"`{name}` must be finite, got {_format_value(array[index])} at index {index}"
-        )
+        raise ValueError(f"`{name}` must be finite, got {_format_value(array[index])} at index {index}")
     return array
 
 
@@ -103,21 +102,13 @@ class SpectralNK:
         n = _check_1d_finite("n", self.n)
         k = _check_1d_finite("k", self.k)
         if wavelength.size < 2:
-            raise ValueError(
-                f"`wavelength_nm` must hold at least 2 samples, got {wavelength.size}"
-            )
+            raise ValueError(f"`wavelength_nm` must hold at least 2 samples, got {wavelength.size}")
         for label, array in (("n", n), ("k", k)):
             if array.size != wavelength.size:
-                raise ValueError(
-                    f"`{label}` must have one value per wavelength "
-                    f"({wavelength.size}), got {array.size}"
-                )
+                raise ValueError(f"`{label}` must have one value per wavelength ({wavelength.size}), got {array.size}")
         if np.any(wavelength <= 0):
             index = int(np.flatnonzero(wavelength <= 0)[0])
-            raise ValueError(
-                f"`wavelength_nm` must be > 0, got {_format_value(wavelength[index])} "
-                f"at index {index}"
-            )
+            raise ValueError(f"`wavelength_nm` must be > 0, got {_format_value(wavelength[index])} at index {index}")
         steps = np.diff(wavelength)
         if np.any(steps <= 0):
             index = int(np.flatnonzero(steps <= 0)[0]) + 1
@@ -128,14 +119,10 @@ class SpectralNK:
             )
         if np.any(n <= 0):
             index = int(np.flatnonzero(n <= 0)[0])
-            raise ValueError(
-                f"`n` must be > 0, got {_format_value(n[index])} at index {index}"
-            )
+            raise ValueError(f"`n` must be > 0, got {_format_value(n[index])} at index {index}")
         if np.any(k < 0):
             index = int(np.flatnonzero(k < 0)[0])
-            raise ValueError(
-                f"`k` must be >= 0, got {_format_value(k[index])} at index {index}"
-            )
+            raise ValueError(f"`k` must be >= 0, got {_format_value(k[index])} at index {index}")
         if not isinstance(self.name, str) or not self.name.strip():
             raise ValueError("`name` must be a non-empty string")
         for label, array in (("wavelength_nm", wavelength), ("n", n), ("k", k)):
@@ -149,10 +136,7 @@ class SpectralNK:
 
     def content_key(self) -> bytes:
         """Bytes that identify the data (for content addressing)."""
-        return b"".join(
-            np.ascontiguousarray(a, dtype="<f8").tobytes()
-            for a in (self.wavelength_nm, self.n, self.k)
-        )
+        return b"".join(np.ascontiguousarray(a, dtype="<f8").tobytes() for a in (self.wavelength_nm, self.n, self.k))
 
 
 def visible_coverage(
@@ -223,7 +207,7 @@ def check_nk_range(nk: SpectralNK, limit: float = MAX_NK) -> None:
     first = max(int(np.searchsorted(w, lo, side="right")) - 1, 0)
     last = min(int(np.searchsorted(w, hi, side="left")), w.size - 1)
     for label, values in (("n", nk.n), ("k", nk.k)):
-        used = values[first:last + 1]
+        used = values[first : last + 1]
         over = np.flatnonzero(used > limit)
         if over.size:
             i = first + int(over[0])

@@ -45,8 +45,16 @@ import numpy as np
 
 from ..domain import VISIBLE_RANGE_NM
 
-__all__ = ["DEFAULT_MAX_GAP_NM", "UNCERTAIN_GAP_NM", "OUTLIER_DECADES", "visible_gaps", "check_max_gap",
-           "check_gaps", "find_outliers", "outlier_warnings"]
+__all__ = [
+    "DEFAULT_MAX_GAP_NM",
+    "UNCERTAIN_GAP_NM",
+    "OUTLIER_DECADES",
+    "visible_gaps",
+    "check_max_gap",
+    "check_gaps",
+    "find_outliers",
+    "outlier_warnings",
+]
 
 DEFAULT_MAX_GAP_NM: float = 120.0
 """Largest spacing of samples inside 360-830 nm accepted by default (see the module docstring)."""
@@ -114,8 +122,10 @@ def check_gaps(nk, max_gap_nm: float = DEFAULT_MAX_GAP_NM) -> list[str]:
             f"between {a:g} and {b:g} nm ({b - a:g} nm); relax `max_gap_nm` to fit them anyway"
         )
     if b - a > DEFAULT_MAX_GAP_NM:
-        return [f"sparse data: no samples between {a:g} and {b:g} nm ({b - a:g} nm, more than "
-                f"the default largest gap {DEFAULT_MAX_GAP_NM:g} nm); the colour there is interpolated"]
+        return [
+            f"sparse data: no samples between {a:g} and {b:g} nm ({b - a:g} nm, more than "
+            f"the default largest gap {DEFAULT_MAX_GAP_NM:g} nm); the colour there is interpolated"
+        ]
     return []
 
 
@@ -143,8 +153,15 @@ def find_outliers(nk, decades: float = OUTLIER_DECADES) -> list[dict]:
             expected = logs[a] + (logs[b] - logs[a]) * (w[i] - w[a]) / (w[b] - w[a])
             off = logs[i] - expected
             if abs(off) > decades and abs(off) > abs(logs[b] - logs[a]):
-                found.append({"field": label, "wavelength_nm": float(w[i]), "value": float(values[i]),
-                              "expected": float(10.0 ** expected), "decades": float(abs(off))})
+                found.append(
+                    {
+                        "field": label,
+                        "wavelength_nm": float(w[i]),
+                        "value": float(values[i]),
+                        "expected": float(10.0**expected),
+                        "decades": float(abs(off)),
+                    }
+                )
     return sorted(found, key=lambda o: (o["wavelength_nm"], o["field"]))
 
 

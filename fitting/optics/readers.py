@@ -59,13 +59,12 @@ def _unit_scale(header: str) -> float:
         return 1.0
     if re.search(r"(^|[^a-z])(um|µm|μm)([^a-z]|$)|micron|micromet", h):
         return 1e3
-    raise ValueError(
-        f"CSV header {excerpt(header.strip())} must state the wavelength unit (nm or um)"
-    )
+    raise ValueError(f"CSV header {excerpt(header.strip())} must state the wavelength unit (nm or um)")
 
 
-def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV",
-                max_samples: int = MAX_SAMPLES) -> SpectralNK:
+def read_nk_csv(
+    text: str, name: str = "uploaded", source: str = "user CSV", max_samples: int = MAX_SAMPLES
+) -> SpectralNK:
     """
     Read a CSV with columns wavelength, n, k; the wavelength header states
     its unit, e.g. ``wavelength_nm,n,k`` or ``wavelength (um),n,k``. At most
@@ -76,13 +75,10 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV",
         raise ValueError("CSV is empty: expected a header `wavelength_nm,n,k` and rows")
     header = [c.strip() for c in rows[0]]
     if len(header) < 3 or not header[0].lower().startswith(("wavelength", "lambda", "wl")):
-        raise ValueError(
-            f"CSV header must be `wavelength_<unit>,n,k`, got {excerpt(','.join(header))}"
-        )
+        raise ValueError(f"CSV header must be `wavelength_<unit>,n,k`, got {excerpt(','.join(header))}")
     if header[1].lower() != "n" or header[2].lower() != "k":
         raise ValueError(
-            f"CSV columns 2 and 3 must be `n` and `k`, got {excerpt(header[1], 30)}, "
-            f"{excerpt(header[2], 30)}"
+            f"CSV columns 2 and 3 must be `n` and `k`, got {excerpt(header[1], 30)}, {excerpt(header[2], 30)}"
         )
     scale = _unit_scale(header[0])
     values = []
@@ -90,20 +86,18 @@ def read_nk_csv(text: str, name: str = "uploaded", source: str = "user CSV",
         if len(row) < 3:
             raise ValueError(f"CSV line {line} must have 3 columns, got {len(row)}")
         try:
-            values.append([parse_number(cell, f"CSV line {line} column {i + 1}")
-                           for i, cell in enumerate(row[:3])])
+            values.append([parse_number(cell, f"CSV line {line} column {i + 1}") for i, cell in enumerate(row[:3])])
         except ValueError:
-            raise ValueError(
-                f"CSV line {line} must hold three numbers, got {excerpt(','.join(row[:3]))}"
-            ) from None
+            raise ValueError(f"CSV line {line} must hold three numbers, got {excerpt(','.join(row[:3]))}") from None
     if not values:
         raise ValueError("CSV has a header but no data rows")
     data = np.array(values)
     return SpectralNK(data[:, 0] * scale, data[:, 1], data[:, 2], name=name, source=source)
 
 
-def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user JSON",
-                 max_samples: int = MAX_SAMPLES) -> SpectralNK:
+def read_nk_json(
+    text: str | bytes, name: str = "uploaded", source: str = "user JSON", max_samples: int = MAX_SAMPLES
+) -> SpectralNK:
     """
     Read JSON ``{"wavelength_nm": [...], "n": [...], "k": [...]}`` (or
     ``wavelength_um``), optionally with ``name`` and ``source``; lists of
@@ -111,9 +105,7 @@ def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user 
     """
     view = load_json_bounded(text)
     if not isinstance(view, dict):
-        raise ValueError(
-            f"JSON must be an object with `wavelength_nm`, `n` and `k`, got {kind_of(view)}"
-        )
+        raise ValueError(f"JSON must be an object with `wavelength_nm`, `n` and `k`, got {kind_of(view)}")
     if "wavelength_nm" in view:
         label, scale = "wavelength_nm", 1.0
     elif "wavelength_um" in view:
@@ -136,8 +128,11 @@ def read_nk_json(text: str | bytes, name: str = "uploaded", source: str = "user 
         else:
             texts[key] = value.strip() or default
     return SpectralNK(
-        wl, _json_numbers("n", view["n"], max_samples), _json_numbers("k", view["k"], max_samples),
-        name=texts["name"], source=texts["source"],
+        wl,
+        _json_numbers("n", view["n"], max_samples),
+        _json_numbers("k", view["k"], max_samples),
+        name=texts["name"],
+        source=texts["source"],
     )
 
 
@@ -149,9 +144,7 @@ def _json_numbers(label: str, values: Any, max_samples: int) -> np.ndarray:
         raise ValueError(f"JSON `{label}` must hold at most {max_samples} numbers, got {len(values)}")
     for index, value in enumerate(values):
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ValueError(
-                f"JSON `{label}[{index}]` must be a number, got {kind_of(value)}"
-            )
+            raise ValueError(f"JSON `{label}[{index}]` must be a number, got {kind_of(value)}")
     try:
         return np.array(values, dtype=np.float64)
     except OverflowError:  # an integer literal beyond float64
@@ -167,9 +160,7 @@ def _numbers(text: Any, what: str, max_samples: int) -> np.ndarray:
     lines = [line for line in text.strip().splitlines() if line.strip()]
     longest = max(map(len, lines), default=0)
     if longest > MAX_LINE_CHARS:
-        raise ValueError(
-            f"YAML `{what}` `data` rows must be at most {MAX_LINE_CHARS} characters, got {longest}"
-        )
+        raise ValueError(f"YAML `{what}` `data` rows must be at most {MAX_LINE_CHARS} characters, got {longest}")
     words = [line.split() for line in lines]
     bad_word = next((v for row in words for v in row if not is_number(v)), None)
     if bad_word is not None:
@@ -182,9 +173,7 @@ def _numbers(text: Any, what: str, max_samples: int) -> np.ndarray:
     bad = np.argwhere(~np.isfinite(table))
     if bad.size:
         row, column = (int(v) for v in bad[0])
-        raise ValueError(
-            f"YAML `{what}` data must be finite numbers, got {table[row, column]} in row {row + 1}"
-        )
+        raise ValueError(f"YAML `{what}` data must be finite numbers, got {table[row, column]} in row {row + 1}")
     steps = np.diff(table[:, 0])
     if np.any(steps <= 0):
         row = int(np.flatnonzero(steps <= 0)[0]) + 1
@@ -195,8 +184,9 @@ def _numbers(text: Any, what: str, max_samples: int) -> np.ndarray:
     return table
 
 
-def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user YAML",
-                 max_samples: int = MAX_SAMPLES) -> SpectralNK:
+def read_nk_yaml(
+    text: str | bytes, name: str = "uploaded", source: str = "user YAML", max_samples: int = MAX_SAMPLES
+) -> SpectralNK:
     """
     Read a refractiveindex.info YAML file: ``tabulated nk``, ``tabulated n``
     plus ``tabulated k``, and ``formula 1``-``formula 9`` entries (with an
@@ -237,18 +227,22 @@ def read_nk_yaml(text: str | bytes, name: str = "uploaded", source: str = "user 
             try:
                 number = int(kind.split()[1])
             except (IndexError, ValueError):
-                raise ValueError(f"YAML `DATA[{index}].type` must be `formula 1`-`formula 9`, "
-                                 f"got {excerpt(kind)}") from None
+                raise ValueError(
+                    f"YAML `DATA[{index}].type` must be `formula 1`-`formula 9`, got {excerpt(kind)}"
+                ) from None
             if not 1 <= number <= 9:
                 raise ValueError(f"YAML formula type must be 1-9, got {number}")
             coefficients = _yaml_floats(item, "coefficients", kind)
             if len(coefficients) > _MAX_COEFFICIENTS:
-                raise ValueError(f"YAML `{kind}` must have at most {_MAX_COEFFICIENTS} "
-                                 f"`coefficients`, got {len(coefficients)}")
+                raise ValueError(
+                    f"YAML `{kind}` must have at most {_MAX_COEFFICIENTS} `coefficients`, got {len(coefficients)}"
+                )
             wr = tuple(_yaml_floats(item, "wavelength_range", kind))
             if len(wr) != 2 or not wr[0] < wr[1]:
-                raise ValueError(f"YAML `{kind}` `wavelength_range` must be two increasing numbers, "
-                                 f"got {excerpt(' '.join(f'{v:g}' for v in wr[:4]))}")
+                raise ValueError(
+                    f"YAML `{kind}` `wavelength_range` must be two increasing numbers, "
+                    f"got {excerpt(' '.join(f'{v:g}' for v in wr[:4]))}"
+                )
             wl_n, n = sample_model(formula_from_yaml(number, coefficients, wr), max_samples=max_samples)
         else:
             raise ValueError(f"YAML data type {excerpt(kind)} is not supported")
@@ -273,16 +267,14 @@ def _yaml_floats(item: dict, key: str, kind: str) -> list[float]:
         raise ValueError(f"YAML `{kind}` `{key}` must be text of numbers, got {kind_of(value)}")
     words = value.split()
     if len(words) > _MAX_COEFFICIENTS:
-        raise ValueError(f"YAML `{kind}` `{key}` must have at most {_MAX_COEFFICIENTS} numbers, "
-                         f"got {len(words)}")
+        raise ValueError(f"YAML `{kind}` `{key}` must have at most {_MAX_COEFFICIENTS} numbers, got {len(words)}")
     try:
         return [parse_number(v, f"YAML `{kind}` `{key}`") for v in words]
     except ValueError:
         raise ValueError(f"YAML `{kind}` `{key}` must be numbers, got {excerpt(value)}") from None
 
 
-def read_nk(data: str | bytes, format: str, name: str = "uploaded",
-            max_samples: int = MAX_SAMPLES) -> SpectralNK:
+def read_nk(data: str | bytes, format: str, name: str = "uploaded", max_samples: int = MAX_SAMPLES) -> SpectralNK:
     """
     Read *n*, *k* from file content in ``format`` (``csv``, ``json`` or
     ``yaml``; a file name's suffix also works, e.g. ``gold.yml``): UTF-8 text
@@ -299,13 +291,10 @@ def read_nk(data: str | bytes, format: str, name: str = "uploaded",
         try:
             data = data.decode("utf-8-sig")
         except UnicodeDecodeError as error:
-            raise ValueError(
-                f"the file must be UTF-8 text: byte {error.start} is not (UTF-16 or binary?)"
-            ) from None
+            raise ValueError(f"the file must be UTF-8 text: byte {error.start} is not (UTF-16 or binary?)") from None
     if "\x00" in data:
         raise ValueError(
-            f"the file must be UTF-8 text: it holds a NUL character at {data.index(chr(0))} "
-            "(UTF-16 or binary?)"
+            f"the file must be UTF-8 text: it holds a NUL character at {data.index(chr(0))} (UTF-16 or binary?)"
         )
     reader = {"csv": read_nk_csv, "json": read_nk_json, "yaml": read_nk_yaml}[fmt]
     return reader(data, name=name, max_samples=max_samples)

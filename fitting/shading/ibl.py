@@ -110,6 +110,7 @@ __all__ = [
     "energy_compensation",
 ]
 
+
 def _inputs(NdotV, roughness):
     return as_finite_array("NdotV", NdotV), as_finite_array("roughness", roughness)
 
@@ -147,9 +148,7 @@ def split_sum_schlick(NdotV, roughness, F0, lut: SplitSumLUT | None = None) -> n
     return np.asarray(F0, dtype=np.float64) * terms[..., 0:1] + terms[..., 1:2]
 
 
-def split_sum_lazanyi(
-    NdotV, roughness, eta_i, F0_air, F82_air, lut: SplitSumLUT | None = None
-) -> np.ndarray:
+def split_sum_lazanyi(NdotV, roughness, eta_i, F0_air, F82_air, lut: SplitSumLUT | None = None) -> np.ndarray:
     """
     Directional albedo with adjusted Lazanyi (:func:`fitting.models.baselines.lazanyi_adjusted`):
     the model's form with :math:`F_0'` at ``eta_i`` (scalar), *a* from F0 and

@@ -124,9 +124,8 @@ class SplitSumLUT:
         fx, fy = (x - i0)[..., None], (y - j0)[..., None]
 
         def bilinear(k):
-            return (
-                (1.0 - fy) * ((1.0 - fx) * data[k, j0, i0] + fx * data[k, j0, i0 + 1])
-                + fy * ((1.0 - fx) * data[k, j0 + 1, i0] + fx * data[k, j0 + 1, i0 + 1])
+            return (1.0 - fy) * ((1.0 - fx) * data[k, j0, i0] + fx * data[k, j0, i0 + 1]) + fy * (
+                (1.0 - fx) * data[k, j0 + 1, i0] + fx * data[k, j0 + 1, i0 + 1]
             )
 
         low, high = bilinear(k0), bilinear(k0 + 1)
@@ -136,8 +135,7 @@ class SplitSumLUT:
         # G > 0 wherever the lobe has weight; the floor keeps log2 finite
         # at NdotV = 0, where every term is 0.
         G = np.exp2(
-            (1.0 - t) * np.log2(np.maximum(low[..., 2], _G_FLOOR))
-            + t * np.log2(np.maximum(high[..., 2], _G_FLOOR))
+            (1.0 - t) * np.log2(np.maximum(low[..., 2], _G_FLOOR)) + t * np.log2(np.maximum(high[..., 2], _G_FLOOR))
         )
         return np.concatenate([low[..., :2], G[..., None]], axis=-1)
 
@@ -165,9 +163,7 @@ def _node_terms(mu: np.ndarray, roughness: float, alphas: np.ndarray, u1, u2) ->
     h = sample_visible_normal(v, alpha_g, u1[None, :], u2[None, :])
     VdotH = np.clip(np.sum(v * h, axis=-1), 0.0, 1.0)
     NdotL = 2.0 * VdotH * h[..., 2] - v[..., 2]
-    w = np.where(
-        NdotL > 0.0, smith_G2(mu[:, None], NdotL, alpha_g) / smith_G1(mu[:, None], alpha_g), 0.0
-    )
+    w = np.where(NdotL > 0.0, smith_G2(mu[:, None], NdotL, alpha_g) / smith_G1(mu[:, None], alpha_g), 0.0)
     x = 1.0 - VdotH
     x5 = x**5
     A = np.mean(w * (1.0 - x5), axis=1)

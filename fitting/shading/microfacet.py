@@ -262,13 +262,17 @@ def coated_brdf(wo, wi, roughness, base_fresnel, eta_i, coat_roughness=0.0) -> n
     eta = np.maximum(np.asarray(eta_i, dtype=np.float64), 1.0)
     NdotV, NdotL = wo[..., 2], wi[..., 2]
     coat = specular_brdf(
-        wo, wi, alpha_g_from_roughness(coat_roughness),
+        wo,
+        wi,
+        alpha_g_from_roughness(coat_roughness),
         lambda VdotH: _coat_fresnel(VdotH, eta)[..., None],
     )
     transmission = (1.0 - _coat_fresnel(NdotV, eta)) * (1.0 - _coat_fresnel(NdotL, eta))
     base = specular_brdf(
-        refract_into_coat(wo, eta), refract_into_coat(wi, eta),
-        alpha_g_from_roughness(roughness), base_fresnel,
+        refract_into_coat(wo, eta),
+        refract_into_coat(wi, eta),
+        alpha_g_from_roughness(roughness),
+        base_fresnel,
     )
     above = ((NdotV > 0.0) & (NdotL > 0.0))[..., None]
     return np.where(above, coat + (transmission / (eta * eta))[..., None] * base, 0.0)
@@ -281,9 +285,7 @@ def model_fresnel(F0, a, alpha):
     return lambda VdotH: model_from_parameters(np.asarray(VdotH)[..., None], F0, a, alpha)
 
 
-def microfacet_brdf(
-    wo, wi, roughness, F0, a, alpha, mode="immersed", eta_i=1.0, coat_roughness=0.0
-) -> np.ndarray:
+def microfacet_brdf(wo, wi, roughness, F0, a, alpha, mode="immersed", eta_i=1.0, coat_roughness=0.0) -> np.ndarray:
     """
     The GGX BRDF with the coated-conductor model's Fresnel, linear ACEScg,
     1/sr.
@@ -358,10 +360,7 @@ def sample_visible_normal(wo, alpha_g, u1, u2) -> np.ndarray:
     t1, t2 = r * np.cos(phi), r * np.sin(phi)
     s = 0.5 * (1.0 + Vh[..., 2])
     t2 = (1.0 - s) * np.sqrt(np.clip(1.0 - t1 * t1, 0.0, 1.0)) + s * t2
-    Nh = (
-        t1[..., None] * T1 + t2[..., None] * T2
-        + np.sqrt(np.clip(1.0 - t1 * t1 - t2 * t2, 0.0, 1.0))[..., None] * Vh
-    )
+    Nh = t1[..., None] * T1 + t2[..., None] * T2 + np.sqrt(np.clip(1.0 - t1 * t1 - t2 * t2, 0.0, 1.0))[..., None] * Vh
     # Back from the hemisphere configuration to the ellipsoid.
     Ne = np.concatenate([alpha * Nh[..., :2], np.maximum(Nh[..., 2:], 0.0)], axis=-1)
     return _normalise(Ne)

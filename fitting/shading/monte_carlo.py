@@ -307,9 +307,7 @@ def rough_sphere_image(
     mask = r2 < 1.0
     mu_pixels = np.sqrt(np.clip(1.0 - r2, 0.0, 1.0))
     mu_nodes = np.linspace(1.0 / NdotV_bins, 1.0, NdotV_bins)
-    estimate = directional_albedo(
-        mu_nodes, roughness, fresnel, mode, eta_i, coat_roughness, samples, seed, masking
-    )
+    estimate = directional_albedo(mu_nodes, roughness, fresnel, mode, eta_i, coat_roughness, samples, seed, masking)
     image = np.zeros((size, size, estimate.mean.shape[1]))
     for c in range(image.shape[2]):
         image[..., c] = np.where(mask, np.interp(mu_pixels, mu_nodes, estimate.mean[:, c]), 0.0)

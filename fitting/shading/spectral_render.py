@@ -58,9 +58,7 @@ def XYZ_to_ACEScg_matrix(XYZ_white) -> np.ndarray:
     acescg = colour.RGB_COLOURSPACES["ACEScg"]
     XYZ_w = np.asarray(XYZ_white, dtype=np.float64)
     XYZ_wr = acescg.matrix_RGB_to_XYZ @ np.ones(3)
-    cat = colour.adaptation.matrix_chromatic_adaptation_VonKries(
-        XYZ_w / XYZ_w[1], XYZ_wr, transform="CAT02"
-    )
+    cat = colour.adaptation.matrix_chromatic_adaptation_VonKries(XYZ_w / XYZ_w[1], XYZ_wr, transform="CAT02")
     M = acescg.matrix_XYZ_to_RGB @ cat
     return M / (M @ XYZ_w)[:, None]
 
@@ -96,37 +94,55 @@ def mitsuba_rough_sphere(
     r = float(np.clip(roughness, 0.0, 1.0))
     sampled = resample_nk(nk, _LAMBDA, min_coverage)
     colour = colour_science()
-    D60 = colour.sd_CIE_illuminant_D_series(ACES_WHITE_XY).copy().align(
-        colour.SpectralShape(360, 830, 5)
-    )
+    D60 = colour.sd_CIE_illuminant_D_series(ACES_WHITE_XY).copy().align(colour.SpectralShape(360, 830, 5))
     illuminant = D60.values / D60.values.mean()
-    scene = mi.load_dict({
-        "type": "scene",
-        "integrator": {"type": "path", "max_depth": 2},
-        "sensor": {
-            "type": "orthographic",
-            "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0, 5], target=[0, 0, 0], up=[0, 1, 0]),
-            "film": {"type": "hdrfilm", "width": size, "height": size, "pixel_format": "xyz",
-                     "rfilter": {"type": "box"}},
-            "sampler": {"type": "independent", "sample_count": spp, "seed": int(seed)},
-        },
-        "emitter": {"type": "constant", "radiance": _spectrum(illuminant)},
-        "sphere": {"type": "sphere", "bsdf": {
-            "type": "roughconductor", "distribution": "ggx", "alpha": max(r * r, 1e-4),
-            "eta": _spectrum(sampled.n / eta_i), "k": _spectrum(sampled.k / eta_i),
-        }},
-    })
+    scene = mi.load_dict(
+        {
+            "type": "scene",
+            "integrator": {"type": "path", "max_depth": 2},
+            "sensor": {
+                "type": "orthographic",
+                "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0, 5], target=[0, 0, 0], up=[0, 1, 0]),
+                "film": {
+                    "type": "hdrfilm",
+                    "width": size,
+                    "height": size,
+                    "pixel_format": "xyz",
+                    "rfilter": {"type": "box"},
+                },
+                "sampler": {"type": "independent", "sample_count": spp, "seed": int(seed)},
+            },
+            "emitter": {"type": "constant", "radiance": _spectrum(illuminant)},
+            "sphere": {
+                "type": "sphere",
+                "bsdf": {
+                    "type": "roughconductor",
+                    "distribution": "ggx",
+                    "alpha": max(r * r, 1e-4),
+                    "eta": _spectrum(sampled.n / eta_i),
+                    "k": _spectrum(sampled.k / eta_i),
+                },
+            },
+        }
+    )
     XYZ = np.array(mi.render(scene), dtype=np.float64)
     # The environment seen directly is the white of the XYZ film. Each
     # sample has one random wavelength, so the white is averaged over 2^20
     # samples (chromatic noise ~1e-3, below the sphere's own noise).
-    white = mi.render(mi.load_dict({
-        "type": "scene", "integrator": {"type": "path", "max_depth": 1},
-        "sensor": {"type": "orthographic",
-                   "film": {"type": "hdrfilm", "width": 64, "height": 64, "pixel_format": "xyz"},
-                   "sampler": {"type": "independent", "sample_count": 256, "seed": int(seed) + 1}},
-        "emitter": {"type": "constant", "radiance": _spectrum(illuminant)},
-    }))
+    white = mi.render(
+        mi.load_dict(
+            {
+                "type": "scene",
+                "integrator": {"type": "path", "max_depth": 1},
+                "sensor": {
+                    "type": "orthographic",
+                    "film": {"type": "hdrfilm", "width": 64, "height": 64, "pixel_format": "xyz"},
+                    "sampler": {"type": "independent", "sample_count": 256, "seed": int(seed) + 1},
+                },
+                "emitter": {"type": "constant", "radiance": _spectrum(illuminant)},
+            }
+        )
+    )
     M = XYZ_to_ACEScg_matrix(np.array(white, dtype=np.float64).reshape(-1, 3).mean(axis=0))
     image = XYZ @ M.T
     centres = (np.arange(size) + 0.5) / size * 2.0 - 1.0

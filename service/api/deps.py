@@ -104,28 +104,59 @@ async def note_save(rate: SaveRate, store: Store, material_id: str, fit_id: str,
     existing one), so it is neither counted nor refused.
     """
     row = await run_in_threadpool(store.material, material_id)
-    if row is not None and row.latest_fit_id == fit_id and row.deleted_at is None \
-            and row.name == summary_text(name):
+    if row is not None and row.latest_fit_id == fit_id and row.deleted_at is None and row.name == summary_text(name):
         return
     rate.note(CLAIM.get())
 
 
 FitIdPath = Annotated[str, Path(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
-MaterialIdPath = Annotated[str, Path(pattern=MATERIAL_ID_PATTERN,
-                                     description="A library name or a saved material's id")]
-RoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description=(
-    "The metal's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
-CoatRoughnessQuery = Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description=(
-    "The coat's perceptual roughness of an export, [0, 1] (the editor's preview value)"))]
-MetricsQuery = Annotated[Literal["solve", "full"], Query(description=(
-    "`solve` (default): answer as soon as the fit is saved, with what its solve measured "
-    "(`metrics.evaluated` false until its evaluation on the metrics grid has run, after the answer); "
-    "`full`: wait for that evaluation (the figure, Delta E of the model and the baselines)"))]
-WorkingSpaceQuery = Annotated[WorkingSpace, Query(description=(
-    "lin_rec709 | acescg: the working space an export is fitted and written in (docs/exports.md)"))]
-MinCoverageForm = Annotated[float | None, Form(ge=0.0, le=1.0, allow_inf_nan=False, description=(
-    "Least covered fraction of 360-830 nm to accept, in [0.9, 1] (default 0.9, the service's own "
-    "rule; a higher value refuses data the service would fit)"))]
+MaterialIdPath = Annotated[
+    str, Path(pattern=MATERIAL_ID_PATTERN, description="A library name or a saved material's id")
+]
+RoughnessQuery = Annotated[
+    float,
+    Query(
+        ge=0.0,
+        le=1.0,
+        allow_inf_nan=False,
+        description=("The metal's perceptual roughness of an export, [0, 1] (the editor's preview value)"),
+    ),
+]
+CoatRoughnessQuery = Annotated[
+    float,
+    Query(
+        ge=0.0,
+        le=1.0,
+        allow_inf_nan=False,
+        description=("The coat's perceptual roughness of an export, [0, 1] (the editor's preview value)"),
+    ),
+]
+MetricsQuery = Annotated[
+    Literal["solve", "full"],
+    Query(
+        description=(
+            "`solve` (default): answer as soon as the fit is saved, with what its solve measured "
+            "(`metrics.evaluated` false until its evaluation on the metrics grid has run, after the answer); "
+            "`full`: wait for that evaluation (the figure, Delta E of the model and the baselines)"
+        )
+    ),
+]
+WorkingSpaceQuery = Annotated[
+    WorkingSpace,
+    Query(description=("lin_rec709 | acescg: the working space an export is fitted and written in (docs/exports.md)")),
+]
+MinCoverageForm = Annotated[
+    float | None,
+    Form(
+        ge=0.0,
+        le=1.0,
+        allow_inf_nan=False,
+        description=(
+            "Least covered fraction of 360-830 nm to accept, in [0.9, 1] (default 0.9, the service's own "
+            "rule; a higher value refuses data the service would fit)"
+        ),
+    ),
+]
 
 
 def get_stored_fit(fit_id: FitIdPath, store: StoreDep) -> FitRecord:
@@ -185,11 +216,13 @@ async def refuse_repeated_form_fields(request: Request) -> None:
     form = await request.form()  # parsed once for the route's fields: cached
     repeated = sorted({key for key in form.keys() if len(form.getlist(key)) > 1})
     if repeated:
-        raise ValueError(f"each form field must be given once, got {len(form.getlist(repeated[0]))} "
-                         f"`{repeated[0][:40]}` parts")
+        raise ValueError(
+            f"each form field must be given once, got {len(form.getlist(repeated[0]))} `{repeated[0][:40]}` parts"
+        )
 
 
 SingleFormFields = Depends(refuse_repeated_form_fields)
+
 
 def _error(description: str) -> dict:
     return {"model": ErrorBody, "description": description}
@@ -201,9 +234,13 @@ ERROR_RESPONSES = {
     status.HTTP_503_SERVICE_UNAVAILABLE: _error("The store is unavailable, or the service is busy; see Retry-After"),
 }
 NOT_FOUND = {status.HTTP_404_NOT_FOUND: _error("Not stored")}
-CONFLICT = {status.HTTP_409_CONFLICT: _error("`expected_version` is not the material's version, or the "
-                                             "material was renamed or moved to the bin since: the "
-                                             "message names what changed; nothing was saved")}
+CONFLICT = {
+    status.HTTP_409_CONFLICT: _error(
+        "`expected_version` is not the material's version, or the "
+        "material was renamed or moved to the bin since: the "
+        "message names what changed; nothing was saved"
+    )
+}
 FIT_ERROR_RESPONSES = {
     **ERROR_RESPONSES,
     status.HTTP_401_UNAUTHORIZED: _error("Missing or wrong bearer token (when required)"),
@@ -211,9 +248,11 @@ FIT_ERROR_RESPONSES = {
     status.HTTP_408_REQUEST_TIMEOUT: _error("The body arrived slower than COATED_BODY_TIMEOUT_S"),
     status.HTTP_413_CONTENT_TOO_LARGE: _error("The body is larger than the limit"),
     status.HTTP_429_TOO_MANY_REQUESTS: _error("A save past COATED_SAVES_PER_CLIENT_PER_MINUTE; see Retry-After"),
-    status.HTTP_503_SERVICE_UNAVAILABLE: _error("Too many fits in flight, a worker died twice, "
-                                                "or the store is unavailable; see Retry-After"),
-    status.HTTP_504_GATEWAY_TIMEOUT: _error("The fit ran past its time limit; it goes on, retry "
-                                            "after Retry-After for its result"),
+    status.HTTP_503_SERVICE_UNAVAILABLE: _error(
+        "Too many fits in flight, a worker died twice, or the store is unavailable; see Retry-After"
+    ),
+    status.HTTP_504_GATEWAY_TIMEOUT: _error(
+        "The fit ran past its time limit; it goes on, retry after Retry-After for its result"
+    ),
     status.HTTP_507_INSUFFICIENT_STORAGE: _error("The store is full; nothing was fitted"),
 }

@@ -46,10 +46,10 @@ __all__ = ["install_error_handlers", "error_response"]
 log = logging.getLogger("service.errors")
 
 
-def error_response(status_code: int, detail: str, errors: list | None = None,
-                   headers: dict[str, str] | None = None) -> JSONResponse:
-    return JSONResponse({"detail": detail, "errors": errors or []}, status_code=status_code,
-                        headers=headers)
+def error_response(
+    status_code: int, detail: str, errors: list | None = None, headers: dict[str, str] | None = None
+) -> JSONResponse:
+    return JSONResponse({"detail": detail, "errors": errors or []}, status_code=status_code, headers=headers)
 
 
 def _location(loc: tuple[Any, ...]) -> str:
@@ -76,7 +76,7 @@ async def _validation_error(request: Request, error: RequestValidationError) -> 
         loc = [p if isinstance(p, (str, int)) else str(p) for p in item.get("loc", ())]
         msg = item.get("msg", "invalid")
         if msg.startswith("Value error, "):
-            msg = msg[len("Value error, "):]
+            msg = msg[len("Value error, ") :]
         if item.get("type") == "json_invalid":
             reason = (item.get("ctx") or {}).get("error", "")
             position = loc[-1] if loc and isinstance(loc[-1], int) else "?"
@@ -87,8 +87,7 @@ async def _validation_error(request: Request, error: RequestValidationError) -> 
         lines.append(line)
         items.append({"loc": loc, "msg": msg[:500], "type": item.get("type", "value_error")})
     detail = "; ".join(lines[:5]) + (f"; and {len(lines) - 5} more" if len(lines) > 5 else "")
-    return error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, detail or "the request is invalid",
-                          items[:50])
+    return error_response(status.HTTP_422_UNPROCESSABLE_CONTENT, detail or "the request is invalid", items[:50])
 
 
 # FastAPI's answer when a body cannot be decoded at all (JSON that is not
@@ -104,9 +103,14 @@ async def _http_error(request: Request, error: StarletteHTTPException) -> JSONRe
     if isinstance(cause, OSError) and cause.errno in _NO_SPACE:
         # The body was spooled to a full temporary directory: the server's fault, not the file's.
         log.error("a request body could not be spooled: %s", cause)
-        return error_response(status.HTTP_507_INSUFFICIENT_STORAGE, (
-            "the server's temporary directory is full: the upload could not be received; nothing was "
-            "fitted; retry later"), headers={"Retry-After": "60"})
+        return error_response(
+            status.HTTP_507_INSUFFICIENT_STORAGE,
+            (
+                "the server's temporary directory is full: the upload could not be received; nothing was "
+                "fitted; retry later"
+            ),
+            headers={"Retry-After": "60"},
+        )
     if error.status_code == status.HTTP_400_BAD_REQUEST and error.detail != _UNPARSABLE_BODY:
         # Starlette's multipart parser (a missing boundary, too many fields
         # or files): the body is invalid, as every other unparsable body.
@@ -136,18 +140,19 @@ async def _lookup_error(request: Request, error: LookupError) -> JSONResponse:
 
 
 async def _busy(request: Request, error: Overloaded | WorkerLost | ShareExceeded) -> JSONResponse:
-    return error_response(status.HTTP_503_SERVICE_UNAVAILABLE, str(error),
-                          headers={"Retry-After": str(error.retry_after)})
+    return error_response(
+        status.HTTP_503_SERVICE_UNAVAILABLE, str(error), headers={"Retry-After": str(error.retry_after)}
+    )
 
 
 async def _too_many(request: Request, error: TooManySaves) -> JSONResponse:
-    return error_response(status.HTTP_429_TOO_MANY_REQUESTS, str(error),
-                          headers={"Retry-After": str(error.retry_after)})
+    return error_response(
+        status.HTTP_429_TOO_MANY_REQUESTS, str(error), headers={"Retry-After": str(error.retry_after)}
+    )
 
 
 async def _timeout(request: Request, error: FitTimeout) -> JSONResponse:
-    return error_response(status.HTTP_504_GATEWAY_TIMEOUT, str(error),
-                          headers={"Retry-After": str(error.retry_after)})
+    return error_response(status.HTTP_504_GATEWAY_TIMEOUT, str(error), headers={"Retry-After": str(error.retry_after)})
 
 
 async def _no_renderer(request: Request, error: RendererUnavailable) -> JSONResponse:
@@ -156,8 +161,13 @@ async def _no_renderer(request: Request, error: RendererUnavailable) -> JSONResp
 
 async def _store_error(request: Request, error: StoreError) -> JSONResponse:
     if error.status == status.HTTP_409_CONFLICT:
-        errors = [{"loc": ["body", getattr(error, "field", "expected_version")], "msg": str(error)[:500],
-                   "type": getattr(error, "type", "version_conflict")}]
+        errors = [
+            {
+                "loc": ["body", getattr(error, "field", "expected_version")],
+                "msg": str(error)[:500],
+                "type": getattr(error, "type", "version_conflict"),
+            }
+        ]
         return error_response(error.status, str(error), errors)
     log.error("store: %s", error)
     headers = {"Retry-After": str(error.retry_after)} if error.status in (503, 507) else None
@@ -166,8 +176,9 @@ async def _store_error(request: Request, error: StoreError) -> JSONResponse:
 
 async def _internal(request: Request, error: Exception) -> JSONResponse:
     log.exception("internal error on %s %s", request.method, request.url.path, exc_info=error)
-    return error_response(status.HTTP_500_INTERNAL_SERVER_ERROR,
-                          f"internal error ({type(error).__name__}); it was logged")
+    return error_response(
+        status.HTTP_500_INTERNAL_SERVER_ERROR, f"internal error ({type(error).__name__}); it was logged"
+    )
 
 
 def install_error_handlers(app: FastAPI) -> None:

@@ -40,12 +40,17 @@ LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "::1")
 
 async def _refuse(send: Send, status_code: int, detail: str) -> None:
     body = json.dumps({"detail": detail, "errors": []}).encode()
-    await send({
-        "type": "http.response.start", "status": status_code,
-        "headers": [(b"content-type", b"application/json"),
-                    (b"content-length", str(len(body)).encode()),
-                    (b"connection", b"close")],
-    })
+    await send(
+        {
+            "type": "http.response.start",
+            "status": status_code,
+            "headers": [
+                (b"content-type", b"application/json"),
+                (b"content-length", str(len(body)).encode()),
+                (b"connection", b"close"),
+            ],
+        }
+    )
     await send({"type": "http.response.body", "body": body})
 
 
@@ -114,7 +119,8 @@ class HostAllowList:
         if not host_allowed(host, self.allowed):
             shown = host[:80] if host.isprintable() else repr(host[:80])
             await _refuse(
-                send, status.HTTP_400_BAD_REQUEST,
+                send,
+                status.HTTP_400_BAD_REQUEST,
                 f"the `Host` {shown!r} is not served here: allowed are "
                 f"{', '.join(self.allowed)} (COATED_ALLOWED_HOSTS)",
             )
@@ -131,8 +137,14 @@ class RequestLimits:
     ``body_timeout_s`` of the request's start is answered 408.
     """
 
-    def __init__(self, app: ASGIApp, max_body_bytes: int, max_upload_bytes: int,
-                 upload_paths: tuple[str, ...], body_timeout_s: float) -> None:
+    def __init__(
+        self,
+        app: ASGIApp,
+        max_body_bytes: int,
+        max_upload_bytes: int,
+        upload_paths: tuple[str, ...],
+        body_timeout_s: float,
+    ) -> None:
         self.app = app
         self.max_body_bytes = max_body_bytes
         self.max_upload_bytes = max_upload_bytes
@@ -160,9 +172,11 @@ class RequestLimits:
             try:
                 message = await asyncio.wait_for(receive(), max(0.0, deadline - loop.time()))
             except asyncio.TimeoutError:
-                await _refuse(send, status.HTTP_408_REQUEST_TIMEOUT,
-                              f"the request body did not arrive within {self.body_timeout_s:g} s "
-                              "(COATED_BODY_TIMEOUT_S)")
+                await _refuse(
+                    send,
+                    status.HTTP_408_REQUEST_TIMEOUT,
+                    f"the request body did not arrive within {self.body_timeout_s:g} s (COATED_BODY_TIMEOUT_S)",
+                )
                 return
             if message["type"] == "http.disconnect":
                 return
@@ -233,8 +247,9 @@ class ClaimWork:
     for anything else.
     """
 
-    def __init__(self, app: ASGIApp, token: str | None, save_paths: tuple[str, ...], scene_path: str,
-                 pack_path: str) -> None:
+    def __init__(
+        self, app: ASGIApp, token: str | None, save_paths: tuple[str, ...], scene_path: str, pack_path: str
+    ) -> None:
         self.app = app
         self.token = f"Bearer {token}".encode() if token else None
         self.kinds = {**dict.fromkeys(save_paths, "save"), scene_path: "scene", pack_path: "pack"}

@@ -82,8 +82,11 @@ def measured_nk(record: FitRecord) -> SpectralNK | None:
     if record.nk is None:
         return None
     return SpectralNK(
-        np.asarray(record.nk["wavelength_nm"]), np.asarray(record.nk["n"]),
-        np.asarray(record.nk["k"]), name=record.name, source=record.source,
+        np.asarray(record.nk["wavelength_nm"]),
+        np.asarray(record.nk["n"]),
+        np.asarray(record.nk["k"]),
+        name=record.name,
+        source=record.source,
     )
 
 
@@ -178,12 +181,22 @@ def checked_version(store: Store, material_id: str, name: str, expected_version:
     return row is not None and row.deleted_at is not None
 
 
-def fit_record(fit_id: str, kind: str, material_id: str, name: str, source: str,
-               job: dict[str, Any], objective: str, **extra: Any) -> FitRecord:
+def fit_record(
+    fit_id: str, kind: str, material_id: str, name: str, source: str, job: dict[str, Any], objective: str, **extra: Any
+) -> FitRecord:
     """The record of a finished fitting job (material, metrics, timings, convergence)."""
     return FitRecord(
-        id=fit_id, kind=kind, material_id=material_id, name=name, source=source,
-        material=job["material"], metrics=job["metrics"], timings=job["timings"],
-        convergence=job["convergence"], objective=objective, coverage=job.get("coverage"),
-        created_at=time.time(), **extra,
+        id=fit_id,
+        kind=kind,
+        material_id=material_id,
+        name=name,
+        source=source,
+        material=job["material"],
+        metrics=job["metrics"],
+        timings=job["timings"],
+        convergence=job["convergence"],
+        objective=objective,
+        coverage=job.get("coverage"),
+        created_at=time.time(),
+        **extra,
     )

@@ -50,12 +50,23 @@ class BaseSpec:
         return SpectralNK(wavelength, n, k, name=self.name, source=self.source)
 
     def key(self) -> list:
-        return [self.kind, self.name, self.source, self.library_material,
-                None if self.nk is None else [np.asarray(a) for a in self.nk],
-                None if self.coefficients is None else np.asarray(self.coefficients).ravel(),
-                list(self.eta_i_range), *(() if self.model == DEFAULT_MODEL else (self.model,))]
+        return [
+            self.kind,
+            self.name,
+            self.source,
+            self.library_material,
+            None if self.nk is None else [np.asarray(a) for a in self.nk],
+            None if self.coefficients is None else np.asarray(self.coefficients).ravel(),
+            list(self.eta_i_range),
+            *(() if self.model == DEFAULT_MODEL else (self.model,)),
+        ]
 
     def provenance(self) -> dict[str, Any]:
-        return {"kind": self.kind, "name": self.name, "eta_i_range": list(self.eta_i_range),
-                "library_material": self.library_material, "coefficients": self.coefficients,
-                "model": self.model}
+        return {
+            "kind": self.kind,
+            "name": self.name,
+            "eta_i_range": list(self.eta_i_range),
+            "library_material": self.library_material,
+            "coefficients": self.coefficients,
+            "model": self.model,
+        }

@@ -70,8 +70,9 @@ def _target_of(record: FitRecord, mu: np.ndarray, eta: np.ndarray):
             target = np.stack([next(c for c in curves if c.eta_i == e).sampled(mu) for e in rows])
             return rows, target, "curves"
         if base["kind"] == "model":
-            grid = curve_base_from_coefficients(np.asarray(base["coefficients"]), domain, base["name"],
-                                                model=base.get("model", DEFAULT_MODEL))
+            grid = curve_base_from_coefficients(
+                np.asarray(base["coefficients"]), domain, base["name"], model=base.get("model", DEFAULT_MODEL)
+            )
         else:
             grid = curve_base_from_nk(_measured_nk_or_refuse(record), domain)
         E, M = np.meshgrid(eta, mu, indexing="ij")
@@ -112,7 +113,11 @@ def error_map(record: FitRecord, angles: int, rows: int) -> dict[str, Any]:
     model = model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range)
     dE = delta_E_map(target, model)
     return {
-        "fit_id": record.id, "against": against, "theta_deg": theta.tolist(), "eta_i": eta.tolist(),
-        "delta_E": np.round(dE, 4).tolist(), "delta_E_mean": float(dE.mean()),
+        "fit_id": record.id,
+        "against": against,
+        "theta_deg": theta.tolist(),
+        "eta_i": eta.tolist(),
+        "delta_E": np.round(dE, 4).tolist(),
+        "delta_E_mean": float(dE.mean()),
         "delta_E_max": float(dE.max()),
     }

@@ -36,8 +36,17 @@ from fitting.optics.catalogue import catalogue_material
 
 from ..runtime import FitRunner
 from ..store import FitRecord, Store
-from .common import (FIT_FORMAT_VERSION, check_finite, checked_version, checked_writable, content_address,
-                     draft_nk_reference, fit_record, stored_fit, with_measured_nk)
+from .common import (
+    FIT_FORMAT_VERSION,
+    check_finite,
+    checked_version,
+    checked_writable,
+    content_address,
+    draft_nk_reference,
+    fit_record,
+    stored_fit,
+    with_measured_nk,
+)
 from .curve_bases import BaseSpec
 from .curve_targets import error_map, snap_to_domain, target_at
 from .materials import resolve_material
@@ -74,11 +83,13 @@ def _float32_equal(a: tuple[float, float], b: tuple[float, float]) -> bool:
     return bool(np.all(np.float32(a) == np.float32(b)))
 
 
-def _base_spec(store: Store, name: str, material: str | None, fit: str | None,
-               nk: tuple | None, requested) -> tuple[BaseSpec | None, FitRecord | None]:
+def _base_spec(
+    store: Store, name: str, material: str | None, fit: str | None, nk: tuple | None, requested
+) -> tuple[BaseSpec | None, FitRecord | None]:
     if material is not None:
-        return BaseSpec("nk", material, catalogue_material(material).source,
-                        requested or DEFAULT_DOMAIN, library_material=material), None
+        return BaseSpec(
+            "nk", material, catalogue_material(material).source, requested or DEFAULT_DOMAIN, library_material=material
+        ), None
     if nk is not None:
         return BaseSpec("nk", f"{name} base", "user n, k", requested or DEFAULT_DOMAIN, nk=nk), None
     if fit is None:
@@ -94,24 +105,45 @@ def _base_spec(store: Store, name: str, material: str | None, fit: str | None,
         # An edited material: its edits live in its stored model, not in the
         # n, k it started from.
         packed = material_from_json(record.material)
-        spec = BaseSpec("model", record.name, record.source, domain,
-                        coefficients=packed.coefficients.astype(np.float64).tolist(), model=packed.model)
+        spec = BaseSpec(
+            "model",
+            record.name,
+            record.source,
+            domain,
+            coefficients=packed.coefficients.astype(np.float64).tolist(),
+            model=packed.model,
+        )
     elif record.library_material is not None:
-        spec = BaseSpec("nk", record.library_material, record.source, domain,
-                        library_material=record.library_material)
+        spec = BaseSpec("nk", record.library_material, record.source, domain, library_material=record.library_material)
     else:  # an n, k fit
-        spec = BaseSpec("nk", record.name, record.source, domain,
-                        nk=(tuple(record.nk["wavelength_nm"]), tuple(record.nk["n"]), tuple(record.nk["k"])))
+        spec = BaseSpec(
+            "nk",
+            record.name,
+            record.source,
+            domain,
+            nk=(tuple(record.nk["wavelength_nm"]), tuple(record.nk["n"]), tuple(record.nk["k"])),
+        )
     return spec, record
 
 
-def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_material: str | None = None,
-                      base_fit: str | None = None, base_nk: tuple | None = None,
-                      eta_i_range=None, objective: str = DEFAULTS.objective,
-                      blend_width: float = DEFAULTS.blend_width,
-                      request: dict[str, Any] | None = None, draft: bool = False,
-                      model: str = DEFAULT_MODEL, live: bool = False,
-                      start_fit: str | None = None, material_id: str | None = None) -> CurveFit:
+def prepare_curve_fit(
+    store: Store,
+    name: str,
+    curves: list[dict],
+    *,
+    base_material: str | None = None,
+    base_fit: str | None = None,
+    base_nk: tuple | None = None,
+    eta_i_range=None,
+    objective: str = DEFAULTS.objective,
+    blend_width: float = DEFAULTS.blend_width,
+    request: dict[str, Any] | None = None,
+    draft: bool = False,
+    model: str = DEFAULT_MODEL,
+    live: bool = False,
+    start_fit: str | None = None,
+    material_id: str | None = None,
+) -> CurveFit:
     """
     Resolve the base (``LookupError`` for a base fit not stored), check the
     curves and the domain (``ValueError``), and compute the id. A ``live``
@@ -133,8 +165,15 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
     start = None if start_fit is None else _start_coefficients(store, start_fit, domain, model, base, curves)
     material_id = resolve_material(store, name, material_id)
     fit_id = content_address(
-        FIT_FORMAT_VERSION, CURVES_FORMAT, name, None if base is None else base.key(), curves,
-        list(domain), objective, blend_width, repr(DEFAULTS),
+        FIT_FORMAT_VERSION,
+        CURVES_FORMAT,
+        name,
+        None if base is None else base.key(),
+        curves,
+        list(domain),
+        objective,
+        blend_width,
+        repr(DEFAULTS),
         # The default kind adds nothing, so coated-conductor ids stay as they were.
         *(() if model == DEFAULT_MODEL else (model,)),
         # Nor does a full refit.
@@ -142,9 +181,22 @@ def prepare_curve_fit(store: Store, name: str, curves: list[dict], *, base_mater
         # Nor does the material a name gives (a record names its material once).
         *(() if material_id == content_address("edited material", name) else ("material", material_id)),
     )
-    return CurveFit(name, base, base_record, curves, domain, objective, blend_width,
-                    request or {}, fit_id, draft, model, live,
-                    None if start is None else tuple(np.ravel(start).tolist()), material_id)
+    return CurveFit(
+        name,
+        base,
+        base_record,
+        curves,
+        domain,
+        objective,
+        blend_width,
+        request or {},
+        fit_id,
+        draft,
+        model,
+        live,
+        None if start is None else tuple(np.ravel(start).tolist()),
+        material_id,
+    )
 
 
 def _start_coefficients(store: Store, start_fit: str, domain, model: str, base, curves) -> np.ndarray | None:
@@ -172,17 +224,31 @@ def _start_coefficients(store: Store, start_fit: str, domain, model: str, base, 
     return coefficients
 
 
-def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: str,
-                objective: str, blend_width: float, model: str = DEFAULT_MODEL,
-                live: bool = False, start: tuple | None = None) -> dict[str, Any]:
+def _curves_job(
+    base: BaseSpec | None,
+    curves: list[dict],
+    eta_i_range,
+    name: str,
+    objective: str,
+    blend_width: float,
+    model: str = DEFAULT_MODEL,
+    live: bool = False,
+    start: tuple | None = None,
+) -> dict[str, Any]:
     """Worker process: build (or reuse) the base grid, fit, score."""
     t0 = time.perf_counter()
     base_grid = None if base is None else base.build()
     t_base = time.perf_counter() - t0
     result = fit_curves(
-        curves, base_grid, None if base is not None else eta_i_range, name,
-        settings=LIVE_SETTINGS if live else DEFAULTS, objective=objective, blend_width=blend_width,
-        model=model, start=None if start is None else np.reshape(start, (3, 3, -1)),
+        curves,
+        base_grid,
+        None if base is not None else eta_i_range,
+        name,
+        settings=LIVE_SETTINGS if live else DEFAULTS,
+        objective=objective,
+        blend_width=blend_width,
+        model=model,
+        start=None if start is None else np.reshape(start, (3, 3, -1)),
     )
     metrics = result.metrics
     summary = result.summary()
@@ -195,8 +261,9 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
         "metrics": {
             **metrics,
             "grid": f"{sum(len(c['rgb']) for c in curves)} samples on {len(curves)} curve(s)",
-            "model_float16": {key: metrics[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at")
-                              if key in metrics},
+            "model_float16": {
+                key: metrics[key] for key in ("against", "delta_E_mean", "delta_E_max", "max_at") if key in metrics
+            },
         },
         "timings": {**result.timings, "base": t_base},
         "convergence": summary,
@@ -204,8 +271,9 @@ def _curves_job(base: BaseSpec | None, curves: list[dict], eta_i_range, name: st
     }
 
 
-async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
-                          expected_version: int | None = None) -> tuple[FitRecord, bool, bool]:
+async def fit_from_curves(
+    fit: CurveFit, store: Store, runner: FitRunner, expected_version: int | None = None
+) -> tuple[FitRecord, bool, bool]:
     """
     The stored fit of ``fit`` (an earlier state saved again becomes the
     latest), else fitted and saved; a draft (the editor's refits while
@@ -237,9 +305,15 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
     # The measured data behind the edit (for the reference curves and
     # previews): the base's, or, for an edited base, the data it had.
     measured_library = base.library_material if base else None
-    measured = None if base is None or base.nk is None else {
-        "wavelength_nm": list(base.nk[0]), "n": list(base.nk[1]), "k": list(base.nk[2]),
-    }
+    measured = (
+        None
+        if base is None or base.nk is None
+        else {
+            "wavelength_nm": list(base.nk[0]),
+            "n": list(base.nk[1]),
+            "k": list(base.nk[2]),
+        }
+    )
     if base_record is not None and base_record.kind == "curves":
         measured_library, measured = base_record.library_material, base_record.nk
     # A draft refers to its n, k, never holds a copy (~0.5 MB a step for 20,000 samples).
@@ -250,17 +324,35 @@ async def fit_from_curves(fit: CurveFit, store: Store, runner: FitRunner,
 
     async def make() -> FitRecord:
         made_here.append(True)
-        job = await runner.run(_curves_job, base, fit.curves, fit.eta_i_range, fit.name,
-                               fit.objective, fit.blend_width, fit.model, fit.live, fit.start,
-                               cost_s=0.03 if fit.live else 0.5)  # its turn: live steps first
+        job = await runner.run(
+            _curves_job,
+            base,
+            fit.curves,
+            fit.eta_i_range,
+            fit.name,
+            fit.objective,
+            fit.blend_width,
+            fit.model,
+            fit.live,
+            fit.start,
+            cost_s=0.03 if fit.live else 0.5,
+        )  # its turn: live steps first
         check_finite("metrics", job["metrics"])
         record = fit_record(
-            fit.fit_id, "curves", material_id, fit.name,
-            job["source"], job, fit.objective,
-            library_material=measured_library, nk=own_nk, nk_id=nk_id,
+            fit.fit_id,
+            "curves",
+            material_id,
+            fit.name,
+            job["source"],
+            job,
+            fit.objective,
+            library_material=measured_library,
+            nk=own_nk,
+            nk_id=nk_id,
             base_fit_id=base_record.id if base_record else None,
             provenance={
-                "fit_format": FIT_FORMAT_VERSION, "curves_format": CURVES_FORMAT,
+                "fit_format": FIT_FORMAT_VERSION,
+                "curves_format": CURVES_FORMAT,
                 "request": fit.request,
                 "base": None if base is None else base.provenance(),
                 "settings": {k: getattr(settings, k) for k in settings.__dataclass_fields__},

@@ -54,21 +54,43 @@ def _to_ACEScg(F0, tint, space: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _make(store: Store, name: str, source: str, F0, tint, space: str, eta_i_range) -> tuple[FitRecord, bool]:
-    fit_id = content_address("f0-f82/v1", FIT_FORMAT_VERSION, name, source, [float(v) for v in F0],
-                             [float(v) for v in tint], space, [float(v) for v in eta_i_range])
+    fit_id = content_address(
+        "f0-f82/v1",
+        FIT_FORMAT_VERSION,
+        name,
+        source,
+        [float(v) for v in F0],
+        [float(v) for v in tint],
+        space,
+        [float(v) for v in eta_i_range],
+    )
     stored = store.get_fit(fit_id)
     if stored is not None:
         return stored, False
     checked_writable(store)
     F0_a, tint_a = _to_ACEScg(F0, tint, space)
     index = nk_from_F0_F82(F0_a, tint_a)
-    packed = PackedMaterial(name, to_float16(np.stack([index.n, index.k])), tuple(eta_i_range), source,
-                            model=RGB_CONDUCTOR)
+    packed = PackedMaterial(
+        name, to_float16(np.stack([index.n, index.k])), tuple(eta_i_range), source, model=RGB_CONDUCTOR
+    )
     job = {"material": material_to_json(packed), "metrics": {}, "timings": {}, "convergence": {}}
-    record = fit_record(fit_id, "curves", fit_id, name, source, job, objective="", provenance={
-        "from_F0_F82": {"f0": list(map(float, F0)), "f82": list(map(float, tint)), "space": space,
-                        "F82_error_ACEScg": index.F82_error.tolist()},
-    })
+    record = fit_record(
+        fit_id,
+        "curves",
+        fit_id,
+        name,
+        source,
+        job,
+        objective="",
+        provenance={
+            "from_F0_F82": {
+                "f0": list(map(float, F0)),
+                "f82": list(map(float, tint)),
+                "space": space,
+                "F82_error_ACEScg": index.F82_error.tolist(),
+            },
+        },
+    )
     return store.put_fit(record), True
 
 
@@ -78,8 +100,16 @@ async def fit_from_colours(store: Store, request) -> tuple[FitRecord, bool]:
     by ``f0``, ``f82``, ``space`` (with ``name``, default "metal", ``source``
     and ``eta_i_range``; see the module docstring), and whether it is new.
     """
-    return await asyncio.to_thread(_make, store, (request.name or "metal").strip(), request.source,
-                                   request.f0, request.f82, request.space, request.eta_i_range)
+    return await asyncio.to_thread(
+        _make,
+        store,
+        (request.name or "metal").strip(),
+        request.source,
+        request.f0,
+        request.f82,
+        request.space,
+        request.eta_i_range,
+    )
 
 
 def colour_curves(F0, tint, space: str, seen_at: float, eta_i, samples: int) -> dict:
@@ -98,7 +128,15 @@ def colour_curves(F0, tint, space: str, seen_at: float, eta_i, samples: int) -> 
     n, k = index.n * float(seen_at), index.k * float(seen_at)
     theta = np.linspace(0.0, 90.0, int(samples))
     mu = cos_theta_from_angle(theta)
-    curves = [{"eta_i": float(eta), "rgb": np.clip(rgb_fresnel_conductor(mu, float(eta), n, k), 0.0, 1.0).tolist()}
-              for eta in eta_i]
-    return {"theta_deg": theta.tolist(), "curves": curves, "n": n.tolist(), "k": k.tolist(),
-            "reachable": index.reachable.tolist(), "F82_error": index.F82_error.tolist()}
+    curves = [
+        {"eta_i": float(eta), "rgb": np.clip(rgb_fresnel_conductor(mu, float(eta), n, k), 0.0, 1.0).tolist()}
+        for eta in eta_i
+    ]
+    return {
+        "theta_deg": theta.tolist(),
+        "curves": curves,
+        "n": n.tolist(),
+        "k": k.tolist(),
+        "reachable": index.reachable.tolist(),
+        "F82_error": index.F82_error.tolist(),
+    }

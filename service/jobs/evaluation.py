@@ -49,8 +49,15 @@ from ..runtime import FitRunner
 from ..store import FitRecord, Store
 from .common import check_finite, measured_nk, with_measured_nk
 
-__all__ = ["METRICS_DTYPE", "PENDING_LIMIT", "solve_metrics", "evaluated", "evaluation_provenance",
-           "ensure_metrics", "Evaluations"]
+__all__ = [
+    "METRICS_DTYPE",
+    "PENDING_LIMIT",
+    "solve_metrics",
+    "evaluated",
+    "evaluation_provenance",
+    "ensure_metrics",
+    "Evaluations",
+]
 
 log = logging.getLogger("service.evaluation")
 
@@ -96,12 +103,15 @@ def evaluated(record: FitRecord) -> bool:
 
 def evaluation_provenance(result, samples: int) -> dict[str, Any]:
     """What the evaluation needs of a fit that the record does not otherwise keep (its provenance)."""
-    return {"coefficients_float64": np.asarray(result.coefficients, dtype=np.float64).tolist(),
-            "metrics_samples": int(samples)}
+    return {
+        "coefficients_float64": np.asarray(result.coefficients, dtype=np.float64).tolist(),
+        "metrics_samples": int(samples),
+    }
 
 
 def _reference(nk: SpectralNK, library: str | None, eta_i_range: tuple[float, float], samples: int):
     """Worker: the 1 nm reference on the metrics grid and the baselines' scores against it (kept, per material)."""
+
     def build():
         M, E = evaluation_grid(samples, eta_i_range)
         reference = reference_ACEScg_grid(nk, M[0], E[:, 0], 1.0, DEFAULT_MIN_COVERAGE, METRICS_DTYPE)
@@ -112,8 +122,14 @@ def _reference(nk: SpectralNK, library: str | None, eta_i_range: tuple[float, fl
     return _REFERENCES.get(key, build)
 
 
-def _evaluate_part(nk: SpectralNK, library: str | None, material: dict[str, Any], coefficients_float64,
-                   samples: int, coverage: float | None) -> dict[str, Any]:
+def _evaluate_part(
+    nk: SpectralNK,
+    library: str | None,
+    material: dict[str, Any],
+    coefficients_float64,
+    samples: int,
+    coverage: float | None,
+) -> dict[str, Any]:
     """Worker: the metrics JSON of one fit (:func:`fitting.fits.evaluate.metrics_json`), its grids kept here."""
     packed = material_from_json(material)
     eta_i_range = tuple(float(x) for x in packed.eta_i_range)
@@ -121,8 +137,7 @@ def _evaluate_part(nk: SpectralNK, library: str | None, material: dict[str, Any]
     M, E = evaluation_grid(samples, eta_i_range)
     models = {
         name: model_ACEScg(packed.model, M, E, np.asarray(coefficients, dtype=np.float64), eta_i_range)
-        for name, coefficients in (("model_float16", packed.coefficients),
-                                   ("model_float64", coefficients_float64))
+        for name, coefficients in (("model_float16", packed.coefficients), ("model_float64", coefficients_float64))
     }
     errors = score_on_grid(nk, M, E, models, baselines=False, reference=reference)
     # metrics_json reads the fit's coverage and quality and sets its ``error``: a stand-in of the fit
@@ -152,17 +167,26 @@ async def ensure_metrics(record: FitRecord, store: Store, runner: FitRunner) -> 
         fresh = await asyncio.to_thread(store.get_fit, record.id)
         if fresh is not None and evaluated(fresh):  # another replica (or an earlier flight) evaluated it
             return fresh
-        full = record if record.nk is not None or record.library_material else \
-            await asyncio.to_thread(with_measured_nk, store, record)
+        full = (
+            record
+            if record.nk is not None or record.library_material
+            else await asyncio.to_thread(with_measured_nk, store, record)
+        )
         nk = measured_nk(full)
         if nk is None:
             raise LookupError(f"the measured n, k of fit {record.id} are no longer stored: it cannot be evaluated")
         provenance = record.provenance or {}
         pending = record.metrics or {}
         metrics = await runner.run(
-            _evaluate_part, nk, record.library_material, record.material,
-            provenance["coefficients_float64"], int(provenance.get("metrics_samples", 100)),
-            pending.get("coverage"), cost_s=EVALUATE_COST_S)
+            _evaluate_part,
+            nk,
+            record.library_material,
+            record.material,
+            provenance["coefficients_float64"],
+            int(provenance.get("metrics_samples", 100)),
+            pending.get("coverage"),
+            cost_s=EVALUATE_COST_S,
+        )
         # The quality report and what the solve measured stay beside the evaluation, as the core's
         # fit_spectral(evaluate=True) has them.
         metrics = {**metrics, **{key: pending[key] for key in ("quality", "guard") if key in pending}}

@@ -63,9 +63,14 @@ def _find_or_make(store: Store, read, model, named: str | None) -> tuple[FitReco
     checked_writable(store)
     job = {"material": material_to_json(model), "metrics": {}, "timings": {}, "convergence": {}}
     record = fit_record(
-        fit_id, "curves", fit_id, model.name, model.source, job, objective="",
-        provenance={"imported": {"format": read.format, "identity": read.identity,
-                                 "named_fit_id": named}},
+        fit_id,
+        "curves",
+        fit_id,
+        model.name,
+        model.source,
+        job,
+        objective="",
+        provenance={"imported": {"format": read.format, "identity": read.identity, "named_fit_id": named}},
     )
     return store.put_fit(record), True
 

@@ -65,11 +65,19 @@ def library_about(material_id: str) -> dict[str, Any]:
     entry = catalogue()[material_id]
     source = f"refractiveindex.info {entry['page']}" + (f": {entry['reference']}" if entry["reference"] else "")
     return {
-        "id": entry["id"], "symbol": entry["symbol"], "name": entry["name"],
-        "category": entry["category"], "label": entry["label"], "preferred": entry["preferred"],
-        "source": source, "reference": entry["reference"], "database": "refractiveindex.info",
-        "page": entry["page"], "page_url": _page_url(entry["page"]),
-        "wavelength_range_nm": tuple(entry["wavelength_range_nm"]), "coverage": entry["coverage"],
+        "id": entry["id"],
+        "symbol": entry["symbol"],
+        "name": entry["name"],
+        "category": entry["category"],
+        "label": entry["label"],
+        "preferred": entry["preferred"],
+        "source": source,
+        "reference": entry["reference"],
+        "database": "refractiveindex.info",
+        "page": entry["page"],
+        "page_url": _page_url(entry["page"]),
+        "wavelength_range_nm": tuple(entry["wavelength_range_nm"]),
+        "coverage": entry["coverage"],
     }
 
 
@@ -80,13 +88,20 @@ def library_entries(eta_i: float, query: str | None = None, limit: int | None = 
     out = []
     for entry in search_catalogue(query)[:limit]:
         acescg, hexes = _swatch(entry["id"], eta_i)
-        out.append({**library_about(entry["id"]),
-                    "swatch": {"eta_i": eta_i, "angles_deg": list(SWATCH_ANGLES_DEG),
-                               "srgb": list(hexes), "acescg": [list(row) for row in acescg]}})
+        out.append(
+            {
+                **library_about(entry["id"]),
+                "swatch": {
+                    "eta_i": eta_i,
+                    "angles_deg": list(SWATCH_ANGLES_DEG),
+                    "srgb": list(hexes),
+                    "acescg": [list(row) for row in acescg],
+                },
+            }
+        )
     return out
 
 
 def coat_presets() -> list[dict[str, Any]]:
     """:data:`fitting.domain.COAT_PRESETS` as JSON rows."""
-    return [{"id": key, "name": name, "eta_i": eta_i, "source": source}
-            for key, name, eta_i, source in COAT_PRESETS]
+    return [{"id": key, "name": name, "eta_i": eta_i, "source": source} for key, name, eta_i, source in COAT_PRESETS]

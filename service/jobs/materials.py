@@ -42,9 +42,12 @@ def resolve_material(store: Store, name: str, material_id: str | None = None) ->
         if row is None or row.kind != "curves":
             raise LookupError(f"`material_id` {material_id!r} is not a saved edited material")
         if holder is not None and holder != material_id:
-            raise NameTaken(f"`name` {name!r} is the name of another saved material {holder}: save "
-                            f"{material_id} under another name, or rename that one first",
-                            version=row.version, latest_fit_id=row.latest_fit_id)
+            raise NameTaken(
+                f"`name` {name!r} is the name of another saved material {holder}: save "
+                f"{material_id} under another name, or rename that one first",
+                version=row.version,
+                latest_fit_id=row.latest_fit_id,
+            )
         return material_id
     if holder is not None:
         return holder
@@ -69,8 +72,13 @@ def fit_edit(store: Store, record: FitRecord) -> dict[str, Any]:
     """
     row = store.material(record.material_id)
     name = row.name if row is not None else record.name
-    out = {"fit_id": record.id, "kind": record.kind, "material_id": record.material_id, "name": name,
-           "version": 0 if row is None else row.version}
+    out = {
+        "fit_id": record.id,
+        "kind": record.kind,
+        "material_id": record.material_id,
+        "name": name,
+        "version": 0 if row is None else row.version,
+    }
     if record.kind != "curves":
         base = {"material": record.library_material} if record.kind == "library" else {"fit": record.id}
         return {**out, "base": base, "request": None}
@@ -85,7 +93,10 @@ def fit_edit(store: Store, record: FitRecord) -> dict[str, Any]:
         base = None if nk is None else {"nk": nk}
     else:
         base = None
-    request = {key: value for key, value in (provenance.get("request") or {}).items()
-               if key not in ("draft", "live", "start_fit", "expected_version")}
+    request = {
+        key: value
+        for key, value in (provenance.get("request") or {}).items()
+        if key not in ("draft", "live", "start_fit", "expected_version")
+    }
     request.update(name=name, material_id=record.material_id, base=base)
     return {**out, "base": base, "request": request}

@@ -78,52 +78,100 @@ class NKFit:
     model: str = DEFAULT_MODEL
 
     @classmethod
-    def _make(cls, kind: str, name: str, nk: SpectralNK, eta_i_range, objective: str,
-              metrics_samples: int, library: str | None, model: str = DEFAULT_MODEL) -> "NKFit":
+    def _make(
+        cls,
+        kind: str,
+        name: str,
+        nk: SpectralNK,
+        eta_i_range,
+        objective: str,
+        metrics_samples: int,
+        library: str | None,
+        model: str = DEFAULT_MODEL,
+    ) -> "NKFit":
         lo, hi = check_eta_i_range(eta_i_range)
         if nk.wavelength_nm.size > MAX_NK_SAMPLES:
-            raise ValueError(
-                f"`nk` must hold at most {MAX_NK_SAMPLES} wavelengths, got {nk.wavelength_nm.size}"
-            )
+            raise ValueError(f"`nk` must hold at most {MAX_NK_SAMPLES} wavelengths, got {nk.wavelength_nm.size}")
         resample_nk(nk, spectral_grid(FitSettings().step_nm), DEFAULT_MIN_COVERAGE)
         arrays = [nk.wavelength_nm, nk.n, nk.k]
         fit_id = content_address(
-            FIT_FORMAT_VERSION, kind, name, nk.source, arrays, [lo, hi], objective,
-            repr(FitSettings()), metrics_samples,
+            FIT_FORMAT_VERSION,
+            kind,
+            name,
+            nk.source,
+            arrays,
+            [lo, hi],
+            objective,
+            repr(FitSettings()),
+            metrics_samples,
             # The default kind adds nothing, so coated-conductor ids stay as they were.
             *(() if model == DEFAULT_MODEL else (model, repr(fit_kind(model).settings))),
         )
         material_id = library or content_address("material", name, nk.source, arrays)
-        return cls(kind, name, nk, (lo, hi), objective, metrics_samples, library, fit_id, material_id,
-                   model)
+        return cls(kind, name, nk, (lo, hi), objective, metrics_samples, library, fit_id, material_id, model)
 
     @classmethod
-    def library(cls, material: str, eta_i_range, objective: str = DEFAULT_OBJECTIVE,
-                metrics_samples: int = 100, model: str = DEFAULT_MODEL) -> "NKFit":
+    def library(
+        cls,
+        material: str,
+        eta_i_range,
+        objective: str = DEFAULT_OBJECTIVE,
+        metrics_samples: int = 100,
+        model: str = DEFAULT_MODEL,
+    ) -> "NKFit":
         """A fit of a library conductor by name, symbol or id (ValueError for an unknown one)."""
         material = resolve_material(material)
-        return cls._make("library", material, catalogue_material(material), eta_i_range,
-                         objective, metrics_samples, material, model)
+        return cls._make(
+            "library", material, catalogue_material(material), eta_i_range, objective, metrics_samples, material, model
+        )
 
     @classmethod
-    def data(cls, name: str, source: str, wavelength_nm, n, k, eta_i_range,
-             objective: str = DEFAULT_OBJECTIVE, metrics_samples: int = 100,
-             model: str = DEFAULT_MODEL) -> "NKFit":
+    def data(
+        cls,
+        name: str,
+        source: str,
+        wavelength_nm,
+        n,
+        k,
+        eta_i_range,
+        objective: str = DEFAULT_OBJECTIVE,
+        metrics_samples: int = 100,
+        model: str = DEFAULT_MODEL,
+    ) -> "NKFit":
         """A fit of measured data (ValueError for invalid data or too little coverage)."""
-        nk = SpectralNK(np.asarray(wavelength_nm, dtype=np.float64), np.asarray(n, dtype=np.float64),
-                        np.asarray(k, dtype=np.float64), name=name, source=source)
+        nk = SpectralNK(
+            np.asarray(wavelength_nm, dtype=np.float64),
+            np.asarray(n, dtype=np.float64),
+            np.asarray(k, dtype=np.float64),
+            name=name,
+            source=source,
+        )
         return cls._make("nk", name, nk, eta_i_range, objective, metrics_samples, None, model)
 
     @classmethod
-    def from_nk(cls, nk: SpectralNK, eta_i_range, objective: str = DEFAULT_OBJECTIVE,
-                metrics_samples: int = 100, model: str = DEFAULT_MODEL) -> "NKFit":
+    def from_nk(
+        cls,
+        nk: SpectralNK,
+        eta_i_range,
+        objective: str = DEFAULT_OBJECTIVE,
+        metrics_samples: int = 100,
+        model: str = DEFAULT_MODEL,
+    ) -> "NKFit":
         """A fit of an n, k already read (an upload), of the model kind ``model``."""
         return cls._make("nk", nk.name, nk, eta_i_range, objective, metrics_samples, None, model)
 
     @classmethod
-    def upload(cls, data: bytes, file_name: str, format: str | None, name: str | None,
-               eta_i_range, objective: str = DEFAULT_OBJECTIVE, metrics_samples: int = 100,
-               model: str = DEFAULT_MODEL) -> "NKFit":
+    def upload(
+        cls,
+        data: bytes,
+        file_name: str,
+        format: str | None,
+        name: str | None,
+        eta_i_range,
+        objective: str = DEFAULT_OBJECTIVE,
+        metrics_samples: int = 100,
+        model: str = DEFAULT_MODEL,
+    ) -> "NKFit":
         """
         A fit of an uploaded file: ``format`` (csv, json, yaml) or the file
         name's suffix; the display name ``name`` or the file's stem; the
@@ -141,8 +189,7 @@ class NKFit:
             )
         display = (name or PurePath(file_name).stem or "uploaded").strip()[:200]
         # The row limit is checked on the line count, before any number is parsed.
-        return cls.from_nk(read_nk(data, fmt, display, MAX_NK_SAMPLES), eta_i_range, objective,
-                           metrics_samples, model)
+        return cls.from_nk(read_nk(data, fmt, display, MAX_NK_SAMPLES), eta_i_range, objective, metrics_samples, model)
 
 
 def _fit_part(fit: NKFit) -> dict[str, Any]:
@@ -167,8 +214,9 @@ def _fit_part(fit: NKFit) -> dict[str, Any]:
     }
 
 
-async def fit_nk(fit: NKFit, store: Store, runner: FitRunner, evaluations: Evaluations | None = None,
-                 metrics: bool = False) -> tuple[FitRecord, bool]:
+async def fit_nk(
+    fit: NKFit, store: Store, runner: FitRunner, evaluations: Evaluations | None = None, metrics: bool = False
+) -> tuple[FitRecord, bool]:
     """
     The stored fit of ``fit``: served from ``store`` when its id is there,
     otherwise fitted in ``runner``'s pool (one part, one worker) and saved
@@ -184,6 +232,7 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner, evaluations: Evalu
     Overloaded, FitTimeout, WorkerLost
         From :class:`service.runtime.pool.FitRunner`.
     """
+
     def stored_or_writable() -> FitRecord | None:
         """The stored fit, asked for again (logged as the material's latest save), else None once the
         store can take a save (one trip to a thread for both)."""
@@ -200,7 +249,13 @@ async def fit_nk(fit: NKFit, store: Store, runner: FitRunner, evaluations: Evalu
     async def make() -> FitRecord:
         job = await runner.run(_fit_part, fit, cost_s=PART_COST_S)
         record = fit_record(
-            fit.fit_id, fit.kind, fit.material_id, fit.name, fit.nk.source, job, fit.objective,
+            fit.fit_id,
+            fit.kind,
+            fit.material_id,
+            fit.name,
+            fit.nk.source,
+            job,
+            fit.objective,
             library_material=fit.library_material,
             nk=None if fit.library_material else nk_view(fit.nk),
             # The settings that ran (the kind's, with the request's objective), and what the
@@ -227,11 +282,14 @@ def _measured_curves(nk: SpectralNK, eta_i: float, samples: int) -> tuple[list, 
     refit of one material (an editor drag asks for one per step) reuses
     them; the most recent few are kept.
     """
+
     def build() -> tuple[list, list]:
         mu = cos_theta_from_angle(np.linspace(0.0, 90.0, samples))
         inputs = baseline_inputs(nk)
-        return (reference_ACEScg(nk, mu, eta_i).tolist(),
-                lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist())
+        return (
+            reference_ACEScg(nk, mu, eta_i).tolist(),
+            lazanyi_adjusted(mu, eta_i, inputs["F0_air"], inputs["F82_air"]).tolist(),
+        )
 
     return _MEASURED_CURVES.get((nk.content_key(), eta_i, samples), build)
 
@@ -257,7 +315,12 @@ def angle_curves(record: FitRecord, eta_i: float, samples: int) -> dict[str, Any
         except ValueError:
             target = None  # no curve at this eta_i and no base to blend into
     return {
-        "fit_id": record.id, "eta_i": eta_i, "theta_deg": theta.tolist(), "cos_theta": mu.tolist(),
-        "model": model.tolist(), "target": target, "reference": reference,
+        "fit_id": record.id,
+        "eta_i": eta_i,
+        "theta_deg": theta.tolist(),
+        "cos_theta": mu.tolist(),
+        "model": model.tolist(),
+        "target": target,
+        "reference": reference,
         "lazanyi_adjusted": baseline,
     }

@@ -50,21 +50,52 @@ def preview_cost_s(size: int, compare: str, roughness: float, mode: str) -> floa
     return fixed_s + per_megapixel_s * size * size / 1e6
 
 
-def preview_png(packed: PackedMaterial, nk: SpectralNK | None, eta_i: float, size: int, compare: str,
-                environment: str, roughness: float, mode: str, coat_roughness: float) -> bytes:
+def preview_png(
+    packed: PackedMaterial,
+    nk: SpectralNK | None,
+    eta_i: float,
+    size: int,
+    compare: str,
+    environment: str,
+    roughness: float,
+    mode: str,
+    coat_roughness: float,
+) -> bytes:
     """Render process: the preview's 8-bit sRGB PNG (ValueError for a view the fit's kind cannot draw)."""
-    return renderer().render_preview(
-        packed, nk, eta_i=eta_i, size=size, compare=compare, environment=environment,
-        differences=False, roughness=roughness, mode=mode, coat_roughness=coat_roughness,
-    ).png
+    return (
+        renderer()
+        .render_preview(
+            packed,
+            nk,
+            eta_i=eta_i,
+            size=size,
+            compare=compare,
+            environment=environment,
+            differences=False,
+            roughness=roughness,
+            mode=mode,
+            coat_roughness=coat_roughness,
+        )
+        .png
+    )
 
 
 def _inputs(record: FitRecord) -> tuple[PackedMaterial, SpectralNK | None]:
     return material_from_json(record.material), measured_nk(record)
 
 
-async def render_preview(runner: PreviewRunner, record: FitRecord, *, eta_i: float, size: int, compare: str,
-                         environment: str, roughness: float, mode: str, coat_roughness: float) -> bytes:
+async def render_preview(
+    runner: PreviewRunner,
+    record: FitRecord,
+    *,
+    eta_i: float,
+    size: int,
+    compare: str,
+    environment: str,
+    roughness: float,
+    mode: str,
+    coat_roughness: float,
+) -> bytes:
     """
     The PNG of ``record``'s preview (the parameters of
     :func:`preview_png`), rendered in a render process.

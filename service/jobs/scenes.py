@@ -74,7 +74,6 @@ class PreparedScene:
     prefer: str | None = None
 
 
-
 def _catalogued(material: str) -> bool:
     """Whether ``material`` names a library conductor (else it may be a saved material's id)."""
     try:
@@ -82,6 +81,7 @@ def _catalogued(material: str) -> bool:
     except ValueError:
         return False
     return True
+
 
 def _renumber(error: ValueError, index: int) -> ValueError:
     return ValueError(str(error).replace("materials[0]", f"materials[{index}]"))
@@ -137,8 +137,9 @@ def prepare_scene(store: Store, scene: dict[str, Any]) -> PreparedScene:
                     f"`{where}.eta_i` must lie in the domain [{lo:g}, {hi:g}] of the edited "
                     f"material {material!r}, got [{eta.domain[0]:g}, {eta.domain[1]:g}]"
                 )
-            stored = PackedMaterial(entry_name, packed.coefficients, packed.eta_i_range,
-                                    source=packed.source, model=packed.model)
+            stored = PackedMaterial(
+                entry_name, packed.coefficients, packed.eta_i_range, source=packed.source, model=packed.model
+            )
             materials.append(StoredModel(entry_name, material, eta, stored, record.id))
             used_fits.append(record.id)
             continue
@@ -168,8 +169,11 @@ def _stored_model_report(entry: StoredModel) -> dict[str, Any]:
         "delta_E_2000": zero,
         "by_degree": {str(packed.degree): zero},
         "general": {
-            "eta_i_range": list(packed.eta_i_range), "degree": packed.degree,
-            "coefficients": kind.count(packed.degree), "bytes": bytes_, "delta_E_2000": zero,
+            "eta_i_range": list(packed.eta_i_range),
+            "degree": packed.degree,
+            "coefficients": kind.count(packed.degree),
+            "bytes": bytes_,
+            "delta_E_2000": zero,
         },
         "scene_vs_general_delta_E_2000": zero,
         "fit": {"from_stored_model": True, "fit_id": entry.fit_id},
@@ -199,9 +203,7 @@ def _scene_report(scene: PreparedScene, parts: list[tuple[dict[str, Any], Any, A
             "coefficients": sum(r["coefficients"] for r in reports),
             "general_coefficients": 27 * len(reports),
             "delta_E_2000_mean": float(np.mean([r["delta_E_2000"]["mean"] for r in reports])),
-            "general_delta_E_2000_mean": float(
-                np.mean([r["general"]["delta_E_2000"]["mean"] for r in reports])
-            ),
+            "general_delta_E_2000_mean": float(np.mean([r["general"]["delta_E_2000"]["mean"] for r in reports])),
         },
         "pack": json.loads(pack_to_json(packed)),
         "pack_base64": base64.b64encode(pack).decode("ascii"),
@@ -214,8 +216,7 @@ ETA_COST_S = 0.03
 
 def scene_parts(scene: PreparedScene) -> int:
     """The parts of ``scene``: each fitted material times the eta_i rows it is fitted and scored at."""
-    return sum(len(entry.eta_i.evaluation_eta_i()) for entry in scene.materials
-               if not isinstance(entry, StoredModel))
+    return sum(len(entry.eta_i.evaluation_eta_i()) for entry in scene.materials if not isinstance(entry, StoredModel))
 
 
 def check_scene_cost(scene: PreparedScene, runner: FitRunner) -> None:
@@ -225,7 +226,8 @@ def check_scene_cost(scene: PreparedScene, runner: FitRunner) -> None:
     if parts * ETA_COST_S > budget_s:
         raise ValueError(
             f"the scene has {parts} parts (materials x eta_i), about {parts * ETA_COST_S:.0f} s of fitting, more "
-            f"than one request may use: {budget_s:g} s (COATED_FIT_TIMEOUT_S x COATED_FIT_WORKERS); split it")
+            f"than one request may use: {budget_s:g} s (COATED_FIT_TIMEOUT_S x COATED_FIT_WORKERS); split it"
+        )
 
 
 async def _scene_parts(scene: PreparedScene, runner: FitRunner) -> list[tuple[dict[str, Any], Any, Any]]:
@@ -244,8 +246,9 @@ async def _scene_parts(scene: PreparedScene, runner: FitRunner) -> list[tuple[di
         else:
             parts.append(None)
             cost_s = ETA_COST_S * len(entry.eta_i.evaluation_eta_i())
-            tasks[index] = asyncio.ensure_future(runner.submit(
-                _material_part, entry, scene.max_delta_e, scene.prefer, cost_s=cost_s))
+            tasks[index] = asyncio.ensure_future(
+                runner.submit(_material_part, entry, scene.max_delta_e, scene.prefer, cost_s=cost_s)
+            )
     try:
         done = await asyncio.gather(*tasks.values())
     except BaseException:

@@ -30,9 +30,12 @@ def check_coverage(nk: SpectralNK, min_coverage: float | None) -> None:
         raise ValueError(
             f"`min_coverage` must lie in [{DEFAULT_MIN_COVERAGE:g}, 1], got {min_coverage:g}: the "
             f"reference integrates {_RANGE} and the service fits no data covering less than "
-            f"{DEFAULT_MIN_COVERAGE:.0%} of it (the rest is held flat at the data's ends)")
+            f"{DEFAULT_MIN_COVERAGE:.0%} of it (the rest is held flat at the data's ends)"
+        )
     coverage = visible_coverage(nk.wavelength_range_nm)
     if coverage < min_coverage:
         lo, hi = nk.wavelength_range_nm
-        raise ValueError(f"`min_coverage` is {min_coverage:.1%} of {_RANGE}, the data "
-                         f"({lo:g}-{hi:g} nm) cover {coverage:.1%}: nothing was fitted")
+        raise ValueError(
+            f"`min_coverage` is {min_coverage:.1%} of {_RANGE}, the data "
+            f"({lo:g}-{hi:g} nm) cover {coverage:.1%}: nothing was fitted"
+        )

@@ -149,5 +149,7 @@ class Admission:
         """Why a new connection could not be served now (every one accepted is busy), or None."""
         if len(self.everyone) < self.max_connections or any(c.idle() for c in self.everyone):
             return None
-        return (f"all {self.max_connections} connections this replica accepts have a request in progress "
-                "(COATED_MAX_CONNECTIONS)")
+        return (
+            f"all {self.max_connections} connections this replica accepts have a request in progress "
+            "(COATED_MAX_CONNECTIONS)"
+        )

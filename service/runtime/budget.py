@@ -61,7 +61,8 @@ class JobBudgetExceeded(ValueError):
     def __init__(self, limit_s: float, estimate_s: float) -> None:
         super().__init__(
             f"the job used its CPU budget of {limit_s:.1f} s ({BUDGET_FACTOR:g} x its estimated {estimate_s:.1f} s, "
-            "at least COATED_JOB_CPU_LIMIT_S) and was stopped; make the request smaller")
+            "at least COATED_JOB_CPU_LIMIT_S) and was stopped; make the request smaller"
+        )
         self.limit_s, self.estimate_s = limit_s, estimate_s
 
     def __reduce__(self):
@@ -107,8 +108,9 @@ def part_limit(cpu_limit_s: float) -> tuple[JobBudget | None, float]:
     return budget, (cpu_limit_s if budget is None else budget.part_limit(cpu_limit_s))
 
 
-async def charged(answer: Awaitable[tuple[float, Any]], budget: JobBudget | None, limit_s: float,
-                  cpu_limit_s: float) -> Any:
+async def charged(
+    answer: Awaitable[tuple[float, Any]], budget: JobBudget | None, limit_s: float, cpu_limit_s: float
+) -> Any:
     """
     The result of a part run by :func:`run_part_timed` (``answer``), its CPU
     time charged to ``budget``; a part stopped at a limit that was its job's

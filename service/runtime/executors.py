@@ -84,8 +84,12 @@ def unstick(executor: concurrent.futures.ProcessPoolExecutor) -> None:
     close_result_pipe(executor)
 
 
-async def result(executor: concurrent.futures.ProcessPoolExecutor, future: concurrent.futures.Future,
-                 stuck_s: float = STUCK_S, watch_s: float = WATCH_S) -> Any:
+async def result(
+    executor: concurrent.futures.ProcessPoolExecutor,
+    future: concurrent.futures.Future,
+    stuck_s: float = STUCK_S,
+    watch_s: float = WATCH_S,
+) -> Any:
     """
     ``future``'s result (a job of ``executor``), or its exception; as
     ``await asyncio.wrap_future(future)`` (cancelling the await cancels
@@ -105,8 +109,10 @@ async def result(executor: concurrent.futures.ProcessPoolExecutor, future: concu
             elif dead_since is None:
                 dead_since = time.monotonic()
             elif time.monotonic() - dead_since >= stuck_s:
-                log.warning("a worker process died while it sent a result, and its pool did not see it; "
-                            "the pool was stopped (its jobs run again as after any worker's death)")
+                log.warning(
+                    "a worker process died while it sent a result, and its pool did not see it; "
+                    "the pool was stopped (its jobs run again as after any worker's death)"
+                )
                 unstick(executor)
                 dead_since = None
     except asyncio.CancelledError:

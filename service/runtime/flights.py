@@ -43,8 +43,9 @@ class Flights:
             task.add_done_callback(lambda t: self.pending.pop(key, None))
         return task
 
-    async def join(self, key: Hashable, task: asyncio.Task, timeout_s: float,
-                   timed_out: Callable[[], BaseException]) -> Any:
+    async def join(
+        self, key: Hashable, task: asyncio.Task, timeout_s: float, timed_out: Callable[[], BaseException]
+    ) -> Any:
         """
         ``task``'s result within ``timeout_s`` seconds, else ``timed_out()``
         raised; the last request to stop waiting for an unfinished task

@@ -19,8 +19,10 @@ import time
 __all__ = ["OncePerInterval", "SLOW_CLIENT", "OVER_BOUND", "SLOW_BODY"]
 
 SLOW_CLIENT = "closed a connection whose request header did not arrive within %g s (COATED_HEADER_TIMEOUT_S)"
-OVER_BOUND = ("closed a connection past the connection bound that sent no request within %g s "
-              "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT)")
+OVER_BOUND = (
+    "closed a connection past the connection bound that sent no request within %g s "
+    "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT)"
+)
 SLOW_BODY = "answered 408 to a request whose body arrived slower than %g bytes per second (COATED_MIN_BODY_RATE)"
 
 

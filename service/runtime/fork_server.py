@@ -36,7 +36,6 @@ SUN_PATH_MAX = 107
 """The longest path of a Unix socket on Linux (``sun_path``'s 108 bytes with the final NUL)."""
 
 
-
 def _cannot_fork_server(server, threads: int) -> str | None:
     """Why :func:`start_fork_server` starts nothing, given multiprocessing's ``ForkServer`` and the Python threads."""
     if set(vars(server)) != FORK_SERVER_STATE:
@@ -89,7 +88,8 @@ def start_fork_server() -> bool:
         if len(os.fsencode(address)) > SUN_PATH_MAX:
             raise ValueError(
                 f"the fork server's socket, {address}, is {len(os.fsencode(address))} bytes long; a Unix "
-                f"socket's path has at most {SUN_PATH_MAX}: set TMPDIR to a shorter directory")
+                f"socket's path has at most {SUN_PATH_MAX}: set TMPDIR to a shorter directory"
+            )
         listener.bind(address)
         if not util.is_abstract_socket_namespace(address):
             os.chmod(address, 0o600)

@@ -23,12 +23,26 @@ import multiprocessing
 from multiprocessing import forkserver
 from typing import Any
 
-__all__ = ["FORK_SERVER_STATE", "adopt_fork_server", "close_result_pipe", "executor_processes", "fork_server",
-           "fork_server_pid", "mismatches"]
+__all__ = [
+    "FORK_SERVER_STATE",
+    "adopt_fork_server",
+    "close_result_pipe",
+    "executor_processes",
+    "fork_server",
+    "fork_server_pid",
+    "mismatches",
+]
 
-FORK_SERVER_STATE = frozenset({
-    "_forkserver_address", "_forkserver_alive_fd", "_forkserver_pid", "_inherited_fds", "_lock", "_preload_modules",
-})
+FORK_SERVER_STATE = frozenset(
+    {
+        "_forkserver_address",
+        "_forkserver_alive_fd",
+        "_forkserver_pid",
+        "_inherited_fds",
+        "_lock",
+        "_preload_modules",
+    }
+)
 """The state of multiprocessing's ``ForkServer`` that :func:`adopt_fork_server` sets, as Python 3.11-3.13 hold it."""
 
 

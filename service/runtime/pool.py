@@ -64,8 +64,17 @@ from .fork_server import START_ERRORS, fork_server_exited
 from .budget import BUDGET, JobBudget, JobBudgetExceeded, charged, part_limit, run_part_timed
 from .worker import JobCPULimit, ping, process_context, warm_process, worker_start
 
-__all__ = ["FitRunner", "Overloaded", "FitTimeout", "WorkerLost", "WorkersNotStarted", "Quarantined", "JobCPULimit",
-           "JobBudgetExceeded", "warm_process"]
+__all__ = [
+    "FitRunner",
+    "Overloaded",
+    "FitTimeout",
+    "WorkerLost",
+    "WorkersNotStarted",
+    "Quarantined",
+    "JobCPULimit",
+    "JobBudgetExceeded",
+    "warm_process",
+]
 
 log = logging.getLogger("service.runtime.pool")
 
@@ -92,8 +101,16 @@ class FitRunner:
     workers run side by side. Each part may use ``cpu_limit_s`` seconds of CPU time (:class:`JobCPULimit`).
     """
 
-    def __init__(self, workers: int, max_in_flight: int, timeout_s: float, cpu_limit_s: float = 60.0,
-                 quarantine_s: float = 600.0, express_workers: int = 0, client_bulk_jobs: int | None = None) -> None:
+    def __init__(
+        self,
+        workers: int,
+        max_in_flight: int,
+        timeout_s: float,
+        cpu_limit_s: float = 60.0,
+        quarantine_s: float = 600.0,
+        express_workers: int = 0,
+        client_bulk_jobs: int | None = None,
+    ) -> None:
         if workers < 1 or max_in_flight < workers:
             raise ValueError(f"`max_in_flight` ({max_in_flight}) must be >= `workers` ({workers}) >= 1")
         if express_workers < 0:
@@ -108,8 +125,9 @@ class FitRunner:
         self._alone: concurrent.futures.ProcessPoolExecutor | None = None
         self._alone_lock = asyncio.Lock()
         self._turns = Turns(workers, express_workers, EXPRESS_COST_S)
-        self.shares = Shares(max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers,
-                             timeout_s * workers)  # a client's bulk jobs: what one request may use, in all
+        self.shares = Shares(
+            max_in_flight, min(workers, max_in_flight - 1), client_bulk_jobs or workers, timeout_s * workers
+        )  # a client's bulk jobs: what one request may use, in all
         self._context = process_context()
         self._cancels = CancelRing(self._context)
         self._serial = 0
@@ -138,8 +156,11 @@ class FitRunner:
                 )
             return self._pool
 
-    def _restart(self, broken: concurrent.futures.ProcessPoolExecutor,
-                 why: str = "a fitting worker died; the pool was restarted (interrupted jobs run once more)") -> None:
+    def _restart(
+        self,
+        broken: concurrent.futures.ProcessPoolExecutor,
+        why: str = "a fitting worker died; the pool was restarted (interrupted jobs run once more)",
+    ) -> None:
         """Replace a broken pool (once, however many jobs saw it break) and warm the new one; log ``why``."""
         with self._lock:
             replaced = self._pool is broken
@@ -161,8 +182,9 @@ class FitRunner:
         loop = asyncio.get_running_loop()
         pool = self._executor()
         try:
-            await asyncio.gather(*(loop.run_in_executor(pool, ping)
-                                   for _ in range(self.workers + self.express_workers)))
+            await asyncio.gather(
+                *(loop.run_in_executor(pool, ping) for _ in range(self.workers + self.express_workers))
+            )
         except (BrokenProcessPool, RuntimeError, *START_ERRORS):
             pass  # a pool that broke (or could not start a worker) while warming is replaced by the job that sees it
         except OSError as error:  # no process could be started at all: set aside, tried again by the next start
@@ -253,8 +275,10 @@ class FitRunner:
                     return await self._run_in(pool, function, args)
             except StartFailed as error:
                 # Not the part's doing: it runs on a pool whose workers start, at most twice more.
-                self._restart(pool, f"a fitting worker could not be started ({error}); the pool was "
-                                    "restarted with a new fork server")
+                self._restart(
+                    pool,
+                    f"a fitting worker could not be started ({error}); the pool was restarted with a new fork server",
+                )
                 start_failures += 1
                 if start_failures > 2:
                     self.cannot_start = f"no fitting worker process could be started, three times: {error}"
@@ -269,8 +293,11 @@ class FitRunner:
             with self._lock:
                 if self._alone is None:
                     self._alone = concurrent.futures.ProcessPoolExecutor(
-                        max_workers=1, mp_context=self._context, initializer=worker_start,
-                        initargs=(self._cancels.shared,))
+                        max_workers=1,
+                        mp_context=self._context,
+                        initializer=worker_start,
+                        initargs=(self._cancels.shared,),
+                    )
                 alone = self._alone
             try:
                 return await self._run_in(alone, function, args)
@@ -356,8 +383,9 @@ class FitRunner:
                 _JOB_KEY.reset(token)
 
         task = self._flights.start(key, start)
-        return await self._flights.join(key, task, self.timeout_s,
-                                        lambda: FitTimeout(self.timeout_s, self._retry_after()))
+        return await self._flights.join(
+            key, task, self.timeout_s, lambda: FitTimeout(self.timeout_s, self._retry_after())
+        )
 
     def close(self) -> None:
         self._flights.cancel_all()

@@ -25,8 +25,9 @@ class Overloaded(Exception):
     """Too many jobs in flight; ``retry_after`` is a wait estimate in seconds."""
 
     def __init__(self, retry_after: int, limit: int) -> None:
-        super().__init__(f"the service is fitting {limit} materials already (the limit); "
-                         f"retry in about {retry_after} s")
+        super().__init__(
+            f"the service is fitting {limit} materials already (the limit); retry in about {retry_after} s"
+        )
         self.retry_after = retry_after
 
 
@@ -35,8 +36,7 @@ class FitTimeout(Exception):
 
     def __init__(self, limit_s: float, retry_after: int = 1) -> None:
         super().__init__(
-            f"the fit did not finish within the time limit of {limit_s:g} s "
-            "(COATED_FIT_TIMEOUT_S); it was cancelled"
+            f"the fit did not finish within the time limit of {limit_s:g} s (COATED_FIT_TIMEOUT_S); it was cancelled"
         )
         self.retry_after = retry_after
 

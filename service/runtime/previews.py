@@ -83,8 +83,15 @@ from .flights import CancelRing, Flights
 from .shares import CLAIM
 from .worker import JobCPULimit, process_context
 
-__all__ = ["PreviewRunner", "PreviewsBusy", "PreviewTimeout", "RenderWorkerLost", "RendererUnavailable",
-           "TEXTURE_QUEUE", "CANCEL_GRACE_S"]
+__all__ = [
+    "PreviewRunner",
+    "PreviewsBusy",
+    "PreviewTimeout",
+    "RenderWorkerLost",
+    "RendererUnavailable",
+    "TEXTURE_QUEUE",
+    "CANCEL_GRACE_S",
+]
 
 log = logging.getLogger("service.runtime.previews")
 
@@ -108,16 +115,19 @@ class PreviewTimeout(FitTimeout):
 
     def __init__(self, limit_s: float) -> None:
         Exception.__init__(
-            self, f"the render did not finish within the time limit of {limit_s:g} s "
-                  "(COATED_PREVIEW_TIMEOUT_S); it was cancelled (a smaller preview `size` renders faster)")
+            self,
+            f"the render did not finish within the time limit of {limit_s:g} s "
+            "(COATED_PREVIEW_TIMEOUT_S); it was cancelled (a smaller preview `size` renders faster)",
+        )
         self.retry_after = max(1, math.ceil(limit_s / 4))
 
 
 class RenderWorkerLost(WorkerLost):
     """The render process of a job died (503); another is started for the next job."""
 
-    def __init__(self, message: str = "the render process of this preview died; another is started for the next one"
-                 ) -> None:
+    def __init__(
+        self, message: str = "the render process of this preview died; another is started for the next one"
+    ) -> None:
         Exception.__init__(self, message)
         self.retry_after = 1
 
@@ -131,7 +141,8 @@ class _RenderProcess:
 
     def __init__(self, context, cancelled) -> None:
         self.executor = concurrent.futures.ProcessPoolExecutor(
-            max_workers=1, mp_context=context, initializer=render_worker_start, initargs=(cancelled,))
+            max_workers=1, mp_context=context, initializer=render_worker_start, initargs=(cancelled,)
+        )
         self.pid: int | None = None
         self.jobs = 0
         self.broken = False
@@ -149,9 +160,15 @@ class PreviewRunner:
     with the fewest jobs.
     """
 
-    def __init__(self, workers: int, timeout_s: float, cpu_limit_s: float,
-                 texture_queue: int = TEXTURE_QUEUE, cancel_grace_s: float = CANCEL_GRACE_S,
-                 client_cost_s: float | None = None) -> None:
+    def __init__(
+        self,
+        workers: int,
+        timeout_s: float,
+        cpu_limit_s: float,
+        texture_queue: int = TEXTURE_QUEUE,
+        cancel_grace_s: float = CANCEL_GRACE_S,
+        client_cost_s: float | None = None,
+    ) -> None:
         if workers < 1:
             raise ValueError(f"`workers` must be >= 1, got {workers}")
         self.workers = workers
@@ -215,14 +232,23 @@ class PreviewRunner:
             waves = math.ceil(max(self._counts["preview"], 1) / self.workers)
             retry = max(1, math.ceil(waves * self._mean_s))
             if self._counts[what] >= limit:
-                raise PreviewsBusy(retry, (
-                    f"{limit} previews are being rendered (COATED_MAX_PREVIEWS_IN_FLIGHT)" if what == "preview"
-                    else f"{limit} textures are waiting for a render process"))
+                raise PreviewsBusy(
+                    retry,
+                    (
+                        f"{limit} previews are being rendered (COATED_MAX_PREVIEWS_IN_FLIGHT)"
+                        if what == "preview"
+                        else f"{limit} textures are waiting for a render process"
+                    ),
+                )
             held, cost = self._by_client.get(client, (0, 0.0))
             if what == "preview" and held and cost + cost_s > self.client_cost_s:
-                raise PreviewsBusy(retry, (
-                    f"this client's previews in flight are estimated at {cost:.1f} s of CPU; with this one's "
-                    f"{cost_s:.1f} s they would pass its share, {self.client_cost_s:g} s (COATED_JOB_CPU_LIMIT_S)"))
+                raise PreviewsBusy(
+                    retry,
+                    (
+                        f"this client's previews in flight are estimated at {cost:.1f} s of CPU; with this one's "
+                        f"{cost_s:.1f} s they would pass its share, {self.client_cost_s:g} s (COATED_JOB_CPU_LIMIT_S)"
+                    ),
+                )
             self._counts[what] += 1
             if what == "preview":
                 self._by_client[client] = (held + 1, cost + cost_s)
@@ -237,8 +263,15 @@ class PreviewRunner:
             if started is not None and what == "preview":
                 self._mean_s = 0.8 * self._mean_s + 0.2 * (time.perf_counter() - started)
 
-    async def _job(self, what: str, function: Callable[..., Any], args: tuple, submitted: list,
-                   share: tuple[str, float], budget_s: float) -> Any:
+    async def _job(
+        self,
+        what: str,
+        function: Callable[..., Any],
+        args: tuple,
+        submitted: list,
+        share: tuple[str, float],
+        budget_s: float,
+    ) -> Any:
         """
         One job in a render process; its place is left when its process is
         free of it (before it was submitted: when its task ends, :meth:`_once`).
@@ -258,8 +291,10 @@ class PreviewRunner:
                 # Its fork server died or is dying: the next job's process starts from another.
                 self._break(process)
                 await fork_server_exited()
-                raise RenderWorkerLost("the render process of this preview could not be started (its fork server "
-                                       "died); another is started for the next one") from None
+                raise RenderWorkerLost(
+                    "the render process of this preview could not be started (its fork server "
+                    "died); another is started for the next one"
+                ) from None
             if isinstance(error, (BrokenProcessPool, RuntimeError)):
                 self._break(process)
                 raise RenderWorkerLost() from None
@@ -294,12 +329,12 @@ class PreviewRunner:
         starved of CPU): its process is stopped, and the next job starts another."""
         if future.done():
             return
-        log.warning("a cancelled render did not stop within %g s; its render process was stopped",
-                    self.cancel_grace_s)
+        log.warning("a cancelled render did not stop within %g s; its render process was stopped", self.cancel_grace_s)
         self._break(process, kill=True)
 
-    async def _once(self, what: str, key: tuple, function: Callable[..., Any], args: tuple,
-                    cost_s: float | None = None) -> Any:
+    async def _once(
+        self, what: str, key: tuple, function: Callable[..., Any], args: tuple, cost_s: float | None = None
+    ) -> Any:
         """
         ``function(*args)`` as one job shared by the calls with ``key``, within the time limit;
         with ``cost_s`` (estimated CPU seconds) its budget proportional to it, else the CPU-time limit.

@@ -74,12 +74,32 @@ from ..config import Settings
 from .admission import BODY_GRACE_S, HEALTH_RESERVE, IDLE_GRACE_S, Admission
 from .flood_log import OVER_BOUND, SLOW_BODY, SLOW_CLIENT, OncePerInterval
 
-__all__ = ["DeadlineH11Protocol", "protocol_with_deadline", "serve", "MAX_HEADER_BYTES",
-           "HEALTH_RESERVE", "IDLE_GRACE_S", "BODY_GRACE_S", "UVICORN_PRIVATE", "uvicorn_mismatches"]
+__all__ = [
+    "DeadlineH11Protocol",
+    "protocol_with_deadline",
+    "serve",
+    "MAX_HEADER_BYTES",
+    "HEALTH_RESERVE",
+    "IDLE_GRACE_S",
+    "BODY_GRACE_S",
+    "UVICORN_PRIVATE",
+    "uvicorn_mismatches",
+]
 
 UVICORN_PRIVATE = {
-    H11Protocol: ("connection_made", "data_received", "on_response_complete", "connection_lost",
-                  "conn", "cycle", "server_state", "transport", "client", "loop", "flow"),
+    H11Protocol: (
+        "connection_made",
+        "data_received",
+        "on_response_complete",
+        "connection_lost",
+        "conn",
+        "cycle",
+        "server_state",
+        "transport",
+        "client",
+        "loop",
+        "flow",
+    ),
     RequestResponseCycle: ("response_complete", "response_started", "body"),
     FlowControl: ("read_paused",),
     uvicorn.Server: ("server_state",),
@@ -92,34 +112,67 @@ def uvicorn_mismatches() -> list[str]:
     found = []
     for cls, names in UVICORN_PRIVATE.items():
         tree = ast.parse(inspect.getsource(cls))
-        assigned = {node.attr for node in ast.walk(tree) if isinstance(node, ast.Attribute)
-                    and isinstance(node.ctx, ast.Store) and isinstance(node.value, ast.Name) and node.value.id == "self"}
-        found += [f"uvicorn's {cls.__name__} has no {name} (uvicorn {uvicorn.__version__})"
-                  for name in names if not callable(getattr(cls, name, None)) and name not in assigned]
+        assigned = {
+            node.attr
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Attribute)
+            and isinstance(node.ctx, ast.Store)
+            and isinstance(node.value, ast.Name)
+            and node.value.id == "self"
+        }
+        found += [
+            f"uvicorn's {cls.__name__} has no {name} (uvicorn {uvicorn.__version__})"
+            for name in names
+            if not callable(getattr(cls, name, None)) and name not in assigned
+        ]
     return found
+
 
 log = logging.getLogger("uvicorn.error")
 MAX_HEADER_BYTES = 16 * 1024
 """Largest request line and header fields together (h11's own bound for an incomplete one)."""
 _HEALTH_REQUESTS = (b"GET /healthz", b"HEAD /healthz")
 _HEADER_END = b"\r\n\r\n"
-_TOO_LARGE = json.dumps({
-    "detail": f"the request header must be at most {MAX_HEADER_BYTES} bytes", "errors": [],
-}).encode()
-_FULL = json.dumps({
-    "detail": "the service has as many connections as it accepts, all busy "
-              "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT); retry shortly", "errors": [],
-}).encode()
+_TOO_LARGE = json.dumps(
+    {
+        "detail": f"the request header must be at most {MAX_HEADER_BYTES} bytes",
+        "errors": [],
+    }
+).encode()
+_FULL = json.dumps(
+    {
+        "detail": "the service has as many connections as it accepts, all busy "
+        "(COATED_MAX_CONNECTIONS, COATED_MAX_CONNECTIONS_PER_CLIENT); retry shortly",
+        "errors": [],
+    }
+).encode()
+
+
 def _slow_body_answer(rate: float) -> bytes:
-    return json.dumps({"detail": f"the request body arrived slower than {rate:g} bytes per second after its first "
-                                 f"{BODY_GRACE_S:g} s (COATED_MIN_BODY_RATE)", "errors": []}).encode()
+    return json.dumps(
+        {
+            "detail": f"the request body arrived slower than {rate:g} bytes per second after its first "
+            f"{BODY_GRACE_S:g} s (COATED_MIN_BODY_RATE)",
+            "errors": [],
+        }
+    ).encode()
 
 
 def _raw_answer(transport: asyncio.Transport, status: bytes, body: bytes, extra: bytes = b"") -> None:
     """A JSON answer written straight to ``transport``, which is then closed."""
-    transport.write(b"HTTP/1.1 " + status + b"\r\ncontent-type: application/json\r\ncontent-length: "
-                    + str(len(body)).encode() + b"\r\nconnection: close\r\n" + extra + b"\r\n" + body)
+    transport.write(
+        b"HTTP/1.1 "
+        + status
+        + b"\r\ncontent-type: application/json\r\ncontent-length: "
+        + str(len(body)).encode()
+        + b"\r\nconnection: close\r\n"
+        + extra
+        + b"\r\n"
+        + body
+    )
     transport.close()
+
+
 class DeadlineH11Protocol(H11Protocol):
     """uvicorn's h11 protocol with a deadline on each request's header, a minimum body rate and admission."""
 
@@ -263,14 +316,23 @@ class DeadlineH11Protocol(H11Protocol):
         super().connection_lost(exc)
 
 
-def protocol_with_deadline(header_timeout_s: float, max_connections: int = 512,
-                           max_connections_per_client: int = 128,
-                           min_body_rate: float = 1024.0) -> type[DeadlineH11Protocol]:
+def protocol_with_deadline(
+    header_timeout_s: float,
+    max_connections: int = 512,
+    max_connections_per_client: int = 128,
+    min_body_rate: float = 1024.0,
+) -> type[DeadlineH11Protocol]:
     """A :class:`DeadlineH11Protocol` subclass with its deadline, body rate and connection bounds set."""
-    return type("DeadlineH11Protocol", (DeadlineH11Protocol,), {
-        "header_timeout_s": header_timeout_s, "max_connections": max_connections,
-        "max_connections_per_client": max_connections_per_client, "min_body_rate": min_body_rate,
-    })
+    return type(
+        "DeadlineH11Protocol",
+        (DeadlineH11Protocol,),
+        {
+            "header_timeout_s": header_timeout_s,
+            "max_connections": max_connections,
+            "max_connections_per_client": max_connections_per_client,
+            "min_body_rate": min_body_rate,
+        },
+    )
 
 
 class _Server(uvicorn.Server):
@@ -286,13 +348,21 @@ def serve(app, settings: Settings, host: str, port: int) -> None:
     admission = Admission(settings.max_connections, settings.max_connections_per_client)
     app.state.connections = admission  # /healthz: 503 while every connection is held
     config = uvicorn.Config(
-        app, host=host, port=port, log_level="info",
-        http=protocol_with_deadline(settings.header_timeout_s, settings.max_connections,
-                                    settings.max_connections_per_client, settings.min_body_rate),
+        app,
+        host=host,
+        port=port,
+        log_level="info",
+        http=protocol_with_deadline(
+            settings.header_timeout_s,
+            settings.max_connections,
+            settings.max_connections_per_client,
+            settings.min_body_rate,
+        ),
         # No limit_concurrency: past it uvicorn answers 503 to /healthz too; the admission bounds the connections.
         timeout_keep_alive=settings.keep_alive_s,
         timeout_graceful_shutdown=settings.drain_timeout_s,
-        ws="none", lifespan="on",
+        ws="none",
+        lifespan="on",
     )
     flood = OncePerInterval()  # after Config, which configures uvicorn's logging
     logging.getLogger("uvicorn.error").addFilter(flood)

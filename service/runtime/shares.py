@@ -44,8 +44,17 @@ import threading
 import time
 from dataclasses import dataclass
 
-__all__ = ["Claim", "CLAIM", "KINDS", "INTERACTIVE", "Shares", "ShareExceeded", "HALF_LIFE_S", "SaveRate",
-           "TooManySaves"]
+__all__ = [
+    "Claim",
+    "CLAIM",
+    "KINDS",
+    "INTERACTIVE",
+    "Shares",
+    "ShareExceeded",
+    "HALF_LIFE_S",
+    "SaveRate",
+    "TooManySaves",
+]
 
 KINDS = ("save", "scene", "pack", "read")
 """The kinds of work, as the pool accounts them."""
@@ -93,11 +102,11 @@ class Shares:
     seconds together at most (None: no bound). Thread-safe.
     """
 
-    def __init__(self, max_in_flight: int, reserved: int, per_client: int,
-                 client_cost_s: float | None = None) -> None:
+    def __init__(self, max_in_flight: int, reserved: int, per_client: int, client_cost_s: float | None = None) -> None:
         if not 0 <= reserved < max_in_flight or per_client < 1:
-            raise ValueError(f"`reserved` ({reserved}) must lie in [0, {max_in_flight}) and `per_client` "
-                             f"({per_client}) be >= 1")
+            raise ValueError(
+                f"`reserved` ({reserved}) must lie in [0, {max_in_flight}) and `per_client` ({per_client}) be >= 1"
+            )
         self.bulk_max = max_in_flight - reserved
         self.per_client = per_client
         self.client_cost_s = client_cost_s
@@ -119,19 +128,31 @@ class Shares:
         with self._lock:
             held = self._bulk_by_client.get(claim.client, 0)
             if held >= self.per_client:
-                raise ShareExceeded(retry_after, (
-                    f"this client has {held} {claim.kind} jobs in flight, its share of the fitting pool "
-                    f"(COATED_CLIENT_BULK_JOBS); retry in about {retry_after} s"))
+                raise ShareExceeded(
+                    retry_after,
+                    (
+                        f"this client has {held} {claim.kind} jobs in flight, its share of the fitting pool "
+                        f"(COATED_CLIENT_BULK_JOBS); retry in about {retry_after} s"
+                    ),
+                )
             cost = self._cost_by_client.get(claim.client, 0.0)
             if self.client_cost_s is not None and held and cost + cost_s > self.client_cost_s:
-                raise ShareExceeded(retry_after, (
-                    f"this client's jobs in flight are estimated at {cost:.1f} s of fitting; with this "
-                    f"{claim.kind} job's {cost_s:.1f} s they would pass its share, {self.client_cost_s:g} s "
-                    f"(COATED_FIT_TIMEOUT_S x COATED_FIT_WORKERS); retry in about {retry_after} s"))
+                raise ShareExceeded(
+                    retry_after,
+                    (
+                        f"this client's jobs in flight are estimated at {cost:.1f} s of fitting; with this "
+                        f"{claim.kind} job's {cost_s:.1f} s they would pass its share, {self.client_cost_s:g} s "
+                        f"(COATED_FIT_TIMEOUT_S x COATED_FIT_WORKERS); retry in about {retry_after} s"
+                    ),
+                )
             if self._bulk >= self.bulk_max:
-                raise ShareExceeded(retry_after, (
-                    f"the fitting pool runs {self._bulk} reads, packs and scenes, their share (the rest is kept "
-                    f"for saves); retry in about {retry_after} s"))
+                raise ShareExceeded(
+                    retry_after,
+                    (
+                        f"the fitting pool runs {self._bulk} reads, packs and scenes, their share (the rest is kept "
+                        f"for saves); retry in about {retry_after} s"
+                    ),
+                )
             self._bulk += 1
             self._bulk_by_client[claim.client] = held + 1
             self._cost_by_client[claim.client] = cost + cost_s
@@ -206,9 +227,13 @@ class SaveRate:
                 times.popleft()
             if len(times) >= self.per_minute:
                 wait = max(1, math.ceil(times[0] + 60.0 - now))
-                raise TooManySaves(wait, (
-                    f"this client saved {len(times)} times in the last minute, the most it may "
-                    f"(COATED_SAVES_PER_CLIENT_PER_MINUTE); retry in about {wait} s"))
+                raise TooManySaves(
+                    wait,
+                    (
+                        f"this client saved {len(times)} times in the last minute, the most it may "
+                        f"(COATED_SAVES_PER_CLIENT_PER_MINUTE); retry in about {wait} s"
+                    ),
+                )
             times.append(now)
             if len(self._times) > _CLIENTS_KEPT:  # forget the clients whose window has ended
                 for client in [c for c, t in self._times.items() if not t or t[-1] <= now - 60.0]:

@@ -32,8 +32,18 @@ import time
 from multiprocessing.connection import wait
 from typing import Any, Callable
 
-__all__ = ["CANCEL_SLOTS", "JobCPULimit", "warm_process", "freeze_heap", "thaw_heap", "worker_start", "run_part",
-           "ping", "process_context", "end_with_parent"]
+__all__ = [
+    "CANCEL_SLOTS",
+    "JobCPULimit",
+    "warm_process",
+    "freeze_heap",
+    "thaw_heap",
+    "worker_start",
+    "run_part",
+    "ping",
+    "process_context",
+    "end_with_parent",
+]
 
 _PR_SET_PDEATHSIG = 1  # prctl(2) option, <linux/prctl.h>
 
@@ -140,8 +150,7 @@ def end_with_parent(parent_pid: int | None = None) -> None:
         os._exit(1)
     starter = multiprocessing.parent_process()
     if starter is not None and starter.sentinel is not None:
-        threading.Thread(target=_kill_at_end_of, args=(starter.sentinel,), name="end-with-server",
-                         daemon=True).start()
+        threading.Thread(target=_kill_at_end_of, args=(starter.sentinel,), name="end-with-server", daemon=True).start()
 
 
 def _kill_at_end_of(sentinel: int) -> None:

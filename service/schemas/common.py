@@ -29,12 +29,36 @@ from ..jobs.nk import MAX_NK_SAMPLES
 from ..store.names import name_key
 
 __all__ = [
-    "API_PREFIX", "INT64_MAX", "MAX_NK_SAMPLES", "FIT_ID_PATTERN", "MATERIAL_ID_PATTERN", "PACK_FORMATS",
-    "DownloadFormat", "download_formats", "MAX_EXPORT_PACK",
-    "ETA_I_LIMITS", "DEFAULT_ETA_I_RANGE", "DEFAULT_OBJECTIVE",
-    "DEFAULT_MODEL", "FiniteFloat", "EtaI", "FitId", "LibraryName", "Objective", "ModelKind",
-    "PackFormat", "Text", "MaterialName", "material_name", "RequestModel", "WORKING_SPACES", "WorkingSpace",
-    "Mirror", "absent", "ErrorItem", "ErrorBody",
+    "API_PREFIX",
+    "INT64_MAX",
+    "MAX_NK_SAMPLES",
+    "FIT_ID_PATTERN",
+    "MATERIAL_ID_PATTERN",
+    "PACK_FORMATS",
+    "DownloadFormat",
+    "download_formats",
+    "MAX_EXPORT_PACK",
+    "ETA_I_LIMITS",
+    "DEFAULT_ETA_I_RANGE",
+    "DEFAULT_OBJECTIVE",
+    "DEFAULT_MODEL",
+    "FiniteFloat",
+    "EtaI",
+    "FitId",
+    "LibraryName",
+    "Objective",
+    "ModelKind",
+    "PackFormat",
+    "Text",
+    "MaterialName",
+    "material_name",
+    "RequestModel",
+    "WORKING_SPACES",
+    "WorkingSpace",
+    "Mirror",
+    "absent",
+    "ErrorItem",
+    "ErrorBody",
 ]
 
 API_PREFIX = "/api/v1"
@@ -55,9 +79,18 @@ ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False, strict=True)]
 EtaI = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False, strict=True)]
 FitId = Annotated[str, Field(pattern=FIT_ID_PATTERN, description="32 lowercase hex digits")]
-LibraryName = Annotated[str, Field(min_length=1, max_length=200, description=(
-    "A conductor of the library by name, symbol or id, any case: gold, Au, aluminum, TiN, Ti.Johnson "
-    "(GET /library)")), AfterValidator(resolve_material)]
+LibraryName = Annotated[
+    str,
+    Field(
+        min_length=1,
+        max_length=200,
+        description=(
+            "A conductor of the library by name, symbol or id, any case: gold, Au, aluminum, TiN, Ti.Johnson "
+            "(GET /library)"
+        ),
+    ),
+    AfterValidator(resolve_material),
+]
 """A catalogue conductor, checked and turned into its id (``gold`` -> ``Au``)."""
 Objective = Literal[OBJECTIVES]  # type: ignore[valid-type]
 
@@ -68,8 +101,11 @@ def _check_model_kind(model: str) -> str:
     return model
 
 
-ModelKind = Annotated[str, Field(description="A registered model kind (GET /api/v1/domain: model_kinds)"),
-                      AfterValidator(_check_model_kind)]
+ModelKind = Annotated[
+    str,
+    Field(description="A registered model kind (GET /api/v1/domain: model_kinds)"),
+    AfterValidator(_check_model_kind),
+]
 """A model kind's name (checked against the registry when the request is read, so a plugin's kind counts)."""
 PackFormat = Literal[PACK_FORMATS]  # type: ignore[valid-type]
 
@@ -128,8 +164,10 @@ def material_name(value: str) -> str:
     reserved = reserved_names().get(name_key(value))
     if reserved is not None:
         same = "is" if reserved.casefold() == value.casefold() else "looks the same as"
-        raise ValueError(f"`name` {value!r} is reserved: it {same} {reserved!r}, which names a material of "
-                         "the catalogue (GET /api/v1/library)")
+        raise ValueError(
+            f"`name` {value!r} is reserved: it {same} {reserved!r}, which names a material of "
+            "the catalogue (GET /api/v1/library)"
+        )
     return value
 
 
@@ -158,9 +196,7 @@ class RequestModel(BaseModel):
             unknown = [key for key in data if key not in fields]
             if len(unknown) > _MAX_UNKNOWN_LISTED:
                 shown = ", ".join(excerpt(key, 30) for key in unknown[:_MAX_UNKNOWN_LISTED])
-                raise ValueError(
-                    f"extra fields are not permitted: {len(unknown)} unknown fields ({shown}, ...)"
-                )
+                raise ValueError(f"extra fields are not permitted: {len(unknown)} unknown fields ({shown}, ...)")
         return data
 
 

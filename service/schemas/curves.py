@@ -15,8 +15,17 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from fitting.fits.curves import CurveFitSettings
 from fitting.fits.curves_input import CURVE_MAX_COUNT, CURVE_MAX_SAMPLES, CURVE_MIN_SAMPLES
 
-from .common import (DEFAULT_MODEL, FIT_ID_PATTERN, EtaI, FitId, LibraryName, MaterialName, ModelKind, Objective,
-                     RequestModel)
+from .common import (
+    DEFAULT_MODEL,
+    FIT_ID_PATTERN,
+    EtaI,
+    FitId,
+    LibraryName,
+    MaterialName,
+    ModelKind,
+    Objective,
+    RequestModel,
+)
 from .fits import NKData
 
 __all__ = ["CurveIn", "CurveBaseIn", "CurveFitRequest", "ErrorMap"]
@@ -36,12 +45,16 @@ class CurveIn(RequestModel):
     model_config = ConfigDict(extra="forbid")
 
     eta_i: EtaI
-    cos_theta: list[CosTheta] | None = Field(None, min_length=CURVE_MIN_SAMPLES,
-                                             max_length=CURVE_MAX_SAMPLES, fail_fast=True)
-    angle_deg: list[Angle] | None = Field(None, min_length=CURVE_MIN_SAMPLES,
-                                          max_length=CURVE_MAX_SAMPLES, fail_fast=True)
+    cos_theta: list[CosTheta] | None = Field(
+        None, min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES, fail_fast=True
+    )
+    angle_deg: list[Angle] | None = Field(
+        None, min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES, fail_fast=True
+    )
     rgb: list[tuple[Reflectance, Reflectance, Reflectance]] = Field(
-        min_length=CURVE_MIN_SAMPLES, max_length=CURVE_MAX_SAMPLES, fail_fast=True,
+        min_length=CURVE_MIN_SAMPLES,
+        max_length=CURVE_MAX_SAMPLES,
+        fail_fast=True,
         description="[R, G, B] per sample, linear ACEScg",
     )
 
@@ -51,9 +64,7 @@ class CurveIn(RequestModel):
             raise ValueError("give exactly one of `cos_theta` or `angle_deg`")
         samples = self.cos_theta if self.cos_theta is not None else self.angle_deg
         if len(samples) != len(self.rgb):
-            raise ValueError(
-                f"`rgb` must hold one [R, G, B] per sample ({len(samples)}), got {len(self.rgb)}"
-            )
+            raise ValueError(f"`rgb` must hold one [R, G, B] per sample ({len(samples)}), got {len(self.rgb)}")
         return self
 
     def as_dict(self) -> dict:
@@ -93,22 +104,34 @@ class CurveFitRequest(RequestModel):
     model_config = ConfigDict(
         extra="forbid",
         json_schema_extra={
-            "examples": [{
-                "name": "warm gold",
-                "base": {"material": "Au"},
-                "curves": [{
-                    "eta_i": 1.5,
-                    "angle_deg": [0, 30, 60, 75, 90],
-                    "rgb": [[0.9, 0.7, 0.35], [0.9, 0.7, 0.35], [0.88, 0.69, 0.36],
-                            [0.85, 0.7, 0.45], [1, 1, 1]],
-                }],
-            }]
+            "examples": [
+                {
+                    "name": "warm gold",
+                    "base": {"material": "Au"},
+                    "curves": [
+                        {
+                            "eta_i": 1.5,
+                            "angle_deg": [0, 30, 60, 75, 90],
+                            "rgb": [
+                                [0.9, 0.7, 0.35],
+                                [0.9, 0.7, 0.35],
+                                [0.88, 0.69, 0.36],
+                                [0.85, 0.7, 0.45],
+                                [1, 1, 1],
+                            ],
+                        }
+                    ],
+                }
+            ]
         },
     )
 
-    name: MaterialName = Field("edited", description="The material's name (NFC; a visible character, no "
-                               "bidirectional control, not a built-in material's); refits under one name "
-                               "are one material")
+    name: MaterialName = Field(
+        "edited",
+        description="The material's name (NFC; a visible character, no "
+        "bidirectional control, not a built-in material's); refits under one name "
+        "are one material",
+    )
     base: CurveBaseIn | None = None
     eta_i_range: tuple[EtaI, EtaI] | None = Field(
         None, description="Domain [lo, hi]: default the base fit's, else [1, 2.5]"
@@ -117,26 +140,43 @@ class CurveFitRequest(RequestModel):
     objective: Objective = _DEFAULTS.objective
     blend_width: float = Field(_DEFAULTS.blend_width, gt=0.0, le=3.0, allow_inf_nan=False, strict=True)
     model: ModelKind = Field(
-        DEFAULT_MODEL, description="Model kind of the refit: coated-conductor (Vernooij 2024) or "
-        "rgb-conductor (per-channel n, k; always within [0, 1])")
-    draft: bool = Field(False, description="Store the fit without saving it under `name` (the editor's "
-                                           "refits while editing); the same request with false saves it")
-    live: bool = Field(False, description="A live refit while a curve is dragged: one short solve "
-                                          "(fitting.fits.curves.LIVE_SETTINGS) started from `start_fit`, "
-                                          "a draft only; the editor replaces it with a full refit on release")
-    start_fit: FitId | None = Field(None, description="With `live`: the stored fit (of the same kind and "
-                                                      "domain) whose coefficients the solve starts from")
+        DEFAULT_MODEL,
+        description="Model kind of the refit: coated-conductor (Vernooij 2024) or "
+        "rgb-conductor (per-channel n, k; always within [0, 1])",
+    )
+    draft: bool = Field(
+        False,
+        description="Store the fit without saving it under `name` (the editor's "
+        "refits while editing); the same request with false saves it",
+    )
+    live: bool = Field(
+        False,
+        description="A live refit while a curve is dragged: one short solve "
+        "(fitting.fits.curves.LIVE_SETTINGS) started from `start_fit`, "
+        "a draft only; the editor replaces it with a full refit on release",
+    )
+    start_fit: FitId | None = Field(
+        None,
+        description="With `live`: the stored fit (of the same kind and "
+        "domain) whose coefficients the solve starts from",
+    )
 
     material_id: Annotated[str, Field(pattern=r"^[0-9a-f]{32}$")] | None = Field(
-        None, description="Save as the next version of this saved edited material (its `id` in "
-                          "`GET /materials`; the editor sends the material it opened, so a renamed "
-                          "material keeps its history). Unset: the material called `name` now, else a "
-                          "new one; 409 when another material is called `name`")
+        None,
+        description="Save as the next version of this saved edited material (its `id` in "
+        "`GET /materials`; the editor sends the material it opened, so a renamed "
+        "material keeps its history). Unset: the material called `name` now, else a "
+        "new one; 409 when another material is called `name`",
+    )
     expected_version: int | None = Field(
-        None, ge=0, le=2**62, strict=True,
+        None,
+        ge=0,
+        le=2**62,
+        strict=True,
         description="Save only if the material `name` is at this version now (0: not saved yet; the "
-                    "`version` of `GET /materials/{id}`); else 409, nothing saved. Unset: the save "
-                    "becomes the next version whatever came before")
+        "`version` of `GET /materials/{id}`); else 409, nothing saved. Unset: the save "
+        "becomes the next version whatever came before",
+    )
 
     @model_validator(mode="after")
     def _check_range(self) -> "CurveFitRequest":

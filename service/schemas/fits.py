@@ -37,8 +37,16 @@ from .common import (
 )
 from .metrics import FitDetails, FitMetrics
 
-__all__ = ["NKData", "FitRequest", "PackRequest", "FitLinks", "FitPublic",
-           "CurvesPublic", "CurveFitPublic", "fit_public"]
+__all__ = [
+    "NKData",
+    "FitRequest",
+    "PackRequest",
+    "FitLinks",
+    "FitPublic",
+    "CurvesPublic",
+    "CurveFitPublic",
+    "fit_public",
+]
 
 Wavelength = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True, description="nm")]
 IndexN = Annotated[float, Field(gt=0.0, allow_inf_nan=False, strict=True)]
@@ -61,8 +69,7 @@ class NKData(RequestModel):
         for label in ("n", "k"):
             if len(getattr(self, label)) != size:
                 raise ValueError(
-                    f"`{label}` must have one value per wavelength ({size}), "
-                    f"got {len(getattr(self, label))}"
+                    f"`{label}` must have one value per wavelength ({size}), got {len(getattr(self, label))}"
                 )
         for i in range(1, size):
             if self.wavelength_nm[i] <= self.wavelength_nm[i - 1]:
@@ -98,11 +105,9 @@ class FitRequest(RequestModel):
                 {"material": "Au", "model": "rgb-conductor"},
                 {
                     "name": "my gold",
-                    "nk": {"wavelength_nm": [350, 600, 850], "n": [1.6, 0.25, 0.2],
-                           "k": [1.9, 3.0, 5.4]},
+                    "nk": {"wavelength_nm": [350, 600, 850], "n": [1.6, 0.25, 0.2], "k": [1.9, 3.0, 5.4]},
                 },
-                {"name": "artist gold", "f0": [0.944, 0.776, 0.373], "f82": [0.93, 0.96, 0.99],
-                 "space": "lin_rec709"},
+                {"name": "artist gold", "f0": [0.944, 0.776, 0.373], "f82": [0.93, 0.96, 0.99], "space": "lin_rec709"},
             ]
         },
     )
@@ -130,8 +135,7 @@ class FitRequest(RequestModel):
             raise ValueError("give `f0` and `f82` together (a metal given by its F0 and F82 tint)")
         if sum(x is not None for x in (self.material, self.nk, self.f0)) != 1:
             raise ValueError(
-                "give exactly one of `material` (a built-in conductor), `nk` (inline data) or "
-                "`f0` with `f82` (colours)"
+                "give exactly one of `material` (a built-in conductor), `nk` (inline data) or `f0` with `f82` (colours)"
             )
         if self.material is not None and self.name is not None:
             raise ValueError("`name` is only for inline `nk` data (a built-in material has its own)")
@@ -148,15 +152,20 @@ class PackRequest(RequestModel):
 
     fit_ids: list[FitId] = Field(min_length=1, max_length=256)
     format: DownloadFormat = Field(
-        "binary", description="binary | json | glsl | hlsl, or an export format of `GET /api/v1/domain`'s "
-        f"`export_formats` (a zip archive of one file per fit, at most {MAX_EXPORT_PACK} fits)")
+        "binary",
+        description="binary | json | glsl | hlsl, or an export format of `GET /api/v1/domain`'s "
+        f"`export_formats` (a zip archive of one file per fit, at most {MAX_EXPORT_PACK} fits)",
+    )
     eta_i: EtaI = Field(1.5, description="Coating index of an export, [1, 3]")
     roughness: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = Field(
-        0.2, description="The metal's perceptual roughness of an export, [0, 1]")
+        0.2, description="The metal's perceptual roughness of an export, [0, 1]"
+    )
     coat_roughness: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = Field(
-        0.03, description="The coat's perceptual roughness of an export, [0, 1]")
+        0.03, description="The coat's perceptual roughness of an export, [0, 1]"
+    )
     working_space: WorkingSpace = Field(
-        "lin_rec709", description="lin_rec709 | acescg: the space an export is fitted and written in")
+        "lin_rec709", description="lin_rec709 | acescg: the space an export is fitted and written in"
+    )
     name: Annotated[str, Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9._-]+$")] = "materials"
 
     @model_validator(mode="after")
@@ -193,9 +202,12 @@ class FitPublic(BaseModel):
     model: ModelKind = DEFAULT_MODEL
     degree: int
     colour_space: Literal["ACEScg"] = "ACEScg"
-    coefficients: dict[str, list[list[float]] | list[float]] = Field(description=(
-        "Float16 coefficients by the kind's parameters (GET /api/v1/domain: model_kinds): per parameter three "
-        "rows (R, G, B) of powers (1, t, t^2) for a kind with a power axis, else one value per channel"))
+    coefficients: dict[str, list[list[float]] | list[float]] = Field(
+        description=(
+            "Float16 coefficients by the kind's parameters (GET /api/v1/domain: model_kinds): per parameter three "
+            "rows (R, G, B) of powers (1, t, t^2) for a kind with a power axis, else one value per channel"
+        )
+    )
     metrics: FitMetrics
     timings: dict[str, float]
     convergence: dict[str, Any]
@@ -215,8 +227,10 @@ class CurvesPublic(BaseModel):
     cos_theta: list[float]
     model: list[list[float]]
     target: list[list[float]] | None = Field(
-        None, description="What the fit was fitted to at this eta_i: for a curve fit the blended "
-                          "edited target (or its curve), else the reference")
+        None,
+        description="What the fit was fitted to at this eta_i: for a curve fit the blended "
+        "edited target (or its curve), else the reference",
+    )
     reference: list[list[float]] | None = None
     lazanyi_adjusted: list[list[float]] | None = None
 
@@ -225,11 +239,13 @@ class CurveFitPublic(FitPublic):
     """A curve fit, with its curves at one eta_i when the request asked (``curves_eta_i``)."""
 
     curves: CurvesPublic | None = Field(
-        None, description="`GET /fits/{id}/curves` of this fit at `curves_eta_i`, in the same answer "
-                          "(the editor's live refits: one round trip per drag step)")
+        None,
+        description="`GET /fits/{id}/curves` of this fit at `curves_eta_i`, in the same answer "
+        "(the editor's live refits: one round trip per drag step)",
+    )
     restored_from_bin: bool = Field(
-        False, description="The material was in the bin: this save (made without `expected_version`) "
-                           "took it out")
+        False, description="The material was in the bin: this save (made without `expected_version`) took it out"
+    )
 
 
 def fit_public(record: FitRecord) -> FitPublic:

@@ -18,20 +18,25 @@ class Swatch(BaseModel):
 
     eta_i: float
     angles_deg: list[float]
-    srgb: list[str] = Field(description="`#rrggbb` per angle: linear ACEScg to Rec.709 (CAT02), "
-                                        "clipped, sRGB-encoded, exposure 1, no tone mapping")
-    acescg: list[list[float]] = Field(description="Linear ACEScg reflectance per angle (the 1 nm "
-                                                  "spectral reference the model is fitted to)")
+    srgb: list[str] = Field(
+        description="`#rrggbb` per angle: linear ACEScg to Rec.709 (CAT02), "
+        "clipped, sRGB-encoded, exposure 1, no tone mapping"
+    )
+    acescg: list[list[float]] = Field(
+        description="Linear ACEScg reflectance per angle (the 1 nm spectral reference the model is fitted to)"
+    )
 
 
 class LibraryEntry(BaseModel):
-    id: str = Field(description="The material's id (`GET /materials/{id}`, `POST /fits` `material`): "
-                                "a library symbol (`Au`) or BOOK.PAGE (`Ti.Johnson`)")
+    id: str = Field(
+        description="The material's id (`GET /materials/{id}`, `POST /fits` `material`): "
+        "a library symbol (`Au`) or BOOK.PAGE (`Ti.Johnson`)"
+    )
     symbol: str = Field(description="Symbol or formula, e.g. Au, TiN, Cu-Zn")
     name: str = Field(description="Common name, e.g. gold, brass 70/30")
     category: str = Field(description="metal, alloy, nitride, carbide, semiconductor, ...")
     label: str = Field(description="The page's label in the database (authors, year, what was measured)")
-    preferred: bool = Field(description="The page a bare name or symbol fits (`\"material\": \"gold\"`)")
+    preferred: bool = Field(description='The page a bare name or symbol fits (`"material": "gold"`)')
     source: str = Field(description="The data's citation as the database gives it")
     reference: str = Field(description="The citation alone (authors, title, journal)")
     database: str

@@ -18,8 +18,17 @@ from ..store import FIT_KINDS
 from .common import MaterialName, RequestModel
 from .fits import FitPublic
 
-__all__ = ["MaterialSummary", "MaterialList", "MaterialDetail", "MaterialRename", "VersionSummary",
-           "VersionList", "FitEdit", "FitLink", "LISTING_KINDS"]
+__all__ = [
+    "MaterialSummary",
+    "MaterialList",
+    "MaterialDetail",
+    "MaterialRename",
+    "VersionSummary",
+    "VersionList",
+    "FitEdit",
+    "FitLink",
+    "LISTING_KINDS",
+]
 
 LISTING_KINDS = ("library", "curves", "nk")
 """What ``GET /materials?kind=`` selects: built-in, saved edits (the artist's), n, k uploads."""
@@ -32,11 +41,15 @@ class MaterialSummary(BaseModel):
     source: str
     coverage: float | None = None
     latest_fit_id: str | None = None
-    version: int = Field(0, description="Saves of the material so far (0: never saved); a save of "
-                                        "edited curves may name it as `expected_version` (409 when "
-                                        "another save came first)")
-    deleted_at: float | None = Field(None, description="Unix time it went to the bin (`DELETE "
-                                                       "/materials/{id}`); null: not deleted")
+    version: int = Field(
+        0,
+        description="Saves of the material so far (0: never saved); a save of "
+        "edited curves may name it as `expected_version` (409 when "
+        "another save came first)",
+    )
+    deleted_at: float | None = Field(
+        None, description="Unix time it went to the bin (`DELETE /materials/{id}`); null: not deleted"
+    )
     share_url: str = Field(description="The editor's link that reopens it: `/?material={id}`")
 
 
@@ -45,8 +58,9 @@ class MaterialList(BaseModel):
 
     materials: list[MaterialSummary]
     next_cursor: int | None = Field(None, description="Pass as `cursor` for the next page; null at the end")
-    skipped: list[str] = Field(default_factory=list,
-                               description="Saved materials whose summary could not be read (logged)")
+    skipped: list[str] = Field(
+        default_factory=list, description="Saved materials whose summary could not be read (logged)"
+    )
 
 
 class MaterialDetail(MaterialSummary):
@@ -101,10 +115,13 @@ class FitEdit(BaseModel):
     material_id: str
     name: str
     base: dict[str, Any] | None = Field(
-        None, description="`{\"material\": name}`, `{\"fit\": id}` or `{\"nk\": {...}}`: what the edit starts "
-                          "from (null: curves alone)")
+        None,
+        description='`{"material": name}`, `{"fit": id}` or `{"nk": {...}}`: what the edit starts '
+        "from (null: curves alone)",
+    )
     request: dict[str, Any] | None = Field(
-        None, description="The curve fit's request, ready to post again (null for library and n, k fits)")
+        None, description="The curve fit's request, ready to post again (null for library and n, k fits)"
+    )
     version: int = Field(0, description="The material's version now (send it as `expected_version`)")
 
 
@@ -115,4 +132,5 @@ class FitLink(BaseModel):
     url: str = Field(description="The editor's link (`/?fit={fit_id}`), relative to the service")
     draft: bool = Field(description="Whether it opens an unsaved edit (a draft), kept until `expires_at`")
     expires_at: float | None = Field(
-        description="Unix time the draft is removed (null: a saved fit, or the base of one, never is)")
+        description="Unix time the draft is removed (null: a saved fit, or the base of one, never is)"
+    )

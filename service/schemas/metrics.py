@@ -16,8 +16,17 @@ from pydantic import BaseModel, Field
 
 from .common import Mirror, absent
 
-__all__ = ["RowError", "MaxAt", "Figure", "DeltaE", "CurveError", "DataUncertainty", "DataQuality", "FitDetails",
-           "FitMetrics"]
+__all__ = [
+    "RowError",
+    "MaxAt",
+    "Figure",
+    "DeltaE",
+    "CurveError",
+    "DataUncertainty",
+    "DataQuality",
+    "FitDetails",
+    "FitMetrics",
+]
 
 
 class RowError(Mirror):
@@ -40,8 +49,10 @@ class Figure(Mirror):
     numbers as the pack JSON's ``metrics.figure`` and the GLSL / HLSL headers.
     """
 
-    against: str = Field(description="What it is measured against, in words: 'the measured metal "
-                                     "(1 nm spectral reference), ...' or 'your edited curves ...'")
+    against: str = Field(
+        description="What it is measured against, in words: 'the measured metal "
+        "(1 nm spectral reference), ...' or 'your edited curves ...'"
+    )
     delta_E_mean: float
     delta_E_max: float
     max_at: MaxAt | None = absent("Where the max is")
@@ -69,8 +80,10 @@ class CurveError(Mirror):
 class DataUncertainty(Mirror):
     """How far the figure can be off for gaps or sparse data (``fitting.fits.fit_quality.data_uncertainty``)."""
 
-    delta_E_mean: float = Field(description="Largest mean Delta E 2000 between the reference of the data "
-                                            "as given and of other plausible interpolations of them")
+    delta_E_mean: float = Field(
+        description="Largest mean Delta E 2000 between the reference of the data "
+        "as given and of other plausible interpolations of them"
+    )
     fit_delta_E_mean: float | None = Field(None, description="The fit's own mean on the same grid")
     widest_gap_nm: list[float]
     samples_inside_visible: int
@@ -80,8 +93,10 @@ class DataUncertainty(Mirror):
 class DataQuality(Mirror):
     """What the fit can be trusted for: the data's warnings, the range proof, the uncertainty."""
 
-    warnings: list[str] = Field(default_factory=list, description="Sparse or gapped data, outliers "
-                                "(named with their wavelength), a model not proven in [0, 1]")
+    warnings: list[str] = Field(
+        default_factory=list,
+        description="Sparse or gapped data, outliers (named with their wavelength), a model not proven in [0, 1]",
+    )
     uncertainty: DataUncertainty | None = absent("Present for gapped (60 nm or more) or sparse data")
 
 
@@ -99,10 +114,14 @@ class FitDetails(Mirror):
     figure: Figure | None = absent("The one figure (FitMetrics.figure)")
     by_curve: list[CurveError] | None = absent()
     samples: int | None = absent("Samples a curve fit fitted")
-    best_effort: bool | None = absent("True when the refit's evaluation budget ran out and the fit was made to stay in [0, 1]")
+    best_effort: bool | None = absent(
+        "True when the refit's evaluation budget ran out and the fit was made to stay in [0, 1]"
+    )
     target: DeltaE | None = absent()
-    guard: dict[str, Any] | None = absent("What the fit's solve measured itself: the worst-case guard's "
-                                          "candidates (Delta E 2000 on its points) and which it kept")
+    guard: dict[str, Any] | None = absent(
+        "What the fit's solve measured itself: the worst-case guard's "
+        "candidates (Delta E 2000 on its points) and which it kept"
+    )
     quality: DataQuality | None = absent("The data's warnings and uncertainty (n, k fits)")
 
 
@@ -115,11 +134,17 @@ class FitMetrics(BaseModel):
     (``details.guard`` holds what the solve measured itself).
     """
 
-    evaluated: bool = Field(True, description="False while an n, k fit's evaluation on the metrics grid "
-                            "has not run yet: `figure`, `grid`, `model` and `lazanyi_adjusted` are then null; "
-                            "`GET /fits/{id}` (or `?metrics=full` on the fit) waits for it")
-    figure: Figure | None = Field(None, description="The fit's figure: what it is measured against, "
-                                  "mean, max and where the max is; the pack JSON and shader headers quote it")
+    evaluated: bool = Field(
+        True,
+        description="False while an n, k fit's evaluation on the metrics grid "
+        "has not run yet: `figure`, `grid`, `model` and `lazanyi_adjusted` are then null; "
+        "`GET /fits/{id}` (or `?metrics=full` on the fit) waits for it",
+    )
+    figure: Figure | None = Field(
+        None,
+        description="The fit's figure: what it is measured against, "
+        "mean, max and where the max is; the pack JSON and shader headers quote it",
+    )
     grid: str | None = None
     model: DeltaE | None = None
     lazanyi_adjusted: DeltaE | None = None

@@ -18,11 +18,19 @@ from fitting.fits.scene_schema import MAX_ETA_I_VALUES, MAX_SCENE_MATERIALS
 from .common import ETA_I_LIMITS, Mirror, RequestModel
 from .fits import NKData
 
-__all__ = ["EtaRange", "SceneMaterialRequest", "SceneRequest", "SceneError",
-           "SceneMaterialReport", "SceneTotals", "ScenePublic"]
+__all__ = [
+    "EtaRange",
+    "SceneMaterialRequest",
+    "SceneRequest",
+    "SceneError",
+    "SceneMaterialReport",
+    "SceneTotals",
+    "ScenePublic",
+]
 
-EtaValue = Annotated[float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-                                  strict=True, description="1 is uncoated")]
+EtaValue = Annotated[
+    float, Field(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False, strict=True, description="1 is uncoated")
+]
 Name = Annotated[str, Field(min_length=1, max_length=200, pattern=r"\S")]
 
 
@@ -45,8 +53,7 @@ class SceneMaterialRequest(RequestModel):
         default=None, description="A library conductor (name, symbol or id, e.g. gold, Au) or a saved material id"
     )
     nk: NKData | None = None
-    source: str = Field(default="scene description", max_length=2000,
-                        description="Citation of inline `nk`")
+    source: str = Field(default="scene description", max_length=2000, description="Citation of inline `nk`")
     eta_i: EtaValue | Annotated[list[EtaValue], Field(min_length=1, max_length=MAX_ETA_I_VALUES)] | EtaRange
 
     @model_validator(mode="after")
@@ -71,10 +78,12 @@ class SceneRequest(RequestModel):
     model_config = ConfigDict(extra="forbid")
 
     name: Name = "scene"
-    materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS,
-                                                  fail_fast=True)
+    materials: list[SceneMaterialRequest] = Field(min_length=1, max_length=MAX_SCENE_MATERIALS, fail_fast=True)
     max_delta_e: float | None = Field(
-        default=None, gt=0.0, le=100.0, allow_inf_nan=False,
+        default=None,
+        gt=0.0,
+        le=100.0,
+        allow_inf_nan=False,
         description="Each material gets the cheapest model kind and degree whose mean Delta E 2000 "
         "on its eta_i is at most this",
     )

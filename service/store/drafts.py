@@ -23,7 +23,8 @@ __all__ = ["keep_draft", "expire_drafts"]
 _KEPT_BASES = (
     "WITH RECURSIVE kept(id) AS (SELECT f.base_fit_id FROM fits f JOIN saves s ON s.fit_id = f.id "
     "WHERE f.base_fit_id IS NOT NULL UNION SELECT f.base_fit_id FROM fits f JOIN kept ON f.id = kept.id "
-    "WHERE f.base_fit_id IS NOT NULL)")
+    "WHERE f.base_fit_id IS NOT NULL)"
+)
 """The fits a saved fit starts from, and those these start from, to any depth: never swept."""
 
 
@@ -36,7 +37,9 @@ def keep_draft(connection: Any, p: str, fit_id: str, until: float) -> float | No
     """
     found = connection.execute(
         f"{_KEPT_BASES} SELECT EXISTS (SELECT 1 FROM saves WHERE saves.fit_id = fits.id) "
-        f"OR id IN (SELECT id FROM kept), coalesce(kept_until, 0) FROM fits WHERE id = {p}", (fit_id,)).fetchone()
+        f"OR id IN (SELECT id FROM kept), coalesce(kept_until, 0) FROM fits WHERE id = {p}",
+        (fit_id,),
+    ).fetchone()
     if found is None:
         raise LookupError(f"fit {fit_id!r} not found (a draft is kept only for its time to live)")
     if found[0]:
@@ -61,7 +64,8 @@ def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) ->
     rows = connection.execute(
         f"{_KEPT_BASES} SELECT id, created_at, length(record), nk_id, coalesce(kept_until, 0) FROM fits "
         "WHERE NOT EXISTS (SELECT 1 FROM saves WHERE saves.fit_id = fits.id) AND id NOT IN (SELECT id FROM kept) "
-        "ORDER BY created_at DESC").fetchall()
+        "ORDER BY created_at DESC"
+    ).fetchall()
     # Drafts a link keeps come first: past the quota, the others go before them.
     rows.sort(key=lambda row: row[4] < now)
     nk_sizes = dict(connection.execute("SELECT id, length(record) FROM nk_records").fetchall())
@@ -76,6 +80,5 @@ def expire_drafts(connection: Any, p: str, older_than: float, max_bytes: int) ->
     if doomed:
         # A cursor's: psycopg's connection has no executemany (the sweep failed on PostgreSQL).
         connection.cursor().executemany(f"DELETE FROM fits WHERE id = {p}", doomed)
-    connection.execute("DELETE FROM nk_records WHERE NOT EXISTS "
-                       "(SELECT 1 FROM fits WHERE fits.nk_id = nk_records.id)")
+    connection.execute("DELETE FROM nk_records WHERE NOT EXISTS (SELECT 1 FROM fits WHERE fits.nk_id = nk_records.id)")
     return len(doomed)

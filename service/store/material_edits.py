@@ -29,8 +29,7 @@ def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
     if row is None:
         raise LookupError(f"`material_id` {material_id!r} is not a saved material")
     if row.kind == "library":
-        raise ValueError(f"`material_id` {material_id!r} is a built-in material: it cannot be "
-                         "renamed or deleted")
+        raise ValueError(f"`material_id` {material_id!r} is a built-in material: it cannot be renamed or deleted")
     return row
 
 
@@ -43,11 +42,16 @@ def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
             raise NameTaken(_looks_like(name, holder), version=row.version, latest_fit_id=row.latest_fit_id)
         if holder is not None:
             where = " (in the bin)" if holder[1] is not None else ""
-            raise NameTaken(f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
-                            "choose another name, or rename that one first", version=row.version,
-                            latest_fit_id=row.latest_fit_id)
-    connection.execute(f"UPDATE materials SET name = {p}, name_key = {p} WHERE material_id = {p}",
-                       (summary_text(name), name_key(name), material_id))
+            raise NameTaken(
+                f"`name` {name!r} is the name of another saved material {holder[0]}{where}: "
+                "choose another name, or rename that one first",
+                version=row.version,
+                latest_fit_id=row.latest_fit_id,
+            )
+    connection.execute(
+        f"UPDATE materials SET name = {p}, name_key = {p} WHERE material_id = {p}",
+        (summary_text(name), name_key(name), material_id),
+    )
     return material_row(connection, p, material_id)
 
 
@@ -55,8 +59,7 @@ def set_deleted(connection: Any, p: str, material_id: str, deleted: bool) -> Mat
     """Inside a write transaction: ``material_id`` moved to the bin (``deleted``) or out of it."""
     row = _saved(connection, p, material_id)
     if deleted and row.deleted_at is None:
-        connection.execute(f"UPDATE materials SET deleted_at = {p} WHERE material_id = {p}",
-                           (time.time(), material_id))
+        connection.execute(f"UPDATE materials SET deleted_at = {p} WHERE material_id = {p}", (time.time(), material_id))
     elif not deleted and row.deleted_at is not None:
         connection.execute(f"UPDATE materials SET deleted_at = NULL WHERE material_id = {p}", (material_id,))
     return material_row(connection, p, material_id)

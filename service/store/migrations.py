@@ -78,7 +78,8 @@ def _backfill_materials(connection: Any, dialect: str) -> None:
     for material_id, first_seq, first_at, last_seq in missing:
         for fit_id, text in connection.execute(
             "SELECT f.id, f.record FROM saves s JOIN fits f ON f.id = s.fit_id "
-            "WHERE s.material_id = ? AND s.seq <= ? ORDER BY s.seq DESC", (material_id, last_seq)
+            "WHERE s.material_id = ? AND s.seq <= ? ORDER BY s.seq DESC",
+            (material_id, last_seq),
         ).fetchall():
             try:
                 record = FitRecord.from_json(text)
@@ -88,8 +89,8 @@ def _backfill_materials(connection: Any, dialect: str) -> None:
             connection.execute(
                 "INSERT INTO materials (material_id, first_seq, first_saved_at, latest_fit_id, kind, "
                 "name, source, coverage) VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                (material_id, first_seq, first_at, record.id, record.kind, record.name,
-                 record.source, record.coverage))
+                (material_id, first_seq, first_at, record.id, record.kind, record.name, record.source, record.coverage),
+            )
             break
 
 
@@ -126,8 +127,7 @@ _POSTGRES_V1: list[Step] = [
 
 _V2: list[Step] = [
     "ALTER TABLE materials ADD COLUMN version BIGINT NOT NULL DEFAULT 0",
-    "UPDATE materials SET version = (SELECT COUNT(*) FROM saves s "
-    "WHERE s.material_id = materials.material_id)",
+    "UPDATE materials SET version = (SELECT COUNT(*) FROM saves s WHERE s.material_id = materials.material_id)",
 ]
 
 _V3: list[Step] = [
@@ -146,12 +146,14 @@ _V5: list[Step] = [
     "CREATE INDEX IF NOT EXISTS fits_by_nk ON fits (nk_id)",
 ]
 
+
 def _fill_name_keys(connection: Any, dialect: str) -> None:
     """Each material's :func:`name_key` (computed here: SQL has no TR39 skeleton)."""
     p = "?" if dialect == "sqlite" else "%s"
     for material_id, name in connection.execute("SELECT material_id, name FROM materials").fetchall():
-        connection.execute(f"UPDATE materials SET name_key = {p} WHERE material_id = {p}",
-                           (name_key(name), material_id))
+        connection.execute(
+            f"UPDATE materials SET name_key = {p} WHERE material_id = {p}", (name_key(name), material_id)
+        )
 
 
 _V6: list[Step] = [
@@ -159,6 +161,7 @@ _V6: list[Step] = [
     _fill_name_keys,
     "CREATE INDEX IF NOT EXISTS materials_by_name_key ON materials (kind, name_key)",
 ]
+
 
 def _fill_base_fit_ids(connection: Any, dialect: str) -> None:
     """Each curve fit's ``base_fit_id``, read from its record (the column is new)."""
@@ -181,27 +184,33 @@ _V7: list[Step] = [
 ]
 
 MIGRATIONS: dict[str, list[tuple[int, str, list[Step]]]] = {
-    "sqlite": [(1, "fits, save log, material summaries", _SQLITE_V1),
-               (2, "material versions", _V2),
-               (3, "saves by fit (the drafts' sweep)", _V3),
-               (4, "materials in the bin, by name", _V4),
-               (5, "n, k records of drafts", _V5),
-               (6, "look-alike keys of names", _V6),
-               (7, "the base each fit starts from, drafts kept for links", _V7)],
-    "postgresql": [(1, "fits, save log, material summaries", _POSTGRES_V1),
-                   (2, "material versions", _V2),
-                   (3, "saves by fit (the drafts' sweep)", _V3),
-                   (4, "materials in the bin, by name", _V4),
-                   (5, "n, k records of drafts", _V5),
-                   (6, "look-alike keys of names", _V6),
-                   (7, "the base each fit starts from, drafts kept for links", _V7)],
+    "sqlite": [
+        (1, "fits, save log, material summaries", _SQLITE_V1),
+        (2, "material versions", _V2),
+        (3, "saves by fit (the drafts' sweep)", _V3),
+        (4, "materials in the bin, by name", _V4),
+        (5, "n, k records of drafts", _V5),
+        (6, "look-alike keys of names", _V6),
+        (7, "the base each fit starts from, drafts kept for links", _V7),
+    ],
+    "postgresql": [
+        (1, "fits, save log, material summaries", _POSTGRES_V1),
+        (2, "material versions", _V2),
+        (3, "saves by fit (the drafts' sweep)", _V3),
+        (4, "materials in the bin, by name", _V4),
+        (5, "n, k records of drafts", _V5),
+        (6, "look-alike keys of names", _V6),
+        (7, "the base each fit starts from, drafts kept for links", _V7),
+    ],
 }
 SCHEMA_VERSION = max(version for version, _, _ in MIGRATIONS["sqlite"])
 """The schema version this code reads and writes."""
 
 _PG_LOCK_KEY = 0x636F61746564  # "coated": the advisory lock of migrations
-_TABLE = ("CREATE TABLE IF NOT EXISTS schema_migrations (version INTEGER PRIMARY KEY, "
-          "description TEXT NOT NULL, applied_at DOUBLE PRECISION NOT NULL)")
+_TABLE = (
+    "CREATE TABLE IF NOT EXISTS schema_migrations (version INTEGER PRIMARY KEY, "
+    "description TEXT NOT NULL, applied_at DOUBLE PRECISION NOT NULL)"
+)
 
 
 def _current(connection: Any) -> int:
@@ -230,11 +239,13 @@ def migrate(connection: Any, dialect: str, apply: bool = True) -> tuple[int, int
         if before > SCHEMA_VERSION:
             raise SchemaMismatch(
                 f"the store's schema is version {before}, newer than this code knows "
-                f"({SCHEMA_VERSION}): run the newer service, or restore a backup of the store")
+                f"({SCHEMA_VERSION}): run the newer service, or restore a backup of the store"
+            )
         if before < SCHEMA_VERSION and not apply:
             raise SchemaMismatch(
                 f"the store's schema is version {before}, this code needs {SCHEMA_VERSION}: "
-                "run `python -m service migrate` (or start with COATED_STORE_MIGRATE=true)")
+                "run `python -m service migrate` (or start with COATED_STORE_MIGRATE=true)"
+            )
         for version, description, steps in MIGRATIONS[dialect]:
             if version <= before:
                 continue
@@ -246,7 +257,8 @@ def migrate(connection: Any, dialect: str, apply: bool = True) -> tuple[int, int
             connection.execute(
                 f"INSERT INTO schema_migrations (version, description, applied_at) "
                 f"VALUES ({placeholder}, {placeholder}, {placeholder})",
-                (version, description, time.time()))
+                (version, description, time.time()),
+            )
             log.warning("store schema: applied version %d (%s)", version, description)
         connection.commit()
     except BaseException:

@@ -28,8 +28,19 @@ __all__ = ["MoveReport", "store_checksum", "move_sqlite_to_postgres"]
 _TABLES = {
     "fits": ("id", "kind", "material_id", "created_at", "record", "nk_id", "base_fit_id"),
     "saves": ("seq", "material_id", "fit_id", "saved_at"),
-    "materials": ("material_id", "first_seq", "first_saved_at", "latest_fit_id", "kind", "name",
-                  "source", "coverage", "version", "deleted_at", "name_key"),
+    "materials": (
+        "material_id",
+        "first_seq",
+        "first_saved_at",
+        "latest_fit_id",
+        "kind",
+        "name",
+        "source",
+        "coverage",
+        "version",
+        "deleted_at",
+        "name_key",
+    ),
     "nk_records": ("id", "created_at", "record"),
 }
 _ORDER = {"fits": "id", "saves": "seq", "materials": "material_id", "nk_records": "id"}
@@ -46,8 +57,10 @@ class MoveReport:
     checksum: str
 
     def line(self, source: str, target: str) -> str:
-        return (f"moved {self.fits} fits, {self.saves} saves, {self.materials} materials from "
-                f"{source} to {target}; checksum {self.checksum} (source and target agree)")
+        return (
+            f"moved {self.fits} fits, {self.saves} saves, {self.materials} materials from "
+            f"{source} to {target}; checksum {self.checksum} (source and target agree)"
+        )
 
 
 def _rows(connection: Any, table: str):
@@ -92,8 +105,10 @@ def move_sqlite_to_postgres(source: str | Path, target: PostgresStore) -> MoveRe
             connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))
             (present,) = connection.execute("SELECT COUNT(*) FROM fits").fetchone()
             if present:
-                raise StoreUnavailable(f"the target store {target.where} already holds {present} fits: "
-                                       "a SQLite store moves into an empty PostgreSQL store only")
+                raise StoreUnavailable(
+                    f"the target store {target.where} already holds {present} fits: "
+                    "a SQLite store moves into an empty PostgreSQL store only"
+                )
             for table, columns in _TABLES.items():
                 marks = ", ".join(["%s"] * len(columns))
                 sql = f"INSERT INTO {table} ({', '.join(columns)}) VALUES ({marks})"
@@ -106,13 +121,14 @@ def move_sqlite_to_postgres(source: str | Path, target: PostgresStore) -> MoveRe
                             batch.clear()
                     if batch:
                         cursor.executemany(sql, batch)
-            connection.execute("SELECT setval(pg_get_serial_sequence('saves', 'seq'), "
-                               "GREATEST((SELECT MAX(seq) FROM saves), 1), "
-                               "(SELECT MAX(seq) FROM saves) IS NOT NULL)")
+            connection.execute(
+                "SELECT setval(pg_get_serial_sequence('saves', 'seq'), "
+                "GREATEST((SELECT MAX(seq) FROM saves), 1), "
+                "(SELECT MAX(seq) FROM saves) IS NOT NULL)"
+            )
             got, _ = store_checksum(connection)
             if got != want:
-                raise StoreUnavailable(f"the copy's checksum {got} differs from the source's {want}; "
-                                       "nothing was moved")
+                raise StoreUnavailable(f"the copy's checksum {got} differs from the source's {want}; nothing was moved")
             return got
 
         checksum = target.transaction(copy)

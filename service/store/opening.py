@@ -30,9 +30,12 @@ def open_store(settings: "Settings", migrate: bool | None = None) -> Store:
         from .postgres import PostgresStore  # psycopg is loaded only for a PostgreSQL store
 
         return PostgresStore(
-            settings.store_url.get_secret_value(), pool_min=settings.store_pool_min,
-            pool_max=settings.store_pool_max, pool_timeout_s=settings.store_pool_timeout_s,
+            settings.store_url.get_secret_value(),
+            pool_min=settings.store_pool_min,
+            pool_max=settings.store_pool_max,
+            pool_timeout_s=settings.store_pool_timeout_s,
             statement_timeout_s=settings.store_statement_timeout_s,
-            max_bytes=settings.store_max_bytes, migrate=migrate)
-    return SQLiteStore(settings.store_path, settings.store_max_bytes, settings.store_min_free_bytes,
-                       migrate=migrate)
+            max_bytes=settings.store_max_bytes,
+            migrate=migrate,
+        )
+    return SQLiteStore(settings.store_path, settings.store_max_bytes, settings.store_min_free_bytes, migrate=migrate)

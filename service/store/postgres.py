@@ -101,17 +101,21 @@ def _translate(error: Exception, where: str) -> StoreError:
         return StoreUnavailable(
             f"the store at {where} is unavailable: no database connection within the pool timeout "
             f"(COATED_STORE_POOL_TIMEOUT_S; all COATED_STORE_POOL_MAX connections busy, or the server "
-            f"is down): {_message(error)}", retry_after=RETRY_AFTER_S)
+            f"is down): {_message(error)}",
+            retry_after=RETRY_AFTER_S,
+        )
     if isinstance(error, pg_errors.DiskFull):
-        return StoreFull(f"the store at {where} is full ({_message(error)}): free disk space on the database "
-                         "server or raise COATED_STORE_MAX_BYTES, then retry")
+        return StoreFull(
+            f"the store at {where} is full ({_message(error)}): free disk space on the database "
+            "server or raise COATED_STORE_MAX_BYTES, then retry"
+        )
     if isinstance(error, pg_errors.TooManyConnections):
         return StoreUnavailable(
             f"the store at {where} refused a connection ({_message(error)}): the replicas' connections exceed "
             "the role's CONNECTION LIMIT or the server's max_connections (docs/deploy.md)",
-            retry_after=RETRY_AFTER_S)
-    return StoreUnavailable(f"the store at {where} is unavailable: {_message(error)}",
-                            retry_after=RETRY_AFTER_S)
+            retry_after=RETRY_AFTER_S,
+        )
+    return StoreUnavailable(f"the store at {where} is unavailable: {_message(error)}", retry_after=RETRY_AFTER_S)
 
 
 class PostgresStore(SQLStore):
@@ -131,9 +135,17 @@ class PostgresStore(SQLStore):
     kind = "postgresql"
     placeholder = "%s"
 
-    def __init__(self, url: str, pool_min: int = 1, pool_max: int = 4, pool_timeout_s: float = 5.0,
-                 statement_timeout_s: float = 30.0, connect_timeout_s: float = 5.0,
-                 max_bytes: int | None = None, migrate: bool = True) -> None:
+    def __init__(
+        self,
+        url: str,
+        pool_min: int = 1,
+        pool_max: int = 4,
+        pool_timeout_s: float = 5.0,
+        statement_timeout_s: float = 30.0,
+        connect_timeout_s: float = 5.0,
+        max_bytes: int | None = None,
+        migrate: bool = True,
+    ) -> None:
         self.where = redacted(url)
         self._url, self._down = url, False
         self._pool_timeout_s = float(pool_timeout_s)
@@ -143,12 +155,19 @@ class PostgresStore(SQLStore):
         self.max_bytes = max_bytes
         self.pool_max = pool_max
         name = f"coated-service {socket.gethostname()}:{os.getpid()}"[:63]
-        options = f"-c statement_timeout={int(statement_timeout_s * 1000)} -c lock_timeout={int(statement_timeout_s * 1000)}"
+        options = (
+            f"-c statement_timeout={int(statement_timeout_s * 1000)} -c lock_timeout={int(statement_timeout_s * 1000)}"
+        )
         self._pool = ConnectionPool(
-            url, min_size=pool_min, max_size=pool_max, timeout=pool_timeout_s, open=False,
-            check=ConnectionPool.check_connection, reconnect_timeout=2 * pool_timeout_s, max_waiting=256,
-            kwargs={"application_name": name, "connect_timeout": max(1, int(connect_timeout_s)),
-                    "options": options},
+            url,
+            min_size=pool_min,
+            max_size=pool_max,
+            timeout=pool_timeout_s,
+            open=False,
+            check=ConnectionPool.check_connection,
+            reconnect_timeout=2 * pool_timeout_s,
+            max_waiting=256,
+            kwargs={"application_name": name, "connect_timeout": max(1, int(connect_timeout_s)), "options": options},
             name="coated-store",
         )
         try:
@@ -159,22 +178,28 @@ class PostgresStore(SQLStore):
             if "too many connections" in str(error):
                 error = psycopg.OperationalError(
                     f"{_message(error)}: this replica's COATED_STORE_POOL_MIN connections exceed what "
-                    "the role's CONNECTION LIMIT or max_connections leaves (docs/deploy.md)")
+                    "the role's CONNECTION LIMIT or max_connections leaves (docs/deploy.md)"
+                )
             self._pool.close(timeout=1.0)
-            raise StoreUnavailable(f"the store at {self.where} cannot be reached: "
-                                   f"{_message(error)}") from None
+            raise StoreUnavailable(f"the store at {self.where} cannot be reached: {_message(error)}") from None
         try:
             self.migrated = self._guard(lambda: self._run(lambda c: _migrate(c, "postgresql", migrate)))
-            self.role_limit, self.server_limit = self._read(lambda c: c.execute(
-                "SELECT (SELECT rolconnlimit FROM pg_roles WHERE rolname = current_user), "
-                "current_setting('max_connections')::int - current_setting('superuser_reserved_connections')::int"
-            ).fetchone())
+            self.role_limit, self.server_limit = self._read(
+                lambda c: c.execute(
+                    "SELECT (SELECT rolconnlimit FROM pg_roles WHERE rolname = current_user), "
+                    "current_setting('max_connections')::int - current_setting('superuser_reserved_connections')::int"
+                ).fetchone()
+            )
         except StoreError:
             self._pool.close(timeout=1.0)
             raise
         if self.role_limit < 0:
-            log.warning("the role of %s has no CONNECTION LIMIT: N replicas may take up to the server's "
-                        "%d connections (docs/deploy.md)", self.where, self.server_limit)
+            log.warning(
+                "the role of %s has no CONNECTION LIMIT: N replicas may take up to the server's "
+                "%d connections (docs/deploy.md)",
+                self.where,
+                self.server_limit,
+            )
 
     # -- plumbing ----------------------------------------------------------
 
@@ -249,8 +274,13 @@ class PostgresStore(SQLStore):
 
     # -- the interface -----------------------------------------------------
 
-    def put_fit(self, record: FitRecord, save: bool = True,
-                expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
+    def put_fit(
+        self,
+        record: FitRecord,
+        save: bool = True,
+        expected_version: int | None = None,
+        nk: dict[str, list[float]] | None = None,
+    ) -> FitRecord:
         record, text, nk_json = records.prepared(record, nk)
 
         def write(connection: psycopg.Connection) -> FitRecord:
@@ -264,6 +294,7 @@ class PostgresStore(SQLStore):
 
     def _write(self, function: Callable[[psycopg.Connection], _T]) -> _T:
         """``function(connection)`` in one transaction holding the saves' advisory lock."""
+
         def write(connection: psycopg.Connection) -> _T:
             connection.execute("SELECT pg_advisory_xact_lock(%s)", (SAVE_LOCK,))
             return function(connection)
@@ -272,22 +303,30 @@ class PostgresStore(SQLStore):
 
     def check(self) -> None:
         """The server answers and the schema is this code's (PostgreSQL checks its own pages)."""
-        (version,) = self._read(lambda c: c.execute(
-            "SELECT COALESCE(MAX(version), 0) FROM schema_migrations").fetchone())
+        (version,) = self._read(
+            lambda c: c.execute("SELECT COALESCE(MAX(version), 0) FROM schema_migrations").fetchone()
+        )
         if version != SCHEMA_VERSION:
-            raise StoreUnavailable(f"the store at {self.where} has schema version {version}, "
-                                   f"this code needs {SCHEMA_VERSION}")
+            raise StoreUnavailable(
+                f"the store at {self.where} has schema version {version}, this code needs {SCHEMA_VERSION}"
+            )
 
     def ping(self) -> None:
         self._read(lambda c: c.execute("SELECT 1 FROM saves LIMIT 1").fetchall())
 
     def describe(self) -> dict[str, Any]:
         stats = self._pool.get_stats()
-        return {"kind": self.kind, "schema_version": SCHEMA_VERSION, "url": self.where,
-                "connections": stats.get("pool_size", 0), "connections_max": self.pool_max,
-                "connections_idle": stats.get("pool_available", 0),
-                "requests_waiting": stats.get("requests_waiting", 0),
-                "role_connection_limit": self.role_limit, "server_connection_limit": self.server_limit}
+        return {
+            "kind": self.kind,
+            "schema_version": SCHEMA_VERSION,
+            "url": self.where,
+            "connections": stats.get("pool_size", 0),
+            "connections_max": self.pool_max,
+            "connections_idle": stats.get("pool_available", 0),
+            "requests_waiting": stats.get("requests_waiting", 0),
+            "role_connection_limit": self.role_limit,
+            "server_connection_limit": self.server_limit,
+        }
 
     def writable(self) -> str | None:
         def probe(connection: psycopg.Connection) -> str | None:
@@ -297,8 +336,7 @@ class PostgresStore(SQLStore):
             if self.max_bytes:
                 (size,) = connection.execute("SELECT pg_database_size(current_database())").fetchone()
                 if size >= self.max_bytes:
-                    return (f"the store holds {size} bytes, at its quota COATED_STORE_MAX_BYTES "
-                            f"({self.max_bytes})")
+                    return f"the store holds {size} bytes, at its quota COATED_STORE_MAX_BYTES ({self.max_bytes})"
             return None
 
         # A server that cannot be reached raises (503 + Retry-After), as every other call does.

@@ -92,8 +92,7 @@ class FitRecord:
         return cls(**json.loads(text))
 
 
-def prepared(record: FitRecord, nk: dict[str, list[float]] | None
-             ) -> tuple[FitRecord, str, Callable[[], str] | None]:
+def prepared(record: FitRecord, nk: dict[str, list[float]] | None) -> tuple[FitRecord, str, Callable[[], str] | None]:
     """
     What a store's ``put_fit`` writes: the record (its ``created_at`` set
     when it has none), its JSON, and what makes the JSON of the n, k record
@@ -106,8 +105,13 @@ def prepared(record: FitRecord, nk: dict[str, list[float]] | None
         raise TypeError(f"fit {record.id}: an n, k record needs the fit's `nk_id`")
     if not record.created_at:
         record = replace(record, created_at=time.time())
-    nk_json = None if nk is None else lambda: json.dumps(
-        {key: nk[key] for key in ("wavelength_nm", "n", "k")}, allow_nan=False, separators=(",", ":"))
+    nk_json = (
+        None
+        if nk is None
+        else lambda: json.dumps(
+            {key: nk[key] for key in ("wavelength_nm", "n", "k")}, allow_nan=False, separators=(",", ":")
+        )
+    )
     return record, record.to_json(), nk_json
 
 
@@ -117,8 +121,10 @@ def nk_from_json(nk_id: str, text: str) -> dict[str, list[float]]:
         nk = json.loads(text)
         return {key: list(nk[key]) for key in ("wavelength_nm", "n", "k")}
     except (TypeError, ValueError, KeyError) as error:
-        raise RecordDamaged(f"the stored n, k record {nk_id} is damaged and cannot be read ({error}); "
-                            "the rest of the store is unaffected") from None
+        raise RecordDamaged(
+            f"the stored n, k record {nk_id} is damaged and cannot be read ({error}); "
+            "the rest of the store is unaffected"
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -231,8 +237,13 @@ class RecordDamaged(StoreError):
 class Store(Protocol):
     """The store interface of the service (thread-safe implementations)."""
 
-    def put_fit(self, record: FitRecord, save: bool = True,
-                expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
+    def put_fit(
+        self,
+        record: FitRecord,
+        save: bool = True,
+        expected_version: int | None = None,
+        nk: dict[str, list[float]] | None = None,
+    ) -> FitRecord:
         """
         Save ``record`` unless its id exists, and log the save (the fit
         becomes its material's latest, the material's version one more);
@@ -268,8 +279,14 @@ class Store(Protocol):
     def saved_materials(self) -> list[MaterialRow]:
         """Materials with at least one non-library fit, oldest first."""
 
-    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = ("nk", "curves"),
-                      deleted: bool = False, query: str | None = None) -> MaterialPage:
+    def material_page(
+        self,
+        after: int | None,
+        limit: int,
+        kinds: tuple[str, ...] = ("nk", "curves"),
+        deleted: bool = False,
+        query: str | None = None,
+    ) -> MaterialPage:
         """
         Saved materials of ``kinds`` after cursor ``after`` (None: from the
         first), at most ``limit``: those not deleted, or (``deleted``) only
@@ -349,5 +366,3 @@ class Store(Protocol):
 
     def close(self) -> None:
         """Release connections."""
-
-

@@ -46,8 +46,9 @@ class SQLStore:
             return FitRecord.from_json(text)
         except (TypeError, ValueError) as error:
             log.error("stored fit %s cannot be decoded: %s", fit_id, error)
-            raise RecordDamaged(f"the stored record of fit {fit_id} is damaged and cannot be "
-                                "read; the rest of the store is unaffected") from None
+            raise RecordDamaged(
+                f"the stored record of fit {fit_id} is damaged and cannot be read; the rest of the store is unaffected"
+            ) from None
 
     def _decoded(self, fit_id: str, text: Any) -> FitRecord | None:
         try:
@@ -90,10 +91,17 @@ class SQLStore:
     def material_version(self, material_id: str) -> int:
         return self._read(lambda c: queries.version_of(c, self.placeholder, material_id))
 
-    def material_page(self, after: int | None, limit: int, kinds: tuple[str, ...] = queries.LISTED_KINDS,
-                      deleted: bool = False, query: str | None = None) -> MaterialPage:
-        return queries.page_of(self._read(
-            lambda c: queries.page_rows(c, self.placeholder, after, limit, kinds, deleted, query)), limit)
+    def material_page(
+        self,
+        after: int | None,
+        limit: int,
+        kinds: tuple[str, ...] = queries.LISTED_KINDS,
+        deleted: bool = False,
+        query: str | None = None,
+    ) -> MaterialPage:
+        return queries.page_of(
+            self._read(lambda c: queries.page_rows(c, self.placeholder, after, limit, kinds, deleted, query)), limit
+        )
 
     def material(self, material_id: str) -> MaterialRow | None:
         return self._read(lambda c: queries.material_row(c, self.placeholder, material_id))

@@ -36,17 +36,18 @@ def _translate(error: sqlite3.Error, path: Path) -> StoreError:
     """A SQLite error as the store error it means."""
     code = getattr(error, "sqlite_errorname", "") or ""
     if code == "SQLITE_FULL" or "full" in str(error):
-        return StoreFull(f"the store at {path} is full ({error}): free disk space or raise "
-                         "COATED_STORE_MAX_BYTES, then retry")
+        return StoreFull(
+            f"the store at {path} is full ({error}): free disk space or raise COATED_STORE_MAX_BYTES, then retry"
+        )
     if code in ("SQLITE_CORRUPT", "SQLITE_NOTADB"):
         return StoreDamaged(f"the store at {path} is damaged: {error}")
     return StoreUnavailable(f"the store at {path} is unavailable: {error}")
 
 
-
 _WRITE_FLOOR_BYTES = 1_000_000
 """Free disk below which the store is not writable even with COATED_STORE_MIN_FREE_BYTES=0
 (a save writes its record, the journal and the index pages)."""
+
 
 class SQLiteStore(SQLStore):
     """
@@ -65,8 +66,9 @@ class SQLiteStore(SQLStore):
     kind = "sqlite"
     placeholder = "?"
 
-    def __init__(self, path: str | Path, max_bytes: int | None = None,
-                 min_free_bytes: int = 0, migrate: bool = True) -> None:
+    def __init__(
+        self, path: str | Path, max_bytes: int | None = None, min_free_bytes: int = 0, migrate: bool = True
+    ) -> None:
         self.path = Path(path)
         self.max_bytes = max_bytes
         self.min_free_bytes = min_free_bytes
@@ -79,8 +81,9 @@ class SQLiteStore(SQLStore):
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as error:
-            raise StoreUnavailable(f"the store directory {self.path.parent} cannot be made: "
-                                   f"{error.strerror or error}") from None
+            raise StoreUnavailable(
+                f"the store directory {self.path.parent} cannot be made: {error.strerror or error}"
+            ) from None
 
         def setup() -> tuple[int, int]:
             connection = self._connection()
@@ -139,8 +142,13 @@ class SQLiteStore(SQLStore):
 
     # -- the interface -----------------------------------------------------
 
-    def put_fit(self, record: FitRecord, save: bool = True,
-                expected_version: int | None = None, nk: dict[str, list[float]] | None = None) -> FitRecord:
+    def put_fit(
+        self,
+        record: FitRecord,
+        save: bool = True,
+        expected_version: int | None = None,
+        nk: dict[str, list[float]] | None = None,
+    ) -> FitRecord:
         record, text, nk_json = records.prepared(record, nk)
 
         def write() -> FitRecord:
@@ -148,8 +156,7 @@ class SQLiteStore(SQLStore):
             with connection:
                 # BEGIN IMMEDIATE: the write lock first, so the version read is the one written after.
                 connection.execute("BEGIN IMMEDIATE")
-                return queries.save(connection, "?", record, text, save, expected_version, self._decode,
-                                    nk_json)
+                return queries.save(connection, "?", record, text, save, expected_version, self._decode, nk_json)
 
         return self._guard(write)
 
@@ -158,6 +165,7 @@ class SQLiteStore(SQLStore):
 
     def _write(self, function: Callable[[sqlite3.Connection], _T]) -> _T:
         """``function(connection)`` in one write transaction holding the write lock (as saves do)."""
+
         def write() -> _T:
             connection = self._connection()
             with connection:
@@ -182,8 +190,12 @@ class SQLiteStore(SQLStore):
         self._guard(lambda: self._connection().execute("SELECT 1 FROM saves LIMIT 1").fetchall())
 
     def describe(self) -> dict[str, Any]:
-        return {"kind": self.kind, "schema_version": SCHEMA_VERSION, "path": str(self.path),
-                "connections": len(self._connections)}
+        return {
+            "kind": self.kind,
+            "schema_version": SCHEMA_VERSION,
+            "path": str(self.path),
+            "connections": len(self._connections),
+        }
 
     def writable(self) -> str | None:
         try:
@@ -192,11 +204,12 @@ class SQLiteStore(SQLStore):
         except OSError as error:
             return f"the store directory {self.path.parent} cannot be read: {error}"
         if free_bytes < self.min_free_bytes:
-            return (f"the disk of the store has {free_bytes} bytes free, less than "
-                    f"COATED_STORE_MIN_FREE_BYTES ({self.min_free_bytes})")
+            return (
+                f"the disk of the store has {free_bytes} bytes free, less than "
+                f"COATED_STORE_MIN_FREE_BYTES ({self.min_free_bytes})"
+            )
         if free_bytes < _WRITE_FLOOR_BYTES:  # whatever the setting, even 0: a full disk takes no save
-            return (f"the disk of the store has {free_bytes} bytes free, less than one save needs "
-                    f"({_WRITE_FLOOR_BYTES})")
+            return f"the disk of the store has {free_bytes} bytes free, less than one save needs ({_WRITE_FLOOR_BYTES})"
         try:
             with self._in_use():
                 return self._writable_here()
@@ -212,8 +225,9 @@ class SQLiteStore(SQLStore):
             (pages,) = connection.execute("PRAGMA page_count").fetchone()
             (page_size,) = connection.execute("PRAGMA page_size").fetchone()
             if (pages + 4) * page_size > self.max_bytes:
-                return (f"the store holds {pages * page_size} bytes, at its quota "
-                        f"COATED_STORE_MAX_BYTES ({self.max_bytes})")
+                return (
+                    f"the store holds {pages * page_size} bytes, at its quota COATED_STORE_MAX_BYTES ({self.max_bytes})"
+                )
         # A write statement that changes nothing: refused by a read-only
         # store; rolled back at once so that it holds no lock. It never waits
         # for another writer's lock (a probe must answer at once): a store

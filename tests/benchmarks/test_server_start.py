@@ -13,7 +13,9 @@ from benchmarks.server_start import ROOT, by_kind, kind_of, main, start
 
 SERVER = "/r/.venv/bin/python -m service --port 40123 --data-dir /tmp/x"
 TRACKER = "/r/.venv/bin/python -B -c from multiprocessing.resource_tracker import main;main(15)"
-FORK_SERVER = "/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.runtime.preload'])"
+FORK_SERVER = (
+    "/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.runtime.preload'])"
+)
 
 
 def test_kinds_by_command_line():
@@ -43,10 +45,13 @@ def test_a_start_of_this_checkout_is_measured():
     assert run["kinds"]["server"] > 0 and run["cpu_s"] == pytest.approx(sum(run["kinds"].values()))
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--rounds", "0"], "--rounds must lie in [1, 100], got 0"),
-    (["--workers", "17"], "--workers must lie in [1, 16], got 17"),
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--rounds", "0"], "--rounds must lie in [1, 100], got 0"),
+        (["--workers", "17"], "--workers must lie in [1, 16], got 17"),
+    ],
+)
 def test_arguments_out_of_bounds_are_refused(argv, message, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(argv)

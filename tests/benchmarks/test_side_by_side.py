@@ -52,12 +52,14 @@ def test_a_side_that_fails_to_start_says_so(tmp_path):
 
 
 def test_a_checkout_is_the_commit_with_the_installed_dependencies_and_goes_away():
-    head = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True,
-                          check=True).stdout.strip()
+    head = subprocess.run(
+        ["git", "-C", str(ROOT), "rev-parse", "HEAD"], capture_output=True, text=True, check=True
+    ).stdout.strip()
     with checkout(head) as root:
         assert (root / "fitting" / "__init__.py").exists()
-        worktree_head = subprocess.run(["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True,
-                                       text=True, check=True).stdout.strip()
+        worktree_head = subprocess.run(
+            ["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True, text=True, check=True
+        ).stdout.strip()
         assert worktree_head == head
         for path in INSTALLED:
             assert (root / path).resolve() == (ROOT / path).resolve()

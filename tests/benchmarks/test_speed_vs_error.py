@@ -116,8 +116,7 @@ class TestErrorSummary:
 
 class TestParetoFront:
     def test_dominated_and_ties(self):
-        points = {"cheap": (1.0, 5.0), "good": (3.0, 1.0), "worse": (3.0, 2.0), "same": (1.0, 5.0),
-                  "mid": (2.0, 5.0)}
+        points = {"cheap": (1.0, 5.0), "good": (3.0, 1.0), "worse": (3.0, 2.0), "same": (1.0, 5.0), "mid": (2.0, 5.0)}
         # "same" ties "cheap" exactly: neither dominates the other.
         assert pareto_front(points) == ["cheap", "same", "good"]
 
@@ -125,16 +124,22 @@ class TestParetoFront:
         assert pareto_front({"a": (1.0, 1.0)}) == ["a"]
 
 
-MODELS = {"fast": ("Fast", "schlick", 12, ""), "base": ("Base", "lazanyi", 24, ""),
-          "ref": ("Reference", None, 3768, "")}
+MODELS = {
+    "fast": ("Fast", "schlick", 12, ""),
+    "base": ("Base", "lazanyi", 24, ""),
+    "ref": ("Reference", None, 3768, ""),
+}
 
 
 class TestTables:
     def test_models_table_ratios_fronts_and_no_shader(self):
-        rows = {m: {"mean": e, "max": 2 * e, "worst": "Au", "worst_mean": e, "worst_max": 2 * e}
-                for m, e in (("fast", 3.0), ("base", 2.0), ("ref", 0.0))}
-        lines, out = models_table(MODELS, rows, {"fast": 10.0, "base": 20.0, "ref": 1e4},
-                                  {"schlick": 50.0, "lazanyi": 100.0}, pixels=1000)
+        rows = {
+            m: {"mean": e, "max": 2 * e, "worst": "Au", "worst_mean": e, "worst_max": 2 * e}
+            for m, e in (("fast", 3.0), ("base", 2.0), ("ref", 0.0))
+        }
+        lines, out = models_table(
+            MODELS, rows, {"fast": 10.0, "base": 20.0, "ref": 1e4}, {"schlick": 50.0, "lazanyi": 100.0}, pixels=1000
+        )
         assert out["ratio"] == {"fast": 0.5, "base": 1.0, "ref": None}
         assert out["shader"] == ["fast", "base"] and out["cpu"] == ["fast", "base", "ref"]
         assert len(lines) == 2 + len(MODELS)
@@ -143,31 +148,54 @@ class TestTables:
 
     def test_split_sum_raw_and_net_ratios(self):
         variants = {"m": ("model", "split_sum_model", 24), "l": ("Lazanyi", "split_sum_lazanyi", 8)}
-        split = {"m": {"mean": 0.1, "max": 0.5, "worst": "W", "worst_mean": 0.2, "worst_max": 0.5,
-                       "by_roughness": [0.05, 0.15]},
-                 "l": {"mean": 4.0, "max": 9.0, "worst": "Au", "worst_mean": 6.0, "worst_max": 9.0,
-                       "by_roughness": [4.0, 4.0]}}
+        split = {
+            "m": {
+                "mean": 0.1,
+                "max": 0.5,
+                "worst": "W",
+                "worst_mean": 0.2,
+                "worst_max": 0.5,
+                "by_roughness": [0.05, 0.15],
+            },
+            "l": {
+                "mean": 4.0,
+                "max": 9.0,
+                "worst": "Au",
+                "worst_mean": 6.0,
+                "worst_max": 9.0,
+                "by_roughness": [4.0, 4.0],
+            },
+        }
         shader = {"split_sum_model": 300.0, "split_sum_lazanyi": 150.0, "split_sum_fixed": 50.0}
         lines, out = split_sum_table_lines(variants, split, {"m": 90.0, "l": 30.0}, shader, 100, (0.1, 0.6))
         assert out["raw"] == {"m": 2.0, "l": 1.0} and out["net"] == {"m": 2.5, "l": 1.0}
         assert out["front"] == ["l", "m"]
         assert "roughness 0.1 / 0.6" in lines[0]
-        assert "| model | 0.100 | 0.50 | W: 0.200 / 0.50 | 0.050 / 0.150 | 3000.00 | 2.00x / 2.50x | 90 | 24 | yes |" in lines
+        assert (
+            "| model | 0.100 | 0.50 | W: 0.200 / 0.50 | 0.050 / 0.150 | 3000.00 | 2.00x / 2.50x | 90 | 24 | yes |"
+            in lines
+        )
 
     def test_run_header_names_command_and_load(self):
         lines = run_header(["--models-only", "--batch-report", "a b/report.json"], "llvmpipe")
-        assert lines[0] == ("Command: `.venv/bin/python benchmarks/speed_vs_error.py --models-only "
-                            "--batch-report 'a b/report.json'`")
+        assert lines[0] == (
+            "Command: `.venv/bin/python benchmarks/speed_vs_error.py --models-only --batch-report 'a b/report.json'`"
+        )
         assert "load average" in lines[1] and lines[1].endswith("GL: llvmpipe")
 
 
 def _record(page, status, kinds=None, laz=None):
     """A journal record as fitting.batch.page makes it, with only the means that matter here."""
     fitted = status == "fitted"
-    return {"page": page, "status": status, "reason": None if fitted else "covers 10% of 360-830 nm",
-            "coverage": 1.0 if fitted else 0.1, "wavelength_range_nm": [300.0, 900.0],
-            "kinds": {k: {"delta_E_mean": v, "delta_E_max": 2 * v} for k, v in (kinds or {}).items()},
-            "baselines": {b: {"delta_E_mean": laz, "delta_E_max": 2 * laz} for b in BASELINES} if fitted else {}}
+    return {
+        "page": page,
+        "status": status,
+        "reason": None if fitted else "covers 10% of 360-830 nm",
+        "coverage": 1.0 if fitted else 0.1,
+        "wavelength_range_nm": [300.0, 900.0],
+        "kinds": {k: {"delta_E_mean": v, "delta_E_max": 2 * v} for k, v in (kinds or {}).items()},
+        "baselines": {b: {"delta_E_mean": laz, "delta_E_max": 2 * laz} for b in BASELINES} if fitted else {},
+    }
 
 
 @pytest.fixture
@@ -182,10 +210,18 @@ def report(tmp_path):
         _record("main/D/x", "fitted", {"coated-conductor": 9.0, "rgb-conductor": 1.5}, laz=2.0),
         _record("main/E/x", "skipped"),
     ]
-    config = {"model_kinds": list(kinds), "baselines": list(baselines), "grid": "100x100",
-              "eta_i_range": [1.0, 2.5], "reference_step_nm": 1.0}
-    body = {"config": config, "summary": accuracy_summary(records, kinds, baselines),
-            "pages": report_rows(records, kinds, baselines)}
+    config = {
+        "model_kinds": list(kinds),
+        "baselines": list(baselines),
+        "grid": "100x100",
+        "eta_i_range": [1.0, 2.5],
+        "reference_step_nm": 1.0,
+    }
+    body = {
+        "config": config,
+        "summary": accuracy_summary(records, kinds, baselines),
+        "pages": report_rows(records, kinds, baselines),
+    }
     path = tmp_path / "shelf" / "report.json"
     path.parent.mkdir()
     path.write_text(json.dumps(body), encoding="utf-8")
@@ -218,15 +254,39 @@ class TestBatchSummary:
         assert "| rgb-conductor | 3.475 | 0.900 | 8.850 | 12.00 | 50% | 0% | 25% | 0% | 0% | 25% | 75.0% |" in lines
 
     def test_kinds_table_one_column_per_report(self, report):
-        rows = [{"name": "coated-conductor", "label": "coated", "bytes": 54, "mean": 0.147, "max": 1.27,
-                 "shader_ns_px": 10.0, "shader_ratio": 2.9, "cpu_ns": 236.0, "split_mean": 0.2, "split_ratio": 2.7},
-                {"name": "rgb-conductor", "label": "rgb", "bytes": 12, "mean": 0.019, "max": 0.22,
-                 "shader_ns_px": 6.0, "shader_ratio": 1.6, "cpu_ns": 500.0, "split_mean": None, "split_ratio": None}]
+        rows = [
+            {
+                "name": "coated-conductor",
+                "label": "coated",
+                "bytes": 54,
+                "mean": 0.147,
+                "max": 1.27,
+                "shader_ns_px": 10.0,
+                "shader_ratio": 2.9,
+                "cpu_ns": 236.0,
+                "split_mean": 0.2,
+                "split_ratio": 2.7,
+            },
+            {
+                "name": "rgb-conductor",
+                "label": "rgb",
+                "bytes": 12,
+                "mean": 0.019,
+                "max": 0.22,
+                "shader_ns_px": 6.0,
+                "shader_ratio": 1.6,
+                "cpu_ns": 500.0,
+                "split_mean": None,
+                "split_ratio": None,
+            },
+        ]
         lines = kinds_table(rows, [report, report])
         assert lines[0].count("batch shelf (4 pages)") == 2
         assert lines[1].count("|") == lines[0].count("|")
-        assert lines[2] == ("| coated | 54 | 0.147 | 1.27 | 10.00 | 2.90x | 236 | 0.200 | 2.70x | "
-                            "1.850 / 7.200 / 9.00; 75.0% | 1.850 / 7.200 / 9.00; 75.0% |")
+        assert lines[2] == (
+            "| coated | 54 | 0.147 | 1.27 | 10.00 | 2.90x | 236 | 0.200 | 2.70x | "
+            "1.850 / 7.200 / 9.00; 75.0% | 1.850 / 7.200 / 9.00; 75.0% |"
+        )
         assert "| no split-sum table | n/a |" in lines[3]
 
     def test_not_a_report_is_refused_by_file(self, tmp_path):

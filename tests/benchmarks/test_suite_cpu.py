@@ -17,24 +17,29 @@ from benchmarks.suite_time import TICK, calibration
 CHROMIUM = "/usr/lib/chromium/chromium --headless --no-sandbox"
 
 
-@pytest.mark.parametrize("command, key", [
-    (f"{CHROMIUM} --type=renderer --enable-automation", "chromium_renderer"),
-    (f"{CHROMIUM} --type=gpu-process --use-angle=swiftshader", "chromium_gpu"),
-    (f"{CHROMIUM} --type=zygote", "chromium_other"),
-    (f"{CHROMIUM} --remote-debugging-pipe", "chromium_browser"),
-    ("/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.runtime.preload'])",
-     "fork_servers"),
-    ("/r/.venv/bin/python -m service --host 127.0.0.1 --port 40123 --data-dir /tmp/x", "servers"),
-    (".venv/bin/python -m pytest -n 2 --dist loadscope", "pytest"),
-    ("/r/.venv/bin/python -u -c import sys;exec(eval(sys.stdin.readline()))", "pytest"),
-    ("/r/.venv/lib/python3.11/site-packages/playwright/driver/node run-driver", "playwright"),
-    ("node node_modules/gltf-validator/cli.js a.gltf", "node"),
-    ("/usr/lib/postgresql/15/bin/postgres -D /tmp/coated-pg-1", "postgres"),
-    ("/r/.venv/bin/python -m fitting fit Au --eta-i 1.5", "cli"),
-    ("/r/.venv/bin/python -c print(1)", "other_python"),
-    ("/usr/bin/glslangValidator shader.frag", "other"),
-    ("", "kernel"),
-])
+@pytest.mark.parametrize(
+    "command, key",
+    [
+        (f"{CHROMIUM} --type=renderer --enable-automation", "chromium_renderer"),
+        (f"{CHROMIUM} --type=gpu-process --use-angle=swiftshader", "chromium_gpu"),
+        (f"{CHROMIUM} --type=zygote", "chromium_other"),
+        (f"{CHROMIUM} --remote-debugging-pipe", "chromium_browser"),
+        (
+            "/r/.venv/bin/python -B -c from multiprocessing.forkserver import main; main(18, 19, ['service.runtime.preload'])",
+            "fork_servers",
+        ),
+        ("/r/.venv/bin/python -m service --host 127.0.0.1 --port 40123 --data-dir /tmp/x", "servers"),
+        (".venv/bin/python -m pytest -n 2 --dist loadscope", "pytest"),
+        ("/r/.venv/bin/python -u -c import sys;exec(eval(sys.stdin.readline()))", "pytest"),
+        ("/r/.venv/lib/python3.11/site-packages/playwright/driver/node run-driver", "playwright"),
+        ("node node_modules/gltf-validator/cli.js a.gltf", "node"),
+        ("/usr/lib/postgresql/15/bin/postgres -D /tmp/coated-pg-1", "postgres"),
+        ("/r/.venv/bin/python -m fitting fit Au --eta-i 1.5", "cli"),
+        ("/r/.venv/bin/python -c print(1)", "other_python"),
+        ("/usr/bin/glslangValidator shader.frag", "other"),
+        ("", "kernel"),
+    ],
+)
 def test_a_process_is_classed_by_its_command_line(command, key):
     assert classify(command) == key
     assert key in LABELS
@@ -43,7 +48,9 @@ def test_a_process_is_classed_by_its_command_line(command, key):
 def test_a_server_s_forks_are_fork_servers():
     server = "/r/.venv/bin/python -m service --host 127.0.0.1 --port 40123 --data-dir /tmp/x"
     assert classify(server, "pytest") == "servers"
-    assert classify(server, "servers") == "fork_servers"  # its fork server (service.runtime.fork_server.start_fork_server)
+    assert (
+        classify(server, "servers") == "fork_servers"
+    )  # its fork server (service.runtime.fork_server.start_fork_server)
     assert classify(server, "fork_servers") == "fork_servers"  # that fork server's workers
     assert classify(".venv/bin/python -m pytest", "servers") == "pytest"
 
@@ -69,8 +76,11 @@ def test_the_sampler_counts_a_child_s_cpu_time_in_its_class():
     assert child.wait(timeout=60) == 0
     sampler.done.set()
     sampler.join()
-    mine = [(label, (last - first) / TICK) for (pid, _), (label, first, last, _) in sampler.seen.items()
-            if pid == str(child.pid)]
+    mine = [
+        (label, (last - first) / TICK)
+        for (pid, _), (label, first, last, _) in sampler.seen.items()
+        if pid == str(child.pid)
+    ]
     assert [label for label, _ in mine] == ["other_python"], mine
     # Its whole CPU time but what it spent after the last sample (under one interval), and its start-up.
     assert 0.9 <= mine[0][1] <= 1.5, mine

@@ -17,12 +17,21 @@ def test_the_side_by_side_runs_scripts_test_s_full_suite():
     assert f'"$py" -m compileall -q {" ".join(COMPILED)} >/dev/null\n' in script
 
 
-@pytest.mark.parametrize("argv, message", [
-    (["--rounds", "0"], "--rounds must lie in [1, 5], got 0"),
-    (["--name", "../suite_time"], "--name must be suite_time_ and lower-case letters, digits or _, got '../suite_time'"),
-    pytest.param(["--before", "no-such-commit"], "--before must name a commit of this repository, got 'no-such-commit'",
-                 marks=pytest.mark.slow),  # asks git
-])
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--rounds", "0"], "--rounds must lie in [1, 5], got 0"),
+        (
+            ["--name", "../suite_time"],
+            "--name must be suite_time_ and lower-case letters, digits or _, got '../suite_time'",
+        ),
+        pytest.param(
+            ["--before", "no-such-commit"],
+            "--before must name a commit of this repository, got 'no-such-commit'",
+            marks=pytest.mark.slow,
+        ),  # asks git
+    ],
+)
 def test_arguments_out_of_bounds_are_refused(argv, message, capsys):
     with pytest.raises(SystemExit) as exit_:
         main(argv)
@@ -35,9 +44,18 @@ def test_the_memory_calibration_takes_cpu_time():
 
 
 def test_each_mode_s_median_and_worst_run():
-    rows = [{"mode": mode_name(args), "seconds": seconds, "returncode": code}
-            for args, seconds, code in [(["--quick"], 50.0, 0), ([], 300.0, 0), (["--quick"], 61.0, 0), ([], 380.0, 1),
-                                        (["--quick"], 52.0, 0), ([], 310.0, 0), (["--other-cpus"], 190.0, 0)]]
+    rows = [
+        {"mode": mode_name(args), "seconds": seconds, "returncode": code}
+        for args, seconds, code in [
+            (["--quick"], 50.0, 0),
+            ([], 300.0, 0),
+            (["--quick"], 61.0, 0),
+            ([], 380.0, 1),
+            (["--quick"], 52.0, 0),
+            ([], 310.0, 0),
+            (["--other-cpus"], 190.0, 0),
+        ]
+    ]
     figures = mode_figures(rows)
     assert list(figures) == ["quick", "full", "other-cpus"]
     assert figures["quick"] == {"runs": 3, "median_s": 52.0, "worst_s": 61.0, "all_passed": True}

@@ -14,6 +14,7 @@ def test_builds_once_and_drops_the_least_recently_used():
         def build():
             built.append(key)
             return [key]
+
         return build
 
     a = cache.get("a", builder("a"))

@@ -134,12 +134,12 @@ class TestDomainEnds:
         assert result.success
         assert result.eta_i_range == eta_i_range
         metrics = result.metrics["model_float16"]
-        assert np.isfinite(metrics["delta_E_mean"]) and metrics["delta_E_mean"] < 1.0  # product figure (docs/hard-cases.md)
+        assert (
+            np.isfinite(metrics["delta_E_mean"]) and metrics["delta_E_mean"] < 1.0
+        )  # product figure (docs/hard-cases.md)
         assert result.degree == (0 if eta_i_range[0] == eta_i_range[1] else 2)
 
-    @pytest.mark.parametrize(
-        "eta_i_range", [(0.99, 2.0), (1.0, 3.0000001), (2.0, 1.5), (1.0, float("nan"))]
-    )
+    @pytest.mark.parametrize("eta_i_range", [(0.99, 2.0), (1.0, 3.0000001), (2.0, 1.5), (1.0, float("nan"))])
     def test_outside_the_domain_is_refused(self, eta_i_range):
         with pytest.raises(ValueError, match="`eta_i_range` must"):
             fit_material(library_material("Cr"), eta_i_range)
@@ -183,8 +183,7 @@ FLOAT16_EXTREMES = {
     "min": np.full((3, 3, 3), -FLOAT16_MAX),
     "alpha negative": np.concatenate([np.full((2, 3, 3), 0.5), np.full((1, 3, 3), -FLOAT16_MAX)]),
     "subnormal": np.full((3, 3, 3), 2.0**-24),
-    "mixed": np.stack([np.full((3, 3), FLOAT16_MAX), np.full((3, 3), -FLOAT16_MAX),
-                       np.full((3, 3), 2.0**-24)]),
+    "mixed": np.stack([np.full((3, 3), FLOAT16_MAX), np.full((3, 3), -FLOAT16_MAX), np.full((3, 3), 2.0**-24)]),
 }
 
 
@@ -219,9 +218,9 @@ class TestEvaluateWithLowCoverage:
 
 
 class TestSingleIndexFitWithUnidentifiableExponent:
-    @pytest.mark.parametrize("name, eta_i", [("Ag", 1.5151515151515151),
-                                             ("Fe", 1.8787878787878789),
-                                             ("Ta", 2.121212121212121)])
+    @pytest.mark.parametrize(
+        "name, eta_i", [("Ag", 1.5151515151515151), ("Fe", 1.8787878787878789), ("Ta", 2.121212121212121)]
+    )
     def test_fits(self, name, eta_i):
         result = fit_material(library_material(name), (eta_i, eta_i))
         assert np.all(np.isfinite(result.coefficients_float16))
@@ -243,10 +242,12 @@ class TestShaderOnHardCases:
 
         nk = HARD_CASES[name][0]()
         packed = fit_material(nk).packed
-        F, mu, eta = evaluate_grid(thread, "packed", shader_inputs(packed),
-                                   (0.0, 1.0 / 63.0, 64), (1.0, 2.0 / 31.0, 32))
-        expected = coated_conductor_model(mu.astype(np.float64), eta.astype(np.float64),
-                                          packed.coefficients, packed.eta_i_range)
+        F, mu, eta = evaluate_grid(
+            thread, "packed", shader_inputs(packed), (0.0, 1.0 / 63.0, 64), (1.0, 2.0 / 31.0, 32)
+        )
+        expected = coated_conductor_model(
+            mu.astype(np.float64), eta.astype(np.float64), packed.coefficients, packed.eta_i_range
+        )
         assert np.all(np.isfinite(F))
         assert np.abs(F - expected).max() <= GLSL_MODEL_REL * max(1.0, np.abs(expected).max())
 
@@ -255,11 +256,13 @@ class TestShaderOnHardCases:
         from preview_shaders.evaluate import evaluate_grid, shader_inputs
 
         packed = PackedMaterial(name, to_float16(FLOAT16_EXTREMES[name]), (1.0, 2.5))
-        F, mu, eta = evaluate_grid(thread, "packed", shader_inputs(packed),
-                                   (0.0, 1.0 / 63.0, 64), (1.0, 2.0 / 15.0, 16))
+        F, mu, eta = evaluate_grid(
+            thread, "packed", shader_inputs(packed), (0.0, 1.0 / 63.0, 64), (1.0, 2.0 / 15.0, 16)
+        )
         assert np.all(np.isfinite(F))
-        expected = coated_conductor_model(mu.astype(np.float64), eta.astype(np.float64),
-                                          packed.coefficients, packed.eta_i_range)
+        expected = coated_conductor_model(
+            mu.astype(np.float64), eta.astype(np.float64), packed.coefficients, packed.eta_i_range
+        )
         # float32 arithmetic on values up to ~2e5: relative agreement.
         assert np.abs(F - expected).max() <= GLSL_MODEL_REL * max(1.0, np.abs(expected).max())
 
@@ -268,11 +271,11 @@ class TestShaderOnHardCases:
 
         packed = PackedMaterial("x", np.zeros((3, 3, 1), np.float16), (1.5, 1.5))
         n, k = np.array([1.46, 1.46, 1.46]), np.zeros(3)
-        F, mu, eta = evaluate_grid(thread, "exact", shader_inputs(packed, n=n, k=k),
-                                   (0.0, 1.0 / 127.0, 128), (1.0, 2.0 / 15.0, 16))
+        F, mu, eta = evaluate_grid(
+            thread, "exact", shader_inputs(packed, n=n, k=k), (0.0, 1.0 / 127.0, 128), (1.0, 2.0 / 15.0, 16)
+        )
         assert np.all(np.isfinite(F))
-        expected = fresnel_conductor(mu.astype(np.float64)[..., None],
-                                     eta.astype(np.float64)[..., None], n, k)
+        expected = fresnel_conductor(mu.astype(np.float64)[..., None], eta.astype(np.float64)[..., None], n, k)
         # float32 Fresnel near the critical angle: t0 = 1 - (eta_i / n)^2 (1 -
         # mu^2) carries ~4 u32 (eta_i / n)^2 = 1e-6 absolute, its square root
         # 1e-6 / (2 sqrt(t0)), and R moves by <= ~4 per unit of sqrt(t0): at the

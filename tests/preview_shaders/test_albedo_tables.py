@@ -21,7 +21,11 @@ from fitting.models.pack import pack_from_json
 from fitting.optics.fresnel import fresnel_dielectric
 from fitting.optics.library import library_material
 from fitting.shading.ibl import (
-    default_lut, directional_albedo, split_sum_lazanyi, split_sum_model, split_sum_schlick,
+    default_lut,
+    directional_albedo,
+    split_sum_lazanyi,
+    split_sum_model,
+    split_sum_schlick,
 )
 from preview_shaders.gl import RenderThread, check_gl_error, read_float_target
 from preview_shaders.preview import padded_words
@@ -86,10 +90,15 @@ def _tables(thread, gold, nk, eta_i, roughness, coat_roughness):
     b = baseline_inputs(nk)
     lut = default_lut()
     uniforms = {
-        "u_resolution": (float(NODES), 3.0), "u_eta_i": eta_i, "u_roughness": roughness,
-        "u_coat_roughness": coat_roughness, "cf_words": padded_words(gold).tolist(),
-        "cf_eta_i_range": tuple(gold.eta_i_range), "cf_F0_air": tuple(b["F0_air"]),
-        "cf_F82_air": tuple(b["F82_air"]), "cf_alpha_range": lut.alpha_range,
+        "u_resolution": (float(NODES), 3.0),
+        "u_eta_i": eta_i,
+        "u_roughness": roughness,
+        "u_coat_roughness": coat_roughness,
+        "cf_words": padded_words(gold).tolist(),
+        "cf_eta_i_range": tuple(gold.eta_i_range),
+        "cf_F0_air": tuple(b["F0_air"]),
+        "cf_F82_air": tuple(b["F82_air"]),
+        "cf_alpha_range": lut.alpha_range,
     }
     return thread.call(_render, "albedo_table.frag", 3, uniforms, {"cf_lut": lambda state: upload_lut(state, lut)})
 
@@ -101,8 +110,9 @@ def test_albedo_table_rows_are_the_numpy_split_sums(thread, gold, eta_i, roughne
     p = collapse_to_eta_i(gold.coefficients.astype(np.float64), eta_i, gold.eta_i_range)[..., 0]
     np.testing.assert_allclose(got[0], split_sum_model(MU, roughness, p[0], p[1], p[2]), atol=TOLERANCE)
     b = baseline_inputs(nk)
-    np.testing.assert_allclose(got[1], split_sum_lazanyi(MU, roughness, eta_i, b["F0_air"], b["F82_air"]),
-                               atol=TOLERANCE)
+    np.testing.assert_allclose(
+        got[1], split_sum_lazanyi(MU, roughness, eta_i, b["F0_air"], b["F82_air"]), atol=TOLERANCE
+    )
     F0c = ((eta_i - 1.0) / (eta_i + 1.0)) ** 2
     coat = split_sum_schlick(MU, coat_roughness, np.full(3, F0c)) if eta_i > 1.0 else np.zeros((NODES, 3))
     np.testing.assert_allclose(got[2], coat, atol=TOLERANCE)
@@ -119,16 +129,20 @@ def test_mirrors_are_their_fresnel(thread, gold):
     np.testing.assert_allclose(got[0], model, atol=TOLERANCE)
     b = baseline_inputs(nk)
     np.testing.assert_allclose(got[1], lazanyi_adjusted(MU, 1.7, b["F0_air"], b["F82_air"]), atol=TOLERANCE)
-    np.testing.assert_allclose(got[2], np.repeat(fresnel_dielectric(MU, 1.0, 1.7)[:, None], 3, axis=1),
-                               atol=TOLERANCE)
+    np.testing.assert_allclose(got[2], np.repeat(fresnel_dielectric(MU, 1.0, 1.7)[:, None], 3, axis=1), atol=TOLERANCE)
 
 
 @pytest.mark.parametrize("eta_i, roughness", [(1.5, 0.45), (2.4, 0.05), (1.2, 1.0)])
 def test_reference_albedo_is_the_numpy_directional_albedo(thread, eta_i, roughness):
     base = curve_base_from_nk(library_material("Cu"), (1.0, 2.5))
     RGB = np.ascontiguousarray(base.RGB, dtype="f4")
-    uniforms = {"u_resolution": (float(NODES), 1.0), "u_eta_i": eta_i, "u_roughness": roughness,
-                "u_samples": 2048, "u_reference_eta_i_range": tuple(base.eta_i_range)}
+    uniforms = {
+        "u_resolution": (float(NODES), 1.0),
+        "u_eta_i": eta_i,
+        "u_roughness": roughness,
+        "u_samples": 2048,
+        "u_reference_eta_i_range": tuple(base.eta_i_range),
+    }
 
     def texture(state):
         made = state.ctx.texture((RGB.shape[1], RGB.shape[0]), 3, RGB.tobytes(), dtype="f4")

@@ -70,8 +70,9 @@ def test_detects_a_changed_alpha(thread, lut):
 def test_every_split_sum_timing_variant_renders(thread, lut):
     from preview_shaders.shading import SPLIT_SUM_VARIANTS, time_split_sum
 
-    samples = time_split_sum(thread, lut, (0.5,) * 3, (0.2,) * 3, (5.0,) * 3, (0.5,) * 3, (0.3,) * 3,
-                             (0.6,) * 3, 64, 32, 2)
+    samples = time_split_sum(
+        thread, lut, (0.5,) * 3, (0.2,) * 3, (5.0,) * 3, (0.5,) * 3, (0.3,) * 3, (0.6,) * 3, 64, 32, 2
+    )
     assert set(samples) == set(SPLIT_SUM_VARIANTS)
     for values in samples.values():
         assert values.shape == (2, 3) and np.all(np.isfinite(values)) and np.all(values[:, 1] > 0)

@@ -62,7 +62,8 @@ class TestRenderMaterialX:
 
     def test_refuses_invalid_documents(self):
         with pytest.raises(ValueError, match="does not validate"):
-            render_materialx(bare_conductor([1, 1, 1], [2, 2, 2]).replace(
-                'nodename="metal"', 'nodename="missing"'), SIZE)
+            render_materialx(
+                bare_conductor([1, 1, 1], [2, 2, 2]).replace('nodename="metal"', 'nodename="missing"'), SIZE
+            )
         with pytest.raises(ValueError, match="`size` must be an integer in"):
             render_materialx(bare_conductor([1, 1, 1], [2, 2, 2]), 8)

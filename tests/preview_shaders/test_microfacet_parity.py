@@ -54,7 +54,10 @@ def test_immersed_matches_numpy(thread, name, roughness, phi):
 @pytest.mark.parametrize(
     "roughness, coat_roughness, tolerance",
     [
-        (0.3, 0.0, TOLERANCE), (0.6, 0.1, TOLERANCE), (0.1, 0.5, TOLERANCE), (1.0, 1.0, TOLERANCE),
+        (0.3, 0.0, TOLERANCE),
+        (0.6, 0.1, TOLERANCE),
+        (0.1, 0.5, TOLERANCE),
+        (1.0, 1.0, TOLERANCE),
         # At r = 0.05 (alpha_g^2 = 6e-6) the base's peak inside the coat is
         # ill-conditioned in float32: the refracted directions round by
         # ~6e-8, which moves sin^2(theta_h) by a part of alpha_g^2 and D by
@@ -65,12 +68,17 @@ def test_immersed_matches_numpy(thread, name, roughness, phi):
 def test_coated_matches_numpy(thread, eta_i, roughness, coat_roughness, tolerance):
     F0, a, alpha = PARAMETERS["Cr"]
     for phi in (np.pi, 1.0):
-        f, V, L = evaluate_brdf_grid(
-            thread, "coated", F0, a, alpha, roughness, eta_i, coat_roughness, phi=phi
-        )
+        f, V, L = evaluate_brdf_grid(thread, "coated", F0, a, alpha, roughness, eta_i, coat_roughness, phi=phi)
         expected = microfacet_brdf(
-            V.astype(np.float64), L.astype(np.float64), roughness, F0, a, alpha,
-            "coated", eta_i, coat_roughness,
+            V.astype(np.float64),
+            L.astype(np.float64),
+            roughness,
+            F0,
+            a,
+            alpha,
+            "coated",
+            eta_i,
+            coat_roughness,
         )
         assert np.all(np.isfinite(f))
         assert _error(f, expected) <= tolerance

@@ -50,8 +50,10 @@ def nk():
 
 def _model(packed, cos_theta, eta_i):
     return coated_conductor_model(
-        np.asarray(cos_theta, dtype=np.float64), eta_i,
-        packed.coefficients.astype(np.float64), packed.eta_i_range,
+        np.asarray(cos_theta, dtype=np.float64),
+        eta_i,
+        packed.coefficients.astype(np.float64),
+        packed.eta_i_range,
     )
 
 
@@ -76,7 +78,10 @@ class TestSphereValues:
             # Near the rim: GLSL_F32_BOUND plus the float32 cos theta's error
             # (u32 / z, z >= ~0.1 here: 6e-7) times the model's slope there
             # (<= ~10): 1e-5 + 6e-6 < 2e-5.
-            result.image[row, column], _model(gold, cos_theta[row, column], 2.0), atol=2e-5, rtol=0
+            result.image[row, column],
+            _model(gold, cos_theta[row, column], 2.0),
+            atol=2e-5,
+            rtol=0,
         )
 
     def test_every_sphere_pixel_is_the_model_under_the_white_sky(self, renderer, gold):
@@ -96,8 +101,10 @@ class TestSphereValues:
         right[:, 32:] = True
         inputs = baseline_inputs(nk)
         expected = lazanyi_adjusted(
-            result.cos_theta[result.mask & right].astype(np.float64), 2.5,
-            inputs["F0_air"], inputs["F82_air"],
+            result.cos_theta[result.mask & right].astype(np.float64),
+            2.5,
+            inputs["F0_air"],
+            inputs["F82_air"],
         )
         assert np.abs(result.image[result.mask & right] - expected).max() <= GLSL_F32_BOUND
         left = result.mask & ~right
@@ -202,8 +209,20 @@ class TestCommandLine:
         pack.write_bytes(encode_pack(pack_from_json((GOLDEN / "Au_golden.json").read_text())))
         out = tmp_path / "out.png"
         eta_i, size, compare, environment = CASES["preview_Au_lazanyi_2.5"]
-        run = self._run("--fit", str(pack), "--eta-i", str(eta_i), "--size", str(size),
-                        "--compare", compare, "--environment", environment, "-o", str(out))
+        run = self._run(
+            "--fit",
+            str(pack),
+            "--eta-i",
+            str(eta_i),
+            "--size",
+            str(size),
+            "--compare",
+            compare,
+            "--environment",
+            environment,
+            "-o",
+            str(out),
+        )
         assert run.returncode == 0, run.stderr
         np.testing.assert_array_equal(
             np.asarray(Image.open(out).convert("RGB")),
@@ -211,8 +230,7 @@ class TestCommandLine:
         )
 
     def test_bad_size_is_an_error(self, tmp_path):
-        run = self._run("--fit", str(GOLDEN / "Au_golden.json"), "--size", "4096",
-                        "-o", str(tmp_path / "x.png"))
+        run = self._run("--fit", str(GOLDEN / "Au_golden.json"), "--size", "4096", "-o", str(tmp_path / "x.png"))
         assert run.returncode == 2
         assert "`size` must lie in [64, 2048], got 4096" in run.stderr
         assert not (tmp_path / "x.png").exists()

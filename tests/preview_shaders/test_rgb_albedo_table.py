@@ -31,11 +31,17 @@ def nk_rgb():
 
 def _table(thread, n, k, eta_i, roughness, coat_roughness):
     lut = default_lut()
-    uniforms = {"u_resolution": (float(NODES), 3.0), "u_eta_i": eta_i, "u_roughness": roughness,
-                "u_coat_roughness": coat_roughness, "cf_n": tuple(n), "cf_k": tuple(k),
-                "u_samples": 2048, "cf_alpha_range": lut.alpha_range}
-    return thread.call(_render, "rgb_albedo_table.frag", 3, uniforms,
-                       {"cf_lut": lambda state: upload_lut(state, lut)})
+    uniforms = {
+        "u_resolution": (float(NODES), 3.0),
+        "u_eta_i": eta_i,
+        "u_roughness": roughness,
+        "u_coat_roughness": coat_roughness,
+        "cf_n": tuple(n),
+        "cf_k": tuple(k),
+        "u_samples": 2048,
+        "cf_alpha_range": lut.alpha_range,
+    }
+    return thread.call(_render, "rgb_albedo_table.frag", 3, uniforms, {"cf_lut": lambda state: upload_lut(state, lut)})
 
 
 @pytest.mark.parametrize("eta_i, roughness, coat_roughness", [(1.5, 0.45, 0.2), (2.3, 0.9, 0.0), (1.0, 0.1, 0.3)])

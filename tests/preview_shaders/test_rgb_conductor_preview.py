@@ -30,9 +30,10 @@ def test_rgb_conductor_preview_against_reference(renderer):
     assert ours.delta_E_mean < paper.delta_E_mean
     # The left half is the kind's Fresnel times the environment, pixel by pixel.
     mask = ours.mask[:, :32]
-    expected = rgb_conductor_model(
-        ours.cos_theta[:, :32][mask].astype(np.float64), 1.5, rgb.coefficients.astype(np.float64)
-    ) * ours.radiance[:, :32][mask]
+    expected = (
+        rgb_conductor_model(ours.cos_theta[:, :32][mask].astype(np.float64), 1.5, rgb.coefficients.astype(np.float64))
+        * ours.radiance[:, :32][mask]
+    )
     # The exact rgb-conductor Fresnel in float32 GLSL: its cancelling
     # 1 - sin^2 term near the critical angle (as in test_hard_cases' 1e-4:
     # 6e-5 at the closest pixel) times the radiance; not the smooth model's 1e-5.

@@ -66,16 +66,14 @@ class TestWhiteSky:
         np.testing.assert_array_equal(result.radiance[result.mask], 1.0)
 
     def test_coated_is_the_numpy_coated_split_sum(self, renderer, gold):
-        result = renderer.render_preview(gold, None, 2.0, 65, roughness=0.4, mode="coated",
-                                         coat_roughness=0.2)
+        result = renderer.render_preview(gold, None, 2.0, 65, roughness=0.4, mode="coated", coat_roughness=0.2)
         mu = result.cos_theta[result.mask].astype(np.float64)
         expected = split_sum_coated(mu, 0.4, *_params(gold, 2.0), 2.0, 0.2)
         np.testing.assert_allclose(result.model[result.mask], expected, atol=SPLIT_SUM_BOUND)
 
     def test_coated_at_eta_1_equals_immersed(self, renderer, gold):
         immersed = renderer.render_preview(gold, None, 1.0, 65, roughness=0.5)
-        coated = renderer.render_preview(gold, None, 1.0, 65, roughness=0.5, mode="coated",
-                                         coat_roughness=0.7)
+        coated = renderer.render_preview(gold, None, 1.0, 65, roughness=0.5, mode="coated", coat_roughness=0.7)
         np.testing.assert_allclose(coated.image, immersed.image, atol=1e-6)  # eta_i = 1:
         # the coat's terms are identities up to a few float32 roundings (3e-7)
 
@@ -89,8 +87,9 @@ class TestWhiteSky:
         assert np.array_equal(result.image[:, 32:], result.comparison[:, 32:])
 
     def test_reference_near_mirror_is_the_smooth_reference(self, renderer, gold, nk):
-        rough = renderer.render_preview(gold, nk, 1.5, 65, "reference", roughness=0.0,
-                                        mode="coated")  # coated path, rough shader, r = 0
+        rough = renderer.render_preview(
+            gold, nk, 1.5, 65, "reference", roughness=0.0, mode="coated"
+        )  # coated path, rough shader, r = 0
         smooth = renderer.render_preview(gold, nk, 1.5, 65, "reference")
         # The smooth reference at eta_i 1.5 is the immersed mirror; the coated
         # reference at r = 0 is the coat over it. Check the immersed table instead:
@@ -129,8 +128,7 @@ class TestPrefilter:
 
     def test_studio_sphere_gets_smoother(self, renderer, gold):
         def roughness_texture(r):
-            result = renderer.render_preview(gold, None, 1.5, 96, environment="studio",
-                                             roughness=r)
+            result = renderer.render_preview(gold, None, 1.5, 96, environment="studio", roughness=r)
             inner = result.mask & np.roll(result.mask, 1, 0) & np.roll(result.mask, 1, 1)
             g = result.model[..., 1]
             grad = np.abs(g - np.roll(g, 1, 0)) + np.abs(g - np.roll(g, 1, 1))
@@ -168,19 +166,33 @@ class TestCommandLine:
         from preview_shaders.display import ACEScg_to_sRGB, to_uint8
 
         out = tmp_path / "rough.png"
-        run = self._run("--fit", str(GOLDEN / "Au_golden.json"), "--eta-i", "1.8", "--size", "64",
-                        "--roughness", "0.45", "--mode", "coated", "--coat-roughness", "0.2",
-                        "-o", str(out))
+        run = self._run(
+            "--fit",
+            str(GOLDEN / "Au_golden.json"),
+            "--eta-i",
+            "1.8",
+            "--size",
+            "64",
+            "--roughness",
+            "0.45",
+            "--mode",
+            "coated",
+            "--coat-roughness",
+            "0.2",
+            "-o",
+            str(out),
+        )
         assert run.returncode == 0, run.stderr
         assert "coated, roughness 0.45, coat roughness 0.2" in run.stdout
-        expected = renderer.render_preview(gold, None, 1.8, 64, roughness=0.45, mode="coated",
-                                           coat_roughness=0.2)
-        np.testing.assert_array_equal(np.asarray(Image.open(out).convert("RGB")),
-                                      to_uint8(ACEScg_to_sRGB(expected.image)))
+        expected = renderer.render_preview(gold, None, 1.8, 64, roughness=0.45, mode="coated", coat_roughness=0.2)
+        np.testing.assert_array_equal(
+            np.asarray(Image.open(out).convert("RGB")), to_uint8(ACEScg_to_sRGB(expected.image))
+        )
 
     def test_bad_roughness_is_an_error(self, tmp_path):
-        run = self._run("--fit", str(GOLDEN / "Au_golden.json"), "--size", "64",
-                        "--roughness", "2", "-o", str(tmp_path / "x.png"))
+        run = self._run(
+            "--fit", str(GOLDEN / "Au_golden.json"), "--size", "64", "--roughness", "2", "-o", str(tmp_path / "x.png")
+        )
         assert run.returncode == 2
         assert "`roughness` must lie in [0, 1], got 2.0" in run.stderr
         assert not (tmp_path / "x.png").exists()

@@ -28,13 +28,14 @@ def test_shader_ball_compiles_as_desktop_glsl_for_every_kind():
             sources = {PREVIEW_MODEL_FILE: preview_model_source(kind, inline=True)}
             # The mirror reads the packed words, the split sum its albedo table;
             # a kind without the split-sum lookup has its table row by quadrature.
-            passes = [("shader_ball.frag", {}, {"cf_words", "u_reference", "u_eye", "u_panel_kind", "u_output"}),
-                      ("shader_ball.frag", {"CF_SPLIT_SUM": 1}, {"u_albedo", "u_prefiltered"})]
+            passes = [
+                ("shader_ball.frag", {}, {"cf_words", "u_reference", "u_eye", "u_panel_kind", "u_output"}),
+                ("shader_ball.frag", {"CF_SPLIT_SUM": 1}, {"u_albedo", "u_prefiltered"}),
+            ]
             if not kind.split_sum:
                 passes.append(("model_albedo_table.frag", {}, {"cf_words", "u_roughness", "u_samples"}))
             for name, defines, used in passes:
-                program = ctx.program(vertex_shader=vertex,
-                                      fragment_shader=load_shader_source(name, defines, sources))
+                program = ctx.program(vertex_shader=vertex, fragment_shader=load_shader_source(name, defines, sources))
                 assert used <= set(program), (kind.name, name, defines)
                 program.release()
     finally:

@@ -75,8 +75,20 @@ def _numpy_inputs(mu, eta):
 class TestHalvesDecoding:
     def test_decodes_exactly_numpy_float16(self, thread):
         special = np.array(
-            [0.0, -0.0, 1.0, -1.0, 65504.0, -65504.0, 2.0**-24, -(2.0**-24), 2.0**-14,
-             6.103515625e-05 - 2.0**-24, 0.333251953125, 1.0009765625],
+            [
+                0.0,
+                -0.0,
+                1.0,
+                -1.0,
+                65504.0,
+                -65504.0,
+                2.0**-24,
+                -(2.0**-24),
+                2.0**-14,
+                6.103515625e-05 - 2.0**-24,
+                0.333251953125,
+                1.0009765625,
+            ],
             dtype=np.float16,
         )
         rng = np.random.default_rng(7)
@@ -144,9 +156,7 @@ class TestCoatedConductorModel:
         F, mu, eta = evaluate_grid(thread, "packed", shader_inputs(material), MU_AXIS, ETA_AXIS)
         changed = material.coefficients.astype(np.float16).copy()
         changed[0, 1, 0] = np.nextafter(changed[0, 1, 0], np.float16(2.0))
-        other = coated_conductor_model(
-            *_numpy_inputs(mu, eta), changed.astype(np.float64), material.eta_i_range
-        )
+        other = coated_conductor_model(*_numpy_inputs(mu, eta), changed.astype(np.float64), material.eta_i_range)
         assert np.abs(F - other).max() > TOLERANCE
 
     def test_degree_padding_is_the_same_model(self):
@@ -189,7 +199,6 @@ class TestBaselines:
         expected = fresnel_conductor(mu64[..., None], eta64[..., None], np.array(n), np.array(k))
         assert np.all(np.isfinite(F))
         assert np.abs(F - expected).max() <= TOLERANCE
-
 
     def test_dielectric_total_internal_reflection(self, thread):
         n, k = np.array([1.2, 1.6, 2.8]), np.zeros(3)

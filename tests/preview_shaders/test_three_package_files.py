@@ -54,17 +54,27 @@ def test_a_kind_registered_later_is_packaged():
     parameters, its sign rule as its check states it, its model function and
     model-row program, and in the types; the files on disk are then stale.
     """
+
     def check(coefficients):
         C = np.asarray(coefficients, dtype=np.float64)
         if C.shape != (1, 3) or not np.all((C >= 0) & (C <= 1)):
             raise ValueError("`coefficients` of a toy must be (1, 3) in [0, 1]")
         return C
 
-    toy = ModelKind(name="toy-packaged", code=201, description="toy", parameters=("F0",), max_degree=0,
-                    check=check, evaluate=lambda *args: None, glsl_file="cf_fresnel_baselines.glsl",
-                    hlsl_file="none.hlsl", glsl_function="cf_schlick",
-                    preview_call="cf_schlick(NdotV, vec3(unpackHalf2x16(words[0]), unpackHalf2x16(words[1]).x))",
-                    material_template="none")
+    toy = ModelKind(
+        name="toy-packaged",
+        code=201,
+        description="toy",
+        parameters=("F0",),
+        max_degree=0,
+        check=check,
+        evaluate=lambda *args: None,
+        glsl_file="cf_fresnel_baselines.glsl",
+        hlsl_file="none.hlsl",
+        glsl_function="cf_schlick",
+        preview_call="cf_schlick(NdotV, vec3(unpackHalf2x16(words[0]), unpackHalf2x16(words[1]).x))",
+        material_template="none",
+    )
     register_model_kind(toy)
     try:
         kinds = _module_kinds(three_package.kinds_module())
@@ -94,11 +104,14 @@ def test_the_lut_layout_needs_a_and_b_equal_across_slices():
 def test_the_package_decodes_the_lut_bit_for_bit():
     node = shutil.which("node")
     assert node, "node is needed (docs/testing.md)"
-    script = ("import('./web/three/src/lut.js').then(async (m) => { const l = await m.lutTexels();"
-              " process.stdout.write(JSON.stringify([l.width, l.height, l.depth, l.alphaRange]) + '\\n');"
-              " process.stdout.write(Buffer.from(l.data.buffer)); });")
-    done = subprocess.run([node, "--input-type=module", "-e", script], cwd=three_package.ROOT, capture_output=True,
-                          timeout=120)
+    script = (
+        "import('./web/three/src/lut.js').then(async (m) => { const l = await m.lutTexels();"
+        " process.stdout.write(JSON.stringify([l.width, l.height, l.depth, l.alphaRange]) + '\\n');"
+        " process.stdout.write(Buffer.from(l.data.buffer)); });"
+    )
+    done = subprocess.run(
+        [node, "--input-type=module", "-e", script], cwd=three_package.ROOT, capture_output=True, timeout=120
+    )
     assert done.returncode == 0, done.stderr.decode()
     head, _, body = done.stdout.partition(b"\n")
     lut = default_lut()

@@ -70,8 +70,10 @@ def test_healthz_answers_fast_with_600_idle_connections_open(tmp_path):
 
 
 def test_one_address_cannot_shut_out_another(tmp_path):
-    with server_process(tmp_path / "data", COATED_WARM_POOL="false",
-                        COATED_MAX_CONNECTIONS_PER_CLIENT="20") as server, contextlib.ExitStack() as stack:
+    with (
+        server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS_PER_CLIENT="20") as server,
+        contextlib.ExitStack() as stack,
+    ):
         flood = idle_sockets(server.port, 60)
         for s in flood:
             stack.callback(s.close)
@@ -85,8 +87,10 @@ def test_one_address_cannot_shut_out_another(tmp_path):
 def bodies_at_the_rate(busy: list[socket.socket]):
     """``busy`` connections whose bodies trickle 5 B/s (a rate of 2 B/s is asked) while the block runs."""
     for s in busy:
-        s.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                  b"content-length: 1000\r\n\r\n")
+        s.sendall(
+            b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+            b"content-length: 1000\r\n\r\n"
+        )
     trickling = threading.Event()
     trickling.set()
 
@@ -109,8 +113,12 @@ def bodies_at_the_rate(busy: list[socket.socket]):
 def test_with_every_connection_busy_healthz_answers_503_and_slow_bodies_are_answered_408(tmp_path):
     """Eight bodies at the rate hold every connection: /healthz is answered, 503 naming why, and a library
     request 503; once they stop each is answered 408 within the rate's allowance and /healthz is 200 again."""
-    with server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS="8",
-                        COATED_MIN_BODY_RATE="2") as server, contextlib.ExitStack() as stack:
+    with (
+        server_process(
+            tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS="8", COATED_MIN_BODY_RATE="2"
+        ) as server,
+        contextlib.ExitStack() as stack,
+    ):
         busy = idle_sockets(server.port, 8)
         stack.callback(lambda: [s.close() for s in busy])
         with bodies_at_the_rate(busy):
@@ -129,16 +137,21 @@ def test_with_every_connection_busy_healthz_answers_503_and_slow_bodies_are_answ
 
 
 def test_with_an_address_s_every_connection_busy_its_healthz_is_answered(tmp_path):
-    with server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS_PER_CLIENT="4",
-                        COATED_MIN_BODY_RATE="2") as server, contextlib.ExitStack() as stack:
+    with (
+        server_process(
+            tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS_PER_CLIENT="4", COATED_MIN_BODY_RATE="2"
+        ) as server,
+        contextlib.ExitStack() as stack,
+    ):
         busy = idle_sockets(server.port, 4, "127.0.0.2")
         stack.callback(lambda: [s.close() for s in busy])
         with bodies_at_the_rate(busy):
             transport = httpx.HTTPTransport(local_address="127.0.0.2", verify=loopback.TLS)
             with httpx.Client(transport=transport, timeout=10) as same:
                 assert same.get(f"{server.url}/healthz").status_code == 200  # the replica serves others
-            with httpx.Client(transport=httpx.HTTPTransport(local_address="127.0.0.2", verify=loopback.TLS),
-                              timeout=10) as same:
+            with httpx.Client(
+                transport=httpx.HTTPTransport(local_address="127.0.0.2", verify=loopback.TLS), timeout=10
+            ) as same:
                 assert same.get(f"{server.url}/api/v1/materials").status_code == 503
             assert loopback.get(f"{server.url}/api/v1/materials", timeout=10).status_code == 200
 
@@ -148,8 +161,10 @@ def test_a_burst_past_the_bound_is_answered_503_not_cut(tmp_path):
     once, against a bound of 20: every one gets an answer, 200 or 503 with
     Retry-After (before, the burst's new connections closed its earlier
     ones, whose requests were still on their way: connection resets)."""
-    with server_process(tmp_path / "data", COATED_WARM_POOL="false",
-                        COATED_MAX_CONNECTIONS_PER_CLIENT="20") as server, contextlib.ExitStack() as stack:
+    with (
+        server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS_PER_CLIENT="20") as server,
+        contextlib.ExitStack() as stack,
+    ):
         sockets = idle_sockets(server.port, 60)
         for s in sockets:
             stack.callback(s.close)
@@ -181,8 +196,10 @@ def test_a_burst_past_the_bound_is_answered_503_not_cut(tmp_path):
 
 def test_a_connection_past_the_bound_closes_the_one_idle_longest(tmp_path):
     """The longest idle is counted from each connection's last activity, not from its opening."""
-    with server_process(tmp_path / "data", COATED_WARM_POOL="false",
-                        COATED_MAX_CONNECTIONS_PER_CLIENT="3") as server, contextlib.ExitStack() as stack:
+    with (
+        server_process(tmp_path / "data", COATED_WARM_POOL="false", COATED_MAX_CONNECTIONS_PER_CLIENT="3") as server,
+        contextlib.ExitStack() as stack,
+    ):
         first, second, third = idle_sockets(server.port, 3)
         for s in (first, second, third):
             stack.callback(s.close)

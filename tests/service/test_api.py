@@ -27,7 +27,7 @@ API = "/api/v1"
 def gold_like_nk(name_shift: float = 0.0) -> dict:
     """Smooth n, k over 350-850 nm (a gold-like conductor)."""
     wavelength = np.linspace(350.0, 850.0, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + name_shift
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2)) + name_shift
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}
 
@@ -153,10 +153,13 @@ class TestFits:
         nk = library_material("Au")
         result = fit_model(nk, (1.0, 2.5))
         expected = evaluate_model(nk, result, samples=30, dtype=METRICS_DTYPE)
-        assert {k: v for k, v in record.metrics.items() if k not in ("quality", "guard")} == \
-            {k: v for k, v in expected.items() if k != "quality"}
-        assert json.loads(json.dumps([result.quality, result.guard])) == [record.metrics["quality"],
-                                                                         record.metrics["guard"]]
+        assert {k: v for k, v in record.metrics.items() if k not in ("quality", "guard")} == {
+            k: v for k, v in expected.items() if k != "quality"
+        }
+        assert json.loads(json.dumps([result.quality, result.guard])) == [
+            record.metrics["quality"],
+            record.metrics["guard"],
+        ]
 
     @pytest.mark.slow  # starts a process or GL context
     def test_same_input_same_id_no_refit(self, shared):
@@ -186,8 +189,13 @@ class TestFits:
 
     def test_inline_fit_is_a_saved_material(self, shared):
         client, _ = shared
-        body = {"name": "my gold", "source": "lab 2024", "nk": gold_like_nk(), "eta_i_range": [1.2, 1.8],
-                "objective": "rgb"}
+        body = {
+            "name": "my gold",
+            "source": "lab 2024",
+            "nk": gold_like_nk(),
+            "eta_i_range": [1.2, 1.8],
+            "objective": "rgb",
+        }
         response = client.post(f"{API}/fits", json=body)
         assert response.status_code == 201, response.text
         fit = response.json()
@@ -212,19 +220,19 @@ class TestFits:
         elif suffix == "json":
             content = json.dumps(nk)
         else:
-            rows = "\n".join(
-                f"      {w / 1000} {n} {k}" for w, n, k in zip(nk["wavelength_nm"], nk["n"], nk["k"])
-            )
+            rows = "\n".join(f"      {w / 1000} {n} {k}" for w, n, k in zip(nk["wavelength_nm"], nk["n"], nk["k"]))
             content = f"REFERENCES: test data\nDATA:\n  - type: tabulated nk\n    data: |\n{rows}\n"
         response = client.post(
-            f"{API}/fits/upload", files={"file": (f"metal.{suffix}", content)},
+            f"{API}/fits/upload",
+            files={"file": (f"metal.{suffix}", content)},
             data={"eta_i_min": "1.0", "eta_i_max": "2.0"},
         )
         assert response.status_code == 201, response.text
         fit = response.json()
         assert fit["name"] == "metal" and fit["eta_i_range"] == [1.0, 2.0]
         again = client.post(
-            f"{API}/fits/upload", files={"file": (f"metal.{suffix}", content)},
+            f"{API}/fits/upload",
+            files={"file": (f"metal.{suffix}", content)},
             data={"eta_i_min": "1.0", "eta_i_max": "2.0"},
         )
         assert again.status_code == 200 and again.json()["id"] == fit["id"]
@@ -251,7 +259,8 @@ class TestFits:
 
     def test_upload_broken_multipart_422(self, client):
         response = client.post(
-            f"{API}/fits/upload", content=b"--x\r\nContent-Disposition: form-data; name=\"file\"",
+            f"{API}/fits/upload",
+            content=b'--x\r\nContent-Disposition: form-data; name="file"',
             headers={"content-type": "multipart/form-data; boundary=x"},
         )
         assert response.status_code == 422, response.text
@@ -286,7 +295,7 @@ class TestBadInput:
             (b'{"material": "Au"', "valid JSON"),
             (b'{"material": NaN}', "material"),
             (b'{"material": "Au", "eta_i_range": [1, Infinity]}', "eta_i_range[1]"),
-            (b'[1, 2]', "dictionary"),
+            (b"[1, 2]", "dictionary"),
             (b'\xe75\xbd\x91{"material": "Au"}', "must be UTF-8"),
             (b"[" * 100_000 + b"]" * 100_000, "nested at most"),
             (b'{"material": 3}', "material"),
@@ -312,13 +321,18 @@ class TestBadInput:
         [
             (nk_body(n=[0.0] + gold_like_nk()["n"][1:]), "`nk.n[0]` (body): Input should be greater than 0"),
             (nk_body(n=[-1.0] + gold_like_nk()["n"][1:]), "nk.n[0]"),
-            (nk_body(k=[-0.1] + gold_like_nk()["k"][1:]), "`nk.k[0]` (body): Input should be greater than or equal to 0"),
+            (
+                nk_body(k=[-0.1] + gold_like_nk()["k"][1:]),
+                "`nk.k[0]` (body): Input should be greater than or equal to 0",
+            ),
             (nk_body(wavelength_nm=gold_like_nk()["wavelength_nm"][::-1]), "strictly increasing (unsorted)"),
             (nk_body(wavelength_nm=[350.0, 350.0] + gold_like_nk()["wavelength_nm"][2:]), "(duplicate)"),
             ({"name": "x", "nk": {"wavelength_nm": [500.0], "n": [1.0], "k": [1.0]}}, "at least 2 items"),
             (nk_body(n=[1.0, 1.0]), "`n` must have one value per wavelength"),
-            ({"name": "x", "nk": {"wavelength_nm": [400.0, 500.0], "n": [1, 1], "k": [1, 1]}},
-             "must cover at least 90% of 360-830 nm"),
+            (
+                {"name": "x", "nk": {"wavelength_nm": [400.0, 500.0], "n": [1, 1], "k": [1, 1]}},
+                "must cover at least 90% of 360-830 nm",
+            ),
             ({"name": " ", "nk": gold_like_nk()}, "name"),
             (nk_body(wavelength_nm=["a"] * 26), "wavelength_nm[0]"),
         ],
@@ -410,7 +424,9 @@ class TestCurves:
         mu = np.cos(np.radians(theta))
         coefficients = np.array([fit["coefficients"][p] for p in ("F0", "a", "alpha")])
         np.testing.assert_allclose(
-            curves["model"], coated_conductor_model(np.clip(mu, 0, 1), 1.5, coefficients), atol=1e-12  # the
+            curves["model"],
+            coated_conductor_model(np.clip(mu, 0, 1), 1.5, coefficients),
+            atol=1e-12,  # the
             # same float64 kernel on JSON-exact inputs; only cos(radians) rounds
             # differently by <= 4 ulps, times the model's slope <= ~10: 5e-15
         )
@@ -554,8 +570,11 @@ class TestSecurity:
     @pytest.mark.slow  # 2.8 s (all cases 2.8 s) in a --durations=0 run
     def test_configured_origin_may_write(self, tmp_path):
         with app_client(tmp_path, cors_origins=["https://editor.example"]) as client:
-            response = client.post(f"{API}/fits/upload", files={"file": ("x.csv", csv_text(gold_like_nk()), "text/csv")},
-                                   headers={"Origin": "https://editor.example"})
+            response = client.post(
+                f"{API}/fits/upload",
+                files={"file": ("x.csv", csv_text(gold_like_nk()), "text/csv")},
+                headers={"Origin": "https://editor.example"},
+            )
             assert response.status_code == 201, response.text
 
 

@@ -16,13 +16,21 @@ ROOT = Path(__file__).resolve().parents[2]
 LOCK = json.loads((ROOT / "scripts" / "babylon" / "package-lock.json").read_text())
 
 
-@pytest.mark.parametrize("path", [
-    "/static/babylon/index.js", "/static/babylon/coated_conductor.js", "/static/babylon/gltf_loader.js",
-    "/static/babylon/check_model.js", "/static/babylon/generated/glsl.js",
-    "/vendor/babylon/core/Materials/materialPluginBase.js", "/vendor/babylon/core/Engines/engine.js",
-    "/vendor/babylon/loaders/glTF/2.0/glTFLoader.js", "/vendor/babylon/loaders/glTF/index.js",
-    "/examples/babylon.js",
-])
+@pytest.mark.parametrize(
+    "path",
+    [
+        "/static/babylon/index.js",
+        "/static/babylon/coated_conductor.js",
+        "/static/babylon/gltf_loader.js",
+        "/static/babylon/check_model.js",
+        "/static/babylon/generated/glsl.js",
+        "/vendor/babylon/core/Materials/materialPluginBase.js",
+        "/vendor/babylon/core/Engines/engine.js",
+        "/vendor/babylon/loaders/glTF/2.0/glTFLoader.js",
+        "/vendor/babylon/loaders/glTF/index.js",
+        "/examples/babylon.js",
+    ],
+)
 def test_modules_served_as_javascript(client, path):
     response = client.get(path)
     assert response.status_code == 200, path

@@ -29,8 +29,12 @@ def body(name, draft):
     base = curve_base_from_nk(library_material("Au"))
     rgb = base.rgb(MU, 1.5)
     rgb[:, 0] *= 0.9
-    return {"name": name, "base": {"material": "Au"}, "draft": draft,
-            "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
+    return {
+        "name": name,
+        "base": {"material": "Au"},
+        "draft": draft,
+        "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
+    }
 
 
 def saved_names(client):
@@ -67,7 +71,9 @@ def test_curves_return_the_blended_target(shared):
         # blend on JSON-exact inputs (a few u64); 1e-9 is a loose rounding bound
     # Beyond the blend width (0.5) the target is the base again.
     far = shared.get(f"/api/v1/fits/{fit['id']}/curves?eta_i=2.3&samples=19").json()
-    np.testing.assert_allclose(far["target"], np.clip(base.rgb(np.asarray(far["cos_theta"]), 2.3), 0, 1), atol=1e-9)  # as above
+    np.testing.assert_allclose(
+        far["target"], np.clip(base.rgb(np.asarray(far["cos_theta"]), 2.3), 0, 1), atol=1e-9
+    )  # as above
     # A fit of n, k: the target is its reference.
     gold = shared.post("/api/v1/fits", json={"material": "Au"}).json()
     answer = shared.get(f"/api/v1/fits/{gold['id']}/curves?eta_i=1.5&samples=19").json()

@@ -28,9 +28,13 @@ def shared(tmp_path_factory):
 def body(base_id, scale, **extra):
     rgb = curve_base_from_nk(library_material("Au")).rgb(MU, 1.5)
     rgb[:, 0] *= scale
-    return {"name": "Live gold", "base": {"fit": base_id}, "draft": True,
-            "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
-            **extra}
+    return {
+        "name": "Live gold",
+        "base": {"fit": base_id},
+        "draft": True,
+        "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
+        **extra,
+    }
 
 
 def saved_names(client):
@@ -70,12 +74,15 @@ def test_the_start_is_part_of_the_id(shared):
 
 
 @pytest.mark.slow  # its module fixture's fits start the fitting pool's processes
-@pytest.mark.parametrize("extra, status, needle", [
-    ({"live": True, "draft": False}, 422, "`live` refits are drafts"),
-    ({"start_fit": "0" * 32}, 422, "`start_fit` is for `live` refits only"),
-    ({"live": True, "start_fit": "0" * 32}, 404, "`start_fit`"),
-    ({"live": True, "start_fit": "nothex"}, 422, "start_fit"),
-])
+@pytest.mark.parametrize(
+    "extra, status, needle",
+    [
+        ({"live": True, "draft": False}, 422, "`live` refits are drafts"),
+        ({"start_fit": "0" * 32}, 422, "`start_fit` is for `live` refits only"),
+        ({"live": True, "start_fit": "0" * 32}, 404, "`start_fit`"),
+        ({"live": True, "start_fit": "nothex"}, 422, "start_fit"),
+    ],
+)
 def test_bad_live_requests_name_the_field(shared, extra, status, needle):
     client, base = shared
     answer = client.post(ROUTE, json=body(base["id"], 0.9, **extra))

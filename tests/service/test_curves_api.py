@@ -97,8 +97,7 @@ class TestFromCurves:
         # X: Au with red pulled down at eta_i 1; then X edited at eta_i 2.5 only.
         low = gold_curve(eta_i=1.0, red_scale=0.4)
         x = shared.post(URL, json={"name": "red down", "base": {"material": "Au"}, "curves": [low]}).json()
-        y = shared.post(URL, json={"name": "red down", "base": {"fit": x["id"]},
-                                   "curves": [gold_curve(eta_i=2.5)]})
+        y = shared.post(URL, json={"name": "red down", "base": {"fit": x["id"]}, "curves": [gold_curve(eta_i=2.5)]})
         assert y.status_code == 201, y.text
         y = y.json()
         assert y["base_fit_id"] == x["id"] and y["library_material"] == "Au"
@@ -143,11 +142,23 @@ class TestFromCurves:
     @pytest.mark.parametrize(
         "change, needle",
         [
-            (lambda b: b["curves"][0]["rgb"][3].__setitem__(0, 1.2), "`curves[0].rgb[3][0]` (body): Input should be less than or equal to 1"),
-            (lambda b: b["curves"][0]["rgb"][5].__setitem__(2, -0.1), "`curves[0].rgb[5][2]` (body): Input should be greater than or equal to 0"),
-            (lambda b: b["curves"][0].update(angle_deg=ANGLE[:4].tolist(), rgb=b["curves"][0]["rgb"][:4]), "at least 5 items"),
+            (
+                lambda b: b["curves"][0]["rgb"][3].__setitem__(0, 1.2),
+                "`curves[0].rgb[3][0]` (body): Input should be less than or equal to 1",
+            ),
+            (
+                lambda b: b["curves"][0]["rgb"][5].__setitem__(2, -0.1),
+                "`curves[0].rgb[5][2]` (body): Input should be greater than or equal to 0",
+            ),
+            (
+                lambda b: b["curves"][0].update(angle_deg=ANGLE[:4].tolist(), rgb=b["curves"][0]["rgb"][:4]),
+                "at least 5 items",
+            ),
             (lambda b: b["curves"][0].update(cos_theta=[0.5] * 31), "exactly one of `cos_theta` or `angle_deg`"),
-            (lambda b: b["curves"][0].update(angle_deg=None, cos_theta=[1.5] * 31), "`curves[0].cos_theta[0]` (body): Input should be less than or equal to 1"),
+            (
+                lambda b: b["curves"][0].update(angle_deg=None, cos_theta=[1.5] * 31),
+                "`curves[0].cos_theta[0]` (body): Input should be less than or equal to 1",
+            ),
             (lambda b: b["curves"][0].update(eta_i=2.8), "`curves[0].eta_i` must lie in the domain [1, 2.5], got 2.8"),
             (lambda b: b["curves"].append(b["curves"][0]), "`curves[1].eta_i` must differ from `curves[0].eta_i`"),
             (lambda b: b.update(base={"material": "Au", "fit": "0" * 32}), "exactly one of `material`, `fit` or `nk`"),

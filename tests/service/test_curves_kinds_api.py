@@ -33,8 +33,12 @@ def client(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def rgb_fit(client):
-    body = {"name": "cool copper", "base": {"material": "Cu"}, "curves": [copper_curve(blue=1.1)],
-            "model": "rgb-conductor"}
+    body = {
+        "name": "cool copper",
+        "base": {"material": "Cu"},
+        "curves": [copper_curve(blue=1.1)],
+        "model": "rgb-conductor",
+    }
     response = client.post(URL, json=body)
     assert response.status_code == 201, response.text
     return body, response.json()
@@ -73,8 +77,12 @@ class TestCurveFitKinds:
 
     def test_edit_of_an_edited_rgb_conductor(self, client, rgb_fit):
         _, fit = rgb_fit
-        body = {"name": "cool copper", "base": {"fit": fit["id"]}, "curves": [copper_curve(2.0, blue=1.05)],
-                "model": "rgb-conductor"}
+        body = {
+            "name": "cool copper",
+            "base": {"fit": fit["id"]},
+            "curves": [copper_curve(2.0, blue=1.05)],
+            "model": "rgb-conductor",
+        }
         response = client.post(URL, json=body)
         assert response.status_code == 201, response.text
         error_map = client.get(f"/api/v1/fits/{response.json()['id']}/error-map?angles=10&rows=4")
@@ -82,7 +90,6 @@ class TestCurveFitKinds:
         assert error_map.json()["against"] == "edited target"
 
     def test_unknown_kind_422(self, client):
-        response = client.post(URL, json={"base": {"material": "Cu"}, "curves": [copper_curve()],
-                                          "model": "rgb"})
+        response = client.post(URL, json={"base": {"material": "Cu"}, "curves": [copper_curve()], "model": "rgb"})
         assert response.status_code == 422, response.text
         assert "model" in response.text and "rgb-conductor" in response.text

@@ -32,7 +32,7 @@ ANGLE = np.linspace(0.0, 90.0, 31)
 
 def big_nk(samples=20_000) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     wavelength = np.linspace(300.0, 900.0, samples)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2)
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2))
     k = 1.8 + 4.0 * (wavelength - 300.0) / 600.0
     return wavelength, n, k
 
@@ -47,8 +47,11 @@ def inline_nk(samples=20_000) -> dict:
     """The same n, k as an inline base, with the upload's digits (all 17 of each float64 would take
     the body past COATED_MAX_BODY_BYTES at 20,000 samples)."""
     wavelength, n, k = big_nk(samples)
-    return {"wavelength_nm": np.round(wavelength, 4).tolist(), "n": np.round(n, 6).tolist(),
-            "k": np.round(k, 6).tolist()}
+    return {
+        "wavelength_nm": np.round(wavelength, 4).tolist(),
+        "n": np.round(n, 6).tolist(),
+        "k": np.round(k, 6).tolist(),
+    }
 
 
 def step(base_id, start, value, live=True, inline=None, name="dragged"):
@@ -56,9 +59,14 @@ def step(base_id, start, value, live=True, inline=None, name="dragged"):
     on an inline base: a save."""
     rgb = np.full((ANGLE.size, 3), 0.6)
     rgb[:, 1] = value
-    return {"name": name, "base": inline or {"fit": base_id}, "draft": live or inline is None, "live": live,
-            **({"start_fit": start} if live and start else {}),
-            "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": rgb.tolist()}]}
+    return {
+        "name": name,
+        "base": inline or {"fit": base_id},
+        "draft": live or inline is None,
+        "live": live,
+        **({"start_fit": start} if live and start else {}),
+        "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": rgb.tolist()}],
+    }
 
 
 def encoded(body: dict, base_json: str) -> dict:
@@ -70,15 +78,19 @@ def encoded(body: dict, base_json: str) -> dict:
     """
     text = json.dumps({**body, "base": None}, separators=(",", ":"))
     assert text.count('"base":null') == 1
-    return {"content": text.replace('"base":null', f'"base":{base_json}').encode(),
-            "headers": {"content-type": "application/json"}}
+    return {
+        "content": text.replace('"base":null', f'"base":{base_json}').encode(),
+        "headers": {"content-type": "application/json"},
+    }
 
 
 def stored_bytes(data_dir):
     """The bytes of every stored record: fits and n, k records."""
     with sqlite3.connect(data_dir / "store.sqlite3") as db:
-        return db.execute("SELECT (SELECT coalesce(sum(length(record)), 0) FROM fits) + "
-                          "(SELECT coalesce(sum(length(record)), 0) FROM nk_records)").fetchone()[0]
+        return db.execute(
+            "SELECT (SELECT coalesce(sum(length(record)), 0) FROM fits) + "
+            "(SELECT coalesce(sum(length(record)), 0) FROM nk_records)"
+        ).fetchone()[0]
 
 
 def counted(data_dir, sql):
@@ -114,8 +126,9 @@ def test_100_live_steps_on_a_20000_sample_inline_base_add_under_2_mb(tmp_path):
         before = stored_bytes(data)
         start = None
         for i in range(100):
-            answer = http.post(f"{API}/fits/from-curves",
-                               **encoded(step(None, start, 0.5 + 0.002 * i, inline=base), base_json))
+            answer = http.post(
+                f"{API}/fits/from-curves", **encoded(step(None, start, 0.5 + 0.002 * i, inline=base), base_json)
+            )
             assert answer.status_code == 201, answer.text[:300]
             start = answer.json()["id"]
         grown = stored_bytes(data) - before
@@ -142,8 +155,10 @@ def test_100_live_steps_on_a_20000_sample_inline_base_add_under_2_mb(tmp_path):
 def test_an_inline_base_expires_with_its_drafts(tmp_path):
     data = tmp_path / "data"
     base = {"nk": inline_nk(2_000)}
-    with server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         start = None
         for i in range(3):
             answer = http.post(f"{API}/fits/from-curves", json=step(None, start, 0.5 + 0.01 * i, inline=base))
@@ -159,8 +174,10 @@ def test_an_inline_base_expires_with_its_drafts(tmp_path):
 
 def test_drafts_expire_and_count_against_their_quota(tmp_path):
     data = tmp_path / "data"
-    with server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(data, COATED_DRAFT_TTL_S="3", COATED_DRAFT_SWEEP_S="0.5") as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5, live=False))
         assert draft.status_code == 201, draft.text[:300]
@@ -171,12 +188,15 @@ def test_drafts_expire_and_count_against_their_quota(tmp_path):
             time.sleep(0.25)
         assert http.get(f"{API}/fits/{draft_id}").status_code == 404
         assert http.get(f"{API}/fits/{base}").status_code == 200  # saved fits never expire
-    with server_process(tmp_path / "quota", COATED_DRAFT_MAX_BYTES="20000", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(tmp_path / "quota", COATED_DRAFT_MAX_BYTES="20000", COATED_DRAFT_SWEEP_S="0.5") as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         # Live steps: drafts as the save above is one, without its full refit each.
-        ids = [http.post(f"{API}/fits/from-curves", json=step(base, None, 0.3 + 0.05 * i)).json()["id"]
-               for i in range(6)]
+        ids = [
+            http.post(f"{API}/fits/from-curves", json=step(base, None, 0.3 + 0.05 * i)).json()["id"] for i in range(6)
+        ]
         deadline = time.monotonic() + 20  # a sweep every 0.5 s
         while http.get(f"{API}/fits/{ids[0]}").status_code == 200 and time.monotonic() < deadline:
             time.sleep(0.1)
@@ -193,9 +213,12 @@ def test_a_draft_a_saved_material_or_a_link_refers_to_outlives_its_time_to_live(
         # The drafts are live steps (a draft without a save's full refit); the save on one is a full refit.
         on_draft, loose, linked = (
             http.post(f"{API}/fits/from-curves", json=step(base, None, value)).json()["id"]
-            for value in (0.50, 0.55, 0.60))
-        saved = http.post(f"{API}/fits/from-curves", json={**step(on_draft, None, 0.45, live=False),
-                                                          "draft": False, "name": "saved on a draft"})
+            for value in (0.50, 0.55, 0.60)
+        )
+        saved = http.post(
+            f"{API}/fits/from-curves",
+            json={**step(on_draft, None, 0.45, live=False), "draft": False, "name": "saved on a draft"},
+        )
         assert saved.status_code == 201, saved.text[:300]
         saved_id = saved.json()["id"]
         time.sleep(1.0)
@@ -204,11 +227,17 @@ def test_a_draft_a_saved_material_or_a_link_refers_to_outlives_its_time_to_live(
         created = http.get(f"{API}/fits/{linked}").json()["created_at"]
         assert link.json()["draft"] and link.json()["expires_at"] >= created + 86_400 + 1.0  # from the link
         assert http.post(f"{API}/fits/{saved_id}/link").json() == {
-            "fit_id": saved_id, "url": f"/?fit={saved_id}", "draft": False, "expires_at": None}
+            "fit_id": saved_id,
+            "url": f"/?fit={saved_id}",
+            "draft": False,
+            "expires_at": None,
+        }
         assert http.post(f"{API}/fits/{'0' * 32}/link").status_code == 404
     # ... then served with drafts kept 1 s: what nothing refers to goes, the rest stays.
-    with server_process(data, COATED_DRAFT_TTL_S="1", COATED_DRAFT_SWEEP_S="0.5") as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(data, COATED_DRAFT_TTL_S="1", COATED_DRAFT_SWEEP_S="0.5") as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         deadline = time.monotonic() + 30
         while http.get(f"{API}/fits/{loose}").status_code == 200 and time.monotonic() < deadline:
             time.sleep(0.25)
@@ -237,8 +266,10 @@ def _workers(server_pid: int) -> list[int]:
 def test_a_save_keeps_its_draft_base_while_it_is_fitted(tmp_path):
     # A save on a draft base whose fit outlasts the draft's time to live (its workers stopped, as a
     # loaded machine would delay it): the base is kept from the save's start, the save is answered 201.
-    with server_process(tmp_path / "data", COATED_DRAFT_TTL_S="4", COATED_DRAFT_SWEEP_S="0.25") as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(tmp_path / "data", COATED_DRAFT_TTL_S="4", COATED_DRAFT_SWEEP_S="0.25") as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         base = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         draft = http.post(f"{API}/fits/from-curves", json=step(base, None, 0.5))  # a live step: a draft
         assert draft.status_code == 201, draft.text[:300]
@@ -250,8 +281,11 @@ def test_a_save_keeps_its_draft_base_while_it_is_fitted(tmp_path):
             os.kill(pid, signal.SIGSTOP)
         try:
             body = {**step(draft_id, None, 0.45, live=False), "draft": False, "name": "saved on a short draft"}
-            save = threading.Thread(target=lambda: answers.append(
-                loopback.post(f"{server.url}{API}/fits/from-curves", json=body, timeout=120)))
+            save = threading.Thread(
+                target=lambda: answers.append(
+                    loopback.post(f"{server.url}{API}/fits/from-curves", json=body, timeout=120)
+                )
+            )
             save.start()
             deadline = time.monotonic() + 20
             while http.get("/healthz").json()["fits_in_flight"] < 1:  # the save is in the pool, waiting

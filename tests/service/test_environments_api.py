@@ -60,8 +60,10 @@ def test_no_gl_driver_503(tmp_path):
     # The server's render processes inherit its environment: libglvnd then finds no EGL
     # vendor, as on a machine without a GL driver. (A server process of its own: render
     # processes fork from a fork server that keeps the environment it started with.)
-    with server_process(tmp_path / "data", __EGL_VENDOR_LIBRARY_FILENAMES=str(tmp_path / "no-vendor.json")) as server, \
-            loopback.Client(base_url=server.url, timeout=60) as other:
+    with (
+        server_process(tmp_path / "data", __EGL_VENDOR_LIBRARY_FILENAMES=str(tmp_path / "no-vendor.json")) as server,
+        loopback.Client(base_url=server.url, timeout=60) as other,
+    ):
         response = other.get(f"{API}/environments/studio/prefiltered")
         assert response.status_code == 503
         assert response.json()["detail"].startswith("the preview renderer is unavailable: no GL context")

@@ -37,19 +37,26 @@ def stored_model(client, fit_id):
 @pytest.mark.slow  # its shared fixture's fits start the fitting pool's processes
 class TestExportDownloads:
     @pytest.mark.slow  # 2.7 s (all cases 2.8 s) in a --durations=0 run
-    @pytest.mark.parametrize("format, media_type, suffix", [
-        ("mtlx", "application/xml", ".mtlx"), ("openpbr", "application/xml", ".openpbr.mtlx"),
-        ("blender", "text/x-python; charset=utf-8", ".py"), ("gltf", "model/gltf+json", ".gltf"),
-    ])
+    @pytest.mark.parametrize(
+        "format, media_type, suffix",
+        [
+            ("mtlx", "application/xml", ".mtlx"),
+            ("openpbr", "application/xml", ".openpbr.mtlx"),
+            ("blender", "text/x-python; charset=utf-8", ".py"),
+            ("gltf", "model/gltf+json", ".gltf"),
+        ],
+    )
     def test_each_format_is_the_library_export(self, shared, format, media_type, suffix):
         client, fit_id = shared
         response = pack(client, fit_id, f"format={format}&eta_i=1.7")
         assert response.status_code == 200, response.text
         assert response.headers["content-type"] == media_type
         assert response.headers["content-disposition"] == (
-            f'attachment; filename="Cu-{fit_id[:8]}-eta1.7-rough0.2-coat0.03{suffix}"')
-        expected = export_material(library_material("Cu"), format, 1.7, model=stored_model(client, fit_id),
-                                   fit_id=fit_id)
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.7-rough0.2-coat0.03{suffix}"'
+        )
+        expected = export_material(
+            library_material("Cu"), format, 1.7, model=stored_model(client, fit_id), fit_id=fit_id
+        )
         assert response.content == expected
         assert (b"EXT_materials_coated_conductor" in response.content) == (format == "gltf")
 
@@ -59,7 +66,8 @@ class TestExportDownloads:
         response = pack(client, fit_id, "format=mtlx&eta_i=1.5&working_space=acescg")
         assert response.status_code == 200, response.text
         assert response.headers["content-disposition"] == (
-            f'attachment; filename="Cu-{fit_id[:8]}-eta1.5-rough0.2-coat0.03-acescg.mtlx"')
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.5-rough0.2-coat0.03-acescg.mtlx"'
+        )
         root = ET.fromstring(response.content)
         assert root.get("colorspace") == "acescg" and root.get("coatedfresnel_fit_id") == fit_id
         assert root.find("nodedef").get("name") == f"ND_coated_metal_Cu_{fit_id[:8]}_eta1p5"
@@ -78,9 +86,11 @@ class TestExportDownloads:
         response = pack(client, fit_id, "format=openpbr&eta_i=1.33&roughness=0.45&coat_roughness=0.1")
         assert response.status_code == 200, response.text
         assert response.headers["content-disposition"] == (
-            f'attachment; filename="Cu-{fit_id[:8]}-eta1.33-rough0.45-coat0.1.openpbr.mtlx"')
-        expected = export_material(library_material("Cu"), "openpbr", 1.33, 0.45, 0.1,
-                                   model=stored_model(client, fit_id), fit_id=fit_id)
+            f'attachment; filename="Cu-{fit_id[:8]}-eta1.33-rough0.45-coat0.1.openpbr.mtlx"'
+        )
+        expected = export_material(
+            library_material("Cu"), "openpbr", 1.33, 0.45, 0.1, model=stored_model(client, fit_id), fit_id=fit_id
+        )
         assert response.content == expected
         assert response.content != pack(client, fit_id, "format=openpbr&eta_i=1.33").content
         for query in ("roughness=1.5", "coat_roughness=-0.1", "roughness=nan", "working_space=srgb"):
@@ -88,13 +98,16 @@ class TestExportDownloads:
             assert refused.status_code == 422 and query.split("=")[0] in refused.json()["detail"]
 
     @pytest.mark.slow  # starts a process or GL context
-    @pytest.mark.parametrize("query, words", [
-        ("format=mtlx&eta_i=0.8", ["eta_i", "greater than or equal to 1"]),
-        ("format=gltf&eta_i=3.5", ["eta_i", "less than or equal to 3"]),
-        ("format=blender&eta_i=nan", ["eta_i", "finite"]),
-        ("format=mtlx&eta_i=abc", ["eta_i", "number"]),
-        ("format=usd&eta_i=1.5", ["format", "'mtlx'", "'gltf'"]),
-    ])
+    @pytest.mark.parametrize(
+        "query, words",
+        [
+            ("format=mtlx&eta_i=0.8", ["eta_i", "greater than or equal to 1"]),
+            ("format=gltf&eta_i=3.5", ["eta_i", "less than or equal to 3"]),
+            ("format=blender&eta_i=nan", ["eta_i", "finite"]),
+            ("format=mtlx&eta_i=abc", ["eta_i", "number"]),
+            ("format=usd&eta_i=1.5", ["format", "'mtlx'", "'gltf'"]),
+        ],
+    )
     def test_bad_query_422(self, shared, query, words):
         client, fit_id = shared
         response = pack(client, fit_id, query)
@@ -122,8 +135,7 @@ def curve_fit(shared):
         rgb = np.clip(curve_base_from_nk(library_material("Cu")).rgb(mu, eta_i), 0, 1)
         rgb[:, 2] *= 0.8
         curves.append({"eta_i": eta_i, "angle_deg": angle.tolist(), "rgb": rgb.tolist()})
-    response = client.post(f"{API}/fits/from-curves", json={"name": "edited copper",
-                                                             "curves": curves})
+    response = client.post(f"{API}/fits/from-curves", json={"name": "edited copper", "curves": curves})
     assert response.status_code == 201, response.text
     return response.json()
 
@@ -165,14 +177,14 @@ class TestExportPacks:
         response = client.post(f"{API}/packs", json=body)
         assert response.status_code == 200, response.text
         assert response.headers["content-type"] == "application/zip"
-        assert response.headers["content-disposition"] == (
-            f'attachment; filename="scene-{format}-eta1.3.zip"')
+        assert response.headers["content-disposition"] == (f'attachment; filename="scene-{format}-eta1.3.zip"')
         archive = zipfile.ZipFile(io.BytesIO(response.content))
         assert archive.namelist() == [f"Cu-eta1.3{suffix}", f"Au-eta1.3{suffix}"]
         for name, material, fit_id in zip(archive.namelist(), ("Cu", "Au"), ids):
             model = stored_model(client, fit_id)
-            assert archive.read(name) == export_material(library_material(material), format, 1.3, model=model,
-                                                         fit_id=fit_id)
+            assert archive.read(name) == export_material(
+                library_material(material), format, 1.3, model=model, fit_id=fit_id
+            )
         # Deterministic: the same request, the same bytes.
         assert client.post(f"{API}/packs", json=body).content == response.content
 
@@ -181,22 +193,38 @@ class TestExportPacks:
         import zipfile
 
         client, ids = two_fits
-        body = {"fit_ids": ids[:1], "format": "openpbr", "eta_i": 1.3, "roughness": 0.45,
-                "coat_roughness": 0.1, "working_space": "acescg"}
+        body = {
+            "fit_ids": ids[:1],
+            "format": "openpbr",
+            "eta_i": 1.3,
+            "roughness": 0.45,
+            "coat_roughness": 0.1,
+            "working_space": "acescg",
+        }
         response = client.post(f"{API}/packs", json=body)
         assert response.status_code == 200, response.text
         (entry,) = zipfile.ZipFile(io.BytesIO(response.content)).namelist()
         assert zipfile.ZipFile(io.BytesIO(response.content)).read(entry) == export_material(
-            library_material("Cu"), "openpbr", 1.3, 0.45, 0.1, model=stored_model(client, ids[0]),
-            fit_id=ids[0], working_space="acescg")
+            library_material("Cu"),
+            "openpbr",
+            1.3,
+            0.45,
+            0.1,
+            model=stored_model(client, ids[0]),
+            fit_id=ids[0],
+            working_space="acescg",
+        )
 
-    @pytest.mark.parametrize("body, words", [
-        ({"format": "mtlx", "eta_i": 0.5}, ["eta_i", "greater than or equal to 1"]),
-        ({"format": "mtlx", "working_space": "srgb"}, ["working_space", "'acescg'"]),
-        ({"format": "mtlx", "roughness": 2}, ["roughness", "less than or equal to 1"]),
-        ({"format": "usdz"}, ["format", "'mtlx'"]),
-        ({"format": "gltf", "eta_i": True}, ["eta_i"]),
-    ])
+    @pytest.mark.parametrize(
+        "body, words",
+        [
+            ({"format": "mtlx", "eta_i": 0.5}, ["eta_i", "greater than or equal to 1"]),
+            ({"format": "mtlx", "working_space": "srgb"}, ["working_space", "'acescg'"]),
+            ({"format": "mtlx", "roughness": 2}, ["roughness", "less than or equal to 1"]),
+            ({"format": "usdz"}, ["format", "'mtlx'"]),
+            ({"format": "gltf", "eta_i": True}, ["eta_i"]),
+        ],
+    )
     def test_bad_export_pack_422(self, two_fits, body, words):
         client, ids = two_fits
         response = client.post(f"{API}/packs", json={"fit_ids": ids, **body})
@@ -235,8 +263,12 @@ class TestExportPackNames:
         names = zipfile.ZipFile(io.BytesIO(response.content)).namelist()
         assert len(names) == len(self.NAMES)
         assert len({n.lower() for n in names}) == len(self.NAMES), names
-        assert names[:4] == ["gold_alloy-eta1.5.mtlx", "gold_alloy-eta1.5-2.mtlx", "gold_alloy-eta1.5-3.mtlx",
-                             "Gold_Alloy-eta1.5-4.mtlx"]
+        assert names[:4] == [
+            "gold_alloy-eta1.5.mtlx",
+            "gold_alloy-eta1.5-2.mtlx",
+            "gold_alloy-eta1.5-3.mtlx",
+            "Gold_Alloy-eta1.5-4.mtlx",
+        ]
 
 
 def test_unique_names_suffix_repeats_ignoring_case():

@@ -42,13 +42,15 @@ API = "/api/v1"
 TOKEN = "fair-share-token"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
 ANGLE = np.linspace(0.0, 90.0, 10)
-MAX_SCENE = {"name": "max", "materials": [
-    {"material": "Au", "name": f"m{i}", "eta_i": [1.0 + 0.06 * j for j in range(32)]} for i in range(64)]}
+MAX_SCENE = {
+    "name": "max",
+    "materials": [{"material": "Au", "name": f"m{i}", "eta_i": [1.0 + 0.06 * j for j in range(32)]} for i in range(64)],
+}
 
 
 def nk_body(i: int) -> dict:
     wavelength = np.linspace(350.0, 850.0, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + i * 1e-4
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2)) + i * 1e-4
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return {"name": f"w{i}", "nk": {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}}
 
@@ -56,8 +58,11 @@ def nk_body(i: int) -> dict:
 def editor_save(http: httpx.Client, i: int) -> float:
     """The editor's save of a fresh edit (a full refit, ``i`` < 10**6: as hard as any other): its seconds."""
     rgb = np.stack([0.95 - 1e-7 * i - 0.2 * ANGLE / 90, 0.75 + 0 * ANGLE, 0.35 + 0 * ANGLE], 1)
-    body = {"name": f"edit {i}", "base": {"material": "Au"},
-            "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": rgb.tolist()}]}
+    body = {
+        "name": f"edit {i}",
+        "base": {"material": "Au"},
+        "curves": [{"eta_i": 1.5, "angle_deg": ANGLE.tolist(), "rgb": rgb.tolist()}],
+    }
     started = time.perf_counter()
     answer = http.post(f"{API}/fits/from-curves", json=body, headers=AUTH)
     assert answer.status_code == 201, answer.text
@@ -110,8 +115,10 @@ def _under(server, fit_id: str, idle: float, floods, jobs) -> tuple[list[int], l
     try:
         _until_the_floods_hold(server, jobs)
         with loopback.Client(base_url=server.url, timeout=120) as http:
-            writes = [http.post(f"{API}/fits", json=nk_body(random.randrange(10**6)), headers=AUTH).status_code
-                      for _ in range(10)]
+            writes = [
+                http.post(f"{API}/fits", json=nk_body(random.randrange(10**6)), headers=AUTH).status_code
+                for _ in range(10)
+            ]
             saves = [editor_save(http, random.randrange(1000, 10**6)) for _ in range(3)]
     finally:
         stop.set()
@@ -126,8 +133,13 @@ def test_export_loops_leave_the_writers_their_share(server):
 
     def loop(stop):
         with loopback.Client(base_url=server.url, timeout=120) as http:
-            _flood(stop, lambda: http.get(f"{API}/fits/{fit_id}/pack", params={
-                "format": "mtlx", "eta_i": round(random.uniform(1.0, 3.0), 6)}), statuses)
+            _flood(
+                stop,
+                lambda: http.get(
+                    f"{API}/fits/{fit_id}/pack", params={"format": "mtlx", "eta_i": round(random.uniform(1.0, 3.0), 6)}
+                ),
+                statuses,
+            )
 
     # An export is one job on one worker: the loops hold every worker.
     writes, saves = _under(server, fit_id, idle, [loop] * 10, jobs=lambda workers: workers)
@@ -146,11 +158,13 @@ def test_maximal_scenes_leave_the_writers_their_share(server):
             with httpx.Client(base_url=server.url, timeout=5.0, transport=transport) as http:
                 # Each scene is cut off after 5 s (the client goes away: its job is cancelled) and sent again.
                 _flood(stop, lambda: http.post(f"{API}/scenes", json=MAX_SCENE), statuses)
+
         return loop
 
     # A scene is one job whose parts idle workers run side by side: one in flight takes every worker.
-    writes, saves = _under(server, fit_id, idle, [scene_from(f"127.0.0.{i}") for i in (2, 3, 4)],
-                           jobs=lambda workers: 1)
+    writes, saves = _under(
+        server, fit_id, idle, [scene_from(f"127.0.0.{i}") for i in (2, 3, 4)], jobs=lambda workers: 1
+    )
     assert writes.count(201) >= 0.95 * len(writes), writes
     assert statistics.median(saves) <= 3 * idle, (saves, idle)
 

@@ -31,12 +31,13 @@ API = "/api/v1"
 
 def gold_like_nk(shift: float = 0.0) -> dict:
     wavelength = np.linspace(350.0, 850.0, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + shift
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2)) + shift
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}
 
 
 # -- 3. DNS rebinding ---------------------------------------------------------
+
 
 @pytest.mark.slow  # 4.8 s (all cases 4.8 s) in a --durations=0 run
 @pytest.mark.server
@@ -68,6 +69,7 @@ def test_allowed_hosts_configured(tmp_path):
 
 # -- 4. slow clients ------------------------------------------------------------
 
+
 @pytest.mark.slow  # 6.2 s (all cases 6.2 s) in a --durations=0 run
 @pytest.mark.server
 def test_slow_clients_are_cut_off_and_healthz_answers(tmp_path):
@@ -78,8 +80,10 @@ def test_slow_clients_are_cut_off_and_healthz_answers(tmp_path):
             sock.sendall(b"GET /healthz HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # header never finished
             slow.append(sock)
         body = socket.create_connection(("127.0.0.1", server.port), timeout=10)
-        body.sendall(b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
-                     b"Content-Length: 100\r\n\r\n{")
+        body.sendall(
+            b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+            b"Content-Length: 100\r\n\r\n{"
+        )
         started = time.monotonic()
         assert loopback.get(f"{server.url}/healthz", timeout=5).status_code == 200
         answer = b""
@@ -104,15 +108,24 @@ def test_slow_clients_are_cut_off_and_healthz_answers(tmp_path):
 
 # -- 5. paged listing -----------------------------------------------------------
 
+
 def test_materials_paged_by_summary(tmp_path):
     from service.store import FitRecord, SQLiteStore
 
     store = SQLiteStore(tmp_path / "data" / "store.sqlite3")
-    material = {"name": "m", "degree": 2, "eta_i_range": [1.0, 2.5], "source": "",
-                "coefficients": {"F0": [[0.5] * 3] * 3, "a": [[0.0] * 3] * 3, "alpha": [[1.0] * 3] * 3}}
+    material = {
+        "name": "m",
+        "degree": 2,
+        "eta_i_range": [1.0, 2.5],
+        "source": "",
+        "coefficients": {"F0": [[0.5] * 3] * 3, "a": [[0.0] * 3] * 3, "alpha": [[1.0] * 3] * 3},
+    }
     for i in range(30):
-        store.put_fit(FitRecord(id=f"{i:032x}", kind="nk", material_id=f"{i + 100:032x}", name=f"m{i}",
-                                source="s", material=material))
+        store.put_fit(
+            FitRecord(
+                id=f"{i:032x}", kind="nk", material_id=f"{i + 100:032x}", name=f"m{i}", source="s", material=material
+            )
+        )
     store.close()
     with app_client(tmp_path, materials_page_max=12) as client:
         first = client.get(f"{API}/materials", params={"kind": ["library", "nk"]}).json()
@@ -132,6 +145,7 @@ def test_materials_paged_by_summary(tmp_path):
 
 
 # -- 6. storage faults -------------------------------------------------------------
+
 
 @pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
 def test_corrupt_record_reported_and_skipped(tmp_path):
@@ -204,8 +218,13 @@ def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
         (data / "store.sqlite3").write_bytes(b"this is not a database" * 200)
     else:
         data.write_text("a file where the directory should be")
-    result = subprocess.run([sys.executable, "-m", "service", "--data-dir", str(data), "--port", "0"],
-                            cwd=ROOT, capture_output=True, text=True, timeout=120)
+    result = subprocess.run(
+        [sys.executable, "-m", "service", "--data-dir", str(data), "--port", "0"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert result.returncode == 1
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("python -m service: cannot start: the store")
@@ -240,9 +259,14 @@ def test_a_stopped_server_exits_with_the_signal_s_status_and_leaves_no_temporary
 def test_a_temporary_directory_too_long_for_the_fork_server_s_socket_stops_the_start_with_one_line(tmp_path):
     temporary = tmp_path / ("t" * 90)  # its fork server's socket: pymp-XXXXXXXX/listener-XXXXXXXX in it
     temporary.mkdir()
-    run = subprocess.run([sys.executable, "-m", "service", "--port", "0", "--data-dir", str(tmp_path / "data")],
-                         cwd=ROOT, env={**os.environ, "TMPDIR": str(temporary)}, capture_output=True, text=True,
-                         timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "service", "--port", "0", "--data-dir", str(tmp_path / "data")],
+        cwd=ROOT,
+        env={**os.environ, "TMPDIR": str(temporary)},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert run.returncode == 1
     assert run.stderr.startswith("python -m service: cannot start: the fork server's socket, "), run.stderr
     assert "a Unix socket's path has at most 107: set TMPDIR to a shorter directory" in run.stderr
@@ -296,6 +320,7 @@ def test_serve_sets_its_stop_handlers_in_the_main_thread_only(monkeypatch, tmp_p
 
 # -- 7. worker death -------------------------------------------------------------
 
+
 def _children(pid: int) -> list[int]:
     out = subprocess.run(["ps", "-o", "pid=", "--ppid", str(pid)], capture_output=True, text=True).stdout
     return [int(p) for p in out.split()]
@@ -330,8 +355,10 @@ def test_worker_kill_fails_at_most_its_own_job_and_restart_keeps_saves(tmp_path)
         assert workers
         fits = 6
         with loopback.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(fits) as pool:
-            futures = [pool.submit(http.post, f"{API}/fits", json={"name": f"k{i}", "nk": gold_like_nk(i / 50)})
-                       for i in range(fits)]
+            futures = [
+                pool.submit(http.post, f"{API}/fits", json={"name": f"k{i}", "nk": gold_like_nk(i / 50)})
+                for i in range(fits)
+            ]
             deadline = time.monotonic() + 60
             while http.get("/healthz").json()["fits_in_flight"] < 2 and time.monotonic() < deadline:
                 time.sleep(0.01)
@@ -377,8 +404,10 @@ def test_the_fork_server_is_forked_only_where_multiprocessing_would_start_the_sa
 @pytest.mark.slow
 @pytest.mark.server
 def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_starts_its_own(tmp_path):
-    with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         # Started before the first thread (service.runtime.fork_server.start_fork_server): the server's own
         # command line, one thread, and the workers are its forks.
         fork_servers = _fork_servers(server.process.pid)
@@ -409,8 +438,9 @@ def test_the_fork_server_is_a_fork_of_the_server_and_if_it_dies_multiprocessing_
 
 def _run_script(script: str, *args: str, env: dict | None = None, timeout_s: float) -> dict:
     """Run ``script`` (``python -c``, in the repository) in a process of its own; the dict its last line prints."""
-    run = subprocess.run([sys.executable, "-c", script, *args], cwd=ROOT, env=env, capture_output=True, text=True,
-                         timeout=timeout_s)
+    run = subprocess.run(
+        [sys.executable, "-c", script, *args], cwd=ROOT, env=env, capture_output=True, text=True, timeout=timeout_s
+    )
     assert run.returncode == 0, run.stderr[-3000:]
     return ast.literal_eval(run.stdout.strip().splitlines()[-1])
 
@@ -502,8 +532,9 @@ def test_a_worker_start_that_a_dying_fork_server_refuses_waits_for_its_exit_and_
     assert seen["preview_second"] > 0 and seen["fork_server_is_new"], seen
     # A fork server that stays unreachable: 503 (WorkersNotStarted) after three failed starts, not quarantined;
     # once it has exited, the next fit runs.
-    assert seen["stuck"] == ("no fitting worker process could be started (their fork server died); try again "
-                             "(Retry-After 1), restarts 3"), seen
+    assert seen["stuck"] == (
+        "no fitting worker process could be started (their fork server died); try again (Retry-After 1), restarts 3"
+    ), seen
     assert seen["again"] > 0, seen
 
 
@@ -605,51 +636,73 @@ def test_timed_out_fit_is_cancelled_and_its_worker_freed(tmp_path):
 
 # -- 8. generated code and ids ---------------------------------------------------
 
+
 @pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
 def test_symbols_unique_and_every_download_compiles(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
-        ids = [client.post(f"{API}/fits", json={"name": name, "nk": gold_like_nk(i / 10)}).json()["id"]
-               for i, name in enumerate(["material x", "x F0", "x"])]
-        sources = {fmt: client.post(f"{API}/packs", json={"fit_ids": ids, "format": fmt}).text
-                   for fmt in ("glsl", "hlsl")}
+        ids = [
+            client.post(f"{API}/fits", json={"name": name, "nk": gold_like_nk(i / 10)}).json()["id"]
+            for i, name in enumerate(["material x", "x F0", "x"])
+        ]
+        sources = {
+            fmt: client.post(f"{API}/packs", json={"fit_ids": ids, "format": fmt}).text for fmt in ("glsl", "hlsl")
+        }
     glsl = sources["glsl"]
     functions = re.findall(r"vec3 (cf_material_\w+)\(float NdotV", glsl)
     assert len(functions) == 3
     for head in ("#version 330\n", "#version 300 es\nprecision highp float;\n"):
         path = tmp_path / "pack.frag"
-        path.write_text(head + glsl + "\nout vec4 o;\nvoid main() { o = vec4(%s, 1.0); }\n"
-                        % " + ".join(f"{f}(0.5, 1.5)" for f in functions))
+        path.write_text(
+            head
+            + glsl
+            + "\nout vec4 o;\nvoid main() { o = vec4(%s, 1.0); }\n" % " + ".join(f"{f}(0.5, 1.5)" for f in functions)
+        )
         result = subprocess.run(["glslangValidator", str(path)], capture_output=True, text=True, timeout=60)
         assert result.returncode == 0, head + result.stdout
     hlsl = sources["hlsl"]
     calls = " + ".join(f"{f}(0.5, 1.5)" for f in re.findall(r"float3 (cf_material_\w+)\(float NdotV", hlsl))
     path = tmp_path / "pack.hlsl"
     path.write_text(hlsl + "\nfloat4 main() : SV_Target { return float4(%s, 1.0); }\n" % calls)
-    result = subprocess.run(["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o",
-                             str(tmp_path / "p.spv"), str(path)], capture_output=True, text=True, timeout=60)
+    result = subprocess.run(
+        ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "p.spv"), str(path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode == 0, result.stdout
 
 
 # -- 9. edits in scenes, float32 bounds --------------------------------------------
 
+
 @pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run
 def test_scene_uses_the_edited_model(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
-        edit = {"name": "warm gold", "base": {"material": "Au"}, "curves": [{
-            "eta_i": 1.5, "angle_deg": [0, 30, 60, 75, 90],
-            "rgb": [[0.2, 0.9, 0.2], [0.2, 0.9, 0.2], [0.2, 0.88, 0.22], [0.3, 0.85, 0.4], [1, 1, 1]]}]}
+        edit = {
+            "name": "warm gold",
+            "base": {"material": "Au"},
+            "curves": [
+                {
+                    "eta_i": 1.5,
+                    "angle_deg": [0, 30, 60, 75, 90],
+                    "rgb": [[0.2, 0.9, 0.2], [0.2, 0.9, 0.2], [0.2, 0.88, 0.22], [0.3, 0.85, 0.4], [1, 1, 1]],
+                }
+            ],
+        }
         edited = client.post(f"{API}/fits/from-curves", json=edit)
         assert edited.status_code == 201, edited.text
         fit = edited.json()
-        scene = client.post(f"{API}/scenes", json={"materials": [
-            {"name": "w", "material": fit["material_id"], "eta_i": 1.5}]})
+        scene = client.post(
+            f"{API}/scenes", json={"materials": [{"name": "w", "material": fit["material_id"], "eta_i": 1.5}]}
+        )
         assert scene.status_code == 200, scene.text
         report = scene.json()["materials"][0]
         assert report["fit"]["from_stored_model"] is True and report["material"] == fit["material_id"]
         shipped = scene.json()["pack"]["materials"][0]["coefficients"]
         assert shipped == fit["coefficients"]  # the edits, not gold's n, k
-        outside = client.post(f"{API}/scenes", json={"materials": [
-            {"name": "w", "material": fit["material_id"], "eta_i": 2.9}]})
+        outside = client.post(
+            f"{API}/scenes", json={"materials": [{"name": "w", "material": fit["material_id"], "eta_i": 2.9}]}
+        )
         assert outside.status_code == 422 and "materials[0].eta_i" in outside.json()["detail"]
 
 
@@ -658,29 +711,45 @@ def test_edit_at_the_float32_rounded_upper_end(tmp_path):
     with app_client(tmp_path, metrics_samples=10) as client:
         base = client.post(f"{API}/fits", json={"material": "Cu", "eta_i_range": [2.9999999, 3.0]})
         assert base.status_code == 201, base.text
-        edit = {"name": "edge", "base": {"fit": base.json()["id"]}, "eta_i_range": [2.9999999, 3.0],
-                "curves": [{"eta_i": 2.9999999, "cos_theta": [1.0, 0.7, 0.4, 0.1, 0.0],
-                            "rgb": [[0.9, 0.6, 0.5], [0.9, 0.6, 0.5], [0.9, 0.62, 0.52],
-                                    [0.93, 0.8, 0.75], [1, 1, 1]]}]}
+        edit = {
+            "name": "edge",
+            "base": {"fit": base.json()["id"]},
+            "eta_i_range": [2.9999999, 3.0],
+            "curves": [
+                {
+                    "eta_i": 2.9999999,
+                    "cos_theta": [1.0, 0.7, 0.4, 0.1, 0.0],
+                    "rgb": [[0.9, 0.6, 0.5], [0.9, 0.6, 0.5], [0.9, 0.62, 0.52], [0.93, 0.8, 0.75], [1, 1, 1]],
+                }
+            ],
+        }
         response = client.post(f"{API}/fits/from-curves", json=edit)
         assert response.status_code == 201, response.text
 
 
 # -- a client that goes away cancels its job ------------------------------
 
+
 @pytest.mark.slow
 @pytest.mark.server
 def test_a_job_whose_client_went_away_is_cancelled_within_a_second(tmp_path):
     import json
 
-    scene = {"name": "big", "materials": [
-        {"name": f"m{i}", "nk": gold_like_nk(i / 100), "eta_i": np.linspace(1.0, 2.5, 32).tolist()}
-        for i in range(64)]}
+    scene = {
+        "name": "big",
+        "materials": [
+            {"name": f"m{i}", "nk": gold_like_nk(i / 100), "eta_i": np.linspace(1.0, 2.5, 32).tolist()}
+            for i in range(64)
+        ],
+    }
     payload = json.dumps(scene).encode()
     with server_process(tmp_path / "data") as server, loopback.Client(base_url=server.url, timeout=30) as http:
         with socket.create_connection(("127.0.0.1", server.port), timeout=10) as raw:
-            raw.sendall(b"POST /api/v1/scenes HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                        + f"content-length: {len(payload)}\r\n\r\n".encode() + payload)
+            raw.sendall(
+                b"POST /api/v1/scenes HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
+                + f"content-length: {len(payload)}\r\n\r\n".encode()
+                + payload
+            )
             deadline = time.monotonic() + 30
             while http.get("/healthz").json()["fits_in_flight"] == 0 and time.monotonic() < deadline:
                 time.sleep(0.05)

@@ -43,11 +43,21 @@ def fits(client):
         # `?metrics=full`: the answer waits for the fit's evaluation on the metrics grid.
         ("nk", f"{API}/fits?metrics=full", {"material": "Au"}),
         ("rgb-nk", f"{API}/fits?metrics=full", {"material": "Au", "model": "rgb-conductor"}),
-        ("curves", f"{API}/fits/from-curves",
-         {"name": "pale gold", "base": {"material": "Au"}, "curves": [pale_gold_curve()]}),
-        ("rgb-curves", f"{API}/fits/from-curves",
-         {"name": "pale gold rgb", "base": {"material": "Au"}, "curves": [pale_gold_curve()],
-          "model": "rgb-conductor"}),
+        (
+            "curves",
+            f"{API}/fits/from-curves",
+            {"name": "pale gold", "base": {"material": "Au"}, "curves": [pale_gold_curve()]},
+        ),
+        (
+            "rgb-curves",
+            f"{API}/fits/from-curves",
+            {
+                "name": "pale gold rgb",
+                "base": {"material": "Au"},
+                "curves": [pale_gold_curve()],
+                "model": "rgb-conductor",
+            },
+        ),
     ):
         response = client.post(url, json=body)
         assert response.status_code == 201, response.text
@@ -83,8 +93,7 @@ def test_a_curve_fits_figure_is_the_whole_target_the_editor_shows(fits):
     figure = fits["curves"]["metrics"]["figure"]
     assert figure["delta_E_mean"] == details["target"]["delta_E_mean"]
     assert figure["delta_E_max"] == details["target"]["delta_E_max"]
-    assert figure["max_at"] == {"eta_i": details["target"]["at_eta_i"],
-                                "theta_deg": details["target"]["at_theta_deg"]}
+    assert figure["max_at"] == {"eta_i": details["target"]["at_eta_i"], "theta_deg": details["target"]["at_theta_deg"]}
 
 
 @pytest.mark.slow

@@ -23,8 +23,9 @@ pytestmark = [pytest.mark.slow, pytest.mark.server]
 def _cli(table, directory, *extra):
     w, n, k = table
     path = directory / "case.csv"
-    path.write_text("wavelength_nm,n,k\n" + "".join(
-        f"{float(a)!r},{float(b)!r},{float(c)!r}\n" for a, b, c in zip(w, n, k)))
+    path.write_text(
+        "wavelength_nm,n,k\n" + "".join(f"{float(a)!r},{float(b)!r},{float(c)!r}\n" for a, b, c in zip(w, n, k))
+    )
     return run_command("fitting", "fit", "--nk", str(path), "--name", "case", "--json", *extra)
 
 
@@ -37,9 +38,12 @@ def test_cli_and_service_agree_on_20_extreme_tables(tmp_path):
             done = _cli(table, tmp_path)
             if done.returncode == 0:
                 view = _strict_json(done.stdout)  # raises on NaN or infinity
-                cli = {"accepted": True, "coefficients": view["coefficients"],
-                       "warnings": view["fit"].get("quality", {}).get("warnings", []),
-                       "delta_E_mean": view["metrics"]["figure"]["delta_E_mean"]}
+                cli = {
+                    "accepted": True,
+                    "coefficients": view["coefficients"],
+                    "warnings": view["fit"].get("quality", {}).get("warnings", []),
+                    "delta_E_mean": view["metrics"]["figure"]["delta_E_mean"],
+                }
             else:
                 assert done.returncode == 2, (name, done.stderr)
                 cli = {"accepted": False, "rule": _rule(done.stderr.strip().splitlines()[-1])}
@@ -50,9 +54,16 @@ def test_cli_and_service_agree_on_20_extreme_tables(tmp_path):
                 if answer["accepted"]:
                     assert math.isfinite(answer["delta_E_mean"]), name
     refused = {name for name, (cli, _) in answers.items() if not cli["accepted"]}
-    assert refused == {"k 1001 everywhere", "k 1e6 everywhere", "n 1e200 everywhere", "k 1e20 at 550 nm",
-                       "k 1e200 at 550 nm", "n 1e200 at 550 nm", "n 1e6 at 550 nm",
-                       "n 1e200 at 350 nm, the nearest beyond 360 nm"}
+    assert refused == {
+        "k 1001 everywhere",
+        "k 1e6 everywhere",
+        "n 1e200 everywhere",
+        "k 1e20 at 550 nm",
+        "k 1e200 at 550 nm",
+        "n 1e200 at 550 nm",
+        "n 1e6 at 550 nm",
+        "n 1e200 at 350 nm, the nearest beyond 360 nm",
+    }
     for name in refused:
         assert answers[name][0]["rule"].startswith(("`n` must be at most 1000", "`k` must be at most 1000"))
     spikes = ("n 50 at 550 nm", "k 300 at 550 nm", "k 1e-6 at 550 nm", "n 1e-6 at 550 nm")

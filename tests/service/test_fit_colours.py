@@ -51,13 +51,16 @@ class TestFitFromColours:
         response = client.get(f"{API}/fits/{fit['id']}/pack?format=openpbr&eta_i=1.5")
         assert response.status_code == 200 and b"open_pbr_surface" in response.content
 
-    @pytest.mark.parametrize("body, words", [
-        ({"name": "x", "f0": [0.5, 0.5, 0.5]}, ["`f0` and `f82` together"]),
-        ({"name": "x", "f0": [0.5, 0.5], "f82": [1, 1]}, ["f0", "at least 3"]),
-        ({"name": "x", "f0": [0.5, 1.5, 0.5], "f82": [1, 1, 1]}, ["less than or equal to 1"]),
-        ({"material": "Au", "f0": [0.5, 0.5, 0.5], "f82": [1, 1, 1]}, ["exactly one of"]),
-        ({"name": "x", "f0": [0.5, 0.5, 0.5], "f82": [1, 1, 1], "space": "srgb"}, ["space", "'acescg'"]),
-    ])
+    @pytest.mark.parametrize(
+        "body, words",
+        [
+            ({"name": "x", "f0": [0.5, 0.5, 0.5]}, ["`f0` and `f82` together"]),
+            ({"name": "x", "f0": [0.5, 0.5], "f82": [1, 1]}, ["f0", "at least 3"]),
+            ({"name": "x", "f0": [0.5, 1.5, 0.5], "f82": [1, 1, 1]}, ["less than or equal to 1"]),
+            ({"material": "Au", "f0": [0.5, 0.5, 0.5], "f82": [1, 1, 1]}, ["exactly one of"]),
+            ({"name": "x", "f0": [0.5, 0.5, 0.5], "f82": [1, 1, 1], "space": "srgb"}, ["space", "'acescg'"]),
+        ],
+    )
     def test_bad_colours_422(self, client, body, words):
         response = client.post(f"{API}/fits", json=body)
         assert response.status_code == 422, response.text
@@ -94,14 +97,17 @@ class TestColourCurves:
         air = client.post(f"{API}/colour-curves", json=self.BODY).json()
         np.testing.assert_allclose(np.asarray(answer["n"]), 1.5 * np.asarray(air["n"]), rtol=1e-12)
 
-    @pytest.mark.parametrize("change, words", [
-        ({"eta_i": []}, ["eta_i", "at least 1"]),
-        ({"eta_i": [1.5] * 17}, ["eta_i", "at most 16"]),
-        ({"seen_at": 3.5}, ["seen_at", "less than or equal to 3"]),
-        ({"samples": 1}, ["samples", "greater than or equal to 2"]),
-        ({"f82": [0.5, -0.1, 0.5]}, ["f82", "greater than or equal to 0"]),
-        ({"f0": None}, ["f0"]),
-    ])
+    @pytest.mark.parametrize(
+        "change, words",
+        [
+            ({"eta_i": []}, ["eta_i", "at least 1"]),
+            ({"eta_i": [1.5] * 17}, ["eta_i", "at most 16"]),
+            ({"seen_at": 3.5}, ["seen_at", "less than or equal to 3"]),
+            ({"samples": 1}, ["samples", "greater than or equal to 2"]),
+            ({"f82": [0.5, -0.1, 0.5]}, ["f82", "greater than or equal to 0"]),
+            ({"f0": None}, ["f0"]),
+        ],
+    )
     def test_bad_requests_422(self, client, change, words):
         response = client.post(f"{API}/colour-curves", json={**self.BODY, **change})
         assert response.status_code == 422, response.text

@@ -67,8 +67,7 @@ class TestImport:
         client, fit_id, _ = shared
         # An export made elsewhere (the CLI's: a content address, not a stored id).
         stored = model_of(client, fit_id)
-        model = type(stored)("Cu elsewhere", stored.coefficients, stored.eta_i_range, stored.source,
-                             model=stored.model)
+        model = type(stored)("Cu elsewhere", stored.coefficients, stored.eta_i_range, stored.source, model=stored.model)
         text = export_material(library_material("Cu"), "mtlx", 1.33, model=model)
         response = post(client, text)
         assert response.status_code == 201, response.text
@@ -86,21 +85,39 @@ class TestImport:
         stored = encode_pack([model_of(client, fit_id)])
         assert files["binary"] == stored
 
-    @pytest.mark.parametrize("damage, words", [
-        (lambda f: f["binary"][:-1] + bytes([f["binary"][-1] ^ 1]), "checksum mismatch"),
-        (lambda f: f["binary"][:20], "truncated"),
-        # The document's fit id changed, not the material's.
-        (lambda f: f["mtlx"].replace(b'coatedfresnel_fit_id="', b'coatedfresnel_fit_id="f', 1), "differ in fit_id"),
-        (lambda f: gltf_extras(f["gltf"], eta_i=9), "`eta_i` must lie in [1, 3], got 9"),
-        (lambda f: gltf_extras(f["gltf"], eta_i=2.0), "the coat index EXT_materials_coated_conductor is drawn under"),
-        (lambda f: f["blender"].replace(b"PACK = '", b"PACK = 'x", 1), "damaged fit model (PACK)"),
-        (lambda f: f["glb"][:-4], "damaged GLB"),
-        (lambda f: b"<materialx version=\"1.39\"/>", "one surfacematerial"),
-        (lambda f: b"\xff\xfegarbage", "neither a pack, a GLB nor UTF-8"),
-        (lambda f: b"hello", "is not a pack, its JSON view, a glTF/GLB"),
-        (lambda f: b"", "`file` is empty"),
-    ], ids=["crc", "truncated", "mtlx-identity", "gltf-eta", "gltf-coat-ior", "blender-pack", "glb-length", "no-material",
-            "binary-garbage", "text", "empty"])
+    @pytest.mark.parametrize(
+        "damage, words",
+        [
+            (lambda f: f["binary"][:-1] + bytes([f["binary"][-1] ^ 1]), "checksum mismatch"),
+            (lambda f: f["binary"][:20], "truncated"),
+            # The document's fit id changed, not the material's.
+            (lambda f: f["mtlx"].replace(b'coatedfresnel_fit_id="', b'coatedfresnel_fit_id="f', 1), "differ in fit_id"),
+            (lambda f: gltf_extras(f["gltf"], eta_i=9), "`eta_i` must lie in [1, 3], got 9"),
+            (
+                lambda f: gltf_extras(f["gltf"], eta_i=2.0),
+                "the coat index EXT_materials_coated_conductor is drawn under",
+            ),
+            (lambda f: f["blender"].replace(b"PACK = '", b"PACK = 'x", 1), "damaged fit model (PACK)"),
+            (lambda f: f["glb"][:-4], "damaged GLB"),
+            (lambda f: b'<materialx version="1.39"/>', "one surfacematerial"),
+            (lambda f: b"\xff\xfegarbage", "neither a pack, a GLB nor UTF-8"),
+            (lambda f: b"hello", "is not a pack, its JSON view, a glTF/GLB"),
+            (lambda f: b"", "`file` is empty"),
+        ],
+        ids=[
+            "crc",
+            "truncated",
+            "mtlx-identity",
+            "gltf-eta",
+            "gltf-coat-ior",
+            "blender-pack",
+            "glb-length",
+            "no-material",
+            "binary-garbage",
+            "text",
+            "empty",
+        ],
+    )
     def test_damaged_files_422(self, shared, damage, words):
         client, _, files = shared
         response = post(client, damage(files))
@@ -128,8 +145,9 @@ class TestImportGuards:
             response = post(client, b"CFPK")
             assert response.status_code == 401 and response.headers["www-authenticate"] == "Bearer"
             # Past the token check: refused for what the file is.
-            allowed = client.post(f"{API}/fits/import", files={"file": ("a", b"CFPK")},
-                                  headers={"Authorization": "Bearer s3cret"})
+            allowed = client.post(
+                f"{API}/fits/import", files={"file": ("a", b"CFPK")}, headers={"Authorization": "Bearer s3cret"}
+            )
             assert allowed.status_code == 422 and "truncated" in allowed.json()["detail"]
 
     def test_too_large_413(self, tmp_path):

@@ -47,8 +47,10 @@ def test_healthz_is_503_while_no_fitting_worker_can_start_and_200_once_one_does(
 
 
 def _check(tmp_path, temporary):
-    with server_process(tmp_path / "data", TMPDIR=str(temporary)) as server, \
-            loopback.Client(base_url=server.url, timeout=120) as http:
+    with (
+        server_process(tmp_path / "data", TMPDIR=str(temporary)) as server,
+        loopback.Client(base_url=server.url, timeout=120) as http,
+    ):
         assert http.post(f"{API}/fits", json={"material": "Au"}).status_code == 201
         assert http.get("/healthz").status_code == 200
         (mp_dir,) = temporary.glob("pymp-*")

@@ -45,8 +45,11 @@ def unreachable_curve(rng: random.Random, base_is_metal: bool) -> dict:
     rgb[:, channel] += (rng.choice([0.0, 0.02, 1.0]) - rgb[:, channel]) * pull
     if not base_is_metal and rng.random() < 0.5:
         rgb[:] = rng.uniform(0.2, 0.8)  # a flat curve on a base with no conductor
-    return {"eta_i": rng.choice([1.0, 1.33, 1.5, 2.0, 2.5]), "angle_deg": angles.tolist(),
-            "rgb": np.clip(rgb, 0.0, 1.0).tolist()}
+    return {
+        "eta_i": rng.choice([1.0, 1.33, 1.5, 2.0, 2.5]),
+        "angle_deg": angles.tolist(),
+        "rgb": np.clip(rgb, 0.0, 1.0).tolist(),
+    }
 
 
 def corpus(seed: int = SEED, count: int = 10) -> list[dict]:
@@ -65,6 +68,7 @@ def corpus(seed: int = SEED, count: int = 10) -> list[dict]:
 def test_worst_case_refits_are_bounded_and_do_not_hold_a_library_fit(tmp_path):
     answers: list[tuple[int, float, dict]] = []
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2", COATED_FIT_QUEUE="16") as server:
+
         def send(body):
             with loopback.Client(base_url=server.url, timeout=120) as http:
                 t0 = time.perf_counter()
@@ -100,10 +104,13 @@ def test_a_large_scene_takes_turns_with_a_library_fit(tmp_path):
     scene (it takes its turn between the scene's parts), and the scene's
     report still lists every material in its order.
     """
-    scene = {"name": "large", "materials": [
-        {"material": name, "eta_i": [1.0, 1.33, 1.5, 2.0]} for name in LIBRARY_NAMES]}
+    scene = {
+        "name": "large",
+        "materials": [{"material": name, "eta_i": [1.0, 1.33, 1.5, 2.0]} for name in LIBRARY_NAMES],
+    }
     finished: list[tuple[str, int]] = []
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="1") as server:
+
         def post(label: str, path: str, body: dict) -> None:
             with loopback.Client(base_url=server.url, timeout=300) as http:
                 response = http.post(f"{API}{path}", json=body)

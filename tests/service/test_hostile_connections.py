@@ -31,8 +31,9 @@ from conftest import server_process
 
 pytestmark = [pytest.mark.slow, pytest.mark.server]
 
-TRICKLE_HEADER = (b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\n"
-                  b"content-length: 1000\r\n\r\n")
+TRICKLE_HEADER = (
+    b"POST /api/v1/fits HTTP/1.1\r\nHost: 127.0.0.1\r\ncontent-type: application/json\r\ncontent-length: 1000\r\n\r\n"
+)
 
 
 def _connect(port: int, source: str) -> socket.socket | None:
@@ -103,20 +104,27 @@ def _probe(url: str, stop: threading.Event, answers: list) -> None:
         stop.wait(0.25)
 
 
-@pytest.mark.parametrize("trickles, bounds", [
-    pytest.param({"127.0.0.2": 128}, {}, id="128-trickles-from-one-address"),
-    # The bound filled with trickles from four addresses, at a quarter of the scale (before: 503 to others).
-    pytest.param({f"127.0.0.{i}": 16 for i in range(2, 6)},
-                 {"COATED_MAX_CONNECTIONS": "64", "COATED_MAX_CONNECTIONS_PER_CLIENT": "16"},
-                 id="the-bound-filled-with-trickles"),
-])
+@pytest.mark.parametrize(
+    "trickles, bounds",
+    [
+        pytest.param({"127.0.0.2": 128}, {}, id="128-trickles-from-one-address"),
+        # The bound filled with trickles from four addresses, at a quarter of the scale (before: 503 to others).
+        pytest.param(
+            {f"127.0.0.{i}": 16 for i in range(2, 6)},
+            {"COATED_MAX_CONNECTIONS": "64", "COATED_MAX_CONNECTIONS_PER_CLIENT": "16"},
+            id="the-bound-filled-with-trickles",
+        ),
+    ],
+)
 def test_trickling_bodies_and_churning_idle_sockets_leave_another_address_served(tmp_path, trickles, bounds):
     with server_process(tmp_path / "data", COATED_WARM_POOL="false", **bounds) as server:
         stop = threading.Event()
         closed = [0, 0]  # trickles closed, of them answered 408
         probes: list = []
-        threads = [threading.Thread(target=_trickle, args=(server.port, source, count, stop, closed))
-                   for source, count in trickles.items()]
+        threads = [
+            threading.Thread(target=_trickle, args=(server.port, source, count, stop, closed))
+            for source, count in trickles.items()
+        ]
         threads += [threading.Thread(target=_churn, args=(server.port, f"127.0.0.{i}", stop)) for i in range(3, 7)]
         try:
             for t in threads:

@@ -74,25 +74,37 @@ class Case:
 
 # -- building blocks -------------------------------------------------------
 
-GOOD_ROWS = "\n".join(
-    f"        {0.35 + 0.05 * i:.2f} {1.5 - 0.1 * i:.3f} {1.8 + 0.4 * i:.3f}" for i in range(10)
-)
+GOOD_ROWS = "\n".join(f"        {0.35 + 0.05 * i:.2f} {1.5 - 0.1 * i:.3f} {1.8 + 0.4 * i:.3f}" for i in range(10))
 GOOD_NK_ENTRY = f"  - type: tabulated nk\n    data: |\n{GOOD_ROWS}\n"
 GOOD_JSON = {"wavelength_nm": [400.0, 500.0, 600.0], "n": [1.5, 0.9, 0.3], "k": [1.9, 2.5, 3.2]}
 
 
-def upload(klass: str, label: str, content: bytes | str, filename: str, expect: str,
-           **form: str) -> Case:
+def upload(klass: str, label: str, content: bytes | str, filename: str, expect: str, **form: str) -> Case:
     data = content.encode() if isinstance(content, str) else content
-    return Case(klass, label, "POST", f"{API}/fits/upload", expect, data,
-                {"files": {"file": (filename, data, "application/octet-stream")}, "data": form})
+    return Case(
+        klass,
+        label,
+        "POST",
+        f"{API}/fits/upload",
+        expect,
+        data,
+        {"files": {"file": (filename, data, "application/octet-stream")}, "data": form},
+    )
 
 
-def body(klass: str, label: str, path: str, content: bytes | str, expect: str,
-         content_type: str = "application/json", **extra: Any) -> Case:
+def body(
+    klass: str,
+    label: str,
+    path: str,
+    content: bytes | str,
+    expect: str,
+    content_type: str = "application/json",
+    **extra: Any,
+) -> Case:
     data = content.encode() if isinstance(content, str) else content
-    return Case(klass, label, "POST", path, expect, data,
-                {"content": data, "headers": {"content-type": content_type}}, **extra)
+    return Case(
+        klass, label, "POST", path, expect, data, {"content": data, "headers": {"content-type": content_type}}, **extra
+    )
 
 
 def json_body(klass: str, label: str, path: str, value: Any, expect: str) -> Case:
@@ -104,6 +116,7 @@ def yaml_upload(klass: str, label: str, text: str, expect: str) -> Case:
 
 
 # -- generators: each returns many randomised variants of one class ---------
+
 
 def gen_yaml_alias_bomb(rng: random.Random) -> list[Case]:
     cases = []
@@ -136,8 +149,11 @@ def gen_yaml_alias_bomb(rng: random.Random) -> list[Case]:
             lines.append("k: &k [a, b]")
             lines.append("m: {? *k : 1, ? [*k, *k] : 2}")
         where = rng.choice(["REFERENCES", "DATA", "data", "COMMENTS"])
-        last = f"l{levels - 1}" if shape in ("flow", "block", "mapping", "merge") else {
-            "scalar": "s", "recursive": "r", "key": "k"}[shape]
+        last = (
+            f"l{levels - 1}"
+            if shape in ("flow", "block", "mapping", "merge")
+            else {"scalar": "s", "recursive": "r", "key": "k"}[shape]
+        )
         doc = "\n".join(lines) + "\n"
         if where == "REFERENCES":
             doc += f"REFERENCES: *{last}\nDATA:\n{GOOD_NK_ENTRY}"
@@ -147,8 +163,7 @@ def gen_yaml_alias_bomb(rng: random.Random) -> list[Case]:
             doc += f"DATA:\n  - type: tabulated nk\n    data: *{last}\n"
         else:
             doc += f"COMMENTS: *{last}\nDATA:\n{GOOD_NK_ENTRY}"
-        cases.append(yaml_upload("yaml_alias_bomb", f"{shape}-{where}-{levels}x{fan}-{i}", doc,
-                                 r"alias|merge"))
+        cases.append(yaml_upload("yaml_alias_bomb", f"{shape}-{where}-{levels}x{fan}-{i}", doc, r"alias|merge"))
     return cases
 
 
@@ -183,8 +198,14 @@ def gen_deep_nesting(rng: random.Random) -> list[Case]:
 
 
 FORMULA_COEFFICIENTS = {
-    1: "0 1.03 0.07 0.23 0.15", 2: "0 1.03 0.006", 3: "2.2 -0.01 2", 4: "2.2 0.01 0 0.05 2",
-    5: "1.45 0.004 -2", 6: "0 0.05 238", 7: "1.5 0.004 0 0 0 0", 8: "0.5 0.1 0.01 0.01",
+    1: "0 1.03 0.07 0.23 0.15",
+    2: "0 1.03 0.006",
+    3: "2.2 -0.01 2",
+    4: "2.2 0.01 0 0.05 2",
+    5: "1.45 0.004 -2",
+    6: "0 0.05 238",
+    7: "1.5 0.004 0 0 0 0",
+    8: "0.5 0.1 0.01 0.01",
     9: "2.1 0.1 0.02 0.01 0.3 0.2",
 }
 
@@ -209,8 +230,10 @@ def gen_huge_wavelength_range(rng: random.Random) -> list[Case]:
             wr, expect = f"{lo:g} {lo:g}", r"wavelength_range"
         else:
             wr, expect = f"-{hi:g} -{lo:g}", r"wavelength_range|samples|wavelength|> 0|real n"
-        text = (f"DATA:\n  - type: formula {number}\n    wavelength_range: {wr}\n"
-                f"    coefficients: {FORMULA_COEFFICIENTS[number]}\n")
+        text = (
+            f"DATA:\n  - type: formula {number}\n    wavelength_range: {wr}\n"
+            f"    coefficients: {FORMULA_COEFFICIENTS[number]}\n"
+        )
         if rng.random() < 0.4:
             text += f"  - type: tabulated k\n    data: |\n        {lo:g} 0.1\n        {hi:g} 0.2\n"
         cases.append(yaml_upload("huge_wavelength_range", f"f{number}-{kind}-{i}", text, expect))
@@ -241,13 +264,11 @@ def gen_huge_samples(rng: random.Random) -> list[Case]:
         cases.append(upload("huge_samples", f"json-file-{count}-{i}", text, "many.json", r"at most \d+"))
     for i in range(6):
         count = rng.randint(20_001, 60_000)
-        value = {"name": "big", "nk": {"wavelength_nm": list(range(1, count + 1)),
-                                       "n": [1.0] * 3, "k": [1.0] * 3}}
+        value = {"name": "big", "nk": {"wavelength_nm": list(range(1, count + 1)), "n": [1.0] * 3, "k": [1.0] * 3}}
         path = rng.choice([f"{API}/fits", f"{API}/scenes"])
         if path.endswith("scenes"):
             value = {"name": "s", "materials": [{"name": "m", "nk": value["nk"], "eta_i": 1.5}]}
-        cases.append(json_body("huge_samples", f"json-body-{count}-{i}", path, value,
-                               r"at most \d+|\d+ items"))
+        cases.append(json_body("huge_samples", f"json-body-{count}-{i}", path, value, r"at most \d+|\d+ items"))
     return cases
 
 
@@ -268,8 +289,9 @@ def gen_wrong_types(rng: random.Random) -> list[Case]:
     for i in range(40):
         kind = rng.choice(kinds)
         value = rng.choice(YAML_WRONG_VALUES[kind])
-        target = rng.choice(["REFERENCES", "DATA", "DATA[0]", "type", "data", "coefficients",
-                             "wavelength_range", "top"])
+        target = rng.choice(
+            ["REFERENCES", "DATA", "DATA[0]", "type", "data", "coefficients", "wavelength_range", "top"]
+        )
         if target == "REFERENCES":
             text = f"REFERENCES: {value}\nDATA:\n{GOOD_NK_ENTRY}"
         elif target == "DATA":
@@ -290,13 +312,25 @@ def gen_wrong_types(rng: random.Random) -> list[Case]:
             text = f"DATA:\n  - type: formula 2\n    wavelength_range: {value}\n    coefficients: 0 1 0.1\n"
         else:
             text = f"{value}\n"
-        field_name = {"DATA[0]": r"DATA\[0\]", "top": "DATA", "type": r"type|not supported",
-                      "data": r"`data`|rows",
-                      "wavelength_range": "wavelength_range"}.get(target, target)
+        field_name = {
+            "DATA[0]": r"DATA\[0\]",
+            "top": "DATA",
+            "type": r"type|not supported",
+            "data": r"`data`|rows",
+            "wavelength_range": "wavelength_range",
+        }.get(target, target)
         cases.append(yaml_upload("wrong_types", f"yaml-{target}-{kind}-{i}", text, field_name))
-    json_wrong = [("true", "a boolean"), ('"1.5"', "str"), ("null", "null"), ('{"a": 1}', "a map"),
-                  ("[[1], [2]]", "a list"), ('["a", "b"]', "str"), ("[null, 1]", "null"),
-                  ('[{"x": 1}, 2]', "a map"), ("5", "a number")]
+    json_wrong = [
+        ("true", "a boolean"),
+        ('"1.5"', "str"),
+        ("null", "null"),
+        ('{"a": 1}', "a map"),
+        ("[[1], [2]]", "a list"),
+        ('["a", "b"]', "str"),
+        ("[null, 1]", "null"),
+        ('[{"x": 1}, 2]', "a map"),
+        ("5", "a number"),
+    ]
     for i in range(20):
         field_name = rng.choice(["wavelength_nm", "n", "k", "name", "source"])
         value, _ = rng.choice(json_wrong)
@@ -325,13 +359,17 @@ def gen_wrong_types(rng: random.Random) -> list[Case]:
         (f"{API}/scenes", {"name": "s", "materials": {"a": 1}}, "materials"),
         (f"{API}/scenes", {"name": "s", "materials": [{"material": "Au", "eta_i": "1.5"}]}, "eta_i"),
         (f"{API}/fits/from-curves", {"curves": "none"}, "curves"),
-        (f"{API}/fits/from-curves", {"curves": [{"eta_i": 1.5, "angle_deg": "0 90", "rgb": []}]},
-         "curves"),
+        (f"{API}/fits/from-curves", {"curves": [{"eta_i": 1.5, "angle_deg": "0 90", "rgb": []}]}, "curves"),
     ]
     for i in range(3):  # thousands of unknown fields: refused in one error, cheaply
         extra = {f"x{j}": j for j in range(rng.randint(1_000, 50_000))}
-        body_wrong.append((rng.choice([f"{API}/fits", f"{API}/packs", f"{API}/scenes"]),
-                           {"material": "Au", **extra}, r"extra fields are not permitted: \d+ unknown"))
+        body_wrong.append(
+            (
+                rng.choice([f"{API}/fits", f"{API}/packs", f"{API}/scenes"]),
+                {"material": "Au", **extra},
+                r"extra fields are not permitted: \d+ unknown",
+            )
+        )
     for i, (path, value, expect) in enumerate(body_wrong):
         cases.append(json_body("wrong_types", f"json-body-{expect}-{i}", path, value, expect))
     return cases
@@ -343,12 +381,30 @@ def gen_yaml_tags(rng: random.Random) -> list[Case]:
     for i in range(24):
         size = rng.randint(100, 200_000)
         filler = ("".join(rng.choices("xyz0123456789", k=97)) * (size // 97 + 1))[:size]
-        shape = rng.choice(["python", "unknown", "float", "int", "timestamp", "binary", "documents",
-                            "unhashable", "big-int", "wrong-node", "long-anchor"])
+        shape = rng.choice(
+            [
+                "python",
+                "unknown",
+                "float",
+                "int",
+                "timestamp",
+                "binary",
+                "documents",
+                "unhashable",
+                "big-int",
+                "wrong-node",
+                "long-anchor",
+            ]
+        )
         value = {
-            "python": rng.choice(["!!python/object/apply:os.system ['true']", "!!python/name:os.system ''",
-                                  "!!python/object:__main__.X {}"]),
-            "unknown": f"!{filler[:rng.randint(1, 5000)]} x",
+            "python": rng.choice(
+                [
+                    "!!python/object/apply:os.system ['true']",
+                    "!!python/name:os.system ''",
+                    "!!python/object:__main__.X {}",
+                ]
+            ),
+            "unknown": f"!{filler[: rng.randint(1, 5000)]} x",
             "float": f"!!float {filler}",
             "int": f"!!int {filler}",
             "timestamp": rng.choice(["!!timestamp 2020-13-45", "!!timestamp 0000-00-00", "2020-02-31"]),
@@ -357,8 +413,9 @@ def gen_yaml_tags(rng: random.Random) -> list[Case]:
             "documents": "x\n---\nDATA: []\n---\n" + "--- a\n" * rng.randint(1, 1000),
             "unhashable": "{? [a, b] : 1}",
             "big-int": "9" * rng.randint(4_301, 500_000),
-            "wrong-node": rng.choice(["!!str [1, 2]", "!!map [1]", "!!seq {a: 1}", "!!omap {a: 1}",
-                                      "!!pairs [1]", "!!set [1]"]),
+            "wrong-node": rng.choice(
+                ["!!str [1, 2]", "!!map [1]", "!!seq {a: 1}", "!!omap {a: 1}", "!!pairs [1]", "!!set [1]"]
+            ),
             "long-anchor": f"[&{filler[:60_000]} 1, *{filler[:60_000]}]",
         }[shape]
         where = rng.choice(["REFERENCES", "data", "top"])
@@ -378,18 +435,27 @@ def gen_big_numbers(rng: random.Random) -> list[Case]:
     cases = []
     for i in range(12):
         digits = rng.randint(4_301, 400_000)
-        literal = rng.choice(["9" * digits, "-" + "1" * digits, "1" + "0" * digits + ".5",
-                              "1e" + "9" * rng.randint(3, 5000)])
+        literal = rng.choice(
+            ["9" * digits, "-" + "1" * digits, "1" + "0" * digits + ".5", "1e" + "9" * rng.randint(3, 5000)]
+        )
         field_name = rng.choice(["wavelength_nm", "n", "k"])
         nk = {key: json.dumps(v) for key, v in GOOD_JSON.items()}
         nk[field_name] = f"[{literal}, 1, 2]"
         nk_text = "{" + ", ".join(f'"{key}": {val}' for key, val in nk.items()) + "}"
         if rng.random() < 0.5:
-            cases.append(upload("big_numbers", f"file-{field_name}-{i}", nk_text, "big.json",
-                                r"JSON|finite|float64|must be"))
+            cases.append(
+                upload("big_numbers", f"file-{field_name}-{i}", nk_text, "big.json", r"JSON|finite|float64|must be")
+            )
         else:
-            cases.append(body("big_numbers", f"body-{field_name}-{i}", f"{API}/fits",
-                              f'{{"name": "x", "nk": {nk_text}}}', r"parsed|finite|valid"))
+            cases.append(
+                body(
+                    "big_numbers",
+                    f"body-{field_name}-{i}",
+                    f"{API}/fits",
+                    f'{{"name": "x", "nk": {nk_text}}}',
+                    r"parsed|finite|valid",
+                )
+            )
     return cases
 
 
@@ -400,24 +466,46 @@ def gen_booleans(rng: random.Random) -> list[Case]:
         field_name = rng.choice(["wavelength_nm", "n", "k"])
         nk[field_name][rng.randrange(3)] = rng.choice([True, False])
         if rng.random() < 0.5:
-            cases.append(json_body("booleans", f"body-{field_name}-{i}", f"{API}/fits",
-                                   {"name": "b", "nk": nk}, r"valid number|boolean"))
+            cases.append(
+                json_body(
+                    "booleans",
+                    f"body-{field_name}-{i}",
+                    f"{API}/fits",
+                    {"name": "b", "nk": nk},
+                    r"valid number|boolean",
+                )
+            )
         else:
-            cases.append(upload("booleans", f"file-{field_name}-{i}", json.dumps(nk), "b.json",
-                                rf"`{field_name}\[\d\]` must be a number, got a boolean"))
+            cases.append(
+                upload(
+                    "booleans",
+                    f"file-{field_name}-{i}",
+                    json.dumps(nk),
+                    "b.json",
+                    rf"`{field_name}\[\d\]` must be a number, got a boolean",
+                )
+            )
     extra = [
         (f"{API}/fits", {"material": "Au", "eta_i_range": [True, 2]}, "eta_i_range"),
         (f"{API}/fits", {"material": "Au", "eta_i_range": [1.2, False]}, "eta_i_range"),
         (f"{API}/scenes", {"name": "s", "materials": [{"material": "Au", "eta_i": True}]}, "eta_i"),
         (f"{API}/scenes", {"name": "s", "materials": [{"material": "Au", "eta_i": [1.5, True]}]}, "eta_i"),
-        (f"{API}/scenes", {"name": "s", "materials": [{"material": "Au",
-                                                       "eta_i": {"min": True, "max": 2}}]}, "eta_i"),
-        (f"{API}/fits/from-curves", {"curves": [{"eta_i": True, "angle_deg": [0, 45, 90],
-                                                 "rgb": [[0.5, 0.5, 0.5]] * 3}]}, "eta_i"),
-        (f"{API}/fits/from-curves", {"curves": [{"eta_i": 1.5, "angle_deg": [0, True, 90],
-                                                 "rgb": [[0.5, 0.5, 0.5]] * 3}]}, "angle_deg"),
-        (f"{API}/fits/from-curves", {"curves": [{"eta_i": 1.5, "angle_deg": [0, 45, 90],
-                                                 "rgb": [[0.5, True, 0.5]] * 3}]}, "rgb"),
+        (f"{API}/scenes", {"name": "s", "materials": [{"material": "Au", "eta_i": {"min": True, "max": 2}}]}, "eta_i"),
+        (
+            f"{API}/fits/from-curves",
+            {"curves": [{"eta_i": True, "angle_deg": [0, 45, 90], "rgb": [[0.5, 0.5, 0.5]] * 3}]},
+            "eta_i",
+        ),
+        (
+            f"{API}/fits/from-curves",
+            {"curves": [{"eta_i": 1.5, "angle_deg": [0, True, 90], "rgb": [[0.5, 0.5, 0.5]] * 3}]},
+            "angle_deg",
+        ),
+        (
+            f"{API}/fits/from-curves",
+            {"curves": [{"eta_i": 1.5, "angle_deg": [0, 45, 90], "rgb": [[0.5, True, 0.5]] * 3}]},
+            "rgb",
+        ),
     ]
     for i, (path, value, expect) in enumerate(extra):
         cases.append(json_body("booleans", f"body-{expect}-{i}", path, value, expect))
@@ -433,15 +521,22 @@ def gen_non_finite(rng: random.Random) -> list[Case]:
         values = {key: json.dumps(v) for key, v in GOOD_JSON.items()}
         numbers = list(GOOD_JSON[field_name])
         position = rng.randrange(3)
-        values[field_name] = "[" + ", ".join(literal if j == position else str(v)
-                                            for j, v in enumerate(numbers)) + "]"
+        values[field_name] = "[" + ", ".join(literal if j == position else str(v) for j, v in enumerate(numbers)) + "]"
         nk_text = "{" + ", ".join(f'"{key}": {val}' for key, val in values.items()) + "}"
         if rng.random() < 0.5:
-            cases.append(body("non_finite", f"body-{field_name}-{literal}-{i}", f"{API}/fits",
-                              f'{{"name": "x", "nk": {nk_text}}}', r"finite"))
+            cases.append(
+                body(
+                    "non_finite",
+                    f"body-{field_name}-{literal}-{i}",
+                    f"{API}/fits",
+                    f'{{"name": "x", "nk": {nk_text}}}',
+                    r"finite",
+                )
+            )
         else:
-            cases.append(upload("non_finite", f"file-{field_name}-{literal}-{i}", nk_text, "nan.json",
-                                r"finite|NaN|Infinity"))
+            cases.append(
+                upload("non_finite", f"file-{field_name}-{literal}-{i}", nk_text, "nan.json", r"finite|NaN|Infinity")
+            )
     for i in range(6):
         literal = rng.choice([".nan", ".inf", "-.inf", "1e999", "nan", "inf", "-Infinity"])
         rows = GOOD_ROWS.splitlines()
@@ -455,8 +550,11 @@ def gen_non_finite(rng: random.Random) -> list[Case]:
         literal = rng.choice(["nan", "inf", "-inf", "NaN", "1e999", "Infinity"])
         text = f"wavelength_nm,n,k\n400,1,1\n500,{literal},1\n600,1,1\n"
         cases.append(upload("non_finite", f"csv-{literal}-{i}", text, "nan.csv", r"finite"))
-    eta = ['{"material": "Au", "eta_i_range": [NaN, 2]}', '{"material": "Au", "eta_i_range": [1, Infinity]}',
-           '{"name": "s", "materials": [{"material": "Au", "eta_i": NaN}]}']
+    eta = [
+        '{"material": "Au", "eta_i_range": [NaN, 2]}',
+        '{"material": "Au", "eta_i_range": [1, Infinity]}',
+        '{"name": "s", "materials": [{"material": "Au", "eta_i": NaN}]}',
+    ]
     for i, text in enumerate(eta):
         path = f"{API}/scenes" if "materials" in text else f"{API}/fits"
         cases.append(body("non_finite", f"body-eta-{i}", path, text, r"finite"))
@@ -465,7 +563,7 @@ def gen_non_finite(rng: random.Random) -> list[Case]:
 
 def streamed(data: bytes, chunk: int = 65_536):
     for start in range(0, len(data), chunk):
-        yield data[start:start + chunk]
+        yield data[start : start + chunk]
 
 
 def gen_oversized(rng: random.Random) -> list[Case]:
@@ -475,21 +573,35 @@ def gen_oversized(rng: random.Random) -> list[Case]:
         filler = rng.choice(["a", "[", " ", "0"])
         text = ('{"material": "Au", "name": "' + filler * size + '"}').encode()
         path = rng.choice([f"{API}/fits", f"{API}/scenes", f"{API}/packs"])
-        cases.append(body("oversized", f"body-{size}-{i}", path, text, r"at most \d+ bytes",
-                          statuses=(413,)))
+        cases.append(body("oversized", f"body-{size}-{i}", path, text, r"at most \d+ bytes", statuses=(413,)))
     for i in range(4):
         size = rng.randint(BODY_LIMIT + 1, BODY_LIMIT * 2)
         data = b'{"material": "' + b"A" * size + b'"}'
-        cases.append(Case("oversized", f"body-chunked-{size}-{i}", "POST", f"{API}/fits",
-                          r"at most \d+ bytes", data,
-                          {"content": streamed(data), "headers": {"content-type": "application/json"}},
-                          statuses=(413,)))
+        cases.append(
+            Case(
+                "oversized",
+                f"body-chunked-{size}-{i}",
+                "POST",
+                f"{API}/fits",
+                r"at most \d+ bytes",
+                data,
+                {"content": streamed(data), "headers": {"content-type": "application/json"}},
+                statuses=(413,),
+            )
+        )
     for i in range(6):
         size = rng.randint(UPLOAD_LIMIT + 1, UPLOAD_LIMIT * 2)
         pattern = rng.choice([b"1,1,1\n", b"- ", b"[", b"\x00"])
         data = (pattern * (size // len(pattern) + 1))[:size]
-        cases.append(upload("oversized", f"upload-{size}-{i}", data,
-                            rng.choice(["big.csv", "big.yml", "big.json"]), r"at most \d+ bytes"))
+        cases.append(
+            upload(
+                "oversized",
+                f"upload-{size}-{i}",
+                data,
+                rng.choice(["big.csv", "big.yml", "big.json"]),
+                r"at most \d+ bytes",
+            )
+        )
         cases[-1].statuses = (413,)
     return cases
 
@@ -509,9 +621,21 @@ def gen_malformed_multipart(rng: random.Random) -> list[Case]:
     expect = r"multipart|boundary|file|field|body|parse|form"
     for i in range(22):
         boundary = "".join(rng.choice("abcdefXYZ0123456789-") for _ in range(rng.randint(1, 60))).encode()
-        shape = rng.choice(["no-boundary", "wrong-boundary", "truncated", "no-disposition",
-                            "no-file", "many-fields", "long-header", "garbage", "not-multipart",
-                            "empty", "header-no-colon"])
+        shape = rng.choice(
+            [
+                "no-boundary",
+                "wrong-boundary",
+                "truncated",
+                "no-disposition",
+                "no-file",
+                "many-fields",
+                "long-header",
+                "garbage",
+                "not-multipart",
+                "empty",
+                "header-no-colon",
+            ]
+        )
         ctype = b"multipart/form-data; boundary=" + boundary
         if shape == "no-boundary":
             data, ctype = multipart([(file_headers, good_file)], boundary), b"multipart/form-data"
@@ -526,28 +650,37 @@ def gen_malformed_multipart(rng: random.Random) -> list[Case]:
             data = multipart([(b'Content-Disposition: form-data; name="format"', b"csv")], boundary)
         elif shape == "many-fields":
             count = rng.randint(1_100, 5_000)
-            data = multipart([(f'Content-Disposition: form-data; name="f{j}"'.encode(), b"v")
-                              for j in range(count)], boundary)
+            data = multipart(
+                [(f'Content-Disposition: form-data; name="f{j}"'.encode(), b"v") for j in range(count)], boundary
+            )
         elif shape == "long-header":
-            data = multipart([(file_headers + b"; x=" + b"y" * rng.randint(10_000, 500_000), good_file)],
-                             boundary)
+            data = multipart([(file_headers + b"; x=" + b"y" * rng.randint(10_000, 500_000), good_file)], boundary)
         elif shape == "garbage":
             data = rng.randbytes(rng.randint(1, 5_000))
         elif shape == "not-multipart":
-            data, ctype = good_file, rng.choice([b"text/plain", b"application/json",
-                                                 b"application/x-www-form-urlencoded"])
+            data, ctype = (
+                good_file,
+                rng.choice([b"text/plain", b"application/json", b"application/x-www-form-urlencoded"]),
+            )
         elif shape == "empty":
             data = b""
         else:
             data = multipart([(b"this is not a header", good_file)], boundary)
         if len(data) > UPLOAD_LIMIT:
             continue
-        cases.append(body("malformed_multipart", f"{shape}-{i}", path, data, expect,
-                          content_type=ctype.decode("latin-1")))
-    form_bad = [({"eta_i_min": "abc"}, "eta_i_min"), ({"eta_i_max": "nan"}, "eta_i_max"),
-                ({"eta_i_min": "true"}, "eta_i_min"), ({"eta_i_max": "1e999"}, "eta_i_max"),
-                ({"format": "exe"}, "format"), ({"objective": "x" * 500}, "objective"),
-                ({"name": " "}, "name"), ({"name": "n" * 5000}, "name")]
+        cases.append(
+            body("malformed_multipart", f"{shape}-{i}", path, data, expect, content_type=ctype.decode("latin-1"))
+        )
+    form_bad = [
+        ({"eta_i_min": "abc"}, "eta_i_min"),
+        ({"eta_i_max": "nan"}, "eta_i_max"),
+        ({"eta_i_min": "true"}, "eta_i_min"),
+        ({"eta_i_max": "1e999"}, "eta_i_max"),
+        ({"format": "exe"}, "format"),
+        ({"objective": "x" * 500}, "objective"),
+        ({"name": " "}, "name"),
+        ({"name": "n" * 5000}, "name"),
+    ]
     for i, (form, expect) in enumerate(form_bad):
         cases.append(upload("malformed_multipart", f"form-{expect}-{i}", good_file, "a.csv", expect, **form))
     return cases
@@ -558,9 +691,11 @@ def gen_encoding(rng: random.Random) -> list[Case]:
     bad_sequences = [b"\xff\xfe", b"\xc0\xaf", b"\xed\xa0\x80", b"\xe9", b"\x80\x80", b"\xf8\x88\x80\x80\x80"]
     for i in range(16):
         fmt = rng.choice(["csv", "json", "yml"])
-        base = {"csv": b"wavelength_nm,n,k\n400,1,1\n500,1,1\n",
-                "json": json.dumps(GOOD_JSON).encode(),
-                "yml": f"DATA:\n{GOOD_NK_ENTRY}".encode()}[fmt]
+        base = {
+            "csv": b"wavelength_nm,n,k\n400,1,1\n500,1,1\n",
+            "json": json.dumps(GOOD_JSON).encode(),
+            "yml": f"DATA:\n{GOOD_NK_ENTRY}".encode(),
+        }[fmt]
         shape = rng.choice(["inject", "latin1", "utf16", "utf32", "random"])
         if shape == "inject":
             cut = rng.randrange(len(base))
@@ -610,8 +745,20 @@ def gen_csv_hostile(rng: random.Random) -> list[Case]:
     cases = []
     header = "wavelength_nm,n,k\n"
     for i in range(18):
-        shape = rng.choice(["huge-field", "huge-header", "many-columns", "quoted-multiline",
-                            "blank-rows", "many-rows", "nul", "unterminated", "no-unit", "ragged"])
+        shape = rng.choice(
+            [
+                "huge-field",
+                "huge-header",
+                "many-columns",
+                "quoted-multiline",
+                "blank-rows",
+                "many-rows",
+                "nul",
+                "unterminated",
+                "no-unit",
+                "ragged",
+            ]
+        )
         if shape == "huge-field":
             text = header + "400," + "9" * rng.randint(1_001, 1_900_000) + ",1\n500,1,1\n"
         elif shape == "huge-header":
@@ -635,8 +782,7 @@ def gen_csv_hostile(rng: random.Random) -> list[Case]:
             text = header + "400,1\n500,1,1,1\n"
         if len(text) > UPLOAD_LIMIT - 500:
             text = text[: UPLOAD_LIMIT - 500]
-        cases.append(upload("csv_hostile", f"{shape}-{i}", text, "h.csv",
-                            r"CSV|finite|wavelength|column|UTF-8"))
+        cases.append(upload("csv_hostile", f"{shape}-{i}", text, "h.csv", r"CSV|finite|wavelength|column|UTF-8"))
     return cases
 
 
@@ -646,25 +792,39 @@ def gen_hostile_queries(rng: random.Random) -> list[Case]:
     for i in range(20):
         fit_id = "".join(rng.choice("0123456789abcdef") for _ in range(32))
         bad = rng.choice(["1e9", "-1", "nan", "inf", "true", "x" * rng.randint(1, 5000), "9" * 5000, ""])
-        path, name = rng.choice([
-            (f"{API}/fits/{fit_id}/curves?samples={bad}", "samples"),
-            (f"{API}/fits/{fit_id}/curves?eta_i={bad}", "eta_i"),
-            (f"{API}/fits/{fit_id}/error-map?angles={bad}", "angles"),
-            (f"{API}/fits/{fit_id}/error-map?rows={bad}", "rows"),
-            (f"{API}/fits/{fit_id}/pack?format={bad}", "format"),
-            (f"{API}/preview.png?fit={fit_id}&size={bad}", "size"),
-            (f"{API}/preview.png?fit={fit_id}&eta_i={bad}", "eta_i"),
-            (f"{API}/preview.png?fit={bad}", "fit"),
-            (f"{API}/fits/{bad or 'x'}", "fit_id"),
-        ])
+        path, name = rng.choice(
+            [
+                (f"{API}/fits/{fit_id}/curves?samples={bad}", "samples"),
+                (f"{API}/fits/{fit_id}/curves?eta_i={bad}", "eta_i"),
+                (f"{API}/fits/{fit_id}/error-map?angles={bad}", "angles"),
+                (f"{API}/fits/{fit_id}/error-map?rows={bad}", "rows"),
+                (f"{API}/fits/{fit_id}/pack?format={bad}", "format"),
+                (f"{API}/preview.png?fit={fit_id}&size={bad}", "size"),
+                (f"{API}/preview.png?fit={fit_id}&eta_i={bad}", "eta_i"),
+                (f"{API}/preview.png?fit={bad}", "fit"),
+                (f"{API}/fits/{bad or 'x'}", "fit_id"),
+            ]
+        )
         cases.append(Case("hostile_queries", f"{name}-{i}", "GET", path, name, path.encode()))
     return cases
 
 
 GENERATORS: list[Callable[[random.Random], list[Case]]] = [
-    gen_yaml_alias_bomb, gen_deep_nesting, gen_huge_wavelength_range, gen_huge_samples,
-    gen_wrong_types, gen_yaml_tags, gen_big_numbers, gen_booleans, gen_non_finite, gen_oversized, gen_malformed_multipart,
-    gen_encoding, gen_bom, gen_csv_hostile, gen_hostile_queries,
+    gen_yaml_alias_bomb,
+    gen_deep_nesting,
+    gen_huge_wavelength_range,
+    gen_huge_samples,
+    gen_wrong_types,
+    gen_yaml_tags,
+    gen_big_numbers,
+    gen_booleans,
+    gen_non_finite,
+    gen_oversized,
+    gen_malformed_multipart,
+    gen_encoding,
+    gen_bom,
+    gen_csv_hostile,
+    gen_hostile_queries,
 ]
 CLASSES = [g.__name__.removeprefix("gen_") for g in GENERATORS]
 
@@ -730,8 +890,9 @@ def send(http: httpx.Client, case: Case) -> Answer:
         response = http.request(case.method, case.path, **case.request)
     except httpx.HTTPError as error:
         return Answer(case, None, "", "", time.perf_counter() - start, f"{type(error).__name__}: {error}")
-    return Answer(case, response.status_code, response.headers.get("content-type", ""),
-                  response.text, time.perf_counter() - start)
+    return Answer(
+        case, response.status_code, response.headers.get("content-type", ""), response.text, time.perf_counter() - start
+    )
 
 
 @pytest.fixture(scope="module")
@@ -746,13 +907,13 @@ def hostile_run(tmp_path_factory):
         before = memory_mb(server.process.pid)
         poller = subprocess.Popen(
             [sys.executable, "-c", POLLER, f"{server.url}/healthz", str(stop), str(server.process.pid)],
-            stdout=subprocess.PIPE, text=True,
+            stdout=subprocess.PIPE,
+            text=True,
         )
         start = time.perf_counter()
         try:
             time.sleep(0.5)
-            with loopback.Client(base_url=server.url, timeout=30.0) as http, \
-                    ThreadPoolExecutor(CLIENTS) as pool:
+            with loopback.Client(base_url=server.url, timeout=30.0) as http, ThreadPoolExecutor(CLIENTS) as pool:
                 answers = list(pool.map(lambda case: send(http, case), cases))
         finally:
             stop.touch()
@@ -763,16 +924,19 @@ def hostile_run(tmp_path_factory):
     peak = after["VmHWM"] if after["VmHWM"] > before["VmHWM"] else before["VmRSS"]
     latencies = sorted(polled["latencies"])
     report = {
-        "requests": len(answers), "seconds": seconds,
-        "rss_before_mb": before["VmRSS"], "rss_after_mb": after["VmRSS"],
+        "requests": len(answers),
+        "seconds": seconds,
+        "rss_before_mb": before["VmRSS"],
+        "rss_after_mb": after["VmRSS"],
         "peak_growth_mb": max(peak, polled["peak_rss_mb"]) - before["VmRSS"],
-        "healthz_polls": len(latencies), "healthz_failures": polled["failures"],
+        "healthz_polls": len(latencies),
+        "healthz_failures": polled["failures"],
         "healthz_p50_s": latencies[len(latencies) // 2],
         "healthz_p99_s": latencies[min(len(latencies) - 1, int(0.99 * len(latencies)))],
-        "healthz_max_s": latencies[-1], "server_alive": alive,
+        "healthz_max_s": latencies[-1],
+        "server_alive": alive,
     }
-    print("\nhostile run:", json.dumps({k: round(v, 3) if isinstance(v, float) else v
-                                        for k, v in report.items()}))
+    print("\nhostile run:", json.dumps({k: round(v, 3) if isinstance(v, float) else v for k, v in report.items()}))
     return answers, report
 
 
@@ -782,7 +946,7 @@ def echoed(answer_text: str, payload: bytes) -> str | None:
         return None
     haystack = payload.decode("utf-8", "replace")
     for start in range(len(answer_text) - MAX_ECHO):
-        window = answer_text[start:start + MAX_ECHO + 1]
+        window = answer_text[start : start + MAX_ECHO + 1]
         if window in haystack:
             return window
     return None

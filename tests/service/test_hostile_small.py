@@ -41,7 +41,7 @@ class TestSmallOnesByClass:
     def test_integers_past_64_bits_in_queries_are_422(self, server):
         _, http = server
         rng = random.Random(SEED)
-        values = [2**63, 2**63 + rng.randint(1, 10**6), 10**rng.randint(19, 40), 2**64 - 1]
+        values = [2**63, 2**63 + rng.randint(1, 10**6), 10 ** rng.randint(19, 40), 2**64 - 1]
         for value in values:
             for query in ("cursor", "limit"):
                 assert_clear_4xx(http.get(f"{API}/materials", params={query: str(value)}), 422, query)
@@ -64,7 +64,7 @@ class TestSmallOnesByClass:
         rng = random.Random(SEED + 2)
         for size in [16_500, rng.randint(17_000, 60_000), 100_000, 300_000]:
             many = rng.random() < 0.5
-            headers = ({f"x-h{i}": "v" * 990 for i in range(size // 1000)} if many else {"x-big": "v" * size})
+            headers = {f"x-h{i}": "v" * 990 for i in range(size // 1000)} if many else {"x-big": "v" * size}
             response = loopback.get(f"{running.url}/healthz", headers=headers, timeout=30)
             assert response.status_code == 431, (size, many, response.status_code)
             assert "16384 bytes" in response.json()["detail"]
@@ -85,9 +85,14 @@ class TestSmallOnesByClass:
         boundary = "b" + "".join(rng.choice("abc0123") for _ in range(20))
         shapes = {
             "no boundary": ("multipart/form-data", b"--x\r\n\r\n"),
-            "too many fields": (f"multipart/form-data; boundary={boundary}", b"".join(
-                f'--{boundary}\r\nContent-Disposition: form-data; name="f{i}"\r\n\r\nv\r\n'.encode()
-                for i in range(1_200)) + f"--{boundary}--\r\n".encode()),
+            "too many fields": (
+                f"multipart/form-data; boundary={boundary}",
+                b"".join(
+                    f'--{boundary}\r\nContent-Disposition: form-data; name="f{i}"\r\n\r\nv\r\n'.encode()
+                    for i in range(1_200)
+                )
+                + f"--{boundary}--\r\n".encode(),
+            ),
         }
         for label, (ctype, data) in shapes.items():
             response = http.post(f"{API}/fits/upload", content=data, headers={"content-type": ctype})

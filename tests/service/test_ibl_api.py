@@ -47,13 +47,19 @@ class TestRoughPreview:
         from PIL import Image
 
         client, fit = shared
-        params = {"fit": fit["id"], "size": 64, "roughness": 0.4, "mode": "coated",
-                  "coat_roughness": 0.1, "environment": "studio", "compare": "lazanyi"}
+        params = {
+            "fit": fit["id"],
+            "size": 64,
+            "roughness": 0.4,
+            "mode": "coated",
+            "coat_roughness": 0.1,
+            "environment": "studio",
+            "compare": "lazanyi",
+        }
         response = client.get(f"{API}/preview.png", params=params)
         assert response.status_code == 200, response.text
         rough = np.asarray(Image.open(io.BytesIO(response.content)).convert("RGB"))
-        smooth = client.get(f"{API}/preview.png", params={"fit": fit["id"], "size": 64,
-                                                          "environment": "studio"})
+        smooth = client.get(f"{API}/preview.png", params={"fit": fit["id"], "size": 64, "environment": "studio"})
         assert rough.shape == (64, 64, 3)
         assert not np.array_equal(rough, np.asarray(Image.open(io.BytesIO(smooth.content)).convert("RGB")))
 
@@ -149,7 +155,9 @@ def test_hlsl_pack_split_sum_compiles(tmp_path):
     path.write_text(source + HLSL_ENTRY)
     result = subprocess.run(
         ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "p.spv"), str(path)],
-        capture_output=True, text=True, timeout=60,
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert (tmp_path / "p.spv").stat().st_size > 0

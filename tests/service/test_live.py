@@ -36,15 +36,17 @@ pytestmark = pytest.mark.server
 
 def gold_like_nk(shift: float) -> dict:
     wavelength = np.linspace(350.0, 850.0, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + shift
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2)) + shift
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}
 
 
 def test_start_up_and_docs(tmp_path):
     """The command itself (``python -m service``, as README starts it; other tests' servers are forks)."""
-    with server_process(tmp_path / "data", spawn=True) as server, \
-            loopback.Client(base_url=server.url, timeout=30) as http:
+    with (
+        server_process(tmp_path / "data", spawn=True) as server,
+        loopback.Client(base_url=server.url, timeout=30) as http,
+    ):
         assert server.process.args[:3] == [sys.executable, "-m", "service"]
         assert http.get("/healthz").json()["status"] == "ok"
         assert http.get("/openapi.json").json()["info"]["title"]
@@ -58,7 +60,10 @@ def test_start_up_and_docs(tmp_path):
 def test_refuses_public_bind_without_token(tmp_path):
     result = subprocess.run(
         [sys.executable, "-m", "service", "--host", "0.0.0.0", "--data-dir", str(tmp_path)],
-        cwd=ROOT, capture_output=True, text=True, timeout=120,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert result.returncode == 2
     assert "COATED_API_TOKEN" in result.stderr
@@ -68,8 +73,10 @@ def test_concurrent_identical_fits_and_reads(tmp_path):
     with server_process(tmp_path / "data", COATED_FIT_WORKERS="2") as server:
         with loopback.Client(base_url=server.url, timeout=120) as http, ThreadPoolExecutor(8) as pool:
             fits = [pool.submit(http.post, f"{API}/fits", json={"material": "Cu"}) for _ in range(4)]
-            others = [pool.submit(http.post, f"{API}/fits", json={"material": "Ag", "eta_i_range": [1.0, 1.0 + i / 10]})
-                      for i in range(1, 4)]
+            others = [
+                pool.submit(http.post, f"{API}/fits", json={"material": "Ag", "eta_i_range": [1.0, 1.0 + i / 10]})
+                for i in range(1, 4)
+            ]
             reads = [pool.submit(http.get, f"{API}/materials") for _ in range(8)]
             answers = [f.result() for f in fits]
             assert all(a.status_code in (200, 201) for a in answers)
@@ -151,20 +158,25 @@ def test_fuzz_no_server_error_no_schema_violation(tmp_path):
     Schemathesis against the service's own OpenAPI document: per operation,
     20 valid cases and 20 invalid ones (where the schema allows invalid input).
     """
-    with server_process(tmp_path / "data", COATED_METRICS_SAMPLES="10",
-                        COATED_MAX_PREVIEW_SIZE="128") as server:
+    with server_process(tmp_path / "data", COATED_METRICS_SAMPLES="10", COATED_MAX_PREVIEW_SIZE="128") as server:
         schema = schemathesis.openapi.from_url(f"{server.url}/openapi.json")
         operations = [result.ok() for result in schema.get_all_operations()]
         assert len(operations) >= 10
         for operation, mode in itertools.product(operations, schemathesis.GenerationMode):
 
             @given(case=operation.as_strategy(generation_mode=mode))
-            @settings(max_examples=20, deadline=None, suppress_health_check=list(HealthCheck),
-                      derandomize=True, database=None)
+            @settings(
+                max_examples=20, deadline=None, suppress_health_check=list(HealthCheck), derandomize=True, database=None
+            )
             def fuzz(case):
                 case.call_and_validate(
-                    checks=[not_a_server_error, status_code_conformance, content_type_conformance,
-                            response_headers_conformance, response_schema_conformance],
+                    checks=[
+                        not_a_server_error,
+                        status_code_conformance,
+                        content_type_conformance,
+                        response_headers_conformance,
+                        response_schema_conformance,
+                    ],
                     timeout=60,
                 )
 

@@ -44,7 +44,7 @@ def gold_curve(red_scale: float, eta_i: float = 1.5) -> dict:
 
 def nk_csv(shift: float = 0.0, lo: float = 350.0, hi: float = 850.0) -> str:
     wavelength = np.linspace(lo, hi, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + shift
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2)) + shift
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return "wavelength_nm,n,k\n" + "".join(f"{w},{a},{b}\n" for w, a, b in zip(wavelength, n, k))
 
@@ -96,8 +96,9 @@ def test_each_save_is_a_version_opened_and_downloaded_by_id(http, brass):
     # Paged: one at a time, newest first.
     page = http.get(f"{API}/materials/{material_id}/versions", params={"limit": 1}).json()
     assert [v["version"] for v in page["versions"]] == [2] and page["next_before"] == 2
-    older = http.get(f"{API}/materials/{material_id}/versions",
-                     params={"limit": 1, "before": page["next_before"]}).json()
+    older = http.get(
+        f"{API}/materials/{material_id}/versions", params={"limit": 1, "before": page["next_before"]}
+    ).json()
     assert [v["version"] for v in older["versions"]] == [1] and older["next_before"] is None
     assert http.get(f"{API}/materials/{material_id}/versions/3").status_code == 404
     assert http.get(f"{API}/materials/{'0' * 32}/versions").status_code == 404
@@ -207,13 +208,17 @@ def test_a_stale_save_does_not_undo_a_rename_or_a_delete(http):
     material_id = first["material_id"]
     opened = http.get(f"{API}/fits/{first['id']}/edit").json()["request"]  # an editor, at version 1
     assert http.patch(f"{API}/materials/{material_id}", json={"name": "fresh gold"}, headers=AUTH).status_code == 200
-    stale = http.post(f"{API}/fits/from-curves", headers=AUTH, json={
-        **opened, "curves": [gold_curve(0.8)], "expected_version": 1})
+    stale = http.post(
+        f"{API}/fits/from-curves", headers=AUTH, json={**opened, "curves": [gold_curve(0.8)], "expected_version": 1}
+    )
     assert stale.status_code == 409 and "renamed 'fresh gold'" in stale.json()["detail"], stale.text
     assert http.get(f"{API}/materials/{material_id}").json()["name"] == "fresh gold"
     assert http.delete(f"{API}/materials/{material_id}", headers=AUTH).status_code == 200
-    again = http.post(f"{API}/fits/from-curves", headers=AUTH, json={
-        **opened, "name": "fresh gold", "curves": [gold_curve(0.8)], "expected_version": 1})
+    again = http.post(
+        f"{API}/fits/from-curves",
+        headers=AUTH,
+        json={**opened, "name": "fresh gold", "curves": [gold_curve(0.8)], "expected_version": 1},
+    )
     assert again.status_code == 409 and "moved to the bin" in again.json()["detail"], again.text
     # Without `expected_version` the save takes it out of the bin, and says so.
     restoring = save(http, "fresh gold", 0.8, material_id=material_id)
@@ -238,8 +243,12 @@ def test_names_are_one_spelling_visible_and_not_a_built_in_material_s(http):
     assert nfd.status_code == 201 and nfc.json()["material_id"] == nfd.json()["material_id"]
     assert nfc.json()["name"] == "Caf\u00e9 brass"
     material_id = nfd.json()["material_id"]
-    for name, rule in (("Au", "reserved"), ("gold", "reserved"), ("\u200b\u200b", "visible character"),
-                       ("brass\u202eevil", "bidirectional control")):
+    for name, rule in (
+        ("Au", "reserved"),
+        ("gold", "reserved"),
+        ("\u200b\u200b", "visible character"),
+        ("brass\u202eevil", "bidirectional control"),
+    ):
         renamed = http.patch(f"{API}/materials/{material_id}", json={"name": name}, headers=AUTH)
         assert renamed.status_code == 422 and rule in renamed.json()["detail"], renamed.text
         assert save(http, name, 0.8).status_code == 422
@@ -333,15 +342,17 @@ def test_library_to_browse(http):
     swatch = gold["swatch"]
     assert swatch["eta_i"] == 1.33 and swatch["angles_deg"][0] == 0.0
     assert len(swatch["srgb"]) == len(swatch["angles_deg"]) == len(swatch["acescg"])
-    red, green, blue = (int(swatch["srgb"][0][i:i + 2], 16) for i in (1, 3, 5))
+    red, green, blue = (int(swatch["srgb"][0][i : i + 2], 16) for i in (1, 3, 5))
     assert red > green > blue  # gold is yellow at normal incidence
     air = http.get(f"{API}/library", params={"eta_i": 1.0, "q": "gold", "limit": 1}).json()
     assert [m["id"] for m in air["materials"]] == ["Au"] and air["total"] > 30
     assert air["materials"][0]["swatch"]["srgb"] != swatch["srgb"]
     # Names and symbols rank first; the citation is never searched.
     assert http.get(f"{API}/library", params={"q": "johnson christy"}).json()["materials"] == []
-    first = {q: http.get(f"{API}/library", params={"q": q, "limit": 1}).json()["materials"][0]["id"]
-             for q in ("brass", "TiN", "aluminum")}
+    first = {
+        q: http.get(f"{API}/library", params={"q": q, "limit": 1}).json()["materials"][0]["id"]
+        for q in ("brass", "TiN", "aluminum")
+    }
     assert first == {"brass": "CuZn", "TiN": catalogue()[first["TiN"]]["id"], "aluminum": "Al"}
     assert catalogue()[first["TiN"]]["book"] == "TiN"
     assert http.get(f"{API}/library", params={"q": "unobtainium"}).json()["materials"] == []

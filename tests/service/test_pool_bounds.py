@@ -36,8 +36,12 @@ def worker_modules() -> dict:
 
     from fitting.colour import reference
 
-    return {"colour": "colour" in sys.modules, "scipy.optimize": "scipy.optimize" in sys.modules,
-            "matplotlib": "matplotlib" in sys.modules, "weights_cached": reference._weights.cache_info().currsize}
+    return {
+        "colour": "colour" in sys.modules,
+        "scipy.optimize": "scipy.optimize" in sys.modules,
+        "matplotlib": "matplotlib" in sys.modules,
+        "weights_cached": reference._weights.cache_info().currsize,
+    }
 
 
 async def _with_runner(body, **kwargs):
@@ -51,6 +55,7 @@ async def _with_runner(body, **kwargs):
 
 def test_workers_start_with_the_core_warm_and_without_matplotlib():
     """The fork server imports colour-science as the core does (its plotting, and matplotlib, only on use)."""
+
     async def body(runner):
         return await runner.run(worker_modules)
 
@@ -78,6 +83,7 @@ def burn(cpu_s: float) -> float:
 
 def test_a_job_of_parts_has_a_cpu_budget_proportional_to_its_estimate():
     """Parts within the part limit each, but past their job's budget together: the job is stopped, naming it."""
+
     async def body(runner):
         async with runner.slot(0.1):  # budget: max(0.5, 3 x 0.1) = 0.5 s; three parts of 0.2 s
             first = [await runner.submit(burn, 0.2, cost_s=0.03) for _ in range(2)]
@@ -106,6 +112,7 @@ def checked_input_for_two_seconds() -> str:
 
 def test_the_cpu_limit_is_not_taken_for_bad_input_by_the_job_s_own_checks():
     """The limit lands wherever the job is: inside an input check it is still the limit, not "must be numbers"."""
+
     async def body(runner):
         for _ in range(3):
             with pytest.raises(JobCPULimit, match=r"CPU-time limit of 0\.05 s"):
@@ -156,8 +163,9 @@ def test_a_job_that_kills_its_workers_fails_only_itself_and_is_quarantined():
     import os
 
     async def body(runner):
-        others = [asyncio.ensure_future(runner.once(f"other{i}", lambda i=i: runner.run(time.sleep, 0.4)))
-                  for i in range(5)]
+        others = [
+            asyncio.ensure_future(runner.once(f"other{i}", lambda i=i: runner.run(time.sleep, 0.4))) for i in range(5)
+        ]
         await asyncio.sleep(0.1)
         with pytest.raises(WorkerLost, match="three times"):
             await runner.once("killer", lambda: runner.run(os._exit, 1))
@@ -192,8 +200,10 @@ def test_turns_let_the_cheapest_waiting_part_go_first():
 
         first = asyncio.ensure_future(part("first", 5.0))
         await asyncio.sleep(0)
-        waiting = [asyncio.ensure_future(part(n, c)) for n, c in (("slow", 5.0), ("cancelled", 0.01),
-                                                                   ("cheap", 0.1), ("slow2", 5.0))]
+        waiting = [
+            asyncio.ensure_future(part(n, c))
+            for n, c in (("slow", 5.0), ("cancelled", 0.01), ("cheap", 0.1), ("slow2", 5.0))
+        ]
         await asyncio.sleep(0)
         waiting[1].cancel()
         await asyncio.gather(first, *waiting, return_exceptions=True)

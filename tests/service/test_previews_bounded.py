@@ -28,16 +28,22 @@ from conftest import server_process
 
 pytestmark = [pytest.mark.slow, pytest.mark.server, pytest.mark.gl]
 API = "/api/v1"
-ROUGH_COATED_REFERENCE = {"roughness": 0.3, "mode": "coated", "coat_roughness": 0.1,
-                          "environment": "studio", "compare": "reference"}
+ROUGH_COATED_REFERENCE = {
+    "roughness": 0.3,
+    "mode": "coated",
+    "coat_roughness": 0.1,
+    "environment": "studio",
+    "compare": "reference",
+}
 
 
 def preview(fit_id: str, size: int, eta_i: float) -> dict:
     return {"fit": fit_id, "size": size, "eta_i": eta_i, **ROUGH_COATED_REFERENCE}
 
 
-def in_background(url: str, params: dict, out: list, timeout: float = 300,
-                  ended: list | None = None) -> threading.Thread:
+def in_background(
+    url: str, params: dict, out: list, timeout: float = 300, ended: list | None = None
+) -> threading.Thread:
     """
     GET a preview on a thread of its own; its answer (or the exception) lands in ``out``, and
     the time.monotonic() it came at in ``ended`` if given.
@@ -89,15 +95,19 @@ def test_healthz_within_half_a_second_p99_during_two_1024_px_previews(tmp_path):
         assert all(a.content[:4] == b"\x89PNG" for a in answers)
         assert rendering == 2  # the two rendered side by side
         p99 = float(np.percentile(latencies, 99))
-        print(f"/healthz during two 1024 px previews: {len(latencies)} requests, "
-              f"p50 {np.percentile(latencies, 50) * 1e3:.1f} ms, p99 {p99 * 1e3:.1f} ms, "
-              f"max {max(latencies) * 1e3:.1f} ms")
+        print(
+            f"/healthz during two 1024 px previews: {len(latencies)} requests, "
+            f"p50 {np.percentile(latencies, 50) * 1e3:.1f} ms, p99 {p99 * 1e3:.1f} ms, "
+            f"max {max(latencies) * 1e3:.1f} ms"
+        )
         assert len(latencies) >= 20 and p99 < 0.5, (len(latencies), p99)
 
 
 def test_bound_shared_renders_and_a_client_that_goes_away(tmp_path):
-    with server_process(tmp_path / "data", COATED_MAX_PREVIEWS_IN_FLIGHT="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
-            loopback.Client(base_url=server.url, timeout=30) as http:
+    with (
+        server_process(tmp_path / "data", COATED_MAX_PREVIEWS_IN_FLIGHT="1", COATED_MAX_PREVIEW_SIZE="2048") as server,
+        loopback.Client(base_url=server.url, timeout=30) as http,
+    ):
         fit = http.post(f"{API}/fits", json={"material": "Cu"}).json()["id"]
         assert http.get(f"{API}/preview.png", params={"fit": fit, "size": 64, "eta_i": 1.5}).status_code == 200
         # One large preview renders; the same request again joins it, another is refused.
@@ -134,8 +144,10 @@ def test_bound_shared_renders_and_a_client_that_goes_away(tmp_path):
 
 
 def test_time_limit_504_and_cpu_limit_422(tmp_path):
-    with server_process(tmp_path / "slow", COATED_PREVIEW_TIMEOUT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
-            loopback.Client(base_url=server.url, timeout=60) as http:
+    with (
+        server_process(tmp_path / "slow", COATED_PREVIEW_TIMEOUT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server,
+        loopback.Client(base_url=server.url, timeout=60) as http,
+    ):
         fit = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         http.get(f"{API}/preview.png", params=preview(fit, 64, 1.5))  # the render process started
         answer = http.get(f"{API}/preview.png", params=preview(fit, 2048, 1.5))
@@ -144,8 +156,10 @@ def test_time_limit_504_and_cpu_limit_422(tmp_path):
         assert wait_for_previews(http, 0, 30) < 4.0  # cancelled: the process is free
     # The render process is warmed first (GL start-up and shader compile, which llvmpipe's threads
     # make over 1 s of process CPU time under load), so that the limit of 1 s falls on the render.
-    with server_process(tmp_path / "cpu", COATED_JOB_CPU_LIMIT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server, \
-            loopback.Client(base_url=server.url, timeout=300) as http:
+    with (
+        server_process(tmp_path / "cpu", COATED_JOB_CPU_LIMIT_S="1", COATED_MAX_PREVIEW_SIZE="2048") as server,
+        loopback.Client(base_url=server.url, timeout=300) as http,
+    ):
         fit = http.post(f"{API}/fits", json={"material": "Au"}).json()["id"]
         warm = http.get(f"{API}/preview.png", params={"fit": fit, "size": 64, "eta_i": 1.5})
         assert warm.status_code == 200, warm.text

@@ -29,8 +29,12 @@ pytestmark = [pytest.mark.server, pytest.mark.slow]
 
 API = "/api/v1"
 # Enough fitting for a minute of CPU: the job is still running when the signal comes.
-BIG_SCENE = {"name": "busy", "materials": [
-    {"material": m, "eta_i": [1.0 + 0.05 * i for i in range(32)]} for m in ("Au", "Cu", "Al", "Ag", "Cr", "Ni")]}
+BIG_SCENE = {
+    "name": "busy",
+    "materials": [
+        {"material": m, "eta_i": [1.0 + 0.05 * i for i in range(32)]} for m in ("Au", "Cu", "Al", "Ag", "Cr", "Ni")
+    ],
+}
 
 
 def _alive(pid: int) -> bool:

@@ -44,14 +44,19 @@ def test_texture_is_the_reference_grid(shared, gold):
     assert [float(v) for v in response.headers["x-eta-i-range"].split(",")] == [1.0, 2.5]
     inputs = baseline_inputs(nk)
     for header, key in (("x-f0-air", "F0_air"), ("x-f82-air", "F82_air")):
-        np.testing.assert_allclose([float(v) for v in response.headers[header].split(",")], inputs[key], rtol=1e-8)  # headers
+        np.testing.assert_allclose(
+            [float(v) for v in response.headers[header].split(",")], inputs[key], rtol=1e-8
+        )  # headers
         # print ~9 significant digits: within 5e-9 relative
 
 
 @pytest.mark.slow  # starts a process or GL context
 def test_texture_refusals(shared):
-    curves = {"eta_i": 1.5, "angle_deg": [0, 30, 60, 80, 90],
-              "rgb": [[0.9, 0.6, 0.3], [0.9, 0.6, 0.3], [0.9, 0.62, 0.35], [0.93, 0.8, 0.6], [1, 1, 1]]}
+    curves = {
+        "eta_i": 1.5,
+        "angle_deg": [0, 30, 60, 80, 90],
+        "rgb": [[0.9, 0.6, 0.3], [0.9, 0.6, 0.3], [0.9, 0.62, 0.35], [0.93, 0.8, 0.6], [1, 1, 1]],
+    }
     fit = shared.post("/api/v1/fits/from-curves", json={"name": "no nk", "curves": [curves]})
     assert fit.status_code == 201, fit.text
     response = shared.get(f"/api/v1/fits/{fit.json()['id']}/reference-texture")

@@ -34,7 +34,7 @@ pytestmark = [pytest.mark.xdist_group("postgres"), pytest.mark.slow, pytest.mark
 
 def nk_body(i: int, prefix: str = "r") -> dict:
     wavelength = np.linspace(350.0, 850.0, 26)
-    n = 0.2 + 1.3 * np.exp(-((wavelength - 350.0) / 150.0) ** 2) + i * 1e-4
+    n = 0.2 + 1.3 * np.exp(-(((wavelength - 350.0) / 150.0) ** 2)) + i * 1e-4
     k = 1.8 + 4.0 * (wavelength - 350.0) / 500.0
     return {"name": f"{prefix}{i}", "nk": {"wavelength_nm": wavelength.tolist(), "n": n.tolist(), "k": k.tolist()}}
 
@@ -47,9 +47,19 @@ def curves_body(i: int, name: str, **extra) -> dict:
     were most of this module's time).
     """
     g = 0.6 + i * 0.005
-    return {"name": name, "model": "rgb-conductor", "base": {"material": "Au"}, "curves": [{
-        "eta_i": 1.5, "angle_deg": [0, 30, 60, 75, 90],
-        "rgb": [[0.9, g, 0.35], [0.9, g, 0.35], [0.88, g, 0.36], [0.85, 0.7, 0.45], [1, 1, 1]]}], **extra}
+    return {
+        "name": name,
+        "model": "rgb-conductor",
+        "base": {"material": "Au"},
+        "curves": [
+            {
+                "eta_i": 1.5,
+                "angle_deg": [0, 30, 60, 75, 90],
+                "rgb": [[0.9, g, 0.35], [0.9, g, 0.35], [0.88, g, 0.36], [0.85, 0.7, 0.45], [1, 1, 1]],
+            }
+        ],
+        **extra,
+    }
 
 
 def listed(url: str) -> dict[str, dict]:
@@ -75,8 +85,12 @@ def replicas(tmp_path_factory, postgres_server):
     """
     tmp_path = tmp_path_factory.mktemp("replicas")
     url = postgres_server.database("replicas")
-    env = {"COATED_STORE_URL": url, "COATED_METRICS_SAMPLES": "10", "COATED_FIT_QUEUE": "64",
-           "COATED_STORE_POOL_MAX": "4"}
+    env = {
+        "COATED_STORE_URL": url,
+        "COATED_METRICS_SAMPLES": "10",
+        "COATED_FIT_QUEUE": "64",
+        "COATED_STORE_POOL_MAX": "4",
+    }
     with server_process(tmp_path / "a", **env) as a, server_process(tmp_path / "b", **env) as b:
         yield a, b
 
@@ -125,7 +139,10 @@ def test_same_name_at_once_one_winner(replicas):
     assert codes == [201] + [409] * 19, [r.text for r in answers if r.status_code not in (201, 409)]
     winner = next(r.json() for r in answers if r.status_code == 201)
     conflict = next(r.json() for r in answers if r.status_code == 409)
-    assert "another save came first" in conflict["detail"] and conflict["errors"][0]["loc"] == ["body", "expected_version"]
+    assert "another save came first" in conflict["detail"] and conflict["errors"][0]["loc"] == [
+        "body",
+        "expected_version",
+    ]
     for replica in (a, b):
         detail = loopback.get(f"{replica.url}{API}/materials/{winner['material_id']}", timeout=30).json()
         assert detail["version"] == 1 and detail["latest_fit_id"] == winner["id"]
@@ -138,8 +155,9 @@ def test_same_name_at_once_one_winner(replicas):
     material = answers[0].json()["material_id"]
     views = [loopback.get(f"{r.url}{API}/materials/{material}", timeout=30).json() for r in (a, b)]
     assert views[0] == views[1] and views[0]["version"] == 20 and views[0]["latest_fit_id"] in ids
-    stale = loopback.post(f"{a.url}{API}/fits/from-curves", json=curves_body(50, "shared", expected_version=3),
-                          timeout=60)
+    stale = loopback.post(
+        f"{a.url}{API}/fits/from-curves", json=curves_body(50, "shared", expected_version=3), timeout=60
+    )
     assert stale.status_code == 409 and "nothing was fitted" in stale.json()["detail"]
 
 
@@ -149,12 +167,16 @@ def test_a_stale_save_on_one_replica_does_not_undo_a_rename_or_delete_on_the_oth
         first = http.post(f"{a.url}{API}/fits/from-curves", json=curves_body(60, "renamed away")).json()
         material_id = first["material_id"]
         assert http.patch(f"{b.url}{API}/materials/{material_id}", json={"name": "renamed here"}).status_code == 200
-        stale = http.post(f"{a.url}{API}/fits/from-curves", json=curves_body(
-            61, "renamed away", material_id=material_id, expected_version=1))
+        stale = http.post(
+            f"{a.url}{API}/fits/from-curves",
+            json=curves_body(61, "renamed away", material_id=material_id, expected_version=1),
+        )
         assert stale.status_code == 409 and "renamed 'renamed here'" in stale.json()["detail"], stale.text
         assert http.delete(f"{a.url}{API}/materials/{material_id}").status_code == 200
-        binned = http.post(f"{b.url}{API}/fits/from-curves", json=curves_body(
-            61, "renamed here", material_id=material_id, expected_version=1))
+        binned = http.post(
+            f"{b.url}{API}/fits/from-curves",
+            json=curves_body(61, "renamed here", material_id=material_id, expected_version=1),
+        )
         assert binned.status_code == 409 and "moved to the bin" in binned.json()["detail"], binned.text
         assert http.get(f"{a.url}{API}/materials/{material_id}").json()["version"] == 1
 

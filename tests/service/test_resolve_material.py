@@ -20,8 +20,15 @@ POSTGRES = pytest.param("postgresql", marks=[pytest.mark.xdist_group("postgres")
 
 
 def curves_record(fit_id: str, material_id: str, name: str) -> FitRecord:
-    return FitRecord(id=fit_id, kind="curves", material_id=material_id, name=name, source="edit",
-                     material={"name": name, "coefficients": {"F0": [[0.5]] * 3}}, metrics={"x": 1.0})
+    return FitRecord(
+        id=fit_id,
+        kind="curves",
+        material_id=material_id,
+        name=name,
+        source="edit",
+        material={"name": name, "coefficients": {"F0": [[0.5]] * 3}},
+        metrics={"x": 1.0},
+    )
 
 
 class StaleLookup:

@@ -85,9 +85,7 @@ class TestDownloads:
         assert int.from_bytes(response.content[4:6], "little") == PACK_VERSION == 2
         (material,) = decode_pack(response.content)
         assert material.model == "rgb-conductor"
-        assert material.coefficients.astype(np.float64).tolist() == [
-            rgb["coefficients"]["n"], rgb["coefficients"]["k"]
-        ]
+        assert material.coefficients.astype(np.float64).tolist() == [rgb["coefficients"]["n"], rgb["coefficients"]["k"]]
 
     def test_json(self, fitted):
         client, rgb, _ = fitted
@@ -112,7 +110,9 @@ class TestDownloads:
         path.write_text(hlsl.text + entry % "cf_material_Au(saturate(p.x / 32.0), 1.5)")
         result = subprocess.run(
             ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "p.spv"), str(path)],
-            capture_output=True, text=True, timeout=60,
+            capture_output=True,
+            text=True,
+            timeout=60,
         )
         assert result.returncode == 0, result.stdout + result.stderr
 

@@ -41,20 +41,28 @@ void main()
 
 
 def _record(name, packed, fit_id):
-    return FitRecord(id=fit_id, kind="library", material_id=name, name=name, source="test",
-                     material=material_to_json(packed))
+    return FitRecord(
+        id=fit_id, kind="library", material_id=name, name=name, source="test", material=material_to_json(packed)
+    )
 
 
 def mixed() -> list[FitRecord]:
     rng = np.random.default_rng(3)
-    coated = np.stack([rng.uniform(0.1, 0.9, (3, 3)), rng.uniform(-0.5, 0.5, (3, 3)),
-                       rng.uniform(1.0, 8.0, (3, 3))])
+    coated = np.stack([rng.uniform(0.1, 0.9, (3, 3)), rng.uniform(-0.5, 0.5, (3, 3)), rng.uniform(1.0, 8.0, (3, 3))])
     return [
-        _record("gold", PackedMaterial("gold", to_float16([[0.26, 0.4727, 1.317], [3.029, 2.3125, 1.923]]),
-                                       (1.0, 2.5), model="rgb-conductor"), "a" * 32),
+        _record(
+            "gold",
+            PackedMaterial(
+                "gold", to_float16([[0.26, 0.4727, 1.317], [3.029, 2.3125, 1.923]]), (1.0, 2.5), model="rgb-conductor"
+            ),
+            "a" * 32,
+        ),
         _record("paper", PackedMaterial("paper", to_float16(coated), (1.0, 2.5)), "b" * 32),
-        _record("glassy", PackedMaterial("glassy", to_float16([[1.2, 1.6, 2.8], [0.3, 0.1, 0.0]]),
-                                         (1.0, 2.5), model="rgb-conductor"), "c" * 32),
+        _record(
+            "glassy",
+            PackedMaterial("glassy", to_float16([[1.2, 1.6, 2.8], [0.3, 0.1, 0.0]]), (1.0, 2.5), model="rgb-conductor"),
+            "c" * 32,
+        ),
     ]
 
 
@@ -102,12 +110,16 @@ def test_mixed_glsl_snippet_matches_numpy(index):
 def test_mixed_hlsl_snippet_compiles(tmp_path):
     source = render_pack(mixed(), "hlsl", "mixed").decode()
     assert source.count("float3 cf_rgb_conductor(") == 1 and source.count("float3 cf_coated_conductor(") == 1
-    entry = "\nfloat4 main(float4 p : SV_Position) : SV_Target\n{\n    float m = saturate(p.x / 32.0);\n" \
-            "    return float4(cf_material_gold(m, 1.5) + cf_material_paper(m, 1.5) + cf_material_glassy(m, 2.0), 1.0);\n}\n"
+    entry = (
+        "\nfloat4 main(float4 p : SV_Position) : SV_Target\n{\n    float m = saturate(p.x / 32.0);\n"
+        "    return float4(cf_material_gold(m, 1.5) + cf_material_paper(m, 1.5) + cf_material_glassy(m, 2.0), 1.0);\n}\n"
+    )
     path = tmp_path / "mixed.hlsl"
     path.write_text(source + entry)
     result = subprocess.run(
         ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "m.spv"), str(path)],
-        capture_output=True, text=True, timeout=60,
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert result.returncode == 0, result.stdout + result.stderr

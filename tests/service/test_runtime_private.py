@@ -33,7 +33,8 @@ def test_the_checks_can_fail():
     try:
         server.UVICORN_PRIVATE[H11Protocol] = ("conn", "_no_such_state")
         assert server.uvicorn_mismatches() == [
-            f"uvicorn's H11Protocol has no _no_such_state (uvicorn {server.uvicorn.__version__})"]
+            f"uvicorn's H11Protocol has no _no_such_state (uvicorn {server.uvicorn.__version__})"
+        ]
     finally:
         server.UVICORN_PRIVATE.clear()
         server.UVICORN_PRIVATE.update(saved)
@@ -41,8 +42,11 @@ def test_the_checks_can_fail():
 
 def _private_reads(path: Path, names: set[str]) -> list[str]:
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    return [f"{path.name}:{node.lineno} .{node.attr}" for node in ast.walk(tree)
-            if isinstance(node, ast.Attribute) and node.attr in names]
+    return [
+        f"{path.name}:{node.lineno} .{node.attr}"
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Attribute) and node.attr in names
+    ]
 
 
 def _imports_uvicorn(path: Path) -> bool:
@@ -55,7 +59,10 @@ def _imports_uvicorn(path: Path) -> bool:
 def test_only_the_adapters_touch_the_private_state():
     """No other module of the service names multiprocessing's private attributes or imports uvicorn (or h11)."""
     mp_names = {name for name in mp_private.FORK_SERVER_STATE if name.startswith("_forkserver")} | {
-        "_forkserver", "_result_queue", "_writer"}
+        "_forkserver",
+        "_result_queue",
+        "_writer",
+    }
     wrong = []
     for path in sorted((ROOT / "service").rglob("*.py")):
         if path != RUNTIME / "mp_private.py":

@@ -9,10 +9,13 @@ from fitting.optics.library import library_material
 from conftest import app_client
 
 API = "/api/v1"
-SCENE = {"name": "desk", "materials": [
-    {"material": "Cu", "eta_i": 1.5},
-    {"material": "Al", "name": "lamp", "eta_i": [1.0, 1.5]},
-]}
+SCENE = {
+    "name": "desk",
+    "materials": [
+        {"material": "Cu", "eta_i": 1.5},
+        {"material": "Al", "name": "lamp", "eta_i": [1.0, 1.5]},
+    ],
+}
 
 
 @pytest.fixture(scope="module")
@@ -51,14 +54,19 @@ class TestScenePack:
     def test_inline_nk_matches_the_library(self, shared):
         client, body = shared
         Cu = library_material("Cu")
-        inline = {"materials": [{
-            "name": "Cu", "eta_i": 1.5, "source": Cu.source,
-            "nk": {"wavelength_nm": Cu.wavelength_nm.tolist(), "n": Cu.n.tolist(), "k": Cu.k.tolist()},
-        }]}
+        inline = {
+            "materials": [
+                {
+                    "name": "Cu",
+                    "eta_i": 1.5,
+                    "source": Cu.source,
+                    "nk": {"wavelength_nm": Cu.wavelength_nm.tolist(), "n": Cu.n.tolist(), "k": Cu.k.tolist()},
+                }
+            ]
+        }
         response = client.post(f"{API}/scenes", json=inline)
         assert response.status_code == 200, response.text
-        assert response.json()["pack"]["materials"][0]["coefficients"] == \
-            body["pack"]["materials"][0]["coefficients"]
+        assert response.json()["pack"]["materials"][0]["coefficients"] == body["pack"]["materials"][0]["coefficients"]
 
     @pytest.mark.slow  # starts a process or GL context
     def test_saved_material_by_id(self, shared):
@@ -81,12 +89,24 @@ class TestRefusals:
             ({"materials": [{"material": "Au", "eta_i": 0.5}]}, "eta_i"),
             ({"materials": [{"material": "Au", "eta_i": {"min": 2.0, "max": 1.5}}]}, "min <= max"),
             ({"materials": [{"material": "Au"}]}, "eta_i"),
-            ({"materials": [{"material": "Au", "nk": {"wavelength_nm": [400, 700], "n": [1, 1],
-                                                     "k": [0, 0]}, "eta_i": 1}]}, "exactly one of"),
+            (
+                {
+                    "materials": [
+                        {"material": "Au", "nk": {"wavelength_nm": [400, 700], "n": [1, 1], "k": [0, 0]}, "eta_i": 1}
+                    ]
+                },
+                "exactly one of",
+            ),
             ({"materials": [{"material": "Unobtainium", "eta_i": 1}]}, "library conductor"),
             ({"materials": [{"material": "Au", "eta_i": 1}, {"material": "Au", "eta_i": 2}]}, "used twice"),
-            ({"materials": [{"name": "x", "eta_i": 1.5, "nk": {
-                "wavelength_nm": [500, 600], "n": [1, 1], "k": [1, 1]}}]}, "must cover at least 90%"),
+            (
+                {
+                    "materials": [
+                        {"name": "x", "eta_i": 1.5, "nk": {"wavelength_nm": [500, 600], "n": [1, 1], "k": [1, 1]}}
+                    ]
+                },
+                "must cover at least 90%",
+            ),
             ({"materials": [{"material": "Au", "eta_i": 1}], "colour": "red"}, "colour"),
         ],
     )

@@ -23,8 +23,14 @@ def client(tmp_path_factory):
 
 @pytest.mark.slow  # 2.9 s (all cases 2.9 s) in a --durations=0 run
 def test_max_delta_e_chooses_per_material(client):
-    response = client.post(f"{API}/scenes", json={"name": "ring", "max_delta_e": 0.05, "materials": [
-        {"material": "Au", "eta_i": 1.5}, {"material": "Ag", "name": "band", "eta_i": 1.2}]})
+    response = client.post(
+        f"{API}/scenes",
+        json={
+            "name": "ring",
+            "max_delta_e": 0.05,
+            "materials": [{"material": "Au", "eta_i": 1.5}, {"material": "Ag", "name": "band", "eta_i": 1.2}],
+        },
+    )
     assert response.status_code == 200, response.text
     body = response.json()
     au, band = body["materials"]
@@ -37,8 +43,9 @@ def test_max_delta_e_chooses_per_material(client):
 
 @pytest.mark.slow  # starts a process or GL context
 def test_prefer_accuracy(client):
-    response = client.post(f"{API}/scenes", json={"prefer": "accuracy", "materials": [
-        {"material": "Cu", "eta_i": 1.33}]})
+    response = client.post(
+        f"{API}/scenes", json={"prefer": "accuracy", "materials": [{"material": "Cu", "eta_i": 1.33}]}
+    )
     assert response.status_code == 200, response.text
     (cu,) = response.json()["materials"]
     assert cu["choice"]["rule"] == "prefer accuracy"

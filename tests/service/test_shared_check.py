@@ -26,6 +26,7 @@ def slow(runs, outcome=None, seconds=0.5):
         time.sleep(seconds)
         if outcome is not None:
             raise outcome
+
     return check
 
 

@@ -42,8 +42,11 @@ class TestShares:
         shares.admit(a, 1, 2048 * 0.03)  # a 64 x 32 scene: 61 s, not one job
         shares.admit(a, 1, 2048 * 0.03)
         shares.admit(a, 1, 2048 * 0.03)
-        with pytest.raises(ShareExceeded, match=r"estimated at 184\.3 s of fitting; with this scene job's 61\.4 s "
-                                                r"they would pass its share, 240 s"):
+        with pytest.raises(
+            ShareExceeded,
+            match=r"estimated at 184\.3 s of fitting; with this scene job's 61\.4 s "
+            r"they would pass its share, 240 s",
+        ):
             shares.admit(a, 1, 2048 * 0.03)
         shares.admit(a, 1, 1.0)  # a small read still fits
         shares.admit(b, 1, 500.0)  # another client's first job is admitted by cost whatever it is
@@ -122,9 +125,11 @@ def test_one_worker_is_shared_and_bulk_parts_never_take_express_turns():
                 started.append(name)
                 await gate.wait()
 
-        tasks = [asyncio.ensure_future(part("read", READ, 1.0)),
-                 asyncio.ensure_future(part("cheap read", READ, 0.01)),
-                 asyncio.ensure_future(part("live step", SAVE, 0.03))]
+        tasks = [
+            asyncio.ensure_future(part("read", READ, 1.0)),
+            asyncio.ensure_future(part("cheap read", READ, 0.01)),
+            asyncio.ensure_future(part("live step", SAVE, 0.03)),
+        ]
         await asyncio.sleep(0)
         assert started == ["read", "live step"]  # one worker: bulk may use it; the express turn is a save's
         gate.set()
@@ -159,9 +164,20 @@ def test_saves_past_the_rate_are_429_with_retry_after(tmp_path):
     with app_client(tmp_path, saves_per_client_per_minute=2, metrics_samples=10) as client:
         # Repeats of the latest version add nothing: neither counted nor refused; Cu is the second save.
         answers = [client.post("/api/v1/fits", json={"material": m}) for m in ("Au",) * 4 + ("Cu", "Ag")]
-        draft = client.post("/api/v1/fits/from-curves", json={"draft": True, "base": {"material": "Au"}, "curves": [
-            {"eta_i": 1.5, "angle_deg": [0, 30, 60, 75, 90],
-             "rgb": [[0.9, 0.7, 0.35], [0.9, 0.7, 0.35], [0.88, 0.69, 0.36], [0.85, 0.7, 0.45], [1, 1, 1]]}]})
+        draft = client.post(
+            "/api/v1/fits/from-curves",
+            json={
+                "draft": True,
+                "base": {"material": "Au"},
+                "curves": [
+                    {
+                        "eta_i": 1.5,
+                        "angle_deg": [0, 30, 60, 75, 90],
+                        "rgb": [[0.9, 0.7, 0.35], [0.9, 0.7, 0.35], [0.88, 0.69, 0.36], [0.85, 0.7, 0.45], [1, 1, 1]],
+                    }
+                ],
+            },
+        )
     assert [a.status_code for a in answers] == [201, 200, 200, 200, 201, 429], answers[-1].text
     assert "COATED_SAVES_PER_CLIENT_PER_MINUTE" in answers[-1].json()["detail"]
     assert int(answers[-1].headers["retry-after"]) >= 1

@@ -38,14 +38,19 @@ void main()
 
 def record(name: str, coefficients: np.ndarray, eta_i_range=(1.0, 2.5), fit_id="a" * 32) -> FitRecord:
     packed = PackedMaterial(name, np.asarray(coefficients, dtype=np.float16), eta_i_range, "test")
-    return FitRecord(id=fit_id, kind="curves", material_id=fit_id, name=name, source="a\nb // c \\",
-                     material=material_to_json(packed))
+    return FitRecord(
+        id=fit_id,
+        kind="curves",
+        material_id=fit_id,
+        name=name,
+        source="a\nb // c \\",
+        material=material_to_json(packed),
+    )
 
 
 def materials() -> list[FitRecord]:
     rng = np.random.default_rng(7)
-    quadratic = np.stack([rng.uniform(0.1, 0.9, (3, 3)), rng.uniform(-0.5, 0.5, (3, 3)),
-                          rng.uniform(1.0, 8.0, (3, 3))])
+    quadratic = np.stack([rng.uniform(0.1, 0.9, (3, 3)), rng.uniform(-0.5, 0.5, (3, 3)), rng.uniform(1.0, 8.0, (3, 3))])
     constant = quadratic[:, :, :1]
     return [
         record("gold 1", quadratic),
@@ -111,14 +116,20 @@ def test_hlsl_snippet_compiles(tmp_path):
     path.write_text(source + HLSL_ENTRY % calls)
     result = subprocess.run(
         ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "pack.spv"), str(path)],
-        capture_output=True, text=True, timeout=60,
+        capture_output=True,
+        text=True,
+        timeout=60,
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert (tmp_path / "pack.spv").stat().st_size > 0
     broken = tmp_path / "broken.hlsl"
     broken.write_text(source + HLSL_ENTRY % "cf_material_missing(NdotV, eta_i)")
-    result = subprocess.run(["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", str(broken)],
-                            capture_output=True, text=True, timeout=60)
+    result = subprocess.run(
+        ["glslangValidator", "-D", "-V", "-S", "frag", "-e", "main", str(broken)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert result.returncode != 0
 
 

@@ -17,8 +17,14 @@ POSTGRES = pytest.param("postgresql", marks=[pytest.mark.xdist_group("postgres")
 
 def record(fit_id: str, material_id: str = "m" * 32, kind: str = "nk", name: str = "gold", **extra) -> FitRecord:
     return FitRecord(
-        id=fit_id, kind=kind, material_id=material_id, name=name, source="lab",
-        material={"name": name, "coefficients": {"F0": [[0.5]] * 3}}, metrics={"x": 1.0}, **extra,
+        id=fit_id,
+        kind=kind,
+        material_id=material_id,
+        name=name,
+        source="lab",
+        material={"name": name, "coefficients": {"F0": [[0.5]] * 3}},
+        metrics={"x": 1.0},
+        **extra,
     )
 
 
@@ -87,7 +93,8 @@ class TestStoreContract:
         assert store.latest_fit("c" * 32) is None
         rows = store.saved_materials()
         assert [(r.material_id, r.latest_fit_id, r.name) for r in rows] == [
-            ("a" * 32, "4" * 32, "new"), ("b" * 32, "3" * 32, "edited"),
+            ("a" * 32, "4" * 32, "new"),
+            ("b" * 32, "3" * 32, "edited"),
         ]
 
     def test_record_kind_checked(self):
@@ -165,8 +172,10 @@ class TestStoreContract:
         # Drafts on an inline n, k refer to it (``nk_id``); it is stored once.
         nk = {"wavelength_nm": [400.0, 500.0, 600.0], "n": [0.2, 0.3, 0.4], "k": [3.0, 2.5, 2.0]}
         other = {"wavelength_nm": [400.0, 700.0], "n": [1.0, 1.1], "k": [0.5, 0.6]}
-        drafts = [store.put_fit(record(f"{i:032x}", kind="curves", nk_id="e" * 32, created_at=100.0 + i),
-                                save=False, nk=nk) for i in range(3)]
+        drafts = [
+            store.put_fit(record(f"{i:032x}", kind="curves", nk_id="e" * 32, created_at=100.0 + i), save=False, nk=nk)
+            for i in range(3)
+        ]
         assert store.get_nk("e" * 32) == nk and store.get_nk("f" * 32) is None
         assert [store.get_fit(d.id) for d in drafts] == drafts and drafts[0].nk is None
         assert store.saved_materials() == []  # neither listed nor a material
@@ -175,8 +184,9 @@ class TestStoreContract:
         assert store.expire_drafts(older_than=101.5, max_bytes=10**9) == 2
         assert store.get_nk("e" * 32) == nk and store.get_fit(drafts[2].id) == drafts[2]
         # The quota counts the draft with its n, k record: one byte short, both go.
-        draft_bytes = len(drafts[2].to_json()) + len('{"wavelength_nm":[400.0,500.0,600.0],"n":[0.2,0.3,0.4],'
-                                                     '"k":[3.0,2.5,2.0]}')
+        draft_bytes = len(drafts[2].to_json()) + len(
+            '{"wavelength_nm":[400.0,500.0,600.0],"n":[0.2,0.3,0.4],"k":[3.0,2.5,2.0]}'
+        )
         assert store.expire_drafts(older_than=0.0, max_bytes=draft_bytes) == 0
         assert store.expire_drafts(older_than=0.0, max_bytes=draft_bytes - 1) == 1
         assert store.get_fit(drafts[2].id) is None and store.get_nk("e" * 32) is None
@@ -187,9 +197,15 @@ class TestStoreContract:
 
     def test_a_draft_a_saved_fit_starts_from_is_kept_with_its_own_base(self, store):
         # Draft 1 starts from draft 0; the saved fit "s" starts from draft 1; draft 2 is alone.
-        drafts = [store.put_fit(record(f"{i:032x}", kind="curves", created_at=float(i),
-                                       base_fit_id=f"{i - 1:032x}" if i == 1 else None), save=False)
-                  for i in range(3)]
+        drafts = [
+            store.put_fit(
+                record(
+                    f"{i:032x}", kind="curves", created_at=float(i), base_fit_id=f"{i - 1:032x}" if i == 1 else None
+                ),
+                save=False,
+            )
+            for i in range(3)
+        ]
         saved = store.put_fit(record("5" * 32, kind="curves", name="kept", base_fit_id=drafts[1].id))
         assert store.expire_drafts(older_than=10.0**12, max_bytes=0) == 1  # only the one nothing refers to
         assert [store.get_fit(d.id) for d in drafts] == [drafts[0], drafts[1], None]
@@ -201,8 +217,7 @@ class TestStoreContract:
     def test_a_draft_a_link_keeps_outlives_its_time_to_live_but_not_the_quota(self, store):
         import time
 
-        linked, other = (store.put_fit(record(f"{i:032x}", kind="curves", created_at=1.0), save=False)
-                         for i in (1, 2))
+        linked, other = (store.put_fit(record(f"{i:032x}", kind="curves", created_at=1.0), save=False) for i in (1, 2))
         until = time.time() + 3600
         assert store.keep_draft(linked.id, until) == until
         assert store.keep_draft(linked.id, until - 10) == until  # never shortened
@@ -248,7 +263,9 @@ class TestStoreContract:
                 break
         assert names == [f"m{i}" for i in range(7)]
         assert store.latest_fit_ids([f"{i + 50:032x}" for i in (0, 6)] + ["x"]) == {
-            f"{50:032x}": f"{0:032x}", f"{56:032x}": f"{6:032x}"}
+            f"{50:032x}": f"{0:032x}",
+            f"{56:032x}": f"{6:032x}",
+        }
 
     def test_ping_writable_check(self, store):
         store.ping()
@@ -385,8 +402,9 @@ class TestSQLiteStore:
         )
         for i, name in ((1, "old"), (2, "new")):
             r = record(str(i) * 32, material_id="a" * 32, name=name, created_at=float(i))
-            old.execute("INSERT INTO fits VALUES (?, ?, ?, ?, ?)",
-                        (r.id, r.kind, r.material_id, r.created_at, r.to_json()))
+            old.execute(
+                "INSERT INTO fits VALUES (?, ?, ?, ?, ?)", (r.id, r.kind, r.material_id, r.created_at, r.to_json())
+            )
         old.commit()
         old.close()
         store = SQLiteStore(path)
@@ -405,10 +423,12 @@ class TestSQLiteStore:
         store.put_fit(record("8" * 32, material_id="e" * 32, kind="curves", name="on a draft", base_fit_id="9" * 32))
         store.close()
         old = sqlite3.connect(path)  # back to version 5: no keys, and two look-alike names
-        old.executescript("DROP INDEX materials_by_name_key; ALTER TABLE materials DROP COLUMN name_key; "
-                          "DROP INDEX fits_by_base; ALTER TABLE fits DROP COLUMN base_fit_id; ALTER TABLE fits DROP COLUMN kept_until; "
-                          "DELETE FROM schema_migrations WHERE version >= 6; "
-                          "UPDATE materials SET name = 'brass mix' WHERE material_id = 'bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb'")
+        old.executescript(
+            "DROP INDEX materials_by_name_key; ALTER TABLE materials DROP COLUMN name_key; "
+            "DROP INDEX fits_by_base; ALTER TABLE fits DROP COLUMN base_fit_id; ALTER TABLE fits DROP COLUMN kept_until; "
+            "DELETE FROM schema_migrations WHERE version >= 6; "
+            "UPDATE materials SET name = 'brass mix' WHERE material_id = 'bbbbbbbbbbbbbbbbbbbbbbbbbbbbbbbb'"
+        )
         old.close()
         store = SQLiteStore(path)
         try:
@@ -442,4 +462,3 @@ class TestSQLiteStore:
         store.close()
         with pytest.raises((RuntimeError, sqlite3.ProgrammingError)):
             store.check()
-

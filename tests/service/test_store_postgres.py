@@ -28,30 +28,46 @@ pytestmark = [pytest.mark.xdist_group("postgres"), pytest.mark.slow]
 
 
 def record(fit_id: str, material_id: str = "m" * 32, name: str = "gold", kind: str = "nk", **extra) -> FitRecord:
-    return FitRecord(id=fit_id, kind=kind, material_id=material_id, name=name, source="lab",
-                     material={"name": name, "coefficients": {"F0": [[0.5]] * 3}}, metrics={"x": 1.0},
-                     coverage=0.95, **extra)
+    return FitRecord(
+        id=fit_id,
+        kind=kind,
+        material_id=material_id,
+        name=name,
+        source="lab",
+        material={"name": name, "coefficients": {"F0": [[0.5]] * 3}},
+        metrics={"x": 1.0},
+        coverage=0.95,
+        **extra,
+    )
 
 
 def run_service(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
     import os
 
-    return subprocess.run([sys.executable, "-m", "service", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=120, env={**os.environ, **(env or {})})
+    return subprocess.run(
+        [sys.executable, "-m", "service", *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, **(env or {})},
+    )
 
 
 class TestMigrations:
     def test_newer_schema_refused_on_both(self, tmp_path, postgres_url):
         lite = SQLiteStore(tmp_path / "s.sqlite3")
         with sqlite3.connect(lite.path) as connection:
-            connection.execute("INSERT INTO schema_migrations VALUES (?, 'from the future', 0)",
-                               (SCHEMA_VERSION + 1,))
+            connection.execute("INSERT INTO schema_migrations VALUES (?, 'from the future', 0)", (SCHEMA_VERSION + 1,))
         lite.close()
         with pytest.raises(SchemaMismatch, match=f"version {SCHEMA_VERSION + 1}, newer than this code"):
             SQLiteStore(tmp_path / "s.sqlite3")
         store = PostgresStore(postgres_url)
-        store.transaction(lambda c: c.execute(
-            "INSERT INTO schema_migrations VALUES (%s, 'from the future', 0)", (SCHEMA_VERSION + 1,)))
+        store.transaction(
+            lambda c: c.execute(
+                "INSERT INTO schema_migrations VALUES (%s, 'from the future', 0)", (SCHEMA_VERSION + 1,)
+            )
+        )
         store.close()
         with pytest.raises(SchemaMismatch, match="newer than this code"):
             PostgresStore(postgres_url)
@@ -69,7 +85,8 @@ class TestMigrations:
         old = sqlite3.connect(path)  # a store of the schema before versions (version 0)
         old.executescript(
             "CREATE TABLE fits (id TEXT PRIMARY KEY, kind TEXT NOT NULL, material_id TEXT NOT NULL,"
-            " created_at REAL NOT NULL, record TEXT NOT NULL);")
+            " created_at REAL NOT NULL, record TEXT NOT NULL);"
+        )
         r = record("1" * 32)
         old.execute("INSERT INTO fits VALUES (?, ?, ?, ?, ?)", (r.id, r.kind, r.material_id, 1.0, r.to_json()))
         old.commit()
@@ -86,8 +103,10 @@ class TestMigrations:
         store.close()
 
     def test_bad_store_settings_refused_at_start(self):
-        for env, message in (({"COATED_STORE_URL": "mysql://x/y"}, "must be a postgresql:// URL"),
-                             ({"COATED_STORE_POOL_MIN": "5", "COATED_STORE_POOL_MAX": "2"}, "must not exceed")):
+        for env, message in (
+            ({"COATED_STORE_URL": "mysql://x/y"}, "must be a postgresql:// URL"),
+            ({"COATED_STORE_POOL_MIN": "5", "COATED_STORE_POOL_MAX": "2"}, "must not exceed"),
+        ):
             result = run_service("--port", "0", env=env)
             assert result.returncode == 2 and message in result.stderr and "Traceback" not in result.stderr
 
@@ -115,14 +134,18 @@ class TestMove:
         for i in range(30):
             lite.put_fit(record(f"{i:032x}", material_id=f"{i % 7:032x}", name=f"m{i % 7}"))
         lite.put_fit(record(f"{3:032x}"), save=False)
-        lite.put_fit(record(f"{101:032x}", kind="curves", nk_id="e" * 32), save=False,
-                     nk={"wavelength_nm": [400.0, 600.0], "n": [0.2, 0.3], "k": [3.0, 2.0]})
+        lite.put_fit(
+            record(f"{101:032x}", kind="curves", nk_id="e" * 32),
+            save=False,
+            nk={"wavelength_nm": [400.0, 600.0], "n": [0.2, 0.3], "k": [3.0, 2.0]},
+        )
         lite.put_fit(record(f"{100:032x}", material_id="Au", kind="library"))
         in_bin = lite.delete_material(f"{6:032x}").deleted_at  # the bin moves too
         lite.close()
         url = postgres_server.database()
-        result = run_service("migrate", "--from-sqlite", str(tmp_path / "data" / "store.sqlite3"),
-                             env={"COATED_STORE_URL": url})
+        result = run_service(
+            "migrate", "--from-sqlite", str(tmp_path / "data" / "store.sqlite3"), env={"COATED_STORE_URL": url}
+        )
         assert result.returncode == 0, result.stderr
         with sqlite3.connect(tmp_path / "data" / "store.sqlite3") as connection:
             checksum, counts = store_checksum(connection)

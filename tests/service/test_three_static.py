@@ -16,18 +16,32 @@ ROOT = Path(__file__).resolve().parents[2]
 LOCK = json.loads((ROOT / "scripts" / "three" / "package-lock.json").read_text())
 
 
-@pytest.mark.parametrize("path", [
-    "/static/three/index.js", "/static/three/coated_conductor.js", "/static/three/albedo_table.js",
-    "/static/three/escape_table.js", "/static/three/gltf_loader.js", "/static/three/gltf_exporter.js",
-    "/static/three/packing.js", "/static/three/kinds.js", "/static/three/generated/glsl.js",
-    "/static/three/generated/kinds.js", "/static/three/generated/lut.js",
-    "/static/three/node_material.js", "/static/three/node_models.js",
-    "/vendor/three/build/three.webgpu.js", "/vendor/three/build/three.tsl.js",
-    "/static/glsl.js",
-    "/vendor/three/build/three.module.js", "/vendor/three/build/three.core.js",
-    "/vendor/three/examples/jsm/loaders/GLTFLoader.js",
-    "/vendor/three/examples/jsm/environments/RoomEnvironment.js", "/examples/three.js",
-])
+@pytest.mark.parametrize(
+    "path",
+    [
+        "/static/three/index.js",
+        "/static/three/coated_conductor.js",
+        "/static/three/albedo_table.js",
+        "/static/three/escape_table.js",
+        "/static/three/gltf_loader.js",
+        "/static/three/gltf_exporter.js",
+        "/static/three/packing.js",
+        "/static/three/kinds.js",
+        "/static/three/generated/glsl.js",
+        "/static/three/generated/kinds.js",
+        "/static/three/generated/lut.js",
+        "/static/three/node_material.js",
+        "/static/three/node_models.js",
+        "/vendor/three/build/three.webgpu.js",
+        "/vendor/three/build/three.tsl.js",
+        "/static/glsl.js",
+        "/vendor/three/build/three.module.js",
+        "/vendor/three/build/three.core.js",
+        "/vendor/three/examples/jsm/loaders/GLTFLoader.js",
+        "/vendor/three/examples/jsm/environments/RoomEnvironment.js",
+        "/examples/three.js",
+    ],
+)
 def test_modules_served_as_javascript(client, path):
     response = client.get(path)
     assert response.status_code == 200, path
@@ -49,7 +63,8 @@ def test_example_page_uses_the_import_map_not_a_cdn(client):
     assert "http://" not in page.text and "https://" not in page.text
 
 
-@pytest.mark.parametrize("path", ["/vendor/three/package.json", "/vendor/three/src/Three.js",
-                                  "/vendor/three/../../package-lock.json"])
+@pytest.mark.parametrize(
+    "path", ["/vendor/three/package.json", "/vendor/three/src/Three.js", "/vendor/three/../../package-lock.json"]
+)
 def test_only_build_and_addons(client, path):
     assert client.get(path).status_code == 404

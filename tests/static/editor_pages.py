@@ -28,8 +28,14 @@ import pytest
 from playwright.sync_api import expect, sync_playwright
 
 CHROMIUM_ARGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-    "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+    "--disable-quic",
 ]
 TIMEOUT_MS = 120_000  # first fits start worker processes
 # expect() waits as long as the page's own calls: its 5 s default is a
@@ -131,8 +137,9 @@ def disable_features(p) -> str:
 
 def launch(p, plain: bool = False):
     """Chromium with :data:`CHROMIUM_ARGS` and, unless ``plain``, :data:`UNUSED_FEATURES` disabled."""
-    return p.chromium.launch(executable_path="/usr/bin/chromium",
-                             args=CHROMIUM_ARGS if plain else [*CHROMIUM_ARGS, disable_features(p)])
+    return p.chromium.launch(
+        executable_path="/usr/bin/chromium", args=CHROMIUM_ARGS if plain else [*CHROMIUM_ARGS, disable_features(p)]
+    )
 
 
 class Pages:

@@ -69,26 +69,47 @@ def live_case(material: str, eta: float, centre: float, gains) -> dict:
     weights = np.full(mu.size, settings.edit_weight)
     # The fit on screen: the unedited base, fitted (float16).
     plain = base.rgb(mu, eta_s)
-    start = to_float16(fit_coefficients(plain, mu, eta_s, (lo, hi), 2, "de2000", 40, False,
-                                        irls_rounds=0).coefficients).astype(np.float64)
+    start = to_float16(
+        fit_coefficients(plain, mu, eta_s, (lo, hi), 2, "de2000", 40, False, irls_rounds=0).coefficients
+    ).astype(np.float64)
     CM, CE = check_grid((lo, hi), *settings.check_samples)
-    first = fit_coefficients(target, mu, eta_s, (lo, hi), 2, settings.objective, settings.max_nfev, False,
-                             weights=weights, irls_rounds=0,
-                             range_check=(CM.ravel(), CE.ravel(), settings.range_weight), start=start)
+    first = fit_coefficients(
+        target,
+        mu,
+        eta_s,
+        (lo, hi),
+        2,
+        settings.objective,
+        settings.max_nfev,
+        False,
+        weights=weights,
+        irls_rounds=0,
+        range_check=(CM.ravel(), CE.ravel(), settings.range_weight),
+        start=start,
+    )
     live = fit_curves(curves, base, settings=settings, start=start)
     first16 = to_float16(first.coefficients)
-    escalated = bool(outside_range(first16, (lo, hi)).any()
-                     or not proven_in_range(first16, (lo, hi), max_cells=settings.proof_cells))
+    escalated = bool(
+        outside_range(first16, (lo, hi)).any() or not proven_in_range(first16, (lo, hi), max_cells=settings.proof_cells)
+    )
     return {
         "name": f"{material} at {eta:g}, bump at {centre:g} deg x {list(gains)}",
-        "target": target.tolist(), "mu": mu.tolist(), "eta": eta_s.tolist(), "weights": weights.tolist(),
-        "range": [lo, hi], "degree": 2, "start": start.ravel().tolist(),
+        "target": target.tolist(),
+        "mu": mu.tolist(),
+        "eta": eta_s.tolist(),
+        "weights": weights.tolist(),
+        "range": [lo, hi],
+        "degree": 2,
+        "start": start.ravel().tolist(),
         "edit": {"eta_i": eta, "angle_deg": THETA.tolist(), "rgb": rgb.tolist()},
         "base_rows": {f"{e:.6f}": base.rgb(mu_row, e).tolist() for e in [*rows, eta]},
         "mu_row": mu_row.tolist(),
         "first": {"x": first.coefficients.ravel().tolist(), "nfev": int(first.nfev)},
-        "live": {"coefficients16": live.coefficients_float16.astype(np.float64).ravel().tolist(),
-                 "best_effort": bool(live.best_effort), "escalated": escalated},
+        "live": {
+            "coefficients16": live.coefficients_float16.astype(np.float64).ravel().tolist(),
+            "best_effort": bool(live.best_effort),
+            "escalated": escalated,
+        },
     }
 
 

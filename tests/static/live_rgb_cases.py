@@ -49,28 +49,48 @@ def live_case(material: str, eta: float, centre: float, gains) -> dict:
     rgb = np.clip(reference * (1.0 + _bump(THETA, centre)[:, None] * (np.array(gains) - 1.0)), 0.0, 1.0)
     curves = check_curves([{"eta_i": eta, "angle_deg": THETA.tolist(), "rgb": rgb.tolist()}])
     problem = curve_problem(curves, base, None, "live", settings, MODEL)
-    solve = problem.solver.solve(problem.target, problem.mu, problem.eta, problem.eta_i_range, problem.degree,
-                                 settings.objective, max(settings.max_nfev, 200), settings.quantise,
-                                 weights=problem.weights, irls_rounds=settings.irls_rounds)
+    solve = problem.solver.solve(
+        problem.target,
+        problem.mu,
+        problem.eta,
+        problem.eta_i_range,
+        problem.degree,
+        settings.objective,
+        max(settings.max_nfev, 200),
+        settings.quantise,
+        weights=problem.weights,
+        irls_rounds=settings.irls_rounds,
+    )
     live = fit_curves(curves, base, settings=settings, model=MODEL)
     mu_row = angle_mu(np.linspace(0.0, 90.0, settings.mu_samples))
     rows = sorted({*np.linspace(lo, hi, settings.eta_samples).tolist(), eta})
     return {
         "name": f"{material} at {eta:g}, bump at {centre:g} deg x {list(gains)}",
-        "target": problem.target.tolist(), "mu": problem.mu.tolist(), "eta": problem.eta.tolist(),
+        "target": problem.target.tolist(),
+        "mu": problem.mu.tolist(),
+        "eta": problem.eta.tolist(),
         "weights": None if problem.weights is None else np.asarray(problem.weights).tolist(),
-        "range": [lo, hi], "edit": {"eta_i": eta, "angle_deg": THETA.tolist(), "rgb": rgb.tolist()},
+        "range": [lo, hi],
+        "edit": {"eta_i": eta, "angle_deg": THETA.tolist(), "rgb": rgb.tolist()},
         "base_rows": {f"{e:.6f}": base.rgb(mu_row, e).tolist() for e in rows},
         "x": solve.coefficients.ravel().tolist(),
-        "live": {"coefficients16": live.coefficients_float16.astype(np.float64).ravel().tolist(),
-                 "best_effort": bool(live.best_effort)},
+        "live": {
+            "coefficients16": live.coefficients_float16.astype(np.float64).ravel().tolist(),
+            "best_effort": bool(live.best_effort),
+        },
     }
 
 
 def fresnel_points() -> list[dict]:
     """The exact Fresnel and its n, k derivatives at points of a conductor, a dielectric (TIR) and grazing."""
-    points = [(0.8, 1.5, 0.2, 3.4), (0.3, 1.0, 1.1, 2.2), (0.05, 2.5, 2.0, 0.0), (0.6, 2.0, 1.2, 0.0),
-              (0.0, 1.3, 0.5, 4.0), (1.0, 1.0, 1.0, 0.0)]
+    points = [
+        (0.8, 1.5, 0.2, 3.4),
+        (0.3, 1.0, 1.1, 2.2),
+        (0.05, 2.5, 2.0, 0.0),
+        (0.6, 2.0, 1.2, 0.0),
+        (0.0, 1.3, 0.5, 4.0),
+        (1.0, 1.0, 1.0, 0.0),
+    ]
     out = []
     for mu, eta_i, n, k in points:
         R, dn, dk = fresnel_conductor_derivatives(mu, eta_i, n, k)

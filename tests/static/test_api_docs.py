@@ -42,8 +42,12 @@ def test_docs_render_every_operation_and_the_schemas(pages, live_server):
     spec = requests.get(live_server + "/openapi.json", timeout=30).json()
     assert spec["openapi"].startswith("3.1")
     # Swagger UI draws an operation once under each of its tags (GET /fits/{id}/edit is under two).
-    operations = sum(len(op.get("tags") or ["default"]) for item in spec["paths"].values()
-                     for method, op in item.items() if method in ("get", "post", "put", "patch", "delete"))
+    operations = sum(
+        len(op.get("tags") or ["default"])
+        for item in spec["paths"].values()
+        for method, op in item.items()
+        if method in ("get", "post", "put", "patch", "delete")
+    )
     schemas = spec["components"]["schemas"]
     page = pages.new(1280, 900)
     blocked = _offline(page)
@@ -54,8 +58,9 @@ def test_docs_render_every_operation_and_the_schemas(pages, live_server):
     # One operation by its path, as a reader finds it.
     expect(page.locator(".opblock-summary-path", has_text="/api/v1/materials").first).to_be_visible()
     # The schemas section lists the document's components, each by its title.
-    titles = page.locator("section.models article[data-json-schema-level='0'] > "
-                          ".json-schema-2020-12-head .json-schema-2020-12__title")
+    titles = page.locator(
+        "section.models article[data-json-schema-level='0'] > .json-schema-2020-12-head .json-schema-2020-12__title"
+    )
     expect(titles).to_have_count(len(schemas))
     assert set(titles.all_text_contents()) == {s.get("title", name) for name, s in schemas.items()}
     # An operation opens, with its parameters and answers.

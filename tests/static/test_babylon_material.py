@@ -25,8 +25,12 @@ pytestmark = [pytest.mark.server, pytest.mark.browser, pytest.mark.slow]
 
 PARITY_MEAN, PARITY_P99, PARITY_CENTRE = 0.05, 0.3, 0.02
 
-GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5],
-            "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]}}
+GOOD_RGB = {
+    "kind": "rgb-conductor",
+    "colorSpace": "ACEScg",
+    "etaIRange": [1, 2.5],
+    "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]},
+}
 
 
 def coat(ior: float) -> dict:
@@ -84,7 +88,8 @@ def test_malformed_extensions_draw_the_fallback(pages, live_server):
     if babylon.evaluate("window.cfBabylon === undefined"):
         open_babylon(babylon, live_server, create_fit(live_server, "Cu", "coated-conductor")["id"], 1.5)
     objects = [(GOOD_RGB, coat(1.8))] + [(o, c) for _, o, c, _ in MALFORMED]
-    result = babylon.evaluate("""async (objects) => {
+    result = babylon.evaluate(
+        """async (objects) => {
         const { LoadAssetContainerAsync } = await import('@babylonjs/core/Loading/sceneLoader.js');
         const { EngineStore } = await import('@babylonjs/core/Engines/engineStore.js');
         const scene = EngineStore.LastCreatedScene;
@@ -114,7 +119,9 @@ def test_malformed_extensions_draw_the_fallback(pages, live_server):
         } finally {
             console.warn = warn;
         }
-    }""", objects)
+    }""",
+        objects,
+    )
     assert result["drawn"] == [True] + [False] * len(MALFORMED), result
     ours = [w for w in result["warnings"] if "EXT_materials_coated_conductor" in w]
     assert len(ours) == len(MALFORMED), result["warnings"]

@@ -55,4 +55,3 @@ def test_the_page_cost_benchmark_reads_a_load_by_kind_of_process(chromium, brows
     assert wall > 0
     assert set(spent) <= set(KINDS)
     assert spent["chromium_renderer"] > 0 and spent["chromium_browser"] > 0
-

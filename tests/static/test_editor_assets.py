@@ -24,8 +24,10 @@ def key_edit(page, channel=1, angle=36, key="Shift+ArrowUp"):
 
 def saved_names(page, other=()):
     """Names of the saved curve materials, but ``other`` (what other modules on the shared server saved)."""
-    names = page.evaluate("fetch('/api/v1/materials').then(r => r.json())"
-                          ".then(j => j.materials.filter(m => m.kind === 'curves').map(m => m.name))")
+    names = page.evaluate(
+        "fetch('/api/v1/materials').then(r => r.json())"
+        ".then(j => j.materials.filter(m => m.kind === 'curves').map(m => m.name))"
+    )
     return [name for name in names if name not in other]
 
 
@@ -83,15 +85,17 @@ def test_drafts_save_replace_and_reload(pages, editor_url):
     page.click("#save")
     expect(page.locator("#message")).to_contain_text("Not saved")
     assert "Replace" in dialogs[-1]
-    gold = page.evaluate("fetch('/api/v1/materials').then(r => r.json()).then(j => j.materials"
-                         ".find(m => m.name === 'Asset test gold'))")
+    gold = page.evaluate(
+        "fetch('/api/v1/materials').then(r => r.json()).then(j => j.materials.find(m => m.name === 'Asset test gold'))"
+    )
     assert "Au" in gold["source"]
     # Accepting replaces it.
     page.once("dialog", lambda dialog: dialog.accept())
     page.click("#save")
     expect(page.locator("#message")).to_contain_text("Saved “Asset test gold”")
-    gold = page.evaluate("fetch('/api/v1/materials').then(r => r.json()).then(j => j.materials"
-                         ".find(m => m.name === 'Asset test gold'))")
+    gold = page.evaluate(
+        "fetch('/api/v1/materials').then(r => r.json()).then(j => j.materials.find(m => m.name === 'Asset test gold'))"
+    )
     assert "Cu" in gold["source"]
     assert saved_names(page, other) == ["Asset test gold"]
 

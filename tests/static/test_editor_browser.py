@@ -155,8 +155,9 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
     # A key press that moves nothing (the point is at 1 already) does not refit.
     point = edit_by_keyboard(page, 1, 84, "Shift+PageUp")
     page.keyboard.press("Shift+PageUp")
-    page.wait_for_function("document.querySelector(\"circle.handle.c1[data-angle='84']\")"
-                           ".getAttribute('aria-valuenow') === '1.000'")
+    page.wait_for_function(
+        "document.querySelector(\"circle.handle.c1[data-angle='84']\").getAttribute('aria-valuenow') === '1.000'"
+    )
     keyboard_id = wait_fit(page, keyboard_id)
     # End the key burst now (the point loses the focus) rather than KEY_BURST_MS after
     # the last press: its full refit, then no refit waits (static/plot.js).
@@ -165,7 +166,8 @@ def test_edit_refit_undo_save_reload_download(page, editor_url, tmp_path):
         "() => { const id = document.getElementById('fit-id').textContent;"
         " return !document.body.hasAttribute('aria-busy')"
         " && !document.getElementById('plot').classList.contains('updating')"
-        " && document.getElementById('preview').dataset.fit === id; }")
+        " && document.getElementById('preview').dataset.fit === id; }"
+    )
     keyboard_id = page.inner_text("#fit-id")
     point.focus()
     requests = from_curves_requests(page)
@@ -230,8 +232,10 @@ def test_refused_save_is_not_claimed(page, editor_url):
     # test_editor_live.py): the page says so, names the service's reason,
     # and neither claims nor lists a saved material.
     detail = "`name` must not be this one (a test's refusal)"
-    page.route(FROM_CURVES, lambda route: route.fulfill(
-        status=422, content_type="application/json", body=json.dumps({"detail": detail})))
+    page.route(
+        FROM_CURVES,
+        lambda route: route.fulfill(status=422, content_type="application/json", body=json.dumps({"detail": detail})),
+    )
     page.fill("#name", "Refused browser test")
     page.click("#save")
     expect(page.locator("#message")).to_have_text(f"Not saved: {detail}")

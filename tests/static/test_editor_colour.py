@@ -40,9 +40,14 @@ console.log(JSON.stringify({
 def browser(hexes: list[str], linear: np.ndarray) -> dict:
     node = shutil.which("node")
     assert node, "node is needed for the editor's unit tests (docs/testing.md)"
-    done = subprocess.run([node, "--input-type=module", "-e", SCRIPT,
-                           json.dumps({"hexes": hexes, "linear": linear.tolist()})],
-                          cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)
+    done = subprocess.run(
+        [node, "--input-type=module", "-e", SCRIPT, json.dumps({"hexes": hexes, "linear": linear.tolist()})],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
     return json.loads(done.stdout)
 
 
@@ -57,8 +62,9 @@ def test_conversions_match_colour_science():
     got = browser(hexes, linear)
 
     np.testing.assert_allclose(got["decoded"], colour.cctf_decoding(codes / 255.0, function="sRGB"), rtol=0, atol=1e-12)
-    expected_hex = ["#" + "".join(f"{int(round(v)):02x}" for v in c)
-                    for c in 255.0 * colour.cctf_encoding(linear, function="sRGB")]
+    expected_hex = [
+        "#" + "".join(f"{int(round(v)):02x}" for v in c) for c in 255.0 * colour.cctf_encoding(linear, function="sRGB")
+    ]
     assert got["encoded"] == expected_hex
     to_acescg = colour.RGB_to_RGB(linear, "ITU-R BT.709", "ACEScg", chromatic_adaptation_transform="CAT02")
     np.testing.assert_allclose(got["acescg"], to_acescg, rtol=0, atol=1e-12)

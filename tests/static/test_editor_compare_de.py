@@ -36,8 +36,14 @@ console.log(JSON.stringify({ each, whole }));
 def browser_delta_E(a: np.ndarray, b: np.ndarray) -> dict:
     node = shutil.which("node")
     assert node, "node is needed for the editor's unit tests (docs/testing.md)"
-    done = subprocess.run([node, "--input-type=module", "-e", SCRIPT, json.dumps({"a": a.tolist(), "b": b.tolist()})],
-                          cwd=ROOT, capture_output=True, text=True, timeout=60, check=True)
+    done = subprocess.run(
+        [node, "--input-type=module", "-e", SCRIPT, json.dumps({"a": a.tolist(), "b": b.tolist()})],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
     return json.loads(done.stdout)
 
 

@@ -23,8 +23,9 @@ PACKS = {"binary", "json", "glsl", "hlsl"}
 
 
 def set_range(page, selector, value):
-    page.eval_on_selector(selector, "(el, v) => { el.value = v; el.dispatchEvent(new Event('input', {bubbles: true})); }",
-                          str(value))
+    page.eval_on_selector(
+        selector, "(el, v) => { el.value = v; el.dispatchEvent(new Event('input', {bubbles: true})); }", str(value)
+    )
 
 
 # What each format's file is called and what its content must hold.
@@ -77,7 +78,11 @@ def download(page, format):
     with page.expect_download() as info:
         page.click("#download")
     got = info.value
-    return {"name": got.suggested_filename, "mimeType": "application/octet-stream", "buffer": open(got.path(), "rb").read()}
+    return {
+        "name": got.suggested_filename,
+        "mimeType": "application/octet-stream",
+        "buffer": open(got.path(), "rb").read(),
+    }
 
 
 def open_file(page, file):
@@ -129,8 +134,9 @@ def test_saving_again_continues_the_saved_material(pages, editor_url):
     key_edit(page, channel=0, angle=60, key="Shift+ArrowDown")
     page.click("#save")
     expect(page.locator("#message")).to_contain_text("version 2")
-    material = page.evaluate("fetch('/api/v1/materials').then(r => r.json()).then(j => j.materials"
-                             ".find(m => m.name === 'Continued gold'))")
+    material = page.evaluate(
+        "fetch('/api/v1/materials').then(r => r.json()).then(j => j.materials.find(m => m.name === 'Continued gold'))"
+    )
     assert material["version"] == 2
     # Opened from the list, a save continues it too.
     page.select_option("#material", f"saved:{material['id']}")

@@ -33,8 +33,14 @@ def test_editor_modules_pass_node_test(tmp_path):
     assert TESTS, "no tests/static/js/*.test.mjs"
     domain = tmp_path / "domain.json"
     domain.write_text(current_domain().model_dump_json())
-    done = subprocess.run([node, "--test", *map(str, TESTS)], cwd=ROOT, capture_output=True, text=True,
-                          timeout=120, env={**os.environ, "COATED_DOMAIN_JSON": str(domain)})
+    done = subprocess.run(
+        [node, "--test", *map(str, TESTS)],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "COATED_DOMAIN_JSON": str(domain)},
+    )
     report = done.stdout + done.stderr
     assert done.returncode == 0, report[-4000:]
     passed = re.search(r"^# pass (\d+)", report, re.M)

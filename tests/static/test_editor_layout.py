@@ -42,11 +42,20 @@ def test_the_dragged_point_stays_under_the_pointer(pages, editor_url, width):
     trail = []
     for dy in (2, 6, 14, 24, 36):
         page.mouse.move(x, y + dy)
-        page.wait_for_function(f"document.querySelector(\"{handle}\").getAttribute('aria-valuenow') !== '{before:.3f}'"
-                               if dy == 2 else "true")
+        page.wait_for_function(
+            f"document.querySelector(\"{handle}\").getAttribute('aria-valuenow') !== '{before:.3f}'"
+            if dy == 2
+            else "true"
+        )
         hx, hy = centre(page, handle)
-        trail.append((dy, hy - y, float(page.get_attribute(handle, "aria-valuenow")),
-                      page.locator("#plot svg").bounding_box()["y"] - plot_top))
+        trail.append(
+            (
+                dy,
+                hy - y,
+                float(page.get_attribute(handle, "aria-valuenow")),
+                page.locator("#plot svg").bounding_box()["y"] - plot_top,
+            )
+        )
     page.mouse.up()
     for dy, moved, _, shift in trail:
         assert shift == 0, (width, trail)  # nothing above the plot changed height
@@ -98,6 +107,8 @@ def test_the_preview_takes_45_percent_and_save_stays_in_view(pages, editor_url, 
     # Save is on the first screen, not covered by anything.
     save = page.locator("#save").bounding_box()
     assert 0 <= save["y"] and save["y"] + save["height"] <= height, save
-    hit = page.evaluate("([x, y]) => document.elementFromPoint(x, y).id",
-                        [save["x"] + save["width"] / 2, save["y"] + save["height"] / 2])
+    hit = page.evaluate(
+        "([x, y]) => document.elementFromPoint(x, y).id",
+        [save["x"] + save["width"] / 2, save["y"] + save["height"] / 2],
+    )
     assert hit == "save"

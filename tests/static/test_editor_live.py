@@ -67,13 +67,16 @@ def test_continuous_drag_refits_in_the_page_and_ends_on_the_server_fit(pages, ed
              const r = await fetch(`/api/v1/fits/from-curves?curves_eta_i=1.5&curves_samples=46`,
                                    { method: "POST", headers: { "Content-Type": "application/json" },
                                      body: JSON.stringify(body) });
-             return r.json(); }""", [base_id, theta, first["edits"]])
+             return r.json(); }""",
+        [base_id, theta, first["edits"]],
+    )
     mine = page.evaluate(
         """([C, theta]) => theta.map((t) => { const mu = t === 90 ? 0 : Math.cos(t * Math.PI / 180);
              return [0, 1, 2].map((c) => { const P = ["F0", "a", "alpha"].map((p) =>
                C[p][c].reduce((s, v, j) => s + v * (1 / 3) ** j, 0));
                return P[0] + (1 - P[0]) * (1 - mu) ** 5 - P[1] * mu * (1 - mu) ** Math.max(P[2], 1e-3); }); })""",
-        [first["coefficients"], theta])
+        [first["coefficients"], theta],
+    )
     # t = 1/3 at eta_i 1.5 over the default domain [1, 2.5] (the powers 1, t, t^2 above).
     assert server["eta_i_range"] == [1.0, 2.5]
     worst = max(abs(a - b) for row_a, row_b in zip(mine, server["curves"]["model"]) for a, b in zip(row_a, row_b))
@@ -123,9 +126,12 @@ def test_503_is_retried_and_its_message_cleared(pages, editor_url):
     def busy_twice(route):
         if len(refused) < 2:
             refused.append(route.request)
-            route.fulfill(status=503, content_type="application/json",
-                          headers={"Retry-After": "1"},
-                          body=json.dumps({"detail": "too many fits in flight (COATED_MAX_IN_FLIGHT)"}))
+            route.fulfill(
+                status=503,
+                content_type="application/json",
+                headers={"Retry-After": "1"},
+                body=json.dumps({"detail": "too many fits in flight (COATED_MAX_IN_FLIGHT)"}),
+            )
         else:
             route.continue_()
 
@@ -141,8 +147,8 @@ def test_503_is_retried_and_its_message_cleared(pages, editor_url):
     assert page.is_visible("#preview-state")
     assert page.inner_text("#fit-id") == base_id == page.get_attribute("#preview", "data-fit")
     new_id = page.wait_for_function(
-        f"(() => {{ const id = document.getElementById('fit-id').textContent;"
-        f" return id !== '{base_id}' && id; }})()").json_value()
+        f"(() => {{ const id = document.getElementById('fit-id').textContent; return id !== '{base_id}' && id; }})()"
+    ).json_value()
     assert settled(page) == new_id
     assert len(refused) == 2
     assert message.inner_text() == ""
@@ -160,8 +166,12 @@ def test_rgb_conductor_drag_is_solved_in_the_page_as_the_server_would(pages, liv
     mu = np.where(angles == 90.0, 0.0, np.cos(np.radians(angles)))
     rgb = curve_base_from_nk(library_material("Cu")).rgb(mu, 1.5)
     rgb[:, 2] *= 1.1
-    body = {"name": "live copper", "base": {"material": "Cu"}, "model": "rgb-conductor",
-            "curves": [{"eta_i": 1.5, "angle_deg": angles.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
+    body = {
+        "name": "live copper",
+        "base": {"material": "Cu"},
+        "model": "rgb-conductor",
+        "curves": [{"eta_i": 1.5, "angle_deg": angles.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
+    }
     response = loopback.post(f"{live_server}/api/v1/fits/from-curves", json=body, timeout=300)
     assert response.status_code == 201, response.text
     fit = response.json()
@@ -196,7 +206,9 @@ def test_rgb_conductor_drag_is_solved_in_the_page_as_the_server_would(pages, liv
                                                                         rgb: edits[eta] })) };
              const r = await fetch("/api/v1/fits/from-curves", { method: "POST",
                headers: { "Content-Type": "application/json" }, body: JSON.stringify(body) });
-             return r.json(); }""", [fit["id"], theta, first["edits"]])
+             return r.json(); }""",
+        [fit["id"], theta, first["edits"]],
+    )
     assert server["model"] == "rgb-conductor", server
     page.mouse.up()
     settled(page)

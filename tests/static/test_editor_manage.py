@@ -19,13 +19,19 @@ from playwright.sync_api import expect
 
 pytestmark = [pytest.mark.server, pytest.mark.browser]
 
-NK = {"wavelength_nm": [350, 450, 550, 650, 750, 850], "n": [1.5, 1.4, 0.4, 0.2, 0.15, 0.2],
-      "k": [1.9, 1.9, 2.4, 3.6, 4.6, 5.6]}
+NK = {
+    "wavelength_nm": [350, 450, 550, 650, 750, 850],
+    "n": [1.5, 1.4, 0.4, 0.2, 0.15, 0.2],
+    "k": [1.9, 1.9, 2.4, 3.6, 4.6, 5.6],
+}
 
 
 def api(page, path, method="GET", body=None):
-    init = f"{{method: '{method}', headers: {{'Content-Type': 'application/json'}}, body: JSON.stringify({body!r})}}" \
-        if body is not None else f"{{method: '{method}'}}"
+    init = (
+        f"{{method: '{method}', headers: {{'Content-Type': 'application/json'}}, body: JSON.stringify({body!r})}}"
+        if body is not None
+        else f"{{method: '{method}'}}"
+    )
     return page.evaluate(f"fetch('/api/v1{path}', {init}).then(r => r.json())")
 
 
@@ -138,7 +144,8 @@ def test_versions_open_download_and_continue(pages, editor_url):
     # Each version's figures: the mean and the worst point.
     for row in api(page, f"/materials/{material}/versions")["versions"]:
         expect(page.locator(f"#versions-list li[data-version='{row['version']}']")).to_contain_text(
-            f"ΔE₀₀ {row['delta_E_mean']:.2f}, max {row['delta_E_max']:.2f}")
+            f"ΔE₀₀ {row['delta_E_mean']:.2f}, max {row['delta_E_max']:.2f}"
+        )
     # Any version downloads, in the Download menu's format as it is at the click (the list is not
     # listed again), an export at the preview's settings, as the fit's own Download.
     download_v1 = page.locator("#versions-list li[data-version='1']").get_by_role("link", name="Download version 1")
@@ -146,12 +153,15 @@ def test_versions_open_download_and_continue(pages, editor_url):
     with page.expect_download() as info:
         download_v1.click()
     assert info.value.suggested_filename.endswith(".json") and first[:8] in info.value.suggested_filename
-    page.eval_on_selector("#roughness", "el => { el.value = '0.35'; el.dispatchEvent(new Event('input', {bubbles: true})); }")
+    page.eval_on_selector(
+        "#roughness", "el => { el.value = '0.35'; el.dispatchEvent(new Event('input', {bubbles: true})); }"
+    )
     page.select_option("#format", "mtlx")
     with page.expect_download() as info:
         download_v1.click()
-    assert re.fullmatch(rf".*-{first[:8]}-eta1\.5-rough0\.35-coat[0-9.]+\.mtlx", info.value.suggested_filename), \
+    assert re.fullmatch(rf".*-{first[:8]}-eta1\.5-rough0\.35-coat[0-9.]+\.mtlx", info.value.suggested_filename), (
         info.value.suggested_filename
+    )
     # An older version opens with its edit: its fit, its edited points, the material it belongs to.
     page.locator("#versions-list li[data-version='1']").get_by_role("button", name="Open version 1").click()
     expect(page.locator("#fit-id")).to_have_text(first)

@@ -39,9 +39,17 @@ def live_server(tmp_path_factory):
     store = SQLiteStore(data / "store.sqlite3")
     try:
         for i in range(COUNT):
-            store.put_fit(FitRecord(
-                id=_id(i), kind="curves", material_id=_id(i), name=_name(i), source="edit",
-                material={"name": _name(i), "coefficients": {"F0": [[0.5]] * 3}}, metrics={"x": 1.0}))
+            store.put_fit(
+                FitRecord(
+                    id=_id(i),
+                    kind="curves",
+                    material_id=_id(i),
+                    name=_name(i),
+                    source="edit",
+                    material={"name": _name(i), "coefficients": {"F0": [[0.5]] * 3}},
+                    metrics={"x": 1.0},
+                )
+            )
     finally:
         store.close()
     with server_process(data) as server:

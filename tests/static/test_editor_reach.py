@@ -23,8 +23,7 @@ def value(page, channel, angle):
 def model_range(page, fit_id):
     low, high = np.inf, -np.inf
     for eta in np.linspace(1.0, 2.5, 7):
-        curves = page.evaluate(f"fetch('/api/v1/fits/{fit_id}/curves?eta_i={eta:.3f}&samples=181')"
-                               ".then(r => r.json())")
+        curves = page.evaluate(f"fetch('/api/v1/fits/{fit_id}/curves?eta_i={eta:.3f}&samples=181').then(r => r.json())")
         model = np.asarray(curves["model"])
         low, high = min(low, model.min()), max(high, model.max())
     return low, high

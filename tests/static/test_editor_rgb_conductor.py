@@ -63,8 +63,12 @@ def rgb_fit(live_server):
     mu = np.where(ANGLES == 90.0, 0.0, np.cos(np.radians(ANGLES)))
     rgb = curve_base_from_nk(library_material("Cu")).rgb(mu, 1.5)
     rgb[:, 2] *= 1.1
-    body = {"name": "cool copper", "base": {"material": "Cu"}, "model": "rgb-conductor",
-            "curves": [{"eta_i": 1.5, "angle_deg": ANGLES.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
+    body = {
+        "name": "cool copper",
+        "base": {"material": "Cu"},
+        "model": "rgb-conductor",
+        "curves": [{"eta_i": 1.5, "angle_deg": ANGLES.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
+    }
     response = loopback.post(f"{live_server}/api/v1/fits/from-curves", json=body, timeout=300)
     assert response.status_code == 201, response.text
     fit = response.json()
@@ -78,8 +82,10 @@ def open_rgb(page, live_server, fit):
     assert page.locator(f"#material option[value='{value}']").count() == 1
     page.select_option("#material", value)
     expect(page.locator("#fit-id")).to_have_text(fit["id"])
-    page.wait_for_function("!document.body.hasAttribute('aria-busy')"
-                           " && document.getElementById('preview').dataset.fit === document.getElementById('fit-id').textContent")
+    page.wait_for_function(
+        "!document.body.hasAttribute('aria-busy')"
+        " && document.getElementById('preview').dataset.fit === document.getElementById('fit-id').textContent"
+    )
 
 
 def nk(fit):
@@ -98,15 +104,19 @@ def test_rgb_conductor_opens_and_its_preview_is_numpy(pages, live_server, rgb_fi
 
     page.select_option("#environment", "white_sky")
     page.select_option("#compare", "none")  # the whole ball is the model band
-    state = page.evaluate("(() => { const s = window.cfPreview.state;"
-                          " return {orbit: s.orbit, fov: s.fov, eta: s.eta, words: Array.from(s.words), panels: s.panels}; })()")
+    state = page.evaluate(
+        "(() => { const s = window.cfPreview.state;"
+        " return {orbit: s.orbit, fov: s.fov, eta: s.eta, words: Array.from(s.words), panels: s.panels}; })()"
+    )
     assert state["panels"] == [0]
     n, k = nk(rgb_fit)
     halves = np.concatenate([n, k]).astype(np.float16).view(np.uint16).astype(np.uint32)
     assert state["words"][:3] == (halves[0::2] | (halves[1::2] << 16)).tolist()  # the pack's 3 words
     assert state["words"][3:] == [0] * 11
 
-    geometry, fresnel, linear, display = (read_float(page, o, W, H) for o in ("geometry", "fresnel", "linear", "display"))
+    geometry, fresnel, linear, display = (
+        read_float(page, o, W, H) for o in ("geometry", "fresnel", "linear", "display")
+    )
     NdotV, hit, _, _ = camera_rays(*state["orbit"], state["fov"], W, H)
     on = geometry[..., 1] > 0.5
     assert np.mean(on != hit) < 0.01  # silhouette pixels, a count, not precision
@@ -165,7 +175,9 @@ def test_rgb_conductor_rough_preview_and_refit(pages, live_server, rgb_fit):
     page.locator("circle.handle.c2[data-angle='50']").focus()
     page.keyboard.press("Shift+ArrowDown")
     page.wait_for_function(f"document.getElementById('fit-id').textContent !== '{rgb_fit['id']}'")
-    page.wait_for_function("!document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden")
+    page.wait_for_function(
+        "!document.body.hasAttribute('aria-busy') && document.getElementById('preview-state').hidden"
+    )
     refit = page.evaluate("fetch('/api/v1/fits/' + document.getElementById('fit-id').textContent).then(r => r.json())")
     assert refit["model"] == "rgb-conductor" and refit["base_fit_id"] == rgb_fit["id"]
     assert page.get_attribute("#preview", "data-fit") == refit["id"]

@@ -55,7 +55,9 @@ def box_glb(half=(1.0, 0.35, 0.6)) -> bytes:
     n_vertices = len(positions)
     document = {
         "asset": {"version": "2.0"},
-        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
         "buffers": [{"byteLength": len(binary)}],
         "bufferViews": [
@@ -64,8 +66,14 @@ def box_glb(half=(1.0, 0.35, 0.6)) -> bytes:
             {"buffer": 0, "byteOffset": 24 * n_vertices, "byteLength": 2 * len(indices)},
         ],
         "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": n_vertices, "type": "VEC3",
-             "min": pos.min(0).tolist(), "max": pos.max(0).tolist()},
+            {
+                "bufferView": 0,
+                "componentType": 5126,
+                "count": n_vertices,
+                "type": "VEC3",
+                "min": pos.min(0).tolist(),
+                "max": pos.max(0).tolist(),
+            },
             {"bufferView": 1, "componentType": 5126, "count": n_vertices, "type": "VEC3"},
             {"bufferView": 2, "componentType": 5123, "count": len(indices), "type": "SCALAR"},
         ],
@@ -111,7 +119,9 @@ def drawn(page, text):
     """Wait until the scene is drawn and its status names `text`."""
     page.wait_for_function(
         "(text) => document.getElementById('scene').dataset.state === 'ready'"
-        " && document.getElementById('scene-status').textContent.includes(text)", arg=text)
+        " && document.getElementById('scene-status').textContent.includes(text)",
+        arg=text,
+    )
 
 
 def colour_of(image, mask):

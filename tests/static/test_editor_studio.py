@@ -70,9 +70,13 @@ def test_presets_and_typed_entry(pages, editor_url):
     open_editor(page, editor_url)
     settled(page)
     presets = api(page, "/coat-presets")["presets"]
-    buttons = page.eval_on_selector_all("#coat-presets button", "els => els.map(e => [e.dataset.id, e.title, e.textContent])")
-    shown = [f"{p['name']} {p['eta_i']:.1f}" if float(p["eta_i"]).is_integer() else f"{p['name']} {p['eta_i']:g}"
-             for p in presets]
+    buttons = page.eval_on_selector_all(
+        "#coat-presets button", "els => els.map(e => [e.dataset.id, e.title, e.textContent])"
+    )
+    shown = [
+        f"{p['name']} {p['eta_i']:.1f}" if float(p["eta_i"]).is_integer() else f"{p['name']} {p['eta_i']:g}"
+        for p in presets
+    ]
     assert buttons == [[p["id"], p["source"], text] for p, text in zip(presets, shown)]
     page.click("#coat-presets button[data-id='water']")
     expect(page.locator("#eta-value")).to_have_text("1.33")
@@ -194,8 +198,10 @@ def test_compare_a_fit_with_its_edit_and_two_metals(pages, editor_url):
     page.wait_for_function("window.cfPreviewCompare && window.cfPreviewCompare.then(b => b.state.coated)")
     # Two metals: the fit on screen against copper from the library.
     page.locator("#library-list li[data-id='Cu'] button", has_text="Compare").click()
-    copper = page.evaluate("fetch('/api/v1/fits', {method: 'POST', headers: {'Content-Type': 'application/json'},"
-                           " body: JSON.stringify({material: 'Cu', eta_i_range: [1, 2.5]})}).then(r => r.json())")["id"]
+    copper = page.evaluate(
+        "fetch('/api/v1/fits', {method: 'POST', headers: {'Content-Type': 'application/json'},"
+        " body: JSON.stringify({material: 'Cu', eta_i_range: [1, 2.5]})}).then(r => r.json())"
+    )["id"]
     expect(page.locator("#preview-compare")).to_have_attribute("data-fit", copper)
     expect(page.locator("#preview-compare-labels")).to_have_text("Compared: Cu (library): Model")
     expect(page.locator("#compare-de")).to_have_attribute("data-fit", copper)
@@ -237,8 +243,11 @@ def test_split_menu_and_presets_are_never_cut_off(pages, editor_url, width):
     fits = page.evaluate(MENU_FITS, "compare")
     assert fits["inside"] and fits["widest"] <= fits["room"], (width, fits)
     page.wait_for_function("document.querySelectorAll('#coat-presets button').length === 8")
-    cut = page.eval_on_selector_all("#coat-presets button", """els => els.filter((e) => {
+    cut = page.eval_on_selector_all(
+        "#coat-presets button",
+        """els => els.filter((e) => {
         const panel = e.closest('.panel').getBoundingClientRect(), box = e.getBoundingClientRect();
         return e.scrollWidth > e.clientWidth || box.left < panel.left || box.right > panel.right;
-    }).map((e) => e.textContent)""")
+    }).map((e) => e.textContent)""",
+    )
     assert not cut, (width, cut)

@@ -16,7 +16,11 @@ import pytest
 from editor_pages import camera_rays, editor_url, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 from fitting import (
-    baseline_inputs, coated_conductor_model, curve_base_from_nk, halves_to_uint32, lazanyi_adjusted,
+    baseline_inputs,
+    coated_conductor_model,
+    curve_base_from_nk,
+    halves_to_uint32,
+    lazanyi_adjusted,
     library_material,
 )
 from preview_shaders.display import ACEScg_to_sRGB
@@ -51,9 +55,11 @@ def test_preview_matches_numpy(pages, editor_url):
     page.select_option("#compare", "all")
     fit_id = page.inner_text("#fit-id")
     fit = page.evaluate(f"fetch('/api/v1/fits/{fit_id}').then(r => r.json())")
-    state = page.evaluate("(() => { const s = window.cfPreview.state;"
-                          " return {orbit: s.orbit, fov: s.fov, eta: s.eta, words: Array.from(s.words),"
-                          " panels: s.panels}; })()")
+    state = page.evaluate(
+        "(() => { const s = window.cfPreview.state;"
+        " return {orbit: s.orbit, fov: s.fov, eta: s.eta, words: Array.from(s.words),"
+        " panels: s.panels}; })()"
+    )
     assert state["panels"] == [0, 1, 2]
     C = np.array([fit["coefficients"][p] for p in ("F0", "a", "alpha")])
     assert C.shape == (3, 3, 3)
@@ -83,8 +89,13 @@ def test_preview_matches_numpy(pages, editor_url):
         mask = gl_hit & (geometry[..., 2] == k)
         assert mask.sum() > 100
         expected[mask] = values[mask]
-        np.testing.assert_allclose(fresnel[..., :3][mask], values[mask], atol=PARITY_BOUND, rtol=PARITY_BOUND,
-                                   err_msg=["model", "adjusted Lazanyi", "spectral reference"][k])
+        np.testing.assert_allclose(
+            fresnel[..., :3][mask],
+            values[mask],
+            atol=PARITY_BOUND,
+            rtol=PARITY_BOUND,
+            err_msg=["model", "adjusted Lazanyi", "spectral reference"][k],
+        )
     # The bands differ (the reference is not the model, Lazanyi is neither).
     assert np.abs(model - reference)[gl_hit].max() > 1e-3
     assert np.abs(model - lazanyi)[gl_hit].max() > 1e-3
@@ -100,7 +111,7 @@ def test_preview_matches_numpy(pages, editor_url):
     page.fill("#exposure", "1.5")
     page.dispatch_event("#exposure", "input")
     brighter = read(page, "linear")
-    np.testing.assert_allclose(brighter[..., :3][gl_hit], 2 ** 1.5 * linear[..., :3][gl_hit], rtol=1e-5)  # 2^1.5 via
+    np.testing.assert_allclose(brighter[..., :3][gl_hit], 2**1.5 * linear[..., :3][gl_hit], rtol=1e-5)  # 2^1.5 via
     # exp2 (3 ulps) and one product: 4 u32 = 2.4e-7, inside 1e-5
 
 

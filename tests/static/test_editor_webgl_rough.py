@@ -46,13 +46,27 @@ import loopback
 import numpy as np
 import pytest
 from playwright.sync_api import expect
-from editor_pages import F32_BASE64, camera_rays, editor_url, from_f32, open_editor, pages, read_float, chromium, live_server  # noqa: F401 (fixtures: one server and one Chromium a module)
+from editor_pages import (
+    F32_BASE64,
+    camera_rays,
+    editor_url,  # noqa: F401 (a fixture)
+    from_f32,
+    open_editor,
+    pages,  # noqa: F401 (a fixture)
+    read_float,
+    chromium,  # noqa: F401 (a fixture)
+    live_server,  # noqa: F401 (a fixture)
+)  # noqa: F401 (fixtures: one server and one Chromium a module)
 
 from fitting import baseline_inputs, coated_conductor_model, curve_base_from_nk, library_material
 from fitting.models.coated_conductor import collapse_to_eta_i
 from fitting.optics.fresnel import fresnel_dielectric
 from fitting.shading.ibl import (
-    directional_albedo, split_sum_coated, split_sum_lazanyi, split_sum_model, split_sum_schlick,
+    directional_albedo,
+    split_sum_coated,
+    split_sum_lazanyi,
+    split_sum_model,
+    split_sum_schlick,
 )
 from fitting.shading.microfacet import microfacet_brdf
 
@@ -156,8 +170,10 @@ def test_rough_and_coated_split_sum_match_numpy(pages, editor_url, live_server):
     page.select_option("#compare", "all")
     page.select_option("#environment", "studio")
     control(page, "roughness", 0.45)
-    state = page.evaluate("(() => { const s = window.cfPreview.state;"
-                          " return {orbit: s.orbit, fov: s.fov, eta: s.eta, panels: s.panels}; })()")
+    state = page.evaluate(
+        "(() => { const s = window.cfPreview.state;"
+        " return {orbit: s.orbit, fov: s.fov, eta: s.eta, panels: s.panels}; })()"
+    )
     assert state["panels"] == [0, 1, 2]
     assert page.get_attribute("#preview", "data-program") == "split-sum"
     eta, r = state["eta"], 0.45
@@ -177,8 +193,7 @@ def test_rough_and_coated_split_sum_match_numpy(pages, editor_url, live_server):
     NdotV, hit, _, R = camera_rays(*state["orbit"], state["fov"], W, H)
     on = (geometry[..., 1] > 0.5) & hit
     mu = geometry[..., 0]
-    direct = {0: split_sum_model(mu, r, *params), 1: split_sum_lazanyi(mu, r, eta, b["F0_air"], b["F82_air"]),
-              2: None}
+    direct = {0: split_sum_model(mu, r, *params), 1: split_sum_lazanyi(mu, r, eta, b["F0_air"], b["F82_air"]), 2: None}
     for k, table in enumerate((albedo[0], albedo[1], reference)):
         mask = on & (geometry[..., 2] == k)
         assert mask.sum() > 100
@@ -200,7 +215,8 @@ def test_rough_and_coated_split_sum_match_numpy(pages, editor_url, live_server):
     F0c = ((eta - 1.0) / (eta + 1.0)) ** 2
     np.testing.assert_allclose(albedo[2], split_sum_schlick(MU, rc, np.full(3, F0c)), atol=TABLE)
     coat, fresnel, light, coat_light, linear = (
-        read(page, o) for o in ("coat", "fresnel", "baseLight", "coatLight", "linear"))
+        read(page, o) for o in ("coat", "fresnel", "baseLight", "coatLight", "linear")
+    )
     mu = geometry[..., 0]
     mu_t = np.sqrt(1.0 - (1.0 - mu**2) / eta**2)
     np.testing.assert_allclose(coat[..., 2][on], mu_t[on], atol=EXACT)
@@ -236,8 +252,9 @@ def test_mirror_coat_and_the_way_back_to_smooth(pages, editor_url):
     # dielectric on top, the model at the cosine inside the coat.
     control(page, "coat", True)
     assert page.get_attribute("#preview", "data-program") == "mirror"
-    state = page.evaluate("({orbit: window.cfPreview.state.orbit, fov: window.cfPreview.state.fov,"
-                          " eta: window.cfPreview.state.eta})")
+    state = page.evaluate(
+        "({orbit: window.cfPreview.state.orbit, fov: window.cfPreview.state.fov, eta: window.cfPreview.state.eta})"
+    )
     eta = state["eta"]
     fit, C, _ = fit_parameters(page, eta)
     geometry, coat, fresnel, linear = (read(page, o) for o in ("geometry", "coat", "fresnel", "linear"))
@@ -269,7 +286,9 @@ def brdf_grid(page, mode, roughness, F0, a, alpha, eta_i=1.0, coat_roughness=0.0
     n x n view x light angles in [0, 1.5] rad: the BRDF, V and L."""
     got = page.evaluate(
         """async ([mode, grid, phi, uniforms, n]) => {
-            """ + F32_BASE64 + """
+            """
+        + F32_BASE64
+        + """
             const { fullscreenProgram, floatTarget, drawInto, readTarget } = await import('/glpass.js');
             const gl = window.cfPreview.gl;
             const pass = await fullscreenProgram(gl, 'microfacet.frag', { CF_MODE: mode });
@@ -287,9 +306,20 @@ def brdf_grid(page, mode, roughness, F0, a, alpha, eta_i=1.0, coat_roughness=0.0
             targets.forEach((t) => gl.deleteTexture(t));
             return { out, error: gl.getError() };
         }""",
-        [0 if mode == "immersed" else 1, [0.0, 1.5 / (n - 1), 0.0, 1.5 / (n - 1)], float(phi),
-         {"cf_F0": list(F0), "cf_a": list(a), "cf_alpha": list(alpha), "cf_roughness": roughness,
-          "cf_eta_i": eta_i, "cf_coat_roughness": coat_roughness}, n],
+        [
+            0 if mode == "immersed" else 1,
+            [0.0, 1.5 / (n - 1), 0.0, 1.5 / (n - 1)],
+            float(phi),
+            {
+                "cf_F0": list(F0),
+                "cf_a": list(a),
+                "cf_alpha": list(alpha),
+                "cf_roughness": roughness,
+                "cf_eta_i": eta_i,
+                "cf_coat_roughness": coat_roughness,
+            },
+            n,
+        ],
     )
     assert got["error"] == 0
     f, V, L = (from_f32(x).reshape(n, n, 4)[..., :3] for x in got["out"])
@@ -340,20 +370,24 @@ def test_controls_change_the_image(pages, editor_url):
     views["rough coat"] = read(page, "display")
     names = list(views)
     for i, first in enumerate(names):
-        for second in names[i + 1:]:
+        for second in names[i + 1 :]:
             assert np.abs(views[first] - views[second]).max() > 0.02, (first, second)
     # The rough sphere is blurred: its neighbouring pixels differ less.
     on = read(page, "geometry")[..., 1] > 0.5
+
     def roughness_of(image):  # noqa: E306
         return np.abs(np.diff(image[..., :3], axis=1))[on[:, 1:] & on[:, :-1]].mean()
+
     assert roughness_of(views["rough"]) < 0.7 * roughness_of(views["smooth"])
     assert page.is_hidden("#preview-lighting")
 
     # A split sum out of reach (the service refuses the slices): every lobe
     # is drawn as a mirror, and the page says so.
     other = pages.new()
-    other.route("**/api/v1/environments/**", lambda route: route.fulfill(
-        status=503, content_type="application/json", body='{"detail": "no GL driver"}'))
+    other.route(
+        "**/api/v1/environments/**",
+        lambda route: route.fulfill(status=503, content_type="application/json", body='{"detail": "no GL driver"}'),
+    )
     open_editor(other, editor_url)
     other.select_option("#environment", "studio")
     other.fill("#roughness", "0.5")

@@ -37,8 +37,13 @@ def modules() -> list[str]:
 
 
 def parse_errors(paths: list[str]) -> list[str]:
-    out = subprocess.run([shutil.which("node"), "--experimental-vm-modules", "--no-warnings", "-e", PARSE,
-                          json.dumps(paths)], capture_output=True, text=True, timeout=60, check=True)
+    out = subprocess.run(
+        [shutil.which("node"), "--experimental-vm-modules", "--no-warnings", "-e", PARSE, json.dumps(paths)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=True,
+    )
     return json.loads(out.stdout)
 
 
@@ -50,7 +55,7 @@ def test_every_served_module_parses():
 
 def test_the_check_sees_a_syntax_error(tmp_path):
     broken = tmp_path / "broken.js"
-    broken.write_text('export const x = (1 + 2));\n', encoding="utf-8")
+    broken.write_text("export const x = (1 + 2));\n", encoding="utf-8")
     fine = tmp_path / "fine.js"
     fine.write_text('import { y } from "./y.js";\nexport const x = y + 1;\n', encoding="utf-8")
     errors = parse_errors([str(broken), str(fine)])

@@ -46,8 +46,9 @@ def no_page_errors(example):
 @pytest.mark.parametrize("material, eta_i, roughness", [("Cu", 1.5, 0.0), ("Au", 1.0, 0.0), ("Au", 1.5, 0.3)])
 def test_three_fallback_is_the_mirror(example, live_server, material, eta_i, roughness):
     fit = create_fit(live_server, material, "rgb-conductor")
-    response = loopback.get(f"{live_server}/api/v1/fits/{fit['id']}/pack",
-                            params={"format": "gltf", "eta_i": eta_i}, timeout=300)
+    response = loopback.get(
+        f"{live_server}/api/v1/fits/{fit['id']}/pack", params={"format": "gltf", "eta_i": eta_i}, timeout=300
+    )
     response.raise_for_status()
     gltf_material = json.loads(response.content)["materials"][0]
     base = np.asarray(gltf_material["pbrMetallicRoughness"]["baseColorFactor"][:3])
@@ -60,8 +61,9 @@ def test_three_fallback_is_the_mirror(example, live_server, material, eta_i, rou
     for angle in ANGLES_DEG:
         at = hit & mask & (np.abs(theta - angle) <= 1.0)
         assert at.sum() >= 1
-        mirror = three_clearcoat(NdotV[at], base, coat["clearcoatFactor"] if coat else 0.0, coat is not None,
-                                 roughness)
+        mirror = three_clearcoat(NdotV[at], base, coat["clearcoatFactor"] if coat else 0.0, coat is not None, roughness)
         dE = delta_E_map(rendered[at], lin_rec709_to_ACEScg(mirror))
-        print(f"{material} {eta_i} roughness {roughness:g} {angle:g} deg: Delta E max {dE.max():.4f} over {at.sum()} pixels")
+        print(
+            f"{material} {eta_i} roughness {roughness:g} {angle:g} deg: Delta E max {dE.max():.4f} over {at.sum()} pixels"
+        )
         assert dE.max() < BOUND, (material, eta_i, roughness, angle, dE.max())

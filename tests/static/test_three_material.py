@@ -104,10 +104,14 @@ def check_white_sky(figures, kind):
     assert figures["fallback"]["mean"] > physics["mean"], (figures["fallback"], physics)
 
 
-@pytest.mark.parametrize("kind, material, eta_i, env, lobe", [
-    ("coated-conductor", "Au", 1.5, "outdoor", (0.3, 0.1)),
-    ("rgb-conductor", "Au", 1.33, "studio", (0.0, 0.0)),
-], ids=["coated-Au", "rgb-Au"])
+@pytest.mark.parametrize(
+    "kind, material, eta_i, env, lobe",
+    [
+        ("coated-conductor", "Au", 1.5, "outdoor", (0.3, 0.1)),
+        ("rgb-conductor", "Au", 1.33, "studio", (0.0, 0.0)),
+    ],
+    ids=["coated-Au", "rgb-Au"],
+)
 def test_plugin_matches_preview_and_physics(session, kind, material, eta_i, env, lobe):
     """
     White sky, mirror and rough: the preview, the twin and the physics; a
@@ -161,11 +165,19 @@ def test_roughness_and_coat_change_the_render(session):
 
 
 # Malformed or out-of-range extension objects, each with what its warning names.
-GOOD_RGB = {"kind": "rgb-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2.5],
-            "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]}}
-GOOD_COATED = {"kind": "coated-conductor", "colorSpace": "ACEScg", "etaIRange": [1, 2], "degree": 0,
-               "coefficients": {"F0": [[0.9], [0.7], [0.4]], "a": [[0.1], [0.2], [0.1]],
-                                "alpha": [[5.0], [4.0], [3.0]]}}
+GOOD_RGB = {
+    "kind": "rgb-conductor",
+    "colorSpace": "ACEScg",
+    "etaIRange": [1, 2.5],
+    "coefficients": {"n": [0.2, 0.5, 1.3], "k": [3, 2.3, 1.9]},
+}
+GOOD_COATED = {
+    "kind": "coated-conductor",
+    "colorSpace": "ACEScg",
+    "etaIRange": [1, 2],
+    "degree": 0,
+    "coefficients": {"F0": [[0.9], [0.7], [0.4]], "a": [[0.1], [0.2], [0.1]], "alpha": [[5.0], [4.0], [3.0]]},
+}
 
 
 def coat(ior) -> dict:
@@ -182,8 +194,7 @@ MALFORMED = [
     ("coat index below 1", GOOD_RGB, "`clearcoatIor`", coat(0.5)),
     ("coat index a string", GOOD_RGB, "`clearcoatIor`", coat("1.5")),
     ("coat index outside the fit", GOOD_COATED, "outside", coat(2.4)),
-    ("glTF's 1.5 outside the fit", {**GOOD_COATED, "etaIRange": [1.8, 2]}, "outside",
-     {"clearcoatFactor": 0.5}),
+    ("glTF's 1.5 outside the fit", {**GOOD_COATED, "etaIRange": [1.8, 2]}, "outside", {"clearcoatFactor": 0.5}),
     ("revision 1's coat index", {**GOOD_RGB, "coatIor": 1.5}, "`coatIor`"),
     ("range reversed", {**GOOD_COATED, "etaIRange": [2, 1]}, "`etaIRange`"),
     ("range missing", {k: v for k, v in GOOD_RGB.items() if k != "etaIRange"}, "`etaIRange`"),
@@ -192,8 +203,11 @@ MALFORMED = [
     ("no coefficients", {k: v for k, v in GOOD_RGB.items() if k != "coefficients"}, "`coefficients`"),
     ("rows too short", {**GOOD_COATED, "degree": 2}, "`coefficients.F0`"),
     ("degree 5", {**GOOD_COATED, "degree": 5}, "`degree`"),
-    ("beyond float16", {**GOOD_COATED, "coefficients": {**GOOD_COATED["coefficients"],
-                                                        "alpha": [[1e6], [4.0], [3.0]]}}, "`coefficients.alpha`"),
+    (
+        "beyond float16",
+        {**GOOD_COATED, "coefficients": {**GOOD_COATED["coefficients"], "alpha": [[1e6], [4.0], [3.0]]}},
+        "`coefficients.alpha`",
+    ),
     ("revision 1's coat factor", {**GOOD_RGB, "coatFactor": 1}, "`coatFactor`"),
     ("unknown property", {**GOOD_RGB, "tint": [1, 0, 0]}, "`tint`"),
 ]
@@ -209,7 +223,8 @@ def test_malformed_extensions_draw_the_fallback(session):
     """
     page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
     objects = [(GOOD_RGB, None), (GOOD_COATED, coat(1.2))] + [(o, (c or [None])[0]) for _, o, _, *c in MALFORMED]
-    result = page.evaluate("""async (objects) => {
+    result = page.evaluate(
+        """async (objects) => {
         const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
         const { CoatedConductorExtension } = await import('/static/three/index.js');
         const json = { asset: { version: '2.0' }, extensionsUsed: ['EXT_materials_coated_conductor',
@@ -231,7 +246,9 @@ def test_malformed_extensions_draw_the_fallback(session):
         } finally {
             console.warn = warn;
         }
-    }""", objects)
+    }""",
+        objects,
+    )
     assert result["drawn"] == [True, True] + [False] * len(MALFORMED), result
     assert len(result["warnings"]) == len(MALFORMED), result["warnings"]
     for (what, _, field, *_), warning in zip(MALFORMED, result["warnings"]):
@@ -246,7 +263,8 @@ def test_export_round_trip_keeps_the_extension(session):
     """
     fit = session.fit("Cu", "coated-conductor")
     page = session.example(fit, 1.8)
-    result = page.evaluate("""async (url) => {
+    result = page.evaluate(
+        """async (url) => {
         const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
         const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
         const { CoatedConductorExtension, CoatedConductorExporterExtension } =
@@ -267,7 +285,9 @@ def test_export_round_trip_keeps_the_extension(session):
         const ext = (doc) => doc.materials[0].extensions;
         return { original: ext(original), written: ext(written), used: written.extensionsUsed,
                  required: written.extensionsRequired ?? [], extras: written.materials[0].extras ?? {}, drawn };
-    }""", f"{session.server}/api/v1/fits/{fit['id']}/pack?format=gltf&eta_i=1.8")
+    }""",
+        f"{session.server}/api/v1/fits/{fit['id']}/pack?format=gltf&eta_i=1.8",
+    )
     for name in ("EXT_materials_coated_conductor", "KHR_materials_clearcoat"):
         assert result["written"][name] == result["original"][name], name
     assert "EXT_materials_coated_conductor" in result["used"] and result["required"] == []
@@ -296,14 +316,19 @@ def test_material_refuses_malformed_extensions(session):
         return messages;
     }""")
     assert all(messages), messages
-    for message, field in zip(messages, ["`kind`", "`colorSpace`", "`coatIor`", "n > 0",
-                                         "`coefficients.F0`", "`degree`", "`clearcoatIor`"], strict=True):
+    for message, field in zip(
+        messages,
+        ["`kind`", "`colorSpace`", "`coatIor`", "n > 0", "`coefficients.F0`", "`degree`", "`clearcoatIor`"],
+        strict=True,
+    ):
         assert field in message, message
 
 
 # A 1 x 1 PNG (grey), the clear coat's factor and roughness textures.
-PIXEL = ("data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQ"
-         "AAAABJRU5ErkJggg==")
+PIXEL = (
+    "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8BQDwAEhQGAhKmMIQ"
+    "AAAABJRU5ErkJggg=="
+)
 
 
 def test_the_coat_is_the_clear_coats_textures_included(session):
@@ -314,10 +339,15 @@ def test_the_coat_is_the_clear_coats_textures_included(session):
     the coat's textures, and the exporter plugin writes them back with the index.
     """
     page = session.example(session.fit("Cu", "coated-conductor"), 1.8)
-    clearcoat = {"clearcoatFactor": 0.8, "clearcoatTexture": {"index": 0}, "clearcoatRoughnessFactor": 0.2,
-                 "clearcoatRoughnessTexture": {"index": 0},
-                 "extensions": {"KHR_materials_clearcoat_ior": {"clearcoatIor": 1.7}}}
-    result = page.evaluate("""async ([model, clearcoat, pixel]) => {
+    clearcoat = {
+        "clearcoatFactor": 0.8,
+        "clearcoatTexture": {"index": 0},
+        "clearcoatRoughnessFactor": 0.2,
+        "clearcoatRoughnessTexture": {"index": 0},
+        "extensions": {"KHR_materials_clearcoat_ior": {"clearcoatIor": 1.7}},
+    }
+    result = page.evaluate(
+        """async ([model, clearcoat, pixel]) => {
         const THREE = await import('three');
         const { GLTFLoader } = await import('three/addons/loaders/GLTFLoader.js');
         const { GLTFExporter } = await import('three/addons/exporters/GLTFExporter.js');
@@ -361,7 +391,9 @@ def test_the_coat_is_the_clear_coats_textures_included(session):
                  roughness: material.clearcoatRoughness, map: Boolean(material.clearcoatMap),
                  roughnessMap: Boolean(material.clearcoatRoughnessMap), centre, programs,
                  written: written.materials[0].extensions, used: written.extensionsUsed };
-    }""", [GOOD_RGB, clearcoat, PIXEL])
+    }""",
+        [GOOD_RGB, clearcoat, PIXEL],
+    )
     assert result["coatIor"] == pytest.approx(1.7)
     assert result["clearcoat"] == pytest.approx(0.8) and result["roughness"] == pytest.approx(0.2)
     assert result["map"] and result["roughnessMap"]

@@ -115,7 +115,9 @@ def test_webgl_and_the_node_material_draw_the_same_image(models, chromium, tmp_p
             assert found["pixels"] > 10_000, found
             assert found["mean"] <= PARITY_MEAN, (kind, eta_i, roughness, lit, found)
         # Two materials of one kind alive together: each draws its own model (no program shared between them).
-        first, last = ((model, eta_i) for kind, eta_i, model in models if kind == models[0][0] and eta_i in (ETAS[0], ETAS[-1]))
+        first, last = (
+            (model, eta_i) for kind, eta_i, model in models if kind == models[0][0] and eta_i in (ETAS[0], ETAS[-1])
+        )
         gl_a, node_a, gl_b, node_b = draw_pair(page, first, last, 0.3, 0.1)
         assert parity(gl_a, node_a)["mean"] <= PARITY_MEAN and parity(gl_b, node_b)["mean"] <= PARITY_MEAN
         assert parity(gl_a, gl_b)["mean"] > 1  # the two models differ: the check above can see a swap

@@ -115,13 +115,14 @@ def import_map(entries: dict) -> str:
     return f'\n<script type="importmap">{json.dumps({"imports": entries})}</script>'
 
 
-THREE_MAP = {"three": "./node_modules/three/build/three.module.js",
-             "three/addons/": "./node_modules/three/examples/jsm/"}
+THREE_MAP = {
+    "three": "./node_modules/three/build/three.module.js",
+    "three/addons/": "./node_modules/three/examples/jsm/",
+}
 
 
 def scene(package: str) -> str:
-    values = {"PACKAGE": package, "ORBIT": json.dumps(list(ORBIT)), "FOV": repr(FOV), "WIDTH": str(W),
-              "HEIGHT": str(H)}
+    values = {"PACKAGE": package, "ORBIT": json.dumps(list(ORBIT)), "FOV": repr(FOV), "WIDTH": str(W), "HEIGHT": str(H)}
     text = SCENE
     for key, value in values.items():
         text = text.replace(key, value)
@@ -151,17 +152,25 @@ def folder(tmp_path_factory):
     document = export_material(nk, "gltf", ETA_I, model=fit_model(nk, (1.0, 2.5), "coated-conductor").packed)
     (root / "coated.gltf").write_bytes(document if isinstance(document, bytes) else document.encode())
     (root / "static.js").write_text(scene("./node_modules/coated-conductor-three/src/index.js"))
-    (root / "static.html").write_text(PAGE.replace("WAY", "static").replace("IMPORTMAP", import_map(THREE_MAP))
-                                      .replace("SCRIPT", "static.js"))
+    (root / "static.html").write_text(
+        PAGE.replace("WAY", "static").replace("IMPORTMAP", import_map(THREE_MAP)).replace("SCRIPT", "static.js")
+    )
     (root / "importmap.js").write_text(scene("coated-conductor-three"))
     entries = {**THREE_MAP, "coated-conductor-three": "./node_modules/coated-conductor-three/src/index.js"}
-    (root / "importmap.html").write_text(PAGE.replace("WAY", "importmap").replace("IMPORTMAP", import_map(entries))
-                                         .replace("SCRIPT", "importmap.js"))
-    done = subprocess.run([str(ESBUILD), "importmap.js", "--bundle", "--format=esm", "--log-level=warning",
-                           "--outfile=bundle.js"], cwd=root, capture_output=True, text=True, timeout=120)
+    (root / "importmap.html").write_text(
+        PAGE.replace("WAY", "importmap").replace("IMPORTMAP", import_map(entries)).replace("SCRIPT", "importmap.js")
+    )
+    done = subprocess.run(
+        [str(ESBUILD), "importmap.js", "--bundle", "--format=esm", "--log-level=warning", "--outfile=bundle.js"],
+        cwd=root,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert done.returncode == 0, done.stderr
-    (root / "bundler.html").write_text(PAGE.replace("WAY", "bundler").replace("IMPORTMAP", "")
-                                       .replace("SCRIPT", "bundle.js"))
+    (root / "bundler.html").write_text(
+        PAGE.replace("WAY", "bundler").replace("IMPORTMAP", "").replace("SCRIPT", "bundle.js")
+    )
     extension = json.loads(document)["materials"][0]["extensions"]["EXT_materials_coated_conductor"]
     return root, extension
 
@@ -198,15 +207,21 @@ def images(chromium, site, folder):
             page.set_default_timeout(TIMEOUT_MS)
             requests, errors = [], []
             page.on("request", lambda request, requests=requests: requests.append(request.url))
-            page.on("response", lambda r, errors=errors: errors.append(f"{r.status} {r.url}") if r.status != 200 else None)
+            page.on(
+                "response", lambda r, errors=errors: errors.append(f"{r.status} {r.url}") if r.status != 200 else None
+            )
             page.on("pageerror", lambda error, errors=errors: errors.append(f"uncaught: {error}"))
-            page.on("console", lambda m, errors=errors: errors.append(f"console: {m.text}") if m.type == "error" else None)
+            page.on(
+                "console", lambda m, errors=errors: errors.append(f"console: {m.text}") if m.type == "error" else None
+            )
             page.goto(f"{site}/{way}.html")
             page.wait_for_function("document.body.dataset.ready")
             drawn = {}
             for roughness, coat_roughness in SETTINGS:
-                flat = page.evaluate(f"(s) => {{ {F32_BASE64} return f32(window.cfDraw(s)); }}",
-                                     {"roughness": roughness, "clearcoatRoughness": coat_roughness})
+                flat = page.evaluate(
+                    f"(s) => {{ {F32_BASE64} return f32(window.cfDraw(s)); }}",
+                    {"roughness": roughness, "clearcoatRoughness": coat_roughness},
+                )
                 drawn[roughness, coat_roughness] = from_f32(flat).reshape(H, W, 4)[::-1]
             out[way] = drawn, requests, errors, page.evaluate("window.cfModel")
         finally:
@@ -224,8 +239,9 @@ def test_static_folder_fetches_nothing_else(images, site, folder):
     assert all((root / path.lstrip("/")).is_file() for path in paths), paths
     assert not [p for p in paths if p.startswith(("/glsl", "/api"))], paths
     # The package's own modules were loaded from the folder, the GLSL, kinds and LUT among them.
-    assert {f"/node_modules/coated-conductor-three/src/generated/{name}"
-            for name in ("lut.js", "glsl.js", "kinds.js")} <= set(paths)
+    assert {
+        f"/node_modules/coated-conductor-three/src/generated/{name}" for name in ("lut.js", "glsl.js", "kinds.js")
+    } <= set(paths)
 
 
 @pytest.mark.parametrize("way", ["importmap", "bundler"])
@@ -258,6 +274,11 @@ def test_the_image_is_the_fit_through_the_full_stack(images, folder):
 
 def test_types_check():
     """tsc --noEmit on the example: the API's types resolve through the package's exports and reject misuse."""
-    done = subprocess.run([str(TSC), "--noEmit", "-p", str(PACKAGE / "types-check")], cwd=PACKAGE,
-                          capture_output=True, text=True, timeout=300)
+    done = subprocess.run(
+        [str(TSC), "--noEmit", "-p", str(PACKAGE / "types-check")],
+        cwd=PACKAGE,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert done.returncode == 0, done.stdout + done.stderr

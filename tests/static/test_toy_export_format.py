@@ -56,8 +56,9 @@ def test_the_cli_writes_the_toy(tmp_path):
     import os
 
     out = tmp_path / "au.usda"
-    done = run_command("fitting", "fit", "Au", "--export", "usda", "--eta-i", "1.33", "-o", str(out),
-                       env={**os.environ, **PLUGIN})
+    done = run_command(
+        "fitting", "fit", "Au", "--export", "usda", "--eta-i", "1.33", "-o", str(out), env={**os.environ, **PLUGIN}
+    )
     assert done.returncode == 0, done.stderr[-500:]
     text = out.read_text()
     assert text.startswith("#usda 1.0") and "UsdPreviewSurface" in text and "eta_i 1.33" in text
@@ -70,8 +71,13 @@ def test_the_domain_lists_the_toy(toy_server):
         formats = http.get(f"{API}/domain").json()["export_formats"]
     names = [f["name"] for f in formats]
     assert names[:4] == ["mtlx", "openpbr", "blender", "gltf"] and names[-1] == "usda"
-    assert formats[-1] == {"name": "usda", "label": "USD preview surface (.usda)", "media_type": "model/vnd.usda",
-                           "extension": "usda", "options": ["eta_i", "roughness", "coat_roughness", "working_space"]}
+    assert formats[-1] == {
+        "name": "usda",
+        "label": "USD preview surface (.usda)",
+        "media_type": "model/vnd.usda",
+        "extension": "usda",
+        "options": ["eta_i", "roughness", "coat_roughness", "working_space"],
+    }
 
 
 def test_rest_and_packs_serve_the_toy(toy_server, gold):
@@ -86,11 +92,15 @@ def test_rest_and_packs_serve_the_toy(toy_server, gold):
         with zipfile.ZipFile(io.BytesIO(pack.content)) as archive:
             (name,) = archive.namelist()
             assert name == "Au-eta1.2.usda" and archive.read(name).startswith(b"#usda 1.0")
-        for bad in (http.get(f"{API}/fits/{gold}/pack", params={"format": "usdz"}),
-                    http.post(f"{API}/packs", json={"fit_ids": [gold], "format": "usdz"})):
+        for bad in (
+            http.get(f"{API}/fits/{gold}/pack", params={"format": "usdz"}),
+            http.post(f"{API}/packs", json={"fit_ids": [gold], "format": "usdz"}),
+        ):
             assert bad.status_code == 422
-            assert "`format` must be one of 'binary', 'json', 'glsl', 'hlsl', 'mtlx', 'openpbr', 'blender', 'gltf', 'glb', 'usda', got 'usdz'" \
+            assert (
+                "`format` must be one of 'binary', 'json', 'glsl', 'hlsl', 'mtlx', 'openpbr', 'blender', 'gltf', 'glb', 'usda', got 'usdz'"
                 in bad.text
+            )
 
 
 def test_the_editor_offers_and_downloads_the_toy(pages, live_server, gold):

@@ -79,8 +79,9 @@ def test_the_toy_is_registered_only_by_its_plugin():
 
 def test_the_cli_fits_the_toy(tmp_path):
     out = tmp_path / "au.bin"
-    done = run_command("fitting", "fit", "Au", "--model", TOY, "--no-metrics", "-o", str(out),
-                       env={**os.environ, **PLUGIN})
+    done = run_command(
+        "fitting", "fit", "Au", "--model", TOY, "--no-metrics", "-o", str(out), env={**os.environ, **PLUGIN}
+    )
     assert done.returncode == 0, done.stderr[-500:]
     refused = run_command("fitting", "fit", "Au", "--model", TOY)
     assert refused.returncode == 2 and f"invalid choice: '{TOY}'" in refused.stderr
@@ -114,7 +115,10 @@ def test_rest_and_packs_serve_the_toy(toy_server, gold):
         binary = http.post(f"{API}/packs", json={"fit_ids": [gold["id"]], "format": "binary"})
         assert binary.status_code == 200 and binary.content[:4] == b"CFPK", binary.content[:40]
         refused = http.post(f"{API}/fits", json={"material": "Au", "model": "toy-fresnel"})
-        assert refused.status_code == 422 and f"'coated-conductor', 'rgb-conductor', '{TOY}', got 'toy-fresnel'" in refused.text
+        assert (
+            refused.status_code == 422
+            and f"'coated-conductor', 'rgb-conductor', '{TOY}', got 'toy-fresnel'" in refused.text
+        )
 
 
 @pytest.fixture(scope="module")
@@ -123,8 +127,12 @@ def toy_curve_fit(live_server):
     mu = np.where(ANGLES == 90.0, 0.0, np.cos(np.radians(ANGLES)))
     rgb = curve_base_from_nk(library_material("Au")).rgb(mu, 1.5)
     rgb[:, 2] *= 1.1
-    body = {"name": "cool toy gold", "base": {"material": "Au"}, "model": TOY,
-            "curves": [{"eta_i": 1.5, "angle_deg": ANGLES.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}]}
+    body = {
+        "name": "cool toy gold",
+        "base": {"material": "Au"},
+        "model": TOY,
+        "curves": [{"eta_i": 1.5, "angle_deg": ANGLES.tolist(), "rgb": np.clip(rgb, 0, 1).tolist()}],
+    }
     response = loopback.post(f"{live_server}{API}/fits/from-curves", json=body, timeout=300)
     assert response.status_code == 201, response.text
     fit = response.json()
@@ -138,14 +146,18 @@ def test_the_editor_draws_the_toy(pages, live_server, toy_curve_fit):
     open_editor(page, live_server + "/")
     page.select_option("#material", f"saved:{fit['material_id']}")
     expect(page.locator("#fit-id")).to_have_text(fit["id"])
-    page.wait_for_function("!document.body.hasAttribute('aria-busy')"
-                           " && document.getElementById('preview').dataset.fit === document.getElementById('fit-id').textContent")
+    page.wait_for_function(
+        "!document.body.hasAttribute('aria-busy')"
+        " && document.getElementById('preview').dataset.fit === document.getElementById('fit-id').textContent"
+    )
     assert page.text_content("#coefficients").startswith(TOY)
     assert page.get_attribute("#preview", "data-model") == TOY
     assert page.get_attribute("#preview", "data-program") == "mirror"
     page.select_option("#environment", "white_sky")
     page.select_option("#compare", "none")
-    state = page.evaluate("(() => { const s = window.cfPreview.state; return {orbit: s.orbit, fov: s.fov, eta: s.eta}; })()")
+    state = page.evaluate(
+        "(() => { const s = window.cfPreview.state; return {orbit: s.orbit, fov: s.fov, eta: s.eta}; })()"
+    )
     geometry, fresnel = read_float(page, "geometry", W, H), read_float(page, "fresnel", W, H)
     NdotV, hit, _, _ = camera_rays(*state["orbit"], state["fov"], W, H)
     model = (geometry[..., 1] > 0.5) & (geometry[..., 2] == 0)

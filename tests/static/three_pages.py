@@ -64,7 +64,11 @@ from fitting.models.kinds import model_kind
 from fitting.optics.coated_stack import refracted_cos
 from fitting.optics.fresnel import fresnel_dielectric
 from fitting.shading.coated_layer import (
-    escape_fraction, hemispherical_albedo, internal_reflectance, seen_base, through_coat,
+    escape_fraction,
+    hemispherical_albedo,
+    internal_reflectance,
+    seen_base,
+    through_coat,
 )
 from fitting.shading.ibl import split_sum_schlick
 from preview_shaders.display import ACEScg_to_sRGB_matrix
@@ -164,12 +168,15 @@ def set_environment(page, env: str) -> None:
         page.evaluate("(env) => window.cfThree.setEnvironment(env)", env)
 
 
-def preview_ACEScg(page, fit: dict, eta_i: float, roughness: float, coat_roughness: float,
-                   env: str = "white_sky") -> np.ndarray:
+def preview_ACEScg(
+    page, fit: dict, eta_i: float, roughness: float, coat_roughness: float, env: str = "white_sky"
+) -> np.ndarray:
     """(H, W, 3) linear ACEScg of the editor's preview (static/preview.js) at the same settings (one ball a page)."""
     flat = page.evaluate(
         """async ([fit, eta, roughness, coatRoughness, env, orbit, fov, w, h]) => {
-            """ + F32_BASE64 + """
+            """
+        + F32_BASE64
+        + """
             const { ShaderBall, OUTPUT, ENVIRONMENT } = await import('/preview.js');
             if (!window.cfParityBall) {
                 const canvas = document.createElement('canvas');
@@ -220,7 +227,9 @@ def preview_lit_in_rec709(page, NdotV: np.ndarray, fit: dict, eta_i: float, roug
     """
     flat = page.evaluate(
         """async ([w, h]) => {
-            """ + F32_BASE64 + """
+            """
+        + F32_BASE64
+        + """
             const { OUTPUT } = await import('/preview.js');
             const ball = await window.cfParityBall;
             return ['fresnel', 'baseLight', 'coatLight', 'coat'].map((o) => f32(ball.readFloat(OUTPUT[o], w, h)));
@@ -245,8 +254,11 @@ def coated_albedo(metal_fresnel, eta_i: float, roughness: float, coat_roughness:
     """
     mu = _NODES
     F0c = ((eta_i - 1.0) / (eta_i + 1.0)) ** 2
-    coat = (fresnel_dielectric(mu, 1.0, eta_i)[:, None] if coat_roughness == 0
-            else split_sum_schlick(mu, coat_roughness, np.full(3, F0c)))
+    coat = (
+        fresnel_dielectric(mu, 1.0, eta_i)[:, None]
+        if coat_roughness == 0
+        else split_sum_schlick(mu, coat_roughness, np.full(3, F0c))
+    )
     return coat + seen_base(mu, eta_i, roughness, metal_fresnel)
 
 
@@ -266,13 +278,17 @@ def per_pixel(nodes_rgb: np.ndarray, NdotV: np.ndarray) -> np.ndarray:
 def _stats(dE: np.ndarray, NdotV: np.ndarray, region: np.ndarray) -> dict:
     centre, ring = region & (NdotV >= CENTRE), region & (NdotV >= RING[0]) & (NdotV <= RING[1])
     return {
-        "mean": float(dE[region].mean()), "p99": float(np.percentile(dE[region], 99)),
-        "max": float(dE[region].max()), "centre": float(dE[centre].mean()), "ring": float(dE[ring].mean()),
+        "mean": float(dE[region].mean()),
+        "p99": float(np.percentile(dE[region], 99)),
+        "max": float(dE[region].max()),
+        "centre": float(dE[centre].mean()),
+        "ring": float(dE[ring].mean()),
     }
 
 
-def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: float,
-                  coat_roughness: float, env: str = "white_sky") -> dict:
+def measure_three(
+    page, server: str, nk, fit: dict, eta_i: float, roughness: float, coat_roughness: float, env: str = "white_sky"
+) -> dict:
     """
     Delta E 2000 figures ({mean, p99, max, centre, ring} each) of the
     three.js ball through the plugin under ``env`` against the editor's
@@ -292,9 +308,12 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
     if env != "white_sky":  # the preview alone, as it draws and lit in three's working space
         region = hit & three_mask & (NdotV >= NDOTV_MIN)
         in_rec709 = preview_lit_in_rec709(page, NdotV, fit, eta_i, roughness)
-        return {"pixels": int(region.sum()), "preview": _stats(delta_E_map(preview, three), NdotV, region),
-                "preview_rec709": _stats(delta_E_map(in_rec709, three), NdotV, region),
-                "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist()}
+        return {
+            "pixels": int(region.sum()),
+            "preview": _stats(delta_E_map(preview, three), NdotV, region),
+            "preview_rec709": _stats(delta_E_map(in_rec709, three), NdotV, region),
+            "centre_rgb": three[region & (NdotV >= CENTRE)].mean(axis=0).tolist(),
+        }
     fallback, fallback_mask = three_ACEScg(page, "fallback", roughness, coat_roughness)
     region = hit & three_mask & fallback_mask & (NdotV >= NDOTV_MIN)
     figures = {
@@ -307,9 +326,15 @@ def measure_three(page, server: str, nk, fit: dict, eta_i: float, roughness: flo
     # The 1 nm reference through its product-grid kernel (one eta_i, every cosine the quadrature
     # asks for), which is reference_ACEScg to 1.3e-13 per channel (tests/fitting/colour/
     # test_reference_grid.py) at about an eighth of the cost.
-    physics = per_pixel(coated_albedo(
-        lambda c: reference_ACEScg_grid(nk, np.asarray(c).reshape(-1), [eta_i])[0].reshape(np.shape(c) + (3,)),
-        eta_i, roughness, coat_roughness), NdotV)
+    physics = per_pixel(
+        coated_albedo(
+            lambda c: reference_ACEScg_grid(nk, np.asarray(c).reshape(-1), [eta_i])[0].reshape(np.shape(c) + (3,)),
+            eta_i,
+            roughness,
+            coat_roughness,
+        ),
+        NdotV,
+    )
     figures["physics"] = _stats(delta_E_map(physics, three), NdotV, region)
     figures["fallback"] = _stats(delta_E_map(physics, fallback), NdotV, region)
     composed = per_pixel(coated_albedo(fit_fresnel(fit, eta_i), eta_i, roughness, coat_roughness), NdotV)

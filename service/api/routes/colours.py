@@ -28,5 +28,8 @@ async def post_colour_curves(request: ColourCurvesRequest) -> ColourCurves:
     from a medium of index `seen_at` (1: in air), with its per-channel
     index in air and whether each channel's tint was reachable.
     """
-    return ColourCurves(**await run_in_threadpool(
-        colour_curves, request.f0, request.f82, request.space, request.seen_at, request.eta_i, request.samples))
+    return ColourCurves(
+        **await run_in_threadpool(
+            colour_curves, request.f0, request.f82, request.space, request.seen_at, request.eta_i, request.samples
+        )
+    )

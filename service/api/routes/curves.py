@@ -23,8 +23,18 @@ from ...jobs.common import stored_fit
 from ...jobs.curves import error_map, fit_from_curves, prepare_curve_fit
 from ...jobs.nk import angle_curves
 from ...schemas import API_PREFIX, ETA_I_LIMITS, CurveFitPublic, CurveFitRequest, CurvesPublic, ErrorMap, fit_public
-from ..deps import (CONFLICT, ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, FitIdPath, RunnerDep, SaveRateDep,
-                    StoreDep, WriteAccess, note_save)
+from ..deps import (
+    CONFLICT,
+    ERROR_RESPONSES,
+    FIT_ERROR_RESPONSES,
+    NOT_FOUND,
+    FitIdPath,
+    RunnerDep,
+    SaveRateDep,
+    StoreDep,
+    WriteAccess,
+    note_save,
+)
 
 router = APIRouter(prefix=API_PREFIX, tags=["curves"])
 
@@ -32,17 +42,34 @@ KEEP_BASE_MARGIN_S = 60.0
 """A save on a draft base keeps it for the fit's time limit and this much more."""
 
 
-@router.post("/fits/from-curves", response_model=CurveFitPublic, status_code=status.HTTP_201_CREATED,
-             responses={
-                 status.HTTP_200_OK: {"model": CurveFitPublic, "description": "Served from the store"},
-                 status.HTTP_201_CREATED: {"model": CurveFitPublic, "description": "Fitted and saved"},
-                 **NOT_FOUND, **FIT_ERROR_RESPONSES, **CONFLICT,
-             }, dependencies=[WriteAccess])
+@router.post(
+    "/fits/from-curves",
+    response_model=CurveFitPublic,
+    status_code=status.HTTP_201_CREATED,
+    responses={
+        status.HTTP_200_OK: {"model": CurveFitPublic, "description": "Served from the store"},
+        status.HTTP_201_CREATED: {"model": CurveFitPublic, "description": "Fitted and saved"},
+        **NOT_FOUND,
+        **FIT_ERROR_RESPONSES,
+        **CONFLICT,
+    },
+    dependencies=[WriteAccess],
+)
 async def create_fit_from_curves(
-    request: CurveFitRequest, store: StoreDep, runner: RunnerDep, response: Response, rate: SaveRateDep,
-    curves_eta_i: Annotated[float | None, Query(
-        ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-        description="Also answer `GET /fits/{id}/curves` of the fit at this coating index")] = None,
+    request: CurveFitRequest,
+    store: StoreDep,
+    runner: RunnerDep,
+    response: Response,
+    rate: SaveRateDep,
+    curves_eta_i: Annotated[
+        float | None,
+        Query(
+            ge=ETA_I_LIMITS[0],
+            le=ETA_I_LIMITS[1],
+            allow_inf_nan=False,
+            description="Also answer `GET /fits/{id}/curves` of the fit at this coating index",
+        ),
+    ] = None,
     curves_samples: Annotated[int, Query(ge=2, le=1024, description="Angles of `curves`")] = 91,
 ) -> CurveFitPublic:
     """
@@ -56,22 +83,31 @@ async def create_fit_from_curves(
     base = request.base
     fit = await run_in_threadpool(
         lambda: prepare_curve_fit(
-            store, request.name, [c.as_dict() for c in request.curves],
-            base_material=base.material if base else None, base_fit=base.fit if base else None,
+            store,
+            request.name,
+            [c.as_dict() for c in request.curves],
+            base_material=base.material if base else None,
+            base_fit=base.fit if base else None,
             base_nk=base.nk.arrays() if base and base.nk else None,
-            eta_i_range=request.eta_i_range, objective=request.objective,
+            eta_i_range=request.eta_i_range,
+            objective=request.objective,
             blend_width=request.blend_width,
-            request=request.model_dump(mode="json", exclude={"base", "draft", "live", "start_fit", "expected_version"}), draft=request.draft,
-            model=request.model, live=request.live, start_fit=request.start_fit,
+            request=request.model_dump(mode="json", exclude={"base", "draft", "live", "start_fit", "expected_version"}),
+            draft=request.draft,
+            model=request.model,
+            live=request.live,
+            start_fit=request.start_fit,
             material_id=request.material_id,
-        ))
+        )
+    )
     if not request.draft:  # a save: counted against its client's saves per minute (429), unless a repeat
         await note_save(rate, store, fit.material_id, fit.fit_id, fit.name)
     if not request.draft and fit.base_record is not None:
         # A draft base outlives this save's fit (its waits and its run), however short its time to live;
         # once saved, the save keeps it (a saved fit's base never expires).
-        await run_in_threadpool(store.keep_draft, fit.base_record.id,
-                                time.time() + runner.timeout_s + KEEP_BASE_MARGIN_S)
+        await run_in_threadpool(
+            store.keep_draft, fit.base_record.id, time.time() + runner.timeout_s + KEEP_BASE_MARGIN_S
+        )
     record, created, restored = await fit_from_curves(fit, store, runner, request.expected_version)
     response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
     response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
@@ -83,7 +119,8 @@ async def create_fit_from_curves(
 
 @router.get("/fits/{fit_id}/error-map", response_model=ErrorMap, responses={**ERROR_RESPONSES, **NOT_FOUND})
 async def get_error_map(
-    fit_id: FitIdPath, store: StoreDep,
+    fit_id: FitIdPath,
+    store: StoreDep,
     angles: Annotated[int, Query(ge=2, le=181, description="Angles evenly from 0 to 90 degrees")] = 46,
     rows: Annotated[int, Query(ge=1, le=101, description="eta_i values evenly over the domain")] = 31,
 ) -> ErrorMap:

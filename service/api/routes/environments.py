@@ -44,13 +44,19 @@ __all__ = ["router"]
     "/environments/{environment}/prefiltered",
     response_class=Response,
     responses={
-        status.HTTP_200_OK: {"content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}},
-                             "description": "float32 RGB [slice][row][column][channel]"},
+        status.HTTP_200_OK: {
+            "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}},
+            "description": "float32 RGB [slice][row][column][channel]",
+        },
         **ERROR_RESPONSES,
-        status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody, "description": (
-            "No GL on this machine, or too many textures waiting for the render pool (Retry-After)")},
-        status.HTTP_504_GATEWAY_TIMEOUT: {"model": ErrorBody, "description": (
-            "Not ready within COATED_PREVIEW_TIMEOUT_S (Retry-After)")},
+        status.HTTP_503_SERVICE_UNAVAILABLE: {
+            "model": ErrorBody,
+            "description": ("No GL on this machine, or too many textures waiting for the render pool (Retry-After)"),
+        },
+        status.HTTP_504_GATEWAY_TIMEOUT: {
+            "model": ErrorBody,
+            "description": ("Not ready within COATED_PREVIEW_TIMEOUT_S (Retry-After)"),
+        },
     },
 )
 async def get_prefiltered_environment(

@@ -26,13 +26,40 @@ from ...jobs.evaluation import ensure_metrics
 from ...jobs.edge_tint import fit_from_colours
 from ...jobs.nk import NKFit, angle_curves, fit_nk
 from ...jobs.uploads import check_coverage
-from ...schemas import (API_PREFIX, DEFAULT_ETA_I_RANGE, DEFAULT_MODEL, DEFAULT_OBJECTIVE, ETA_I_LIMITS,
-                        CurvesPublic, DownloadFormat, FitPublic, FitRequest, ModelKind, Objective, fit_public)
+from ...schemas import (
+    API_PREFIX,
+    DEFAULT_ETA_I_RANGE,
+    DEFAULT_MODEL,
+    DEFAULT_OBJECTIVE,
+    ETA_I_LIMITS,
+    CurvesPublic,
+    DownloadFormat,
+    FitPublic,
+    FitRequest,
+    ModelKind,
+    Objective,
+    fit_public,
+)
 from ...runtime import CLAIM
 from ...store import FitRecord
-from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, CoatRoughnessQuery, FitIdPath,
-                    MetricsQuery, MinCoverageForm, RoughnessQuery, WorkingSpaceQuery, RunnerDep, SettingsDep,
-                    SingleFormFields, SaveRateDep, StoreDep, WriteAccess, note_save)
+from ..deps import (
+    ERROR_RESPONSES,
+    FIT_ERROR_RESPONSES,
+    NOT_FOUND,
+    CoatRoughnessQuery,
+    FitIdPath,
+    MetricsQuery,
+    MinCoverageForm,
+    RoughnessQuery,
+    WorkingSpaceQuery,
+    RunnerDep,
+    SettingsDep,
+    SingleFormFields,
+    SaveRateDep,
+    StoreDep,
+    WriteAccess,
+    note_save,
+)
 
 router = APIRouter(prefix=f"{API_PREFIX}/fits", tags=["fits"])
 
@@ -50,11 +77,23 @@ def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPubli
     return fit_public(record)
 
 
-@router.post("", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
-             responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess])
-async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, settings: SettingsDep,
-                     response: Response, http: Request, rate: SaveRateDep, metrics: MetricsQuery = "solve",
-                     ) -> FitPublic:
+@router.post(
+    "",
+    response_model=FitPublic,
+    status_code=status.HTTP_201_CREATED,
+    responses={**CREATED, **FIT_ERROR_RESPONSES},
+    dependencies=[WriteAccess],
+)
+async def create_fit(
+    request: FitRequest,
+    store: StoreDep,
+    runner: RunnerDep,
+    settings: SettingsDep,
+    response: Response,
+    http: Request,
+    rate: SaveRateDep,
+    metrics: MetricsQuery = "solve",
+) -> FitPublic:
     """
     Fit a built-in material (``{"material": "Au"}``), inline n, k (``{"name": ..., "nk": {"wavelength_nm",
     "n", "k"}}``) or F0 and F82 tint (``{"name", "f0", "f82", "space"}``: an ``rgb-conductor``) over
@@ -67,23 +106,47 @@ async def create_fit(request: FitRequest, store: StoreDep, runner: RunnerDep, se
         return fit_answer(*await fit_from_colours(store, request), response)
     runner.check_capacity()
     if request.material is not None:
-        fit = await run_in_threadpool(NKFit.library, request.material, request.eta_i_range,
-                                      request.objective, settings.metrics_samples, request.model)
+        fit = await run_in_threadpool(
+            NKFit.library,
+            request.material,
+            request.eta_i_range,
+            request.objective,
+            settings.metrics_samples,
+            request.model,
+        )
     else:
         fit = await run_in_threadpool(
-            NKFit.data, (request.name or "uploaded").strip(), request.source, *request.nk.arrays(),
-            request.eta_i_range, request.objective, settings.metrics_samples, request.model)
+            NKFit.data,
+            (request.name or "uploaded").strip(),
+            request.source,
+            *request.nk.arrays(),
+            request.eta_i_range,
+            request.objective,
+            settings.metrics_samples,
+            request.model,
+        )
     await note_save(rate, store, fit.material_id, fit.fit_id, fit.name)  # a repeat: not counted
     return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
 
 
-@router.post("/upload", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
-             responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess, SingleFormFields])
+@router.post(
+    "/upload",
+    response_model=FitPublic,
+    status_code=status.HTTP_201_CREATED,
+    responses={**CREATED, **FIT_ERROR_RESPONSES},
+    dependencies=[WriteAccess, SingleFormFields],
+)
 async def upload_fit(
     file: Annotated[UploadFile, File(description="n, k as CSV, JSON or refractiveindex.info YAML")],
-    store: StoreDep, runner: RunnerDep, settings: SettingsDep, response: Response, http: Request, rate: SaveRateDep,
-    format: Annotated[str | None, Form(pattern=r"^(csv|json|yaml|yml)$",
-                                       description="Default: from the file name")] = None,
+    store: StoreDep,
+    runner: RunnerDep,
+    settings: SettingsDep,
+    response: Response,
+    http: Request,
+    rate: SaveRateDep,
+    format: Annotated[
+        str | None, Form(pattern=r"^(csv|json|yaml|yml)$", description="Default: from the file name")
+    ] = None,
     name: Annotated[str | None, Form(min_length=1, max_length=200, pattern=r"\S")] = None,
     eta_i_min: EtaForm = DEFAULT_ETA_I_RANGE[0],
     eta_i_max: EtaForm = DEFAULT_ETA_I_RANGE[1],
@@ -98,8 +161,17 @@ async def upload_fit(
     """
     runner.check_capacity()
     data = await file.read()
-    fit = await run_in_threadpool(NKFit.upload, data, file.filename or "", format, name,
-                                  (eta_i_min, eta_i_max), objective, settings.metrics_samples, model)
+    fit = await run_in_threadpool(
+        NKFit.upload,
+        data,
+        file.filename or "",
+        format,
+        name,
+        (eta_i_min, eta_i_max),
+        objective,
+        settings.metrics_samples,
+        model,
+    )
     check_coverage(fit.nk, min_coverage)
     await note_save(rate, store, fit.material_id, fit.fit_id, fit.name)
     return fit_answer(*await fit_nk(fit, store, runner, http.app.state.evaluations, metrics == "full"), response)
@@ -112,18 +184,35 @@ async def get_fit(fit_id: FitIdPath, store: StoreDep, runner: RunnerDep) -> FitP
     return fit_public(await ensure_metrics(record, store, runner))
 
 
-@router.get("/{fit_id}/pack", response_class=Response, responses={
-    status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The download"},
-    **NOT_FOUND, **FIT_ERROR_RESPONSES,
-})
+@router.get(
+    "/{fit_id}/pack",
+    response_class=Response,
+    responses={
+        status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The download"},
+        **NOT_FOUND,
+        **FIT_ERROR_RESPONSES,
+    },
+)
 async def get_pack(
-    fit_id: FitIdPath, store: StoreDep, runner: RunnerDep, http: Request,
-    format: Annotated[DownloadFormat, Query(
-        description="binary | json | glsl | hlsl, or an export format (`GET /api/v1/domain`: `export_formats`)")] = "binary",
-    eta_i: Annotated[float, Query(
-        ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-        description="Coating index of an export, [1, 3]")] = 1.5,
-    roughness: RoughnessQuery = 0.2, coat_roughness: CoatRoughnessQuery = 0.03,
+    fit_id: FitIdPath,
+    store: StoreDep,
+    runner: RunnerDep,
+    http: Request,
+    format: Annotated[
+        DownloadFormat,
+        Query(description="binary | json | glsl | hlsl, or an export format (`GET /api/v1/domain`: `export_formats`)"),
+    ] = "binary",
+    eta_i: Annotated[
+        float,
+        Query(
+            ge=ETA_I_LIMITS[0],
+            le=ETA_I_LIMITS[1],
+            allow_inf_nan=False,
+            description="Coating index of an export, [1, 3]",
+        ),
+    ] = 1.5,
+    roughness: RoughnessQuery = 0.2,
+    coat_roughness: CoatRoughnessQuery = 0.03,
     working_space: WorkingSpaceQuery = "lin_rec709",
 ) -> Response:
     """
@@ -137,8 +226,9 @@ async def get_pack(
     suffix), named ``<name>-<id>-eta1.5-rough0.2-coat0.03.<suffix>``.
     """
     if is_export(format):
-        return await export_download(http.app.state.derived, store, runner, fit_id, format, eta_i, roughness,
-                                     coat_roughness, working_space)
+        return await export_download(
+            http.app.state.derived, store, runner, fit_id, format, eta_i, roughness, coat_roughness, working_space
+        )
     record = await run_in_threadpool(stored_fit, store, fit_id)  # after the query is validated: 422 before 404
     if format != "binary":  # the JSON and the snippets quote the figures
         record = await ensure_metrics(record, store, runner)
@@ -147,9 +237,11 @@ async def get_pack(
 
 @router.get("/{fit_id}/curves", response_model=CurvesPublic, responses={**ERROR_RESPONSES, **NOT_FOUND})
 def get_curves(
-    fit_id: FitIdPath, store: StoreDep,
-    eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-                                  description="Coating index")] = 1.5,
+    fit_id: FitIdPath,
+    store: StoreDep,
+    eta_i: Annotated[
+        float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False, description="Coating index")
+    ] = 1.5,
     samples: Annotated[int, Query(ge=2, le=1024, description="Angles from 0 to 90 degrees")] = 91,
 ) -> CurvesPublic:
     """

@@ -59,8 +59,7 @@ def _probe(store: Store) -> tuple[str | None, dict]:
     return store.writable(), store.describe()
 
 
-@router.get("/healthz", response_model=Health,
-            responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
+@router.get("/healthz", response_model=Health, responses={status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody}})
 async def healthz(request: Request, store: StoreDep, runner: RunnerDep, previews: PreviewsDep) -> Health:
     """Readiness: the store answers, a new client's connection would be served; whether a save can be written."""
     connections = getattr(request.app.state, "connections", None)  # set by the server (none in-process)
@@ -69,33 +68,56 @@ async def healthz(request: Request, store: StoreDep, runner: RunnerDep, previews
         raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, f"not ready: {held}", headers={"Retry-After": "2"})
     if runner.cannot_start is not None:  # no fit could run: tried again in the background, 200 once it starts
         runner.retry_start()
-        raise HTTPException(status.HTTP_503_SERVICE_UNAVAILABLE, f"not ready: {runner.cannot_start}",
-                            headers={"Retry-After": "2"})
+        raise HTTPException(
+            status.HTTP_503_SERVICE_UNAVAILABLE, f"not ready: {runner.cannot_start}", headers={"Retry-After": "2"}
+        )
     problem, described = await asyncio.get_running_loop().run_in_executor(_PROBE_THREAD, _probe, store)
     return Health(
-        status="ok", fits_in_flight=runner.in_flight, fit_workers=runner.workers,
-        max_in_flight=runner.max_in_flight, store_writable=problem is None, store_problem=problem,
-        pool_restarts=runner.restarts, previews_in_flight=previews.previews_in_flight, store=described,
+        status="ok",
+        fits_in_flight=runner.in_flight,
+        fit_workers=runner.workers,
+        max_in_flight=runner.max_in_flight,
+        store_writable=problem is None,
+        store_problem=problem,
+        pool_restarts=runner.restarts,
+        previews_in_flight=previews.previews_in_flight,
+        store=described,
     )
 
 
 def describe_model_kinds() -> list[ModelKindPublic]:
     """Every registered model kind as the browser draws it (its preview's GLSL generated from the registry)."""
-    return [ModelKindPublic(name=kind.name, description=kind.description, parameters=list(kind.parameters),
-                            max_degree=kind.max_degree, split_sum=kind.split_sum, live_solver=kind.live_solver,
-                            glsl=preview_model_source(kind, inline=True))
-            for kind in MODEL_KINDS.values()]
+    return [
+        ModelKindPublic(
+            name=kind.name,
+            description=kind.description,
+            parameters=list(kind.parameters),
+            max_degree=kind.max_degree,
+            split_sum=kind.split_sum,
+            live_solver=kind.live_solver,
+            glsl=preview_model_source(kind, inline=True),
+        )
+        for kind in MODEL_KINDS.values()
+    ]
 
 
 def current_domain() -> Domain:
     """The rules and defaults, with the export formats and model kinds registered now (a plugin's among them)."""
     return Domain(
-        eta_i_limits=list(ETA_I_LIMITS), default_eta_i_range=list(DEFAULT_ETA_I_RANGE),
-        objectives=list(OBJECTIVES), default_objective=DEFAULT_OBJECTIVE, library=list(LIBRARY_NAMES),
-        pack_formats=list(PACK_FORMATS), export_formats=describe_export_formats(),
-        model_kinds=describe_model_kinds(), default_model=DEFAULT_MODEL,
-        curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES], max_curves=CURVE_MAX_COUNT,
-        max_nk_samples=MAX_NK_SAMPLES, visible_range_nm=list(VISIBLE_RANGE_NM), min_coverage=DEFAULT_MIN_COVERAGE,
+        eta_i_limits=list(ETA_I_LIMITS),
+        default_eta_i_range=list(DEFAULT_ETA_I_RANGE),
+        objectives=list(OBJECTIVES),
+        default_objective=DEFAULT_OBJECTIVE,
+        library=list(LIBRARY_NAMES),
+        pack_formats=list(PACK_FORMATS),
+        export_formats=describe_export_formats(),
+        model_kinds=describe_model_kinds(),
+        default_model=DEFAULT_MODEL,
+        curve_samples=[CURVE_MIN_SAMPLES, CURVE_MAX_SAMPLES],
+        max_curves=CURVE_MAX_COUNT,
+        max_nk_samples=MAX_NK_SAMPLES,
+        visible_range_nm=list(VISIBLE_RANGE_NM),
+        min_coverage=DEFAULT_MIN_COVERAGE,
     )
 
 

@@ -35,7 +35,7 @@ router = APIRouter(prefix=API_PREFIX, tags=["downloads"])
 def ibl_lut() -> Response:
     """The split-sum LUT of the model for image-based lighting, as a file."""
     return Response(
-        ibl_lut_file(), media_type="application/octet-stream",
-        headers={"Content-Disposition": f'attachment; filename="{IBL_LUT_FILENAME}"',
-                 "Cache-Control": "max-age=86400"},
+        ibl_lut_file(),
+        media_type="application/octet-stream",
+        headers={"Content-Disposition": f'attachment; filename="{IBL_LUT_FILENAME}"', "Cache-Control": "max-age=86400"},
     )

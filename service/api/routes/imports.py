@@ -26,13 +26,25 @@ CREATED = {
 }
 
 
-@router.post("/import", response_model=FitPublic, status_code=status.HTTP_201_CREATED,
-             responses={**CREATED, **FIT_ERROR_RESPONSES}, dependencies=[WriteAccess, SingleFormFields])
+@router.post(
+    "/import",
+    response_model=FitPublic,
+    status_code=status.HTTP_201_CREATED,
+    responses={**CREATED, **FIT_ERROR_RESPONSES},
+    dependencies=[WriteAccess, SingleFormFields],
+)
 async def import_fit_file(
-    file: Annotated[UploadFile, File(description=(
-        "A binary pack, its JSON view, or an export of this service: .gltf, .glb, .mtlx, "
-        ".openpbr.mtlx, Blender .py"))],
-    store: StoreDep, response: Response,
+    file: Annotated[
+        UploadFile,
+        File(
+            description=(
+                "A binary pack, its JSON view, or an export of this service: .gltf, .glb, .mtlx, "
+                ".openpbr.mtlx, Blender .py"
+            )
+        ),
+    ],
+    store: StoreDep,
+    response: Response,
 ) -> FitPublic:
     """
     Read a pack or an export back to its fit (docs/exports.md): checked

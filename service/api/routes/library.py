@@ -28,11 +28,19 @@ router = APIRouter(prefix=API_PREFIX, tags=["library"])
 
 @router.get("/library", response_model=LibraryList, responses=ERROR_RESPONSES)
 async def get_library(
-    eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False,
-                                  description="Coating index of the swatches")] = 1.5,
-    q: Annotated[str | None, Query(min_length=1, max_length=200,
-                                   description="Words each in the name, symbol, category or page "
-                                               "description (case-insensitive); best matches first")] = None,
+    eta_i: Annotated[
+        float,
+        Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False, description="Coating index of the swatches"),
+    ] = 1.5,
+    q: Annotated[
+        str | None,
+        Query(
+            min_length=1,
+            max_length=200,
+            description="Words each in the name, symbol, category or page "
+            "description (case-insensitive); best matches first",
+        ),
+    ] = None,
     limit: Annotated[int | None, Query(ge=1, le=1000, description="At most this many (default all)")] = None,
 ) -> LibraryList:
     """The library's conductors: names, symbols, sources, ranges, swatches under the coat at `eta_i`."""

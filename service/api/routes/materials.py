@@ -33,37 +33,63 @@ from fitting.optics.catalogue import catalogue, search_catalogue
 from ...jobs.common import with_measured_nk
 from ...jobs.library import library_about
 from ...jobs.materials import share_url as _share
-from ...schemas import (API_PREFIX, INT64_MAX, LISTING_KINDS, ErrorBody, MaterialDetail, MaterialList, MaterialRename,
-                        MaterialSummary, fit_public)
+from ...schemas import (
+    API_PREFIX,
+    INT64_MAX,
+    LISTING_KINDS,
+    ErrorBody,
+    MaterialDetail,
+    MaterialList,
+    MaterialRename,
+    MaterialSummary,
+    fit_public,
+)
 from ...store import MaterialRow
-from ..deps import (ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdPath, SettingsDep, StoreDep,
-                    WriteAccess)
+from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdPath, SettingsDep, StoreDep, WriteAccess
 
 router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
-WRITE_RESPONSES = {**FIT_ERROR_RESPONSES, **NOT_FOUND,
-                   409: {"model": ErrorBody, "description": "Another saved edited material is called `name`"}}
+WRITE_RESPONSES = {
+    **FIT_ERROR_RESPONSES,
+    **NOT_FOUND,
+    409: {"model": ErrorBody, "description": "Another saved edited material is called `name`"},
+}
 
 
 def _summary(row: MaterialRow) -> MaterialSummary:
-    return MaterialSummary(id=row.material_id, name=row.name, kind=row.kind, source=row.source,
-                           coverage=row.coverage, latest_fit_id=row.latest_fit_id, version=row.version,
-                           deleted_at=row.deleted_at, share_url=_share(row.material_id))
+    return MaterialSummary(
+        id=row.material_id,
+        name=row.name,
+        kind=row.kind,
+        source=row.source,
+        coverage=row.coverage,
+        latest_fit_id=row.latest_fit_id,
+        version=row.version,
+        deleted_at=row.deleted_at,
+        share_url=_share(row.material_id),
+    )
 
 
 @router.get("/materials", response_model=MaterialList, responses=ERROR_RESPONSES)
 def list_materials(
-    store: StoreDep, settings: SettingsDep,
-    limit: Annotated[int | None, Query(ge=1, le=INT64_MAX, description="Saved materials per page "
-                                       "(default and most: COATED_MATERIALS_PAGE_MAX)")] = None,
-    cursor: Annotated[int | None, Query(ge=0, le=INT64_MAX,
-                                        description="`next_cursor` of the previous page")] = None,
-    kind: Annotated[list[str] | None, Query(
-        description="library | curves (saved edits) | nk (n, k uploads); repeat for several; "
-                    "default library and curves")] = None,
-    q: Annotated[str | None, Query(min_length=1, max_length=200,
-                                   description="Only names, symbols or sources holding it "
-                                               "(case-insensitive)")] = None,
+    store: StoreDep,
+    settings: SettingsDep,
+    limit: Annotated[
+        int | None,
+        Query(ge=1, le=INT64_MAX, description="Saved materials per page (default and most: COATED_MATERIALS_PAGE_MAX)"),
+    ] = None,
+    cursor: Annotated[int | None, Query(ge=0, le=INT64_MAX, description="`next_cursor` of the previous page")] = None,
+    kind: Annotated[
+        list[str] | None,
+        Query(
+            description="library | curves (saved edits) | nk (n, k uploads); repeat for several; "
+            "default library and curves"
+        ),
+    ] = None,
+    q: Annotated[
+        str | None,
+        Query(min_length=1, max_length=200, description="Only names, symbols or sources holding it (case-insensitive)"),
+    ] = None,
     deleted: Annotated[bool, Query(description="List the bin (deleted materials) instead")] = False,
 ) -> MaterialList:
     """The library's conductors (first page), then the saved materials of `kind`, oldest first."""
@@ -78,10 +104,17 @@ def list_materials(
         latest = store.latest_fit_ids(listed)
         for material_id in listed:
             about = library_about(material_id)
-            materials.append(MaterialSummary(id=material_id, name=f"{about['name']} ({about['symbol']})",
-                                             kind="library", source=about["source"],
-                                             coverage=about["coverage"], latest_fit_id=latest.get(material_id),
-                                             share_url=_share(material_id)))
+            materials.append(
+                MaterialSummary(
+                    id=material_id,
+                    name=f"{about['name']} ({about['symbol']})",
+                    kind="library",
+                    source=about["source"],
+                    coverage=about["coverage"],
+                    latest_fit_id=latest.get(material_id),
+                    share_url=_share(material_id),
+                )
+            )
     saved_kinds = tuple(k for k in kinds if k != "library")
     if not saved_kinds:
         return MaterialList(materials=materials)
@@ -90,17 +123,21 @@ def list_materials(
     return MaterialList(materials=materials, next_cursor=page.next_cursor, skipped=page.skipped)
 
 
-@router.get("/materials/{material_id}", response_model=MaterialDetail,
-            responses={**ERROR_RESPONSES, **NOT_FOUND})
+@router.get("/materials/{material_id}", response_model=MaterialDetail, responses={**ERROR_RESPONSES, **NOT_FOUND})
 def get_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialDetail:
     """One material with its latest fit (None for a library material not fitted yet); one in the bin too."""
     latest = with_measured_nk(store, store.latest_fit(material_id))
     if material_id in catalogue():
         about = library_about(material_id)
         return MaterialDetail(
-            id=material_id, name=f"{about['name']} ({about['symbol']})", kind="library", source=about["source"],
-            coverage=about["coverage"], latest_fit_id=latest.id if latest else None,
-            version=store.material_version(material_id), share_url=_share(material_id),
+            id=material_id,
+            name=f"{about['name']} ({about['symbol']})",
+            kind="library",
+            source=about["source"],
+            coverage=about["coverage"],
+            latest_fit_id=latest.id if latest else None,
+            version=store.material_version(material_id),
+            share_url=_share(material_id),
             wavelength_range_nm=about["wavelength_range_nm"],
             latest_fit=fit_public(latest) if latest else None,
         )
@@ -110,12 +147,12 @@ def get_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialDetail
     wavelength_range = None
     if latest.nk is not None:
         wavelength_range = (latest.nk["wavelength_nm"][0], latest.nk["wavelength_nm"][-1])
-    return MaterialDetail(**dict(_summary(row)), wavelength_range_nm=wavelength_range,
-                          latest_fit=fit_public(latest))
+    return MaterialDetail(**dict(_summary(row)), wavelength_range_nm=wavelength_range, latest_fit=fit_public(latest))
 
 
-@router.patch("/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES,
-              dependencies=[WriteAccess])
+@router.patch(
+    "/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES, dependencies=[WriteAccess]
+)
 def rename_material(material_id: MaterialIdPath, body: MaterialRename, store: StoreDep) -> MaterialSummary:
     """
     Rename a saved material. Not a save: its version, fits and history stay
@@ -128,8 +165,9 @@ def rename_material(material_id: MaterialIdPath, body: MaterialRename, store: St
     return _summary(store.rename_material(material_id, body.name.strip()))
 
 
-@router.delete("/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES,
-               dependencies=[WriteAccess])
+@router.delete(
+    "/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES, dependencies=[WriteAccess]
+)
 def delete_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSummary:
     """
     Move a saved material to the bin: it leaves the listings (`?deleted=true`
@@ -142,8 +180,12 @@ def delete_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSum
     return _summary(store.delete_material(material_id))
 
 
-@router.post("/materials/{material_id}/restore", response_model=MaterialSummary, responses=WRITE_RESPONSES,
-             dependencies=[WriteAccess])
+@router.post(
+    "/materials/{material_id}/restore",
+    response_model=MaterialSummary,
+    responses=WRITE_RESPONSES,
+    dependencies=[WriteAccess],
+)
 def restore_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSummary:
     """Take a material out of the bin (a material not in it answers as it is)."""
     return _summary(store.restore_material(material_id))

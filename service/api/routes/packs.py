@@ -22,10 +22,16 @@ from ..deps import FIT_ERROR_RESPONSES, NOT_FOUND, RunnerDep, StoreDep, WriteAcc
 router = APIRouter(prefix=f"{API_PREFIX}/packs", tags=["packs"])
 
 
-@router.post("", response_class=Response, responses={
-    status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
-    **NOT_FOUND, **FIT_ERROR_RESPONSES,
-}, dependencies=[WriteAccess])
+@router.post(
+    "",
+    response_class=Response,
+    responses={
+        status.HTTP_200_OK: {"content": PACK_CONTENT, "description": "The pack"},
+        **NOT_FOUND,
+        **FIT_ERROR_RESPONSES,
+    },
+    dependencies=[WriteAccess],
+)
 async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep, http: Request) -> Response:
     """
     The fits named by ``fit_ids``, in that order, as one pack. A renderer
@@ -37,13 +43,33 @@ async def create_pack(request: PackRequest, store: StoreDep, runner: RunnerDep, 
         # Each export fits its tool's values (up to about a second of CPU): a job in the
         # fitting pool, with its CPU limit and timeout, shared by identical requests, and
         # kept (the fits never change).
-        key = (f"export pack {request.format} {request.eta_i!r} {request.roughness!r} "
-               f"{request.coat_roughness!r} {request.working_space} {' '.join(r.id for r in records)}")
-        body = await http.app.state.derived.get_or_make(key, lambda: runner.once(key, lambda: runner.run(
-            render_export_pack, records, request.format, request.eta_i, request.roughness,
-            request.coat_roughness, request.working_space, cost_s=float(len(records)))))
-        return Response(body, media_type="application/zip", headers={
-            "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'})
+        key = (
+            f"export pack {request.format} {request.eta_i!r} {request.roughness!r} "
+            f"{request.coat_roughness!r} {request.working_space} {' '.join(r.id for r in records)}"
+        )
+        body = await http.app.state.derived.get_or_make(
+            key,
+            lambda: runner.once(
+                key,
+                lambda: runner.run(
+                    render_export_pack,
+                    records,
+                    request.format,
+                    request.eta_i,
+                    request.roughness,
+                    request.coat_roughness,
+                    request.working_space,
+                    cost_s=float(len(records)),
+                ),
+            ),
+        )
+        return Response(
+            body,
+            media_type="application/zip",
+            headers={
+                "Content-Disposition": f'attachment; filename="{request.name}-{request.format}-eta{request.eta_i:g}.zip"'
+            },
+        )
     if request.format != "binary":  # the JSON and the snippets quote the figures
         records = [await ensure_metrics(record, store, runner) for record in records]
     return await run_in_threadpool(pack_response, records, request.format, request.name)

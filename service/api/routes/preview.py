@@ -40,27 +40,44 @@ router = APIRouter(prefix=API_PREFIX, tags=["preview"])
         status.HTTP_200_OK: {"content": {"image/png": {"schema": {"type": "string", "format": "binary"}}}},
         status.HTTP_404_NOT_FOUND: {"model": ErrorBody},
         **ERROR_RESPONSES,
-        status.HTTP_503_SERVICE_UNAVAILABLE: {"model": ErrorBody, "description": (
-            "COATED_MAX_PREVIEWS_IN_FLIGHT previews rendering (Retry-After), or no GL on this machine")},
-        status.HTTP_504_GATEWAY_TIMEOUT: {"model": ErrorBody, "description": (
-            "The preview ran past COATED_PREVIEW_TIMEOUT_S and was cancelled (Retry-After)")},
+        status.HTTP_503_SERVICE_UNAVAILABLE: {
+            "model": ErrorBody,
+            "description": ("COATED_MAX_PREVIEWS_IN_FLIGHT previews rendering (Retry-After), or no GL on this machine"),
+        },
+        status.HTTP_504_GATEWAY_TIMEOUT: {
+            "model": ErrorBody,
+            "description": ("The preview ran past COATED_PREVIEW_TIMEOUT_S and was cancelled (Retry-After)"),
+        },
     },
 )
 async def preview_png(
-    store: StoreDep, settings: SettingsDep, previews: PreviewsDep, http: Request,
+    store: StoreDep,
+    settings: SettingsDep,
+    previews: PreviewsDep,
+    http: Request,
     fit: Annotated[str, Query(pattern=FIT_ID_PATTERN, description="A stored fit's id")],
     eta_i: Annotated[float, Query(ge=ETA_I_LIMITS[0], le=ETA_I_LIMITS[1], allow_inf_nan=False)] = 1.5,
     size: Annotated[int, Query(ge=64, le=2048, description="Pixels per side")] = 512,
     compare: Annotated[Literal["none", "lazanyi", "reference"], Query()] = "none",
-    environment: Annotated[Literal[ENVIRONMENTS], Query(  # type: ignore[valid-type]
-        description="The light around the sphere (as the CLI's `render --environment`)")] = "white_sky",
-    roughness: Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False,
-                                      description="GGX perceptual roughness of the metal")] = 0.0,
-    mode: Annotated[Literal["immersed", "coated"], Query(
-        description="immersed: the camera in the medium of index eta_i; coated: a clear coat of "
-                    "index eta_i seen from air")] = "immersed",
-    coat_roughness: Annotated[float, Query(ge=0.0, le=1.0, allow_inf_nan=False,
-                                           description="The coat's roughness (mode=coated)")] = 0.0,
+    environment: Annotated[
+        Literal[ENVIRONMENTS],
+        Query(  # type: ignore[valid-type]
+            description="The light around the sphere (as the CLI's `render --environment`)"
+        ),
+    ] = "white_sky",
+    roughness: Annotated[
+        float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description="GGX perceptual roughness of the metal")
+    ] = 0.0,
+    mode: Annotated[
+        Literal["immersed", "coated"],
+        Query(
+            description="immersed: the camera in the medium of index eta_i; coated: a clear coat of "
+            "index eta_i seen from air"
+        ),
+    ] = "immersed",
+    coat_roughness: Annotated[
+        float, Query(ge=0.0, le=1.0, allow_inf_nan=False, description="The coat's roughness (mode=coated)")
+    ] = 0.0,
 ) -> Response:
     """The preview sphere as an 8-bit sRGB PNG: smooth (roughness 0, immersed),
     or rough / coated through the split sum with a prefiltered environment."""
@@ -73,7 +90,18 @@ async def preview_png(
     png = http.app.state.derived.get(key)
     if png is None:
         record = await run_in_threadpool(stored_fit, store, fit)
-        png = await http.app.state.derived.get_or_make(key, lambda: render_preview(
-            previews, record, eta_i=eta_i, size=size, compare=compare, environment=environment,
-            roughness=roughness, mode=mode, coat_roughness=coat_roughness))
+        png = await http.app.state.derived.get_or_make(
+            key,
+            lambda: render_preview(
+                previews,
+                record,
+                eta_i=eta_i,
+                size=size,
+                compare=compare,
+                environment=environment,
+                roughness=roughness,
+                mode=mode,
+                coat_roughness=coat_roughness,
+            ),
+        )
     return Response(png, media_type="image/png", headers={"Cache-Control": "max-age=3600"})

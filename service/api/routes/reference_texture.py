@@ -42,9 +42,12 @@ __all__ = ["router"]
     "/fits/{fit_id}/reference-texture",
     response_class=Response,
     responses={
-        status.HTTP_200_OK: {"content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}},
-                             "description": "float32 RGB [eta_i row][cos theta column][channel]"},
-        **NOT_FOUND, **ERROR_RESPONSES,
+        status.HTTP_200_OK: {
+            "content": {"application/octet-stream": {"schema": {"type": "string", "format": "binary"}}},
+            "description": "float32 RGB [eta_i row][cos theta column][channel]",
+        },
+        **NOT_FOUND,
+        **ERROR_RESPONSES,
     },
 )
 async def get_reference_texture(fit_id: FitIdPath, store: StoreDep) -> Response:

@@ -24,8 +24,7 @@ from ..deps import FIT_ERROR_RESPONSES, RunnerDep, StoreDep, WriteAccess
 router = APIRouter(prefix=API_PREFIX, tags=["scenes"])
 
 
-@router.post("/scenes", response_model=ScenePublic, responses=FIT_ERROR_RESPONSES,
-             dependencies=[WriteAccess])
+@router.post("/scenes", response_model=ScenePublic, responses=FIT_ERROR_RESPONSES, dependencies=[WriteAccess])
 async def create_scene_pack(request: SceneRequest, store: StoreDep, runner: RunnerDep) -> ScenePublic:
     """
     Fit each material of the scene over the eta_i it uses, with the lowest

@@ -26,8 +26,7 @@ from fitting.batch import (
 from fitting.batch.journal import JOURNAL_NAME, Journal
 from fitting.batch.kinds import check_model_kinds, decode_material
 
-FITTED = ["main/Ag/Johnson", "main/Au/Johnson", "main/Cr/Johnson", "main/Cu/Johnson",
-          "main/SiO2/Malitson"]
+FITTED = ["main/Ag/Johnson", "main/Au/Johnson", "main/Cr/Johnson", "main/Cu/Johnson", "main/SiO2/Malitson"]
 SKIPPED = {
     "main/Al/Mathewson": "covers 71.1% of 360-830 nm",
     "main/Al2O3/Querry-e": "unreadable: `k` must be >= 0",
@@ -64,14 +63,17 @@ class TestSelectPages:
         listing.write_text("# metals\nmain/Cu/Johnson\n\nmain/Au/Johnson\nmain/Cu/Johnson\n")
         assert select_pages(page_list=read_page_list(listing)) == ["main/Au/Johnson", "main/Cu/Johnson"]
 
-    @pytest.mark.parametrize("kwargs, message", [
-        ({}, "give a selection"),
-        ({"shelf": "attic"}, "`shelf` must be one of"),
-        ({"book": "Unobtainium"}, "`book` 'Unobtainium' is not on shelf 'main'"),
-        ({"pages_glob": "main/Au/Nobody*"}, "matches no page"),
-        ({"page_list": ["main/Au/Nobody"]}, "'main/Au/Nobody' is not in"),
-        ({"page_list": ["Au-Johnson"]}, "`page` must be SHELF/BOOK/PAGE"),
-    ])
+    @pytest.mark.parametrize(
+        "kwargs, message",
+        [
+            ({}, "give a selection"),
+            ({"shelf": "attic"}, "`shelf` must be one of"),
+            ({"book": "Unobtainium"}, "`book` 'Unobtainium' is not on shelf 'main'"),
+            ({"pages_glob": "main/Au/Nobody*"}, "matches no page"),
+            ({"page_list": ["main/Au/Nobody"]}, "'main/Au/Nobody' is not in"),
+            ({"page_list": ["Au-Johnson"]}, "`page` must be SHELF/BOOK/PAGE"),
+        ],
+    )
     def test_refusals_name_the_option(self, kwargs, message):
         with pytest.raises(ValueError, match=message.replace("(", r"\(")):
             select_pages(**kwargs)
@@ -88,9 +90,11 @@ class TestFitPage:
         # The same evaluation once more (a separate process): equal up to
         # summation order, ~1e3 u64 = 1e-13 relative; 1e-12 with a 9x margin.
         assert record["kinds"]["coated-conductor"]["delta_E_mean"] == pytest.approx(
-            metrics["model_float16"]["delta_E_mean"], rel=1e-12)
+            metrics["model_float16"]["delta_E_mean"], rel=1e-12
+        )
         assert record["baselines"]["lazanyi_adjusted"]["delta_E_max"] == pytest.approx(
-            metrics["lazanyi_adjusted"]["delta_E_max"], rel=1e-12)
+            metrics["lazanyi_adjusted"]["delta_E_max"], rel=1e-12
+        )
         view = record["materials"]["coated-conductor"]
         assert decode_material(view) == result.packed
 
@@ -125,8 +129,7 @@ class TestRunBatch:
         assert "lazanyi_adjusted_delta_E_mean" in csv_lines[0]
         summary = report["summary"]["delta_E_mean"]
         metals = [r for r in result.records if r["status"] == "fitted"]
-        assert summary["coated-conductor"]["max"] == max(
-            r["kinds"]["coated-conductor"]["delta_E_mean"] for r in metals)
+        assert summary["coated-conductor"]["max"] == max(r["kinds"]["coated-conductor"]["delta_E_mean"] for r in metals)
         assert summary["coated-conductor"]["beats_lazanyi_adjusted"] == 1.0
 
     def test_finished_batch_rerun_fits_nothing_same_bytes(self, serial, tmp_path):
@@ -160,8 +163,9 @@ class TestRunBatch:
 
     def test_every_kind_in_one_pack(self, tmp_path):
         kinds = ["coated-conductor", "rgb-conductor"]
-        result = run_batch(["main/Au/Johnson", "main/Al/Mathewson"], tmp_path, kinds=kinds,
-                           workers=1, samples=SAMPLES, progress=False)
+        result = run_batch(
+            ["main/Au/Johnson", "main/Al/Mathewson"], tmp_path, kinds=kinds, workers=1, samples=SAMPLES, progress=False
+        )
         pack = decode_pack((tmp_path / "pack.cfpk").read_bytes())
         assert [(m.name, m.model) for m in pack] == [
             ("main/Au/Johnson [coated-conductor]", "coated-conductor"),
@@ -182,12 +186,15 @@ class TestRunBatch:
         run_batch(PAGES, tmp_path, workers=2, samples=SAMPLES, progress=False)
         assert outputs(tmp_path) == serial[1]
 
-    @pytest.mark.parametrize("kwargs, message", [
-        ({"workers": 0}, "`workers` must be an integer >= 1, got 0"),
-        ({"samples": 1}, "`samples` must be an integer in"),
-        ({"eta_i_range": (0.5, 2.0)}, "eta_i"),
-        ({"kinds": ["nope"]}, "`model` must be one of"),
-    ])
+    @pytest.mark.parametrize(
+        "kwargs, message",
+        [
+            ({"workers": 0}, "`workers` must be an integer >= 1, got 0"),
+            ({"samples": 1}, "`samples` must be an integer in"),
+            ({"eta_i_range": (0.5, 2.0)}, "eta_i"),
+            ({"kinds": ["nope"]}, "`model` must be one of"),
+        ],
+    )
     def test_refusals(self, tmp_path, kwargs, message):
         with pytest.raises(ValueError, match=message):
             run_batch(PAGES[:1], tmp_path, progress=False, **{"samples": SAMPLES, **kwargs})
@@ -198,8 +205,10 @@ class TestDaskCluster:
     def test_local_cluster_worker_killed_mid_batch(self, serial, tmp_path):
         from distributed import Client, LocalCluster
 
-        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+        with (
+            LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+            Client(cluster) as client,
+        ):
             pids = client.run(os.getpid)
             killed: dict[str, list[str]] = {}
             lock = threading.Lock()
@@ -215,8 +224,7 @@ class TestDaskCluster:
                             os.kill(pids[address], signal.SIGKILL)
                             return
 
-            result = run_batch(PAGES, tmp_path, scheduler=client, samples=SAMPLES,
-                               progress=False, on_record=kill_one)
+            result = run_batch(PAGES, tmp_path, scheduler=client, samples=SAMPLES, progress=False, on_record=kill_one)
         assert killed, "no worker was busy to be killed"
         lost_pages = [key.split("-", 2)[2] for keys in killed.values() for key in keys]
         assert lost_pages and all(p in PAGES for p in lost_pages)

@@ -74,14 +74,17 @@ def test_a_second_run_on_one_directory_is_refused(tmp_path):
     Journal(tmp_path, config).close()  # free again once the first is closed
 
 
-@pytest.mark.parametrize("damage", [
-    '{"page": "b", "status": "fit',  # torn mid-file
-    "[1, 2, 3]",                     # JSON, not an object
-    '"text"',
-    '{"no": "page"}',
-    '{"page": 7}',
-    "\x00\x00garbage",
-])
+@pytest.mark.parametrize(
+    "damage",
+    [
+        '{"page": "b", "status": "fit',  # torn mid-file
+        "[1, 2, 3]",  # JSON, not an object
+        '"text"',
+        '{"no": "page"}',
+        '{"page": 7}',
+        "\x00\x00garbage",
+    ],
+)
 def test_every_valid_record_around_a_damaged_line_is_kept(tmp_path, damage):
     config = {"pages": ["a", "c"]}
     with Journal(tmp_path, config) as journal:

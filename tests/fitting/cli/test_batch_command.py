@@ -13,8 +13,7 @@ class TestBatchCommand:
         listing = tmp_path / "pages.txt"
         listing.write_text("main/Au/Johnson\nmain/Al/Mathewson\n")
         out = tmp_path / "out"
-        rc = main(["batch", "--page-list", str(listing), "-o", str(out), "--workers", "1",
-                   "--samples", "20"])
+        rc = main(["batch", "--page-list", str(listing), "-o", str(out), "--workers", "1", "--samples", "20"])
         assert rc == 0
         assert all((out / name).exists() for name in OUTPUT_FILES)
         captured = capsys.readouterr()

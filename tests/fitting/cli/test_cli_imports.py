@@ -27,8 +27,9 @@ print(json.dumps({"status": status, "loaded": [m for m in %r if m in sys.modules
 
 
 def _loaded_after(*args: str) -> dict:
-    done = subprocess.run([sys.executable, "-c", _PROBE, *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=120, check=True)
+    done = subprocess.run(
+        [sys.executable, "-c", _PROBE, *args], cwd=ROOT, capture_output=True, text=True, timeout=120, check=True
+    )
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 

@@ -18,8 +18,9 @@ def _run(*args, timeout=600):
 
 @pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run
 def test_ibl_json_shape_and_agreement():
-    out = _run("ibl", "Cr", "--eta-i", "1.5", "--roughness", "0.4", "--json",
-               "--n-dot-v", "0.05,0.3,0.8", "--samples", "8192")
+    out = _run(
+        "ibl", "Cr", "--eta-i", "1.5", "--roughness", "0.4", "--json", "--n-dot-v", "0.05,0.3,0.8", "--samples", "8192"
+    )
     assert out.returncode == 0, out.stderr
     view = json.loads(out.stdout)
     assert list(view) == ["n_dot_v", "split_sum", "monte_carlo", "monte_carlo_stderr", "reference"]
@@ -34,8 +35,21 @@ def test_ibl_json_shape_and_agreement():
 
 @pytest.mark.slow  # 5.2 s (all cases 5.2 s) in a --durations=0 run
 def test_ibl_coated_at_eta_1_and_bad_input():
-    out = _run("ibl", "Au", "--eta-i", "1", "--roughness", "0.2", "--mode", "coated", "--json",
-               "--n-dot-v", "0.5", "--samples", "1024")
+    out = _run(
+        "ibl",
+        "Au",
+        "--eta-i",
+        "1",
+        "--roughness",
+        "0.2",
+        "--mode",
+        "coated",
+        "--json",
+        "--n-dot-v",
+        "0.5",
+        "--samples",
+        "1024",
+    )
     assert out.returncode == 0, out.stderr
     assert len(json.loads(out.stdout)["split_sum"]) == 1
     bad = _run("ibl", "Au", "--eta-i", "0.8", "--json")

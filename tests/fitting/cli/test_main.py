@@ -28,8 +28,9 @@ def run(*args, check=True):
 @pytest.mark.slow  # starts a process or GL context
 def test_library_lists_the_catalogue():
     # The command itself, as a user types it (the other tests fork it).
-    result = subprocess.run([sys.executable, "-m", "fitting", "library"], cwd=ROOT, capture_output=True,
-                            text=True, timeout=300)
+    result = subprocess.run(
+        [sys.executable, "-m", "fitting", "library"], cwd=ROOT, capture_output=True, text=True, timeout=300
+    )
     assert result.returncode == 0, result.stderr
     lines = result.stdout.strip().splitlines()
     assert len(lines) >= 300
@@ -57,8 +58,9 @@ def test_fit_json_with_metrics():
 @pytest.mark.slow  # 2.6 s (all cases 2.6 s) in a --durations=0 run
 def test_fit_user_file(tmp_path):
     path = tmp_path / "metal.csv"
-    path.write_text("wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n650,0.6,3.0\n"
-                    "750,0.7,3.8\n850,0.8,4.5\n")
+    path.write_text(
+        "wavelength_nm,n,k\n350,0.4,2.0\n450,0.5,2.5\n550,0.55,2.8\n650,0.6,3.0\n750,0.7,3.8\n850,0.8,4.5\n"
+    )
     view = json.loads(run("fit", "--nk", str(path), "--no-metrics").stdout)
     assert view["name"] == "metal" and view["source"].startswith("user CSV")
     # Six samples 100 nm apart: the fit says how far its figure can be off.
@@ -112,8 +114,10 @@ def test_errors_are_clear():
 @pytest.mark.slow  # 4.3 s (all cases 4.3 s) in a --durations=0 run
 def test_reproduce_subset(tmp_path):
     out = tmp_path / "results.md"
-    out.write_text("old\n<!-- end of the part written by python -m fitting reproduce: what follows is kept by "
-                   "--write-docs -->\n\n## Kept\n")
+    out.write_text(
+        "old\n<!-- end of the part written by python -m fitting reproduce: what follows is kept by "
+        "--write-docs -->\n\n## Kept\n"
+    )
     result = run("reproduce", "--materials", "Au,Ta", "-o", str(out))
     assert "2/2" in result.stderr and f"wrote {out}" in result.stderr  # progress bar, where it went
     assert "| Au |" in result.stdout and "| Ta |" in result.stdout  # the table, printed

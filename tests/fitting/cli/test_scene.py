@@ -9,10 +9,13 @@ from conftest import run_command
 from fitting.cli.scene import add_scene_parser
 from fitting.models.pack import decode_pack, pack_from_json
 
-SCENE = {"name": "desk", "materials": [
-    {"material": "Cu", "eta_i": 1.5},
-    {"material": "Au", "name": "uncoated gold", "eta_i": 1},
-]}
+SCENE = {
+    "name": "desk",
+    "materials": [
+        {"material": "Cu", "eta_i": 1.5},
+        {"material": "Au", "name": "uncoated gold", "eta_i": 1},
+    ],
+}
 
 
 def run_scene(argv):

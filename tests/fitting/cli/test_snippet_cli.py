@@ -7,8 +7,13 @@ import pytest
 from fitting.cli.main import main
 
 
-@pytest.mark.parametrize("language, words", [("glsl", ("vec3 cf_material_Al(float NdotV, float eta_i)", "mat3")),
-                                             ("hlsl", ("float3 cf_material_Al(float NdotV, float eta_i)", "float3x3"))])
+@pytest.mark.parametrize(
+    "language, words",
+    [
+        ("glsl", ("vec3 cf_material_Al(float NdotV, float eta_i)", "mat3")),
+        ("hlsl", ("float3 cf_material_Al(float NdotV, float eta_i)", "float3x3")),
+    ],
+)
 def test_fit_writes_a_snippet(tmp_path, capsys, language, words):
     out = tmp_path / f"al.{language}"
     assert main(["fit", "Al", "--snippet", language, "--no-metrics", "-o", str(out)]) == 0

@@ -55,7 +55,8 @@ class TestColorimetry:
         W_XYZ = cmfs.T / cmfs[:, 1].sum()  # the CIE weights' size (the illuminant is within 2x of flat)
         acescg = colour.RGB_COLOURSPACES["ACEScg"]
         cat = colour.adaptation.matrix_chromatic_adaptation_VonKries(
-            W_XYZ.sum(axis=1), acescg.matrix_RGB_to_XYZ @ np.ones(3), transform="CAT02")
+            W_XYZ.sum(axis=1), acescg.matrix_RGB_to_XYZ @ np.ones(3), transform="CAT02"
+        )
         term = 3 * np.abs(acescg.matrix_XYZ_to_RGB).max() * 3 * np.abs(cat).max() * 2 * np.abs(W_XYZ).max()
         bound = 6 * eps * term
         assert np.abs(stored_weights - weights).max() <= bound, (np.abs(stored_weights - weights).max(), bound)
@@ -77,16 +78,25 @@ class TestColorimetry:
         XYZ = colour.sd_to_XYZ(sd, cmfs, illuminant, method="Integration") / 100.0
         # Same white on both sides: adapt colour's XYZ to ACEScg, normalise by white.
         W = spectral_weights(1.0)[1]
-        white_XYZ = colour.sd_to_XYZ(
-            colour.SpectralDistribution(dict(zip(nodes, np.ones_like(nodes)))),
-            cmfs, illuminant, method="Integration",
-        ) / 100.0
+        white_XYZ = (
+            colour.sd_to_XYZ(
+                colour.SpectralDistribution(dict(zip(nodes, np.ones_like(nodes)))),
+                cmfs,
+                illuminant,
+                method="Integration",
+            )
+            / 100.0
+        )
         RGB_colour = colour.XYZ_to_RGB(
-            XYZ, colour.RGB_COLOURSPACES["ACEScg"], illuminant=colour.XYZ_to_xy(white_XYZ),
+            XYZ,
+            colour.RGB_COLOURSPACES["ACEScg"],
+            illuminant=colour.XYZ_to_xy(white_XYZ),
             chromatic_adaptation_transform="CAT02",
         )
         RGB_white = colour.XYZ_to_RGB(
-            white_XYZ, colour.RGB_COLOURSPACES["ACEScg"], illuminant=colour.XYZ_to_xy(white_XYZ),
+            white_XYZ,
+            colour.RGB_COLOURSPACES["ACEScg"],
+            illuminant=colour.XYZ_to_xy(white_XYZ),
             chromatic_adaptation_transform="CAT02",
         )
         # Not a rounding bound: colour-science interpolates the CMFS and the
@@ -144,9 +154,7 @@ class TestColorimetry:
         # Sharma, Wu & Dalal (2005), Table 1, pair 1: 2.0425, printed to 4
         # decimals: the exact value lies within 5e-5 of it (see SHARMA_ATOL in
         # test_delta_e); 1e-4 is one unit of the last printed place.
-        assert delta_E_2000([50.0, 2.6772, -79.7751], [50.0, 0.0, -82.7485]) == pytest.approx(
-            2.0425, abs=1e-4
-        )
+        assert delta_E_2000([50.0, 2.6772, -79.7751], [50.0, 0.0, -82.7485]) == pytest.approx(2.0425, abs=1e-4)
 
 
 @pytest.mark.slow  # a fresh interpreter
@@ -168,6 +176,11 @@ def test_colour_science_loads_its_plotting_only_on_use():
         "assert 'matplotlib' in sys.modules\n"
         "print('ok')\n"
     )
-    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
-                          cwd=__file__.rsplit("/tests/", 1)[0])
+    done = subprocess.run(
+        [sys.executable, "-c", script],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=__file__.rsplit("/tests/", 1)[0],
+    )
     assert done.returncode == 0 and done.stdout.strip() == "ok", done.stderr[-2000:]

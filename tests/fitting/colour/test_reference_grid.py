@@ -28,7 +28,7 @@ WAVELENGTH = np.linspace(300.0, 900.0, 61)
 
 # Derived tolerances (docs/service.md, "How the reported Delta E stays
 # within 0.001 of the definition").
-U64, U32 = 2.0**-53, 2.0**-24   # unit roundoff of float64, float32
+U64, U32 = 2.0**-53, 2.0**-24  # unit roundoff of float64, float32
 # The 1 nm weights: 471 nodes, each channel's sum of |w| at most 1.147.
 _NODES, _W = reference_module.spectral_weights(1.0)
 SUM_ABS_W = float(np.abs(_W).sum(axis=1).max())
@@ -66,9 +66,7 @@ class TestReferenceGrid:
         M, E = evaluation_grid(100, result.eta_i_range)
         slow_ref = reference_ACEScg(nk, M, E, 1.0)
         assert np.max(np.abs(reference_ACEScg_grid(nk, M[0], E[:, 0]) - slow_ref)) < F64_RGB_BOUND
-        slow = error_metrics(
-            slow_ref, coated_conductor_model(M, E, result.coefficients_float16, result.eta_i_range)
-        )
+        slow = error_metrics(slow_ref, coated_conductor_model(M, E, result.coefficients_float16, result.eta_i_range))
         for key, value in (("delta_E_mean", slow.mean), ("delta_E_max", slow.max)):
             assert abs(fast["model_float16"][key] - value) < DELTA_E_PROMISE
             # In fact they agree to rounding: Delta E 2000 moves by at most
@@ -77,14 +75,17 @@ class TestReferenceGrid:
             # references within F64_RGB_BOUND give Delta E within 1.3e-9.
             assert abs(fast["model_float16"][key] - value) < 1e4 * F64_RGB_BOUND
 
-    @pytest.mark.parametrize("n, k", [
-        (1.5, 0.0),    # dielectric: total internal reflection for eta_i > 1.5
-        (1.0, 0.0),    # index matched at eta_i = 1, grazing row included
-        (2.5, 0.0),
-        (1.2, 1e-9),   # weak absorber past the critical angle: the cancelling branch
-        (0.05, 4.0),   # silver-like
-        (3.0, 3.0),
-    ])
+    @pytest.mark.parametrize(
+        "n, k",
+        [
+            (1.5, 0.0),  # dielectric: total internal reflection for eta_i > 1.5
+            (1.0, 0.0),  # index matched at eta_i = 1, grazing row included
+            (2.5, 0.0),
+            (1.2, 1e-9),  # weak absorber past the critical angle: the cancelling branch
+            (0.05, 4.0),  # silver-like
+            (3.0, 3.0),
+        ],
+    )
     def test_limits_and_edge_cases(self, n, k):
         nk = constant_nk(n, k)
         mu = np.linspace(0.0, 1.0, 37)
@@ -118,13 +119,16 @@ class TestReferenceGrid:
         np.testing.assert_allclose(fast, reference_ACEScg(nk, M, E), rtol=0, atol=F64_RGB_BOUND)
         assert np.array_equal(fast[0], fast[2]) and np.array_equal(fast[:, 0], fast[:, 2])
 
-    @pytest.mark.parametrize("mu_count, eta_count", [
-        (100, 100),  # the scoring grid: loop over cos theta, eta_i in blocks
-        (41, 15),    # few eta_i: loop over eta_i, cos theta in blocks
-        (9, 16),
-        (9, 101),    # blocks of unequal size
-        (1025, 1),   # a preview table
-    ])
+    @pytest.mark.parametrize(
+        "mu_count, eta_count",
+        [
+            (100, 100),  # the scoring grid: loop over cos theta, eta_i in blocks
+            (41, 15),  # few eta_i: loop over eta_i, cos theta in blocks
+            (9, 16),
+            (9, 101),  # blocks of unequal size
+            (1025, 1),  # a preview table
+        ],
+    )
     def test_both_orientations_give_the_definition(self, mu_count, eta_count, monkeypatch):
         nk = library_material("Au")
         mu = np.linspace(0.0, 1.0, mu_count)
@@ -135,12 +139,15 @@ class TestReferenceGrid:
             monkeypatch.setattr(reference_module, "_MIN_ETA_FOR_MU_LOOP", least)
             assert np.max(np.abs(reference_ACEScg_grid(nk, mu, eta) - slow)) < F64_RGB_BOUND
 
-    @pytest.mark.parametrize("mu, eta, message", [
-        ([[0.5]], [1.5], "1-D"),
-        ([0.5], [0.8], "`eta_i` must be >= 1, got 0.8"),
-        ([np.nan], [1.5], "cos_theta"),
-        ([0.5], [np.inf], "eta_i"),
-    ])
+    @pytest.mark.parametrize(
+        "mu, eta, message",
+        [
+            ([[0.5]], [1.5], "1-D"),
+            ([0.5], [0.8], "`eta_i` must be >= 1, got 0.8"),
+            ([np.nan], [1.5], "cos_theta"),
+            ([0.5], [np.inf], "eta_i"),
+        ],
+    )
     def test_refusals(self, mu, eta, message):
         with pytest.raises(ValueError, match=message):
             reference_ACEScg_grid(library_material("Au"), mu, eta)
@@ -171,8 +178,12 @@ class TestReferenceGridFloat32:
         # Near the critical angle of a weak absorber Re(eta^2) - sin^2 theta
         # cancels: formed in float32 it alone would move Delta E by 1e-2.
         wavelength = np.linspace(300.0, 900.0, 61)
-        nk = SpectralNK(wavelength, n * (1.0 + 0.1 * np.sin(wavelength / 50.0)),
-                        np.full(61, k) * (1.0 + 0.1 * np.cos(wavelength / 40.0)), name="test")
+        nk = SpectralNK(
+            wavelength,
+            n * (1.0 + 0.1 * np.sin(wavelength / 50.0)),
+            np.full(61, k) * (1.0 + 0.1 * np.cos(wavelength / 40.0)),
+            name="test",
+        )
         mu, eta = np.linspace(0.0, 1.0, 100), np.linspace(1.0, 3.0, 100)
         ref = reference_ACEScg_grid(nk, mu, eta)
         ref32 = reference_ACEScg_grid(nk, mu, eta, dtype=np.float32)

@@ -30,8 +30,7 @@ SIZE = 4
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(prog="cycles_angles.py")
     parser.add_argument("script", nargs="+")
-    parser.add_argument("--output", default="principled",
-                        help="principled, conductor, or both comma-separated")
+    parser.add_argument("--output", default="principled", help="principled, conductor, or both comma-separated")
     parser.add_argument("--angles", default="0,30,60")
     parser.add_argument("--samples", type=int, default=256)
     parser.add_argument("--working-space", choices=("lin_rec709", "acescg"), default="lin_rec709")
@@ -51,16 +50,16 @@ def main(argv: list[str]) -> int:
         many[script] = {}
         for output in outputs:
             try:
-                many[script][output] = render_angles(script, output, angles, args.samples,
-                                                     args.working_space)
+                many[script][output] = render_angles(script, output, angles, args.samples, args.working_space)
             except (KeyError, ValueError, RuntimeError) as error:
                 many[script][output] = {"error": str(error)}
     print("CYCLES_MANY " + json.dumps(many))
     return 0
 
 
-def render_angles(script: str, output: str, angles: list[float], samples: int,
-                  working_space: str) -> dict[str, list[float]]:
+def render_angles(
+    script: str, output: str, angles: list[float], samples: int, working_space: str
+) -> dict[str, list[float]]:
     """Mean linear RGB of the export's ``output`` on a plane at each view angle, in a fresh file."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     if working_space == "acescg":
@@ -119,6 +118,5 @@ def render_angles(script: str, output: str, angles: list[float], samples: int,
     return out
 
 
-
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]))
+    sys.exit(main(sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else sys.argv[1:]))

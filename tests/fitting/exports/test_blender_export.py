@@ -36,9 +36,25 @@ def run_in_blender(values, tmp_path: Path, output: str) -> tuple[dict, np.ndarra
     script.write_bytes(export_material(values, "blender", values.eta_i))
     read_back, png = tmp_path / "values.json", tmp_path / "sphere.png"
     result = subprocess.run(
-        [str(BLENDER_PYTHON), str(PREVIEW), str(script), "--values", str(read_back),
-         "--render", str(png), "--size", str(SIZE), "--samples", "4", "--output", output],
-        capture_output=True, text=True, timeout=300, cwd=tmp_path,
+        [
+            str(BLENDER_PYTHON),
+            str(PREVIEW),
+            str(script),
+            "--values",
+            str(read_back),
+            "--render",
+            str(png),
+            "--size",
+            str(SIZE),
+            "--samples",
+            "4",
+            "--output",
+            output,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
     )
     assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
     # No deprecated call for the pinned Blender (it warns `use_nodes` on 5.0).
@@ -89,7 +105,7 @@ class TestPrincipled:
     def test_render(self, principled):
         pixels = principled[1]
         assert pixels.shape == (SIZE, SIZE, 3)
-        centre = pixels[SIZE // 2 - 2: SIZE // 2 + 2, SIZE // 2 - 2: SIZE // 2 + 2].mean(axis=(0, 1))
+        centre = pixels[SIZE // 2 - 2 : SIZE // 2 + 2, SIZE // 2 - 2 : SIZE // 2 + 2].mean(axis=(0, 1))
         # The sphere is there and copper-coloured (red over blue) where the
         # checkered environment is grey.
         assert centre[0] > centre[2] + 20, centre
@@ -123,7 +139,9 @@ class TestPhysicalConductor:
             assert nodes[NODE_NAMES["facing"]]["inputs"]["Blend"] == 0.5
         else:
             assert NODE_NAMES["facing"] not in nodes
-        assert nodes[NODE_NAMES["coat_fresnel"]]["inputs"]["IOR"] == pytest.approx(1.6, rel=1e-6)  # float32, as assert_rgb
+        assert nodes[NODE_NAMES["coat_fresnel"]]["inputs"]["IOR"] == pytest.approx(
+            1.6, rel=1e-6
+        )  # float32, as assert_rgb
         assert nodes[NODE_NAMES["conductor_output"]]["is_active_output"] is True
         assert nodes[NODE_NAMES["output"]]["is_active_output"] is False
         assert [NODE_NAMES["coat_mix"], "Shader", NODE_NAMES["conductor_output"], "Surface"] in links
@@ -132,5 +150,5 @@ class TestPhysicalConductor:
     @pytest.mark.slow  # starts a process or GL context
     def test_render(self, conductor):
         pixels = conductor[1]
-        centre = pixels[SIZE // 2 - 2: SIZE // 2 + 2, SIZE // 2 - 2: SIZE // 2 + 2].mean(axis=(0, 1))
+        centre = pixels[SIZE // 2 - 2 : SIZE // 2 + 2, SIZE // 2 - 2 : SIZE // 2 + 2].mean(axis=(0, 1))
         assert centre[0] > centre[2] + 20, centre

@@ -62,12 +62,18 @@ def merged(texts: list[str]) -> mx.Document:
 class TestNames:
     def test_eta_tag(self):
         assert [eta_tag(e) for e in (1.0, 1.33, 1.5, 2.0, 1.23456)] == [
-            "eta1", "eta1p33", "eta1p5", "eta2", "eta1p2346"]
+            "eta1",
+            "eta1p33",
+            "eta1p5",
+            "eta2",
+            "eta1p2346",
+        ]
 
     def test_stem(self):
         # What the names are made of, without a fit (the fields ExportValues has).
-        values = SimpleNamespace(name="Au", source="s", origin="o", eta_i=1.0, model=None,
-                                 target_ACEScg=np.full((4, 3), 0.5), fit_id=FIT_A)
+        values = SimpleNamespace(
+            name="Au", source="s", origin="o", eta_i=1.0, model=None, target_ACEScg=np.full((4, 3), 0.5), fit_id=FIT_A
+        )
         assert element_stem(values) == "Au_1a2b3c4d_eta1"
         # No stored fit: a content address, the same for the same data, another for other data.
         content = SimpleNamespace(**{**vars(values), "fit_id": None})
@@ -107,8 +113,7 @@ class TestMerge:
 
 @pytest.fixture(scope="module")
 def cu_values():
-    return export_values(library_material("Cu"), 1.5, tools=("gltf", "blender", "blender-conductor"),
-                         fit_id=FIT_A)
+    return export_values(library_material("Cu"), 1.5, tools=("gltf", "blender", "blender-conductor"), fit_id=FIT_A)
 
 
 @pytest.mark.slow  # one export fit of three tools, about 3 s

@@ -46,7 +46,8 @@ class TestMxFresnelConductor:
         for _ in range(20):
             n, k = rng.uniform(0.05, 4.0, 3), rng.uniform(0.0, 8.0, 3)
             np.testing.assert_allclose(
-                mx_fresnel_conductor(MU, n, k), fresnel_conductor(MU[:, None], 1.0, n, k),
+                mx_fresnel_conductor(MU, n, k),
+                fresnel_conductor(MU[:, None], 1.0, n, k),
                 atol=1e-10,  # two closed forms (MaterialX's real-arithmetic one,
                 # the complex one): ~30 roundings of terms up to n^2 + k^2 <= 80:
                 # 2400 u64 = 2.7e-13, so 1e-10 has a 400x margin
@@ -131,10 +132,7 @@ class TestColourSpaces:
         np.testing.assert_allclose(lin_rec709_to_ACEScg(ACEScg_to_lin_rec709(rgb)), rgb, atol=MATRIX_BOUND)
 
     def test_target_is_the_reference_in_rec709(self, cu_values):
-        np.testing.assert_allclose(
-            lin_rec709_to_ACEScg(cu_values.target), cu_values.target_ACEScg, atol=MATRIX_BOUND
-        )
-
+        np.testing.assert_allclose(lin_rec709_to_ACEScg(cu_values.target), cu_values.target_ACEScg, atol=MATRIX_BOUND)
 
     def test_formats_share_one_target_per_material_and_space(self, cu_values):
         # Another format of the same n, k and eta_i reuses the seen target and the naive fits
@@ -161,9 +159,7 @@ class TestFidelity:
     def test_refit_in_rec709_beats_pasting_acescg_values(self, cu_values):
         # The air-fitted ACEScg index pasted unchanged into a Rec.709 tool.
         n, k = rgb_nk(library_material("Cu"))
-        pasted = export_fidelity(
-            ExportValues(**{**cu_values.__dict__, "n_rel": n / 1.5, "k_rel": k / 1.5}), "mtlx"
-        )
+        pasted = export_fidelity(ExportValues(**{**cu_values.__dict__, "n_rel": n / 1.5, "k_rel": k / 1.5}), "mtlx")
         assert export_fidelity(cu_values, "mtlx")["delta_E_mean"] < pasted["delta_E_mean"] / 10
 
     def test_unknown_target(self, cu_values):
@@ -181,10 +177,15 @@ class TestInputs:
         mtlx = export_fidelity(values, "mtlx")["delta_E_mean"]
         assert mtlx < 0.3 and mtlx < export_fidelity(values, "gltf")["delta_E_mean"] / 3
 
-    @pytest.mark.parametrize("eta_i, rule", [
-        (0.8, "`eta_i` must lie in [1, 3], got 0.8"), (3.5, "`eta_i` must lie in [1, 3], got 3.5"),
-        (float("nan"), "`eta_i` must lie in [1, 3], got nan"), ("x", "`eta_i` must be a number, got 'x'"),
-    ])
+    @pytest.mark.parametrize(
+        "eta_i, rule",
+        [
+            (0.8, "`eta_i` must lie in [1, 3], got 0.8"),
+            (3.5, "`eta_i` must lie in [1, 3], got 3.5"),
+            (float("nan"), "`eta_i` must lie in [1, 3], got nan"),
+            ("x", "`eta_i` must be a number, got 'x'"),
+        ],
+    )
     def test_bad_eta_i(self, eta_i, rule):
         with pytest.raises(ValueError) as info:
             export_material(library_material("Cu"), "mtlx", eta_i)

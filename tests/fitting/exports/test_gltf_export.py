@@ -30,7 +30,9 @@ def khronos_report(path: Path) -> tuple[int, dict]:
     )
     result = subprocess.run(
         ["node", str(VALIDATOR / "validate.mjs"), str(path)],
-        capture_output=True, text=True, timeout=120,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     return result.returncode, json.loads(result.stdout)
 
@@ -116,16 +118,32 @@ class TestBlenderImport:
         assert blender_python.exists(), "the Blender environment is missing: run scripts/bootstrap"
         read_back, png = tmp_path / "values.json", tmp_path / "sphere.png"
         result = subprocess.run(
-            [str(blender_python), str(ROOT / "fitting" / "exports" / "blender_preview.py"),
-             str(path), "--gltf", "--values", str(read_back), "--render", str(png),
-             "--size", "24", "--samples", "2"],
-            capture_output=True, text=True, timeout=300, cwd=tmp_path,
+            [
+                str(blender_python),
+                str(ROOT / "fitting" / "exports" / "blender_preview.py"),
+                str(path),
+                "--gltf",
+                "--values",
+                str(read_back),
+                "--render",
+                str(png),
+                "--size",
+                "24",
+                "--samples",
+                "2",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            cwd=tmp_path,
         )
         assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
         material = json.loads(read_back.read_text())
         (principled,) = [n for n in material["nodes"].values() if n["type"] == "ShaderNodeBsdfPrincipled"]
         inputs = principled["inputs"]
-        np.testing.assert_allclose(inputs["Base Color"][:3], values.tools["gltf"]["base_color"], atol=1e-6)  # float32, as above
+        np.testing.assert_allclose(
+            inputs["Base Color"][:3], values.tools["gltf"]["base_color"], atol=1e-6
+        )  # float32, as above
         assert inputs["Metallic"] == 1.0
         # The coat's clearcoatFactor (1), float32 as above.
         assert inputs["Coat Weight"] == pytest.approx(values.tools["gltf"]["clearcoat"], abs=1e-6)

@@ -71,37 +71,60 @@ class TestSchema:
         change(broken)
         return list(VALIDATOR.iter_errors(broken))
 
-    @pytest.mark.parametrize("change", [
-        lambda e: e.pop("kind"),
-        lambda e: e.update(kind="schlick"),
-        lambda e: e.update(colorSpace="sRGB"),
-        lambda e: e.update(etaIRange=[0.9, 2.0]),
-        lambda e: e.update(etaIRange=[1.0, 3.5]),
-        lambda e: e.update(etaIRange=[1.0]),
-        lambda e: e.update(coatIor=1.5),
-        lambda e: e.update(degree=3),
-        lambda e: e.pop("degree"),
-        lambda e: e["coefficients"].pop("alpha"),
-        lambda e: e["coefficients"]["F0"].pop(),
-        lambda e: e["coefficients"]["a"][0].append(0.0),
-        lambda e: e["coefficients"]["F0"][1].__setitem__(0, "0.5"),
-        lambda e: e["coefficients"]["F0"][1].__setitem__(0, 1.0e6),
-        lambda e: e["coefficients"].update(n=[1, 1, 1]),
-        lambda e: e.update(extra_field=1),
-    ], ids=["no-kind", "unknown-kind", "colour-space", "range-low", "range-high", "range-short",
-            "revision-1-coat", "degree-3", "no-degree", "no-alpha", "two-rows", "long-row",
-            "string", "past-float16", "stray-n", "unknown-property"])
+    @pytest.mark.parametrize(
+        "change",
+        [
+            lambda e: e.pop("kind"),
+            lambda e: e.update(kind="schlick"),
+            lambda e: e.update(colorSpace="sRGB"),
+            lambda e: e.update(etaIRange=[0.9, 2.0]),
+            lambda e: e.update(etaIRange=[1.0, 3.5]),
+            lambda e: e.update(etaIRange=[1.0]),
+            lambda e: e.update(coatIor=1.5),
+            lambda e: e.update(degree=3),
+            lambda e: e.pop("degree"),
+            lambda e: e["coefficients"].pop("alpha"),
+            lambda e: e["coefficients"]["F0"].pop(),
+            lambda e: e["coefficients"]["a"][0].append(0.0),
+            lambda e: e["coefficients"]["F0"][1].__setitem__(0, "0.5"),
+            lambda e: e["coefficients"]["F0"][1].__setitem__(0, 1.0e6),
+            lambda e: e["coefficients"].update(n=[1, 1, 1]),
+            lambda e: e.update(extra_field=1),
+        ],
+        ids=[
+            "no-kind",
+            "unknown-kind",
+            "colour-space",
+            "range-low",
+            "range-high",
+            "range-short",
+            "revision-1-coat",
+            "degree-3",
+            "no-degree",
+            "no-alpha",
+            "two-rows",
+            "long-row",
+            "string",
+            "past-float16",
+            "stray-n",
+            "unknown-property",
+        ],
+    )
     def test_refuses_malformed_coated_conductor(self, valid, change):
         VALIDATOR.validate(valid["coated-conductor"])
         assert self.bad(valid["coated-conductor"], change)
 
-    @pytest.mark.parametrize("change", [
-        lambda e: e["coefficients"].update(n=[0.0, 1.0, 1.0]),
-        lambda e: e["coefficients"].update(k=[-0.1, 1.0, 1.0]),
-        lambda e: e["coefficients"].update(k=[1.0, 1.0]),
-        lambda e: e.update(degree=0),
-        lambda e: e["coefficients"].update(F0=[[0.5]] * 3),
-    ], ids=["n-zero", "k-negative", "k-two", "degree", "stray-F0"])
+    @pytest.mark.parametrize(
+        "change",
+        [
+            lambda e: e["coefficients"].update(n=[0.0, 1.0, 1.0]),
+            lambda e: e["coefficients"].update(k=[-0.1, 1.0, 1.0]),
+            lambda e: e["coefficients"].update(k=[1.0, 1.0]),
+            lambda e: e.update(degree=0),
+            lambda e: e["coefficients"].update(F0=[[0.5]] * 3),
+        ],
+        ids=["n-zero", "k-negative", "k-two", "degree", "stray-F0"],
+    )
     def test_refuses_malformed_rgb_conductor(self, valid, change):
         VALIDATOR.validate(valid["rgb-conductor"])
         assert self.bad(valid["rgb-conductor"], change)

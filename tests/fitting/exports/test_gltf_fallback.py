@@ -14,7 +14,11 @@ import pytest
 
 from fitting.exports import export_material, export_values
 from fitting.exports.gltf_fallback import (
-    GLTF_COAT_FACTOR, VISIBLE_COAT_F0, coat_F0, gltf_seen_delta_E, rough_seen_ACEScg,
+    GLTF_COAT_FACTOR,
+    VISIBLE_COAT_F0,
+    coat_F0,
+    gltf_seen_delta_E,
+    rough_seen_ACEScg,
 )
 from fitting.exports.seen_fit import fit_tool_values
 from fitting.optics.library import library_material

@@ -34,12 +34,17 @@ VALIDATOR = jsonschema.Draft202012Validator(json.loads(SCHEMA_PATH.read_text()))
 def glb_json(data: bytes) -> dict:
     length, kind = struct.unpack_from("<II", data, 12)
     assert data[:4] == b"glTF" and kind == 0x4E4F534A
-    return json.loads(data[20:20 + length])
+    return json.loads(data[20 : 20 + length])
 
 
 def test_the_layout_of_a_sample():
-    for name in ("README.md", "glTF/CoatedConductorGrid.gltf", "glTF/CoatedConductorGrid.bin",
-                 "glTF-Binary/CoatedConductorGrid.glb", "screenshot/screenshot.jpg"):
+    for name in (
+        "README.md",
+        "glTF/CoatedConductorGrid.gltf",
+        "glTF/CoatedConductorGrid.bin",
+        "glTF-Binary/CoatedConductorGrid.glb",
+        "screenshot/screenshot.jpg",
+    ):
         assert (SAMPLE / name).is_file(), name
     assert (SAMPLE / "screenshot" / "screenshot.jpg").read_bytes()[:3] == b"\xff\xd8\xff"  # a JPEG
 

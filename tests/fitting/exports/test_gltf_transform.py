@@ -35,7 +35,7 @@ def glb_json(path: Path) -> dict:
     magic, version, _ = struct.unpack_from("<III", data, 0)
     length, kind = struct.unpack_from("<II", data, 12)
     assert (magic, version, kind) == (0x46546C67, 2, 0x4E4F534A)
-    return json.loads(data[20:20 + length])
+    return json.loads(data[20 : 20 + length])
 
 
 def transform(command: list[str], source: Path, out: Path, config: bool = True) -> dict:

@@ -83,9 +83,7 @@ def glsl_compiles(doc: mx.Document, tmp_path) -> list[str]:
         source = shader.getSourceCode(stage)
         path = tmp_path / f"shader.{suffix}"
         path.write_text(source)
-        result = subprocess.run(
-            ["glslangValidator", str(path)], capture_output=True, text=True, timeout=120
-        )
+        result = subprocess.run(["glslangValidator", str(path)], capture_output=True, text=True, timeout=120)
         assert result.returncode == 0, result.stdout + result.stderr
         sources.append(source)
     return sources
@@ -127,8 +125,7 @@ class TestMtlx:
             return
         assert value_of(shader, "coat_ior") == pytest.approx(values.eta_i)
         assert value_of(shader, "coat_roughness") == pytest.approx(values.coat_roughness)
-        assert {i.getName() for i in nodedef.getActiveInputs()} == {
-            "base_roughness", "coat_roughness", "coat_ior"}
+        assert {i.getName() for i in nodedef.getActiveInputs()} == {"base_roughness", "coat_roughness", "coat_ior"}
         coat = graph.getNode("coat")
         assert coat.getCategory() == "dielectric_bsdf"
         assert coat.getInput("ior").getInterfaceName() == "coat_ior"
@@ -167,9 +164,13 @@ class TestOpenPBR:
         # coat_darkening 1 (OpenPBR's default): the fit is made with it on;
         # no coat at all at eta_i 1.
         coat_weight = 1.0 if values.eta_i > 1.0 else 0.0
-        for name, expected in (("base_metalness", 1.0), ("coat_weight", coat_weight),
-                               ("coat_ior", values.eta_i), ("specular_roughness", values.roughness),
-                               ("coat_darkening", 1.0)):
+        for name, expected in (
+            ("base_metalness", 1.0),
+            ("coat_weight", coat_weight),
+            ("coat_ior", values.eta_i),
+            ("specular_roughness", values.roughness),
+            ("coat_darkening", 1.0),
+        ):
             assert value_of(shader, name) == pytest.approx(expected)
         assert "f82-tint" in material.getDocString()
 

@@ -13,12 +13,23 @@ import pytest
 from fitting.colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
 from fitting.exports import channel_fit, export_material, export_values, seen_fit
 from fitting.exports.seen_fit import (
-    K_BOUNDS, N_BOUNDS, fit_tool_values, gltf_clearcoat_factor, layer_only, seen_delta_E,
-    seen_fidelity, tool_floor,
+    K_BOUNDS,
+    N_BOUNDS,
+    fit_tool_values,
+    gltf_clearcoat_factor,
+    layer_only,
+    seen_delta_E,
+    seen_fidelity,
+    tool_floor,
 )
 from fitting.exports.tool_fresnel import f82_tint, mx_fresnel_conductor
 from fitting.exports.tool_layering import (
-    TOOLS, cycles_principled, materialx_layer, three_clearcoat, three_dfg, tool_seen,
+    TOOLS,
+    cycles_principled,
+    materialx_layer,
+    three_clearcoat,
+    three_dfg,
+    tool_seen,
 )
 from fitting.optics.library import library_material
 
@@ -114,8 +125,10 @@ def test_the_jacobians_are_the_residuals_derivatives(tool, eta, space):
     """
     from fitting.exports.seen_jacobian import DeltaEComponents, delta_E_jacobian
 
-    for x_of in (lambda x0, lo, hi: np.clip(x0, lo + 0.05, np.minimum(hi, 8.0) - 0.05),
-                 lambda x0, lo, hi: np.r_[lo[0], np.clip(x0[1:], lo[1:] + 0.05, np.minimum(hi[1:], 8.0) - 0.05)]):
+    for x_of in (
+        lambda x0, lo, hi: np.clip(x0, lo + 0.05, np.minimum(hi, 8.0) - 0.05),
+        lambda x0, lo, hi: np.r_[lo[0], np.clip(x0[1:], lo[1:] + 0.05, np.minimum(hi[1:], 8.0) - 0.05)],
+    ):
         pack, lo, hi, x, target = _problem(tool, eta, x_of)
         problem = DeltaEComponents(tool, pack, lo, hi, MU, eta, target, space)
         J, Jv = delta_E_jacobian(tool, pack, x, lo, hi, MU, eta, target, space=space), problem.jac(x)
@@ -123,15 +136,16 @@ def test_the_jacobians_are_the_residuals_derivatives(tool, eta, space):
             h = 1e-6 * max(1.0, abs(x[j]))
             up, down = x.copy(), x.copy()
             up[j], down[j] = min(x[j] + h, hi[j]), max(x[j] - h, lo[j])
-            fd = (seen_delta_E(tool, pack(up), MU, eta, target, space)
-                  - seen_delta_E(tool, pack(down), MU, eta, target, space)) / (up[j] - down[j])
+            fd = (
+                seen_delta_E(tool, pack(up), MU, eta, target, space)
+                - seen_delta_E(tool, pack(down), MU, eta, target, space)
+            ) / (up[j] - down[j])
             fd_v = (problem.fun(up) - problem.fun(down)) / (up[j] - down[j])
             scale = 1e-4 * (1.0 + np.abs(fd).max())
             assert np.abs(J[:, j] - fd).max() <= scale, (tool, eta, j)
             assert np.abs(Jv[:, j] - fd_v).max() <= 1e-4 * (1.0 + np.abs(fd_v).max()), (tool, eta, j)
         # The components' sum of squares is the Delta E's.
-        assert np.isclose(np.sum(problem.fun(x) ** 2),
-                          np.sum(seen_delta_E(tool, pack(x), MU, eta, target, space) ** 2))
+        assert np.isclose(np.sum(problem.fun(x) ** 2), np.sum(seen_delta_E(tool, pack(x), MU, eta, target, space) ** 2))
 
 
 def test_the_seen_fits_end_at_their_optimum(monkeypatch):
@@ -193,6 +207,11 @@ def test_the_channel_fits_jacobians():
         fd = np.stack([(f82_tint(mu, *(x + h * e)) - f82_tint(mu, *(x - h * e))) / (2 * h) for e in np.eye(2)], 1)
         assert np.abs(channel_fit._f82_jacobian(mu, x) - fd).max() < 1e-7
     for x in (np.array([0.3, 3.0]), np.array([1.5, 0.2])):
-        fd = np.stack([(fresnel_conductor(mu, 1.0, *(x + h * e)) - fresnel_conductor(mu, 1.0, *(x - h * e))) / (2 * h)
-                       for e in np.eye(2)], 1)
+        fd = np.stack(
+            [
+                (fresnel_conductor(mu, 1.0, *(x + h * e)) - fresnel_conductor(mu, 1.0, *(x - h * e))) / (2 * h)
+                for e in np.eye(2)
+            ],
+            1,
+        )
         assert np.abs(channel_fit._conductor_jacobian(mu, x) - fd).max() < 1e-6

@@ -46,8 +46,9 @@ def materialx_renders():
     out = {}
     with RenderThread("materialx-mirrors") as thread:
         for name, eta in CASES:
-            values = export_values(library_material(name), eta, roughness=0.0, coat_roughness=0.0,
-                                   tools=("mtlx", "openpbr"))
+            values = export_values(
+                library_material(name), eta, roughness=0.0, coat_roughness=0.0, tools=("mtlx", "openpbr")
+            )
             for fmt in ("mtlx", "openpbr"):
                 image, _ = render_materialx(export_material(values, fmt, eta).decode(), SIZE, thread)
                 out[name, eta, fmt] = (values, image.astype(np.float64))
@@ -89,16 +90,28 @@ def cycles_renders(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("cycles")
     out = {}
     for name, eta in CYCLES_CASES:
-        values = export_values(library_material(name), eta, roughness=0.0, coat_roughness=0.0,
-                               tools=("blender", "blender-conductor"))
+        values = export_values(
+            library_material(name), eta, roughness=0.0, coat_roughness=0.0, tools=("blender", "blender-conductor")
+        )
         script = tmp / f"{name}.py"
         script.write_bytes(export_material(values, "blender", eta))
         for output in CYCLES_OUTPUTS:
             result = subprocess.run(
-                [str(BLENDER_PYTHON), str(Path(__file__).with_name("cycles_angles.py")), str(script),
-                 "--output", output, "--angles", ",".join(f"{a:g}" for a in CYCLES_ANGLES),
-                 "--samples", "128"],
-                capture_output=True, text=True, timeout=600, cwd=tmp,
+                [
+                    str(BLENDER_PYTHON),
+                    str(Path(__file__).with_name("cycles_angles.py")),
+                    str(script),
+                    "--output",
+                    output,
+                    "--angles",
+                    ",".join(f"{a:g}" for a in CYCLES_ANGLES),
+                    "--samples",
+                    "128",
+                ],
+                capture_output=True,
+                text=True,
+                timeout=600,
+                cwd=tmp,
             )
             assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
             line = [ln for ln in result.stdout.splitlines() if ln.startswith("CYCLES_ANGLES ")][-1]

@@ -18,7 +18,11 @@ from fitting.colour.seen import SEEN_ANGLES_DEG, seen_ACEScg
 from fitting.exports import export_material, export_values
 from fitting.exports.colour_space import lin_rec709_to_ACEScg
 from fitting.exports.seen_fit import (
-    K_BOUNDS, N_BOUNDS, fit_tool_values, fit_view_dependent_index, seen_delta_E,
+    K_BOUNDS,
+    N_BOUNDS,
+    fit_tool_values,
+    fit_view_dependent_index,
+    seen_delta_E,
 )
 from fitting.exports.tool_layering import conductor_index, tool_seen
 from fitting.optics.library import library_material
@@ -66,8 +70,12 @@ def test_falls_back_to_the_constants_with_slopes_zero(tool):
 
 
 def test_index_at_least_the_lower_bounds():
-    values = {"ior": np.full(3, 0.5), "ior_per_facing": np.array([-1.0, 0.0, 1.0]),
-              "extinction": np.full(3, 1.0), "extinction_per_facing": np.array([-2.0, 0.0, 2.0])}
+    values = {
+        "ior": np.full(3, 0.5),
+        "ior_per_facing": np.array([-1.0, 0.0, 1.0]),
+        "extinction": np.full(3, 1.0),
+        "extinction_per_facing": np.array([-2.0, 0.0, 2.0]),
+    }
     n, k = conductor_index(values, MU)
     assert n.shape == k.shape == (MU.size, 3)
     assert n[:, 0].min() == N_BOUNDS[0] and k[:, 0].min() == K_BOUNDS[0]
@@ -85,12 +93,13 @@ def test_writers_emit_the_graph_only_for_slopes():
         assert np.any(values.tools[tool]["ior_per_facing"]), tool
     mtlx = export_material(values, "mtlx", 1.5).decode()
     script = export_material(values, "blender", 1.5).decode()
-    for part in ("<viewdirection", "<normal", "<dotproduct", 'nodename="ior_at_view"',
-                 'nodename="extinction_at_view"'):
+    for part in ("<viewdirection", "<normal", "<dotproduct", 'nodename="ior_at_view"', 'nodename="extinction_at_view"'):
         assert part in mtlx, part
     assert "ShaderNodeLayerWeight" in script and "CONDUCTOR_IOR_PER_FACING = (0.0, 0.0, 0.0)" not in script
-    flat = {tool: {**values.tools[tool], "ior_per_facing": np.zeros(3), "extinction_per_facing": np.zeros(3)}
-            for tool in CONDUCTORS}
+    flat = {
+        tool: {**values.tools[tool], "ior_per_facing": np.zeros(3), "extinction_per_facing": np.zeros(3)}
+        for tool in CONDUCTORS
+    }
     constant = dataclasses.replace(values, tools={**values.tools, **flat})
     mtlx = export_material(constant, "mtlx", 1.5).decode()
     script = export_material(constant, "blender", 1.5).decode()

@@ -56,8 +56,10 @@ def test_materialx_renders_the_shipped_view_dependent_index():
         image, _ = render_materialx(document, size)
         for angle in (0.0, 20.0, 40.0, 60.0, 70.0):
             at = mask & (np.abs(theta - angle) <= 1.0)
-            dE = delta_E_map(lin_rec709_to_ACEScg(image[at].astype(np.float64)),
-                             lin_rec709_to_ACEScg(tool_seen("mtlx", fitted, mu[at], ETA)))
+            dE = delta_E_map(
+                lin_rec709_to_ACEScg(image[at].astype(np.float64)),
+                lin_rec709_to_ACEScg(tool_seen("mtlx", fitted, mu[at], ETA)),
+            )
             assert dE.max() < BOUND, (name, angle, dE.max())
 
 
@@ -71,16 +73,29 @@ def test_cycles_renders_the_shipped_view_dependent_index(tmp_path):
         script = tmp_path / f"{name}.py"
         script.write_text(export_material(values, "blender", ETA).decode())
         result = subprocess.run(
-            [str(BLENDER_PYTHON), str(Path(__file__).with_name("cycles_angles.py")), str(script),
-             "--output", "conductor", "--angles", ",".join(f"{a:g}" for a in angles), "--samples", "128"],
-            capture_output=True, text=True, timeout=600, cwd=tmp_path,
+            [
+                str(BLENDER_PYTHON),
+                str(Path(__file__).with_name("cycles_angles.py")),
+                str(script),
+                "--output",
+                "conductor",
+                "--angles",
+                ",".join(f"{a:g}" for a in angles),
+                "--samples",
+                "128",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=600,
+            cwd=tmp_path,
         )
         assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-2000:]
         assert "deprecated" not in (result.stdout + result.stderr).lower()
         line = [ln for ln in result.stdout.splitlines() if ln.startswith("CYCLES_ANGLES ")][-1]
         rendered = json.loads(line.split(" ", 1)[1])
         render = np.array([rendered[f"{a:g}"] for a in angles])
-        dE = delta_E_map(lin_rec709_to_ACEScg(render),
-                         lin_rec709_to_ACEScg(tool_seen("blender-conductor", fitted,
-                                                        np.cos(np.radians(angles)), ETA)))
+        dE = delta_E_map(
+            lin_rec709_to_ACEScg(render),
+            lin_rec709_to_ACEScg(tool_seen("blender-conductor", fitted, np.cos(np.radians(angles)), ETA)),
+        )
         assert dE.max() < BOUND, (name, dE)

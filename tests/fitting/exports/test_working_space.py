@@ -29,8 +29,7 @@ class TestSpaces:
     def test_round_trip(self):
         rgb = np.array([[0.9, 0.6, 0.2], [0.1, 0.5, 0.8]])
         for space in ("lin_rec709", "acescg"):
-            np.testing.assert_allclose(working_to_ACEScg(ACEScg_to_working(rgb, space), space), rgb,
-                                       atol=1e-12)
+            np.testing.assert_allclose(working_to_ACEScg(ACEScg_to_working(rgb, space), space), rgb, atol=1e-12)
         np.testing.assert_array_equal(ACEScg_to_working(rgb, "acescg"), rgb)
 
     def test_bad_space(self):
@@ -43,9 +42,10 @@ class TestSpaces:
 @pytest.fixture(scope="module")
 def au_values():
     """Gold at 1.5 fitted in each working space: (lin_rec709, acescg)."""
-    return tuple(export_values(library_material("Au"), 1.5, working_space=space,
-                               tools=("mtlx", "blender", "blender-conductor"))
-                 for space in ("lin_rec709", "acescg"))
+    return tuple(
+        export_values(library_material("Au"), 1.5, working_space=space, tools=("mtlx", "blender", "blender-conductor"))
+        for space in ("lin_rec709", "acescg")
+    )
 
 
 @pytest.mark.slow  # two export fits, about 6 s
@@ -58,8 +58,9 @@ class TestMaterialX:
         mx.readFromXmlString(doc, export_material(aces, "mtlx", 1.5).decode())
         assert doc.getColorSpace() == "acescg"
         (graph,) = doc.getNodeGraphs()
-        values = [i for node in graph.getNodes() for i in node.getInputs()
-                  if i.getType() == "color3" and i.getValueString()]
+        values = [
+            i for node in graph.getNodes() for i in node.getInputs() if i.getType() == "color3" and i.getValueString()
+        ]
         assert values and {i.getColorSpace() for i in values} == {"acescg"}
 
     def test_matching_host_converts_nothing(self, au_values):
@@ -78,8 +79,7 @@ def run_blender(code: str, tmp_path: Path) -> subprocess.CompletedProcess:
     assert BLENDER_PYTHON.exists(), "the Blender environment is missing: run scripts/bootstrap"
     driver = tmp_path / "driver.py"
     driver.write_text(textwrap.dedent(code))
-    return subprocess.run([str(BLENDER_PYTHON), str(driver)], capture_output=True, text=True,
-                          timeout=300, cwd=tmp_path)
+    return subprocess.run([str(BLENDER_PYTHON), str(driver)], capture_output=True, text=True, timeout=300, cwd=tmp_path)
 
 
 @pytest.mark.slow  # starts Blender
@@ -87,7 +87,8 @@ def test_blender_refuses_another_working_space_and_touches_one_slot(au_values, t
     rec709, aces = au_values
     (tmp_path / "rec709.py").write_bytes(export_material(rec709, "blender", 1.5))
     (tmp_path / "aces.py").write_bytes(export_material(aces, "blender", 1.5))
-    result = run_blender("""
+    result = run_blender(
+        """
         import runpy, bpy
         bpy.ops.wm.read_factory_settings(use_empty=True)
         bpy.ops.mesh.primitive_cube_add()
@@ -113,12 +114,15 @@ def test_blender_refuses_another_working_space_and_touches_one_slot(au_values, t
         runpy.run_path("aces.py", run_name="__main__")
         assert cube.material_slots[1].material["coated_fresnel_working_space"] == "acescg"
         print("OK")
-    """, tmp_path)
+    """,
+        tmp_path,
+    )
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     assert "OK" in result.stdout
-    assert ("REFUSED coated-fresnel: this file's working space is 'lin_ap1_scene', but this material's "
-            "colours and n, k were fitted in 'lin_rec709'; export it again with working_space=acescg"
-            ) in result.stdout
+    assert (
+        "REFUSED coated-fresnel: this file's working space is 'lin_ap1_scene', but this material's "
+        "colours and n, k were fitted in 'lin_rec709'; export it again with working_space=acescg"
+    ) in result.stdout
 
 
 @pytest.mark.slow  # 16 export fits, about 15 s
@@ -131,9 +135,12 @@ def test_acescg_is_as_faithful_as_rec709_metal_by_metal():
 
     tools = ("mtlx", "openpbr", "blender", "blender-conductor")
     for metal in ("Au", "Cu", "Ag", "Al", "CuZn", "Cr", "Ni", "W"):
-        rec709, aces = (export_values(library_material(metal), 1.5, roughness=0.0, coat_roughness=0.0,
-                                      tools=tools, working_space=space)
-                        for space in ("lin_rec709", "acescg"))
+        rec709, aces = (
+            export_values(
+                library_material(metal), 1.5, roughness=0.0, coat_roughness=0.0, tools=tools, working_space=space
+            )
+            for space in ("lin_rec709", "acescg")
+        )
         for tool in tools:
             worse = seen_fidelity(aces, tool)["delta_E_mean"] - seen_fidelity(rec709, tool)["delta_E_mean"]
             assert worse <= 0.1, (metal, tool, worse)

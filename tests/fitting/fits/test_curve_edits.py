@@ -14,8 +14,14 @@ import numpy as np
 import pytest
 
 from fitting import (
-    RGBCurve, coated_conductor_model, curve_base_from_nk, delta_E_map, edited_target, fit_coefficients,
-    fit_curves, library_material,
+    RGBCurve,
+    coated_conductor_model,
+    curve_base_from_nk,
+    delta_E_map,
+    edited_target,
+    fit_coefficients,
+    fit_curves,
+    library_material,
 )
 from fitting.fits.curves import SCORE_GRID, score_grid, whole_target_error
 from fitting.fits.curves_guard import AUDIT_SAMPLES
@@ -50,11 +56,14 @@ def dense_range(result):
 
 
 @pytest.mark.slow  # 22.5 s (all cases 33.1 s) in a --durations=0 run
-@pytest.mark.parametrize("material, edits", [
-    ("Au", [(1.5, 0, 60, 0.0)]),                       # a point pulled to 0
-    ("Ag", [(1.5, 2, 40, 0.2), (2.4, 1, 70, 1.0)]),    # a bright metal darkened, and pulled to 1
-    ("Cu", [(1.0, 0, 78, 0.0), (2.5, 2, 20, 1.0)]),    # opposite extremes at both ends
-])
+@pytest.mark.parametrize(
+    "material, edits",
+    [
+        ("Au", [(1.5, 0, 60, 0.0)]),  # a point pulled to 0
+        ("Ag", [(1.5, 2, 40, 0.2), (2.4, 1, 70, 1.0)]),  # a bright metal darkened, and pulled to 1
+        ("Cu", [(1.0, 0, 78, 0.0), (2.5, 2, 20, 1.0)]),  # opposite extremes at both ends
+    ],
+)
 def test_extreme_edits_stay_in_range(material, edits):
     base = base_of(material)
     curves = [pulled(base, *edit) for edit in edits]
@@ -95,7 +104,9 @@ def test_single_curve_edit_leaves_far_rows_at_the_base():
     # The blended target is the base beyond the blend width (0.5) ...
     far = np.array([1.0, 2.1, 2.5])
     E, M = np.meshgrid(far, MU, indexing="ij")
-    np.testing.assert_allclose(edited_target(base, curves, M, E, 0.5), np.clip(base.rgb(M, E), 0, 1), atol=1e-12)  # blend
+    np.testing.assert_allclose(
+        edited_target(base, curves, M, E, 0.5), np.clip(base.rgb(M, E), 0, 1), atol=1e-12
+    )  # blend
     # weight exactly 0: only a few roundings of values <= 1
     # ... and the fit stays close to it there (well under a visible difference).
     E, M = np.meshgrid(np.linspace(2.1, 2.5, 5), MU, indexing="ij")
@@ -111,12 +122,15 @@ def paper_method(base, curves):
     return whole_target_error(base, curves, C, 0.5)["delta_E_mean"]
 
 
-@pytest.mark.parametrize("material, edits", [
-    ("Au", [(1.5, 0, 50, 0.75)]),
-    ("Cu", [(1.5, 1, 36, None, 0.8), (1.2, 1, 36, None, 0.8)]),
-    ("Al", [(1.5, 2, 60, 0.5)]),
-    ("Cr", [(1.5, 0, 55, 0.5), (1.2, 1, 60, 0.4), (2.0, 2, 66, 0.3), (2.4, 0, 72, 0.2)]),
-])
+@pytest.mark.parametrize(
+    "material, edits",
+    [
+        ("Au", [(1.5, 0, 50, 0.75)]),
+        ("Cu", [(1.5, 1, 36, None, 0.8), (1.2, 1, 36, None, 0.8)]),
+        ("Al", [(1.5, 2, 60, 0.5)]),
+        ("Cr", [(1.5, 0, 55, 0.5), (1.2, 1, 60, 0.4), (2.0, 2, 66, 0.3), (2.4, 0, 72, 0.2)]),
+    ],
+)
 @pytest.mark.slow  # 1.6-7.4 s a case (refits of four metals) in a --durations=0 run under load
 def test_default_refit_is_at_least_as_close_as_the_papers_method(material, edits):
     """
@@ -132,8 +146,9 @@ def test_default_refit_is_at_least_as_close_as_the_papers_method(material, edits
     ours = fit_curves(curves, base).packed.coefficients
     _, _, M, E = score_grid(base.eta_i_range, (AUDIT_SAMPLES, AUDIT_SAMPLES))
     target = edited_target(base, curves, M, E, 0.5)
-    paper = fit_coefficients(target.reshape(-1, 3), M.ravel(), E.ravel(), base.eta_i_range, 2,
-                             "rgb").coefficients_float16
+    paper = fit_coefficients(
+        target.reshape(-1, 3), M.ravel(), E.ravel(), base.eta_i_range, 2, "rgb"
+    ).coefficients_float16
 
     def mean(C):
         return float(delta_E_map(target, coated_conductor_model(M, E, C, base.eta_i_range)).mean())

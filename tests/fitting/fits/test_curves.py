@@ -24,11 +24,13 @@ MU = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))
 # the float16 rounding of its coefficients, at most 1e-4 over.
 FLOAT16_RANGE_SLACK = 1e-4
 
-KNOWN = np.array([
-    [[0.90, -0.08, 0.03], [0.74, -0.17, 0.10], [0.42, -0.36, 0.22]],
-    [[0.20, 0.05, 0.00], [0.15, 0.03, 0.01], [0.10, 0.02, 0.00]],
-    [[6.00, 1.00, 0.00], [5.00, 0.50, 0.00], [4.00, 0.50, 0.00]],
-])
+KNOWN = np.array(
+    [
+        [[0.90, -0.08, 0.03], [0.74, -0.17, 0.10], [0.42, -0.36, 0.22]],
+        [[0.20, 0.05, 0.00], [0.15, 0.03, 0.01], [0.10, 0.02, 0.00]],
+        [[6.00, 1.00, 0.00], [5.00, 0.50, 0.00], [4.00, 0.50, 0.00]],
+    ]
+)
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +64,9 @@ class TestFitCurves:
         etas = (1.0, 1.75, 2.5)
         result = fit_curves([curve_of(KNOWN, e) for e in etas], max_nfev=200)
         eta = np.linspace(1.0, 2.5, 16)[:, None]
-        dE = delta_E_map(coated_conductor_model(MU, eta, KNOWN), coated_conductor_model(MU, eta, result.coefficients_float16))
+        dE = delta_E_map(
+            coated_conductor_model(MU, eta, KNOWN), coated_conductor_model(MU, eta, result.coefficients_float16)
+        )
         # A fit-quality figure (the fit of exact model curves; docs/editor.md), not a
         # precision bound: another CPU's kernels move it by ~1e-10 (solver tol).
         assert dE.mean() < 0.2
@@ -172,6 +176,8 @@ class TestLiveRefit:
             curves = [{"eta_i": 1.5, "cos_theta": MU.tolist(), "rgb": rgb.tolist()}]
             live = fit_curves(curves, gold_base, settings=LIVE_SETTINGS, start=start)
             target = live.metrics["target"]
-            assert -FLOAT16_RANGE_SLACK <= target["model_min"] and target["model_max"] <= 1.0 + FLOAT16_RANGE_SLACK, step
+            assert -FLOAT16_RANGE_SLACK <= target["model_min"] and target["model_max"] <= 1.0 + FLOAT16_RANGE_SLACK, (
+                step
+            )
             assert live.nfev + live.njev <= LIVE_SETTINGS.max_evaluations, step
             start = live.coefficients_float16.astype(np.float64)

@@ -18,12 +18,15 @@ from fitting.fits.curves_range import proven_in_range
 
 
 def test_edit_warnings_name_where_and_by_how_much():
-    rows = [{"eta_i": 1.5, "delta_E_mean": 18.6, "delta_E_max": 24.0},
-            {"eta_i": 2.0, "delta_E_mean": 0.2, "delta_E_max": 0.9},
-            {"eta_i": 1.2, "delta_E_mean": 0.5, "delta_E_max": FOLLOW_MAX + 0.1}]
+    rows = [
+        {"eta_i": 1.5, "delta_E_mean": 18.6, "delta_E_max": 24.0},
+        {"eta_i": 2.0, "delta_E_mean": 0.2, "delta_E_max": 0.9},
+        {"eta_i": 1.2, "delta_E_mean": 0.5, "delta_E_max": FOLLOW_MAX + 0.1},
+    ]
     first, second = edit_warnings(rows)
-    assert first.startswith("edit not followed: the fit stays 18.60 mean Delta E 2000 from the edited "
-                            "curve at eta_i 1.5 (max 24.00)")
+    assert first.startswith(
+        "edit not followed: the fit stays 18.60 mean Delta E 2000 from the edited curve at eta_i 1.5 (max 24.00)"
+    )
     assert "eta_i 1.2" in second
     assert edit_warnings([{"eta_i": 1.5, "delta_E_mean": FOLLOW_MEAN, "delta_E_max": FOLLOW_MAX}]) == []
 

@@ -36,11 +36,13 @@ ANGLE = np.linspace(0.0, 90.0, 46)
 MU = np.where(ANGLE == 90.0, 0.0, np.cos(np.radians(ANGLE)))
 
 # A gold-like model, quadratic in t (layout [parameter, channel, power]).
-KNOWN = np.array([
-    [[0.90, -0.08, 0.03], [0.74, -0.17, 0.10], [0.42, -0.36, 0.22]],
-    [[0.20, 0.05, 0.00], [0.15, 0.03, 0.01], [0.10, 0.02, 0.00]],
-    [[6.00, 1.00, 0.00], [5.00, 0.50, 0.00], [4.00, 0.50, 0.00]],
-])
+KNOWN = np.array(
+    [
+        [[0.90, -0.08, 0.03], [0.74, -0.17, 0.10], [0.42, -0.36, 0.22]],
+        [[0.20, 0.05, 0.00], [0.15, 0.03, 0.01], [0.10, 0.02, 0.00]],
+        [[6.00, 1.00, 0.00], [5.00, 0.50, 0.00], [4.00, 0.50, 0.00]],
+    ]
+)
 
 
 @pytest.fixture(scope="module")
@@ -92,19 +94,22 @@ class TestCurveBase:
         base = curve_base_from_coefficients(KNOWN, (1.0, 2.5))
         eta = np.array([1.0, 1.33, 2.5])
         np.testing.assert_allclose(
-            base.rgb(MU[None, :], eta[:, None]), coated_conductor_model(MU[None, :], eta[:, None], KNOWN),
+            base.rgb(MU[None, :], eta[:, None]),
+            coated_conductor_model(MU[None, :], eta[:, None], KNOWN),
             atol=BASE_INTERPOLATION_BOUND,
         )
 
     def test_single_eta_domain(self):
         base = curve_base_from_coefficients(KNOWN, (1.5, 1.5))
-        np.testing.assert_allclose(base.rgb(MU, 1.5), coated_conductor_model(MU, 1.5, KNOWN, (1.5, 1.5)), atol=BASE_INTERPOLATION_BOUND)
+        np.testing.assert_allclose(
+            base.rgb(MU, 1.5), coated_conductor_model(MU, 1.5, KNOWN, (1.5, 1.5)), atol=BASE_INTERPOLATION_BOUND
+        )
 
 
 class TestEditedTarget:
     def test_curve_replaces_base_at_its_eta_and_fades(self, gold_base):
         edit = gold_base.rgb(MU, 1.5)
-        edit[:, 0] = np.clip(edit[:, 0] + 0.1 * np.exp(-((ANGLE - 60) / 12) ** 2), 0, 1)
+        edit[:, 0] = np.clip(edit[:, 0] + 0.1 * np.exp(-(((ANGLE - 60) / 12) ** 2)), 0, 1)
         curve = RGBCurve(1.5, MU, edit)
         np.testing.assert_allclose(edited_target(gold_base, [curve], MU, 1.5, 0.3), edit, atol=BLEND_ROUNDING)
         far = edited_target(gold_base, [curve], MU, 2.2, 0.3)

@@ -32,7 +32,9 @@ class TestRGBCurve:
     def test_above_one_names_the_place(self):
         rgb = np.full((MU.size, 3), 0.5)
         rgb[12, 0] = 1.2
-        with pytest.raises(ValueError, match=r"`curve\.rgb\[\d+\]\[0\]` \(R at cos_theta .*\) must lie in \[0, 1\], got 1\.2"):
+        with pytest.raises(
+            ValueError, match=r"`curve\.rgb\[\d+\]\[0\]` \(R at cos_theta .*\) must lie in \[0, 1\], got 1\.2"
+        ):
             RGBCurve(1.5, MU, rgb)
 
     def test_below_zero_names_the_place(self):

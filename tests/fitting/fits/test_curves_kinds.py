@@ -46,11 +46,13 @@ class TestRGBConductorCurveFits:
         model = rgb_conductor_model(MU, 1.3, result.coefficients_float16)
         target = np.asarray(curves[0]["rgb"])
         assert result.metrics["by_curve"][0]["delta_E_mean"] == pytest.approx(
-            float(delta_E_map(target, model).mean()), rel=1e-9)  # the same Delta E
+            float(delta_E_map(target, model).mean()), rel=1e-9
+        )  # the same Delta E
         # by another path: per sample ~1e-12 (1e4 per unit RGB x 1e-16), a mean of
         # Delta E ~0.1: rel <= 1e-10, so 1e-9 holds with a 10x margin
-        whole = whole_target_error(copper, check_curves(curves), result.coefficients_float16, 0.5,
-                                   model="rgb-conductor")
+        whole = whole_target_error(
+            copper, check_curves(curves), result.coefficients_float16, 0.5, model="rgb-conductor"
+        )
         assert whole == result.metrics["target"]
         assert np.all(n > 0) and np.all(k >= 0)
 
@@ -74,8 +76,9 @@ class TestRGBConductorCurveFits:
 
     def test_a_stored_rgb_conductor_model_is_a_base(self, copper):
         first = fit_curves([curve(copper, 1.5)], copper, model="rgb-conductor")
-        base = curve_base_from_coefficients(first.coefficients_float16, copper.eta_i_range, "Cu rgb",
-                                            model="rgb-conductor")
+        base = curve_base_from_coefficients(
+            first.coefficients_float16, copper.eta_i_range, "Cu rgb", model="rgb-conductor"
+        )
         M, E = np.meshgrid(MU, np.array([1.0, 2.5]))
         expected = rgb_conductor_model(M, E, first.coefficients_float16)
         # The base's bilinear table of the model (see BASE_INTERPOLATION_BOUND in

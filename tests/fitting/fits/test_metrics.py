@@ -36,8 +36,7 @@ class TestErrorMetrics:
         view = m.to_dict()
         assert list(view) == ["delta_E_mean", "delta_E_max", "against", "rmse", "by_eta_i"]
         assert list(view["by_eta_i"]) == ["1", "1.5", "2", "2.5"]
-        assert view["by_eta_i"]["1.5"] == {"delta_E_mean": float(dE[1].mean()),
-                                           "delta_E_max": float(dE[1].max())}
+        assert view["by_eta_i"]["1.5"] == {"delta_E_mean": float(dE[1].mean()), "delta_E_max": float(dE[1].max())}
         assert view["rmse"] == pytest.approx(np.sqrt(np.mean((REF - MODEL) ** 2)), rel=1e-15)  # the same sum, once
         # more: 28 squares, a sqrt: <= 4 u64 relative
 
@@ -60,15 +59,22 @@ class TestErrorMetrics:
         assert [c["eta_i"] for c in view["by_curve"]] == [1.0, 2.0]
         both = np.concatenate([delta_E_map(REF[0], MODEL[0]), delta_E_map(REF[2], MODEL[2])])
         worst = int(np.argmax(both))  # the max's place: the curve and the angle of that sample
-        assert view["max_at"] == {"eta_i": [1.0, 2.0][worst // 7],
-                                  "theta_deg": float(np.degrees(np.arccos(mu[worst % 7])))}
-        assert m.figure() == {"against": view["against"], "delta_E_mean": m.mean, "delta_E_max": m.max,
-                              "max_at": view["max_at"]}
+        assert view["max_at"] == {
+            "eta_i": [1.0, 2.0][worst // 7],
+            "theta_deg": float(np.degrees(np.arccos(mu[worst % 7]))),
+        }
+        assert m.figure() == {
+            "against": view["against"],
+            "delta_E_mean": m.mean,
+            "delta_E_max": m.max,
+            "max_at": view["max_at"],
+        }
         assert view["delta_E_mean"] == float(both.mean())
         s = delta_E_summary(REF, MODEL, "x")
         assert s.to_dict() == {"mean": m_mean(REF, MODEL), "max": float(delta_E_map(REF, MODEL).max())}
         assert delta_E_summary(REF, MODEL, layout="grid").to_dict() == {
-            "delta_E_mean": m_mean(REF, MODEL), "delta_E_max": float(delta_E_map(REF, MODEL).max())
+            "delta_E_mean": m_mean(REF, MODEL),
+            "delta_E_max": float(delta_E_map(REF, MODEL).max()),
         }
 
     def test_frozen_and_layout_checked(self):

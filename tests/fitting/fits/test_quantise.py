@@ -71,10 +71,10 @@ class TestCompensations:
         order = np.argsort(-np.diag(H))
         moves = compensations(Hs, order)
         for k, i in enumerate(order):
-            free = order[k + 1:]
+            free = order[k + 1 :]
             assert moves[k, k] == pytest.approx(1.0, abs=1e-12)
             if free.size:
                 expected = -np.linalg.solve(Hs[np.ix_(free, free)], Hs[free, i])
                 # Two factorisations of Hs (condition up to ~1e4 here, its columns
                 # spanning 1e-2..1e2 before scaling): 1e4 * u64 << 1e-9.
-                np.testing.assert_allclose(moves[k, k + 1:], expected, rtol=1e-9, atol=1e-11)
+                np.testing.assert_allclose(moves[k, k + 1 :], expected, rtol=1e-9, atol=1e-11)

@@ -94,8 +94,9 @@ class TestObjectiveJacobian:
         problem = RGBConductorObjective(target, mu, eta, objective, w)
         x = np.array([0.3, 0.8, 1.2, 3.2, 2.6, 2.3])
         h = 1e-6
-        differences = np.stack([(problem.residuals(x + h * e) - problem.residuals(x - h * e)) / (2 * h)
-                                for e in np.eye(6)], axis=1)
+        differences = np.stack(
+            [(problem.residuals(x + h * e) - problem.residuals(x - h * e)) / (2 * h) for e in np.eye(6)], axis=1
+        )
         J = problem.jacobian(x)
         assert J.shape == (3 * mu.size, 6)
         np.testing.assert_allclose(J, differences, atol=1e-8 * np.abs(differences).max())
@@ -144,7 +145,10 @@ class TestCommandLine:
         assert view["metrics"]["model_float16"]["delta_E_mean"] < 0.06  # product claim, as above
         (material,) = decode_pack(out.read_bytes())
         assert material.model == "rgb-conductor"
-        assert material.coefficients.astype(np.float64).tolist() == [view["coefficients"]["n"], view["coefficients"]["k"]]
+        assert material.coefficients.astype(np.float64).tolist() == [
+            view["coefficients"]["n"],
+            view["coefficients"]["k"],
+        ]
 
     @pytest.mark.slow  # 3.6 s (all cases 3.6 s) in a --durations=0 run
     def test_default_kind_unchanged_and_bad_kind_refused(self):

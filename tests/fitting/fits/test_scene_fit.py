@@ -43,13 +43,11 @@ class TestDefaultRule:
     """Without a budget: the cheapest candidate no worse on mean and max than every dearer one."""
 
     def test_a_cheaper_candidate_better_on_both_wins(self):
-        errors = {CC0: E(0.30, 1.0), RGB: E(0.05, 0.2), CC1: E(0.12, 0.5), CC2: E(0.10, 0.4),
-                  GENERAL: E(0.5, 2.0)}
+        errors = {CC0: E(0.30, 1.0), RGB: E(0.05, 0.2), CC1: E(0.12, 0.5), CC2: E(0.10, 0.4), GENERAL: E(0.5, 2.0)}
         assert choose_candidate(errors, None, None)[0] == RGB
 
     def test_a_dearer_candidate_better_on_the_max_is_not_passed_over(self):
-        errors = {CC0: E(0.30, 1.0), RGB: E(0.05, 0.5), CC1: E(0.06, 0.4), CC2: E(0.07, 0.45),
-                  GENERAL: E(0.5, 2.0)}
+        errors = {CC0: E(0.30, 1.0), RGB: E(0.05, 0.5), CC1: E(0.06, 0.4), CC2: E(0.07, 0.45), GENERAL: E(0.5, 2.0)}
         chosen, why = choose_candidate(errors, None, None)
         assert chosen == CC1 and "no worse on mean and max than every dearer one" in why
 
@@ -68,7 +66,7 @@ class TestDefaultRule:
             order = [*CANDIDATES, GENERAL]
             assert errors[chosen].mean <= errors[GENERAL].mean
             assert errors[chosen].max <= errors[GENERAL].max
-            for dearer in order[order.index(chosen) + 1:]:
+            for dearer in order[order.index(chosen) + 1 :]:
                 if errors[dearer].mean <= errors[GENERAL].mean and errors[dearer].max <= errors[GENERAL].max:
                     assert errors[chosen].mean <= errors[dearer].mean
                     assert errors[chosen].max <= errors[dearer].max
@@ -112,14 +110,12 @@ class TestFitScene:
         decoded = {m.name: m for m in decode_pack(showroom.pack_bytes())}
         for result in showroom.materials:
             spec = result.material.eta_i
-            rows = np.array(spec.values) if spec.kind != "range" else np.linspace(
-                *spec.values, EVALUATION_ETA_ROWS)
+            rows = np.array(spec.values) if spec.kind != "range" else np.linspace(*spec.values, EVALUATION_ETA_ROWS)
             mu = np.linspace(0.0, 1.0, EVALUATION_MU_SAMPLES)
             E, M = np.meshgrid(rows, mu, indexing="ij")
             ref = reference_ACEScg(result.material.nk, M, E)
             packed = decoded[result.packed.name]
-            dE = delta_E_map(ref, model_ACEScg(packed.model, M, E, packed.coefficients,
-                                               packed.eta_i_range))
+            dE = delta_E_map(ref, model_ACEScg(packed.model, M, E, packed.coefficients, packed.eta_i_range))
             # The same reference and model on the same grid; only the
             # wavelength sum's order may differ (F64_RGB_BOUND 1.3e-13) times
             # Delta E's slope (<= ~1e3 per unit RGB at these reflectances):
@@ -151,10 +147,20 @@ class TestFitScene:
     def test_refusal_names_the_material(self):
         Au = library_material("Au")
         keep = (Au.wavelength_nm >= 500) & (Au.wavelength_nm <= 900)
-        scene = parse_scene({"materials": [{
-            "name": "red end", "eta_i": 1.5,
-            "nk": {"wavelength_nm": Au.wavelength_nm[keep].tolist(),
-                   "n": Au.n[keep].tolist(), "k": Au.k[keep].tolist()},
-        }]})
+        scene = parse_scene(
+            {
+                "materials": [
+                    {
+                        "name": "red end",
+                        "eta_i": 1.5,
+                        "nk": {
+                            "wavelength_nm": Au.wavelength_nm[keep].tolist(),
+                            "n": Au.n[keep].tolist(),
+                            "k": Au.k[keep].tolist(),
+                        },
+                    }
+                ]
+            }
+        )
         with pytest.raises(ValueError, match=r"material 'red end': `wavelength_nm` must cover at least 90%"):
             fit_scene(scene)

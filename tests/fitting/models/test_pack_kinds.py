@@ -110,7 +110,8 @@ class TestJSONView:
         view = material_to_json(m)
         assert view["model"] == "rgb-conductor"
         assert view["coefficients"] == {
-            "n": [float(v) for v in m.coefficients[0]], "k": [float(v) for v in m.coefficients[1]]
+            "n": [float(v) for v in m.coefficients[0]],
+            "k": [float(v) for v in m.coefficients[1]],
         }
         assert "degree" not in view
         assert json.loads(json.dumps(view)) == view  # plain JSON numbers, exactly the halves
@@ -166,12 +167,15 @@ class TestKinds:
         C = np.array([[0.26, 0.47, 1.32], [3.03, 2.31, 1.92]])
         mu = np.linspace(0.0, 1.0, 7)
         np.testing.assert_allclose(
-            rgb_conductor_model(mu, 2.0, C), rgb_conductor_model(mu, 1.0, C / 2.0), atol=1e-15  # halving
+            rgb_conductor_model(mu, 2.0, C),
+            rgb_conductor_model(mu, 1.0, C / 2.0),
+            atol=1e-15,  # halving
             # is exact, so both sides form the same relative index; only the
             # kernel's ~20 roundings of R <= 1 in another order: 9 u64 = 1e-15
         )
-        np.testing.assert_allclose(model_ACEScg("rgb-conductor", mu, 1.5, C, (1.0, 2.5)),
-                                   rgb_fresnel_conductor(mu, 1.5, C[0], C[1]), atol=0)
+        np.testing.assert_allclose(
+            model_ACEScg("rgb-conductor", mu, 1.5, C, (1.0, 2.5)), rgb_fresnel_conductor(mu, 1.5, C[0], C[1]), atol=0
+        )
         F = rgb_conductor_model(mu, np.array([[1.0], [2.5]]), C)
         assert F.shape == (2, 7, 3) and np.all(F[:, 0] == 1.0)  # grazing incidence
 

@@ -12,8 +12,7 @@ SCENE = SHOWROOM_SCENE  # and the `showroom` fixture: its fit, once a session (t
 class TestRecordBytes:
     @pytest.mark.parametrize("degree", [0, 1, 2])
     def test_matches_the_binary_pack(self, degree):
-        material = PackedMaterial("Gold é", np.zeros((3, 3, degree + 1), np.float16),
-                                  (1.0, 2.0), source="J&C 1972")
+        material = PackedMaterial("Gold é", np.zeros((3, 3, degree + 1), np.float16), (1.0, 2.0), source="J&C 1972")
         pack = encode_pack([material])
         header, crc = 12, 4
         assert material_record_bytes("Gold é", "J&C 1972", degree) == len(pack) - header - crc

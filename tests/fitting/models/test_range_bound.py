@@ -86,8 +86,9 @@ def test_centred_form_encloses_the_model_on_every_cell():
         x1 = np.minimum(1.0, x0 + rng.uniform(1e-3, 0.2, 20))
         t0 = rng.uniform(0.0, 0.9, 20)
         t1 = np.minimum(1.0, t0 + rng.uniform(1e-3, 0.3, 20))
-        centre = coated_conductor_model(1.0 - 0.5 * (x0 + x1), DOMAIN[0] + (DOMAIN[1] - DOMAIN[0]) * 0.5 * (t0 + t1),
-                                        C, DOMAIN)
+        centre = coated_conductor_model(
+            1.0 - 0.5 * (x0 + x1), DOMAIN[0] + (DOMAIN[1] - DOMAIN[0]) * 0.5 * (t0 + t1), C, DOMAIN
+        )
         lo, hi = _centred_enclosure(C, x0, x1, t0, t1, centre)
         for i in range(20):
             X, T = np.meshgrid(np.linspace(x0[i], x1[i], 31), np.linspace(t0[i], t1[i], 11))
@@ -100,9 +101,13 @@ def test_a_fit_touching_one_inside_the_domain_is_proven_in_few_cells():
     # The green channel of the degenerate base's refit, which
     # touches 1 inside the domain: the first-order form alone took 93,304
     # cells (0.2 s); with the centred form 1,456.
-    C = np.array([[[0.5, 0.0, 0.0], [0.0003001689910888672, 1.865234375, -1.712890625], [0.5, 0.0, 0.0]],
-                  [[0.0, 0.0, 0.0], [0.0823974609375, -0.499267578125, -2.734375], [0.0, 0.0, 0.0]],
-                  [[0.0, 0.0, 0.0], [3.033203125, -6.33984375, 4.48046875], [0.0, 0.0, 0.0]]])
+    C = np.array(
+        [
+            [[0.5, 0.0, 0.0], [0.0003001689910888672, 1.865234375, -1.712890625], [0.5, 0.0, 0.0]],
+            [[0.0, 0.0, 0.0], [0.0823974609375, -0.499267578125, -2.734375], [0.0, 0.0, 0.0]],
+            [[0.0, 0.0, 0.0], [3.033203125, -6.33984375, 4.48046875], [0.0, 0.0, 0.0]],
+        ]
+    )
     cert = certify_range(C, DOMAIN)
     assert cert.in_range is True and cert.cells < 5_000
     F = dense(C)

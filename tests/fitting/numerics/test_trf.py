@@ -41,8 +41,9 @@ class TestTrfLeastSquares:
         """The same steps as scipy's trf (x_scale='jac'): the same evaluations and optimum."""
         fun, jac, x0 = problem()
         ours = trf_least_squares(fun, jac, x0, 1e-10, 1e-10, 1e-10, 200)
-        theirs = least_squares(fun, x0, jac=jac, method="trf", x_scale="jac",
-                               ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=200)
+        theirs = least_squares(
+            fun, x0, jac=jac, method="trf", x_scale="jac", ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=200
+        )
         assert (ours.nfev, ours.njev, ours.status) == (theirs.nfev, theirs.njev, theirs.status)
         np.testing.assert_allclose(ours.x, theirs.x, rtol=1e-9, atol=1e-12)
         assert ours.cost == pytest.approx(theirs.cost, rel=1e-9, abs=1e-15)
@@ -56,6 +57,7 @@ class TestTrfLeastSquares:
 
     def test_rank_deficient(self):
         """Two unknowns that only their sum identifies: a finite minimiser of least norm step, cost 0."""
+
         def fun(x):
             return np.array([x[0] + x[1] - 1.0, 2.0 * (x[0] + x[1] - 1.0)])
 
@@ -67,6 +69,7 @@ class TestTrfLeastSquares:
 
     def test_non_finite_trial_shrinks_the_region(self):
         """A step to where f is not finite is refused, not taken."""
+
         def fun(x):
             return np.array([np.log(x[0]) - 1.0]) if x[0] > 0 else np.array([np.nan])
 
@@ -78,6 +81,7 @@ class TestTrfLeastSquares:
 
     def test_a_jacobian_not_finite_stops_the_solve(self):
         """A Jacobian with a NaN is reported (status -1), never looped on."""
+
         def fun(x):
             return np.array([x[0] - 1.0, x[1] - 2.0])
 

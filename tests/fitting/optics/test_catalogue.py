@@ -6,8 +6,14 @@ import numpy as np
 import pytest
 
 from fitting.cli.main import main
-from fitting.optics.catalogue import (CATALOGUE_PATH, catalogue, catalogue_header, catalogue_material,
-                                      resolve_material, search_catalogue)
+from fitting.optics.catalogue import (
+    CATALOGUE_PATH,
+    catalogue,
+    catalogue_header,
+    catalogue_material,
+    resolve_material,
+    search_catalogue,
+)
 from fitting.optics.library import LIBRARY, library_material
 from fitting.optics.names import BOOK_NAMES, CATEGORIES, page_name
 
@@ -58,11 +64,23 @@ class TestCatalogue:
             assert catalogue()[material_id]["coverage"] >= rule["min_coverage"]
         assert "SiO2" not in {e["book"] for e in catalogue().values()}  # glass is not a conductor
 
-    @pytest.mark.parametrize("query, book", [
-        ("gold", "Au"), ("titanium", "Ti"), ("stainless", "stainless_steel"), ("brass", "Cu-Zn"),
-        ("aluminium", "Al"), ("aluminum", "Al"), ("TiN", "TiN"), ("Cu", "Cu"),
-        ("platinum", "Pt"), ("zinc", "Zn"), ("steel", "stainless_steel"), ("Ti", "Ti"),
-    ])
+    @pytest.mark.parametrize(
+        "query, book",
+        [
+            ("gold", "Au"),
+            ("titanium", "Ti"),
+            ("stainless", "stainless_steel"),
+            ("brass", "Cu-Zn"),
+            ("aluminium", "Al"),
+            ("aluminum", "Al"),
+            ("TiN", "TiN"),
+            ("Cu", "Cu"),
+            ("platinum", "Pt"),
+            ("zinc", "Zn"),
+            ("steel", "stainless_steel"),
+            ("Ti", "Ti"),
+        ],
+    )
     def test_the_expected_entry_comes_first(self, query, book):
         found = search_catalogue(query)
         assert found[0]["book"] == book and found[0]["preferred"]

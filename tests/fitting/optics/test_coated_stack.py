@@ -13,7 +13,10 @@ import pytest
 from fitting.colour.reference import reference_ACEScg
 from fitting.colour.seen import seen_ACEScg
 from fitting.optics.coated_stack import (
-    coated_stack, coated_stack_from_metal, fresnel_conductor_sp, fresnel_dielectric_sp,
+    coated_stack,
+    coated_stack_from_metal,
+    fresnel_conductor_sp,
+    fresnel_dielectric_sp,
     refracted_cos,
 )
 from fitting.optics.fresnel import fresnel_conductor, fresnel_dielectric
@@ -96,20 +99,32 @@ def _mitsuba_scene(mi, theta, eta, n, k):
             "type": "orthographic",
             "to_world": T.look_at(origin=(5 * direction).tolist(), target=[0, 0, 0], up=[0, 1, 0])
             @ T.scale([0.01, 0.01, 1.0]),
-            "film": {"type": "hdrfilm", "width": MITSUBA_PIXELS, "height": MITSUBA_PIXELS,
-                     "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+            "film": {
+                "type": "hdrfilm",
+                "width": MITSUBA_PIXELS,
+                "height": MITSUBA_PIXELS,
+                "rfilter": {"type": "box"},
+                "pixel_format": "rgb",
+            },
             "sampler": {"type": "independent", "sample_count": MITSUBA_SPP},
         },
         "sky": {"type": "constant", "radiance": {"type": "spectrum", "value": 1.0}},
     }
     if theta is not None and n is not None:
         scene["metal"] = {
-            "type": "rectangle", "to_world": T.translate([0, 0, -1e-3]) @ T.scale(100.0),
-            "bsdf": {"type": "conductor", "eta": {"type": "spectrum", "value": n / eta},
-                     "k": {"type": "spectrum", "value": k / eta}},
+            "type": "rectangle",
+            "to_world": T.translate([0, 0, -1e-3]) @ T.scale(100.0),
+            "bsdf": {
+                "type": "conductor",
+                "eta": {"type": "spectrum", "value": n / eta},
+                "k": {"type": "spectrum", "value": k / eta},
+            },
         }
-        scene["coat"] = {"type": "rectangle", "to_world": T.scale(100.0),
-                         "bsdf": {"type": "dielectric", "int_ior": eta, "ext_ior": 1.0}}
+        scene["coat"] = {
+            "type": "rectangle",
+            "to_world": T.scale(100.0),
+            "bsdf": {"type": "dielectric", "int_ior": eta, "ext_ior": 1.0},
+        }
     return mi.load_dict(scene)
 
 
@@ -146,8 +161,9 @@ def test_stack_agrees_with_mitsuba_within_its_noise(mitsuba_renders):
         ratio = px.sum() / sky_px.sum()
         # Noise of the ratio from the pixels' spread (each pixel an
         # independent estimate): standard error of both means, combined.
-        sigma = ratio * np.hypot(px.std(ddof=1) / px.sum() * np.sqrt(px.size),
-                                 sky_px.std(ddof=1) / sky_px.sum() * np.sqrt(sky_px.size))
+        sigma = ratio * np.hypot(
+            px.std(ddof=1) / px.sum() * np.sqrt(px.size), sky_px.std(ddof=1) / sky_px.sum() * np.sqrt(sky_px.size)
+        )
         expected = float(coated_stack(np.cos(np.radians(theta)), *case))
         # 5 standard errors: a false failure once in 1.7 million.
         assert abs(ratio - expected) <= 5.0 * sigma, (case, theta, ratio, expected, sigma)
@@ -159,5 +175,7 @@ def test_stack_agrees_with_mitsuba_within_its_noise(mitsuba_renders):
     # And the bounce sum matters at this noise: without it (first bounce
     # only) the stack would be off by far more than the worst difference.
     eta, n, k = MITSUBA_CASES[0]
-    single = fresnel_dielectric(1.0, 1.0, eta) + (1 - fresnel_dielectric(1.0, 1.0, eta)) ** 2 * fresnel_conductor(1.0, eta, n, k)
+    single = fresnel_dielectric(1.0, 1.0, eta) + (1 - fresnel_dielectric(1.0, 1.0, eta)) ** 2 * fresnel_conductor(
+        1.0, eta, n, k
+    )
     assert abs(float(coated_stack(1.0, eta, n, k)) - float(single)) > 3 * worst

@@ -12,7 +12,11 @@ from fitting.exports.seen_fit import layer_only
 from fitting.exports.tool_fresnel import f82_tint
 from fitting.optics.coated_stack import coated_stack
 from fitting.optics.edge_tint import (
-    F82_COS_THETA, F0_F82_from_nk, F0_F82_under_coat, gulbrandsen_nk, nk_from_F0_F82,
+    F82_COS_THETA,
+    F0_F82_from_nk,
+    F0_F82_under_coat,
+    gulbrandsen_nk,
+    nk_from_F0_F82,
 )
 from fitting.optics.fresnel import fresnel_conductor
 
@@ -34,8 +38,9 @@ class TestNkFromF0F82:
         index = nk_from_F0_F82(F0, tint)
         np.testing.assert_allclose(fresnel_conductor(1.0, 1.0, index.n, index.k), F0, atol=1e-12)
         schlick82 = F0 + (1.0 - F0) * (1.0 - F82_COS_THETA) ** 5
-        np.testing.assert_allclose(fresnel_conductor(F82_COS_THETA, 1.0, index.n, index.k),
-                                   tint * schlick82, atol=1e-10)
+        np.testing.assert_allclose(
+            fresnel_conductor(F82_COS_THETA, 1.0, index.n, index.k), tint * schlick82, atol=1e-10
+        )
 
     def test_out_of_reach_is_reported(self):
         # A dielectric-like F0 with a strong edge dip: no conductor has it.
@@ -43,13 +48,16 @@ class TestNkFromF0F82:
         assert not index.reachable[0] and index.F82_error[0] > 0.0
         assert np.isfinite(index.n).all() and np.isfinite(index.k).all()
 
-    @pytest.mark.parametrize("F0, tint, words", [
-        ([0.5, np.nan, 0.5], [1, 1, 1], "`F0` must lie in [0, 1]"),
-        ([0.5, 1.2, 0.5], [1, 1, 1], "`F0` must lie in [0, 1]"),
-        ([0.5, 0.5, 0.5], [1, 1], "`F82_tint` must have one value per channel"),
-        ([[0.5]], [1], "`F0` must be a list of numbers"),
-        ([0.5], [np.inf], "`F82_tint` must lie in [0, 1]"),
-    ])
+    @pytest.mark.parametrize(
+        "F0, tint, words",
+        [
+            ([0.5, np.nan, 0.5], [1, 1, 1], "`F0` must lie in [0, 1]"),
+            ([0.5, 1.2, 0.5], [1, 1, 1], "`F0` must lie in [0, 1]"),
+            ([0.5, 0.5, 0.5], [1, 1], "`F82_tint` must have one value per channel"),
+            ([[0.5]], [1], "`F0` must be a list of numbers"),
+            ([0.5], [np.inf], "`F82_tint` must lie in [0, 1]"),
+        ],
+    )
     def test_bad_input(self, F0, tint, words):
         with pytest.raises(ValueError, match=words.replace("[", r"\[").replace("]", r"\]")):
             nk_from_F0_F82(F0, tint)

@@ -46,7 +46,9 @@ class TestFresnelConductor:
         mu = np.linspace(0.0, 1.0, 201)
         for eta_i, n in [(1.0, 1.5), (1.5, 1.0), (2.0, 1.33), (1.2, 2.4)]:
             np.testing.assert_allclose(
-                fresnel_conductor(mu, eta_i, n, 0.0), fresnel_dielectric(mu, eta_i, n), atol=1e-12  # two closed forms of
+                fresnel_conductor(mu, eta_i, n, 0.0),
+                fresnel_dielectric(mu, eta_i, n),
+                atol=1e-12,  # two closed forms of
                 # ~20 operations, the critical-angle difference of condition
                 # <= 1e2 on this grid: 2000 u64 = 2.2e-13
             )
@@ -69,8 +71,14 @@ class TestFresnelConductor:
     def test_kernels_never_raise_and_clamp_to_the_physical_limit(self):
         # Finite but unphysical input: clamped, never raised, never NaN.
         mu = np.array([-1.0, 0.0, 0.3, 1.0, 2.0])
-        for n, k, eta_i in [(0.0, 0.0, 1.0), (-2.0, -1.0, 1.5), (1e300, 1e300, 1.0), (1.5, 0.0, 0.0),
-                            (1e-300, 0.0, 1e300), (2.0, 3.0, -1.0)]:
+        for n, k, eta_i in [
+            (0.0, 0.0, 1.0),
+            (-2.0, -1.0, 1.5),
+            (1e300, 1e300, 1.0),
+            (1.5, 0.0, 0.0),
+            (1e-300, 0.0, 1e300),
+            (2.0, 3.0, -1.0),
+        ]:
             R = fresnel_conductor(mu, eta_i, n, k)
             assert np.all(np.isfinite(R)) and np.all((R >= 0) & (R <= 1)), (n, k, eta_i)
         # A huge index is a perfect mirror; a negative k is clamped to k = 0.
@@ -122,8 +130,9 @@ class TestFresnelConductorDerivatives:
 
     def test_broadcast_and_clamps(self):
         """Per channel (S, 1) x (3,) shapes; an index clamped at its limit has no derivative; grazing (R = 1) none."""
-        R, dn, dk = fresnel_conductor_derivatives(np.linspace(0.0, 1.0, 5)[:, None], 1.5,
-                                                  np.array([0.3, 0.6, 1.2]), np.array([3.0, -1.0, 2.0]))
+        R, dn, dk = fresnel_conductor_derivatives(
+            np.linspace(0.0, 1.0, 5)[:, None], 1.5, np.array([0.3, 0.6, 1.2]), np.array([3.0, -1.0, 2.0])
+        )
         assert R.shape == dn.shape == dk.shape == (5, 3)
         assert np.all(dk[:, 1] == 0.0) and np.all(dn[0] == 0.0) and np.all(dk[0] == 0.0)
         assert np.all(np.isfinite(dn)) and np.all(np.isfinite(dk))

@@ -20,7 +20,10 @@ class TestSpectralNK:
     @pytest.mark.parametrize(
         "kwargs, message",
         [
-            (dict(wavelength_nm=[500.0, 400.0, 600.0]), r"`wavelength_nm` must be strictly increasing, got 400 after 500 at index 1"),
+            (
+                dict(wavelength_nm=[500.0, 400.0, 600.0]),
+                r"`wavelength_nm` must be strictly increasing, got 400 after 500 at index 1",
+            ),
             (dict(wavelength_nm=[400.0, 400.0, 600.0]), r"`wavelength_nm` must be strictly increasing"),
             (dict(wavelength_nm=[400.0, np.inf, 600.0]), r"`wavelength_nm` must be finite, got inf at index 1"),
             (dict(wavelength_nm=[-1.0, 500.0, 600.0]), r"`wavelength_nm` must be > 0"),

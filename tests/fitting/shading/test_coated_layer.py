@@ -14,7 +14,11 @@ import pytest
 from fitting.optics.coated_stack import coated_stack_from_metal, refracted_cos
 from fitting.optics.fresnel import fresnel_dielectric
 from fitting.shading.coated_layer import (
-    escape_fraction, hemispherical_albedo, internal_reflectance, seen_base, through_coat,
+    escape_fraction,
+    hemispherical_albedo,
+    internal_reflectance,
+    seen_base,
+    through_coat,
 )
 
 pytestmark = pytest.mark.numeric

@@ -99,7 +99,8 @@ class TestLUT:
         # At roughness 0 the albedo is the Fresnel itself (up to shadowing at grazing).
         np.testing.assert_allclose(
             split_sum_lazanyi(0.8, 0.0, 1.5, F0_air, F82_air, lut),
-            lazanyi_adjusted(0.8, 1.5, F0_air, F82_air), rtol=2e-3,  # not rounding: the
+            lazanyi_adjusted(0.8, 1.5, F0_air, F82_air),
+            rtol=2e-3,  # not rounding: the
             # LUT's interpolation and the shadowing term at roughness 0 (a model claim)
         )
 
@@ -158,9 +159,14 @@ class TestDirectionalAlbedo:
         got = directional_albedo(np.full((2, 3), 0.5), 0.3, lambda c: np.ones(c.shape + (3,)), 64)
         assert got.shape == (6, 3)
 
-    @pytest.mark.parametrize("NdotV, roughness, samples, message", [
-        ([0.5, np.nan], 0.3, 64, "NdotV"), ([0.5], np.inf, 64, "roughness"), ([0.5], 0.3, 0, "samples"),
-    ])
+    @pytest.mark.parametrize(
+        "NdotV, roughness, samples, message",
+        [
+            ([0.5, np.nan], 0.3, 64, "NdotV"),
+            ([0.5], np.inf, 64, "roughness"),
+            ([0.5], 0.3, 0, "samples"),
+        ],
+    )
     def test_refusals_name_the_argument(self, NdotV, roughness, samples, message):
         with pytest.raises(ValueError, match=message):
             directional_albedo(NdotV, roughness, lambda c: np.ones(c.shape + (3,)), samples)

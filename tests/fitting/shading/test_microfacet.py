@@ -25,9 +25,7 @@ CR = ((0.37, 0.38, 0.39), (0.6, 0.55, 0.0), (4.8, 4.8, 5.0))
 
 def _directions(theta, phi=0.0):
     theta = np.asarray(theta, dtype=np.float64)
-    return np.stack(
-        [np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi) + 0.0 * theta, np.cos(theta)], axis=-1
-    )
+    return np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi) + 0.0 * theta, np.cos(theta)], axis=-1)
 
 
 class TestGGX:
@@ -43,7 +41,9 @@ class TestGGX:
 
     def test_peak_value(self):
         alpha = 0.3
-        assert ggx_D(np.array([0.0, 0.0, 1.0]), alpha) == pytest.approx(1.0 / (np.pi * alpha**2), rel=16 * 2.0**-53)  # a few
+        assert ggx_D(np.array([0.0, 0.0, 1.0]), alpha) == pytest.approx(
+            1.0 / (np.pi * alpha**2), rel=16 * 2.0**-53
+        )  # a few
         # roundings; tightened from approx's default rel=1e-6
 
     def test_roughness_clamped(self):

@@ -66,10 +66,17 @@ class TestSplitSumAgainstMonteCarlo:
 
 class TestWhiteFurnace:
     @pytest.mark.parametrize("roughness", [0.0, 0.1, 0.3, 0.5, 0.8, 1.0])
-    @pytest.mark.parametrize("mode, eta_i, coat_roughness", [
-        ("immersed", 1.0, 0.0), ("coated", 1.0, 0.0), ("coated", 1.5, 0.0),
-        ("coated", 1.5, 0.5), ("coated", 2.5, 0.2), ("coated", 3.0, 1.0),
-    ])
+    @pytest.mark.parametrize(
+        "mode, eta_i, coat_roughness",
+        [
+            ("immersed", 1.0, 0.0),
+            ("coated", 1.0, 0.0),
+            ("coated", 1.5, 0.0),
+            ("coated", 1.5, 0.5),
+            ("coated", 2.5, 0.2),
+            ("coated", 3.0, 1.0),
+        ],
+    )
     def test_reflects_no_more_than_it_receives(self, roughness, mode, eta_i, coat_roughness):
         mu = np.array([0.02, 0.1, 0.3, 0.6, 1.0])
         E = directional_albedo(mu, roughness, MIRROR, mode, eta_i, coat_roughness, samples=8192, seed=2)
