@@ -100,8 +100,8 @@ def test_every_marked_figure_is_the_recorded_one(page):
 def test_the_readme_quotes_the_editor_and_rest_figures_from_their_records():
     keys = {f["key"] for f in figures((docs_figures.ROOT / "README.md").read_text(encoding="utf-8"))}
     assert {
-        "editor_speed:drag_to_frame_ms.gentle.median_ms",
-        "editor_speed:drag_to_frame_ms.gentle.p90_ms",
+        "editor_live_latency:busy.all.move_to_frame_ms.median_ms",
+        "editor_live_latency:busy.all.move_to_frame_ms.p99_ms",
         "service_load:rest_fit_unseen_ms.p50",
     } <= keys
 

@@ -26,6 +26,8 @@ Dependencies
     :class:`service.runtime.previews.PreviewRunner`).
 -   :data:`ERROR_RESPONSES`, :data:`FIT_ERROR_RESPONSES`,
     :data:`NOT_FOUND`: the error answers for the OpenAPI document.
+-   :func:`fit_answer` and :data:`FIT_CREATED`: a fit's answer (201 when just
+    fitted, 200 from the store, its Location), for the routes that fit.
 """
 
 from __future__ import annotations
@@ -33,14 +35,14 @@ from __future__ import annotations
 import hmac
 from typing import Annotated, Literal
 
-from fastapi import Depends, Form, HTTPException, Path, Query, Request, status
+from fastapi import Depends, Form, HTTPException, Path, Query, Request, Response, status
 from fastapi.concurrency import run_in_threadpool
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 
 from ..config import Settings
 from ..jobs.common import stored_fit
 from ..runtime import CLAIM, FitRunner, PreviewRunner, SaveRate
-from ..schemas import FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody, WorkingSpace
+from ..schemas import API_PREFIX, FIT_ID_PATTERN, MATERIAL_ID_PATTERN, ErrorBody, FitPublic, WorkingSpace, fit_public
 from ..store import FitRecord, Store
 from ..store.queries import summary_text
 
@@ -65,6 +67,8 @@ __all__ = [
     "FIT_ERROR_RESPONSES",
     "NOT_FOUND",
     "CONFLICT",
+    "FIT_CREATED",
+    "fit_answer",
 ]
 
 
@@ -256,3 +260,17 @@ FIT_ERROR_RESPONSES = {
     ),
     status.HTTP_507_INSUFFICIENT_STORAGE: _error("The store is full; nothing was fitted"),
 }
+
+
+# A fit's answer (POST /fits, /fits/upload): 201 when just fitted, 200 from the store.
+FIT_CREATED = {
+    status.HTTP_200_OK: {"model": FitPublic, "description": "Served from the store"},
+    status.HTTP_201_CREATED: {"model": FitPublic, "description": "Fitted and saved"},
+}
+
+
+def fit_answer(record: FitRecord, created: bool, response: Response) -> FitPublic:
+    """A fit's answer: 201 when just fitted, 200 from the store; Location of the fit."""
+    response.status_code = status.HTTP_201_CREATED if created else status.HTTP_200_OK
+    response.headers["Location"] = f"{API_PREFIX}/fits/{record.id}"
+    return fit_public(record)

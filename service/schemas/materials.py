@@ -14,12 +14,13 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from ..store import FIT_KINDS
+from ..store import FIT_KINDS, MaterialRow
 from .common import MaterialName, RequestModel
 from .fits import FitPublic
 
 __all__ = [
     "MaterialSummary",
+    "material_summary",
     "MaterialList",
     "MaterialDetail",
     "MaterialRename",
@@ -51,6 +52,21 @@ class MaterialSummary(BaseModel):
         None, description="Unix time it went to the bin (`DELETE /materials/{id}`); null: not deleted"
     )
     share_url: str = Field(description="The editor's link that reopens it: `/?material={id}`")
+
+
+def material_summary(row: MaterialRow, share_url: str) -> MaterialSummary:
+    """A material's summary row as the API answers it, with its link ``share_url``."""
+    return MaterialSummary(
+        id=row.material_id,
+        name=row.name,
+        kind=row.kind,
+        source=row.source,
+        coverage=row.coverage,
+        latest_fit_id=row.latest_fit_id,
+        version=row.version,
+        deleted_at=row.deleted_at,
+        share_url=share_url,
+    )
 
 
 class MaterialList(BaseModel):

@@ -12,14 +12,9 @@ Materials
     ``q`` keeps those whose name, symbol or source holds it; ``deleted``
     lists the bin instead. ``next_cursor`` continues.
 -   ``GET /api/v1/materials/{material_id}``: one material with its latest fit.
--   ``PATCH /api/v1/materials/{material_id}``: rename (``{"name"}``).
--   ``DELETE /api/v1/materials/{material_id}``: to the bin (soft delete).
--   ``POST /api/v1/materials/{material_id}/restore``: out of the bin.
 
-A material's versions and a fit's edit: :mod:`service.api.routes.versions`.
-
-The writes need what saves need (:data:`service.api.deps.WriteAccess`:
-same site, and the bearer token when the service requires one).
+Renames and the bin: :mod:`service.api.routes.material_edits`; a material's
+versions and a fit's edit: :mod:`service.api.routes.versions`.
 """
 
 from __future__ import annotations
@@ -40,12 +35,12 @@ from ...schemas import (
     ErrorBody,
     MaterialDetail,
     MaterialList,
-    MaterialRename,
     MaterialSummary,
     fit_public,
+    material_summary,
 )
 from ...store import MaterialRow
-from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdPath, SettingsDep, StoreDep, WriteAccess
+from ..deps import ERROR_RESPONSES, FIT_ERROR_RESPONSES, NOT_FOUND, MaterialIdPath, SettingsDep, StoreDep
 
 router = APIRouter(prefix=API_PREFIX, tags=["materials"])
 
@@ -57,17 +52,7 @@ WRITE_RESPONSES = {
 
 
 def _summary(row: MaterialRow) -> MaterialSummary:
-    return MaterialSummary(
-        id=row.material_id,
-        name=row.name,
-        kind=row.kind,
-        source=row.source,
-        coverage=row.coverage,
-        latest_fit_id=row.latest_fit_id,
-        version=row.version,
-        deleted_at=row.deleted_at,
-        share_url=_share(row.material_id),
-    )
+    return material_summary(row, _share(row.material_id))
 
 
 @router.get("/materials", response_model=MaterialList, responses=ERROR_RESPONSES)
@@ -148,44 +133,3 @@ def get_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialDetail
     if latest.nk is not None:
         wavelength_range = (latest.nk["wavelength_nm"][0], latest.nk["wavelength_nm"][-1])
     return MaterialDetail(**dict(_summary(row)), wavelength_range_nm=wavelength_range, latest_fit=fit_public(latest))
-
-
-@router.patch(
-    "/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES, dependencies=[WriteAccess]
-)
-def rename_material(material_id: MaterialIdPath, body: MaterialRename, store: StoreDep) -> MaterialSummary:
-    """
-    Rename a saved material. Not a save: its version, fits and history stay
-    as they are; the next save of it (with its `material_id`) keeps the
-    new name, and a save expecting a version read before the rename (still
-    carrying the old name) is refused (409 naming the new one). An edited
-    material's name is unique among edited materials (409 when another, in
-    the bin or not, is called that).
-    """
-    return _summary(store.rename_material(material_id, body.name.strip()))
-
-
-@router.delete(
-    "/materials/{material_id}", response_model=MaterialSummary, responses=WRITE_RESPONSES, dependencies=[WriteAccess]
-)
-def delete_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSummary:
-    """
-    Move a saved material to the bin: it leaves the listings (`?deleted=true`
-    lists the bin), nothing is erased (its fits, downloads and versions stay
-    reachable by id), `POST .../restore` brings it back, and so does a save
-    of it without `expected_version` (its answer says `restored_from_bin`);
-    a save with `expected_version` is refused (409: it would undo the
-    delete unseen). Deleting one in the bin again answers the same.
-    """
-    return _summary(store.delete_material(material_id))
-
-
-@router.post(
-    "/materials/{material_id}/restore",
-    response_model=MaterialSummary,
-    responses=WRITE_RESPONSES,
-    dependencies=[WriteAccess],
-)
-def restore_material(material_id: MaterialIdPath, store: StoreDep) -> MaterialSummary:
-    """Take a material out of the bin (a material not in it answers as it is)."""
-    return _summary(store.restore_material(material_id))
