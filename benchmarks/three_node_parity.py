@@ -46,7 +46,8 @@ sys.path.insert(0, str(ROOT / "tests" / "static"))
 from benchmarks.record import write_result  # noqa: E402
 from editor_pages import CHROMIUM_ARGS  # noqa: E402
 from playwright.sync_api import sync_playwright  # noqa: E402
-from three_node_pages import draw_both, parity, parity_page, serve, write_folder  # noqa: E402
+from three_node_pages import draw_both, parity, parity_page, write_folder  # noqa: E402
+from three_pages import serve  # noqa: E402
 
 from fitting.exports import export_material  # noqa: E402
 from fitting.fits.kinds import fit_model  # noqa: E402

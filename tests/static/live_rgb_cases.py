@@ -23,6 +23,7 @@ from fitting.fits.curves_base import curve_base_from_nk
 from fitting.fits.curves_input import check_curves
 from fitting.fits.curves_problem import curve_problem
 from fitting.fits.curves_score import angle_mu
+from fitting.fits.curves_steps import bounded_fit
 from fitting.fits.kinds import fit_kind
 from fitting.models.kinds import MODEL_KINDS
 from fitting.optics.catalogue import catalogue_material
@@ -49,18 +50,7 @@ def live_case(material: str, eta: float, centre: float, gains) -> dict:
     rgb = np.clip(reference * (1.0 + _bump(THETA, centre)[:, None] * (np.array(gains) - 1.0)), 0.0, 1.0)
     curves = check_curves([{"eta_i": eta, "angle_deg": THETA.tolist(), "rgb": rgb.tolist()}])
     problem = curve_problem(curves, base, None, "live", settings, MODEL)
-    solve = problem.solver.solve(
-        problem.target,
-        problem.mu,
-        problem.eta,
-        problem.eta_i_range,
-        problem.degree,
-        settings.objective,
-        max(settings.max_nfev, 200),
-        settings.quantise,
-        weights=problem.weights,
-        irls_rounds=settings.irls_rounds,
-    )
+    solve = bounded_fit(problem)  # the server's own step for this kind (curves_steps)
     live = fit_curves(curves, base, settings=settings, model=MODEL)
     mu_row = angle_mu(np.linspace(0.0, 90.0, settings.mu_samples))
     rows = sorted({*np.linspace(lo, hi, settings.eta_samples).tolist(), eta})

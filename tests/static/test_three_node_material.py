@@ -30,7 +30,8 @@ import subprocess
 import numpy as np
 import pytest
 from editor_pages import _CHROMIUM
-from three_node_pages import PACKAGE, draw_both, draw_gltf, draw_pair, parity, parity_page, serve, write_folder
+from three_node_pages import PACKAGE, draw_both, draw_gltf, draw_pair, parity, parity_page, write_folder
+from three_pages import serve
 
 from fitting.exports import export_material
 from fitting.fits.kinds import fit_model

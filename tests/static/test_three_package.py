@@ -30,19 +30,16 @@ Cost: one folder, one esbuild run, one page a way (SwiftShader WebGL2,
 
 from __future__ import annotations
 
-import functools
-import http.server
 import json
 import shutil
 import subprocess
-import threading
 from pathlib import Path
 from urllib.parse import urlsplit
 
 import numpy as np
 import pytest
 from editor_pages import _CHROMIUM, F32_BASE64, TIMEOUT_MS, camera_rays, from_f32
-from three_pages import CENTRE, FOV, H, NDOTV_MIN, ORBIT, W, coated_albedo, fit_fresnel, per_pixel
+from three_pages import CENTRE, FOV, H, NDOTV_MIN, ORBIT, W, coated_albedo, fit_fresnel, per_pixel, serve
 
 from fitting.colour.delta_e import delta_E_map
 from fitting.exports import export_material
@@ -129,11 +126,6 @@ def scene(package: str) -> str:
     return text
 
 
-class QuietHandler(http.server.SimpleHTTPRequestHandler):
-    def log_message(self, *args) -> None:
-        pass
-
-
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     """The static folder: the package as npm installs it, three, the asset and the three pages; the extension object."""
@@ -179,14 +171,8 @@ def folder(tmp_path_factory):
 def site(folder):
     """http.server on 127.0.0.1 serving the folder (and nothing else): its URL."""
     root, _ = folder
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(QuietHandler, directory=str(root)))
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{server.server_address[1]}"
-    finally:
-        server.shutdown()
-        server.server_close()
+    with serve(root) as url:
+        yield url
 
 
 @pytest.fixture(scope="module")

@@ -16,11 +16,8 @@ NdotV >= 0.1.
 
 from __future__ import annotations
 
-import functools
-import http.server
 import json
 import shutil
-import threading
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -176,24 +173,6 @@ def write_folder(root: Path) -> None:
         script = script.replace(key, value)
     (root / "parity.js").write_text(script)
     (root / "parity.html").write_text(PAGE.replace("IMPORTS", json.dumps({"imports": IMPORTS})))
-
-
-class _Quiet(http.server.SimpleHTTPRequestHandler):
-    def log_message(self, *args) -> None:
-        pass
-
-
-@contextmanager
-def serve(root: Path):
-    """http.server on 127.0.0.1 serving ``root`` only: its URL."""
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(root)))
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{server.server_address[1]}"
-    finally:
-        server.shutdown()
-        server.server_close()
 
 
 @contextmanager

@@ -4,6 +4,9 @@ preview and the physics, in one Chromium page (import it: ``from
 three_pages import measure_three``); shared by
 tests/static/test_three_material.py and benchmarks/three_parity.py.
 
+:func:`serve` (a quiet http.server on 127.0.0.1 serving one folder) is also
+the three.js package's and the node material's static site.
+
 Set-up, the same for both renders: an environment of the preview, the
 white sky (radiance 1 in every direction, so that the two environment
 filters, the project's prefiltered slices and three's PMREM, drop out and
@@ -51,7 +54,11 @@ reference under the coat through it.
 
 from __future__ import annotations
 
+import functools
+import http.server
+import threading
 from contextlib import contextmanager
+from pathlib import Path
 
 import loopback
 import numpy as np
@@ -341,3 +348,21 @@ def measure_three(
     figures["composed"] = _stats(delta_E_map(composed, three), NdotV, region)
     figures["fit_vs_physics"] = _stats(delta_E_map(physics, composed), NdotV, region)
     return figures
+
+
+class _Quiet(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args) -> None:
+        pass
+
+
+@contextmanager
+def serve(root: Path):
+    """http.server on 127.0.0.1 serving ``root`` only: its URL."""
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), functools.partial(_Quiet, directory=str(root)))
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}"
+    finally:
+        server.shutdown()
+        server.server_close()
