@@ -244,13 +244,13 @@ def main() -> None:
     )
     print("| variant | timer query (us) | wall (ms) | wall net ratio | CPU (ms) | CPU net ratio |")
     print("|---|---:|---:|---:|---:|---:|")
+
+    def net(times, v):
+        return (times[v] - times[fixed]) / (times["split_sum_lazanyi"] - times[fixed])
+
     for v in SPLIT_SUM_VARIANTS:
-
-        def net(times):
-            return (times[v] - times[fixed]) / (times["split_sum_lazanyi"] - times[fixed])
-
-        wn = "" if v == fixed else f"{net(sw):.2f}x"
-        cn = "" if v == fixed else f"{net(sc):.2f}x"
+        wn = "" if v == fixed else f"{net(sw, v):.2f}x"
+        cn = "" if v == fixed else f"{net(sc, v):.2f}x"
         print(f"| {SPLIT_LABELS[v]} | {sq[v]:.0f} | {sw[v]:.1f} | {wn} | {sc[v]:.1f} | {cn} |")
 
     figures = {
@@ -277,7 +277,14 @@ def main() -> None:
             "wall_net_ratio": float(ratio(wall, "collapsed", LAZANYI_SCENE, net=True)),
             "cpu_net_ratio": float(ratio(cpu, "collapsed", LAZANYI_SCENE, net=True)),
         },
-        "split_sum": {v: {"wall_ms": float(sw[v]), "cpu_ms": float(sc[v])} for v in SPLIT_SUM_VARIANTS},
+        "split_sum": {
+            v: {
+                "wall_ms": float(sw[v]),
+                "cpu_ms": float(sc[v]),
+                **({} if v == fixed else {"wall_net_ratio": float(net(sw, v)), "cpu_net_ratio": float(net(sc, v))}),
+            }
+            for v in SPLIT_SUM_VARIANTS
+        },
     }
     path = write_result(
         "shader_cost",
