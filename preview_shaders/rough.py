@@ -44,6 +44,7 @@ from fitting.shading.ibl import cache_dir, directional_albedo, split_sum_schlick
 from fitting.shading.microfacet import alpha_g_from_roughness
 
 from .gl import GLState, check_gl_error, load_shader_source, read_float_target
+from .views import ENVIRONMENTS, MODES
 
 __all__ = [
     "MODES",
@@ -59,10 +60,6 @@ __all__ = [
     "render_rough_layers",
 ]
 
-MODES = ("immersed", "coated")
-ENVIRONMENTS = ("white_sky", "studio", "outdoor")
-"""The environments that can be prefiltered, by their index in
-``cf_environment.glsl`` (CF_ENVIRONMENT_*)."""
 EQUIRECT_SIZE = (128, 64)
 """(width, height) of the prefiltered equirect slices."""
 PREFILTER_VERSION = 1

@@ -24,6 +24,8 @@ __all__ = ["COMPARISONS", "MODES", "ENVIRONMENTS", "SIZE_RANGE", "ETA_I_LIMITS",
 COMPARISONS = ("none", "lazanyi", "reference")
 MODES = ("immersed", "coated")
 ENVIRONMENTS = ("white_sky", "studio", "outdoor")
+"""The preview environments, by their index in ``cf_environment.glsl``
+(CF_ENVIRONMENT_*); the rough preview prefilters each of them."""
 SIZE_RANGE = (64, 2048)
 ETA_I_LIMITS = (ETA_I_MIN, ETA_I_MAX)
 SPHERE_RADIUS = 0.45
