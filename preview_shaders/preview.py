@@ -60,6 +60,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fitting.domain import check_eta_i
 from fitting.models.baselines import baseline_inputs
 from fitting.models.kinds import model_kind
 from fitting.models.pack import PackedMaterial
@@ -81,10 +82,9 @@ from .views import (
     MODES,
     SIZE_RANGE,
     SPHERE_RADIUS,
-    _check_choice,
-    _check_eta_i,
-    _check_size,
-    _check_unit,
+    check_choice,
+    check_size,
+    check_unit,
     sphere_cos_theta,
 )
 
@@ -234,15 +234,15 @@ class PreviewRenderer:
         """
         if not isinstance(packed, PackedMaterial):
             raise ValueError(f"`packed` must be a PackedMaterial, got {type(packed).__name__}")
-        size = _check_size(size)
-        eta_i = _check_eta_i(eta_i)
-        compare = _check_choice("compare", compare, COMPARISONS)
-        environment = _check_choice("environment", environment, ENVIRONMENTS)
+        size = check_size(size)
+        eta_i = check_eta_i(eta_i)
+        compare = check_choice("compare", compare, COMPARISONS)
+        environment = check_choice("environment", environment, ENVIRONMENTS)
         if compare != "none" and nk is None:
             raise ValueError(f"`nk` is needed for compare={compare!r}: the material's n, k")
-        roughness = _check_unit("roughness", roughness)
-        coat_roughness = _check_unit("coat_roughness", coat_roughness)
-        mode = _check_choice("mode", mode, MODES)
+        roughness = check_unit("roughness", roughness)
+        coat_roughness = check_unit("coat_roughness", coat_roughness)
+        mode = check_choice("mode", mode, MODES)
         if roughness > 0.0 or mode != "immersed":
             if not model_kind(packed.model).split_sum:
                 raise ValueError(
@@ -360,9 +360,9 @@ class PreviewRenderer:
     def render_split_in_shader(self, packed, nk, eta_i, size, environment="white_sky"):
         """The model | adjusted Lazanyi split drawn by the shader itself (one
         pass), float32 linear ACEScg, top row first."""
-        size = _check_size(size)
-        eta_i = _check_eta_i(eta_i)
-        environment = _check_choice("environment", environment, ENVIRONMENTS)
+        size = check_size(size)
+        eta_i = check_eta_i(eta_i)
+        environment = check_choice("environment", environment, ENVIRONMENTS)
         baseline = baseline_inputs(nk)
         layers = self.thread.call(
             _render_layers,

@@ -9,6 +9,7 @@ imports to check a request before it reaches a renderer.
 
 -   :data:`COMPARISONS`, :data:`MODES`, :data:`ENVIRONMENTS`,
     :data:`SIZE_RANGE`, :data:`ETA_I_LIMITS`, :data:`SPHERE_RADIUS`.
+-   :func:`check_size`, :func:`check_unit`, :func:`check_choice`: the checks.
 -   :func:`sphere_cos_theta`: cos theta per pixel from the geometry (the
     geometry: :mod:`preview_shaders.preview`'s description).
 """
@@ -17,9 +18,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from fitting.domain import ETA_I_MAX, ETA_I_MIN, check_eta_i
+from fitting.domain import ETA_I_MAX, ETA_I_MIN
 
-__all__ = ["COMPARISONS", "MODES", "ENVIRONMENTS", "SIZE_RANGE", "ETA_I_LIMITS", "SPHERE_RADIUS", "sphere_cos_theta"]
+__all__ = [
+    "COMPARISONS",
+    "MODES",
+    "ENVIRONMENTS",
+    "SIZE_RANGE",
+    "ETA_I_LIMITS",
+    "SPHERE_RADIUS",
+    "check_choice",
+    "check_size",
+    "check_unit",
+    "sphere_cos_theta",
+]
 
 COMPARISONS = ("none", "lazanyi", "reference")
 MODES = ("immersed", "coated")
@@ -32,7 +44,8 @@ SPHERE_RADIUS = 0.45
 """Sphere radius as a fraction of the image size."""
 
 
-def _check_size(size) -> int:
+def check_size(size) -> int:
+    """``size`` as an int, or a ValueError naming it and the range :data:`SIZE_RANGE`."""
     if isinstance(size, bool) or not isinstance(size, (int, np.integer)):
         raise ValueError(f"`size` must be an integer in [64, 2048], got {size!r}")
     if not SIZE_RANGE[0] <= size <= SIZE_RANGE[1]:
@@ -40,11 +53,8 @@ def _check_size(size) -> int:
     return int(size)
 
 
-def _check_eta_i(eta_i) -> float:
-    return check_eta_i(eta_i)
-
-
-def _check_unit(name: str, value) -> float:
+def check_unit(name: str, value) -> float:
+    """``value`` as a float in [0, 1], or a ValueError naming ``name`` and the rule."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
         raise ValueError(f"`{name}` must be a number in [0, 1], got {value!r}")
     value = float(value)
@@ -53,7 +63,8 @@ def _check_unit(name: str, value) -> float:
     return value
 
 
-def _check_choice(name: str, value, choices) -> str:
+def check_choice(name: str, value, choices) -> str:
+    """``value`` if it is one of ``choices``, or a ValueError naming ``name`` and the choices."""
     if value not in choices:
         raise ValueError(f"`{name}` must be one of {', '.join(choices)}, got {value!r}")
     return value
@@ -64,7 +75,7 @@ def sphere_cos_theta(size: int) -> tuple[np.ndarray, np.ndarray]:
     cos theta per pixel (top row first) and the sphere mask, from the
     geometry in float64 (the module docstring gives the geometry).
     """
-    size = _check_size(size)
+    size = check_size(size)
     centre = 0.5 * size
     radius = SPHERE_RADIUS * size
     x = (np.arange(size) + 0.5 - centre) / radius

@@ -17,7 +17,7 @@ import time
 from typing import Any
 
 from .names import name_key
-from .queries import _looks_like, _other_holder, material_row, summary_text
+from .queries import name_clash_message, other_name_holder, material_row, summary_text
 from .records import MaterialRow, NameTaken
 
 __all__ = ["rename", "set_deleted"]
@@ -37,9 +37,9 @@ def rename(connection: Any, p: str, material_id: str, name: str) -> MaterialRow:
     """Inside a write transaction holding the saves' lock: the summary of ``material_id`` renamed."""
     row = _saved(connection, p, material_id)
     if row.kind == "curves":  # an edited material is found by its name: names are unique
-        holder = _other_holder(connection, p, name, material_id)
+        holder = other_name_holder(connection, p, name, material_id)
         if holder is not None and holder[2] != summary_text(name):
-            raise NameTaken(_looks_like(name, holder), version=row.version, latest_fit_id=row.latest_fit_id)
+            raise NameTaken(name_clash_message(name, holder), version=row.version, latest_fit_id=row.latest_fit_id)
         if holder is not None:
             where = " (in the bin)" if holder[1] is not None else ""
             raise NameTaken(

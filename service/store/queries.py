@@ -50,6 +50,8 @@ __all__ = [
     "version_texts",
     "version_text",
     "summary_text",
+    "other_name_holder",
+    "name_clash_message",
     "check_expected",
     "LISTED_KINDS",
 ]
@@ -110,11 +112,11 @@ def save(
         # since the save chose its material (a rename at the same moment) wins.
         # A look-alike of another's name is refused when the name is new to
         # this material (two look-alikes saved before keys existed both stay saveable).
-        holder = _other_holder(connection, p, stored.name, stored.material_id)
+        holder = other_name_holder(connection, p, stored.name, stored.material_id)
         version, latest = (row.version, row.latest_fit_id) if row else (0, None)
         if holder is not None and holder[2] != summary_text(stored.name):
             if row is None or row.name != summary_text(stored.name):
-                raise NameTaken(_looks_like(stored.name, holder), version=version, latest_fit_id=latest)
+                raise NameTaken(name_clash_message(stored.name, holder), version=version, latest_fit_id=latest)
         elif holder is not None:
             raise NameTaken(
                 f"`name` {stored.name!r} was just given to another saved material {holder[0]}: "
@@ -342,7 +344,7 @@ def find_material(connection: Any, p: str, kind: str, name: str) -> str | None:
     return None if row is None else row[0]
 
 
-def _other_holder(connection: Any, p: str, name: str, material_id: str):
+def other_name_holder(connection: Any, p: str, name: str, material_id: str):
     """
     (id, deleted_at, name) of an edited material other than ``material_id``
     (in the bin or not) whose name is ``name`` or looks the same
@@ -356,8 +358,8 @@ def _other_holder(connection: Any, p: str, name: str, material_id: str):
     ).fetchone()
 
 
-def _looks_like(name: str, holder: tuple) -> str:
-    """The message of a name that looks the same as another material's (``holder``: :func:`_other_holder`'s)."""
+def name_clash_message(name: str, holder: tuple) -> str:
+    """The message of a name that looks the same as another material's (``holder``: :func:`other_name_holder`'s)."""
     where = " (in the bin)" if holder[1] is not None else ""
     return (
         f"`name` {name!r} looks the same as {holder[2]!r}, the name of saved material {holder[0]}{where} "
