@@ -95,6 +95,8 @@ export class Studio {
     $("copy-link").addEventListener("click", guard(() => state.fit && this.copyLink(state.fit.id)));
     app.store.subscribe((name) => this.#follow(name));
     this.loading = null; // the studio's lists load once the first fit is on screen (never ahead of it: cold start)
+    this.refreshes = 0; // refresh() calls so far: only the latest one's lists are shown
+    this.turns = Promise.resolve(); // the rename, delete and restore actions, one at a time in the order asked
   }
 
   #follow(name) {
@@ -148,10 +150,16 @@ export class Studio {
     if ($("saved-search").value === query) this.app.store.dispatch("savedSearch", { query, ids });
   }
 
-  /** The saved edited materials and the bin, again. */
+  /**
+   * The saved edited materials and the bin, again. Only the latest call's
+   * lists are shown: an earlier call answered later (its pages read before
+   * a delete or restore it did not see) would show them as they were.
+   */
   async refresh() {
+    const asked = ++this.refreshes;
     const [saved, bin] = await Promise.all([api.listAllMaterials({ kinds: ["curves"] }),
                                             api.listAllMaterials({ kinds: ["curves"], deleted: true })]);
+    if (asked !== this.refreshes) return;
     this.app.store.dispatch("materials", { saved, bin });
     const listed = this.state.versions;
     if (listed && !saved.some((m) => m.id === listed.material.id)) this.app.store.dispatch("versions", null);
@@ -172,7 +180,29 @@ export class Studio {
     }
   }
 
-  async rename(m, name) {
+  /**
+   * `work` once the actions asked before it are done (their lists shown and
+   * said): a delete clicked while a restore is answered acts after it.
+   */
+  #inTurn(work) {
+    const turn = this.turns.then(work);
+    this.turns = turn.catch(() => {});
+    return turn;
+  }
+
+  rename(m, name) {
+    return this.#inTurn(() => this.#rename(m, name));
+  }
+
+  remove(m) {
+    return this.#inTurn(() => this.#remove(m));
+  }
+
+  restore(m) {
+    return this.#inTurn(() => this.#restore(m));
+  }
+
+  async #rename(m, name) {
     let renamed;
     try {
       renamed = await api.renameMaterial(m.id, name);
@@ -189,7 +219,7 @@ export class Studio {
     this.#said(`Renamed “${m.name}” to “${renamed.name}” (its versions keep the names they were saved under).`);
   }
 
-  async remove(m) {
+  async #remove(m) {
     try {
       await api.deleteMaterial(m.id);
     } catch (error) {
@@ -199,7 +229,7 @@ export class Studio {
     this.#said(`Moved “${m.name}” to the bin (nothing is erased).`, () => this.restore(m));
   }
 
-  async restore(m) {
+  async #restore(m) {
     try {
       await api.restoreMaterial(m.id);
     } catch (error) {

@@ -89,6 +89,8 @@ def test_saved_list_rename_delete_restore(pages, editor_url):
     assert api(page, f"/materials/{material}")["deleted_at"] is None
     # ... and Restore from the bin.
     item.get_by_role("button", name="Delete Renamed gold (to the bin)").click()
+    expect(item).to_have_count(0)
+    expect(page.locator("#bin-count")).to_have_text("1")
     page.click("#bin summary")
     page.locator(f"#bin-list li[data-id='{material}']").get_by_role("button", name="Restore Renamed gold").click()
     expect(item.locator(".title")).to_have_text("Renamed gold")
