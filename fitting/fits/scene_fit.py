@@ -26,13 +26,15 @@ import time
 
 import numpy as np
 
+from ..colour.colorimetry import ACEScg_to_Lab
+from ..colour.delta_e import delta_E_2000
 from ..colour.reference import reference_ACEScg_grid
 from ..domain import DEFAULT_ETA_I_RANGE
 from ..models.coated_conductor import coated_conductor_model
 from ..models.kinds import DEFAULT_MODEL, model_ACEScg, model_kind
 from ..models.pack import PackedMaterial
 from .kinds import fit_kind
-from .metrics import ErrorMetrics, delta_E_summary
+from .metrics import ErrorMetrics
 from .pipeline import FitProblem, finish_fit, fit_problem, guard_problem, solve_problem
 from .result import FitResult
 from .scene_report import SceneMaterialResult, SceneResult
@@ -140,8 +142,10 @@ def choose_candidate(
     )
 
 
-def _error(ref: np.ndarray, model: np.ndarray, against: str) -> ErrorMetrics:
-    return delta_E_summary(ref, model, against)
+def _error(ref_Lab: np.ndarray, model: np.ndarray, against: str) -> ErrorMetrics:
+    """:func:`fitting.fits.metrics.delta_E_summary` of ``model`` against a reference already in Lab."""
+    dE = delta_E_2000(ref_Lab, ACEScg_to_Lab(model))
+    return ErrorMetrics(mean=float(dE.mean()), max=float(dE.max()), against=against, layout="summary")
 
 
 def _candidate_problem(entry: SceneMaterial, kind: str, settings: FitSettings) -> FitProblem:
@@ -195,12 +199,12 @@ def fit_scene_material(
     E, M = np.meshgrid(eta_rows, mu, indexing="ij")
     # The product-grid kernel of the fits' own reference: the same values as
     # reference_ACEScg sample by sample (to 1e-14), a fraction of the cost.
-    ref = reference_ACEScg_grid(entry.nk, mu, eta_rows, 1.0, settings.min_coverage)
+    ref_Lab = ACEScg_to_Lab(reference_ACEScg_grid(entry.nk, mu, eta_rows, 1.0, settings.min_coverage))
     against = f"spectral reference 1 nm, {M.shape[1]} x {M.shape[0]} (cos theta x the scene's eta_i)"
 
     def score(fit: FitResult) -> ErrorMetrics:
         # Scored as shipped: float16 coefficients, the pack's float32 domain.
-        return _error(ref, model_ACEScg(fit.model, M, E, fit.packed.coefficients, fit.packed.eta_i_range), against)
+        return _error(ref_Lab, model_ACEScg(fit.model, M, E, fit.packed.coefficients, fit.packed.eta_i_range), against)
 
     # Every fit is assessed (range proof, data uncertainty) only once shipped.
     problems = {GENERAL: fit_problem(fit_kind(DEFAULT_MODEL), entry.nk, general_domain(spec), settings, degree=2)}
@@ -214,7 +218,7 @@ def fit_scene_material(
         source=entry.nk.source,
     )
     general_model = coated_conductor_model(M, E, general.coefficients, general.eta_i_range)
-    general_error = _error(ref, general_model, against)
+    general_error = _error(ref_Lab, general_model, against)
     fits, by_degree, errors, not_guarded = {}, {}, {GENERAL: general_error}, []
     shared: dict[str, FitProblem] = {}
     for candidate in CANDIDATES:
@@ -230,8 +234,11 @@ def fit_scene_material(
         if problem.guarded and error.mean > SCREEN * general_error.mean:
             not_guarded.append(candidate)
         else:
-            fit = finish_fit(problem, guard_problem(problem, fit), False)
-            error = score(fit)
+            guarded = finish_fit(problem, guard_problem(problem, fit), False)
+            # The guard keeps the mean fit where it is no worse: the same coefficients, the same score.
+            if not np.array_equal(guarded.coefficients_float16, fit.coefficients_float16):
+                error = score(guarded)
+            fit = guarded
         fits[candidate], errors[candidate] = fit, error
         if kind == DEFAULT_MODEL:
             by_degree[degree] = errors[candidate]
@@ -280,7 +287,7 @@ def fit_scene_material(
         by_degree=by_degree,
         scene=scene_error,
         general_error=general_error,
-        scene_vs_general=_error(general_model, scene_model, "the general fit's model"),
+        scene_vs_general=_error(ACEScg_to_Lab(general_model), scene_model, "the general fit's model"),
         seconds=time.perf_counter() - t0,
         choice=choice,
     )
