@@ -219,7 +219,13 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
     parts: dict[str, float] = {
         "splines": max(float(delta_E_map(base, reference_ACEScg_grid(s, _MU, eta, 1.0, 0.0)).mean()) for s in splines)
     }
-    spread = _spreads(nk, eta, base, left_out + windows)
+    # Windows a step apart often leave out the same samples (and a window one sample): each reading once.
+    variants = left_out + windows
+    readings: dict[bytes, int] = {}
+    which = [readings.setdefault(v.wavelength_nm.tobytes(), len(readings)) for v in variants]
+    distinct = {i: v for v, i in zip(variants, which)}
+    spread = _spreads(nk, eta, base, [distinct[i] for i in range(len(readings))]) if variants else np.zeros(0)
+    spread = spread[np.array(which, dtype=int)]
     # Leaving a sample out doubles the spacing there; linear interpolation's
     # error grows with the spacing squared, so a quarter of that move is the
     # data's own at their spacing.
