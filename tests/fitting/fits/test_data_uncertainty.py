@@ -61,3 +61,10 @@ def test_moved_references_are_the_references_of_the_thinned_data():
     full = [float(delta_E_map(base, reference_ACEScg_grid(v, _MU, eta, 1.0, 0.0)).mean()) for v in variants]
     assert np.allclose(_spreads(nk, eta, base, variants), full, rtol=1e-9, atol=1e-12)
     assert full[-1] == 0.0 and min(full[:-1]) > 0.0
+
+
+def test_data_with_nothing_to_leave_out_keep_zero_parts():
+    # Two samples astride the visible range: no sample inside to leave out, the one window inside the gap.
+    nk = SpectralNK(np.array([300.0, 900.0]), np.array([0.5, 0.3]), np.array([3.0, 5.0]), name="astride")
+    parts = data_uncertainty(nk, (1.0, 2.5), 0.0)["parts"]
+    assert parts["leave_one_out"] == 0.0 and parts["window_left_out"] == 0.0 and parts["splines"] > 0.0
