@@ -24,3 +24,24 @@ def test_stages_give_the_one_calls_fit_and_assess_on_request():
         assert finish_fit(staged, result).quality == one_call.quality
         assert result.packed.source == one_call.packed.source
         assert result.timings["total"] >= result.timings["fit"]
+
+
+def test_a_scenes_shipped_fit_is_assessed_as_the_one_call_fit_of_its_kind():
+    from fitting.fits.scene_fit import fit_scene_material
+    from fitting.models.kinds import DEFAULT_MODEL
+    from fitting.fits.scene_schema import EtaSpec, SceneMaterial
+    from fitting.fits.settings import FitSettings, fit_grid
+
+    # Au's data are sparse: the shipped fit carries the data's uncertainty and its warning.
+    nk = library_material("Au")
+    entry = SceneMaterial("Au", "Au", nk, EtaSpec("set", (1.0, 2.5)))
+    result = fit_scene_material(entry)
+    kind, degree = result.choice["model"], result.choice["degree"]
+    assert not result.choice["from_general_fit"]
+    settings = FitSettings() if kind == DEFAULT_MODEL else fit_kind(kind).settings
+    rows = [fit_grid((v, v), settings.mu_samples, 1, settings.grid) for v in (1.0, 2.5)]
+    samples = tuple(np.concatenate(parts) for parts in zip(*rows))
+    one_call = fit_model(nk, (1.0, 2.5), kind, settings, samples=samples, degree=degree)
+    np.testing.assert_array_equal(result.fit.coefficients_float16, one_call.coefficients_float16)
+    assert result.fit.quality == one_call.quality and "uncertainty" in result.fit.quality
+    assert result.fit.packed.source == one_call.packed.source
