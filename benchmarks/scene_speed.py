@@ -20,7 +20,10 @@ median time of the reference alone, and ``delta_E_change_max``).
 
 ``--output NAME`` records benchmarks/results/NAME.json instead
 (``scene_speed_uncertainty_kept``: against 80c7dee, before the data's
-uncertainty was kept across a scene's fits of one range).
+uncertainty was kept across a scene's fits of one range;
+``scene_speed_stages``: against 36bdfd2, before a scene's candidates shared
+their reference, only the shipped fit was assessed and a candidate already
+worse than the general fit went unguarded).
 
 Usage: python benchmarks/scene_speed.py [--before REV] [--range 1.2:1.8] [--materials Au,Cu] [--output NAME]
 """

@@ -27,11 +27,12 @@ from typing import Any
 import numpy as np
 
 from ..colour.delta_e import delta_E_map
-from ..colour.reference import reference_ACEScg_grid
+from ..colour.reference import reference_ACEScg_grid, spectral_weights
 from ..domain import VISIBLE_RANGE_NM
 from ..models.kinds import model_ACEScg
 from ..models.range_bound import certify_range
-from ..optics.nk import SpectralNK
+from ..optics.fresnel import fresnel_conductor
+from ..optics.nk import SpectralNK, check_nk_range, resample_nk
 from ..optics.quality import UNCERTAIN_GAP_NM, visible_gaps
 
 __all__ = [
@@ -111,6 +112,35 @@ def _spline_nk(nk: SpectralNK, spline) -> SpectralNK:
     return SpectralNK(grid, n, k, name=nk.name)
 
 
+def _spreads(nk: SpectralNK, eta: np.ndarray, base: np.ndarray, variants: list[SpectralNK]) -> np.ndarray:
+    """
+    The mean Delta E 2000 on (``eta``, :data:`_MU`) between the reference of
+    ``nk``, ``base`` (E, M, 3), and that of each of ``variants``. A variant's reference is
+    ``nk``'s plus the change of Fresnel at the 1 nm nodes where its linear
+    interpolation differs (a sample or a window left out moves a few), all
+    variants in one evaluation: the sums of
+    :func:`fitting.colour.reference.reference_ACEScg_grid` to rounding, at
+    a fraction of the cost.
+    """
+    nodes, W = spectral_weights(1.0)
+    sampled = resample_nk(nk, nodes, 0.0)
+    E, M = (g[..., None] for g in np.meshgrid(eta, _MU, indexing="ij"))
+    moved = [resample_nk(v, nodes, 0.0) for v in variants]
+    changed = [np.flatnonzero((v.n != sampled.n) | (v.k != sampled.k)) for v in moved]
+    at = np.concatenate(changed)
+    n = np.concatenate([v.n[c] for v, c in zip(moved, changed)])
+    k = np.concatenate([v.k[c] for v, c in zip(moved, changed)])
+    dR = (fresnel_conductor(M, E, n, k) - fresnel_conductor(M, E, sampled.n, sampled.k)[..., at]).reshape(-1, at.size)
+    # Each variant's changed nodes are one run of columns: summed run by run.
+    sizes = np.array([c.size for c in changed])
+    moves = np.zeros((len(variants), dR.shape[0], 3))
+    if at.size:
+        runs = np.add.reduceat(dR[:, :, None] * W[:, at].T, np.cumsum(sizes)[sizes > 0] - sizes[sizes > 0], axis=1)
+        moves[sizes > 0] = runs.transpose(1, 0, 2)
+    moves = moves.reshape(len(variants), *base.shape)
+    return delta_E_map(base, base + moves).reshape(len(variants), -1).mean(axis=1)
+
+
 _UNCERTAINTY_KEPT: dict = {}
 
 
@@ -163,30 +193,16 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
         return None
     eta = np.linspace(eta_i_range[0], eta_i_range[1], 3)
 
-    def reference(data: SpectralNK):
-        return reference_ACEScg_grid(data, _MU, eta, 1.0, 0.0)
-
-    def spread(data: SpectralNK) -> float:
-        return float(delta_E_map(base, reference(data)).mean())
-
     # scipy.interpolate (and with it scipy.optimize) is imported only for data that needs it: a
     # fit of dense data (no gap of UNCERTAIN_GAP_NM, enough samples) never pays for the import.
     from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
 
-    base = reference(nk)
-    parts: dict[str, float] = {}
-    parts["splines"] = max(
-        spread(_spline_nk(nk, spline)) for spline in (PchipInterpolator, Akima1DInterpolator, CubicSpline)
-    )
+    splines = [_spline_nk(nk, spline) for spline in (PchipInterpolator, Akima1DInterpolator, CubicSpline)]
     left_out = []
     for i in np.unique(np.round(np.linspace(0, inner.size - 1, min(inner.size, _MOST_LEFT_OUT))).astype(int)):
         keep = np.ones(w.size, dtype=bool)
         keep[inner[i]] = False
-        left_out.append(spread(SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name)))
-    # Leaving a sample out doubles the spacing there; linear interpolation's
-    # error grows with the spacing squared, so a quarter of that move is the
-    # data's own at their spacing.
-    parts["leave_one_out"] = max(left_out, default=0.0) / 4.0
+        left_out.append(SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name))
     windows = []
     for centre in np.arange(lo + width / 2, hi - width / 2 + 1e-9, _WINDOW_STEP_NM):
         keep = (w < centre - width / 2) | (w > centre + width / 2)
@@ -194,10 +210,28 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
             continue
         thin = SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name)
         try:
-            windows.append(spread(thin))
+            check_nk_range(thin)  # what its reference would refuse
         except ValueError:  # the window took an end of the data past the coverage
             continue
-    parts["window_left_out"] = float(np.median(windows)) if windows else 0.0
+        windows.append(thin)
+    # A spline moves every node: its reference by the product-grid kernel; the others move a few.
+    base = reference_ACEScg_grid(nk, _MU, eta, 1.0, 0.0)
+    parts: dict[str, float] = {
+        "splines": max(float(delta_E_map(base, reference_ACEScg_grid(s, _MU, eta, 1.0, 0.0)).mean()) for s in splines)
+    }
+    # Windows a step apart often leave out the same samples (and a window one sample): each reading once.
+    variants = left_out + windows
+    readings: dict[bytes, int] = {}
+    which = [readings.setdefault(v.wavelength_nm.tobytes(), len(readings)) for v in variants]
+    distinct = {i: v for v, i in zip(variants, which)}
+    spread = _spreads(nk, eta, base, [distinct[i] for i in range(len(readings))]) if variants else np.zeros(0)
+    spread = spread[np.array(which, dtype=int)]
+    # Leaving a sample out doubles the spacing there; linear interpolation's
+    # error grows with the spacing squared, so a quarter of that move is the
+    # data's own at their spacing.
+    parts["leave_one_out"] = float(spread[: len(left_out)].max(initial=0.0)) / 4.0
+    spread_windows = spread[len(left_out) :]
+    parts["window_left_out"] = float(np.median(spread_windows)) if spread_windows.size else 0.0
     value = max(parts.values())
     return {
         "delta_E_mean": value,

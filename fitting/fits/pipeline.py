@@ -12,6 +12,10 @@ whose ``settings`` are the settings that ran (its provenance) and whose
     solve of RGB samples (one per kind, registered in
     :mod:`fitting.fits.kinds`).
 -   :func:`fit_spectral`: measured *n*, *k* to a fitted, packed material.
+-   :class:`FitProblem`, :func:`fit_problem`, :func:`solve_problem`,
+    :func:`guard_problem`, :func:`finish_fit`: its stages, for callers that
+    share one reference between fits (a scene's candidates) or assess only
+    the fit they keep.
 -   :func:`settings_with`: settings with individual fields replaced.
 -   :func:`with_metrics`: a result given its metrics JSON, its pack record rebuilt with them.
 """
@@ -19,7 +23,7 @@ whose ``settings`` are the settings that ran (its provenance) and whose
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Callable
 
 import numpy as np
@@ -35,7 +39,17 @@ from .fit_quality import data_uncertainty, provenance, uncertainty_warning
 from .result import FitResult
 from .settings import FitSettings, fit_grid
 
-__all__ = ["FitKind", "fit_spectral", "settings_with", "with_metrics"]
+__all__ = [
+    "FitKind",
+    "FitProblem",
+    "fit_problem",
+    "solve_problem",
+    "guard_problem",
+    "finish_fit",
+    "fit_spectral",
+    "settings_with",
+    "with_metrics",
+]
 
 
 @dataclass(frozen=True)
@@ -101,6 +115,139 @@ def with_metrics(result: FitResult, metrics: dict[str, Any], name: str | None = 
     return result
 
 
+@dataclass(frozen=True)
+class FitProblem:
+    """
+    What a fit of one kind to ``nk`` over ``eta_i_range`` solves
+    (:func:`fit_problem`): the ``settings`` that run, the samples (``mu``,
+    ``eta``, ``weights``) and the spectral reference ``target`` there,
+    ``rows`` (a scene's set of eta_i, else None), the data's ``coverage`` and
+    ``warnings``, and the seconds the reference took. Fits of other degrees
+    share it (:meth:`with_degree`).
+    """
+
+    kind: FitKind
+    nk: SpectralNK
+    eta_i_range: tuple[float, float]
+    settings: FitSettings
+    mu: np.ndarray
+    eta: np.ndarray
+    weights: np.ndarray | None
+    target: np.ndarray
+    rows: np.ndarray | None
+    coverage: float
+    warnings: tuple[str, ...]
+    seconds: float
+
+    def with_degree(self, degree: int) -> "FitProblem":
+        """The same problem for a polynomial of ``degree`` (the reference is shared)."""
+        return replace(self, settings=settings_with(self.settings, {"degree": degree}))
+
+    @property
+    def guarded(self) -> bool:
+        """Whether the kind guards its max under these settings (see :attr:`FitKind.guard`)."""
+        return self.kind.guard is not None and self.settings.guard_max and self.settings.objective != "rgb"
+
+
+def fit_problem(
+    kind: FitKind, nk: SpectralNK, eta_i_range, settings: FitSettings | None = None, samples=None, **overrides
+) -> FitProblem:
+    """The :class:`FitProblem` of :func:`fit_spectral` (its arguments): the reference on the samples."""
+    t0 = time.perf_counter()
+    model = model_kind(kind.name)
+    if not model.polynomial:
+        overrides.pop("degree", None)
+    settings = settings_with(settings or kind.settings, overrides)
+    eta_i_range = check_eta_i_range(eta_i_range)
+    nodes, _ = spectral_weights(settings.step_nm)
+    coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
+    # Gaps inside the visible range, isolated outliers (fitting.optics.quality).
+    warnings = tuple(check_gaps(nk, settings.max_gap_nm) + outlier_warnings(nk))
+    rows = None if samples is None else np.unique(np.ravel(samples[1]))
+    if samples is None:
+        samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
+    mu, eta, weights = samples
+    target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
+    return FitProblem(
+        kind, nk, eta_i_range, settings, mu, eta, weights, target, rows, coverage, warnings, time.perf_counter() - t0
+    )
+
+
+def solve_problem(problem: FitProblem, **settings) -> FitResult:
+    """The kind's solve and float16 quantisation of ``problem`` (no guard); ``settings``: as :attr:`FitKind.solve`'s."""
+    s = problem.settings
+    return problem.kind.solve(
+        problem.target,
+        problem.mu,
+        problem.eta,
+        problem.eta_i_range,
+        s.degree,
+        s.objective,
+        s.max_nfev,
+        s.quantise,
+        weights=problem.weights,
+        irls_rounds=s.irls_rounds,
+        **settings,
+    )
+
+
+def guard_problem(problem: FitProblem, result: FitResult) -> FitResult:
+    """``result`` (:func:`solve_problem`'s) with its max guarded when :attr:`FitProblem.guarded`, else itself."""
+    if not problem.guarded:
+        return result
+    p = problem
+    return p.kind.guard(p.nk, p.target, p.mu, p.eta, p.weights, p.eta_i_range, p.settings, result, rows=p.rows)
+
+
+def finish_fit(problem: FitProblem, result: FitResult, assess: bool = True, evaluate: bool = False) -> FitResult:
+    """
+    ``result`` with its ``coverage``, ``settings``, ``quality`` and
+    ``packed`` record (the citation of the data with the warnings as its
+    source) and, with ``evaluate``, its metrics; ``assess=False`` leaves out
+    the kind's quality (the proof of [0, 1]) and the data's uncertainty, for
+    a fit that is scored but not shipped (:func:`finish_fit` again assesses it).
+    """
+    nk, eta_i_range, settings = problem.nk, problem.eta_i_range, problem.settings
+    t0 = time.perf_counter()
+    result.coverage = problem.coverage
+    result.settings = settings
+    result.timings["reference"] = problem.seconds
+    warnings = list(problem.warnings)
+    result.quality = {"warnings": warnings}
+    if assess:
+        t_quality = time.perf_counter()
+        if problem.kind.quality is not None:
+            result.quality = problem.kind.quality(result, eta_i_range, warnings)
+        # How far gaps and sparse sampling leave the figure uncertain (fitting.fits.fit_quality).
+        uncertainty = data_uncertainty(nk, eta_i_range, settings.min_coverage)
+        if uncertainty is not None:
+            own, warning = uncertainty_warning(
+                uncertainty, nk, eta_i_range, model_kind(problem.kind.name).name, result.coefficients_float16
+            )
+            result.quality["uncertainty"] = {**uncertainty, "fit_delta_E_mean": own}
+            if warning is not None:
+                result.quality["warnings"] = [*result.quality["warnings"], warning]
+        result.timings["quality"] = time.perf_counter() - t_quality
+    result.packed = PackedMaterial(
+        name=nk.name,
+        coefficients=result.coefficients_float16,
+        eta_i_range=eta_i_range,
+        source=provenance(nk.source, result.quality),
+        model=result.model,
+    )
+    if evaluate:
+        t_eval = time.perf_counter()
+        metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
+        metrics["quality"] = result.quality
+        if result.guard is not None:
+            metrics["guard"] = result.guard
+        with_metrics(result, metrics)
+        result.timings["evaluate"] = time.perf_counter() - t_eval
+    stages = ("reference", "fit", "quantise", "guard")
+    result.timings["total"] = sum(result.timings.get(k, 0.0) for k in stages) + time.perf_counter() - t0
+    return result
+
+
 def fit_spectral(
     kind: FitKind,
     nk: SpectralNK,
@@ -119,7 +266,10 @@ def fit_spectral(
     kind with a power axis) comes from the exact Fresnel equations integrated
     to linear ACEScg at ``step_nm``; ``samples``, ``(cos_theta, eta_i,
     weights)``, replace that grid (a scene's own eta_i). ``kind.solve`` fits
-    and quantises.
+    and quantises, ``kind.guard`` guards the max, ``kind.quality`` and the
+    data's uncertainty say what the fit can be trusted for: the stages
+    :func:`fit_problem`, :func:`solve_problem`, :func:`guard_problem`,
+    :func:`finish_fit`.
 
     Returns
     -------
@@ -137,62 +287,7 @@ def fit_spectral(
         too little of the visible range.
     """
     t0 = time.perf_counter()
-    model = model_kind(kind.name)
-    if not model.polynomial:
-        overrides.pop("degree", None)
-    settings = settings_with(settings or kind.settings, overrides)
-    eta_i_range = check_eta_i_range(eta_i_range)
-    nodes, _ = spectral_weights(settings.step_nm)
-    coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
-    # Gaps inside the visible range, isolated outliers, and how far gaps and
-    # sparse sampling leave the figure uncertain (fitting.fits.fit_quality).
-    warnings = check_gaps(nk, settings.max_gap_nm) + outlier_warnings(nk)
-    uncertainty = data_uncertainty(nk, eta_i_range, settings.min_coverage)
-    rows = None if samples is None else np.unique(np.ravel(samples[1]))
-    if samples is None:
-        samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
-    mu, eta, weights = samples
-    target = reference_ACEScg(nk, mu, eta, settings.step_nm, settings.min_coverage)
-    t_ref = time.perf_counter()
-    result = kind.solve(
-        target,
-        mu,
-        eta,
-        eta_i_range,
-        settings.degree,
-        settings.objective,
-        settings.max_nfev,
-        settings.quantise,
-        weights=weights,
-        irls_rounds=settings.irls_rounds,
-    )
-    if kind.guard is not None and settings.guard_max and settings.objective != "rgb":
-        result = kind.guard(nk, target, mu, eta, weights, eta_i_range, settings, result, rows=rows)
-    result.coverage = coverage
-    result.settings = settings
-    result.timings["reference"] = t_ref - t0
-    result.quality = (
-        kind.quality(result, eta_i_range, warnings) if kind.quality is not None else {"warnings": list(warnings)}
-    )
-    if uncertainty is not None:
-        own, warning = uncertainty_warning(uncertainty, nk, eta_i_range, model.name, result.coefficients_float16)
-        result.quality["uncertainty"] = {**uncertainty, "fit_delta_E_mean": own}
-        if warning is not None:
-            result.quality["warnings"] = [*result.quality["warnings"], warning]
-    result.packed = PackedMaterial(
-        name=nk.name,
-        coefficients=result.coefficients_float16,
-        eta_i_range=eta_i_range,
-        source=provenance(nk.source, result.quality),
-        model=result.model,
-    )
-    if evaluate:
-        t_eval = time.perf_counter()
-        metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
-        metrics["quality"] = result.quality
-        if result.guard is not None:
-            metrics["guard"] = result.guard
-        with_metrics(result, metrics)
-        result.timings["evaluate"] = time.perf_counter() - t_eval
+    problem = fit_problem(kind, nk, eta_i_range, settings, samples, **overrides)
+    result = finish_fit(problem, guard_problem(problem, solve_problem(problem)), evaluate=evaluate)
     result.timings["total"] = time.perf_counter() - t0
     return result

@@ -148,3 +148,14 @@ class TestWhereTheSceneLooks:
         for dearer in labels[labels.index("rgb-conductor") + 1 :]:
             other = tungsten["choice"]["candidates"][dearer]
             assert shipped["mean"] <= other["mean"] and shipped["max"] <= other["max"]
+
+    def test_only_hopeless_candidates_skip_their_guard(self, tungsten):
+        from fitting.fits.scene_fit import SCREEN
+
+        candidates, general = tungsten["choice"]["candidates"], tungsten["general"]["delta_E_2000"]
+        # Degree 0 at {1.0, 2.5}: many times the general fit's mean before any guard, so never guarded.
+        assert tungsten["choice"]["not_guarded"] == ["coated-conductor degree 0"]
+        for label in tungsten["choice"]["not_guarded"]:
+            assert candidates[label]["mean"] > SCREEN * general["mean"]
+        # The shipped fit alone is assessed: its report carries the data's warnings and the guard's choice.
+        assert "warnings" in tungsten["fit"]["quality"]
