@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from fitting import library_material
 from fitting.fits.kinds import fit_kind, fit_model
 from fitting.fits.pipeline import finish_fit, fit_problem, guard_problem, solve_problem
 
 
+@pytest.mark.slow  # two fits and their assessment: 2-4 s
 def test_stages_give_the_one_calls_fit_and_assess_on_request():
     nk = library_material("Au")
     problem = fit_problem(fit_kind("coated-conductor"), nk, (1.2, 1.8), degree=2)
