@@ -77,15 +77,15 @@ FAILURE = re.compile(r"^(?:FAILED|ERROR) .*$", re.M)
 TICK = os.sysconf("SC_CLK_TCK")
 
 
-def calibration() -> float:
+def calibration(rounds: int = 3) -> float:
     """
     Seconds of CPU time a fixed pure-Python loop takes here (the best of
-    3): the interpreter's speed on one core at the moment. The suite's own
+    ``rounds``): the interpreter's speed on one core at the moment. The suite's own
     CPU seconds have varied by a third between runs where this loop did not
     (docs/testing.md), so it tells one cause of a slow run apart, not all.
     """
     best = float("inf")
-    for _ in range(3):
+    for _ in range(rounds):
         start, total = time.process_time(), 0
         for i in range(2_000_000):
             total += i * i % 7
@@ -93,10 +93,10 @@ def calibration() -> float:
     return round(best, 3)
 
 
-def memory_calibration() -> float:
+def memory_calibration(rounds: int = 3) -> float:
     """
     CPU seconds 8 copies of a 128 MiB float64 array into another take here
-    (the best of 3): 2 GiB read and written, far past the caches, so the
+    (the best of ``rounds``): 2 GiB read and written, far past the caches, so the
     memory bandwidth one core gets at the moment.
     """
     import numpy as np
@@ -104,7 +104,7 @@ def memory_calibration() -> float:
     source = np.ones(16 * 2**20)
     target = np.empty_like(source)
     best = float("inf")
-    for _ in range(3):
+    for _ in range(rounds):
         start = time.process_time()
         for _ in range(8):
             np.copyto(target, source)

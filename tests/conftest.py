@@ -21,6 +21,8 @@ Shared fixtures of the test suite.
     from the same program where the environment allows.
 -   :func:`app_client`: the TestClient factory behind ``client``, with
     settings overrides (``with app_client(tmp_path, fit_queue=0) as c: ...``).
+-   ``reader``: one such app for all the tests of a module that only read
+    or are refused (nothing stored, the store left open).
 -   :func:`server_process`: the context manager behind ``live_server``, for
     tests that need their own data directory, environment or a restart
     (``with server_process(data_dir, COATED_FIT_QUEUE="0") as server: ...``;
@@ -243,6 +245,18 @@ def postgres_url(postgres_server) -> str:
 @pytest.fixture
 def client(tmp_path):
     with app_client(tmp_path, metrics_samples=30) as test_client:
+        yield test_client
+
+
+@pytest.fixture(scope="module")
+def reader(tmp_path_factory):
+    """
+    ``client``'s app shared by a module's tests that only read or are
+    refused (a 404, 413 or 422: nothing they send is stored, and none closes
+    the store): an app's first request costs about 0.3 s of CPU (FastAPI
+    builds its routes' models then), more than most such tests.
+    """
+    with app_client(tmp_path_factory.mktemp("reader"), metrics_samples=30) as test_client:
         yield test_client
 
 

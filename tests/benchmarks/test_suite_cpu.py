@@ -64,7 +64,7 @@ def test_a_server_forked_by_the_tests_program_is_a_server():
 
 
 def test_the_calibration_loop_takes_cpu_time():
-    assert 0.0 < calibration() < 60.0
+    assert 0.0 < calibration(rounds=1) < 60.0  # the record takes the best of 3 of the same loop
 
 
 @pytest.mark.slow

@@ -40,7 +40,7 @@ def test_arguments_out_of_bounds_are_refused(argv, message, capsys):
 
 
 def test_the_memory_calibration_takes_cpu_time():
-    assert 0.0 < memory_calibration() < 60.0
+    assert 0.0 < memory_calibration(rounds=1) < 60.0  # the record takes the best of 3 of the same copies
 
 
 def test_each_mode_s_median_and_worst_run():

@@ -47,8 +47,8 @@ def shared(tmp_path_factory):
 
 
 class TestHealthAndDocs:
-    def test_healthz(self, client):
-        response = client.get("/healthz")
+    def test_healthz(self, reader):
+        response = reader.get("/healthz")
         assert response.status_code == 200
         assert response.json()["status"] == "ok"
         assert response.json()["fit_workers"] == 1
@@ -59,8 +59,8 @@ class TestHealthAndDocs:
         assert response.status_code == 503
         assert "store" in response.json()["detail"]
 
-    def test_openapi_shows_constraints(self, client):
-        schema = client.get("/openapi.json").json()
+    def test_openapi_shows_constraints(self, reader):
+        schema = reader.get("/openapi.json").json()
         request = schema["components"]["schemas"]["FitRequest"]["properties"]
         items = request["eta_i_range"]["prefixItems"]
         assert items[0]["minimum"] == 1.0 and items[0]["maximum"] == 3.0
@@ -69,18 +69,18 @@ class TestHealthAndDocs:
         assert nk["k"]["items"]["minimum"] == 0.0
         material = request["material"]["anyOf"][0]
         assert material["maxLength"] == 200 and "gold" in material["description"]
-        assert client.get("/docs").status_code == 200
+        assert reader.get("/docs").status_code == 200
 
-    def test_domain_states_the_upload_coverage_rule(self, client):
-        domain = client.get(f"{API}/domain").json()
+    def test_domain_states_the_upload_coverage_rule(self, reader):
+        domain = reader.get(f"{API}/domain").json()
         assert domain["visible_range_nm"] == list(VISIBLE_RANGE_NM)
         assert domain["min_coverage"] == DEFAULT_MIN_COVERAGE
         assert domain["draft_ttl_s"] == 86_400.0  # how long a link to an unsaved edit lasts
 
 
 class TestMaterials:
-    def test_library_listed_with_sources(self, client):
-        materials = client.get(f"{API}/materials").json()["materials"]
+    def test_library_listed_with_sources(self, reader):
+        materials = reader.get(f"{API}/materials").json()["materials"]
         library = [m for m in materials if m["kind"] == "library"]
         assert set(LIBRARY_NAMES) <= {m["id"] for m in library}
         (gold,) = [m for m in library if m["id"] == "Au"]
@@ -88,14 +88,14 @@ class TestMaterials:
         # equal sums, 1 to a few u64; approx's default rel=1e-6 is loose but harmless
         assert gold["latest_fit_id"] is None
 
-    def test_library_material_detail(self, client):
-        detail = client.get(f"{API}/materials/Cu").json()
+    def test_library_material_detail(self, reader):
+        detail = reader.get(f"{API}/materials/Cu").json()
         assert detail["kind"] == "library" and detail["latest_fit"] is None
         low, high = detail["wavelength_range_nm"]
         assert low <= 360 and high >= 830
 
-    def test_unknown_material_404(self, client):
-        response = client.get(f"{API}/materials/{'ab' * 16}")
+    def test_unknown_material_404(self, reader):
+        response = reader.get(f"{API}/materials/{'ab' * 16}")
         assert response.status_code == 404
         assert "material_id" in response.json()["detail"]
 
@@ -112,8 +112,8 @@ class TestMaterials:
             ("A" * 9, 422),
         ],
     )
-    def test_bad_material_id_never_reaches_files(self, client, bad, code):
-        response = client.get(f"{API}/materials/{bad}")
+    def test_bad_material_id_never_reaches_files(self, reader, bad, code):
+        response = reader.get(f"{API}/materials/{bad}")
         assert response.status_code == code
         if code == 422:
             assert "`material_id`" in response.json()["detail"]
@@ -252,13 +252,13 @@ class TestFits:
             ("ok.csv", "x", {"eta_i_min": "0.5"}, "eta_i_min"),
         ],
     )
-    def test_upload_bad_files_422(self, client, file_name, content, form, needle):
-        response = client.post(f"{API}/fits/upload", files={"file": (file_name, content)}, data=form)
+    def test_upload_bad_files_422(self, reader, file_name, content, form, needle):
+        response = reader.post(f"{API}/fits/upload", files={"file": (file_name, content)}, data=form)
         assert response.status_code == 422, response.text
         assert needle in response.json()["detail"]
 
-    def test_upload_broken_multipart_422(self, client):
-        response = client.post(
+    def test_upload_broken_multipart_422(self, reader):
+        response = reader.post(
             f"{API}/fits/upload",
             content=b'--x\r\nContent-Disposition: form-data; name="file"',
             headers={"content-type": "multipart/form-data; boundary=x"},
@@ -311,8 +311,8 @@ class TestBadInput:
             (b'{"material": "Au", "eta_i_range": "1-2"}', "eta_i_range"),
         ],
     )
-    def test_bad_json_422(self, client, body, needle):
-        response = client.post(f"{API}/fits", content=body, headers={"content-type": "application/json"})
+    def test_bad_json_422(self, reader, body, needle):
+        response = reader.post(f"{API}/fits", content=body, headers={"content-type": "application/json"})
         assert response.status_code == 422, response.text
         assert needle in response.json()["detail"]
 
@@ -337,14 +337,14 @@ class TestBadInput:
             (nk_body(wavelength_nm=["a"] * 26), "wavelength_nm[0]"),
         ],
     )
-    def test_bad_nk_422(self, client, body, needle):
-        response = client.post(f"{API}/fits", json=body)
+    def test_bad_nk_422(self, reader, body, needle):
+        response = reader.post(f"{API}/fits", json=body)
         assert response.status_code == 422, response.text
         assert needle in response.json()["detail"]
 
-    def test_nan_inside_nk_422(self, client):
+    def test_nan_inside_nk_422(self, reader):
         body = json.dumps(nk_body()).replace('"k": [1.8', '"k": [NaN')
-        response = client.post(f"{API}/fits", content=body, headers={"content-type": "application/json"})
+        response = reader.post(f"{API}/fits", content=body, headers={"content-type": "application/json"})
         assert response.status_code == 422
         assert "`nk.k[0]` (body): Input should be a finite number" in response.json()["detail"]
 
@@ -384,8 +384,8 @@ class TestPacks:
         response = client.get(f"{API}/fits/{fit['id']}/pack", params={"format": "fbx"})
         assert response.status_code == 422 and "format" in response.json()["detail"]
 
-    def test_pack_of_unknown_fit_404(self, client):
-        assert client.get(f"{API}/fits/{'1' * 32}/pack").status_code == 404
+    def test_pack_of_unknown_fit_404(self, reader):
+        assert reader.get(f"{API}/fits/{'1' * 32}/pack").status_code == 404
 
     def test_multi_material_pack(self, shared):
         client, fit = shared
@@ -407,8 +407,8 @@ class TestPacks:
             ({"fit_ids": ["2" * 32], "name": "../x"}, 422),
         ],
     )
-    def test_pack_errors(self, client, body, status):
-        response = client.post(f"{API}/packs", json=body)
+    def test_pack_errors(self, reader, body, status):
+        response = reader.post(f"{API}/packs", json=body)
         assert response.status_code == status
         assert response.json()["detail"]
 
@@ -444,8 +444,8 @@ class TestCurves:
         assert response.status_code == 422
         assert next(iter(params)) in response.json()["detail"]
 
-    def test_unknown_fit_404(self, client):
-        assert client.get(f"{API}/fits/{'3' * 32}/curves").status_code == 404
+    def test_unknown_fit_404(self, reader):
+        assert reader.get(f"{API}/fits/{'3' * 32}/curves").status_code == 404
 
 
 @pytest.mark.gl
@@ -480,8 +480,8 @@ class TestPreview:
         response = client.get(f"{API}/preview.png", params={"fit": fit["id"], **params})
         assert response.status_code == status
 
-    def test_unknown_fit_404(self, client):
-        assert client.get(f"{API}/preview.png", params={"fit": "4" * 32}).status_code == 404
+    def test_unknown_fit_404(self, reader):
+        assert reader.get(f"{API}/preview.png", params={"fit": "4" * 32}).status_code == 404
 
     def test_size_above_setting_422(self, tmp_path):
         with app_client(tmp_path, max_preview_size=128) as client:
@@ -539,10 +539,10 @@ class TestSecurity:
         assert not Settings(data_dir=tmp_path, host="127.0.0.1").token_required
         assert not Settings(data_dir=tmp_path, host="0.0.0.0", require_token=False).token_required
 
-    def test_cors_closed_by_default(self, client):
-        response = client.get(f"{API}/materials", headers={"Origin": "https://evil.example"})
+    def test_cors_closed_by_default(self, reader):
+        response = reader.get(f"{API}/materials", headers={"Origin": "https://evil.example"})
         assert "access-control-allow-origin" not in response.headers
-        preflight = client.options(
+        preflight = reader.options(
             f"{API}/fits", headers={"Origin": "https://evil.example", "Access-Control-Request-Method": "POST"}
         )
         assert "access-control-allow-origin" not in preflight.headers

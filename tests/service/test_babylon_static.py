@@ -31,22 +31,22 @@ LOCK = json.loads((ROOT / "scripts" / "babylon" / "package-lock.json").read_text
         "/examples/babylon.js",
     ],
 )
-def test_modules_served_as_javascript(client, path):
-    response = client.get(path)
+def test_modules_served_as_javascript(reader, path):
+    response = reader.get(path)
     assert response.status_code == 200, path
     assert response.headers["content-type"].startswith(("text/javascript", "application/javascript"))
 
 
-def test_the_locked_babylon_is_served(client):
+def test_the_locked_babylon_is_served(reader):
     for name in ("core", "loaders"):
         want = LOCK["packages"][f"node_modules/@babylonjs/{name}"]["version"]
         assert LOCK["packages"][""]["dependencies"][f"@babylonjs/{name}"] == want
-        served = client.get(f"/vendor/babylon/{name}/package.json")
+        served = reader.get(f"/vendor/babylon/{name}/package.json")
         assert served.status_code == 200 and served.json()["version"] == want
 
 
-def test_example_page_uses_the_import_map_not_a_cdn(client):
-    page = client.get("/examples/babylon.html")
+def test_example_page_uses_the_import_map_not_a_cdn(reader):
+    page = reader.get("/examples/babylon.html")
     assert page.status_code == 200
     assert '"@babylonjs/core/": "/vendor/babylon/core/"' in page.text
     assert "http://" not in page.text and "https://" not in page.text

@@ -24,7 +24,7 @@ import loopback
 import numpy as np
 import pytest
 
-from conftest import ROOT, app_client, server_process
+from conftest import ROOT, app_client, run_command, server_process
 
 API = "/api/v1"
 
@@ -218,13 +218,7 @@ def test_bad_store_at_start_up_exits_with_one_line(tmp_path, damage):
         (data / "store.sqlite3").write_bytes(b"this is not a database" * 200)
     else:
         data.write_text("a file where the directory should be")
-    result = subprocess.run(
-        [sys.executable, "-m", "service", "--data-dir", str(data), "--port", "0"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    result = run_command("service", "--data-dir", str(data), "--port", "0", timeout=120)
     assert result.returncode == 1
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("python -m service: cannot start: the store")
@@ -259,13 +253,8 @@ def test_a_stopped_server_exits_with_the_signal_s_status_and_leaves_no_temporary
 def test_a_temporary_directory_too_long_for_the_fork_server_s_socket_stops_the_start_with_one_line(tmp_path):
     temporary = tmp_path / ("t" * 90)  # its fork server's socket: pymp-XXXXXXXX/listener-XXXXXXXX in it
     temporary.mkdir()
-    run = subprocess.run(
-        [sys.executable, "-m", "service", "--port", "0", "--data-dir", str(tmp_path / "data")],
-        cwd=ROOT,
-        env={**os.environ, "TMPDIR": str(temporary)},
-        capture_output=True,
-        text=True,
-        timeout=120,
+    run = run_command(
+        "service", "--port", "0", "--data-dir", str(tmp_path / "data"), env={**os.environ, "TMPDIR": str(temporary)}
     )
     assert run.returncode == 1
     assert run.stderr.startswith("python -m service: cannot start: the fork server's socket, "), run.stderr

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import itertools
 import sqlite3
-import subprocess
 import sys
 import threading
 import time
@@ -28,7 +27,7 @@ from schemathesis.checks import (
     status_code_conformance,
 )
 
-from conftest import ROOT, server_process
+from conftest import run_command, server_process
 
 API = "/api/v1"
 pytestmark = pytest.mark.server
@@ -58,13 +57,7 @@ def test_start_up_and_docs(tmp_path):
 
 
 def test_refuses_public_bind_without_token(tmp_path):
-    result = subprocess.run(
-        [sys.executable, "-m", "service", "--host", "0.0.0.0", "--data-dir", str(tmp_path)],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    result = run_command("service", "--host", "0.0.0.0", "--data-dir", str(tmp_path), timeout=120)
     assert result.returncode == 2
     assert "COATED_API_TOKEN" in result.stderr
 

@@ -55,22 +55,26 @@ def test_the_next_call_after_a_run_runs_it_again():
 
 
 def test_a_follower_waits_at_most_wait_s():
-    runs, started = [], threading.Event()
+    runs, started, release = [], threading.Event(), threading.Event()
 
     def check():
         runs.append(1)
         started.set()
-        time.sleep(1.0)
+        release.wait(10)  # the leader's check runs until the follower has given up
 
     shared = SharedCheck(check, Refused, wait_s=0.1)
     leader = threading.Thread(target=shared)
     leader.start()
     started.wait(10)
     begun = time.monotonic()
-    with pytest.raises(Refused, match="no outcome of another call's check within 0.1 s"):
-        shared()
-    assert time.monotonic() - begun < 0.9
-    leader.join()
+    try:
+        with pytest.raises(Refused, match="no outcome of another call's check within 0.1 s"):
+            shared()
+        assert time.monotonic() - begun < 0.9
+        assert leader.is_alive()  # refused while the check it would have shared still ran
+    finally:
+        release.set()
+        leader.join()
     assert len(runs) == 1
 
 

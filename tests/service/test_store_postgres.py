@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import sqlite3
 import subprocess
-import sys
 import threading
 import time
 import types
@@ -19,7 +18,7 @@ import psycopg
 import pytest
 from at_once import at_once
 
-from conftest import ROOT
+from conftest import run_command
 from service.store import SCHEMA_VERSION, FitRecord, SchemaMismatch, SQLiteStore, StoreConflict, StoreUnavailable
 from service.store.move import move_sqlite_to_postgres, store_checksum
 from service.store.postgres import QUICK_WAIT_S, PostgresStore, redacted
@@ -42,16 +41,10 @@ def record(fit_id: str, material_id: str = "m" * 32, name: str = "gold", kind: s
 
 
 def run_service(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    """``python -m service ARGS`` with ``env`` added (forked: tests/conftest.py's ``run_command``)."""
     import os
 
-    return subprocess.run(
-        [sys.executable, "-m", "service", *args],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, **(env or {})},
-    )
+    return run_command("service", *args, timeout=120, env={**os.environ, **(env or {})})
 
 
 class TestMigrations:

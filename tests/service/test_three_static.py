@@ -42,22 +42,22 @@ LOCK = json.loads((ROOT / "scripts" / "three" / "package-lock.json").read_text()
         "/examples/three.js",
     ],
 )
-def test_modules_served_as_javascript(client, path):
-    response = client.get(path)
+def test_modules_served_as_javascript(reader, path):
+    response = reader.get(path)
     assert response.status_code == 200, path
     assert response.headers["content-type"].startswith(("text/javascript", "application/javascript"))
 
 
-def test_the_locked_three_is_served(client):
+def test_the_locked_three_is_served(reader):
     want = LOCK["packages"]["node_modules/three"]["version"]
-    head = client.get("/vendor/three/build/three.core.js").text[:400]
+    head = reader.get("/vendor/three/build/three.core.js").text[:400]
     assert "Three.js Authors" in head and LOCK["packages"][""]["dependencies"]["three"] == want
     revision = want.split(".")[1]
-    assert f"REVISION = '{revision}'" in client.get("/vendor/three/build/three.core.js").text
+    assert f"REVISION = '{revision}'" in reader.get("/vendor/three/build/three.core.js").text
 
 
-def test_example_page_uses_the_import_map_not_a_cdn(client):
-    page = client.get("/examples/three.html")
+def test_example_page_uses_the_import_map_not_a_cdn(reader):
+    page = reader.get("/examples/three.html")
     assert page.status_code == 200
     assert '"three": "/vendor/three/build/three.module.js"' in page.text
     assert "http://" not in page.text and "https://" not in page.text
@@ -66,5 +66,5 @@ def test_example_page_uses_the_import_map_not_a_cdn(client):
 @pytest.mark.parametrize(
     "path", ["/vendor/three/package.json", "/vendor/three/src/Three.js", "/vendor/three/../../package-lock.json"]
 )
-def test_only_build_and_addons(client, path):
-    assert client.get(path).status_code == 404
+def test_only_build_and_addons(reader, path):
+    assert reader.get(path).status_code == 404

@@ -9,11 +9,11 @@ are one of each a test process: the server is tests/conftest.py's
 session-scoped ``browser_server`` (``live_server`` here overrides its
 function-scoped ``live_server``), so a test must assume nothing of the store
 but what it made; Chromium is launched by the first test that asks for it
-and closed after the last test of a run of such tests (tests/conftest.py's
-``pytest_runtest_teardown`` calls :func:`release_chromium`), so that no
-other test runs beside it: while a browser is open, playwright's sync API
-holds an asyncio loop on the thread, and ``asyncio.run`` in another test
-would refuse to start. Each test has fresh browser contexts (no cookies,
+and closed after the last test of a run of such tests and of the other
+tests marked ``browser`` (tests/conftest.py's ``pytest_runtest_teardown``
+calls :func:`release_chromium`), so that no other test runs beside it:
+while a browser is open, playwright's sync API holds an asyncio loop on the
+thread, and ``asyncio.run`` in another test would refuse to start. Each test has fresh browser contexts (no cookies,
 storage or cache from another test).
 :func:`camera_rays` is numpy's twin of the preview's camera
 (shader_ball.frag), for the WebGL parity tests.
@@ -69,8 +69,15 @@ _CHROMIUM = SharedChromium()
 
 
 def release_chromium(nextitem) -> None:
-    """Close the shared Chromium unless ``nextitem`` (the next test, or None) uses it."""
-    if nextitem is None or "chromium" not in getattr(nextitem, "fixturenames", ()):
+    """
+    Close the shared Chromium unless ``nextitem`` (the next test, or None)
+    uses it or is marked ``browser``: a browser module's tests that draw
+    nothing (its REST, CLI and type checks) run between those that do, and a
+    launch is seconds of CPU; none of them runs an asyncio loop of its own.
+    """
+    if nextitem is None or not (
+        "chromium" in getattr(nextitem, "fixturenames", ()) or nextitem.get_closest_marker("browser")
+    ):
         _CHROMIUM.close()
 
 
