@@ -163,7 +163,7 @@ def prepare_curve_fit(
     check_curves(curves)
     domain = base.eta_i_range if base is not None else check_eta_i_range(requested or DEFAULT_DOMAIN)
     start = None if start_fit is None else _start_coefficients(store, start_fit, domain, model, base, curves)
-    material_id = resolve_material(store, name, material_id)
+    material_id = resolve_material(store, name, material_id, saving=not draft)
     fit_id = content_address(
         FIT_FORMAT_VERSION,
         CURVES_FORMAT,

@@ -25,7 +25,7 @@ def share_url(material_id: str, version: int | None = None) -> str:
     return f"/?material={material_id}" + ("" if version is None else f"&version={version}")
 
 
-def resolve_material(store: Store, name: str, material_id: str | None = None) -> str:
+def resolve_material(store: Store, name: str, material_id: str | None = None, saving: bool = False) -> str:
     """
     The material a curve fit called ``name`` belongs to: ``material_id``
     when given (``LookupError`` unless it is a saved edited material;
@@ -34,8 +34,18 @@ def resolve_material(store: Store, name: str, material_id: str | None = None) ->
     material is found by its new name; one in the bin too, which the save
     takes out), else a new one: the content address of the name, or, when
     that id belongs to a material since renamed, the first free
-    ``(name, n)``.
+    ``(name, n)``. ``saving``: :class:`service.store.NameTaken` too when
+    the save would be refused for a name that looks the same as another's
+    (the store's rule, asked before the fit rather than after it).
     """
+    material = _resolved(store, name, material_id)
+    if saving and (clash := store.name_clash(name, material)) is not None:
+        row = store.material(material)
+        raise NameTaken(clash, version=0 if row is None else row.version, latest_fit_id=row and row.latest_fit_id)
+    return material
+
+
+def _resolved(store: Store, name: str, material_id: str | None) -> str:
     holder = store.find_material("curves", name)
     if material_id is not None:
         row = store.material(material_id)

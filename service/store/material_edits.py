@@ -9,6 +9,9 @@ summary row only; records and saves stay as written.
 -   :func:`rename`: a material renamed, refused (:class:`NameTaken`) when
     another edited material has that name or one that looks the same.
 -   :func:`set_deleted`: a material moved to the bin or out of it.
+-   :func:`look_alike_clash`: why a save of ``material_id`` under a name
+    would be refused for looking the same as another's (the save's own
+    rule, read ahead of its fit), or None.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from .names import name_key
 from .queries import name_clash_message, other_name_holder, material_row, summary_text
 from .records import MaterialRow, NameTaken
 
-__all__ = ["rename", "set_deleted"]
+__all__ = ["rename", "set_deleted", "look_alike_clash"]
 
 
 def _saved(connection: Any, p: str, material_id: str) -> MaterialRow:
@@ -63,3 +66,19 @@ def set_deleted(connection: Any, p: str, material_id: str, deleted: bool) -> Mat
     elif not deleted and row.deleted_at is not None:
         connection.execute(f"UPDATE materials SET deleted_at = NULL WHERE material_id = {p}", (material_id,))
     return material_row(connection, p, material_id)
+
+
+def look_alike_clash(connection: Any, p: str, name: str, material_id: str) -> str | None:
+    """
+    The refusal a save of ``material_id`` under ``name`` meets now
+    (:func:`service.store.queries.save`'s rule): another edited
+    material's name looks the same and ``name`` is new to this material;
+    None when the save may go ahead.
+    """
+    holder = other_name_holder(connection, p, name, material_id)
+    if holder is None or holder[2] == summary_text(name):
+        return None  # free, or the very name (the save then goes to that material: resolve_material)
+    row = material_row(connection, p, material_id)
+    if row is not None and row.name == summary_text(name):
+        return None
+    return name_clash_message(name, holder)

@@ -300,6 +300,13 @@ class Store(Protocol):
     def find_material(self, kind: str, name: str) -> str | None:
         """The id of the material of ``kind`` called ``name`` now (one not deleted first), or None."""
 
+    def name_clash(self, name: str, material_id: str) -> str | None:
+        """
+        Why a save of ``material_id`` under ``name`` would now be refused
+        (:class:`NameTaken`: another edited material's name looks the same),
+        or None: the save's rule read ahead, so that a refused save costs no fit.
+        """
+
     def rename_material(self, material_id: str, name: str) -> MaterialRow:
         """
         Call a saved material ``name`` (not a save: its version is kept);

@@ -109,6 +109,9 @@ class SQLStore:
     def find_material(self, kind: str, name: str) -> str | None:
         return self._read(lambda c: queries.find_material(c, self.placeholder, kind, name))
 
+    def name_clash(self, name: str, material_id: str) -> str | None:
+        return self._read(lambda c: material_edits.look_alike_clash(c, self.placeholder, name, material_id))
+
     def rename_material(self, material_id: str, name: str) -> MaterialRow:
         return self._write(lambda c: material_edits.rename(c, self.placeholder, material_id, name))
 

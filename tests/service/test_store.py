@@ -312,8 +312,13 @@ class TestMaterialsManaged:
                 store.put_fit(record("3" * 32, material_id=c, kind="curves", name=name))
             with pytest.raises(NameTaken, match=f"looks the same as 'Brass mix', the name of saved material {a}"):
                 store.rename_material(b, name)
+            # The same refusal, asked ahead of a save (before its fit): the store's own rule.
+            assert store.name_clash(name, c).startswith(f"`name` {name!r} looks the same as 'Brass mix'")
+        assert store.name_clash("Brass mix", c) is None  # the very name: the save goes to that material
+        assert store.name_clash("warm 2", c) is None
         assert store.material(c) is None and store.material(b).name == "warm"
         # Its own material may take a look-alike spelling; another name is free.
+        assert store.name_clash("brass mix", a) is None
         assert store.rename_material(a, "brass mix").name == "brass mix"
         store.put_fit(record("4" * 32, material_id=c, kind="curves", name="Brass mix 2"))
         store.delete_material(a)  # the bin keeps the name
