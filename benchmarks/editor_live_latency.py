@@ -8,15 +8,20 @@ drag holds a control point and moves it (``--moves`` pointer moves, one every
 40 ms): gentle drags (a channel at 50 degrees, a few px per move) and
 extreme ones (green at 60 degrees pulled down 10-14 px a move, an edit the
 model cannot follow); after each the edit is undone, so drags do not pile
-up. Measured, from the pointer events' own time stamps (``event.timeStamp``,
+up, and each drag of each phase ends on a curve of its own, so that no full
+refit is served from the store. Measured, from the pointer events' own time stamps (``event.timeStamp``,
 caught before the page's handlers) and the page's frames
 (``window.cfTelemetry``):
 
 -   ``move_to_frame_ms``: for every pointer move, the time to the first
     preview frame that shows its refit (of that move or a later one);
     median, p90, p99 and worst, gentle and extreme;
--   ``release_to_final_ms``: from the pointer's release to the first frame
-    of the server's full refit;
+-   ``release_to_final_ms``: from the pointer's release (the drag's own
+    ``pointerup``) to the first frame of the server's full refit; and where
+    that wait goes (``release``): the release to the request sent (a request
+    in flight first), the request to its answer, of it the server's own fit
+    (the answer's ``timings.total``) and the rest (a worker's queue, the
+    store, the curves, the round trip), the answer to its frame;
 -   where a live refit's time goes, each step on the page's clock: the
     move's event to its edit (the page's handler), the edit to its message
     posted, the message to the worker's start (the wait for a solve in
@@ -101,17 +106,22 @@ def editor(browser, url):
     return page
 
 
-def drag(page, d, moves, extreme):
-    """One drag: (move -> frame latencies (ms), moves never shown live, release -> final frame (ms))."""
-    page.evaluate("window.cfTelemetry.shown.length = 0; window.cfMoves.length = 0; window.cfReleases.length = 0")
+def drag(page, d, moves, extreme, phase_index=0):
+    """
+    One drag: (move -> frame latencies (ms), moves never shown live, release -> final frame (ms),
+    the live refits' steps, the release's steps).
+    """
     channel, angle = (1, 60) if extreme else (d % 3, 50)
     page.locator(f"input[name=channel][value='{channel}']").check()
     handle = page.locator(f"circle.handle.c{channel}[data-angle='{angle}']")
     handle.scroll_into_view_if_needed()
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
-    # Each drag ends on its own curve, so that no full refit is served from the store.
-    step = (10 + 0.25 * d) if extreme else (1.5 + 0.1 * d) * (1 if d % 2 == 0 else -1)
+    # Cleared after the channel's radio button is clicked (its own pointerup is not the drag's release).
+    page.evaluate("window.cfTelemetry.shown.length = 0; window.cfMoves.length = 0; window.cfReleases.length = 0")
+    # Each drag ends on its own curve, in each phase, so that no full refit is served from the store.
+    step = (10 + 0.25 * d + 0.125 * phase_index) if extreme else (1.5 + 0.1 * d + 0.05 * phase_index)
+    step *= 1 if extreme or d % 2 == 0 else -1
     page.mouse.move(x, y)
     page.mouse.down()
     for k in range(1, moves + 1):
@@ -123,7 +133,9 @@ def drag(page, d, moves, extreme):
     page.wait_for_timeout(100)
     shown = page.evaluate("window.cfTelemetry.shown")
     moves_at = page.evaluate("window.cfMoves")
-    released = page.evaluate("window.cfReleases")[0]
+    releases = page.evaluate("window.cfReleases")
+    assert len(releases) == 1, f"one release a drag, got {len(releases)}"
+    released = releases[0]
     live = [s for s in shown if s.get("live") == "page" and s["frameAt"]]
     final = [s for s in shown if not s.get("live") and s["frameAt"] and s["frameAt"] > released]
     parts = [trace(s) for s in live]
@@ -136,7 +148,10 @@ def drag(page, d, moves, extreme):
             missed += 1
     page.click("#undo")
     page.wait_for_function(SETTLED, timeout=120_000)
-    return latencies, missed, (min(s["frameAt"] for s in final) - released) if final else None, parts
+    if not final:
+        return latencies, missed, None, parts, None
+    first = min(final, key=lambda s: s["frameAt"])
+    return latencies, missed, first["frameAt"] - released, parts, release_trace(first, released)
 
 
 # Where a live refit's time goes, step by step on the page's clock (ms): the move's event to its edit
@@ -152,20 +167,34 @@ def trace(s):
     return [b - a for a, b in zip(marks, marks[1:])]
 
 
-def phase(browser, url, drags, moves):
+# Where the release's wait goes: the release to the full refit's request sent (a request in flight
+# first), the request to its answer, of it the server's own fit (``timings.total``: the solves, the
+# guard, the scores) and the rest (the queue for a worker, the store, the curves, the round trip),
+# the answer to its frame drawn.
+RELEASE_STEPS = ("release_to_sent_ms", "sent_to_answer_ms", "server_fit_ms", "answer_wait_ms", "answer_to_frame_ms")
+
+
+def release_trace(s, released):
+    server = s["serverMs"] or 0.0
+    answer = s["fittedAt"] - s["sentAt"]
+    return [s["sentAt"] - released, answer, server, answer - server, s["frameAt"] - s["fittedAt"]]
+
+
+def phase(browser, url, drags, moves, phase_index=0):
     """Gentle and extreme drags on one page: the figures of one phase."""
     page = editor(browser, url)
     load = [load_average()]
     out = {}
     for kind, extreme in (("gentle", False), ("extreme", True)):
-        latencies, missed, releases, parts = [], 0, [], []
+        latencies, missed, releases, parts, release_parts = [], 0, [], [], []
         for d in range(drags):
-            lat, miss, release, part = drag(page, d, moves, extreme)
+            lat, miss, release, part, release_part = drag(page, d, moves, extreme, phase_index)
             latencies += lat
             missed += miss
             parts += part
             if release is not None:
                 releases.append(release)
+                release_parts.append(release_part)
             print(
                 f"{kind} drag {d + 1}/{drags}: {len(lat)} moves, median {statistics.median(lat) if lat else 0:.0f} ms,"
                 f" release {release or 0:.0f} ms",
@@ -178,6 +207,7 @@ def phase(browser, url, drags, moves):
             "release_to_final_ms": summary(releases),
             "latencies": latencies,
             **{step: summary([p[i] for p in parts]) for i, step in enumerate(STEPS)},
+            "release": {step: summary([p[i] for p in release_parts]) for i, step in enumerate(RELEASE_STEPS)},
         }
     page.close()
     load.append(load_average())
@@ -231,7 +261,7 @@ def main() -> None:
                 reached = wait_for_load(args.busy_load, 300)  # the 1-minute average follows within a few minutes
                 print(f"busy phase: load average {reached:.1f}", file=sys.stderr, flush=True)
                 figures["busy_load_reached"] = reached
-                figures["busy"] = phase(browser, url, args.drags, args.moves)
+                figures["busy"] = phase(browser, url, args.drags, args.moves, phase_index=1)
             finally:
                 for loop in loops:
                     loop.kill()
@@ -256,6 +286,14 @@ def main() -> None:
             s = figures[name][kind]["release_to_final_ms"]
             print(
                 f"{name + ', ' + kind:<44} {s['median_ms']:>7.0f} {s['p90_ms']:>7.0f} {s['worst_ms']:>7.0f} {s['n']:>5}"
+            )
+    print(f"\n{'the release (ms, median / p90)':<17}" + "".join(f"{step[:-3]:>20}" for step in RELEASE_STEPS))
+    for name in ("idle", "busy"):
+        for kind in ("gentle", "extreme"):
+            f = figures[name][kind]["release"]
+            print(
+                f"{name + ', ' + kind:<17}"
+                + "".join(f"{f[k]['median_ms']:>11.0f}/{f[k]['p90_ms']:>7.0f} " for k in RELEASE_STEPS)
             )
     print(f"\n{'a live refit (ms, median / p99)':<17}" + "".join(f"{step[:-3]:>17}" for step in STEPS))
     for name in ("idle", "busy"):

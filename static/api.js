@@ -45,11 +45,12 @@ export async function getJSON(path) {
   return answer(await fetch(API + path, { headers: headers({ Accept: "application/json" }) }));
 }
 
-export async function postJSON(path, body) {
+export async function postJSON(path, body, signal = undefined) {
   return answer(await fetch(API + path, {
     method: "POST",
     headers: headers({ "Content-Type": "application/json", Accept: "application/json" }),
     body: JSON.stringify(body),
+    signal,
   }));
 }
 
@@ -117,9 +118,10 @@ export const fitLibrary = (name, etaRange) =>
   postJSON("/fits?metrics=full", { material: name, eta_i_range: etaRange });
 // With `curvesAt` ({ etaI, samples }), the answer also holds the fit's curves
 // there (`curves`, as curves() gives): one round trip per refit.
-export function fitFromCurves(body, curvesAt = null) {
+// `signal` (an AbortSignal) aborts the request: the service then cancels its job.
+export function fitFromCurves(body, curvesAt = null, signal = undefined) {
   const query = curvesAt ? `?curves_eta_i=${curvesAt.etaI.toFixed(3)}&curves_samples=${curvesAt.samples}` : "";
-  return postJSON(`/fits/from-curves${query}`, body);
+  return postJSON(`/fits/from-curves${query}`, body, signal);
 }
 // The curves (linear ACEScg) of the metal of a base colour and an edge tint (nothing stored).
 export const colourCurves = (body) => postJSON("/colour-curves", body);

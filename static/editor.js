@@ -35,7 +35,7 @@ const state = store.state;
 // Bookkeeping of the page around the state: the latest eta_i request (older
 // curves are dropped), the slider's debounce, the material open (to return
 // to when a switch is declined), and the cold start's prefetched curves.
-const page = { etaRequest: 0, etaTimer: null, picked: null, prefetched: new Map(), liveFit: null };
+const page = { etaRequest: 0, etaTimer: null, picked: null, prefetched: new Map(), liveFit: null, restTimer: 0 };
 
 // Timings for benchmarks/editor_speed.py: when the last edit happened, and
 // for each fit shown, the edit it answers and when its curve and its first
@@ -49,13 +49,13 @@ const guard = (work) => messages.guard(work);
 
 const pipeline = new RefitPipeline({
   context: () => ({ base: state.base, startFit: liveStart(state), editAt: telemetry.lastEditAt }),
-  async fit(job) {
+  async fit(job, signal) {
     const edits = JSON.parse(job.wanted);
     const sentAt = performance.now();
     const curvesAt = { etaI: state.eta, samples: SAMPLES };
     const fit = Object.keys(edits).length
       ? await api.fitFromCurves(refitBody({ name: $("name").value, base: job.base, theta: state.theta, edits,
-                                            startFit: job.startFit }), curvesAt)
+                                            startFit: job.startFit }), curvesAt, signal)
       : job.base;
     const fittedAt = performance.now();
     const curves = fit.curves && key(fit.curves.eta_i) === key(curvesAt.etaI)
@@ -114,6 +114,15 @@ function requestRefit() {
   pipeline.request(snapshot(state));
 }
 
+// While a pointer rests on a point for REST_MS (a pause, not the gaps of a moving pointer), the full
+// refit of the edits is asked at once: the release then finds it under way, or answered; a move after
+// it aborts it (refit.js: stale).
+const REST_MS = 500;
+function refitAtRest() {
+  clearTimeout(page.restTimer);
+  page.restTimer = setTimeout(() => state.pointerDrag && pipeline.request(snapshot(state), { full: true }), REST_MS);
+}
+
 // Once no refit is pending: true when the fit on screen is the fit of the edits on screen.
 const whenFitted = () => pipeline.whenIdle().then((failed) => !failed && fitted(state));
 
@@ -141,11 +150,14 @@ const plotView = new PlotView({
     const moved = store.dispatch("drag", payload);
     if (moved) {
       telemetry.lastEditAt = performance.now();
-      if (!liveRefit()) requestRefit();
+      if (liveRefit()) pipeline.outdate(snapshot(state));
+      else requestRefit();
+      refitAtRest();
     }
     return moved;
   },
   onDragEnd() {
+    clearTimeout(page.restTimer);
     live.drop();
     page.liveFit = null;
     previewView.hold(false);

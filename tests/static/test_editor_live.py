@@ -4,8 +4,9 @@ is refitted in the page while the pointer moves (no request; the first
 move's curve is the server's live step's from the same start), the page
 says so (for the exact-Fresnel kind too: its n, k the server's live step's),
 and on release the server's full refit replaces it: the preview
-shows the fit whose id is on screen, fitted to the curves on screen; a 503 is retried with
-backoff, its message shown while it lasts and cleared by the next answer.
+shows the fit whose id is on screen, fitted to the curves on screen; a pointer at rest asks
+for the full refit while it holds the point, and the release ends on that refit; a 503 is
+retried with backoff, its message shown while it lasts and cleared by the next answer.
 """
 
 from __future__ import annotations
@@ -217,3 +218,37 @@ def test_rgb_conductor_drag_is_solved_in_the_page_as_the_server_would(pages, liv
     mine = np.array([first["coefficients"][p] for p in ("n", "k")])
     theirs = np.array([server["coefficients"][p] for p in ("n", "k")])
     np.testing.assert_allclose(mine, theirs, rtol=2.0**-9, atol=2.0**-14)
+
+
+def test_a_pointer_at_rest_asks_for_the_full_refit_and_the_release_ends_on_it(pages, editor_url):
+    """Held still for more than 0.5 s, the point's full refit is asked while the pointer holds it; the
+    release where it rested ends on that refit's answer (never a refit of other edits)."""
+    page = pages.new()
+    open_editor(page, editor_url)
+    base_id = settled(page)
+    page.locator("input[name=channel][value='0']").check()
+    posted, answered = [], []
+    refit = lambda url: url.split("?")[0].endswith("/fits/from-curves")  # noqa: E731
+    page.on("request", lambda r: posted.append(r) if refit(r.url) else None)
+    page.on("response", lambda r: answered.append(r) if refit(r.url) else None)
+    handle = page.locator("circle.handle.c0[data-angle='50']")
+    handle.scroll_into_view_if_needed()
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    for step in range(1, 6):
+        page.mouse.move(x, y + 3 * step)
+        page.wait_for_timeout(40)
+    page.wait_for_timeout(1500)  # at rest
+    assert len(posted) == 1, "the full refit is asked while the pointer rests on the point"
+    assert "live" not in posted[0].post_data_json and "start_fit" not in posted[0].post_data_json
+    page.mouse.up()
+    final_id = settled(page)
+    assert final_id != base_id
+    # Asked again at the release only when it had already answered (the store answers the same fit).
+    assert {json.dumps(r.post_data_json["curves"]) for r in posted} == {json.dumps(posted[0].post_data_json["curves"])}
+    assert {r.json()["id"] for r in answered} == {final_id}
+    assert page.get_attribute("#preview", "data-fit") == final_id
+    page.click("#undo")
+    assert settled(page) == base_id

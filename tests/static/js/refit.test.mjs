@@ -9,7 +9,7 @@ import "./domain.mjs";
 
 import {
   RETRY_MS, RefitPipeline, answered, dropAnswers, idle, initialPipeline, refitBody, refused, retryDelay,
-  settle, take, want,
+  settle, stale, take, want,
 } from "../../../static/editor/refit.js";
 
 const BASE = { id: "base-fit", model: "coated-conductor" };
@@ -117,7 +117,11 @@ function fakeService() {
     retries: [],
     updating: [],
     context: () => ({ base: io.base, startFit: io.startFit, editAt: 0 }),
-    fit: (job) => new Promise((resolve, reject) => calls.push({ job, resolve, reject })),
+    // As fetch does: an aborted request rejects with an AbortError.
+    fit: (job, signal) => new Promise((resolve, reject) => {
+      calls.push({ job, resolve, reject, signal });
+      signal.addEventListener("abort", () => reject(new DOMException("aborted", "AbortError")));
+    }),
     show: (answer, job) => io.shown.push([answer, job.wanted]),
     onReport: (error) => io.reports.push(error),
     onRetry: (ms) => io.retries.push(ms),
@@ -183,4 +187,82 @@ test("the driver retries a 503 and reports a 422 once", async () => {
   assert.equal(failed.message, "refused");
   assert.equal(io.reports.length, 1);
   assert.equal(io.updating.at(-1), true, "the fit on screen still lags the edits");
+});
+
+test("a full refit asked for the edits already in flight as one waits for that answer; a full one asked while dragging is full", () => {
+  let p = want(initialPipeline(), "e", { full: true, base: BASE });
+  const taken = take(p, { base: BASE, startFit: "on-screen" });
+  assert.equal(taken.job.startFit, null, "asked full: full whatever the context");
+  p = want(taken.p, "e", { full: true, base: BASE });
+  assert.equal(p.wanted, null, "the same edits, already in flight as a full refit: nothing waits");
+  assert.equal(stale(p, "e"), false);
+  assert.equal(want(taken.p, "e", { full: true, base: OTHER }).wanted, "e", "another base: asked again");
+  assert.equal(want(taken.p, "e").wanted, "e", "a live refit of them is still asked");
+  assert.equal(stale(want(taken.p, "f"), "f"), true, "a full refit of other edits is stale");
+  const live = take(want(initialPipeline(), "e"), { base: BASE, startFit: "on-screen" }).p;
+  assert.equal(stale(live, "f"), false, "a live step in flight is never aborted (it is short)");
+});
+
+test("the driver aborts a stale full refit at once and sends the latest edits; nothing is reported", async () => {
+  const { io, calls } = fakeService();
+  const pipeline = new RefitPipeline(io);
+  pipeline.request("release 1"); // a full refit (no pointer drags)
+  await tick();
+  assert.equal(calls.length, 1);
+  const idle = pipeline.whenIdle();
+  pipeline.request("release 2");
+  assert.equal(calls[0].signal.aborted, true, "the stale refit is aborted when newer edits are asked");
+  await tick();
+  await tick();
+  assert.equal(calls.length, 2, "the latest is sent without waiting for the stale one's answer");
+  assert.equal(calls[1].job.wanted, "release 2");
+  calls[1].resolve("fit 2");
+  assert.equal(await idle, null);
+  assert.deepEqual(io.shown, [["fit 2", "release 2"]]);
+  assert.deepEqual(io.reports, [], "an aborted refit is not a refusal");
+  assert.deepEqual(io.retries, []);
+});
+
+test("the driver: a full refit at rest during a drag is not asked again at the release; a move aborts it", async () => {
+  const { io, calls } = fakeService();
+  const pipeline = new RefitPipeline(io);
+  io.startFit = "on-screen"; // a pointer drags (its live steps are solved in the page)
+  pipeline.request("rest 1", { full: true });
+  await tick();
+  assert.equal(calls[0].job.startFit, null, "a full refit while the pointer drags");
+  pipeline.outdate("rest 1");
+  assert.equal(calls[0].signal.aborted, false, "the same edits: kept");
+  pipeline.outdate("moved");
+  assert.equal(calls[0].signal.aborted, true, "the pointer moved on: aborted");
+  await tick();
+  pipeline.request("moved", { full: true }); // at rest again
+  await tick();
+  assert.equal(calls.length, 2);
+  io.startFit = null; // released where it rested
+  pipeline.request("moved");
+  await tick();
+  assert.equal(calls.length, 2, "the release's refit is the one under way");
+  calls[1].resolve("fit at rest");
+  await pipeline.whenIdle();
+  assert.deepEqual(io.shown, [["fit at rest", "moved"]]);
+});
+
+test("a full refit refused with a 503 is sent again after its wait, even when its edits are asked meanwhile", async () => {
+  const { io, calls } = fakeService();
+  let wake;
+  io.sleep = () => new Promise((resolve) => { wake = resolve; });
+  const pipeline = new RefitPipeline(io);
+  pipeline.request("e");
+  await tick();
+  calls[0].reject({ status: 503, retryAfter: 1 });
+  await tick();
+  pipeline.request("e"); // the same edits, asked while the refused one waits for its retry
+  wake();
+  await tick();
+  await tick();
+  assert.equal(calls.length, 2, "sent again after the wait");
+  assert.equal(calls[1].job.wanted, "e");
+  calls[1].resolve("fit e");
+  await pipeline.whenIdle();
+  assert.deepEqual(io.shown, [["fit e", "e"]]);
 });
