@@ -187,7 +187,7 @@ def mean_refined_base_colour(
         jac=True,
         method="L-BFGS-B",
         bounds=list(zip(lo, hi)),
-        options={"ftol": 1e-9, "gtol": 1e-7, "maxiter": 100},
+        options={"ftol": 1e-6, "gtol": 1e-5, "maxiter": 100},
     )
     return np.asarray(fit.x, dtype=np.float64) if fit.fun < start else x0
 
