@@ -45,7 +45,7 @@ from ..colour.delta_e import delta_E_map
 from ..optics.fresnel import fresnel_dielectric
 from .channel_fit import fit_channel_conductor, fit_channel_f82, fit_channel_schlick, least_squares
 from .colour_space import DEFAULT_WORKING_SPACE, ACEScg_to_working, working_to_ACEScg
-from .gltf_fallback import GLTF_COAT_FACTOR
+from .gltf_fallback import GLTF_COAT_FACTOR, mean_refined_base_colour
 from .seen_jacobian import DeltaEComponents, delta_E_jacobian
 from .tool_layering import K_BOUNDS, N_BOUNDS, TOOLS, materialx_layer, three_clearcoat, tool_seen
 
@@ -312,7 +312,9 @@ def fit_tool_values(
     shows it; started from the smooth fit's floor). With ``keep_coat`` its
     ``clearcoatFactor`` is the coat's,
     :data:`fitting.exports.gltf_fallback.GLTF_COAT_FACTOR` (1), and the base
-    colour alone is fitted (``False``: the factor fitted too, in [0, 1], as
+    colour alone is fitted, by least squares then to the least mean Delta E
+    over the angles (:func:`fitting.exports.gltf_fallback.mean_refined_base_colour`)
+    (``False``: the factor fitted too, in [0, 1], by least squares alone, as
     the export once wrote it; for comparison).
     """
     if tool not in TOOLS:
@@ -340,6 +342,11 @@ def fit_tool_values(
     fit = _solve(tool, pack, residuals, x0, lo, hi, mu, eta, target, 100, space)
     best = fit.x if fit.cost <= 0.5 * np.sum(residuals(x0) ** 2) else x0
     values = _pack(tool, np.asarray(best, dtype=np.float64), coat, clearcoat)
+    if tool == "gltf" and keep_coat:
+        # The export's base colour: the least squares' refined to the least mean Delta E (what is scored).
+        values["base_color"] = mean_refined_base_colour(
+            values["base_color"], mu, eta, target, rough or 0.0, clearcoat, coat, space
+        )
     if view_dependent and tool in ("mtlx", "blender-conductor"):
         return fit_view_dependent_index(tool, mu, eta, target_ACEScg, values, space)
     return values
