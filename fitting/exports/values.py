@@ -234,7 +234,8 @@ class ExportValues:
             "fitted_how": (
                 "the tool's coat over its base, against the physical coat on the metal seen "
                 "from air (both polarisations, metal at the refracted angle, bounces between "
-                "the interfaces), Delta E 2000 least squares"
+                "the interfaces), Delta E 2000 least squares (the glTF fallback's base colour then "
+                "refined to the least mean Delta E over the angles)"
             ),
             "colour_space": self.working_space,
             "generator": f"coated-fresnel {self.version}",
