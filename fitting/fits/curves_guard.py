@@ -62,6 +62,10 @@ below the paper's, and an unreachable cap would spend the work)."""
 CAP_SAMPLES = 50
 """The side of each measure's grid where the constrained refits cap the max."""
 
+FAR_TOLERANCE = 0.05
+"""How far above the choice without it a minimax fit's max may be on any eta_i row far from
+every edit (the editor's grid, the blend width or more from each edited curve), in Delta E 2000."""
+
 __all__ = [
     "GUARD_WORK",
     "AUDIT_SAMPLES",
@@ -255,18 +259,32 @@ def guard_curve_choice(
         for i, (C, C16) in enumerate(minimax):
             if in_range(C16):
                 add("minimax" + (f"-{i + 1}" if i else ""), candidates[own].with_coefficients(C, C16))
-    # A fit of both measures shipped only where it holds both auditors, or where it is no
-    # worse on any figure than what is kept without it: one that still loses trades the
-    # edit's own look (the curves far from the edit) for a smaller loss.
-    losing = [n for n in candidates if n.startswith("minimax") and not _fine(scores_by, n, floor, 0.0)]
-    if losing:
-        rest = {by: {n: s for n, s in scores.items() if n not in losing} for by, scores in scores_by.items()}
+    # A minimax fit ships only where it keeps the look far from the edits (each eta_i row of the
+    # editor's grid at least the blend width from every edited curve: the base there) no worse
+    # at its max than what is kept without it, and where it holds both auditors or is no worse on any
+    # figure than that: one that loses there trades the edit's own look for a smaller loss.
+    minimax = [n for n in candidates if n.startswith("minimax")]
+    if minimax:
+        rest = {by: {n: s for n, s in scores.items() if n not in minimax} for by, scores in scores_by.items()}
         fallback = pick(rest, aim, floor, hard)
-        for name in losing:
-            if not all(
-                scores_by[by][name].mean <= scores_by[by][fallback].mean
-                and scores_by[by][name].max <= scores_by[by][fallback].max
-                for by in scores_by
+        grid = grids["angle"]
+        far = np.all(np.abs(grid.E[:, None] - np.array([c.eta_i for c in curves])[None, :]) >= blend_width, axis=1)
+
+        rows = np.unique(grid.E[far])
+
+        def far_max(name):
+            """The max Delta E 2000 on each eta_i row far from the edits."""
+            dE = grid.delta_E(candidates[name].coefficients_float16)
+            return np.array([dE[grid.E == e].max() for e in rows])
+
+        for name in minimax:
+            if np.any(far_max(name) > far_max(fallback) + FAR_TOLERANCE) or not (
+                _fine(scores_by, name, floor, 0.0)
+                or all(
+                    scores_by[by][name].mean <= scores_by[by][fallback].mean
+                    and scores_by[by][name].max <= scores_by[by][fallback].max
+                    for by in scores_by
+                )
             ):
                 del candidates[name]
                 for by in scores_by:
