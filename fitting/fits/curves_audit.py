@@ -24,11 +24,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..colour.colorimetry import ACEScg_to_Lab
+from ..colour.delta_e import delta_E_2000
 from ..colour.reference import evaluation_grid
 from ..models.coated_conductor import coated_conductor_model
 from ..models.pack import to_float16
 from .curves_base import edited_target
 from .curves_score import score_grid
+from .objective import coefficient_bounds
 from .paper_method import paper_fit as paper_method_fit
 from .result import FitResult
 from .solver import fit_coefficients
@@ -95,6 +97,10 @@ class AuditGrid:
     def score(self, C16) -> GuardScore:
         return guard_score(self.Lab, coated_conductor_model(self.M, self.E, C16, self.range), self.M, self.E)
 
+    def delta_E(self, C16) -> np.ndarray:
+        """The Delta E 2000 of float16 coefficients ``C16`` at each point here."""
+        return delta_E_2000(self.Lab, ACEScg_to_Lab(coated_conductor_model(self.M, self.E, C16, self.range)))
+
     def cost(self, C) -> float:
         """Half the sum of squared rgb residuals of coefficients ``C`` here."""
         r = coated_conductor_model(self.M, self.E, C, self.range).reshape(-1, 3) - self.T
@@ -118,8 +124,9 @@ def auditor_fits(grid: AuditGrid, starts: dict, like: FitResult, degree: int, in
     (coefficients by label), solved channel by channel
     (:func:`fitting.fits.paper_method.paper_fit`). Gives every distinct
     optimum (:class:`AuditorFit`), the lowest residual first (polished and
-    quantised jointly from its optimum, as the fits are; the others rounded
-    to nearest, as the paper ships them), and every start's residual.
+    quantised jointly from its optimum, as the fits are, where inside the
+    coefficients' box; the others rounded to nearest, as the paper ships
+    them), and every start's residual.
     ``in_range(C16)`` says whether float16 coefficients are a reflectance.
     """
     optima, costs = {}, {}
@@ -138,7 +145,11 @@ def auditor_fits(grid: AuditGrid, starts: dict, like: FitResult, degree: int, in
     out = []
     for i, group in enumerate(groups):
         C = optima[group[0]]
-        if i == 0:  # the starts' polish is a joint solve from a converged optimum: the best one's only
+        lower, upper = (b.reshape(C.shape) for b in coefficient_bounds(degree))
+        if i == 0 and np.all((C > lower) & (C < upper)):
+            # The starts' polish is a joint solve from a converged optimum: the best one's only, and
+            # only inside the box (one on its edge would leave it for the bounded solve, whose SVD of
+            # the whole grid's Jacobian each step costs more than the audit).
             fit = fit_coefficients(grid.T, grid.M, grid.E, grid.range, degree, "rgb", _POLISH_MAX_NFEV, start=C)
         else:
             fit = like.with_coefficients(C, to_float16(C))

@@ -16,10 +16,13 @@ could end with the worse max (5 of 8 edits, one by 3 Delta E).
     reflectance a bar); when the own fit is not
     under both, the fits of least mean with the max capped on both grids
     (:func:`fitting.fits.guarded.constrained_refits`), and, when still
-    nothing holds both auditors, the least mean of both measures at once
-    (:func:`fitting.fits.curves_measures.both_measures_fit`, its max reweighted down while above the
-    auditors'); kept only when proven inside [0, 1], the
-    choice of :func:`pick`. A kept twin of the paper's method is polished
+    nothing holds both auditors, the minimax over both at once (the least
+    largest excess over either auditor's mean or max, then the least mean
+    under both, :func:`fitting.fits.curves_measures.minimax_fit`); kept
+    only when proven inside [0, 1], the choice of :func:`pick`. A minimax
+    fit that still loses on one auditor is kept only where it is no worse
+    on any figure than the choice without it. A kept twin of the paper's
+    method, or a minimax fit, is polished
     in float16 (:func:`fitting.fits.polish.polish_float16`) so that it is
     ahead of an auditor's rounding of the same optimum on both figures,
     not tied with it.
@@ -32,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from .curves_audit import AUDIT_GRIDS, AUDIT_SAMPLES, AUDIT_STARTS, AuditGrid, audit_floor, audit_grid, auditor_fits
-from .curves_measures import CHECK_SAMPLES, blends, both_measures_fit
+from .curves_measures import CHECK_SAMPLES, minimax_fit
 from .curves_score import check_grid
 from .guarded import _THREADPOOLS, GuardWork, constrained_refits, guard_report
 from .polish import polish_float16
@@ -58,6 +61,10 @@ below the paper's, and an unreachable cap would spend the work)."""
 
 CAP_SAMPLES = 50
 """The side of each measure's grid where the constrained refits cap the max."""
+
+FAR_TOLERANCE = 0.05
+"""How far above the choice without it a minimax fit's max may be on any eta_i row far from
+every edit (the editor's grid, the blend width or more from each edited curve), in Delta E 2000."""
 
 __all__ = [
     "GUARD_WORK",
@@ -244,41 +251,46 @@ def guard_curve_choice(
     if not _fine(scores_by, own, aim) and scores_by["angle"][own].mean < scores_by["angle"][paper].mean:
         capped(samples, (("", candidates[paper].coefficients), ("-from-own", candidates[own].coefficients)), levels)
     if not any(_fine(scores_by, name, floor) for name in candidates):
-        # Nothing holds both auditors (each measure's paper fit loses on the other's):
-        # least mean on both measures at once, capped there too when its max is over.
-        rounds = both_measures_fit(
-            base,
-            curves,
-            blend_width,
-            candidates[own],
-            aim,
-            floor,
-            lambda C16: {by: grid.score(C16) for by, grid in grids.items()},
-            in_range,
-            degree,
+        # Nothing holds both auditors: the least largest excess over both at once, from the candidate nearest.
+        start = min(candidates, key=lambda n: _excess(scores_by, n, floor))
+        minimax = minimax_fit(
+            base, curves, blend_width, list(grids.values()), candidates[start].coefficients, floor, aim, degree
         )
-        for i, (fit, _) in enumerate(rounds):
-            if in_range(fit.coefficients_float16):
-                add("both-measures" + (f"-{i + 1}" if i else ""), fit)
-        if not any(_fine(scores_by, n, floor, 0.0) for n in candidates if n.startswith("both-measures")):
-            # One round's max over, the next one's mean: a fit between the two may hold both.
-            for k, fit in enumerate(blends(rounds)):
-                if in_range(fit.coefficients_float16):
-                    add(f"both-measures-blend-{k + 1}", fit)
-                    if _fine(scores_by, f"both-measures-blend-{k + 1}", floor, 0.0):
-                        break
-        if not any(_fine(scores_by, n, aim) for n in candidates if n.startswith("both-measures")):
-            both, both_samples = rounds[-1]
-            capped(both_samples, (("-both-measures", both.coefficients),), levels)
-        # Shipped only where it holds both auditors: a both-measures fit that still
-        # loses on one trades the edit's own look (the curves far from the edit)
-        # for a smaller loss, so the paper method's twin stays the fallback.
-        for name in [n for n in candidates if "both-measures" in n and not _fine(scores_by, n, floor, 0.0)]:
-            del candidates[name]
-            for by in scores_by:
-                scores_by[by].pop(name, None)
+        for i, (C, C16) in enumerate(minimax):
+            if in_range(C16):
+                add("minimax" + (f"-{i + 1}" if i else ""), candidates[own].with_coefficients(C, C16))
+    # A minimax fit ships only where it keeps the look far from the edits (each eta_i row of the
+    # editor's grid at least the blend width from every edited curve: the base there) no worse
+    # at its max than what is kept without it, and where it holds both auditors or is no worse on any
+    # figure than that: one that loses there trades the edit's own look for a smaller loss.
+    minimax = [n for n in candidates if n.startswith("minimax")]
+    if minimax:
+        rest = {by: {n: s for n, s in scores.items() if n not in minimax} for by, scores in scores_by.items()}
+        fallback = pick(rest, aim, floor, hard)
+        grid = grids["angle"]
+        far = np.all(np.abs(grid.E[:, None] - np.array([c.eta_i for c in curves])[None, :]) >= blend_width, axis=1)
+
+        rows = np.unique(grid.E[far])
+
+        def far_max(name):
+            """The max Delta E 2000 on each eta_i row far from the edits."""
+            dE = grid.delta_E(candidates[name].coefficients_float16)
+            return np.array([dE[grid.E == e].max() for e in rows])
+
+        for name in minimax:
+            if np.any(far_max(name) > far_max(fallback) + FAR_TOLERANCE) or not (
+                _fine(scores_by, name, floor, 0.0)
+                or all(
+                    scores_by[by][name].mean <= scores_by[by][fallback].mean
+                    and scores_by[by][name].max <= scores_by[by][fallback].max
+                    for by in scores_by
+                )
+            ):
+                del candidates[name]
+                for by in scores_by:
+                    scores_by[by].pop(name, None)
     chosen = pick(scores_by, aim, floor, hard)
-    if chosen.startswith(paper) or chosen.startswith("both-measures"):
+    if chosen.startswith((paper, "minimax")):
         # The paper method's twin: ahead of the auditors' rounding on both figures, not a tie.
         C16, _ = polish_float16(candidates[chosen].coefficients_float16, *union, eta_i_range)
         after = {by: grid.score(C16) for by, grid in grids.items()}

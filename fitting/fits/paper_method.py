@@ -21,7 +21,7 @@ import numpy as np
 
 from ..models.coated_conductor import ALPHA_MIN, normalised_eta_i
 from ..models.pack import to_float16
-from ..numerics import scipy_optimize, trf_least_squares
+from ..numerics import trf_least_squares
 from .objective import coefficient_bounds
 from .result import FitResult
 from .solver import fit_coefficients
@@ -37,7 +37,7 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
     of one channel at a time (Eq. 1 and its derivative written out for one
     channel), from ``start``; None when a channel does not converge or
     leaves the box. With ``boxed``, such a channel is solved again inside
-    the box (``trf`` with bounds, from ``start`` clipped into it) instead.
+    the box (:func:`_boxed`, from ``start`` clipped into it) instead.
     """
     C = np.array(start, dtype=np.float64)
     d1 = C.shape[2]
@@ -82,25 +82,49 @@ def _paper_channels(target, mu, eta, eta_i_range, start, max_nfev: int, boxed: b
         if not fit.success or not np.all(np.isfinite(xc)) or np.any(xc < lower[:, c]) or np.any(xc > upper[:, c]):
             if not boxed:
                 return None
-            optimize, threadpools = scipy_optimize()  # a channel out of its box only
             lo, hi = lower[:, c].ravel(), upper[:, c].ravel()
-            with threadpools.limit(limits=1, user_api="blas"):
-                fit = optimize.least_squares(
-                    residuals,
-                    np.clip(x0, lo, hi),
-                    jac=jacobian,
-                    method="trf",
-                    bounds=(lo, hi),
-                    xtol=1e-10,
-                    ftol=1e-10,
-                    gtol=1e-10,
-                    max_nfev=max_nfev,
-                )
-            xc = fit.x.reshape(3, d1)
-            if fit.status < 0 or not np.all(np.isfinite(xc)):
+            inside = _boxed(residuals, jacobian, np.clip(x0, lo, hi), lo, hi, max_nfev)
+            if inside is None:
                 return None
+            xc = inside.reshape(3, d1)
         C[:, c, :] = xc
     return C
+
+
+def _boxed(residuals, jacobian, x0, lo, hi, max_nfev: int):
+    """
+    Least squares of ``residuals`` inside the box [``lo``, ``hi``] from
+    ``x0`` (inside it) by an active set: the trust-region solve
+    (:func:`fitting.numerics.trf_least_squares`) of the unknowns still
+    free, each unknown that leaves the box held at the end it crossed, then
+    the others solved again (at most once per unknown; no SVD of the tall
+    Jacobian, as scipy's bounded solve does each step). None when a solve
+    is not finite.
+    """
+    x, free = np.array(x0, dtype=np.float64), np.ones(np.size(x0), dtype=bool)
+    while free.any():
+
+        def at(v, x=x, free=free):
+            y = x.copy()
+            y[free] = v
+            return y
+
+        def free_residuals(v, at=at):
+            return residuals(at(v))
+
+        def free_jacobian(v, at=at, free=free):
+            return jacobian(at(v))[:, free]
+
+        fit = trf_least_squares(free_residuals, free_jacobian, x[free], 1e-10, 1e-10, 1e-10, max_nfev)
+        if not np.all(np.isfinite(fit.x)):
+            return None
+        y = at(fit.x)
+        out = (y < lo) | (y > hi)
+        x = np.clip(y, lo, hi)
+        if not out.any():
+            break
+        free = free & ~out
+    return x
 
 
 def paper_fit(

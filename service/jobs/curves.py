@@ -53,7 +53,7 @@ from .materials import resolve_material
 
 __all__ = ["CURVES_FORMAT", "CurveFit", "prepare_curve_fit", "fit_from_curves", "error_map", "target_at"]
 
-CURVES_FORMAT = "curves/v4"
+CURVES_FORMAT = "curves/v5"
 """Part of every curve fit's id: bump it when a change to fit_curves changes results."""
 DEFAULTS = CurveFitSettings()
 DEFAULT_DOMAIN = DEFAULT_ETA_I_RANGE

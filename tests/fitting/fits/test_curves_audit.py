@@ -81,3 +81,20 @@ def test_two_tints_are_no_worse_than_either_auditors_fit():
         assert proven_in_range(P16, base.eta_i_range)
         (mean, max_), (paper_mean, paper_max) = score(result.packed.coefficients, base, grid), score(P16, base, grid)
         assert mean <= paper_mean + 0.005 and max_ <= paper_max + 0.05, (by, mean, max_, paper_mean, paper_max)
+
+
+@pytest.mark.slow  # one refit with its guard and one audit: 5.3 s (load 1)
+def test_a_red_pull_is_held_against_both_auditors_at_once():
+    # Gold's red pulled to 0.1: the angle auditor's in-range optimum loses on the cos theta
+    # grid's mean and that auditor's fit on the angle grid's max; the minimax over both
+    # auditors holds both, and the refit is no worse than an independent cos theta audit.
+    label = "Au red pulled to 0.1"
+    _, material, specs, _ = next(edit for edit in EDITS if edit[0] == label)
+    base = curve_base_from_nk(library_material(material), (1.0, 2.5))
+    curves = [edit_curve(base, eta, *spec) for eta, *spec in specs]
+    result = fit_curves(curves, base)
+    assert result.metrics["guard"]["chosen"].startswith("minimax")
+    P16, grid = audit(base, curves, CurveFitSettings().blend_width, library_material(material), "mu", 100)
+    assert proven_in_range(P16, base.eta_i_range)
+    (mean, max_), (paper_mean, paper_max) = score(result.packed.coefficients, base, grid), score(P16, base, grid)
+    assert mean <= paper_mean + 0.005 and max_ <= paper_max + 0.05, (mean, max_, paper_mean, paper_max)
