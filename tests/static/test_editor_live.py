@@ -26,6 +26,22 @@ FROM_CURVES = re.compile(r".*/api/v1/fits/from-curves(\?.*)?$")  # with or witho
 IN_PAGE = "cfTelemetry.shown.filter((s) => s.live === 'page')"
 
 
+def refits(page):
+    """The page's refit requests and their answers from now on (two lists that fill as they come)."""
+    posted, answered = [], []
+    page.on("request", lambda r: posted.append(r) if FROM_CURVES.match(r.url) else None)
+    page.on("response", lambda r: answered.append(r) if FROM_CURVES.match(r.url) else None)
+    return posted, answered
+
+
+def handle_at(page, channel: int, angle: int):
+    """The control point of ``channel`` at ``angle`` brought into view, and its centre (x, y)."""
+    handle = page.locator(f"circle.handle.c{channel}[data-angle='{angle}']")
+    handle.scroll_into_view_if_needed()
+    box = handle.bounding_box()
+    return handle, box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+
+
 def test_continuous_drag_refits_in_the_page_and_ends_on_the_server_fit(pages, editor_url):
     page = pages.new()
     open_editor(page, editor_url)
@@ -40,17 +56,11 @@ def test_continuous_drag_refits_in_the_page_and_ends_on_the_server_fit(pages, ed
     settled(page)
     expect(page.locator("#fit-source")).to_have_text("server fit")
     page.locator("input[name=channel][value='0']").check()
-    posted, answered = [], []
-    refit = lambda url: url.split("?")[0].endswith("/fits/from-curves")  # noqa: E731
-    page.on("request", lambda r: posted.append(r) if refit(r.url) else None)
-    page.on("response", lambda r: answered.append(r) if refit(r.url) else None)
+    posted, answered = refits(page)
 
-    handle = page.locator("circle.handle.c0[data-angle='50']")
     # The page had scrolled by 306 px between the radio's check and the drag (scrollY 65 -> 371, seen
     # since the studio's panels joined the page; its cause not found yet): the handle is brought into view.
-    handle.scroll_into_view_if_needed()
-    box = handle.bounding_box()
-    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    handle, x, y = handle_at(page, 0, 50)
     page.mouse.move(x, y)
     page.mouse.down()
     # The first move is solved in the page from the fit on screen (the base fit): the server's
@@ -184,12 +194,8 @@ def test_rgb_conductor_drag_is_solved_in_the_page_as_the_server_would(pages, liv
     expect(page.locator("#fit-id")).to_have_text(fit["id"])
     settled(page)
     page.locator("input[name=channel][value='2']").check()
-    posted = []
-    page.on("request", lambda r: posted.append(r) if r.url.split("?")[0].endswith("/fits/from-curves") else None)
-    handle = page.locator("circle.handle.c2[data-angle='50']")
-    handle.scroll_into_view_if_needed()
-    box = handle.bounding_box()
-    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    posted, _ = refits(page)
+    handle, x, y = handle_at(page, 2, 50)
     page.mouse.move(x, y)
     page.mouse.down()
     page.mouse.move(x, y + 6)
@@ -232,14 +238,8 @@ def test_a_pointer_at_rest_asks_for_the_full_refit_and_the_release_ends_on_it(pa
     open_editor(page, editor_url)
     base_id = settled(page)
     page.locator("input[name=channel][value='0']").check()
-    posted, answered = [], []
-    refit = lambda url: url.split("?")[0].endswith("/fits/from-curves")  # noqa: E731
-    page.on("request", lambda r: posted.append(r) if refit(r.url) else None)
-    page.on("response", lambda r: answered.append(r) if refit(r.url) else None)
-    handle = page.locator("circle.handle.c0[data-angle='50']")
-    handle.scroll_into_view_if_needed()
-    box = handle.bounding_box()
-    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    posted, answered = refits(page)
+    handle, x, y = handle_at(page, 0, 50)
     page.mouse.move(x, y)
     page.mouse.down()
     for step in range(1, 6):
