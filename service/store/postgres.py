@@ -42,6 +42,7 @@ from __future__ import annotations
 import logging
 import os
 import socket
+import threading
 import time
 from typing import Any, Callable, TypeVar
 
@@ -118,6 +119,24 @@ def _translate(error: Exception, where: str) -> StoreError:
     return StoreUnavailable(f"the store at {where} is unavailable: {_message(error)}", retry_after=RETRY_AFTER_S)
 
 
+def _handing(handed: list[psycopg.Connection[Any]]) -> type[psycopg.Connection[Any]]:
+    """
+    A connection class for the pool whose next ``connect`` hands over a
+    connection from ``handed`` (opened before the pool) instead of opening
+    one more; once ``handed`` is empty it connects as usual.
+    """
+
+    class Handed(psycopg.Connection[Any]):
+        @classmethod
+        def connect(cls, conninfo: str = "", **kwargs: Any) -> Any:  # type: ignore[override]
+            try:
+                return handed.pop()
+            except IndexError:
+                return super().connect(conninfo, **kwargs)
+
+    return Handed
+
+
 class PostgresStore(SQLStore):
     """
     :class:`Store` on PostgreSQL at ``url`` (``postgresql://user:password@host:port/db``).
@@ -148,6 +167,8 @@ class PostgresStore(SQLStore):
     ) -> None:
         self.where = redacted(url)
         self._url, self._down = url, False
+        self._lent, self._lent_lock = 0, threading.Lock()  # pooled connections in calls now
+        self._answered_at = -float("inf")  # when a pooled call last heard from the server
         self._pool_timeout_s = float(pool_timeout_s)
         self._connect_timeout = max(1, int(connect_timeout_s))
         # One plain connection at a time beside the pool (at most pool_max + 1), shared by concurrent calls.
@@ -158,8 +179,11 @@ class PostgresStore(SQLStore):
         options = (
             f"-c statement_timeout={int(statement_timeout_s * 1000)} -c lock_timeout={int(statement_timeout_s * 1000)}"
         )
+        connect_kwargs = {"application_name": name, "connect_timeout": self._connect_timeout, "options": options}
+        handed: list[psycopg.Connection[Any]] = []
         self._pool = ConnectionPool(
             url,
+            connection_class=_handing(handed),
             min_size=pool_min,
             max_size=pool_max,
             timeout=pool_timeout_s,
@@ -167,12 +191,15 @@ class PostgresStore(SQLStore):
             check=ConnectionPool.check_connection,
             reconnect_timeout=2 * pool_timeout_s,
             max_waiting=256,
-            kwargs={"application_name": name, "connect_timeout": max(1, int(connect_timeout_s)), "options": options},
+            kwargs=connect_kwargs,
             name="coated-store",
         )
         try:
             # One plain connection first: its refusal is the server's own message (the pool's is a timeout).
-            psycopg.connect(url, connect_timeout=max(1, int(connect_timeout_s))).close()
+            # It is then the pool's first connection, not closed beside it: a server counts a closed
+            # connection until its backend has exited, so a replica at the role's CONNECTION LIMIT
+            # would otherwise be refused its own last connection at start-up.
+            handed.append(psycopg.Connection.connect(url, **connect_kwargs))
             self._pool.open(wait=True, timeout=connect_timeout_s + pool_timeout_s)
         except (PoolTimeout, psycopg.Error) as error:
             if "too many connections" in str(error):
@@ -181,6 +208,8 @@ class PostgresStore(SQLStore):
                     "the role's CONNECTION LIMIT or max_connections leaves (docs/deploy.md)"
                 )
             self._pool.close(timeout=1.0)
+            for connection in handed:
+                connection.close()
             raise StoreUnavailable(f"the store at {self.where} cannot be reached: {_message(error)}") from None
         try:
             self.migrated = self._guard(lambda: self._run(lambda c: _migrate(c, "postgresql", migrate)))
@@ -215,7 +244,8 @@ class PostgresStore(SQLStore):
         error). After a connection fault, each call first tries one plain
         connection (refused at once while the server is down, so a 503 is
         quick instead of a wait of ``pool_timeout_s``) until one succeeds;
-        so does a call that waited :data:`QUICK_WAIT_S` for a pooled one.
+        so does a call that waited :data:`QUICK_WAIT_S` for a pooled one
+        while no other call heard from the server.
         """
         if self._down:
             self._probe()
@@ -227,29 +257,53 @@ class PostgresStore(SQLStore):
         except psycopg.OperationalError:
             self._down = True
             raise
+        with self._lent_lock:
+            self._lent += 1
         try:
             with connection:  # commit, or roll back on an error (the pool keeps the connection open)
-                return function(connection)
+                result = function(connection)
+            self._answered_at = time.monotonic()
+            return result
         except psycopg.OperationalError:
             self._down = True
             raise
+        except psycopg.Error:
+            self._answered_at = time.monotonic()  # the server's own refusal: it is there
+            raise
         finally:
+            with self._lent_lock:
+                self._lent -= 1
             self._pool.putconn(connection)
 
     def _connection(self) -> psycopg.Connection:
         """
         A pooled connection within ``pool_timeout_s``: past
-        :data:`QUICK_WAIT_S`, one plain connection first (or the one another
+        :data:`QUICK_WAIT_S`, unless the pool is busy with live work
+        (:meth:`_busy_since`), one plain connection first (or the one another
         call is making, :attr:`_probe`), whose refusal raises at once.
         """
-        deadline = time.monotonic() + self._pool_timeout_s
+        asked = time.monotonic()
+        deadline = asked + self._pool_timeout_s
         try:
             return self._pool.getconn(timeout=min(QUICK_WAIT_S, self._pool_timeout_s))
         except PoolTimeout:
             if time.monotonic() >= deadline:
                 raise
-        self._probe()
+        if not self._busy_since(asked):
+            self._probe()
         return self._pool.getconn(timeout=max(0.0, deadline - time.monotonic()))
+
+    def _busy_since(self, asked: float) -> bool:
+        """
+        Whether a wait for a pooled connection that began at ``asked`` is a
+        queue behind live work rather than a server that went away: another
+        call heard from the server since, or all ``pool_max`` connections
+        are in calls now (a lent connection that loses its server fails its
+        own call, which marks the store down). Then no plain connection is
+        opened beside the pool. (The pool's own ``pool_size`` is no guide:
+        it counts the connections it is still trying to open.)
+        """
+        return self._answered_at > asked or self._lent >= self.pool_max
 
     def _connect_once(self) -> None:
         """

@@ -164,7 +164,14 @@ class TestMove:
 
 
 class TestConnections:
-    def test_pool_bound_holds_under_load(self, postgres_server, postgres_url):
+    def test_pool_bound_holds_under_load(self, postgres_server, postgres_url, monkeypatch):
+        """
+        24 threads on 3 connections: the server never sees more than 3, and
+        the store opens no plain connection beside the pool (its check for a
+        server that went away) while the pool is merely busy; the start-up's
+        own first connection becomes the pool's.
+        """
+        probes = TestFaults.counted_probes(monkeypatch)
         store = PostgresStore(postgres_url, pool_min=1, pool_max=3, pool_timeout_s=30)
         dbname = postgres_url.rsplit("/", 1)[1]
         peak, stop = [0], threading.Event()
@@ -175,11 +182,19 @@ class TestConnections:
 
         watcher = threading.Thread(target=watch)
         watcher.start()
+
+        def call(i: int) -> None:
+            if i < 0:  # three slow calls first: the queue's waits pass QUICK_WAIT_S on an idle machine too
+                store.transaction(lambda c: c.execute("SELECT pg_sleep(1)"))
+            else:
+                store.put_fit(record(f"{i:032x}", material_id=f"{i:032x}"))
+
         with ThreadPoolExecutor(24) as pool:
-            list(pool.map(lambda i: store.put_fit(record(f"{i:032x}", material_id=f"{i:032x}")), range(300)))
+            list(pool.map(call, range(-3, 300)))
         stop.set()
         watcher.join()
         assert 1 <= peak[0] <= 3
+        assert probes["attempts"] == 0, probes
         assert len(store.saved_materials()) == 300
         assert store.describe()["connections_max"] == 3
         store.close()
