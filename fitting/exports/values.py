@@ -54,8 +54,6 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import importlib.metadata
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -120,6 +118,10 @@ def _nk_key(nk: SpectralNK) -> str:
 @functools.cache
 def project_version() -> str:
     """This project's version: the installed ``coated-fresnel``, else pyproject.toml's."""
+    # Imported here: importlib.metadata (with email and zipfile) costs ~20 ms of every start.
+    import importlib.metadata
+    import tomllib
+
     try:
         return importlib.metadata.version("coated-fresnel")
     except importlib.metadata.PackageNotFoundError:

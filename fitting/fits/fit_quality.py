@@ -31,6 +31,7 @@ from ..colour.reference import reference_ACEScg_grid, spectral_weights
 from ..domain import VISIBLE_RANGE_NM
 from ..models.kinds import model_ACEScg
 from ..models.range_bound import certify_range
+from ..numerics.splines import akima, cubic_spline, pchip
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, check_nk_range, resample_nk
 from ..optics.quality import UNCERTAIN_GAP_NM, visible_gaps
@@ -176,7 +177,8 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
     The uncertainty is the largest mean Delta E 2000 (12 angles x 3 eta_i
     over ``eta_i_range``) between the reference of the data as given and of
     other plausible readings of them: monotone cubic (PCHIP), Akima and
-    natural cubic splines through log n and log k; each sample left out
+    not-a-knot cubic splines through log n and log k (scipy.interpolate's, as
+    :mod:`fitting.numerics.splines` builds them); each sample left out
     (at most 40, evenly chosen; a quarter of the largest move, as leaving
     one out doubles the spacing and linear interpolation's error grows
     with its square); and the median over positions of a window
@@ -193,11 +195,9 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
         return None
     eta = np.linspace(eta_i_range[0], eta_i_range[1], 3)
 
-    # scipy.interpolate (and with it scipy.optimize) is imported only for data that needs it: a
-    # fit of dense data (no gap of UNCERTAIN_GAP_NM, enough samples) never pays for the import.
-    from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolator
-
-    splines = [_spline_nk(nk, spline) for spline in (PchipInterpolator, Akima1DInterpolator, CubicSpline)]
+    # scipy.interpolate's PCHIP, Akima and not-a-knot splines, as fitting.numerics.splines builds
+    # them in numpy: scipy.interpolate's import alone costs a command-line fit ~0.5 s.
+    splines = [_spline_nk(nk, spline) for spline in (pchip, akima, cubic_spline)]
     left_out = []
     for i in np.unique(np.round(np.linspace(0, inner.size - 1, min(inner.size, _MOST_LEFT_OUT))).astype(int)):
         keep = np.ones(w.size, dtype=bool)

@@ -126,6 +126,7 @@ class TestFitCurves:
 class TestLiveRefit:
     """LIVE_SETTINGS with a warm start: what the editor fits while a point is dragged."""
 
+    @pytest.mark.slow  # 3.6 s in the quick loop's run (six live steps, then a full guarded refit)
     def test_warm_start_follows_a_drag_within_range(self, gold_base):
         from fitting.fits.curves import LIVE_SETTINGS
         from fitting.fits.material import fit_material

@@ -62,6 +62,7 @@ class TestRGBConductorCurveFits:
         values = result.metrics["target"]
         assert 0.0 <= values["model_min"] and values["model_max"] <= 1.0
 
+    @pytest.mark.slow  # 2.3 s in the quick loop's run (two full guarded refits)
     def test_more_accurate_kind_is_not_worse_than_coated_on_the_reference(self, copper):
         curves = [curve(copper, 1.5)]
         rgb = fit_curves(curves, copper, model="rgb-conductor").metrics["target"]["delta_E_mean"]
