@@ -138,7 +138,14 @@ const save = () => saveEdit({
     remember(value);
     return materials;
   },
-  onSaved(fit) {
+  async onSaved(fit, edited) {
+    // The saved fit goes on screen when another fit of the same edits is there (a draft refit sent
+    // under the name as it was before the save's): what is shown, downloaded and compared is what was
+    // saved, and the page does not call it unsaved.
+    if (state.fit && state.fit.id !== fit.id && !pipeline.pending && snapshot(state) === edited) {
+      const curves = await api.curves(fit.id, state.eta, SAMPLES);
+      if (!pipeline.pending && snapshot(state) === edited) present(fit, curves, edited);
+    }
     store.dispatch("saved", fit.id);
     readout.showSaved(state);
   },

@@ -9,11 +9,12 @@
 // `ctx`: state, name() -> the name field, say(text, ok), report(error,
 // retry, prefix), busy(text, work), refitFirst() -> Promise<bool> (the fit
 // on screen is the fit of the edits), failed() -> the pipeline's refusal,
-// refresh(value) -> the material list again, `value` chosen, onSaved(fit).
+// refresh(value) -> the material list again, `value` chosen, onSaved(fit, edited) -> Promise
+// (`edited`: the snapshot of the edits saved).
 
 import * as api from "../api.js";
 import { refitBody } from "./refit.js";
-import { fitted, unsaved } from "./state.js";
+import { fitted, snapshot, unsaved } from "./state.js";
 
 /** The saved material an edit continues: {id, name, version} (version: saves so far when last read). */
 export class Continuing {
@@ -65,6 +66,7 @@ export async function save(ctx, continuing) {
     if (ctx.failed()) ctx.say(`Not saved: ${ctx.failed().message}`);
     return false;
   }
+  const edited = snapshot(state);
   const body = refitBody({ name, base: state.base, theta: state.theta, edits: state.edits, draft: false });
   if (going) {
     body.material_id = continuing.material.id;
@@ -84,7 +86,7 @@ export async function save(ctx, continuing) {
   const materials = await ctx.refresh(`saved:${fit.material_id}`);
   const entry = materials.find((m) => m.id === fit.material_id);
   continuing.material = { id: fit.material_id, name: fit.name, version: entry ? entry.version : null };
-  ctx.onSaved(fit);
+  await ctx.onSaved(fit, edited);
   ctx.say((going
     ? `Saved “${fit.name}”, version ${entry ? entry.version : "?"}: it continues the material (its history is kept).`
     : `Saved “${fit.name}”: it is in the material list (Saved) and survives restarts.`)

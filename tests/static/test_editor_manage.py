@@ -10,6 +10,7 @@ with its edit (`?fit=`) and the service's `?material=&version=` link.
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
@@ -215,3 +216,34 @@ def test_link_reopens_the_material_with_its_edit(pages, editor_url):
     version_link = f"{editor_url}?material={material}&version=1"
     open_editor(other, version_link)
     expect(other.locator("#fit-id")).to_have_text(fit)
+
+
+def test_a_save_puts_its_own_fit_on_screen(pages, editor_url):
+    """
+    The fit on screen before a save can be a draft of the same edits under the name as it was (a
+    refit in flight when the name was changed): the draft refits are made to carry the old name
+    here, on the way to the server. The save's own fit then replaces it on screen: what is shown
+    and downloaded is the saved material's latest fit, and the page does not call it unsaved.
+    """
+    page = pages.new()
+    open_editor(page, editor_url)
+    settled(page)
+    draft = key_edit(page, channel=0, angle=60, key="Shift+ArrowDown")
+    old_name = page.input_value("#name")
+
+    def under_the_old_name(route):
+        body = route.request.post_data_json
+        if body and body.get("draft"):
+            route.continue_(post_data=json.dumps({**body, "name": old_name}))
+        else:
+            route.continue_()
+
+    page.route("**/fits/from-curves**", under_the_old_name)
+    try:
+        shown = save_as(page, "Saved under its own name")
+    finally:
+        page.unroute("**/fits/from-curves**")
+    saved = api(page, f"/fits/{shown}")
+    assert shown != draft and saved["name"] == "Saved under its own name"
+    assert api(page, f"/materials/{saved['material_id']}")["latest_fit"]["id"] == shown
+    expect(page.locator("body")).to_have_attribute("data-unsaved", "false")
