@@ -2,9 +2,11 @@
 Hostile input as a fresh corpus against a real ``python -m service`` on
 127.0.0.1: worst-case curve refits (degenerate bases, edits the model cannot
 follow), generated with a fixed seed, ten at once on two workers. Every one
-is answered 2xx within its budget, in [0, 1] (a best effort when flagged),
-and a library fit sent meanwhile is answered within 2 s: parts take turns
-in the workers cheapest first (service/runtime/turns.py).
+is answered 2xx, in [0, 1] (a best effort when flagged), none fits for 30 s,
+the last within 1.5x the ten fits' own time over the two workers (no wait
+past the work ahead of it), and a library fit sent meanwhile is answered
+within 2 s: parts take turns in the workers cheapest first
+(service/runtime/turns.py).
 """
 
 from __future__ import annotations
@@ -94,7 +96,14 @@ def test_worst_case_refits_are_bounded_and_do_not_hold_a_library_fit(tmp_path):
         assert status in (200, 201), (status, str(body)[:300])
         target = body["metrics"]["details"]["target"]
         assert target["model_min"] >= -1e-4 and target["model_max"] <= 1.0 + 1e-4, target
-        assert seconds < 30.0
+        # Bounded: no worst-case refit runs 30 s (its own fit, in its worker).
+        assert body["timings"]["total"] < 30.0, body["timings"]
+    # And none waits past the work ahead of it: the last answer comes within 1.5x the ten fits'
+    # own time shared by the two workers (idle: 18.4 s for 34.1 s of fits, 1.08x). Both sides
+    # stretch alike when the machine is shared (the suite's other worker), which a fixed wall
+    # bound did not: 30 s held alone (~21 s) and failed by 0.04 s in a full run.
+    work = sum(body["timings"]["total"] for _, _, body in answers)
+    assert max(seconds for _, seconds, _ in answers) <= 1.5 * work / 2, (sorted(a[1] for a in answers), work)
 
 
 def test_a_large_scene_takes_turns_with_a_library_fit(tmp_path):
