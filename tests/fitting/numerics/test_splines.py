@@ -9,6 +9,8 @@ from scipy.interpolate import Akima1DInterpolator, CubicSpline, PchipInterpolato
 from fitting.numerics.splines import akima, cubic_spline, pchip
 from fitting.optics.library import LIBRARY, library_material
 
+pytestmark = pytest.mark.numeric  # run again with other CPUs' kernels (scripts/test --other-cpus)
+
 PAIRS = [(pchip, PchipInterpolator), (akima, Akima1DInterpolator), (cubic_spline, CubicSpline)]
 IDS = ["pchip", "akima", "not-a-knot"]
 
