@@ -34,6 +34,31 @@ def refits(page):
     return posted, answered
 
 
+def watch_sends(page):
+    """Log, in the page, each refit request's time, the time of the edit before it and whether it was a
+    live step, and the time of the pointer's release (read by sends_while_held)."""
+    page.evaluate(
+        """() => { const send = window.fetch; window.cfSent = []; window.cfUp = Infinity;
+             window.addEventListener('pointerup', () => { window.cfUp = performance.now(); }, true);
+             window.fetch = (url, init) => { if (String(url).includes('/fits/from-curves'))
+               window.cfSent.push({ at: performance.now(), editAt: cfTelemetry.lastEditAt,
+                                    live: 'live' in JSON.parse(init.body) });
+               return send(url, init); }; }"""
+    )
+
+
+def sends_while_held(page):
+    """The refit requests since watch_sends, and those of them sent before the release, each checked to be
+    the full refit of a pointer at rest: a moving pointer sends nothing (every refit is the page's own),
+    but on a busy machine a gap between two moves can pass the rest (REST_MS, 500 ms, static/editor.js;
+    a CI run saw one), and the page then rightly asks for the full refit of the point it holds."""
+    sent, up = page.evaluate("[window.cfSent, window.cfUp]")
+    during = [s for s in sent if s["at"] < up]
+    for times in during:
+        assert not times["live"] and times["at"] - times["editAt"] >= 499, (times, up)
+    return sent, during
+
+
 def handle_at(page, channel: int, angle: int):
     """The control point of ``channel`` at ``angle`` brought into view, and its centre (x, y)."""
     handle = page.locator(f"circle.handle.c{channel}[data-angle='{angle}']")
@@ -62,6 +87,7 @@ def test_continuous_drag_refits_in_the_page_and_ends_on_the_server_fit(pages, ed
     # since the studio's panels joined the page; its cause not found yet): the handle is brought into view.
     handle, x, y = handle_at(page, 0, 50)
     page.mouse.move(x, y)
+    watch_sends(page)
     page.mouse.down()
     # The first move is solved in the page from the fit on screen (the base fit): the server's
     # live step from the same start on the same edit lands on the same curve (checked at the end).
@@ -69,22 +95,22 @@ def test_continuous_drag_refits_in_the_page_and_ends_on_the_server_fit(pages, ed
     page.wait_for_function(f"{IN_PAGE}.length >= 1")
     expect(page.locator("#fit-source")).to_have_text("live (in page)")
     first = page.evaluate(f"{IN_PAGE}[0]")
-    posted.clear()
     shown_during_drag = set()
     for step in range(2, 31):
         page.mouse.move(x, y + 3 * step)
         page.wait_for_timeout(40)
         shown_during_drag.add(page.evaluate("document.getElementById('preview').dataset.fit"))
-    # No request while the pointer moved: every refit was the page's own.
-    assert posted == []
     assert len({f for f in shown_during_drag if f.startswith("in-page-")}) >= 2, shown_during_drag
     assert page.locator("#fit-id").text_content() == base_id  # ids, figures and downloads stay the server's
     page.mouse.up()
     final_id = settled(page)
     expect(page.locator("#fit-source")).to_have_text("server fit")
 
-    # The full refit on release replaces the page's: one request, not live, its answer on screen.
-    assert len(posted) == 1
+    # No request while the pointer moved: every refit was the page's own (or a rest's full refit).
+    sent, during = sends_while_held(page)
+    # The full refit on release replaces the page's: one request, not live, its answer on screen (or,
+    # after a rest, the rest's request, when it was already asked for the edits released).
+    assert len(sent) == len(during) + 1 or (during and len(sent) == len(during)), sent
     last = posted[-1].post_data_json
     assert "live" not in last and last["draft"] is True
     assert final_id != base_id
@@ -194,20 +220,19 @@ def test_rgb_conductor_drag_is_solved_in_the_page_as_the_server_would(pages, liv
     expect(page.locator("#fit-id")).to_have_text(fit["id"])
     settled(page)
     page.locator("input[name=channel][value='2']").check()
-    posted, _ = refits(page)
     handle, x, y = handle_at(page, 2, 50)
     page.mouse.move(x, y)
+    watch_sends(page)
     page.mouse.down()
     page.mouse.move(x, y + 6)
     page.wait_for_function(f"{IN_PAGE}.length >= 1", timeout=20_000)
     expect(page.locator("#fit-source")).to_have_text("live (in page)")
-    # The pointer held still while the worker made its first solve (a cold start can pass the 500 ms
-    # that asks for the full refit at rest): the moves from here on are the ones that must send nothing.
-    posted.clear()
+    # The pointer may hold still past the rest while the worker makes its first solve (a cold start):
+    # only that full refit is sent.
     for step in range(2, 12):
         page.mouse.move(x, y + 3 * step)
         page.wait_for_timeout(40)
-    assert posted == [], "no request while the pointer moved"
+    sends_while_held(page)
     first = page.evaluate(f"{IN_PAGE}[0]")
     theta = page.evaluate("Array.from({length: 46}, (_, i) => 2 * i)")
     server = page.evaluate(
