@@ -13,6 +13,8 @@ the package.
     paper's (Vernooij 2024, Section 4.1).
 -   :data:`VISIBLE_RANGE_NM`, :data:`DEFAULT_MIN_COVERAGE`: the integration
     range of the reference and the least fraction of it data must cover.
+-   :data:`WORKING_SPACES`, :data:`DEFAULT_WORKING_SPACE`: the colour spaces an
+    export is fitted and written in (:mod:`fitting.exports.colour_space`).
 -   :data:`COAT_PRESETS`: common clear coats by name, their index at the
     sodium D line (589 nm) and its source (the editor's coat presets).
 -   :func:`check_eta_i`, :func:`check_eta_i_range`: one index, a domain.
@@ -53,6 +55,8 @@ __all__ = [
     "STEP_NM_LIMITS",
     "ANGLE_LIMITS_DEG",
     "COAT_PRESETS",
+    "WORKING_SPACES",
+    "DEFAULT_WORKING_SPACE",
     "as_float_array",
     "as_finite_array",
     "INDEX_LIMITS",
@@ -89,6 +93,13 @@ STEP_NM_LIMITS: tuple[float, float] = (0.5, 100.0)
 
 ANGLE_LIMITS_DEG: tuple[float, float] = (0.0, 90.0)
 """Angles theta in the coating, degrees: normal to grazing incidence."""
+
+WORKING_SPACES: tuple[str, ...] = ("lin_rec709", "acescg")
+"""The working spaces an export can be fitted and written in (MaterialX's names;
+:mod:`fitting.exports.colour_space` converts between them)."""
+
+DEFAULT_WORKING_SPACE: str = "lin_rec709"
+"""The working space of an export unless one is asked: glTF's, Blender's and MaterialX's default."""
 
 COAT_PRESETS: tuple[tuple[str, str, float, str], ...] = (
     (

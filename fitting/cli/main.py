@@ -25,11 +25,13 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
+from typing import Any
 
-from ..domain import DEFAULT_ETA_I_RANGE
+from ..domain import DEFAULT_ETA_I_RANGE, DEFAULT_WORKING_SPACE, WORKING_SPACES
 
-__all__ = ["main", "parse_eta_range"]
+__all__ = ["COMMANDS", "LazyChoices", "build_parser", "main", "parse_eta_range"]
 
 
 def parse_eta_range(text: str) -> tuple[float, float]:
@@ -138,25 +140,49 @@ def _write_snippet(nk, result, args) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from ..exports.colour_space import DEFAULT_WORKING_SPACE, WORKING_SPACES
-    from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
-    from .batch import add_batch_parser, add_catalogue_parser
+class LazyChoices(Sequence[str]):
+    """
+    The choices of an option read from a registry when argparse first asks
+    (a check of a value, a help or an error), not when the parser is built:
+    a command that never reads them never imports the registry's writers
+    (the export formats' are most of the CLI's start otherwise). A plugin
+    registered before the parse is among them.
+    """
+
+    def __init__(self, names: Callable[[], Iterable[str]]):
+        self._names = names
+
+    def _all(self) -> tuple[str, ...]:
+        return tuple(self._names())
+
+    def __contains__(self, value: object) -> bool:
+        return value in self._all()
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._all())
+
+    def __len__(self) -> int:
+        return len(self._all())
+
+    def __getitem__(self, index):  # type: ignore[override]
+        return self._all()[index]
+
+
+def _export_formats() -> tuple[str, ...]:
     from ..exports.formats import EXPORT_FORMATS
-    from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
-    from .ibl import add_ibl_parsers
-    from .import_fit import add_import_parser
-    from .scene import add_scene_parser
 
-    parser = argparse.ArgumentParser(
-        prog="python -m fitting",
-        description="Measured n, k of a conductor to the float16 coated-conductor Fresnel model.",
-    )
-    sub = parser.add_subparsers(dest="command", required=True)
+    return tuple(EXPORT_FORMATS)
 
+
+def _add_library(sub) -> None:
     p = sub.add_parser("library", help="list the library's conductors (or those matching QUERY)")
     p.add_argument("query", nargs="?", help="words of a name or symbol, e.g. 'stainless' or TiN")
     p.set_defaults(func=_cmd_library)
+
+
+def _add_fit(sub) -> None:
+    from ..fits.settings import DEFAULT_OBJECTIVE, OBJECTIVES
+    from ..models.kinds import DEFAULT_MODEL, MODEL_KINDS
 
     p = sub.add_parser("fit", help="fit a library material or an n, k file")
     p.add_argument(
@@ -178,7 +204,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the JSON view")
     p.add_argument("--no-metrics", action="store_true", help="skip the 100x100 metrics")
     p.add_argument(
-        "--export", choices=EXPORT_FORMATS, help="write this export (docs/exports.md) to -o or stdout instead of a pack"
+        "--export",
+        choices=LazyChoices(_export_formats),
+        metavar="FORMAT",  # argparse lists the choices in the metavar when adding the option: not here, lazily
+        help="write this export (%(choices)s; docs/exports.md) to -o or stdout instead of a pack",
     )
     p.add_argument(
         "--snippet",
@@ -211,6 +240,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_cmd_fit)
 
+
+def _add_reproduce(sub) -> None:
     p = sub.add_parser(
         "reproduce", help="print Table 1 and write the results page (Table 1, Section 4.3, the worst point)"
     )
@@ -220,11 +251,66 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--materials", help="comma-separated subset (default: all 22)")
     p.set_defaults(func=lambda args: __import__("fitting.cli.reproduce", fromlist=["run"]).run(args))
 
+
+def _add_scene(sub) -> None:
+    from .scene import add_scene_parser
+
     add_scene_parser(sub)
+
+
+def _add_batch(sub) -> None:
+    from .batch import add_batch_parser
+
     add_batch_parser(sub, parse_eta_range)
+
+
+def _add_catalogue(sub) -> None:
+    from .batch import add_catalogue_parser
+
     add_catalogue_parser(sub)
+
+
+def _add_ibl(sub) -> None:
+    from .ibl import add_ibl_parsers
+
     add_ibl_parsers(sub)
+
+
+def _add_import(sub) -> None:
+    from .import_fit import add_import_parser
+
     add_import_parser(sub)
+
+
+COMMANDS: dict[str, Callable[[Any], None]] = {
+    "library": _add_library,
+    "fit": _add_fit,
+    "reproduce": _add_reproduce,
+    "scene": _add_scene,
+    "batch": _add_batch,
+    "catalogue": _add_catalogue,
+    "ibl": _add_ibl,
+    "ibl-lut": _add_ibl,
+    "import": _add_import,
+}
+"""Each sub-command by name, and what adds its parser (``ibl`` adds ``ibl-lut`` too)."""
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """
+    The command line's parser: every sub-command, or with ``command`` (one
+    of :data:`COMMANDS`) that one alone, so that a command imports only what
+    its own options need (``fit Au`` neither the batch's, the scene's nor
+    the exports' modules).
+    """
+    parser = argparse.ArgumentParser(
+        prog="python -m fitting",
+        description="Measured n, k of a conductor to the float16 coated-conductor Fresnel model.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    adders = [COMMANDS[command]] if command in COMMANDS else list(dict.fromkeys(COMMANDS.values()))
+    for add in adders:
+        add(sub)
     return parser
 
 
@@ -236,7 +322,9 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    # The first word is the sub-command (the main parser has no option but --help): only its parser is built.
+    parser = build_parser(argv[0] if argv else None)
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)

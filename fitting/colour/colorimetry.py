@@ -33,9 +33,6 @@ formula. Color Research & Application, 30(1), 21-30.
 from __future__ import annotations
 
 import functools
-import importlib.abc
-import importlib.machinery
-import importlib.util
 import sys
 import threading
 from collections.abc import Callable
@@ -68,31 +65,39 @@ _DELTA = 6.0 / 29.0
 _DELTA3 = _DELTA**3
 
 
-class _LazyPlotting(importlib.abc.MetaPathFinder):
+def _lazy_plotting():
     """
-    Finds ``colour.plotting`` with a lazy loader (:class:`importlib.util.LazyLoader`):
+    A finder of ``colour.plotting`` with a lazy loader (:class:`importlib.util.LazyLoader`):
     colour-science's ``__init__`` imports its plotting package, and with it
     matplotlib, about 0.4 s of every process that imports it (each server
     and fitting worker, each CLI run); nothing here plots with it. The
     package runs on its first attribute access, as a plain import would.
+    (``importlib.abc`` is imported here, not with this module: it is a
+    twentieth of a second of a command's start.)
     """
+    import importlib.abc
+    import importlib.machinery
+    import importlib.util
 
-    def find_spec(self, name, path, target=None):
-        if name != "colour.plotting":
-            return None
-        spec = importlib.machinery.PathFinder.find_spec(name, path)
-        if spec is not None and spec.loader is not None:
-            spec.loader = importlib.util.LazyLoader(spec.loader)
-        return spec
+    class LazyPlotting(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path, target=None):
+            if name != "colour.plotting":
+                return None
+            spec = importlib.machinery.PathFinder.find_spec(name, path)
+            if spec is not None and spec.loader is not None:
+                spec.loader = importlib.util.LazyLoader(spec.loader)
+            return spec
+
+    return LazyPlotting()
 
 
 @functools.cache
 def colour_science():
-    """colour-science, imported once, quietly (its plotting package on first use: :class:`_LazyPlotting`)."""
+    """colour-science, imported once, quietly (its plotting package on first use: :func:`_lazy_plotting`)."""
     import warnings
 
     with _IMPORT_LOCK:
-        finder = _LazyPlotting()
+        finder = _lazy_plotting()
         sys.meta_path.insert(0, finder)
         try:
             with warnings.catch_warnings():

@@ -24,6 +24,7 @@ import functools
 import numpy as np
 
 from ..colour.colorimetry import colour_science
+from ..domain import DEFAULT_WORKING_SPACE, WORKING_SPACES
 
 __all__ = [
     "WORKING_SPACES",
@@ -34,10 +35,6 @@ __all__ = [
     "ACEScg_to_working",
     "working_to_ACEScg",
 ]
-
-WORKING_SPACES = ("lin_rec709", "acescg")
-"""The working spaces an export can be fitted and written in (MaterialX's names)."""
-DEFAULT_WORKING_SPACE = "lin_rec709"
 
 
 def check_working_space(working_space) -> str:

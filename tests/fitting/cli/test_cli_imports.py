@@ -2,7 +2,9 @@
 What a command's start imports: ``python -m fitting fit`` of a coated-conductor
 material never imports scipy.optimize, scipy.interpolate or colour-science
 (most of a start: their import took about 1 s of a 30 ms fit); the commands that need them
-import them when they run.
+import them when they run. Nor does it import the parts of the package other
+commands need (the export writers, the batch, scenes): only the command's own
+parser is built, and the export formats are read when ``--export`` is checked.
 """
 
 from __future__ import annotations
@@ -17,18 +19,26 @@ import pytest
 ROOT = Path(__file__).resolve().parents[3]
 HEAVY = ("scipy.optimize", "scipy.interpolate", "colour", "matplotlib")
 
+OTHER_COMMANDS = ("fitting.exports", "fitting.batch", "fitting.fits.scene_fit", "fitting.shading")
+
 _PROBE = """
 import contextlib, io, json, sys
 from fitting.cli.main import main
+watched = json.loads(sys.argv[1])
 with contextlib.redirect_stdout(io.StringIO()):
-    status = main(sys.argv[1:])
-print(json.dumps({"status": status, "loaded": [m for m in %r if m in sys.modules]}))
-""" % (HEAVY,)
+    status = main(sys.argv[2:])
+print(json.dumps({"status": status, "loaded": [m for m in watched if m in sys.modules]}))
+"""
 
 
-def _loaded_after(*args: str) -> dict:
+def _loaded_after(*args: str, watched=HEAVY) -> dict:
     done = subprocess.run(
-        [sys.executable, "-c", _PROBE, *args], cwd=ROOT, capture_output=True, text=True, timeout=120, check=True
+        [sys.executable, "-c", _PROBE, json.dumps(watched), *args],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
     )
     return json.loads(done.stdout.strip().splitlines()[-1])
 
@@ -54,3 +64,11 @@ def test_the_probe_sees_an_import():
     """The probe can fail: the rgb-conductor fit, which solves with scipy, shows scipy.optimize loaded."""
     after = _loaded_after("fit", "Au", "--json", "--model", "rgb-conductor")
     assert after["status"] == 0 and "scipy.optimize" in after["loaded"]
+
+
+@pytest.mark.slow  # starts processes
+def test_fit_imports_no_other_command_s_modules(tmp_path):
+    """``fit Au`` builds its own parser only; ``fit Au --export gltf`` loads the exports (it writes one)."""
+    assert _loaded_after("fit", "Au", "--json", watched=OTHER_COMMANDS) == {"status": 0, "loaded": []}
+    after = _loaded_after("fit", "Au", "--export", "gltf", "-o", str(tmp_path / "Au.gltf"), watched=OTHER_COMMANDS)
+    assert after["status"] == 0 and "fitting.exports" in after["loaded"]
