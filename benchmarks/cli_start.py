@@ -12,8 +12,13 @@ the wall time (recorded with the load average); CPU time is the steadier
 figure.
 
 Records benchmarks/results/cli_start.json (``figures``: the median and max
-of each side's wall and CPU seconds, and ``heavy_after``: which of
-scipy.optimize and colour-science this checkout's fit imported).
+of each side's wall and CPU seconds, ``heavy_after``: which of
+scipy.optimize and colour-science this checkout's fit imported, and
+``parts``: where this checkout's command spends its wall time, the median
+over ``--runs`` fresh processes that take the command's steps one by one:
+the interpreter's start and exit, the package's import (numpy's within it), the
+parser, the material's data, the fit with its quality checks, and the
+100 x 100 metrics).
 
 Usage: python benchmarks/cli_start.py [--before REV] [--runs 7] [--material Au]
 """
@@ -61,6 +66,45 @@ def run_once(root: Path, material: str) -> tuple[float, float]:
     return wall, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
+_PARTS_PROBE = """
+import json, sys, time
+t0 = time.perf_counter()
+import numpy
+t1 = time.perf_counter()
+import fitting
+t2 = time.perf_counter()
+from fitting.cli.main import build_parser
+args = build_parser("fit").parse_args(["fit", sys.argv[1], "--json"])
+t3 = time.perf_counter()
+from fitting.cli.materials import material_nk
+nk = material_nk(args)
+t4 = time.perf_counter()
+from fitting.fits.kinds import fit_model
+from fitting.fits.evaluate import evaluate_material
+result = fit_model(nk, args.eta_range, args.model, objective=args.objective)
+t5 = time.perf_counter()
+evaluate_material(nk, result)
+t6 = time.perf_counter()
+print(json.dumps({"numpy_import_s": t1 - t0, "package_import_s": t2 - t1, "parser_s": t3 - t2,
+                  "material_s": t4 - t3, "fit_s": t5 - t4, "metrics_s": t6 - t5}))
+import gc
+gc.freeze()  # as fitting/__main__.py does before its exit
+"""
+
+PARTS = ("start_and_exit_s", "numpy_import_s", "package_import_s", "parser_s", "material_s", "fit_s", "metrics_s")
+
+
+def parts_once(root: Path, material: str) -> dict[str, float]:
+    """The seconds of each step of the command in one fresh process (``start_and_exit_s``: the interpreter's, the rest)."""
+    t = time.perf_counter()
+    done = subprocess.run(
+        [sys.executable, "-c", _PARTS_PROBE, material], cwd=root, check=True, capture_output=True, text=True
+    )
+    wall = time.perf_counter() - t
+    steps = json.loads(done.stdout.strip().splitlines()[-1])
+    return {"start_and_exit_s": wall - sum(steps.values()), **steps}
+
+
 def heavy_modules(root: Path, material: str) -> list[str]:
     done = subprocess.run(
         [sys.executable, "-c", _HEAVY_PROBE, "fit", material, "--json"],
@@ -94,6 +138,7 @@ def main(argv=None) -> int:
                 flush=True,
             )
         heavy = {name: heavy_modules(root, args.material) for name, root in roots.items()}
+        parts = [parts_once(ROOT, args.material) for _ in range(args.runs)]
     figures = {"before_commit": args.before, "material": args.material, "runs": args.runs}
     for name, values in runs.items():
         wall, cpu = np.array(values).T
@@ -105,8 +150,9 @@ def main(argv=None) -> int:
         }
     figures["cpu_ratio"] = figures["after"]["cpu_median_s"] / figures["before"]["cpu_median_s"]
     figures["heavy_before"], figures["heavy_after"] = heavy["before"], heavy["after"]
+    figures["parts"] = {part: float(np.median([p[part] for p in parts])) for part in PARTS}
     print(json.dumps(figures, indent=1))
-    print("recorded:", write_result("cli_start", figures, load_start, runs=runs))
+    print("recorded:", write_result("cli_start", figures, load_start, runs=runs, part_runs=parts))
     return 0
 
 
