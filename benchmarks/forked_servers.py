@@ -48,7 +48,7 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.server_start import measured, stat_fields, summary  # noqa: E402
+from benchmarks.server_start import PORT_TAKEN, PORT_TRIES, measured, stat_fields, summary  # noqa: E402
 from benchmarks.service_load import free_port  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from server_forks import ServerForks  # noqa: E402
@@ -63,23 +63,33 @@ COMMAND = ("fit", "Au", "--eta-range", "1:2", "--no-metrics", "-o")
 
 def start(side: str, forks: ServerForks) -> dict:
     """One start: seconds to the first answer and CPU seconds per kind of the start's session by then."""
-    port = free_port()
     env = {**os.environ, **ENV}
-    with tempfile.TemporaryDirectory() as data:
-        argv = ["--host", "127.0.0.1", "--port", str(port), "--data-dir", f"{data}/data"]
-        t0 = time.monotonic()
-        if side == "fork":
-            process = forks.start(argv, env, Path(data) / "log")
-        else:
-            process = subprocess.Popen(
-                [sys.executable, "-m", "service", *argv],
-                cwd=ROOT,
-                env=env,
-                stdout=subprocess.DEVNULL,
-                stderr=subprocess.DEVNULL,
-                start_new_session=True,
-            )
-        return measured(process, port, t0, f"the {side}'s server")
+    for attempt in range(PORT_TRIES):
+        port = free_port()
+        with tempfile.TemporaryDirectory() as data:
+            argv = ["--host", "127.0.0.1", "--port", str(port), "--data-dir", f"{data}/data"]
+            log = Path(data) / "log"
+            t0 = time.monotonic()
+            if side == "fork":
+                process = forks.start(argv, env, log)
+            else:
+                with open(log, "wb") as out:
+                    process = subprocess.Popen(
+                        [sys.executable, "-m", "service", *argv],
+                        cwd=ROOT,
+                        env=env,
+                        stdout=out,
+                        stderr=subprocess.STDOUT,
+                        start_new_session=True,
+                    )
+            try:
+                return measured(
+                    process, port, t0, f"the {side}'s server", lambda: log.read_text(errors="replace")[-4000:]
+                )
+            except RuntimeError:
+                if attempt + 1 == PORT_TRIES or PORT_TAKEN not in log.read_text(errors="replace"):
+                    raise
+    raise AssertionError("unreachable")
 
 
 def run_command(side: str, forks: ServerForks) -> dict:

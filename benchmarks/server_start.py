@@ -116,25 +116,42 @@ def by_kind(processes: dict[int, tuple[int, str, float]], server: int) -> Counte
     return kinds
 
 
+PORT_TAKEN = "address already in use"
+"""What a server says when its port was taken between :func:`free_port` and its bind (another
+program on the machine): the start is tried again on another port, :data:`PORT_TRIES` times in all."""
+
+PORT_TRIES = 3
+
+
 def start(root: Path, workers: int | None) -> dict:
     """One start of ``root``'s service: seconds to the first answer and CPU seconds per kind by then."""
-    port = free_port()
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     if workers is not None:
         env["COATED_FIT_WORKERS"] = str(workers)
-    with tempfile.TemporaryDirectory() as data:
-        t0 = time.monotonic()
-        process = subprocess.Popen(
-            [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
-            cwd=root,
-            env=env,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.PIPE,
-            start_new_session=True,
-        )
-        return measured(
-            process, port, t0, f"the server of {root}", lambda: process.stderr.read().decode(errors="replace")[-2000:]
-        )
+    for attempt in range(PORT_TRIES):
+        port = free_port()
+        with tempfile.TemporaryDirectory() as data:
+            t0 = time.monotonic()
+            process = subprocess.Popen(
+                [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
+                cwd=root,
+                env=env,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.PIPE,
+                start_new_session=True,
+            )
+            try:
+                return measured(
+                    process,
+                    port,
+                    t0,
+                    f"the server of {root}",
+                    lambda: process.stderr.read().decode(errors="replace")[-2000:],
+                )
+            except RuntimeError as error:
+                if attempt + 1 == PORT_TRIES or PORT_TAKEN not in str(error):
+                    raise
+    raise AssertionError("unreachable")
 
 
 def measured(process, port: int, t0: float, what: str, output=lambda: "") -> dict:

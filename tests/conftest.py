@@ -83,6 +83,11 @@ def free_port() -> int:
 SERVER_FORKS = ServerForks()
 """This test process's program that forks servers (tests/server_forks.py), started on first use."""
 
+PORT_TAKEN = "address already in use"
+"""What a server's log says when its port was taken between free_port() and its bind."""
+
+PORT_TRIES = 3
+
 
 class ServerProcess:
     """
@@ -94,28 +99,48 @@ class ServerProcess:
 
     def __init__(self, data_dir: Path, env: dict[str, str], log: Path, spawn: bool = False) -> None:
         self.data_dir = data_dir
-        self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
         self.log = log
         self._log_file = open(log, "ab")
-        argv = ["--host", "127.0.0.1", "--port", str(self.port), "--data-dir", str(data_dir)]
-        env = {**os.environ, **env}
-        if not spawn and SERVER_FORKS.can_fork(env):
-            self.process = SERVER_FORKS.start(argv, env, log)
+        self._env = {**os.environ, **env}
+        self._spawn = spawn
+        self._start()
+
+    def _start(self) -> None:
+        """Start the server on a free port (its output appended to the log)."""
+        self.port = free_port()
+        self.url = f"http://127.0.0.1:{self.port}"
+        self._log_start = self.log.stat().st_size if self.log.exists() else 0
+        argv = ["--host", "127.0.0.1", "--port", str(self.port), "--data-dir", str(self.data_dir)]
+        if not self._spawn and SERVER_FORKS.can_fork(self._env):
+            self.process = SERVER_FORKS.start(argv, self._env, self.log)
         else:
             self.process = subprocess.Popen(
                 [sys.executable, "-m", "service", *argv],
                 cwd=ROOT,
-                env=env,
+                env=self._env,
                 stdout=self._log_file,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,
             )
 
+    def _port_taken(self) -> bool:
+        """Whether this start's output says its port was taken between free_port() and its bind."""
+        self._log_file.flush()
+        with open(self.log, "rb") as log:
+            log.seek(self._log_start)
+            return PORT_TAKEN in log.read().decode(errors="replace")
+
     def wait_ready(self, timeout_s: float = SERVER_START_TIMEOUT_S) -> None:
         deadline = time.monotonic() + timeout_s
+        tries = 1
         while time.monotonic() < deadline:
             if self.process.poll() is not None:
+                # Another test's server (or any program) can take the port between free_port() and the
+                # bind: that start is tried again on another port, twice at most.
+                if tries < PORT_TRIES and self._port_taken():
+                    tries += 1
+                    self._start()
+                    continue
                 raise RuntimeError(f"the server exited with {self.process.returncode}:\n{self.log_text()}")
             try:
                 if loopback.get(f"{self.url}/healthz", timeout=2.0).status_code == 200:

@@ -135,3 +135,43 @@ def test_an_environment_a_fork_cannot_take_runs_the_command():
     assert result.returncode == 0 and len(result.stdout.strip().splitlines()) == len(catalogue())
     with pytest.raises(ValueError, match="module must be one of service, fitting, preview_shaders"):
         SERVER_FORKS.run("benchmarks", ["--help"], dict(os.environ), ROOT)
+
+
+@pytest.mark.parametrize("spawn", [False, True], ids=["forked", "command"])
+def test_a_start_whose_port_was_taken_is_tried_again_on_another(tmp_path, monkeypatch, spawn):
+    """A port taken between free_port() and the server's bind (another test's server; a CI run saw one)
+    fails that start with "address already in use": the start is tried again on another port."""
+    import conftest
+
+    with __import__("socket").socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        first = [taken.getsockname()[1]]
+        real = conftest.free_port
+        monkeypatch.setattr(conftest, "free_port", lambda: first.pop() if first else real())
+        with server_process(tmp_path / "data", spawn=spawn) as server:
+            assert server.port != taken.getsockname()[1]
+            assert loopback.get(f"{server.url}/healthz", timeout=10).status_code == 200
+            assert conftest.PORT_TAKEN in server.log_text()
+
+
+def test_the_benchmark_s_start_is_tried_again_on_another_port(monkeypatch):
+    """benchmarks/forked_servers.py's start: the same rule, for each side."""
+    import socket
+
+    import benchmarks.forked_servers as forked
+
+    forks = __import__("server_forks").ServerForks()
+    try:
+        with socket.socket() as taken:
+            taken.bind(("127.0.0.1", 0))
+            taken.listen()
+            for side in forked.SIDES:
+                first = [taken.getsockname()[1]]
+                real = forked.free_port
+                monkeypatch.setattr(forked, "free_port", lambda: first.pop() if first else real())
+                run = forked.start(side, forks)
+                assert run["ready_s"] > 0 and not first, (side, run)
+                monkeypatch.undo()
+    finally:
+        forks.close()
