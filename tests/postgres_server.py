@@ -97,7 +97,7 @@ class PostgresServer:
             "--no-instructions",
         )
         pwfile.unlink()
-        self.start()
+        self._first_start()
         with self.admin() as connection:
             connection.execute(
                 f"CREATE ROLE {ROLE} LOGIN PASSWORD '{self.password}' CONNECTION LIMIT {ROLE_CONNECTION_LIMIT}"
@@ -119,6 +119,21 @@ class PostgresServer:
         with contextlib.suppress(OSError):
             return self.log.read_text(errors="replace")[-4000:]
         return ""
+
+    def _first_start(self, tries: int = 3) -> None:
+        """
+        The first start, on another free port while the one chosen was taken
+        between :func:`_free_port` and the server's bind (another test's
+        server: "Address already in use"), ``tries`` times in all.
+        """
+        for attempt in range(tries):
+            try:
+                self.start()
+                return
+            except RuntimeError as error:
+                if attempt + 1 == tries or "already in use" not in str(error):
+                    raise
+                self.port = _free_port()
 
     def start(self) -> None:
         """Start on the same port (and data) as before."""
