@@ -142,36 +142,27 @@ def test_a_start_whose_port_was_taken_is_tried_again_on_another(tmp_path, monkey
     """A port taken between free_port() and the server's bind (another test's server; a CI run saw one)
     fails that start with "address already in use": the start is tried again on another port."""
     import conftest
+    from ports import taken_first
 
-    with __import__("socket").socket() as taken:
-        taken.bind(("127.0.0.1", 0))
-        taken.listen()
-        first = [taken.getsockname()[1]]
-        real = conftest.free_port
-        monkeypatch.setattr(conftest, "free_port", lambda: first.pop() if first else real())
+    with taken_first(monkeypatch, conftest, "free_port") as (port, _):
         with server_process(tmp_path / "data", spawn=spawn) as server:
-            assert server.port != taken.getsockname()[1]
+            assert server.port != port
             assert loopback.get(f"{server.url}/healthz", timeout=10).status_code == 200
             assert conftest.PORT_TAKEN in server.log_text()
 
 
 def test_the_benchmark_s_start_is_tried_again_on_another_port(monkeypatch):
     """benchmarks/forked_servers.py's start: the same rule, for each side."""
-    import socket
+    from ports import taken_first
 
     import benchmarks.forked_servers as forked
 
     forks = __import__("server_forks").ServerForks()
     try:
-        with socket.socket() as taken:
-            taken.bind(("127.0.0.1", 0))
-            taken.listen()
-            for side in forked.SIDES:
-                first = [taken.getsockname()[1]]
-                real = forked.free_port
-                monkeypatch.setattr(forked, "free_port", lambda: first.pop() if first else real())
+        for side in forked.SIDES:
+            with taken_first(monkeypatch, forked, "free_port") as (_, first):
                 run = forked.start(side, forks)
-                assert run["ready_s"] > 0 and not first, (side, run)
-                monkeypatch.undo()
+            assert run["ready_s"] > 0 and not first, (side, run)
+            monkeypatch.undo()
     finally:
         forks.close()

@@ -48,16 +48,11 @@ def test_a_start_of_this_checkout_is_measured():
 @pytest.mark.slow  # starts servers
 def test_a_start_whose_port_was_taken_is_tried_again_on_another(monkeypatch):
     """A port taken between free_port() and the bind ("address already in use"): tried again on another."""
-    import socket
+    from ports import taken_first
 
     import benchmarks.server_start as server_start
 
-    with socket.socket() as taken:
-        taken.bind(("127.0.0.1", 0))
-        taken.listen()
-        first = [taken.getsockname()[1]]
-        real = server_start.free_port
-        monkeypatch.setattr(server_start, "free_port", lambda: first.pop() if first else real())
+    with taken_first(monkeypatch, server_start, "free_port") as (_, first):
         run = start(ROOT, 1)
     assert run["ready_s"] > 0 and not first
 

@@ -382,19 +382,13 @@ class TestFaults:
 def test_a_server_whose_port_was_taken_starts_on_another(monkeypatch):
     """The tests' PostgreSQL server (tests/postgres_server.py): a port taken between its choice and the bind
     ("Address already in use", another test's server) makes the first start try another port."""
-    import socket
-
     import postgres_server
+    from ports import taken_first
 
-    with socket.socket() as taken:
-        taken.bind(("127.0.0.1", 0))
-        taken.listen()
-        first = [taken.getsockname()[1]]
-        real = postgres_server._free_port
-        monkeypatch.setattr(postgres_server, "_free_port", lambda: first.pop() if first else real())
+    with taken_first(monkeypatch, postgres_server, "_free_port") as (port, first):
         server = postgres_server.PostgresServer()
         try:
-            assert not first and server.port != taken.getsockname()[1]
+            assert not first and server.port != port
             with server.admin() as connection:
                 assert connection.execute("SELECT 1").fetchone() == (1,)
         finally:
