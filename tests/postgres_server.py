@@ -184,6 +184,23 @@ class PostgresServer:
                 args.append(dbname)
             return connection.execute(query, args).fetchone()[0]
 
+    def wait_for_no_connections(self, timeout_s: float = 10.0) -> None:
+        """
+        Until the role ``coated`` has no connection: the server counts a
+        closed connection against the role's CONNECTION LIMIT until its
+        backend has exited, which an earlier test's closed store may not
+        have yet on a loaded machine.
+        """
+        deadline = time.monotonic() + timeout_s
+        while self.connections():
+            if time.monotonic() > deadline:
+                with self.admin() as connection:
+                    rows = connection.execute(
+                        "SELECT datname, application_name, state FROM pg_stat_activity WHERE usename = %s", [ROLE]
+                    ).fetchall()
+                raise AssertionError(f"the role {ROLE} still has connections after {timeout_s:g} s: {rows}")
+            time.sleep(0.05)
+
     def close(self) -> None:
         self.stop("immediate")
         shutil.rmtree(self.root, ignore_errors=True)

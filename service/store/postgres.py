@@ -32,9 +32,12 @@ schema and every query are those of the SQLite store
     attempt beside the pool at a time, which calls that come during it
     share: at most ``pool_max + 1`` connections, however many calls),
     the first one after it went away too: a call that gets no pooled
-    connection within :data:`QUICK_WAIT_S` tries one plain connection (or
-    shares the one in flight), whose refusal answers it, and otherwise
-    waits the rest of ``pool_timeout_s`` (the pool is busy, or reconnecting).
+    connection within :data:`QUICK_WAIT_S` goes on waiting while the pool
+    is busy (another call heard from the server since, every connection
+    is in a call, or the pool is opening one), else takes the refusal of
+    the pool's own attempt, else tries one plain connection (or shares the
+    one in flight), whose refusal answers it, and otherwise waits the rest
+    of ``pool_timeout_s``.
 """
 
 from __future__ import annotations
@@ -42,7 +45,6 @@ from __future__ import annotations
 import logging
 import os
 import socket
-import threading
 import time
 from typing import Any, Callable, TypeVar
 
@@ -60,9 +62,10 @@ from .records import (
     StoreFull,
     StoreUnavailable,
 )
+from .pool_watch import QUICK_WAIT_S, PoolWatch, watched_connections
 from .shared_check import SharedCheck
 
-__all__ = ["PostgresStore", "SAVE_LOCK", "redacted"]
+__all__ = ["PostgresStore", "QUICK_WAIT_S", "SAVE_LOCK", "redacted"]
 
 log = logging.getLogger("service.store")
 _T = TypeVar("_T")
@@ -70,14 +73,6 @@ _T = TypeVar("_T")
 SAVE_LOCK = 0x636F617465645F73  # the advisory lock every save takes (pg_advisory_xact_lock)
 RETRY_AFTER_S = 2
 """Retry-After of a 503 for a connection fault: the pool reconnects within a few seconds."""
-QUICK_WAIT_S = 0.25
-"""
-How long a call waits for a pooled connection before it asks the server
-itself (:meth:`PostgresStore._run`): a pool with a connection free answers
-at once, and a server that went away refuses at once, so the first call
-after it did is a 503 in well under a second instead of a wait of the pool
-timeout, which a load balancer's health check would read as a hang.
-"""
 
 
 def redacted(url: str) -> str:
@@ -119,24 +114,6 @@ def _translate(error: Exception, where: str) -> StoreError:
     return StoreUnavailable(f"the store at {where} is unavailable: {_message(error)}", retry_after=RETRY_AFTER_S)
 
 
-def _handing(handed: list[psycopg.Connection[Any]]) -> type[psycopg.Connection[Any]]:
-    """
-    A connection class for the pool whose next ``connect`` hands over a
-    connection from ``handed`` (opened before the pool) instead of opening
-    one more; once ``handed`` is empty it connects as usual.
-    """
-
-    class Handed(psycopg.Connection[Any]):
-        @classmethod
-        def connect(cls, conninfo: str = "", **kwargs: Any) -> Any:  # type: ignore[override]
-            try:
-                return handed.pop()
-            except IndexError:
-                return super().connect(conninfo, **kwargs)
-
-    return Handed
-
-
 class PostgresStore(SQLStore):
     """
     :class:`Store` on PostgreSQL at ``url`` (``postgresql://user:password@host:port/db``).
@@ -167,8 +144,7 @@ class PostgresStore(SQLStore):
     ) -> None:
         self.where = redacted(url)
         self._url, self._down = url, False
-        self._lent, self._lent_lock = 0, threading.Lock()  # pooled connections in calls now
-        self._answered_at = -float("inf")  # when a pooled call last heard from the server
+        self._watch = PoolWatch(pool_max)
         self._pool_timeout_s = float(pool_timeout_s)
         self._connect_timeout = max(1, int(connect_timeout_s))
         # One plain connection at a time beside the pool (at most pool_max + 1), shared by concurrent calls.
@@ -183,7 +159,7 @@ class PostgresStore(SQLStore):
         handed: list[psycopg.Connection[Any]] = []
         self._pool = ConnectionPool(
             url,
-            connection_class=_handing(handed),
+            connection_class=watched_connections(handed, self._watch),
             min_size=pool_min,
             max_size=pool_max,
             timeout=pool_timeout_s,
@@ -244,8 +220,8 @@ class PostgresStore(SQLStore):
         error). After a connection fault, each call first tries one plain
         connection (refused at once while the server is down, so a 503 is
         quick instead of a wait of ``pool_timeout_s``) until one succeeds;
-        so does a call that waited :data:`QUICK_WAIT_S` for a pooled one
-        while no other call heard from the server.
+        a call that waits past :data:`QUICK_WAIT_S` for a pooled one
+        while the pool is not busy asks the server too (:meth:`_connection`).
         """
         if self._down:
             self._probe()
@@ -257,53 +233,48 @@ class PostgresStore(SQLStore):
         except psycopg.OperationalError:
             self._down = True
             raise
-        with self._lent_lock:
-            self._lent += 1
+        self._watch.lent(+1)
         try:
             with connection:  # commit, or roll back on an error (the pool keeps the connection open)
                 result = function(connection)
-            self._answered_at = time.monotonic()
+            self._watch.answered()
             return result
         except psycopg.OperationalError:
             self._down = True
             raise
         except psycopg.Error:
-            self._answered_at = time.monotonic()  # the server's own refusal: it is there
+            self._watch.answered()  # the server's own refusal: it is there
             raise
         finally:
-            with self._lent_lock:
-                self._lent -= 1
+            self._watch.lent(-1)
             self._pool.putconn(connection)
 
     def _connection(self) -> psycopg.Connection:
         """
-        A pooled connection within ``pool_timeout_s``: past
-        :data:`QUICK_WAIT_S`, unless the pool is busy with live work
-        (:meth:`_busy_since`), one plain connection first (or the one another
-        call is making, :attr:`_probe`), whose refusal raises at once.
+        A pooled connection within ``pool_timeout_s``, waited for in steps
+        of :data:`QUICK_WAIT_S`. While the pool is busy with live work
+        (:meth:`PoolWatch.busy_since`) the wait goes on; else a connection
+        attempt of the pool's that the server refused since the call asked
+        raises that refusal at once; else one plain connection (or the one
+        another call is making, :attr:`_probe`) asks the server, whose
+        refusal raises at once, and the call then waits the rest.
         """
         asked = time.monotonic()
         deadline = asked + self._pool_timeout_s
-        try:
-            return self._pool.getconn(timeout=min(QUICK_WAIT_S, self._pool_timeout_s))
-        except PoolTimeout:
-            if time.monotonic() >= deadline:
-                raise
-        if not self._busy_since(asked):
-            self._probe()
+        while True:
+            try:
+                return self._pool.getconn(timeout=max(0.0, min(QUICK_WAIT_S, deadline - time.monotonic())))
+            except PoolTimeout:
+                if time.monotonic() >= deadline:
+                    raise
+            if self._watch.busy_since(asked):
+                continue
+            refused = self._watch.refusal_since(asked)
+            if refused is not None:
+                raise refused
+            break
+        self._probe()
         return self._pool.getconn(timeout=max(0.0, deadline - time.monotonic()))
-
-    def _busy_since(self, asked: float) -> bool:
-        """
-        Whether a wait for a pooled connection that began at ``asked`` is a
-        queue behind live work rather than a server that went away: another
-        call heard from the server since, or all ``pool_max`` connections
-        are in calls now (a lent connection that loses its server fails its
-        own call, which marks the store down). Then no plain connection is
-        opened beside the pool. (The pool's own ``pool_size`` is no guide:
-        it counts the connections it is still trying to open.)
-        """
-        return self._answered_at > asked or self._lent >= self.pool_max
 
     def _connect_once(self) -> None:
         """

@@ -164,15 +164,25 @@ class TestMove:
 
 
 class TestConnections:
-    def test_pool_bound_holds_under_load(self, postgres_server, postgres_url, monkeypatch):
+    @pytest.mark.parametrize("connect_s", [0.0, 0.6], ids=["quick-connections", "slow-connections"])
+    def test_pool_bound_holds_under_load(self, postgres_server, postgres_url, monkeypatch, connect_s):
         """
         24 threads on 3 connections: the server never sees more than 3, and
         the store opens no plain connection beside the pool (its check for a
         server that went away) while the pool is merely busy; the start-up's
-        own first connection becomes the pool's.
+        own first connection becomes the pool's. Slow connections (0.6 s
+        each, past QUICK_WAIT_S, as a loaded machine made them on CI): the
+        calls wait for the pool's growth instead of asking the server.
         """
-        probes = TestFaults.counted_probes(monkeypatch)
         store = PostgresStore(postgres_url, pool_min=1, pool_max=3, pool_timeout_s=30)
+        probes = TestFaults.counted_probes(monkeypatch)
+        plain_connect = psycopg.Connection.connect.__func__
+
+        def slow_connect(cls, *args, **kwargs):
+            time.sleep(connect_s)
+            return plain_connect(cls, *args, **kwargs)
+
+        monkeypatch.setattr(psycopg.Connection, "connect", classmethod(slow_connect))
         dbname = postgres_url.rsplit("/", 1)[1]
         peak, stop = [0], threading.Event()
 
@@ -222,6 +232,7 @@ class TestConnections:
         from postgres_server import ROLE_CONNECTION_LIMIT
 
         url = postgres_server.database()
+        postgres_server.wait_for_no_connections()  # the limit counts the role's connections to every database
         with postgres_server.admin() as admin:
             admin.execute("ALTER ROLE coated CONNECTION LIMIT 2")
         try:
@@ -321,7 +332,11 @@ class TestFaults:
         store.close()
 
     def test_a_burst_while_the_server_is_down_shares_each_refusal(self, postgres_server, postgres_url, monkeypatch):
-        """Every call is refused at once (503), with one plain connection attempt at a time."""
+        """
+        Every call is refused at once (503) by the server's own refusal (the
+        pool's reconnection's, or a plain connection's), with at most one
+        plain connection attempt at a time.
+        """
         store = PostgresStore(postgres_url, pool_max=4, pool_timeout_s=5)
         store.put_fit(record("1" * 32))
         postgres_server.stop()
@@ -333,7 +348,8 @@ class TestFaults:
         finally:
             postgres_server.start()
         assert all(isinstance(a, StoreUnavailable) and "unavailable" in str(a) for a in answers), answers
-        assert seen["most"] == 1 and seen["attempts"] >= 1, seen
+        assert not any("COATED_STORE_POOL_TIMEOUT_S" in str(a) for a in answers), answers
+        assert seen["most"] <= 1, seen
         # Bound: the first call's quick wait and 16 refusals of 0.2 s one after another, at worst, under the
         # 16 pool timeouts (80 s) that waiting calls would take.
         assert elapsed < QUICK_WAIT_S + 16 * 0.2 + 5, elapsed
