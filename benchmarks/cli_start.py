@@ -83,7 +83,7 @@ from fitting.fits.kinds import fit_model
 from fitting.fits.evaluate import evaluate_material
 result = fit_model(nk, args.eta_range, args.model, objective=args.objective)
 t5 = time.perf_counter()
-evaluate_material(nk, result)
+evaluate_material(nk, result, dtype="float32")  # as the command line does
 t6 = time.perf_counter()
 print(json.dumps({"numpy_import_s": t1 - t0, "package_import_s": t2 - t1, "parser_s": t3 - t2,
                   "material_s": t4 - t3, "fit_s": t5 - t4, "metrics_s": t6 - t5}))

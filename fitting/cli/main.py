@@ -71,7 +71,9 @@ def _cmd_fit(args) -> int:
     if args.export is not None:
         return _write_export(nk, args)
     extra = {} if args.max_gap_nm is None else {"max_gap_nm": args.max_gap_nm}
-    result = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=not args.no_metrics, **extra)
+    # The metrics as the service stores them (its float32 reference, within 0.001 Delta E of float64).
+    evaluate = False if args.no_metrics else "float32"
+    result = fit_model(nk, args.eta_range, args.model, objective=args.objective, evaluate=evaluate, **extra)
     for warning in result.quality.get("warnings", []):
         # Sparse data, outliers or a model outside [0, 1] are said, and refused with --strict.
         if args.strict:

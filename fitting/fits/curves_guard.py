@@ -42,6 +42,7 @@ from .polish import polish_float16
 from .result import FitResult
 from .start import initial_guess
 from .worst_case import MAX_MARGIN, GuardScore
+from ..numerics.plain import unique
 
 FOLLOW_MEAN = 1.0
 """An edited curve whose fit stays more than this mean Delta E 2000 (one
@@ -270,7 +271,7 @@ def guard_curve_choice(
         grid = grids["angle"]
         far = np.all(np.abs(grid.E[:, None] - np.array([c.eta_i for c in curves])[None, :]) >= blend_width, axis=1)
 
-        rows = np.unique(grid.E[far])
+        rows = unique(grid.E[far])
 
         def far_max(name):
             """The max Delta E 2000 on each eta_i row far from the edits."""

@@ -27,6 +27,7 @@ from .curves_audit import AUDIT_GRIDS, AUDIT_SAMPLES, AuditGrid
 from .curves_score import check_grid
 from .objective import Problem, coefficient_bounds, delta_E_gradients
 from .worst_case import MAX_MARGIN
+from ..numerics.plain import union
 
 __all__ = ["CHECK_SAMPLES", "MINIMAX_SAMPLES", "MINIMAX_LEVEL", "minimax_fit"]
 
@@ -111,7 +112,7 @@ def minimax_fit(base, curves, blend_width, full: list, start, floor: dict, aim: 
         all_cap = np.repeat(max_floor, sizes)
         relative = np.concatenate(true) / all_cap
         top = np.argsort(-relative)[:_MINIMAX_ROWS]
-        kept = np.union1d(kept, top[relative[top] > 0.5 * relative.max()])
+        kept = union(kept, top[relative[top] > 0.5 * relative.max()])
         M, E, Lab, cap = all_M[kept], all_E[kept], all_Lab[kept], all_cap[kept]
         r = means.residuals_deferred(x)[0]
         dE = np.sqrt(np.sum(r * r, axis=1))

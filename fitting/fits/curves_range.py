@@ -25,6 +25,7 @@ from ..models.coated_conductor import coated_conductor_model, model_parameters
 from ..models.range_bound import certify_range
 from ..models.pack import to_float16
 from .curves_score import SCORE_GRID, check_grid
+from ..numerics.plain import unique
 
 __all__ = [
     "RANGE_TOLERANCE",
@@ -105,7 +106,7 @@ def escape_points(C16, eta_i_range, mask, range_M, range_E, check_rows: int, max
     certificate = _certified(C16, eta_i_range, max_cells)
     if certificate.in_range is not True:
         mu_w, eta_w = certificate.worst[0], certificate.worst[1]
-        rows = np.unique(np.concatenate([check_grid(eta_i_range, 2, check_rows)[1][:, 0], [eta_w]]))
+        rows = unique(np.concatenate([check_grid(eta_i_range, 2, check_rows)[1][:, 0], [eta_w]]))
         near = np.clip(mu_w * np.array([0.5, 1.0, 1.5, 2.0]), 0.0, 1.0)
         NM, NE = np.meshgrid(near, rows)
         pm, pe = np.concatenate([pm, NM.ravel()]), np.concatenate([pe, NE.ravel()])

@@ -23,6 +23,7 @@ from ..models.kinds import DEFAULT_MODEL, model_ACEScg
 from .curves_base import CurveBase, edited_target
 from .curves_input import RGBCurve
 from .metrics import AGAINST_CURVES
+from ..numerics.plain import union
 
 __all__ = ["SCORE_GRID", "score_grid", "whole_target_error", "check_grid", "angle_mu"]
 
@@ -52,7 +53,7 @@ def check_grid(eta_i_range, angles: int, rows: int) -> tuple[np.ndarray, np.ndar
     can overshoot 1 just before grazing, where it meets 1), ``rows`` eta_i.
     """
     lo, hi = eta_i_range
-    theta = np.union1d(np.linspace(0.0, 90.0, angles), np.arange(80.0, 90.0, 0.5))
+    theta = union(np.linspace(0.0, 90.0, angles), np.arange(80.0, 90.0, 0.5))
     eta = np.linspace(lo, hi, rows) if hi > lo else np.array([lo])
     E, T = np.meshgrid(eta, theta, indexing="ij")
     return angle_mu(T), E

@@ -35,6 +35,7 @@ from ..numerics.splines import akima, cubic_spline, pchip
 from ..optics.fresnel import fresnel_conductor
 from ..optics.nk import SpectralNK, check_nk_range, resample_nk
 from ..optics.quality import UNCERTAIN_GAP_NM, visible_gaps
+from ..numerics.plain import median, union, unique
 
 __all__ = [
     "fit_quality",
@@ -102,7 +103,7 @@ def _spline_nk(nk: SpectralNK, spline) -> SpectralNK:
     last = min(int(np.searchsorted(w, hi, side="left")) + 3, w.size)
     ws = w[first:last]
     dense = np.arange(np.ceil(max(ws[0], lo)), np.floor(min(ws[-1], hi)) + 1.0)
-    grid = np.union1d(w, dense)
+    grid = union(w, dense)
     inside = (grid >= ws[0]) & (grid <= ws[-1])
     n, k = np.interp(grid, w, nk.n), np.interp(grid, w, nk.k)
     with np.errstate(all="ignore"):
@@ -199,7 +200,7 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
     # them in numpy: scipy.interpolate's import alone costs a command-line fit ~0.5 s.
     splines = [_spline_nk(nk, spline) for spline in (pchip, akima, cubic_spline)]
     left_out = []
-    for i in np.unique(np.round(np.linspace(0, inner.size - 1, min(inner.size, _MOST_LEFT_OUT))).astype(int)):
+    for i in unique(np.round(np.linspace(0, inner.size - 1, min(inner.size, _MOST_LEFT_OUT))).astype(int)):
         keep = np.ones(w.size, dtype=bool)
         keep[inner[i]] = False
         left_out.append(SpectralNK(w[keep], nk.n[keep], nk.k[keep], name=nk.name))
@@ -231,7 +232,7 @@ def _data_uncertainty(nk: SpectralNK, eta_i_range, min_coverage: float) -> dict[
     # data's own at their spacing.
     parts["leave_one_out"] = float(spread[: len(left_out)].max(initial=0.0)) / 4.0
     spread_windows = spread[len(left_out) :]
-    parts["window_left_out"] = float(np.median(spread_windows)) if spread_windows.size else 0.0
+    parts["window_left_out"] = median(spread_windows) if spread_windows.size else 0.0
     value = max(parts.values())
     return {
         "delta_E_mean": value,

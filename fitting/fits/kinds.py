@@ -72,7 +72,7 @@ def fit_model(
     eta_i_range=DEFAULT_ETA_I_RANGE,
     model: str = DEFAULT_MODEL,
     settings: FitSettings | None = None,
-    evaluate: bool = False,
+    evaluate: bool | str = False,
     samples=None,
     **overrides,
 ) -> FitResult:
@@ -81,7 +81,7 @@ def fit_model(
     :func:`fitting.fits.pipeline.fit_spectral`: ``settings`` default to the
     kind's (:attr:`FitKind.settings`), ``overrides`` replace fields
     (``degree`` applies to kinds with a power axis only), ``samples`` replace
-    the fitting grid. The result's ``model`` and ``packed.model`` name the
+    the fitting grid, ``evaluate`` as there. The result's ``model`` and ``packed.model`` name the
     kind, its ``settings`` are those that ran.
 
     Raises

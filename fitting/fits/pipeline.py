@@ -28,7 +28,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..colour.reference import reference_ACEScg, spectral_weights
+from ..colour.reference import DTYPES, reference_ACEScg, spectral_weights
 from ..domain import check_eta_i_range
 from ..models.kinds import model_kind
 from ..models.pack import PackedMaterial
@@ -38,6 +38,7 @@ from .evaluate import evaluate_material
 from .fit_quality import data_uncertainty, provenance, uncertainty_warning
 from .result import FitResult
 from .settings import FitSettings, fit_grid
+from ..numerics.plain import unique
 
 __all__ = [
     "FitKind",
@@ -163,7 +164,7 @@ def fit_problem(
     coverage = resample_nk(nk, nodes, settings.min_coverage).coverage
     # Gaps inside the visible range, isolated outliers (fitting.optics.quality).
     warnings = tuple(check_gaps(nk, settings.max_gap_nm) + outlier_warnings(nk))
-    rows = None if samples is None else np.unique(np.ravel(samples[1]))
+    rows = None if samples is None else unique(samples[1])
     if samples is None:
         samples = fit_grid(eta_i_range, settings.mu_samples, settings.eta_samples, settings.grid)
     mu, eta, weights = samples
@@ -199,15 +200,25 @@ def guard_problem(problem: FitProblem, result: FitResult) -> FitResult:
     return p.kind.guard(p.nk, p.target, p.mu, p.eta, p.weights, p.eta_i_range, p.settings, result, rows=p.rows)
 
 
-def finish_fit(problem: FitProblem, result: FitResult, assess: bool = True, evaluate: bool = False) -> FitResult:
+def _metrics_dtype(evaluate: bool | str) -> str | None:
+    """The arithmetic of the metrics' reference ``evaluate`` asks for (None: no metrics)."""
+    if isinstance(evaluate, str):
+        if evaluate not in DTYPES:
+            raise ValueError(f"`evaluate` must be a bool or one of {', '.join(DTYPES)}, got {evaluate!r}")
+        return evaluate
+    return "float64" if evaluate else None
+
+
+def finish_fit(problem: FitProblem, result: FitResult, assess: bool = True, evaluate: bool | str = False) -> FitResult:
     """
     ``result`` with its ``coverage``, ``settings``, ``quality`` and
     ``packed`` record (the citation of the data with the warnings as its
-    source) and, with ``evaluate``, its metrics; ``assess=False`` leaves out
+    source) and, with ``evaluate`` (as :func:`fit_spectral`), its metrics; ``assess=False`` leaves out
     the kind's quality (the proof of [0, 1]) and the data's uncertainty, for
     a fit that is scored but not shipped (:func:`finish_fit` again assesses it).
     """
     nk, eta_i_range, settings = problem.nk, problem.eta_i_range, problem.settings
+    dtype = _metrics_dtype(evaluate)
     t0 = time.perf_counter()
     result.coverage = problem.coverage
     result.settings = settings
@@ -235,9 +246,9 @@ def finish_fit(problem: FitProblem, result: FitResult, assess: bool = True, eval
         source=provenance(nk.source, result.quality),
         model=result.model,
     )
-    if evaluate:
+    if dtype is not None:
         t_eval = time.perf_counter()
-        metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage)
+        metrics = evaluate_material(nk, result, min_coverage=settings.min_coverage, dtype=dtype)
         metrics["quality"] = result.quality
         if result.guard is not None:
             metrics["guard"] = result.guard
@@ -253,13 +264,17 @@ def fit_spectral(
     nk: SpectralNK,
     eta_i_range,
     settings: FitSettings | None = None,
-    evaluate: bool = False,
+    evaluate: bool | str = False,
     samples=None,
     **overrides,
 ) -> FitResult:
     """
     Fit model kind ``kind`` to the spectral reference of ``nk`` over
-    ``eta_i_range``.
+    ``eta_i_range``; ``evaluate``: no metrics (False), the metrics (True:
+    their 1 nm reference in float64, the definition) or the metrics with
+    their reference in the arithmetic named (one of
+    :data:`fitting.colour.reference.DTYPES`; ``"float32"``, as the service
+    evaluates its fits, is within 0.001 Delta E of float64).
 
     The reference on the fitting grid of ``settings`` (default
     ``kind.settings``; ``overrides`` replace fields, ``degree`` only for a
@@ -277,16 +292,17 @@ def fit_spectral(
         With ``packed`` (float16, the citation of ``nk`` as source),
         ``coverage``, ``settings`` (those that ran), ``timings``
         (``reference``, ``fit``, ``quantise``, ``evaluate`` when evaluated,
-        ``total``: the whole call) and, when ``evaluate`` is true, ``metrics``
+        ``total``: the whole call) and, when ``evaluate`` is not False, ``metrics``
         and ``error`` (:func:`fitting.fits.evaluate.evaluate_material`).
 
     Raises
     ------
     ValueError
-        For an unknown kind, an invalid domain or setting, or data covering
-        too little of the visible range.
+        For an unknown kind, an invalid domain, setting or ``evaluate``, or
+        data covering too little of the visible range.
     """
     t0 = time.perf_counter()
+    _metrics_dtype(evaluate)  # refused before the fit
     problem = fit_problem(kind, nk, eta_i_range, settings, samples, **overrides)
     result = finish_fit(problem, guard_problem(problem, solve_problem(problem)), evaluate=evaluate)
     result.timings["total"] = time.perf_counter() - t0

@@ -34,6 +34,7 @@ from ..colour.delta_e import delta_E_2000
 from ..models.coated_conductor import coated_conductor_model
 from .objective import Problem, delta_E_gradients
 from .worst_case import score_of
+from ..numerics.plain import unique
 
 __all__ = ["POLISH_STEPS", "SCREEN", "polish_float16"]
 
@@ -96,7 +97,7 @@ def polish_float16(C16, target_RGB, cos_theta, eta_i, eta_i_range, steps: int = 
         moves = _neighbours(C16)
         predicted = _predicted(problem, C16, moves, where)
         p_mean, p_max = predicted.mean(axis=1), predicted.max(axis=1)
-        picks = np.unique(
+        picks = unique(
             np.concatenate(
                 [
                     np.argsort(np.where(p_max <= peak, p_mean, np.inf))[:by_mean],

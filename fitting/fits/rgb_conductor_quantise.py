@@ -24,6 +24,7 @@ from ..colour.delta_e import de2000_weights, delta_E_2000
 from ..models.pack import to_float16
 from ..models.rgb_conductor import rgb_conductor_model
 from ..optics.fresnel import fresnel_conductor, fresnel_conductor_derivatives
+from ..numerics.plain import unique
 
 __all__ = ["N_BOUNDS", "K_BOUNDS", "nk_bounds", "RGBConductorObjective", "quantise_rgb_conductor"]
 
@@ -114,7 +115,7 @@ def _lattice(value: float, radius: int, lo: float, hi: float) -> np.ndarray:
     for _ in range(radius - 1):
         values.append(np.nextafter(values[-1], np.float16(np.inf)))
     out = np.array(values, dtype=np.float64)
-    out = np.unique(np.clip(out, lo, hi))
+    out = unique(np.clip(out, lo, hi))
     return out[np.isfinite(out)]
 
 

@@ -41,6 +41,7 @@ import numpy as np
 from ..colour.colorimetry import ACEScg_to_Lab
 from ..colour.delta_e import delta_E_2000
 from ..colour.reference import reference_ACEScg_grid
+from ..numerics.plain import unique
 
 __all__ = [
     "GUARD_GRID",
@@ -99,11 +100,11 @@ def guard_grid(eta_i_range, shape: tuple[int, int] = GUARD_GRID, samples: int = 
     lo, hi = eta_i_range
     mu_all = np.linspace(0.0, 1.0, samples)
     eta_all = np.linspace(lo, hi, samples)
-    mu = mu_all[np.unique(np.round(np.linspace(0, samples - 1, shape[0])).astype(int))]
+    mu = mu_all[unique(np.round(np.linspace(0, samples - 1, shape[0])).astype(int))]
     if rows is not None:
-        eta = np.unique(np.asarray(rows, dtype=np.float64))
+        eta = unique(np.asarray(rows, dtype=np.float64))
     elif hi > lo:
-        eta = eta_all[np.unique(np.round(np.linspace(0, samples - 1, shape[1])).astype(int))]
+        eta = eta_all[unique(np.round(np.linspace(0, samples - 1, shape[1])).astype(int))]
     else:
         eta = np.array([lo])
     E, M = np.meshgrid(eta, mu, indexing="ij")
@@ -120,7 +121,7 @@ def guard_reference(nk, eta_i_range, min_coverage: float, shape: tuple[int, int]
     choice on a hard case (TiO2 at 80 % coverage, mean 0.97 to 1.07).
     """
     M, E = guard_grid(eta_i_range, shape, rows=rows)
-    mu, eta = np.unique(M), np.unique(E)
+    mu, eta = unique(M), unique(E)
     reference = reference_ACEScg_grid(nk, mu, eta, 1.0, min_coverage)
     return M, E, reference.reshape(-1, 3)
 

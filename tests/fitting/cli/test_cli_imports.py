@@ -2,7 +2,8 @@
 What a command's start imports: ``python -m fitting fit`` of a coated-conductor
 material never imports scipy.optimize, scipy.interpolate or colour-science
 (most of a start: their import took about 1 s of a 30 ms fit); the commands that need them
-import them when they run. Nor does it import the parts of the package other
+import them when they run. Nor numpy.ma (about 15 ms), which numpy's unique and median import
+(fitting.numerics.plain has theirs without it). Nor does it import the parts of the package other
 commands need (the export writers, the batch, scenes): only the command's own
 parser is built, and the export formats are read when ``--export`` is checked.
 """
@@ -17,7 +18,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[3]
-HEAVY = ("scipy.optimize", "scipy.interpolate", "colour", "matplotlib")
+HEAVY = ("scipy.optimize", "scipy.interpolate", "colour", "matplotlib", "numpy.ma")
 
 OTHER_COMMANDS = ("fitting.exports", "fitting.batch", "fitting.fits.scene_fit", "fitting.shading")
 

@@ -47,3 +47,16 @@ def test_a_scenes_shipped_fit_is_assessed_as_the_one_call_fit_of_its_kind():
     np.testing.assert_array_equal(result.fit.coefficients_float16, one_call.coefficients_float16)
     assert result.fit.quality == one_call.quality and "uncertainty" in result.fit.quality
     assert result.fit.packed.source == one_call.packed.source
+
+
+@pytest.mark.slow  # three fits with their metrics: about 2 s
+def test_metrics_in_float32_as_the_service_evaluates_them():
+    """``evaluate="float32"``: the metrics of its float32 reference, within 0.001 Delta E of float64's."""
+    nk = library_material("Cu")
+    exact, quick = fit_model(nk, evaluate=True), fit_model(nk, evaluate="float32")
+    np.testing.assert_array_equal(exact.coefficients_float16, quick.coefficients_float16)
+    for figure in ("delta_E_mean", "delta_E_max"):
+        assert abs(exact.metrics["model_float16"][figure] - quick.metrics["model_float16"][figure]) < 1e-3
+    assert not fit_model(nk, evaluate=False).metrics
+    with pytest.raises(ValueError, match="`evaluate` must be a bool or one of float64, float32, got 'float16'"):
+        fit_model(nk, evaluate="float16")
