@@ -19,11 +19,9 @@ from __future__ import annotations
 import json
 import math
 import os
-import socket
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import httpx
@@ -33,6 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
+from benchmarks.service_load import start_replicas  # noqa: E402
 
 WAVELENGTH_NM = np.arange(350.0, 851.0, 10.0)
 """The base table: a smooth metal (n 0.4-0.8, k 2-4.5) every 10 nm over 350-850 nm."""
@@ -160,35 +159,11 @@ def same_answer(cli: dict, service: dict) -> bool:
     return cli["coefficients"] == service["coefficients"] and cli["warnings"] == service["warnings"]
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def start_server(data: str) -> tuple[subprocess.Popen, str]:
-    port = _free_port()
-    env = {**os.environ, "COATED_FIT_WORKERS": "1"}
-    process = subprocess.Popen(
-        [sys.executable, "-m", "service", "--port", str(port), "--data-dir", data],
-        cwd=ROOT,
-        env=env,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
-    url = f"http://127.0.0.1:{port}"
-    deadline = time.monotonic() + 180
-    while True:
-        try:
-            if httpx.get(f"{url}/healthz", timeout=2).status_code == 200:
-                return process, url
-        except httpx.TransportError:
-            pass
-        if time.monotonic() > deadline or process.poll() is not None:
-            process.kill()
-            raise SystemExit("the server did not start")
-        time.sleep(0.2)
+    """One server with one fit worker (:func:`benchmarks.service_load.start_replicas`: a start whose
+    port was taken is tried again on another)."""
+    ((process, url),) = start_replicas(1, {**os.environ, "COATED_FIT_WORKERS": "1"}, data)
+    return process, url
 
 
 def main() -> int:

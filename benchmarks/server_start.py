@@ -41,7 +41,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_load import free_port  # noqa: E402
+from benchmarks.service_load import PORT_TAKEN, PORT_TRIES, free_port  # noqa: E402  (the start's retry rule)
 from benchmarks.side_by_side import checkout  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 
@@ -114,13 +114,6 @@ def by_kind(processes: dict[int, tuple[int, str, float]], server: int) -> Counte
         else:
             kinds["workers"] += seconds
     return kinds
-
-
-PORT_TAKEN = "address already in use"
-"""What a server says when its port was taken between :func:`free_port` and its bind (another
-program on the machine): the start is tried again on another port, :data:`PORT_TRIES` times in all."""
-
-PORT_TRIES = 3
 
 
 def start(root: Path, workers: int | None) -> dict:

@@ -166,3 +166,20 @@ def test_the_benchmark_s_start_is_tried_again_on_another_port(monkeypatch):
             monkeypatch.undo()
     finally:
         forks.close()
+
+
+def test_the_load_benchmarks_start_is_tried_again_on_another_port(tmp_path, monkeypatch):
+    """benchmarks/service_load.py's start_replicas (service_stores, export_downloads, preview_load and
+    finite_inputs start their servers with it): a port taken first, the start is tried again."""
+    from ports import taken_first
+
+    import benchmarks.service_load as load
+
+    with taken_first(monkeypatch, load, "free_port") as (port, first):
+        ((process, url),) = load.start_replicas(1, dict(os.environ), str(tmp_path))
+    try:
+        assert not first and not url.endswith(f":{port}")
+        assert loopback.get(f"{url}/healthz", timeout=10).status_code == 200
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
