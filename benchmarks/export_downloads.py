@@ -37,7 +37,7 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.service_cpu import tree_cpu  # noqa: E402
-from benchmarks.service_load import start_replicas  # noqa: E402
+from benchmarks.serve import start_replicas  # noqa: E402
 
 API = "/api/v1"
 FORMATS = ("mtlx", "openpbr", "blender", "gltf")

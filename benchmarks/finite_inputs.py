@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_load import start_replicas  # noqa: E402
+from benchmarks.serve import start_replicas  # noqa: E402
 
 WAVELENGTH_NM = np.arange(350.0, 851.0, 10.0)
 """The base table: a smooth metal (n 0.4-0.8, k 2-4.5) every 10 nm over 350-850 nm."""

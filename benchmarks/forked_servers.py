@@ -48,8 +48,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.server_start import PORT_TAKEN, PORT_TRIES, measured, stat_fields, summary  # noqa: E402
-from benchmarks.service_load import free_port  # noqa: E402
+from benchmarks.server_start import measured, stat_fields, summary  # noqa: E402
+from benchmarks.serve import PORT_TAKEN, PORT_TRIES, free_port  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 from server_forks import ServerForks  # noqa: E402
 

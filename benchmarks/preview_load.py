@@ -47,7 +47,8 @@ sys.path.insert(0, str(ROOT))
 API = "/api/v1"
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_load import percentiles, start_replicas  # noqa: E402
+from benchmarks.serve import start_replicas  # noqa: E402
+from benchmarks.service_load import percentiles  # noqa: E402
 
 ROUGH_COATED_REFERENCE = {
     "roughness": 0.3,

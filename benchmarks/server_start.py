@@ -41,7 +41,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
-from benchmarks.service_load import PORT_TAKEN, PORT_TRIES, free_port  # noqa: E402  (the start's retry rule)
+from benchmarks.serve import PORT_TAKEN, PORT_TRIES, free_port  # noqa: E402  (the start's retry rule)
 from benchmarks.side_by_side import checkout  # noqa: E402
 from benchmarks.suite_time import TICK  # noqa: E402
 

@@ -48,7 +48,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import socket
 import subprocess
 import sys
 import tempfile
@@ -65,19 +64,7 @@ API = "/api/v1"
 
 from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.service_cpu import cpu_figures, fit_latencies  # noqa: E402
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-PORT_TAKEN = "address already in use"
-"""What a server says when its port was taken between :func:`free_port` and its bind (another
-program on the machine): the start is tried again on another port, :data:`PORT_TRIES` times in all."""
-
-PORT_TRIES = 3
+from benchmarks.serve import start_replicas  # noqa: E402
 
 
 def nk_body(name: str) -> dict:
@@ -194,55 +181,6 @@ def listing(url: str) -> list[str]:
             cursor = page["next_cursor"]
             if cursor is None:
                 return ids
-
-
-def start_replicas(count: int, env: dict[str, str], data: str) -> list[tuple[subprocess.Popen, str]]:
-    """
-    ``count`` service processes (each its own data directory, for SQLite) once all answer /healthz.
-    A start that exits because its port was taken between :func:`free_port` and its bind
-    (:data:`PORT_TAKEN` in its output) is tried again on another port, :data:`PORT_TRIES` times in
-    all; any other early exit, or no answer in 180 s, ends the run with the server's last output.
-    """
-
-    def launch(i: int) -> tuple[subprocess.Popen, str, object]:
-        port = free_port()
-        log = tempfile.TemporaryFile()  # a file, not a pipe: a pipe nobody reads would stall the server
-        process = subprocess.Popen(
-            [sys.executable, "-m", "service", "--port", str(port), "--data-dir", f"{data}/{i}"],
-            cwd=ROOT,
-            env=env,
-            stdout=subprocess.DEVNULL,
-            stderr=log,
-            start_new_session=True,
-        )
-        return process, f"http://127.0.0.1:{port}", log
-
-    starts = [launch(i) for i in range(count)]
-    deadline = time.monotonic() + 180
-    for i in range(count):
-        tries = 1
-        while True:
-            process, url, log = starts[i]
-            try:
-                if httpx.get(f"{url}/healthz", timeout=2).status_code == 200:
-                    break
-            except httpx.TransportError:
-                pass
-            if process.poll() is not None:
-                log.seek(0)
-                output = log.read().decode(errors="replace")
-                if tries < PORT_TRIES and PORT_TAKEN in output:
-                    tries += 1
-                    log.close()
-                    starts[i] = launch(i)
-                    continue
-                raise SystemExit(f"a server exited ({process.returncode}): {output[-2000:]}")
-            if time.monotonic() > deadline:
-                raise SystemExit(f"a server did not answer /healthz in 180 s ({url})")
-            time.sleep(0.2)
-    for _, _, log in starts:
-        log.close()
-    return [(process, url) for process, url, _ in starts]
 
 
 def main() -> int:

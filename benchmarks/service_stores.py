@@ -47,7 +47,8 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.record import load_average, write_result  # noqa: E402
 from benchmarks.service_cpu import cpu_figures, evaluation_cpu, fit_latencies  # noqa: E402
-from benchmarks.service_load import post_fits, start_replicas, unseen_fit_bodies  # noqa: E402
+from benchmarks.serve import start_replicas  # noqa: E402
+from benchmarks.service_load import post_fits, unseen_fit_bodies  # noqa: E402
 
 STORES = ("sqlite", "postgresql")
 

@@ -169,14 +169,14 @@ def test_the_benchmark_s_start_is_tried_again_on_another_port(monkeypatch):
 
 
 def test_the_load_benchmarks_start_is_tried_again_on_another_port(tmp_path, monkeypatch):
-    """benchmarks/service_load.py's start_replicas (service_stores, export_downloads, preview_load and
+    """benchmarks/serve.py's start_replicas (service_load, service_stores, export_downloads, preview_load and
     finite_inputs start their servers with it): a port taken first, the start is tried again."""
     from ports import taken_first
 
-    import benchmarks.service_load as load
+    import benchmarks.serve as serve
 
-    with taken_first(monkeypatch, load, "free_port") as (port, first):
-        ((process, url),) = load.start_replicas(1, dict(os.environ), str(tmp_path))
+    with taken_first(monkeypatch, serve, "free_port") as (port, first):
+        ((process, url),) = serve.start_replicas(1, dict(os.environ), str(tmp_path))
     try:
         assert not first and not url.endswith(f":{port}")
         assert loopback.get(f"{url}/healthz", timeout=10).status_code == 200

@@ -125,8 +125,20 @@ def resolve_material(material: str) -> str:
             return found["id"]
     raise ValueError(
         f"`material` must name a conductor of the library (a name such as gold, "
-        f"a symbol such as Au, or an id), got {material[:80]!r}"
+        f"a symbol such as Au, or an id), got {material[:80]!r}{_suggestions(material)}"
     )
+
+
+SUGGESTIONS = 3
+"""How many of the library's best matches a refused ``material`` names."""
+
+
+def _suggestions(material: str) -> str:
+    """``"; did you mean ...?"`` with the ids (and names) of :data:`SUGGESTIONS` best search matches, or ""."""
+    found = search_catalogue(material[:80])[:SUGGESTIONS]
+    if not found:
+        return ""
+    return "; did you mean " + ", ".join(f"{e['id']} ({e['name']})" for e in found) + "?"
 
 
 @functools.cache  # at most one entry per catalogue page

@@ -11,6 +11,7 @@ from fitting.optics.catalogue import (
     catalogue,
     catalogue_header,
     catalogue_material,
+    SUGGESTIONS,
     resolve_material,
     search_catalogue,
 )
@@ -107,6 +108,24 @@ class TestCatalogue:
     def test_an_unknown_name_is_refused_naming_the_argument(self, bad):
         with pytest.raises(ValueError, match="`material`"):
             resolve_material(bad)
+
+    def test_a_refusal_names_the_best_matches(self):
+        """A name that is not quite one ("stainless steel": two pages) is refused with what search finds first."""
+        with pytest.raises(ValueError) as refused:
+            resolve_material("stainless steel")
+        message = str(refused.value)
+        assert message.startswith("`material` must name a conductor of the library")
+        assert message.endswith(
+            "; did you mean stainless-steel.Karlsson-austenitic (stainless steel, austenitic), "
+            "stainless-steel.Karlsson-ferritic (stainless steel, ferritic)?"
+        )
+        titan = str(pytest.raises(ValueError, resolve_material, "titan").value)
+        suggestions = titan.split("; did you mean ")[1].removesuffix("?").split("), ")
+        assert len(suggestions) == SUGGESTIONS and "Ti.Palm (titanium" in suggestions
+        for suggestion in suggestions:
+            identifier = suggestion.split(" (")[0]
+            assert resolve_material(identifier) == identifier  # each suggestion resolves as given
+        assert "did you mean" not in str(pytest.raises(ValueError, resolve_material, "unobtainium").value)
 
     def test_a_book_without_a_name_is_refused(self):
         with pytest.raises(ValueError, match="`book` 'Xx' has no common name"):
