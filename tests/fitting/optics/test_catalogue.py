@@ -109,10 +109,17 @@ class TestCatalogue:
         with pytest.raises(ValueError, match="`material`"):
             resolve_material(bad)
 
+    def test_a_book_s_name_gives_its_preferred_page(self):
+        """A book whose pages are named apart ("stainless steel, austenitic", "..., ferritic") by its own name."""
+        assert resolve_material("stainless steel") == resolve_material("Stainless  Steel") == resolve_material("steel")
+        assert catalogue()[resolve_material("stainless steel")]["preferred"]
+        assert resolve_material("brass") == resolve_material("brass 70/30") == "CuZn"
+
     def test_a_refusal_names_the_best_matches(self):
-        """A name that is not quite one ("stainless steel": two pages) is refused with what search finds first."""
+        """A name that is not quite one is refused with what the search finds first: for the name, for it
+        less a word, else the names nearest in spelling; nothing when nothing is near."""
         with pytest.raises(ValueError) as refused:
-            resolve_material("stainless steel")
+            resolve_material("stainless steel 316")
         message = str(refused.value)
         assert message.startswith("`material` must name a conductor of the library")
         assert message.endswith(
@@ -125,6 +132,9 @@ class TestCatalogue:
         for suggestion in suggestions:
             identifier = suggestion.split(" (")[0]
             assert resolve_material(identifier) == identifier  # each suggestion resolves as given
+        assert str(pytest.raises(ValueError, resolve_material, "titanum").value).endswith(
+            "; did you mean Ti.Palm (titanium)?"  # the preferred page of the name spelt nearest
+        )
         assert "did you mean" not in str(pytest.raises(ValueError, resolve_material, "unobtainium").value)
 
     def test_a_book_without_a_name_is_refused(self):
