@@ -13,6 +13,7 @@ every other page's id is ``BOOK.PAGE`` in ASCII (``Ti.Johnson``).
 -   :func:`catalogue`: id -> entry (name, symbol, category, page, label,
     reference, coverage, ``preferred``: the page a bare name fits).
 -   :func:`search_catalogue`: the entries matching a query, best first.
+-   :func:`suggest_materials`: what a query that matches nothing may have meant.
 -   :func:`resolve_material`: a name, symbol or id, any case -> its id.
 -   :func:`catalogue_material`: the :class:`fitting.optics.nk.SpectralNK` of a name or id.
 """
@@ -34,6 +35,8 @@ __all__ = [
     "catalogue",
     "catalogue_header",
     "search_catalogue",
+    "suggest_materials",
+    "SUGGESTIONS",
     "resolve_material",
     "catalogue_material",
 ]
@@ -137,26 +140,32 @@ SUGGESTIONS = 3
 """How many of the library's best matches a refused ``material`` names."""
 
 
-def _suggestions(material: str) -> str:
+def suggest_materials(query: str) -> list[dict[str, Any]]:
     """
-    ``"; did you mean ...?"`` with the ids (and names) of the :data:`SUGGESTIONS` best matches, or
-    "": the search's for ``material``; else for it less one word ("stainless steel 316"), the
-    first word dropped first; else the names nearest in spelling ("titanum": ``difflib``).
+    What a query that names no page may have meant, best first, at most :data:`SUGGESTIONS`: the
+    search's matches for ``query`` (:func:`search_catalogue`); else for it less one word
+    ("stainless steel 316"), the first word dropped first; else the names nearest in spelling
+    ("titanum": ``difflib``, each name's preferred page); else none.
     """
-    words = material[:80].split()
+    words = str(query)[:80].split()
     found = search_catalogue(" ".join(words))
     for drop in range(len(words) if len(words) > 1 and not found else 0):
         found = search_catalogue(" ".join(words[:drop] + words[drop + 1 :]))
         if found:
             break
-    if not found:
-        import difflib  # only a refusal needs it
+    if not found and words:
+        import difflib  # only a query that matches nothing needs it
 
         # A name's preferred page (a name of several pages: the one it resolves to).
         names = {n.casefold(): e for e in sorted(catalogue().values(), key=lambda e: e["preferred"]) for n in _names(e)}
         near = difflib.get_close_matches(" ".join(words).casefold(), list(names), n=SUGGESTIONS, cutoff=0.75)
         found = list({names[n]["id"]: names[n] for n in near}.values())
-    found = found[:SUGGESTIONS]
+    return found[:SUGGESTIONS]
+
+
+def _suggestions(material: str) -> str:
+    """``"; did you mean ...?"`` with the ids (and names) of :func:`suggest_materials`, or ""."""
+    found = suggest_materials(material)
     if not found:
         return ""
     return "; did you mean " + ", ".join(f"{e['id']} ({e['name']})" for e in found) + "?"

@@ -30,9 +30,9 @@ from fitting.colour.colorimetry import colour_science
 from fitting.colour.reference import reference_ACEScg
 from fitting.domain import COAT_PRESETS, check_eta_i, cos_theta_from_angle
 from fitting.exports.colour_space import ACEScg_to_lin_rec709
-from fitting.optics.catalogue import catalogue, catalogue_material, search_catalogue
+from fitting.optics.catalogue import catalogue, catalogue_material, search_catalogue, suggest_materials
 
-__all__ = ["SWATCH_ANGLES_DEG", "library_entries", "library_about", "srgb_hex", "coat_presets"]
+__all__ = ["SWATCH_ANGLES_DEG", "library_entries", "library_suggestions", "library_about", "srgb_hex", "coat_presets"]
 
 SWATCH_ANGLES_DEG: tuple[float, ...] = (0.0, 45.0, 70.0, 85.0)
 """The angles in the coating of a swatch: normal incidence, then towards grazing."""
@@ -85,21 +85,27 @@ def library_entries(eta_i: float, query: str | None = None, limit: int | None = 
     """The catalogue's conductors (those matching ``query``, best first, when given; at most
     ``limit``), each with its swatch at ``eta_i``."""
     eta_i = check_eta_i(eta_i)
-    out = []
-    for entry in search_catalogue(query)[:limit]:
-        acescg, hexes = _swatch(entry["id"], eta_i)
-        out.append(
-            {
-                **library_about(entry["id"]),
-                "swatch": {
-                    "eta_i": eta_i,
-                    "angles_deg": list(SWATCH_ANGLES_DEG),
-                    "srgb": list(hexes),
-                    "acescg": [list(row) for row in acescg],
-                },
-            }
-        )
-    return out
+    return [_listed(entry, eta_i) for entry in search_catalogue(query)[:limit]]
+
+
+def library_suggestions(eta_i: float, query: str) -> list[dict[str, Any]]:
+    """What ``query``, which matches nothing, may have meant
+    (:func:`fitting.optics.catalogue.suggest_materials`), listed as :func:`library_entries` lists."""
+    eta_i = check_eta_i(eta_i)
+    return [_listed(entry, eta_i) for entry in suggest_materials(query)]
+
+
+def _listed(entry: dict[str, Any], eta_i: float) -> dict[str, Any]:
+    acescg, hexes = _swatch(entry["id"], eta_i)
+    return {
+        **library_about(entry["id"]),
+        "swatch": {
+            "eta_i": eta_i,
+            "angles_deg": list(SWATCH_ANGLES_DEG),
+            "srgb": list(hexes),
+            "acescg": [list(row) for row in acescg],
+        },
+    }
 
 
 def coat_presets() -> list[dict[str, Any]]:

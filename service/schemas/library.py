@@ -51,6 +51,11 @@ class LibraryList(BaseModel):
     eta_i: float
     total: int = Field(description="Conductors matching (before `limit`)")
     materials: list[LibraryEntry]
+    suggestions: list[LibraryEntry] = Field(
+        default_factory=list,
+        description="When `q` matches nothing: what it may have meant (the search less one word, "
+        "else the names nearest in spelling), at most 3; else empty",
+    )
 
 
 class CoatPreset(BaseModel):

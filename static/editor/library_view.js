@@ -36,12 +36,19 @@ export class LibraryView {
       return;
     }
     const query = state.library.found ? state.library.query : "";
-    const found = shownLibrary(state.library);
+    const matched = shownLibrary(state.library);
+    // A search that found none lists what the service suggested (the search less a word, a near spelling).
+    const suggested = query.trim() && !matched.length
+      ? shownLibrary({ materials, found: state.library.suggested || [] }) : [];
+    const found = suggested.length ? suggested : matched;
     const signature = `${eta}|${query}|${state.base ? state.base.id : ""}|${found.map((m) => m.id).join()}`;
-    $("library-state").textContent = query.trim()
-      ? `${found.length} of ${materials.length} match “${query.trim()}”, names and symbols first; ` +
-        `swatches under a coat of ηᵢ ${eta}.`
-      : `${materials.length} conductors; swatches under a coat of ηᵢ ${eta} (0°, 45°, 70°, 85°).`;
+    $("library-state").textContent = suggested.length
+      ? `No conductor matches “${query.trim()}”; did you mean one of these? ` +
+        `Swatches under a coat of ηᵢ ${eta}.`
+      : query.trim()
+        ? `${found.length} of ${materials.length} match “${query.trim()}”, names and symbols first; ` +
+          `swatches under a coat of ηᵢ ${eta}.`
+        : `${materials.length} conductors; swatches under a coat of ηᵢ ${eta} (0°, 45°, 70°, 85°).`;
     list.dataset.eta = eta;
     if (signature === this.signature) return;
     this.signature = signature;

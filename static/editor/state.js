@@ -34,7 +34,8 @@ export function initialState() {
     onScreen: "server", // whose fit the curve and preview show: "server", or "page" (a live refit in the page)
     selected: null,   // the control point typed entry changes: {channel, handle}
     compare: null,    // compare mode: {fit, label, model: its curve at `eta` (or null while it loads)}
-    library: { eta: null, materials: [], query: "", found: null }, // GET /library at an eta_i; found: ?q= ids, best first
+    // GET /library at an eta_i; found: ?q= ids, best first; suggested: what a ?q= that found none may have meant
+    library: { eta: null, materials: [], query: "", found: null, suggested: [] },
     saved: [],        // the artist's saved edited materials (kind curves), every page
     savedSearch: { query: "", found: null }, // GET /materials?kind=curves&q=: the ids found (null: no search)
     bin: [],          // the saved materials in the bin
@@ -270,9 +271,11 @@ export const ACTIONS = {
     s.library = { ...s.library, eta: key(eta), materials };
     return true;
   },
-  /** The library's search: the ids GET /library?q= answered for `query`, best first (null: no search). */
-  librarySearch(s, { query, ids }) {
-    s.library = { ...s.library, query, found: query.trim() ? ids : null };
+  /** The library's search: the ids GET /library?q= answered for `query`, best first (null: no search),
+   *  and, when it found none, the ids it suggested. */
+  librarySearch(s, { query, ids, suggested = [] }) {
+    const searched = Boolean(query.trim());
+    s.library = { ...s.library, query, found: searched ? ids : null, suggested: searched ? suggested : [] };
     return true;
   },
   /** The saved edited materials and the bin. */

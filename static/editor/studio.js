@@ -140,8 +140,10 @@ export class Studio {
 
   /** The library's search, asked of the service (names and symbols first; never inside a citation). */
   async #search(query) {
-    const ids = query.trim() ? (await api.library(this.state.eta, query)).materials.map((m) => m.id) : null;
-    if ($("library-search").value === query) this.app.store.dispatch("librarySearch", { query, ids });
+    const answer = query.trim() ? await api.library(this.state.eta, query) : null;
+    const ids = answer ? answer.materials.map((m) => m.id) : null;
+    const suggested = answer ? (answer.suggestions || []).map((m) => m.id) : [];
+    if ($("library-search").value === query) this.app.store.dispatch("librarySearch", { query, ids, suggested });
   }
 
   /** The search of the saved materials, asked of the service (GET /materials?kind=curves&q=, every page). */

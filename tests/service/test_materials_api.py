@@ -366,7 +366,18 @@ def test_library_to_browse(http):
     }
     assert first == {"brass": "CuZn", "TiN": catalogue()[first["TiN"]]["id"], "aluminum": "Al"}
     assert catalogue()[first["TiN"]]["book"] == "TiN"
-    assert http.get(f"{API}/library", params={"q": "unobtainium"}).json()["materials"] == []
+    nothing = http.get(f"{API}/library", params={"q": "unobtainium"}).json()
+    assert nothing["materials"] == [] and nothing["suggestions"] == []
+    # A query that matches nothing is answered with what it may have meant, swatches and all.
+    near = http.get(f"{API}/library", params={"q": "stainless steel 316", "eta_i": 1.33}).json()
+    assert near["materials"] == [] and near["total"] == 0
+    assert [m["id"] for m in near["suggestions"]] == [
+        "stainless-steel.Karlsson-austenitic",
+        "stainless-steel.Karlsson-ferritic",
+    ]
+    assert near["suggestions"][0]["swatch"]["eta_i"] == 1.33 and len(near["suggestions"][0]["swatch"]["srgb"]) == 4
+    assert [m["id"] for m in http.get(f"{API}/library", params={"q": "titanum"}).json()["suggestions"]] == ["Ti.Palm"]
+    assert air["suggestions"] == []  # a query that matches has none
     assert http.get(f"{API}/library", params={"eta_i": 0.5}).status_code == 422
     presets = http.get(f"{API}/coat-presets").json()["presets"]
     assert [(p["id"], p["eta_i"]) for p in presets] == [(key, eta) for key, _, eta, _ in COAT_PRESETS]

@@ -49,6 +49,12 @@ def test_library_search_swatches_and_open(pages, editor_url):
         assert ids == served and ids, (query, ids, served)
         assert ids[0] == {"gold": "Au", "Cu": "Cu", "aluminum": "Al"}.get(query, ids[0])
     assert catalogue()[ids[0]]["book"] == "stainless_steel"
+    # A search that matches nothing lists what the service suggests instead, and says so.
+    page.fill("#library-search", "stainless steel 316")
+    expect(page.locator("#library-state")).to_contain_text("No conductor matches “stainless steel 316”; did you mean")
+    suggested = [m["id"] for m in api(page, "/library?eta_i=1.5&q=stainless+steel+316")["suggestions"]]
+    ids = page.eval_on_selector_all("#library-list li", "els => els.map(e => e.dataset.id)")
+    assert ids == suggested and len(ids) == 2, (ids, suggested)
     page.fill("#library-search", "")
     # The swatches follow eta_i.
     page.fill("#eta-typed", "1.00")

@@ -6,7 +6,8 @@ The library to browse
     common names, symbols, categories, sources, ranges and swatches at
     ``eta_i`` (:mod:`service.jobs.library`); ``q`` keeps those whose name,
     symbol, category or page description holds every word of it, name and
-    symbol matches first (never the citation).
+    symbol matches first (never the citation); a ``q`` that matches nothing
+    is answered with ``suggestions``, what it may have meant.
 -   ``GET /api/v1/coat-presets``: common clear coats and their eta_i, with sources.
 """
 
@@ -19,7 +20,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from fitting.optics.catalogue import search_catalogue
 
-from ...jobs.library import coat_presets, library_entries
+from ...jobs.library import coat_presets, library_entries, library_suggestions
 from ...schemas import API_PREFIX, ETA_I_LIMITS, CoatPresets, LibraryList
 from ..deps import ERROR_RESPONSES
 
@@ -45,7 +46,8 @@ async def get_library(
 ) -> LibraryList:
     """The library's conductors: names, symbols, sources, ranges, swatches under the coat at `eta_i`."""
     found = await run_in_threadpool(library_entries, eta_i, q, limit)
-    return LibraryList(eta_i=eta_i, total=len(search_catalogue(q)), materials=found)
+    suggested = await run_in_threadpool(library_suggestions, eta_i, q) if q and not found else []
+    return LibraryList(eta_i=eta_i, total=len(search_catalogue(q)), materials=found, suggestions=suggested)
 
 
 @router.get("/coat-presets", response_model=CoatPresets, responses=ERROR_RESPONSES)

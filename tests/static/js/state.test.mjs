@@ -234,3 +234,14 @@ test("a live fit from the page is drawn while a point is held, never the fit on 
   store.dispatch("shown", { fit: { ...BASE, id: "full" }, model: flat(0.65) });
   assert.equal(s.onScreen, "server");
 });
+
+test("librarySearch: the ids found and, for a search that found none, the ids suggested; cleared with the search", () => {
+  const store = createStore();
+  store.dispatch("librarySearch", { query: "stainless steel 316", ids: [], suggested: ["ss-a", "ss-f"] });
+  assert.deepEqual(store.state.library.found, []);
+  assert.deepEqual(store.state.library.suggested, ["ss-a", "ss-f"]);
+  store.dispatch("librarySearch", { query: "gold", ids: ["Au"] });
+  assert.deepEqual([store.state.library.found, store.state.library.suggested], [["Au"], []]);
+  store.dispatch("librarySearch", { query: " ", ids: null, suggested: ["x"] });
+  assert.deepEqual([store.state.library.found, store.state.library.suggested], [null, []]);
+});
