@@ -1,9 +1,19 @@
 """
-The README's command-line examples, run as a newcomer copies them (in a
-folder of their own, one after another: a later line reads what an earlier
-one wrote), its REST examples with curl against a real server, and the
-catalogue names its prose promises. A README example
-that no longer works is the first thing a user meets.
+The examples a user copies from the README and the guides, run as written:
+each document's shell blocks line by line in a folder of its own (a later
+line reads what an earlier one wrote), ``curl`` against a real server and
+``.venv/bin/python -m ...`` as commands; and the catalogue names the
+README's prose promises. An example that no longer works is the first
+thing a user meets.
+
+What the examples leave to the reader is filled in as a reader would:
+``localhost:8000`` is the server's address; ``ID`` the first fit the
+document's examples answered, ``ID1`` and ``ID2`` the first two (gold's
+and copper's fits where the document has not made two); an n, k
+file (``my-metal.csv``) is a smooth gold-like metal; a file to import that
+no example wrote is the first fit's export of that kind, downloaded under
+the document's name. Lines that run the service, the tests or the
+benchmarks are not examples of using it and are left out.
 """
 
 from __future__ import annotations
@@ -15,6 +25,7 @@ import shlex
 import subprocess
 from pathlib import Path
 
+import loopback
 import numpy as np
 import pytest
 from conftest import ROOT, run_command, server_process
@@ -22,20 +33,45 @@ from conftest import ROOT, run_command, server_process
 from fitting.optics.catalogue import resolve_material
 
 README = (ROOT / "README.md").read_text()
+DOCUMENTS = ("README.md", "docs/service.md", "docs/exports.md", "docs/edge_tint.md")
+"""The documents whose shell examples are run."""
+
+NK_FILES = ("my_metal.csv", "my-metal.csv", "my-gold.csv")
+"""The n, k files the examples name (the reader's own)."""
 
 LONG = {"reproduce": "a minute of fits (the 22 conductors, every baseline): checked to parse (--help)"}
 """Commands run with ``--help`` instead, and why."""
 
+EXPORTS = {".gltf": "gltf", ".glb": "glb", ".mtlx": "mtlx", ".py": "blender"}
+"""A file to import that no example wrote: the export its extension names."""
 
-def command_lines() -> list[list[str]]:
-    """The ``.venv/bin/python -m ...`` lines of the README's "On the command line" block, comments cut."""
-    block = README.split("**On the command line**", 1)[1].split("```sh", 1)[1].split("```", 1)[0]
-    lines = [line.split("#", 1)[0].strip() for line in block.strip().splitlines()]
-    return [shlex.split(line) for line in lines if line]
+
+def examples(document: str) -> list[list[str]]:
+    """
+    The curl and ``python -m fitting|preview_shaders`` commands of ``document``'s ``sh`` blocks, in
+    order, each as its words (a shell's: lines joined where a backslash or an open quote continues
+    them, comments cut).
+    """
+    text = (ROOT / document).read_text()
+    commands, pending = [], ""
+    for block in re.findall(r"```sh\n(.*?)```", text, flags=re.S):
+        for line in block.replace("\\\n", " ").splitlines():
+            pending = f"{pending}\n{line}" if pending else line
+            try:
+                words = shlex.split(pending, comments=True)
+            except ValueError:  # a quote still open: the command goes on
+                continue
+            pending = ""
+            if words[:1] == ["curl"] or words[:3] in (
+                [".venv/bin/python", "-m", "fitting"],
+                [".venv/bin/python", "-m", "preview_shaders"],
+            ):
+                commands.append(words)
+    return commands
 
 
 def write_nk_csv(path: Path) -> None:
-    """An n, k file as the README's ``my_metal.csv``: a smooth gold-like metal, 360-830 nm every 10 nm."""
+    """An n, k file: a smooth gold-like metal, 360-830 nm every 10 nm."""
     wavelength = np.arange(360.0, 831.0, 10.0)
     n = 0.2 + 1.3 * np.exp(-(((wavelength - 360.0) / 150.0) ** 2))
     k = 1.8 + 4.0 * (wavelength - 360.0) / 470.0
@@ -50,61 +86,59 @@ def test_the_prose_s_names_resolve():
         assert resolve_material(name), name
 
 
-@pytest.mark.slow  # processes and a GL context: about 15 s
-def test_the_command_line_examples_run_in_order(tmp_path):
-    write_nk_csv(tmp_path / "my_metal.csv")
-    lines = command_lines()
-    assert len(lines) >= 6
+def test_each_document_has_examples():
+    counts = {document: len(examples(document)) for document in DOCUMENTS}
+    assert all(count >= 1 for count in counts.values()) and counts["README.md"] >= 14, counts
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    with server_process(tmp_path_factory.mktemp("examples") / "data") as running:
+        yield running
+
+
+@pytest.mark.slow  # a server, commands and a GL context
+@pytest.mark.parametrize("document", DOCUMENTS)
+def test_the_examples_run_as_written(document, server, tmp_path):
+    for name in NK_FILES:
+        write_nk_csv(tmp_path / name)
+    address = server.url.removeprefix("http://")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    for argv in lines:
-        assert argv[:2] == [".venv/bin/python", "-m"], argv
-        module, args = argv[2], argv[3:]
-        if args and args[0] in LONG:
-            args = [args[0], "--help"]
-        result = run_command(module, *args, cwd=tmp_path, env=env)
-        assert result.returncode == 0, (argv, result.stderr[-2000:])
-    for written in re.findall(r"-o (\S+)", README.split("**On the command line**", 1)[1].split("```", 2)[1]):
-        assert (tmp_path / written).stat().st_size > 0, written
-
-
-def rest_commands() -> list[str]:
-    """The README's ``curl`` lines of the "Over REST" block, continuation lines joined, comments cut."""
-    block = README.split("**Over REST**", 1)[1].split("```sh", 1)[1].split("```", 1)[0]
-    joined = block.replace("\\\n", " ")
-    return [line.strip() for line in joined.splitlines() if line.strip() and not line.strip().startswith("#")]
-
-
-@pytest.mark.slow  # a server process and curl
-def test_the_rest_examples_answer_with_curl(tmp_path):
-    """
-    Each ``curl`` line as the README writes it, against a real server
-    (``localhost:8000`` its address, ``ID`` the id the first example
-    answered, the file to import one the service exported under that
-    name), answered 2xx; the downloads are written where curl runs.
-    """
-    commands = rest_commands()
-    assert len(commands) >= 8 and all(c.startswith("curl ") for c in commands), commands
-    write_nk_csv(tmp_path / "my-metal.csv")
-    fit_id = None
-    with server_process(tmp_path / "data") as server:
-        address = server.url.removeprefix("http://")
-        for command in commands:
-            if fit_id is not None:
-                command = command.replace("/ID/", f"/{fit_id}/")
-            for name in re.findall(r"file=@(\S+\.gltf)", command):  # a user's export of the first fit
-                gltf = f"{server.url}/api/v1/fits/{fit_id}/pack?format=gltf&eta_i=1.33"
-                subprocess.run(["curl", "-s", "-o", name, gltf], cwd=tmp_path, check=True, timeout=120)
+    fits: list[str] = []
+    for words in examples(document):
+        line = shlex.join(words)
+        if re.search(r"\bID[12]?\b", line) and len(fits) < 2:  # a document that starts from "any stored fit"
+            for body in ({"material": "Au"}, {"material": "Cu"})[len(fits) :]:
+                fits.append(loopback.post(f"{server.url}/api/v1/fits", json=body, timeout=300).json()["id"])
+        words = [_filled(word, fits, address) for word in words]
+        if words[0] == "curl":
+            for name in [w.split("@", 1)[1] for w in words if w.startswith("file=@")]:
+                if not (tmp_path / name).exists():
+                    kind = EXPORTS[Path(name).suffix]
+                    url = f"{server.url}/api/v1/fits/{fits[0]}/pack?format={kind}&eta_i=1.33"
+                    subprocess.run(["curl", "-sf", "-o", name, url], cwd=tmp_path, check=True, timeout=300)
             done = subprocess.run(
-                command.replace("localhost:8000", address) + " -w '\\n%{http_code}'",
-                shell=True,
-                cwd=tmp_path,
-                capture_output=True,
-                text=True,
-                timeout=300,
+                [*words, "-w", "\n%{http_code}"], cwd=tmp_path, capture_output=True, text=True, timeout=300
             )
             body, _, status = done.stdout.rpartition("\n")
-            assert done.returncode == 0 and status.startswith("2"), (command, status, body[-500:], done.stderr)
-            if fit_id is None:
-                fit_id = json.loads(body)["id"]
-    downloads = {p.name for p in tmp_path.iterdir()}
-    assert any(n.endswith(".cfpk") for n in downloads) and any(n.endswith("acescg.mtlx") for n in downloads)
+            assert done.returncode == 0 and status.startswith("2"), (document, line, status, body[-500:])
+            if any(w.endswith("/api/v1/fits") for w in words) and body.startswith("{"):
+                fit = json.loads(body).get("id")
+                if fit and fit not in fits:
+                    fits.append(fit)
+        else:
+            module, args = words[2], words[3:]
+            if args and args[0] in LONG:
+                args = [args[0], "--help"]
+            result = run_command(module, *args, cwd=tmp_path, env=env)
+            assert result.returncode == 0, (document, line, result.stderr[-2000:])
+            for written in [args[i + 1] for i, w in enumerate(args[:-1]) if w == "-o"]:
+                assert (tmp_path / written).stat().st_size > 0, (document, line)
+
+
+def _filled(word: str, fits: list[str], address: str) -> str:
+    """``word`` with the reader's values: the server's address, the fits' ids for ``ID1``, ``ID2``, ``ID``."""
+    word = word.replace("localhost:8000", address)
+    for i, fit in enumerate(fits[:2]):
+        word = word.replace(f"ID{i + 1}", fit)
+    return re.sub(r"\bID\b", fits[0], word) if fits else word
