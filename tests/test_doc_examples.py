@@ -10,7 +10,8 @@ What the examples leave to the reader is filled in as a reader would:
 ``localhost:8000`` is the server's address; ``ID`` the first fit the
 document's examples answered, ``ID1`` and ``ID2`` the first two (gold's
 and copper's fits where the document has not made two); an n, k
-file (``my-metal.csv``) is a smooth gold-like metal; a file to import that
+file (``my-metal.csv``) is a smooth gold-like metal, ``scene.json`` the
+README's scene; a file to import that
 no example wrote is the first fit's export of that kind, downloaded under
 the document's name. Lines that run the service, the tests or the
 benchmarks are not examples of using it and are left out.
@@ -33,8 +34,12 @@ from conftest import ROOT, run_command, server_process
 from fitting.optics.catalogue import resolve_material
 
 README = (ROOT / "README.md").read_text()
-DOCUMENTS = ("README.md", "docs/service.md", "docs/exports.md", "docs/edge_tint.md")
-"""The documents whose shell examples are run."""
+DOCUMENTS = ("README.md", "docs/service.md", "docs/exports.md", "docs/edge_tint.md", "docs/fitting.md")
+"""The documents whose shell examples are run (docs/batch.md's and docs/speed-vs-error.md's fit whole
+shelves of the database, or rebuild the committed catalogue: minutes each, and their own tests run them)."""
+
+SCENE = {"materials": [{"material": "Au", "eta_i": 1.5}, {"material": "Cu", "eta_i": {"min": 1.3, "max": 1.6}}]}
+"""The reader's ``scene.json``: the README's scene."""
 
 NK_FILES = ("my_metal.csv", "my-metal.csv", "my-gold.csv")
 """The n, k files the examples name (the reader's own)."""
@@ -102,6 +107,7 @@ def server(tmp_path_factory):
 def test_the_examples_run_as_written(document, server, tmp_path):
     for name in NK_FILES:
         write_nk_csv(tmp_path / name)
+    (tmp_path / "scene.json").write_text(json.dumps(SCENE))
     address = server.url.removeprefix("http://")
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     fits: list[str] = []
