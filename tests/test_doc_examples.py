@@ -24,6 +24,7 @@ import os
 import re
 import shlex
 import subprocess
+import sys
 from pathlib import Path
 
 import loopback
@@ -148,3 +149,34 @@ def _filled(word: str, fits: list[str], address: str) -> str:
     for i, fit in enumerate(fits[:2]):
         word = word.replace(f"ID{i + 1}", fit)
     return re.sub(r"\bID\b", fits[0], word) if fits else word
+
+
+READER = {"usda_document": 'def usda_document(values):\n    return "#usda 1.0\\n"\n'}
+"""What a Python example leaves to the reader to write, as the reader would write it."""
+
+
+def python_examples() -> list[tuple[str, str]]:
+    """(document, code) of every ``python`` block of the README and docs/ (at the margin: a block indented
+    in a list is a step of a recipe, such as docs/architecture.md's new model kind, not a program)."""
+    return [
+        (path.relative_to(ROOT).as_posix(), code)
+        for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+        for code in re.findall(r"^```python\n(.*?)^```", path.read_text(), flags=re.S | re.M)
+    ]
+
+
+@pytest.mark.slow  # a Python process each
+def test_the_python_examples_run(tmp_path):
+    examples = python_examples()
+    assert len(examples) >= 3
+    for document, code in examples:
+        prelude = "".join(text for name, text in READER.items() if re.search(rf"\b{name}\b", code))
+        done = subprocess.run(
+            [sys.executable, "-c", prelude + code],
+            cwd=tmp_path,
+            env={**os.environ, "PYTHONPATH": str(ROOT)},
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+        assert done.returncode == 0, (document, code, done.stderr[-2000:])
