@@ -160,7 +160,7 @@ def same_answer(cli: dict, service: dict) -> bool:
 
 
 def start_server(data: str) -> tuple[subprocess.Popen, str]:
-    """One server with one fit worker (:func:`benchmarks.service_load.start_replicas`: a start whose
+    """One server with one fit worker (:func:`benchmarks.serve.start_replicas`: a start whose
     port was taken is tried again on another)."""
     ((process, url),) = start_replicas(1, {**os.environ, "COATED_FIT_WORKERS": "1"}, data)
     return process, url

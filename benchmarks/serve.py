@@ -10,6 +10,9 @@ Service processes for the benchmarks
 
 from __future__ import annotations
 
+import contextlib
+import os
+import signal
 import socket
 import subprocess
 import sys
@@ -42,7 +45,8 @@ def start_replicas(count: int, env: dict[str, str], data: str) -> list[tuple[sub
     ``count`` service processes (each its own data directory, for SQLite) once all answer /healthz.
     A start that exits because its port was taken between :func:`free_port` and its bind
     (:data:`PORT_TAKEN` in its output) is tried again on another port, :data:`PORT_TRIES` times in
-    all; any other early exit, or no answer in 180 s, ends the run with the server's last output.
+    all; any other early exit, or no answer in 180 s, ends the run with the server's last output,
+    every server it started killed.
     """
 
     def launch(i: int) -> tuple[subprocess.Popen, str, object]:
@@ -57,6 +61,12 @@ def start_replicas(count: int, env: dict[str, str], data: str) -> list[tuple[sub
             start_new_session=True,
         )
         return process, f"http://127.0.0.1:{port}", log
+
+    def fail(message: str):
+        for process, _, _ in starts:  # none is left running behind the failed run
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(process.pid, signal.SIGKILL)
+        raise SystemExit(message)
 
     starts = [launch(i) for i in range(count)]
     deadline = time.monotonic() + 180
@@ -77,9 +87,9 @@ def start_replicas(count: int, env: dict[str, str], data: str) -> list[tuple[sub
                     log.close()
                     starts[i] = launch(i)
                     continue
-                raise SystemExit(f"a server exited ({process.returncode}): {output[-2000:]}")
+                fail(f"a server exited ({process.returncode}): {output[-2000:]}")
             if time.monotonic() > deadline:
-                raise SystemExit(f"a server did not answer /healthz in 180 s ({url})")
+                fail(f"a server did not answer /healthz in 180 s ({url})")
             time.sleep(0.2)
     for _, _, log in starts:
         log.close()

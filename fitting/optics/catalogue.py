@@ -149,10 +149,11 @@ def suggest_materials(query: str) -> list[dict[str, Any]]:
     """
     words = str(query)[:80].split()
     found = search_catalogue(" ".join(words))
-    for drop in range(len(words) if len(words) > 1 and not found else 0):
-        found = search_catalogue(" ".join(words[:drop] + words[drop + 1 :]))
-        if found:
-            break
+    if not found and len(words) > 1:
+        for drop in range(len(words)):
+            found = search_catalogue(" ".join(words[:drop] + words[drop + 1 :]))
+            if found:
+                break
     if not found and words:
         import difflib  # only a query that matches nothing needs it
 

@@ -39,7 +39,7 @@ export class LibraryView {
     const matched = shownLibrary(state.library);
     // A search that found none lists what the service suggested (the search less a word, a near spelling).
     const suggested = query.trim() && !matched.length
-      ? shownLibrary({ materials, found: state.library.suggested || [] }) : [];
+      ? shownLibrary({ materials, found: state.library.suggested }) : [];
     const found = suggested.length ? suggested : matched;
     const signature = `${eta}|${query}|${state.base ? state.base.id : ""}|${found.map((m) => m.id).join()}`;
     $("library-state").textContent = suggested.length
